@@ -1,0 +1,10 @@
+//! cotui: a terminal CANopen bus analyzer and commander.
+//!
+//! The protocol core (`frame`, `log`, `od`, `decode`) is pure: it takes bytes
+//! and returns values, with no IO, clock or terminal. Sources, panes and the
+//! command line live at the edges and call into it.
+
+pub mod decode;
+pub mod frame;
+pub mod hex;
+pub mod od;

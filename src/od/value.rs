@@ -1,0 +1,174 @@
+//! CANopen data types and decoded values.
+
+use std::fmt;
+
+/// CiA 301 basic data types (codes 0x0001..0x001B) we decode.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DataType {
+    Boolean,
+    I8,
+    I16,
+    I24,
+    I32,
+    I40,
+    I48,
+    I56,
+    I64,
+    U8,
+    U16,
+    U24,
+    U32,
+    U40,
+    U48,
+    U56,
+    U64,
+    F32,
+    F64,
+    VisibleString,
+    OctetString,
+    UnicodeString,
+    TimeOfDay,
+    TimeDifference,
+    #[default]
+    Domain,
+}
+
+impl DataType {
+    /// Size in bytes of fixed-size types; `None` for strings and domains.
+    pub fn size(self) -> Option<usize> {
+        use DataType::*;
+        Some(match self {
+            Boolean | I8 | U8 => 1,
+            I16 | U16 => 2,
+            I24 | U24 => 3,
+            I32 | U32 | F32 => 4,
+            I40 | U40 => 5,
+            I48 | U48 | TimeOfDay | TimeDifference => 6,
+            I56 | U56 => 7,
+            I64 | U64 | F64 => 8,
+            VisibleString | OctetString | UnicodeString | Domain => return None,
+        })
+    }
+
+    /// The type for a CiA 301 DataType code (as in EDS `DataType=0x0007`).
+    pub fn from_code(code: u16) -> Option<DataType> {
+        use DataType::*;
+        Some(match code {
+            0x01 => Boolean,
+            0x02 => I8,
+            0x03 => I16,
+            0x04 => I32,
+            0x05 => U8,
+            0x06 => U16,
+            0x07 => U32,
+            0x08 => F32,
+            0x09 => VisibleString,
+            0x0A => OctetString,
+            0x0B => UnicodeString,
+            0x0C => TimeOfDay,
+            0x0D => TimeDifference,
+            0x0F => Domain,
+            0x10 => I24,
+            0x11 => F64,
+            0x12 => I40,
+            0x13 => I48,
+            0x14 => I56,
+            0x15 => I64,
+            0x16 => U24,
+            0x18 => U40,
+            0x19 => U48,
+            0x1A => U56,
+            0x1B => U64,
+            _ => return None,
+        })
+    }
+
+    /// Decodes little-endian bytes as this type. Short input decodes what is
+    /// there (zero-extended); the caller flags the length mismatch.
+    pub fn decode(self, bytes: &[u8]) -> Value {
+        use DataType::*;
+        let le = |n: usize| -> u64 {
+            let mut v = 0u64;
+            for (i, b) in bytes.iter().take(n).enumerate() {
+                v |= (*b as u64) << (8 * i);
+            }
+            v
+        };
+        let signed = |n: usize| -> i64 {
+            let v = le(n);
+            let shift = 64 - 8 * n as u32;
+            ((v << shift) as i64) >> shift
+        };
+        match self {
+            Boolean => Value::Bool(le(1) != 0),
+            U8 | U16 | U24 | U32 | U40 | U48 | U56 | U64 => Value::Unsigned(le(self.size().unwrap_or(8))),
+            I8 | I16 | I24 | I32 | I40 | I48 | I56 | I64 => Value::Signed(signed(self.size().unwrap_or(8))),
+            F32 => Value::Float(f32::from_bits(le(4) as u32) as f64),
+            F64 => Value::Float(f64::from_bits(le(8))),
+            VisibleString => Value::Text(bytes.iter().take_while(|b| **b != 0).map(|b| *b as char).collect()),
+            UnicodeString => {
+                let units: Vec<u16> = bytes.chunks_exact(2).map(|c| u16::from_le_bytes([c[0], c[1]])).collect();
+                Value::Text(String::from_utf16_lossy(&units))
+            }
+            TimeOfDay | TimeDifference | OctetString | Domain => Value::Bytes(bytes.to_vec()),
+        }
+    }
+}
+
+/// A decoded object value.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Value {
+    Bool(bool),
+    Unsigned(u64),
+    Signed(i64),
+    Float(f64),
+    Text(String),
+    Bytes(Vec<u8>),
+}
+
+impl Value {
+    /// The value as a number, when it is one.
+    pub fn as_f64(&self) -> Option<f64> {
+        match self {
+            Value::Bool(b) => Some(*b as u8 as f64),
+            Value::Unsigned(u) => Some(*u as f64),
+            Value::Signed(i) => Some(*i as f64),
+            Value::Float(f) => Some(*f),
+            _ => None,
+        }
+    }
+    /// The value as an integer, when it is one.
+    pub fn as_i64(&self) -> Option<i64> {
+        match self {
+            Value::Bool(b) => Some(*b as i64),
+            Value::Unsigned(u) => Some(*u as i64),
+            Value::Signed(i) => Some(*i),
+            _ => None,
+        }
+    }
+    /// JSON form: numbers stay numbers, text stays text, bytes become upper-case hex.
+    pub fn to_json(&self) -> serde_json::Value {
+        match self {
+            Value::Bool(b) => (*b).into(),
+            Value::Unsigned(u) => (*u).into(),
+            Value::Signed(i) => (*i).into(),
+            Value::Float(f) => serde_json::Number::from_f64(*f).map(Into::into).unwrap_or(serde_json::Value::Null),
+            Value::Text(s) => s.clone().into(),
+            Value::Bytes(b) => crate::hex::upper(b).into(),
+        }
+    }
+}
+
+impl fmt::Display for Value {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Value::Bool(b) => write!(f, "{b}"),
+            Value::Unsigned(u) => write!(f, "{u}"),
+            Value::Signed(i) => write!(f, "{i}"),
+            Value::Float(x) => write!(f, "{x}"),
+            Value::Text(s) => write!(f, "\"{}\"", s.escape_debug()),
+            Value::Bytes(b) => write!(f, "{}", crate::hex::spaced(b)),
+        }
+    }
+}
