@@ -32,11 +32,7 @@ impl Flags {
     }
     /// Sets or clears the bits of `mask`.
     pub fn set(&mut self, mask: u8, on: bool) {
-        if on {
-            self.0 |= mask
-        } else {
-            self.0 &= !mask
-        }
+        if on { self.0 |= mask } else { self.0 &= !mask }
     }
 }
 
@@ -72,7 +68,15 @@ pub struct Frame {
 
 impl Default for Frame {
     fn default() -> Self {
-        Frame { ts_ns: 0, id: 0, flags: Flags::default(), len: 0, raw_dlc: 0, iface: 0, data: [0; 64] }
+        Frame {
+            ts_ns: 0,
+            id: 0,
+            flags: Flags::default(),
+            len: 0,
+            raw_dlc: 0,
+            iface: 0,
+            data: [0; 64],
+        }
     }
 }
 
@@ -90,7 +94,11 @@ impl Frame {
     }
     /// The payload bytes (empty for RTR frames).
     pub fn payload(&self) -> &[u8] {
-        if self.is_rtr() { &[] } else { &self.data[..self.len as usize] }
+        if self.is_rtr() {
+            &[]
+        } else {
+            &self.data[..self.len as usize]
+        }
     }
     /// 29-bit identifier?
     pub fn is_ext(&self) -> bool {
@@ -110,7 +118,11 @@ impl Frame {
     }
     /// Sent by us?
     pub fn direction(&self) -> Direction {
-        if self.flags.has(Flags::TX) { Direction::Tx } else { Direction::Rx }
+        if self.flags.has(Flags::TX) {
+            Direction::Tx
+        } else {
+            Direction::Rx
+        }
     }
     /// Timestamp in seconds.
     pub fn seconds(&self) -> f64 {

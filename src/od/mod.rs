@@ -119,7 +119,9 @@ impl Dictionary {
     }
     /// The name of the object (index level, sub 0 when it has no own entry), for labels.
     pub fn name(&self, index: u16, sub: u8) -> Option<&str> {
-        self.object(index, sub).or_else(|| self.object(index, 0)).map(|o| o.name.as_str())
+        self.object(index, sub)
+            .or_else(|| self.object(index, 0))
+            .map(|o| o.name.as_str())
     }
     /// The most specific profile's name (e.g. "syntron-ds"), or "cia301".
     pub fn profile_name(&self) -> &str {
@@ -127,7 +129,10 @@ impl Dictionary {
     }
     /// A vendor EMCY text for an exact code.
     pub fn emcy_text(&self, code: u16) -> Option<&str> {
-        self.layers.iter().find_map(|p| p.emcy_codes.get(&code)).map(String::as_str)
+        self.layers
+            .iter()
+            .find_map(|p| p.emcy_codes.get(&code))
+            .map(String::as_str)
     }
 }
 

@@ -108,7 +108,10 @@ impl DataType {
             F64 => Value::Float(f64::from_bits(le(8))),
             VisibleString => Value::Text(bytes.iter().take_while(|b| **b != 0).map(|b| *b as char).collect()),
             UnicodeString => {
-                let units: Vec<u16> = bytes.chunks_exact(2).map(|c| u16::from_le_bytes([c[0], c[1]])).collect();
+                let units: Vec<u16> = bytes
+                    .chunks_exact(2)
+                    .map(|c| u16::from_le_bytes([c[0], c[1]]))
+                    .collect();
                 Value::Text(String::from_utf16_lossy(&units))
             }
             TimeOfDay | TimeDifference | OctetString | Domain => Value::Bytes(bytes.to_vec()),
@@ -153,7 +156,9 @@ impl Value {
             Value::Bool(b) => (*b).into(),
             Value::Unsigned(u) => (*u).into(),
             Value::Signed(i) => (*i).into(),
-            Value::Float(f) => serde_json::Number::from_f64(*f).map(Into::into).unwrap_or(serde_json::Value::Null),
+            Value::Float(f) => serde_json::Number::from_f64(*f)
+                .map(Into::into)
+                .unwrap_or(serde_json::Value::Null),
             Value::Text(s) => s.clone().into(),
             Value::Bytes(b) => crate::hex::upper(b).into(),
         }
