@@ -3,6 +3,8 @@
 //! One module per CANopen service. `registry` ties them together with the
 //! per-bus state (learned COB-IDs, PDO mappings, SDO transfers).
 
+pub mod sdo;
+
 /// The CANopen service a frame belongs to (the JSONL `kind`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Kind {
