@@ -42,3 +42,18 @@ impl Kind {
         }
     }
 }
+
+pub mod cia402;
+pub mod cob_id;
+pub mod emcy;
+pub mod error_frame;
+pub mod heartbeat;
+pub mod lss;
+pub mod nmt;
+pub mod pdo;
+pub mod registry;
+pub mod sdo;
+pub mod sync;
+pub mod time;
+
+pub use registry::{Body, Decoded, Decoder};
