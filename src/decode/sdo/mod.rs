@@ -1,4 +1,4 @@
-//! TEMPORARY local stand-in (not committed) until the sdo branch lands.
+//! TEMPORARY stand-in until the SDO tracker branch lands.
 use crate::od::Dictionary;
 #[derive(Debug)]
 pub struct SdoFrame {
@@ -26,6 +26,12 @@ pub struct Transaction {
 impl Transaction {
     pub fn is_ok(&self) -> bool {
         true
+    }
+    pub fn label(&self, _d: &Dictionary) -> String {
+        String::new()
+    }
+    pub fn to_json(&self, _d: &Dictionary) -> serde_json::Value {
+        serde_json::Value::Null
     }
 }
 #[derive(Default)]
