@@ -3,8 +3,6 @@
 //! One module per CANopen service. `registry` ties them together with the
 //! per-bus state (learned COB-IDs, PDO mappings, SDO transfers).
 
-pub mod sdo;
-
 /// The CANopen service a frame belongs to (the JSONL `kind`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Kind {
@@ -44,3 +42,18 @@ impl Kind {
         }
     }
 }
+
+pub mod cia402;
+pub mod cob_id;
+pub mod emcy;
+pub mod error_frame;
+pub mod heartbeat;
+pub mod lss;
+pub mod nmt;
+pub mod pdo;
+pub mod registry;
+pub mod sdo;
+pub mod sync;
+pub mod time;
+
+pub use registry::{Body, Decoded, Decoder};

@@ -75,6 +75,19 @@ pub struct PdoMapping {
     pub source: MappingSource,
 }
 
+/// One field of the EMCY manufacturer-specific bytes.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct EmcyField {
+    /// Offset in the 8-byte EMCY frame (3..=7).
+    pub offset: u8,
+    /// Length in bytes (little-endian).
+    pub len: u8,
+    /// Name shown in labels, e.g. "M1 alarm".
+    pub name: String,
+    /// Texts for values of this field.
+    pub values: BTreeMap<i64, String>,
+}
+
 /// Everything known about one device type.
 #[derive(Clone, Debug, Default)]
 pub struct Profile {
@@ -84,10 +97,12 @@ pub struct Profile {
     pub objects: BTreeMap<(u16, u8), ObjectInfo>,
     /// Vendor EMCY code texts by exact code.
     pub emcy_codes: BTreeMap<u16, String>,
+    /// How the 5 manufacturer bytes of an EMCY are laid out (empty: shown as hex).
+    pub emcy_layout: Vec<EmcyField>,
     /// Default RPDO mappings by PDO number (1-based).
-    pub rpdo: BTreeMap<u8, PdoMapping>,
+    pub rpdo: BTreeMap<u16, PdoMapping>,
     /// Default TPDO mappings by PDO number (1-based).
-    pub tpdo: BTreeMap<u8, PdoMapping>,
+    pub tpdo: BTreeMap<u16, PdoMapping>,
 }
 
 impl Profile {
@@ -142,9 +157,7 @@ impl Dictionary {
 /// `15000` of an I32 with scale 0.1 and unit "rpm" -> `1500 rpm`.
 pub fn format_value(info: Option<&ObjectInfo>, value: &Value) -> String {
     let Some(info) = info else { return value.to_string() };
-    if let Some(raw) = value.as_i64()
-        && let Some(text) = info.values.get(&raw)
-    {
+    if let Some((raw, text)) = value.as_i64().and_then(|raw| info.values.get(&raw).map(|t| (raw, t))) {
         return format!("{raw} ({text})");
     }
     match (value.as_f64(), info.scale, &info.unit) {
@@ -169,4 +182,24 @@ pub fn format_number(x: f64) -> String {
         let s = format!("{x:.6}");
         s.trim_end_matches('0').trim_end_matches('.').to_string()
     }
+}
+
+/// The EMCY manufacturer fields of an 8-byte frame through the first layout in `dict`.
+pub fn emcy_fields(dict: &Dictionary, frame: &[u8; 8]) -> Vec<(String, String)> {
+    let Some(layout) = dict.layers().iter().map(|p| &p.emcy_layout).find(|l| !l.is_empty()) else {
+        return Vec::new();
+    };
+    layout
+        .iter()
+        .filter(|f| (3..8).contains(&f.offset) && f.len >= 1 && f.offset as usize + f.len as usize <= 8)
+        .map(|f| {
+            let bytes = &frame[f.offset as usize..f.offset as usize + f.len as usize];
+            let raw = bytes.iter().rev().fold(0i64, |acc, b| (acc << 8) | *b as i64);
+            let text = match f.values.get(&raw) {
+                Some(t) => format!("0x{raw:02X} ({t})"),
+                None => format!("0x{raw:02X}"),
+            };
+            (f.name.clone(), text)
+        })
+        .collect()
 }

@@ -1,0 +1,252 @@
+//! PDO payloads decoded into named, typed, scaled signals through the mapping in force.
+
+use crate::od::{DataType, Dictionary, MappedEntry, MappingSource, PdoMapping, Value, format_value};
+use serde_json::json;
+
+/// One mapped signal taken out of a PDO payload.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Signal {
+    pub index: u16,
+    pub sub: u8,
+    /// Object name from the dictionary (or `0xIIII:SS`).
+    pub name: String,
+    /// Raw value typed by the object's data type.
+    pub value: Value,
+    /// Value as shown: enum text, scaled with unit, CiA 402 meaning.
+    pub text: String,
+}
+
+/// A decoded PDO.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pdo {
+    /// PDO number (1-based).
+    pub num: u16,
+    /// True for TPDO (device transmits), false for RPDO.
+    pub transmit: bool,
+    /// Signals; empty when no mapping is known.
+    pub signals: Vec<Signal>,
+    /// Where the mapping came from, when one was used.
+    pub source: Option<MappingSource>,
+}
+
+impl Pdo {
+    /// One-line label for `node`.
+    pub fn label(&self, node: u8, payload: &[u8]) -> String {
+        let name = if self.transmit { "TPDO" } else { "RPDO" };
+        if self.signals.is_empty() {
+            return format!("{name}{} node {node}: {}", self.num, crate::hex::spaced(payload));
+        }
+        let parts: Vec<String> = self.signals.iter().map(|s| format!("{}={}", s.name, s.text)).collect();
+        format!("{name}{} node {node}: {}", self.num, parts.join(", "))
+    }
+
+    /// The kind-specific JSON object.
+    pub fn to_json(&self) -> serde_json::Value {
+        let signals: Vec<serde_json::Value> = self
+            .signals
+            .iter()
+            .map(
+                |s| json!({"index": s.index, "sub": s.sub, "name": s.name, "value": s.value.to_json(), "text": s.text}),
+            )
+            .collect();
+        json!({"num": self.num, "signals": signals, "mapping_source": self.source.as_ref().map(source_text)})
+    }
+}
+
+/// Short text of a mapping source: `profile syntron-ds`, `eds drive.eds`, `sniffed @ 12.345678 s`.
+pub fn source_text(source: &MappingSource) -> String {
+    match source {
+        MappingSource::Profile(p) => format!("profile {p}"),
+        MappingSource::Eds(f) => format!("eds {f}"),
+        MappingSource::Sniffed { ts_ns } => format!("sniffed @ {:.6} s", *ts_ns as f64 / 1e9),
+    }
+}
+
+/// Reads `bits` bits starting at bit `start` (little-endian, LSB first) from `data`.
+fn extract_bits(data: &[u8], start: usize, bits: usize) -> u64 {
+    let mut v = 0u64;
+    for i in 0..bits.min(64) {
+        let bit = start + i;
+        if data[bit / 8] >> (bit % 8) & 1 != 0 {
+            v |= 1 << i;
+        }
+    }
+    v
+}
+
+/// Signals of `payload` through `mapping`; the second value explains a length mismatch.
+/// `mode` is the node's mode of operation, for CiA 402 bit names.
+pub fn decode_signals(
+    payload: &[u8],
+    mapping: &PdoMapping,
+    dict: &Dictionary,
+    mode: Option<i8>,
+) -> (Vec<Signal>, Option<String>) {
+    let total: usize = mapping.entries.iter().map(|e| e.bits as usize).sum();
+    let available = payload.len() * 8;
+    let mut signals = Vec::with_capacity(mapping.entries.len());
+    let mut pos = 0usize;
+    for e in &mapping.entries {
+        let bits = e.bits as usize;
+        if pos + bits > available {
+            break;
+        }
+        // Dummy entries (index 0x0001..0x0007 are data type "dummies") only pad.
+        if e.index >= 0x0001 && e.index <= 0x0007 {
+            pos += bits;
+            continue;
+        }
+        signals.push(signal(payload, pos, e, dict, mode));
+        pos += bits;
+    }
+    let problem = if total.div_ceil(8) != payload.len() {
+        Some(format!(
+            "PDO has {} data bytes, mapping needs {} bits ({} bytes)",
+            payload.len(),
+            total,
+            total.div_ceil(8)
+        ))
+    } else {
+        None
+    };
+    (signals, problem)
+}
+
+fn signal(payload: &[u8], pos: usize, e: &MappedEntry, dict: &Dictionary, mode: Option<i8>) -> Signal {
+    let bits = e.bits as usize;
+    let info = dict.object(e.index, e.sub);
+    let value = if pos.is_multiple_of(8) && bits.is_multiple_of(8) {
+        let bytes = &payload[pos / 8..(pos + bits) / 8];
+        match info.map(|i| i.data_type) {
+            Some(dt) if dt.size().is_none_or(|s| s * 8 == bits) => dt.decode(bytes),
+            _ => DataType::U64.decode(bytes),
+        }
+    } else {
+        let raw = extract_bits(payload, pos, bits);
+        match info.map(|i| i.data_type) {
+            Some(DataType::Boolean) => Value::Bool(raw != 0),
+            _ => Value::Unsigned(raw),
+        }
+    };
+    let name = dict
+        .name(e.index, e.sub)
+        .map(str::to_string)
+        .unwrap_or_else(|| format!("0x{:04X}:{:02X}", e.index, e.sub));
+    let text = match value
+        .as_i64()
+        .and_then(|raw| super::cia402::describe(e.index, e.sub, raw, mode))
+    {
+        Some(meaning) => format!("0x{:04X} ({meaning})", value.as_i64().unwrap_or(0)),
+        None => format_value(info, &value),
+    };
+    Signal {
+        index: e.index,
+        sub: e.sub,
+        name,
+        value,
+        text,
+    }
+}
+
+/// A mapping entry from its 32-bit object value (index << 16 | sub << 8 | bits).
+pub fn entry_from_u32(v: u32) -> MappedEntry {
+    MappedEntry {
+        index: (v >> 16) as u16,
+        sub: (v >> 8) as u8,
+        bits: v as u8,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::od::{ObjectInfo, Profile};
+    use std::sync::Arc;
+
+    fn dict() -> Dictionary {
+        let mut p = Profile {
+            name: "test".into(),
+            ..Profile::default()
+        };
+        p.objects.insert(
+            (0x6041, 0),
+            ObjectInfo {
+                name: "Statusword".into(),
+                data_type: DataType::U16,
+                ..Default::default()
+            },
+        );
+        p.objects.insert(
+            (0x606C, 0),
+            ObjectInfo {
+                name: "Velocity actual value".into(),
+                data_type: DataType::I32,
+                unit: Some("rpm".into()),
+                scale: Some(0.1),
+                ..Default::default()
+            },
+        );
+        Dictionary::new(vec![Arc::new(p)])
+    }
+
+    fn mapping(entries: &[u32]) -> PdoMapping {
+        PdoMapping {
+            cob_id: None,
+            entries: entries.iter().map(|v| entry_from_u32(*v)).collect(),
+            source: MappingSource::Profile("test".into()),
+        }
+    }
+
+    #[test]
+    fn typed_scaled_signals() {
+        let m = mapping(&[0x6041_0010, 0x606C_0020]);
+        let payload = [0x37, 0x02, 0x98, 0x3A, 0x00, 0x00];
+        let (s, problem) = decode_signals(&payload, &m, &dict(), None);
+        assert_eq!(problem, None);
+        assert_eq!(
+            s[0].text,
+            "0x0237 (Operation enabled [ready to switch on, switched on, operation enabled, voltage enabled, quick stop, remote])"
+        );
+        assert_eq!(s[1].value, Value::Signed(15000));
+        assert_eq!(s[1].text, "1500 rpm");
+        let pdo = Pdo {
+            num: 1,
+            transmit: true,
+            signals: s,
+            source: Some(m.source.clone()),
+        };
+        assert!(
+            pdo.label(2, &payload)
+                .starts_with("TPDO1 node 2: Statusword=0x0237 (Operation enabled")
+        );
+        assert_eq!(pdo.to_json()["signals"][1]["value"], 15000);
+        assert_eq!(pdo.to_json()["mapping_source"], "profile test");
+    }
+
+    #[test]
+    fn unknown_objects_bit_fields_and_length_mismatch() {
+        let m = mapping(&[0x2000_0101, 0x2000_0207, 0x2001_0010]);
+        let (s, problem) = decode_signals(&[0x03, 0x34, 0x12], &m, &dict(), None);
+        assert_eq!(s.len(), 3);
+        assert_eq!(s[0].value, Value::Unsigned(1));
+        assert_eq!(s[1].value, Value::Unsigned(1));
+        assert_eq!(s[2].name, "0x2001:00");
+        assert_eq!(s[2].value, Value::Unsigned(0x1234));
+        assert_eq!(problem, None);
+        let (s, problem) = decode_signals(&[0x03], &m, &dict(), None);
+        assert_eq!(s.len(), 2, "signals that fit are still shown");
+        assert!(problem.unwrap().contains("1 data bytes"));
+    }
+
+    #[test]
+    fn empty_payload_without_mapping_is_raw() {
+        let pdo = Pdo {
+            num: 2,
+            transmit: false,
+            signals: vec![],
+            source: None,
+        };
+        assert_eq!(pdo.label(3, &[1, 2]), "RPDO2 node 3: 01 02");
+        assert_eq!(pdo.to_json()["signals"], json!([]));
+    }
+}

@@ -1,0 +1,413 @@
+//! The decoder registry: routes each frame to its service decoder and keeps the
+//! bus state that decoding depends on (moved COB-IDs, PDO mappings, SDO
+//! transfers, modes of operation).
+
+use super::cob_id::{CobId, CobTable, Route};
+use super::heartbeat::Heartbeat;
+use super::pdo::{self, Pdo};
+use super::sdo::{SdoFrame, SdoTracker, Transaction};
+use super::{Kind, emcy, error_frame, heartbeat, lss, nmt, sync, time};
+use crate::frame::Frame;
+use crate::od::{Dictionary, MappingSource, PdoMapping};
+use std::collections::HashMap;
+
+/// The decoded meaning of one frame.
+#[derive(Debug)]
+pub struct Decoded {
+    pub kind: Kind,
+    /// The node the frame belongs to (None for NMT broadcast, SYNC, TIME, LSS, other).
+    pub node: Option<u8>,
+    /// One-line human label.
+    pub label: String,
+    /// Kind-specific structured content.
+    pub body: Body,
+    /// Set when the frame breaks its kind's rules (it is still decoded and shown).
+    pub malformed: Option<String>,
+}
+
+/// Kind-specific content of a [`Decoded`] frame.
+#[derive(Debug)]
+pub enum Body {
+    None,
+    Nmt(nmt::Nmt),
+    Heartbeat(Heartbeat),
+    Sync(sync::Sync),
+    Time(time::Time),
+    Emcy(emcy::Emcy),
+    Pdo(Pdo),
+    Sdo(SdoFrame),
+    Lss(lss::Lss),
+    ErrorFrame { class: u32 },
+}
+
+/// Identifies one PDO of one node: (node, transmit, number).
+type PdoKey = (u8, bool, u16);
+
+/// Mapping entries seen in SDO traffic for one PDO, not yet complete.
+#[derive(Clone, Debug, Default)]
+struct LearnedMapping {
+    count: Option<u8>,
+    entries: Vec<Option<u32>>,
+}
+
+/// Decodes frames one after another, keeping the state of the bus.
+pub struct Decoder {
+    /// Per-node dictionaries, index = node id (0 unused).
+    dicts: Vec<Dictionary>,
+    cobs: CobTable,
+    mappings: HashMap<PdoKey, PdoMapping>,
+    learning: HashMap<PdoKey, LearnedMapping>,
+    /// Mode of operation per node, from 0x6060/0x6061 traffic.
+    modes: [Option<i8>; 128],
+    sdo: SdoTracker,
+    /// SDO channels moved by 0x1200 writes: COB-ID -> (node, client_to_server).
+    sdo_cobs: HashMap<u32, (u8, bool)>,
+    completed: Vec<Transaction>,
+    seq: u64,
+}
+
+impl Decoder {
+    /// A decoder where node `n` uses `dict_for(n)`. Nodes listed in `bound`
+    /// (explicit `--profile`/`--eds` bindings) also get their default PDO
+    /// mappings and COB-IDs from their dictionary.
+    pub fn new(default: Dictionary, bound: Vec<(u8, Dictionary)>) -> Decoder {
+        let mut dicts = vec![default; 128];
+        let mut d = Decoder {
+            dicts: Vec::new(),
+            cobs: CobTable::default(),
+            mappings: HashMap::new(),
+            learning: HashMap::new(),
+            modes: [None; 128],
+            sdo: SdoTracker::new(),
+            sdo_cobs: HashMap::new(),
+            completed: Vec::new(),
+            seq: 0,
+        };
+        for (node, dict) in bound {
+            if (1..128).contains(&node) {
+                d.install_default_mappings(node, &dict);
+                dicts[node as usize] = dict;
+            }
+        }
+        d.dicts = dicts;
+        d
+    }
+
+    fn install_default_mappings(&mut self, node: u8, dict: &Dictionary) {
+        for layer in dict.layers().iter().rev() {
+            for (transmit, maps) in [(false, &layer.rpdo), (true, &layer.tpdo)] {
+                for (num, m) in maps {
+                    if let Some(cob) = m.cob_id {
+                        let kind = if transmit { Kind::Tpdo } else { Kind::Rpdo };
+                        self.cobs.assign(
+                            cob_key(cob),
+                            Route {
+                                kind,
+                                node: Some(node),
+                                pdo: *num,
+                                reserved: false,
+                            },
+                        );
+                    }
+                    self.mappings.insert((node, transmit, *num), m.clone());
+                }
+            }
+        }
+    }
+
+    /// The dictionary used for `node`.
+    pub fn dictionary(&self, node: u8) -> &Dictionary {
+        &self.dicts[(node & 0x7F) as usize]
+    }
+
+    /// The mapping in force for a PDO, if known.
+    pub fn mapping(&self, node: u8, transmit: bool, num: u16) -> Option<&PdoMapping> {
+        self.mappings.get(&(node, transmit, num))
+    }
+
+    /// The last mode of operation seen for `node`.
+    pub fn mode(&self, node: u8) -> Option<i8> {
+        self.modes[(node & 0x7F) as usize]
+    }
+
+    /// Where a frame goes, without building its label (the cheap path for `--summary`).
+    /// SDO frames are still tracked so that COB-ID and mapping changes are learned.
+    pub fn classify(&mut self, frame: &Frame) -> (Kind, Option<u8>) {
+        let route = self.route(frame);
+        if matches!(route.kind, Kind::SdoRx | Kind::SdoTx) {
+            let d = self.decode_routed(frame, route);
+            return (d.kind, d.node);
+        }
+        (route.kind, route.node)
+    }
+
+    fn route(&self, frame: &Frame) -> Route {
+        if frame.is_err() {
+            return Route {
+                kind: Kind::ErrorFrame,
+                node: None,
+                pdo: 0,
+                reserved: false,
+            };
+        }
+        if let Some(&(node, c2s)) = self
+            .sdo_cobs
+            .get(&(frame.id | if frame.is_ext() { 1 << 29 } else { 0 }))
+        {
+            let kind = if c2s { Kind::SdoRx } else { Kind::SdoTx };
+            return Route {
+                kind,
+                node: Some(node),
+                pdo: 0,
+                reserved: false,
+            };
+        }
+        self.cobs.route(frame.id, frame.is_ext())
+    }
+
+    /// Decodes one frame, updating the bus state.
+    pub fn decode(&mut self, frame: &Frame) -> Decoded {
+        let route = self.route(frame);
+        self.decode_routed(frame, route)
+    }
+
+    fn decode_routed(&mut self, frame: &Frame, route: Route) -> Decoded {
+        self.seq += 1;
+        let payload = frame.payload();
+        let node = route.node;
+        let n = node.unwrap_or(0);
+        let mut rtr_problem = None;
+        if frame.is_rtr() && !matches!(route.kind, Kind::Heartbeat | Kind::Tpdo | Kind::Other) {
+            rtr_problem = Some(format!("remote frame on a {} COB-ID", route.kind.as_str()));
+        }
+        let (label, body, problem) = match route.kind {
+            Kind::ErrorFrame => (
+                error_frame::label(frame.id, payload),
+                Body::ErrorFrame { class: frame.id },
+                None,
+            ),
+            Kind::Nmt => {
+                let (m, p) = nmt::decode(payload);
+                (m.label(), Body::Nmt(m), p)
+            }
+            Kind::Sync => {
+                let (s, p) = sync::decode(payload);
+                (s.label(), Body::Sync(s), p)
+            }
+            Kind::Time => {
+                let (t, p) = time::decode(payload);
+                (t.label(), Body::Time(t), p)
+            }
+            Kind::Emcy => {
+                let (e, p) = emcy::decode(payload, &self.dicts[n as usize]);
+                (e.label(n), Body::Emcy(e), p)
+            }
+            Kind::Heartbeat => {
+                let (h, p) = heartbeat::decode(payload, frame.is_rtr());
+                (h.label(n), Body::Heartbeat(h), p)
+            }
+            Kind::Lss => {
+                let (l, p) = lss::decode(payload, frame.id == 0x7E5);
+                (l.label(), Body::Lss(l), p)
+            }
+            Kind::Tpdo | Kind::Rpdo => self.decode_pdo(frame, route),
+            Kind::SdoRx | Kind::SdoTx => {
+                let c2s = route.kind == Kind::SdoRx;
+                let s = self
+                    .sdo
+                    .on_frame(self.seq, frame.ts_ns, n, c2s, payload, &self.dicts[n as usize]);
+                for t in self.sdo.take_completed() {
+                    self.learn(&t);
+                    self.completed.push(t);
+                }
+                let p = s.malformed();
+                (s.label(), Body::Sdo(s), p)
+            }
+            Kind::Other => {
+                let label = if route.reserved {
+                    format!("Reserved COB-ID 0x{:03X}", frame.id)
+                } else if frame.is_ext() {
+                    format!("29-bit frame 0x{:08X}", frame.id)
+                } else {
+                    format!("Not a predefined CANopen COB-ID (0x{:03X})", frame.id)
+                };
+                let p = route
+                    .reserved
+                    .then(|| format!("COB-ID 0x{:03X} is reserved by CiA 301", frame.id));
+                (label, Body::None, p)
+            }
+        };
+        let malformed = match (rtr_problem, problem) {
+            (Some(a), Some(b)) => Some(format!("{a}; {b}")),
+            (a, b) => a.or(b),
+        };
+        Decoded {
+            kind: route.kind,
+            node,
+            label,
+            body,
+            malformed,
+        }
+    }
+
+    fn decode_pdo(&mut self, frame: &Frame, route: Route) -> (String, Body, Option<String>) {
+        let n = route.node.unwrap_or(0);
+        let transmit = route.kind == Kind::Tpdo;
+        let payload = frame.payload();
+        if frame.is_rtr() {
+            let name = if transmit { "TPDO" } else { "RPDO" };
+            let pdo = Pdo {
+                num: route.pdo,
+                transmit,
+                signals: Vec::new(),
+                source: None,
+            };
+            return (
+                format!("{name}{} node {n}: remote request", route.pdo),
+                Body::Pdo(pdo),
+                None,
+            );
+        }
+        let (signals, source, problem) = match self.mappings.get(&(n, transmit, route.pdo)) {
+            Some(m) => {
+                let (s, p) = pdo::decode_signals(payload, m, &self.dicts[n as usize], self.modes[n as usize]);
+                (s, Some(m.source.clone()), p)
+            }
+            None => (Vec::new(), None, None),
+        };
+        for s in &signals {
+            if matches!((s.index, s.sub), (0x6060 | 0x6061, 0)) {
+                self.modes[n as usize] = s.value.as_i64().map(|m| m as i8);
+            }
+        }
+        let pdo = Pdo {
+            num: route.pdo,
+            transmit,
+            signals,
+            source,
+        };
+        (pdo.label(n, payload), Body::Pdo(pdo), problem)
+    }
+
+    /// Learns COB-IDs, PDO mappings and modes from a completed SDO transfer.
+    fn learn(&mut self, t: &Transaction) {
+        if !t.is_ok() || t.data.is_empty() {
+            return;
+        }
+        let node = t.node;
+        let mut b = [0u8; 4];
+        let len = t.data.len().min(4);
+        b[..len].copy_from_slice(&t.data[..len]);
+        let v = u32::from_le_bytes(b);
+        match (t.index, t.sub) {
+            (0x6060 | 0x6061, 0) => self.modes[(node & 0x7F) as usize] = Some(t.data[0] as i8),
+            (0x1005, 0) => self.assign_cob(
+                v,
+                Route {
+                    kind: Kind::Sync,
+                    node: None,
+                    pdo: 0,
+                    reserved: false,
+                },
+            ),
+            (0x1014, 0) => self.assign_cob(
+                v,
+                Route {
+                    kind: Kind::Emcy,
+                    node: Some(node),
+                    pdo: 0,
+                    reserved: false,
+                },
+            ),
+            (0x1200, 1 | 2) if v & 0x8000_0000 == 0 => {
+                let key = (v & 0x1FFF_FFFF) | if v & (1 << 29) != 0 { 1 << 29 } else { 0 };
+                self.sdo_cobs.insert(key, (node, t.sub == 1));
+            }
+            (0x1400..=0x15FF, 1) => self.pdo_cob(node, false, t.index - 0x1400 + 1, v),
+            (0x1800..=0x19FF, 1) => self.pdo_cob(node, true, t.index - 0x1800 + 1, v),
+            (0x1600..=0x17FF, sub) => self.learn_mapping((node, false, t.index - 0x1600 + 1), sub, v, t.end_ns),
+            (0x1A00..=0x1BFF, sub) => self.learn_mapping((node, true, t.index - 0x1A00 + 1), sub, v, t.end_ns),
+            _ => {}
+        }
+    }
+
+    fn assign_cob(&mut self, v: u32, route: Route) {
+        if v & 0x8000_0000 == 0 || route.kind == Kind::Sync {
+            self.cobs.assign(cob_key(v), route);
+        }
+    }
+
+    fn pdo_cob(&mut self, node: u8, transmit: bool, num: u16, v: u32) {
+        let kind = if transmit { Kind::Tpdo } else { Kind::Rpdo };
+        if v & 0x8000_0000 != 0 {
+            self.cobs.unassign(kind, Some(node), num);
+            return;
+        }
+        let route = Route {
+            kind,
+            node: Some(node),
+            pdo: num,
+            reserved: false,
+        };
+        let predefined = super::cob_id::predefined(v & 0x7FF);
+        let is_default = v & (1 << 29) == 0 && predefined == route;
+        if is_default {
+            self.cobs.unassign(kind, Some(node), num);
+        } else {
+            self.cobs.assign(cob_key(v), route);
+        }
+    }
+
+    fn learn_mapping(&mut self, key: PdoKey, sub: u8, v: u32, ts_ns: u64) {
+        let l = self.learning.entry(key).or_default();
+        if sub == 0 {
+            l.count = Some(v as u8);
+            if v as u8 == 0 {
+                self.mappings.remove(&key);
+                return;
+            }
+        } else if sub <= 64 {
+            let i = sub as usize - 1;
+            if l.entries.len() <= i {
+                l.entries.resize(i + 1, None);
+            }
+            l.entries[i] = Some(v);
+        }
+        let Some(count) = l.count.filter(|c| *c > 0 && *c <= 64) else {
+            return;
+        };
+        let entries: Option<Vec<u32>> = (0..count as usize)
+            .map(|i| l.entries.get(i).copied().flatten())
+            .collect();
+        if let Some(entries) = entries {
+            let cob_id = self.mappings.get(&key).and_then(|m| m.cob_id);
+            let mapping = PdoMapping {
+                cob_id,
+                entries: entries.into_iter().map(pdo::entry_from_u32).collect(),
+                source: MappingSource::Sniffed { ts_ns },
+            };
+            self.mappings.insert(key, mapping);
+        }
+    }
+
+    /// SDO transactions completed since the last call.
+    pub fn take_transactions(&mut self) -> Vec<Transaction> {
+        std::mem::take(&mut self.completed)
+    }
+
+    /// Ends the input: returns completed transactions plus those left incomplete.
+    pub fn finish(&mut self) -> Vec<Transaction> {
+        let mut all = std::mem::take(&mut self.completed);
+        all.extend(self.sdo.finish());
+        all
+    }
+}
+
+/// COB-ID value of a communication object (bit 29 = 29-bit frame) as a table key.
+fn cob_key(v: u32) -> CobId {
+    let ext = v & (1 << 29) != 0;
+    CobId {
+        id: if ext { v & 0x1FFF_FFFF } else { v & 0x7FF },
+        ext,
+    }
+}
