@@ -12,3 +12,4 @@ pub mod log;
 pub mod od;
 pub mod output;
 pub mod synth;
+pub mod tui;

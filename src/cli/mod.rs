@@ -3,6 +3,7 @@
 pub mod bench;
 mod bind;
 pub mod decode;
+pub mod tui;
 
 use clap::{Parser, Subcommand};
 
@@ -28,6 +29,10 @@ pub enum Command {
     Decode(decode::DecodeArgs),
     /// Print throughput and memory figures of the decoder on a generated log.
     Bench(bench::BenchArgs),
+    /// Open a log in the interactive analyzer (loads at once; browse, filter, search).
+    Open(tui::OpenArgs),
+    /// Replay a log in the interactive analyzer, paced by its timestamps.
+    Replay(tui::ReplayArgs),
 }
 
 /// Short usage printed by `cotui` without arguments.
@@ -35,6 +40,8 @@ pub const USAGE: &str = "\
 cotui: a terminal CANopen bus analyzer and commander
 
 Try it without hardware:   cotui demo
+Browse a log:              cotui open FILE
+Replay a log:              cotui replay FILE [--speed 2]
 Decode a candump log:      cotui decode FILE [--format jsonl] [--transactions] [--summary]
 All commands:              cotui --help
 ";
@@ -55,5 +62,7 @@ pub fn run() -> i32 {
         }
         Some(Command::Decode(args)) => decode::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
+        Some(Command::Open(args)) => tui::run_open(&args),
+        Some(Command::Replay(args)) => tui::run_replay(&args),
     }
 }
