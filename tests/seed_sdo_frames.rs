@@ -280,9 +280,9 @@ fn syntron_dual_axis_commands_are_unknown() {
         t.feed("601 E8 04 50 00 00 00 00 00")
             .starts_with("Unknown SDO command 0xE8")
     );
-    assert!(
-        t.feed("581 E8 04 50 00 B7 13 AB 12")
-            .contains("[malformed: unknown server command specifier 0xE8]")
+    assert_eq!(
+        t.feed("581 E8 04 50 00 B7 13 AB 12"),
+        "Unknown SDO command 0xE8: E8 04 50 00 B7 13 AB 12"
     );
     assert!(
         t.feed("601 E9 18 23 00 36 00 CA FF")

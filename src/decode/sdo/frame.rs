@@ -471,7 +471,8 @@ impl SdoFrame {
             .unwrap_or_default()
     }
 
-    /// One-line label, e.g. `Download 0x6040:00 Controlword = 6 (Shutdown)`.
+    /// One-line label, e.g. `Download 0x6040:00 Controlword = 6 (Shutdown)`, with tracker
+    /// problems in brackets. Malformation is reported by [`SdoFrame::malformed`], not here.
     pub fn label(&self) -> String {
         use SdoCommand::*;
         let obj = self.object_text();
@@ -537,11 +538,6 @@ impl SdoFrame {
         for p in &self.problems {
             s.push_str(" [");
             s.push_str(p);
-            s.push(']');
-        }
-        if let Some(m) = &self.malformed_reason {
-            s.push_str(" [malformed: ");
-            s.push_str(m);
             s.push(']');
         }
         s
@@ -1007,10 +1003,8 @@ mod tests {
         let f = SdoFrame::new(Side::Client, &[0xE8, 0x04, 0x50, 0x00, 0, 0, 0, 0], false);
         assert_eq!(f.command, Unknown { command: 0xE8 });
         assert!(f.malformed().is_some());
-        assert_eq!(
-            f.label(),
-            "Unknown SDO command 0xE8: E8 04 50 00 00 00 00 00 [malformed: unknown client command specifier 0xE8]"
-        );
+        assert_eq!(f.label(), "Unknown SDO command 0xE8: E8 04 50 00 00 00 00 00");
+        assert_eq!(f.malformed().as_deref(), Some("unknown client command specifier 0xE8"));
         assert_eq!(f.to_json()["cs"], "unknown");
         assert_eq!(f.to_json()["malformed"], true);
         assert_eq!(
@@ -1030,7 +1024,7 @@ mod tests {
         let f = SdoFrame::new(Side::Client, &[0x40, 0x41, 0x60], false);
         assert_eq!(f.command, InitiateUpload { index: 0x6041, sub: 0 });
         assert_eq!(f.malformed_reason.as_deref(), Some("DLC 3, expected 8"));
-        assert!(f.label().ends_with("[malformed: DLC 3, expected 8]"));
+        assert_eq!(f.label(), "Upload 0x6041:00");
         // Expedited data stops where the payload does.
         assert_eq!(
             client(&[0x23, 0x83, 0x60, 0x00, 0xE8]),

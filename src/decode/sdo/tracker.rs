@@ -124,9 +124,8 @@ impl SdoTracker {
 
         if let SdoCommand::Unknown { .. } = frame.command {
             // Shown as malformed, never allowed to disturb a running transfer.
-            if side == Side::Client {
-                state.unknown_request = true;
-            }
+            // A client's unknown command awaits a reply; a server's unknown command is that reply.
+            state.unknown_request = side == Side::Client;
             return frame;
         }
         let ctx = FrameCtx {
