@@ -131,9 +131,7 @@ fn decode_stream(
             }
             Mode::Frames(OutputFormat::Jsonl) => {
                 let d = decoder.decode(&frame);
-                let j = jsonl::frame_json(line, &frame, reader.interfaces(), &d);
-                buf.push_str(&j.to_string());
-                buf.push('\n');
+                jsonl::write_frame(&mut buf, line, &frame, reader.interfaces(), &d);
             }
             Mode::Transactions(fmt) => {
                 decoder.decode(&frame);
