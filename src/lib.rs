@@ -11,4 +11,5 @@ pub mod hex;
 pub mod log;
 pub mod od;
 pub mod output;
+pub mod read_ahead;
 pub mod synth;

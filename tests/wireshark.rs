@@ -209,10 +209,10 @@ fn cotui_agrees_with_wireshark_canopen_dissector() {
             continue;
         }
         assert_eq!(kind, kind_of_function_code(fc, id), "{ctx}: kind");
-        if let Some(node) = o["node"].as_u64() {
-            if kind != "nmt" {
-                assert_eq!(t[2], Some(node), "{ctx}: node");
-            }
+        if let Some(node) = o["node"].as_u64()
+            && kind != "nmt"
+        {
+            assert_eq!(t[2], Some(node), "{ctx}: node");
         }
         match kind {
             "nmt" => {
