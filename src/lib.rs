@@ -11,4 +11,6 @@ pub mod hex;
 pub mod log;
 pub mod od;
 pub mod output;
+pub mod sdo_client;
+pub mod sdo_server;
 pub mod synth;

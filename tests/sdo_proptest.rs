@@ -41,7 +41,7 @@ fn payload() -> impl Strategy<Value = Vec<u8>> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(256))]
+    #![proptest_config(ProptestConfig::with_cases(128))]
     #[test]
     fn random_frames_never_panic(frames in prop::collection::vec((1u8..4, any::<bool>(), payload()), 0..200)) {
         let dict = Dictionary::default();

@@ -32,7 +32,9 @@ impl Channel {
 /// Upload (read from the server) or download (write to the server).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TransferDirection {
+    /// Read from the server.
     Upload,
+    /// Written to the server.
     Download,
 }
 
@@ -49,8 +51,11 @@ impl TransferDirection {
 /// The SDO protocol a transfer used.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Protocol {
+    /// Up to 4 bytes in the initiate frames.
     Expedited,
+    /// 7-byte segments with a toggle bit, each confirmed.
     Segmented,
+    /// Sub-blocks of numbered segments with a CRC.
     Block,
 }
 
@@ -151,9 +156,13 @@ pub struct Transaction {
     pub node: u8,
     /// The channel it ran on.
     pub channel: Channel,
+    /// Object index.
     pub index: u16,
+    /// Object sub-index.
     pub sub: u8,
+    /// Upload (read) or download (write).
     pub direction: TransferDirection,
+    /// Expedited, segmented or block.
     pub protocol: Protocol,
     /// The bytes transferred (so far, when not complete).
     pub data: Vec<u8>,
@@ -163,7 +172,9 @@ pub struct Transaction {
     pub start_ns: u64,
     /// Timestamp of the last frame (ns).
     pub end_ns: u64,
+    /// How it ended.
     pub outcome: Outcome,
+    /// What went wrong along the way, each kind once.
     pub problems: Vec<Problem>,
     /// Sequence numbers of the frames that belong to it.
     pub frames: Vec<u64>,
