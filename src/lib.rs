@@ -12,4 +12,6 @@ pub mod log;
 pub mod od;
 pub mod output;
 pub mod read_ahead;
+pub mod sdo_client;
+pub mod sdo_server;
 pub mod synth;
