@@ -7,4 +7,5 @@
 pub mod decode;
 pub mod frame;
 pub mod hex;
+pub mod log;
 pub mod od;

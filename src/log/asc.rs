@@ -1,0 +1,436 @@
+//! Vector ASC logs, as Vector tools and can-utils' `log2asc` write them.
+//!
+//! ```text
+//! date Tue Nov 14 22:13:20 2023
+//! base hex  timestamps absolute
+//! no internal events logged
+//! Begin Triggerblock Tue Nov 14 22:13:20 2023
+//!    0.000000 Start of measurement
+//!    0.001000 1  123             Rx   d 3 11 22 33
+//!    0.002000 2  1ABCDEFx        Tx   d 8 01 02 03 04 05 06 07 08  Length = 0 BitCount = 0
+//!    0.003000 1  7FF             Rx   r 8
+//!    0.004000 1  ErrorFrame
+//!    0.005000 CANFD   1 Rx        123  msgName  1 0 9 12 11 22 ... 130000  130  3000 0 0 0 0 0
+//! End TriggerBlock
+//! ```
+//! Lines are split on any run of blanks. Choices, all as can-utils' `asc2log` makes them:
+//! - channel N is interface `can{N-1}` (channel 1 is `can0`); channel 0 is `canX`;
+//! - timestamps are kept as written: seconds since the start of the measurement (the `date`
+//!   line is not read); with `timestamps relative` each line's time is added to the last;
+//! - `base dec` reads ids and data bytes as decimal (the DLC stays hex);
+//! - `ErrorFrame` has no detail in ASC, so it becomes a generic bus error: an error frame
+//!   with class `CAN_ERR_BUSERROR` (0x80) and 8 zero bytes;
+//! - a `CANFD` line is an FD frame (with [`Flags::FDF`]) when its flags column has bit
+//!   0x1000 or is missing, else a classic frame (remote when bit 0x10 is set);
+//! - `Rx`/`Tx` set the direction; `TxRq`, `Start of measurement` and other events are
+//!   skipped as [`SkipReason::Event`], `CANXL` lines as [`SkipReason::CanXl`], lines not
+//!   starting with a timestamp as [`SkipReason::Header`] or [`SkipReason::Comment`] (`//`).
+
+use super::lex::{self, IfaceCache, Tokens, dec_u32, err, hex_u32, trim_end};
+use super::{Line, ParseError, SkipReason};
+use crate::frame::{Flags, Frame, Interfaces};
+
+/// `CAN_ERR_BUSERROR`: the class given to ASC error frames.
+pub const CAN_ERR_BUSERROR: u32 = 0x80;
+
+const ASC_F_RTR: u32 = 0x10;
+const ASC_F_FDF: u32 = 0x1000;
+
+/// Channels whose interface index is cached; higher ones are interned per line.
+const CACHED_CHANNELS: usize = 64;
+
+/// Parser state for ASC lines (number base, timestamp mode, channel names).
+#[derive(Debug)]
+pub struct Parser {
+    decimal: bool,
+    relative: bool,
+    last_ns: u64,
+    channels: [Option<u16>; CACHED_CHANNELS],
+    iface: IfaceCache,
+}
+
+impl Default for Parser {
+    fn default() -> Self {
+        Parser {
+            decimal: false,
+            relative: false,
+            last_ns: 0,
+            channels: [None; CACHED_CHANNELS],
+            iface: IfaceCache::default(),
+        }
+    }
+}
+
+impl Parser {
+    /// A parser in the defaults of an ASC file: hex, absolute timestamps.
+    pub fn new() -> Self {
+        Parser::default()
+    }
+
+    /// Parses one ASC line.
+    pub fn parse_line(&mut self, line: &[u8], ifaces: &mut Interfaces) -> Result<Line, ParseError> {
+        let s = trim_end(line);
+        let mut toks = Tokens::new(s, 0);
+        let Some((at, first)) = toks.next() else {
+            return Ok(Line::Skip(SkipReason::Blank));
+        };
+        if first.starts_with(b"//") {
+            return Ok(Line::Skip(SkipReason::Comment));
+        }
+        if !first[0].is_ascii_digit() {
+            if first == b"base" {
+                self.base_line(&mut toks);
+            }
+            return Ok(Line::Skip(SkipReason::Header));
+        }
+        let (mut ts, end) = lex::timestamp(s, at)?;
+        if end != at + first.len() {
+            return Err(err(end, "expected a timestamp like 1.000000"));
+        }
+        let (ch_at, ch_tok) = toks
+            .next()
+            .ok_or_else(|| err(s.len(), "expected a channel or event after the time"))?;
+        let mut f = match ch_tok {
+            b"CANFD" => {
+                let (ch_at, ch) = toks
+                    .next()
+                    .ok_or_else(|| err(s.len(), "expected a channel after CANFD"))?;
+                let channel = dec_u32(ch).ok_or_else(|| err(ch_at, "expected a channel number"))?;
+                let Some(mut f) = self.fd_line(&mut toks, s.len())? else {
+                    return Ok(Line::Skip(SkipReason::Event));
+                };
+                f.iface = self.channel(ifaces, channel, ch_at)?;
+                f
+            }
+            b"CANXL" => return Ok(Line::Skip(SkipReason::CanXl)),
+            _ => match dec_u32(ch_tok) {
+                Some(channel) => {
+                    let Some(mut f) = self.classic_line(&mut toks, s.len())? else {
+                        return Ok(Line::Skip(SkipReason::Event));
+                    };
+                    f.iface = self.channel(ifaces, channel, ch_at)?;
+                    f
+                }
+                None => return Ok(Line::Skip(SkipReason::Event)),
+            },
+        };
+        if self.relative {
+            ts = self.last_ns.saturating_add(ts);
+        }
+        self.last_ns = ts;
+        f.ts_ns = ts;
+        Ok(Line::Frame(f))
+    }
+
+    /// `base hex|dec  timestamps absolute|relative`.
+    fn base_line(&mut self, toks: &mut Tokens<'_>) {
+        for (_, t) in toks {
+            match t {
+                b"dec" => self.decimal = true,
+                b"hex" => self.decimal = false,
+                b"relative" => self.relative = true,
+                b"absolute" => self.relative = false,
+                _ => {}
+            }
+        }
+    }
+
+    /// Interface index of channel `n` (`can{n-1}`, `canX` for 0).
+    fn channel(&mut self, ifaces: &mut Interfaces, n: u32, at: usize) -> Result<u16, ParseError> {
+        if let Some(Some(idx)) = self.channels.get(n as usize) {
+            return Ok(*idx);
+        }
+        let mut buf = [0u8; 16];
+        buf[..3].copy_from_slice(b"can");
+        let len = if n == 0 {
+            buf[3] = b'X';
+            4
+        } else {
+            let digits = (n - 1).to_string();
+            buf[3..3 + digits.len()].copy_from_slice(digits.as_bytes());
+            3 + digits.len()
+        };
+        let idx = self.iface.get(ifaces, &buf[..len], at)?;
+        if let Some(slot) = self.channels.get_mut(n as usize) {
+            *slot = Some(idx);
+        }
+        Ok(idx)
+    }
+
+    /// Parses an id token (`123`, `1ABx`) in the current base.
+    fn id(&self, f: &mut Frame, at: usize, tok: &[u8]) -> Result<(), ParseError> {
+        let (digits, ext) = match tok.split_last() {
+            Some((b'x' | b'X', rest)) => (rest, true),
+            _ => (tok, false),
+        };
+        let id =
+            if self.decimal { dec_u32(digits) } else { hex_u32(digits) }.ok_or_else(|| err(at, "expected a CAN id"))?;
+        if id > if ext { 0x1FFF_FFFF } else { 0x7FF } {
+            return Err(err(at, "CAN id out of range (29-bit ids end in 'x')"));
+        }
+        f.id = id;
+        f.flags.set(Flags::EXT, ext);
+        Ok(())
+    }
+
+    /// A data byte in the current base.
+    fn byte(&self, at: usize, tok: &[u8]) -> Result<u8, ParseError> {
+        let v = if self.decimal { dec_u32(tok) } else { hex_u32(tok) };
+        match v {
+            Some(v) if v <= 0xFF && tok.len() <= 3 => Ok(v as u8),
+            _ => Err(err(at, "expected a data byte")),
+        }
+    }
+
+    /// `<id> <Rx|Tx> <d|r> <dlc> <bytes…>` or `ErrorFrame`; `None` for events.
+    fn classic_line(&self, toks: &mut Tokens<'_>, end: usize) -> Result<Option<Frame>, ParseError> {
+        let mut f = Frame::default();
+        let (id_at, id) = toks.next().ok_or_else(|| err(end, "expected a CAN id"))?;
+        if id == b"ErrorFrame" {
+            f.flags.set(Flags::ERR, true);
+            f.id = CAN_ERR_BUSERROR;
+            f.len = 8;
+            return Ok(Some(f));
+        }
+        if !id[0].is_ascii_hexdigit() {
+            return Ok(None);
+        }
+        self.id(&mut f, id_at, id)?;
+        if !direction(&mut f, toks, end)? {
+            return Ok(None);
+        }
+        let (kind_at, kind) = toks.next().ok_or_else(|| err(end, "expected 'd' or 'r'"))?;
+        let remote = match kind {
+            b"d" => false,
+            b"r" => true,
+            _ => return Err(err(kind_at, "expected 'd' (data) or 'r' (remote)")),
+        };
+        let dlc = match toks.peek() {
+            Some((dlc_at, t)) if t.len() == 1 || !remote => {
+                toks.next();
+                match hex_u32(t) {
+                    Some(v) if v <= 15 => v as u8,
+                    _ if remote => return Ok(Some(remote_frame(f, 0))),
+                    _ => return Err(err(dlc_at, "expected a DLC 0..F")),
+                }
+            }
+            _ => 0,
+        };
+        if remote {
+            return Ok(Some(remote_frame(f, dlc)));
+        }
+        f.len = dlc.min(8);
+        if dlc > 8 {
+            f.raw_dlc = dlc;
+        }
+        for k in 0..f.len as usize {
+            let (b_at, b) = toks
+                .next()
+                .ok_or_else(|| err(end, "fewer data bytes than the DLC says"))?;
+            f.data[k] = self.byte(b_at, b)?;
+        }
+        Ok(Some(f))
+    }
+
+    /// `<dir> <id> [name] <brs> <esi> <dlc> <len> <bytes…> <dur> <bits> <flags> …`.
+    fn fd_line(&self, toks: &mut Tokens<'_>, end: usize) -> Result<Option<Frame>, ParseError> {
+        let mut f = Frame::default();
+        if !direction(&mut f, toks, end)? {
+            return Ok(None);
+        }
+        let (id_at, id) = toks.next().ok_or_else(|| err(end, "expected a CAN id"))?;
+        let hex_mode = Parser {
+            decimal: false,
+            ..Parser::default()
+        };
+        hex_mode.id(&mut f, id_at, id)?;
+        let bit = |t: &[u8]| matches!(t, b"0" | b"1");
+        if toks.peek().is_some_and(|(_, t)| !bit(t)) {
+            toks.next(); // symbolic name
+        }
+        let mut next = |what: &'static str| toks.next().ok_or_else(|| err(end, what));
+        let (brs_at, brs) = next("expected the BRS column")?;
+        let (esi_at, esi) = next("expected the ESI column")?;
+        if !bit(brs) {
+            return Err(err(brs_at, "BRS must be 0 or 1"));
+        }
+        if !bit(esi) {
+            return Err(err(esi_at, "ESI must be 0 or 1"));
+        }
+        let (dlc_at, dlc) = next("expected a DLC")?;
+        let dlc = hex_u32(dlc)
+            .filter(|&d| d <= 15)
+            .ok_or_else(|| err(dlc_at, "expected a DLC 0..f"))? as u8;
+        let (len_at, len) = next("expected a data length")?;
+        let len = dec_u32(len)
+            .filter(|&l| l <= 64)
+            .ok_or_else(|| err(len_at, "expected a data length 0..64"))? as usize;
+        for k in 0..len {
+            let (b_at, b) = toks
+                .next()
+                .ok_or_else(|| err(end, "fewer data bytes than the length says"))?;
+            f.data[k] = hex_mode.byte(b_at, b)?;
+        }
+        let flags = match (toks.next(), toks.next(), toks.next()) {
+            (Some(_), Some(_), Some((fl_at, fl))) => {
+                hex_u32(fl).ok_or_else(|| err(fl_at, "expected the flags in hex"))?
+            }
+            _ => ASC_F_FDF,
+        };
+        if flags & ASC_F_FDF != 0 {
+            f.flags.set(Flags::FD | Flags::FDF, true);
+            f.flags.set(Flags::BRS, brs == b"1");
+            f.flags.set(Flags::ESI, esi == b"1");
+            f.len = len as u8;
+        } else if flags & ASC_F_RTR != 0 {
+            f = remote_frame(f, dlc);
+        } else {
+            if len > 8 {
+                return Err(err(len_at, "classic frame with more than 8 data bytes"));
+            }
+            f.len = len as u8;
+            if len == 8 && dlc > 8 {
+                f.raw_dlc = dlc;
+            }
+        }
+        Ok(Some(f))
+    }
+}
+
+/// Reads `Rx`/`Tx` into the TX flag; `false` for other directions (`TxRq`).
+fn direction(f: &mut Frame, toks: &mut Tokens<'_>, end: usize) -> Result<bool, ParseError> {
+    let (_, dir) = toks.next().ok_or_else(|| err(end, "expected Rx or Tx"))?;
+    match dir {
+        b"Rx" => Ok(true),
+        b"Tx" => {
+            f.flags.set(Flags::TX, true);
+            Ok(true)
+        }
+        _ => Ok(false),
+    }
+}
+
+/// `f` as a remote frame with DLC `dlc` (length capped at 8, raw DLC kept).
+fn remote_frame(mut f: Frame, dlc: u8) -> Frame {
+    f.flags.set(Flags::RTR, true);
+    f.len = dlc.min(8);
+    if dlc > 8 {
+        f.raw_dlc = dlc;
+    }
+    f
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse_all(text: &str) -> (Vec<Result<Line, ParseError>>, Interfaces) {
+        let mut p = Parser::new();
+        let mut ifaces = Interfaces::default();
+        let out = text.lines().map(|l| p.parse_line(l.as_bytes(), &mut ifaces)).collect();
+        (out, ifaces)
+    }
+
+    fn frames(text: &str) -> (Vec<Frame>, Interfaces) {
+        let (lines, ifaces) = parse_all(text);
+        let fs = lines
+            .into_iter()
+            .filter_map(|l| match l {
+                Ok(Line::Frame(f)) => Some(f),
+                Ok(Line::Skip(_)) => None,
+                Err(e) => panic!("{e}"),
+            })
+            .collect();
+        (fs, ifaces)
+    }
+
+    #[test]
+    fn header_lines_are_skipped_and_base_is_read() {
+        let (lines, _) = parse_all(
+            "date Tue Nov 14 22:13:20 2023\nbase hex  timestamps absolute\nno internal events logged\n// version 18.2.0\nBegin Triggerblock Tue Nov 14 22:13:20 2023\n   0.000000 Start of measurement\nEnd TriggerBlock\n",
+        );
+        let reasons: Vec<_> = lines.into_iter().map(Result::unwrap).collect();
+        use SkipReason::*;
+        let want = [Header, Header, Header, Comment, Header, Event, Header];
+        assert_eq!(reasons, want.map(Line::Skip));
+    }
+
+    #[test]
+    fn classic_lines() {
+        let (fs, ifaces) = frames(
+            "   0.001000 1  123             Rx   d 3 11 22 33\n   0.002500 2  1ABCDEFx        Tx   d 8 01 02 03 04 05 06 07 08  Length = 0 BitCount = 0 ID = 1\n   0.003000 1  7FF             Rx   r 8\n   0.004000 1  12              Rx   r\n   0.005000 1  ErrorFrame\n   0.006000 1  100             Rx   d F 01 02 03 04 05 06 07 08\n",
+        );
+        assert_eq!(fs.len(), 6);
+        assert_eq!(
+            (fs[0].ts_ns, fs[0].id, fs[0].payload()),
+            (1_000_000, 0x123, &[0x11, 0x22, 0x33][..])
+        );
+        assert_eq!(ifaces.name(fs[0].iface), "can0");
+        assert_eq!(
+            (fs[1].id, fs[1].flags.0, fs[1].data[7]),
+            (0x1AB_CDEF, Flags::EXT | Flags::TX, 8)
+        );
+        assert_eq!(ifaces.name(fs[1].iface), "can1");
+        assert_eq!((fs[2].flags.0, fs[2].len), (Flags::RTR, 8));
+        assert_eq!((fs[3].id, fs[3].flags.0, fs[3].len), (0x12, Flags::RTR, 0));
+        assert_eq!(
+            (fs[4].flags.0, fs[4].id, fs[4].len, fs[4].payload()),
+            (Flags::ERR, 0x80, 8, &[0u8; 8][..])
+        );
+        assert_eq!((fs[5].len, fs[5].raw_dlc), (8, 15));
+    }
+
+    #[test]
+    fn fd_lines_with_and_without_symbolic_name() {
+        let (fs, _) = frames(
+            "   0.176544 CANFD   1 Rx        123                                   1 0 9 12 11 22 33 44 55 66 77 88 99 AA BB CC   130000  130     3000 0 0 0 0 0\n  21.671796 CANFD   1 Tx         11  msgCanFdFr1                      0 1 a 16 00 00 00 00 00 00 00 00 00 00 00 00 00 00 59 c0 100000  214   223040 80000000 46500250\n   1.000000 CANFD   2 Rx   1234x  0 0 8 8 01 02 03 04 05 06 07 08 130000 130 0 0\n   2.000000 CANFD   2 Rx   1234x  0 0 d 0 130000 130 10 0\n",
+        );
+        assert_eq!(
+            (fs[0].flags.0, fs[0].len, fs[0].data[11]),
+            (Flags::FD | Flags::FDF | Flags::BRS, 12, 0xCC)
+        );
+        assert_eq!(
+            (fs[1].id, fs[1].flags.0, fs[1].len, fs[1].data[15]),
+            (0x11, Flags::FD | Flags::FDF | Flags::ESI | Flags::TX, 16, 0xC0)
+        );
+        assert_eq!((fs[2].flags.0, fs[2].len), (Flags::EXT, 8));
+        assert_eq!(
+            (fs[3].flags.0, fs[3].len, fs[3].raw_dlc),
+            (Flags::EXT | Flags::RTR, 8, 0xD)
+        );
+    }
+
+    #[test]
+    fn decimal_base_and_relative_timestamps() {
+        let (fs, _) = frames(
+            "base dec  timestamps relative\n   0.500000 1  291             Rx   d 2 17 255\n   0.250000 1  2047            Rx   d 0\n",
+        );
+        assert_eq!((fs[0].id, fs[0].payload()), (0x123, &[17, 255][..]));
+        assert_eq!((fs[1].id, fs[1].ts_ns), (0x7FF, 750_000_000));
+    }
+
+    #[test]
+    fn events_and_errors() {
+        let (lines, _) = parse_all(
+            "   0.1 1  123  TxRq d 1 11\n   0.1 CANXL   2 Rx   XLFF   984438\n   0.1 1  123  Rx   d 2 11\n   0.1 1  123  Rx   q 2 11\n   0.1 1  800  Rx   d 0\n   0.1 1  123  Rx   d 1 1FF\n",
+        );
+        assert_eq!(lines[0], Ok(Line::Skip(SkipReason::Event)));
+        assert_eq!(lines[1], Ok(Line::Skip(SkipReason::CanXl)));
+        assert_eq!(
+            lines[2],
+            Err(ParseError {
+                column: 27,
+                message: "fewer data bytes than the DLC says"
+            })
+        );
+        assert_eq!(
+            lines[3],
+            Err(ParseError {
+                column: 21,
+                message: "expected 'd' (data) or 'r' (remote)"
+            })
+        );
+        assert_eq!(lines[4].unwrap_err().column, 11);
+        assert_eq!(lines[5].unwrap_err().message, "expected a data byte");
+    }
+}

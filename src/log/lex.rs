@@ -1,0 +1,194 @@
+//! Byte-level lexing helpers shared by the log parsers (no allocation).
+
+use super::ParseError;
+use crate::frame::Interfaces;
+
+/// Value of each byte as a hex digit, `0xFF` when it is not one.
+const HEX: [u8; 256] = {
+    let mut t = [0xFFu8; 256];
+    let mut i = 0;
+    while i < 10 {
+        t[b'0' as usize + i] = i as u8;
+        i += 1;
+    }
+    let mut i = 0;
+    while i < 6 {
+        t[b'a' as usize + i] = 10 + i as u8;
+        t[b'A' as usize + i] = 10 + i as u8;
+        i += 1;
+    }
+    t
+};
+
+/// Hex value of `b`, or `None`.
+#[inline]
+pub(crate) fn hex(b: u8) -> Option<u8> {
+    let v = HEX[b as usize];
+    (v != 0xFF).then_some(v)
+}
+
+/// Space or tab.
+#[inline]
+pub(crate) fn is_ws(b: u8) -> bool {
+    b == b' ' || b == b'\t'
+}
+
+/// The line without its trailing `\n`, `\r`, spaces and tabs.
+#[inline]
+pub(crate) fn trim_end(line: &[u8]) -> &[u8] {
+    let mut n = line.len();
+    while n > 0 && matches!(line[n - 1], b'\n' | b'\r' | b' ' | b'\t') {
+        n -= 1;
+    }
+    &line[..n]
+}
+
+/// Index of the first non-blank byte at or after `i`.
+#[inline]
+pub(crate) fn skip_ws(s: &[u8], mut i: usize) -> usize {
+    while i < s.len() && is_ws(s[i]) {
+        i += 1;
+    }
+    i
+}
+
+/// Index of the first blank byte (or the end) at or after `i`.
+#[inline]
+pub(crate) fn token_end(s: &[u8], mut i: usize) -> usize {
+    while i < s.len() && !is_ws(s[i]) {
+        i += 1;
+    }
+    i
+}
+
+/// Whitespace tokenizer yielding `(start_index, token)`.
+pub(crate) struct Tokens<'a> {
+    s: &'a [u8],
+    i: usize,
+}
+
+impl<'a> Tokens<'a> {
+    /// Tokens of `s` starting at index `i`.
+    pub(crate) fn new(s: &'a [u8], i: usize) -> Self {
+        Tokens { s, i }
+    }
+    /// Index just past the last token returned (the end of the line when exhausted).
+    pub(crate) fn pos(&self) -> usize {
+        self.i
+    }
+    /// The next token, without consuming it.
+    pub(crate) fn peek(&self) -> Option<(usize, &'a [u8])> {
+        let start = skip_ws(self.s, self.i);
+        if start >= self.s.len() {
+            return None;
+        }
+        Some((start, &self.s[start..token_end(self.s, start)]))
+    }
+}
+
+impl<'a> Iterator for Tokens<'a> {
+    type Item = (usize, &'a [u8]);
+    fn next(&mut self) -> Option<Self::Item> {
+        let (start, tok) = self.peek()?;
+        self.i = start + tok.len();
+        Some((start, tok))
+    }
+}
+
+/// Error at byte index `i` (reported 1-based).
+#[inline]
+pub(crate) fn err(i: usize, message: &'static str) -> ParseError {
+    ParseError { column: i + 1, message }
+}
+
+/// Parses `digits[.digits]` at `i` into nanoseconds; returns the value and the index after it.
+///
+/// Any number of fraction digits is accepted (python-can writes `(0.0)`); digits past the
+/// ninth are truncated.
+pub(crate) fn timestamp(s: &[u8], mut i: usize) -> Result<(u64, usize), ParseError> {
+    let start = i;
+    let mut secs: u64 = 0;
+    while i < s.len() && s[i].is_ascii_digit() {
+        secs = secs
+            .checked_mul(10)
+            .and_then(|v| v.checked_add((s[i] - b'0') as u64))
+            .ok_or_else(|| err(start, "timestamp is too large"))?;
+        i += 1;
+    }
+    if i == start {
+        return Err(err(start, "expected a timestamp (seconds)"));
+    }
+    let mut frac: u64 = 0;
+    let mut digits = 0u32;
+    if i < s.len() && s[i] == b'.' {
+        i += 1;
+        while i < s.len() && s[i].is_ascii_digit() {
+            if digits < 9 {
+                frac = frac * 10 + (s[i] - b'0') as u64;
+                digits += 1;
+            }
+            i += 1;
+        }
+    }
+    let frac = frac * 10u64.pow(9 - digits);
+    let ns = secs
+        .checked_mul(1_000_000_000)
+        .and_then(|v| v.checked_add(frac))
+        .ok_or_else(|| err(start, "timestamp is too large"))?;
+    Ok((ns, i))
+}
+
+/// Parses an unsigned hex number of up to 8 digits occupying all of `tok`.
+pub(crate) fn hex_u32(tok: &[u8]) -> Option<u32> {
+    if tok.is_empty() || tok.len() > 8 {
+        return None;
+    }
+    let mut v = 0u32;
+    for &b in tok {
+        v = (v << 4) | hex(b)? as u32;
+    }
+    Some(v)
+}
+
+/// Parses an unsigned decimal number occupying all of `tok`.
+pub(crate) fn dec_u32(tok: &[u8]) -> Option<u32> {
+    if tok.is_empty() || tok.len() > 10 {
+        return None;
+    }
+    let mut v = 0u32;
+    for &b in tok {
+        if !b.is_ascii_digit() {
+            return None;
+        }
+        v = v.checked_mul(10)?.checked_add((b - b'0') as u32)?;
+    }
+    Some(v)
+}
+
+/// Remembers the last interface seen so that the common single-interface log interns
+/// nothing per line.
+#[derive(Debug, Default)]
+pub(crate) struct IfaceCache {
+    last: Option<u16>,
+}
+
+impl IfaceCache {
+    /// Index of interface `name` (bytes at line index `at`), interning it on first sight.
+    pub(crate) fn get(&mut self, ifaces: &mut Interfaces, name: &[u8], at: usize) -> Result<u16, ParseError> {
+        if let Some(idx) = self.last
+            && ifaces.name(idx).as_bytes() == name
+        {
+            return Ok(idx);
+        }
+        let text = std::str::from_utf8(name).map_err(|_| err(at, "interface name is not valid UTF-8"))?;
+        let idx = match ifaces.names().iter().position(|n| n == text) {
+            Some(i) => i as u16,
+            None if ifaces.names().len() >= u16::MAX as usize => {
+                return Err(err(at, "too many distinct interface names"));
+            }
+            None => ifaces.intern(text),
+        };
+        self.last = Some(idx);
+        Ok(idx)
+    }
+}

@@ -1,0 +1,345 @@
+//! Log formats: candump `-l` logs, candump's screen output and Vector ASC, plus a candump
+//! log writer.
+//!
+//! Each format has a line parser (`parse_line(&mut self, &[u8], &mut Interfaces)`) that
+//! works on bytes, allocates nothing per line and never panics. [`LogReader`] drives one
+//! over any [`BufRead`], reusing one line buffer, and counts what it saw.
+
+pub mod asc;
+pub mod candump;
+mod lex;
+pub mod screen;
+pub mod writer;
+
+use std::fmt;
+use std::io::{self, BufRead};
+
+use crate::frame::{Frame, Interfaces};
+
+/// The log formats cotui reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// candump `-l` / `-L`: `(1436509052.249713) can0 123#1122`.
+    Candump,
+    /// candump's default screen output: `  can0  123   [2]  11 22`.
+    Screen,
+    /// Vector ASC: `   0.001000 1  123             Rx   d 2 11 22`.
+    Asc,
+}
+
+/// Why a line was not a frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SkipReason {
+    /// Empty or blank.
+    Blank,
+    /// A comment or other text that is not a frame line.
+    Comment,
+    /// candump's `DROPCOUNT: ...` notice.
+    DropCount,
+    /// A CAN XL frame (not modelled).
+    CanXl,
+    /// A header or block line (ASC `date`, `base`, `Begin Triggerblock`, ...).
+    Header,
+    /// A timed event that is not a CAN frame (ASC `Start of measurement`, `TxRq`, ...).
+    Event,
+    /// A detail line of candump `-e` under an error frame (starts with a tab).
+    ErrorDetail,
+}
+
+impl SkipReason {
+    /// Every reason, in [`Counts`] order.
+    pub const ALL: [SkipReason; 7] = [
+        SkipReason::Blank,
+        SkipReason::Comment,
+        SkipReason::DropCount,
+        SkipReason::CanXl,
+        SkipReason::Header,
+        SkipReason::Event,
+        SkipReason::ErrorDetail,
+    ];
+
+    /// Short lower-case name for summaries.
+    pub fn label(self) -> &'static str {
+        match self {
+            SkipReason::Blank => "blank",
+            SkipReason::Comment => "comment",
+            SkipReason::DropCount => "dropcount",
+            SkipReason::CanXl => "can-xl",
+            SkipReason::Header => "header",
+            SkipReason::Event => "event",
+            SkipReason::ErrorDetail => "error-detail",
+        }
+    }
+
+    fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// What one line held, as returned by the per-format parsers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Line {
+    /// A frame.
+    Frame(Frame),
+    /// Not a frame, for this reason.
+    Skip(SkipReason),
+}
+
+/// A malformed line: 1-based byte column and what was wrong.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ParseError {
+    /// 1-based byte column of the problem.
+    pub column: usize,
+    /// What was wrong.
+    pub message: &'static str,
+}
+
+impl fmt::Display for ParseError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "column {}: {}", self.column, self.message)
+    }
+}
+
+impl std::error::Error for ParseError {}
+
+/// What [`LogReader`] made of one input line.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// A frame.
+    Frame(Frame),
+    /// Not a frame, for this reason.
+    Skip(SkipReason),
+    /// A malformed line; the message says where (column) and what was wrong.
+    Warning(String),
+}
+
+/// Running totals of a [`LogReader`].
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Counts {
+    /// Lines that gave a frame.
+    pub frames: u64,
+    /// Malformed lines.
+    pub warnings: u64,
+    skipped: [u64; SkipReason::ALL.len()],
+}
+
+impl Counts {
+    /// Lines skipped for `reason`.
+    pub fn skipped(&self, reason: SkipReason) -> u64 {
+        self.skipped[reason.index()]
+    }
+    /// Lines skipped for any reason.
+    pub fn skipped_total(&self) -> u64 {
+        self.skipped.iter().sum()
+    }
+}
+
+/// Guesses the format from the first non-empty lines of `sample` (e.g. the reader's first
+/// buffer). Comments, `DROPCOUNT` lines and blank lines are passed over; `None` when no
+/// line decides.
+pub fn detect(sample: &[u8]) -> Option<Format> {
+    sample.split(|&b| b == b'\n').take(64).find_map(detect_line)
+}
+
+/// The format one line belongs to, if it tells.
+fn detect_line(line: &[u8]) -> Option<Format> {
+    let s = lex::trim_end(line);
+    let mut toks = lex::Tokens::new(s, 0);
+    let (_, first) = toks.next()?;
+    let second = toks.peek().map(|(_, t)| t);
+    if first.starts_with(b"(") {
+        // candump log: `(ts) iface id#data`; screen: `(ts)  iface  id  [n] ...`.
+        let third = lex::Tokens::new(s, toks.pos()).nth(1).map(|(_, t)| t);
+        return match third {
+            Some(t) if t.contains(&b'#') => Some(Format::Candump),
+            Some(_) => Some(Format::Screen),
+            None => None,
+        };
+    }
+    let is_time = |t: &[u8]| lex::timestamp(t, 0).is_ok_and(|(_, end)| end == t.len() && t.contains(&b'.'));
+    match first {
+        b"date" | b"base" | b"Begin" | b"no" | b"internal" => return Some(Format::Asc),
+        _ if is_time(first) => return Some(Format::Asc),
+        _ => {}
+    }
+    // Screen without timestamp: `iface id [n]` or `iface RX - - id [n]`.
+    let rest: Vec<&[u8]> = lex::Tokens::new(s, 0).skip(1).map(|(_, t)| t).take(5).collect();
+    let is_len = |t: &[u8]| {
+        t.first().is_some_and(|&b| b == b'[' || b == b'{') && t.last().is_some_and(|&b| b == b']' || b == b'}')
+    };
+    if second.is_some() && (rest.get(1).is_some_and(|t| is_len(t)) || rest.get(4).is_some_and(|t| is_len(t))) {
+        return Some(Format::Screen);
+    }
+    None
+}
+
+/// The parser of one format, with its state.
+#[derive(Debug)]
+enum Parser {
+    Candump(candump::Parser),
+    Screen(screen::Parser),
+    Asc(Box<asc::Parser>),
+}
+
+/// Streams a log line by line, yielding `(line_number, Outcome)` for every line.
+///
+/// One line buffer is reused; bytes are parsed directly, so non-UTF-8 input only gives
+/// warnings on the lines concerned. IO errors end the stream.
+#[derive(Debug)]
+pub struct LogReader<R> {
+    src: R,
+    buf: Vec<u8>,
+    line_no: u64,
+    format: Format,
+    parser: Parser,
+    ifaces: Interfaces,
+    counts: Counts,
+}
+
+impl<R: BufRead> LogReader<R> {
+    /// A reader that detects the format from the start of `src` (candump when undecided).
+    pub fn new(mut src: R) -> io::Result<Self> {
+        let format = detect(src.fill_buf()?).unwrap_or(Format::Candump);
+        Ok(LogReader::with_format(src, format))
+    }
+
+    /// A reader for a known format.
+    pub fn with_format(src: R, format: Format) -> Self {
+        let parser = match format {
+            Format::Candump => Parser::Candump(candump::Parser::new()),
+            Format::Screen => Parser::Screen(screen::Parser::new()),
+            Format::Asc => Parser::Asc(Box::default()),
+        };
+        LogReader {
+            src,
+            buf: Vec::with_capacity(256),
+            line_no: 0,
+            format,
+            parser,
+            ifaces: Interfaces::default(),
+            counts: Counts::default(),
+        }
+    }
+
+    /// Reads screen timestamps as deltas (candump `-t d`) and sums them up.
+    pub fn screen_delta(mut self, on: bool) -> Self {
+        if let Parser::Screen(p) = &mut self.parser {
+            p.set_delta(on);
+        }
+        self
+    }
+
+    /// The format being read.
+    pub fn format(&self) -> Format {
+        self.format
+    }
+
+    /// Interface names seen so far (frames hold indexes into it).
+    pub fn interfaces(&self) -> &Interfaces {
+        &self.ifaces
+    }
+
+    /// Totals so far.
+    pub fn counts(&self) -> &Counts {
+        &self.counts
+    }
+
+    /// The next line's number (1-based) and outcome; `None` at the end of input.
+    pub fn next_line(&mut self) -> io::Result<Option<(u64, Outcome)>> {
+        self.buf.clear();
+        if self.src.read_until(b'\n', &mut self.buf)? == 0 {
+            return Ok(None);
+        }
+        self.line_no += 1;
+        let parsed = match &mut self.parser {
+            Parser::Candump(p) => p.parse_line(&self.buf, &mut self.ifaces),
+            Parser::Screen(p) => p.parse_line(&self.buf, &mut self.ifaces),
+            Parser::Asc(p) => p.parse_line(&self.buf, &mut self.ifaces),
+        };
+        let outcome = match parsed {
+            Ok(Line::Frame(f)) => {
+                self.counts.frames += 1;
+                Outcome::Frame(f)
+            }
+            Ok(Line::Skip(r)) => {
+                self.counts.skipped[r.index()] += 1;
+                Outcome::Skip(r)
+            }
+            Err(e) => {
+                self.counts.warnings += 1;
+                Outcome::Warning(e.to_string())
+            }
+        };
+        Ok(Some((self.line_no, outcome)))
+    }
+}
+
+impl<R: BufRead> Iterator for LogReader<R> {
+    type Item = io::Result<(u64, Outcome)>;
+    fn next(&mut self) -> Option<Self::Item> {
+        self.next_line().transpose()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn detects_each_format_past_comments() {
+        assert_eq!(
+            detect(b"# hi\n\nDROPCOUNT: x\n(1700000000.000001) can0 123#11\n"),
+            Some(Format::Candump)
+        );
+        assert_eq!(detect(b"  can0  123   [3]  11 22 33\n"), Some(Format::Screen));
+        assert_eq!(
+            detect(b" (1700000000.123456)  can0  123   [1]  11\n"),
+            Some(Format::Screen)
+        );
+        assert_eq!(
+            detect(b"  vcan0  TX - -  123   [0]  remote request\n"),
+            Some(Format::Screen)
+        );
+        assert_eq!(
+            detect(b"date Tue Nov 14 22:13:20 2023\nbase hex  timestamps absolute\n"),
+            Some(Format::Asc)
+        );
+        assert_eq!(
+            detect(b"   0.001000 1  123             Rx   d 1 11\n"),
+            Some(Format::Asc)
+        );
+        assert_eq!(detect(b"hello\n\n"), None);
+    }
+
+    #[test]
+    fn reader_numbers_lines_counts_and_goes_on_after_bad_bytes() {
+        let input: &[u8] = b"(1.000000) can0 123#11\n\xFF\xFE garbage\n(1.000000) c\xFF 123#11\nDROPCOUNT: 1\n\n(2.000000) can0 124#\n";
+        let mut r = LogReader::new(input).unwrap();
+        assert_eq!(r.format(), Format::Candump);
+        let all: Vec<(u64, Outcome)> = r.by_ref().map(Result::unwrap).collect();
+        assert_eq!(all.len(), 6);
+        assert!(matches!(all[0], (1, Outcome::Frame(f)) if f.id == 0x123));
+        assert_eq!(all[1], (2, Outcome::Skip(SkipReason::Comment)));
+        assert_eq!(
+            all[2],
+            (
+                3,
+                Outcome::Warning("column 12: interface name is not valid UTF-8".into())
+            )
+        );
+        assert_eq!(all[3], (4, Outcome::Skip(SkipReason::DropCount)));
+        assert_eq!(all[4], (5, Outcome::Skip(SkipReason::Blank)));
+        assert!(matches!(all[5], (6, Outcome::Frame(f)) if f.id == 0x124 && f.ts_ns == 2_000_000_000));
+        let c = r.counts();
+        assert_eq!((c.frames, c.warnings, c.skipped_total()), (2, 1, 3));
+        assert_eq!(c.skipped(SkipReason::DropCount), 1);
+        assert_eq!(r.interfaces().names(), ["can0"]);
+    }
+
+    #[test]
+    fn last_line_without_newline_is_read() {
+        let mut r = LogReader::with_format(&b"(1.000000) can0 123#11"[..], Format::Candump);
+        assert!(matches!(r.next_line().unwrap(), Some((1, Outcome::Frame(_)))));
+        assert_eq!(r.next_line().unwrap(), None);
+    }
+}
