@@ -263,8 +263,9 @@ impl Parser {
             .ok_or_else(|| err(dlc_at, "expected a DLC 0..f"))? as u8;
         let (len_at, len) = next("expected a data length")?;
         let len = dec_u32(len)
-            .filter(|&l| l <= 64)
-            .ok_or_else(|| err(len_at, "expected a data length 0..64"))? as usize;
+            .filter(|&l| l <= 8 || matches!(l, 12 | 16 | 20 | 24 | 32 | 48 | 64))
+            .ok_or_else(|| err(len_at, "expected a data length 0..8, 12, 16, 20, 24, 32, 48 or 64"))?
+            as usize;
         for k in 0..len {
             let (b_at, b) = toks
                 .next()
@@ -412,7 +413,7 @@ mod tests {
     #[test]
     fn events_and_errors() {
         let (lines, _) = parse_all(
-            "   0.1 1  123  TxRq d 1 11\n   0.1 CANXL   2 Rx   XLFF   984438\n   0.1 1  123  Rx   d 2 11\n   0.1 1  123  Rx   q 2 11\n   0.1 1  800  Rx   d 0\n   0.1 1  123  Rx   d 1 1FF\n",
+            "   0.1 1  123  TxRq d 1 11\n   0.1 CANXL   2 Rx   XLFF   984438\n   0.1 1  123  Rx   d 2 11\n   0.1 1  123  Rx   q 2 11\n   0.1 1  800  Rx   d 0\n   0.1 1  123  Rx   d 1 1FF\n   0.1 CANFD 1 Rx 123 0 0 9  9 00 01 02 03 04 05 06 07 08\n",
         );
         assert_eq!(lines[0], Ok(Line::Skip(SkipReason::Event)));
         assert_eq!(lines[1], Ok(Line::Skip(SkipReason::CanXl)));
@@ -432,5 +433,6 @@ mod tests {
         );
         assert_eq!(lines[4].unwrap_err().column, 11);
         assert_eq!(lines[5].unwrap_err().message, "expected a data byte");
+        assert_eq!(lines[6].unwrap_err().column, 30);
     }
 }
