@@ -135,17 +135,20 @@ impl SdoTracker {
             command: frame.command,
             dlc_problem,
         };
+        if side == Side::Client {
+            state.unknown_request = false;
+        }
         let mut notes = Vec::new();
         if let Some(mut p) = state.pending.take() {
             match step(&mut p, &ctx, &mut notes) {
                 Step::Continue => {
                     attach(&mut p.txn, &ctx);
-                    frame.object = Some((p.txn.index, p.txn.sub));
+                    frame.object = frame.object.or(Some((p.txn.index, p.txn.sub)));
                     state.pending = Some(p);
                 }
                 Step::Complete(outcome) => {
                     attach(&mut p.txn, &ctx);
-                    frame.object = Some((p.txn.index, p.txn.sub));
+                    frame.object = frame.object.or(Some((p.txn.index, p.txn.sub)));
                     self.completed.push(finalize(p, outcome, dict));
                 }
                 Step::Unexpected => {
@@ -171,9 +174,6 @@ impl SdoTracker {
         let state = self.channels.entry(channel).or_default();
         if frame.object.is_none() {
             frame.object = state.pending.as_ref().map(|p| (p.txn.index, p.txn.sub));
-        }
-        if frame.object.is_none() {
-            frame.object = frame.command.object();
         }
         if let Some((index, sub)) = frame.object {
             frame.name = dict.name(index, sub).map(str::to_string);
