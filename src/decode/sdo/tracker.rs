@@ -153,7 +153,7 @@ impl SdoTracker {
                 }
                 Step::Unexpected => {
                     let outcome = if p.phase == (Phase::DownloadSegment { toggle: false })
-                        && p.txn.protocol == Protocol::Expedited
+                        && p.txn.protocol == Protocol::Unknown
                     {
                         // Only an initiate download response was seen: it was expedited.
                         Outcome::Incomplete
@@ -329,7 +329,7 @@ fn start(
             begin(pending(t, Phase::InitDownload, false), false);
         }
         (Side::Client, InitiateUpload { index, sub }) => {
-            let t = new_txn(channel, ctx, index, sub, Upload, Protocol::Expedited);
+            let t = new_txn(channel, ctx, index, sub, Upload, Protocol::Unknown);
             begin(pending(t, Phase::InitUpload, false), false);
         }
         (Side::Client, BlockDownloadInitiate { index, sub, crc, size }) => {
@@ -397,7 +397,7 @@ fn start(
         }
         (Side::Server, InitiateDownloadResponse { index, sub }) => {
             // Expedited or the start of a segmented download: only the next frame tells.
-            let t = new_txn(channel, ctx, index, sub, Download, Protocol::Expedited);
+            let t = new_txn(channel, ctx, index, sub, Download, Protocol::Unknown);
             begin(pending(t, Phase::DownloadSegment { toggle: false }, false), true);
         }
         (side, Abort { .. }) => {
@@ -443,7 +443,7 @@ fn step(p: &mut Pending, ctx: &FrameCtx, notes: &mut Vec<String>) -> Step {
             if toggle != want {
                 flag(t, Problem::ToggleError);
             }
-            if t.protocol == Protocol::Expedited {
+            if t.protocol == Protocol::Unknown {
                 // Picked up at an unmatched initiate response: it was segmented after all.
                 t.protocol = Protocol::Segmented;
             }
