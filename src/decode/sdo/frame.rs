@@ -658,7 +658,11 @@ impl SdoFrame {
         s
     }
 
-    /// JSON fragment: `cs`, `index`, `sub`, `abort_code`, `abort_text` and the decoded fields.
+    /// JSON fragment: `cs`, `side`, `index`, `sub`, `abort_code`, `abort_text`, `malformed` and the
+    /// decoded fields (`expedited`, `size`, `toggle`, `last`, `data`, `seqno`, `ackseq`, `blksize`,
+    /// `pst`, `crc_supported`, `unused`, `crc`, `block_step`, `name`, `value`, `value_text`,
+    /// `problems`). `index`/`sub` are the frame's own or, for segments and block steps, those of
+    /// the transfer the tracker puts the frame in (null when unknown).
     pub fn to_json(&self) -> Json {
         use SdoCommand::*;
         let (index, sub) = match self.object {

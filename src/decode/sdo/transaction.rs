@@ -57,15 +57,19 @@ pub enum Protocol {
     Segmented,
     /// Sub-blocks of numbered segments with a CRC.
     Block,
+    /// Not seen yet: an upload the server has not answered, or a transfer whose
+    /// request was not captured.
+    Unknown,
 }
 
 impl Protocol {
-    /// `"expedited"`, `"segmented"` or `"block"`.
+    /// `"expedited"`, `"segmented"`, `"block"` or `"unknown"`.
     pub fn as_str(self) -> &'static str {
         match self {
             Protocol::Expedited => "expedited",
             Protocol::Segmented => "segmented",
             Protocol::Block => "block",
+            Protocol::Unknown => "unknown",
         }
     }
 }
@@ -228,10 +232,14 @@ impl Transaction {
             s.push_str(&text);
         }
         let n = self.data.len();
+        s.push_str(" (");
+        if self.protocol != Protocol::Unknown {
+            s.push_str(self.protocol.as_str());
+            s.push_str(", ");
+        }
+        let plural = if n == 1 { "" } else { "s" };
         s.push_str(&format!(
-            " ({}, {n} byte{}, {:.3} ms): ",
-            self.protocol.as_str(),
-            if n == 1 { "" } else { "s" },
+            "{n} byte{plural}, {:.3} ms): ",
             self.duration_ns() as f64 / 1e6
         ));
         match &self.outcome {
