@@ -6,7 +6,6 @@ pub mod error;
 pub mod grammar;
 pub mod nmt;
 pub mod sdo;
-pub mod sdo_client;
 pub mod value;
 
 pub use error::CommandError;

@@ -4,11 +4,11 @@
 //!
 //! Pure: frames and the current time in, frames out.
 
-use super::od::ObjectStore;
+use super::od::DeviceObjects;
 use super::profile;
-use super::sdo_server::SdoServer;
 use crate::decode::cia402::DriveState;
 use crate::frame::Frame;
+use crate::sdo_server::{SdoServer, ServerConfig};
 
 /// NMT state of a simulated node.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -38,7 +38,7 @@ pub const MODE_CSV: i8 = 9;
 #[derive(Clone, Debug)]
 pub struct Drive {
     node: u8,
-    od: ObjectStore,
+    od: DeviceObjects,
     sdo: SdoServer,
     nmt: NmtState,
     state: DriveState,
@@ -60,7 +60,7 @@ impl Drive {
         Drive {
             node,
             od: profile::drive_objects(node, profile),
-            sdo: SdoServer::new(),
+            sdo: SdoServer::new(ServerConfig::default()),
             nmt: NmtState::PreOperational,
             state: DriveState::SwitchOnDisabled,
             reset_bit: false,
@@ -85,7 +85,7 @@ impl Drive {
         self.state
     }
     /// The object dictionary (read-only view).
-    pub fn objects(&self) -> &ObjectStore {
+    pub fn objects(&self) -> &DeviceObjects {
         &self.od
     }
     /// Switches the simulated DC link voltage on or off.
@@ -110,7 +110,7 @@ impl Drive {
 
     fn reset(&mut self, range: std::ops::RangeInclusive<u16>) {
         self.od.reset(range.clone());
-        self.sdo = SdoServer::new();
+        self.sdo = SdoServer::new(ServerConfig::default());
         if range.contains(&0x6000) {
             // Reset of the application: the power stage starts over.
             self.state = DriveState::SwitchOnDisabled;
@@ -143,7 +143,7 @@ impl Drive {
             0x000 => self.on_nmt(f.payload(), now_ns),
             0x080 if self.nmt == NmtState::Operational => self.on_sync(),
             id if id == 0x600 + node && self.nmt != NmtState::Stopped && !f.is_rtr() => {
-                let replies = self.sdo.on_request(f.payload(), &mut self.od);
+                let replies = self.sdo.on_frame(f.payload(), now_ns, &mut self.od).frames;
                 let mut out: Vec<Frame> = replies.iter().map(|r| Frame::classic(0x580 + node, r)).collect();
                 out.extend(self.apply_objects());
                 out

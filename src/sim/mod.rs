@@ -6,7 +6,6 @@ pub mod demo;
 pub mod drive;
 pub mod od;
 pub mod profile;
-pub mod sdo_server;
 
 use crate::frame::Frame;
 use drive::Drive;

@@ -3,6 +3,7 @@
 
 use crate::decode::sdo::abort::codes;
 use crate::od::{Access, DataType};
+use crate::sdo_server::ObjectStore;
 use std::collections::BTreeMap;
 
 /// One entry of a simulated object dictionary.
@@ -18,12 +19,12 @@ pub struct Entry {
 
 /// The entries of one device with their power-on defaults.
 #[derive(Clone, Debug, Default)]
-pub struct ObjectStore {
+pub struct DeviceObjects {
     entries: BTreeMap<(u16, u8), Entry>,
     defaults: BTreeMap<(u16, u8), Vec<u8>>,
 }
 
-impl ObjectStore {
+impl DeviceObjects {
     /// Adds an entry with its default value (fixed-size types take the low bytes of `value`).
     pub fn add(&mut self, index: u16, sub: u8, name: &str, data_type: DataType, access: Access, value: i64) {
         let size = data_type.size().unwrap_or(0);
@@ -61,18 +62,7 @@ impl ObjectStore {
     }
     /// Writes an entry for an SDO download; `Err` is the abort code.
     pub fn write(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), u32> {
-        let e = self.lookup(index, sub)?;
-        if matches!(e.access, Access::Ro | Access::Const) {
-            return Err(codes::READ_ONLY);
-        }
-        if let Some(size) = e.data_type.size() {
-            if data.len() > size {
-                return Err(codes::LENGTH_TOO_HIGH);
-            }
-            if data.len() < size {
-                return Err(codes::LENGTH_TOO_LOW);
-            }
-        }
+        self.writable(index, sub, Some(data.len()))?;
         self.set(index, sub, data);
         Ok(())
     }
@@ -114,6 +104,19 @@ impl ObjectStore {
         }
     }
 
+    /// Checks a write of `len` bytes (when known) without storing anything.
+    fn writable(&self, index: u16, sub: u8, len: Option<usize>) -> Result<(), u32> {
+        let e = self.lookup(index, sub)?;
+        if matches!(e.access, Access::Ro | Access::Const) {
+            return Err(codes::READ_ONLY);
+        }
+        match (e.data_type.size(), len) {
+            (Some(size), Some(n)) if n > size => Err(codes::LENGTH_TOO_HIGH),
+            (Some(size), Some(n)) if n < size => Err(codes::LENGTH_TOO_LOW),
+            _ => Ok(()),
+        }
+    }
+
     fn lookup(&self, index: u16, sub: u8) -> Result<&Entry, u32> {
         match self.entries.get(&(index, sub)) {
             Some(e) => Ok(e),
@@ -123,12 +126,27 @@ impl ObjectStore {
     }
 }
 
+impl ObjectStore for DeviceObjects {
+    fn read(&mut self, index: u16, sub: u8) -> Result<Vec<u8>, u32> {
+        DeviceObjects::read(self, index, sub)
+    }
+    fn write(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), u32> {
+        DeviceObjects::write(self, index, sub, data)
+    }
+    fn check_write(&mut self, index: u16, sub: u8, size: Option<usize>) -> Result<(), u32> {
+        self.writable(index, sub, size)
+    }
+    fn size(&self, index: u16, sub: u8) -> Option<usize> {
+        self.entry(index, sub).and_then(|e| e.data_type.size())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn store() -> ObjectStore {
-        let mut s = ObjectStore::default();
+    fn store() -> DeviceObjects {
+        let mut s = DeviceObjects::default();
         s.add(0x1000, 0, "Device type", DataType::U32, Access::Ro, 0x0002_0192);
         s.add(0x6040, 0, "Controlword", DataType::U16, Access::Rww, 0);
         s.add(0x6064, 0, "Position actual value", DataType::I32, Access::Ro, -5);

@@ -1,7 +1,7 @@
 //! The object dictionary of a simulated CiA 402 drive (CiA 301 communication
 //! objects plus the CiA 402 objects the simulator acts on).
 
-use super::od::ObjectStore;
+use super::od::DeviceObjects;
 use crate::od::{Access, DataType};
 
 /// What makes one simulated drive model different from another.
@@ -30,11 +30,11 @@ impl DriveProfile {
 }
 
 /// The objects of a drive at `node` (COB-IDs follow the pre-defined connection set).
-pub fn drive_objects(node: u8, p: DriveProfile) -> ObjectStore {
+pub fn drive_objects(node: u8, p: DriveProfile) -> DeviceObjects {
     use Access::*;
     use DataType::*;
     let n = node as i64;
-    let mut s = ObjectStore::default();
+    let mut s = DeviceObjects::default();
     s.add(0x1000, 0, "Device type", U32, Ro, 0x0002_0192);
     s.add(0x1001, 0, "Error register", U8, Ro, 0);
     s.add(0x1003, 0, "Number of errors", U8, Rw, 0);
