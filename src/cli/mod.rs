@@ -33,6 +33,10 @@ pub enum Command {
     Open(tui::OpenArgs),
     /// Replay a log in the interactive analyzer, paced by its timestamps.
     Replay(tui::ReplayArgs),
+    /// Capture a SocketCAN interface in the interactive analyzer, with the command palette.
+    Live(tui::LiveArgs),
+    /// The interactive analyzer on an in-process bus with simulated CiA 402 drives.
+    Demo(tui::DemoArgs),
 }
 
 /// Short usage printed by `cotui` without arguments.
@@ -64,5 +68,7 @@ pub fn run() -> i32 {
         Some(Command::Bench(args)) => bench::run(&args),
         Some(Command::Open(args)) => tui::run_open(&args),
         Some(Command::Replay(args)) => tui::run_replay(&args),
+        Some(Command::Live(args)) => tui::run_live(&args),
+        Some(Command::Demo(args)) => tui::run_demo(&args),
     }
 }

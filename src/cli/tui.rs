@@ -50,6 +50,28 @@ pub struct ReplayArgs {
     pub ui: UiArgs,
 }
 
+/// Arguments of `cotui live`.
+#[derive(Args, Debug)]
+pub struct LiveArgs {
+    /// SocketCAN interface (e.g. can0, vcan0).
+    pub iface: String,
+    /// Never send: the bus is opened without a send path.
+    #[arg(long)]
+    pub listen_only: bool,
+    #[command(flatten)]
+    pub ui: UiArgs,
+}
+
+/// Arguments of `cotui demo`.
+#[derive(Args, Debug)]
+pub struct DemoArgs {
+    /// Never send: watch the simulated drives only.
+    #[arg(long)]
+    pub listen_only: bool,
+    #[command(flatten)]
+    pub ui: UiArgs,
+}
+
 /// The user's keymap file: `$XDG_CONFIG_HOME/cotui/keymap.json` or `~/.config/cotui/keymap.json`.
 pub fn user_keymap_path() -> Option<PathBuf> {
     let base = std::env::var_os("XDG_CONFIG_HOME")
@@ -79,7 +101,15 @@ pub fn load_keymap(choice: &str) -> Result<Keymap, String> {
     Keymap::load(base, &overrides).map_err(|e: KeymapError| format!("keymap: {e}"))
 }
 
-fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: source::Feeds) -> i32 {
+/// How the app gets its frames.
+enum Feeding {
+    /// A log task with an optional control line.
+    Log(source::Feeds),
+    /// A live bus that also runs commands.
+    Live(std::sync::mpsc::Receiver<source::Feed>, crate::tui::live::Requests),
+}
+
+fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> i32 {
     let keymap = match load_keymap(&ui.keymap) {
         Ok(k) => k,
         Err(e) => {
@@ -94,12 +124,11 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: source::Feeds) -> i32 
             return EXIT_USAGE;
         }
     };
-    let (rx, ctl) = feed;
-    let mut app = App::new(
-        Trace::new(decoder, ui.bitrate),
-        keymap,
-        SourceInfo::new(name, kind, rx, ctl),
-    );
+    let src = match feed {
+        Feeding::Log((rx, ctl)) => SourceInfo::new(name, kind, rx, ctl),
+        Feeding::Live(rx, req) => SourceInfo::live(name, kind, rx, req),
+    };
+    let mut app = App::new(Trace::new(decoder, ui.bitrate), keymap, src);
     if let Some(f) = &ui.filter {
         app.set_filter(f);
         if let Some(m) = app.message.take() {
@@ -140,7 +169,7 @@ pub fn run_open(args: &OpenArgs) -> i32 {
         &args.ui,
         &name,
         SourceKind::Open,
-        (source::open(args.file.clone()), None),
+        Feeding::Log((source::open(args.file.clone()), None)),
     )
 }
 
@@ -159,6 +188,24 @@ pub fn run_replay(args: &ReplayArgs) -> i32 {
         &args.ui,
         &name,
         SourceKind::Replay { speed: args.speed },
-        (rx, Some(ctl)),
+        Feeding::Log((rx, Some(ctl))),
     )
+}
+
+/// Runs `cotui live IFACE`.
+pub fn run_live(args: &LiveArgs) -> i32 {
+    let (rx, req) = crate::tui::live::start(&args.iface, args.listen_only);
+    let kind = SourceKind::Live {
+        listen_only: args.listen_only,
+    };
+    start(&args.ui, &args.iface, kind, Feeding::Live(rx, req))
+}
+
+/// Runs `cotui demo`.
+pub fn run_demo(args: &DemoArgs) -> i32 {
+    let (rx, req) = crate::tui::live::start(crate::bus::DEMO, args.listen_only);
+    let kind = SourceKind::Demo {
+        listen_only: args.listen_only,
+    };
+    start(&args.ui, crate::bus::DEMO, kind, Feeding::Live(rx, req))
 }

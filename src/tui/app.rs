@@ -3,14 +3,18 @@
 
 use super::filter::Filter;
 use super::keymap::{Action, Key, Keymap, Lookup};
+use super::live::{Request, Requests};
+use super::palette::{self, COMMANDER_WORDS, Planned};
 use super::prompt::{Prompt, PromptKind};
 use super::rows::{Row, RowCache};
 use super::source::{Control, Feed};
 use super::trace::Trace;
 use super::view::View;
+use crate::command::{Command, DriveAction};
 use crate::decode::Decoded;
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers, MouseButton, MouseEvent, MouseEventKind};
 use ratatui::layout::Rect;
+use std::collections::BTreeSet;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError};
 use std::time::{Duration, Instant};
 
@@ -46,6 +50,10 @@ pub enum SourceKind {
     Open,
     /// A log played by its timestamps.
     Replay { speed: f64 },
+    /// A live interface.
+    Live { listen_only: bool },
+    /// The in-process simulated bus.
+    Demo { listen_only: bool },
 }
 
 /// The capture source as the status bar shows it.
@@ -60,8 +68,11 @@ pub struct SourceInfo {
     pub done: bool,
     /// Frames the UI could not take (dropped).
     pub drops: u64,
+    /// The interface error in force (with the command that fixes it).
+    pub bus_error: Option<String>,
     feed: Option<Receiver<Feed>>,
     control: Option<Sender<Control>>,
+    requests: Option<Requests>,
 }
 
 impl SourceInfo {
@@ -73,8 +84,18 @@ impl SourceInfo {
             paused: false,
             done: false,
             drops: 0,
+            bus_error: None,
             feed: Some(feed),
             control,
+            requests: None,
+        }
+    }
+
+    /// A live source that also runs palette commands.
+    pub fn live(name: &str, kind: SourceKind, feed: Receiver<Feed>, requests: Requests) -> SourceInfo {
+        SourceInfo {
+            requests: Some(requests),
+            ..SourceInfo::new(name, kind, feed, None)
         }
     }
 }
@@ -155,6 +176,10 @@ pub struct App {
     pub quit: bool,
     /// Layout of the last draw.
     pub layout: Layout,
+    /// A commander line waiting for `y`.
+    pub confirm: Option<Planned>,
+    /// Drives this session enabled (what stop-all stops).
+    pub enabled: BTreeSet<u8>,
     pending: Vec<Key>,
     rate_mark: (Instant, usize),
     /// Set when something changed since the last draw.
@@ -192,6 +217,8 @@ impl App {
             rate: 0.0,
             quit: false,
             layout: Layout::default(),
+            confirm: None,
+            enabled: BTreeSet::new(),
             pending: Vec::new(),
             rate_mark: (Instant::now(), 0),
             dirty: true,
@@ -226,8 +253,20 @@ impl App {
                     self.rate_mark = (Instant::now(), 0);
                     self.dirty = true;
                 }
-                Ok(Feed::Status(s)) => {
+                Ok(Feed::Status(s) | Feed::Result(s)) => {
                     self.message = Some(s);
+                    self.dirty = true;
+                }
+                Ok(Feed::Lost(n)) => {
+                    self.source.drops += n;
+                    self.dirty = true;
+                }
+                Ok(Feed::BusError(e)) => {
+                    self.source.bus_error = Some(e);
+                    self.dirty = true;
+                }
+                Ok(Feed::BusOk) => {
+                    self.source.bus_error = None;
                     self.dirty = true;
                 }
                 Ok(Feed::Done) | Err(TryRecvError::Disconnected) => {
@@ -278,8 +317,17 @@ impl App {
     /// Handles a key press.
     pub fn key(&mut self, ev: KeyEvent) {
         self.dirty = true;
+        if let Some(p) = self.confirm.take() {
+            if ev.code == KeyCode::Char('y') {
+                self.send(p);
+            } else {
+                self.message = Some("not sent".into());
+            }
+            return;
+        }
         if self.prompt.is_some() {
             self.prompt_key(ev);
+            self.preview();
             return;
         }
         let Some(k) = Key::from_event(&ev) else { return };
@@ -325,13 +373,78 @@ impl App {
             KeyCode::Up => p.history(&self.history, true),
             KeyCode::Down => p.history(&self.history, false),
             KeyCode::Tab if p.kind == PromptKind::Palette => {
-                let shown = p.complete(PALETTE_COMMANDS);
+                let words: Vec<&str> = PALETTE_COMMANDS.iter().chain(COMMANDER_WORDS).copied().collect();
+                let shown = p.complete(&words);
                 if !shown.is_empty() {
                     self.message = Some(shown.join("  "));
                 }
             }
             _ => {}
         }
+    }
+
+    /// While typing a commander line, shows the frames it would send.
+    fn preview(&mut self) {
+        let Some(p) = &self.prompt else { return };
+        let first = p.text.split_whitespace().next().unwrap_or("");
+        if p.kind == PromptKind::Palette && COMMANDER_WORDS.contains(&first) {
+            self.message = Some(match palette::plan(&p.text, |n| self.drive_state(n)) {
+                Ok(pl) => format!("will send: {}", pl.preview),
+                Err(e) => e,
+            });
+        }
+    }
+
+    fn drive_state(&self, node: u8) -> Option<crate::decode::cia402::DriveState> {
+        self.trace.nodes.get(node).and_then(|n| n.drive)
+    }
+
+    /// Runs a commander line: asks for confirmation first when it needs one.
+    fn commander(&mut self, line: &str) {
+        match palette::plan(line, |n| self.drive_state(n)) {
+            Ok(p) => match &p.confirm {
+                Some(why) => {
+                    self.message = Some(format!("{why}: {} — press y to send, any other key cancels", p.preview));
+                    self.confirm = Some(p);
+                }
+                None => self.send(p),
+            },
+            Err(e) => self.message = Some(e),
+        }
+    }
+
+    fn send(&mut self, p: Planned) {
+        let Some(req) = &self.source.requests else {
+            self.message = Some("not sent: this source has no bus (use `cotui live IFACE` or `cotui demo`)".into());
+            return;
+        };
+        if let Command::Drive { node, action, .. } = &p.command {
+            match action {
+                DriveAction::Enable => {
+                    self.enabled.insert(*node);
+                }
+                DriveAction::Disable | DriveAction::QuickStop => {
+                    self.enabled.remove(node);
+                }
+                _ => {}
+            }
+        }
+        self.message = Some(format!("sending: {}", p.preview));
+        let _ = req.send(Request::Run(p.command));
+    }
+
+    fn stop_all(&mut self) {
+        let Some(req) = &self.source.requests else {
+            self.message = Some("stop all: this source has no bus".into());
+            return;
+        };
+        if self.enabled.is_empty() {
+            self.message = Some("stop all: no drive was enabled from this session".into());
+            return;
+        }
+        let nodes: Vec<u8> = std::mem::take(&mut self.enabled).into_iter().collect();
+        self.message = Some(format!("stop all: quick stop then disable voltage on nodes {nodes:?}"));
+        let _ = req.send(Request::StopAll(nodes));
     }
 
     fn submit(&mut self, p: Prompt) {
@@ -417,9 +530,14 @@ impl App {
                 self.quit = true;
                 Ok(String::new())
             }
+            w if COMMANDER_WORDS.contains(&w) => {
+                self.commander(line);
+                return;
+            }
             other => Err(format!(
-                "unknown command `{other}` (commands: {})",
-                PALETTE_COMMANDS.join(" ")
+                "unknown command `{other}` (commands: {} {})",
+                PALETTE_COMMANDS.join(" "),
+                COMMANDER_WORDS.join(" ")
             )),
         };
         self.message = match result {
@@ -669,9 +787,7 @@ impl App {
             Action::PrevMatch => self.jump_match(false),
             Action::ClearFilter => self.set_filter(""),
             Action::Palette => self.prompt = Some(Prompt::new(PromptKind::Palette, "")),
-            Action::StopAll => {
-                self.message = Some("stop-all: no drive was enabled from this session (file source)".into())
-            }
+            Action::StopAll => self.stop_all(),
             Action::SpeedUp | Action::SpeedDown => {
                 if let SourceKind::Replay { speed } = self.source.kind {
                     let base = if speed <= 0.0 { 1.0 } else { speed };

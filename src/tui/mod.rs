@@ -7,7 +7,9 @@
 pub mod app;
 pub mod filter;
 pub mod keymap;
+pub mod live;
 pub mod nodes;
+pub mod palette;
 pub mod panes;
 pub mod prompt;
 pub mod rows;

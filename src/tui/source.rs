@@ -27,6 +27,14 @@ pub enum Feed {
     Status(String),
     /// The source ended; no more frames will come.
     Done,
+    /// Frames lost before reaching the UI (queue full, reader too slow).
+    Lost(u64),
+    /// The interface failed or is unavailable; the text names the command that fixes it.
+    BusError(String),
+    /// The interface is (again) capturing.
+    BusOk,
+    /// The result of a palette command.
+    Result(String),
 }
 
 /// Replay commands.
@@ -308,6 +316,7 @@ mod tests {
                 Feed::Status(s) => notes.push(s),
                 Feed::Interfaces(n) => assert_eq!(n, ["can0"]),
                 Feed::Done => break,
+                other => panic!("{other:?}"),
             }
         }
         (frames, resets, notes)

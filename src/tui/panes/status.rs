@@ -14,6 +14,16 @@ pub fn text(app: &App) -> String {
         SourceKind::Open => format!("open {}", app.source.name),
         SourceKind::Replay { speed } if speed <= 0.0 => format!("replay {} ×max", app.source.name),
         SourceKind::Replay { speed } => format!("replay {} ×{speed}", app.source.name),
+        SourceKind::Live { listen_only } => {
+            format!(
+                "live {}{}",
+                app.source.name,
+                if listen_only { " (listen-only)" } else { "" }
+            )
+        }
+        SourceKind::Demo { listen_only } => {
+            format!("demo bus{}", if listen_only { " (listen-only)" } else { "" })
+        }
     };
     let state = if app.source.done {
         " (end)"
@@ -49,10 +59,13 @@ pub fn text(app: &App) -> String {
 
 /// Draws the status bar and, below it, the prompt or the last message.
 pub fn render(app: &App, f: &mut Frame, bar: Rect, line: Rect) {
-    f.render_widget(
-        Paragraph::new(text(app)).style(Style::default().bg(Color::Blue).fg(Color::White)),
-        bar,
-    );
+    let (txt, bg) = match (&app.source.bus_error, &app.prompt, &app.message) {
+        // While typing, the bar shows what the line will do (preview or error).
+        (_, Some(_), Some(m)) => (m.clone(), Color::Magenta),
+        (Some(e), _, _) => (format!("{} | {e}", text(app)), Color::Red),
+        _ => (text(app), Color::Blue),
+    };
+    f.render_widget(Paragraph::new(txt).style(Style::default().bg(bg).fg(Color::White)), bar);
     if let Some(p) = &app.prompt {
         let lead = p.kind.lead();
         f.render_widget(
