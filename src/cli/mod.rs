@@ -1,6 +1,7 @@
 //! The command line: clap definitions and one module per subcommand.
 
 pub mod bench;
+mod bench_tui;
 mod bind;
 pub mod decode;
 pub mod tui;

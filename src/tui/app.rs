@@ -270,6 +270,7 @@ impl App {
                     self.dirty = true;
                 }
                 Ok(Feed::Done) | Err(TryRecvError::Disconnected) => {
+                    self.trace.store.shrink();
                     self.source.done = true;
                     self.source.feed = None;
                     self.dirty = true;

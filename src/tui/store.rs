@@ -146,6 +146,14 @@ impl Store {
         &self.chunks[i / CHUNK][i % CHUNK]
     }
 
+    /// Gives back the unused room of the last chunk (when no more frames will come).
+    pub fn shrink(&mut self) {
+        if let Some(last) = self.chunks.last_mut() {
+            last.shrink_to_fit();
+        }
+        self.arena.shrink_to_fit();
+    }
+
     /// The frame at `i`, unpacked.
     pub fn frame(&self, i: usize) -> Frame {
         let p = self.packed(i);
@@ -212,6 +220,8 @@ mod tests {
         }
         let at = s.push(&fd, Kind::Other, None);
         assert_eq!(s.len(), CHUNK + 4);
+        s.shrink();
+        assert_eq!(s.bytes(), (CHUNK + 4) * 32 + 12);
         assert_eq!(s.frame(at), fd);
         assert_eq!(s.frame(CHUNK + 1).payload(), &[(CHUNK + 1) as u8, 2, 3]);
         assert_eq!(s.packed(5).kind(), Kind::Tpdo);

@@ -39,18 +39,33 @@ pub fn run(mut app: App) -> Result<(), String> {
     result
 }
 
+/// Time per loop turn for taking in frames.
+pub const INGEST_BUDGET: Duration = Duration::from_millis(12);
+/// Time per loop turn for filter scanning.
+pub const WORK_BUDGET: Duration = Duration::from_millis(8);
+
+/// One turn of background work: take in frames, scan filters, update rates. True when
+/// more is waiting (the loop then polls input without sleeping).
+pub fn step(app: &mut App) -> bool {
+    let more_input = app.ingest(INGEST_BUDGET);
+    let more_work = app.work(WORK_BUDGET);
+    app.tick();
+    more_input || more_work
+}
+
 fn event_loop(terminal: &mut ratatui::DefaultTerminal, app: &mut App) -> Result<(), String> {
     let mut last_draw = Instant::now() - FRAME;
+    // Input is answered at once; frames alone redraw at most every FRAME.
+    let mut input = false;
     loop {
-        let more_input = app.ingest(Duration::from_millis(12));
-        let more_work = app.work(Duration::from_millis(8));
-        app.tick();
-        if app.dirty && last_draw.elapsed() >= FRAME {
+        let busy = step(app);
+        if app.dirty && (input || last_draw.elapsed() >= FRAME) {
             terminal.draw(|f| ui::draw(f, app)).map_err(|e| e.to_string())?;
             app.dirty = false;
+            input = false;
             last_draw = Instant::now();
         }
-        let wait = if more_input || more_work {
+        let wait = if busy {
             Duration::ZERO
         } else {
             Duration::from_millis(20)
@@ -59,8 +74,14 @@ fn event_loop(terminal: &mut ratatui::DefaultTerminal, app: &mut App) -> Result<
             // Take every pending event before the next draw.
             loop {
                 match event::read().map_err(|e| e.to_string())? {
-                    Event::Key(k) if k.kind != KeyEventKind::Release => app.key(k),
-                    Event::Mouse(m) => app.mouse(m),
+                    Event::Key(k) if k.kind != KeyEventKind::Release => {
+                        app.key(k);
+                        input = true;
+                    }
+                    Event::Mouse(m) => {
+                        app.mouse(m);
+                        input = true;
+                    }
                     Event::Resize(..) => app.dirty = true,
                     _ => {}
                 }
