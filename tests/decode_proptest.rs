@@ -16,9 +16,19 @@ fn frame_strategy() -> impl Strategy<Value = Frame> {
         Just(0x7E5u32),
         0u32..0x2000_0000,
     ];
-    (id, any::<u8>(), 0u8..=64, prop::collection::vec(any::<u8>(), 64), any::<u64>()).prop_map(
-        |(id, flags, len, data, ts)| {
-            let mut f = Frame { id, ts_ns: ts, ..Frame::default() };
+    (
+        id,
+        any::<u8>(),
+        0u8..=64,
+        prop::collection::vec(any::<u8>(), 64),
+        any::<u64>(),
+    )
+        .prop_map(|(id, flags, len, data, ts)| {
+            let mut f = Frame {
+                id,
+                ts_ns: ts,
+                ..Frame::default()
+            };
             f.flags = Flags(flags & !Flags::FDF);
             if !f.is_ext() {
                 f.id &= 0x7FF;
@@ -26,8 +36,7 @@ fn frame_strategy() -> impl Strategy<Value = Frame> {
             f.len = if f.is_fd() { len } else { len % 9 };
             f.data[..f.len as usize].copy_from_slice(&data[..f.len as usize]);
             f
-        },
-    )
+        })
 }
 
 proptest! {

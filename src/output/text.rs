@@ -3,24 +3,7 @@
 use crate::decode::Decoded;
 use crate::frame::{Frame, Interfaces};
 
-/// Appends `v` in decimal, zero-padded to at least `width` digits.
-fn push_decimal(out: &mut String, mut v: u64, width: usize) {
-    let mut buf = [b'0'; 20];
-    let mut i = buf.len();
-    while v > 0 || buf.len() - i < width.max(1) {
-        i -= 1;
-        buf[i] = b'0' + (v % 10) as u8;
-        v /= 10;
-    }
-    buf[i..].iter().for_each(|b| out.push(*b as char));
-}
-
-/// Appends the low `digits` hex digits of `v`, upper case.
-fn push_hex(out: &mut String, v: u32, digits: u32) {
-    for i in (0..digits).rev() {
-        out.push(char::from(b"0123456789ABCDEF"[(v >> (4 * i) & 0xF) as usize]));
-    }
-}
+use crate::hex::{push_decimal, push_hex};
 
 /// Appends one line (with `\n`) for `frame`:
 /// `(1700000000.123456)  can0  181   [8]  37 02 00 00 00 00 00 00  TPDO1 node 1: ...`.
