@@ -39,7 +39,8 @@ const ASC_F_FDF: u32 = 0x1000;
 /// Channels whose interface index is cached; higher ones are interned per line.
 const CACHED_CHANNELS: usize = 64;
 
-/// Parser state for ASC lines (number base, timestamp mode, channel names).
+/// Parser state for ASC lines (number base, timestamp mode, channel names). Use one parser
+/// with one [`Interfaces`] table: it caches indexes into it.
 #[derive(Debug)]
 pub struct Parser {
     decimal: bool,
@@ -146,9 +147,19 @@ impl Parser {
             buf[3] = b'X';
             4
         } else {
-            let digits = (n - 1).to_string();
-            buf[3..3 + digits.len()].copy_from_slice(digits.as_bytes());
-            3 + digits.len()
+            let mut digits = [0u8; 10];
+            let (mut k, mut v) = (digits.len(), n - 1);
+            loop {
+                k -= 1;
+                digits[k] = b'0' + (v % 10) as u8;
+                v /= 10;
+                if v == 0 {
+                    break;
+                }
+            }
+            let d = &digits[k..];
+            buf[3..3 + d.len()].copy_from_slice(d);
+            3 + d.len()
         };
         let idx = self.iface.get(ifaces, &buf[..len], at)?;
         if let Some(slot) = self.channels.get_mut(n as usize) {
