@@ -167,32 +167,33 @@ impl Parser {
         }
         Ok(idx)
     }
+}
 
-    /// Parses an id token (`123`, `1ABx`) in the current base.
-    fn id(&self, f: &mut Frame, at: usize, tok: &[u8]) -> Result<(), ParseError> {
-        let (digits, ext) = match tok.split_last() {
-            Some((b'x' | b'X', rest)) => (rest, true),
-            _ => (tok, false),
-        };
-        let id =
-            if self.decimal { dec_u32(digits) } else { hex_u32(digits) }.ok_or_else(|| err(at, "expected a CAN id"))?;
-        if id > if ext { 0x1FFF_FFFF } else { 0x7FF } {
-            return Err(err(at, "CAN id out of range (29-bit ids end in 'x')"));
-        }
-        f.id = id;
-        f.flags.set(Flags::EXT, ext);
-        Ok(())
+/// Parses an id token (`123`, `1ABx`), decimal or hex, into `f`.
+fn parse_id(decimal: bool, f: &mut Frame, at: usize, tok: &[u8]) -> Result<(), ParseError> {
+    let (digits, ext) = match tok.split_last() {
+        Some((b'x' | b'X', rest)) => (rest, true),
+        _ => (tok, false),
+    };
+    let id = if decimal { dec_u32(digits) } else { hex_u32(digits) }.ok_or_else(|| err(at, "expected a CAN id"))?;
+    if id > if ext { 0x1FFF_FFFF } else { 0x7FF } {
+        return Err(err(at, "CAN id out of range (29-bit ids end in 'x')"));
     }
+    f.id = id;
+    f.flags.set(Flags::EXT, ext);
+    Ok(())
+}
 
-    /// A data byte in the current base.
-    fn byte(&self, at: usize, tok: &[u8]) -> Result<u8, ParseError> {
-        let v = if self.decimal { dec_u32(tok) } else { hex_u32(tok) };
-        match v {
-            Some(v) if v <= 0xFF && tok.len() <= 3 => Ok(v as u8),
-            _ => Err(err(at, "expected a data byte")),
-        }
+/// A data byte, decimal or hex.
+fn byte(decimal: bool, at: usize, tok: &[u8]) -> Result<u8, ParseError> {
+    let v = if decimal { dec_u32(tok) } else { hex_u32(tok) };
+    match v {
+        Some(v) if v <= 0xFF && tok.len() <= 3 => Ok(v as u8),
+        _ => Err(err(at, "expected a data byte")),
     }
+}
 
+impl Parser {
     /// `<id> <Rx|Tx> <d|r> <dlc> <bytes…>` or `ErrorFrame`; `None` for events.
     fn classic_line(&self, toks: &mut Tokens<'_>, end: usize) -> Result<Option<Frame>, ParseError> {
         let mut f = Frame::default();
@@ -206,7 +207,7 @@ impl Parser {
         if !id[0].is_ascii_hexdigit() {
             return Ok(None);
         }
-        self.id(&mut f, id_at, id)?;
+        parse_id(self.decimal, &mut f, id_at, id)?;
         if !direction(&mut f, toks, end)? {
             return Ok(None);
         }
@@ -238,7 +239,7 @@ impl Parser {
             let (b_at, b) = toks
                 .next()
                 .ok_or_else(|| err(end, "fewer data bytes than the DLC says"))?;
-            f.data[k] = self.byte(b_at, b)?;
+            f.data[k] = byte(self.decimal, b_at, b)?;
         }
         Ok(Some(f))
     }
@@ -250,11 +251,8 @@ impl Parser {
             return Ok(None);
         }
         let (id_at, id) = toks.next().ok_or_else(|| err(end, "expected a CAN id"))?;
-        let hex_mode = Parser {
-            decimal: false,
-            ..Parser::default()
-        };
-        hex_mode.id(&mut f, id_at, id)?;
+        // CANFD lines are hex whatever the base line says (as asc2log reads them).
+        parse_id(false, &mut f, id_at, id)?;
         let bit = |t: &[u8]| matches!(t, b"0" | b"1");
         if toks.peek().is_some_and(|(_, t)| !bit(t)) {
             toks.next(); // symbolic name
@@ -281,7 +279,7 @@ impl Parser {
             let (b_at, b) = toks
                 .next()
                 .ok_or_else(|| err(end, "fewer data bytes than the length says"))?;
-            f.data[k] = hex_mode.byte(b_at, b)?;
+            f.data[k] = byte(false, b_at, b)?;
         }
         let flags = match (toks.next(), toks.next(), toks.next()) {
             (Some(_), Some(_), Some((fl_at, fl))) => {
