@@ -4,8 +4,14 @@
 //! and returns values, with no IO, clock or terminal. Sources, panes and the
 //! command line live at the edges and call into it.
 
+pub mod cli;
 pub mod decode;
 pub mod frame;
 pub mod hex;
 pub mod log;
 pub mod od;
+pub mod output;
+pub mod read_ahead;
+pub mod sdo_client;
+pub mod sdo_server;
+pub mod synth;

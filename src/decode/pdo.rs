@@ -115,7 +115,7 @@ pub fn decode_signals(
 fn signal(payload: &[u8], pos: usize, e: &MappedEntry, dict: &Dictionary, mode: Option<i8>) -> Signal {
     let bits = e.bits as usize;
     let info = dict.object(e.index, e.sub);
-    let value = if pos % 8 == 0 && bits % 8 == 0 {
+    let value = if pos.is_multiple_of(8) && bits.is_multiple_of(8) {
         let bytes = &payload[pos / 8..(pos + bits) / 8];
         match info.map(|i| i.data_type) {
             Some(dt) if dt.size().is_none_or(|s| s * 8 == bits) => dt.decode(bytes),

@@ -157,10 +157,8 @@ impl Dictionary {
 /// `15000` of an I32 with scale 0.1 and unit "rpm" -> `1500 rpm`.
 pub fn format_value(info: Option<&ObjectInfo>, value: &Value) -> String {
     let Some(info) = info else { return value.to_string() };
-    if let Some(raw) = value.as_i64() {
-        if let Some(text) = info.values.get(&raw) {
-            return format!("{raw} ({text})");
-        }
+    if let Some((raw, text)) = value.as_i64().and_then(|raw| info.values.get(&raw).map(|t| (raw, t))) {
+        return format!("{raw} ({text})");
     }
     match (value.as_f64(), info.scale, &info.unit) {
         (Some(x), scale, unit) if scale.is_some() || unit.is_some() => {

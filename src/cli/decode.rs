@@ -1,0 +1,199 @@
+//! `cotui decode FILE...`: the headless decoder.
+
+use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
+use crate::decode::{Decoder, sdo::Transaction};
+use crate::frame::{Frame, Interfaces};
+use crate::log::Outcome;
+use crate::output::{jsonl, summary::Summary, text};
+use crate::read_ahead;
+use clap::{Args, ValueEnum};
+use std::io::{self, BufRead, BufReader, Write};
+
+/// Output formats of `cotui decode`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum OutputFormat {
+    /// candump-like lines with the decoded label.
+    Text,
+    /// One JSON object per frame (see README, "JSONL contract").
+    Jsonl,
+}
+
+/// Arguments of `cotui decode`.
+#[derive(Args, Debug)]
+pub struct DecodeArgs {
+    /// Log files (candump -l/-L, candump screen output, Vector ASC); `-` reads stdin.
+    #[arg(required = true)]
+    pub files: Vec<String>,
+    /// Output format.
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: OutputFormat,
+    /// Print reassembled SDO transactions instead of frames.
+    #[arg(long)]
+    pub transactions: bool,
+    /// Print per-node and per-kind totals only.
+    #[arg(long, conflicts_with = "transactions")]
+    pub summary: bool,
+    /// Bind a device profile to a node: NODE=NAME (a name in decoders/ or a JSON path).
+    #[arg(long = "profile", value_name = "NODE=NAME")]
+    pub profiles: Vec<String>,
+    /// Bind an EDS/DCF file to a node: NODE=FILE.
+    #[arg(long = "eds", value_name = "NODE=FILE")]
+    pub eds: Vec<String>,
+}
+
+/// What a decode run writes, chosen once from the arguments.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    Frames(OutputFormat),
+    Transactions(OutputFormat),
+    Summary(OutputFormat),
+}
+
+/// Runs `cotui decode`; returns the exit status.
+pub fn run(args: &DecodeArgs) -> i32 {
+    let mut decoder = match super::bind::decoder(&args.profiles, &args.eds) {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("cotui decode: {e}");
+            return EXIT_USAGE;
+        }
+    };
+    let mode = if args.summary {
+        Mode::Summary(args.format)
+    } else if args.transactions {
+        Mode::Transactions(args.format)
+    } else {
+        Mode::Frames(args.format)
+    };
+    let stdout = io::stdout();
+    let mut out = io::BufWriter::with_capacity(1 << 16, stdout.lock());
+    let mut summary = Summary::default();
+    let mut status = EXIT_OK;
+    for path in &args.files {
+        let input: Box<dyn BufRead + Send> = if path == "-" {
+            Box::new(BufReader::with_capacity(1 << 16, io::stdin()))
+        } else {
+            match std::fs::File::open(path) {
+                Ok(f) => Box::new(BufReader::with_capacity(1 << 16, f)),
+                Err(e) => {
+                    eprintln!("cotui decode: {path}: {e}");
+                    status = EXIT_UNAVAILABLE;
+                    continue;
+                }
+            }
+        };
+        match decode_stream(path, input, &mut decoder, mode, &mut summary, &mut out) {
+            Ok(()) => {}
+            Err(e) if e.kind() == io::ErrorKind::BrokenPipe => return status,
+            Err(e) => {
+                eprintln!("cotui decode: {path}: {e}");
+                status = EXIT_UNAVAILABLE;
+            }
+        }
+    }
+    let result = finish(&mut decoder, mode, &mut summary, &mut out).and_then(|_| out.flush());
+    match result {
+        Err(e) if e.kind() != io::ErrorKind::BrokenPipe => {
+            eprintln!("cotui decode: {e}");
+            EXIT_UNAVAILABLE
+        }
+        _ => status,
+    }
+}
+
+/// Decodes one input into `out` (parsing runs on a second thread).
+fn decode_stream(
+    path: &str,
+    input: Box<dyn BufRead + Send>,
+    decoder: &mut Decoder,
+    mode: Mode,
+    summary: &mut Summary,
+    out: &mut impl Write,
+) -> io::Result<()> {
+    let mut buf = String::with_capacity(1 << 16);
+    let mut ifaces = Interfaces::default();
+    let finished = read_ahead::for_each_batch(input, |batch| -> io::Result<()> {
+        if let Some(i) = &batch.interfaces {
+            ifaces = i.clone();
+        }
+        for (line, outcome) in &batch.lines {
+            let frame: &Frame = match outcome {
+                Outcome::Frame(f) => f,
+                Outcome::Skip(_) => continue,
+                Outcome::Warning(msg) => {
+                    eprintln!("{path}:{line}: warning: {msg}");
+                    continue;
+                }
+            };
+            match mode {
+                Mode::Summary(_) => {
+                    let (kind, node) = decoder.classify(frame);
+                    summary.add(kind, node);
+                }
+                Mode::Frames(OutputFormat::Text) => {
+                    let d = decoder.decode(frame);
+                    text::write_line(&mut buf, frame, &ifaces, &d);
+                }
+                Mode::Frames(OutputFormat::Jsonl) => {
+                    let d = decoder.decode(frame);
+                    jsonl::write_frame(&mut buf, *line, frame, &ifaces, &d);
+                }
+                Mode::Transactions(fmt) => {
+                    decoder.decode(frame);
+                    for t in decoder.take_transactions() {
+                        write_transaction(&mut buf, &t, decoder, fmt);
+                    }
+                }
+            }
+        }
+        out.write_all(buf.as_bytes())?;
+        buf.clear();
+        Ok(())
+    })??;
+    if let Some(e) = finished.error {
+        return Err(e);
+    }
+    let c = finished.counts;
+    if c.warnings > 0 || c.skipped_total() > 0 {
+        eprintln!(
+            "{path}: {} frames, {} lines skipped, {} malformed lines",
+            c.frames,
+            c.skipped_total(),
+            c.warnings
+        );
+    }
+    Ok(())
+}
+
+fn write_transaction(buf: &mut String, t: &Transaction, decoder: &Decoder, fmt: OutputFormat) {
+    let dict = decoder.dictionary(t.node);
+    match fmt {
+        OutputFormat::Text => buf.push_str(&t.label(dict)),
+        OutputFormat::Jsonl => buf.push_str(&t.to_json(dict).to_string()),
+    }
+    buf.push('\n');
+}
+
+/// Writes what is due at the end of all inputs.
+fn finish(decoder: &mut Decoder, mode: Mode, summary: &mut Summary, out: &mut impl Write) -> io::Result<()> {
+    let mut buf = String::new();
+    match mode {
+        Mode::Transactions(fmt) => {
+            for t in decoder.finish() {
+                write_transaction(&mut buf, &t, decoder, fmt);
+            }
+        }
+        Mode::Summary(fmt) => {
+            summary.finish();
+            match fmt {
+                OutputFormat::Text => buf.push_str(&summary.to_text()),
+                OutputFormat::Jsonl => {
+                    buf.push_str(&summary.to_json().to_string());
+                    buf.push('\n');
+                }
+            }
+        }
+        Mode::Frames(_) => {}
+    }
+    out.write_all(buf.as_bytes())
+}

@@ -1,0 +1,129 @@
+//! `--summary`: per-node and per-kind totals.
+
+use crate::decode::Kind;
+use std::collections::BTreeMap;
+
+/// Running totals of frames by kind and by node.
+#[derive(Clone, Debug, Default)]
+pub struct Summary {
+    /// Frames per kind.
+    pub by_kind: BTreeMap<Kind, u64>,
+    /// Frames per node, split by kind.
+    pub by_node: BTreeMap<u8, BTreeMap<Kind, u64>>,
+    /// Frames in all.
+    pub frames: u64,
+    /// Frames marked malformed (only counted when the caller decoded them).
+    pub malformed: u64,
+    kind_counts: [u64; 12],
+    node_counts: Vec<[u64; 12]>,
+}
+
+const KINDS: [Kind; 12] = [
+    Kind::Nmt,
+    Kind::Sync,
+    Kind::Emcy,
+    Kind::Time,
+    Kind::Tpdo,
+    Kind::Rpdo,
+    Kind::SdoTx,
+    Kind::SdoRx,
+    Kind::Heartbeat,
+    Kind::Lss,
+    Kind::ErrorFrame,
+    Kind::Other,
+];
+
+impl Summary {
+    /// Counts one frame (a fixed-size array increment: this is the hot path).
+    pub fn add(&mut self, kind: Kind, node: Option<u8>) {
+        self.frames += 1;
+        let k = kind as usize;
+        self.kind_counts[k] += 1;
+        if let Some(n) = node {
+            if self.node_counts.is_empty() {
+                self.node_counts = vec![[0; 12]; 128];
+            }
+            self.node_counts[(n & 0x7F) as usize][k] += 1;
+        }
+    }
+
+    /// Folds the counters into the `by_kind`/`by_node` maps.
+    pub fn finish(&mut self) {
+        self.by_kind.clear();
+        self.by_node.clear();
+        for (i, k) in KINDS.iter().enumerate() {
+            if self.kind_counts[i] > 0 {
+                self.by_kind.insert(*k, self.kind_counts[i]);
+            }
+        }
+        for (n, counts) in self.node_counts.iter().enumerate() {
+            for (i, k) in KINDS.iter().enumerate() {
+                if counts[i] > 0 {
+                    self.by_node.entry(n as u8).or_default().insert(*k, counts[i]);
+                }
+            }
+        }
+    }
+
+    /// Text report.
+    pub fn to_text(&self) -> String {
+        let mut s = format!("frames: {}\n", self.frames);
+        if self.malformed > 0 {
+            s.push_str(&format!("malformed: {}\n", self.malformed));
+        }
+        s.push_str("by kind:\n");
+        for (k, n) in &self.by_kind {
+            s.push_str(&format!("  {:<12} {n}\n", k.as_str()));
+        }
+        s.push_str("by node:\n");
+        for (node, kinds) in &self.by_node {
+            let total: u64 = kinds.values().sum();
+            let parts: Vec<String> = kinds.iter().map(|(k, n)| format!("{}={n}", k.as_str())).collect();
+            s.push_str(&format!("  node {node:<3} {total:>10}  {}\n", parts.join(" ")));
+        }
+        s
+    }
+
+    /// JSON report.
+    pub fn to_json(&self) -> serde_json::Value {
+        let kinds: serde_json::Map<String, serde_json::Value> = self
+            .by_kind
+            .iter()
+            .map(|(k, n)| (k.as_str().to_string(), (*n).into()))
+            .collect();
+        let nodes: serde_json::Map<String, serde_json::Value> = self
+            .by_node
+            .iter()
+            .map(|(node, kinds)| {
+                let m: serde_json::Map<String, serde_json::Value> = kinds
+                    .iter()
+                    .map(|(k, n)| (k.as_str().to_string(), (*n).into()))
+                    .collect();
+                (node.to_string(), m.into())
+            })
+            .collect();
+        serde_json::json!({"frames": self.frames, "malformed": self.malformed, "by_kind": kinds, "by_node": nodes})
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn totals() {
+        let mut s = Summary::default();
+        s.add(Kind::Heartbeat, Some(5));
+        s.add(Kind::Heartbeat, Some(5));
+        s.add(Kind::Sync, None);
+        s.add(Kind::Tpdo, Some(2));
+        s.finish();
+        assert_eq!(s.frames, 4);
+        assert_eq!(s.by_kind[&Kind::Heartbeat], 2);
+        assert_eq!(s.by_node[&5][&Kind::Heartbeat], 2);
+        let t = s.to_text();
+        assert!(t.contains("  heartbeat    2"), "{t}");
+        assert!(t.contains("node 5            2  heartbeat=2"), "{t}");
+        assert_eq!(s.to_json()["by_node"]["2"]["tpdo"], 1);
+    }
+}

@@ -1,0 +1,125 @@
+//! candump-like text lines with the decoded label appended.
+
+use crate::decode::Decoded;
+use crate::frame::{Frame, Interfaces};
+
+/// Appends `v` in decimal, zero-padded to at least `width` digits.
+fn push_decimal(out: &mut String, mut v: u64, width: usize) {
+    let mut buf = [b'0'; 20];
+    let mut i = buf.len();
+    while v > 0 || buf.len() - i < width.max(1) {
+        i -= 1;
+        buf[i] = b'0' + (v % 10) as u8;
+        v /= 10;
+    }
+    buf[i..].iter().for_each(|b| out.push(*b as char));
+}
+
+/// Appends the low `digits` hex digits of `v`, upper case.
+fn push_hex(out: &mut String, v: u32, digits: u32) {
+    for i in (0..digits).rev() {
+        out.push(char::from(b"0123456789ABCDEF"[(v >> (4 * i) & 0xF) as usize]));
+    }
+}
+
+/// Appends one line (with `\n`) for `frame`:
+/// `(1700000000.123456)  can0  181   [8]  37 02 00 00 00 00 00 00  TPDO1 node 1: ...`.
+/// A frame that breaks its kind's rules ends with `  !! <reason>`.
+pub fn write_line(out: &mut String, frame: &Frame, ifaces: &Interfaces, decoded: &Decoded) {
+    out.push('(');
+    push_decimal(out, frame.ts_ns / 1_000_000_000, 10);
+    out.push('.');
+    push_decimal(out, frame.ts_ns % 1_000_000_000 / 1000, 6);
+    out.push_str(")  ");
+    let name = ifaces.name(frame.iface);
+    for _ in name.len()..4 {
+        out.push(' ');
+    }
+    out.push_str(name);
+    out.push_str("  ");
+    if frame.is_ext() || frame.is_err() {
+        push_hex(out, frame.id, 8);
+    } else {
+        out.push_str("     ");
+        push_hex(out, frame.id, 3);
+    }
+    if frame.is_fd() {
+        out.push_str("  [");
+        push_decimal(out, frame.len as u64, 2);
+    } else {
+        out.push_str("   [");
+        push_decimal(out, frame.len as u64, 1);
+    }
+    out.push_str("]  ");
+    let width = if frame.is_fd() { 3 * frame.len as usize } else { 24 };
+    let start = out.len();
+    if frame.is_rtr() {
+        out.push_str("remote request");
+    } else {
+        for b in frame.payload() {
+            crate::hex::push_upper(out, std::slice::from_ref(b));
+            out.push(' ');
+        }
+    }
+    let used = out.len() - start;
+    for _ in used..width {
+        out.push(' ');
+    }
+    if frame.flags.has(crate::frame::Flags::TX) {
+        out.push_str("T ");
+    }
+    out.push(' ');
+    out.push_str(&decoded.label);
+    if let Some(m) = &decoded.malformed {
+        out.push_str("  !! ");
+        out.push_str(m);
+    }
+    out.push('\n');
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::decode::Decoder;
+    use crate::od::Dictionary;
+
+    fn line(frame: Frame) -> String {
+        let mut ifaces = Interfaces::default();
+        ifaces.intern("can0");
+        let mut dec = Decoder::new(Dictionary::default(), vec![]);
+        let d = dec.decode(&frame);
+        let mut s = String::new();
+        write_line(&mut s, &frame, &ifaces, &d);
+        s
+    }
+
+    #[test]
+    fn number_formatting() {
+        let mut s = String::new();
+        push_decimal(&mut s, 42, 6);
+        push_decimal(&mut s, 0, 1);
+        push_decimal(&mut s, 1234567, 2);
+        push_hex(&mut s, 0x1ABCDEF, 8);
+        push_hex(&mut s, 0x7E5, 3);
+        assert_eq!(s, "00004201234567".to_string() + "01ABCDEF7E5");
+    }
+
+    #[test]
+    fn heartbeat_line() {
+        let mut f = Frame::classic(0x705, &[0x05]);
+        f.ts_ns = 1_700_000_000_123_456_789;
+        assert_eq!(
+            line(f),
+            "(1700000000.123456)  can0       705   [1]  05                       Heartbeat node 5: Operational\n"
+        );
+    }
+
+    #[test]
+    fn malformed_is_marked_not_dropped() {
+        let s = line(Frame::classic(0x000, &[0x01]));
+        assert!(
+            s.contains("NMT Start remote node -> all nodes  !! NMT frame has 1 data bytes, expected 2"),
+            "{s}"
+        );
+    }
+}
