@@ -703,7 +703,7 @@ impl Cx<'_> {
             );
             return None;
         }
-        let hex = match f.format.as_deref() {
+        let hex = match f.format.as_deref().map(str::to_ascii_lowercase).as_deref() {
             None | Some("dec") => false,
             Some("hex") => true,
             Some(other) => {
