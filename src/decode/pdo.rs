@@ -1,6 +1,6 @@
 //! PDO payloads decoded into named, typed, scaled signals through the mapping in force.
 
-use crate::od::{DataType, Dictionary, MappedEntry, MappingSource, PdoMapping, Value, format_value};
+use crate::od::{DataType, Dictionary, MappedEntry, MappingSource, PdoMapping, Value};
 use serde_json::json;
 
 /// One mapped signal taken out of a PDO payload.
@@ -144,13 +144,7 @@ fn signal(payload: &[u8], pos: usize, e: &MappedEntry, dict: &Dictionary, mode: 
         .name(e.index, e.sub)
         .map(str::to_string)
         .unwrap_or_else(|| format!("0x{:04X}:{:02X}", e.index, e.sub));
-    let text = match value
-        .as_i64()
-        .and_then(|raw| super::cia402::describe(e.index, e.sub, raw, mode))
-    {
-        Some(meaning) => format!("0x{:04X} ({meaning})", value.as_i64().unwrap_or(0)),
-        None => format_value(info, &value),
-    };
+    let text = super::value_text::object_text(dict, e.index, e.sub, &value, mode);
     Signal {
         index: e.index,
         sub: e.sub,
