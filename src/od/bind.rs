@@ -384,6 +384,7 @@ mod tests {
         assert_eq!(d.name(0x6040, 0), Some("Controlword"));
         assert_eq!(d.default_pdos(true).unwrap()[&1].cob_id, Some(0x182));
         assert_eq!(b.dictionary(3).profile_name(), "cia402");
+        assert_eq!(b.default_dictionary().layers().len(), 2);
         assert_eq!(b.bound_nodes().collect::<Vec<_>>(), vec![2]);
         assert_eq!(resolve_object(d, "F1.3.018"), Ok((0x3318, 0)));
         assert_eq!(resolve_object(d, "f0.3.018"), Ok((0x2318, 0)));
