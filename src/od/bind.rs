@@ -188,6 +188,18 @@ impl Bindings {
         best
     }
 
+    /// Binds the built-in profile that `identify` picks to `node`, unless the node
+    /// already has a profile; returns the name bound.
+    pub fn bind_identified(&mut self, node: u8, read: &dyn Fn(u16, u8) -> Option<Value>) -> Option<String> {
+        if self.nodes.get(&node).is_some_and(|b| b.profile.is_some()) {
+            return None;
+        }
+        let profile = self.identify(read)?;
+        let no_files = |p: &Path| Err(std::io::Error::other(format!("{} not read", p.display())));
+        self.bind_profile(node, &profile.name, &no_files).ok()?;
+        Some(profile.name.clone())
+    }
+
     /// A profile by name: already loaded, built-in, or `dir/NAME.json`.
     fn named(&mut self, name: &str, dir: Option<&Path>, read: Option<ReadFile>) -> Result<Arc<Profile>, String> {
         if let Some(p) = self.loaded.get(name) {
@@ -372,6 +384,7 @@ mod tests {
         assert_eq!(d.name(0x6040, 0), Some("Controlword"));
         assert_eq!(d.default_pdos(true).unwrap()[&1].cob_id, Some(0x182));
         assert_eq!(b.dictionary(3).profile_name(), "cia402");
+        assert_eq!(b.default_dictionary().layers().len(), 2);
         assert_eq!(b.bound_nodes().collect::<Vec<_>>(), vec![2]);
         assert_eq!(resolve_object(d, "F1.3.018"), Ok((0x3318, 0)));
         assert_eq!(resolve_object(d, "f0.3.018"), Ok((0x2318, 0)));
@@ -416,5 +429,10 @@ mod tests {
         let drive = |i: u16, _s: u8| (i == 0x1000).then_some(crate::od::Value::Unsigned(0x0002_0192));
         assert_eq!(b.identify(&drive).map(|p| p.name.clone()), Some("cia402".to_string()));
         assert!(b.identify(&|_, _| Some(crate::od::Value::Unsigned(0x191))).is_none());
+        assert_eq!(b.bind_identified(7, &drive), Some("cia402".to_string()));
+        assert_eq!(b.bound_nodes().collect::<Vec<_>>(), vec![7]);
+        assert_eq!(b.dictionary(7).profile_name(), "cia402");
+        // A node that already has a profile keeps it.
+        assert_eq!(b.bind_identified(7, &drive), None);
     }
 }

@@ -99,11 +99,6 @@ impl Expr {
         }
     }
 
-    /// The source text.
-    pub fn source(&self) -> &str {
-        &self.src
-    }
-
     /// Names of the variables the expression uses, in order of first use.
     pub fn variables(&self) -> Vec<&str> {
         fn walk<'a>(n: &'a Node, out: &mut Vec<&'a str>) {
@@ -134,11 +129,6 @@ impl Expr {
     /// Evaluates with `vars` giving each variable's value.
     pub fn eval(&self, vars: &dyn Fn(&str) -> Option<i64>) -> Result<i64, String> {
         eval(&self.node, vars).map_err(|e| format!("{e} in `{}`", self.src))
-    }
-
-    /// Evaluates an expression that uses no variables except possibly none at all.
-    pub fn eval_const(&self) -> Result<i64, String> {
-        self.eval(&|_| None)
     }
 }
 
