@@ -79,6 +79,8 @@ pub mod sync;
 pub mod time;
 pub mod value_text;
 
+pub use registry::{Body, Decoded, Decoder};
+
 #[cfg(test)]
 mod tests {
     use super::Kind;
@@ -90,5 +92,3 @@ mod tests {
         }
     }
 }
-
-pub use registry::{Body, Decoded, Decoder};
