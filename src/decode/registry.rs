@@ -104,12 +104,12 @@ impl Decoder {
                             Route {
                                 kind,
                                 node: Some(node),
-                                pdo: *num,
+                                pdo: u16::from(*num),
                                 reserved: false,
                             },
                         );
                     }
-                    self.mappings.insert((node, transmit, *num), m.clone());
+                    self.mappings.insert((node, transmit, u16::from(*num)), m.clone());
                 }
             }
         }

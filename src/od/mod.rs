@@ -6,11 +6,37 @@
 //! `docs/PROFILE_FORMAT.md`) or imported from EDS/DCF files. All of this is
 //! pure data: loading takes text and returns values plus warnings.
 
+pub mod alias;
+pub mod expr;
+pub mod fields;
+pub mod json;
+pub mod procedure;
 mod value;
 
+pub use alias::{AliasRule, resolve_object};
+pub use expr::Expr;
+pub use fields::{ByteField, SdoCommand, SdoDirection};
+pub use procedure::{Procedure, Step};
 pub use value::{DataType, Value};
 
 use std::collections::BTreeMap;
+
+/// A problem found while loading a profile or EDS that did not stop the load.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Warning {
+    /// The file (or built-in name) being loaded.
+    pub file: String,
+    /// Where: a JSON path such as `objects.0x6041.type`, or `line 12`.
+    pub at: String,
+    /// What is wrong and what was done about it.
+    pub message: String,
+}
+
+impl std::fmt::Display for Warning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}: {}", self.file, self.at, self.message)
+    }
+}
 
 /// Access rights of an object entry.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -44,6 +70,31 @@ pub struct ObjectInfo {
     pub values: BTreeMap<i64, String>,
     /// Vendor parameter alias printed on the drive or in its manual, e.g. `F0.3.018`.
     pub alias: Option<String>,
+    /// Names of single bits of a bit field (bit 0 = LSB).
+    pub bits: BTreeMap<u8, String>,
+    /// Whether the entry may be mapped into PDOs.
+    pub pdo: PdoMappable,
+    /// Factory default value.
+    pub default: Option<Value>,
+    /// Lowest allowed raw value.
+    pub min: Option<i64>,
+    /// Highest allowed raw value.
+    pub max: Option<i64>,
+    /// Longer help text.
+    pub description: Option<String>,
+}
+
+/// Whether an object may be mapped into PDOs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PdoMappable {
+    #[default]
+    No,
+    /// Into transmit PDOs (device to bus).
+    Tpdo,
+    /// Into receive PDOs (bus to device).
+    Rpdo,
+    /// Into either.
+    Both,
 }
 
 /// Where a PDO mapping came from, kept with every mapping we decode through.
@@ -75,17 +126,136 @@ pub struct PdoMapping {
     pub source: MappingSource,
 }
 
-/// One field of the EMCY manufacturer-specific bytes.
+/// A PDO of a mapping set before it is placed on a node.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PdoTemplate {
+    /// COB-ID, may use `node`; `None` = the predefined COB-ID for that PDO number.
+    pub cob_id: Option<Expr>,
+    /// Transmission type (0x00..0xFF), when the profile gives one.
+    pub transmission_type: Option<u8>,
+    /// The mapped objects.
+    pub entries: Vec<MappedEntry>,
+}
+
+/// A named set of default PDO mappings (Dexmart has two, chosen by parameter 09-26).
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct EmcyField {
-    /// Offset in the 8-byte EMCY frame (3..=7).
-    pub offset: u8,
-    /// Length in bytes (little-endian).
-    pub len: u8,
-    /// Name shown in labels, e.g. "M1 alarm".
+pub struct PdoSet {
+    /// Set name, e.g. "mapping-0".
     pub name: String,
-    /// Texts for values of this field.
-    pub values: BTreeMap<i64, String>,
+    /// Help text.
+    pub description: Option<String>,
+    /// The set the decoder uses until it learns better.
+    pub default: bool,
+    /// The parameter (object text, may be an alias) and value that select this set on the device.
+    pub selected_by: Option<(String, i64)>,
+    /// RPDOs by number (1-based).
+    pub rpdo: BTreeMap<u8, PdoTemplate>,
+    /// TPDOs by number (1-based).
+    pub tpdo: BTreeMap<u8, PdoTemplate>,
+}
+
+impl PdoSet {
+    /// The mappings of this set on `node`, with COB-IDs worked out (`None` when the
+    /// profile leaves the predefined one, or the expression needs a node and none is given).
+    pub fn mappings(&self, transmit: bool, node: Option<u8>, source: &MappingSource) -> BTreeMap<u8, PdoMapping> {
+        let pdos = if transmit { &self.tpdo } else { &self.rpdo };
+        pdos.iter()
+            .map(|(n, t)| {
+                let cob_id = t.cob_id.as_ref().and_then(|e| {
+                    let v = e.eval(&|v| node.filter(|_| v == "node").map(i64::from)).ok()?;
+                    u32::try_from(v).ok()
+                });
+                let mapping = PdoMapping {
+                    cob_id,
+                    entries: t.entries.clone(),
+                    source: source.clone(),
+                };
+                (*n, mapping)
+            })
+            .collect()
+    }
+}
+
+/// How a value of an identity object is compared.
+#[derive(Clone, Debug, PartialEq)]
+pub enum IdTest {
+    /// `(value & mask) == expected`.
+    Number { expected: u64, mask: u64 },
+    /// Visible string, case-insensitive, trailing NULs and spaces ignored.
+    Text { expected: String, mode: TextMatch },
+}
+
+/// How an identification text is compared.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TextMatch {
+    #[default]
+    Exact,
+    Prefix,
+    Contains,
+}
+
+/// One condition on an identity object (0x1000, 0x1008, 0x1018:1, ...).
+#[derive(Clone, Debug, PartialEq)]
+pub struct IdCondition {
+    /// The object read.
+    pub index: u16,
+    /// Its sub-index.
+    pub sub: u8,
+    /// The test.
+    pub test: IdTest,
+}
+
+impl IdCondition {
+    /// Whether a read value passes.
+    pub fn matches(&self, value: &Value) -> bool {
+        match (&self.test, value) {
+            (IdTest::Number { expected, mask }, v) => match v.as_i64() {
+                Some(x) => (x as u64) & mask == expected & mask,
+                None => false,
+            },
+            (IdTest::Text { expected, mode }, Value::Text(t)) => {
+                let t = t.trim_end_matches(['\0', ' ']).to_lowercase();
+                let e = expected.to_lowercase();
+                match mode {
+                    TextMatch::Exact => t == e,
+                    TextMatch::Prefix => t.starts_with(&e),
+                    TextMatch::Contains => t.contains(&e),
+                }
+            }
+            _ => false,
+        }
+    }
+}
+
+/// Objects an axis owns: one sub, all subs of an index, or an index range.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ObjectRange {
+    /// First index.
+    pub first: u16,
+    /// Last index (inclusive).
+    pub last: u16,
+    /// One sub only, when given.
+    pub sub: Option<u8>,
+}
+
+impl ObjectRange {
+    /// Whether (index, sub) is in the range.
+    pub fn contains(&self, index: u16, sub: u8) -> bool {
+        (self.first..=self.last).contains(&index) && self.sub.is_none_or(|s| s == sub)
+    }
+}
+
+/// A logical axis served by a node (Dexmart M1/M2, Syn-tron A/B).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Axis {
+    /// Label, e.g. "M1".
+    pub name: String,
+    /// Help text.
+    pub description: Option<String>,
+    /// The objects that belong to this axis.
+    pub objects: Vec<ObjectRange>,
+    /// Name of the EMCY manufacturer field carrying this axis' alarm code.
+    pub emcy_field: Option<String>,
 }
 
 /// Everything known about one device type.
@@ -93,22 +263,87 @@ pub struct EmcyField {
 pub struct Profile {
     /// Short name, e.g. "cia402" or "syntron-ds".
     pub name: String,
+    /// One line for humans.
+    pub description: String,
+    /// Profiles this one builds on, most specific first (e.g. ["cia402"]).
+    pub extends: Vec<String>,
+    /// Names of records and arrays at index level, e.g. 0x1018 -> "Identity object".
+    pub object_names: BTreeMap<u16, String>,
+    /// Extra vendor aliases besides each object's own `alias`.
+    pub aliases: BTreeMap<String, (u16, u8)>,
+    /// Rules turning vendor parameter numbers into objects.
+    pub alias_rules: Vec<AliasRule>,
+    /// Layout of the EMCY manufacturer-specific bytes.
+    pub emcy_fields: Vec<ByteField>,
+    /// Named default PDO mapping sets; `rpdo`/`tpdo` hold the default one's.
+    pub pdo_sets: Vec<PdoSet>,
+    /// Vendor SDO commands.
+    pub sdo_commands: Vec<SdoCommand>,
+    /// Named procedures.
+    pub procedures: BTreeMap<String, Procedure>,
+    /// Conditions on identity objects that recognise the device (all must hold).
+    pub identification: Vec<IdCondition>,
+    /// Logical axes on one node.
+    pub axes: Vec<Axis>,
+    /// Node-ID from an EDS/DCF `[DeviceCommissioning]` section.
+    pub node_id: Option<u8>,
+    /// Node name from an EDS/DCF `[DeviceCommissioning]` section.
+    pub node_name: Option<String>,
     /// Objects by (index, sub). Single-valued objects use sub 0.
     pub objects: BTreeMap<(u16, u8), ObjectInfo>,
     /// Vendor EMCY code texts by exact code.
     pub emcy_codes: BTreeMap<u16, String>,
-    /// How the 5 manufacturer bytes of an EMCY are laid out (empty: shown as hex).
-    pub emcy_layout: Vec<EmcyField>,
     /// Default RPDO mappings by PDO number (1-based).
-    pub rpdo: BTreeMap<u16, PdoMapping>,
+    pub rpdo: BTreeMap<u8, PdoMapping>,
     /// Default TPDO mappings by PDO number (1-based).
-    pub tpdo: BTreeMap<u16, PdoMapping>,
+    pub tpdo: BTreeMap<u8, PdoMapping>,
 }
 
 impl Profile {
     /// The entry at (index, sub), falling back to sub 0 for the name of a record/array.
     pub fn object(&self, index: u16, sub: u8) -> Option<&ObjectInfo> {
         self.objects.get(&(index, sub))
+    }
+
+    /// The default PDO set (the one marked default, else the first).
+    pub fn default_pdo_set(&self) -> Option<&PdoSet> {
+        self.pdo_sets.iter().find(|s| s.default).or(self.pdo_sets.first())
+    }
+
+    /// A copy placed on `node`: `rpdo`/`tpdo` are the default set's mappings with
+    /// COB-IDs worked out for that node.
+    pub fn for_node(&self, node: u8) -> Profile {
+        let mut p = self.clone();
+        if let Some(set) = self.default_pdo_set() {
+            let source = MappingSource::Profile(self.name.clone());
+            p.rpdo = set.mappings(false, Some(node), &source);
+            p.tpdo = set.mappings(true, Some(node), &source);
+        }
+        p
+    }
+
+    /// Whether the identity values (`read(index, sub)`) match all identification
+    /// conditions; false when the profile has none or a value is missing.
+    pub fn identifies(&self, read: &dyn Fn(u16, u8) -> Option<Value>) -> bool {
+        !self.identification.is_empty()
+            && self
+                .identification
+                .iter()
+                .all(|c| read(c.index, c.sub).is_some_and(|v| c.matches(&v)))
+    }
+
+    /// The logical axis an object belongs to.
+    pub fn axis_of(&self, index: u16, sub: u8) -> Option<&Axis> {
+        self.axes
+            .iter()
+            .find(|a| a.objects.iter().any(|r| r.contains(index, sub)))
+    }
+
+    /// The vendor SDO command for this command byte and direction.
+    pub fn sdo_command(&self, command: u8, direction: SdoDirection) -> Option<&SdoCommand> {
+        self.sdo_commands
+            .iter()
+            .find(|c| c.command == command && c.direction == direction)
     }
 }
 
@@ -132,15 +367,52 @@ impl Dictionary {
     pub fn object(&self, index: u16, sub: u8) -> Option<&ObjectInfo> {
         self.layers.iter().find_map(|p| p.object(index, sub))
     }
-    /// The name of the object (index level, sub 0 when it has no own entry), for labels.
+    /// The name of the entry, else of the object (index level: a record's name or
+    /// its sub 0 entry's), for labels.
     pub fn name(&self, index: u16, sub: u8) -> Option<&str> {
         self.object(index, sub)
-            .or_else(|| self.object(index, 0))
             .map(|o| o.name.as_str())
+            .or_else(|| self.object_name(index))
     }
     /// The most specific profile's name (e.g. "syntron-ds"), or "cia301".
     pub fn profile_name(&self) -> &str {
         self.layers.first().map(|p| p.name.as_str()).unwrap_or("cia301")
+    }
+    /// The name of an object at index level: a record's name, or its sub 0 entry's.
+    pub fn object_name(&self, index: u16) -> Option<&str> {
+        self.layers.iter().find_map(|p| {
+            p.object_names
+                .get(&index)
+                .map(String::as_str)
+                .or(p.object(index, 0).map(|o| o.name.as_str()))
+        })
+    }
+    /// The first layer with an EMCY manufacturer-byte layout, and that layout.
+    pub fn emcy_fields(&self) -> &[ByteField] {
+        self.layers
+            .iter()
+            .map(|p| p.emcy_fields.as_slice())
+            .find(|f| !f.is_empty())
+            .unwrap_or(&[])
+    }
+    /// A named procedure from the first layer that has it.
+    pub fn procedure(&self, name: &str) -> Option<&Procedure> {
+        self.layers.iter().find_map(|p| p.procedures.get(name))
+    }
+    /// A vendor SDO command from the first layer that has it.
+    pub fn sdo_command(&self, command: u8, direction: SdoDirection) -> Option<&SdoCommand> {
+        self.layers.iter().find_map(|p| p.sdo_command(command, direction))
+    }
+    /// The logical axis of an object, from the first layer that has axes.
+    pub fn axis_of(&self, index: u16, sub: u8) -> Option<&Axis> {
+        self.layers.iter().find_map(|p| p.axis_of(index, sub))
+    }
+    /// The PDO mappings (RPDO when `transmit` is false) of the first layer that has any.
+    pub fn default_pdos(&self, transmit: bool) -> Option<&BTreeMap<u8, PdoMapping>> {
+        self.layers
+            .iter()
+            .map(|p| if transmit { &p.tpdo } else { &p.rpdo })
+            .find(|m| !m.is_empty())
     }
     /// A vendor EMCY text for an exact code.
     pub fn emcy_text(&self, code: u16) -> Option<&str> {
@@ -157,7 +429,9 @@ impl Dictionary {
 /// `15000` of an I32 with scale 0.1 and unit "rpm" -> `1500 rpm`.
 pub fn format_value(info: Option<&ObjectInfo>, value: &Value) -> String {
     let Some(info) = info else { return value.to_string() };
-    if let Some((raw, text)) = value.as_i64().and_then(|raw| info.values.get(&raw).map(|t| (raw, t))) {
+    if let Some(raw) = value.as_i64()
+        && let Some(text) = info.values.get(&raw)
+    {
         return format!("{raw} ({text})");
     }
     match (value.as_f64(), info.scale, &info.unit) {
@@ -182,24 +456,4 @@ pub fn format_number(x: f64) -> String {
         let s = format!("{x:.6}");
         s.trim_end_matches('0').trim_end_matches('.').to_string()
     }
-}
-
-/// The EMCY manufacturer fields of an 8-byte frame through the first layout in `dict`.
-pub fn emcy_fields(dict: &Dictionary, frame: &[u8; 8]) -> Vec<(String, String)> {
-    let Some(layout) = dict.layers().iter().map(|p| &p.emcy_layout).find(|l| !l.is_empty()) else {
-        return Vec::new();
-    };
-    layout
-        .iter()
-        .filter(|f| (3..8).contains(&f.offset) && f.len >= 1 && f.offset as usize + f.len as usize <= 8)
-        .map(|f| {
-            let bytes = &frame[f.offset as usize..f.offset as usize + f.len as usize];
-            let raw = bytes.iter().rev().fold(0i64, |acc, b| (acc << 8) | *b as i64);
-            let text = match f.values.get(&raw) {
-                Some(t) => format!("0x{raw:02X} ({t})"),
-                None => format!("0x{raw:02X}"),
-            };
-            (f.name.clone(), text)
-        })
-        .collect()
 }
