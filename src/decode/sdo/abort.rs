@@ -1,0 +1,139 @@
+//! SDO abort codes (CiA 301, table "SDO abort codes") and their texts.
+
+/// Text used for codes CiA 301 does not define.
+pub const UNKNOWN_ABORT_TEXT: &str = "unknown abort code";
+
+/// Every abort code CiA 301 defines, with its text as the standard words it
+/// (the standard's trailing full stops are left out so texts fit in labels).
+pub const ABORT_CODES: &[(u32, &str)] = &[
+    (0x0503_0000, "Toggle bit not alternated"),
+    (0x0504_0000, "SDO protocol timed out"),
+    (0x0504_0001, "Client/server command specifier not valid or unknown"),
+    (0x0504_0002, "Invalid block size (block mode only)"),
+    (0x0504_0003, "Invalid sequence number (block mode only)"),
+    (0x0504_0004, "CRC error (block mode only)"),
+    (0x0504_0005, "Out of memory"),
+    (0x0601_0000, "Unsupported access to an object"),
+    (0x0601_0001, "Attempt to read a write only object"),
+    (0x0601_0002, "Attempt to write a read only object"),
+    (0x0602_0000, "Object does not exist in the object dictionary"),
+    (0x0604_0041, "Object cannot be mapped to the PDO"),
+    (
+        0x0604_0042,
+        "The number and length of the objects to be mapped would exceed PDO length",
+    ),
+    (0x0604_0043, "General parameter incompatibility reason"),
+    (0x0604_0047, "General internal incompatibility in the device"),
+    (0x0606_0000, "Access failed due to a hardware error"),
+    (
+        0x0607_0010,
+        "Data type does not match, length of service parameter does not match",
+    ),
+    (
+        0x0607_0012,
+        "Data type does not match, length of service parameter too high",
+    ),
+    (
+        0x0607_0013,
+        "Data type does not match, length of service parameter too low",
+    ),
+    (0x0609_0011, "Sub-index does not exist"),
+    (0x0609_0030, "Invalid value for parameter (download only)"),
+    (0x0609_0031, "Value of parameter written too high (download only)"),
+    (0x0609_0032, "Value of parameter written too low (download only)"),
+    (0x0609_0036, "Maximum value is less than minimum value"),
+    (0x060A_0023, "Resource not available: SDO connection"),
+    (0x0800_0000, "General error"),
+    (0x0800_0020, "Data cannot be transferred or stored to the application"),
+    (
+        0x0800_0021,
+        "Data cannot be transferred or stored to the application because of local control",
+    ),
+    (
+        0x0800_0022,
+        "Data cannot be transferred or stored to the application because of the present device state",
+    ),
+    (
+        0x0800_0023,
+        "Object dictionary dynamic generation fails or no object dictionary is present \
+         (e.g. object dictionary is generated from file and generation fails because of a file error)",
+    ),
+    (0x0800_0024, "No data available"),
+];
+
+/// The CiA 301 text of an abort code, or `None` for codes the standard does not define.
+pub fn known_abort_text(code: u32) -> Option<&'static str> {
+    ABORT_CODES.iter().find(|(c, _)| *c == code).map(|(_, t)| *t)
+}
+
+/// The CiA 301 text of an abort code, or [`UNKNOWN_ABORT_TEXT`].
+pub fn abort_text(code: u32) -> &'static str {
+    known_abort_text(code).unwrap_or(UNKNOWN_ABORT_TEXT)
+}
+
+/// Named abort codes the client and server send.
+pub mod codes {
+    /// Toggle bit not alternated.
+    pub const TOGGLE: u32 = 0x0503_0000;
+    /// SDO protocol timed out.
+    pub const TIMEOUT: u32 = 0x0504_0000;
+    /// Client/server command specifier not valid or unknown.
+    pub const UNKNOWN_COMMAND: u32 = 0x0504_0001;
+    /// Invalid block size (block mode only).
+    pub const BLOCK_SIZE: u32 = 0x0504_0002;
+    /// Invalid sequence number (block mode only).
+    pub const SEQUENCE: u32 = 0x0504_0003;
+    /// CRC error (block mode only).
+    pub const CRC: u32 = 0x0504_0004;
+    /// Out of memory.
+    pub const OUT_OF_MEMORY: u32 = 0x0504_0005;
+    /// Attempt to read a write only object.
+    pub const WRITE_ONLY: u32 = 0x0601_0001;
+    /// Attempt to write a read only object.
+    pub const READ_ONLY: u32 = 0x0601_0002;
+    /// Object does not exist in the object dictionary.
+    pub const NO_OBJECT: u32 = 0x0602_0000;
+    /// Data type does not match, length of service parameter does not match.
+    pub const LENGTH_MISMATCH: u32 = 0x0607_0010;
+    /// Data type does not match, length of service parameter too high.
+    pub const LENGTH_TOO_HIGH: u32 = 0x0607_0012;
+    /// Data type does not match, length of service parameter too low.
+    pub const LENGTH_TOO_LOW: u32 = 0x0607_0013;
+    /// Sub-index does not exist.
+    pub const NO_SUB: u32 = 0x0609_0011;
+    /// General error.
+    pub const GENERAL: u32 = 0x0800_0000;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn texts_of_the_dexmart_table() {
+        assert_eq!(abort_text(0x0503_0000), "Toggle bit not alternated");
+        assert_eq!(abort_text(0x0504_0000), "SDO protocol timed out");
+        assert_eq!(
+            abort_text(0x0602_0000),
+            "Object does not exist in the object dictionary"
+        );
+        assert_eq!(abort_text(0x0609_0011), "Sub-index does not exist");
+        assert_eq!(abort_text(0x060A_0023), "Resource not available: SDO connection");
+        assert_eq!(abort_text(0x0800_0024), "No data available");
+        assert!(abort_text(0x0800_0023).starts_with("Object dictionary dynamic generation fails"));
+    }
+
+    #[test]
+    fn all_codes_defined_once() {
+        assert_eq!(ABORT_CODES.len(), 31);
+        for (i, (c, _)) in ABORT_CODES.iter().enumerate() {
+            assert!(ABORT_CODES[i + 1..].iter().all(|(d, _)| d != c), "{c:#010X} twice");
+        }
+    }
+
+    #[test]
+    fn unknown_codes() {
+        assert_eq!(abort_text(0x1234_5678), "unknown abort code");
+        assert_eq!(known_abort_text(0x0503_0004), None);
+    }
+}

@@ -1,0 +1,278 @@
+//! A reassembled SDO transfer: what was read or written, how, and how it ended.
+
+use super::frame::Side;
+use super::value::view;
+use crate::hex;
+use crate::od::Dictionary;
+use serde_json::{Value as Json, json};
+use std::fmt;
+
+/// An SDO channel: a node and the COB-ID pair its client and server use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Channel {
+    /// The server's node-ID.
+    pub node: u8,
+    /// Client to server COB-ID (0x600 + node by default).
+    pub request_cob: u32,
+    /// Server to client COB-ID (0x580 + node by default).
+    pub response_cob: u32,
+}
+
+impl Channel {
+    /// The default SDO channel of a node (0x600 + node / 0x580 + node).
+    pub fn default_for(node: u8) -> Channel {
+        Channel {
+            node,
+            request_cob: 0x600 + node as u32,
+            response_cob: 0x580 + node as u32,
+        }
+    }
+}
+
+/// Upload (read from the server) or download (write to the server).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TransferDirection {
+    Upload,
+    Download,
+}
+
+impl TransferDirection {
+    /// `"upload"` or `"download"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            TransferDirection::Upload => "upload",
+            TransferDirection::Download => "download",
+        }
+    }
+}
+
+/// The SDO protocol a transfer used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Protocol {
+    Expedited,
+    Segmented,
+    Block,
+}
+
+impl Protocol {
+    /// `"expedited"`, `"segmented"` or `"block"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Protocol::Expedited => "expedited",
+            Protocol::Segmented => "segmented",
+            Protocol::Block => "block",
+        }
+    }
+}
+
+/// How a transfer ended.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// Completed (problems may still be listed).
+    Ok,
+    /// Aborted with a code by one side.
+    Aborted { code: u32, text: &'static str, by: Side },
+    /// Still running at the end of the input (or only its end was seen).
+    Incomplete,
+    /// The frames did not follow the protocol.
+    ProtocolError(String),
+}
+
+impl Outcome {
+    /// `"ok"`, `"aborted"`, `"incomplete"` or `"protocol_error"`.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Outcome::Ok => "ok",
+            Outcome::Aborted { .. } => "aborted",
+            Outcome::Incomplete => "incomplete",
+            Outcome::ProtocolError(_) => "protocol_error",
+        }
+    }
+}
+
+/// Something wrong seen in a transfer that did not necessarily end it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Problem {
+    /// A response without the request it answers (e.g. capture started after the request).
+    UnmatchedResponse,
+    /// A segment's toggle bit did not alternate.
+    ToggleError,
+    /// The block CRC sent does not match the data.
+    BadCrc { sent: u16, computed: u16 },
+    /// A frame of the transfer had a DLC other than 8.
+    WrongDlc { dlc: u8 },
+    /// Block segments out of sequence or not all acknowledged.
+    SequenceError,
+    /// Indicated size and transferred bytes differ.
+    SizeMismatch { indicated: u32, actual: usize },
+    /// The bytes do not fit the size of the object's type in the dictionary.
+    TypeLengthMismatch { expected: usize, actual: usize },
+}
+
+impl Problem {
+    /// Machine name for JSON, e.g. `"toggle_error"`.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Problem::UnmatchedResponse => "unmatched_response",
+            Problem::ToggleError => "toggle_error",
+            Problem::BadCrc { .. } => "bad_crc",
+            Problem::WrongDlc { .. } => "wrong_dlc",
+            Problem::SequenceError => "sequence_error",
+            Problem::SizeMismatch { .. } => "size_mismatch",
+            Problem::TypeLengthMismatch { .. } => "type_length_mismatch",
+        }
+    }
+}
+
+impl fmt::Display for Problem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Problem::UnmatchedResponse => write!(f, "unmatched response"),
+            Problem::ToggleError => write!(f, "toggle error"),
+            Problem::BadCrc { sent, computed } => {
+                write!(f, "bad block CRC: sent 0x{sent:04X}, data gives 0x{computed:04X}")
+            }
+            Problem::WrongDlc { dlc } => write!(f, "wrong DLC {dlc}"),
+            Problem::SequenceError => write!(f, "sequence error"),
+            Problem::SizeMismatch { indicated, actual } => {
+                write!(f, "size mismatch: indicated {indicated}, transferred {actual}")
+            }
+            Problem::TypeLengthMismatch { expected, actual } => {
+                write!(f, "length {actual} does not fit the object's type ({expected} bytes)")
+            }
+        }
+    }
+}
+
+/// One reassembled SDO transfer.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Transaction {
+    /// The server's node-ID.
+    pub node: u8,
+    /// The channel it ran on.
+    pub channel: Channel,
+    pub index: u16,
+    pub sub: u8,
+    pub direction: TransferDirection,
+    pub protocol: Protocol,
+    /// The bytes transferred (so far, when not complete).
+    pub data: Vec<u8>,
+    /// The size the initiating frames indicated.
+    pub size: Option<u32>,
+    /// Timestamp of the first frame (ns).
+    pub start_ns: u64,
+    /// Timestamp of the last frame (ns).
+    pub end_ns: u64,
+    pub outcome: Outcome,
+    pub problems: Vec<Problem>,
+    /// Sequence numbers of the frames that belong to it.
+    pub frames: Vec<u64>,
+}
+
+impl Transaction {
+    /// Duration from first to last frame, in ns.
+    pub fn duration_ns(&self) -> u64 {
+        self.end_ns.saturating_sub(self.start_ns)
+    }
+
+    /// Completed, and its data can be trusted (no bad CRC, toggle error or size mismatch):
+    /// what the decoder may learn COB-IDs and PDO mappings from.
+    pub fn is_ok(&self) -> bool {
+        self.outcome == Outcome::Ok
+            && !self.problems.iter().any(|p| {
+                matches!(
+                    p,
+                    Problem::BadCrc { .. } | Problem::ToggleError | Problem::SizeMismatch { .. }
+                )
+            })
+    }
+
+    /// Adds a problem once.
+    pub(crate) fn flag(&mut self, p: Problem) {
+        if !self.problems.contains(&p) {
+            self.problems.push(p);
+        }
+    }
+
+    /// One-line label, e.g.
+    /// `Upload 0x1008:00 Manufacturer device name = "DEXMART" (segmented, 7 bytes, 1.200 ms): ok`.
+    pub fn label(&self, dict: &Dictionary) -> String {
+        let dir = match self.direction {
+            TransferDirection::Upload => "Upload",
+            TransferDirection::Download => "Download",
+        };
+        let mut s = format!("{dir} 0x{:04X}:{:02X}", self.index, self.sub);
+        if let Some(name) = dict.name(self.index, self.sub) {
+            s.push(' ');
+            s.push_str(name);
+        }
+        if self.outcome == Outcome::Ok && !self.data.is_empty() {
+            let v = view(dict, self.index, self.sub, &self.data);
+            let text: String = if v.text.chars().count() > 80 {
+                v.text.chars().take(77).chain("...".chars()).collect()
+            } else {
+                v.text
+            };
+            s.push_str(" = ");
+            s.push_str(&text);
+        }
+        let n = self.data.len();
+        s.push_str(&format!(
+            " ({}, {n} byte{}, {:.3} ms): ",
+            self.protocol.as_str(),
+            if n == 1 { "" } else { "s" },
+            self.duration_ns() as f64 / 1e6
+        ));
+        match &self.outcome {
+            Outcome::Ok => s.push_str("ok"),
+            Outcome::Aborted { code, text, by } => {
+                s.push_str(&format!("aborted by {}: 0x{code:08X} {text}", by.as_str()))
+            }
+            Outcome::Incomplete => s.push_str("incomplete"),
+            Outcome::ProtocolError(e) => s.push_str(&format!("protocol error: {e}")),
+        }
+        for p in &self.problems {
+            s.push_str(&format!(" [{p}]"));
+        }
+        s
+    }
+
+    /// JSON object with the object, name, typed value, hex data, timing, outcome and problems.
+    pub fn to_json(&self, dict: &Dictionary) -> Json {
+        let v = (!self.data.is_empty()).then(|| view(dict, self.index, self.sub, &self.data));
+        let (code, text, by, error) = match &self.outcome {
+            Outcome::Aborted { code, text, by } => (
+                Json::from(*code),
+                Json::from(*text),
+                Json::from(by.as_str()),
+                Json::Null,
+            ),
+            Outcome::ProtocolError(e) => (Json::Null, Json::Null, Json::Null, Json::from(e.clone())),
+            _ => (Json::Null, Json::Null, Json::Null, Json::Null),
+        };
+        json!({
+            "node": self.node,
+            "request_cob": self.channel.request_cob,
+            "response_cob": self.channel.response_cob,
+            "index": self.index,
+            "sub": self.sub,
+            "name": dict.name(self.index, self.sub),
+            "direction": self.direction.as_str(),
+            "protocol": self.protocol.as_str(),
+            "size": self.size,
+            "data": hex::upper(&self.data),
+            "value": v.as_ref().map_or(Json::Null, |v| v.json.clone()),
+            "value_text": v.as_ref().map(|v| v.text.clone()),
+            "start_ns": self.start_ns,
+            "end_ns": self.end_ns,
+            "duration_ns": self.duration_ns(),
+            "outcome": self.outcome.as_str(),
+            "abort_code": code,
+            "abort_text": text,
+            "aborted_by": by,
+            "error": error,
+            "problems": self.problems.iter().map(|p| json!({"kind": p.as_str(), "text": p.to_string()})).collect::<Vec<_>>(),
+            "frames": self.frames,
+        })
+    }
+}
