@@ -310,6 +310,42 @@ pub fn load_profile(file: &str, text: &str) -> Result<(Profile, Vec<Warning>), L
     Ok((profile, cx.warnings))
 }
 
+/// Most entries one index-range key may expand to.
+const MAX_RANGE_ENTRIES: usize = 100_000;
+
+/// The entries of one `objects` key before they are placed at an index.
+struct Built {
+    /// A record/array (replaces every sub of its index).
+    record: bool,
+    /// The record's name.
+    name: Option<String>,
+    /// The record's alias.
+    alias: Option<String>,
+    /// Entries by sub.
+    entries: Vec<(u8, ObjectInfo)>,
+}
+
+/// Puts built entries at `index`; `nth` (1-based place in an index range) replaces `{i}` in names.
+fn place(p: &mut Profile, index: u16, nth: Option<u32>, b: &Built) {
+    let name = |n: &str| match nth {
+        Some(i) => n.replace("{i}", &i.to_string()),
+        None => n.to_string(),
+    };
+    if let Some(n) = &b.name {
+        p.object_names.insert(index, name(n));
+    }
+    if let Some(a) = &b.alias {
+        p.aliases.insert(name(a), (index, 0));
+    }
+    for (sub, info) in &b.entries {
+        let mut info = info.clone();
+        if nth.is_some() {
+            info.name = name(&info.name);
+        }
+        p.objects.insert((index, *sub), info);
+    }
+}
+
 /// Conversion context: collects warnings.
 struct Cx<'a> {
     file: &'a str,
@@ -343,7 +379,28 @@ impl Cx<'_> {
             extends: d.extends,
             ..Default::default()
         };
-        for (key, entry) in d.objects {
+        // Index ranges first, so that single objects written next can override them.
+        let (ranges, singles): (Vec<_>, Vec<_>) = d.objects.into_iter().partition(|(k, _)| k.contains(".."));
+        for (key, entry) in ranges {
+            let at = format!("objects.{key}");
+            let Some((first, last)) = index_range(&key) else {
+                self.warn(&at, format!("`{key}` is not an index range (0xFIRST..0xLAST), skipped"));
+                continue;
+            };
+            let built = self.build(&at, 0, entry);
+            let size = (usize::from(last - first) + 1) * built.entries.len().max(1);
+            if size > MAX_RANGE_ENTRIES {
+                self.warn(
+                    &at,
+                    format!("range expands to {size} entries, more than {MAX_RANGE_ENTRIES}; skipped"),
+                );
+                continue;
+            }
+            for index in first..=last {
+                place(&mut p, index, Some(u32::from(index - first) + 1), &built);
+            }
+        }
+        for (key, entry) in singles {
             let at = format!("objects.{key}");
             let Some((index, sub)) = parse_object_ref(&key) else {
                 self.warn(
@@ -352,7 +409,11 @@ impl Cx<'_> {
                 );
                 continue;
             };
-            self.object(&mut p, &at, index, sub, entry);
+            let built = self.build(&at, sub, entry);
+            if built.record {
+                p.objects.retain(|(i, _), _| *i != index);
+            }
+            place(&mut p, index, None, &built);
         }
         for (alias, target) in d.aliases {
             let at = format!("aliases.{alias}");
@@ -441,28 +502,33 @@ impl Cx<'_> {
         p
     }
 
-    fn object(&mut self, p: &mut Profile, at: &str, index: u16, sub: u8, e: EntryDto) {
+    /// The entries one `objects` key describes (one entry, or a record's subs).
+    fn build(&mut self, at: &str, sub: u8, e: EntryDto) -> Built {
         let Some(subs) = e.subs else {
-            if let Some(info) = self.entry(at, e) {
-                p.objects.insert((index, sub), info);
-            }
-            return;
+            let entries = self.entry(at, e).map(|info| vec![(sub, info)]).unwrap_or_default();
+            return Built {
+                record: false,
+                name: None,
+                alias: None,
+                entries,
+            };
         };
         if sub != 0 {
             self.warn(&format!("{at}.subs"), "a sub-entry cannot have subs, ignored");
+            return Built {
+                record: false,
+                name: None,
+                alias: None,
+                entries: vec![],
+            };
         }
-        match &e.name {
-            Some(n) => {
-                p.object_names.insert(index, n.clone());
-            }
-            None => self.warn(at, "record or array without a name"),
-        }
-        if let Some(alias) = &e.alias {
-            p.aliases.insert(alias.clone(), (index, 0));
+        if e.name.is_none() {
+            self.warn(at, "record or array without a name");
         }
         if e.data_type.is_some() || e.access.is_some() || !e.values.is_empty() || e.unit.is_some() {
             self.warn(at, "type/access/unit/values of a record belong on its subs, ignored");
         }
+        let mut entries = Vec::new();
         for (key, s) in subs {
             let at = format!("{at}.subs.{key}");
             let Some(range) = self.ok(&at, sub_range(&key)) else {
@@ -474,11 +540,17 @@ impl Cx<'_> {
             let Some(info) = self.entry(&at, s) else { continue };
             for n in range.clone() {
                 let mut info = info.clone();
-                if range.start() != range.end() {
+                if key.contains("..") {
                     info.name = info.name.replace("{n}", &n.to_string());
                 }
-                p.objects.insert((index, n), info);
+                entries.push((n, info));
             }
+        }
+        Built {
+            record: true,
+            name: e.name,
+            alias: e.alias,
+            entries,
         }
     }
 
@@ -985,6 +1057,18 @@ fn mapped_entry(v: &Json) -> Result<MappedEntry, String> {
     Ok(e)
 }
 
+/// `"0x1400..0x15FF"` as (first, last).
+fn index_range(key: &str) -> Option<(u16, u16)> {
+    let (a, b) = key.split_once("..")?;
+    let idx = |t: &str| {
+        parse_object_ref(t)
+            .filter(|(_, s)| *s == 0 && !t.contains(':'))
+            .map(|(i, _)| i)
+    };
+    let (first, last) = (idx(a)?, idx(b)?);
+    (first <= last).then_some((first, last))
+}
+
 /// `"3"`, `"0x1A"` or `"1..127"`.
 fn sub_range(key: &str) -> Result<std::ops::RangeInclusive<u8>, String> {
     let one = |t: &str| {
@@ -1098,7 +1182,11 @@ mod tests {
             "1": { "name": "Vendor-ID", "type": "u32", "access": "ro" } } },
         "0x1016": { "name": "Consumer heartbeat time", "subs": {
             "1..3": { "name": "Consumer heartbeat time {n}", "type": "u32" } } },
-        "0x1008": { "name": "Manufacturer device name", "type": "visible_string", "default": "DEV" }
+        "0x1008": { "name": "Manufacturer device name", "type": "visible_string", "default": "DEV" },
+        "0x1800..0x19FF": { "name": "TPDO{i} communication parameter", "subs": {
+            "1": { "name": "COB-ID used by TPDO{i}", "type": "u32" } } },
+        "0x1801": { "name": "Special TPDO", "subs": { "2": { "name": "Transmission type", "type": "u8" } } },
+        "0x1A00:0": { "name": "Number of mapped objects", "type": "u8" }
       },
       "aliases": { "P-speed": "0x2005:3" },
       "alias_rules": [ { "pattern": "H{xx:hex}-{yy}", "index": "0x2000 + xx", "sub": "yy + 1" } ],
@@ -1147,6 +1235,12 @@ mod tests {
         assert_eq!(p.object(0x1018, 0).unwrap().default, Some(Value::Unsigned(4)));
         assert_eq!(p.object(0x1016, 3).unwrap().name, "Consumer heartbeat time 3");
         assert_eq!(p.object(0x1008, 0).unwrap().default, Some(Value::Text("DEV".into())));
+        assert_eq!(p.object_names[&0x19FF], "TPDO512 communication parameter");
+        assert_eq!(p.object(0x1800, 1).unwrap().name, "COB-ID used by TPDO1");
+        assert_eq!(p.object_names[&0x1801], "Special TPDO");
+        assert_eq!(p.object(0x1801, 1), None);
+        assert_eq!(p.object(0x1801, 2).unwrap().name, "Transmission type");
+        assert_eq!(p.object(0x1A00, 0).unwrap().name, "Number of mapped objects");
         assert_eq!(p.aliases.get("P-speed"), Some(&(0x2005, 3)));
         assert_eq!(p.alias_rules[0].apply("H12-20"), Some((0x2012, 21)));
         assert_eq!(
@@ -1241,7 +1335,9 @@ mod tests {
             "0x6060": { "name": "Modes", "type": "i8", "access": "rx", "values": { "three": "PV", "3": "PV" } },
             "nonsense": { "name": "N" },
             "0x2000": { "type": "u8" },
-            "0x1016": { "name": "HB", "subs": { "9..1": { "name": "x" }, "1": { "name": "Consumer 1" } } }
+            "0x1016": { "name": "HB", "subs": { "9..1": { "name": "x" }, "1": { "name": "Consumer 1" } } },
+            "0x0000..0xFFFF": { "name": "huge", "subs": { "0..255": { "name": "x" } } },
+            "0x3000..0x2000": { "name": "backwards" }
           },
           "alias_rules": [ { "pattern": "F{x}{y}", "index": "x" }, { "pattern": "P{x}", "index": "x +" } ],
           "emcy": { "codes": { "0x1FFFF": "too big" }, "manufacturer_fields": [ { "name": "b", "offset": 7, "length": 2 } ] },
@@ -1260,6 +1356,8 @@ mod tests {
             "objects.nonsense",
             "objects.0x2000",
             "objects.0x1016.subs.9..1",
+            "objects.0x0000..0xFFFF",
+            "objects.0x3000..0x2000",
             "alias_rules.0",
             "alias_rules.1",
             "emcy.codes.0x1FFFF",
@@ -1271,7 +1369,7 @@ mod tests {
         ] {
             assert!(at.contains(&expected), "no warning at {expected}: {w:#?}");
         }
-        assert_eq!(w.len(), 16, "{w:#?}");
+        assert_eq!(w.len(), 18, "{w:#?}");
         // The rest loaded.
         assert_eq!(p.object(0x6041, 0).unwrap().data_type, DataType::Domain);
         assert_eq!(
