@@ -46,3 +46,22 @@ fn syntron_aliases_follow_the_manual_rules() {
     assert_eq!(p.axis_of(0x3318, 0).map(|a| a.name.as_str()), Some("B"));
     assert_eq!(p.axis_of(0x5004, 0).map(|a| a.name.as_str()), Some("A"));
 }
+
+#[test]
+fn dexmart_parameters_and_pdo_sets() {
+    let p = load("dexmart-dev");
+    // "E£809-26 CANOpen PDO Mapping = 0 / = 1": two sets, 0 is the default.
+    assert_eq!(p.pdo_sets.len(), 2);
+    assert_eq!(p.default_pdo_set().map(|s| s.name.as_str()), Some("mapping-0"));
+    let d = dict(p);
+    // "03-01 (Index = 3003h - Sub-Index = 01h)"
+    assert_eq!(resolve_object(&d, "03-01"), Ok((0x3003, 1)));
+    assert_eq!(resolve_object(&d, "09-26"), Ok((0x3009, 26)));
+    // "Sub-Index 01h = 01-01 (Modbus Address 0x0100)", "Monitor Data ( Modbus Address 0x4600 )"
+    assert_eq!(resolve_object(&d, "MB0100"), Ok((0x3001, 1)));
+    assert_eq!(resolve_object(&d, "MB4600"), Ok((0x3046, 1)));
+    assert_eq!(d.name(0x3046, 5), Some("M1: Current Speed"));
+    assert_eq!(d.name(0x3002, 7), Some("EEP parameter 2-7"));
+    let p = &d.layers()[0];
+    assert_eq!(p.axis_of(0x304A, 2).map(|a| a.name.as_str()), Some("M2"));
+}
