@@ -55,5 +55,6 @@ pub mod registry;
 pub mod sdo;
 pub mod sync;
 pub mod time;
+pub mod vendor_sdo;
 
 pub use registry::{Body, Decoded, Decoder};

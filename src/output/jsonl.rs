@@ -44,6 +44,7 @@ pub fn frame_json(line: u64, frame: &Frame, ifaces: &Interfaces, decoded: &Decod
         Body::Pdo(p) => ("pdo", p.to_json()),
         Body::Sdo(s) => ("sdo", s.to_json()),
         Body::Lss(l) => ("lss", l.to_json()),
+        Body::VendorSdo(v) => ("vendor_sdo", v.to_json()),
         Body::ErrorFrame { class } => ("error", crate::decode::error_frame::to_json(*class, frame.payload())),
     };
     if !key.is_empty() {
