@@ -215,11 +215,6 @@ impl Decoder {
                 (l.label(), Body::Lss(l), p)
             }
             Kind::Tpdo | Kind::Rpdo => self.decode_pdo(frame, route),
-            Kind::SdoRx | Kind::SdoTx
-                if let Some(v) = vendor_sdo::decode(&self.dicts[n as usize], route.kind == Kind::SdoRx, payload) =>
-            {
-                (v.label(), Body::VendorSdo(v), None)
-            }
             Kind::SdoRx | Kind::SdoTx => {
                 let c2s = route.kind == Kind::SdoRx;
                 let s = self
@@ -229,8 +224,15 @@ impl Decoder {
                     self.learn(&t);
                     self.completed.push(t);
                 }
-                let p = s.malformed();
-                (s.label(), Body::Sdo(s), p)
+                // The tracker sees vendor commands too (as unknown commands), so that
+                // their standard replies do not disturb a running transfer.
+                match vendor_sdo::decode(&self.dicts[n as usize], c2s, payload) {
+                    Some(v) => (v.label(), Body::VendorSdo(v), None),
+                    None => {
+                        let p = s.malformed();
+                        (s.label(), Body::Sdo(s), p)
+                    }
+                }
             }
             Kind::Other => {
                 let label = if route.reserved {
