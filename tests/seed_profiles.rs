@@ -65,3 +65,43 @@ fn dexmart_parameters_and_pdo_sets() {
     let p = &d.layers()[0];
     assert_eq!(p.axis_of(0x304A, 2).map(|a| a.name.as_str()), Some("M2"));
 }
+
+#[test]
+fn aimotor_h_parameters_follow_the_manual_table() {
+    let d = dict(load("aimotor"));
+    // 1.4: "H02-00 0x2002 0x01", "H03-09 0x2003 0x0A", "H0B-26 0x200B 0x1B", "H12-20 0x2012 0x15"
+    assert_eq!(resolve_object(&d, "H02-00"), Ok((0x2002, 0x01)));
+    assert_eq!(resolve_object(&d, "H03-09"), Ok((0x2003, 0x0A)));
+    assert_eq!(resolve_object(&d, "H0B-26"), Ok((0x200B, 0x1B)));
+    assert_eq!(resolve_object(&d, "H12-20"), Ok((0x2012, 0x15)));
+    // 6.2: "H0B-34 ... 200Bh sub 23h" current fault code, with the fault -> 603Fh table as texts
+    assert_eq!(resolve_object(&d, "H0B-34"), Ok((0x200B, 0x23)));
+    let fault = d.object(0x200B, 0x23).expect("H0B-34");
+    assert!(
+        fault.values[&0x0D03].contains("0x8130"),
+        "{:?}",
+        fault.values.get(&0x0D03)
+    );
+    // Default PDOs: "1600h 0x60400010, 0x60600008, 607A"; "1A00h 0x60410010, 0x60610008, 0x60640020"
+    let p = &d.layers()[0];
+    let set = p.default_pdo_set().expect("default set");
+    let entries = |m: &cotui::od::PdoTemplate| m.entries.iter().map(|e| (e.index, e.bits)).collect::<Vec<_>>();
+    assert_eq!(entries(&set.rpdo[&1]), vec![(0x6040, 16), (0x6060, 8), (0x607A, 32)]);
+    assert_eq!(entries(&set.tpdo[&1]), vec![(0x6041, 16), (0x6061, 8), (0x6064, 32)]);
+}
+
+#[test]
+fn aqmd_modbus_registers_map_to_objects() {
+    let d = dict(load("aqmd2405"));
+    // 7.4: "0x0000~0x0FFF -> 0x4000 + REG_ADDR", "0x7000~0x7FFF -> REG_ADDR - 0x2000"
+    assert_eq!(resolve_object(&d, "MB0121"), Ok((0x4121, 0)));
+    assert_eq!(resolve_object(&d, "MB7010"), Ok((0x5010, 0)));
+    assert!(
+        resolve_object(&d, "MB2000").is_err(),
+        "0x2000 is not a mirrored Modbus range"
+    );
+    // 7.6.3: "0x2202 ... 0: 10kbps ... 7: 1Mbps"
+    let rate = d.object(0x2202, 0).expect("0x2202");
+    assert_eq!(rate.values[&0], "10 kbit/s");
+    assert_eq!(rate.values[&7], "1 Mbit/s");
+}
