@@ -17,8 +17,8 @@ use super::expr::{Expr, parse_int};
 use super::fields::{ByteField, SdoCommand, SdoDirection};
 use super::procedure::{NmtCommand, ProcParam, Procedure, Step, parse_frame_data};
 use super::{
-    Access, Axis, DataType, IdCondition, IdTest, MappedEntry, MappingSource, ObjectInfo, ObjectRange, PdoMappable,
-    PdoSet, PdoTemplate, Profile, TextMatch, Value, Warning,
+    Access, Axis, DataType, IdCondition, IdTest, IndexRange, MappedEntry, MappingSource, ObjectInfo, ObjectRange,
+    PdoMappable, PdoSet, PdoTemplate, Profile, TextMatch, Value, Warning,
 };
 
 /// The newest profile format this loader knows.
@@ -314,6 +314,7 @@ pub fn load_profile(file: &str, text: &str) -> Result<(Profile, Vec<Warning>), L
 const MAX_RANGE_ENTRIES: usize = 100_000;
 
 /// The entries of one `objects` key before they are placed at an index.
+#[derive(Clone)]
 struct Built {
     /// A record/array (replaces every sub of its index).
     record: bool,
@@ -388,6 +389,25 @@ impl Cx<'_> {
                 continue;
             };
             let built = self.build(&at, 0, entry);
+            // Records whose sub names do not depend on the index are kept once as a
+            // template (PDO parameters would otherwise be 70000 entries).
+            if built.record && !built.entries.iter().any(|(_, e)| e.name.contains("{i}")) {
+                for index in first..=last {
+                    let nth = u32::from(index - first) + 1;
+                    place(
+                        &mut p,
+                        index,
+                        Some(nth),
+                        &Built {
+                            entries: vec![],
+                            ..built.clone()
+                        },
+                    );
+                }
+                let subs = built.entries.into_iter().collect();
+                p.ranges.push(IndexRange { first, last, subs });
+                continue;
+            }
             let size = (usize::from(last - first) + 1) * built.entries.len().max(1);
             if size > MAX_RANGE_ENTRIES {
                 self.warn(
@@ -410,8 +430,14 @@ impl Cx<'_> {
                 continue;
             };
             let built = self.build(&at, sub, entry);
+            if !built.record {
+                p.materialize(index);
+            }
             if built.record {
-                p.objects.retain(|(i, _), _| *i != index);
+                let stale: Vec<(u16, u8)> = p.objects.range((index, 0)..=(index, 255)).map(|(k, _)| *k).collect();
+                for k in stale {
+                    p.objects.remove(&k);
+                }
             }
             place(&mut p, index, None, &built);
         }
@@ -677,7 +703,7 @@ impl Cx<'_> {
             );
             return None;
         }
-        let hex = match f.format.as_deref() {
+        let hex = match f.format.as_deref().map(str::to_ascii_lowercase).as_deref() {
             None | Some("dec") => false,
             Some("hex") => true,
             Some(other) => {
@@ -1186,7 +1212,11 @@ mod tests {
         "0x1800..0x19FF": { "name": "TPDO{i} communication parameter", "subs": {
             "1": { "name": "COB-ID used by TPDO{i}", "type": "u32" } } },
         "0x1801": { "name": "Special TPDO", "subs": { "2": { "name": "Transmission type", "type": "u8" } } },
-        "0x1A00:0": { "name": "Number of mapped objects", "type": "u8" }
+        "0x1A00:0": { "name": "Number of mapped objects", "type": "u8" },
+        "0x1600..0x17FF": { "name": "RPDO{i} mapping parameter", "subs": {
+            "0": { "name": "Number of mapped objects", "type": "u8" },
+            "1..64": { "name": "Mapped object {n}", "type": "u32" } } },
+        "0x1601:0": { "name": "Number of entries", "type": "u8", "access": "ro" }
       },
       "aliases": { "P-speed": "0x2005:3" },
       "alias_rules": [ { "pattern": "H{xx:hex}-{yy}", "index": "0x2000 + xx", "sub": "yy + 1" } ],
@@ -1241,6 +1271,16 @@ mod tests {
         assert_eq!(p.object(0x1801, 1), None);
         assert_eq!(p.object(0x1801, 2).unwrap().name, "Transmission type");
         assert_eq!(p.object(0x1A00, 0).unwrap().name, "Number of mapped objects");
+        // A record range without {i} in its subs is kept once, not per index.
+        assert_eq!(p.ranges.len(), 1);
+        assert_eq!(p.object_names[&0x17FF], "RPDO512 mapping parameter");
+        assert_eq!(p.object(0x17FF, 64).unwrap().name, "Mapped object 64");
+        assert_eq!(p.object(0x17FF, 65), None);
+        // A flat key inside the range changes one sub and keeps the others.
+        assert_eq!(p.object(0x1601, 0).unwrap().name, "Number of entries");
+        assert_eq!(p.object(0x1601, 0).unwrap().access, Access::Ro);
+        assert_eq!(p.object(0x1601, 2).unwrap().name, "Mapped object 2");
+        assert_eq!(p.object(0x1602, 0).unwrap().name, "Number of mapped objects");
         assert_eq!(p.aliases.get("P-speed"), Some(&(0x2005, 3)));
         assert_eq!(p.alias_rules[0].apply("H12-20"), Some((0x2012, 21)));
         assert_eq!(
@@ -1336,7 +1376,7 @@ mod tests {
             "nonsense": { "name": "N" },
             "0x2000": { "type": "u8" },
             "0x1016": { "name": "HB", "subs": { "9..1": { "name": "x" }, "1": { "name": "Consumer 1" } } },
-            "0x0000..0xFFFF": { "name": "huge", "subs": { "0..255": { "name": "x" } } },
+            "0x0000..0xFFFF": { "name": "huge", "subs": { "0..255": { "name": "x{i}" } } },
             "0x3000..0x2000": { "name": "backwards" }
           },
           "alias_rules": [ { "pattern": "F{x}{y}", "index": "x" }, { "pattern": "P{x}", "index": "x +" } ],

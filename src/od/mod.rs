@@ -7,6 +7,8 @@
 //! pure data: loading takes text and returns values plus warnings.
 
 pub mod alias;
+pub mod bind;
+pub mod eds;
 pub mod expr;
 pub mod fields;
 pub mod json;
@@ -14,6 +16,7 @@ pub mod procedure;
 mod value;
 
 pub use alias::{AliasRule, resolve_object};
+pub use bind::Bindings;
 pub use expr::Expr;
 pub use fields::{ByteField, SdoCommand, SdoDirection};
 pub use procedure::{Procedure, Step};
@@ -74,7 +77,7 @@ pub struct ObjectInfo {
     pub bits: BTreeMap<u8, String>,
     /// Whether the entry may be mapped into PDOs.
     pub pdo: PdoMappable,
-    /// Factory default value.
+    /// Default value (from an EDS `DefaultValue`, or a DCF's configured `ParameterValue`).
     pub default: Option<Value>,
     /// Lowest allowed raw value.
     pub min: Option<i64>,
@@ -291,6 +294,9 @@ pub struct Profile {
     pub node_name: Option<String>,
     /// Objects by (index, sub). Single-valued objects use sub 0.
     pub objects: BTreeMap<(u16, u8), ObjectInfo>,
+    /// Families of identical records over index ranges (PDO/SDO parameters),
+    /// used for an index that has no entry in `objects`.
+    pub ranges: Vec<IndexRange>,
     /// Vendor EMCY code texts by exact code.
     pub emcy_codes: BTreeMap<u16, String>,
     /// Default RPDO mappings by PDO number (1-based).
@@ -299,27 +305,52 @@ pub struct Profile {
     pub tpdo: BTreeMap<u8, PdoMapping>,
 }
 
+/// Identical records at every index of a range, stored once.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct IndexRange {
+    /// First index.
+    pub first: u16,
+    /// Last index (inclusive).
+    pub last: u16,
+    /// The sub-entries every index in the range has.
+    pub subs: BTreeMap<u8, ObjectInfo>,
+}
+
 impl Profile {
-    /// The entry at (index, sub), falling back to sub 0 for the name of a record/array.
+    /// The entry at (index, sub): from `objects`, or from an index range when
+    /// `objects` has nothing at that index.
     pub fn object(&self, index: u16, sub: u8) -> Option<&ObjectInfo> {
-        self.objects.get(&(index, sub))
+        if let Some(o) = self.objects.get(&(index, sub)) {
+            return Some(o);
+        }
+        if self.objects.range((index, 0)..=(index, 255)).next().is_some() {
+            return None;
+        }
+        self.range_of(index).and_then(|r| r.subs.get(&sub))
+    }
+
+    /// The last-defined index range containing `index`.
+    fn range_of(&self, index: u16) -> Option<&IndexRange> {
+        self.ranges.iter().rev().find(|r| (r.first..=r.last).contains(&index))
+    }
+
+    /// Copies an index range's entries for `index` into `objects`, so that single
+    /// entries can then be changed there.
+    pub fn materialize(&mut self, index: u16) {
+        if self.objects.range((index, 0)..=(index, 255)).next().is_some() {
+            return;
+        }
+        let Some(subs) = self.range_of(index).map(|r| r.subs.clone()) else {
+            return;
+        };
+        for (sub, info) in subs {
+            self.objects.insert((index, sub), info);
+        }
     }
 
     /// The default PDO set (the one marked default, else the first).
     pub fn default_pdo_set(&self) -> Option<&PdoSet> {
         self.pdo_sets.iter().find(|s| s.default).or(self.pdo_sets.first())
-    }
-
-    /// A copy placed on `node`: `rpdo`/`tpdo` are the default set's mappings with
-    /// COB-IDs worked out for that node.
-    pub fn for_node(&self, node: u8) -> Profile {
-        let mut p = self.clone();
-        if let Some(set) = self.default_pdo_set() {
-            let source = MappingSource::Profile(self.name.clone());
-            p.rpdo = set.mappings(false, Some(node), &source);
-            p.tpdo = set.mappings(true, Some(node), &source);
-        }
-        p
     }
 
     /// Whether the identity values (`read(index, sub)`) match all identification
