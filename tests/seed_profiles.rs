@@ -105,3 +105,20 @@ fn aqmd_modbus_registers_map_to_objects() {
     assert_eq!(rate.values[&0], "10 kbit/s");
     assert_eq!(rate.values[&7], "1 Mbit/s");
 }
+
+#[test]
+fn identity_values_suggest_the_profile() {
+    use cotui::od::Value;
+    use cotui::od::bind::Bindings;
+    let mut b = Bindings::new().expect("built-ins");
+    let suggest = |b: &mut Bindings, index: u16, text: &str| {
+        let read = |i: u16, s: u8| (i == index && s == 0).then(|| Value::Text(text.to_string()));
+        b.identify(&read).map(|p| p.name.clone())
+    };
+    // AIMOTOR 2.1.1: "100A ... AIMOTOR_CIA402"
+    assert_eq!(suggest(&mut b, 0x100A, "AIMOTOR_CIA402").as_deref(), Some("aimotor"));
+    // Dexmart device name 1008h "DEV-N050CQ..." (OCR: "DLV-NO050CQ")
+    assert_eq!(suggest(&mut b, 0x1008, "DEV-N050CQ").as_deref(), Some("dexmart-dev"));
+    assert_eq!(suggest(&mut b, 0x1008, "AQMD2405BLS-MT-2").as_deref(), Some("aqmd2405"));
+    assert_eq!(suggest(&mut b, 0x1008, "SOMETHING ELSE"), None);
+}
