@@ -77,7 +77,9 @@ fn tpdo_save_and_sync() {
     assert!(x["sdo"]["value_text"].as_str().unwrap().ends_with("(save)"), "{x}");
     sdo(f.at(25, 0x581, "6010100200000000"), "sdo_tx", 1, 0x1010, 2, None);
     // event time 0x01F4 = 500 ms
-    sdo(f.at(26, 0x601, "2B001805F4010000"), "sdo_rx", 1, 0x1800, 5, Some(500));
+    let x = f.at(26, 0x601, "2B001805F4010000");
+    sdo(x, "sdo_rx", 1, 0x1800, 5, Some(500));
+    assert_eq!(x["sdo"]["value_text"], "500 ms");
     // 7.5.5: "SYNC 0x80, no data"
     let x = f.at(28, 0x080, "");
     assert_eq!((x["kind"].as_str(), x["node"].as_u64()), (Some("sync"), None));

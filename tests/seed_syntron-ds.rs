@@ -26,7 +26,9 @@ fn nmt_heartbeat_and_life_guarding() {
     assert_eq!(x["heartbeat"]["state"], "boot_up");
     // "602 2B 17 10 00 00 ..." heartbeat off, "602 2B 17 10 00 64 ..." 100 ms
     sdo(f.at(8, 0x602, "2B17100000000000"), "sdo_rx", 2, 0x1017, 0, Some(0));
-    sdo(f.at(9, 0x602, "2B17100064000000"), "sdo_rx", 2, 0x1017, 0, Some(100));
+    let x = f.at(9, 0x602, "2B17100064000000");
+    sdo(x, "sdo_rx", 2, 0x1017, 0, Some(100));
+    assert_eq!(x["sdo"]["value_text"], "100 ms");
     // Life guard example 1: "702 -" (remote request), "702 FF" (toggle 1, pre-operational), "702 7F" (toggle 0)
     let x = f.at(11, 0x702, "");
     assert_eq!(x["rtr"], true);
