@@ -11,4 +11,7 @@ pub mod hex;
 pub mod log;
 pub mod od;
 pub mod output;
+pub mod read_ahead;
+pub mod sdo_client;
+pub mod sdo_server;
 pub mod synth;

@@ -117,7 +117,8 @@ fn dcf_tolerances() {
     assert_eq!(p.object(0x1016, 2).unwrap().name, "Heartbeat of node 9");
     assert_eq!(p.object(0x1016, 3).unwrap().data_type, DataType::U32);
     assert!(p.object(0x1016, 4).is_none());
-    // 0x200+$NODEID, $NODEID + 0x190 (ParameterValue), mapping count from ParameterValue.
+    // 0x200+$NODEID, $NODEID + 0x190 (ParameterValue), mapping count from ParameterValue,
+    // [1a00sub01] with a leading zero.
     assert_eq!(p.rpdo[&1].cob_id, Some(0x205));
     assert_eq!(p.rpdo[&1].entries, vec![entry(0x6040, 0, 16), entry(0x6060, 0, 8)]);
     assert_eq!(p.tpdo[&1].cob_id, Some(0x195));

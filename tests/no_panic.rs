@@ -1,6 +1,7 @@
 //! Arbitrary text never makes the profile loader, the EDS importer or the
 //! expression/alias parsers panic.
 
+use cotui::od::bind::BUILTIN;
 use cotui::od::eds::import;
 use cotui::od::expr::Expr;
 use cotui::od::json::load_profile;
@@ -64,6 +65,16 @@ proptest! {
     }
 
     #[test]
+    fn mutated_builtin_profiles_never_panic(at in 0usize..40_000, len in 0usize..40, with in ".{0,3}") {
+        for (_, text) in BUILTIN {
+            let start = floor_char(text, at.min(text.len()));
+            let end = floor_char(text, (start + len).min(text.len()));
+            let mutated = format!("{}{with}{}", &text[..start], &text[end..]);
+            let _ = load_profile("mutated.json", &mutated);
+        }
+    }
+
+    #[test]
     fn expressions_never_panic(text in "[-+*/%()<>=!&|^~?: a-z0-9x]{0,40}", x in any::<i64>()) {
         if let Ok(e) = Expr::parse(&text) {
             let _ = e.eval(&|_| Some(x));
@@ -76,6 +87,14 @@ proptest! {
         let b = Bindings::new().unwrap();
         let _ = resolve_object(b.dictionary(1), &text);
     }
+}
+
+/// The largest char boundary at or below `i`.
+fn floor_char(text: &str, mut i: usize) -> usize {
+    while !text.is_char_boundary(i) {
+        i -= 1;
+    }
+    i
 }
 
 #[test]

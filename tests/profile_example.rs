@@ -128,3 +128,38 @@ fn procedures_and_identification() {
     };
     assert!(d.layers()[1].identifies(&id));
 }
+
+#[test]
+fn doc_examples_load_without_warnings() {
+    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/PROFILE_FORMAT.md")).unwrap();
+    let blocks: Vec<&str> = doc
+        .split("```json\n")
+        .skip(1)
+        .filter_map(|b| b.split("```").next())
+        .collect();
+    // The fragments (except the top-level outline) together form one profile.
+    let (mut objects, mut top, mut rules) = (Vec::new(), Vec::new(), Vec::new());
+    for block in blocks.iter().map(|b| b.trim()).filter(|b| !b.contains("...")) {
+        if block.starts_with("\"0x") {
+            objects.push(block);
+        } else if block.starts_with("{ \"pattern\"") {
+            rules.push(block);
+        } else {
+            top.push(block);
+        }
+    }
+    assert_eq!((objects.len(), rules.len(), top.len()), (1, 1, 6));
+    let text = format!(
+        "{{\"name\": \"doc\", \"objects\": {{ {} }}, {} }}",
+        objects.join(","),
+        top.join(",")
+    );
+    let (p, w) = load_profile("doc", &text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+    assert_eq!(w, vec![]);
+    assert_eq!(p.procedures["pv"].steps.len(), 10);
+    assert_eq!(p.axes.len(), 2);
+    let text = format!("{{\"name\": \"doc\", \"alias_rules\": [ {} ] }}", rules.join(","));
+    let (p, w) = load_profile("doc", &text).unwrap();
+    assert_eq!(w, vec![]);
+    assert_eq!(p.alias_rules[0].apply("R7060"), Some((0x5060, 0)));
+}

@@ -366,3 +366,95 @@ fn aimotor_manual_errors_are_flagged() {
         Outcome::ProtocolError("unexpected download_segment frame from the server".into())
     );
 }
+
+/// Syn-tron PDO mapping procedures (3-28..3-30), request frames as listed, with the manual's notes:
+/// RPDO1 "stop", "60FFh RPDO1 sub1", "enable"; RPDO2 "6040h RPDO2 sub1", "60FFh RPDO2 sub2";
+/// TPDO1 "6041h", event timer / inhibit time 0x32, transmission type "254"; TPDO2 "6063h", "6069h".
+#[test]
+fn syntron_pdo_mapping_frames() {
+    let frames: [(&str, u16, u8, u64); 20] = [
+        ("602 2F 00 16 00 00 00 00 00", 0x1600, 0, 0),
+        ("602 23 00 16 01 20 00 FF 60", 0x1600, 1, 0x60FF_0020),
+        ("602 2F 00 16 00 01 00 00 00", 0x1600, 0, 1),
+        ("602 2F 01 16 00 00 00 00 00", 0x1601, 0, 0),
+        ("602 23 01 16 01 10 00 40 60", 0x1601, 1, 0x6040_0010),
+        ("602 23 01 16 02 20 00 FF 60", 0x1601, 2, 0x60FF_0020),
+        ("602 2F 01 16 00 02 00 00 00", 0x1601, 0, 2),
+        ("602 2F 00 1A 00 00 00 00 00", 0x1A00, 0, 0),
+        ("602 23 00 1A 01 10 00 41 60", 0x1A00, 1, 0x6041_0010),
+        ("602 2F 00 1A 00 01 00 00 00", 0x1A00, 0, 1),
+        ("602 2F 00 18 05 32 00 00 00", 0x1800, 5, 0x32),
+        ("602 2F 00 18 03 32 00 00 00", 0x1800, 3, 0x32),
+        ("602 2F 00 18 02 FE 00 00 00", 0x1800, 2, 254),
+        ("602 2F 01 1A 00 00 00 00 00", 0x1A01, 0, 0),
+        ("602 23 01 1A 01 20 00 63 60", 0x1A01, 1, 0x6063_0020),
+        ("602 23 01 1A 02 20 00 69 60", 0x1A01, 2, 0x6069_0020),
+        ("602 2F 01 1A 00 02 00 00 00", 0x1A01, 0, 2),
+        ("602 2F 01 18 05 32 00 00 00", 0x1801, 5, 0x32),
+        ("602 2F 01 18 03 32 00 00 00", 0x1801, 3, 0x32),
+        ("602 2F 01 18 02 FE 00 00 00", 0x1801, 2, 254),
+    ];
+    let mut t = SdoTracker::new();
+    let dict = Dictionary::default();
+    for (i, (line, index, sub, value)) in frames.iter().enumerate() {
+        let bytes: Vec<u8> = line
+            .split_whitespace()
+            .skip(1)
+            .map(|w| u8::from_str_radix(w, 16).unwrap())
+            .collect();
+        let j = t.on_frame(i as u64, i as u64, 2, true, &bytes, &dict).to_json();
+        assert_eq!(j["cs"], "initiate_download", "{line}");
+        assert_eq!(j["expedited"], true, "{line}");
+        assert_eq!(
+            (j["index"].as_u64(), j["sub"].as_u64()),
+            (Some(*index as u64), Some(*sub as u64)),
+            "{line}"
+        );
+        assert_eq!(j["value"].as_u64(), Some(*value), "{line}");
+    }
+}
+
+/// AIMOTOR PDO remapping list: "601 23 00 14 01 01 02 00 80" ... "601 23 03 18 01 81 04 00 80"
+/// (COB-IDs of RPDO1-4 / TPDO1-4 with bit 31 set), each answered "581 60 <index> <sub> 00 00 00 00";
+/// OCR ran some bytes together ("0114", "8101"), split here. The manual answers
+/// "601 23 01 18 01 81 02 00 80" with "581 60 01 14 01", a copy error flagged as unmatched.
+#[test]
+fn aimotor_cob_id_list() {
+    let mut t = Trace::new();
+    let pairs = [
+        ("601 23 00 14 01 01 02 00 80", "581 60 00 14 01 00 00 00 00"),
+        ("601 23 01 14 01 01 03 00 80", "581 60 01 14 01 00 00 00 00"),
+        ("601 23 02 14 01 01 04 00 80", "581 60 02 14 01 00 00 00 00"),
+        ("601 23 03 14 01 01 05 00 80", "581 60 03 14 01 00 00 00 00"),
+        ("601 23 00 18 01 81 01 00 80", "581 60 00 18 01 00 00 00 00"),
+        ("601 23 01 18 01 81 02 00 80", "581 60 01 14 01 00 00 00 00"),
+        ("601 23 02 18 01 81 03 00 80", "581 60 02 18 01 00 00 00 00"),
+        ("601 23 03 18 01 81 04 00 80", "581 60 03 18 01 00 00 00 00"),
+    ];
+    for (req, resp) in pairs {
+        t.feed(req);
+        t.feed(resp);
+    }
+    let v = t.done();
+    assert_eq!(v.len(), 8);
+    let cob_ids: Vec<u32> = v
+        .iter()
+        .map(|tr| u32::from_le_bytes(tr.data.clone().try_into().unwrap()))
+        .collect();
+    assert_eq!(
+        cob_ids,
+        [
+            0x8000_0201,
+            0x8000_0301,
+            0x8000_0401,
+            0x8000_0501,
+            0x8000_0181,
+            0x8000_0281,
+            0x8000_0381,
+            0x8000_0481
+        ]
+    );
+    let flagged: Vec<usize> = (0..8).filter(|i| !v[*i].problems.is_empty()).collect();
+    assert_eq!(flagged, vec![5]);
+    assert_eq!(v[5].problems, vec![Problem::UnmatchedResponse]);
+}

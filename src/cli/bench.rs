@@ -21,6 +21,9 @@ pub struct BenchArgs {
     /// Print the figures as one JSON object.
     #[arg(long)]
     pub json: bool,
+    /// Only write the generated log to this file (for profiling or tests) and exit.
+    #[arg(long, value_name = "FILE")]
+    pub write_log: Option<PathBuf>,
 }
 
 /// One measured run.
@@ -103,6 +106,9 @@ pub fn run(args: &BenchArgs) -> i32 {
 }
 
 fn bench(args: &BenchArgs) -> std::io::Result<()> {
+    if let Some(path) = &args.write_log {
+        return write_log(path, args.frames);
+    }
     let exe = std::env::current_exe()?;
     let dir = std::env::temp_dir().join(format!("cotui-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;

@@ -2,9 +2,10 @@
 
 use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
 use crate::decode::{Decoder, sdo::Transaction};
-use crate::frame::Frame;
-use crate::log::{LogReader, Outcome};
+use crate::frame::{Frame, Interfaces};
+use crate::log::Outcome;
 use crate::output::{jsonl, summary::Summary, text};
+use crate::read_ahead;
 use clap::{Args, ValueEnum};
 use std::io::{self, BufRead, BufReader, Write};
 
@@ -69,7 +70,7 @@ pub fn run(args: &DecodeArgs) -> i32 {
     let mut summary = Summary::default();
     let mut status = EXIT_OK;
     for path in &args.files {
-        let input: Box<dyn BufRead> = if path == "-" {
+        let input: Box<dyn BufRead + Send> = if path == "-" {
             Box::new(BufReader::with_capacity(1 << 16, io::stdin()))
         } else {
             match std::fs::File::open(path) {
@@ -100,55 +101,59 @@ pub fn run(args: &DecodeArgs) -> i32 {
     }
 }
 
-/// Decodes one input into `out`.
+/// Decodes one input into `out` (parsing runs on a second thread).
 fn decode_stream(
     path: &str,
-    input: Box<dyn BufRead>,
+    input: Box<dyn BufRead + Send>,
     decoder: &mut Decoder,
     mode: Mode,
     summary: &mut Summary,
     out: &mut impl Write,
 ) -> io::Result<()> {
-    let mut reader = LogReader::new(input)?;
-    let mut buf = String::with_capacity(1 << 12);
-    while let Some((line, outcome)) = reader.next_line()? {
-        let frame: Frame = match outcome {
-            Outcome::Frame(f) => f,
-            Outcome::Skip(_) => continue,
-            Outcome::Warning(msg) => {
-                eprintln!("{path}:{line}: warning: {msg}");
-                continue;
-            }
-        };
-        match mode {
-            Mode::Summary(_) => {
-                let (kind, node) = decoder.classify(&frame);
-                summary.add(kind, node);
-            }
-            Mode::Frames(OutputFormat::Text) => {
-                let d = decoder.decode(&frame);
-                text::write_line(&mut buf, &frame, reader.interfaces(), &d);
-            }
-            Mode::Frames(OutputFormat::Jsonl) => {
-                let d = decoder.decode(&frame);
-                let j = jsonl::frame_json(line, &frame, reader.interfaces(), &d);
-                buf.push_str(&j.to_string());
-                buf.push('\n');
-            }
-            Mode::Transactions(fmt) => {
-                decoder.decode(&frame);
-                for t in decoder.take_transactions() {
-                    write_transaction(&mut buf, &t, decoder, fmt);
+    let mut buf = String::with_capacity(1 << 16);
+    let mut ifaces = Interfaces::default();
+    let finished = read_ahead::for_each_batch(input, |batch| -> io::Result<()> {
+        if let Some(i) = &batch.interfaces {
+            ifaces = i.clone();
+        }
+        for (line, outcome) in &batch.lines {
+            let frame: &Frame = match outcome {
+                Outcome::Frame(f) => f,
+                Outcome::Skip(_) => continue,
+                Outcome::Warning(msg) => {
+                    eprintln!("{path}:{line}: warning: {msg}");
+                    continue;
+                }
+            };
+            match mode {
+                Mode::Summary(_) => {
+                    let (kind, node) = decoder.classify(frame);
+                    summary.add(kind, node);
+                }
+                Mode::Frames(OutputFormat::Text) => {
+                    let d = decoder.decode(frame);
+                    text::write_line(&mut buf, frame, &ifaces, &d);
+                }
+                Mode::Frames(OutputFormat::Jsonl) => {
+                    let d = decoder.decode(frame);
+                    jsonl::write_frame(&mut buf, *line, frame, &ifaces, &d);
+                }
+                Mode::Transactions(fmt) => {
+                    decoder.decode(frame);
+                    for t in decoder.take_transactions() {
+                        write_transaction(&mut buf, &t, decoder, fmt);
+                    }
                 }
             }
         }
-        if buf.len() >= 1 << 15 {
-            out.write_all(buf.as_bytes())?;
-            buf.clear();
-        }
+        out.write_all(buf.as_bytes())?;
+        buf.clear();
+        Ok(())
+    })??;
+    if let Some(e) = finished.error {
+        return Err(e);
     }
-    out.write_all(buf.as_bytes())?;
-    let c = reader.counts();
+    let c = finished.counts;
     if c.warnings > 0 || c.skipped_total() > 0 {
         eprintln!(
             "{path}: {} frames, {} lines skipped, {} malformed lines",

@@ -36,6 +36,21 @@ struct Ini {
     sections: BTreeMap<String, Section>,
 }
 
+impl Ini {
+    /// The `[IIIIsubS]` sections of an object, by sub.
+    fn sub_sections(&self, index: u16) -> BTreeMap<u8, &Section> {
+        let prefix = format!("{index:04x}sub");
+        self.sections
+            .range(prefix.clone()..)
+            .take_while(|(name, _)| name.starts_with(&prefix))
+            .filter_map(|(name, sec)| match section_index(name) {
+                Some((i, Some(sub))) if i == index => Some((sub, sec)),
+                _ => None,
+            })
+            .collect()
+    }
+}
+
 /// Splits the text into sections; malformed lines become warnings.
 fn parse_ini(text: &str, w: &mut Vec<(usize, String)>) -> Ini {
     let mut sections: BTreeMap<String, Section> = BTreeMap::new();
@@ -118,13 +133,14 @@ fn parse_plain(t: &str) -> Option<i64> {
     }
 }
 
-/// An object or sub-object section name: `1018` or `1018sub1` (hex, any case).
+/// An object or sub-object section name: `1018` or `1018sub1` (hex, any case,
+/// leading zeros allowed: `1018sub01`).
 fn section_index(name: &str) -> Option<(u16, Option<u8>)> {
     let hex4 = |t: &str| {
         (t.len() == 4 && t.bytes().all(|b| b.is_ascii_hexdigit())).then(|| u16::from_str_radix(t, 16).ok())?
     };
     match name.split_once("sub") {
-        Some((i, s)) if !s.is_empty() && s.len() <= 2 => Some((hex4(i)?, Some(u8::from_str_radix(s, 16).ok()?))),
+        Some((i, s)) if !s.is_empty() && s.len() <= 4 => Some((hex4(i)?, Some(u8::from_str_radix(s, 16).ok()?))),
         Some(_) => None,
         None => Some((hex4(name)?, None)),
     }
@@ -388,13 +404,11 @@ fn import_object(im: &mut Importer, ini: &Ini, p: &mut Profile, index: u16, sec:
                 return;
             }
             let mut found = 0;
-            for sub in 0..=255u8 {
-                if let Some(s) = ini.sections.get(&format!("{index:04x}sub{sub:x}")) {
-                    let info = im.entry(s, &format!("{name} sub {sub}"));
-                    p.objects.insert((index, sub), info);
-                    im.lines.insert((index, sub), s.line);
-                    found += 1;
-                }
+            for (sub, s) in ini.sub_sections(index) {
+                let info = im.entry(s, &format!("{name} sub {sub}"));
+                p.objects.insert((index, sub), info);
+                im.lines.insert((index, sub), s.line);
+                found += 1;
             }
             if found == 0 {
                 im.warn(

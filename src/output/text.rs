@@ -2,25 +2,55 @@
 
 use crate::decode::Decoded;
 use crate::frame::{Frame, Interfaces};
-use std::fmt::Write;
+
+/// Appends `v` in decimal, zero-padded to at least `width` digits.
+fn push_decimal(out: &mut String, mut v: u64, width: usize) {
+    let mut buf = [b'0'; 20];
+    let mut i = buf.len();
+    while v > 0 || buf.len() - i < width.max(1) {
+        i -= 1;
+        buf[i] = b'0' + (v % 10) as u8;
+        v /= 10;
+    }
+    buf[i..].iter().for_each(|b| out.push(*b as char));
+}
+
+/// Appends the low `digits` hex digits of `v`, upper case.
+fn push_hex(out: &mut String, v: u32, digits: u32) {
+    for i in (0..digits).rev() {
+        out.push(char::from(b"0123456789ABCDEF"[(v >> (4 * i) & 0xF) as usize]));
+    }
+}
 
 /// Appends one line (with `\n`) for `frame`:
 /// `(1700000000.123456)  can0  181   [8]  37 02 00 00 00 00 00 00  TPDO1 node 1: ...`.
 /// A frame that breaks its kind's rules ends with `  !! <reason>`.
 pub fn write_line(out: &mut String, frame: &Frame, ifaces: &Interfaces, decoded: &Decoded) {
-    let secs = frame.ts_ns / 1_000_000_000;
-    let usecs = frame.ts_ns % 1_000_000_000 / 1000;
-    let _ = write!(out, "({secs:010}.{usecs:06})  {:>4}  ", ifaces.name(frame.iface));
+    out.push('(');
+    push_decimal(out, frame.ts_ns / 1_000_000_000, 10);
+    out.push('.');
+    push_decimal(out, frame.ts_ns % 1_000_000_000 / 1000, 6);
+    out.push_str(")  ");
+    let name = ifaces.name(frame.iface);
+    for _ in name.len()..4 {
+        out.push(' ');
+    }
+    out.push_str(name);
+    out.push_str("  ");
     if frame.is_ext() || frame.is_err() {
-        let _ = write!(out, "{:08X}", frame.id);
+        push_hex(out, frame.id, 8);
     } else {
-        let _ = write!(out, "     {:03X}", frame.id);
+        out.push_str("     ");
+        push_hex(out, frame.id, 3);
     }
     if frame.is_fd() {
-        let _ = write!(out, "  [{:02}]  ", frame.len);
+        out.push_str("  [");
+        push_decimal(out, frame.len as u64, 2);
     } else {
-        let _ = write!(out, "   [{}]  ", frame.len);
+        out.push_str("   [");
+        push_decimal(out, frame.len as u64, 1);
     }
+    out.push_str("]  ");
     let width = if frame.is_fd() { 3 * frame.len as usize } else { 24 };
     let start = out.len();
     if frame.is_rtr() {
@@ -61,6 +91,17 @@ mod tests {
         let mut s = String::new();
         write_line(&mut s, &frame, &ifaces, &d);
         s
+    }
+
+    #[test]
+    fn number_formatting() {
+        let mut s = String::new();
+        push_decimal(&mut s, 42, 6);
+        push_decimal(&mut s, 0, 1);
+        push_decimal(&mut s, 1234567, 2);
+        push_hex(&mut s, 0x1ABCDEF, 8);
+        push_hex(&mut s, 0x7E5, 3);
+        assert_eq!(s, "00004201234567".to_string() + "01ABCDEF7E5");
     }
 
     #[test]

@@ -3,8 +3,9 @@
 /// Text used for codes CiA 301 does not define.
 pub const UNKNOWN_ABORT_TEXT: &str = "unknown abort code";
 
-/// Every abort code CiA 301 defines, with its text as the standard words it
-/// (the standard's trailing full stops are left out so texts fit in labels).
+/// Every abort code CiA 301 defines, with its text as the standard words it, grammar
+/// included ("an hardware error"). The standard's trailing full stops are left out so
+/// texts end cleanly in labels.
 pub const ABORT_CODES: &[(u32, &str)] = &[
     (0x0503_0000, "Toggle bit not alternated"),
     (0x0504_0000, "SDO protocol timed out"),
@@ -24,7 +25,7 @@ pub const ABORT_CODES: &[(u32, &str)] = &[
     ),
     (0x0604_0043, "General parameter incompatibility reason"),
     (0x0604_0047, "General internal incompatibility in the device"),
-    (0x0606_0000, "Access failed due to a hardware error"),
+    (0x0606_0000, "Access failed due to an hardware error"),
     (
         0x0607_0010,
         "Data type does not match, length of service parameter does not match",
@@ -56,7 +57,7 @@ pub const ABORT_CODES: &[(u32, &str)] = &[
     (
         0x0800_0023,
         "Object dictionary dynamic generation fails or no object dictionary is present \
-         (e.g. object dictionary is generated from file and generation fails because of a file error)",
+         (e.g. object dictionary is generated from file and generation fails because of an file error)",
     ),
     (0x0800_0024, "No data available"),
 ];
@@ -121,6 +122,7 @@ mod tests {
         assert_eq!(abort_text(0x060A_0023), "Resource not available: SDO connection");
         assert_eq!(abort_text(0x0800_0024), "No data available");
         assert!(abort_text(0x0800_0023).starts_with("Object dictionary dynamic generation fails"));
+        assert_eq!(abort_text(0x0606_0000), "Access failed due to an hardware error");
     }
 
     #[test]

@@ -382,6 +382,121 @@ pub fn decode(side: Side, payload: &[u8], block_segments: bool) -> SdoCommand {
     }
 }
 
+/// Builds the 8-byte payload of a command (the inverse of [`decode`]).
+/// Unused bytes are zero; expedited data and segment data set `n` from their length.
+pub fn encode(cmd: &SdoCommand) -> [u8; 8] {
+    use SdoCommand::*;
+    let mut p = [0u8; 8];
+    let head = |p: &mut [u8; 8], c: u8, index: u16, sub: u8| {
+        p[0] = c;
+        p[1..3].copy_from_slice(&index.to_le_bytes());
+        p[3] = sub;
+    };
+    let put32 = |p: &mut [u8; 8], v: u32| p[4..8].copy_from_slice(&v.to_le_bytes());
+    let seg = |p: &mut [u8; 8], c: u8, data: &Chunk| {
+        let d = data.bytes();
+        p[0] = c | ((7 - d.len() as u8) << 1);
+        p[1..1 + d.len()].copy_from_slice(d);
+    };
+    let initiate =
+        |p: &mut [u8; 8], base: u8, index: u16, sub: u8, expedited: bool, size: Option<u32>, data: &Chunk| {
+            if expedited {
+                let d = data.bytes();
+                let sized = if size.is_some() {
+                    0x01 | ((4 - d.len().min(4) as u8) << 2)
+                } else {
+                    0
+                };
+                head(p, base | 0x02 | sized, index, sub);
+                p[4..4 + d.len().min(4)].copy_from_slice(&d[..d.len().min(4)]);
+            } else {
+                head(p, base | size.is_some() as u8, index, sub);
+                put32(p, size.unwrap_or(0));
+            }
+        };
+    match cmd {
+        InitiateDownload {
+            index,
+            sub,
+            expedited,
+            size,
+            data,
+        } => initiate(&mut p, 0x20, *index, *sub, *expedited, *size, data),
+        InitiateDownloadResponse { index, sub } => head(&mut p, 0x60, *index, *sub),
+        DownloadSegment { toggle, last, data } => seg(&mut p, (*toggle as u8) << 4 | *last as u8, data),
+        DownloadSegmentResponse { toggle } => p[0] = 0x20 | (*toggle as u8) << 4,
+        InitiateUpload { index, sub } => head(&mut p, 0x40, *index, *sub),
+        InitiateUploadResponse {
+            index,
+            sub,
+            expedited,
+            size,
+            data,
+        } => initiate(&mut p, 0x40, *index, *sub, *expedited, *size, data),
+        UploadSegment { toggle } => p[0] = 0x60 | (*toggle as u8) << 4,
+        UploadSegmentResponse { toggle, last, data } => seg(&mut p, (*toggle as u8) << 4 | *last as u8, data),
+        Abort { index, sub, code } => {
+            head(&mut p, 0x80, *index, *sub);
+            put32(&mut p, *code);
+        }
+        BlockDownloadInitiate { index, sub, crc, size } => {
+            head(
+                &mut p,
+                0xC0 | (*crc as u8) << 2 | (size.is_some() as u8) << 1,
+                *index,
+                *sub,
+            );
+            put32(&mut p, size.unwrap_or(0));
+        }
+        BlockDownloadInitiateResponse {
+            index,
+            sub,
+            crc,
+            blksize,
+        } => {
+            head(&mut p, 0xA0 | (*crc as u8) << 2, *index, *sub);
+            p[4] = *blksize;
+        }
+        BlockDownloadAck { ackseq, blksize } | BlockUploadAck { ackseq, blksize } => {
+            p[0] = 0xA2;
+            p[1] = *ackseq;
+            p[2] = *blksize;
+        }
+        BlockDownloadEnd { unused, crc } | BlockUploadEnd { unused, crc } => {
+            p[0] = 0xC1 | (unused & 7) << 2;
+            p[1..3].copy_from_slice(&crc.to_le_bytes());
+        }
+        BlockDownloadEndResponse | BlockUploadEndResponse => p[0] = 0xA1,
+        BlockUploadInitiate {
+            index,
+            sub,
+            crc,
+            blksize,
+            pst,
+        } => {
+            head(&mut p, 0xA0 | (*crc as u8) << 2, *index, *sub);
+            p[4] = *blksize;
+            p[5] = *pst;
+        }
+        BlockUploadInitiateResponse { index, sub, crc, size } => {
+            head(
+                &mut p,
+                0xC0 | (*crc as u8) << 2 | (size.is_some() as u8) << 1,
+                *index,
+                *sub,
+            );
+            put32(&mut p, size.unwrap_or(0));
+        }
+        BlockUploadStart => p[0] = 0xA3,
+        BlockSegment { seqno, last, data } => {
+            p[0] = (seqno & 0x7F) | (*last as u8) << 7;
+            p[1..1 + data.bytes().len()].copy_from_slice(data.bytes());
+        }
+        Unknown { command } => p[0] = *command,
+    }
+    p
+}
+
 /// One decoded SDO frame with what the tracker and dictionary add to it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SdoFrame {
@@ -543,7 +658,11 @@ impl SdoFrame {
         s
     }
 
-    /// JSON fragment: `cs`, `index`, `sub`, `abort_code`, `abort_text` and the decoded fields.
+    /// JSON fragment: `cs`, `side`, `index`, `sub`, `abort_code`, `abort_text`, `malformed` and the
+    /// decoded fields (`expedited`, `size`, `toggle`, `last`, `data`, `seqno`, `ackseq`, `blksize`,
+    /// `pst`, `crc_supported`, `unused`, `crc`, `block_step`, `name`, `value`, `value_text`,
+    /// `problems`). `index`/`sub` are the frame's own or, for segments and block steps, those of
+    /// the transfer the tracker puts the frame in (null when unknown).
     pub fn to_json(&self) -> Json {
         use SdoCommand::*;
         let (index, sub) = match self.object {
@@ -1054,5 +1173,165 @@ mod tests {
         assert_eq!(f.label(), "Download segment t=0 FF 00 10 00 00 00 00 c=1");
         assert_eq!(f.to_json()["toggle"], 0);
         assert_eq!(f.to_json()["last"], true);
+    }
+
+    #[test]
+    fn encode_is_the_inverse_of_decode() {
+        let d = chunk(&[1, 2, 3]);
+        let cases: Vec<(Side, bool, SdoCommand)> = vec![
+            (
+                Side::Client,
+                false,
+                InitiateDownload {
+                    index: 0x6040,
+                    sub: 0,
+                    expedited: true,
+                    size: Some(3),
+                    data: d,
+                },
+            ),
+            (
+                Side::Client,
+                false,
+                InitiateDownload {
+                    index: 0x6040,
+                    sub: 0,
+                    expedited: true,
+                    size: None,
+                    data: chunk(&[1, 2, 3, 4]),
+                },
+            ),
+            (
+                Side::Client,
+                false,
+                InitiateDownload {
+                    index: 0x1008,
+                    sub: 0,
+                    expedited: false,
+                    size: Some(99),
+                    data: Chunk::default(),
+                },
+            ),
+            (Side::Server, false, InitiateDownloadResponse { index: 0x1008, sub: 2 }),
+            (
+                Side::Client,
+                false,
+                DownloadSegment {
+                    toggle: true,
+                    last: true,
+                    data: d,
+                },
+            ),
+            (Side::Server, false, DownloadSegmentResponse { toggle: true }),
+            (Side::Client, false, InitiateUpload { index: 0x1018, sub: 4 }),
+            (
+                Side::Server,
+                false,
+                InitiateUploadResponse {
+                    index: 0x1018,
+                    sub: 4,
+                    expedited: true,
+                    size: Some(3),
+                    data: d,
+                },
+            ),
+            (
+                Side::Server,
+                false,
+                InitiateUploadResponse {
+                    index: 0x1018,
+                    sub: 4,
+                    expedited: false,
+                    size: None,
+                    data: Chunk::default(),
+                },
+            ),
+            (Side::Client, false, UploadSegment { toggle: true }),
+            (
+                Side::Server,
+                false,
+                UploadSegmentResponse {
+                    toggle: false,
+                    last: true,
+                    data: d,
+                },
+            ),
+            (
+                Side::Server,
+                false,
+                Abort {
+                    index: 0x1000,
+                    sub: 0,
+                    code: 0x0504_0001,
+                },
+            ),
+            (
+                Side::Client,
+                false,
+                BlockDownloadInitiate {
+                    index: 0x1F50,
+                    sub: 1,
+                    crc: true,
+                    size: Some(900),
+                },
+            ),
+            (
+                Side::Server,
+                false,
+                BlockDownloadInitiateResponse {
+                    index: 0x1F50,
+                    sub: 1,
+                    crc: false,
+                    blksize: 9,
+                },
+            ),
+            (Side::Server, false, BlockDownloadAck { ackseq: 4, blksize: 9 }),
+            (Side::Client, false, BlockDownloadEnd { unused: 6, crc: 0xBEEF }),
+            (Side::Server, false, BlockDownloadEndResponse),
+            (
+                Side::Client,
+                false,
+                BlockUploadInitiate {
+                    index: 0x1008,
+                    sub: 0,
+                    crc: true,
+                    blksize: 127,
+                    pst: 4,
+                },
+            ),
+            (
+                Side::Server,
+                false,
+                BlockUploadInitiateResponse {
+                    index: 0x1008,
+                    sub: 0,
+                    crc: true,
+                    size: None,
+                },
+            ),
+            (Side::Client, false, BlockUploadStart),
+            (
+                Side::Client,
+                false,
+                BlockUploadAck {
+                    ackseq: 127,
+                    blksize: 64,
+                },
+            ),
+            (Side::Server, false, BlockUploadEnd { unused: 1, crc: 0x0102 }),
+            (Side::Client, false, BlockUploadEndResponse),
+            (
+                Side::Server,
+                true,
+                BlockSegment {
+                    seqno: 127,
+                    last: true,
+                    data: chunk(&[9; 7]),
+                },
+            ),
+        ];
+        for (side, seg, cmd) in cases {
+            assert_eq!(decode(side, &encode(&cmd), seg), cmd);
+        }
     }
 }

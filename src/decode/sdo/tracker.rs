@@ -135,22 +135,25 @@ impl SdoTracker {
             command: frame.command,
             dlc_problem,
         };
+        if side == Side::Client {
+            state.unknown_request = false;
+        }
         let mut notes = Vec::new();
         if let Some(mut p) = state.pending.take() {
             match step(&mut p, &ctx, &mut notes) {
                 Step::Continue => {
                     attach(&mut p.txn, &ctx);
-                    frame.object = Some((p.txn.index, p.txn.sub));
+                    frame.object = frame.object.or(Some((p.txn.index, p.txn.sub)));
                     state.pending = Some(p);
                 }
                 Step::Complete(outcome) => {
                     attach(&mut p.txn, &ctx);
-                    frame.object = Some((p.txn.index, p.txn.sub));
+                    frame.object = frame.object.or(Some((p.txn.index, p.txn.sub)));
                     self.completed.push(finalize(p, outcome, dict));
                 }
                 Step::Unexpected => {
                     let outcome = if p.phase == (Phase::DownloadSegment { toggle: false })
-                        && p.txn.protocol == Protocol::Expedited
+                        && p.txn.protocol == Protocol::Unknown
                     {
                         // Only an initiate download response was seen: it was expedited.
                         Outcome::Incomplete
@@ -171,9 +174,6 @@ impl SdoTracker {
         let state = self.channels.entry(channel).or_default();
         if frame.object.is_none() {
             frame.object = state.pending.as_ref().map(|p| (p.txn.index, p.txn.sub));
-        }
-        if frame.object.is_none() {
-            frame.object = frame.command.object();
         }
         if let Some((index, sub)) = frame.object {
             frame.name = dict.label_name(index, sub);
@@ -329,7 +329,7 @@ fn start(
             begin(pending(t, Phase::InitDownload, false), false);
         }
         (Side::Client, InitiateUpload { index, sub }) => {
-            let t = new_txn(channel, ctx, index, sub, Upload, Protocol::Expedited);
+            let t = new_txn(channel, ctx, index, sub, Upload, Protocol::Unknown);
             begin(pending(t, Phase::InitUpload, false), false);
         }
         (Side::Client, BlockDownloadInitiate { index, sub, crc, size }) => {
@@ -397,7 +397,7 @@ fn start(
         }
         (Side::Server, InitiateDownloadResponse { index, sub }) => {
             // Expedited or the start of a segmented download: only the next frame tells.
-            let t = new_txn(channel, ctx, index, sub, Download, Protocol::Expedited);
+            let t = new_txn(channel, ctx, index, sub, Download, Protocol::Unknown);
             begin(pending(t, Phase::DownloadSegment { toggle: false }, false), true);
         }
         (side, Abort { .. }) => {
@@ -443,7 +443,7 @@ fn step(p: &mut Pending, ctx: &FrameCtx, notes: &mut Vec<String>) -> Step {
             if toggle != want {
                 flag(t, Problem::ToggleError);
             }
-            if t.protocol == Protocol::Expedited {
+            if t.protocol == Protocol::Unknown {
                 // Picked up at an unmatched initiate response: it was segmented after all.
                 t.protocol = Protocol::Segmented;
             }

@@ -264,6 +264,11 @@ fn abort_answering_a_request() {
     bus.s(1, &[0x80, 0x00, 0x30, 0x21, 0x00, 0x00, 0x02, 0x06]);
     let t = bus.one();
     assert_eq!((t.index, t.sub), (0x3000, 0x21));
+    assert_eq!(t.protocol, Protocol::Unknown);
+    assert_eq!(
+        t.label(&bus.dict),
+        "Upload 0x3000:21 (0 bytes, 1.000 ms): aborted by server: 0x06020000 Object does not exist in the object dictionary"
+    );
     assert_eq!(
         t.outcome,
         Outcome::Aborted {

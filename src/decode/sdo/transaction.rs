@@ -32,7 +32,9 @@ impl Channel {
 /// Upload (read from the server) or download (write to the server).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TransferDirection {
+    /// Read from the server.
     Upload,
+    /// Written to the server.
     Download,
 }
 
@@ -49,18 +51,25 @@ impl TransferDirection {
 /// The SDO protocol a transfer used.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Protocol {
+    /// Up to 4 bytes in the initiate frames.
     Expedited,
+    /// 7-byte segments with a toggle bit, each confirmed.
     Segmented,
+    /// Sub-blocks of numbered segments with a CRC.
     Block,
+    /// Not seen yet: an upload the server has not answered, or a transfer whose
+    /// request was not captured.
+    Unknown,
 }
 
 impl Protocol {
-    /// `"expedited"`, `"segmented"` or `"block"`.
+    /// `"expedited"`, `"segmented"`, `"block"` or `"unknown"`.
     pub fn as_str(self) -> &'static str {
         match self {
             Protocol::Expedited => "expedited",
             Protocol::Segmented => "segmented",
             Protocol::Block => "block",
+            Protocol::Unknown => "unknown",
         }
     }
 }
@@ -151,9 +160,13 @@ pub struct Transaction {
     pub node: u8,
     /// The channel it ran on.
     pub channel: Channel,
+    /// Object index.
     pub index: u16,
+    /// Object sub-index.
     pub sub: u8,
+    /// Upload (read) or download (write).
     pub direction: TransferDirection,
+    /// Expedited, segmented or block.
     pub protocol: Protocol,
     /// The bytes transferred (so far, when not complete).
     pub data: Vec<u8>,
@@ -163,7 +176,9 @@ pub struct Transaction {
     pub start_ns: u64,
     /// Timestamp of the last frame (ns).
     pub end_ns: u64,
+    /// How it ended.
     pub outcome: Outcome,
+    /// What went wrong along the way, each kind once.
     pub problems: Vec<Problem>,
     /// Sequence numbers of the frames that belong to it.
     pub frames: Vec<u64>,
@@ -217,10 +232,14 @@ impl Transaction {
             s.push_str(&text);
         }
         let n = self.data.len();
+        s.push_str(" (");
+        if self.protocol != Protocol::Unknown {
+            s.push_str(self.protocol.as_str());
+            s.push_str(", ");
+        }
+        let plural = if n == 1 { "" } else { "s" };
         s.push_str(&format!(
-            " ({}, {n} byte{}, {:.3} ms): ",
-            self.protocol.as_str(),
-            if n == 1 { "" } else { "s" },
+            "{n} byte{plural}, {:.3} ms): ",
             self.duration_ns() as f64 / 1e6
         ));
         match &self.outcome {

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs what the test suite needs on a fresh Debian machine: real peers to test
+# against (can-utils, Wireshark's tshark, the python canopen library), tmux for the
+# end-to-end TUI test, and qemu + a Debian kernel for the real SocketCAN bus
+# (tests/vbus/run.sh fetches the kernel itself). Idempotent and quiet when done.
+set -euo pipefail
+
+need_apt=()
+for pkg in can-utils tshark tmux qemu-system-x86 busybox-static; do
+  dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "ok installed" || need_apt+=("$pkg")
+done
+if [ ${#need_apt[@]} -gt 0 ]; then
+  echo "install-test-deps: apt-get install ${need_apt[*]}"
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  # tshark asks whether non-root users may capture; answer no without a prompt.
+  echo "wireshark-common wireshark-common/install-setuid boolean false" | $SUDO debconf-set-selections
+  $SUDO apt-get install -y -qq "${need_apt[@]}" >/dev/null
+fi
+
+if ! python3 -c "import can, canopen" 2>/dev/null; then
+  echo "install-test-deps: pip install python-can canopen"
+  python3 -m pip install -q "python-can>=4.3" "canopen>=2.3"
+fi
