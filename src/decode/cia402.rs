@@ -199,6 +199,16 @@ pub fn describe(index: u16, sub: u8, raw: i64, mode: Option<i8>) -> Option<Strin
     }
 }
 
+/// A value of a CiA 402 word as labels show it: `0x0237 (Operation enabled [...])`,
+/// `3 (Profile velocity)`; `None` for other objects.
+pub fn value_text(index: u16, sub: u8, raw: i64, mode: Option<i8>) -> Option<String> {
+    let meaning = describe(index, sub, raw, mode)?;
+    Some(match index {
+        0x6060 | 0x6061 => format!("{} ({meaning})", raw as i8),
+        _ => format!("0x{:04X} ({meaning})", raw as u16),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -92,7 +92,7 @@ fn block_segments(data: &[u8], blksize: usize) -> Vec<Vec<[u8; 8]>> {
 fn expedited_download() {
     let mut bus = Bus::new();
     let f = bus.c(1, &[0x2B, 0x40, 0x60, 0x00, 0x06, 0x00, 0x00, 0x00]);
-    assert_eq!(f.label(), "Download 0x6040:00 Controlword = 6 (Shutdown)");
+    assert_eq!(f.label(), "Download 0x6040:00 Controlword = 0x0006 (Shutdown)");
     assert_eq!(f.to_json()["cs"], "initiate_download");
     assert_eq!(f.to_json()["value"], 6);
     assert_eq!(f.to_json()["expedited"], true);
@@ -111,7 +111,7 @@ fn expedited_download() {
     let d = dict();
     assert_eq!(
         t.label(&d),
-        "Download 0x6040:00 Controlword = 6 (Shutdown) (expedited, 2 bytes, 1.000 ms): ok"
+        "Download 0x6040:00 Controlword = 0x0006 (Shutdown) (expedited, 2 bytes, 1.000 ms): ok"
     );
     let j = t.to_json(&d);
     assert_eq!(j["value"], 6);
@@ -127,7 +127,10 @@ fn expedited_upload_without_size_uses_type_size() {
     let mut bus = Bus::new();
     bus.c(3, &[0x40, 0x41, 0x60, 0x00, 0, 0, 0, 0]);
     let f = bus.s(3, &[0x42, 0x41, 0x60, 0x00, 0x37, 0x02, 0xAA, 0xBB]);
-    assert_eq!(f.label(), "Upload response 0x6041:00 Statusword = 567");
+    assert_eq!(
+        f.label(),
+        "Upload response 0x6041:00 Statusword = 0x0237 (Operation enabled [ready to switch on, switched on, operation enabled, voltage enabled, quick stop, remote])"
+    );
     let t = bus.one();
     assert_eq!(t.direction, TransferDirection::Upload);
     assert_eq!(t.data, vec![0x37, 0x02]);
@@ -453,7 +456,7 @@ fn unmatched_responses() {
     // An expedited upload response whose request came before the capture: the value is still known.
     let f = bus.s(1, &[0x4B, 0x41, 0x60, 0x00, 0x37, 0x02, 0, 0]);
     assert!(f.label().ends_with("[unmatched response]"), "{}", f.label());
-    assert!(f.label().starts_with("Upload response 0x6041:00 Statusword = 567"));
+    assert!(f.label().starts_with("Upload response 0x6041:00 Statusword = 0x0237 (Operation enabled [ready to switch on, switched on, operation enabled, voltage enabled, quick stop, remote])"));
     let t = bus.one();
     assert_eq!(t.problems, vec![Problem::UnmatchedResponse]);
     assert_eq!(t.outcome, Outcome::Ok);
@@ -515,7 +518,7 @@ fn capture_starting_mid_transfer() {
     assert!(t.problems.is_empty());
     assert_eq!(
         t.label(&bus.dict),
-        "Download 0x6040:00 Controlword = 7 (Switch on) (expedited, 2 bytes, 1.000 ms): ok"
+        "Download 0x6040:00 Controlword = 0x0007 (Switch on / Disable operation) (expedited, 2 bytes, 1.000 ms): ok"
     );
 }
 

@@ -32,8 +32,11 @@ pub fn view(dict: &Dictionary, index: u16, sub: u8, bytes: &[u8]) -> ValueView {
         let size = info.data_type.size();
         let take = size.map_or(bytes.len(), |n| n.min(bytes.len()));
         let typed = info.data_type.decode(&bytes[..take]);
+        let meaning = typed
+            .as_i64()
+            .and_then(|raw| crate::decode::cia402::value_text(index, sub, raw, None));
         return ValueView {
-            text: format_value(Some(info), &typed),
+            text: meaning.unwrap_or_else(|| format_value(Some(info), &typed)),
             json: typed.to_json(),
             typed: Some(typed),
             type_len_mismatch: size.filter(|n| *n != bytes.len()),
@@ -41,7 +44,8 @@ pub fn view(dict: &Dictionary, index: u16, sub: u8, bytes: &[u8]) -> ValueView {
     }
     match le_uint(bytes) {
         Some(n) => ValueView {
-            text: format!("{} ({n})", hex::spaced(bytes)),
+            text: crate::decode::cia402::value_text(index, sub, n as i64, None)
+                .unwrap_or_else(|| format!("{} ({n})", hex::spaced(bytes))),
             json: n.into(),
             typed: None,
             type_len_mismatch: None,
