@@ -17,7 +17,7 @@ fn pv_by_sdo_section_4_2() {
     // "601 2F 60 60 00 03 00 00 00" mode = 3, "581 60 60 60 00 00 00 00 00"
     let x = f.at(5, 0x601, "2F60600003000000");
     sdo(x, "sdo_rx", 1, 0x6060, 0, Some(3));
-    label_has(x, &["Modes of operation", "Profile velocity (PV)"]);
+    label_has(x, &["Modes of operation", "Profile velocity"]);
     let x = f.at(6, 0x581, "6060600000000000");
     sdo(x, "sdo_tx", 1, 0x6060, 0, None);
     assert_eq!(x["sdo"]["cs"], "initiate_download");
@@ -60,7 +60,7 @@ fn pv_by_sdo_section_4_2() {
 fn pp_hm_pt_by_sdo_sections_4_3_to_4_5() {
     let f = frames();
     // 4.3: "601 2F 60 60 00 01", "601 23 7A 60 00 xx" (Pul), "601 23 81 60 00 xx" (Pul/s), "0F -> 1F" starts
-    label_has(f.at(25, 0x601, "2F60600001000000"), &["Profile position (PP)"]);
+    label_has(f.at(25, 0x601, "2F60600001000000"), &["Profile position"]);
     assert_eq!(f.at(27, 0x601, "237A600094880100")["sdo"]["value_text"], "100500 Pul");
     assert_eq!(f.at(29, 0x601, "2381600035820000")["sdo"]["value_text"], "33333 Pul/s");
     sdo(f.at(31, 0x601, "2B4060001F000000"), "sdo_rx", 1, 0x6040, 0, Some(0x1F));
@@ -69,7 +69,7 @@ fn pp_hm_pt_by_sdo_sections_4_3_to_4_5() {
     sdo(x, "sdo_tx", 1, 0x6064, 0, Some(100500));
     assert_eq!(x["sdo"]["value_text"], "100500 Pul");
     // 4.4: "601 2F 60 60 00 06", "601 2F 98 60 00 xx" homing method, "601 23 99 60 01/02", "601 23 9A 60 00"
-    label_has(f.at(37, 0x601, "2F60600006000000"), &["Homing (HM)"]);
+    label_has(f.at(37, 0x601, "2F60600006000000"), &["Homing"]);
     let x = f.at(38, 0x601, "2F98600023000000");
     sdo(x, "sdo_rx", 1, 0x6098, 0, Some(35));
     label_has(x, &["Homing method = 35 (Current position)"]);
@@ -78,7 +78,7 @@ fn pp_hm_pt_by_sdo_sections_4_3_to_4_5() {
     sdo(f.at(41, 0x601, "23996002E8030000"), "sdo_rx", 1, 0x6099, 2, Some(1000));
     assert_eq!(f.at(43, 0x601, "239A600010270000")["sdo"]["value_text"], "10000 Pul/s²");
     // 4.5: "601 2F 60 60 00 04", "601 2B 71 60 00 xx" target torque in 0.1 % (reply printed "60 98 60": it is 60 71 60)
-    label_has(f.at(47, 0x601, "2F60600004000000"), &["Profile torque (PT)"]);
+    label_has(f.at(47, 0x601, "2F60600004000000"), &["Profile torque"]);
     let x = f.at(48, 0x601, "2B71600064000000");
     sdo(x, "sdo_rx", 1, 0x6071, 0, Some(100));
     assert_eq!(x["sdo"]["value_text"], "10 %");

@@ -249,15 +249,15 @@ fn syntron_profile_velocity_procedure() {
     );
     assert_eq!(
         t.feed("602 2B 40 60 00 06 00 00 00"),
-        "Download 0x6040:00 Controlword = 6 (Shutdown)"
+        "Download 0x6040:00 Controlword = 0x0006 (Shutdown)"
     );
     assert_eq!(
         t.feed("602 2B 40 60 00 07 00 00 00"),
-        "Download 0x6040:00 Controlword = 7 (Switch on)"
+        "Download 0x6040:00 Controlword = 0x0007 (Switch on / Disable operation)"
     );
     assert_eq!(
         t.feed("602 2B 40 60 00 0F 00 00 00"),
-        "Download 0x6040:00 Controlword = 15 (Enable operation)"
+        "Download 0x6040:00 Controlword = 0x000F (Enable operation)"
     );
     assert_eq!(
         t.feed("602 23 00 16 01 20 00 FF 60"),
@@ -315,7 +315,7 @@ fn aimotor_profile_velocity_procedure() {
     t.feed("601 40 41 60 00 00 00 00 00");
     assert_eq!(
         t.feed("581 4B 41 60 00 37 02 00 00"),
-        "Upload response 0x6041:00 Statusword = 567"
+        "Upload response 0x6041:00 Statusword = 0x0237 (Operation enabled [ready to switch on, switched on, operation enabled, voltage enabled, quick stop, remote])"
     );
     t.feed("601 40 6C 60 00 00 00 00 00");
     assert_eq!(

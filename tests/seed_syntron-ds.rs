@@ -264,9 +264,9 @@ fn pv_procedure_reads_like_the_manual() {
         // "602 23 FF 60 00 64 00 00 00 // 60FFh = 10rpm"
         "Download 0x60FF:00 Target velocity = 10 rpm",
         // "602 2B 40 60 00 06 // 6040h = 6", "07 // 6040h = 7", "0F // 6040h = F, enabled"
-        "Download 0x6040:00 Controlword = 6 (Shutdown)",
-        "Download 0x6040:00 Controlword = 7 (Switch on)",
-        "Download 0x6040:00 Controlword = 15 (Enable operation)",
+        "Download 0x6040:00 Controlword = 0x0006 (Shutdown)",
+        "Download 0x6040:00 Controlword = 0x0007 (Switch on / Disable operation)",
+        "Download 0x6040:00 Controlword = 0x000F (Enable operation)",
     ];
     assert_eq!(lines.len(), expect.len(), "{lines:#?}");
     for (line, want) in lines.iter().zip(expect) {

@@ -86,11 +86,7 @@ pub fn decode(payload: &[u8], dict: &Dictionary) -> (Emcy, Option<String>) {
         .emcy_text(code)
         .map(str::to_string)
         .unwrap_or_else(|| code_text(code).to_string());
-    let mfr_fields = dict
-        .emcy_fields()
-        .iter()
-        .filter_map(|f| f.raw(&b).map(|raw| (f.name.clone(), f.format(raw))))
-        .collect();
+    let mfr_fields = crate::od::emcy_fields(dict, &b);
     let emcy = Emcy {
         code,
         register: b[2],

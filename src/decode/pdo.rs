@@ -32,12 +32,24 @@ pub struct Pdo {
 impl Pdo {
     /// One-line label for `node`.
     pub fn label(&self, node: u8, payload: &[u8]) -> String {
-        let name = if self.transmit { "TPDO" } else { "RPDO" };
+        let mut s = String::with_capacity(64);
+        s.push_str(if self.transmit { "TPDO" } else { "RPDO" });
+        crate::hex::push_decimal(&mut s, self.num as u64, 1);
+        s.push_str(" node ");
+        crate::hex::push_decimal(&mut s, node as u64, 1);
+        s.push_str(": ");
         if self.signals.is_empty() {
-            return format!("{name}{} node {node}: {}", self.num, crate::hex::spaced(payload));
+            crate::hex::push_spaced(&mut s, payload);
         }
-        let parts: Vec<String> = self.signals.iter().map(|s| format!("{}={}", s.name, s.text)).collect();
-        format!("{name}{} node {node}: {}", self.num, parts.join(", "))
+        for (i, sig) in self.signals.iter().enumerate() {
+            if i > 0 {
+                s.push_str(", ");
+            }
+            s.push_str(&sig.name);
+            s.push('=');
+            s.push_str(&sig.text);
+        }
+        s
     }
 
     /// The kind-specific JSON object.

@@ -97,6 +97,15 @@ impl Decoder {
         d
     }
 
+    /// A decoder for the nodes bound in `bindings` (others use CiA 402 + 301).
+    pub fn from_bindings(bindings: &crate::od::bind::Bindings) -> Decoder {
+        let bound = bindings
+            .bound_nodes()
+            .map(|n| (n, bindings.dictionary(n).clone()))
+            .collect();
+        Decoder::new(bindings.default_dictionary().clone(), bound)
+    }
+
     fn install_default_mappings(&mut self, node: u8, dict: &Dictionary) {
         for layer in dict.layers().iter().rev() {
             for (transmit, maps) in [(false, &layer.rpdo), (true, &layer.tpdo)] {

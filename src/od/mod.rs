@@ -356,3 +356,12 @@ pub fn format_number(x: f64) -> String {
         s.trim_end_matches('0').trim_end_matches('.').to_string()
     }
 }
+
+/// The EMCY manufacturer fields of an 8-byte frame through the node's layout,
+/// as (name, shown value) pairs; empty when no profile describes them.
+pub fn emcy_fields(dict: &Dictionary, frame: &[u8; 8]) -> Vec<(String, String)> {
+    dict.emcy_fields()
+        .iter()
+        .filter_map(|f| f.raw(frame).map(|raw| (f.name.clone(), f.format(raw))))
+        .collect()
+}

@@ -115,7 +115,7 @@ fn expedited_download() {
     );
     let j = t.to_json(&d);
     assert_eq!(j["value"], 6);
-    assert_eq!(j["value_text"], "6 (Shutdown)");
+    assert_eq!(j["value_text"], "0x0006 (Shutdown)");
     assert_eq!(j["data"], "0600");
     assert_eq!(j["outcome"], "ok");
     assert_eq!(j["duration_ns"], 1_000_000);
