@@ -42,14 +42,10 @@ fn pv_by_sdo_section_4_2() {
     sdo(f.at(17, 0x601, "2B4060000F000000"), "sdo_rx", 1, 0x6040, 0, Some(15));
     // "601 40 41 60 00", "581 4B 41 60 00 xx xx" statusword
     assert_eq!(f.at(19, 0x601, "4041600000000000")["sdo"]["cs"], "initiate_upload");
-    sdo(
-        f.at(20, 0x581, "4B41600037020000"),
-        "sdo_tx",
-        1,
-        0x6041,
-        0,
-        Some(0x0237),
-    );
+    let x = f.at(20, 0x581, "4B41600037020000");
+    sdo(x, "sdo_tx", 1, 0x6041, 0, Some(0x0237));
+    let state = x["sdo"]["value_text"].as_str().unwrap();
+    assert!(state.starts_with("0x0237 (Operation enabled"), "{state}");
     // "601 40 6C 60 00", "581 43 6C 60 00 xx xx xx xx" actual velocity
     let x = f.at(22, 0x581, "436C600010270000");
     sdo(x, "sdo_tx", 1, 0x606C, 0, Some(10000));
