@@ -78,6 +78,7 @@ pub mod sdo;
 pub mod sync;
 pub mod time;
 pub mod value_text;
+pub mod vendor_sdo;
 
 pub use registry::{Body, Decoded, Decoder};
 
