@@ -12,36 +12,19 @@ pub struct Summary {
     pub by_node: BTreeMap<u8, BTreeMap<Kind, u64>>,
     /// Frames in all.
     pub frames: u64,
-    /// Frames marked malformed (only counted when the caller decoded them).
-    pub malformed: u64,
-    kind_counts: [u64; 12],
-    node_counts: Vec<[u64; 12]>,
+    kind_counts: [u64; Kind::ALL.len()],
+    node_counts: Vec<[u64; Kind::ALL.len()]>,
 }
-
-const KINDS: [Kind; 12] = [
-    Kind::Nmt,
-    Kind::Sync,
-    Kind::Emcy,
-    Kind::Time,
-    Kind::Tpdo,
-    Kind::Rpdo,
-    Kind::SdoTx,
-    Kind::SdoRx,
-    Kind::Heartbeat,
-    Kind::Lss,
-    Kind::ErrorFrame,
-    Kind::Other,
-];
 
 impl Summary {
     /// Counts one frame (a fixed-size array increment: this is the hot path).
     pub fn add(&mut self, kind: Kind, node: Option<u8>) {
         self.frames += 1;
-        let k = kind as usize;
+        let k = kind.index();
         self.kind_counts[k] += 1;
         if let Some(n) = node {
             if self.node_counts.is_empty() {
-                self.node_counts = vec![[0; 12]; 128];
+                self.node_counts = vec![[0; Kind::ALL.len()]; 128];
             }
             self.node_counts[(n & 0x7F) as usize][k] += 1;
         }
@@ -51,13 +34,13 @@ impl Summary {
     pub fn finish(&mut self) {
         self.by_kind.clear();
         self.by_node.clear();
-        for (i, k) in KINDS.iter().enumerate() {
+        for (i, k) in Kind::ALL.iter().enumerate() {
             if self.kind_counts[i] > 0 {
                 self.by_kind.insert(*k, self.kind_counts[i]);
             }
         }
         for (n, counts) in self.node_counts.iter().enumerate() {
-            for (i, k) in KINDS.iter().enumerate() {
+            for (i, k) in Kind::ALL.iter().enumerate() {
                 if counts[i] > 0 {
                     self.by_node.entry(n as u8).or_default().insert(*k, counts[i]);
                 }
@@ -68,9 +51,6 @@ impl Summary {
     /// Text report.
     pub fn to_text(&self) -> String {
         let mut s = format!("frames: {}\n", self.frames);
-        if self.malformed > 0 {
-            s.push_str(&format!("malformed: {}\n", self.malformed));
-        }
         s.push_str("by kind:\n");
         for (k, n) in &self.by_kind {
             s.push_str(&format!("  {:<12} {n}\n", k.as_str()));
@@ -102,7 +82,7 @@ impl Summary {
                 (node.to_string(), m.into())
             })
             .collect();
-        serde_json::json!({"frames": self.frames, "malformed": self.malformed, "by_kind": kinds, "by_node": nodes})
+        serde_json::json!({"frames": self.frames, "by_kind": kinds, "by_node": nodes})
     }
 }
 
