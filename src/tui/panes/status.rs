@@ -62,7 +62,8 @@ pub fn render(app: &App, f: &mut Frame, bar: Rect, line: Rect) {
     let (txt, bg) = match (&app.source.bus_error, &app.prompt, &app.message) {
         // While typing, the bar shows what the line will do (preview or error).
         (_, Some(_), Some(m)) => (m.clone(), Color::Magenta),
-        (Some(e), _, _) => (format!("{} | {e}", text(app)), Color::Red),
+        // The error (with its fix) first, so a narrow terminal still shows it.
+        (Some(e), _, _) => (format!("{e} | {}", text(app)), Color::Red),
         _ => (text(app), Color::Blue),
     };
     f.render_widget(Paragraph::new(txt).style(Style::default().bg(bg).fg(Color::White)), bar);
