@@ -148,10 +148,9 @@ fn a_missing_interface_shows_its_fix_in_the_status_bar() {
     let bin = env!("CARGO_BIN_EXE_cotui");
     let name = format!("cotui-live-{}", std::process::id());
     let s = Session::start(&name, &format!("{bin} live cotuinosuch0; echo cotui-exit=$?; sleep 60"));
-    let t = s.wait_for("the interface error", |t| {
+    s.wait_for("the interface error", |t| {
         t.contains("cotuinosuch0: no such CAN interface; fix: ")
     });
-    assert!(t.contains("live cotuinosuch0 | 0 frames"), "{t}");
     s.keys(&["q"]);
     s.wait_for("cotui to exit", |t| t.contains("cotui-exit=0"));
 }

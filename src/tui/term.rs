@@ -30,6 +30,17 @@ pub fn run(mut app: App) -> Result<(), String> {
             libc::signal(sig, on_signal as *const () as libc::sighandler_t);
         }
     }
+    // A hung-up terminal can keep crossterm's input poll from returning; after a signal
+    // the loop gets half a second to finish, then this watchdog restores and exits.
+    std::thread::spawn(|| {
+        while !STOP.load(Ordering::SeqCst) {
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        std::thread::sleep(Duration::from_millis(500));
+        let _ = execute!(stdout(), DisableMouseCapture);
+        ratatui::restore();
+        std::process::exit(0);
+    });
     // ratatui::init installs a panic hook that restores the terminal before the message.
     let mut terminal = ratatui::init();
     let _ = execute!(stdout(), EnableMouseCapture);
