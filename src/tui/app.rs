@@ -880,3 +880,94 @@ impl App {
         self.rows.get(pos)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tui::panes::testutil::{app, frames};
+    use crossterm::event::KeyEvent;
+
+    fn key(c: char) -> KeyEvent {
+        KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE)
+    }
+
+    #[test]
+    fn replay_keys_send_pause_step_speed_and_seek() {
+        let (_ftx, frx) = std::sync::mpsc::channel();
+        let (ctx, crx) = std::sync::mpsc::channel();
+        let mut a = app();
+        a.source = SourceInfo::new("r.log", SourceKind::Replay { speed: 1.0 }, frx, Some(ctx));
+        a.act(Action::Step);
+        assert_eq!(a.message.as_deref(), Some("step: pause a replay first"));
+        for k in [' ', '.', '+', '+', '-', ' '] {
+            a.key(key(k));
+        }
+        a.act(Action::SeekBack);
+        let sent: Vec<Control> = crx.try_iter().collect();
+        assert_eq!(
+            sent,
+            [
+                Control::Pause(true),
+                Control::Step,
+                Control::Speed(2.0),
+                Control::Speed(4.0),
+                Control::Speed(2.0),
+                Control::Pause(false),
+                Control::Seek(-10_000_000_000),
+            ]
+        );
+        assert_eq!(a.source.kind, SourceKind::Replay { speed: 2.0 });
+    }
+
+    #[test]
+    fn search_jumps_between_matches_and_goto_selects() {
+        let mut a = app();
+        a.layout.table = Rect::new(0, 0, 100, 10);
+        a.run_command("goto 1");
+        a.run_command("search emcy");
+        assert_eq!(a.selected_position(), Some(frames().len() - 1));
+        a.run_command("search \"boot-up node 2\"");
+        assert_eq!(a.message.as_deref(), Some("no later match for `\"boot-up node 2\"`"));
+        a.act(Action::PrevMatch);
+        assert_eq!(a.selected_position(), Some(1));
+        a.run_command("bogus");
+        assert!(
+            a.message
+                .as_deref()
+                .unwrap_or("")
+                .starts_with("unknown command `bogus`")
+        );
+    }
+
+    #[test]
+    fn palette_commander_lines_need_a_bus_and_confirm_broadcasts() {
+        let mut a = app();
+        a.key(key(':'));
+        for c in "nmt reset-node 0".chars() {
+            a.key(key(c));
+        }
+        assert_eq!(a.message.as_deref(), Some("will send: 000#8100"));
+        a.key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
+        assert!(a.confirm.is_some());
+        a.key(key('y'));
+        assert_eq!(
+            a.message.as_deref(),
+            Some("not sent: this source has no bus (use `cotui live IFACE` or `cotui demo`)")
+        );
+        assert_eq!(a.history, ["nmt reset-node 0"]);
+    }
+
+    #[test]
+    fn sdo_pane_expands_and_enter_on_a_frame_jumps_to_it_in_the_trace() {
+        let mut a = app();
+        a.layout.table = Rect::new(0, 0, 100, 10);
+        a.act(Action::PaneSdo);
+        a.act(Action::Down);
+        a.act(Action::Expand);
+        assert_eq!(a.sdo_expanded, Some(1));
+        a.act(Action::Down);
+        a.act(Action::Expand);
+        assert_eq!(a.pane, Pane::Trace);
+        assert_eq!(a.selected_position(), Some(6));
+    }
+}
