@@ -962,12 +962,14 @@ mod tests {
         let mut a = app();
         a.layout.table = Rect::new(0, 0, 100, 10);
         a.act(Action::PaneSdo);
-        a.act(Action::Down);
+        for _ in 0..4 {
+            a.act(Action::Down);
+        }
         a.act(Action::Expand);
-        assert_eq!(a.sdo_expanded, Some(1));
+        assert_eq!(a.sdo_expanded, Some(4));
         a.act(Action::Down);
         a.act(Action::Expand);
         assert_eq!(a.pane, Pane::Trace);
-        assert_eq!(a.selected_position(), Some(6));
+        assert_eq!(a.selected_position(), Some(12));
     }
 }

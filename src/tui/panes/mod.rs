@@ -83,7 +83,8 @@ pub(crate) mod testutil {
     use ratatui::Terminal;
     use ratatui::backend::TestBackend;
 
-    /// A small fixed capture: boot-ups, NMT start, heartbeats, an EMCY, PDOs, SDO transfers.
+    /// A small fixed capture: boot-ups, NMT start, a PDO mapping written by SDO, heartbeats,
+    /// statusword PDOs (switched on, then operation enabled), an SDO abort, an EMCY.
     pub fn frames() -> Vec<Frame> {
         let mut v = Vec::new();
         let mut t = 1_700_000_000_000_000_000u64;
@@ -98,11 +99,18 @@ pub(crate) mod testutil {
         add(0x000, &[0x01, 0x00], 5);
         add(0x601, &[0x40, 0x17, 0x10, 0x00, 0, 0, 0, 0], 1);
         add(0x581, &[0x4B, 0x17, 0x10, 0x00, 0x64, 0x00, 0, 0], 1);
+        // Map TPDO1 of node 1 to the statusword (the decoder learns it from these writes).
+        add(0x601, &[0x2F, 0x00, 0x1A, 0x00, 0x00, 0, 0, 0], 1);
+        add(0x581, &[0x60, 0x00, 0x1A, 0x00, 0, 0, 0, 0], 1);
+        add(0x601, &[0x23, 0x00, 0x1A, 0x01, 0x10, 0x00, 0x41, 0x60], 1);
+        add(0x581, &[0x60, 0x00, 0x1A, 0x01, 0, 0, 0, 0], 1);
+        add(0x601, &[0x2F, 0x00, 0x1A, 0x00, 0x01, 0, 0, 0], 1);
+        add(0x581, &[0x60, 0x00, 0x1A, 0x00, 0, 0, 0, 0], 1);
         add(0x602, &[0x40, 0x41, 0x60, 0x00, 0, 0, 0, 0], 1);
         add(0x582, &[0x80, 0x41, 0x60, 0x00, 0x00, 0x00, 0x02, 0x06], 2);
         for i in 0..6u8 {
             add(0x080, &[], 10);
-            add(0x181, &[0x37, 0x02, i], 1);
+            add(0x181, &[0x37 - (i < 3) as u8 * 4, 0x02], 1);
             add(0x201, &[0x0F, 0x00, i, 0, 0, 0], 1);
             add(0x701, &[0x05], 1);
             add(0x702, &[0x7F], 1);

@@ -43,7 +43,7 @@ pub fn row_text(id: u8, n: &NodeInfo, now_ns: u64) -> String {
         .map(|(_, c, t)| format!("{c:04X} {t}"))
         .unwrap_or_else(|| "-".into());
     format!(
-        "{:>3} {:<15} {:>11} {:>9} {:>4} {:>4} {:<24} {:<22} {:<18} {:>7.1} {:<10} {}",
+        "{:>3} {:<15} {:>11} {:>9} {:>4} {:>4} {:<22} {:<14} {:<18} {:>7.1} {:<10} {}",
         id,
         nmt_text(n),
         hb,
@@ -51,7 +51,7 @@ pub fn row_text(id: u8, n: &NodeInfo, now_ns: u64) -> String {
         n.missed,
         n.boot_ups,
         n.drive.map(|d| d.text()).unwrap_or("-"),
-        n.mode.map(mode_name).unwrap_or("-"),
+        fit(n.mode.map(mode_name).unwrap_or("-"), 14),
         fit(&emcy, 18),
         n.rate(),
         fit(if n.profile.is_empty() { "-" } else { &n.profile }, 10),
@@ -75,7 +75,7 @@ pub fn render(app: &App, f: &mut Frame, area: Rect, focused: bool) {
         .unwrap_or(0);
     let mut lines = vec![Line::styled(
         format!(
-            "{:>3} {:<15} {:>11} {:>9} {:>4} {:>4} {:<24} {:<22} {:<18} {:>7} {:<10}",
+            "{:>3} {:<15} {:>11} {:>9} {:>4} {:>4} {:<22} {:<14} {:<18} {:>7} {:<10}",
             "id",
             "nmt",
             "hb meas/cfg",

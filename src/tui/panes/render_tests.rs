@@ -11,7 +11,7 @@ fn trace_pane_shows_decoded_rows_and_the_status_bar() {
     assert!(s.contains("Trace [follow]"), "{s}");
     assert!(s.contains("Heartbeat node 2: Pre-operational"), "{s}");
     assert!(s.contains("register 0x11 [generic, communication]"), "{s}");
-    assert!(s.contains("open test.log (end) | 38 frames"), "{s}");
+    assert!(s.contains("open test.log (end) | 44 frames"), "{s}");
     insta::assert_snapshot!(s);
 }
 
@@ -34,6 +34,7 @@ fn nodes_pane_shows_states_heartbeat_and_emcy() {
     let s = screen(&mut a, 160, 14);
     assert!(s.contains("Operational"), "{s}");
     assert!(s.contains("Pre-operational"), "{s}");
+    assert!(s.contains("Operation enabled"), "{s}");
     insta::assert_snapshot!(s);
 }
 
@@ -57,6 +58,16 @@ fn detail_pane_breaks_the_selected_frame_into_fields() {
     a.run_command("goto 5");
     let s = screen(&mut a, 150, 30);
     assert!(s.contains("bits 7-5 scs = 2"), "{s}");
+    insta::assert_snapshot!(s);
+}
+
+#[test]
+fn detail_pane_shows_statusword_bits_of_a_mapped_pdo() {
+    let mut a = app();
+    a.run_command("search kind tpdo");
+    let s = screen(&mut a, 150, 30);
+    assert!(s.contains("0x6041:00"), "{s}");
+    assert!(s.contains("0000001000110011b Switched on"), "{s}");
     insta::assert_snapshot!(s);
 }
 
