@@ -84,8 +84,10 @@ fn stats_pane_shows_rates_and_bus_load() {
 #[test]
 fn plot_pane_draws_a_series() {
     let mut a = app();
-    a.pane = Pane::Plot;
+    a.act(Action::NextSeries);
+    assert_eq!(a.pane, Pane::Plot);
     let s = screen(&mut a, 100, 20);
+    assert!(s.contains("Plot 2/2: node 1 0x6041:00 (6 points)"), "{s}");
     insta::assert_snapshot!(s);
 }
 
