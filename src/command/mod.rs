@@ -5,6 +5,8 @@ pub mod drive;
 pub mod error;
 pub mod grammar;
 pub mod nmt;
+pub mod record;
+pub mod scan;
 pub mod sdo;
 pub mod value;
 
