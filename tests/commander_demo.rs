@@ -219,3 +219,24 @@ async fn listen_only_sends_nothing_whatever_the_command() {
         assert!(!(0x600..0x680).contains(&f.id));
     }
 }
+
+#[tokio::test(start_paused = true)]
+async fn our_requests_come_back_tx_and_decode_like_received_frames() {
+    let d = demo();
+    let mut rx = d.bus.subscribe();
+    upload(&d.bus, 2, 0x6041, 0, false, T).await.unwrap();
+    let mut dec = cotui::decode::Decoder::new(cotui::od::Dictionary::default(), vec![]);
+    let mut seen = Vec::new();
+    while let Some(Ok(f)) = rx.try_recv() {
+        let decoded = dec.decode(&f);
+        if f.id == 0x602 || f.id == 0x582 {
+            seen.push((f.id, f.direction(), decoded.kind));
+        }
+    }
+    use cotui::decode::Kind;
+    use cotui::frame::Direction;
+    assert_eq!(
+        seen,
+        vec![(0x602, Direction::Tx, Kind::SdoRx), (0x582, Direction::Rx, Kind::SdoTx)]
+    );
+}
