@@ -261,7 +261,7 @@ fn syntron_profile_velocity_procedure() {
     );
     assert_eq!(
         t.feed("602 23 00 16 01 20 00 FF 60"),
-        "Download 0x1600:01 Mapped object 1 = 1627324448"
+        "Download 0x1600:01 Mapped object 1 = 0x60FF0020 (0x60FF:00, 32 bits)"
     );
     // The manual lists requests only: each new request leaves the previous one unanswered.
     let v = t.tracker.finish();
@@ -337,7 +337,7 @@ fn aimotor_pdo_cob_id_write() {
     let mut t = Trace::new();
     assert_eq!(
         t.feed("601 23 00 14 01 01 02 00 80"),
-        "Download 0x1400:01 COB-ID used by RPDO = 2147484161"
+        "Download 0x1400:01 COB-ID used by RPDO = 0x80000201 (COB-ID 0x201, invalid/disabled)"
     );
     t.feed("581 60 00 14 01 00 00 00 00");
     let tr = t.one();

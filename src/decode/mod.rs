@@ -45,6 +45,7 @@ impl Kind {
 
 pub mod cia402;
 pub mod cob_id;
+pub mod comm_params;
 pub mod emcy;
 pub mod error_frame;
 pub mod heartbeat;
@@ -55,5 +56,6 @@ pub mod registry;
 pub mod sdo;
 pub mod sync;
 pub mod time;
+pub mod value_text;
 
 pub use registry::{Body, Decoded, Decoder};

@@ -1,6 +1,6 @@
 //! PDO payloads decoded into named, typed, scaled signals through the mapping in force.
 
-use crate::od::{DataType, Dictionary, MappedEntry, MappingSource, PdoMapping, Value, format_value};
+use crate::od::{DataType, Dictionary, MappedEntry, MappingSource, PdoMapping, Value};
 use serde_json::json;
 
 /// One mapped signal taken out of a PDO payload.
@@ -32,12 +32,24 @@ pub struct Pdo {
 impl Pdo {
     /// One-line label for `node`.
     pub fn label(&self, node: u8, payload: &[u8]) -> String {
-        let name = if self.transmit { "TPDO" } else { "RPDO" };
+        let mut s = String::with_capacity(64);
+        s.push_str(if self.transmit { "TPDO" } else { "RPDO" });
+        crate::hex::push_decimal(&mut s, self.num as u64, 1);
+        s.push_str(" node ");
+        crate::hex::push_decimal(&mut s, node as u64, 1);
+        s.push_str(": ");
         if self.signals.is_empty() {
-            return format!("{name}{} node {node}: {}", self.num, crate::hex::spaced(payload));
+            crate::hex::push_spaced(&mut s, payload);
         }
-        let parts: Vec<String> = self.signals.iter().map(|s| format!("{}={}", s.name, s.text)).collect();
-        format!("{name}{} node {node}: {}", self.num, parts.join(", "))
+        for (i, sig) in self.signals.iter().enumerate() {
+            if i > 0 {
+                s.push_str(", ");
+            }
+            s.push_str(&sig.name);
+            s.push('=');
+            s.push_str(&sig.text);
+        }
+        s
     }
 
     /// The kind-specific JSON object.
@@ -132,13 +144,7 @@ fn signal(payload: &[u8], pos: usize, e: &MappedEntry, dict: &Dictionary, mode: 
         .name(e.index, e.sub)
         .map(str::to_string)
         .unwrap_or_else(|| format!("0x{:04X}:{:02X}", e.index, e.sub));
-    let text = match value
-        .as_i64()
-        .and_then(|raw| super::cia402::describe(e.index, e.sub, raw, mode))
-    {
-        Some(meaning) => format!("0x{:04X} ({meaning})", value.as_i64().unwrap_or(0)),
-        None => format_value(info, &value),
-    };
+    let text = super::value_text::object_text(dict, e.index, e.sub, &value, mode);
     Signal {
         index: e.index,
         sub: e.sub,

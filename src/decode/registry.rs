@@ -93,6 +93,15 @@ impl Decoder {
         d
     }
 
+    /// A decoder for the nodes bound in `bindings` (others use CiA 402 + 301).
+    pub fn from_bindings(bindings: &crate::od::bind::Bindings) -> Decoder {
+        let bound = bindings
+            .bound_nodes()
+            .map(|n| (n, bindings.dictionary(n).clone()))
+            .collect();
+        Decoder::new(bindings.default_dictionary().clone(), bound)
+    }
+
     fn install_default_mappings(&mut self, node: u8, dict: &Dictionary) {
         for layer in dict.layers().iter().rev() {
             for (transmit, maps) in [(false, &layer.rpdo), (true, &layer.tpdo)] {
@@ -104,12 +113,12 @@ impl Decoder {
                             Route {
                                 kind,
                                 node: Some(node),
-                                pdo: *num,
+                                pdo: *num as u16,
                                 reserved: false,
                             },
                         );
                     }
-                    self.mappings.insert((node, transmit, *num), m.clone());
+                    self.mappings.insert((node, transmit, *num as u16), m.clone());
                 }
             }
         }

@@ -39,7 +39,8 @@ const ASC_F_FDF: u32 = 0x1000;
 /// Channels whose interface index is cached; higher ones are interned per line.
 const CACHED_CHANNELS: usize = 64;
 
-/// Parser state for ASC lines (number base, timestamp mode, channel names).
+/// Parser state for ASC lines (number base, timestamp mode, channel names). Use one parser
+/// with one [`Interfaces`] table: it caches indexes into it.
 #[derive(Debug)]
 pub struct Parser {
     decimal: bool,
@@ -146,9 +147,19 @@ impl Parser {
             buf[3] = b'X';
             4
         } else {
-            let digits = (n - 1).to_string();
-            buf[3..3 + digits.len()].copy_from_slice(digits.as_bytes());
-            3 + digits.len()
+            let mut digits = [0u8; 10];
+            let (mut k, mut v) = (digits.len(), n - 1);
+            loop {
+                k -= 1;
+                digits[k] = b'0' + (v % 10) as u8;
+                v /= 10;
+                if v == 0 {
+                    break;
+                }
+            }
+            let d = &digits[k..];
+            buf[3..3 + d.len()].copy_from_slice(d);
+            3 + d.len()
         };
         let idx = self.iface.get(ifaces, &buf[..len], at)?;
         if let Some(slot) = self.channels.get_mut(n as usize) {
@@ -156,32 +167,33 @@ impl Parser {
         }
         Ok(idx)
     }
+}
 
-    /// Parses an id token (`123`, `1ABx`) in the current base.
-    fn id(&self, f: &mut Frame, at: usize, tok: &[u8]) -> Result<(), ParseError> {
-        let (digits, ext) = match tok.split_last() {
-            Some((b'x' | b'X', rest)) => (rest, true),
-            _ => (tok, false),
-        };
-        let id =
-            if self.decimal { dec_u32(digits) } else { hex_u32(digits) }.ok_or_else(|| err(at, "expected a CAN id"))?;
-        if id > if ext { 0x1FFF_FFFF } else { 0x7FF } {
-            return Err(err(at, "CAN id out of range (29-bit ids end in 'x')"));
-        }
-        f.id = id;
-        f.flags.set(Flags::EXT, ext);
-        Ok(())
+/// Parses an id token (`123`, `1ABx`), decimal or hex, into `f`.
+fn parse_id(decimal: bool, f: &mut Frame, at: usize, tok: &[u8]) -> Result<(), ParseError> {
+    let (digits, ext) = match tok.split_last() {
+        Some((b'x' | b'X', rest)) => (rest, true),
+        _ => (tok, false),
+    };
+    let id = if decimal { dec_u32(digits) } else { hex_u32(digits) }.ok_or_else(|| err(at, "expected a CAN id"))?;
+    if id > if ext { 0x1FFF_FFFF } else { 0x7FF } {
+        return Err(err(at, "CAN id out of range (29-bit ids end in 'x')"));
     }
+    f.id = id;
+    f.flags.set(Flags::EXT, ext);
+    Ok(())
+}
 
-    /// A data byte in the current base.
-    fn byte(&self, at: usize, tok: &[u8]) -> Result<u8, ParseError> {
-        let v = if self.decimal { dec_u32(tok) } else { hex_u32(tok) };
-        match v {
-            Some(v) if v <= 0xFF && tok.len() <= 3 => Ok(v as u8),
-            _ => Err(err(at, "expected a data byte")),
-        }
+/// A data byte, decimal or hex.
+fn byte(decimal: bool, at: usize, tok: &[u8]) -> Result<u8, ParseError> {
+    let v = if decimal { dec_u32(tok) } else { hex_u32(tok) };
+    match v {
+        Some(v) if v <= 0xFF && tok.len() <= 3 => Ok(v as u8),
+        _ => Err(err(at, "expected a data byte")),
     }
+}
 
+impl Parser {
     /// `<id> <Rx|Tx> <d|r> <dlc> <bytes…>` or `ErrorFrame`; `None` for events.
     fn classic_line(&self, toks: &mut Tokens<'_>, end: usize) -> Result<Option<Frame>, ParseError> {
         let mut f = Frame::default();
@@ -195,7 +207,7 @@ impl Parser {
         if !id[0].is_ascii_hexdigit() {
             return Ok(None);
         }
-        self.id(&mut f, id_at, id)?;
+        parse_id(self.decimal, &mut f, id_at, id)?;
         if !direction(&mut f, toks, end)? {
             return Ok(None);
         }
@@ -227,7 +239,7 @@ impl Parser {
             let (b_at, b) = toks
                 .next()
                 .ok_or_else(|| err(end, "fewer data bytes than the DLC says"))?;
-            f.data[k] = self.byte(b_at, b)?;
+            f.data[k] = byte(self.decimal, b_at, b)?;
         }
         Ok(Some(f))
     }
@@ -239,11 +251,8 @@ impl Parser {
             return Ok(None);
         }
         let (id_at, id) = toks.next().ok_or_else(|| err(end, "expected a CAN id"))?;
-        let hex_mode = Parser {
-            decimal: false,
-            ..Parser::default()
-        };
-        hex_mode.id(&mut f, id_at, id)?;
+        // CANFD lines are hex whatever the base line says (as asc2log reads them).
+        parse_id(false, &mut f, id_at, id)?;
         let bit = |t: &[u8]| matches!(t, b"0" | b"1");
         if toks.peek().is_some_and(|(_, t)| !bit(t)) {
             toks.next(); // symbolic name
@@ -270,7 +279,7 @@ impl Parser {
             let (b_at, b) = toks
                 .next()
                 .ok_or_else(|| err(end, "fewer data bytes than the length says"))?;
-            f.data[k] = hex_mode.byte(b_at, b)?;
+            f.data[k] = byte(false, b_at, b)?;
         }
         let flags = match (toks.next(), toks.next(), toks.next()) {
             (Some(_), Some(_), Some((fl_at, fl))) => {

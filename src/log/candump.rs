@@ -17,14 +17,15 @@
 //! a bad raw DLC, an 11-bit id above 7FF) is reported as an error, so that what parses
 //! is exactly what [`super::writer`] writes back.
 
-use super::lex::{self, IfaceCache, err, hex, skip_ws, token_end, trim_end};
+use super::lex::{self, IfaceCache, err, hex, is_ws, skip_ws, token_end, trim_end};
 use super::{Line, ParseError, SkipReason};
 use crate::frame::{Flags, Frame, Interfaces};
 
 /// `CAN_ERR_FLAG` of the Linux CAN id.
 pub const CAN_ERR_FLAG: u32 = 0x2000_0000;
 
-/// Parser state for candump log lines (remembers the last interface to intern nothing per line).
+/// Parser state for candump log lines (remembers the last interface to intern nothing per
+/// line). Use one parser with one [`Interfaces`] table: it caches an index into it.
 #[derive(Debug, Default)]
 pub struct Parser {
     iface: IfaceCache,
@@ -38,10 +39,25 @@ impl Parser {
 
     /// Parses one line (with or without its line end).
     pub fn parse_line(&mut self, line: &[u8], ifaces: &mut Interfaces) -> Result<Line, ParseError> {
+        let mut frame = Frame::default();
+        Ok(match self.parse_into(line, ifaces, &mut frame)? {
+            Some(reason) => Line::Skip(reason),
+            None => Line::Frame(frame),
+        })
+    }
+
+    /// Like [`Parser::parse_line`], but writes a frame into `frame` (returning `None`) so
+    /// that a hot loop copies no frame around; a skip returns its reason.
+    pub fn parse_into(
+        &mut self,
+        line: &[u8],
+        ifaces: &mut Interfaces,
+        frame: &mut Frame,
+    ) -> Result<Option<SkipReason>, ParseError> {
         let s = trim_end(line);
         if s.first() != Some(&b'(') {
             let t = &s[skip_ws(s, 0)..];
-            return Ok(Line::Skip(if t.is_empty() {
+            return Ok(Some(if t.is_empty() {
                 SkipReason::Blank
             } else if t.starts_with(b"DROPCOUNT") {
                 SkipReason::DropCount
@@ -62,9 +78,8 @@ impl Parser {
         if frame_at >= s.len() {
             return Err(err(frame_at, "expected an interface name and a frame"));
         }
-        let frame_end = token_end(s, frame_at);
-        let Some(mut frame) = compact(&s[frame_at..frame_end], frame_at)? else {
-            return Ok(Line::Skip(SkipReason::CanXl));
+        let Some(frame_end) = compact(&s[frame_at..], frame_at, frame)? else {
+            return Ok(Some(SkipReason::CanXl));
         };
         let extra_at = skip_ws(s, frame_end);
         if extra_at < s.len() {
@@ -81,7 +96,7 @@ impl Parser {
         }
         frame.ts_ns = ts;
         frame.iface = self.iface.get(ifaces, &s[name_at..name_end], name_at)?;
-        Ok(Line::Frame(frame))
+        Ok(None)
     }
 }
 
@@ -95,12 +110,19 @@ pub fn parse_line(line: &[u8], ifaces: &mut Interfaces) -> Result<Line, ParseErr
 /// Returns `Ok(None)` for a CAN XL frame, which cotui does not model. Columns in errors
 /// count from the start of `text`. Timestamp and interface of the frame are left at 0.
 pub fn parse_compact(text: &[u8]) -> Result<Option<Frame>, ParseError> {
-    compact(text, 0)
+    let mut f = Frame::default();
+    match compact(text, 0, &mut f)? {
+        None => Ok(None),
+        Some(end) if end == text.len() => Ok(Some(f)),
+        Some(end) => Err(err(end, "unexpected text after the frame")),
+    }
 }
 
-/// [`parse_compact`] for a token that starts at line index `at`.
-fn compact(t: &[u8], at: usize) -> Result<Option<Frame>, ParseError> {
-    let mut f = Frame::default();
+/// [`parse_compact`] for the text `t` that starts at line index `at`, into `f`: the frame
+/// ends at the first blank or the end of `t`. Returns the line index just past it (`None`
+/// for CAN XL).
+fn compact(t: &[u8], at: usize, f: &mut Frame) -> Result<Option<usize>, ParseError> {
+    *f = Frame::default();
     let mut i = if t.len() > 3 && t[3] == b'#' {
         let id = id_digits(&t[..3], at)?;
         if id > 0x7FF {
@@ -126,23 +148,24 @@ fn compact(t: &[u8], at: usize) -> Result<Option<Frame>, ParseError> {
     } else {
         return Err(err(at, "expected a CAN id of 3 or 8 hex digits followed by '#'"));
     };
+    let more = |i: usize| i < t.len() && !is_ws(t[i]);
     let mut max = 8;
     match t.get(i) {
         Some(b'R' | b'r') => {
             f.flags.set(Flags::RTR, true);
             i += 1;
-            if i < t.len() {
+            if more(i) {
                 match hex(t[i]) {
                     Some(n) if n <= 8 => f.len = n,
                     _ => return Err(err(at + i, "remote frame length must be a digit 0..8")),
                 }
                 i += 1;
             }
-            i = raw_dlc(t, i, &mut f, at)?;
-            if i < t.len() {
+            i = raw_dlc(t, i, f, at)?;
+            if more(i) {
                 return Err(err(at + i, "unexpected text after the remote frame"));
             }
-            return Ok(Some(f));
+            return Ok(Some(at + i));
         }
         Some(b'#') => {
             let flags = t
@@ -160,39 +183,41 @@ fn compact(t: &[u8], at: usize) -> Result<Option<Frame>, ParseError> {
     }
     let mut n = 0usize;
     while i < t.len() {
-        match t[i] {
-            b'.' => i += 1,
-            b'_' => break,
-            _ => {
-                if n == max {
-                    return Err(err(
-                        at + i,
-                        if max == 8 {
-                            "more than 8 data bytes (CAN FD frames use '##')"
-                        } else {
-                            "more than 64 data bytes"
-                        },
-                    ));
-                }
-                let hi = hex(t[i]).ok_or_else(|| err(at + i, "expected a hex digit in the data"))?;
-                let lo = match t.get(i + 1) {
-                    Some(&b) => hex(b).ok_or_else(|| err(at + i + 1, "expected a hex digit in the data"))?,
-                    None => return Err(err(at + i + 1, "odd number of hex digits in the data")),
-                };
-                f.data[n] = hi << 4 | lo;
-                n += 1;
-                i += 2;
+        let c = t[i];
+        if let Some(hi) = hex(c) {
+            if n == max {
+                return Err(err(
+                    at + i,
+                    if max == 8 {
+                        "more than 8 data bytes (CAN FD frames use '##')"
+                    } else {
+                        "more than 64 data bytes"
+                    },
+                ));
             }
+            let lo = match t.get(i + 1) {
+                Some(&b) if !is_ws(b) => hex(b).ok_or_else(|| err(at + i + 1, "expected a hex digit in the data"))?,
+                _ => return Err(err(at + i + 1, "odd number of hex digits in the data")),
+            };
+            f.data[n] = hi << 4 | lo;
+            n += 1;
+            i += 2;
+        } else if c == b'.' {
+            i += 1;
+        } else if c == b'_' || is_ws(c) {
+            break;
+        } else {
+            return Err(err(at + i, "expected a hex digit in the data"));
         }
     }
     f.len = n as u8;
     if max == 8 {
-        i = raw_dlc(t, i, &mut f, at)?;
+        i = raw_dlc(t, i, f, at)?;
     }
-    if i < t.len() {
+    if more(i) {
         return Err(err(at + i, "unexpected text after the data"));
     }
-    Ok(Some(f))
+    Ok(Some(at + i))
 }
 
 /// Parses an optional `_<dlc>` (9..F) at `i`, allowed only when the length is 8.

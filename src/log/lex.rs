@@ -106,35 +106,48 @@ pub(crate) fn err(i: usize, message: &'static str) -> ParseError {
 /// Any number of fraction digits is accepted (python-can writes `(0.0)`); digits past the
 /// ninth are truncated.
 pub(crate) fn timestamp(s: &[u8], mut i: usize) -> Result<(u64, usize), ParseError> {
+    const POW10: [u64; 10] = [
+        1_000_000_000,
+        100_000_000,
+        10_000_000,
+        1_000_000,
+        100_000,
+        10_000,
+        1000,
+        100,
+        10,
+        1,
+    ];
     let start = i;
     let mut secs: u64 = 0;
     while i < s.len() && s[i].is_ascii_digit() {
-        secs = secs
-            .checked_mul(10)
-            .and_then(|v| v.checked_add((s[i] - b'0') as u64))
-            .ok_or_else(|| err(start, "timestamp is too large"))?;
+        secs = secs.wrapping_mul(10).wrapping_add((s[i] - b'0') as u64);
         i += 1;
     }
     if i == start {
         return Err(err(start, "expected a timestamp (seconds)"));
     }
+    // 19 digits always fit a u64; the product below catches the rest.
+    let too_large = || err(start, "timestamp is too large");
+    if i - start > 19 {
+        return Err(too_large());
+    }
     let mut frac: u64 = 0;
-    let mut digits = 0u32;
     if i < s.len() && s[i] == b'.' {
         i += 1;
+        let from = i;
         while i < s.len() && s[i].is_ascii_digit() {
-            if digits < 9 {
+            if i - from < 9 {
                 frac = frac * 10 + (s[i] - b'0') as u64;
-                digits += 1;
             }
             i += 1;
         }
+        frac *= POW10[(i - from).min(9)];
     }
-    let frac = frac * 10u64.pow(9 - digits);
     let ns = secs
         .checked_mul(1_000_000_000)
         .and_then(|v| v.checked_add(frac))
-        .ok_or_else(|| err(start, "timestamp is too large"))?;
+        .ok_or_else(too_large)?;
     Ok((ns, i))
 }
 
@@ -166,20 +179,29 @@ pub(crate) fn dec_u32(tok: &[u8]) -> Option<u32> {
 }
 
 /// Remembers the last interface seen so that the common single-interface log interns
-/// nothing per line.
+/// nothing per line (and compares the name without a library call).
 #[derive(Debug, Default)]
 pub(crate) struct IfaceCache {
     last: Option<u16>,
+    name: [u8; 16],
+    len: usize,
 }
 
 impl IfaceCache {
     /// Index of interface `name` (bytes at line index `at`), interning it on first sight.
+    #[inline]
     pub(crate) fn get(&mut self, ifaces: &mut Interfaces, name: &[u8], at: usize) -> Result<u16, ParseError> {
         if let Some(idx) = self.last
-            && ifaces.name(idx).as_bytes() == name
+            && name.len() == self.len
+            && name.iter().zip(&self.name).all(|(a, b)| a == b)
         {
             return Ok(idx);
         }
+        self.intern(ifaces, name, at)
+    }
+
+    /// The slow path of [`IfaceCache::get`].
+    fn intern(&mut self, ifaces: &mut Interfaces, name: &[u8], at: usize) -> Result<u16, ParseError> {
         let text = std::str::from_utf8(name).map_err(|_| err(at, "interface name is not valid UTF-8"))?;
         let idx = match ifaces.names().iter().position(|n| n == text) {
             Some(i) => i as u16,
@@ -188,7 +210,13 @@ impl IfaceCache {
             }
             None => ifaces.intern(text),
         };
-        self.last = Some(idx);
+        // Only names that fit are cached; longer ones take the slow path every time.
+        self.last = None;
+        if name.len() <= self.name.len() {
+            self.name[..name.len()].copy_from_slice(name);
+            self.len = name.len();
+            self.last = Some(idx);
+        }
         Ok(idx)
     }
 }

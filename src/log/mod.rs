@@ -3,7 +3,8 @@
 //!
 //! Each format has a line parser (`parse_line(&mut self, &[u8], &mut Interfaces)`) that
 //! works on bytes, allocates nothing per line and never panics. [`LogReader`] drives one
-//! over any [`BufRead`], reusing one line buffer, and counts what it saw.
+//! over any [`BufRead`], parsing lines in place in the source's buffer (or in one reused
+//! line buffer when a line straddles it), and counts what it saw.
 
 pub mod asc;
 pub mod candump;
@@ -183,8 +184,9 @@ enum Parser {
 
 /// Streams a log line by line, yielding `(line_number, Outcome)` for every line.
 ///
-/// One line buffer is reused; bytes are parsed directly, so non-UTF-8 input only gives
-/// warnings on the lines concerned. IO errors end the stream.
+/// Lines are parsed as bytes in place (one reused buffer gathers a line that straddles the
+/// source's buffer), so non-UTF-8 input only gives warnings on the lines concerned. IO
+/// errors end the stream.
 #[derive(Debug)]
 pub struct LogReader<R> {
     src: R,
@@ -194,6 +196,7 @@ pub struct LogReader<R> {
     parser: Parser,
     ifaces: Interfaces,
     counts: Counts,
+    frame: Frame,
 }
 
 impl<R: BufRead> LogReader<R> {
@@ -218,6 +221,7 @@ impl<R: BufRead> LogReader<R> {
             parser,
             ifaces: Interfaces::default(),
             counts: Counts::default(),
+            frame: Frame::default(),
         }
     }
 
@@ -245,23 +249,30 @@ impl<R: BufRead> LogReader<R> {
     }
 
     /// The next line's number (1-based) and outcome; `None` at the end of input.
+    ///
+    /// A line that lies whole in the source's buffer is parsed in place; one that straddles
+    /// the buffer's end is gathered in the reader's own line buffer (reused, never shrunk).
     pub fn next_line(&mut self) -> io::Result<Option<(u64, Outcome)>> {
-        self.buf.clear();
-        if self.src.read_until(b'\n', &mut self.buf)? == 0 {
+        let available = self.src.fill_buf()?;
+        if available.is_empty() {
             return Ok(None);
         }
-        self.line_no += 1;
-        let parsed = match &mut self.parser {
-            Parser::Candump(p) => p.parse_line(&self.buf, &mut self.ifaces),
-            Parser::Screen(p) => p.parse_line(&self.buf, &mut self.ifaces),
-            Parser::Asc(p) => p.parse_line(&self.buf, &mut self.ifaces),
+        let parsed = if let Some(pos) = memchr::memchr(b'\n', available) {
+            let parsed = parse(&mut self.parser, &mut self.ifaces, &mut self.frame, &available[..=pos]);
+            self.src.consume(pos + 1);
+            parsed
+        } else {
+            self.buf.clear();
+            self.src.read_until(b'\n', &mut self.buf)?;
+            parse(&mut self.parser, &mut self.ifaces, &mut self.frame, &self.buf)
         };
+        self.line_no += 1;
         let outcome = match parsed {
-            Ok(Line::Frame(f)) => {
+            Ok(None) => {
                 self.counts.frames += 1;
-                Outcome::Frame(f)
+                Outcome::Frame(self.frame)
             }
-            Ok(Line::Skip(r)) => {
+            Ok(Some(r)) => {
                 self.counts.skipped[r.index()] += 1;
                 Outcome::Skip(r)
             }
@@ -271,6 +282,31 @@ impl<R: BufRead> LogReader<R> {
             }
         };
         Ok(Some((self.line_no, outcome)))
+    }
+}
+
+/// Parses `line` with `parser`; a frame goes to `frame` (`Ok(None)`), a skip returns its reason.
+fn parse(
+    parser: &mut Parser,
+    ifaces: &mut Interfaces,
+    frame: &mut Frame,
+    line: &[u8],
+) -> Result<Option<SkipReason>, ParseError> {
+    match parser {
+        Parser::Candump(p) => p.parse_into(line, ifaces, frame),
+        Parser::Screen(p) => into(p.parse_line(line, ifaces), frame),
+        Parser::Asc(p) => into(p.parse_line(line, ifaces), frame),
+    }
+}
+
+/// A [`Line`] in the shape of `candump::Parser::parse_into`: frames go to `frame`.
+fn into(line: Result<Line, ParseError>, frame: &mut Frame) -> Result<Option<SkipReason>, ParseError> {
+    match line? {
+        Line::Frame(f) => {
+            *frame = f;
+            Ok(None)
+        }
+        Line::Skip(r) => Ok(Some(r)),
     }
 }
 
@@ -334,6 +370,26 @@ mod tests {
         assert_eq!((c.frames, c.warnings, c.skipped_total()), (2, 1, 3));
         assert_eq!(c.skipped(SkipReason::DropCount), 1);
         assert_eq!(r.interfaces().names(), ["can0"]);
+    }
+
+    #[test]
+    fn lines_straddling_the_source_buffer_parse_the_same() {
+        let text: &[u8] =
+            b"(1.000000) can0 123#1122\n\n(2.000000)   vcan10 12345678##5AABBCCDDEEFF0011 T\n(3.5) can0 7FF#R8_9";
+        fn all<R: BufRead>(r: LogReader<R>) -> Vec<(u64, Outcome)> {
+            r.map(Result::unwrap).collect()
+        }
+        let whole = all(LogReader::with_format(text, Format::Candump));
+        for cap in [1, 2, 7, 16, 33] {
+            let small = std::io::BufReader::with_capacity(cap, text);
+            assert_eq!(
+                all(LogReader::with_format(small, Format::Candump)),
+                whole,
+                "capacity {cap}"
+            );
+        }
+        assert_eq!(whole.len(), 4);
+        assert!(matches!(whole[3], (4, Outcome::Frame(f)) if f.raw_dlc == 9));
     }
 
     #[test]

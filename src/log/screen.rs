@@ -22,7 +22,8 @@ use super::lex::{self, IfaceCache, Tokens, err, hex, hex_u32, trim_end};
 use super::{Line, ParseError, SkipReason};
 use crate::frame::{Flags, Frame, Interfaces};
 
-/// Parser state for screen lines.
+/// Parser state for screen lines. Use one parser with one [`Interfaces`] table: it caches
+/// an index into it.
 #[derive(Debug, Default)]
 pub struct Parser {
     iface: IfaceCache,

@@ -6,11 +6,42 @@
 //! `docs/PROFILE_FORMAT.md`) or imported from EDS/DCF files. All of this is
 //! pure data: loading takes text and returns values plus warnings.
 
+pub mod alias;
+pub mod bind;
+mod device;
+pub mod eds;
+pub mod expr;
+pub mod fields;
+pub mod json;
+pub mod procedure;
 mod value;
 
+pub use alias::{AliasRule, resolve_object};
+pub use bind::Bindings;
+pub use device::{Axis, IdCondition, IdTest, IndexRange, ObjectRange, PdoSet, PdoTemplate, TextMatch};
+pub use expr::Expr;
+pub use fields::{ByteField, SdoCommand, SdoDirection};
+pub use procedure::{Procedure, Step};
 pub use value::{DataType, Value};
 
 use std::collections::BTreeMap;
+
+/// A problem found while loading a profile or EDS that did not stop the load.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Warning {
+    /// The file (or built-in name) being loaded.
+    pub file: String,
+    /// Where: a JSON path such as `objects.0x6041.type`, or `line 12`.
+    pub at: String,
+    /// What is wrong and what was done about it.
+    pub message: String,
+}
+
+impl std::fmt::Display for Warning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}: {}", self.file, self.at, self.message)
+    }
+}
 
 /// Access rights of an object entry.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -44,6 +75,31 @@ pub struct ObjectInfo {
     pub values: BTreeMap<i64, String>,
     /// Vendor parameter alias printed on the drive or in its manual, e.g. `F0.3.018`.
     pub alias: Option<String>,
+    /// Names of single bits of a bit field (bit 0 = LSB).
+    pub bits: BTreeMap<u8, String>,
+    /// Whether the entry may be mapped into PDOs.
+    pub pdo: PdoMappable,
+    /// Default value (from an EDS `DefaultValue`, or a DCF's configured `ParameterValue`).
+    pub default: Option<Value>,
+    /// Lowest allowed raw value.
+    pub min: Option<i64>,
+    /// Highest allowed raw value.
+    pub max: Option<i64>,
+    /// Longer help text.
+    pub description: Option<String>,
+}
+
+/// Whether an object may be mapped into PDOs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PdoMappable {
+    #[default]
+    No,
+    /// Into transmit PDOs (device to bus).
+    Tpdo,
+    /// Into receive PDOs (bus to device).
+    Rpdo,
+    /// Into either.
+    Both,
 }
 
 /// Where a PDO mapping came from, kept with every mapping we decode through.
@@ -75,40 +131,109 @@ pub struct PdoMapping {
     pub source: MappingSource,
 }
 
-/// One field of the EMCY manufacturer-specific bytes.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct EmcyField {
-    /// Offset in the 8-byte EMCY frame (3..=7).
-    pub offset: u8,
-    /// Length in bytes (little-endian).
-    pub len: u8,
-    /// Name shown in labels, e.g. "M1 alarm".
-    pub name: String,
-    /// Texts for values of this field.
-    pub values: BTreeMap<i64, String>,
-}
-
 /// Everything known about one device type.
 #[derive(Clone, Debug, Default)]
 pub struct Profile {
     /// Short name, e.g. "cia402" or "syntron-ds".
     pub name: String,
+    /// One line for humans.
+    pub description: String,
+    /// Profiles this one builds on, most specific first (e.g. ["cia402"]).
+    pub extends: Vec<String>,
+    /// Names of records and arrays at index level, e.g. 0x1018 -> "Identity object".
+    pub object_names: BTreeMap<u16, String>,
+    /// Extra vendor aliases besides each object's own `alias`.
+    pub aliases: BTreeMap<String, (u16, u8)>,
+    /// Rules turning vendor parameter numbers into objects.
+    pub alias_rules: Vec<AliasRule>,
+    /// Layout of the EMCY manufacturer-specific bytes.
+    pub emcy_fields: Vec<ByteField>,
+    /// Named default PDO mapping sets; `rpdo`/`tpdo` hold the default one's.
+    pub pdo_sets: Vec<PdoSet>,
+    /// Vendor SDO commands.
+    pub sdo_commands: Vec<SdoCommand>,
+    /// Named procedures.
+    pub procedures: BTreeMap<String, Procedure>,
+    /// Conditions on identity objects that recognise the device (all must hold).
+    pub identification: Vec<IdCondition>,
+    /// Logical axes on one node.
+    pub axes: Vec<Axis>,
+    /// Node-ID from an EDS/DCF `[DeviceCommissioning]` section.
+    pub node_id: Option<u8>,
+    /// Node name from an EDS/DCF `[DeviceCommissioning]` section.
+    pub node_name: Option<String>,
     /// Objects by (index, sub). Single-valued objects use sub 0.
     pub objects: BTreeMap<(u16, u8), ObjectInfo>,
+    /// Families of identical records over index ranges (PDO/SDO parameters),
+    /// used for an index that has no entry in `objects`.
+    pub ranges: Vec<IndexRange>,
     /// Vendor EMCY code texts by exact code.
     pub emcy_codes: BTreeMap<u16, String>,
-    /// How the 5 manufacturer bytes of an EMCY are laid out (empty: shown as hex).
-    pub emcy_layout: Vec<EmcyField>,
     /// Default RPDO mappings by PDO number (1-based).
-    pub rpdo: BTreeMap<u16, PdoMapping>,
+    pub rpdo: BTreeMap<u8, PdoMapping>,
     /// Default TPDO mappings by PDO number (1-based).
-    pub tpdo: BTreeMap<u16, PdoMapping>,
+    pub tpdo: BTreeMap<u8, PdoMapping>,
 }
 
 impl Profile {
-    /// The entry at (index, sub), falling back to sub 0 for the name of a record/array.
+    /// The entry at (index, sub): from `objects`, or from an index range when
+    /// `objects` has nothing at that index.
     pub fn object(&self, index: u16, sub: u8) -> Option<&ObjectInfo> {
-        self.objects.get(&(index, sub))
+        if let Some(o) = self.objects.get(&(index, sub)) {
+            return Some(o);
+        }
+        if self.objects.range((index, 0)..=(index, 255)).next().is_some() {
+            return None;
+        }
+        self.range_of(index).and_then(|r| r.subs.get(&sub))
+    }
+
+    /// The last-defined index range containing `index`.
+    fn range_of(&self, index: u16) -> Option<&IndexRange> {
+        self.ranges.iter().rev().find(|r| (r.first..=r.last).contains(&index))
+    }
+
+    /// Copies an index range's entries for `index` into `objects`, so that single
+    /// entries can then be changed there.
+    pub fn materialize(&mut self, index: u16) {
+        if self.objects.range((index, 0)..=(index, 255)).next().is_some() {
+            return;
+        }
+        let Some(subs) = self.range_of(index).map(|r| r.subs.clone()) else {
+            return;
+        };
+        for (sub, info) in subs {
+            self.objects.insert((index, sub), info);
+        }
+    }
+
+    /// The default PDO set (the one marked default, else the first).
+    pub fn default_pdo_set(&self) -> Option<&PdoSet> {
+        self.pdo_sets.iter().find(|s| s.default).or(self.pdo_sets.first())
+    }
+
+    /// Whether the identity values (`read(index, sub)`) match all identification
+    /// conditions; false when the profile has none or a value is missing.
+    pub fn identifies(&self, read: &dyn Fn(u16, u8) -> Option<Value>) -> bool {
+        !self.identification.is_empty()
+            && self
+                .identification
+                .iter()
+                .all(|c| read(c.index, c.sub).is_some_and(|v| c.matches(&v)))
+    }
+
+    /// The logical axis an object belongs to.
+    pub fn axis_of(&self, index: u16, sub: u8) -> Option<&Axis> {
+        self.axes
+            .iter()
+            .find(|a| a.objects.iter().any(|r| r.contains(index, sub)))
+    }
+
+    /// The vendor SDO command for this command byte and direction.
+    pub fn sdo_command(&self, command: u8, direction: SdoDirection) -> Option<&SdoCommand> {
+        self.sdo_commands
+            .iter()
+            .find(|c| c.command == command && c.direction == direction)
     }
 }
 
@@ -132,15 +257,52 @@ impl Dictionary {
     pub fn object(&self, index: u16, sub: u8) -> Option<&ObjectInfo> {
         self.layers.iter().find_map(|p| p.object(index, sub))
     }
-    /// The name of the object (index level, sub 0 when it has no own entry), for labels.
+    /// The name of the entry, else of the object (index level: a record's name or
+    /// its sub 0 entry's), for labels.
     pub fn name(&self, index: u16, sub: u8) -> Option<&str> {
         self.object(index, sub)
-            .or_else(|| self.object(index, 0))
             .map(|o| o.name.as_str())
+            .or_else(|| self.object_name(index))
     }
     /// The most specific profile's name (e.g. "syntron-ds"), or "cia301".
     pub fn profile_name(&self) -> &str {
         self.layers.first().map(|p| p.name.as_str()).unwrap_or("cia301")
+    }
+    /// The name of an object at index level: a record's name, or its sub 0 entry's.
+    pub fn object_name(&self, index: u16) -> Option<&str> {
+        self.layers.iter().find_map(|p| {
+            p.object_names
+                .get(&index)
+                .map(String::as_str)
+                .or(p.object(index, 0).map(|o| o.name.as_str()))
+        })
+    }
+    /// The first layer with an EMCY manufacturer-byte layout, and that layout.
+    pub fn emcy_fields(&self) -> &[ByteField] {
+        self.layers
+            .iter()
+            .map(|p| p.emcy_fields.as_slice())
+            .find(|f| !f.is_empty())
+            .unwrap_or(&[])
+    }
+    /// A named procedure from the first layer that has it.
+    pub fn procedure(&self, name: &str) -> Option<&Procedure> {
+        self.layers.iter().find_map(|p| p.procedures.get(name))
+    }
+    /// A vendor SDO command from the first layer that has it.
+    pub fn sdo_command(&self, command: u8, direction: SdoDirection) -> Option<&SdoCommand> {
+        self.layers.iter().find_map(|p| p.sdo_command(command, direction))
+    }
+    /// The logical axis of an object, from the first layer that has axes.
+    pub fn axis_of(&self, index: u16, sub: u8) -> Option<&Axis> {
+        self.layers.iter().find_map(|p| p.axis_of(index, sub))
+    }
+    /// The PDO mappings (RPDO when `transmit` is false) of the first layer that has any.
+    pub fn default_pdos(&self, transmit: bool) -> Option<&BTreeMap<u8, PdoMapping>> {
+        self.layers
+            .iter()
+            .map(|p| if transmit { &p.tpdo } else { &p.rpdo })
+            .find(|m| !m.is_empty())
     }
     /// A vendor EMCY text for an exact code.
     pub fn emcy_text(&self, code: u16) -> Option<&str> {
@@ -157,7 +319,9 @@ impl Dictionary {
 /// `15000` of an I32 with scale 0.1 and unit "rpm" -> `1500 rpm`.
 pub fn format_value(info: Option<&ObjectInfo>, value: &Value) -> String {
     let Some(info) = info else { return value.to_string() };
-    if let Some((raw, text)) = value.as_i64().and_then(|raw| info.values.get(&raw).map(|t| (raw, t))) {
+    if let Some(raw) = value.as_i64()
+        && let Some(text) = info.values.get(&raw)
+    {
         return format!("{raw} ({text})");
     }
     match (value.as_f64(), info.scale, &info.unit) {
@@ -184,22 +348,11 @@ pub fn format_number(x: f64) -> String {
     }
 }
 
-/// The EMCY manufacturer fields of an 8-byte frame through the first layout in `dict`.
+/// The EMCY manufacturer fields of an 8-byte frame through the node's layout,
+/// as (name, shown value) pairs; empty when no profile describes them.
 pub fn emcy_fields(dict: &Dictionary, frame: &[u8; 8]) -> Vec<(String, String)> {
-    let Some(layout) = dict.layers().iter().map(|p| &p.emcy_layout).find(|l| !l.is_empty()) else {
-        return Vec::new();
-    };
-    layout
+    dict.emcy_fields()
         .iter()
-        .filter(|f| (3..8).contains(&f.offset) && f.len >= 1 && f.offset as usize + f.len as usize <= 8)
-        .map(|f| {
-            let bytes = &frame[f.offset as usize..f.offset as usize + f.len as usize];
-            let raw = bytes.iter().rev().fold(0i64, |acc, b| (acc << 8) | *b as i64);
-            let text = match f.values.get(&raw) {
-                Some(t) => format!("0x{raw:02X} ({t})"),
-                None => format!("0x{raw:02X}"),
-            };
-            (f.name.clone(), text)
-        })
+        .filter_map(|f| f.raw(frame).map(|raw| (f.name.clone(), f.format(raw))))
         .collect()
 }

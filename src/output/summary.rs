@@ -12,8 +12,6 @@ pub struct Summary {
     pub by_node: BTreeMap<u8, BTreeMap<Kind, u64>>,
     /// Frames in all.
     pub frames: u64,
-    /// Frames marked malformed (only counted when the caller decoded them).
-    pub malformed: u64,
     kind_counts: [u64; 12],
     node_counts: Vec<[u64; 12]>,
 }
@@ -68,9 +66,6 @@ impl Summary {
     /// Text report.
     pub fn to_text(&self) -> String {
         let mut s = format!("frames: {}\n", self.frames);
-        if self.malformed > 0 {
-            s.push_str(&format!("malformed: {}\n", self.malformed));
-        }
         s.push_str("by kind:\n");
         for (k, n) in &self.by_kind {
             s.push_str(&format!("  {:<12} {n}\n", k.as_str()));
@@ -102,7 +97,7 @@ impl Summary {
                 (node.to_string(), m.into())
             })
             .collect();
-        serde_json::json!({"frames": self.frames, "malformed": self.malformed, "by_kind": kinds, "by_node": nodes})
+        serde_json::json!({"frames": self.frames, "by_kind": kinds, "by_node": nodes})
     }
 }
 

@@ -3,29 +3,16 @@
 use crate::decode::Decoded;
 use crate::frame::{Frame, Interfaces};
 
-/// Appends `v` in decimal, zero-padded to at least `width` digits.
-fn push_decimal(out: &mut String, mut v: u64, width: usize) {
-    let mut buf = [b'0'; 20];
-    let mut i = buf.len();
-    while v > 0 || buf.len() - i < width.max(1) {
-        i -= 1;
-        buf[i] = b'0' + (v % 10) as u8;
-        v /= 10;
-    }
-    buf[i..].iter().for_each(|b| out.push(*b as char));
-}
+use crate::hex::{push_decimal, push_hex};
 
-/// Appends the low `digits` hex digits of `v`, upper case.
-fn push_hex(out: &mut String, v: u32, digits: u32) {
-    for i in (0..digits).rev() {
-        out.push(char::from(b"0123456789ABCDEF"[(v >> (4 * i) & 0xF) as usize]));
-    }
-}
+/// Spaces for column padding.
+const PADDING: &str = "                                ";
 
 /// Appends one line (with `\n`) for `frame`:
 /// `(1700000000.123456)  can0  181   [8]  37 02 00 00 00 00 00 00  TPDO1 node 1: ...`.
 /// A frame that breaks its kind's rules ends with `  !! <reason>`.
 pub fn write_line(out: &mut String, frame: &Frame, ifaces: &Interfaces, decoded: &Decoded) {
+    out.reserve(160);
     out.push('(');
     push_decimal(out, frame.ts_ns / 1_000_000_000, 10);
     out.push('.');
@@ -56,15 +43,13 @@ pub fn write_line(out: &mut String, frame: &Frame, ifaces: &Interfaces, decoded:
     if frame.is_rtr() {
         out.push_str("remote request");
     } else {
-        for b in frame.payload() {
-            crate::hex::push_upper(out, std::slice::from_ref(b));
+        crate::hex::push_spaced(out, frame.payload());
+        if frame.len > 0 {
             out.push(' ');
         }
     }
     let used = out.len() - start;
-    for _ in used..width {
-        out.push(' ');
-    }
+    out.push_str(&PADDING[..width.saturating_sub(used).min(PADDING.len())]);
     if frame.flags.has(crate::frame::Flags::TX) {
         out.push_str("T ");
     }

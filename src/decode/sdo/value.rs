@@ -1,7 +1,7 @@
 //! Object values as SDO labels and JSON show them, typed through the dictionary.
 
 use crate::hex;
-use crate::od::{Dictionary, Value, format_value};
+use crate::od::{Dictionary, Value};
 
 /// A value ready for a label and for JSON.
 #[derive(Clone, Debug, PartialEq)]
@@ -32,11 +32,8 @@ pub fn view(dict: &Dictionary, index: u16, sub: u8, bytes: &[u8]) -> ValueView {
         let size = info.data_type.size();
         let take = size.map_or(bytes.len(), |n| n.min(bytes.len()));
         let typed = info.data_type.decode(&bytes[..take]);
-        let meaning = typed
-            .as_i64()
-            .and_then(|raw| crate::decode::cia402::value_text(index, sub, raw, None));
         return ValueView {
-            text: meaning.unwrap_or_else(|| format_value(Some(info), &typed)),
+            text: crate::decode::value_text::object_text(dict, index, sub, &typed, None),
             json: typed.to_json(),
             typed: Some(typed),
             type_len_mismatch: size.filter(|n| *n != bytes.len()),
@@ -45,6 +42,7 @@ pub fn view(dict: &Dictionary, index: u16, sub: u8, bytes: &[u8]) -> ValueView {
     match le_uint(bytes) {
         Some(n) => ValueView {
             text: crate::decode::cia402::value_text(index, sub, n as i64, None)
+                .or_else(|| crate::decode::comm_params::describe(index, sub, n as u64, dict))
                 .unwrap_or_else(|| format!("{} ({n})", hex::spaced(bytes))),
             json: n.into(),
             typed: None,

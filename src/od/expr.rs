@@ -1,0 +1,410 @@
+//! Integer expressions used in profiles: alias rules, COB-IDs, procedure values.
+//!
+//! `0x2000 + 0x1000*x + 0x100*y + z`, `index >= 0x5000 ? 0x100 : 0x1000`,
+//! `speed * 10`. C precedence, 64-bit signed arithmetic, no panics: overflow,
+//! division by zero and unknown variables are evaluation errors.
+
+use std::fmt;
+
+/// A parsed expression, keeping its source text for messages.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Expr {
+    src: String,
+    node: Node,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum Node {
+    Num(i64),
+    Var(String),
+    Unary(char, Box<Node>),
+    Binary(Op, Box<Node>, Box<Node>),
+    Cond(Box<Node>, Box<Node>, Box<Node>),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Op {
+    Mul,
+    Div,
+    Rem,
+    Add,
+    Sub,
+    Shl,
+    Shr,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+    Eq,
+    Ne,
+    BitAnd,
+    BitXor,
+    BitOr,
+    And,
+    Or,
+}
+
+impl Op {
+    /// Binding power (higher binds tighter), as in C.
+    fn power(self) -> u8 {
+        use Op::*;
+        match self {
+            Mul | Div | Rem => 10,
+            Add | Sub => 9,
+            Shl | Shr => 8,
+            Lt | Le | Gt | Ge => 7,
+            Eq | Ne => 6,
+            BitAnd => 5,
+            BitXor => 4,
+            BitOr => 3,
+            And => 2,
+            Or => 1,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum Tok {
+    Num(i64),
+    Ident(String),
+    Op(Op),
+    Not,
+    Tilde,
+    Question,
+    Colon,
+    Open,
+    Close,
+}
+
+impl Expr {
+    /// Parses `text`; the error says what is wrong and at which character.
+    pub fn parse(text: &str) -> Result<Expr, String> {
+        let toks = tokenize(text)?;
+        let mut p = Parser { toks: &toks, pos: 0 };
+        let node = p.conditional()?;
+        if p.pos < toks.len() {
+            return Err(format!("unexpected {:?} in expression `{text}`", toks[p.pos]));
+        }
+        Ok(Expr {
+            src: text.trim().to_string(),
+            node,
+        })
+    }
+
+    /// A constant expression.
+    pub fn constant(value: i64) -> Expr {
+        Expr {
+            src: value.to_string(),
+            node: Node::Num(value),
+        }
+    }
+
+    /// Names of the variables the expression uses, in order of first use.
+    pub fn variables(&self) -> Vec<&str> {
+        fn walk<'a>(n: &'a Node, out: &mut Vec<&'a str>) {
+            match n {
+                Node::Num(_) => {}
+                Node::Var(v) => {
+                    if !out.contains(&v.as_str()) {
+                        out.push(v);
+                    }
+                }
+                Node::Unary(_, a) => walk(a, out),
+                Node::Binary(_, a, b) => {
+                    walk(a, out);
+                    walk(b, out);
+                }
+                Node::Cond(c, a, b) => {
+                    walk(c, out);
+                    walk(a, out);
+                    walk(b, out);
+                }
+            }
+        }
+        let mut out = Vec::new();
+        walk(&self.node, &mut out);
+        out
+    }
+
+    /// Evaluates with `vars` giving each variable's value.
+    pub fn eval(&self, vars: &dyn Fn(&str) -> Option<i64>) -> Result<i64, String> {
+        eval(&self.node, vars).map_err(|e| format!("{e} in `{}`", self.src))
+    }
+}
+
+impl fmt::Display for Expr {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.src)
+    }
+}
+
+fn eval(n: &Node, vars: &dyn Fn(&str) -> Option<i64>) -> Result<i64, String> {
+    let overflow = || "arithmetic overflow".to_string();
+    Ok(match n {
+        Node::Num(v) => *v,
+        Node::Var(name) => vars(name).ok_or_else(|| format!("unknown variable `{name}`"))?,
+        Node::Unary(op, a) => {
+            let a = eval(a, vars)?;
+            match op {
+                '-' => a.checked_neg().ok_or_else(overflow)?,
+                '!' => (a == 0) as i64,
+                _ => !a,
+            }
+        }
+        Node::Cond(c, a, b) => {
+            if eval(c, vars)? != 0 {
+                eval(a, vars)?
+            } else {
+                eval(b, vars)?
+            }
+        }
+        Node::Binary(op, a, b) => {
+            let x = eval(a, vars)?;
+            // Short-circuit the logical operators.
+            match op {
+                Op::And if x == 0 => return Ok(0),
+                Op::Or if x != 0 => return Ok(1),
+                _ => {}
+            }
+            let y = eval(b, vars)?;
+            let shift = |y: i64| {
+                u32::try_from(y)
+                    .ok()
+                    .filter(|s| *s < 64)
+                    .ok_or_else(|| format!("bad shift {y}"))
+            };
+            match op {
+                Op::Mul => x.checked_mul(y).ok_or_else(overflow)?,
+                Op::Div => x.checked_div(y).ok_or_else(|| "division by zero".to_string())?,
+                Op::Rem => x.checked_rem(y).ok_or_else(|| "division by zero".to_string())?,
+                Op::Add => x.checked_add(y).ok_or_else(overflow)?,
+                Op::Sub => x.checked_sub(y).ok_or_else(overflow)?,
+                Op::Shl => x.checked_shl(shift(y)?).ok_or_else(overflow)?,
+                Op::Shr => x >> shift(y)?,
+                Op::Lt => (x < y) as i64,
+                Op::Le => (x <= y) as i64,
+                Op::Gt => (x > y) as i64,
+                Op::Ge => (x >= y) as i64,
+                Op::Eq => (x == y) as i64,
+                Op::Ne => (x != y) as i64,
+                Op::BitAnd => x & y,
+                Op::BitXor => x ^ y,
+                Op::BitOr => x | y,
+                Op::And | Op::Or => (y != 0) as i64,
+            }
+        }
+    })
+}
+
+fn tokenize(text: &str) -> Result<Vec<Tok>, String> {
+    let chars: Vec<char> = text.chars().collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        if c.is_whitespace() {
+            i += 1;
+            continue;
+        }
+        if c.is_ascii_digit() {
+            let start = i;
+            while i < chars.len() && (chars[i].is_ascii_alphanumeric() || chars[i] == '_') {
+                i += 1;
+            }
+            let lit: String = chars[start..i].iter().collect();
+            let v = parse_int(&lit).ok_or_else(|| format!("bad number `{lit}` in expression `{text}`"))?;
+            out.push(Tok::Num(v));
+            continue;
+        }
+        if c.is_alphabetic() || c == '_' {
+            let start = i;
+            while i < chars.len() && (chars[i].is_alphanumeric() || chars[i] == '_') {
+                i += 1;
+            }
+            out.push(Tok::Ident(chars[start..i].iter().collect()));
+            continue;
+        }
+        let next = chars.get(i + 1).copied();
+        let (tok, len) = match (c, next) {
+            ('<', Some('<')) => (Tok::Op(Op::Shl), 2),
+            ('>', Some('>')) => (Tok::Op(Op::Shr), 2),
+            ('<', Some('=')) => (Tok::Op(Op::Le), 2),
+            ('>', Some('=')) => (Tok::Op(Op::Ge), 2),
+            ('=', Some('=')) => (Tok::Op(Op::Eq), 2),
+            ('!', Some('=')) => (Tok::Op(Op::Ne), 2),
+            ('&', Some('&')) => (Tok::Op(Op::And), 2),
+            ('|', Some('|')) => (Tok::Op(Op::Or), 2),
+            ('<', _) => (Tok::Op(Op::Lt), 1),
+            ('>', _) => (Tok::Op(Op::Gt), 1),
+            ('*', _) => (Tok::Op(Op::Mul), 1),
+            ('/', _) => (Tok::Op(Op::Div), 1),
+            ('%', _) => (Tok::Op(Op::Rem), 1),
+            ('+', _) => (Tok::Op(Op::Add), 1),
+            ('-', _) => (Tok::Op(Op::Sub), 1),
+            ('&', _) => (Tok::Op(Op::BitAnd), 1),
+            ('^', _) => (Tok::Op(Op::BitXor), 1),
+            ('|', _) => (Tok::Op(Op::BitOr), 1),
+            ('!', _) => (Tok::Not, 1),
+            ('~', _) => (Tok::Tilde, 1),
+            ('?', _) => (Tok::Question, 1),
+            (':', _) => (Tok::Colon, 1),
+            ('(', _) => (Tok::Open, 1),
+            (')', _) => (Tok::Close, 1),
+            _ => {
+                return Err(format!(
+                    "unexpected `{c}` at character {} of expression `{text}`",
+                    i + 1
+                ));
+            }
+        };
+        out.push(tok);
+        i += len;
+    }
+    Ok(out)
+}
+
+/// Parses `0x1A`, `0b101`, `-12` or `42` (no octal here: `018` is decimal 18).
+pub fn parse_int(text: &str) -> Option<i64> {
+    let t = text.trim();
+    let (neg, t) = match t.strip_prefix('-') {
+        Some(rest) => (true, rest.trim_start()),
+        None => (false, t),
+    };
+    let t = t.replace('_', "");
+    let v = if let Some(h) = t.strip_prefix("0x").or_else(|| t.strip_prefix("0X")) {
+        u64::from_str_radix(h, 16).ok()?
+    } else if let Some(b) = t.strip_prefix("0b").or_else(|| t.strip_prefix("0B")) {
+        u64::from_str_radix(b, 2).ok()?
+    } else {
+        t.parse::<u64>().ok()?
+    };
+    if neg {
+        0i64.checked_sub_unsigned(v)
+    } else {
+        // Values up to u64::MAX are kept as their two's-complement bit pattern.
+        Some(v as i64)
+    }
+}
+
+struct Parser<'a> {
+    toks: &'a [Tok],
+    pos: usize,
+}
+
+impl Parser<'_> {
+    fn peek(&self) -> Option<&Tok> {
+        self.toks.get(self.pos)
+    }
+
+    fn conditional(&mut self) -> Result<Node, String> {
+        let c = self.binary(0)?;
+        if self.peek() == Some(&Tok::Question) {
+            self.pos += 1;
+            let a = self.conditional()?;
+            if self.peek() != Some(&Tok::Colon) {
+                return Err("expected `:` after `?` branch".to_string());
+            }
+            self.pos += 1;
+            let b = self.conditional()?;
+            return Ok(Node::Cond(Box::new(c), Box::new(a), Box::new(b)));
+        }
+        Ok(c)
+    }
+
+    fn binary(&mut self, min_power: u8) -> Result<Node, String> {
+        let mut left = self.unary()?;
+        while let Some(Tok::Op(op)) = self.peek() {
+            let op = *op;
+            if op.power() <= min_power {
+                break;
+            }
+            self.pos += 1;
+            let right = self.binary(op.power())?;
+            left = Node::Binary(op, Box::new(left), Box::new(right));
+        }
+        Ok(left)
+    }
+
+    fn unary(&mut self) -> Result<Node, String> {
+        let op = match self.peek() {
+            Some(Tok::Op(Op::Sub)) => '-',
+            Some(Tok::Op(Op::Add)) => '+',
+            Some(Tok::Not) => '!',
+            Some(Tok::Tilde) => '~',
+            _ => return self.primary(),
+        };
+        self.pos += 1;
+        let inner = self.unary()?;
+        Ok(if op == '+' {
+            inner
+        } else {
+            Node::Unary(op, Box::new(inner))
+        })
+    }
+
+    fn primary(&mut self) -> Result<Node, String> {
+        let tok = self.peek().cloned();
+        self.pos += 1;
+        match tok {
+            Some(Tok::Num(v)) => Ok(Node::Num(v)),
+            Some(Tok::Ident(name)) => Ok(Node::Var(name)),
+            Some(Tok::Open) => {
+                let inner = self.conditional()?;
+                if self.peek() != Some(&Tok::Close) {
+                    return Err("missing `)`".to_string());
+                }
+                self.pos += 1;
+                Ok(inner)
+            }
+            Some(t) => Err(format!("unexpected {t:?}")),
+            None => Err("expression ends too early".to_string()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ev(text: &str, vars: &[(&str, i64)]) -> Result<i64, String> {
+        let e = Expr::parse(text)?;
+        e.eval(&|n| vars.iter().find(|(k, _)| *k == n).map(|(_, v)| *v))
+    }
+
+    #[test]
+    fn syntron_rule_and_precedence() {
+        let vars = [("x", 1), ("y", 3), ("z", 0x18)];
+        assert_eq!(ev("0x2000 + 0x1000*x + 0x100*y + z", &vars), Ok(0x3318));
+        assert_eq!(ev("1 + 2 * 3 << 1", &[]), Ok(14));
+        assert_eq!(ev("(1 + 2) * 3", &[]), Ok(9));
+        assert_eq!(ev("-3 + ~0", &[]), Ok(-4));
+        assert_eq!(ev("1 | 2 & 3 == 3", &[]), Ok(1));
+    }
+
+    #[test]
+    fn conditional_and_comparisons() {
+        let e = "index + (index >= 0x5000 ? 0x100 : 0x1000)";
+        assert_eq!(ev(e, &[("index", 0x5004)]), Ok(0x5104));
+        assert_eq!(ev(e, &[("index", 0x2318)]), Ok(0x3318));
+        assert_eq!(ev("0 && 1/0", &[]), Ok(0));
+        assert_eq!(ev("1 ? 2 : 0 ? 3 : 4", &[]), Ok(2));
+    }
+
+    #[test]
+    fn errors_are_messages() {
+        assert!(ev("1 / 0", &[]).unwrap_err().contains("division by zero"));
+        assert!(ev("speed * 10", &[]).unwrap_err().contains("unknown variable `speed`"));
+        assert!(ev("0x7FFFFFFFFFFFFFFF + 1", &[]).unwrap_err().contains("overflow"));
+        assert!(Expr::parse("1 +").is_err());
+        assert!(Expr::parse("(1").is_err());
+        assert!(Expr::parse("2 $ 3").unwrap_err().contains("`$`"));
+        assert!(Expr::parse("0xZZ").is_err());
+        assert!(ev("1 << 64", &[]).is_err());
+    }
+
+    #[test]
+    fn variables_in_order() {
+        let e = Expr::parse("0x600 + node + node * speed").unwrap();
+        assert_eq!(e.variables(), vec!["node", "speed"]);
+    }
+}

@@ -1,0 +1,205 @@
+//! Reading the small value syntaxes of profile files: numbers as numbers or
+//! strings, expressions, PDO mapping entries, sub and index ranges, type and
+//! access names.
+
+use serde_json::Value as Json;
+
+use crate::od::alias::parse_object_ref;
+use crate::od::expr::{Expr, parse_int};
+use crate::od::{Access, DataType, MappedEntry, ObjectRange, Value};
+
+/// A number given as a JSON number or a string (`0x..`, `0b..`, decimal).
+pub(super) fn int(v: &Json) -> Result<i64, String> {
+    match v {
+        Json::Number(n) => n
+            .as_i64()
+            .or_else(|| n.as_u64().map(|u| u as i64))
+            .ok_or_else(|| format!("{n} is not an integer")),
+        Json::String(s) => parse_int(s).ok_or_else(|| format!("`{s}` is not a number")),
+        other => Err(format!("{other} is not a number")),
+    }
+}
+
+pub(super) fn byte(v: i64) -> Result<u8, String> {
+    u8::try_from(v).map_err(|_| format!("{v} is not a byte (0..255)"))
+}
+
+pub(super) fn float(v: &Json) -> Result<f64, String> {
+    match v {
+        Json::Number(n) => n.as_f64().ok_or_else(|| format!("{n} is not a number")),
+        Json::String(s) => s.trim().parse().map_err(|_| format!("`{s}` is not a number")),
+        other => Err(format!("{other} is not a number")),
+    }
+}
+
+pub(super) fn expr(v: &Json) -> Result<Expr, String> {
+    match v {
+        Json::String(s) => Expr::parse(s),
+        Json::Number(_) => int(v).map(Expr::constant),
+        other => Err(format!("{other} is not an expression")),
+    }
+}
+
+pub(super) fn default_value(v: &Json, t: DataType) -> Result<Value, String> {
+    use DataType::*;
+    match t {
+        VisibleString | UnicodeString => match v {
+            Json::String(s) => Ok(Value::Text(s.clone())),
+            other => Err(format!("{other} is not a text")),
+        },
+        F32 | F64 => float(v).map(Value::Float),
+        Boolean => int(v).map(|x| Value::Bool(x != 0)),
+        I8 | I16 | I24 | I32 | I40 | I48 | I56 | I64 => int(v).map(Value::Signed),
+        OctetString | Domain | TimeOfDay | TimeDifference => match v {
+            Json::String(s) => hex_bytes(s)
+                .map(Value::Bytes)
+                .ok_or_else(|| format!("`{s}` is not hex bytes")),
+            other => Err(format!("{other} is not hex bytes")),
+        },
+        _ => int(v).map(|x| Value::Unsigned(x as u64)),
+    }
+}
+
+/// `"01 02 0A"` or `"01020A"` as bytes.
+pub(super) fn hex_bytes(s: &str) -> Option<Vec<u8>> {
+    let digits: Vec<u8> = s.bytes().filter(|b| !b.is_ascii_whitespace()).collect();
+    if !digits.len().is_multiple_of(2) {
+        return None;
+    }
+    digits
+        .chunks(2)
+        .map(|p| Some(crate::hex::nibble(p[0])? << 4 | crate::hex::nibble(p[1])?))
+        .collect()
+}
+
+/// `"0x6041:0/16"`, `"0x6041/16"` or a CiA mapping value `"0x60410010"` / number.
+pub(super) fn mapped_entry(v: &Json) -> Result<MappedEntry, String> {
+    let from_raw = |raw: i64| -> Result<MappedEntry, String> {
+        let raw = u32::try_from(raw).map_err(|_| format!("{raw} is not a 32-bit mapping value"))?;
+        Ok(MappedEntry {
+            index: (raw >> 16) as u16,
+            sub: (raw >> 8) as u8,
+            bits: raw as u8,
+        })
+    };
+    let e = match v {
+        Json::Number(_) => from_raw(int(v)?)?,
+        Json::String(s) => match s.split_once('/') {
+            Some((obj, bits)) => {
+                let (index, sub) = parse_object_ref(obj).ok_or_else(|| format!("`{obj}` is not an object"))?;
+                let bits = bits
+                    .trim()
+                    .parse::<u8>()
+                    .map_err(|_| format!("`{bits}` is not a bit length"))?;
+                MappedEntry { index, sub, bits }
+            }
+            None => from_raw(parse_int(s).ok_or_else(|| format!("`{s}` is not a mapping (use 0xINDEX:SUB/BITS)"))?)?,
+        },
+        other => return Err(format!("{other} is not a mapping entry")),
+    };
+    if e.bits == 0 || e.bits > 64 {
+        return Err(format!(
+            "bit length {} of 0x{:04X}:{} is not 1..64",
+            e.bits, e.index, e.sub
+        ));
+    }
+    Ok(e)
+}
+
+/// `"0x1400..0x15FF"` as (first, last).
+pub(super) fn index_range(key: &str) -> Option<(u16, u16)> {
+    let (a, b) = key.split_once("..")?;
+    let idx = |t: &str| {
+        parse_object_ref(t)
+            .filter(|(_, s)| *s == 0 && !t.contains(':'))
+            .map(|(i, _)| i)
+    };
+    let (first, last) = (idx(a)?, idx(b)?);
+    (first <= last).then_some((first, last))
+}
+
+/// `"3"`, `"0x1A"` or `"1..127"`.
+pub(super) fn sub_range(key: &str) -> Result<std::ops::RangeInclusive<u8>, String> {
+    let one = |t: &str| {
+        parse_int(t)
+            .and_then(|v| u8::try_from(v).ok())
+            .ok_or_else(|| format!("`{t}` is not a sub 0..255"))
+    };
+    match key.split_once("..") {
+        Some((a, b)) => {
+            let (a, b) = (one(a)?, one(b)?);
+            if a > b {
+                return Err(format!("empty sub range `{key}`"));
+            }
+            Ok(a..=b)
+        }
+        None => one(key).map(|s| s..=s),
+    }
+}
+
+/// `"0x3046"` (all subs), `"0x303F:0x11"` (one sub) or `"0x6000..0x67FF"`.
+pub(super) fn object_range(text: &str) -> Result<ObjectRange, String> {
+    if text.contains("..") {
+        let (first, last) =
+            index_range(text).ok_or_else(|| format!("`{text}` is not an index range (0xFIRST..0xLAST)"))?;
+        return Ok(ObjectRange { first, last, sub: None });
+    }
+    let (index, sub) = parse_object_ref(text).ok_or_else(|| format!("`{text}` is not an object"))?;
+    let one_sub = text.contains(':') || text.to_ascii_lowercase().contains("sub");
+    Ok(ObjectRange {
+        first: index,
+        last: index,
+        sub: one_sub.then_some(sub),
+    })
+}
+
+/// A data type by profile name (`u16`) or CiA name (`UNSIGNED16`), case-insensitive.
+pub fn parse_type(name: &str) -> Option<DataType> {
+    use DataType::*;
+    let n: String = name
+        .chars()
+        .filter(|c| *c != '_' && *c != ' ')
+        .collect::<String>()
+        .to_ascii_lowercase();
+    Some(match n.as_str() {
+        "boolean" | "bool" => Boolean,
+        "i8" | "integer8" => I8,
+        "i16" | "integer16" => I16,
+        "i24" | "integer24" => I24,
+        "i32" | "integer32" => I32,
+        "i40" | "integer40" => I40,
+        "i48" | "integer48" => I48,
+        "i56" | "integer56" => I56,
+        "i64" | "integer64" => I64,
+        "u8" | "unsigned8" => U8,
+        "u16" | "unsigned16" => U16,
+        "u24" | "unsigned24" => U24,
+        "u32" | "unsigned32" => U32,
+        "u40" | "unsigned40" => U40,
+        "u48" | "unsigned48" => U48,
+        "u56" | "unsigned56" => U56,
+        "u64" | "unsigned64" => U64,
+        "f32" | "real32" => F32,
+        "f64" | "real64" => F64,
+        "visiblestring" => VisibleString,
+        "octetstring" => OctetString,
+        "unicodestring" => UnicodeString,
+        "timeofday" => TimeOfDay,
+        "timedifference" => TimeDifference,
+        "domain" => Domain,
+        _ => return None,
+    })
+}
+
+/// An access name: `ro`, `wo`, `rw`, `rwr`, `rww`, `const` (case-insensitive).
+pub fn parse_access(name: &str) -> Option<Access> {
+    Some(match name.trim().to_ascii_lowercase().as_str() {
+        "ro" => Access::Ro,
+        "wo" => Access::Wo,
+        "rw" => Access::Rw,
+        "rwr" => Access::Rwr,
+        "rww" => Access::Rww,
+        "const" => Access::Const,
+        _ => return None,
+    })
+}

@@ -1,0 +1,133 @@
+//! Golden tests of `cotui decode`: the real binary over fixture logs, compared
+//! with reviewed output in tests/fixtures/golden/. After an intended change,
+//! regenerate with `COTUI_BLESS=1 cargo test --test decode_golden` and review the diff.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn cotui(args: &[&str], stdin: Option<&str>) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_cotui"));
+    cmd.args(args).current_dir(env!("CARGO_MANIFEST_DIR"));
+    match stdin {
+        None => cmd.output().expect("run cotui"),
+        Some(text) => {
+            use std::io::Write;
+            let mut child = cmd
+                .stdin(std::process::Stdio::piped())
+                .stdout(std::process::Stdio::piped())
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .expect("spawn cotui");
+            child.stdin.take().unwrap().write_all(text.as_bytes()).unwrap();
+            child.wait_with_output().expect("wait cotui")
+        }
+    }
+}
+
+fn check(fixture: &str, mode: &str, args: &[&str]) {
+    let log = format!("tests/fixtures/{fixture}.log");
+    let mut all = vec!["decode"];
+    all.extend_from_slice(args);
+    all.push(&log);
+    let out = cotui(&all, None);
+    assert!(
+        out.status.success(),
+        "cotui {all:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let got = String::from_utf8(out.stdout).expect("UTF-8 output");
+    let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/fixtures/golden/{fixture}.{mode}"));
+    if std::env::var_os("COTUI_BLESS").is_some() {
+        std::fs::write(&golden, &got).unwrap();
+        return;
+    }
+    let want = std::fs::read_to_string(&golden).unwrap_or_else(|e| panic!("{}: {e}", golden.display()));
+    if got != want {
+        let first = got.lines().zip(want.lines()).position(|(a, b)| a != b);
+        panic!(
+            "{} differs (first differing line {:?})\n--- got ---\n{}\n--- want ---\n{}",
+            golden.display(),
+            first.map(|i| i + 1),
+            first.and_then(|i| got.lines().nth(i)).unwrap_or("<end>"),
+            first.and_then(|i| want.lines().nth(i)).unwrap_or("<end>"),
+        );
+    }
+}
+
+#[test]
+fn cia301_mix_all_modes() {
+    check("cia301_mix", "txt", &[]);
+    check("cia301_mix", "jsonl", &["--format", "jsonl"]);
+    check("cia301_mix", "transactions", &["--transactions"]);
+    check("cia301_mix", "summary", &["--summary"]);
+}
+
+#[test]
+fn pdo_mapping_learned_from_sdo_traffic() {
+    check("pdo_learning", "txt", &[]);
+    check("pdo_learning", "jsonl", &["--format", "jsonl"]);
+    check("pdo_learning", "transactions", &["--transactions", "--format", "jsonl"]);
+}
+
+#[test]
+fn sniffed_mapping_keeps_its_source_in_jsonl() {
+    let out = cotui(
+        &["decode", "--format", "jsonl", "tests/fixtures/pdo_learning.log"],
+        None,
+    );
+    let lines: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    // Before the remapping the TPDO is raw; afterwards it arrives on the moved COB-ID 0x1C2.
+    assert_eq!(lines[0]["pdo"]["signals"], serde_json::json!([]));
+    let moved = lines.iter().find(|l| l["id"] == 0x1C2).expect("frame on 0x1C2");
+    assert_eq!(moved["kind"], "tpdo");
+    assert_eq!(moved["node"], 2);
+    assert_eq!(moved["pdo"]["num"], 1);
+    assert_eq!(moved["pdo"]["signals"][0]["name"], "Statusword");
+    assert_eq!(moved["pdo"]["signals"][0]["value"], 0x0237);
+    assert_eq!(moved["pdo"]["signals"][1]["index"], 0x606C);
+    assert_eq!(moved["pdo"]["signals"][1]["value"], 15000);
+    assert!(
+        moved["pdo"]["mapping_source"]
+            .as_str()
+            .unwrap()
+            .starts_with("sniffed @ 1700000100.0")
+    );
+}
+
+#[test]
+fn bad_lines_warn_with_line_numbers_and_the_rest_decodes() {
+    let log = "(1.000000) can0 705#05\n(2.000000) can0 7G5#05\n# comment\n(3.000000) can0 000#0102\n";
+    let out = cotui(&["decode", "-"], Some(log));
+    assert_eq!(out.status.code(), Some(0));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(stdout.lines().count(), 2, "{stdout}");
+    assert!(stdout.contains("Heartbeat node 5: Operational"));
+    assert!(stdout.contains("NMT Start remote node -> node 2"));
+    assert!(stderr.contains("-:2: warning:"), "{stderr}");
+}
+
+#[test]
+fn unreadable_input_exits_2() {
+    let out = cotui(&["decode", "tests/fixtures/does-not-exist.log"], None);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("does-not-exist.log"));
+}
+
+#[test]
+fn profile_binding_errors_are_usage_errors() {
+    let out = cotui(
+        &[
+            "decode",
+            "--profile",
+            "2=no-such-profile",
+            "tests/fixtures/cia301_mix.log",
+        ],
+        None,
+    );
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no-such-profile"));
+}

@@ -1,0 +1,193 @@
+//! EDS/DCF import against fixture files in `tests/fixtures/eds/`.
+
+use cotui::od::eds::{import, parse_number};
+use cotui::od::{Access, Bindings, DataType, MappedEntry, MappingSource, PdoMappable, Value, resolve_object};
+
+fn fixture(name: &str) -> String {
+    std::fs::read_to_string(format!("{}/tests/fixtures/eds/{name}", env!("CARGO_MANIFEST_DIR"))).unwrap()
+}
+
+fn entry(index: u16, sub: u8, bits: u8) -> MappedEntry {
+    MappedEntry { index, sub, bits }
+}
+
+#[test]
+fn realistic_vendor_eds() {
+    let (p, w) = import("servo-ds.eds", &fixture("servo-ds.eds"), 2);
+    assert_eq!(w, vec![]);
+    assert_eq!(p.name, "servo-ds.eds");
+    assert_eq!(p.description, "Example Motion Co. SERVO-DS");
+    assert_eq!(p.object_names[&0x1018], "Identity object");
+    let vendor = p.object(0x1018, 1).unwrap();
+    assert_eq!(
+        (vendor.name.as_str(), vendor.data_type, vendor.access),
+        ("Vendor ID", DataType::U32, Access::Ro)
+    );
+    assert_eq!(vendor.default, Some(Value::Unsigned(0x2E1)));
+    assert_eq!(p.object(0x1014, 0).unwrap().default, Some(Value::Unsigned(0x82)));
+    assert_eq!(p.object(0x1200, 1).unwrap().default, Some(Value::Unsigned(0x602)));
+    assert_eq!(
+        p.object(0x1008, 0).unwrap().default,
+        Some(Value::Text("SERVO-DS".into()))
+    );
+    let sw = p.object(0x6041, 0).unwrap();
+    assert_eq!((sw.data_type, sw.pdo), (DataType::U16, PdoMappable::Tpdo));
+    assert_eq!(p.object(0x6040, 0).unwrap().pdo, PdoMappable::Rpdo);
+    assert_eq!(p.object(0x6060, 0).unwrap().data_type, DataType::I8);
+    let gain = p.object(0x2318, 0).unwrap();
+    assert_eq!(
+        (gain.min, gain.max, gain.default.clone()),
+        (Some(0), Some(5000), Some(Value::Unsigned(200)))
+    );
+
+    let eds = MappingSource::Eds("servo-ds.eds".into());
+    assert_eq!(p.rpdo[&1].entries, vec![entry(0x6040, 0, 16), entry(0x6060, 0, 8)]);
+    assert_eq!(p.rpdo[&1].cob_id, Some(0x202));
+    assert_eq!(p.rpdo[&1].source, eds);
+    assert_eq!(p.rpdo[&4].entries, vec![entry(0x60FF, 0, 32)]);
+    assert_eq!(p.rpdo[&4].cob_id, Some(0x502));
+    assert_eq!(
+        p.tpdo[&1].entries,
+        vec![entry(0x6041, 0, 16), entry(0x6060, 0, 8), entry(0x603F, 0, 16)]
+    );
+    assert_eq!(p.tpdo[&2].cob_id, Some(0x282));
+    assert_eq!(p.tpdo[&3].entries, vec![entry(0x60FD, 0, 32)]);
+    // TPDO4 is disabled (bit 31) and has no entries.
+    assert!(!p.tpdo.contains_key(&4));
+    // The identity in [DeviceInfo] identifies the device.
+    let id = |i: u16, s: u8| match (i, s) {
+        (0x1018, 1) => Some(Value::Unsigned(0x2E1)),
+        (0x1018, 2) => Some(Value::Unsigned(0x0001_0042)),
+        _ => None,
+    };
+    assert!(p.identifies(&id));
+}
+
+#[test]
+fn dcf_tolerances() {
+    let (p, w) = import("quirks.dcf", &fixture("quirks.dcf"), 5);
+    let at = |line: usize| {
+        w.iter()
+            .find(|x| x.at == format!("line {line}"))
+            .map(|x| x.message.clone())
+            .unwrap_or_else(|| panic!("no warning at line {line}: {w:#?}"))
+    };
+    assert!(at(2).contains("outside any section"));
+    assert!(at(15).contains("0x1001 is listed but has no [1001] section"));
+    assert!(at(25).contains("0x1003 is listed but has no [1003] section"));
+    assert!(at(29).contains("not-a-number"));
+    assert!(at(133).contains("unknown DataType 0x0042"));
+    assert!(at(134).contains("unknown AccessType `readwrite`"));
+    assert!(at(135).contains("`zz`"));
+    assert!(at(136).contains("neither [section] nor key=value"));
+    assert!(at(137).contains("[2200sub1] has no parent"));
+    assert_eq!(w.len(), 9, "{w:#?}");
+    assert!(w[0].to_string().starts_with("quirks.dcf: line 2: "));
+
+    // [DeviceComissioning] (CiA 306 spelling) gives node id and name.
+    assert_eq!((p.node_id, p.node_name.as_deref()), (Some(5), Some("left wheel")));
+    // Any section/key case; ParameterValue wins over DefaultValue.
+    assert_eq!(p.object(0x1018, 1).unwrap().name, "Vendor-ID");
+    assert_eq!(p.object(0x1018, 1).unwrap().default, Some(Value::Unsigned(0x13)));
+    assert_eq!(p.object(0x1018, 0).unwrap().access, Access::Const);
+    // Octal and negative numbers, limits, rwr/rww.
+    let gain = p.object(0x2000, 0).unwrap();
+    assert_eq!(
+        (gain.default.clone(), gain.access, gain.pdo),
+        (Some(Value::Unsigned(8)), Access::Rwr, PdoMappable::Tpdo)
+    );
+    let off = p.object(0x2001, 0).unwrap();
+    assert_eq!(
+        (off.default.clone(), off.min, off.max),
+        (Some(Value::Signed(-12)), Some(-100), Some(100))
+    );
+    assert_eq!((off.access, off.pdo), (Access::Rww, PdoMappable::Rpdo));
+    // Unknown type/access fall back and the rest of the object loads.
+    let weird = p.object(0x2100, 0).unwrap();
+    assert_eq!(
+        (weird.name.as_str(), weird.data_type, weird.access),
+        ("Weird", DataType::Domain, Access::Rw)
+    );
+    // A present but unlisted section is imported; floats parse.
+    assert_eq!(p.object(0x2300, 0).unwrap().default, Some(Value::Float(1.5)));
+    // CompactSubObj: sub 0 = count, names/values from [1016Name]/[1016Value].
+    assert_eq!(p.object(0x1016, 0).unwrap().default, Some(Value::Unsigned(3)));
+    assert_eq!(p.object(0x1016, 1).unwrap().name, "Consumer heartbeat time 1");
+    assert_eq!(p.object(0x1016, 1).unwrap().default, Some(Value::Unsigned(0x0009_03E8)));
+    assert_eq!(p.object(0x1016, 2).unwrap().name, "Heartbeat of node 9");
+    assert_eq!(p.object(0x1016, 3).unwrap().data_type, DataType::U32);
+    assert!(p.object(0x1016, 4).is_none());
+    // 0x200+$NODEID, $NODEID + 0x190 (ParameterValue), mapping count from ParameterValue,
+    // [1a00sub01] with a leading zero.
+    assert_eq!(p.rpdo[&1].cob_id, Some(0x205));
+    assert_eq!(p.rpdo[&1].entries, vec![entry(0x6040, 0, 16), entry(0x6060, 0, 8)]);
+    assert_eq!(p.tpdo[&1].cob_id, Some(0x195));
+    assert_eq!(p.tpdo[&1].entries, vec![entry(0x6041, 0, 16)]);
+}
+
+#[test]
+fn dcf_node_id_differing_from_binding_is_a_warning() {
+    let (p, w) = import("quirks.dcf", &fixture("quirks.dcf"), 6);
+    assert!(
+        w.iter()
+            .any(|x| x.at == "line 8" && x.message.contains("NodeID 5 in the file, bound to node 6"))
+    );
+    assert_eq!(p.rpdo[&1].cob_id, Some(0x206));
+}
+
+#[test]
+fn correct_spelling_of_commissioning_section() {
+    let text = "[DeviceInfo]\n[DeviceCommissioning]\nNodeID=0x0A\nNodeName=arm\n";
+    let (p, _) = import("a.dcf", text, 10);
+    assert_eq!((p.node_id, p.node_name.as_deref()), (Some(10), Some("arm")));
+}
+
+#[test]
+fn missing_sections_are_warnings() {
+    let (p, w) = import("minimal.eds", &fixture("minimal.eds"), 1);
+    let messages: Vec<String> = w.iter().map(|x| x.to_string()).collect();
+    assert!(messages.iter().any(|m| m.contains("no [DeviceInfo]")), "{messages:#?}");
+    assert!(
+        messages.iter().any(|m| m.contains("importing every object section")),
+        "{messages:#?}"
+    );
+    assert!(
+        messages
+            .iter()
+            .any(|m| m.starts_with("minimal.eds: line 6:") && m.contains("no `]`")),
+        "{messages:#?}"
+    );
+    assert_eq!(p.object(0x1017, 0).unwrap().default, Some(Value::Unsigned(1000)));
+    let (p, w) = import("empty.eds", "", 1);
+    assert!(p.objects.is_empty() && !w.is_empty());
+}
+
+#[test]
+fn numbers() {
+    assert_eq!(parse_number("$NODEID+0x180", 3), Ok(0x183));
+    assert_eq!(parse_number("0x180+$NODEID", 3), Ok(0x183));
+    assert_eq!(parse_number("$nodeid", 3), Ok(3));
+    assert_eq!(parse_number(" $NODEID + 0x600 ", 127), Ok(0x67F));
+    assert_eq!(parse_number("017", 0), Ok(15));
+    assert_eq!(parse_number("0", 0), Ok(0));
+    assert_eq!(parse_number("42", 0), Ok(42));
+    assert_eq!(parse_number("-0x10", 0), Ok(-16));
+    assert_eq!(parse_number("0XFF", 0), Ok(255));
+    assert!(parse_number("09", 0).is_err());
+    assert!(parse_number("", 0).is_err());
+    assert!(parse_number("0x+", 0).is_err());
+}
+
+#[test]
+fn eds_binding_puts_the_eds_first() {
+    let read = |path: &std::path::Path| std::fs::read_to_string(path);
+    let file = format!("3={}/tests/fixtures/eds/servo-ds.eds", env!("CARGO_MANIFEST_DIR"));
+    let b = Bindings::from_args(&[], &[file], &read).unwrap();
+    let d = b.dictionary(3);
+    assert_eq!(d.profile_name(), "servo-ds.eds");
+    assert_eq!(d.name(0x5004, 0), Some("Motor speed A"));
+    assert_eq!(d.name(0x6502, 0), Some("Supported drive modes"));
+    assert_eq!(d.default_pdos(true).unwrap()[&1].cob_id, Some(0x183));
+    assert_eq!(resolve_object(d, "speed loop gain a"), Ok((0x2318, 0)));
+    assert!(b.warnings().is_empty());
+}
