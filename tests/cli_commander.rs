@@ -25,9 +25,10 @@ fn sdo_read_json_has_value_and_data() {
     let (rc, v, _) = cotui(&["sdo", "read", "demo", "0x3", "0x1018:2", "--json", "--block"]);
     assert_eq!(rc, 0);
     assert_eq!(v["value"], 0x0402_0003);
-    let (rc, v, _) = cotui(&["sdo", "read", "demo", "3", "0x1008", "--type", "string", "--json"]);
+    let (rc, v, _) = cotui(&["sdo", "read", "demo", "3", "Manufacturer device name", "--json"]);
     assert_eq!(rc, 0);
-    assert_eq!(v["value"], "cotui simulated servo B");
+    assert_eq!(v["name"], "Manufacturer device name");
+    assert_eq!(v["value"], "cotui simulated Syn-tron-like DS servo");
 }
 
 #[test]
@@ -127,7 +128,10 @@ fn scan_and_record() {
     assert_eq!(nodes.len(), 2);
     assert_eq!(nodes[0]["node"], 2);
     assert_eq!(nodes[0]["device_profile"], 402);
-    assert_eq!(nodes[1]["device_name"], "cotui simulated servo B");
+    assert_eq!(nodes[0]["software_version"], "AIMOTOR (cotui simulation)");
+    // Syn-tron drives carry no identification: the generic drive profile is suggested.
+    assert_eq!(nodes[1]["profile"], "cia402");
+    assert_eq!(nodes[1]["device_name"], "cotui simulated Syn-tron-like DS servo");
     let path = std::env::temp_dir().join(format!("cotui-rec-{}.log", std::process::id()));
     let (rc, v, _) = cotui(&["record", "demo", "-o", path.to_str().unwrap(), "--count", "5", "--json"]);
     assert_eq!((rc, v["frames"].as_u64()), (0, Some(5)));

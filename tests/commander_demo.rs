@@ -23,12 +23,15 @@ async fn sdo_expedited_segmented_and_block_reads() {
     let sw = upload(&d.bus, 2, 0x6041, 0, false, T).await.unwrap();
     assert_eq!(sw, vec![0x50, 0x02]);
     let name = upload(&d.bus, 3, 0x1008, 0, false, T).await.unwrap();
-    assert_eq!(String::from_utf8(name).unwrap(), "cotui simulated servo B");
+    assert_eq!(
+        String::from_utf8(name).unwrap(),
+        "cotui simulated Syn-tron-like DS servo"
+    );
     let blob = upload(&d.bus, 2, 0x2000, 0, true, T).await.unwrap();
     let want: Vec<u8> = (0..200u32).map(|i| (i * 7 + 2) as u8).collect();
     assert_eq!(blob, want);
     let by_block = upload(&d.bus, 2, 0x1008, 0, true, T).await.unwrap();
-    assert_eq!(by_block, b"cotui simulated servo A");
+    assert_eq!(by_block, b"cotui simulated AIMOTOR-like servo");
 }
 
 #[tokio::test(start_paused = true)]

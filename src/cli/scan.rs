@@ -42,6 +42,9 @@ fn text(v: &serde_json::Value) -> String {
                     .map(|d| format!("\"{d}\""))
                     .unwrap_or_default()
             );
+            if let Some(p) = n["profile"].as_str() {
+                line.push_str(&format!("  profile {p} (--profile {}={p})", n["node"]));
+            }
             if let Some(e) = n["sdo_error"].as_str() {
                 line.push_str(&format!("  ({e})"));
             }

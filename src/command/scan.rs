@@ -6,6 +6,7 @@ use super::sdo::upload;
 use crate::bus::{Bus, BusError};
 use crate::decode::heartbeat::NmtState;
 use crate::frame::Direction;
+use crate::od::Value;
 use std::collections::BTreeMap;
 use std::time::Duration;
 
@@ -21,6 +22,10 @@ pub struct NodeInfo {
     pub identity: [Option<u32>; 4],
     /// 0x1008 manufacturer device name.
     pub device_name: Option<String>,
+    /// 0x100A manufacturer software version.
+    pub software_version: Option<String>,
+    /// The built-in profile the identity matches (suggested for `--profile NODE=NAME`).
+    pub profile: Option<String>,
     /// Why the SDO reads failed, when they did.
     pub sdo_error: Option<String>,
 }
@@ -43,6 +48,8 @@ impl NodeInfo {
             "revision": hex(self.identity[2]),
             "serial": hex(self.identity[3]),
             "device_name": self.device_name,
+            "software_version": self.software_version,
+            "profile": self.profile,
             "sdo_error": self.sdo_error,
         })
     }
@@ -97,6 +104,8 @@ async fn identify(bus: &Bus, node: u8, nmt: Option<NmtState>, timeout_ms: u64) -
         device_type: None,
         identity: [None; 4],
         device_name: None,
+        software_version: None,
+        profile: None,
         sdo_error: None,
     };
     let note = |e: CommandError, info: &mut NodeInfo| -> Result<(), CommandError> {
@@ -122,10 +131,32 @@ async fn identify(bus: &Bus, node: u8, nmt: Option<NmtState>, timeout_ms: u64) -
             Err(e) => note(e, &mut info)?,
         }
     }
-    match upload(bus, node, 0x1008, 0, false, timeout_ms).await {
-        Ok(d) => info.device_name = Some(String::from_utf8_lossy(&d).trim_end_matches('\0').to_string()),
-        Err(CommandError::Abort { .. }) => {}
-        Err(e) => note(e, &mut info)?,
+    for (index, slot) in [(0x1008, &mut info.device_name), (0x100A, &mut info.software_version)] {
+        match upload(bus, node, index, 0, false, timeout_ms).await {
+            Ok(d) => *slot = Some(String::from_utf8_lossy(&d).trim_end_matches('\0').to_string()),
+            // Optional objects: a device without them aborts.
+            Err(CommandError::Abort { .. }) => {}
+            Err(CommandError::Bus(b)) => return Err(CommandError::Bus(b)),
+            Err(e) => {
+                info.sdo_error.get_or_insert(e.to_string());
+            }
+        }
     }
+    info.profile = suggest_profile(&info);
     Ok(info)
+}
+
+/// The built-in profile whose identification matches what the node told us.
+pub fn suggest_profile(info: &NodeInfo) -> Option<String> {
+    let mut bindings = crate::od::bind::Bindings::new().ok()?;
+    let read = |index: u16, sub: u8| -> Option<Value> {
+        match (index, sub) {
+            (0x1000, 0) => info.device_type.map(|v| Value::Unsigned(v as u64)),
+            (0x1018, 1..=4) => info.identity[sub as usize - 1].map(|v| Value::Unsigned(v as u64)),
+            (0x1008, 0) => info.device_name.clone().map(Value::Text),
+            (0x100A, 0) => info.software_version.clone().map(Value::Text),
+            _ => None,
+        }
+    };
+    bindings.identify(&read).map(|p| p.name.clone())
 }

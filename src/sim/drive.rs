@@ -46,8 +46,10 @@ pub struct Drive {
     reset_bit: bool,
     /// DC link voltage present (statusword bit 4; needed for Switch on).
     mains: bool,
-    /// Velocity in units/s (fractional part kept here, 0x606C holds the integer).
+    /// Velocity in raw 0x606C units (fractional part kept here, 0x606C holds the integer).
     velocity: f64,
+    /// Position units one raw velocity unit covers per second.
+    position_per_velocity: f64,
     position: f64,
     last_ns: Option<u64>,
     next_heartbeat_ns: Option<u64>,
@@ -59,6 +61,7 @@ impl Drive {
     pub fn new(node: u8, profile: profile::DriveProfile) -> Drive {
         Drive {
             node,
+            position_per_velocity: profile.position_per_velocity,
             od: profile::drive_objects(node, profile),
             sdo: SdoServer::new(ServerConfig::default()),
             nmt: NmtState::PreOperational,
@@ -380,7 +383,7 @@ impl Drive {
         let dv = (target - self.velocity).clamp(-step, step);
         let v0 = self.velocity;
         self.velocity += dv;
-        self.position += (v0 + self.velocity) / 2.0 * dt;
+        self.position += (v0 + self.velocity) / 2.0 * dt * self.position_per_velocity;
         if self.state == DriveState::QuickStopActive
             && self.velocity == 0.0
             && (1..=4).contains(&self.od.int(0x605A, 0))
