@@ -243,3 +243,34 @@ async fn our_requests_come_back_tx_and_decode_like_received_frames() {
         vec![(0x602, Direction::Tx, Kind::SdoRx), (0x582, Direction::Rx, Kind::SdoTx)]
     );
 }
+
+#[tokio::test(start_paused = true)]
+async fn palette_lines_run_through_execute() {
+    let d = demo();
+    let b = cotui::od::bind::Bindings::new().unwrap();
+    let run = |line: &str| cotui::command::parse_command(line).unwrap();
+    let o = cotui::command::execute(&d.bus, &run("sdo read 2 statusword"), &b)
+        .await
+        .unwrap();
+    assert_eq!(o.json["value"], 0x0250);
+    assert_eq!(
+        o.text,
+        "node 2 6041:00 Statusword = Switch on disabled [voltage enabled, switch on disabled, remote] [5002]"
+    );
+    let o = cotui::command::execute(&d.bus, &run("sdo write 2 \"Target velocity\" -500"), &b)
+        .await
+        .unwrap();
+    assert_eq!(o.json["data"], "0CFEFFFF");
+    let o = cotui::command::execute(&d.bus, &run("drive 2 enable"), &b)
+        .await
+        .unwrap();
+    assert!(
+        o.text.starts_with("node 2: Operation enabled (statusword 0x"),
+        "{}",
+        o.text
+    );
+    let e = cotui::command::execute(&d.bus, &run("sdo write 2 0x2000 12"), &b)
+        .await
+        .unwrap_err();
+    assert!(e.to_string().contains("give --type"), "{e}");
+}

@@ -2,8 +2,8 @@
 //! runtime, opening the bus and printing one result or failure.
 
 use crate::bus::Bus;
-use crate::command::CommandError;
 use crate::command::error::EXIT_OK;
+use crate::command::{Command, CommandError, Outcome};
 use clap::Args;
 use std::future::Future;
 
@@ -21,11 +21,11 @@ pub struct BusArgs {
 }
 
 /// Runs `body` on a fresh single-threaded tokio runtime with the bus of `args` open, then
-/// prints its result (`text` of the JSON value, or the JSON) or its failure; returns the exit status.
-pub fn run<F, Fut>(args: &BusArgs, what: &str, text: fn(&serde_json::Value) -> String, body: F) -> i32
+/// prints its outcome (text, or the JSON object with `--json`) or its failure; returns the exit status.
+pub fn run<F, Fut>(args: &BusArgs, what: &str, body: F) -> i32
 where
     F: FnOnce(Bus) -> Fut,
-    Fut: Future<Output = Result<serde_json::Value, CommandError>>,
+    Fut: Future<Output = Result<Outcome, CommandError>>,
 {
     let rt = match tokio::runtime::Builder::new_current_thread().enable_all().build() {
         Ok(rt) => rt,
@@ -34,7 +34,6 @@ where
                 args,
                 what,
                 Err(CommandError::Usage(format!("cannot start the runtime: {e}"))),
-                text,
             );
         }
     };
@@ -42,24 +41,33 @@ where
         let bus = crate::bus::open(&args.iface, args.listen_only).await?;
         body(bus).await
     });
-    report(args, what, result, text)
+    report(args, what, result)
 }
 
-fn report(
+/// Runs one parsed command (see [`crate::command::execute`]) with `--profile`/`--eds` bindings.
+pub fn run_command(
     args: &BusArgs,
     what: &str,
-    result: Result<serde_json::Value, CommandError>,
-    text: fn(&serde_json::Value) -> String,
+    cmd: Result<Command, String>,
+    profiles: &[String],
+    eds: &[String],
 ) -> i32 {
+    let prepared = cmd
+        .map_err(CommandError::Usage)
+        .and_then(|c| Ok((c, super::bind::bindings(profiles, eds).map_err(CommandError::Usage)?)));
+    run(args, what, |bus| async move {
+        let (cmd, bindings) = prepared?;
+        crate::command::execute(&bus, &cmd, &bindings).await
+    })
+}
+
+fn report(args: &BusArgs, what: &str, result: Result<Outcome, CommandError>) -> i32 {
     match result {
-        Ok(v) => {
+        Ok(o) => {
             if args.json {
-                println!("{v}");
-            } else {
-                let t = text(&v);
-                if !t.is_empty() {
-                    println!("{t}");
-                }
+                println!("{}", o.json);
+            } else if !o.text.is_empty() {
+                println!("{}", o.text);
             }
             EXIT_OK
         }

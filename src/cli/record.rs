@@ -1,8 +1,10 @@
-//! `cotui record IFACE -o FILE [--count N] [--duration MS]`: a candump `-l` log of the bus.
+//! `cotui record IFACE -o FILE [--count N] [--duration MS]`: a candump `-l` log of the bus,
+//! flushed and summed up on Ctrl-C.
 
 use super::commander::{BusArgs, ms_arg, run};
-use crate::command::CommandError;
+use crate::command::exec::text;
 use crate::command::record::{Limits, record};
+use crate::command::{Command, CommandError, Outcome};
 use clap::Args;
 
 /// Arguments of `cotui record`.
@@ -21,14 +23,6 @@ pub struct RecordArgs {
     pub duration: Option<u64>,
 }
 
-fn text(v: &serde_json::Value) -> String {
-    format!(
-        "{} frames written to {}",
-        v["frames"],
-        v["output"].as_str().unwrap_or("")
-    )
-}
-
 /// Runs `cotui record`; returns the exit status.
 pub fn run_record(args: &RecordArgs) -> i32 {
     let limits = Limits {
@@ -36,7 +30,11 @@ pub fn run_record(args: &RecordArgs) -> i32 {
         duration_ms: args.duration,
     };
     let path = args.output.clone();
-    run(&args.bus, "record", text, |bus| async move {
+    let cmd = Command::Record {
+        output: path.clone(),
+        limits,
+    };
+    run(&args.bus, "record", |bus| async move {
         let stop = async {
             // Without a signal handler, Ctrl-C would kill us before the log is flushed.
             if tokio::signal::ctrl_c().await.is_err() {
@@ -52,6 +50,10 @@ pub fn run_record(args: &RecordArgs) -> i32 {
             let mut out = std::io::BufWriter::new(file);
             record(&bus, &mut out, limits, stop).await?
         };
-        Ok(serde_json::json!({"ok": true, "frames": n, "output": path}))
+        let json = serde_json::json!({"ok": true, "frames": n, "output": path});
+        Ok(Outcome {
+            text: text(&cmd, &json),
+            json,
+        })
     })
 }
