@@ -4,7 +4,9 @@
 //! and returns values, with no IO, clock or terminal. Sources, panes and the
 //! command line live at the edges and call into it.
 
+pub mod bus;
 pub mod cli;
+pub mod command;
 pub mod decode;
 pub mod frame;
 pub mod hex;
@@ -14,4 +16,5 @@ pub mod output;
 pub mod read_ahead;
 pub mod sdo_client;
 pub mod sdo_server;
+pub mod sim;
 pub mod synth;

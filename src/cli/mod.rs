@@ -2,7 +2,13 @@
 
 pub mod bench;
 mod bind;
+pub mod commander;
 pub mod decode;
+pub mod drive;
+pub mod nmt;
+pub mod record;
+pub mod scan;
+pub mod sdo;
 
 use clap::{Parser, Subcommand};
 
@@ -28,6 +34,17 @@ pub enum Command {
     Decode(decode::DecodeArgs),
     /// Print throughput and memory figures of the decoder on a generated log.
     Bench(bench::BenchArgs),
+    /// Send an NMT command: cotui nmt IFACE start|stop|preop|reset-node|reset-comm NODE [--wait].
+    Nmt(nmt::NmtArgs),
+    /// Read or write an object by SDO (IFACE `demo` for the simulated bus).
+    #[command(subcommand)]
+    Sdo(sdo::SdoCommand),
+    /// CiA 402 drive: cotui drive IFACE NODE enable|disable|quick-stop|fault-reset|status|mode MODE.
+    Drive(drive::DriveArgs),
+    /// List the nodes on the bus with their identity.
+    Scan(scan::ScanArgs),
+    /// Record the bus to a candump -l log.
+    Record(record::RecordArgs),
 }
 
 /// Short usage printed by `cotui` without arguments.
@@ -55,5 +72,10 @@ pub fn run() -> i32 {
         }
         Some(Command::Decode(args)) => decode::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
+        Some(Command::Nmt(args)) => nmt::run_nmt(&args),
+        Some(Command::Sdo(cmd)) => sdo::run_sdo(&cmd),
+        Some(Command::Drive(args)) => drive::run_drive(&args),
+        Some(Command::Scan(args)) => scan::run_scan(&args),
+        Some(Command::Record(args)) => record::run_record(&args),
     }
 }

@@ -1,0 +1,179 @@
+//! The bus layer: one [`Bus`] handle over two implementations, SocketCAN
+//! ([`socketcan::open`]) and an in-process virtual bus ([`virt::VirtualBus`]).
+//!
+//! Every handle delivers every frame on the bus to every [`Subscription`],
+//! including the frames this handle sent (marked [`Flags::TX`]), so that
+//! consumers decode what we send with the same decoder as what we receive.
+//! A listen-only handle has no send path at all: [`Bus::send`] returns
+//! [`BusError::ListenOnly`] and nothing is written.
+
+pub mod socketcan;
+pub mod virt;
+
+use crate::frame::{Flags, Frame};
+use std::fmt;
+use std::sync::Arc;
+use tokio::sync::broadcast;
+
+/// Frames buffered per subscription before the slowest one starts losing frames.
+pub const QUEUE_DEPTH: usize = 8192;
+
+/// Why the bus could not be used.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum BusError {
+    /// The interface is missing, down, not CAN, or not permitted; `fix` names the command that helps.
+    Unavailable { iface: String, reason: String, fix: String },
+    /// The handle was opened with `--listen-only`; nothing was sent.
+    ListenOnly,
+    /// Reading or writing failed on an open interface.
+    Io { iface: String, reason: String },
+    /// Every sender of the bus is gone.
+    Closed,
+}
+
+impl fmt::Display for BusError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            BusError::Unavailable { iface, reason, fix } => write!(f, "{iface}: {reason}; fix: {fix}"),
+            BusError::ListenOnly => write!(f, "listen-only: this handle cannot send (drop --listen-only to send)"),
+            BusError::Io { iface, reason } => write!(f, "{iface}: {reason}"),
+            BusError::Closed => write!(f, "the bus was closed"),
+        }
+    }
+}
+
+impl std::error::Error for BusError {}
+
+/// One frame on the broadcast channel: the endpoint that sent it (0 = another node) and the frame.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Carried {
+    pub origin: u32,
+    pub frame: Result<Frame, ReadFault>,
+}
+
+/// A read error of a SocketCAN reader, passed to subscribers as an event.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct ReadFault {
+    pub errno: i32,
+}
+
+/// The way a handle writes frames.
+#[derive(Clone)]
+enum Sender {
+    Virtual(virt::Port),
+    Socket(Arc<socketcan::Writer>),
+}
+
+/// A handle on one bus: subscribe to frames, send frames (unless listen-only).
+#[derive(Clone)]
+pub struct Bus {
+    name: String,
+    endpoint: u32,
+    events: broadcast::Sender<Carried>,
+    sender: Option<Sender>,
+    /// Keeps the SocketCAN reader task alive while a handle exists.
+    _task: Option<Arc<socketcan::TaskGuard>>,
+}
+
+impl fmt::Debug for Bus {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Bus")
+            .field("name", &self.name)
+            .field("listen_only", &self.is_listen_only())
+            .finish()
+    }
+}
+
+impl Bus {
+    /// The interface name (`demo` for the simulated bus).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+    /// True when the handle was opened listen-only and cannot send.
+    pub fn is_listen_only(&self) -> bool {
+        self.sender.is_none()
+    }
+    /// A new subscription that sees every frame from now on.
+    pub fn subscribe(&self) -> Subscription {
+        Subscription {
+            name: self.name.clone(),
+            endpoint: self.endpoint,
+            rx: self.events.subscribe(),
+            lost: 0,
+        }
+    }
+    /// Sends one frame. It comes back on every subscription of this handle marked [`Flags::TX`].
+    pub async fn send(&self, frame: &Frame) -> Result<(), BusError> {
+        let mut frame = *frame;
+        frame.flags.set(Flags::TX, false);
+        match &self.sender {
+            None => Err(BusError::ListenOnly),
+            Some(Sender::Virtual(port)) => port.send(self.endpoint, frame),
+            Some(Sender::Socket(w)) => w.write(&frame).await,
+        }
+    }
+}
+
+/// A stream of the frames on a bus, in order.
+pub struct Subscription {
+    name: String,
+    endpoint: u32,
+    rx: broadcast::Receiver<Carried>,
+    lost: u64,
+}
+
+impl Subscription {
+    /// The next frame; frames sent through this subscription's handle carry [`Flags::TX`].
+    /// A read error of the interface (e.g. it went down) is returned once and the stream goes on.
+    pub async fn recv(&mut self) -> Result<Frame, BusError> {
+        loop {
+            match self.rx.recv().await {
+                Ok(c) => return self.unpack(c),
+                Err(broadcast::error::RecvError::Lagged(n)) => self.lost += n,
+                Err(broadcast::error::RecvError::Closed) => return Err(BusError::Closed),
+            }
+        }
+    }
+    /// The next frame if one is queued, without waiting.
+    pub fn try_recv(&mut self) -> Option<Result<Frame, BusError>> {
+        loop {
+            match self.rx.try_recv() {
+                Ok(c) => return Some(self.unpack(c)),
+                Err(broadcast::error::TryRecvError::Lagged(n)) => self.lost += n,
+                Err(broadcast::error::TryRecvError::Empty) => return None,
+                Err(broadcast::error::TryRecvError::Closed) => return Some(Err(BusError::Closed)),
+            }
+        }
+    }
+    /// Frames this subscription missed because it read too slowly.
+    pub fn lost(&self) -> u64 {
+        self.lost
+    }
+
+    fn unpack(&self, c: Carried) -> Result<Frame, BusError> {
+        match c.frame {
+            Ok(mut f) => {
+                f.flags.set(Flags::TX, c.origin != 0 && c.origin == self.endpoint);
+                Ok(f)
+            }
+            Err(fault) => Err(BusError::Io {
+                iface: self.name.clone(),
+                reason: socketcan::errno_text(fault.errno),
+            }),
+        }
+    }
+}
+
+/// Opens `iface`: `demo` gives a fresh virtual bus with the simulated drives
+/// (see [`crate::sim::demo`]), anything else is a SocketCAN interface.
+/// Must be called inside a tokio runtime.
+pub async fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
+    if iface == DEMO {
+        Ok(crate::sim::demo::start(listen_only))
+    } else {
+        socketcan::open(iface, listen_only)
+    }
+}
+
+/// The interface name of the in-process simulated bus.
+pub const DEMO: &str = "demo";

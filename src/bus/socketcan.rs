@@ -1,0 +1,414 @@
+//! SocketCAN: one raw CAN FD socket per handle (classic and FD frames), kernel
+//! receive timestamps (`SO_TIMESTAMPNS`), error frames (all error classes) and our own
+//! frames (`CAN_RAW_RECV_OWN_MSGS`, recognised by `MSG_CONFIRM`, marked TX).
+//!
+//! The `socketcan` crate opens the socket and sets its options. Frames are read with
+//! our own `recvmsg` because the crate does not expose `msg_flags`, which is the only
+//! way to tell our own frames from those of other programs.
+
+use super::{Bus, BusError, Carried, QUEUE_DEPTH, ReadFault, Sender};
+use crate::frame::{Flags, Frame};
+use socketcan::{CanFdSocket, Socket, SocketOptions};
+use std::io;
+use std::os::fd::AsRawFd;
+use std::sync::Arc;
+use tokio::io::Interest;
+use tokio::io::unix::AsyncFd;
+use tokio::sync::broadcast;
+
+const CAN_EFF_FLAG: u32 = 0x8000_0000;
+const CAN_RTR_FLAG: u32 = 0x4000_0000;
+const CAN_ERR_FLAG: u32 = 0x2000_0000;
+const CAN_EFF_MASK: u32 = 0x1FFF_FFFF;
+const CAN_ERR_MASK: u32 = 0x1FFF_FFFF;
+/// All error classes (`CAN_ERR_MASK`).
+const ERR_MASK_ALL: u32 = 0x1FFF_FFFF;
+const CANFD_BRS: u8 = 0x01;
+const CANFD_ESI: u8 = 0x02;
+const CANFD_FDF: u8 = 0x04;
+/// Size of `struct can_frame`.
+pub const CAN_MTU: usize = 16;
+/// Size of `struct canfd_frame`.
+pub const CANFD_MTU: usize = 72;
+/// `ARPHRD_CAN` in `/sys/class/net/IFACE/type`.
+const ARPHRD_CAN: u32 = 280;
+
+/// The commands that bring a CAN interface up, for error messages.
+pub fn up_fix(iface: &str) -> String {
+    format!("sudo ip link set {iface} up type can bitrate 500000 (a vcan: sudo ip link set {iface} up)")
+}
+
+/// The commands that create a virtual CAN interface, for error messages.
+pub fn missing_fix(iface: &str) -> String {
+    format!(
+        "plug in the adapter and check `ip link`, or create a virtual one: \
+         sudo modprobe vcan && sudo ip link add dev {iface} type vcan && sudo ip link set {iface} up"
+    )
+}
+
+/// Checks `/sys/class/net/IFACE`: present, CAN, up.
+fn check_interface(iface: &str) -> Result<(), BusError> {
+    let unavailable = |reason: &str, fix: String| BusError::Unavailable {
+        iface: iface.to_string(),
+        reason: reason.to_string(),
+        fix,
+    };
+    if iface.is_empty() || iface.contains('/') || iface.len() > 15 {
+        return Err(unavailable("not a valid interface name", missing_fix("can0")));
+    }
+    let dir = std::path::Path::new("/sys/class/net").join(iface);
+    if !dir.exists() {
+        return Err(unavailable("no such CAN interface", missing_fix(iface)));
+    }
+    let read_num = |file: &str, radix: u32| {
+        std::fs::read_to_string(dir.join(file))
+            .ok()
+            .and_then(|s| u32::from_str_radix(s.trim().trim_start_matches("0x"), radix).ok())
+    };
+    if let Some(t) = read_num("type", 10)
+        && t != ARPHRD_CAN
+    {
+        return Err(unavailable(
+            "is not a CAN interface",
+            "pick a CAN interface from `ip -details link show type can` (or vcan)".into(),
+        ));
+    }
+    if let Some(flags) = read_num("flags", 16)
+        && flags & 1 == 0
+    {
+        return Err(unavailable("interface is down", up_fix(iface)));
+    }
+    Ok(())
+}
+
+/// Maps an error of opening or configuring the socket to a [`BusError`] naming the fix.
+fn open_error(iface: &str, e: &io::Error) -> BusError {
+    let (reason, fix) = match e.raw_os_error() {
+        Some(libc::ENODEV) => ("no such CAN interface".to_string(), missing_fix(iface)),
+        Some(libc::ENETDOWN) => ("interface is down".to_string(), up_fix(iface)),
+        Some(libc::EPERM) | Some(libc::EACCES) => (
+            "no permission to open a raw CAN socket".to_string(),
+            "run as root or give the binary CAP_NET_RAW: sudo setcap cap_net_raw+ep $(command -v cotui)".to_string(),
+        ),
+        Some(libc::EAFNOSUPPORT) | Some(libc::EPROTONOSUPPORT) => (
+            "this kernel has no SocketCAN support loaded".to_string(),
+            "sudo modprobe can && sudo modprobe can_raw (and sudo modprobe vcan for virtual buses)".to_string(),
+        ),
+        _ => (e.to_string(), up_fix(iface)),
+    };
+    BusError::Unavailable {
+        iface: iface.to_string(),
+        reason,
+        fix,
+    }
+}
+
+/// The text of an errno for read/write errors on an open interface.
+pub fn errno_text(errno: i32) -> String {
+    match errno {
+        libc::ENETDOWN => "interface went down".to_string(),
+        libc::ENOBUFS => "transmit queue full (no ACK? check wiring, termination and bitrate)".to_string(),
+        libc::ENXIO | libc::ENODEV => "interface disappeared".to_string(),
+        _ => io::Error::from_raw_os_error(errno).to_string(),
+    }
+}
+
+/// Opens a SocketCAN interface. Must be called inside a tokio runtime (a reader task is spawned).
+pub fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
+    check_interface(iface)?;
+    let sock = CanFdSocket::open(iface).map_err(|e| open_error(iface, &e))?;
+    let configure = || -> io::Result<()> {
+        sock.set_nonblocking(true)?;
+        sock.set_error_filter(ERR_MASK_ALL)?;
+        sock.set_recv_own_msgs(true)?;
+        sock.set_recv_timestamp(true)?;
+        Ok(())
+    };
+    configure().map_err(|e| open_error(iface, &e))?;
+    // SAFETY: the socket owns its descriptor and the AsyncFd owns the socket until it is dropped.
+    let fd = unsafe { AsyncFd::register(sock) }.map_err(|e| open_error(iface, &e.into_parts().1))?;
+    let fd = Arc::new(fd);
+    let events = broadcast::channel(QUEUE_DEPTH).0;
+    let reader = tokio::spawn(read_loop(fd.clone(), events.clone()));
+    let sender = (!listen_only).then(|| {
+        Sender::Socket(Arc::new(Writer {
+            iface: iface.to_string(),
+            fd: fd.clone(),
+        }))
+    });
+    Ok(Bus {
+        name: iface.to_string(),
+        endpoint: OWN,
+        events,
+        sender,
+        _task: Some(Arc::new(TaskGuard(reader))),
+    })
+}
+
+/// The endpoint number of frames this socket sent.
+const OWN: u32 = 1;
+
+/// Aborts the reader task when the last handle is dropped.
+pub(super) struct TaskGuard(tokio::task::JoinHandle<()>);
+
+impl Drop for TaskGuard {
+    fn drop(&mut self) {
+        self.0.abort();
+    }
+}
+
+/// Reads frames until the task is aborted; read errors are passed on and retried after a pause.
+async fn read_loop(fd: Arc<AsyncFd<CanFdSocket>>, events: broadcast::Sender<Carried>) {
+    loop {
+        let got = fd.async_io(Interest::READABLE, |s| recv(s.as_raw_fd())).await;
+        let carried = match got {
+            Ok((frame, own)) => Carried {
+                origin: if own { OWN } else { 0 },
+                frame: Ok(frame),
+            },
+            Err(e) => Carried {
+                origin: 0,
+                frame: Err(ReadFault {
+                    errno: e.raw_os_error().unwrap_or(libc::EIO),
+                }),
+            },
+        };
+        let failed = carried.frame.is_err();
+        let _ = events.send(carried);
+        if failed {
+            tokio::time::sleep(std::time::Duration::from_millis(500)).await;
+        }
+    }
+}
+
+/// The send path of a SocketCAN handle (absent on listen-only handles).
+pub(super) struct Writer {
+    iface: String,
+    fd: Arc<AsyncFd<CanFdSocket>>,
+}
+
+impl Writer {
+    /// Writes one frame, retrying briefly while the transmit queue is full.
+    pub(super) async fn write(&self, frame: &Frame) -> Result<(), BusError> {
+        let raw = to_raw(frame).map_err(|reason| BusError::Io {
+            iface: self.iface.clone(),
+            reason,
+        })?;
+        let mut tries = 0;
+        loop {
+            let r = self
+                .fd
+                .async_io(Interest::WRITABLE, |s| {
+                    // SAFETY: `raw` is a valid buffer of `raw.len()` bytes for the whole call.
+                    let n = unsafe { libc::write(s.as_raw_fd(), raw.as_ptr().cast(), raw.len()) };
+                    if n < 0 {
+                        Err(io::Error::last_os_error())
+                    } else {
+                        Ok(n as usize)
+                    }
+                })
+                .await;
+            match r {
+                Ok(n) if n == raw.len() => return Ok(()),
+                Ok(n) => {
+                    return Err(BusError::Io {
+                        iface: self.iface.clone(),
+                        reason: format!("short write: {n} of {} bytes", raw.len()),
+                    });
+                }
+                Err(e) if e.raw_os_error() == Some(libc::ENOBUFS) && tries < 20 => {
+                    tries += 1;
+                    tokio::time::sleep(std::time::Duration::from_millis(5)).await;
+                }
+                Err(e) => {
+                    return Err(BusError::Io {
+                        iface: self.iface.clone(),
+                        reason: errno_text(e.raw_os_error().unwrap_or(libc::EIO)),
+                    });
+                }
+            }
+        }
+    }
+}
+
+/// One `recvmsg`: the frame with its kernel timestamp, and whether this socket sent it.
+fn recv(fd: i32) -> io::Result<(Frame, bool)> {
+    let mut buf = [0u8; CANFD_MTU];
+    let mut ctrl = [0u64; 16];
+    let mut iov = libc::iovec {
+        iov_base: buf.as_mut_ptr().cast(),
+        iov_len: buf.len(),
+    };
+    // SAFETY: msghdr is plain data; every pointer set below outlives the recvmsg call.
+    let mut msg: libc::msghdr = unsafe { std::mem::zeroed() };
+    msg.msg_iov = &mut iov;
+    msg.msg_iovlen = 1;
+    msg.msg_control = ctrl.as_mut_ptr().cast();
+    msg.msg_controllen = std::mem::size_of_val(&ctrl) as _;
+    // SAFETY: `msg` points at live buffers of the stated sizes.
+    let n = unsafe { libc::recvmsg(fd, &mut msg, 0) };
+    if n < 0 {
+        return Err(io::Error::last_os_error());
+    }
+    let mut ts_ns = 0u64;
+    // SAFETY: the CMSG macros walk the control buffer the kernel filled within msg_controllen.
+    unsafe {
+        let mut c = libc::CMSG_FIRSTHDR(&msg);
+        while !c.is_null() {
+            if (*c).cmsg_level == libc::SOL_SOCKET && (*c).cmsg_type == libc::SCM_TIMESTAMPNS {
+                let t: libc::timespec = std::ptr::read_unaligned(libc::CMSG_DATA(c).cast());
+                ts_ns = t.tv_sec as u64 * 1_000_000_000 + t.tv_nsec as u64;
+            }
+            c = libc::CMSG_NXTHDR(&msg, c);
+        }
+    }
+    let own = msg.msg_flags & libc::MSG_CONFIRM != 0;
+    let mut frame = from_raw(&buf[..n as usize]).map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e))?;
+    frame.ts_ns = ts_ns;
+    Ok((frame, own))
+}
+
+/// Parses a kernel `can_frame` (16 bytes) or `canfd_frame` (72 bytes).
+pub fn from_raw(raw: &[u8]) -> Result<Frame, String> {
+    if raw.len() != CAN_MTU && raw.len() != CANFD_MTU {
+        return Err(format!(
+            "read {} bytes, expected {CAN_MTU} (CAN) or {CANFD_MTU} (CAN FD)",
+            raw.len()
+        ));
+    }
+    let can_id = u32::from_ne_bytes([raw[0], raw[1], raw[2], raw[3]]);
+    let mut f = Frame::default();
+    let fd = raw.len() == CANFD_MTU;
+    let max = if fd { 64 } else { 8 };
+    let len = (raw[4] as usize).min(max);
+    f.len = len as u8;
+    if can_id & CAN_ERR_FLAG != 0 {
+        f.flags.set(Flags::ERR, true);
+        f.id = can_id & CAN_ERR_MASK;
+    } else if can_id & CAN_EFF_FLAG != 0 {
+        f.flags.set(Flags::EXT, true);
+        f.id = can_id & CAN_EFF_MASK;
+    } else {
+        f.id = can_id & 0x7FF;
+    }
+    if fd {
+        f.flags.set(Flags::FD, true);
+        f.flags.set(Flags::BRS, raw[5] & CANFD_BRS != 0);
+        f.flags.set(Flags::ESI, raw[5] & CANFD_ESI != 0);
+        f.flags.set(Flags::FDF, raw[5] & CANFD_FDF != 0);
+    } else {
+        f.flags
+            .set(Flags::RTR, can_id & CAN_RTR_FLAG != 0 && can_id & CAN_ERR_FLAG == 0);
+        if len == 8 && (9..=15).contains(&raw[7]) {
+            f.raw_dlc = raw[7];
+        }
+    }
+    if !f.is_rtr() {
+        f.data[..len].copy_from_slice(&raw[8..8 + len]);
+    }
+    Ok(f)
+}
+
+/// The kernel `can_frame` / `canfd_frame` bytes of a frame to send.
+pub fn to_raw(f: &Frame) -> Result<Vec<u8>, String> {
+    if f.is_err() {
+        return Err("error frames cannot be sent".into());
+    }
+    let mut can_id = if f.is_ext() {
+        (f.id & CAN_EFF_MASK) | CAN_EFF_FLAG
+    } else if f.id <= 0x7FF {
+        f.id
+    } else {
+        return Err(format!("id 0x{:X} does not fit 11 bits; mark the frame extended", f.id));
+    };
+    let len = f.len as usize;
+    if f.is_fd() {
+        if len > 64 || !matches!(len, 0..=8 | 12 | 16 | 20 | 24 | 32 | 48 | 64) {
+            return Err(format!("{len} bytes is not a CAN FD length"));
+        }
+        let mut raw = vec![0u8; CANFD_MTU];
+        raw[..4].copy_from_slice(&can_id.to_ne_bytes());
+        raw[4] = len as u8;
+        let mut flags = 0;
+        if f.flags.has(Flags::BRS) {
+            flags |= CANFD_BRS;
+        }
+        if f.flags.has(Flags::ESI) {
+            flags |= CANFD_ESI;
+        }
+        raw[5] = flags;
+        raw[8..8 + len].copy_from_slice(&f.data[..len]);
+        Ok(raw)
+    } else {
+        if len > 8 {
+            return Err(format!("{len} bytes do not fit a classic CAN frame"));
+        }
+        if f.is_rtr() {
+            can_id |= CAN_RTR_FLAG;
+        }
+        let mut raw = vec![0u8; CAN_MTU];
+        raw[..4].copy_from_slice(&can_id.to_ne_bytes());
+        raw[4] = len as u8;
+        if len == 8 && (9..=15).contains(&f.raw_dlc) {
+            raw[7] = f.raw_dlc;
+        }
+        if !f.is_rtr() {
+            raw[8..8 + len].copy_from_slice(&f.data[..len]);
+        }
+        Ok(raw)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn classic_frames_round_trip_through_kernel_layout() {
+        let f = Frame::classic(0x602, &[0x40, 0x41, 0x60, 0]);
+        let raw = to_raw(&f).unwrap();
+        assert_eq!(raw.len(), CAN_MTU);
+        assert_eq!(&raw[..5], &[0x02, 0x06, 0, 0, 4]);
+        assert_eq!(from_raw(&raw).unwrap(), f);
+        let mut ext = Frame::classic(0x1234_5678, &[1, 2, 3, 4, 5, 6, 7, 8]);
+        ext.raw_dlc = 0xC;
+        let back = from_raw(&to_raw(&ext).unwrap()).unwrap();
+        assert_eq!((back.id, back.is_ext(), back.raw_dlc), (0x1234_5678, true, 0xC));
+        let mut rtr = Frame::classic(0x702, &[]);
+        rtr.flags.set(Flags::RTR, true);
+        rtr.len = 1;
+        let back = from_raw(&to_raw(&rtr).unwrap()).unwrap();
+        assert!(back.is_rtr());
+        assert_eq!(back.len, 1);
+    }
+
+    #[test]
+    fn fd_and_error_frames() {
+        let mut raw = vec![0u8; CANFD_MTU];
+        raw[..4].copy_from_slice(&0x123u32.to_ne_bytes());
+        raw[4] = 12;
+        raw[5] = CANFD_BRS | CANFD_FDF;
+        raw[8..20].copy_from_slice(&[7; 12]);
+        let f = from_raw(&raw).unwrap();
+        assert!(f.is_fd() && f.flags.has(Flags::BRS) && !f.flags.has(Flags::ESI));
+        assert_eq!(f.payload(), &[7; 12]);
+        let mut err = vec![0u8; CAN_MTU];
+        err[..4].copy_from_slice(&(CAN_ERR_FLAG | 0x04).to_ne_bytes());
+        err[4] = 8;
+        err[9] = 0x0C;
+        let e = from_raw(&err).unwrap();
+        assert!(e.is_err());
+        assert_eq!((e.id, e.payload()[1]), (4, 0x0C));
+        assert_eq!(to_raw(&e), Err("error frames cannot be sent".into()));
+        assert!(from_raw(&[0; 10]).unwrap_err().contains("read 10 bytes"));
+    }
+
+    #[test]
+    fn missing_interface_names_the_fix() {
+        let e = check_interface("cotuinosuch0").unwrap_err();
+        let text = e.to_string();
+        assert!(text.contains("no such CAN interface"), "{text}");
+        assert!(text.contains("sudo modprobe vcan"), "{text}");
+        assert!(up_fix("can0").contains("sudo ip link set can0 up type can bitrate 500000"));
+    }
+}

@@ -1,0 +1,435 @@
+//! CiA 402 drive sequences: the pure plan (which controlwords, which states prove
+//! each step), the pure diagnosis of a step that did not happen, and the IO that
+//! runs them over SDO, watching heartbeats, EMCY and a statusword TPDO on the way.
+
+use super::error::CommandError;
+use super::grammar::DriveAction;
+use super::sdo::{download, upload};
+use crate::bus::{Bus, Subscription};
+use crate::decode::cia402::{DriveState, mode_name};
+use crate::decode::heartbeat::NmtState;
+use crate::frame::Direction;
+use std::time::Duration;
+
+/// One step of a sequence: write `controlword`, then wait for a statusword showing `target`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Step {
+    pub name: &'static str,
+    pub controlword: u16,
+    pub target: DriveState,
+}
+
+const FAULT_RESET: Step = Step {
+    name: "fault reset (0x80)",
+    controlword: 0x0080,
+    target: DriveState::SwitchOnDisabled,
+};
+const DISABLE_VOLTAGE: Step = Step {
+    name: "disable voltage (0x00)",
+    controlword: 0x0000,
+    target: DriveState::SwitchOnDisabled,
+};
+const SHUTDOWN: Step = Step {
+    name: "shutdown (0x06)",
+    controlword: 0x0006,
+    target: DriveState::ReadyToSwitchOn,
+};
+const SWITCH_ON: Step = Step {
+    name: "switch on (0x07)",
+    controlword: 0x0007,
+    target: DriveState::SwitchedOn,
+};
+const ENABLE_OPERATION: Step = Step {
+    name: "enable operation (0x0F)",
+    controlword: 0x000F,
+    target: DriveState::OperationEnabled,
+};
+
+/// The steps that take a drive in `state` through `action` (empty: nothing to do).
+pub fn plan(action: DriveAction, state: DriveState) -> Vec<Step> {
+    use DriveState::*;
+    let quick_stop = |target| Step {
+        name: "quick stop (0x02)",
+        controlword: 0x0002,
+        target,
+    };
+    match (action, state) {
+        (DriveAction::Enable, Fault | FaultReactionActive) => vec![FAULT_RESET, SHUTDOWN, SWITCH_ON, ENABLE_OPERATION],
+        (DriveAction::Enable, QuickStopActive) => vec![DISABLE_VOLTAGE, SHUTDOWN, SWITCH_ON, ENABLE_OPERATION],
+        (DriveAction::Enable, NotReadyToSwitchOn | SwitchOnDisabled) => vec![SHUTDOWN, SWITCH_ON, ENABLE_OPERATION],
+        (DriveAction::Enable, ReadyToSwitchOn) => vec![SWITCH_ON, ENABLE_OPERATION],
+        (DriveAction::Enable, SwitchedOn) => vec![ENABLE_OPERATION],
+        (DriveAction::Disable, OperationEnabled | SwitchedOn) => vec![SHUTDOWN],
+        (DriveAction::Disable, QuickStopActive) => vec![DISABLE_VOLTAGE],
+        (DriveAction::QuickStop, OperationEnabled) => vec![quick_stop(QuickStopActive)],
+        (DriveAction::QuickStop, SwitchedOn | ReadyToSwitchOn) => vec![quick_stop(SwitchOnDisabled)],
+        (DriveAction::FaultReset, Fault) => vec![FAULT_RESET],
+        _ => Vec::new(),
+    }
+}
+
+/// What the bus showed about a drive when a step did not happen.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Observation {
+    /// Last NMT state from a heartbeat or boot-up, if any was seen.
+    pub nmt: Option<NmtState>,
+    /// The statusword before the step's controlword was written.
+    pub before: Option<u16>,
+    /// The last statusword read (SDO or TPDO).
+    pub statusword: Option<u16>,
+    /// 0x6061 modes of operation display, if readable.
+    pub mode_display: Option<i8>,
+    /// 0x603F error code, if readable.
+    pub error_code: Option<u16>,
+    /// The controlword read back from 0x6040, if readable.
+    pub controlword: Option<u16>,
+    /// The last EMCY error code the node sent.
+    pub emcy: Option<u16>,
+    /// True when the node's SDO server stopped answering.
+    pub sdo_silent: bool,
+}
+
+/// Why `step` did not reach its state, from what the bus shows; `node` names the fix commands.
+pub fn diagnose(node: u8, step: &Step, o: &Observation) -> String {
+    let nmt_hint = format!("run `cotui nmt IFACE start {node}`");
+    if o.nmt == Some(NmtState::Stopped) {
+        return format!(
+            "NMT not operational: node {node} is NMT stopped (heartbeat) and serves no SDO or PDO; {nmt_hint}"
+        );
+    }
+    if o.sdo_silent {
+        return match o.nmt {
+            None => {
+                format!("no SDO answer and no heartbeat from node {node}: check the node id, bitrate, wiring and power")
+            }
+            Some(s) => format!("node {node} stopped answering SDO (heartbeat says {})", s.text()),
+        };
+    }
+    let Some(sw) = o.statusword else {
+        return "no statusword could be read".into();
+    };
+    let state = DriveState::from_statusword(sw);
+    if sw & 0x0008 != 0 {
+        let code = o
+            .error_code
+            .or(o.emcy)
+            .map(|c| format!(" (error code 0x{c:04X})"))
+            .unwrap_or_default();
+        return format!(
+            "fault bit set: statusword 0x{sw:04X} shows {}{code}; run `drive {node} fault-reset`",
+            state.text()
+        );
+    }
+    if state == DriveState::QuickStopActive {
+        return format!(
+            "quick stop active (statusword 0x{sw:04X}); `drive {node} enable` leaves it via disable voltage"
+        );
+    }
+    if matches!(step.target, DriveState::SwitchedOn | DriveState::OperationEnabled) && sw & 0x0010 == 0 {
+        return format!(
+            "voltage not enabled: statusword 0x{sw:04X} bit 4 is clear; switch on the drive's DC link / main power"
+        );
+    }
+    if let Some(cw) = o.controlword
+        && cw & 0x0100 != 0
+    {
+        return format!("halt bit set: controlword 0x{cw:04X} has bit 8 (halt) set");
+    }
+    if step.target == DriveState::OperationEnabled
+        && let Some(m) = o.mode_display
+        && !(1..=10).contains(&m)
+    {
+        return format!(
+            "mode not set: modes of operation display 0x6061 = {m} ({}); run `drive {node} mode pv` (or the mode you use)",
+            mode_name(m)
+        );
+    }
+    if o.before == Some(sw) {
+        let nmt = match o.nmt {
+            Some(NmtState::Operational) => String::new(),
+            Some(s) => format!(
+                "; node is NMT {} and some drives take the controlword only when operational: {nmt_hint}",
+                s.text()
+            ),
+            None => "; no heartbeat seen".into(),
+        };
+        return format!(
+            "statusword stale: still 0x{sw:04X} ({}) after controlword 0x{:04X}{nmt}",
+            state.text(),
+            step.controlword
+        );
+    }
+    format!(
+        "statusword 0x{sw:04X} shows {} instead of {}",
+        state.text(),
+        step.target.text()
+    )
+}
+
+/// The outcome of a drive command.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct DriveReport {
+    pub node: u8,
+    pub action: DriveAction,
+    /// The final statusword and the state it shows.
+    pub statusword: u16,
+    pub state: DriveState,
+    /// Controlwords written, in order.
+    pub steps: Vec<Step>,
+    /// 0x6061 modes of operation display, when readable.
+    pub mode_display: Option<i8>,
+    /// 0x603F error code, when readable.
+    pub error_code: Option<u16>,
+    /// Where the final statusword came from: `sdo` or `tpdo`.
+    pub source: &'static str,
+}
+
+impl DriveReport {
+    /// The `--json` object.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "ok": true,
+            "node": self.node,
+            "action": self.action.as_str(),
+            "statusword": format!("0x{:04X}", self.statusword),
+            "state": self.state.as_str(),
+            "state_text": self.state.text(),
+            "controlwords": self.steps.iter().map(|s| format!("0x{:04X}", s.controlword)).collect::<Vec<_>>(),
+            "mode_display": self.mode_display,
+            "error_code": self.error_code.map(|c| format!("0x{c:04X}")),
+            "source": self.source,
+        })
+    }
+}
+
+/// Bus traffic of one node gathered while a sequence runs.
+struct Watch {
+    rx: Subscription,
+    node: u8,
+    obs: Observation,
+    /// COB-ID and byte offset of a TPDO that carries the statusword.
+    tpdo: Option<(u32, usize)>,
+    tpdo_sw: Option<u16>,
+}
+
+impl Watch {
+    fn drain(&mut self) {
+        while let Some(got) = self.rx.try_recv() {
+            let Ok(f) = got else { continue };
+            if f.direction() != Direction::Rx || f.is_ext() || f.is_rtr() {
+                continue;
+            }
+            let p = f.payload();
+            let n = self.node as u32;
+            if f.id == 0x700 + n && !p.is_empty() {
+                self.obs.nmt = Some(NmtState::from_byte(p[0]));
+            } else if f.id == 0x80 + n && p.len() >= 2 {
+                let code = u16::from_le_bytes([p[0], p[1]]);
+                self.obs.emcy = (code != 0).then_some(code);
+            } else if let Some((cob, off)) = self.tpdo
+                && f.id == cob
+                && p.len() >= off + 2
+            {
+                self.tpdo_sw = Some(u16::from_le_bytes([p[off], p[off + 1]]));
+            }
+        }
+    }
+}
+
+fn le_u16(d: &[u8]) -> u16 {
+    u16::from_le_bytes([d.first().copied().unwrap_or(0), d.get(1).copied().unwrap_or(0)])
+}
+
+fn le_u32(d: &[u8]) -> u32 {
+    let mut b = [0u8; 4];
+    for (i, x) in d.iter().take(4).enumerate() {
+        b[i] = *x;
+    }
+    u32::from_le_bytes(b)
+}
+
+/// Finds a TPDO mapping the statusword: (COB-ID, byte offset), reading 0x1A00.. and 0x1800.. by SDO.
+async fn statusword_tpdo(bus: &Bus, node: u8, timeout_ms: u64) -> Option<(u32, usize)> {
+    for n in 0..4u16 {
+        let count = upload(bus, node, 0x1A00 + n, 0, false, timeout_ms).await.ok()?;
+        let mut bits = 0usize;
+        for i in 1..=count.first().copied().unwrap_or(0) {
+            let e = le_u32(&upload(bus, node, 0x1A00 + n, i, false, timeout_ms).await.ok()?);
+            if e >> 16 == 0x6041 && (e >> 8) & 0xFF == 0 && bits.is_multiple_of(8) {
+                let cob = le_u32(&upload(bus, node, 0x1800 + n, 1, false, timeout_ms).await.ok()?);
+                return (cob & 0x8000_0000 == 0).then_some((cob & 0x7FF, bits / 8));
+            }
+            bits += (e & 0xFF) as usize;
+        }
+    }
+    None
+}
+
+async fn read_u16(bus: &Bus, node: u8, index: u16, timeout_ms: u64) -> Result<u16, CommandError> {
+    upload(bus, node, index, 0, false, timeout_ms).await.map(|d| le_u16(&d))
+}
+
+/// Fills in what the drive shows now and explains why `step` failed.
+async fn failure(bus: &Bus, w: &mut Watch, step: &Step, timeout_ms: u64) -> CommandError {
+    w.drain();
+    let node = w.node;
+    if !w.obs.sdo_silent {
+        w.obs.error_code = read_u16(bus, node, 0x603F, timeout_ms).await.ok();
+        w.obs.controlword = read_u16(bus, node, 0x6040, timeout_ms).await.ok();
+        w.obs.mode_display = upload(bus, node, 0x6061, 0, false, timeout_ms)
+            .await
+            .ok()
+            .and_then(|d| d.first().map(|b| *b as i8));
+    }
+    w.drain();
+    CommandError::Drive {
+        node,
+        step: step.name.to_string(),
+        reason: diagnose(node, step, &w.obs),
+    }
+}
+
+/// Reads the statusword (a fresh TPDO value wins over an SDO read).
+async fn statusword(bus: &Bus, w: &mut Watch, timeout_ms: u64) -> Result<(u16, &'static str), CommandError> {
+    w.drain();
+    if let Some(sw) = w.tpdo_sw.take() {
+        return Ok((sw, "tpdo"));
+    }
+    match read_u16(bus, w.node, 0x6041, timeout_ms).await {
+        Ok(sw) => Ok((sw, "sdo")),
+        Err(CommandError::Timeout(_)) => {
+            w.obs.sdo_silent = true;
+            Err(CommandError::Timeout(String::new()))
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// Runs a drive command on `node`. `timeout_ms` bounds each SDO response and each step.
+pub async fn drive(bus: &Bus, node: u8, action: DriveAction, timeout_ms: u64) -> Result<DriveReport, CommandError> {
+    let mut w = Watch {
+        rx: bus.subscribe(),
+        node,
+        obs: Observation::default(),
+        tpdo: None,
+        tpdo_sw: None,
+    };
+    let probe = Step {
+        name: "read statusword",
+        controlword: 0,
+        target: DriveState::SwitchOnDisabled,
+    };
+    let (mut sw, mut source) = match statusword(bus, &mut w, timeout_ms).await {
+        Ok(v) => v,
+        Err(CommandError::Timeout(_)) => {
+            // Give heartbeats a moment to tell whether the node is there at all.
+            tokio::time::sleep(Duration::from_millis(timeout_ms.min(1500))).await;
+            return Err(failure(bus, &mut w, &probe, timeout_ms).await);
+        }
+        Err(e) => return Err(e),
+    };
+    if let DriveAction::Mode(mode) = action {
+        return set_mode(bus, &mut w, mode, sw, timeout_ms).await;
+    }
+    w.tpdo = statusword_tpdo(bus, node, timeout_ms).await;
+    let steps = plan(action, DriveState::from_statusword(sw));
+    for step in &steps {
+        w.obs.before = Some(sw);
+        w.tpdo_sw = None;
+        if let Err(e) = download(
+            bus,
+            node,
+            0x6040,
+            0,
+            step.controlword.to_le_bytes().to_vec(),
+            false,
+            timeout_ms,
+        )
+        .await
+        {
+            return Err(match e {
+                CommandError::Abort { code, .. } => CommandError::Drive {
+                    node,
+                    step: step.name.to_string(),
+                    reason: format!(
+                        "the drive refused controlword 0x{:04X}: SDO abort 0x{code:08X} {}",
+                        step.controlword,
+                        crate::decode::sdo::abort_text(code)
+                    ),
+                },
+                CommandError::Timeout(_) => {
+                    w.obs.sdo_silent = true;
+                    failure(bus, &mut w, step, timeout_ms).await
+                }
+                e => e,
+            });
+        }
+        let deadline = tokio::time::Instant::now() + Duration::from_millis(timeout_ms.max(200) * 2);
+        loop {
+            match statusword(bus, &mut w, timeout_ms).await {
+                Ok((s, src)) => {
+                    (sw, source) = (s, src);
+                    w.obs.statusword = Some(s);
+                }
+                Err(CommandError::Timeout(_)) => return Err(failure(bus, &mut w, step, timeout_ms).await),
+                Err(e) => return Err(e),
+            }
+            if DriveState::from_statusword(sw) == step.target {
+                break;
+            }
+            if tokio::time::Instant::now() >= deadline {
+                return Err(failure(bus, &mut w, step, timeout_ms).await);
+            }
+            tokio::time::sleep(Duration::from_millis(10)).await;
+        }
+    }
+    let mode_display = upload(bus, node, 0x6061, 0, false, timeout_ms)
+        .await
+        .ok()
+        .and_then(|d| d.first().map(|b| *b as i8));
+    let error_code = read_u16(bus, node, 0x603F, timeout_ms).await.ok();
+    Ok(DriveReport {
+        node,
+        action,
+        statusword: sw,
+        state: DriveState::from_statusword(sw),
+        steps,
+        mode_display,
+        error_code,
+        source,
+    })
+}
+
+async fn set_mode(bus: &Bus, w: &mut Watch, mode: i8, sw: u16, timeout_ms: u64) -> Result<DriveReport, CommandError> {
+    let node = w.node;
+    download(bus, node, 0x6060, 0, vec![mode as u8], false, timeout_ms).await?;
+    let deadline = tokio::time::Instant::now() + Duration::from_millis(timeout_ms.max(200) * 2);
+    loop {
+        let shown = upload(bus, node, 0x6061, 0, false, timeout_ms).await?;
+        let shown = shown.first().map(|b| *b as i8);
+        if shown == Some(mode) {
+            return Ok(DriveReport {
+                node,
+                action: DriveAction::Mode(mode),
+                statusword: sw,
+                state: DriveState::from_statusword(sw),
+                steps: Vec::new(),
+                mode_display: shown,
+                error_code: None,
+                source: "sdo",
+            });
+        }
+        if tokio::time::Instant::now() >= deadline {
+            return Err(CommandError::Drive {
+                node,
+                step: format!("mode {mode}"),
+                reason: format!(
+                    "mode not set: 0x6061 shows {} after writing {mode} ({}) to 0x6060; check 0x6502 supported modes",
+                    shown.map(|m| m.to_string()).unwrap_or("nothing".into()),
+                    mode_name(mode)
+                ),
+            });
+        }
+        tokio::time::sleep(Duration::from_millis(10)).await;
+    }
+}

@@ -1,0 +1,105 @@
+//! Why a command failed, with the exit status of each case.
+
+use crate::bus::BusError;
+use crate::decode::sdo::abort_text;
+
+/// Exit status: done.
+pub const EXIT_OK: i32 = 0;
+/// Exit status: usage or internal error.
+pub const EXIT_USAGE: i32 = 1;
+/// Exit status: bus unavailable.
+pub const EXIT_BUS: i32 = 2;
+/// Exit status: SDO abort.
+pub const EXIT_ABORT: i32 = 3;
+/// Exit status: timeout.
+pub const EXIT_TIMEOUT: i32 = 4;
+/// Exit status: drive sequence failed.
+pub const EXIT_DRIVE: i32 = 5;
+
+/// A failed command.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CommandError {
+    /// Bad arguments or a local problem (file, type).
+    Usage(String),
+    /// The bus could not be opened or used.
+    Bus(BusError),
+    /// The SDO transfer was aborted (by the server, or by us for a protocol error).
+    Abort {
+        node: u8,
+        index: u16,
+        sub: u8,
+        code: u32,
+        by_server: bool,
+    },
+    /// No answer in time.
+    Timeout(String),
+    /// A drive sequence step did not happen; `reason` says why, from what the bus shows.
+    Drive { node: u8, step: String, reason: String },
+}
+
+impl CommandError {
+    /// The process exit status for this failure.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            CommandError::Usage(_) => EXIT_USAGE,
+            CommandError::Bus(_) => EXIT_BUS,
+            CommandError::Abort { .. } => EXIT_ABORT,
+            CommandError::Timeout(_) => EXIT_TIMEOUT,
+            CommandError::Drive { .. } => EXIT_DRIVE,
+        }
+    }
+    /// The `--json` object of the failure.
+    pub fn to_json(&self) -> serde_json::Value {
+        use serde_json::json;
+        match self {
+            CommandError::Usage(m) => json!({"ok": false, "error": "usage", "message": m}),
+            CommandError::Bus(e) => json!({"ok": false, "error": "bus", "message": e.to_string()}),
+            CommandError::Abort {
+                node,
+                index,
+                sub,
+                code,
+                by_server,
+            } => json!({
+                "ok": false, "error": "sdo_abort", "node": node,
+                "index": format!("0x{index:04X}"), "sub": sub,
+                "abort_code": format!("0x{code:08X}"), "abort_text": abort_text(*code),
+                "aborted_by": if *by_server { "server" } else { "client" },
+                "message": self.to_string(),
+            }),
+            CommandError::Timeout(m) => json!({"ok": false, "error": "timeout", "message": m}),
+            CommandError::Drive { node, step, reason } => json!({
+                "ok": false, "error": "drive", "node": node, "step": step, "reason": reason,
+                "message": self.to_string(),
+            }),
+        }
+    }
+}
+
+impl std::fmt::Display for CommandError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            CommandError::Usage(m) | CommandError::Timeout(m) => write!(f, "{m}"),
+            CommandError::Bus(e) => write!(f, "{e}"),
+            CommandError::Abort {
+                node,
+                index,
+                sub,
+                code,
+                by_server,
+            } => write!(
+                f,
+                "SDO {index:04X}:{sub:02X} on node {node} aborted by the {}: 0x{code:08X} {}",
+                if *by_server { "server" } else { "client" },
+                abort_text(*code)
+            ),
+            CommandError::Drive { node, step, reason } => write!(f, "drive {node}: {step} failed: {reason}"),
+        }
+    }
+}
+
+impl From<BusError> for CommandError {
+    fn from(e: BusError) -> Self {
+        CommandError::Bus(e)
+    }
+}

@@ -1,0 +1,16 @@
+//! The commander: NMT, SDO, CiA 402 drive sequences, scan and record, as a library
+//! API shared by the command line and the TUI palette.
+
+pub mod drive;
+pub mod error;
+pub mod exec;
+pub mod grammar;
+pub mod nmt;
+pub mod record;
+pub mod scan;
+pub mod sdo;
+pub mod value;
+
+pub use error::CommandError;
+pub use exec::{Outcome, execute};
+pub use grammar::{Command, DriveAction, NmtAction, SdoOptions, parse_command};

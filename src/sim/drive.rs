@@ -1,0 +1,526 @@
+//! A simulated CiA 402 drive: NMT slave with boot-up and heartbeat, SDO server,
+//! TPDOs on SYNC and RPDOs from its mapping objects, the CiA 402 state machine
+//! (transitions 0..16), profile velocity motion and EMCY on faults.
+//!
+//! Pure: frames and the current time in, frames out.
+
+use super::od::DeviceObjects;
+use super::profile;
+use crate::decode::cia402::DriveState;
+use crate::frame::Frame;
+use crate::sdo_server::{SdoServer, ServerConfig};
+
+/// NMT state of a simulated node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NmtState {
+    PreOperational,
+    Operational,
+    Stopped,
+}
+
+impl NmtState {
+    /// The heartbeat state byte.
+    pub fn byte(self) -> u8 {
+        match self {
+            NmtState::PreOperational => 0x7F,
+            NmtState::Operational => 0x05,
+            NmtState::Stopped => 0x04,
+        }
+    }
+}
+
+/// Mode of operation: profile velocity.
+pub const MODE_PV: i8 = 3;
+/// Mode of operation: cyclic synchronous velocity.
+pub const MODE_CSV: i8 = 9;
+
+/// One simulated drive.
+#[derive(Clone, Debug)]
+pub struct Drive {
+    node: u8,
+    od: DeviceObjects,
+    sdo: SdoServer,
+    nmt: NmtState,
+    state: DriveState,
+    /// Controlword bit 7 as last seen, for the rising edge of fault reset.
+    reset_bit: bool,
+    /// DC link voltage present (statusword bit 4; needed for Switch on).
+    mains: bool,
+    /// Velocity in raw 0x606C units (fractional part kept here, 0x606C holds the integer).
+    velocity: f64,
+    /// Position units one raw velocity unit covers per second.
+    position_per_velocity: f64,
+    position: f64,
+    last_ns: Option<u64>,
+    next_heartbeat_ns: Option<u64>,
+    pending_fault: Option<u16>,
+}
+
+impl Drive {
+    /// A drive at `node` with the object dictionary of `profile` (see [`profile::drive_objects`]).
+    pub fn new(node: u8, profile: profile::DriveProfile) -> Drive {
+        Drive {
+            node,
+            position_per_velocity: profile.position_per_velocity,
+            od: profile::drive_objects(node, profile),
+            sdo: SdoServer::new(ServerConfig::default()),
+            nmt: NmtState::PreOperational,
+            state: DriveState::SwitchOnDisabled,
+            reset_bit: false,
+            mains: true,
+            velocity: 0.0,
+            position: 0.0,
+            last_ns: None,
+            next_heartbeat_ns: None,
+            pending_fault: None,
+        }
+    }
+    /// The node id.
+    pub fn node(&self) -> u8 {
+        self.node
+    }
+    /// The NMT state.
+    pub fn nmt(&self) -> NmtState {
+        self.nmt
+    }
+    /// The CiA 402 state.
+    pub fn state(&self) -> DriveState {
+        self.state
+    }
+    /// The object dictionary (read-only view).
+    pub fn objects(&self) -> &DeviceObjects {
+        &self.od
+    }
+    /// Switches the simulated DC link voltage on or off.
+    pub fn set_mains(&mut self, on: bool) {
+        self.mains = on;
+        if !on && matches!(self.state, DriveState::SwitchedOn | DriveState::OperationEnabled) {
+            // Losing the DC link in a powered state is a fault (undervoltage).
+            self.pending_fault = Some(0x3220);
+        }
+        self.update_statusword();
+    }
+    /// Makes the drive go to Fault at its next step with this EMCY error code.
+    pub fn inject_fault(&mut self, code: u16) {
+        self.pending_fault = Some(code);
+    }
+
+    /// Power-on: boot-up message, pre-operational.
+    pub fn power_on(&mut self, now_ns: u64) -> Vec<Frame> {
+        self.reset(0x1000..=0xFFFF);
+        self.boot(now_ns)
+    }
+
+    fn reset(&mut self, range: std::ops::RangeInclusive<u16>) {
+        self.od.reset(range.clone());
+        self.sdo = SdoServer::new(ServerConfig::default());
+        if range.contains(&0x6000) {
+            // Reset of the application: the power stage starts over.
+            self.state = DriveState::SwitchOnDisabled;
+            self.velocity = 0.0;
+            self.position = 0.0;
+            self.reset_bit = false;
+        }
+        self.od.set_int(0x6061, 0, self.od.int(0x6060, 0));
+        self.update_statusword();
+    }
+
+    fn boot(&mut self, now_ns: u64) -> Vec<Frame> {
+        self.nmt = NmtState::PreOperational;
+        self.next_heartbeat_ns = self.heartbeat_period_ns().map(|p| now_ns + p);
+        vec![Frame::classic(0x700 + self.node as u32, &[0])]
+    }
+
+    fn heartbeat_period_ns(&self) -> Option<u64> {
+        let ms = self.od.uint(0x1017, 0);
+        (ms > 0).then_some(ms * 1_000_000)
+    }
+
+    /// Handles one frame from the bus at `now_ns`; returns the frames the drive sends.
+    pub fn on_frame(&mut self, f: &Frame, now_ns: u64) -> Vec<Frame> {
+        if f.is_err() || f.is_ext() || f.is_fd() {
+            return Vec::new();
+        }
+        let node = self.node as u32;
+        match f.id {
+            0x000 => self.on_nmt(f.payload(), now_ns),
+            0x080 if self.nmt == NmtState::Operational => self.on_sync(),
+            id if id == 0x600 + node && self.nmt != NmtState::Stopped && !f.is_rtr() => {
+                let replies = self.sdo.on_frame(f.payload(), now_ns, &mut self.od).frames;
+                let mut out: Vec<Frame> = replies.iter().map(|r| Frame::classic(0x580 + node, r)).collect();
+                out.extend(self.apply_objects());
+                out
+            }
+            id if self.nmt == NmtState::Operational && !f.is_rtr() => {
+                let out = self.on_rpdo(id, f.payload());
+                let mut all = out;
+                all.extend(self.apply_objects());
+                all
+            }
+            _ => Vec::new(),
+        }
+    }
+
+    fn on_nmt(&mut self, p: &[u8], now_ns: u64) -> Vec<Frame> {
+        let [cs, target, ..] = p else { return Vec::new() };
+        if *target != 0 && *target != self.node {
+            return Vec::new();
+        }
+        match cs {
+            0x01 => self.nmt = NmtState::Operational,
+            0x02 => self.nmt = NmtState::Stopped,
+            0x80 => self.nmt = NmtState::PreOperational,
+            0x81 => {
+                self.reset(0x1000..=0xFFFF);
+                return self.boot(now_ns);
+            }
+            0x82 => {
+                self.reset(0x1000..=0x1FFF);
+                return self.boot(now_ns);
+            }
+            _ => {}
+        }
+        Vec::new()
+    }
+
+    /// The COB-ID of a PDO communication parameter, when valid (bit 31 clear).
+    fn pdo_cob(&self, comm: u16) -> Option<u32> {
+        let cob = self.od.uint(comm, 1) as u32;
+        (self.od.entry(comm, 1).is_some() && cob & 0x8000_0000 == 0).then_some(cob & 0x7FF)
+    }
+
+    fn on_rpdo(&mut self, id: u32, p: &[u8]) -> Vec<Frame> {
+        for n in 0..4u16 {
+            if self.pdo_cob(0x1400 + n) != Some(id) {
+                continue;
+            }
+            let map = 0x1600 + n;
+            let mut bit = 0usize;
+            for i in 1..=self.od.uint(map, 0) as u8 {
+                let e = self.od.uint(map, i) as u32;
+                let (index, sub, bits) = ((e >> 16) as u16, (e >> 8) as u8, (e & 0xFF) as usize);
+                let bytes = bits / 8;
+                if bit / 8 + bytes > p.len() {
+                    break;
+                }
+                self.od.set(index, sub, &p[bit / 8..bit / 8 + bytes]);
+                bit += bits;
+            }
+        }
+        Vec::new()
+    }
+
+    fn on_sync(&mut self) -> Vec<Frame> {
+        let mut out = Vec::new();
+        for n in 0..4u16 {
+            let Some(cob) = self.pdo_cob(0x1800 + n) else { continue };
+            let kind = self.od.uint(0x1800 + n, 2);
+            if !(1..=240).contains(&kind) {
+                continue;
+            }
+            let map = 0x1A00 + n;
+            let mut data = Vec::new();
+            for i in 1..=self.od.uint(map, 0) as u8 {
+                let e = self.od.uint(map, i) as u32;
+                let (index, sub, bits) = ((e >> 16) as u16, (e >> 8) as u8, (e & 0xFF) as usize);
+                let mut v = self.od.entry(index, sub).map(|x| x.data.clone()).unwrap_or_default();
+                v.resize(bits / 8, 0);
+                data.extend_from_slice(&v);
+            }
+            if data.len() <= 8 {
+                out.push(Frame::classic(cob, &data));
+            }
+        }
+        out
+    }
+
+    /// Acts on objects written by SDO or RPDO: controlword and mode of operation.
+    fn apply_objects(&mut self) -> Vec<Frame> {
+        let mode = self.od.int(0x6060, 0);
+        self.od.set_int(0x6061, 0, mode);
+        let cw = self.od.uint(0x6040, 0) as u16;
+        let out = self.controlword(cw);
+        self.update_statusword();
+        out
+    }
+
+    /// Applies a controlword to the state machine (CiA 402 figure "state machine").
+    fn controlword(&mut self, cw: u16) -> Vec<Frame> {
+        use DriveState::*;
+        let rising_reset = cw & 0x80 != 0 && !self.reset_bit;
+        self.reset_bit = cw & 0x80 != 0;
+        let shutdown = cw & 0x87 == 0x06;
+        let switch_on = cw & 0x8F == 0x07;
+        let enable = cw & 0x8F == 0x0F;
+        let disable_voltage = cw & 0x82 == 0x00;
+        let quick_stop = cw & 0x86 == 0x02;
+        let qs_option = self.od.int(0x605A, 0);
+        let mut out = Vec::new();
+        self.state = match self.state {
+            Fault if rising_reset => {
+                // Transition 15; the reset EMCY tells the bus the error is gone.
+                self.od.set_int(0x603F, 0, 0);
+                self.od.set_int(0x1001, 0, 0);
+                out.push(self.emcy(0x0000));
+                SwitchOnDisabled
+            }
+            SwitchOnDisabled if shutdown => ReadyToSwitchOn,
+            ReadyToSwitchOn if switch_on && self.mains => SwitchedOn,
+            ReadyToSwitchOn if enable && self.mains && self.mode_ok() => OperationEnabled,
+            ReadyToSwitchOn if disable_voltage || quick_stop => SwitchOnDisabled,
+            SwitchedOn if enable && self.mode_ok() => OperationEnabled,
+            SwitchedOn if shutdown => ReadyToSwitchOn,
+            SwitchedOn if disable_voltage || quick_stop => SwitchOnDisabled,
+            OperationEnabled if switch_on => SwitchedOn,
+            OperationEnabled if shutdown => ReadyToSwitchOn,
+            OperationEnabled if disable_voltage => SwitchOnDisabled,
+            OperationEnabled if quick_stop => QuickStopActive,
+            QuickStopActive if disable_voltage => SwitchOnDisabled,
+            QuickStopActive if enable && (5..=8).contains(&qs_option) => OperationEnabled,
+            s => s,
+        };
+        if !matches!(self.state, OperationEnabled | QuickStopActive) {
+            self.velocity = 0.0;
+        }
+        out
+    }
+
+    /// A mode of operation the simulator can run (CiA 402 leaves "no mode" refusals to the vendor).
+    fn mode_ok(&self) -> bool {
+        matches!(self.od.int(0x6061, 0) as i8, MODE_PV | MODE_CSV)
+    }
+
+    fn emcy(&self, code: u16) -> Frame {
+        let c = code.to_le_bytes();
+        let reg = self.od.uint(0x1001, 0) as u8;
+        Frame::classic(0x80 + self.node as u32, &[c[0], c[1], reg, 0, 0, 0, 0, 0])
+    }
+
+    fn update_statusword(&mut self) {
+        use DriveState::*;
+        let base: u16 = match self.state {
+            NotReadyToSwitchOn => 0x0000,
+            SwitchOnDisabled => 0x0040,
+            ReadyToSwitchOn => 0x0021,
+            SwitchedOn => 0x0023,
+            OperationEnabled => 0x0027,
+            QuickStopActive => 0x0007,
+            FaultReactionActive => 0x000F,
+            Fault => 0x0008,
+        };
+        let mut sw = base | 0x0200; // remote
+        if self.mains {
+            sw |= 0x0010;
+        }
+        let target = self.target_velocity();
+        if self.state == OperationEnabled && (self.velocity - target).abs() < 0.5 {
+            sw |= 0x0400;
+        }
+        if self.state == OperationEnabled && self.velocity.abs() < 0.5 {
+            // Profile velocity mode bit 12: speed is zero.
+            sw |= 0x1000;
+        }
+        self.od.set_int(0x6041, 0, sw as i64);
+        self.od.set_int(0x606C, 0, self.velocity.round() as i64);
+        self.od.set_int(0x6064, 0, self.position.round() as i64);
+    }
+
+    /// The velocity the drive is heading for now.
+    fn target_velocity(&self) -> f64 {
+        let halt = self.od.uint(0x6040, 0) & 0x100 != 0;
+        match self.state {
+            DriveState::OperationEnabled if !halt && self.mode_ok() => self.od.int(0x60FF, 0) as f64,
+            _ => 0.0,
+        }
+    }
+
+    /// Advances time to `now_ns`: motion, faults and heartbeats; returns the frames sent.
+    pub fn tick(&mut self, now_ns: u64) -> Vec<Frame> {
+        let mut out = Vec::new();
+        let dt = self
+            .last_ns
+            .map(|t| now_ns.saturating_sub(t) as f64 / 1e9)
+            .unwrap_or(0.0);
+        self.last_ns = Some(now_ns);
+        if let Some(code) = self.pending_fault.take() {
+            self.state = DriveState::FaultReactionActive;
+            self.od.set_int(0x603F, 0, code as i64);
+            self.od.set_int(0x1001, 0, error_register(code) as i64);
+            self.od.set_int(0x1003, 1, code as i64);
+            self.od.set_int(0x1003, 0, 1);
+            if self.nmt != NmtState::Stopped {
+                out.push(self.emcy(code));
+            }
+        } else if self.state == DriveState::FaultReactionActive {
+            // Transition 14: the fault reaction (motor stopped) is done.
+            self.velocity = 0.0;
+            self.state = DriveState::Fault;
+        }
+        self.move_axis(dt);
+        self.update_statusword();
+        if let Some(next) = self.next_heartbeat_ns {
+            if now_ns >= next {
+                out.push(Frame::classic(0x700 + self.node as u32, &[self.nmt.byte()]));
+                self.next_heartbeat_ns = self.heartbeat_period_ns().map(|p| next.max(now_ns - p) + p);
+            }
+        } else if let Some(p) = self.heartbeat_period_ns() {
+            self.next_heartbeat_ns = Some(now_ns + p);
+        }
+        out
+    }
+
+    /// Ramps the velocity toward its target and integrates the position.
+    fn move_axis(&mut self, dt: f64) {
+        let (target, ramp) = match self.state {
+            DriveState::QuickStopActive => (0.0, self.od.uint(0x6085, 0) as f64),
+            _ => {
+                let t = self.target_velocity();
+                let ramp = if t.abs() > self.velocity.abs() { 0x6083 } else { 0x6084 };
+                (t, self.od.uint(ramp, 0) as f64)
+            }
+        };
+        let step = if ramp > 0.0 { ramp * dt } else { f64::INFINITY };
+        let dv = (target - self.velocity).clamp(-step, step);
+        let v0 = self.velocity;
+        self.velocity += dv;
+        self.position += (v0 + self.velocity) / 2.0 * dt * self.position_per_velocity;
+        if self.state == DriveState::QuickStopActive
+            && self.velocity == 0.0
+            && (1..=4).contains(&self.od.int(0x605A, 0))
+        {
+            // Transition 12 after the quick stop ramp for option codes 1..4.
+            self.state = DriveState::SwitchOnDisabled;
+        }
+    }
+}
+
+/// The error register (0x1001) bits for an EMCY error code: generic plus the class
+/// bit of current (0x2xxx), voltage (0x3xxx), temperature (0x4xxx) or communication (0x81xx).
+pub fn error_register(code: u16) -> u8 {
+    let class = match code >> 12 {
+        0x2 => 0x02,
+        0x3 => 0x04,
+        0x4 => 0x08,
+        0x8 if code & 0xFF00 == 0x8100 => 0x10,
+        _ => 0x00,
+    };
+    0x01 | class
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::profile::DriveProfile;
+
+    fn drive() -> Drive {
+        let mut d = Drive::new(2, DriveProfile::servo("test", 1));
+        d.power_on(0);
+        d
+    }
+
+    /// Writes the controlword by expedited SDO and returns the statusword after it.
+    fn cw(d: &mut Drive, value: u16) -> u16 {
+        let v = value.to_le_bytes();
+        let out = d.on_frame(&Frame::classic(0x602, &[0x2B, 0x40, 0x60, 0, v[0], v[1], 0, 0]), 0);
+        assert_eq!(out[0].payload()[0], 0x60, "SDO download answered");
+        d.objects().uint(0x6041, 0) as u16
+    }
+
+    #[test]
+    fn state_machine_transitions_and_statusword_values() {
+        let mut d = drive();
+        assert_eq!(d.objects().uint(0x6041, 0), 0x0250);
+        assert_eq!(cw(&mut d, 0x06), 0x0231); // 2
+        assert_eq!(cw(&mut d, 0x07), 0x0233); // 3
+        assert_eq!(cw(&mut d, 0x0F) & 0x6F, 0x27); // 4
+        assert_eq!(cw(&mut d, 0x07), 0x0233); // 5
+        assert_eq!(cw(&mut d, 0x06), 0x0231); // 6
+        assert_eq!(cw(&mut d, 0x00), 0x0250); // 7
+        cw(&mut d, 0x06);
+        cw(&mut d, 0x07);
+        cw(&mut d, 0x0F);
+        assert_eq!(cw(&mut d, 0x06), 0x0231); // 8
+        cw(&mut d, 0x0F);
+        assert_eq!(d.state(), DriveState::OperationEnabled); // 3+4 in one step
+        assert_eq!(cw(&mut d, 0x00), 0x0250); // 9
+        cw(&mut d, 0x06);
+        cw(&mut d, 0x07);
+        assert_eq!(cw(&mut d, 0x02), 0x0250); // 10
+        cw(&mut d, 0x06);
+        cw(&mut d, 0x0F);
+        assert_eq!(cw(&mut d, 0x02) & 0x6F, 0x07); // 11, option code 6 stays in quick stop
+        assert_eq!(cw(&mut d, 0x0F) & 0x6F, 0x27); // 16
+        cw(&mut d, 0x02);
+        assert_eq!(cw(&mut d, 0x00), 0x0250); // 12
+    }
+
+    #[test]
+    fn fault_needs_a_rising_edge_of_bit_7() {
+        let mut d = drive();
+        d.on_frame(&Frame::classic(0x000, &[0x01, 0x02]), 0);
+        cw(&mut d, 0x80);
+        d.inject_fault(0x4310);
+        let emcy = d.tick(1_000_000);
+        assert_eq!(emcy[0].id, 0x82);
+        assert_eq!(emcy[0].payload(), &[0x10, 0x43, 0x09, 0, 0, 0, 0, 0]);
+        assert_eq!(d.state(), DriveState::FaultReactionActive); // 13
+        assert_eq!(d.objects().uint(0x6041, 0), 0x021F);
+        d.tick(2_000_000);
+        assert_eq!(d.objects().uint(0x6041, 0), 0x0218); // 14
+        // Bit 7 still set from before the fault: no edge, no reset.
+        assert_eq!(cw(&mut d, 0x80), 0x0218);
+        cw(&mut d, 0x00);
+        let out = d.on_frame(&Frame::classic(0x602, &[0x2B, 0x40, 0x60, 0, 0x80, 0, 0, 0]), 0);
+        assert_eq!(d.state(), DriveState::SwitchOnDisabled); // 15
+        assert_eq!(out[1].payload(), &[0; 8], "reset EMCY");
+        assert_eq!(d.objects().uint(0x603F, 0), 0);
+    }
+
+    #[test]
+    fn quick_stop_option_2_ramps_down_then_disables() {
+        let mut d = drive();
+        d.on_frame(&Frame::classic(0x602, &[0x2B, 0x5A, 0x60, 0, 2, 0, 0, 0]), 0);
+        d.on_frame(&Frame::classic(0x602, &[0x23, 0xFF, 0x60, 0, 0x10, 0x27, 0, 0]), 0);
+        cw(&mut d, 0x06);
+        cw(&mut d, 0x0F);
+        for t in 0..=100u64 {
+            d.tick(t * 10_000_000);
+        }
+        assert_eq!(d.objects().int(0x606C, 0), 10_000);
+        assert!(d.objects().int(0x6064, 0) > 0);
+        cw(&mut d, 0x02);
+        assert_eq!(d.state(), DriveState::QuickStopActive);
+        d.tick(1_010_000_000);
+        assert_eq!(d.state(), DriveState::QuickStopActive, "still braking");
+        for t in 102..=130u64 {
+            d.tick(t * 10_000_000);
+        }
+        assert_eq!(d.state(), DriveState::SwitchOnDisabled);
+        assert_eq!(d.objects().int(0x606C, 0), 0);
+    }
+
+    #[test]
+    fn nmt_gates_pdos_and_sdo_and_resets_boot() {
+        let mut d = drive();
+        assert!(
+            d.on_frame(&Frame::classic(0x080, &[]), 0).is_empty(),
+            "no PDO in pre-operational"
+        );
+        d.on_frame(&Frame::classic(0x000, &[0x01, 0x00]), 0);
+        let pdos = d.on_frame(&Frame::classic(0x080, &[]), 0);
+        assert_eq!(pdos.iter().map(|f| f.id).collect::<Vec<_>>(), vec![0x182, 0x282]);
+        assert_eq!(pdos[0].payload(), &[0x50, 0x02, 0x03]);
+        d.on_frame(&Frame::classic(0x000, &[0x02, 0x02]), 0);
+        assert!(
+            d.on_frame(&Frame::classic(0x602, &[0x40, 0x41, 0x60, 0, 0, 0, 0, 0]), 0)
+                .is_empty()
+        );
+        let hb = d.tick(500_000_000);
+        assert_eq!((hb[0].id, hb[0].payload()), (0x702, &[0x04][..]));
+        let boot = d.on_frame(&Frame::classic(0x000, &[0x81, 0x00]), 0);
+        assert_eq!((boot[0].id, boot[0].payload()), (0x702, &[0x00][..]));
+        assert_eq!(d.nmt(), NmtState::PreOperational);
+        assert!(d.on_frame(&Frame::classic(0x000, &[0x01, 0x03]), 0).is_empty());
+        assert_eq!(d.nmt(), NmtState::PreOperational, "command for node 3 ignored");
+    }
+}

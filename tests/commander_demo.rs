@@ -1,0 +1,276 @@
+//! The commander against the simulated demo bus (tokio time paused: deterministic).
+
+use cotui::bus::BusError;
+use cotui::command::drive::drive;
+use cotui::command::nmt::nmt;
+use cotui::command::sdo::{download, upload};
+use cotui::command::{CommandError, DriveAction, NmtAction};
+use cotui::decode::cia402::DriveState;
+use cotui::decode::heartbeat::NmtState;
+use cotui::sim::Simulation;
+use cotui::sim::demo::Demo;
+use std::time::Duration;
+
+const T: u64 = 500;
+
+fn demo() -> Demo {
+    Demo::spawn(Simulation::demo(), false)
+}
+
+#[tokio::test(start_paused = true)]
+async fn sdo_expedited_segmented_and_block_reads() {
+    let d = demo();
+    let sw = upload(&d.bus, 2, 0x6041, 0, false, T).await.unwrap();
+    assert_eq!(sw, vec![0x50, 0x02]);
+    let name = upload(&d.bus, 3, 0x1008, 0, false, T).await.unwrap();
+    assert_eq!(
+        String::from_utf8(name).unwrap(),
+        "cotui simulated Syn-tron-like DS servo"
+    );
+    let blob = upload(&d.bus, 2, 0x2000, 0, true, T).await.unwrap();
+    let want: Vec<u8> = (0..200u32).map(|i| (i * 7 + 2) as u8).collect();
+    assert_eq!(blob, want);
+    let by_block = upload(&d.bus, 2, 0x1008, 0, true, T).await.unwrap();
+    assert_eq!(by_block, b"cotui simulated AIMOTOR-like servo");
+}
+
+#[tokio::test(start_paused = true)]
+async fn sdo_writes_of_every_kind_read_back() {
+    let d = demo();
+    download(&d.bus, 2, 0x1017, 0, vec![0xE8, 0x03], false, T)
+        .await
+        .unwrap();
+    assert_eq!(upload(&d.bus, 2, 0x1017, 0, false, T).await.unwrap(), vec![0xE8, 0x03]);
+    let seg: Vec<u8> = (0..50).collect();
+    download(&d.bus, 2, 0x2000, 0, seg.clone(), false, T).await.unwrap();
+    assert_eq!(upload(&d.bus, 2, 0x2000, 0, false, T).await.unwrap(), seg);
+    let blk: Vec<u8> = (0..255).rev().collect();
+    download(&d.bus, 3, 0x2000, 0, blk.clone(), true, T).await.unwrap();
+    assert_eq!(upload(&d.bus, 3, 0x2000, 0, true, T).await.unwrap(), blk);
+}
+
+#[tokio::test(start_paused = true)]
+async fn sdo_aborts_carry_the_servers_code() {
+    let d = demo();
+    let e = upload(&d.bus, 2, 0x2345, 0, false, T).await.unwrap_err();
+    assert_eq!(e.exit_code(), 3);
+    assert!(
+        matches!(
+            e,
+            CommandError::Abort {
+                code: 0x0602_0000,
+                by_server: true,
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    assert!(e.to_string().contains("Object does not exist"), "{e}");
+    let e = download(&d.bus, 2, 0x6041, 0, vec![0, 0], false, T).await.unwrap_err();
+    assert!(matches!(e, CommandError::Abort { code: 0x0601_0002, .. }), "{e:?}");
+    let e = download(&d.bus, 2, 0x1018, 9, vec![0; 4], true, T).await.unwrap_err();
+    assert!(matches!(e, CommandError::Abort { code: 0x0609_0011, .. }), "{e:?}");
+    let e = download(&d.bus, 2, 0x6040, 0, vec![1, 2, 3, 4, 5], false, T)
+        .await
+        .unwrap_err();
+    assert!(matches!(e, CommandError::Abort { code: 0x0607_0012, .. }), "{e:?}");
+    assert_eq!(e.to_json()["abort_code"], "0x06070012");
+    assert_eq!(
+        e.to_json()["abort_text"],
+        "Data type does not match, length of service parameter too high"
+    );
+}
+
+#[tokio::test(start_paused = true)]
+async fn sdo_to_a_missing_node_times_out() {
+    let d = demo();
+    let e = upload(&d.bus, 9, 0x1000, 0, false, 200).await.unwrap_err();
+    assert_eq!(e.exit_code(), 4);
+    assert!(e.to_string().contains("node 9 did not answer within 200 ms"), "{e}");
+}
+
+#[tokio::test(start_paused = true)]
+async fn enable_disable_quick_stop_and_fault_reset() {
+    let d = demo();
+    let r = drive(&d.bus, 2, DriveAction::Enable, T).await.unwrap();
+    assert_eq!(r.state, DriveState::OperationEnabled);
+    assert_eq!(
+        r.steps.iter().map(|s| s.controlword).collect::<Vec<_>>(),
+        vec![6, 7, 0x0F]
+    );
+    assert_eq!(r.to_json()["statusword"], "0x1637");
+    let r = drive(&d.bus, 2, DriveAction::QuickStop, T).await.unwrap();
+    assert_eq!(r.state, DriveState::QuickStopActive);
+    let r = drive(&d.bus, 2, DriveAction::Enable, T).await.unwrap();
+    assert_eq!(r.steps.first().map(|s| s.controlword), Some(0));
+    assert_eq!(r.state, DriveState::OperationEnabled);
+    let r = drive(&d.bus, 2, DriveAction::Disable, T).await.unwrap();
+    assert_eq!(r.state, DriveState::ReadyToSwitchOn);
+    // A fault: EMCY, Fault state; `enable` resets it first.
+    let mut rx = d.bus.subscribe();
+    d.sim.lock().unwrap().drive_mut(2).unwrap().inject_fault(0x2310);
+    tokio::time::sleep(Duration::from_millis(50)).await;
+    let r = drive(&d.bus, 2, DriveAction::Status, T).await.unwrap();
+    assert_eq!(r.state, DriveState::Fault);
+    assert_eq!(r.error_code, Some(0x2310));
+    let r = drive(&d.bus, 2, DriveAction::Enable, T).await.unwrap();
+    assert_eq!(
+        r.steps.iter().map(|s| s.controlword).collect::<Vec<_>>(),
+        vec![0x80, 6, 7, 0x0F]
+    );
+    assert_eq!(r.state, DriveState::OperationEnabled);
+    let mut emcy = Vec::new();
+    while let Some(Ok(f)) = rx.try_recv() {
+        if f.id == 0x82 {
+            emcy.push(f.payload().to_vec());
+        }
+    }
+    assert_eq!(
+        emcy,
+        vec![vec![0x10, 0x23, 0x03, 0, 0, 0, 0, 0], vec![0, 0, 0, 0, 0, 0, 0, 0]]
+    );
+}
+
+#[tokio::test(start_paused = true)]
+async fn failures_say_why() {
+    let d = demo();
+    d.sim.lock().unwrap().drive_mut(3).unwrap().set_mains(false);
+    let e = drive(&d.bus, 3, DriveAction::Enable, T).await.unwrap_err();
+    assert_eq!(e.exit_code(), 5);
+    assert!(
+        e.to_string().contains("switch on (0x07) failed: voltage not enabled"),
+        "{e}"
+    );
+    d.sim.lock().unwrap().drive_mut(3).unwrap().set_mains(true);
+    drive(&d.bus, 3, DriveAction::Mode(0), T).await.unwrap();
+    let e = drive(&d.bus, 3, DriveAction::Enable, T).await.unwrap_err();
+    assert!(e.to_string().contains("mode not set"), "{e}");
+    nmt(&d.bus, NmtAction::Stop, 3, true, 2000).await.unwrap();
+    let e = drive(&d.bus, 3, DriveAction::Status, T).await.unwrap_err();
+    assert!(e.to_string().contains("NMT not operational"), "{e}");
+    assert!(
+        e.to_json()["reason"]
+            .as_str()
+            .unwrap()
+            .starts_with("NMT not operational")
+    );
+}
+
+#[tokio::test(start_paused = true)]
+async fn nmt_wait_confirms_by_heartbeat_and_boot_up() {
+    let d = demo();
+    tokio::time::sleep(Duration::from_millis(1500)).await;
+    let seen = nmt(&d.bus, NmtAction::PreOp, 2, true, 2000).await.unwrap();
+    assert_eq!(seen.get(&2), Some(&NmtState::PreOperational));
+    let seen = nmt(&d.bus, NmtAction::ResetNode, 0, true, 500).await.unwrap();
+    assert_eq!(seen.keys().copied().collect::<Vec<_>>(), vec![2, 3]);
+    let e = nmt(&d.bus, NmtAction::Start, 7, true, 300).await.unwrap_err();
+    assert!(
+        e.to_string().contains("no heartbeat showing Operational from node 7"),
+        "{e}"
+    );
+}
+
+#[tokio::test(start_paused = true)]
+async fn operational_drives_send_pdos_on_sync_and_follow_rpdos() {
+    let d = demo();
+    drive(&d.bus, 2, DriveAction::Enable, T).await.unwrap();
+    tokio::time::sleep(Duration::from_millis(1200)).await;
+    // RPDO1: controlword 0x0F + target velocity 1000 units/s.
+    let f = cotui::frame::Frame::classic(0x202, &[0x0F, 0, 0xE8, 0x03, 0, 0]);
+    d.bus.send(&f).await.unwrap();
+    tokio::time::sleep(Duration::from_millis(2000)).await;
+    let v = upload(&d.bus, 2, 0x606C, 0, false, T).await.unwrap();
+    assert_eq!(i32::from_le_bytes(v.try_into().unwrap()), 1000);
+    let mut rx = d.bus.subscribe();
+    tokio::time::sleep(Duration::from_millis(150)).await;
+    let mut tpdo2 = None;
+    while let Some(Ok(g)) = rx.try_recv() {
+        if g.id == 0x282 {
+            tpdo2 = Some(g);
+        }
+    }
+    let tpdo2 = tpdo2.expect("TPDO2 after SYNC");
+    let vel = i32::from_le_bytes(tpdo2.payload()[4..8].try_into().unwrap());
+    assert_eq!(vel, 1000);
+    let pos = i32::from_le_bytes(tpdo2.payload()[0..4].try_into().unwrap());
+    assert!(pos > 1000, "position integrates velocity: {pos}");
+}
+
+#[tokio::test(start_paused = true)]
+async fn listen_only_sends_nothing_whatever_the_command() {
+    let d = Demo::spawn(Simulation::demo(), true);
+    let mut watch = d.vbus.endpoint(true).subscribe();
+    tokio::time::sleep(Duration::from_millis(50)).await;
+    while watch.try_recv().is_some() {}
+    let bus = &d.bus;
+    let errs = [
+        upload(bus, 2, 0x6041, 0, false, T).await.unwrap_err(),
+        download(bus, 2, 0x6040, 0, vec![6, 0], true, T).await.unwrap_err(),
+        nmt(bus, NmtAction::Start, 0, true, T).await.unwrap_err(),
+        drive(bus, 2, DriveAction::Enable, T).await.unwrap_err(),
+    ];
+    for e in errs {
+        assert_eq!(e, CommandError::Bus(BusError::ListenOnly));
+        assert_eq!(e.exit_code(), 2);
+    }
+    while let Some(Ok(f)) = watch.try_recv() {
+        assert!(
+            (0x702..=0x703).contains(&f.id) || f.id == 0x80 || f.id == 0 && f.payload() == [1, 0],
+            "only the simulated nodes talk: {f:?}"
+        );
+        assert!(!(0x600..0x680).contains(&f.id));
+    }
+}
+
+#[tokio::test(start_paused = true)]
+async fn our_requests_come_back_tx_and_decode_like_received_frames() {
+    let d = demo();
+    let mut rx = d.bus.subscribe();
+    upload(&d.bus, 2, 0x6041, 0, false, T).await.unwrap();
+    let mut dec = cotui::decode::Decoder::new(cotui::od::Dictionary::default(), vec![]);
+    let mut seen = Vec::new();
+    while let Some(Ok(f)) = rx.try_recv() {
+        let decoded = dec.decode(&f);
+        if f.id == 0x602 || f.id == 0x582 {
+            seen.push((f.id, f.direction(), decoded.kind));
+        }
+    }
+    use cotui::decode::Kind;
+    use cotui::frame::Direction;
+    assert_eq!(
+        seen,
+        vec![(0x602, Direction::Tx, Kind::SdoRx), (0x582, Direction::Rx, Kind::SdoTx)]
+    );
+}
+
+#[tokio::test(start_paused = true)]
+async fn palette_lines_run_through_execute() {
+    let d = demo();
+    let b = cotui::od::bind::Bindings::new().unwrap();
+    let run = |line: &str| cotui::command::parse_command(line).unwrap();
+    let o = cotui::command::execute(&d.bus, &run("sdo read 2 statusword"), &b)
+        .await
+        .unwrap();
+    assert_eq!(o.json["value"], 0x0250);
+    assert_eq!(
+        o.text,
+        "node 2 6041:00 Statusword = Switch on disabled [voltage enabled, switch on disabled, remote] [5002]"
+    );
+    let o = cotui::command::execute(&d.bus, &run("sdo write 2 \"Target velocity\" -500"), &b)
+        .await
+        .unwrap();
+    assert_eq!(o.json["data"], "0CFEFFFF");
+    let o = cotui::command::execute(&d.bus, &run("drive 2 enable"), &b)
+        .await
+        .unwrap();
+    assert!(
+        o.text.starts_with("node 2: Operation enabled (statusword 0x"),
+        "{}",
+        o.text
+    );
+    let e = cotui::command::execute(&d.bus, &run("sdo write 2 0x2000 12"), &b)
+        .await
+        .unwrap_err();
+    assert!(e.to_string().contains("give --type"), "{e}");
+}
