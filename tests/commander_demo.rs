@@ -23,12 +23,15 @@ async fn sdo_expedited_segmented_and_block_reads() {
     let sw = upload(&d.bus, 2, 0x6041, 0, false, T).await.unwrap();
     assert_eq!(sw, vec![0x50, 0x02]);
     let name = upload(&d.bus, 3, 0x1008, 0, false, T).await.unwrap();
-    assert_eq!(String::from_utf8(name).unwrap(), "cotui simulated servo B");
+    assert_eq!(
+        String::from_utf8(name).unwrap(),
+        "cotui simulated Syn-tron-like DS servo"
+    );
     let blob = upload(&d.bus, 2, 0x2000, 0, true, T).await.unwrap();
     let want: Vec<u8> = (0..200u32).map(|i| (i * 7 + 2) as u8).collect();
     assert_eq!(blob, want);
     let by_block = upload(&d.bus, 2, 0x1008, 0, true, T).await.unwrap();
-    assert_eq!(by_block, b"cotui simulated servo A");
+    assert_eq!(by_block, b"cotui simulated AIMOTOR-like servo");
 }
 
 #[tokio::test(start_paused = true)]
@@ -218,4 +221,56 @@ async fn listen_only_sends_nothing_whatever_the_command() {
         );
         assert!(!(0x600..0x680).contains(&f.id));
     }
+}
+
+#[tokio::test(start_paused = true)]
+async fn our_requests_come_back_tx_and_decode_like_received_frames() {
+    let d = demo();
+    let mut rx = d.bus.subscribe();
+    upload(&d.bus, 2, 0x6041, 0, false, T).await.unwrap();
+    let mut dec = cotui::decode::Decoder::new(cotui::od::Dictionary::default(), vec![]);
+    let mut seen = Vec::new();
+    while let Some(Ok(f)) = rx.try_recv() {
+        let decoded = dec.decode(&f);
+        if f.id == 0x602 || f.id == 0x582 {
+            seen.push((f.id, f.direction(), decoded.kind));
+        }
+    }
+    use cotui::decode::Kind;
+    use cotui::frame::Direction;
+    assert_eq!(
+        seen,
+        vec![(0x602, Direction::Tx, Kind::SdoRx), (0x582, Direction::Rx, Kind::SdoTx)]
+    );
+}
+
+#[tokio::test(start_paused = true)]
+async fn palette_lines_run_through_execute() {
+    let d = demo();
+    let b = cotui::od::bind::Bindings::new().unwrap();
+    let run = |line: &str| cotui::command::parse_command(line).unwrap();
+    let o = cotui::command::execute(&d.bus, &run("sdo read 2 statusword"), &b)
+        .await
+        .unwrap();
+    assert_eq!(o.json["value"], 0x0250);
+    assert_eq!(
+        o.text,
+        "node 2 6041:00 Statusword = Switch on disabled [voltage enabled, switch on disabled, remote] [5002]"
+    );
+    let o = cotui::command::execute(&d.bus, &run("sdo write 2 \"Target velocity\" -500"), &b)
+        .await
+        .unwrap();
+    assert_eq!(o.json["data"], "0CFEFFFF");
+    let o = cotui::command::execute(&d.bus, &run("drive 2 enable"), &b)
+        .await
+        .unwrap();
+    assert!(
+        o.text.starts_with("node 2: Operation enabled (statusword 0x"),
+        "{}",
+        o.text
+    );
+    let e = cotui::command::execute(&d.bus, &run("sdo write 2 0x2000 12"), &b)
+        .await
+        .unwrap_err();
+    assert!(e.to_string().contains("give --type"), "{e}");
 }

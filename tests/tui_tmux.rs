@@ -82,7 +82,7 @@ fn demo_runs_filters_helps_and_quits_cleanly() {
     s.wait_for("the frame preview", |t| t.contains("will send: 602#2B40600006000000"));
     s.keys(&["Enter"]);
     s.wait_for("the drive to be enabled", |t| {
-        t.contains("drive 2 enable: Operation enabled")
+        t.contains("node 2: Operation enabled (statusword")
     });
     s.wait_for("the nodes pane to show it", |t| {
         t.contains("2 Operational     Operation enabled")

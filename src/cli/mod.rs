@@ -3,7 +3,13 @@
 pub mod bench;
 mod bench_tui;
 mod bind;
+pub mod commander;
 pub mod decode;
+pub mod drive;
+pub mod nmt;
+pub mod record;
+pub mod scan;
+pub mod sdo;
 pub mod tui;
 
 use clap::{Parser, Subcommand};
@@ -38,6 +44,17 @@ pub enum Command {
     Live(tui::LiveArgs),
     /// The interactive analyzer on an in-process bus with simulated CiA 402 drives.
     Demo(tui::DemoArgs),
+    /// Send an NMT command: cotui nmt IFACE start|stop|preop|reset-node|reset-comm NODE [--wait].
+    Nmt(nmt::NmtArgs),
+    /// Read or write an object by SDO (IFACE `demo` for the simulated bus).
+    #[command(subcommand)]
+    Sdo(sdo::SdoCommand),
+    /// CiA 402 drive: cotui drive IFACE NODE enable|disable|quick-stop|fault-reset|status|mode MODE.
+    Drive(drive::DriveArgs),
+    /// List the nodes on the bus with their identity.
+    Scan(scan::ScanArgs),
+    /// Record the bus to a candump -l log.
+    Record(record::RecordArgs),
 }
 
 /// Short usage printed by `cotui` without arguments.
@@ -71,5 +88,10 @@ pub fn run() -> i32 {
         Some(Command::Replay(args)) => tui::run_replay(&args),
         Some(Command::Live(args)) => tui::run_live(&args),
         Some(Command::Demo(args)) => tui::run_demo(&args),
+        Some(Command::Nmt(args)) => nmt::run_nmt(&args),
+        Some(Command::Sdo(cmd)) => sdo::run_sdo(&cmd),
+        Some(Command::Drive(args)) => drive::run_drive(&args),
+        Some(Command::Scan(args)) => scan::run_scan(&args),
+        Some(Command::Record(args)) => record::run_record(&args),
     }
 }

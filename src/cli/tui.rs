@@ -105,8 +105,8 @@ pub fn load_keymap(choice: &str) -> Result<Keymap, String> {
 enum Feeding {
     /// A log task with an optional control line.
     Log(source::Feeds),
-    /// A live bus that also runs commands.
-    Live(std::sync::mpsc::Receiver<source::Feed>, crate::tui::live::Requests),
+    /// A live bus (interface, listen-only) that also runs commands.
+    Live(String, bool),
 }
 
 fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> i32 {
@@ -117,18 +117,23 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> i32 {
             return EXIT_USAGE;
         }
     };
-    let decoder = match super::bind::decoder(&ui.profiles, &ui.eds) {
-        Ok(d) => d,
+    let bindings = match super::bind::bindings(&ui.profiles, &ui.eds) {
+        Ok(b) => b,
         Err(e) => {
             eprintln!("cotui: {e}");
             return EXIT_USAGE;
         }
     };
+    let decoder = crate::decode::Decoder::from_bindings(&bindings);
     let src = match feed {
         Feeding::Log((rx, ctl)) => SourceInfo::new(name, kind, rx, ctl),
-        Feeding::Live(rx, req) => SourceInfo::live(name, kind, rx, req),
+        Feeding::Live(iface, listen_only) => {
+            let (rx, req) = crate::tui::live::start(&iface, listen_only, bindings.clone());
+            SourceInfo::live(name, kind, rx, req)
+        }
     };
     let mut app = App::new(Trace::new(decoder, ui.bitrate), keymap, src);
+    app.bindings = bindings;
     if let Some(f) = &ui.filter {
         app.set_filter(f);
         if let Some(m) = app.message.take() {
@@ -194,18 +199,18 @@ pub fn run_replay(args: &ReplayArgs) -> i32 {
 
 /// Runs `cotui live IFACE`.
 pub fn run_live(args: &LiveArgs) -> i32 {
-    let (rx, req) = crate::tui::live::start(&args.iface, args.listen_only);
     let kind = SourceKind::Live {
         listen_only: args.listen_only,
     };
-    start(&args.ui, &args.iface, kind, Feeding::Live(rx, req))
+    let feed = Feeding::Live(args.iface.clone(), args.listen_only);
+    start(&args.ui, &args.iface, kind, feed)
 }
 
 /// Runs `cotui demo`.
 pub fn run_demo(args: &DemoArgs) -> i32 {
-    let (rx, req) = crate::tui::live::start(crate::bus::DEMO, args.listen_only);
     let kind = SourceKind::Demo {
         listen_only: args.listen_only,
     };
-    start(&args.ui, crate::bus::DEMO, kind, Feeding::Live(rx, req))
+    let feed = Feeding::Live(crate::bus::DEMO.to_string(), args.listen_only);
+    start(&args.ui, crate::bus::DEMO, kind, feed)
 }

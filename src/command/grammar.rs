@@ -2,6 +2,7 @@
 //! `parse_command("sdo read 2 0x6041")` gives the same [`Command`] as
 //! `cotui sdo read IFACE 2 0x6041`.
 
+use super::record::Limits;
 use crate::od::DataType;
 
 /// An NMT command.
@@ -137,34 +138,52 @@ impl Default for SdoOptions {
     }
 }
 
+/// Default wait of `nmt --wait` in ms.
+pub const NMT_WAIT_MS: u64 = 2000;
+/// Default SDO timeout of `scan` in ms (short: absent nodes cost this much).
+pub const SCAN_TIMEOUT_MS: u64 = 300;
+/// Default listening time of `scan` in ms (longer than common heartbeat periods).
+pub const SCAN_LISTEN_MS: u64 = 1500;
+
 /// One command of the commander (the interface is chosen separately).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Command {
-    /// `nmt ACTION NODE [--wait]` (NODE 0 = all nodes).
-    Nmt { action: NmtAction, node: u8, wait: bool },
-    /// `sdo read NODE OBJECT [--type T] [--block] [--timeout MS]`.
+    /// `nmt ACTION NODE [--wait] [--timeout MS]` (NODE 0 = all nodes).
+    Nmt {
+        action: NmtAction,
+        node: u8,
+        wait: bool,
+        timeout_ms: u64,
+    },
+    /// `sdo read NODE OBJECT [--type T] [--block] [--timeout MS] [-o FILE]`.
     SdoRead {
         node: u8,
         object: String,
         options: SdoOptions,
+        /// Also write the data read to this file (domains).
+        output: Option<String>,
     },
-    /// `sdo write NODE OBJECT VALUE [--type T] [--block] [--timeout MS]`.
+    /// `sdo write NODE OBJECT VALUE [--type T] [--block] [--timeout MS]` (a file path for domains).
     SdoWrite {
         node: u8,
         object: String,
         value: String,
         options: SdoOptions,
     },
-    /// `drive NODE ACTION`.
+    /// `drive NODE ACTION [MODE] [--timeout MS]`.
     Drive {
         node: u8,
         action: DriveAction,
         timeout_ms: u64,
     },
-    /// `scan`.
-    Scan { timeout_ms: u64 },
-    /// `record -o FILE`.
-    Record { output: String },
+    /// `scan [--listen MS] [--probe] [--timeout MS]`.
+    Scan {
+        listen_ms: u64,
+        probe: bool,
+        timeout_ms: u64,
+    },
+    /// `record -o FILE [--count N] [--duration MS]`.
+    Record { output: String, limits: Limits },
 }
 
 /// Parses a number: decimal, `0x` hex, or negative decimal.
@@ -268,39 +287,46 @@ fn words(line: &str) -> Result<Vec<String>, String> {
     Ok(out)
 }
 
+fn positive(flag: &str, v: &str) -> Result<u64, String> {
+    parse_int(v)
+        .filter(|t| *t > 0)
+        .map(|t| t as u64)
+        .ok_or(format!("{flag} `{v}` must be a positive number"))
+}
+
 /// Parses one palette line, e.g. `sdo read 2 0x6041`, `nmt start 0 --wait`,
 /// `sdo write 2 0x6060 3 --type i8`, `drive 2 enable`, `drive 2 mode pv`, `scan`, `record -o f.log`.
 pub fn parse_command(line: &str) -> Result<Command, String> {
     let all = words(line)?;
     let mut pos: Vec<&str> = Vec::new();
-    let mut options = SdoOptions::default();
-    let mut wait = false;
-    let mut output = None;
-    let mut timeout = None;
+    let mut data_type = None;
+    let (mut block, mut wait, mut probe) = (false, false, false);
+    let (mut output, mut timeout, mut listen) = (None, None, None);
+    let mut limits = Limits::default();
     let mut it = all.iter();
     while let Some(w) = it.next() {
         let mut value = |flag: &str| it.next().map(String::as_str).ok_or(format!("{flag} needs a value"));
         match w.as_str() {
             "--wait" => wait = true,
-            "--block" => options.block = true,
-            "--type" | "-t" => options.data_type = Some(parse_type(value("--type")?)?),
-            "--timeout" => {
-                let v = value("--timeout")?;
-                timeout = Some(
-                    parse_int(v)
-                        .filter(|t| *t > 0)
-                        .ok_or(format!("--timeout `{v}` must be a positive number of ms"))? as u64,
-                )
-            }
+            "--block" => block = true,
+            "--probe" => probe = true,
+            "--type" | "-t" => data_type = Some(parse_type(value("--type")?)?),
+            "--timeout" => timeout = Some(positive("--timeout", value("--timeout")?)?),
+            "--listen" => listen = Some(positive("--listen", value("--listen")?)?),
+            "--count" => limits.count = Some(positive("--count", value("--count")?)?),
+            "--duration" => limits.duration_ms = Some(positive("--duration", value("--duration")?)?),
             "-o" | "--output" => output = Some(value("-o")?.to_string()),
-            w if w.starts_with("--") && w.len() > 2 => return Err(format!("unknown option `{w}`")),
+            w if w.starts_with('-') && w.len() > 1 && parse_int(w).is_none() => {
+                return Err(format!("unknown option `{w}`"));
+            }
             w => pos.push(w),
         }
     }
-    if let Some(t) = timeout {
-        options.timeout_ms = t;
-    }
-    let timeout_ms = options.timeout_ms;
+    let options = SdoOptions {
+        data_type,
+        block,
+        timeout_ms: timeout.unwrap_or(DEFAULT_TIMEOUT_MS),
+    };
     let usage = "commands: nmt ACTION NODE, sdo read NODE OBJECT, sdo write NODE OBJECT VALUE, \
                  drive NODE ACTION, scan, record -o FILE";
     match pos.as_slice() {
@@ -308,11 +334,13 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
             action: NmtAction::parse(action)?,
             node: parse_node(node, true)?,
             wait,
+            timeout_ms: timeout.unwrap_or(NMT_WAIT_MS),
         }),
         ["sdo", "read", node, object] => Ok(Command::SdoRead {
             node: parse_node(node, false)?,
             object: object.to_string(),
             options,
+            output,
         }),
         ["sdo", "write", node, object, value] => Ok(Command::SdoWrite {
             node: parse_node(node, false)?,
@@ -323,11 +351,16 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
         ["drive", node, action, rest @ ..] if rest.len() <= 1 => Ok(Command::Drive {
             node: parse_node(node, false)?,
             action: DriveAction::parse(action, rest.first().copied())?,
-            timeout_ms,
+            timeout_ms: timeout.unwrap_or(DEFAULT_TIMEOUT_MS),
         }),
-        ["scan"] => Ok(Command::Scan { timeout_ms }),
+        ["scan"] => Ok(Command::Scan {
+            listen_ms: listen.unwrap_or(SCAN_LISTEN_MS),
+            probe,
+            timeout_ms: timeout.unwrap_or(SCAN_TIMEOUT_MS),
+        }),
         ["record"] => Ok(Command::Record {
             output: output.ok_or("record needs -o FILE")?,
+            limits,
         }),
         [] => Err(format!("empty command; {usage}")),
         [first, ..] => Err(format!("cannot parse `{}` (after `{first}`); {usage}", all.join(" "))),
@@ -345,7 +378,8 @@ mod tests {
             Command::SdoRead {
                 node: 2,
                 object: "0x6041".into(),
-                options: SdoOptions::default()
+                options: SdoOptions::default(),
+                output: None,
             }
         );
         assert_eq!(
@@ -366,7 +400,8 @@ mod tests {
             Command::Nmt {
                 action: NmtAction::ResetNode,
                 node: 0,
-                wait: true
+                wait: true,
+                timeout_ms: NMT_WAIT_MS,
             }
         );
         assert_eq!(
@@ -378,9 +413,36 @@ mod tests {
             }
         );
         assert_eq!(
+            parse_command("sdo write 2 0x60FF -100 --type i32")
+                .map(|c| matches!(c, Command::SdoWrite { value, .. } if value == "-100")),
+            Ok(true)
+        );
+        assert_eq!(
+            parse_command("scan --probe --listen 500").unwrap(),
+            Command::Scan {
+                listen_ms: 500,
+                probe: true,
+                timeout_ms: SCAN_TIMEOUT_MS
+            }
+        );
+        assert_eq!(
+            parse_command("sdo write 2 0x60FF -100 --type i32")
+                .map(|c| matches!(c, Command::SdoWrite { value, .. } if value == "-100")),
+            Ok(true)
+        );
+        assert_eq!(
+            parse_command("scan --probe --listen 500").unwrap(),
+            Command::Scan {
+                listen_ms: 500,
+                probe: true,
+                timeout_ms: SCAN_TIMEOUT_MS
+            }
+        );
+        assert_eq!(
             parse_command("record -o out.log").unwrap(),
             Command::Record {
-                output: "out.log".into()
+                output: "out.log".into(),
+                limits: Limits::default(),
             }
         );
     }

@@ -3,10 +3,14 @@
 
 pub mod drive;
 pub mod error;
+pub mod exec;
 pub mod grammar;
 pub mod nmt;
+pub mod record;
+pub mod scan;
 pub mod sdo;
 pub mod value;
 
 pub use error::CommandError;
+pub use exec::{Outcome, execute};
 pub use grammar::{Command, DriveAction, NmtAction, SdoOptions, parse_command};

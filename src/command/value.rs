@@ -1,8 +1,7 @@
-//! Typed SDO values: text to bytes for writes, bytes to JSON/text for reads, and
-//! object references (`0x6041`, `0x1018:1`, names) to (index, sub).
+//! Typed SDO values: text to bytes for writes, bytes to values for reads.
 
 use super::grammar::parse_int;
-use crate::od::{DataType, Dictionary, Value};
+use crate::od::{DataType, Value};
 
 /// Encodes `text` as `ty` (little-endian). Octet strings are hex (`01 02`, `0102`);
 /// domains are not text (the caller reads a file).
@@ -77,42 +76,6 @@ pub fn decode(bytes: &[u8], ty: Option<DataType>) -> Value {
     }
 }
 
-/// Resolves an object reference: `0x6041`, `0x1018:1`, `0x1018sub1`, `6041h`, or an object
-/// name known to `dict` (case-insensitive, spaces or underscores).
-pub fn resolve(dict: &Dictionary, text: &str) -> Result<(u16, u8), String> {
-    let t = text.trim();
-    let split = t
-        .split_once(':')
-        .or_else(|| t.to_ascii_lowercase().find("sub").map(|i| (&t[..i], &t[i + 3..])));
-    let (idx_text, sub_text) = match split {
-        Some((a, b)) => (a, Some(b)),
-        None => (t, None),
-    };
-    let hexish = idx_text.strip_suffix('h').map(|h| format!("0x{h}"));
-    let index = parse_int(hexish.as_deref().unwrap_or(idx_text)).filter(|v| (0..=0xFFFF).contains(v));
-    if let Some(index) = index {
-        let sub = match sub_text {
-            None => 0,
-            Some(s) => parse_int(s)
-                .filter(|v| (0..=255).contains(v))
-                .ok_or(format!("sub-index `{s}` must be 0..255"))?,
-        };
-        return Ok((index as u16, sub as u8));
-    }
-    let norm = |s: &str| s.to_ascii_lowercase().replace(['_', '-'], " ");
-    let wanted = norm(t);
-    for layer in dict.layers() {
-        for ((index, sub), info) in &layer.objects {
-            if norm(&info.name) == wanted {
-                return Ok((*index, *sub));
-            }
-        }
-    }
-    Err(format!(
-        "unknown object `{text}`: give an index like 0x6041 or 0x1018:1, or a name from the node's profile"
-    ))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -127,29 +90,5 @@ mod tests {
         assert_eq!(encode("abc", DataType::VisibleString), Ok(b"abc".to_vec()));
         assert_eq!(encode("01 2a", DataType::OctetString), Ok(vec![1, 0x2A]));
         assert!(encode("1x", DataType::U32).unwrap_err().contains("not a number"));
-    }
-
-    #[test]
-    fn resolves_references() {
-        let d = Dictionary::default();
-        assert_eq!(resolve(&d, "0x6041"), Ok((0x6041, 0)));
-        assert_eq!(resolve(&d, "0x1018:1"), Ok((0x1018, 1)));
-        assert_eq!(resolve(&d, "0x1018sub2"), Ok((0x1018, 2)));
-        assert_eq!(resolve(&d, "6041h"), Ok((0x6041, 0)));
-        assert!(
-            resolve(&d, "statusword")
-                .unwrap_err()
-                .contains("unknown object `statusword`")
-        );
-        let mut p = crate::od::Profile::default();
-        p.objects.insert(
-            (0x6041, 0),
-            crate::od::ObjectInfo {
-                name: "Statusword".into(),
-                ..Default::default()
-            },
-        );
-        let d = Dictionary::new(vec![std::sync::Arc::new(p)]);
-        assert_eq!(resolve(&d, "statusword"), Ok((0x6041, 0)));
     }
 }

@@ -46,8 +46,10 @@ pub struct Drive {
     reset_bit: bool,
     /// DC link voltage present (statusword bit 4; needed for Switch on).
     mains: bool,
-    /// Velocity in units/s (fractional part kept here, 0x606C holds the integer).
+    /// Velocity in raw 0x606C units (fractional part kept here, 0x606C holds the integer).
     velocity: f64,
+    /// Position units one raw velocity unit covers per second.
+    position_per_velocity: f64,
     position: f64,
     last_ns: Option<u64>,
     next_heartbeat_ns: Option<u64>,
@@ -59,6 +61,7 @@ impl Drive {
     pub fn new(node: u8, profile: profile::DriveProfile) -> Drive {
         Drive {
             node,
+            position_per_velocity: profile.position_per_velocity,
             od: profile::drive_objects(node, profile),
             sdo: SdoServer::new(ServerConfig::default()),
             nmt: NmtState::PreOperational,
@@ -380,7 +383,7 @@ impl Drive {
         let dv = (target - self.velocity).clamp(-step, step);
         let v0 = self.velocity;
         self.velocity += dv;
-        self.position += (v0 + self.velocity) / 2.0 * dt;
+        self.position += (v0 + self.velocity) / 2.0 * dt * self.position_per_velocity;
         if self.state == DriveState::QuickStopActive
             && self.velocity == 0.0
             && (1..=4).contains(&self.od.int(0x605A, 0))
@@ -402,4 +405,122 @@ pub fn error_register(code: u16) -> u8 {
         _ => 0x00,
     };
     0x01 | class
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::profile::DriveProfile;
+
+    fn drive() -> Drive {
+        let mut d = Drive::new(2, DriveProfile::servo("test", 1));
+        d.power_on(0);
+        d
+    }
+
+    /// Writes the controlword by expedited SDO and returns the statusword after it.
+    fn cw(d: &mut Drive, value: u16) -> u16 {
+        let v = value.to_le_bytes();
+        let out = d.on_frame(&Frame::classic(0x602, &[0x2B, 0x40, 0x60, 0, v[0], v[1], 0, 0]), 0);
+        assert_eq!(out[0].payload()[0], 0x60, "SDO download answered");
+        d.objects().uint(0x6041, 0) as u16
+    }
+
+    #[test]
+    fn state_machine_transitions_and_statusword_values() {
+        let mut d = drive();
+        assert_eq!(d.objects().uint(0x6041, 0), 0x0250);
+        assert_eq!(cw(&mut d, 0x06), 0x0231); // 2
+        assert_eq!(cw(&mut d, 0x07), 0x0233); // 3
+        assert_eq!(cw(&mut d, 0x0F) & 0x6F, 0x27); // 4
+        assert_eq!(cw(&mut d, 0x07), 0x0233); // 5
+        assert_eq!(cw(&mut d, 0x06), 0x0231); // 6
+        assert_eq!(cw(&mut d, 0x00), 0x0250); // 7
+        cw(&mut d, 0x06);
+        cw(&mut d, 0x07);
+        cw(&mut d, 0x0F);
+        assert_eq!(cw(&mut d, 0x06), 0x0231); // 8
+        cw(&mut d, 0x0F);
+        assert_eq!(d.state(), DriveState::OperationEnabled); // 3+4 in one step
+        assert_eq!(cw(&mut d, 0x00), 0x0250); // 9
+        cw(&mut d, 0x06);
+        cw(&mut d, 0x07);
+        assert_eq!(cw(&mut d, 0x02), 0x0250); // 10
+        cw(&mut d, 0x06);
+        cw(&mut d, 0x0F);
+        assert_eq!(cw(&mut d, 0x02) & 0x6F, 0x07); // 11, option code 6 stays in quick stop
+        assert_eq!(cw(&mut d, 0x0F) & 0x6F, 0x27); // 16
+        cw(&mut d, 0x02);
+        assert_eq!(cw(&mut d, 0x00), 0x0250); // 12
+    }
+
+    #[test]
+    fn fault_needs_a_rising_edge_of_bit_7() {
+        let mut d = drive();
+        d.on_frame(&Frame::classic(0x000, &[0x01, 0x02]), 0);
+        cw(&mut d, 0x80);
+        d.inject_fault(0x4310);
+        let emcy = d.tick(1_000_000);
+        assert_eq!(emcy[0].id, 0x82);
+        assert_eq!(emcy[0].payload(), &[0x10, 0x43, 0x09, 0, 0, 0, 0, 0]);
+        assert_eq!(d.state(), DriveState::FaultReactionActive); // 13
+        assert_eq!(d.objects().uint(0x6041, 0), 0x021F);
+        d.tick(2_000_000);
+        assert_eq!(d.objects().uint(0x6041, 0), 0x0218); // 14
+        // Bit 7 still set from before the fault: no edge, no reset.
+        assert_eq!(cw(&mut d, 0x80), 0x0218);
+        cw(&mut d, 0x00);
+        let out = d.on_frame(&Frame::classic(0x602, &[0x2B, 0x40, 0x60, 0, 0x80, 0, 0, 0]), 0);
+        assert_eq!(d.state(), DriveState::SwitchOnDisabled); // 15
+        assert_eq!(out[1].payload(), &[0; 8], "reset EMCY");
+        assert_eq!(d.objects().uint(0x603F, 0), 0);
+    }
+
+    #[test]
+    fn quick_stop_option_2_ramps_down_then_disables() {
+        let mut d = drive();
+        d.on_frame(&Frame::classic(0x602, &[0x2B, 0x5A, 0x60, 0, 2, 0, 0, 0]), 0);
+        d.on_frame(&Frame::classic(0x602, &[0x23, 0xFF, 0x60, 0, 0x10, 0x27, 0, 0]), 0);
+        cw(&mut d, 0x06);
+        cw(&mut d, 0x0F);
+        for t in 0..=100u64 {
+            d.tick(t * 10_000_000);
+        }
+        assert_eq!(d.objects().int(0x606C, 0), 10_000);
+        assert!(d.objects().int(0x6064, 0) > 0);
+        cw(&mut d, 0x02);
+        assert_eq!(d.state(), DriveState::QuickStopActive);
+        d.tick(1_010_000_000);
+        assert_eq!(d.state(), DriveState::QuickStopActive, "still braking");
+        for t in 102..=130u64 {
+            d.tick(t * 10_000_000);
+        }
+        assert_eq!(d.state(), DriveState::SwitchOnDisabled);
+        assert_eq!(d.objects().int(0x606C, 0), 0);
+    }
+
+    #[test]
+    fn nmt_gates_pdos_and_sdo_and_resets_boot() {
+        let mut d = drive();
+        assert!(
+            d.on_frame(&Frame::classic(0x080, &[]), 0).is_empty(),
+            "no PDO in pre-operational"
+        );
+        d.on_frame(&Frame::classic(0x000, &[0x01, 0x00]), 0);
+        let pdos = d.on_frame(&Frame::classic(0x080, &[]), 0);
+        assert_eq!(pdos.iter().map(|f| f.id).collect::<Vec<_>>(), vec![0x182, 0x282]);
+        assert_eq!(pdos[0].payload(), &[0x50, 0x02, 0x03]);
+        d.on_frame(&Frame::classic(0x000, &[0x02, 0x02]), 0);
+        assert!(
+            d.on_frame(&Frame::classic(0x602, &[0x40, 0x41, 0x60, 0, 0, 0, 0, 0]), 0)
+                .is_empty()
+        );
+        let hb = d.tick(500_000_000);
+        assert_eq!((hb[0].id, hb[0].payload()), (0x702, &[0x04][..]));
+        let boot = d.on_frame(&Frame::classic(0x000, &[0x81, 0x00]), 0);
+        assert_eq!((boot[0].id, boot[0].payload()), (0x702, &[0x00][..]));
+        assert_eq!(d.nmt(), NmtState::PreOperational);
+        assert!(d.on_frame(&Frame::classic(0x000, &[0x01, 0x03]), 0).is_empty());
+        assert_eq!(d.nmt(), NmtState::PreOperational, "command for node 3 ignored");
+    }
 }

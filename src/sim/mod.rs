@@ -32,13 +32,13 @@ impl Simulation {
             start_all_at_ns: None,
         }
     }
-    /// The demo bus: drives at node 2 and 3, SYNC every 100 ms, and an NMT master that
+    /// The demo bus: an AIMOTOR-like drive at node 2 and a Syn-tron-like one at node 3, SYNC every 100 ms, and an NMT master that
     /// starts all nodes one second after power-on.
     pub fn demo() -> Simulation {
         let mut s = Simulation::new(
             vec![
-                Drive::new(2, DriveProfile::servo("cotui simulated servo A", 0x0402_0002)),
-                Drive::new(3, DriveProfile::servo("cotui simulated servo B", 0x0402_0003)),
+                Drive::new(2, DriveProfile::aimotor_like()),
+                Drive::new(3, DriveProfile::syntron_like()),
             ],
             100,
         );

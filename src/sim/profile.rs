@@ -5,7 +5,7 @@ use super::od::DeviceObjects;
 use crate::od::{Access, DataType};
 
 /// What makes one simulated drive model different from another.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct DriveProfile {
     /// 0x1008 manufacturer device name.
     pub device_name: String,
@@ -13,18 +13,40 @@ pub struct DriveProfile {
     pub vendor_id: u32,
     /// 0x1018:2 product code.
     pub product_code: u32,
+    /// 0x100A manufacturer software version (profiles identify drives by it).
+    pub software_version: String,
     /// 0x1017 heartbeat producer time in ms (0 = off).
     pub heartbeat_ms: u16,
+    /// Position units (0x6064) a velocity of 1 (0x606C / 0x60FF raw) covers per second.
+    pub position_per_velocity: f64,
 }
 
 impl DriveProfile {
-    /// A simulated servo drive called `name`.
+    /// A simulated servo drive called `name`; velocity in position units per second.
     pub fn servo(name: &str, product_code: u32) -> DriveProfile {
         DriveProfile {
             device_name: name.to_string(),
             vendor_id: 0,
             product_code,
+            software_version: "cotui-sim 1".to_string(),
             heartbeat_ms: 500,
+            position_per_velocity: 1.0,
+        }
+    }
+    /// Like the AIMOTOR servo of the seed manuals (profile `aimotor`): identified by a
+    /// software version starting with `AIMOTOR`, velocities in pulses/s.
+    pub fn aimotor_like() -> DriveProfile {
+        DriveProfile {
+            software_version: "AIMOTOR (cotui simulation)".to_string(),
+            ..DriveProfile::servo("cotui simulated AIMOTOR-like servo", 0x0402_0002)
+        }
+    }
+    /// Like the Syn-tron DS drive of the seed manuals (profile `syntron-ds`): velocities in
+    /// 0.1 rpm, 10000 position increments per revolution.
+    pub fn syntron_like() -> DriveProfile {
+        DriveProfile {
+            position_per_velocity: 10_000.0 / 600.0,
+            ..DriveProfile::servo("cotui simulated Syn-tron-like DS servo", 0x0402_0003)
         }
     }
 }
@@ -62,7 +84,7 @@ pub fn drive_objects(node: u8, p: DriveProfile) -> DeviceObjects {
         "Manufacturer software version",
         VisibleString,
         Const,
-        b"cotui-sim 1".to_vec(),
+        p.software_version.into_bytes(),
     );
     s.add(0x1017, 0, "Producer heartbeat time", U16, Rw, p.heartbeat_ms as i64);
     s.add(0x1018, 0, "Highest sub-index supported", U8, Const, 4);

@@ -12,6 +12,7 @@ use super::trace::Trace;
 use super::view::View;
 use crate::command::{Command, DriveAction};
 use crate::decode::Decoded;
+use crate::od::bind::Bindings;
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers, MouseButton, MouseEvent, MouseEventKind};
 use ratatui::layout::Rect;
 use std::collections::BTreeSet;
@@ -176,6 +177,8 @@ pub struct App {
     pub quit: bool,
     /// Layout of the last draw.
     pub layout: Layout,
+    /// Node bindings (object names and types for palette previews).
+    pub bindings: Bindings,
     /// A commander line waiting for `y`.
     pub confirm: Option<Planned>,
     /// Drives this session enabled (what stop-all stops).
@@ -194,6 +197,7 @@ pub const PALETTE_COMMANDS: &[&str] = &[
 impl App {
     /// An application showing `trace`, fed by `source`.
     pub fn new(trace: Trace, keymap: Keymap, source: SourceInfo) -> App {
+        let bindings = Bindings::new().expect("the built-in profiles load");
         App {
             trace,
             view: View::default(),
@@ -218,6 +222,7 @@ impl App {
             quit: false,
             layout: Layout::default(),
             confirm: None,
+            bindings,
             enabled: BTreeSet::new(),
             pending: Vec::new(),
             rate_mark: (Instant::now(), 0),
@@ -389,7 +394,7 @@ impl App {
         let Some(p) = &self.prompt else { return };
         let first = p.text.split_whitespace().next().unwrap_or("");
         if p.kind == PromptKind::Palette && COMMANDER_WORDS.contains(&first) {
-            self.message = Some(match palette::plan(&p.text, |n| self.drive_state(n)) {
+            self.message = Some(match palette::plan(&p.text, &self.bindings, |n| self.drive_state(n)) {
                 Ok(pl) => format!("will send: {}", pl.preview),
                 Err(e) => e,
             });
@@ -402,7 +407,7 @@ impl App {
 
     /// Runs a commander line: asks for confirmation first when it needs one.
     fn commander(&mut self, line: &str) {
-        match palette::plan(line, |n| self.drive_state(n)) {
+        match palette::plan(line, &self.bindings, |n| self.drive_state(n)) {
             Ok(p) => match &p.confirm {
                 Some(why) => {
                     self.message = Some(format!("{why}: {} — press y to send, any other key cancels", p.preview));

@@ -4,9 +4,9 @@
 
 use super::source::Feed;
 use crate::bus::{self, Bus, BusError};
-use crate::command::{self, Command, CommandError};
+use crate::command::{self, Command};
 use crate::decode::cia402::DriveState;
-use crate::od::Dictionary;
+use crate::od::bind::Bindings;
 use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::time::Duration;
 use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
@@ -28,8 +28,9 @@ const BATCH: usize = 1024;
 /// Capacity of the feed channel in batches; when full, frames are dropped and counted.
 const QUEUE: usize = 256;
 
-/// Starts capturing `iface` (`demo` for the simulated bus).
-pub fn start(iface: &str, listen_only: bool) -> (Receiver<Feed>, Requests) {
+/// Starts capturing `iface` (`demo` for the simulated bus); commands use `bindings` for
+/// object names and types.
+pub fn start(iface: &str, listen_only: bool, bindings: Bindings) -> (Receiver<Feed>, Requests) {
     let (tx, rx) = sync_channel(QUEUE);
     let (req_tx, req_rx) = unbounded_channel();
     let iface = iface.to_string();
@@ -42,7 +43,7 @@ pub fn start(iface: &str, listen_only: bool) -> (Receiver<Feed>, Requests) {
                 return;
             }
         };
-        rt.block_on(capture(iface, listen_only, tx, req_rx));
+        rt.block_on(capture(iface, listen_only, bindings, tx, req_rx));
     });
     (rx, req_tx)
 }
@@ -60,7 +61,13 @@ fn offer(tx: &SyncSender<Feed>, item: Feed, lost: &mut u64) -> bool {
     }
 }
 
-async fn capture(iface: String, listen_only: bool, tx: SyncSender<Feed>, mut req: UnboundedReceiver<Request>) {
+async fn capture(
+    iface: String,
+    listen_only: bool,
+    bindings: Bindings,
+    tx: SyncSender<Feed>,
+    mut req: UnboundedReceiver<Request>,
+) {
     if tx.send(Feed::Interfaces(vec![iface.clone()])).is_err() {
         return;
     }
@@ -122,8 +129,9 @@ async fn capture(iface: String, listen_only: bool, tx: SyncSender<Feed>, mut req
                     Some(r) => {
                         let bus = bus.clone();
                         let tx = tx.clone();
+                        let bindings = bindings.clone();
                         tokio::spawn(async move {
-                            let _ = tx.send(Feed::Result(run(&bus, r).await));
+                            let _ = tx.send(Feed::Result(run(&bus, r, &bindings).await));
                         });
                     }
                     None => return,
@@ -145,10 +153,10 @@ async fn capture(iface: String, listen_only: bool, tx: SyncSender<Feed>, mut req
 }
 
 /// Runs one request on `bus`; returns the text for the status line.
-async fn run(bus: &Bus, r: Request) -> String {
+async fn run(bus: &Bus, r: Request, bindings: &Bindings) -> String {
     match r {
-        Request::Run(c) => match execute(bus, &c).await {
-            Ok(s) => s,
+        Request::Run(c) => match command::execute(bus, &c, bindings).await {
+            Ok(o) => o.text,
             Err(e) => format!("error: {e}"),
         },
         Request::StopAll(nodes) => {
@@ -166,72 +174,6 @@ async fn run(bus: &Bus, r: Request) -> String {
             }
             format!("stop all: {}", out.join("; "))
         }
-    }
-}
-
-/// Carries out a palette command.
-async fn execute(bus: &Bus, c: &Command) -> Result<String, CommandError> {
-    let dict = Dictionary::default();
-    match c {
-        Command::Nmt { action, node, wait } => {
-            let seen = command::nmt::nmt(bus, *action, *node, *wait, 2000).await?;
-            let states: Vec<String> = seen.iter().map(|(n, s)| format!("node {n} {}", s.text())).collect();
-            Ok(if *wait {
-                format!("nmt {}: {}", action.as_str(), states.join(", "))
-            } else {
-                format!("nmt {} sent to node {node}", action.as_str())
-            })
-        }
-        Command::SdoRead { node, object, options } => {
-            let (i, s) = command::value::resolve(&dict, object).map_err(CommandError::Usage)?;
-            let data = command::sdo::upload(bus, *node, i, s, options.block, options.timeout_ms).await?;
-            let v = command::value::decode(&data, options.data_type);
-            Ok(format!(
-                "node {node} 0x{i:04X}:{s:02X} = {v} ({})",
-                crate::hex::spaced(&data)
-            ))
-        }
-        Command::SdoWrite {
-            node,
-            object,
-            value,
-            options,
-        } => {
-            let (i, s) = command::value::resolve(&dict, object).map_err(CommandError::Usage)?;
-            let data = encode(value, options.data_type).map_err(CommandError::Usage)?;
-            command::sdo::download(bus, *node, i, s, data, options.block, options.timeout_ms).await?;
-            Ok(format!("node {node} 0x{i:04X}:{s:02X} written"))
-        }
-        Command::Drive {
-            node,
-            action,
-            timeout_ms,
-        } => {
-            let r = command::drive::drive(bus, *node, *action, *timeout_ms).await?;
-            Ok(format!(
-                "drive {node} {}: {} (statusword 0x{:04X})",
-                action.as_str(),
-                r.state.text(),
-                r.statusword
-            ))
-        }
-        Command::Scan { .. } | Command::Record { .. } => Err(CommandError::Usage(
-            "scan and record run from the command line; the trace already shows every node".into(),
-        )),
-    }
-}
-
-/// The bytes a write sends: typed when a type is given, else the smallest unsigned fit or hex.
-pub fn encode(value: &str, ty: Option<crate::od::DataType>) -> Result<Vec<u8>, String> {
-    match ty {
-        Some(t) => command::value::encode(value, t),
-        None => match command::grammar::parse_int(value) {
-            Some(v) if (0..=0xFF).contains(&v) => Ok(vec![v as u8]),
-            Some(v) if (0..=0xFFFF).contains(&v) => Ok((v as u16).to_le_bytes().to_vec()),
-            Some(v) if (-0x8000_0000..=0xFFFF_FFFF).contains(&v) => Ok((v as u32).to_le_bytes().to_vec()),
-            Some(_) => Err(format!("`{value}` needs --type (more than 32 bits)")),
-            None => command::value::parse_hex(value),
-        },
     }
 }
 

@@ -1,14 +1,15 @@
 //! What a commander line in the palette will do before it is sent: the exact frames, and
 //! whether it needs confirming (broadcast NMT, resets, node 0).
 
-use super::live::{UNKNOWN_STATE, encode};
+use super::live::UNKNOWN_STATE;
 use crate::command::{Command, DriveAction, NmtAction, parse_command};
 use crate::decode::cia402::DriveState;
 use crate::hex;
-use crate::od::Dictionary;
+use crate::od::alias::resolve_object;
+use crate::od::bind::Bindings;
 
 /// The first words of commander lines.
-pub const COMMANDER_WORDS: &[&str] = &["nmt", "sdo", "drive"];
+pub const COMMANDER_WORDS: &[&str] = &["nmt", "sdo", "drive", "scan"];
 
 /// A parsed commander line with its preview.
 #[derive(Clone, Debug, PartialEq)]
@@ -44,10 +45,10 @@ fn sdo_initiate(node: u8, index: u16, sub: u8, data: &[u8]) -> String {
     }
 }
 
-/// Plans a commander line; `state` gives a node's known CiA 402 state for drive previews.
-pub fn plan(line: &str, state: impl Fn(u8) -> Option<DriveState>) -> Result<Planned, String> {
+/// Plans a commander line; `bindings` give object names and types, `state` a node's known
+/// CiA 402 state for drive previews.
+pub fn plan(line: &str, bindings: &Bindings, state: impl Fn(u8) -> Option<DriveState>) -> Result<Planned, String> {
     let command = parse_command(line)?;
-    let dict = Dictionary::default();
     let (preview, confirm) = match &command {
         Command::Nmt { action, node, .. } => {
             let f = candump(0x000, &[action.cs(), *node]);
@@ -60,7 +61,7 @@ pub fn plan(line: &str, state: impl Fn(u8) -> Option<DriveState>) -> Result<Plan
             (f, confirm)
         }
         Command::SdoRead { node, object, .. } => {
-            let (i, s) = crate::command::value::resolve(&dict, object)?;
+            let (i, s) = resolve_object(bindings.dictionary(*node), object)?;
             let [lo, hi] = i.to_le_bytes();
             (candump(0x600 + *node as u32, &[0x40, lo, hi, s, 0, 0, 0, 0]), None)
         }
@@ -70,8 +71,15 @@ pub fn plan(line: &str, state: impl Fn(u8) -> Option<DriveState>) -> Result<Plan
             value,
             options,
         } => {
-            let (i, s) = crate::command::value::resolve(&dict, object)?;
-            let data = encode(value, options.data_type)?;
+            let dict = bindings.dictionary(*node);
+            let (i, s) = resolve_object(dict, object)?;
+            let ty = options
+                .data_type
+                .or_else(|| dict.object(i, s).map(|o| o.data_type))
+                .ok_or(format!(
+                    "the type of {i:04X}:{s:02X} is unknown: give --type (u8..u64, i8..i64, ...)"
+                ))?;
+            let data = crate::command::value::encode(value, ty)?;
             (sdo_initiate(*node, i, s, &data), None)
         }
         Command::Drive { node, action, .. } => {
@@ -101,8 +109,12 @@ pub fn plan(line: &str, state: impl Fn(u8) -> Option<DriveState>) -> Result<Plan
             };
             (text, None)
         }
-        Command::Scan { .. } | Command::Record { .. } => {
-            return Err("scan and record run from the command line (`cotui scan`, `cotui record`)".into());
+        Command::Scan { .. } => (
+            "listens for heartbeats, then reads 0x1018 of each node found".into(),
+            None,
+        ),
+        Command::Record { .. } => {
+            return Err("record runs from the command line (`cotui record IFACE -o FILE`)".into());
         }
     };
     Ok(Planned {
@@ -116,19 +128,23 @@ pub fn plan(line: &str, state: impl Fn(u8) -> Option<DriveState>) -> Result<Plan
 mod tests {
     use super::*;
 
+    fn b() -> Bindings {
+        Bindings::new().unwrap()
+    }
+
     #[test]
     fn previews_show_exact_frames() {
-        let p = plan("nmt start 3", |_| None).unwrap();
+        let p = plan("nmt start 3", &b(), |_| None).unwrap();
         assert_eq!((p.preview.as_str(), p.confirm), ("000#0103", None));
         assert_eq!(
-            plan("sdo read 2 0x6041", |_| None).unwrap().preview,
+            plan("sdo read 2 0x6041", &b(), |_| None).unwrap().preview,
             "602#4041600000000000"
         );
         assert_eq!(
-            plan("sdo write 2 0x6060 3 --type i8", |_| None).unwrap().preview,
+            plan("sdo write 2 0x6060 3 --type i8", &b(), |_| None).unwrap().preview,
             "602#2F60600003000000"
         );
-        let d = plan("drive 2 enable", |_| Some(DriveState::SwitchOnDisabled)).unwrap();
+        let d = plan("drive 2 enable", &b(), |_| Some(DriveState::SwitchOnDisabled)).unwrap();
         assert_eq!(
             d.preview,
             "602#2B40600006000000, 602#2B40600007000000, 602#2B4060000F000000 (from Switch on disabled)"
@@ -138,10 +154,10 @@ mod tests {
     #[test]
     fn broadcasts_and_resets_need_confirming() {
         assert_eq!(
-            plan("nmt start 0", |_| None).unwrap().confirm.as_deref(),
+            plan("nmt start 0", &b(), |_| None).unwrap().confirm.as_deref(),
             Some("broadcast NMT start to every node")
         );
-        assert!(plan("nmt reset-node 4", |_| None).unwrap().confirm.is_some());
-        assert!(plan("sdo read 2 nonsense_object", |_| None).is_err());
+        assert!(plan("nmt reset-node 4", &b(), |_| None).unwrap().confirm.is_some());
+        assert!(plan("sdo read 2 nonsense_object", &b(), |_| None).is_err());
     }
 }

@@ -1,0 +1,246 @@
+//! Runs a parsed [`Command`] on a bus: the one entry point the command line and the
+//! TUI palette share. Each result comes as one JSON object plus its text form.
+
+use super::error::CommandError;
+use super::grammar::Command;
+use super::value::{decode, encode};
+use crate::bus::Bus;
+use crate::decode::cia402::mode_name;
+use crate::od::alias::resolve_object;
+use crate::od::bind::Bindings;
+use crate::od::{DataType, Dictionary};
+use serde_json::{Value as Json, json};
+
+/// The result of a command: the `--json` object and the human text.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Outcome {
+    pub json: Json,
+    pub text: String,
+}
+
+/// Runs `cmd` on `bus`; `bindings` give node dictionaries (object names, aliases, types).
+/// A `record` without limits runs until its future is dropped (the log is flushed then).
+pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Outcome, CommandError> {
+    let json = match cmd {
+        Command::Nmt {
+            action,
+            node,
+            wait,
+            timeout_ms,
+        } => {
+            let seen = super::nmt::nmt(bus, *action, *node, *wait, *timeout_ms).await?;
+            let confirmed: serde_json::Map<String, Json> =
+                seen.iter().map(|(n, s)| (n.to_string(), s.as_str().into())).collect();
+            json!({
+                "ok": true,
+                "action": action.as_str(),
+                "node": node,
+                "confirmed": if *wait { Json::Object(confirmed) } else { Json::Null },
+            })
+        }
+        Command::SdoRead {
+            node,
+            object,
+            options,
+            output,
+        } => {
+            let dict = bindings.dictionary(*node);
+            let (index, sub) = resolve_object(dict, object).map_err(CommandError::Usage)?;
+            let data = super::sdo::upload(bus, *node, index, sub, options.block, options.timeout_ms).await?;
+            if let Some(path) = output {
+                std::fs::write(path, &data).map_err(|e| CommandError::Usage(format!("cannot write {path}: {e}")))?;
+            }
+            let ty = options
+                .data_type
+                .or_else(|| dict.object(index, sub).map(|o| o.data_type));
+            let value = decode(&data, ty);
+            let text = value
+                .as_i64()
+                .and_then(|raw| crate::decode::cia402::describe(index, sub, raw, None))
+                .or_else(|| {
+                    dict.object(index, sub)
+                        .map(|i| crate::od::format_value(Some(i), &value))
+                });
+            json!({
+                "ok": true,
+                "node": node,
+                "index": format!("0x{index:04X}"),
+                "sub": sub,
+                "name": dict.name(index, sub),
+                "value": value.to_json(),
+                "text": text,
+                "data": crate::hex::upper(&data),
+                "len": data.len(),
+            })
+        }
+        Command::SdoWrite {
+            node,
+            object,
+            value,
+            options,
+        } => {
+            let dict = bindings.dictionary(*node);
+            let (index, sub) = resolve_object(dict, object).map_err(CommandError::Usage)?;
+            let data = write_data(dict, index, sub, value, options.data_type)?;
+            super::sdo::download(bus, *node, index, sub, data.clone(), options.block, options.timeout_ms).await?;
+            json!({
+                "ok": true,
+                "written": true,
+                "node": node,
+                "index": format!("0x{index:04X}"),
+                "sub": sub,
+                "name": dict.name(index, sub),
+                "data": crate::hex::upper(&data),
+                "len": data.len(),
+            })
+        }
+        Command::Drive {
+            node,
+            action,
+            timeout_ms,
+        } => super::drive::drive(bus, *node, *action, *timeout_ms).await?.to_json(),
+        Command::Scan {
+            listen_ms,
+            probe,
+            timeout_ms,
+        } => {
+            let nodes = super::scan::scan(bus, *listen_ms, *probe, *timeout_ms).await?;
+            json!({"ok": true, "nodes": nodes.iter().map(|n| n.to_json()).collect::<Vec<_>>()})
+        }
+        Command::Record { output, limits } => {
+            let forever = std::future::pending::<()>();
+            let n = if output == "-" {
+                let mut out = std::io::BufWriter::new(std::io::stdout());
+                super::record::record(bus, &mut out, *limits, forever).await?
+            } else {
+                let file = std::fs::File::create(output)
+                    .map_err(|e| CommandError::Usage(format!("cannot create {output}: {e}")))?;
+                super::record::record(bus, &mut std::io::BufWriter::new(file), *limits, forever).await?
+            };
+            json!({"ok": true, "frames": n, "output": output})
+        }
+    };
+    let text = text(cmd, &json);
+    Ok(Outcome { json, text })
+}
+
+/// The bytes to write: a file for domains, else the value encoded as its type.
+fn write_data(
+    dict: &Dictionary,
+    index: u16,
+    sub: u8,
+    value: &str,
+    ty: Option<DataType>,
+) -> Result<Vec<u8>, CommandError> {
+    match ty.or_else(|| dict.object(index, sub).map(|o| o.data_type)) {
+        Some(DataType::Domain) => {
+            std::fs::read(value).map_err(|e| CommandError::Usage(format!("cannot read {value}: {e}")))
+        }
+        Some(t) => encode(value, t).map_err(CommandError::Usage),
+        None => Err(CommandError::Usage(format!(
+            "the type of {index:04X}:{sub:02X} is unknown: give --type (u8..u64, i8..i64, f32, f64, bool, string, octets, domain)"
+        ))),
+    }
+}
+
+fn s(v: &Json) -> &str {
+    v.as_str().unwrap_or("")
+}
+
+/// The text form of a successful command's JSON object.
+pub fn text(cmd: &Command, v: &Json) -> String {
+    match cmd {
+        Command::Nmt { node, .. } => {
+            let target = if *node == 0 {
+                "all nodes".to_string()
+            } else {
+                format!("node {node}")
+            };
+            let mut t = format!("NMT {} sent to {target}", s(&v["action"]));
+            if let Some(m) = v["confirmed"].as_object() {
+                for (n, state) in m {
+                    t.push_str(&format!("\nnode {n}: {}", s(state)));
+                }
+            }
+            t
+        }
+        Command::SdoRead { .. } | Command::SdoWrite { .. } => {
+            let obj = format!(
+                "node {} {}:{:02X}{}",
+                v["node"],
+                s(&v["index"]).trim_start_matches("0x"),
+                v["sub"].as_u64().unwrap_or(0),
+                v["name"].as_str().map(|n| format!(" {n}")).unwrap_or_default()
+            );
+            if v["written"].as_bool() == Some(true) {
+                return format!("{obj} written ({} bytes: {})", v["len"], s(&v["data"]));
+            }
+            let shown = match (&v["text"], &v["value"]) {
+                (Json::String(t), _) => t.clone(),
+                (_, Json::String(raw)) => raw.clone(),
+                (_, other) => other.to_string(),
+            };
+            format!("{obj} = {shown} [{}]", s(&v["data"]))
+        }
+        Command::Drive { .. } => {
+            let mut t = format!(
+                "node {}: {} (statusword {})",
+                v["node"],
+                s(&v["state_text"]),
+                s(&v["statusword"])
+            );
+            if let Some(cws) = v["controlwords"].as_array()
+                && !cws.is_empty()
+            {
+                let list: Vec<&str> = cws.iter().map(s).collect();
+                t.push_str(&format!(", controlwords {}", list.join(" -> ")));
+            }
+            if let Some(m) = v["mode_display"].as_i64() {
+                t.push_str(&format!(", mode {m} ({})", mode_name(m as i8)));
+            }
+            if let Some(e) = v["error_code"].as_str()
+                && e != "0x0000"
+            {
+                t.push_str(&format!(", error code {e}"));
+            }
+            t
+        }
+        Command::Scan { .. } => scan_text(v),
+        Command::Record { .. } => format!("{} frames written to {}", v["frames"], s(&v["output"])),
+    }
+}
+
+fn scan_text(v: &Json) -> String {
+    let nodes = v["nodes"].as_array().cloned().unwrap_or_default();
+    if nodes.is_empty() {
+        return "no nodes found (no heartbeat or boot-up heard; try --probe)".into();
+    }
+    let or_dash = |x: &Json| x.as_str().unwrap_or("-").to_string();
+    nodes
+        .iter()
+        .map(|n| {
+            let mut line = format!(
+                "node {:>3}  {:<16} type {}  vendor {}  product {}  rev {}  serial {}  {}",
+                n["node"],
+                or_dash(&n["nmt"]),
+                or_dash(&n["device_type"]),
+                or_dash(&n["vendor_id"]),
+                or_dash(&n["product_code"]),
+                or_dash(&n["revision"]),
+                or_dash(&n["serial"]),
+                n["device_name"]
+                    .as_str()
+                    .map(|d| format!("\"{d}\""))
+                    .unwrap_or_default()
+            );
+            if let Some(p) = n["profile"].as_str() {
+                line.push_str(&format!("  profile {p} (--profile {}={p})", n["node"]));
+            }
+            if let Some(e) = n["sdo_error"].as_str() {
+                line.push_str(&format!("  ({e})"));
+            }
+            line
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}

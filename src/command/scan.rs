@@ -1,0 +1,162 @@
+//! `scan`: which nodes are on the bus (heartbeats and boot-ups heard), then who they
+//! are (SDO reads of 0x1000 device type, 0x1018 identity, 0x1008 device name).
+
+use super::error::CommandError;
+use super::sdo::upload;
+use crate::bus::{Bus, BusError};
+use crate::decode::heartbeat::NmtState;
+use crate::frame::Direction;
+use crate::od::Value;
+use std::collections::BTreeMap;
+use std::time::Duration;
+
+/// What a scan found out about one node.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct NodeInfo {
+    pub node: u8,
+    /// Last NMT state heard (heartbeat or boot-up), `None` when found only by probing.
+    pub nmt: Option<NmtState>,
+    /// 0x1000 device type.
+    pub device_type: Option<u32>,
+    /// 0x1018:1..4 vendor-ID, product code, revision, serial number.
+    pub identity: [Option<u32>; 4],
+    /// 0x1008 manufacturer device name.
+    pub device_name: Option<String>,
+    /// 0x100A manufacturer software version.
+    pub software_version: Option<String>,
+    /// The built-in profile the identity matches (suggested for `--profile NODE=NAME`).
+    pub profile: Option<String>,
+    /// Why the SDO reads failed, when they did.
+    pub sdo_error: Option<String>,
+}
+
+impl NodeInfo {
+    /// The CiA device profile number in the low word of 0x1000 (402 for drives).
+    pub fn device_profile(&self) -> Option<u16> {
+        self.device_type.map(|t| t as u16)
+    }
+    /// The `--json` object of the node.
+    pub fn to_json(&self) -> serde_json::Value {
+        let hex = |v: Option<u32>| v.map(|x| format!("0x{x:08X}"));
+        serde_json::json!({
+            "node": self.node,
+            "nmt": self.nmt.map(|s| s.as_str()),
+            "device_type": hex(self.device_type),
+            "device_profile": self.device_profile(),
+            "vendor_id": hex(self.identity[0]),
+            "product_code": hex(self.identity[1]),
+            "revision": hex(self.identity[2]),
+            "serial": hex(self.identity[3]),
+            "device_name": self.device_name,
+            "software_version": self.software_version,
+            "profile": self.profile,
+            "sdo_error": self.sdo_error,
+        })
+    }
+}
+
+/// Listens `listen_ms` for heartbeats and boot-ups (and, with `probe`, also asks every node
+/// 1..127 for 0x1000), then reads the identification of each node found.
+pub async fn scan(bus: &Bus, listen_ms: u64, probe: bool, timeout_ms: u64) -> Result<Vec<NodeInfo>, CommandError> {
+    let mut rx = bus.subscribe();
+    let mut heard: BTreeMap<u8, Option<NmtState>> = BTreeMap::new();
+    let deadline = tokio::time::Instant::now() + Duration::from_millis(listen_ms);
+    loop {
+        let left = deadline.saturating_duration_since(tokio::time::Instant::now());
+        match tokio::time::timeout(left, rx.recv()).await {
+            Err(_) => break,
+            Ok(Err(BusError::Closed)) => return Err(BusError::Closed.into()),
+            Ok(Err(_)) => {}
+            Ok(Ok(f)) => {
+                if f.direction() == Direction::Rx
+                    && !f.is_ext()
+                    && !f.is_rtr()
+                    && (0x701..=0x77F).contains(&f.id)
+                    && let Some(b) = f.payload().first()
+                {
+                    heard.insert((f.id - 0x700) as u8, Some(NmtState::from_byte(*b)));
+                }
+            }
+        }
+    }
+    if probe {
+        for node in 1..=127u8 {
+            if !heard.contains_key(&node) && upload(bus, node, 0x1000, 0, false, timeout_ms).await.is_ok() {
+                heard.insert(node, None);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for (node, nmt) in heard {
+        out.push(identify(bus, node, nmt, timeout_ms).await?);
+    }
+    Ok(out)
+}
+
+fn le_u32(d: &[u8]) -> u32 {
+    d.iter().take(4).rev().fold(0u32, |a, b| (a << 8) | *b as u32)
+}
+
+async fn identify(bus: &Bus, node: u8, nmt: Option<NmtState>, timeout_ms: u64) -> Result<NodeInfo, CommandError> {
+    let mut info = NodeInfo {
+        node,
+        nmt,
+        device_type: None,
+        identity: [None; 4],
+        device_name: None,
+        software_version: None,
+        profile: None,
+        sdo_error: None,
+    };
+    let note = |e: CommandError, info: &mut NodeInfo| -> Result<(), CommandError> {
+        match e {
+            CommandError::Bus(b) => Err(CommandError::Bus(b)),
+            e => {
+                info.sdo_error.get_or_insert(e.to_string());
+                Ok(())
+            }
+        }
+    };
+    match upload(bus, node, 0x1000, 0, false, timeout_ms).await {
+        Ok(d) => info.device_type = Some(le_u32(&d)),
+        Err(e) => {
+            note(e, &mut info)?;
+            // A node that does not answer 0x1000 (stopped, or no SDO) will not answer the rest.
+            return Ok(info);
+        }
+    }
+    for sub in 1..=4u8 {
+        match upload(bus, node, 0x1018, sub, false, timeout_ms).await {
+            Ok(d) => info.identity[sub as usize - 1] = Some(le_u32(&d)),
+            Err(e) => note(e, &mut info)?,
+        }
+    }
+    for (index, slot) in [(0x1008, &mut info.device_name), (0x100A, &mut info.software_version)] {
+        match upload(bus, node, index, 0, false, timeout_ms).await {
+            Ok(d) => *slot = Some(String::from_utf8_lossy(&d).trim_end_matches('\0').to_string()),
+            // Optional objects: a device without them aborts.
+            Err(CommandError::Abort { .. }) => {}
+            Err(CommandError::Bus(b)) => return Err(CommandError::Bus(b)),
+            Err(e) => {
+                info.sdo_error.get_or_insert(e.to_string());
+            }
+        }
+    }
+    info.profile = suggest_profile(&info);
+    Ok(info)
+}
+
+/// The built-in profile whose identification matches what the node told us.
+pub fn suggest_profile(info: &NodeInfo) -> Option<String> {
+    let mut bindings = crate::od::bind::Bindings::new().ok()?;
+    let read = |index: u16, sub: u8| -> Option<Value> {
+        match (index, sub) {
+            (0x1000, 0) => info.device_type.map(|v| Value::Unsigned(v as u64)),
+            (0x1018, 1..=4) => info.identity[sub as usize - 1].map(|v| Value::Unsigned(v as u64)),
+            (0x1008, 0) => info.device_name.clone().map(Value::Text),
+            (0x100A, 0) => info.software_version.clone().map(Value::Text),
+            _ => None,
+        }
+    };
+    bindings.identify(&read).map(|p| p.name.clone())
+}

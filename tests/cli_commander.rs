@@ -1,0 +1,143 @@
+//! The commander subcommands through the real binary, on the demo bus.
+
+use std::process::Command;
+
+fn cotui(args: &[&str]) -> (i32, serde_json::Value, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_cotui")).args(args).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    let json = serde_json::from_str(stdout.trim()).unwrap_or(serde_json::Value::Null);
+    (
+        out.status.code().unwrap_or(-1),
+        json,
+        String::from_utf8_lossy(&out.stderr).to_string(),
+    )
+}
+
+#[test]
+fn sdo_read_json_has_value_and_data() {
+    let (rc, v, _) = cotui(&["sdo", "read", "demo", "2", "0x6041", "--json"]);
+    assert_eq!(rc, 0);
+    assert_eq!(v["node"], 2);
+    assert_eq!(v["index"], "0x6041");
+    assert_eq!(v["sub"], 0);
+    assert_eq!(v["value"], 0x0250);
+    assert_eq!(v["data"], "5002");
+    let (rc, v, _) = cotui(&["sdo", "read", "demo", "0x3", "0x1018:2", "--json", "--block"]);
+    assert_eq!(rc, 0);
+    assert_eq!(v["value"], 0x0402_0003);
+    let (rc, v, _) = cotui(&["sdo", "read", "demo", "3", "Manufacturer device name", "--json"]);
+    assert_eq!(rc, 0);
+    assert_eq!(v["name"], "Manufacturer device name");
+    assert_eq!(v["value"], "cotui simulated Syn-tron-like DS servo");
+}
+
+#[test]
+fn sdo_abort_exits_3_with_code_and_text() {
+    let (rc, v, err) = cotui(&["sdo", "read", "demo", "2", "0x2345:1", "--json"]);
+    assert_eq!(rc, 3);
+    assert_eq!(v["abort_code"], "0x06020000");
+    assert_eq!(v["abort_text"], "Object does not exist in the object dictionary");
+    assert!(err.contains("aborted by the server"), "{err}");
+    let (rc, v, _) = cotui(&["sdo", "write", "demo", "2", "0x6041", "6", "--type", "u16", "--json"]);
+    assert_eq!(rc, 3);
+    assert_eq!(v["abort_code"], "0x06010002");
+}
+
+#[test]
+fn sdo_write_then_domain_round_trip_through_files() {
+    let dir = std::env::temp_dir().join(format!("cotui-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = dir.join("in.bin");
+    let blob: Vec<u8> = (0..100u8).collect();
+    std::fs::write(&input, &blob).unwrap();
+    let (rc, v, _) = cotui(&[
+        "sdo",
+        "write",
+        "demo",
+        "2",
+        "0x2000",
+        input.to_str().unwrap(),
+        "--type",
+        "domain",
+        "--block",
+        "--json",
+    ]);
+    assert_eq!((rc, v["len"].as_u64()), (0, Some(100)));
+    let (rc, v, _) = cotui(&["sdo", "write", "demo", "2", "0x6060", "9", "--type", "i8", "--json"]);
+    assert_eq!((rc, v["data"].as_str()), (0, Some("09")));
+    let out = dir.join("out.bin");
+    let (rc, v, _) = cotui(&[
+        "sdo",
+        "read",
+        "demo",
+        "2",
+        "0x2000",
+        "-o",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(rc, 0);
+    assert_eq!(v["len"], 200);
+    assert_eq!(std::fs::read(&out).unwrap().len(), 200);
+    let (rc, _, err) = cotui(&["sdo", "write", "demo", "2", "0x6060", "300", "--type", "i8"]);
+    assert_eq!(rc, 1);
+    assert!(err.contains("does not fit"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn drive_enable_and_failure_reason() {
+    let (rc, v, _) = cotui(&["drive", "demo", "2", "enable", "--json"]);
+    assert_eq!(rc, 0);
+    assert_eq!(v["state"], "operation_enabled");
+    assert_eq!(v["controlwords"], serde_json::json!(["0x0006", "0x0007", "0x000F"]));
+    let (rc, v, _) = cotui(&["drive", "demo", "2", "status", "--json"]);
+    assert_eq!((rc, v["state"].as_str()), (0, Some("switch_on_disabled")));
+    let (rc, v, _) = cotui(&["drive", "demo", "9", "enable", "--json", "--timeout", "200"]);
+    assert_eq!(rc, 5);
+    assert!(
+        v["reason"]
+            .as_str()
+            .unwrap()
+            .starts_with("no SDO answer and no heartbeat from node 9"),
+        "{v}"
+    );
+}
+
+#[test]
+fn nmt_wait_and_listen_only_and_missing_interface() {
+    let (rc, v, _) = cotui(&["nmt", "demo", "reset-node", "0", "--wait", "--json"]);
+    assert_eq!(rc, 0);
+    assert_eq!(v["confirmed"], serde_json::json!({"2": "boot_up", "3": "boot_up"}));
+    let (rc, v, _) = cotui(&["nmt", "demo", "start", "2", "--listen-only", "--json"]);
+    assert_eq!(rc, 2);
+    assert_eq!(v["error"], "bus");
+    let (rc, _, err) = cotui(&["scan", "cotuinosuch0"]);
+    assert_eq!(rc, 2);
+    assert!(err.contains("sudo modprobe vcan"), "{err}");
+    let (rc, _, err) = cotui(&["sdo", "read", "demo", "200", "0x1000"]);
+    assert_eq!(rc, 1);
+    assert!(err.contains("node `200` must be a number 1..127"), "{err}");
+}
+
+#[test]
+fn scan_and_record() {
+    let (rc, v, _) = cotui(&["scan", "demo", "--json"]);
+    assert_eq!(rc, 0);
+    let nodes = v["nodes"].as_array().unwrap();
+    assert_eq!(nodes.len(), 2);
+    assert_eq!(nodes[0]["node"], 2);
+    assert_eq!(nodes[0]["device_profile"], 402);
+    assert_eq!(nodes[0]["software_version"], "AIMOTOR (cotui simulation)");
+    // Syn-tron drives carry no identification: the generic drive profile is suggested.
+    assert_eq!(nodes[1]["profile"], "cia402");
+    assert_eq!(nodes[1]["device_name"], "cotui simulated Syn-tron-like DS servo");
+    let path = std::env::temp_dir().join(format!("cotui-rec-{}.log", std::process::id()));
+    let (rc, v, _) = cotui(&["record", "demo", "-o", path.to_str().unwrap(), "--count", "5", "--json"]);
+    assert_eq!((rc, v["frames"].as_u64()), (0, Some(5)));
+    let log = std::fs::read_to_string(&path).unwrap();
+    let lines: Vec<&str> = log.lines().collect();
+    assert_eq!(lines.len(), 5);
+    assert!(lines[0].starts_with('(') && lines[0].ends_with(" demo 702#00"), "{log}");
+    std::fs::remove_file(&path).unwrap();
+}
