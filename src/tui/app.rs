@@ -473,6 +473,7 @@ impl App {
                 self.view = View::new(f);
                 self.view.advance(&self.trace, Duration::from_millis(30));
                 self.trace_list.selected = pos.map(|p| self.view.row_of(p)).unwrap_or(0);
+                self.trace_list.clamp(self.view_len(), self.page());
                 self.message = None;
                 self.rows = RowCache::default();
             }
@@ -613,7 +614,8 @@ impl App {
 
     /// The trace position of the selected row.
     pub fn selected_position(&self) -> Option<usize> {
-        (!self.view.is_empty(&self.trace)).then(|| self.view.position(self.trace_list.selected))
+        let n = self.view_len();
+        (n > 0).then(|| self.view.position(self.trace_list.selected.min(n - 1)))
     }
 
     fn select_position(&mut self, pos: usize) {
