@@ -35,7 +35,7 @@ if [ -n "$log" ]; then ok "candump -l wrote $log"; else bad "candump -l wrote no
 has "$log" "vcan0 123#DEADBEEF" && ok "classic frame" || bad "classic frame 123#DEADBEEF missing"
 has "$log" "vcan0 123#R" && ok "RTR frame" || bad "RTR frame 123#R missing"
 has "$log" "vcan0 1ABCDEF0#0102" && ok "29-bit frame" || bad "29-bit frame missing"
-has "$log" "vcan1 456##1112233445566778899AABBCC" && ok "CAN FD frame with BRS" || bad "FD frame missing"
+grep -qE "vcan1 456##[15]112233445566778899AABBCC" "$log" && ok "CAN FD frame with BRS" || bad "FD frame missing"
 n=$(grep -c " vcan0 7E0#" "$log")
 [ "$n" = 20 ] && ok "cangen: 20 frames" || bad "cangen: $n frames of 20"
 n=$(grep -c " vcan1 7E1##" "$log")

@@ -4,7 +4,8 @@
     python3 tests/vbus/peers/sdo_server.py IFACE NODE [--heartbeat-ms 1000] [--duration S]
 
 Prints "sdo_server ready IFACE NODE" once it listens, sends its boot-up message and
-heartbeats, and serves until SIGTERM/SIGINT (or --duration seconds). Its objects:
+heartbeats, and serves SDO (expedited, segmented and block transfers, see sdo_block.py)
+until SIGTERM/SIGINT (or --duration seconds). Its objects:
 
     0x1000 u32 0x00000191 ro      0x1008 visible string "vbus sdo peer"
     0x1017 u16 heartbeat ms rw    0x1018 identity record (sub 1..4)
@@ -25,6 +26,7 @@ import canopen  # noqa: E402
 from canopen import objectdictionary as odt  # noqa: E402
 
 import common  # noqa: E402
+import sdo_block  # noqa: E402
 
 DOMAIN_BYTES = bytes(i % 256 for i in range(300))
 
@@ -49,8 +51,8 @@ def build_od(heartbeat_ms):
 
 
 def make_node(node_id, heartbeat_ms=1000):
-    """Return an unconnected LocalNode with this peer's objects."""
-    return canopen.LocalNode(node_id, build_od(heartbeat_ms))
+    """Return an unconnected LocalNode with this peer's objects and block SDO support."""
+    return sdo_block.use_block_sdo(canopen.LocalNode(node_id, build_od(heartbeat_ms)))
 
 
 def main():

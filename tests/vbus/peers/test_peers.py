@@ -104,15 +104,16 @@ def sdo_segmented_write_domain():
 
 @check
 def sdo_block_upload_domain():
-    SDO.sdo.download(0x2005, 0, sdo_server.DOMAIN_BYTES)
-    with SDO.sdo.open(0x2005, 0, "rb", block_transfer=True) as f:
-        got = f.read()
-    expect(got, sdo_server.DOMAIN_BYTES, "domain by block upload")
+    for data in (sdo_server.DOMAIN_BYTES, bytes(i % 251 for i in range(1000))):  # 1 and 2 blocks
+        SDO.sdo.download(0x2005, 0, data)
+        with SDO.sdo.open(0x2005, 0, "rb", block_transfer=True) as f:
+            got = f.read()
+        expect(got, data, f"{len(data)} bytes by block upload")
 
 
 @check
 def sdo_block_download_domain():
-    data = bytes((i * 7) % 256 for i in range(500))
+    data = bytes((i * 7) % 256 for i in range(1000))  # several blocks of 64 segments
     with SDO.sdo.open(0x2005, 0, "wb", size=len(data), block_transfer=True) as f:
         f.write(data)
     expect(SDO.sdo.upload(0x2005, 0), data, "domain after block download")
