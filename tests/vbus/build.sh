@@ -10,6 +10,8 @@ set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 cache="$here/cache"
 mkdir -p "$cache"
+exec 9>"$cache/.lock"
+flock 9 # one build at a time; concurrent runs wait for it
 
 # Modules the guest loads; their dependencies are added by modprobe --show-depends.
 modules=(virtio_pci virtio_mmio virtio_console 9pnet_virtio 9p vcan can_raw can_bcm can_gw)
@@ -83,4 +85,7 @@ modprobe -d "$kroot" -S "$kver" --show-depends -a "${modules[@]}" |
 
 rm -rf "$kroot" "$ird"
 touch "$out/ok"
+for old in "$cache"/[0-9]*-*/; do # images of older keys
+    [ "${old%/}" = "$out" ] || rm -rf "$old"
+done
 echo "$out"

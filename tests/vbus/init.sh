@@ -54,6 +54,20 @@ while read -r tag path; do
 done < /x/rw
 
 stamp mounts
+# Network: lo and the vcan interfaces (busybox ip: no host binary to load over 9p).
+ip link set lo up || fail "cannot bring up lo"
+for spec in $VBUS_IFACES; do
+    name=${spec%%:*}
+    ip link add dev "$name" type vcan || fail "cannot create $name"
+    case $spec in
+        *:fd) ip link set "$name" mtu 72 || fail "cannot set MTU 72 (CAN FD) on $name" ;;
+        "$name") ;;
+        *) fail "unknown option in VBUS_IFACES entry '$spec' (known: NAME, NAME:fd)" ;;
+    esac
+    ip link set "$name" up || fail "cannot bring up $name"
+done
+stamp network
+
 port() {
     for p in /sys/class/virtio-ports/*; do
         [ "$(cat "$p/name" 2>/dev/null)" = "$1" ] && { echo "/dev/${p##*/}"; return; }

@@ -55,6 +55,7 @@ trap 'exit 130' INT TERM
     printf 'VBUS_XDIR=%q\n' "$x"
     printf 'VBUS_GUEST_SCRIPT=%q\n' "$here/guest.sh"
     printf 'VBUS_TIMEOUT=%q\n' "$timeout_s"
+    printf 'VBUS_IFACES=%q\n' "${VBUS_IFACES:-vcan0}"
 } > "$x/config"
 # A pyenv shim is a shell script that costs seconds per call under TCG: put the directory
 # of the interpreter it resolves to (here, on the host) first on the guest's PATH.

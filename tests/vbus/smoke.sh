@@ -18,7 +18,7 @@ work=$(mktemp -d)
 cd "$work" || exit 1
 
 # --- raw traffic through the kernel, logged by candump -l ----------------------------
-candump -l vcan0 vcan1 &
+candump -l vcan0 vcan1 2>/dev/null &
 dump=$!
 sleep 1
 cansend vcan0 123#DEADBEEF
