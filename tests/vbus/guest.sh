@@ -9,7 +9,7 @@ x=$1
 while IFS= read -r -d '' kv; do
     case ${kv%%=*} in
         BASH_* | BASHOPTS | SHELLOPTS | PWD | OLDPWD | SHLVL | _ | '') ;;
-        *) export "$kv" ;;
+        *) export "$kv" 2>/dev/null ;; # names bash cannot hold are dropped
     esac
 done < "$x/env"
 export VBUS_GUEST=1 PATH=$VBUS_PATH

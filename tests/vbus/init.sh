@@ -3,19 +3,20 @@
 # Loads the modules, mounts the exchange share (tag vbus.x) and the host root (tag
 # vbus.root, read-only), prepares the chroot and runs the harness's guest.sh in it with
 # stdout/stderr on the virtio ports vbus.out/vbus.err. Writes the exit status to
-# /x/status (124 on timeout) and stops the guest (reboot -f: qemu runs with -no-reboot, so it exits). Any failure here leaves no status, which the
-# host reports as a boot failure (125) with the console log.
+# /x/status (124 on timeout) and powers off (qemu exits). Any failure here leaves no
+# status, which the host reports as a boot failure (125) with the console log. A kernel
+# panic reboots, and qemu runs with -no-reboot, so it exits then too.
 /bin/busybox --install -s /bin
 export PATH=/bin
 
 fail() {
     echo "vbus-init: $*" >/dev/console
-    reboot -f
+    sync; poweroff -f
 }
 
 mount -t proc proc /proc
 # The host's KVM probe boots with vbus.probe: answer on the console and stop.
-case " $(cat /proc/cmdline) " in *" vbus.probe "*) echo vbus-probe-ok >/dev/console; reboot -f ;; esac
+case " $(cat /proc/cmdline) " in *" vbus.probe "*) echo vbus-probe-ok >/dev/console; sync; poweroff -f ;; esac
 mount -t sysfs sys /sys
 mount -t devtmpfs dev /dev
 for m in $(cat /modules/order); do
@@ -90,7 +91,7 @@ cat_err=$!
     echo "vbus: command timed out after ${VBUS_TIMEOUT}s" >/e
     echo 124 > /x/status
     sleep 0.3
-    reboot -f
+    sync; poweroff -f
 ) &
 
 chroot $r /bin/bash "$VBUS_GUEST_SCRIPT" "$VBUS_XDIR" </dev/null >/o 2>/e
@@ -103,4 +104,4 @@ while [ $i -lt 20 ] && { kill -0 $cat_out || kill -0 $cat_err; } 2>/dev/null; do
     i=$((i + 1))
 done
 echo $rc > /x/status
-reboot -f
+sync; poweroff -f

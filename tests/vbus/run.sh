@@ -48,7 +48,8 @@ cleanup() {
     rm -rf "$tmp"
 }
 trap cleanup EXIT
-trap 'exit 130' INT TERM
+trap 'exit 130' INT
+trap 'exit 143' TERM
 
 # What the guest needs to know.
 {
@@ -139,7 +140,13 @@ wait "$qpid"
 qrc=$?
 qpid=
 t1=$(date +%s.%N)
-wait # the FIFO readers end when qemu closes the FIFOs
+# The FIFO readers end when qemu closes the FIFOs; if qemu never opened them, a
+# read-write open (which does not block) and close releases them.
+for f in "$tmp/out" "$tmp/err"; do
+    exec 7<>"$f"
+    exec 7>&-
+done
+wait
 
 if [ "${VBUS_TIMING:-0}" = 1 ]; then
     if [ -f "$x/started" ]; then
