@@ -33,7 +33,7 @@ impl Simulation {
         }
     }
     /// The demo bus: an AIMOTOR-like drive at node 2 and a Syn-tron-like one at node 3, SYNC every 100 ms, and an NMT master that
-    /// starts all nodes one second after power-on.
+    /// starts all nodes 0.8 s after power-on.
     pub fn demo() -> Simulation {
         let mut s = Simulation::new(
             vec![
@@ -42,7 +42,7 @@ impl Simulation {
             ],
             100,
         );
-        s.start_all_at_ns = Some(1_000_000_000);
+        s.start_all_at_ns = Some(800_000_000);
         s
     }
     /// The drive at `node`.
