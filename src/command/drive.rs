@@ -331,8 +331,10 @@ pub async fn drive(bus: &Bus, node: u8, action: DriveAction, timeout_ms: u64) ->
     if let DriveAction::Mode(mode) = action {
         return set_mode(bus, &mut w, mode, sw, timeout_ms).await;
     }
-    w.tpdo = statusword_tpdo(bus, node, timeout_ms).await;
     let steps = plan(action, DriveState::from_statusword(sw));
+    if !steps.is_empty() {
+        w.tpdo = statusword_tpdo(bus, node, timeout_ms).await;
+    }
     for step in &steps {
         w.obs.before = Some(sw);
         w.tpdo_sw = None;
