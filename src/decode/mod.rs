@@ -24,6 +24,27 @@ pub enum Kind {
 }
 
 impl Kind {
+    /// Every kind, in declaration order: `Kind::ALL[k.index()] == k`.
+    pub const ALL: [Kind; 12] = [
+        Kind::Nmt,
+        Kind::Sync,
+        Kind::Emcy,
+        Kind::Time,
+        Kind::Tpdo,
+        Kind::Rpdo,
+        Kind::SdoTx,
+        Kind::SdoRx,
+        Kind::Heartbeat,
+        Kind::Lss,
+        Kind::ErrorFrame,
+        Kind::Other,
+    ];
+
+    /// Position of the kind in [`Kind::ALL`] (a dense index for counters and packed stores).
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
     /// The JSONL name of the kind.
     pub fn as_str(self) -> &'static str {
         match self {
@@ -57,5 +78,18 @@ pub mod sdo;
 pub mod sync;
 pub mod time;
 pub mod value_text;
+pub mod vendor_sdo;
 
 pub use registry::{Body, Decoded, Decoder};
+
+#[cfg(test)]
+mod tests {
+    use super::Kind;
+
+    #[test]
+    fn all_kinds_in_index_order() {
+        for (i, k) in Kind::ALL.iter().enumerate() {
+            assert_eq!(k.index(), i);
+        }
+    }
+}

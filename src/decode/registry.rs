@@ -6,9 +6,9 @@ use super::cob_id::{CobId, CobTable, Route};
 use super::heartbeat::Heartbeat;
 use super::pdo::{self, Pdo};
 use super::sdo::{SdoFrame, SdoTracker, Transaction};
-use super::{Kind, emcy, error_frame, heartbeat, lss, nmt, sync, time};
+use super::{Kind, emcy, error_frame, heartbeat, lss, nmt, sync, time, vendor_sdo};
 use crate::frame::Frame;
-use crate::od::{Dictionary, MappingSource, PdoMapping};
+use crate::od::{Dictionary, MappingSource, PdoMapping, resolve_object};
 use std::collections::HashMap;
 
 /// The decoded meaning of one frame.
@@ -37,7 +37,11 @@ pub enum Body {
     Pdo(Pdo),
     Sdo(SdoFrame),
     Lss(lss::Lss),
-    ErrorFrame { class: u32 },
+    ErrorFrame {
+        class: u32,
+    },
+    /// A vendor SDO command the node's profile describes (e.g. Syn-tron 0xE8/0xE9).
+    VendorSdo(vendor_sdo::VendorSdo),
 }
 
 /// Identifies one PDO of one node: (node, transmit, number).
@@ -113,12 +117,12 @@ impl Decoder {
                             Route {
                                 kind,
                                 node: Some(node),
-                                pdo: *num as u16,
+                                pdo: u16::from(*num),
                                 reserved: false,
                             },
                         );
                     }
-                    self.mappings.insert((node, transmit, *num as u16), m.clone());
+                    self.mappings.insert((node, transmit, u16::from(*num)), m.clone());
                 }
             }
         }
@@ -229,8 +233,15 @@ impl Decoder {
                     self.learn(&t);
                     self.completed.push(t);
                 }
-                let p = s.malformed();
-                (s.label(), Body::Sdo(s), p)
+                // The tracker sees vendor commands too (as unknown commands), so that
+                // their standard replies do not disturb a running transfer.
+                match vendor_sdo::decode(&self.dicts[n as usize], c2s, payload) {
+                    Some(v) => (v.label(), Body::VendorSdo(v), None),
+                    None => {
+                        let p = s.malformed();
+                        (s.label(), Body::Sdo(s), p)
+                    }
+                }
             }
             Kind::Other => {
                 let label = if route.reserved {
@@ -308,6 +319,7 @@ impl Decoder {
         let len = t.data.len().min(4);
         b[..len].copy_from_slice(&t.data[..len]);
         let v = u32::from_le_bytes(b);
+        self.select_pdo_set(node, t.index, t.sub, i64::from(v));
         match (t.index, t.sub) {
             (0x6060 | 0x6061, 0) => self.modes[(node & 0x7F) as usize] = Some(t.data[0] as i8),
             (0x1005, 0) => self.assign_cob(
@@ -337,6 +349,40 @@ impl Decoder {
             (0x1600..=0x17FF, sub) => self.learn_mapping((node, false, t.index - 0x1600 + 1), sub, v, t.end_ns),
             (0x1A00..=0x1BFF, sub) => self.learn_mapping((node, true, t.index - 0x1A00 + 1), sub, v, t.end_ns),
             _ => {}
+        }
+    }
+
+    /// Switches `node` to the profile's PDO mapping set that (index, sub) = `value`
+    /// selects (e.g. Dexmart parameter 09-26), when one does.
+    fn select_pdo_set(&mut self, node: u8, index: u16, sub: u8, value: i64) {
+        let dict = self.dicts[(node & 0x7F) as usize].clone();
+        let chosen = dict.layers().iter().find_map(|layer| {
+            layer.pdo_sets.iter().find(|set| {
+                set.selected_by
+                    .as_ref()
+                    .is_some_and(|(object, v)| *v == value && resolve_object(&dict, object) == Ok((index, sub)))
+            })
+        });
+        let Some(set) = chosen else { return };
+        let source = MappingSource::Profile(dict.profile_name().to_string());
+        for transmit in [false, true] {
+            let kind = if transmit { Kind::Tpdo } else { Kind::Rpdo };
+            for (num, m) in set.mappings(transmit, Some(node), &source) {
+                let num = u16::from(num);
+                match m.cob_id {
+                    Some(cob) => self.cobs.assign(
+                        cob_key(cob),
+                        Route {
+                            kind,
+                            node: Some(node),
+                            pdo: num,
+                            reserved: false,
+                        },
+                    ),
+                    None => self.cobs.unassign(kind, Some(node), num),
+                }
+                self.mappings.insert((node, transmit, num), m);
+            }
         }
     }
 

@@ -17,6 +17,10 @@ use super::{Dictionary, MappingSource, Profile, Value, Warning};
 pub const BUILTIN: &[(&str, &str)] = &[
     ("cia301", include_str!("../../decoders/cia301.json")),
     ("cia402", include_str!("../../decoders/cia402.json")),
+    ("aimotor", include_str!("../../decoders/aimotor.json")),
+    ("aqmd2405", include_str!("../../decoders/aqmd2405.json")),
+    ("dexmart-dev", include_str!("../../decoders/dexmart-dev.json")),
+    ("syntron-ds", include_str!("../../decoders/syntron-ds.json")),
 ];
 
 /// Reads a file for the bindings (the CLI passes `std::fs::read_to_string`).

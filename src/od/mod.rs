@@ -264,6 +264,15 @@ impl Dictionary {
             .map(|o| o.name.as_str())
             .or_else(|| self.object_name(index))
     }
+    /// The name for labels: the entry's name followed by the vendor alias when the
+    /// entry has one, e.g. `A speed command (F0.3.018)`.
+    pub fn label_name(&self, index: u16, sub: u8) -> Option<String> {
+        let name = self.name(index, sub)?;
+        match self.object(index, sub).and_then(|o| o.alias.as_deref()) {
+            Some(alias) => Some(format!("{name} ({alias})")),
+            None => Some(name.to_string()),
+        }
+    }
     /// The most specific profile's name (e.g. "syntron-ds"), or "cia301".
     pub fn profile_name(&self) -> &str {
         self.layers.first().map(|p| p.name.as_str()).unwrap_or("cia301")

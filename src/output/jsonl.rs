@@ -44,6 +44,7 @@ pub fn body_json(decoded: &Decoded, frame: &Frame) -> Option<(&'static str, serd
         Body::Pdo(p) => ("pdo", p.to_json()),
         Body::Sdo(s) => ("sdo", s.to_json()),
         Body::Lss(l) => ("lss", l.to_json()),
+        Body::VendorSdo(v) => ("vendor_sdo", v.to_json()),
         Body::ErrorFrame { class } => ("error", crate::decode::error_frame::to_json(*class, frame.payload())),
     })
 }

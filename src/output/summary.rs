@@ -12,34 +12,19 @@ pub struct Summary {
     pub by_node: BTreeMap<u8, BTreeMap<Kind, u64>>,
     /// Frames in all.
     pub frames: u64,
-    kind_counts: [u64; 12],
-    node_counts: Vec<[u64; 12]>,
+    kind_counts: [u64; Kind::ALL.len()],
+    node_counts: Vec<[u64; Kind::ALL.len()]>,
 }
-
-const KINDS: [Kind; 12] = [
-    Kind::Nmt,
-    Kind::Sync,
-    Kind::Emcy,
-    Kind::Time,
-    Kind::Tpdo,
-    Kind::Rpdo,
-    Kind::SdoTx,
-    Kind::SdoRx,
-    Kind::Heartbeat,
-    Kind::Lss,
-    Kind::ErrorFrame,
-    Kind::Other,
-];
 
 impl Summary {
     /// Counts one frame (a fixed-size array increment: this is the hot path).
     pub fn add(&mut self, kind: Kind, node: Option<u8>) {
         self.frames += 1;
-        let k = kind as usize;
+        let k = kind.index();
         self.kind_counts[k] += 1;
         if let Some(n) = node {
             if self.node_counts.is_empty() {
-                self.node_counts = vec![[0; 12]; 128];
+                self.node_counts = vec![[0; Kind::ALL.len()]; 128];
             }
             self.node_counts[(n & 0x7F) as usize][k] += 1;
         }
@@ -49,13 +34,13 @@ impl Summary {
     pub fn finish(&mut self) {
         self.by_kind.clear();
         self.by_node.clear();
-        for (i, k) in KINDS.iter().enumerate() {
+        for (i, k) in Kind::ALL.iter().enumerate() {
             if self.kind_counts[i] > 0 {
                 self.by_kind.insert(*k, self.kind_counts[i]);
             }
         }
         for (n, counts) in self.node_counts.iter().enumerate() {
-            for (i, k) in KINDS.iter().enumerate() {
+            for (i, k) in Kind::ALL.iter().enumerate() {
                 if counts[i] > 0 {
                     self.by_node.entry(n as u8).or_default().insert(*k, counts[i]);
                 }

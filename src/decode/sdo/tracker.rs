@@ -176,7 +176,7 @@ impl SdoTracker {
             frame.object = state.pending.as_ref().map(|p| (p.txn.index, p.txn.sub));
         }
         if let Some((index, sub)) = frame.object {
-            frame.name = dict.name(index, sub).map(str::to_string);
+            frame.name = dict.label_name(index, sub);
             if let Some(data) = match frame.command {
                 SdoCommand::InitiateDownload { expedited: true, .. }
                 | SdoCommand::InitiateUploadResponse { expedited: true, .. } => frame.command.data(),

@@ -217,9 +217,9 @@ impl Transaction {
             TransferDirection::Download => "Download",
         };
         let mut s = format!("{dir} 0x{:04X}:{:02X}", self.index, self.sub);
-        if let Some(name) = dict.name(self.index, self.sub) {
+        if let Some(name) = dict.label_name(self.index, self.sub) {
             s.push(' ');
-            s.push_str(name);
+            s.push_str(&name);
         }
         if self.outcome == Outcome::Ok && !self.data.is_empty() {
             let v = view(dict, self.index, self.sub, &self.data);

@@ -1,0 +1,195 @@
+//! The seed profiles' named procedures, expanded with their default parameters into the
+//! frames an SDO client sends (expedited downloads, uploads, NMT, raw frames), reproduce the
+//! manuals' step-by-step frame lists.
+
+use cotui::od::bind::Bindings;
+use cotui::od::procedure::{Step, frame_bytes};
+use cotui::od::{Dictionary, resolve_object};
+
+/// `ID#DATA` lines (data without padding zeros of SDO frames kept: SDO frames are always 8 bytes).
+fn expand(profile: &str, node: u8, procedure: &str) -> Vec<String> {
+    let read = |p: &std::path::Path| std::fs::read_to_string(p);
+    let b = Bindings::from_args(&[format!("{node}={profile}")], &[], &read).expect("binding");
+    let dict: &Dictionary = b.dictionary(node);
+    let p = dict
+        .procedure(procedure)
+        .unwrap_or_else(|| panic!("{profile} has no `{procedure}`"));
+    let vars = |v: &str| {
+        if v == "node" {
+            return Some(i64::from(node));
+        }
+        p.params.iter().find(|q| q.name == v).and_then(|q| q.default)
+    };
+    let mut out = Vec::new();
+    for step in &p.steps {
+        match step {
+            Step::SdoWrite {
+                object,
+                value,
+                data_type,
+            } => {
+                let (index, sub) = resolve_object(dict, object).expect("object");
+                let t = data_type
+                    .or_else(|| dict.object(index, sub).map(|o| o.data_type))
+                    .expect("type");
+                let n = t.size().expect("fixed size");
+                let cs = match n {
+                    1 => 0x2F,
+                    2 => 0x2B,
+                    3 => 0x27,
+                    _ => 0x23,
+                };
+                let v = value.eval(&vars).expect("value") as u32;
+                let mut d = vec![cs, index as u8, (index >> 8) as u8, sub];
+                d.extend_from_slice(&v.to_le_bytes()[..n.min(4)]);
+                d.resize(8, 0);
+                out.push(format!("{:03X}#{}", 0x600 + u32::from(node), hex(&d)));
+            }
+            Step::SdoRead { object } => {
+                let (index, sub) = resolve_object(dict, object).expect("object");
+                let d = [0x40, index as u8, (index >> 8) as u8, sub, 0, 0, 0, 0];
+                out.push(format!("{:03X}#{}", 0x600 + u32::from(node), hex(&d)));
+            }
+            Step::Nmt { command, node: target } => {
+                let t = target
+                    .as_ref()
+                    .map_or(i64::from(node), |e| e.eval(&vars).expect("node"));
+                out.push(format!("000#{}", hex(&[command.specifier(), t as u8])));
+            }
+            Step::Frame { id, data } => {
+                let id = id.eval(&vars).expect("id");
+                out.push(format!("{id:03X}#{}", hex(&frame_bytes(data, &vars).expect("data"))));
+            }
+            Step::Wait { .. } | Step::Delay { .. } => {}
+        }
+    }
+    out
+}
+
+fn hex(b: &[u8]) -> String {
+    b.iter().map(|x| format!("{x:02X}")).collect()
+}
+
+#[test]
+fn syntron_pv_and_hm_match_the_manual_lists() {
+    // 3.7.1: "000 01 02", "602 2F 60 60 00 03", "602 23 83 60 00 E8 03", "602 23 84 60 00 E8 03",
+    // "602 23 FF 60 00 64 00 00 00", "602 2B 40 60 00 06 / 07 / 0F"
+    assert_eq!(
+        expand("syntron-ds", 2, "pv"),
+        [
+            "000#0102",
+            "602#2F60600003000000",
+            "602#23836000E8030000",
+            "602#23846000E8030000",
+            "602#23FF600064000000",
+            "602#2B40600006000000",
+            "602#2B40600007000000",
+            "602#2B4060000F000000",
+        ]
+    );
+    // 3.7.4: "602 2F 60 60 00 06", "602 2F 98 60 00 14", "602 23 99 60 01 D0 07", "602 23 99 60 02 C8 00",
+    // "602 23 9A 60 00 E8 03", "602 23 93 60 01 01", "602 23 93 60 02 01", 06 / 07 / 0F, "0F", "5F", "4F"
+    let hm = expand("syntron-ds", 2, "hm");
+    assert_eq!(
+        hm[1..],
+        [
+            "602#2F60600006000000",
+            "602#2F98600014000000",
+            "602#23996001D0070000",
+            "602#23996002C8000000",
+            "602#239A6000E8030000",
+            "602#2393600101000000",
+            "602#2393600201000000",
+            "602#2B40600006000000",
+            "602#2B40600007000000",
+            "602#2B4060000F000000",
+            "602#2B4060000F000000",
+            "602#2B4060005F000000",
+            "602#2B4060004F000000",
+        ]
+    );
+    // 3.7.2: "602 2F 60 60 00 01", "602 23 7A 60 00 60 EA 00 00", "602 23 81 60 00 B8 0B 00 00", 6083h, 6084h,
+    // "602 2B 93 60 01 01", "602 2B 93 60 02 01", 06 / 07 / 0F, then "1F" / "0F" (absolute move)
+    assert_eq!(
+        expand("syntron-ds", 2, "pp")[1..],
+        [
+            "602#2F60600001000000",
+            "602#237A600060EA0000",
+            "602#23816000B80B0000",
+            "602#23836000E8030000",
+            "602#23846000E8030000",
+            "602#2B93600101000000",
+            "602#2B93600201000000",
+            "602#2B40600006000000",
+            "602#2B40600007000000",
+            "602#2B4060000F000000",
+            "602#2B4060001F000000",
+            "602#2B4060000F000000",
+        ]
+    );
+    // 3.8.1: "601 E9 18 23 00 36 00 CA FF  // write 0x2318 and 0x3318 = 54 and -54"
+    assert_eq!(expand("syntron-ds", 1, "dual_speed"), ["601#E91823003600CAFF"]);
+    // 3.8: "602 2B 18 23 00 64 00 00 00", "602 2B 00 21 00 01 ...", "602 40 00 50 00 ..."
+    assert_eq!(
+        expand("syntron-ds", 2, "vendor_speed"),
+        ["602#2B18230064000000", "602#2B00210001000000", "602#4000500000000000"]
+    );
+}
+
+#[test]
+fn aimotor_pdo_remapping_matches_section_5_4() {
+    let frames = expand("aimotor", 1, "csv_pdo_remap");
+    assert_eq!(
+        frames,
+        [
+            "000#8001",
+            "601#2300140101020080",
+            "601#2301140101030080",
+            "601#2302140101040080",
+            "601#2303140101050080",
+            "601#2300180181010080",
+            "601#2301180181020080",
+            "601#2302180181030080",
+            "601#2303180181040080",
+            "601#2F00140201000000",
+            "601#2F00160000000000",
+            "601#2300160110004060",
+            "601#2300160208006060",
+            "601#230016032000FF60",
+            "601#2F00160003000000",
+            "601#2300140101020000",
+            "601#2F00180201000000",
+            "601#2F001A0000000000",
+            "601#23001A0110004160",
+            "601#23001A0220006C60",
+            "601#2F001A0002000000",
+            "601#2300180181010000",
+            "000#0101",
+        ]
+    );
+    // 4.3 PP: "601 2F 60 60 00 01", "601 23 7A 60 00 ..", "601 23 81 60 00 ..", 6083h, 6084h, 06 / 07 / 0F / 1F,
+    // "601 40 41 60 00", "601 40 64 60 00"
+    let pp = expand("aimotor", 1, "pp");
+    assert_eq!(pp[0], "601#2F60600001000000");
+    assert_eq!(pp[1], "601#237A600094880100");
+    assert_eq!(pp[8], "601#2B4060001F000000");
+    assert_eq!(pp[9..], ["601#4041600000000000", "601#4064600000000000"]);
+}
+
+#[test]
+fn aqmd_and_dexmart_pdo_commands() {
+    // AQMD 7.5.4: "0x201 03 88 13 00 F4 01 00 00"
+    assert_eq!(
+        expand("aqmd2405", 1, "rpdo_speed"),
+        ["000#0101", "201#03881300F4010000"]
+    );
+    // Dexmart: "201 [5] 0A 00 00 B8 0B" (encoder speed), "201 [3] 01 B8 0B" (hall speed)
+    assert_eq!(
+        expand("dexmart-dev", 1, "encoder_speed_m1"),
+        ["000#0101", "201#0A0000B80B"]
+    );
+    assert_eq!(expand("dexmart-dev", 1, "hall_speed_m2"), ["000#0101", "301#01B80B"]);
+    // "601 2B 03 30 01 B8 0B 00 00" (03-01 = 3000), "601 40 00 30 0A 00 00 00 00" (Dynamic Data 10)
+    assert_eq!(expand("dexmart-dev", 1, "write_parameter"), ["601#2B033001B80B0000"]);
+    assert_eq!(expand("dexmart-dev", 1, "read_dynamic_data"), ["601#4000300A00000000"]);
+}

@@ -1,0 +1,124 @@
+//! The four seed drive profiles load without warnings and carry what their manuals give.
+
+use cotui::od::json::load_profile;
+use cotui::od::{Dictionary, Profile, SdoDirection, resolve_object};
+use std::sync::Arc;
+
+fn load(name: &str) -> Profile {
+    let path = format!("{}/decoders/{name}.json", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let (profile, warnings) = load_profile(&path, &text).unwrap_or_else(|e| panic!("{e}"));
+    let listed: Vec<String> = warnings.iter().map(ToString::to_string).collect();
+    assert!(listed.is_empty(), "{name} has warnings:\n{}", listed.join("\n"));
+    assert_eq!(profile.name, name);
+    profile
+}
+
+fn dict(p: Profile) -> Dictionary {
+    Dictionary::new(vec![Arc::new(p)])
+}
+
+#[test]
+fn all_seed_profiles_load_cleanly() {
+    for name in ["dexmart-dev", "aqmd2405", "syntron-ds", "aimotor"] {
+        let p = load(name);
+        assert!(!p.objects.is_empty(), "{name} has no objects");
+        assert!(!p.procedures.is_empty(), "{name} has no procedures");
+    }
+}
+
+#[test]
+fn syntron_aliases_follow_the_manual_rules() {
+    let d = dict(load("syntron-ds"));
+    // "F0.1.002 ... 0x2102, F1.3.018 ... 0x3318, Pn5.006 ... 0x4506" (manual 1.4)
+    assert_eq!(resolve_object(&d, "F0.1.002"), Ok((0x2102, 0)));
+    assert_eq!(resolve_object(&d, "F1.3.018"), Ok((0x3318, 0)));
+    assert_eq!(resolve_object(&d, "Pn5.006"), Ok((0x4506, 0)));
+    // "Fn1.002 ... 0x2102, Dn002 ... 0x5002"
+    assert_eq!(resolve_object(&d, "Fn1.002"), Ok((0x2102, 0)));
+    assert_eq!(resolve_object(&d, "Dn002"), Ok((0x5002, 0)));
+    // "Dn0.012 0x5012", "Dn1.012 0x5112"; "D0.004 D1.004 ... 0x5004 0x5104"
+    assert_eq!(resolve_object(&d, "Dn1.012"), Ok((0x5112, 0)));
+    assert_eq!(resolve_object(&d, "D1.04"), Ok((0x5104, 0)));
+    let p = &d.layers()[0];
+    assert!(p.sdo_command(0xE8, SdoDirection::Request).is_some());
+    assert!(p.sdo_command(0xE9, SdoDirection::Request).is_some());
+    assert_eq!(p.axis_of(0x3318, 0).map(|a| a.name.as_str()), Some("B"));
+    assert_eq!(p.axis_of(0x5004, 0).map(|a| a.name.as_str()), Some("A"));
+}
+
+#[test]
+fn dexmart_parameters_and_pdo_sets() {
+    let p = load("dexmart-dev");
+    // "E£809-26 CANOpen PDO Mapping = 0 / = 1": two sets, 0 is the default.
+    assert_eq!(p.pdo_sets.len(), 2);
+    assert_eq!(p.default_pdo_set().map(|s| s.name.as_str()), Some("mapping-0"));
+    let d = dict(p);
+    // "03-01 (Index = 3003h - Sub-Index = 01h)"
+    assert_eq!(resolve_object(&d, "03-01"), Ok((0x3003, 1)));
+    assert_eq!(resolve_object(&d, "09-26"), Ok((0x3009, 26)));
+    // "Sub-Index 01h = 01-01 (Modbus Address 0x0100)", "Monitor Data ( Modbus Address 0x4600 )"
+    assert_eq!(resolve_object(&d, "MB0100"), Ok((0x3001, 1)));
+    assert_eq!(resolve_object(&d, "MB4600"), Ok((0x3046, 1)));
+    assert_eq!(d.name(0x3046, 5), Some("M1: Current Speed"));
+    assert_eq!(d.name(0x3002, 7), Some("EEP parameter 2-7"));
+    let p = &d.layers()[0];
+    assert_eq!(p.axis_of(0x304A, 2).map(|a| a.name.as_str()), Some("M2"));
+}
+
+#[test]
+fn aimotor_h_parameters_follow_the_manual_table() {
+    let d = dict(load("aimotor"));
+    // 1.4: "H02-00 0x2002 0x01", "H03-09 0x2003 0x0A", "H0B-26 0x200B 0x1B", "H12-20 0x2012 0x15"
+    assert_eq!(resolve_object(&d, "H02-00"), Ok((0x2002, 0x01)));
+    assert_eq!(resolve_object(&d, "H03-09"), Ok((0x2003, 0x0A)));
+    assert_eq!(resolve_object(&d, "H0B-26"), Ok((0x200B, 0x1B)));
+    assert_eq!(resolve_object(&d, "H12-20"), Ok((0x2012, 0x15)));
+    // 6.2: "H0B-34 ... 200Bh sub 23h" current fault code, with the fault -> 603Fh table as texts
+    assert_eq!(resolve_object(&d, "H0B-34"), Ok((0x200B, 0x23)));
+    let fault = d.object(0x200B, 0x23).expect("H0B-34");
+    assert!(
+        fault.values[&0x0D03].contains("0x8130"),
+        "{:?}",
+        fault.values.get(&0x0D03)
+    );
+    // Default PDOs: "1600h 0x60400010, 0x60600008, 607A"; "1A00h 0x60410010, 0x60610008, 0x60640020"
+    let p = &d.layers()[0];
+    let set = p.default_pdo_set().expect("default set");
+    let entries = |m: &cotui::od::PdoTemplate| m.entries.iter().map(|e| (e.index, e.bits)).collect::<Vec<_>>();
+    assert_eq!(entries(&set.rpdo[&1]), vec![(0x6040, 16), (0x6060, 8), (0x607A, 32)]);
+    assert_eq!(entries(&set.tpdo[&1]), vec![(0x6041, 16), (0x6061, 8), (0x6064, 32)]);
+}
+
+#[test]
+fn aqmd_modbus_registers_map_to_objects() {
+    let d = dict(load("aqmd2405"));
+    // 7.4: "0x0000~0x0FFF -> 0x4000 + REG_ADDR", "0x7000~0x7FFF -> REG_ADDR - 0x2000"
+    assert_eq!(resolve_object(&d, "MB0121"), Ok((0x4121, 0)));
+    assert_eq!(resolve_object(&d, "MB7010"), Ok((0x5010, 0)));
+    assert!(
+        resolve_object(&d, "MB2000").is_err(),
+        "0x2000 is not a mirrored Modbus range"
+    );
+    // 7.6.3: "0x2202 ... 0: 10kbps ... 7: 1Mbps"
+    let rate = d.object(0x2202, 0).expect("0x2202");
+    assert_eq!(rate.values[&0], "10 kbit/s");
+    assert_eq!(rate.values[&7], "1 Mbit/s");
+}
+
+#[test]
+fn identity_values_suggest_the_profile() {
+    use cotui::od::Value;
+    use cotui::od::bind::Bindings;
+    let mut b = Bindings::new().expect("built-ins");
+    let suggest = |b: &mut Bindings, index: u16, text: &str| {
+        let read = |i: u16, s: u8| (i == index && s == 0).then(|| Value::Text(text.to_string()));
+        b.identify(&read).map(|p| p.name.clone())
+    };
+    // AIMOTOR 2.1.1: "100A ... AIMOTOR_CIA402"
+    assert_eq!(suggest(&mut b, 0x100A, "AIMOTOR_CIA402").as_deref(), Some("aimotor"));
+    // Dexmart device name 1008h "DEV-N050CQ..." (OCR: "DLV-NO050CQ")
+    assert_eq!(suggest(&mut b, 0x1008, "DEV-N050CQ").as_deref(), Some("dexmart-dev"));
+    assert_eq!(suggest(&mut b, 0x1008, "AQMD2405BLS-MT-2").as_deref(), Some("aqmd2405"));
+    assert_eq!(suggest(&mut b, 0x1008, "SOMETHING ELSE"), None);
+}
