@@ -129,7 +129,9 @@ fn scan_and_record() {
     assert_eq!(nodes[0]["node"], 2);
     assert_eq!(nodes[0]["device_profile"], 402);
     assert_eq!(nodes[0]["software_version"], "AIMOTOR (cotui simulation)");
-    // Syn-tron drives carry no identification: the generic drive profile is suggested.
+    // The AIMOTOR-like drive is recognised by its software version; Syn-tron drives carry
+    // no identification, so the generic drive profile is suggested.
+    assert_eq!(nodes[0]["profile"], "aimotor");
     assert_eq!(nodes[1]["profile"], "cia402");
     assert_eq!(nodes[1]["device_name"], "cotui simulated Syn-tron-like DS servo");
     let path = std::env::temp_dir().join(format!("cotui-rec-{}.log", std::process::id()));
