@@ -74,7 +74,7 @@ async fn sdo_aborts_carry_the_servers_code() {
         .await
         .unwrap_err();
     assert!(matches!(e, CommandError::Abort { code: 0x0607_0012, .. }), "{e:?}");
-    assert_eq!(e.to_json()["abort_code"], "0x06070012");
+    assert_eq!(e.to_json()["abort_code"], 0x0607_0012);
     assert_eq!(
         e.to_json()["abort_text"],
         "Data type does not match, length of service parameter too high"
@@ -279,7 +279,7 @@ async fn palette_lines_run_through_execute() {
     assert_eq!(o.json["value"], 0x0250);
     assert_eq!(
         o.text,
-        "node 2 6041:00 Statusword = Switch on disabled [voltage enabled, switch on disabled, remote] [5002]"
+        "node 2 0x6041:00 Statusword = 0x0250 (Switch on disabled [voltage enabled, switch on disabled, remote]) (data 5002)"
     );
     let o = cotui::command::execute(&d.bus, &run("sdo write 2 \"Target velocity\" -500"), &b)
         .await
