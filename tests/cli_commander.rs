@@ -18,7 +18,7 @@ fn sdo_read_json_has_value_and_data() {
     let (rc, v, _) = cotui(&["sdo", "read", "demo", "2", "0x6041", "--json"]);
     assert_eq!(rc, 0);
     assert_eq!(v["node"], 2);
-    assert_eq!(v["index"], "0x6041");
+    assert_eq!(v["index"], 0x6041);
     assert_eq!(v["sub"], 0);
     assert_eq!(v["value"], 0x0250);
     assert_eq!(v["data"], "5002");
@@ -35,12 +35,12 @@ fn sdo_read_json_has_value_and_data() {
 fn sdo_abort_exits_3_with_code_and_text() {
     let (rc, v, err) = cotui(&["sdo", "read", "demo", "2", "0x2345:1", "--json"]);
     assert_eq!(rc, 3);
-    assert_eq!(v["abort_code"], "0x06020000");
+    assert_eq!(v["abort_code"], 0x0602_0000);
     assert_eq!(v["abort_text"], "Object does not exist in the object dictionary");
     assert!(err.contains("aborted by the server"), "{err}");
     let (rc, v, _) = cotui(&["sdo", "write", "demo", "2", "0x6041", "6", "--type", "u16", "--json"]);
     assert_eq!(rc, 3);
-    assert_eq!(v["abort_code"], "0x06010002");
+    assert_eq!(v["abort_code"], 0x0601_0002);
 }
 
 #[test]
@@ -129,7 +129,9 @@ fn scan_and_record() {
     assert_eq!(nodes[0]["node"], 2);
     assert_eq!(nodes[0]["device_profile"], 402);
     assert_eq!(nodes[0]["software_version"], "AIMOTOR (cotui simulation)");
-    // Syn-tron drives carry no identification: the generic drive profile is suggested.
+    // The AIMOTOR-like drive is recognised by its software version; Syn-tron drives carry
+    // no identification, so the generic drive profile is suggested.
+    assert_eq!(nodes[0]["profile"], "aimotor");
     assert_eq!(nodes[1]["profile"], "cia402");
     assert_eq!(nodes[1]["device_name"], "cotui simulated Syn-tron-like DS servo");
     let path = std::env::temp_dir().join(format!("cotui-rec-{}.log", std::process::id()));

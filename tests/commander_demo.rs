@@ -74,7 +74,7 @@ async fn sdo_aborts_carry_the_servers_code() {
         .await
         .unwrap_err();
     assert!(matches!(e, CommandError::Abort { code: 0x0607_0012, .. }), "{e:?}");
-    assert_eq!(e.to_json()["abort_code"], "0x06070012");
+    assert_eq!(e.to_json()["abort_code"], 0x0607_0012);
     assert_eq!(
         e.to_json()["abort_text"],
         "Data type does not match, length of service parameter too high"
@@ -214,13 +214,37 @@ async fn listen_only_sends_nothing_whatever_the_command() {
         assert_eq!(e, CommandError::Bus(BusError::ListenOnly));
         assert_eq!(e.exit_code(), 2);
     }
-    while let Some(Ok(f)) = watch.try_recv() {
-        assert!(
-            (0x702..=0x703).contains(&f.id) || f.id == 0x80 || f.id == 0 && f.payload() == [1, 0],
-            "only the simulated nodes talk: {f:?}"
-        );
-        assert!(!(0x600..0x680).contains(&f.id));
+    // Every palette command that sends fails the same way; record only listens.
+    let b = cotui::od::bind::Bindings::new().unwrap();
+    for line in [
+        "nmt reset-node 0",
+        "sdo read 3 0x1008 --block",
+        "sdo write 3 0x2000 \"01 02\" --type octets",
+        "drive 3 quick-stop",
+        "drive 3 mode csv",
+        "scan --listen 600",
+    ] {
+        let cmd = cotui::command::parse_command(line).unwrap();
+        let got = cotui::command::execute(bus, &cmd, &b).await;
+        assert_eq!(got.unwrap_err(), CommandError::Bus(BusError::ListenOnly), "{line}");
     }
+    let log = std::env::temp_dir().join(format!("cotui-lo-{}.log", std::process::id()));
+    let rec = cotui::command::parse_command(&format!("record -o {} --count 3", log.display())).unwrap();
+    let o = cotui::command::execute(bus, &rec, &b).await.unwrap();
+    assert_eq!(o.json["frames"], 3);
+    std::fs::remove_file(&log).unwrap();
+    // Only the simulated nodes talk: no SDO request, no RPDO, no NMT but the master's start.
+    let mut seen = 0;
+    while let Some(Ok(f)) = watch.try_recv() {
+        seen += 1;
+        assert!(!(0x600..0x680).contains(&f.id), "SDO request on the bus: {f:?}");
+        assert!(
+            !((0x200..0x580).contains(&f.id) && f.id & 0x80 == 0),
+            "RPDO on the bus: {f:?}"
+        );
+        assert!(f.id != 0 || f.payload() == [1, 0], "NMT command on the bus: {f:?}");
+    }
+    assert!(seen > 0, "the watcher saw the nodes' traffic");
 }
 
 #[tokio::test(start_paused = true)]
@@ -255,7 +279,7 @@ async fn palette_lines_run_through_execute() {
     assert_eq!(o.json["value"], 0x0250);
     assert_eq!(
         o.text,
-        "node 2 6041:00 Statusword = Switch on disabled [voltage enabled, switch on disabled, remote] [5002]"
+        "node 2 0x6041:00 Statusword = 0x0250 (Switch on disabled [voltage enabled, switch on disabled, remote]) (data 5002)"
     );
     let o = cotui::command::execute(&d.bus, &run("sdo write 2 \"Target velocity\" -500"), &b)
         .await

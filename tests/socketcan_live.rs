@@ -1,5 +1,5 @@
 //! SocketCAN against a real kernel: needs a CAN FD capable `vcan0` (MTU 72). Run in the
-//! vbus guest: `VBUS_IFACES=vcan0:fd tests/vbus/run.sh target/debug/deps/socketcan_live-HASH --ignored`
+//! vbus guest: `VBUS_IFACES=vcan0:fd tests/vbus/run.sh $PWD/target/debug/deps/socketcan_live-HASH --ignored`
 //! (build it first with `cargo test --test socketcan_live --no-run`).
 
 use cotui::bus::socketcan::open;

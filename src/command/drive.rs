@@ -331,8 +331,10 @@ pub async fn drive(bus: &Bus, node: u8, action: DriveAction, timeout_ms: u64) ->
     if let DriveAction::Mode(mode) = action {
         return set_mode(bus, &mut w, mode, sw, timeout_ms).await;
     }
-    w.tpdo = statusword_tpdo(bus, node, timeout_ms).await;
     let steps = plan(action, DriveState::from_statusword(sw));
+    if !steps.is_empty() {
+        w.tpdo = statusword_tpdo(bus, node, timeout_ms).await;
+    }
     for step in &steps {
         w.obs.before = Some(sw);
         w.tpdo_sw = None;
@@ -431,5 +433,84 @@ async fn set_mode(bus: &Bus, w: &mut Watch, mode: i8, sw: u16, timeout_ms: u64) 
             });
         }
         tokio::time::sleep(Duration::from_millis(10)).await;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn obs(sw: u16) -> Observation {
+        Observation {
+            nmt: Some(NmtState::Operational),
+            before: Some(0x0250),
+            statusword: Some(sw),
+            ..Observation::default()
+        }
+    }
+
+    #[test]
+    fn plans_follow_the_state_machine() {
+        let cws = |a, s| plan(a, s).iter().map(|st| st.controlword).collect::<Vec<_>>();
+        assert_eq!(
+            cws(DriveAction::Enable, DriveState::Fault),
+            vec![0x80, 0x06, 0x07, 0x0F]
+        );
+        assert_eq!(cws(DriveAction::Enable, DriveState::SwitchedOn), vec![0x0F]);
+        assert_eq!(
+            cws(DriveAction::Enable, DriveState::OperationEnabled),
+            Vec::<u16>::new()
+        );
+        assert_eq!(cws(DriveAction::QuickStop, DriveState::OperationEnabled), vec![0x02]);
+        assert_eq!(
+            cws(DriveAction::FaultReset, DriveState::SwitchOnDisabled),
+            Vec::<u16>::new()
+        );
+    }
+
+    #[test]
+    fn reasons_from_what_the_bus_shows() {
+        let stopped = Observation {
+            nmt: Some(NmtState::Stopped),
+            ..obs(0x0250)
+        };
+        assert!(diagnose(2, &SHUTDOWN, &stopped).starts_with("NMT not operational: node 2 is NMT stopped"));
+        let fault = Observation {
+            error_code: Some(0x2310),
+            ..obs(0x0218)
+        };
+        assert_eq!(
+            diagnose(2, &SHUTDOWN, &fault),
+            "fault bit set: statusword 0x0218 shows Fault (error code 0x2310); run `drive 2 fault-reset`"
+        );
+        assert!(diagnose(2, &SWITCH_ON, &obs(0x0221)).starts_with("voltage not enabled"));
+        let halt = Observation {
+            controlword: Some(0x010F),
+            ..obs(0x0233)
+        };
+        assert!(diagnose(2, &ENABLE_OPERATION, &halt).starts_with("halt bit set"));
+        let no_mode = Observation {
+            mode_display: Some(0),
+            ..obs(0x0233)
+        };
+        assert!(
+            diagnose(2, &ENABLE_OPERATION, &no_mode).starts_with("mode not set: modes of operation display 0x6061 = 0")
+        );
+        let stale = Observation {
+            nmt: Some(NmtState::PreOperational),
+            ..obs(0x0250)
+        };
+        assert_eq!(
+            diagnose(2, &SHUTDOWN, &stale),
+            "statusword stale: still 0x0250 (Switch on disabled) after controlword 0x0006; node is NMT Pre-operational \
+             and some drives take the controlword only when operational: run `cotui nmt IFACE start 2`"
+        );
+        assert!(diagnose(2, &ENABLE_OPERATION, &obs(0x0217)).starts_with("quick stop active"));
+        let silent = Observation {
+            nmt: None,
+            sdo_silent: true,
+            ..Observation::default()
+        };
+        assert!(diagnose(7, &SHUTDOWN, &silent).starts_with("no SDO answer and no heartbeat from node 7"));
     }
 }

@@ -62,8 +62,8 @@ impl CommandError {
                 by_server,
             } => json!({
                 "ok": false, "error": "sdo_abort", "node": node,
-                "index": format!("0x{index:04X}"), "sub": sub,
-                "abort_code": format!("0x{code:08X}"), "abort_text": abort_text(*code),
+                "index": index, "sub": sub,
+                "abort_code": code, "abort_text": abort_text(*code),
                 "aborted_by": if *by_server { "server" } else { "client" },
                 "message": self.to_string(),
             }),

@@ -54,17 +54,11 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
                 .data_type
                 .or_else(|| dict.object(index, sub).map(|o| o.data_type));
             let value = decode(&data, ty);
-            let text = value
-                .as_i64()
-                .and_then(|raw| crate::decode::cia402::describe(index, sub, raw, None))
-                .or_else(|| {
-                    dict.object(index, sub)
-                        .map(|i| crate::od::format_value(Some(i), &value))
-                });
+            let text = crate::decode::value_text::object_text(dict, index, sub, &value, None);
             json!({
                 "ok": true,
                 "node": node,
-                "index": format!("0x{index:04X}"),
+                "index": index,
                 "sub": sub,
                 "name": dict.name(index, sub),
                 "value": value.to_json(),
@@ -87,7 +81,7 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
                 "ok": true,
                 "written": true,
                 "node": node,
-                "index": format!("0x{index:04X}"),
+                "index": index,
                 "sub": sub,
                 "name": dict.name(index, sub),
                 "data": crate::hex::upper(&data),
@@ -166,9 +160,9 @@ pub fn text(cmd: &Command, v: &Json) -> String {
         }
         Command::SdoRead { .. } | Command::SdoWrite { .. } => {
             let obj = format!(
-                "node {} {}:{:02X}{}",
+                "node {} 0x{:04X}:{:02X}{}",
                 v["node"],
-                s(&v["index"]).trim_start_matches("0x"),
+                v["index"].as_u64().unwrap_or(0),
                 v["sub"].as_u64().unwrap_or(0),
                 v["name"].as_str().map(|n| format!(" {n}")).unwrap_or_default()
             );
@@ -180,7 +174,7 @@ pub fn text(cmd: &Command, v: &Json) -> String {
                 (_, Json::String(raw)) => raw.clone(),
                 (_, other) => other.to_string(),
             };
-            format!("{obj} = {shown} [{}]", s(&v["data"]))
+            format!("{obj} = {shown} (data {})", s(&v["data"]))
         }
         Command::Drive { .. } => {
             let mut t = format!(

@@ -146,9 +146,9 @@ async fn identify(bus: &Bus, node: u8, nmt: Option<NmtState>, timeout_ms: u64) -
     Ok(info)
 }
 
-/// The built-in profile whose identification matches what the node told us.
+/// The built-in profile whose identification matches what the node told us. A vendor
+/// profile wins over a generic one it extends (AIMOTOR over CiA 402); then more conditions win.
 pub fn suggest_profile(info: &NodeInfo) -> Option<String> {
-    let mut bindings = crate::od::bind::Bindings::new().ok()?;
     let read = |index: u16, sub: u8| -> Option<Value> {
         match (index, sub) {
             (0x1000, 0) => info.device_type.map(|v| Value::Unsigned(v as u64)),
@@ -158,5 +158,15 @@ pub fn suggest_profile(info: &NodeInfo) -> Option<String> {
             _ => None,
         }
     };
-    bindings.identify(&read).map(|p| p.name.clone())
+    let matching: Vec<_> = crate::od::bind::builtin_names()
+        .filter_map(|n| crate::od::bind::shared_builtin(n)?.ok())
+        .map(|(p, _)| p)
+        .filter(|p| p.identifies(&read))
+        .collect();
+    let is_base = |p: &crate::od::Profile| matching.iter().any(|q| q.extends.contains(&p.name));
+    matching
+        .iter()
+        .filter(|p| !is_base(p))
+        .max_by_key(|p| p.identification.len())
+        .map(|p| p.name.clone())
 }

@@ -33,7 +33,7 @@ impl Simulation {
         }
     }
     /// The demo bus: an AIMOTOR-like drive at node 2 and a Syn-tron-like one at node 3, SYNC every 100 ms, and an NMT master that
-    /// starts all nodes one second after power-on.
+    /// starts all nodes 0.8 s after power-on.
     pub fn demo() -> Simulation {
         let mut s = Simulation::new(
             vec![
@@ -42,7 +42,7 @@ impl Simulation {
             ],
             100,
         );
-        s.start_all_at_ns = Some(1_000_000_000);
+        s.start_all_at_ns = Some(800_000_000);
         s
     }
     /// The drive at `node`.
@@ -99,5 +99,31 @@ impl Simulation {
             i += 1;
         }
         all
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn demo_boots_starts_and_syncs_without_a_bus() {
+        let mut sim = Simulation::demo();
+        let boot = sim.power_on(0);
+        let on_bus = sim.settle(boot, 0);
+        assert_eq!(on_bus.iter().map(|f| f.id).collect::<Vec<_>>(), vec![0x702, 0x703]);
+        let mut ids = Vec::new();
+        for t in 1..=100u64 {
+            let now = t * 10_000_000;
+            let out = sim.tick(now);
+            ids.extend(sim.settle(out, now).iter().map(|f| (now / 1_000_000, f.id)));
+        }
+        // SYNC every 100 ms; PDOs answer it only after the master's start at 800 ms.
+        let syncs: Vec<u64> = ids.iter().filter(|(_, id)| *id == 0x080).map(|(t, _)| *t).collect();
+        assert_eq!(syncs, (1..=10).map(|k| k * 100).collect::<Vec<_>>());
+        assert!(ids.contains(&(800, 0x000)));
+        let tpdo_times: Vec<u64> = ids.iter().filter(|(_, id)| *id == 0x182).map(|(t, _)| *t).collect();
+        assert_eq!(tpdo_times, vec![800, 900, 1000]);
+        assert_eq!(sim.drive(3).map(|d| d.nmt()), Some(drive::NmtState::Operational));
     }
 }

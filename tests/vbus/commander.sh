@@ -28,7 +28,7 @@ sleep 0.3
 out=$("$cotui" sdo read vcan0 2 0x6041 --json); rc=$?
 [ $rc = 0 ] && [ "$(echo "$out" | json 'd["value"]')" = 592 ] && ok "sdo read 0x6041 = 0x0250" || bad "sdo read: rc=$rc $out"
 out=$("$cotui" sdo read vcan0 2 0x7777 --json); rc=$?
-[ $rc = 3 ] && [ "$(echo "$out" | json 'd["abort_code"]')" = 0x06020000 ] && ok "abort exits 3" || bad "abort: rc=$rc $out"
+[ $rc = 3 ] && [ "$(echo "$out" | json 'hex(d["abort_code"])')" = 0x6020000 ] && ok "abort exits 3" || bad "abort: rc=$rc $out"
 out=$("$cotui" nmt vcan0 start 2 --wait --json); rc=$?
 [ $rc = 0 ] && [ "$(echo "$out" | json 'd["confirmed"]["2"]')" = operational ] && ok "nmt start --wait" || bad "nmt: rc=$rc $out"
 out=$("$cotui" drive vcan0 2 enable --json); rc=$?
