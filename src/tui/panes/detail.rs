@@ -96,12 +96,24 @@ fn frame_lines(app: &App, f: &Frame, d: &Decoded, pos: usize) -> Vec<Line<'stati
                     "object 0x{i:04X}:{sub:02X} {}",
                     s.name.clone().unwrap_or_default()
                 )));
-                if let (SdoCommand::InitiateDownload { data, .. }, 0x6040) = (s.command, i) {
-                    let cw = u16::from_le_bytes([
-                        data.bytes().first().copied().unwrap_or(0),
-                        data.bytes().get(1).copied().unwrap_or(0),
-                    ]);
-                    v.push(Line::raw(format!("controlword: {}", describe_controlword(cw, mode))));
+                let word =
+                    |d: &[u8]| u16::from_le_bytes([d.first().copied().unwrap_or(0), d.get(1).copied().unwrap_or(0)]);
+                match (s.command, i) {
+                    (SdoCommand::InitiateDownload { data, .. }, 0x6040) => {
+                        let cw = word(data.bytes());
+                        v.push(Line::raw(format!(
+                            "controlword {cw:016b}b: {}",
+                            describe_controlword(cw, mode)
+                        )));
+                    }
+                    (SdoCommand::InitiateUploadResponse { data, .. }, 0x6041) => {
+                        let sw = word(data.bytes());
+                        v.push(Line::raw(format!(
+                            "statusword {sw:016b}b: {}",
+                            describe_statusword(sw, mode)
+                        )));
+                    }
+                    _ => {}
                 }
             }
             if let Some(val) = &s.value {
@@ -228,5 +240,34 @@ mod tests {
             ]
         );
         assert_eq!(sdo_command_bits(0x60, Side::Client)[2], "  bit 4 t = 0 (toggle)");
+    }
+
+    #[test]
+    fn sdo_controlword_and_statusword_values_are_broken_into_bits() {
+        let mut a = crate::tui::panes::testutil::app();
+        let mut t = crate::tui::trace::Trace::new(crate::decode::Decoder::new(Default::default(), Vec::new()), 500_000);
+        for (id, data) in [
+            (0x602u32, [0x2B, 0x40, 0x60, 0x00, 0x0F, 0x00, 0, 0]),
+            (0x602, [0x40, 0x41, 0x60, 0x00, 0, 0, 0, 0]),
+            (0x582, [0x4B, 0x41, 0x60, 0x00, 0x37, 0x02, 0, 0]),
+        ] {
+            t.push(&Frame::classic(id, &data));
+        }
+        a.trace = t;
+        let lines = |a: &App, pos: usize| -> Vec<String> {
+            let d = a.trace.decode_positions(&[pos]).pop().unwrap();
+            frame_lines(a, &a.trace.store.frame(pos), &d, pos)
+                .iter()
+                .map(|l| l.spans.iter().map(|s| s.content.to_string()).collect())
+                .collect()
+        };
+        assert!(lines(&a, 0).contains(&"controlword 0000000000001111b: Enable operation".to_string()));
+        assert!(
+            lines(&a, 2)
+                .iter()
+                .any(|l| l.starts_with("statusword 0000001000110111b: Operation enabled [")),
+            "{:?}",
+            lines(&a, 2)
+        );
     }
 }
