@@ -41,8 +41,8 @@ pub fn run(mut app: App) -> Result<(), String> {
         ratatui::restore();
         std::process::exit(0);
     });
-    // ratatui::init installs a panic hook that restores the terminal before the message.
-    let mut terminal = ratatui::init();
+    // ratatui::try_init installs a panic hook that restores the terminal before the message.
+    let mut terminal = ratatui::try_init().map_err(|e| format!("cannot set up the terminal: {e}"))?;
     let ratatui_hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
         let _ = execute!(stdout(), DisableMouseCapture);
