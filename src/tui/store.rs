@@ -17,25 +17,9 @@ const CHUNK: usize = 1 << 16;
 /// `node` byte meaning "no node".
 const NO_NODE: u8 = 0xFF;
 
-/// Every [`Kind`], indexed by its stored byte.
-pub const KINDS: [Kind; 12] = [
-    Kind::Nmt,
-    Kind::Sync,
-    Kind::Emcy,
-    Kind::Time,
-    Kind::Tpdo,
-    Kind::Rpdo,
-    Kind::SdoTx,
-    Kind::SdoRx,
-    Kind::Heartbeat,
-    Kind::Lss,
-    Kind::ErrorFrame,
-    Kind::Other,
-];
-
 /// The stored byte of a kind.
 pub fn kind_byte(kind: Kind) -> u8 {
-    KINDS.iter().position(|k| *k == kind).unwrap_or(KINDS.len() - 1) as u8
+    kind.index() as u8
 }
 
 /// One stored frame (32 bytes).
@@ -63,7 +47,7 @@ pub struct Packed {
 impl Packed {
     /// The kind found when the frame was indexed.
     pub fn kind(&self) -> Kind {
-        KINDS[(self.kind as usize).min(KINDS.len() - 1)]
+        Kind::ALL[(self.kind as usize).min(Kind::ALL.len() - 1)]
     }
     /// The node found when the frame was indexed.
     pub fn node(&self) -> Option<u8> {
