@@ -146,6 +146,10 @@ fn decode_stream(
                 }
             }
         }
+        if !matches!(mode, Mode::Transactions(_)) {
+            // Only --transactions prints them; dropping the rest keeps memory flat.
+            decoder.take_transactions();
+        }
         out.write_all(buf.as_bytes())?;
         buf.clear();
         Ok(())
