@@ -11,3 +11,4 @@ cargo clippy --all-targets --quiet -- -D warnings
 cargo test --quiet
 cargo build --release --quiet
 ./target/release/cotui bench --frames 1000000
+./target/release/cotui bench --tui --frames 10000000

@@ -150,6 +150,12 @@ impl Bindings {
     pub fn bind_eds(&mut self, node: u8, file: &str, text: &str) {
         let (profile, warnings) = super::eds::import(file, text, node);
         self.warnings.extend(warnings);
+        self.bind_layer(node, profile);
+    }
+
+    /// Binds a ready-made top layer to a node, in the place an EDS takes: the device's own
+    /// configuration (e.g. the PDO mappings the demo's simulated drives start with).
+    pub fn bind_layer(&mut self, node: u8, profile: Profile) {
         self.nodes.entry(node).or_default().eds = Some(Arc::new(profile));
         self.rebuild(node, &|p| {
             Err(std::io::Error::other(format!("{} not read", p.display())))

@@ -7,9 +7,12 @@ pub mod drive;
 pub mod od;
 pub mod profile;
 
+use crate::decode::pdo::entry_from_u32;
 use crate::frame::Frame;
+use crate::od::{MappingSource, PdoMapping, Profile};
 use drive::Drive;
 use profile::DriveProfile;
+use std::collections::BTreeMap;
 
 /// A set of simulated nodes plus a SYNC producer.
 #[derive(Clone, Debug)]
@@ -45,6 +48,45 @@ impl Simulation {
         s.start_all_at_ns = Some(800_000_000);
         s
     }
+    /// The PDO mappings each drive starts with, as a dictionary layer per node, so that
+    /// the demo decodes PDOs from the first frame. The source reads "demo simulator".
+    pub fn pdo_layers(&self) -> Vec<(u8, Profile)> {
+        self.drives
+            .iter()
+            .map(|d| {
+                let od = d.objects();
+                let source = MappingSource::Profile("demo simulator".into());
+                let read = |comm: u16, map: u16| -> BTreeMap<u8, PdoMapping> {
+                    (0..4u16)
+                        .filter(|n| od.has_index(map + n))
+                        .map(|n| {
+                            let count = od.uint(map + n, 0) as u8;
+                            let entries = (1..=count)
+                                .map(|s| entry_from_u32(od.uint(map + n, s) as u32))
+                                .collect();
+                            let cob_id = Some(od.uint(comm + n, 1) as u32);
+                            (
+                                n as u8 + 1,
+                                PdoMapping {
+                                    cob_id,
+                                    entries,
+                                    source: source.clone(),
+                                },
+                            )
+                        })
+                        .collect()
+                };
+                let layer = Profile {
+                    name: "demo".into(),
+                    rpdo: read(0x1400, 0x1600),
+                    tpdo: read(0x1800, 0x1A00),
+                    ..Profile::default()
+                };
+                (d.node(), layer)
+            })
+            .collect()
+    }
+
     /// The drive at `node`.
     pub fn drive(&self, node: u8) -> Option<&Drive> {
         self.drives.iter().find(|d| d.node() == node)
@@ -125,5 +167,39 @@ mod tests {
         let tpdo_times: Vec<u64> = ids.iter().filter(|(_, id)| *id == 0x182).map(|(t, _)| *t).collect();
         assert_eq!(tpdo_times, vec![800, 900, 1000]);
         assert_eq!(sim.drive(3).map(|d| d.nmt()), Some(drive::NmtState::Operational));
+    }
+}
+
+#[cfg(test)]
+mod pdo_layer_tests {
+    use super::Simulation;
+    use crate::decode::Decoder;
+    use crate::od::bind::Bindings;
+
+    #[test]
+    fn demo_pdos_decode_from_the_first_frame() {
+        let sim = Simulation::demo();
+        let mut bindings = Bindings::new().unwrap();
+        for (node, layer) in sim.pdo_layers() {
+            bindings.bind_layer(node, layer);
+        }
+        let mut decoder = Decoder::from_bindings(&bindings);
+        let d = decoder.decode(&crate::frame::Frame::classic(0x182, &[0x50, 0x02, 0x03]));
+        assert!(
+            d.label
+                .starts_with("TPDO1 node 2: Statusword=0x0250 (Switch on disabled"),
+            "{}",
+            d.label
+        );
+        assert!(
+            d.label.ends_with("Modes of operation display=3 (Profile velocity)"),
+            "{}",
+            d.label
+        );
+        let d = decoder.decode(&crate::frame::Frame::classic(0x203, &[0x0F, 0x00, 0xE8, 0x03, 0, 0]));
+        assert_eq!(
+            d.label,
+            "RPDO1 node 3: Controlword=0x000F (Enable operation), Target velocity=1000"
+        );
     }
 }
