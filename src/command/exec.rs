@@ -21,6 +21,16 @@ pub struct Outcome {
 /// Runs `cmd` on `bus`; `bindings` give node dictionaries (object names, aliases, types).
 /// A `record` without limits runs until its future is dropped (the log is flushed then).
 pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Outcome, CommandError> {
+    if let Command::Run {
+        node,
+        procedure,
+        args,
+        dry_run,
+        timeout_ms,
+    } = cmd
+    {
+        return run_procedure(bus, bindings, *node, procedure.as_deref(), args, *dry_run, *timeout_ms).await;
+    }
     let json = match cmd {
         Command::Nmt {
             action,
@@ -113,9 +123,68 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
             };
             json!({"ok": true, "frames": n, "output": output})
         }
+        Command::Run { .. } => return Err(CommandError::Usage("run is handled above".into())),
     };
     let text = text(cmd, &json);
     Ok(Outcome { json, text })
+}
+
+/// `run`: lists, dry-runs or runs a procedure; the text holds every step line and result.
+async fn run_procedure(
+    bus: &Bus,
+    bindings: &Bindings,
+    node: u8,
+    procedure: Option<&str>,
+    args: &[(String, String)],
+    dry_run: bool,
+    timeout_ms: u64,
+) -> Result<Outcome, CommandError> {
+    let (json, text) = offline_run(bindings, node, procedure, args, dry_run).map_err(CommandError::Usage)?;
+    if procedure.is_none() || dry_run {
+        return Ok(Outcome { json, text });
+    }
+    let dict = bindings.dictionary(node);
+    let plan = super::run::plan(dict, node, procedure.unwrap_or_default(), args).map_err(CommandError::Usage)?;
+    let mut lines = Vec::new();
+    let json = super::run::run(bus, dict, &plan, timeout_ms, &mut |l| lines.push(l.to_string())).await?;
+    lines.push(run_summary(&json));
+    Ok(Outcome {
+        json,
+        text: lines.join("\n"),
+    })
+}
+
+/// What `run` gives without a bus: the listing (no procedure) or the dry run (also used to
+/// check a procedure and its parameters before opening the bus).
+pub fn offline_run(
+    bindings: &Bindings,
+    node: u8,
+    procedure: Option<&str>,
+    args: &[(String, String)],
+    dry_run: bool,
+) -> Result<(Json, String), String> {
+    let dict = bindings.dictionary(node);
+    match procedure {
+        None => Ok(super::run::list(dict, node)),
+        Some(name) => {
+            let plan = super::run::plan(dict, node, name, args)?;
+            let (mut json, text) = super::run::dry_run(&plan);
+            if !dry_run {
+                json["dry_run"] = false.into();
+            }
+            Ok((json, text))
+        }
+    }
+}
+
+/// The last line of a successful run.
+pub fn run_summary(v: &Json) -> String {
+    format!(
+        "`{}` on node {}: {} steps done",
+        s(&v["procedure"]),
+        v["node"],
+        v["steps"].as_array().map_or(0, Vec::len)
+    )
 }
 
 /// The bytes to write: a file for domains, else the value encoded as its type.
@@ -201,6 +270,7 @@ pub fn text(cmd: &Command, v: &Json) -> String {
         }
         Command::Scan { .. } => scan_text(v),
         Command::Record { .. } => format!("{} frames written to {}", v["frames"], s(&v["output"])),
+        Command::Run { .. } => run_summary(v),
     }
 }
 

@@ -7,6 +7,7 @@ pub mod exec;
 pub mod grammar;
 pub mod nmt;
 pub mod record;
+pub mod run;
 pub mod scan;
 pub mod sdo;
 pub mod value;
