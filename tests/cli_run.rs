@@ -155,7 +155,7 @@ fn dry_run_gives_the_syntron_manual_frame_list_without_a_send_path() {
         "{out}"
     );
     assert!(
-        out.ends_with("dry run of `pv` on node 2: 8 steps, nothing sent\n"),
+        out.starts_with("dry run of `pv` on node 2: 8 steps, nothing sent\n"),
         "{out}"
     );
 }
@@ -195,7 +195,11 @@ fn unknown_procedures_and_parameters_name_the_valid_ones() {
 fn list_shows_procedures_with_descriptions_and_parameters() {
     let (rc, out, _) = cotui(&["run", "demo", "3", "--profile", "3=syntron-ds"]);
     assert_eq!(rc, 0);
-    assert!(out.contains("pv  Profile velocity (manual 3.7.1)"), "{out}");
+    assert!(
+        out.starts_with("node 3 procedures: dual_speed, hm, pp, pp_relative, pt, pv, "),
+        "{out}"
+    );
+    assert!(out.contains("\npv  Profile velocity (manual 3.7.1)"), "{out}");
     assert!(
         out.contains("    speed=VALUE (default 10 rpm): target velocity"),
         "{out}"

@@ -2,8 +2,8 @@
 //! delays, raw frames and NMT steps, and listen-only sending nothing.
 
 use cotui::bus::BusError;
-use cotui::command::CommandError;
 use cotui::command::run::{plan, run};
+use cotui::command::{CommandError, execute, parse_command};
 use cotui::frame::Frame;
 use cotui::od::bind::Bindings;
 use cotui::sim::Simulation;
@@ -29,6 +29,13 @@ const PROFILE: &str = r#"{
         { "delay_ms": 100 },
         { "frame": { "id": "0x200 + node", "data": "0F 00 {i32:speed}" } }
       ]
+    },
+    "velocity": {
+      "params": [ { "name": "speed" }, { "name": "accel", "default": 100 } ],
+      "steps": [ { "sdo_write": { "object": "0x60FF", "value": "speed" } } ]
+    },
+    "start_all": {
+      "steps": [ { "nmt": { "command": "start", "node": "0" } } ]
     },
     "never": {
       "steps": [ { "wait": { "object": "0x6041", "mask": "0x006F", "equals": "0x0008", "timeout_ms": 300 } } ]
@@ -113,4 +120,53 @@ async fn listen_only_sends_nothing() {
         }
     }
     assert!(ours.is_empty(), "{ours:?}");
+}
+
+#[tokio::test(start_paused = true)]
+async fn the_palette_runs_a_line_and_shows_the_summary_first() {
+    let d = Demo::spawn(Simulation::demo(), false);
+    let b = bindings();
+    let cmd = parse_command("run 2 enable_checked speed=5").unwrap();
+    let o = execute(&d.bus, &cmd, &b).await.unwrap();
+    let lines: Vec<&str> = o.text.lines().collect();
+    assert_eq!(lines[0], "`enable_checked` on node 2: 9 steps done");
+    assert_eq!(lines[1], "step 1/9: nmt start to node 2  [000#0102]");
+    assert_eq!(o.json["steps"][1]["frame"], "602#23FF600005000000");
+    let cmd = parse_command("run 2 enable_checked --dry-run").unwrap();
+    let o = execute(&d.bus, &cmd, &b).await.unwrap();
+    assert!(
+        o.text
+            .starts_with("dry run of `enable_checked` on node 2: 9 steps, nothing sent\n")
+    );
+}
+
+#[test]
+fn palette_preview_names_waits_and_asks_before_a_broadcast() {
+    let b = bindings();
+    let p = cotui::tui::palette::plan("run 2 enable_checked speed=1", &b, |_| None).unwrap();
+    assert!(
+        p.preview.contains(
+            "602#2B40600006000000, wait until 0x6041:00 Statusword & 0x006F == 0x0021 (at most 500 ms), 602#2B40600007000000"
+        ),
+        "{}",
+        p.preview
+    );
+    assert!(p.preview.ends_with("delay 100 ms, 202#0F0001000000"), "{}", p.preview);
+    assert_eq!(p.confirm, None);
+    let p = cotui::tui::palette::plan("run 2 start_all", &b, |_| None).unwrap();
+    assert_eq!(p.preview, "000#0100");
+    assert_eq!(p.confirm.as_deref(), Some("`start_all` sends nmt start to all nodes"));
+}
+
+#[test]
+fn a_required_parameter_must_be_given() {
+    let b = bindings();
+    let dict = b.dictionary(2);
+    assert_eq!(
+        plan(dict, 2, "velocity", &[]).unwrap_err(),
+        "`velocity` needs speed=VALUE; its parameters: speed=(required), accel=100"
+    );
+    let p = plan(dict, 2, "velocity", &[("speed".into(), "-1".into())]).unwrap();
+    assert_eq!(p.params, vec![("speed".to_string(), -1), ("accel".to_string(), 100)]);
+    assert_eq!(p.steps[0].frame.as_deref(), Some("602#23FF6000FFFFFFFF"));
 }

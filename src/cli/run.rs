@@ -3,8 +3,8 @@
 
 use super::commander::{BusArgs, ms_arg, node_arg, report, run};
 use crate::command::exec::{offline_run, run_summary};
-use crate::command::grammar::{DEFAULT_TIMEOUT_MS, run_command};
-use crate::command::{Command, CommandError, Outcome};
+use crate::command::grammar::{DEFAULT_TIMEOUT_MS, run_spec};
+use crate::command::{CommandError, Outcome};
 use clap::Args;
 
 /// Arguments of `cotui run`.
@@ -37,41 +37,29 @@ pub struct RunArgs {
 /// Runs `cotui run`; returns the exit status. Listing and `--dry-run` need no bus.
 pub fn run_run(args: &RunArgs) -> i32 {
     let words: Vec<&str> = args.words.iter().map(String::as_str).collect();
-    let prepared = run_command(args.node, &words, args.list, args.dry_run, args.timeout).and_then(|cmd| {
+    let prepared = run_spec(args.node, &words, args.list, args.dry_run, args.timeout).and_then(|spec| {
         let bindings = super::bind::bindings(&args.profiles, &args.eds)?;
-        Ok((cmd, bindings))
+        // Checks the procedure and its parameters before the bus is opened.
+        let offline = offline_run(&bindings, &spec)?;
+        Ok((spec, bindings, offline))
     });
-    let (cmd, bindings) = match prepared {
+    let (spec, bindings, (json, text)) = match prepared {
         Ok(p) => p,
         Err(e) => return report(&args.bus, "run", Err(CommandError::Usage(e))),
     };
-    let Command::Run {
-        node,
-        procedure,
-        args: params,
-        dry_run,
-        timeout_ms,
-    } = cmd
-    else {
-        return report(&args.bus, "run", Err(CommandError::Usage("not a run command".into())));
+    let Some(name) = spec.procedure.clone().filter(|_| !spec.dry_run) else {
+        return report(&args.bus, "run", Ok(Outcome { json, text }));
     };
-    // Checks the procedure and its parameters before the bus is opened.
-    let offline = offline_run(&bindings, node, procedure.as_deref(), &params, dry_run);
-    let (name, json_out) = match (offline, procedure) {
-        (Err(e), _) => return report(&args.bus, "run", Err(CommandError::Usage(e))),
-        (Ok((json, text)), None) => return report(&args.bus, "run", Ok(Outcome { json, text })),
-        (Ok((json, text)), Some(_)) if dry_run => return report(&args.bus, "run", Ok(Outcome { json, text })),
-        (Ok(_), Some(name)) => (name, args.bus.json),
-    };
+    let json_out = args.bus.json;
     run(&args.bus, "run", |bus| async move {
-        let dict = bindings.dictionary(node);
-        let plan = crate::command::run::plan(dict, node, &name, &params).map_err(CommandError::Usage)?;
+        let dict = bindings.dictionary(spec.node);
+        let plan = crate::command::run::plan(dict, spec.node, &name, &spec.args).map_err(CommandError::Usage)?;
         let mut print = |line: &str| {
             if !json_out {
                 println!("{line}");
             }
         };
-        let json = crate::command::run::run(&bus, dict, &plan, timeout_ms, &mut print).await?;
+        let json = crate::command::run::run(&bus, dict, &plan, spec.timeout_ms, &mut print).await?;
         let text = run_summary(&json);
         Ok(Outcome { json, text })
     })

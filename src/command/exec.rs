@@ -2,7 +2,7 @@
 //! TUI palette share. Each result comes as one JSON object plus its text form.
 
 use super::error::CommandError;
-use super::grammar::Command;
+use super::grammar::{Command, RunSpec};
 use super::value::{decode, encode};
 use crate::bus::Bus;
 use crate::decode::cia402::mode_name;
@@ -21,17 +21,8 @@ pub struct Outcome {
 /// Runs `cmd` on `bus`; `bindings` give node dictionaries (object names, aliases, types).
 /// A `record` without limits runs until its future is dropped (the log is flushed then).
 pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Outcome, CommandError> {
-    if let Command::Run {
-        node,
-        procedure,
-        args,
-        dry_run,
-        timeout_ms,
-    } = cmd
-    {
-        return run_procedure(bus, bindings, *node, procedure.as_deref(), args, *dry_run, *timeout_ms).await;
-    }
     let json = match cmd {
+        Command::Run(spec) => return run_procedure(bus, bindings, spec).await,
         Command::Nmt {
             action,
             node,
@@ -123,31 +114,24 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
             };
             json!({"ok": true, "frames": n, "output": output})
         }
-        Command::Run { .. } => return Err(CommandError::Usage("run is handled above".into())),
     };
     let text = text(cmd, &json);
     Ok(Outcome { json, text })
 }
 
-/// `run`: lists, dry-runs or runs a procedure; the text holds every step line and result.
-async fn run_procedure(
-    bus: &Bus,
-    bindings: &Bindings,
-    node: u8,
-    procedure: Option<&str>,
-    args: &[(String, String)],
-    dry_run: bool,
-    timeout_ms: u64,
-) -> Result<Outcome, CommandError> {
-    let (json, text) = offline_run(bindings, node, procedure, args, dry_run).map_err(CommandError::Usage)?;
-    if procedure.is_none() || dry_run {
+/// `run`: lists, dry-runs or runs a procedure; the text is a summary line, then every step
+/// line and result.
+async fn run_procedure(bus: &Bus, bindings: &Bindings, spec: &RunSpec) -> Result<Outcome, CommandError> {
+    let (json, text) = offline_run(bindings, spec).map_err(CommandError::Usage)?;
+    let Some(name) = spec.procedure.as_deref().filter(|_| !spec.dry_run) else {
         return Ok(Outcome { json, text });
-    }
-    let dict = bindings.dictionary(node);
-    let plan = super::run::plan(dict, node, procedure.unwrap_or_default(), args).map_err(CommandError::Usage)?;
+    };
+    let dict = bindings.dictionary(spec.node);
+    let plan = super::run::plan(dict, spec.node, name, &spec.args).map_err(CommandError::Usage)?;
     let mut lines = Vec::new();
-    let json = super::run::run(bus, dict, &plan, timeout_ms, &mut |l| lines.push(l.to_string())).await?;
-    lines.push(run_summary(&json));
+    let json = super::run::run(bus, dict, &plan, spec.timeout_ms, &mut |l| lines.push(l.to_string())).await?;
+    // The summary first: the palette's message line shows one line.
+    lines.insert(0, run_summary(&json));
     Ok(Outcome {
         json,
         text: lines.join("\n"),
@@ -156,20 +140,14 @@ async fn run_procedure(
 
 /// What `run` gives without a bus: the listing (no procedure) or the dry run (also used to
 /// check a procedure and its parameters before opening the bus).
-pub fn offline_run(
-    bindings: &Bindings,
-    node: u8,
-    procedure: Option<&str>,
-    args: &[(String, String)],
-    dry_run: bool,
-) -> Result<(Json, String), String> {
-    let dict = bindings.dictionary(node);
-    match procedure {
-        None => Ok(super::run::list(dict, node)),
+pub fn offline_run(bindings: &Bindings, spec: &RunSpec) -> Result<(Json, String), String> {
+    let dict = bindings.dictionary(spec.node);
+    match &spec.procedure {
+        None => Ok(super::run::list(dict, spec.node)),
         Some(name) => {
-            let plan = super::run::plan(dict, node, name, args)?;
+            let plan = super::run::plan(dict, spec.node, name, &spec.args)?;
             let (mut json, text) = super::run::dry_run(&plan);
-            if !dry_run {
+            if !spec.dry_run {
                 json["dry_run"] = false.into();
             }
             Ok((json, text))
@@ -270,7 +248,7 @@ pub fn text(cmd: &Command, v: &Json) -> String {
         }
         Command::Scan { .. } => scan_text(v),
         Command::Record { .. } => format!("{} frames written to {}", v["frames"], s(&v["output"])),
-        Command::Run { .. } => run_summary(v),
+        Command::Run(_) => run_summary(v),
     }
 }
 

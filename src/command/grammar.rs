@@ -184,18 +184,23 @@ pub enum Command {
     },
     /// `record -o FILE [--count N] [--duration MS]`.
     Record { output: String, limits: Limits },
-    /// `run NODE PROCEDURE [NAME=VALUE ...] [--dry-run] [--timeout MS]`, or `run NODE [--list]`
-    /// (no procedure: list the node's procedures).
-    Run {
-        node: u8,
-        procedure: Option<String>,
-        /// Parameters as given, `NAME=VALUE` split at the first `=`.
-        args: Vec<(String, String)>,
-        /// Show the steps and frames without sending anything.
-        dry_run: bool,
-        /// ms to wait for each SDO answer.
-        timeout_ms: u64,
-    },
+    /// `run NODE PROCEDURE [NAME=VALUE ...] [--dry-run] [--timeout MS]`, or `run NODE [--list]`.
+    Run(RunSpec),
+}
+
+/// What `run` runs: a procedure of a node with its parameters, or (no procedure) the list.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RunSpec {
+    /// The target node.
+    pub node: u8,
+    /// `None`: list the node's procedures.
+    pub procedure: Option<String>,
+    /// Parameters as given, `NAME=VALUE` split at the first `=`.
+    pub args: Vec<(String, String)>,
+    /// Show the steps and frames without sending anything.
+    pub dry_run: bool,
+    /// ms to wait for each SDO answer.
+    pub timeout_ms: u64,
 }
 
 /// Splits `NAME=VALUE` procedure arguments.
@@ -210,7 +215,7 @@ pub fn parse_assignments(words: &[&str]) -> Result<Vec<(String, String)>, String
 }
 
 /// The `run` command from its words after NODE: `[PROCEDURE] [NAME=VALUE ...]`.
-pub fn run_command(node: u8, rest: &[&str], list: bool, dry_run: bool, timeout_ms: u64) -> Result<Command, String> {
+pub fn run_spec(node: u8, rest: &[&str], list: bool, dry_run: bool, timeout_ms: u64) -> Result<RunSpec, String> {
     let (procedure, assignments) = match rest.split_first() {
         Some((p, more)) if !p.contains('=') => (Some(p.to_string()), more),
         _ => (None, rest),
@@ -222,7 +227,7 @@ pub fn run_command(node: u8, rest: &[&str], list: bool, dry_run: bool, timeout_m
     if list && procedure.is_some() {
         return Err("run: give a PROCEDURE or --list, not both".into());
     }
-    Ok(Command::Run {
+    Ok(RunSpec {
         node,
         procedure,
         args,
@@ -400,13 +405,13 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
             action: DriveAction::parse(action, rest.first().copied())?,
             timeout_ms: timeout.unwrap_or(DEFAULT_TIMEOUT_MS),
         }),
-        ["run", node, rest @ ..] => run_command(
+        ["run", node, rest @ ..] => Ok(Command::Run(run_spec(
             parse_node(node, false)?,
             rest,
             list,
             dry_run,
             timeout.unwrap_or(DEFAULT_TIMEOUT_MS),
-        ),
+        )?)),
         ["scan"] => Ok(Command::Scan {
             listen_ms: listen.unwrap_or(SCAN_LISTEN_MS),
             probe,
@@ -530,21 +535,21 @@ mod tests {
     fn run_lines() {
         assert_eq!(
             parse_command("run 2 pv speed=100 accel=0x10 --dry-run").unwrap(),
-            Command::Run {
+            Command::Run(RunSpec {
                 node: 2,
                 procedure: Some("pv".into()),
                 args: vec![("speed".into(), "100".into()), ("accel".into(), "0x10".into())],
                 dry_run: true,
                 timeout_ms: DEFAULT_TIMEOUT_MS,
-            }
+            })
         );
         assert!(matches!(
             parse_command("run 3 --list").unwrap(),
-            Command::Run {
+            Command::Run(RunSpec {
                 node: 3,
                 procedure: None,
                 ..
-            }
+            })
         ));
         assert!(parse_command("run 2 pv speed").unwrap_err().contains("NAME=VALUE"));
         assert!(parse_command("run 2 speed=1").unwrap_err().contains("PROCEDURE before"));

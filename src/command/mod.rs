@@ -14,4 +14,4 @@ pub mod value;
 
 pub use error::CommandError;
 pub use exec::{Outcome, execute};
-pub use grammar::{Command, DriveAction, NmtAction, SdoOptions, parse_command};
+pub use grammar::{Command, DriveAction, NmtAction, RunSpec, SdoOptions, parse_command};

@@ -369,7 +369,8 @@ fn plan_json(plan: &RunPlan, steps: Vec<Json>, ok: bool) -> Json {
     })
 }
 
-/// The outcome of `--dry-run`: every step with its frame, `result` "not sent".
+/// The outcome of `--dry-run`: every step with its frame, `result` "not sent"; the text's
+/// first line is the summary (the palette shows one line).
 pub fn dry_run(plan: &RunPlan) -> (Json, String) {
     let n = plan.steps.len();
     let steps = (1..)
@@ -378,15 +379,16 @@ pub fn dry_run(plan: &RunPlan) -> (Json, String) {
         .collect();
     let mut v = plan_json(plan, steps, true);
     v["dry_run"] = json!(true);
-    let mut lines: Vec<String> = (1..).zip(&plan.steps).map(|(k, s)| s.line(k, n)).collect();
-    lines.push(format!(
+    let mut lines = vec![format!(
         "dry run of `{}` on node {}: {n} steps, nothing sent",
         plan.procedure, plan.node
-    ));
+    )];
+    lines.extend((1..).zip(&plan.steps).map(|(k, s)| s.line(k, n)));
     (v, lines.join("\n"))
 }
 
-/// The procedures of `dict` with their descriptions and parameters (JSON and text).
+/// The procedures of `dict` with their descriptions and parameters (JSON and text; the
+/// text's first line names them all).
 pub fn list(dict: &Dictionary, node: u8) -> (Json, String) {
     let procs = dict.procedures();
     let items: Vec<Json> = procs
@@ -405,9 +407,10 @@ pub fn list(dict: &Dictionary, node: u8) -> (Json, String) {
     let text = if procs.is_empty() {
         format!("node {node} has no procedures (bind a profile: --profile {node}=NAME)")
     } else {
-        procs
-            .iter()
-            .map(|p| {
+        let names: Vec<&str> = procs.iter().map(|p| p.name.as_str()).collect();
+        let header = format!("node {node} procedures: {}", names.join(", "));
+        std::iter::once(header)
+            .chain(procs.iter().map(|p| {
                 let mut t = format!("{}  {}", p.name, p.description.as_deref().unwrap_or(""));
                 for q in &p.params {
                     let default = q.default.map_or("required".to_string(), |d| format!("default {d}"));
@@ -416,7 +419,7 @@ pub fn list(dict: &Dictionary, node: u8) -> (Json, String) {
                     t.push_str(&format!("\n    {}=VALUE ({default}{unit}){about}", q.name));
                 }
                 t
-            })
+            }))
             .collect::<Vec<_>>()
             .join("\n")
     };

@@ -3,7 +3,7 @@
 
 use super::live::UNKNOWN_STATE;
 use crate::command::run::Action;
-use crate::command::{Command, DriveAction, NmtAction, parse_command};
+use crate::command::{Command, DriveAction, NmtAction, RunSpec, parse_command};
 use crate::decode::cia402::DriveState;
 use crate::hex;
 use crate::od::alias::resolve_object;
@@ -114,16 +114,16 @@ pub fn plan(line: &str, bindings: &Bindings, state: impl Fn(u8) -> Option<DriveS
             "listens for heartbeats, then reads 0x1018 of each node found".into(),
             None,
         ),
-        Command::Run {
+        Command::Run(RunSpec {
             node, procedure: None, ..
-        } => (format!("nothing: lists the procedures of node {node}"), None),
-        Command::Run {
+        }) => (format!("nothing: lists the procedures of node {node}"), None),
+        Command::Run(RunSpec {
             node,
             procedure: Some(name),
             args,
             dry_run,
             ..
-        } => {
+        }) => {
             let p = crate::command::run::plan(bindings.dictionary(*node), *node, name, args)?;
             let steps: Vec<String> = p.steps.iter().map(|s| s.preview()).collect();
             let confirm = p.steps.iter().find_map(|s| match s.action {
