@@ -3,7 +3,7 @@
 //! step by step through the same SDO and NMT paths as `sdo write` / `nmt`.
 
 use super::error::CommandError;
-use super::grammar::parse_int;
+use super::grammar::{NmtAction, parse_int};
 use super::value::{decode, encode};
 use crate::bus::{Bus, BusError};
 use crate::decode::value_text::object_text;
@@ -22,8 +22,8 @@ pub enum Action {
     SdoWrite { index: u16, sub: u8, data: Vec<u8> },
     /// SDO upload of (index, sub), decoded as `ty`.
     SdoRead { index: u16, sub: u8, ty: Option<DataType> },
-    /// NMT command specifier `cs` to `target` (0 = all).
-    Nmt { cs: u8, target: u8 },
+    /// An NMT command to `target` (0 = all), sent like `nmt ACTION NODE`.
+    Nmt { action: NmtAction, target: u8 },
     /// A raw frame, sent as-is.
     Frame(Frame),
     /// Read (index, sub) by SDO until `(value & mask) == equals`, at most `timeout_ms`.
@@ -276,17 +276,15 @@ fn plan_step(
                 }
                 None => node,
             };
-            let f = Frame::classic(0x000, &[command.specifier(), target]);
+            let action = nmt_action(*command);
+            let f = Frame::classic(0x000, &[action.cs(), target]);
             let whom = if target == 0 {
                 "all nodes".to_string()
             } else {
                 format!("node {target}")
             };
             PlannedStep {
-                action: Action::Nmt {
-                    cs: command.specifier(),
-                    target,
-                },
+                action: Action::Nmt { action, target },
                 text: format!("nmt {} to {whom}", nmt_word(*command)),
                 value: None,
                 frame: Some(candump(&f)),
@@ -426,9 +424,10 @@ pub fn list(dict: &Dictionary, node: u8) -> (Json, String) {
     (json!({"ok": true, "node": node, "procedures": items}), text)
 }
 
-/// Runs `plan` on `bus` step by step (`dict` gives the read values' meaning): `progress` gets each step's line before it is sent and
-/// its result after. SDO steps wait for the answer (`timeout_ms` each); the first failure stops
-/// the run and comes back as [`CommandError::Step`], with the steps done so far.
+/// Runs `plan` on `bus` step by step (`dict` gives the meaning of values read): `progress`
+/// gets each step's line before it is sent and its result after. SDO steps wait for the
+/// answer (`timeout_ms` each); the first failure stops the run and comes back as
+/// [`CommandError::Step`], with the steps done so far. A listen-only bus fails before step 1.
 pub async fn run(
     bus: &Bus,
     dict: &Dictionary,
@@ -486,8 +485,8 @@ async fn run_step(
                 text,
             )
         }
-        Action::Nmt { cs, target } => {
-            bus.send(&Frame::classic(0x000, &[*cs, *target])).await?;
+        Action::Nmt { action, target } => {
+            super::nmt::nmt(bus, *action, *target, false, 0).await?;
             (json!("sent"), "sent".into())
         }
         Action::Frame(f) => {
@@ -535,6 +534,16 @@ async fn run_step(
 fn read_text(dict: &Dictionary, index: u16, sub: u8, ty: Option<DataType>, data: &[u8]) -> String {
     let shown = object_text(dict, index, sub, &decode(data, ty), None);
     format!("0x{index:04X}:{sub:02X} = {shown}")
+}
+
+fn nmt_action(c: NmtCommand) -> NmtAction {
+    match c {
+        NmtCommand::Start => NmtAction::Start,
+        NmtCommand::Stop => NmtAction::Stop,
+        NmtCommand::PreOperational => NmtAction::PreOp,
+        NmtCommand::Reset => NmtAction::ResetNode,
+        NmtCommand::ResetCommunication => NmtAction::ResetComm,
+    }
 }
 
 fn nmt_word(c: NmtCommand) -> &'static str {

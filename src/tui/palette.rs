@@ -127,7 +127,9 @@ pub fn plan(line: &str, bindings: &Bindings, state: impl Fn(u8) -> Option<DriveS
             let p = crate::command::run::plan(bindings.dictionary(*node), *node, name, args)?;
             let steps: Vec<String> = p.steps.iter().map(|s| s.preview()).collect();
             let confirm = p.steps.iter().find_map(|s| match s.action {
-                Action::Nmt { cs, target } if target == 0 || cs == 0x81 || cs == 0x82 => {
+                Action::Nmt { action, target }
+                    if target == 0 || matches!(action, NmtAction::ResetNode | NmtAction::ResetComm) =>
+                {
                     Some(format!("`{name}` sends {}", s.text))
                 }
                 _ => None,
