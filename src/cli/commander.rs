@@ -61,7 +61,8 @@ pub fn run_command(
     })
 }
 
-fn report(args: &BusArgs, what: &str, result: Result<Outcome, CommandError>) -> i32 {
+/// Prints `result` (text, or JSON with `--json`; failures also to stderr) and gives the exit status.
+pub fn report(args: &BusArgs, what: &str, result: Result<Outcome, CommandError>) -> i32 {
     match result {
         Ok(o) => {
             if args.json {

@@ -8,6 +8,7 @@ pub mod decode;
 pub mod drive;
 pub mod nmt;
 pub mod record;
+pub mod run;
 pub mod scan;
 pub mod sdo;
 pub mod tui;
@@ -51,6 +52,9 @@ pub enum Command {
     Sdo(sdo::SdoCommand),
     /// CiA 402 drive: cotui drive IFACE NODE enable|disable|quick-stop|fault-reset|status|mode MODE.
     Drive(drive::DriveArgs),
+    /// Run a profile's procedure step by step: cotui run IFACE NODE PROCEDURE [NAME=VALUE ...] [--dry-run];
+    /// without PROCEDURE (or with --list), list the node's procedures.
+    Run(run::RunArgs),
     /// List the nodes on the bus with their identity.
     Scan(scan::ScanArgs),
     /// Record the bus to a candump -l log.
@@ -91,6 +95,7 @@ pub fn run() -> i32 {
         Some(Command::Nmt(args)) => nmt::run_nmt(&args),
         Some(Command::Sdo(cmd)) => sdo::run_sdo(&cmd),
         Some(Command::Drive(args)) => drive::run_drive(&args),
+        Some(Command::Run(args)) => run::run_run(&args),
         Some(Command::Scan(args)) => scan::run_scan(&args),
         Some(Command::Record(args)) => record::run_record(&args),
     }

@@ -35,6 +35,15 @@ pub enum CommandError {
     Timeout(String),
     /// A drive sequence step did not happen; `reason` says why, from what the bus shows.
     Drive { node: u8, step: String, reason: String },
+    /// A procedure stopped at step `step` of `of` because of `cause`; `report` is the run's
+    /// JSON so far (`procedure`, `node`, `steps` done, the failed one last).
+    Step {
+        procedure: String,
+        step: usize,
+        of: usize,
+        report: Box<serde_json::Value>,
+        cause: Box<CommandError>,
+    },
 }
 
 impl CommandError {
@@ -46,6 +55,7 @@ impl CommandError {
             CommandError::Abort { .. } => EXIT_ABORT,
             CommandError::Timeout(_) => EXIT_TIMEOUT,
             CommandError::Drive { .. } => EXIT_DRIVE,
+            CommandError::Step { cause, .. } => cause.exit_code(),
         }
     }
     /// The `--json` object of the failure.
@@ -72,6 +82,20 @@ impl CommandError {
                 "ok": false, "error": "drive", "node": node, "step": step, "reason": reason,
                 "message": self.to_string(),
             }),
+            CommandError::Step {
+                step, report, cause, ..
+            } => {
+                let mut v = cause.to_json();
+                if let (Some(out), Some(r)) = (v.as_object_mut(), report.as_object()) {
+                    for (k, x) in r {
+                        out.insert(k.clone(), x.clone());
+                    }
+                    out.insert("ok".into(), false.into());
+                    out.insert("failed_step".into(), (*step).into());
+                    out.insert("message".into(), self.to_string().into());
+                }
+                v
+            }
         }
     }
 }
@@ -94,6 +118,13 @@ impl std::fmt::Display for CommandError {
                 abort_text(*code)
             ),
             CommandError::Drive { node, step, reason } => write!(f, "drive {node}: {step} failed: {reason}"),
+            CommandError::Step {
+                procedure,
+                step,
+                of,
+                cause,
+                ..
+            } => write!(f, "`{procedure}` stopped at step {step}/{of}: {cause}"),
         }
     }
 }

@@ -2,7 +2,7 @@
 //! TUI palette share. Each result comes as one JSON object plus its text form.
 
 use super::error::CommandError;
-use super::grammar::Command;
+use super::grammar::{Command, RunSpec};
 use super::value::{decode, encode};
 use crate::bus::Bus;
 use crate::decode::cia402::mode_name;
@@ -22,6 +22,7 @@ pub struct Outcome {
 /// A `record` without limits runs until its future is dropped (the log is flushed then).
 pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Outcome, CommandError> {
     let json = match cmd {
+        Command::Run(spec) => return run_procedure(bus, bindings, spec).await,
         Command::Nmt {
             action,
             node,
@@ -118,6 +119,52 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
     Ok(Outcome { json, text })
 }
 
+/// `run`: lists, dry-runs or runs a procedure; the text is a summary line, then every step
+/// line and result.
+async fn run_procedure(bus: &Bus, bindings: &Bindings, spec: &RunSpec) -> Result<Outcome, CommandError> {
+    let (json, text) = offline_run(bindings, spec).map_err(CommandError::Usage)?;
+    let Some(name) = spec.procedure.as_deref().filter(|_| !spec.dry_run) else {
+        return Ok(Outcome { json, text });
+    };
+    let dict = bindings.dictionary(spec.node);
+    let plan = super::run::plan(dict, spec.node, name, &spec.args).map_err(CommandError::Usage)?;
+    let mut lines = Vec::new();
+    let json = super::run::run(bus, dict, &plan, spec.timeout_ms, &mut |l| lines.push(l.to_string())).await?;
+    // The summary first: the palette's message line shows one line.
+    lines.insert(0, run_summary(&json));
+    Ok(Outcome {
+        json,
+        text: lines.join("\n"),
+    })
+}
+
+/// What `run` gives without a bus: the listing (no procedure) or the dry run (also used to
+/// check a procedure and its parameters before opening the bus).
+pub fn offline_run(bindings: &Bindings, spec: &RunSpec) -> Result<(Json, String), String> {
+    let dict = bindings.dictionary(spec.node);
+    match &spec.procedure {
+        None => Ok(super::run::list(dict, spec.node)),
+        Some(name) => {
+            let plan = super::run::plan(dict, spec.node, name, &spec.args)?;
+            let (mut json, text) = super::run::dry_run(&plan);
+            if !spec.dry_run {
+                json["dry_run"] = false.into();
+            }
+            Ok((json, text))
+        }
+    }
+}
+
+/// The last line of a successful run.
+pub fn run_summary(v: &Json) -> String {
+    format!(
+        "`{}` on node {}: {} steps done",
+        s(&v["procedure"]),
+        v["node"],
+        v["steps"].as_array().map_or(0, Vec::len)
+    )
+}
+
 /// The bytes to write: a file for domains, else the value encoded as its type.
 fn write_data(
     dict: &Dictionary,
@@ -201,6 +248,7 @@ pub fn text(cmd: &Command, v: &Json) -> String {
         }
         Command::Scan { .. } => scan_text(v),
         Command::Record { .. } => format!("{} frames written to {}", v["frames"], s(&v["output"])),
+        Command::Run(_) => run_summary(v),
     }
 }
 

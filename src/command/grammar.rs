@@ -184,6 +184,56 @@ pub enum Command {
     },
     /// `record -o FILE [--count N] [--duration MS]`.
     Record { output: String, limits: Limits },
+    /// `run NODE PROCEDURE [NAME=VALUE ...] [--dry-run] [--timeout MS]`, or `run NODE [--list]`.
+    Run(RunSpec),
+}
+
+/// What `run` runs: a procedure of a node with its parameters, or (no procedure) the list.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RunSpec {
+    /// The target node.
+    pub node: u8,
+    /// `None`: list the node's procedures.
+    pub procedure: Option<String>,
+    /// Parameters as given, `NAME=VALUE` split at the first `=`.
+    pub args: Vec<(String, String)>,
+    /// Show the steps and frames without sending anything.
+    pub dry_run: bool,
+    /// ms to wait for each SDO answer.
+    pub timeout_ms: u64,
+}
+
+/// Splits `NAME=VALUE` procedure arguments.
+pub fn parse_assignments(words: &[&str]) -> Result<Vec<(String, String)>, String> {
+    words
+        .iter()
+        .map(|w| match w.split_once('=') {
+            Some((n, v)) if !n.is_empty() => Ok((n.to_string(), v.to_string())),
+            _ => Err(format!("`{w}` is not a parameter: write NAME=VALUE, e.g. speed=100")),
+        })
+        .collect()
+}
+
+/// The `run` command from its words after NODE: `[PROCEDURE] [NAME=VALUE ...]`.
+pub fn run_spec(node: u8, rest: &[&str], list: bool, dry_run: bool, timeout_ms: u64) -> Result<RunSpec, String> {
+    let (procedure, assignments) = match rest.split_first() {
+        Some((p, more)) if !p.contains('=') => (Some(p.to_string()), more),
+        _ => (None, rest),
+    };
+    let args = parse_assignments(assignments)?;
+    if procedure.is_none() && !args.is_empty() {
+        return Err("run: give the PROCEDURE before its NAME=VALUE parameters".into());
+    }
+    if list && procedure.is_some() {
+        return Err("run: give a PROCEDURE or --list, not both".into());
+    }
+    Ok(RunSpec {
+        node,
+        procedure,
+        args,
+        dry_run,
+        timeout_ms,
+    })
 }
 
 /// Parses a number: decimal, `0x` hex, or negative decimal.
@@ -300,7 +350,7 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
     let all = words(line)?;
     let mut pos: Vec<&str> = Vec::new();
     let mut data_type = None;
-    let (mut block, mut wait, mut probe) = (false, false, false);
+    let (mut block, mut wait, mut probe, mut list, mut dry_run) = (false, false, false, false, false);
     let (mut output, mut timeout, mut listen) = (None, None, None);
     let mut limits = Limits::default();
     let mut it = all.iter();
@@ -310,6 +360,8 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
             "--wait" => wait = true,
             "--block" => block = true,
             "--probe" => probe = true,
+            "--list" => list = true,
+            "--dry-run" => dry_run = true,
             "--type" | "-t" => data_type = Some(parse_type(value("--type")?)?),
             "--timeout" => timeout = Some(positive("--timeout", value("--timeout")?)?),
             "--listen" => listen = Some(positive("--listen", value("--listen")?)?),
@@ -328,7 +380,7 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
         timeout_ms: timeout.unwrap_or(DEFAULT_TIMEOUT_MS),
     };
     let usage = "commands: nmt ACTION NODE, sdo read NODE OBJECT, sdo write NODE OBJECT VALUE, \
-                 drive NODE ACTION, scan, record -o FILE";
+                 drive NODE ACTION, run NODE PROCEDURE [NAME=VALUE ...], scan, record -o FILE";
     match pos.as_slice() {
         ["nmt", action, node] => Ok(Command::Nmt {
             action: NmtAction::parse(action)?,
@@ -353,6 +405,13 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
             action: DriveAction::parse(action, rest.first().copied())?,
             timeout_ms: timeout.unwrap_or(DEFAULT_TIMEOUT_MS),
         }),
+        ["run", node, rest @ ..] => Ok(Command::Run(run_spec(
+            parse_node(node, false)?,
+            rest,
+            list,
+            dry_run,
+            timeout.unwrap_or(DEFAULT_TIMEOUT_MS),
+        )?)),
         ["scan"] => Ok(Command::Scan {
             listen_ms: listen.unwrap_or(SCAN_LISTEN_MS),
             probe,
@@ -470,6 +529,31 @@ mod tests {
         );
         assert!(parse_command("record").unwrap_err().contains("-o FILE"));
         assert!(parse_command("").unwrap_err().starts_with("empty command"));
+    }
+
+    #[test]
+    fn run_lines() {
+        assert_eq!(
+            parse_command("run 2 pv speed=100 accel=0x10 --dry-run").unwrap(),
+            Command::Run(RunSpec {
+                node: 2,
+                procedure: Some("pv".into()),
+                args: vec![("speed".into(), "100".into()), ("accel".into(), "0x10".into())],
+                dry_run: true,
+                timeout_ms: DEFAULT_TIMEOUT_MS,
+            })
+        );
+        assert!(matches!(
+            parse_command("run 3 --list").unwrap(),
+            Command::Run(RunSpec {
+                node: 3,
+                procedure: None,
+                ..
+            })
+        ));
+        assert!(parse_command("run 2 pv speed").unwrap_err().contains("NAME=VALUE"));
+        assert!(parse_command("run 2 speed=1").unwrap_err().contains("PROCEDURE before"));
+        assert!(parse_command("run 2 pv --list").unwrap_err().contains("not both"));
     }
 
     #[test]

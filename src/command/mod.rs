@@ -7,10 +7,11 @@ pub mod exec;
 pub mod grammar;
 pub mod nmt;
 pub mod record;
+pub mod run;
 pub mod scan;
 pub mod sdo;
 pub mod value;
 
 pub use error::CommandError;
 pub use exec::{Outcome, execute};
-pub use grammar::{Command, DriveAction, NmtAction, SdoOptions, parse_command};
+pub use grammar::{Command, DriveAction, NmtAction, RunSpec, SdoOptions, parse_command};

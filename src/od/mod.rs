@@ -298,6 +298,14 @@ impl Dictionary {
     pub fn procedure(&self, name: &str) -> Option<&Procedure> {
         self.layers.iter().find_map(|p| p.procedures.get(name))
     }
+    /// Every named procedure, by name (the first layer's when several layers have one).
+    pub fn procedures(&self) -> Vec<&Procedure> {
+        let mut by_name: BTreeMap<&str, &Procedure> = BTreeMap::new();
+        for p in self.layers.iter().rev().flat_map(|l| l.procedures.values()) {
+            by_name.insert(&p.name, p);
+        }
+        by_name.into_values().collect()
+    }
     /// A vendor SDO command from the first layer that has it.
     pub fn sdo_command(&self, command: u8, direction: SdoDirection) -> Option<&SdoCommand> {
         self.layers.iter().find_map(|p| p.sdo_command(command, direction))

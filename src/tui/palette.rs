@@ -2,14 +2,15 @@
 //! whether it needs confirming (broadcast NMT, resets, node 0).
 
 use super::live::UNKNOWN_STATE;
-use crate::command::{Command, DriveAction, NmtAction, parse_command};
+use crate::command::run::Action;
+use crate::command::{Command, DriveAction, NmtAction, RunSpec, parse_command};
 use crate::decode::cia402::DriveState;
 use crate::hex;
 use crate::od::alias::resolve_object;
 use crate::od::bind::Bindings;
 
 /// The first words of commander lines.
-pub const COMMANDER_WORDS: &[&str] = &["nmt", "sdo", "drive", "scan"];
+pub const COMMANDER_WORDS: &[&str] = &["nmt", "sdo", "drive", "run", "scan"];
 
 /// A parsed commander line with its preview.
 #[derive(Clone, Debug, PartialEq)]
@@ -113,6 +114,32 @@ pub fn plan(line: &str, bindings: &Bindings, state: impl Fn(u8) -> Option<DriveS
             "listens for heartbeats, then reads 0x1018 of each node found".into(),
             None,
         ),
+        Command::Run(RunSpec {
+            node, procedure: None, ..
+        }) => (format!("nothing: lists the procedures of node {node}"), None),
+        Command::Run(RunSpec {
+            node,
+            procedure: Some(name),
+            args,
+            dry_run,
+            ..
+        }) => {
+            let p = crate::command::run::plan(bindings.dictionary(*node), *node, name, args)?;
+            let steps: Vec<String> = p.steps.iter().map(|s| s.preview()).collect();
+            let confirm = p.steps.iter().find_map(|s| match s.action {
+                Action::Nmt { action, target }
+                    if target == 0 || matches!(action, NmtAction::ResetNode | NmtAction::ResetComm) =>
+                {
+                    Some(format!("`{name}` sends {}", s.text))
+                }
+                _ => None,
+            });
+            if *dry_run {
+                (format!("nothing (dry run of {})", steps.join(", ")), None)
+            } else {
+                (steps.join(", "), confirm)
+            }
+        }
         Command::Record { .. } => {
             return Err("record runs from the command line (`cotui record IFACE -o FILE`)".into());
         }
@@ -148,6 +175,34 @@ mod tests {
         assert_eq!(
             d.preview,
             "602#2B40600006000000, 602#2B40600007000000, 602#2B4060000F000000 (from Switch on disabled)"
+        );
+    }
+
+    #[test]
+    fn run_previews_every_step_frame() {
+        let read = |p: &std::path::Path| std::fs::read_to_string(p);
+        let b = Bindings::from_args(&["2=syntron-ds".to_string()], &[], &read).unwrap();
+        let p = plan("run 2 pv speed=20", &b, |_| None).unwrap();
+        assert_eq!(
+            p.preview,
+            "000#0102, 602#2F60600003000000, 602#23836000E8030000, 602#23846000E8030000, \
+             602#23FF6000C8000000, 602#2B40600006000000, 602#2B40600007000000, 602#2B4060000F000000"
+        );
+        assert!(
+            plan("run 2 pv --dry-run", &b, |_| None)
+                .unwrap()
+                .preview
+                .starts_with("nothing (dry run of 000#0102")
+        );
+        assert!(
+            plan("run 2 pv rpm=3", &b, |_| None)
+                .unwrap_err()
+                .contains("no parameter `rpm`")
+        );
+        assert!(
+            plan("run 2 fly", &b, |_| None)
+                .unwrap_err()
+                .contains("its procedures: ")
         );
     }
 

@@ -1,0 +1,219 @@
+//! `cotui run` through the real binary on the demo bus.
+
+use std::process::Command;
+
+fn cotui(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_cotui")).args(args).output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).to_string(),
+        String::from_utf8_lossy(&out.stderr).to_string(),
+    )
+}
+
+fn json(stdout: &str) -> serde_json::Value {
+    serde_json::from_str(stdout.trim()).unwrap_or_else(|e| panic!("{e}: {stdout}"))
+}
+
+fn frames(v: &serde_json::Value) -> Vec<String> {
+    v["steps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["frame"].as_str().unwrap_or("").to_string())
+        .collect()
+}
+
+#[test]
+fn aimotor_pv_on_the_demo_drive_reaches_operation_enabled() {
+    let (rc, out, err) = cotui(&[
+        "run",
+        "demo",
+        "2",
+        "pv",
+        "speed=2000",
+        "--profile",
+        "2=aimotor",
+        "--json",
+    ]);
+    assert_eq!(rc, 0, "{err}");
+    let v = json(&out);
+    assert_eq!(
+        (v["ok"].as_bool(), v["procedure"].as_str(), v["node"].as_u64()),
+        (Some(true), Some("pv"), Some(2))
+    );
+    assert_eq!(v["params"]["speed"], 2000);
+    assert_eq!(v["params"]["accel"], 100_000);
+    assert_eq!(
+        frames(&v),
+        [
+            "602#2F60600003000000",
+            "602#23FF6000D0070000",
+            "602#23836000A0860100",
+            "602#23846000A0860100",
+            "602#2B40600006000000",
+            "602#2B40600007000000",
+            "602#2B4060000F000000",
+            "602#4041600000000000",
+            "602#406C600000000000",
+        ]
+    );
+    assert_eq!(v["steps"][4]["object"], "0x6040:00");
+    assert_eq!(v["steps"][4]["value"], 6);
+    assert_eq!(v["steps"][4]["result"], "written");
+    let status = v["steps"][7]["result"]["text"].as_str().unwrap();
+    assert!(status.starts_with("0x6041:00 = 0x"), "{status}");
+    assert!(status.contains("Operation enabled"), "{status}");
+}
+
+#[test]
+fn text_mode_prints_each_step_before_its_result() {
+    let (rc, out, err) = cotui(&["run", "demo", "3", "pv", "--profile", "3=syntron-ds"]);
+    assert_eq!(rc, 0, "{err}");
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines[0], "step 1/8: nmt start to node 3  [000#0103]");
+    assert_eq!(lines[1], "  -> sent");
+    assert_eq!(
+        lines[10],
+        "step 6/8: sdo write 0x6040:00 Controlword = 0x0006 (Shutdown)  [603#2B40600006000000]"
+    );
+    assert_eq!(lines[11], "  -> written (0600)");
+    assert_eq!(lines.last(), Some(&"`pv` on node 3: 8 steps done"));
+}
+
+#[test]
+fn a_step_on_a_missing_object_stops_with_abort_0x06020000_and_exit_3() {
+    // The simulated drive has no 0x607A (target position): aimotor `pp` stops at step 2.
+    let (rc, out, err) = cotui(&["run", "demo", "2", "pp", "--profile", "2=aimotor", "--json"]);
+    assert_eq!(rc, 3, "{err}");
+    let v = json(&out);
+    assert_eq!(v["ok"], false);
+    assert_eq!(v["error"], "sdo_abort");
+    assert_eq!(v["abort_code"], 0x0602_0000);
+    assert_eq!(v["abort_text"], "Object does not exist in the object dictionary");
+    assert_eq!(v["failed_step"], 2);
+    assert_eq!(v["steps"].as_array().map(Vec::len), Some(2));
+    assert_eq!(v["steps"][0]["result"], "written");
+    assert!(
+        err.contains("`pp` stopped at step 2/11: SDO 607A:00 on node 2 aborted by the server: 0x06020000"),
+        "{err}"
+    );
+    let (rc, out, _) = cotui(&["run", "demo", "2", "pp", "--profile", "2=aimotor"]);
+    assert_eq!(rc, 3);
+    assert!(
+        out.lines()
+            .any(|l| l.starts_with("step 2/11: sdo write 0x607A:00 Target position = 100500")),
+        "{out}"
+    );
+    assert!(!out.contains("step 3/11"), "{out}");
+}
+
+#[test]
+fn dry_run_gives_the_syntron_manual_frame_list_without_a_send_path() {
+    // Syn-tron manual 3.7.1, the same list tests/seed_procedures.rs checks.
+    let (rc, out, err) = cotui(&[
+        "run",
+        "demo",
+        "2",
+        "pv",
+        "--profile",
+        "2=syntron-ds",
+        "--dry-run",
+        "--listen-only",
+        "--json",
+    ]);
+    assert_eq!(rc, 0, "{err}");
+    let v = json(&out);
+    assert_eq!(v["dry_run"], true);
+    assert_eq!(
+        frames(&v),
+        [
+            "000#0102",
+            "602#2F60600003000000",
+            "602#23836000E8030000",
+            "602#23846000E8030000",
+            "602#23FF600064000000",
+            "602#2B40600006000000",
+            "602#2B40600007000000",
+            "602#2B4060000F000000",
+        ]
+    );
+    assert!(v["steps"].as_array().unwrap().iter().all(|s| s["result"] == "not sent"));
+    let (rc, out, _) = cotui(&[
+        "run",
+        "demo",
+        "2",
+        "pv",
+        "speed=-5",
+        "--profile",
+        "2=syntron-ds",
+        "--dry-run",
+    ]);
+    assert_eq!(rc, 0);
+    assert!(
+        out.contains("Target velocity = -5 rpm  [602#23FF6000CEFFFFFF]"),
+        "{out}"
+    );
+    assert!(
+        out.starts_with("dry run of `pv` on node 2: 8 steps, nothing sent\n"),
+        "{out}"
+    );
+}
+
+#[test]
+fn listen_only_refuses_to_run_and_prints_no_step() {
+    let (rc, out, err) = cotui(&["run", "demo", "2", "pv", "--profile", "2=aimotor", "--listen-only"]);
+    assert_eq!(rc, 2);
+    assert!(!out.contains("step"), "{out}");
+    assert!(err.contains("listen-only"), "{err}");
+}
+
+#[test]
+fn unknown_procedures_and_parameters_name_the_valid_ones() {
+    let (rc, _, err) = cotui(&["run", "demo", "2", "fly", "--profile", "2=aimotor"]);
+    assert_eq!(rc, 1);
+    assert!(
+        err.contains("node 2 has no procedure `fly`; its procedures: csv_pdo_remap, hm, pp, pp_example, pt, pv"),
+        "{err}"
+    );
+    let (rc, out, err) = cotui(&["run", "demo", "2", "pv", "rpm=3", "--profile", "2=aimotor", "--json"]);
+    assert_eq!(rc, 1);
+    assert_eq!(json(&out)["error"], "usage");
+    assert!(
+        err.contains("`pv` has no parameter `rpm`; its parameters: speed=10000, accel=100000"),
+        "{err}"
+    );
+    let (rc, _, err) = cotui(&["run", "demo", "2", "pv", "speed=fast", "--profile", "2=aimotor"]);
+    assert_eq!(rc, 1);
+    assert!(err.contains("speed=`fast` is not a number"), "{err}");
+    let (rc, _, err) = cotui(&["run", "demo", "2", "pv"]);
+    assert_eq!(rc, 1);
+    assert!(err.contains("bind a profile: --profile 2=NAME"), "{err}");
+}
+
+#[test]
+fn list_shows_procedures_with_descriptions_and_parameters() {
+    let (rc, out, _) = cotui(&["run", "demo", "3", "--profile", "3=syntron-ds"]);
+    assert_eq!(rc, 0);
+    assert!(
+        out.starts_with("node 3 procedures: dual_speed, hm, pp, pp_relative, pt, pv, "),
+        "{out}"
+    );
+    assert!(out.contains("\npv  Profile velocity (manual 3.7.1)"), "{out}");
+    assert!(
+        out.contains("    speed=VALUE (default 10 rpm): target velocity"),
+        "{out}"
+    );
+    let (rc, out, _) = cotui(&["run", "demo", "3", "--list", "--profile", "3=syntron-ds", "--json"]);
+    assert_eq!(rc, 0);
+    let v = json(&out);
+    let pv = v["procedures"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == "pv")
+        .unwrap();
+    assert_eq!(pv["params"][1]["name"], "ramp");
+    assert_eq!(pv["params"][1]["default"], 1000);
+    assert_eq!(pv["steps"], 8);
+}
