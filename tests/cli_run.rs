@@ -186,9 +186,13 @@ fn unknown_procedures_and_parameters_name_the_valid_ones() {
     let (rc, _, err) = cotui(&["run", "demo", "2", "pv", "speed=fast", "--profile", "2=aimotor"]);
     assert_eq!(rc, 1);
     assert!(err.contains("speed=`fast` is not a number"), "{err}");
-    let (rc, _, err) = cotui(&["run", "demo", "2", "pv"]);
+    // The demo's drives (nodes 2 and 3) come with their seed profiles; other nodes need one.
+    let (rc, _, err) = cotui(&["run", "demo", "5", "pv"]);
     assert_eq!(rc, 1);
-    assert!(err.contains("bind a profile: --profile 2=NAME"), "{err}");
+    assert!(err.contains("bind a profile: --profile 5=NAME"), "{err}");
+    let (rc, out, _) = cotui(&["run", "demo", "2", "--list"]);
+    assert_eq!(rc, 0);
+    assert!(out.contains("pv"), "{out}");
 }
 
 #[test]

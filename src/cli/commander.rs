@@ -52,9 +52,12 @@ pub fn run_command(
     profiles: &[String],
     eds: &[String],
 ) -> i32 {
-    let prepared = cmd
-        .map_err(CommandError::Usage)
-        .and_then(|c| Ok((c, super::bind::bindings(profiles, eds).map_err(CommandError::Usage)?)));
+    let prepared = cmd.map_err(CommandError::Usage).and_then(|c| {
+        Ok((
+            c,
+            super::bind::bindings_on(&args.iface, profiles, eds).map_err(CommandError::Usage)?,
+        ))
+    });
     run(args, what, |bus| async move {
         let (cmd, bindings) = prepared?;
         crate::command::execute(&bus, &cmd, &bindings).await

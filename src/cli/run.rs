@@ -38,7 +38,7 @@ pub struct RunArgs {
 pub fn run_run(args: &RunArgs) -> i32 {
     let words: Vec<&str> = args.words.iter().map(String::as_str).collect();
     let prepared = run_spec(args.node, &words, args.list, args.dry_run, args.timeout).and_then(|spec| {
-        let bindings = super::bind::bindings(&args.profiles, &args.eds)?;
+        let bindings = super::bind::bindings_on(&args.bus.iface, &args.profiles, &args.eds)?;
         // Checks the procedure and its parameters before the bus is opened.
         let offline = offline_run(&bindings, &spec)?;
         Ok((spec, bindings, offline))

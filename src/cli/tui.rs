@@ -1,8 +1,6 @@
 //! `cotui open FILE` and `cotui replay FILE`: the interactive analyzer on a log.
 
 use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
-use crate::od::Profile;
-use crate::sim::Simulation;
 use crate::tui::app::{App, SourceInfo, SourceKind};
 use crate::tui::keymap::{self, Keymap, KeymapError};
 use crate::tui::source;
@@ -111,7 +109,7 @@ enum Feeding {
     Live(String, bool),
 }
 
-fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding, layers: Vec<(u8, Profile)>) -> i32 {
+fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> i32 {
     let keymap = match load_keymap(&ui.keymap) {
         Ok(k) => k,
         Err(e) => {
@@ -119,16 +117,13 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding, layers: Vec<(
             return EXIT_USAGE;
         }
     };
-    let mut bindings = match super::bind::bindings(&ui.profiles, &ui.eds) {
+    let bindings = match super::bind::bindings_on(name, &ui.profiles, &ui.eds) {
         Ok(b) => b,
         Err(e) => {
             eprintln!("cotui: {e}");
             return EXIT_USAGE;
         }
     };
-    for (node, layer) in layers {
-        bindings.bind_layer(node, layer);
-    }
     let decoder = crate::decode::Decoder::from_bindings(&bindings);
     let src = match feed {
         Feeding::Log((rx, ctl)) => SourceInfo::new(name, kind, rx, ctl),
@@ -180,7 +175,6 @@ pub fn run_open(args: &OpenArgs) -> i32 {
         &name,
         SourceKind::Open,
         Feeding::Log((source::open(args.file.clone()), None)),
-        Vec::new(),
     )
 }
 
@@ -200,7 +194,6 @@ pub fn run_replay(args: &ReplayArgs) -> i32 {
         &name,
         SourceKind::Replay { speed: args.speed },
         Feeding::Log((rx, Some(ctl))),
-        Vec::new(),
     )
 }
 
@@ -210,7 +203,7 @@ pub fn run_live(args: &LiveArgs) -> i32 {
         listen_only: args.listen_only,
     };
     let feed = Feeding::Live(args.iface.clone(), args.listen_only);
-    start(&args.ui, &args.iface, kind, feed, Vec::new())
+    start(&args.ui, &args.iface, kind, feed)
 }
 
 /// Runs `cotui demo`.
@@ -219,18 +212,5 @@ pub fn run_demo(args: &DemoArgs) -> i32 {
         listen_only: args.listen_only,
     };
     let feed = Feeding::Live(crate::bus::DEMO.to_string(), args.listen_only);
-    // The simulated drives are built after the seed drives: name their objects with those
-    // profiles (unless the user bound others) and decode their PDOs from the first frame.
-    let mut ui = args.ui.clone();
-    for (node, profile) in [(2u8, "aimotor"), (3, "syntron-ds")] {
-        let bound = ui
-            .profiles
-            .iter()
-            .chain(&ui.eds)
-            .any(|a| crate::od::bind::parse_node_arg(a).is_ok_and(|(n, _)| n == node));
-        if !bound {
-            ui.profiles.push(format!("{node}={profile}"));
-        }
-    }
-    start(&ui, crate::bus::DEMO, kind, feed, Simulation::demo().pdo_layers())
+    start(&args.ui, crate::bus::DEMO, kind, feed)
 }

@@ -25,6 +25,9 @@ pub struct Simulation {
     start_all_at_ns: Option<u64>,
 }
 
+/// The seed profiles the demo's drives are built after: (node, profile name).
+pub const DEMO_PROFILES: [(u8, &str); 2] = [(2, "aimotor"), (3, "syntron-ds")];
+
 impl Simulation {
     /// Drives at the given nodes, SYNC every `sync_ms` (0 = none), no NMT master.
     pub fn new(drives: Vec<Drive>, sync_ms: u64) -> Simulation {
