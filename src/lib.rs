@@ -18,3 +18,4 @@ pub mod sdo_client;
 pub mod sdo_server;
 pub mod sim;
 pub mod synth;
+pub mod tui;

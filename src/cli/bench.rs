@@ -24,6 +24,10 @@ pub struct BenchArgs {
     /// Only write the generated log to this file (for profiling or tests) and exit.
     #[arg(long, value_name = "FILE")]
     pub write_log: Option<PathBuf>,
+    /// Measure the interactive analyzer instead: first screen, full index, memory per
+    /// frame, redraw and key response times (use --frames 10000000 for the target figures).
+    #[arg(long)]
+    pub tui: bool,
 }
 
 /// One measured run.
@@ -108,6 +112,9 @@ pub fn run(args: &BenchArgs) -> i32 {
 fn bench(args: &BenchArgs) -> std::io::Result<()> {
     if let Some(path) = &args.write_log {
         return write_log(path, args.frames);
+    }
+    if args.tui {
+        return super::bench_tui::bench(args.frames, args.json);
     }
     let exe = std::env::current_exe()?;
     let dir = std::env::temp_dir().join(format!("cotui-bench-{}", std::process::id()));

@@ -1,6 +1,7 @@
 //! The command line: clap definitions and one module per subcommand.
 
 pub mod bench;
+mod bench_tui;
 mod bind;
 pub mod commander;
 pub mod decode;
@@ -9,6 +10,7 @@ pub mod nmt;
 pub mod record;
 pub mod scan;
 pub mod sdo;
+pub mod tui;
 
 use clap::{Parser, Subcommand};
 
@@ -34,6 +36,14 @@ pub enum Command {
     Decode(decode::DecodeArgs),
     /// Print throughput and memory figures of the decoder on a generated log.
     Bench(bench::BenchArgs),
+    /// Open a log in the interactive analyzer (loads at once; browse, filter, search).
+    Open(tui::OpenArgs),
+    /// Replay a log in the interactive analyzer, paced by its timestamps.
+    Replay(tui::ReplayArgs),
+    /// Capture a SocketCAN interface in the interactive analyzer, with the command palette.
+    Live(tui::LiveArgs),
+    /// The interactive analyzer on an in-process bus with simulated CiA 402 drives.
+    Demo(tui::DemoArgs),
     /// Send an NMT command: cotui nmt IFACE start|stop|preop|reset-node|reset-comm NODE [--wait].
     Nmt(nmt::NmtArgs),
     /// Read or write an object by SDO (IFACE `demo` for the simulated bus).
@@ -52,6 +62,8 @@ pub const USAGE: &str = "\
 cotui: a terminal CANopen bus analyzer and commander
 
 Try it without hardware:   cotui demo
+Browse a log:              cotui open FILE
+Replay a log:              cotui replay FILE [--speed 2]
 Decode a candump log:      cotui decode FILE [--format jsonl] [--transactions] [--summary]
 All commands:              cotui --help
 ";
@@ -72,6 +84,10 @@ pub fn run() -> i32 {
         }
         Some(Command::Decode(args)) => decode::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
+        Some(Command::Open(args)) => tui::run_open(&args),
+        Some(Command::Replay(args)) => tui::run_replay(&args),
+        Some(Command::Live(args)) => tui::run_live(&args),
+        Some(Command::Demo(args)) => tui::run_demo(&args),
         Some(Command::Nmt(args)) => nmt::run_nmt(&args),
         Some(Command::Sdo(cmd)) => sdo::run_sdo(&cmd),
         Some(Command::Drive(args)) => drive::run_drive(&args),

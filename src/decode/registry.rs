@@ -55,6 +55,10 @@ struct LearnedMapping {
 }
 
 /// Decodes frames one after another, keeping the state of the bus.
+///
+/// `Clone` lets a viewer keep checkpoints of the state and decode any stretch of a
+/// long trace again from the nearest one.
+#[derive(Clone)]
 pub struct Decoder {
     /// Per-node dictionaries, index = node id (0 unused).
     dicts: Vec<Dictionary>,
@@ -126,6 +130,13 @@ impl Decoder {
                 }
             }
         }
+    }
+
+    /// Numbers the frames that follow from `seq + 1` on (the numbers SDO transactions list in
+    /// `frames`). A caller that skips frames (e.g. classifies only some) keeps them equal to
+    /// frame positions this way.
+    pub fn set_seq(&mut self, seq: u64) {
+        self.seq = seq;
     }
 
     /// The dictionary used for `node`.

@@ -79,7 +79,7 @@ enum Step {
 }
 
 /// Tracks SDO transfers on every channel and collects completed transactions.
-#[derive(Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct SdoTracker {
     channels: BTreeMap<Channel, ChannelState>,
     completed: Vec<Transaction>,

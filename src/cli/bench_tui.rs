@@ -1,0 +1,173 @@
+//! `cotui bench --tui`: figures of the interactive analyzer on a generated log, measured
+//! in-process with the same loop turn as the terminal ([`crate::tui::term::step`]) drawing
+//! to an off-screen 160×50 TestBackend.
+//!
+//! - first screen: from starting to read the log to the first drawn screen with frames;
+//! - full index: until every frame is in the trace store;
+//! - memory: store bytes per frame, and the process's peak RSS per frame;
+//! - redraw: a draw with nothing new, a draw after paging back (rows decoded anew), a
+//!   draw with a filter in force;
+//! - key response while replaying at full speed: from a key press to the end of the
+//!   draw that shows it, i.e. one loop turn (ingest budget, filter budget, draw).
+
+use crate::decode::Decoder;
+use crate::od::Dictionary;
+use crate::tui::app::{App, SourceInfo, SourceKind};
+use crate::tui::keymap::{Action, Keymap};
+use crate::tui::source;
+use crate::tui::term::step;
+use crate::tui::trace::Trace;
+use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+use ratatui::Terminal;
+use ratatui::backend::TestBackend;
+use std::time::{Duration, Instant};
+
+fn app_for(feed: source::Feeds, kind: SourceKind) -> App {
+    let trace = Trace::new(Decoder::new(Dictionary::default(), Vec::new()), 500_000);
+    App::new(
+        trace,
+        Keymap::default_map(),
+        SourceInfo::new("bench.log", kind, feed.0, feed.1),
+    )
+}
+
+fn peak_rss_kib() -> u64 {
+    // SAFETY: rusage is plain data that getrusage fills.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: RUSAGE_SELF with a valid pointer.
+    unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
+    u.ru_maxrss as u64
+}
+
+/// Mean and maximum of `n` timed runs of `f`, in milliseconds.
+fn time_ms(n: usize, mut f: impl FnMut()) -> (f64, f64) {
+    let mut max: f64 = 0.0;
+    let start = Instant::now();
+    for _ in 0..n {
+        let t = Instant::now();
+        f();
+        max = max.max(t.elapsed().as_secs_f64() * 1e3);
+    }
+    (start.elapsed().as_secs_f64() * 1e3 / n as f64, max)
+}
+
+/// Runs the benchmark on `frames` generated frames.
+pub fn bench(frames: u64, json: bool) -> std::io::Result<()> {
+    let dir = std::env::temp_dir().join(format!("cotui-bench-tui-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    let log = dir.join("bench.log");
+    super::bench::write_log(&log, frames)?;
+    let rss_before = peak_rss_kib();
+    let mut term = Terminal::new(TestBackend::new(160, 50)).map_err(std::io::Error::other)?;
+    let draw = |term: &mut Terminal<TestBackend>, app: &mut App| {
+        term.draw(|f| crate::tui::ui::draw(f, app))
+            .map(|_| ())
+            .map_err(std::io::Error::other)
+    };
+
+    // Open: first screen and full index.
+    let start = Instant::now();
+    let mut app = app_for((source::open(log.clone()), None), SourceKind::Open);
+    let mut first_screen = None;
+    while !app.source.done {
+        step(&mut app);
+        if first_screen.is_none() && !app.trace.is_empty() {
+            draw(&mut term, &mut app)?;
+            first_screen = Some(start.elapsed().as_secs_f64());
+        }
+    }
+    let indexed = start.elapsed().as_secs_f64();
+    let n = app.trace.len();
+    let store_per_frame = app.trace.store.bytes() as f64 / n.max(1) as f64;
+    let rss_per_frame = (peak_rss_kib().saturating_sub(rss_before)) as f64 * 1024.0 / n.max(1) as f64;
+
+    // Redraw figures with the whole log loaded.
+    draw(&mut term, &mut app)?;
+    let idle = time_ms(200, || {
+        let _ = draw(&mut term, &mut app);
+    });
+    let page_back = time_ms(200, || {
+        app.act(Action::PageUp);
+        let _ = draw(&mut term, &mut app);
+    });
+    app.set_filter("node 3 kind tpdo");
+    while app.work(Duration::from_millis(100)) {}
+    app.act(Action::Bottom);
+    let filtered = time_ms(200, || {
+        app.act(Action::PageUp);
+        let _ = draw(&mut term, &mut app);
+    });
+    drop(app);
+
+    // Key response while replaying as fast as possible.
+    let (rx, ctl) = source::replay(log.clone(), 0.0);
+    let mut app = app_for((rx, Some(ctl)), SourceKind::Replay { speed: 0.0 });
+    let mut responses = Vec::new();
+    let down = KeyEvent::new(KeyCode::Down, KeyModifiers::NONE);
+    let replay_start = Instant::now();
+    while !app.source.done && responses.len() < 200 {
+        let t = Instant::now();
+        app.key(down);
+        step(&mut app);
+        draw(&mut term, &mut app)?;
+        responses.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    let replayed = app.trace.len();
+    let replay_rate = replayed as f64 / replay_start.elapsed().as_secs_f64();
+    drop(app);
+    let _ = std::fs::remove_dir_all(&dir);
+    let key_mean = responses.iter().sum::<f64>() / responses.len().max(1) as f64;
+    let key_max = responses.iter().copied().fold(0.0, f64::max);
+    let first = first_screen.unwrap_or(f64::NAN);
+
+    if json {
+        println!(
+            "{}",
+            serde_json::json!({
+                "frames": n, "first_screen_s": first, "full_index_s": indexed,
+                "store_bytes_per_frame": store_per_frame, "peak_rss_bytes_per_frame": rss_per_frame,
+                "redraw_idle_ms": {"mean": idle.0, "max": idle.1},
+                "redraw_page_back_ms": {"mean": page_back.0, "max": page_back.1},
+                "redraw_filtered_ms": {"mean": filtered.0, "max": filtered.1},
+                "key_response_ms": {"mean": key_mean, "max": key_max, "samples": responses.len()},
+                "replay_frames_per_s": replay_rate,
+            })
+        );
+        return Ok(());
+    }
+    println!("cotui bench --tui: {n} generated frames (candump -l log), 160x50 off-screen terminal");
+    println!("  first screen            {:>9.3} s   (target < 1 s)", first);
+    println!(
+        "  full index              {:>9.3} s   ({:.0} frames/s)",
+        indexed,
+        n as f64 / indexed
+    );
+    println!(
+        "  trace store             {:>9.1} bytes/frame (target <= 32)",
+        store_per_frame
+    );
+    println!(
+        "  peak RSS growth         {:>9.1} bytes/frame (everything: store, checkpoints, queues)",
+        rss_per_frame
+    );
+    println!(
+        "  redraw, nothing new     {:>9.3} ms mean {:>8.3} ms max (target < 5 ms)",
+        idle.0, idle.1
+    );
+    println!(
+        "  redraw after page up    {:>9.3} ms mean {:>8.3} ms max",
+        page_back.0, page_back.1
+    );
+    println!(
+        "  redraw, filter in force {:>9.3} ms mean {:>8.3} ms max",
+        filtered.0, filtered.1
+    );
+    println!(
+        "  key response, replaying {:>9.3} ms mean {:>8.3} ms max over {} keys at {:.0} frames/s (target < 50 ms)",
+        key_mean,
+        key_max,
+        responses.len(),
+        replay_rate
+    );
+    Ok(())
+}

@@ -1,0 +1,216 @@
+//! `cotui open FILE` and `cotui replay FILE`: the interactive analyzer on a log.
+
+use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
+use crate::tui::app::{App, SourceInfo, SourceKind};
+use crate::tui::keymap::{self, Keymap, KeymapError};
+use crate::tui::source;
+use crate::tui::trace::Trace;
+use clap::Args;
+use std::path::PathBuf;
+
+/// Options shared by every interactive source.
+#[derive(Args, Debug, Clone)]
+pub struct UiArgs {
+    /// Key bindings: `default`, `vim` or a JSON file; the user's keymap.json in the config
+    /// directory then overrides key by key.
+    #[arg(long, value_name = "NAME|FILE", default_value = "default")]
+    pub keymap: String,
+    /// Bus bit rate for the bus load figure.
+    #[arg(long, default_value_t = 500_000)]
+    pub bitrate: u64,
+    /// Initial filter (see the filter language in `?`).
+    #[arg(long)]
+    pub filter: Option<String>,
+    /// Bind a device profile to a node: NODE=NAME (a name in decoders/ or a JSON path).
+    #[arg(long = "profile", value_name = "NODE=NAME")]
+    pub profiles: Vec<String>,
+    /// Bind an EDS/DCF file to a node: NODE=FILE.
+    #[arg(long = "eds", value_name = "NODE=FILE")]
+    pub eds: Vec<String>,
+}
+
+/// Arguments of `cotui open`.
+#[derive(Args, Debug)]
+pub struct OpenArgs {
+    /// Log file (candump -l/-L, candump screen output, Vector ASC).
+    pub file: PathBuf,
+    #[command(flatten)]
+    pub ui: UiArgs,
+}
+
+/// Arguments of `cotui replay`.
+#[derive(Args, Debug)]
+pub struct ReplayArgs {
+    /// Log file (candump -l/-L, candump screen output, Vector ASC).
+    pub file: PathBuf,
+    /// Speed factor (2 = twice as fast; 0 = as fast as possible).
+    #[arg(long, default_value_t = 1.0)]
+    pub speed: f64,
+    #[command(flatten)]
+    pub ui: UiArgs,
+}
+
+/// Arguments of `cotui live`.
+#[derive(Args, Debug)]
+pub struct LiveArgs {
+    /// SocketCAN interface (e.g. can0, vcan0).
+    pub iface: String,
+    /// Never send: the bus is opened without a send path.
+    #[arg(long)]
+    pub listen_only: bool,
+    #[command(flatten)]
+    pub ui: UiArgs,
+}
+
+/// Arguments of `cotui demo`.
+#[derive(Args, Debug)]
+pub struct DemoArgs {
+    /// Never send: watch the simulated drives only.
+    #[arg(long)]
+    pub listen_only: bool,
+    #[command(flatten)]
+    pub ui: UiArgs,
+}
+
+/// The user's keymap file: `$XDG_CONFIG_HOME/cotui/keymap.json` or `~/.config/cotui/keymap.json`.
+pub fn user_keymap_path() -> Option<PathBuf> {
+    let base = std::env::var_os("XDG_CONFIG_HOME")
+        .filter(|v| !v.is_empty())
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".config")))?;
+    Some(base.join("cotui").join("keymap.json"))
+}
+
+/// Loads the keymap named by `--keymap` plus the user's overrides.
+pub fn load_keymap(choice: &str) -> Result<Keymap, String> {
+    let file_text;
+    let base: (&str, &str) = match choice {
+        "default" => ("default", keymap::DEFAULT),
+        "vim" => ("vim", keymap::VIM),
+        path => {
+            file_text = std::fs::read_to_string(path).map_err(|e| format!("--keymap {path}: {e}"))?;
+            (path, &file_text)
+        }
+    };
+    let user = user_keymap_path().and_then(|p| std::fs::read_to_string(&p).ok().map(|t| (p, t)));
+    let user_name = user.as_ref().map(|(p, _)| p.display().to_string());
+    let overrides: Vec<(&str, &str)> = match (&user, &user_name) {
+        (Some((_, t)), Some(n)) => vec![(n.as_str(), t.as_str())],
+        _ => Vec::new(),
+    };
+    Keymap::load(base, &overrides).map_err(|e: KeymapError| format!("keymap: {e}"))
+}
+
+/// How the app gets its frames.
+enum Feeding {
+    /// A log task with an optional control line.
+    Log(source::Feeds),
+    /// A live bus (interface, listen-only) that also runs commands.
+    Live(String, bool),
+}
+
+fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> i32 {
+    let keymap = match load_keymap(&ui.keymap) {
+        Ok(k) => k,
+        Err(e) => {
+            eprintln!("cotui: {e}");
+            return EXIT_USAGE;
+        }
+    };
+    let bindings = match super::bind::bindings(&ui.profiles, &ui.eds) {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("cotui: {e}");
+            return EXIT_USAGE;
+        }
+    };
+    let decoder = crate::decode::Decoder::from_bindings(&bindings);
+    let src = match feed {
+        Feeding::Log((rx, ctl)) => SourceInfo::new(name, kind, rx, ctl),
+        Feeding::Live(iface, listen_only) => {
+            let (rx, req) = crate::tui::live::start(&iface, listen_only, bindings.clone());
+            SourceInfo::live(name, kind, rx, req)
+        }
+    };
+    let mut app = App::new(Trace::new(decoder, ui.bitrate), keymap, src);
+    app.bindings = bindings;
+    if let Some(f) = &ui.filter {
+        app.set_filter(f);
+        if let Some(m) = app.message.take() {
+            eprintln!("cotui: --filter: {m}");
+            return EXIT_USAGE;
+        }
+    }
+    match crate::tui::term::run(app) {
+        Ok(()) => EXIT_OK,
+        Err(e) => {
+            eprintln!("cotui: {e}");
+            EXIT_UNAVAILABLE
+        }
+    }
+}
+
+fn check_file(path: &std::path::Path) -> Result<(), i32> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_file() => Ok(()),
+        Ok(_) => {
+            eprintln!("cotui: {}: not a file", path.display());
+            Err(EXIT_UNAVAILABLE)
+        }
+        Err(e) => {
+            eprintln!("cotui: {}: {e}", path.display());
+            Err(EXIT_UNAVAILABLE)
+        }
+    }
+}
+
+/// Runs `cotui open`.
+pub fn run_open(args: &OpenArgs) -> i32 {
+    if let Err(code) = check_file(&args.file) {
+        return code;
+    }
+    let name = args.file.display().to_string();
+    start(
+        &args.ui,
+        &name,
+        SourceKind::Open,
+        Feeding::Log((source::open(args.file.clone()), None)),
+    )
+}
+
+/// Runs `cotui replay`.
+pub fn run_replay(args: &ReplayArgs) -> i32 {
+    if let Err(code) = check_file(&args.file) {
+        return code;
+    }
+    if !(args.speed >= 0.0 && args.speed.is_finite()) {
+        eprintln!("cotui replay: --speed must be 0 or more");
+        return EXIT_USAGE;
+    }
+    let name = args.file.display().to_string();
+    let (rx, ctl) = source::replay(args.file.clone(), args.speed);
+    start(
+        &args.ui,
+        &name,
+        SourceKind::Replay { speed: args.speed },
+        Feeding::Log((rx, Some(ctl))),
+    )
+}
+
+/// Runs `cotui live IFACE`.
+pub fn run_live(args: &LiveArgs) -> i32 {
+    let kind = SourceKind::Live {
+        listen_only: args.listen_only,
+    };
+    let feed = Feeding::Live(args.iface.clone(), args.listen_only);
+    start(&args.ui, &args.iface, kind, feed)
+}
+
+/// Runs `cotui demo`.
+pub fn run_demo(args: &DemoArgs) -> i32 {
+    let kind = SourceKind::Demo {
+        listen_only: args.listen_only,
+    };
+    let feed = Feeding::Live(crate::bus::DEMO.to_string(), args.listen_only);
+    start(&args.ui, crate::bus::DEMO, kind, feed)
+}

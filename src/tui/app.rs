@@ -1,0 +1,980 @@
+//! The application state and what every action does to it. Pure state transitions:
+//! no terminal here, so tests drive it directly.
+
+use super::filter::Filter;
+use super::keymap::{Action, Key, Keymap, Lookup};
+use super::live::{Request, Requests};
+use super::palette::{self, COMMANDER_WORDS, Planned};
+use super::prompt::{Prompt, PromptKind};
+use super::rows::{Row, RowCache};
+use super::source::{Control, Feed};
+use super::trace::Trace;
+use super::view::View;
+use crate::command::{Command, DriveAction};
+use crate::decode::Decoded;
+use crate::od::bind::Bindings;
+use crossterm::event::{KeyCode, KeyEvent, KeyModifiers, MouseButton, MouseEvent, MouseEventKind};
+use ratatui::layout::Rect;
+use std::collections::BTreeSet;
+use std::sync::mpsc::{Receiver, Sender, TryRecvError};
+use std::time::{Duration, Instant};
+
+/// The main-area panes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pane {
+    Trace,
+    Nodes,
+    Sdo,
+    Stats,
+    Plot,
+}
+
+impl Pane {
+    /// Every pane in tab order.
+    pub const ALL: [Pane; 5] = [Pane::Trace, Pane::Nodes, Pane::Sdo, Pane::Stats, Pane::Plot];
+    /// Tab title.
+    pub fn title(self) -> &'static str {
+        match self {
+            Pane::Trace => "Trace",
+            Pane::Nodes => "Nodes",
+            Pane::Sdo => "SDO",
+            Pane::Stats => "Stats",
+            Pane::Plot => "Plot",
+        }
+    }
+}
+
+/// How the frames come in.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SourceKind {
+    /// A log loaded at once.
+    Open,
+    /// A log played by its timestamps.
+    Replay { speed: f64 },
+    /// A live interface.
+    Live { listen_only: bool },
+    /// The in-process simulated bus.
+    Demo { listen_only: bool },
+}
+
+/// The capture source as the status bar shows it.
+pub struct SourceInfo {
+    /// Name (file or interface).
+    pub name: String,
+    /// Kind.
+    pub kind: SourceKind,
+    /// Paused by the user.
+    pub paused: bool,
+    /// The source has ended.
+    pub done: bool,
+    /// Frames the UI could not take (dropped).
+    pub drops: u64,
+    /// The interface error in force (with the command that fixes it).
+    pub bus_error: Option<String>,
+    feed: Option<Receiver<Feed>>,
+    control: Option<Sender<Control>>,
+    requests: Option<Requests>,
+}
+
+impl SourceInfo {
+    /// A source fed by `feed`, commanded through `control` (replays).
+    pub fn new(name: &str, kind: SourceKind, feed: Receiver<Feed>, control: Option<Sender<Control>>) -> SourceInfo {
+        SourceInfo {
+            name: name.to_string(),
+            kind,
+            paused: false,
+            done: false,
+            drops: 0,
+            bus_error: None,
+            feed: Some(feed),
+            control,
+            requests: None,
+        }
+    }
+
+    /// A live source that also runs palette commands.
+    pub fn live(name: &str, kind: SourceKind, feed: Receiver<Feed>, requests: Requests) -> SourceInfo {
+        SourceInfo {
+            requests: Some(requests),
+            ..SourceInfo::new(name, kind, feed, None)
+        }
+    }
+}
+
+/// Scroll state of a list pane.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ListState {
+    /// Selected row.
+    pub selected: usize,
+    /// First visible row.
+    pub offset: usize,
+}
+
+impl ListState {
+    /// Keeps `selected` within `len` rows and visible in `height` rows.
+    pub fn clamp(&mut self, len: usize, height: usize) {
+        self.selected = self.selected.min(len.saturating_sub(1));
+        let h = height.max(1);
+        if self.selected < self.offset {
+            self.offset = self.selected;
+        } else if self.selected >= self.offset + h {
+            self.offset = self.selected + 1 - h;
+        }
+        self.offset = self.offset.min(len.saturating_sub(h));
+    }
+}
+
+/// Where the last draw put things (for mouse clicks and page sizes).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Layout {
+    /// Rows of the main table, without header.
+    pub table: Rect,
+}
+
+/// The whole application state.
+pub struct App {
+    /// Frames and what is derived from them.
+    pub trace: Trace,
+    /// The filtered view of the trace.
+    pub view: View,
+    /// Key bindings.
+    pub keymap: Keymap,
+    /// The pane in the main area.
+    pub pane: Pane,
+    /// Trace pane scroll state (rows of the view).
+    pub trace_list: ListState,
+    /// Follow the newest frame.
+    pub follow: bool,
+    /// Nodes pane selection.
+    pub nodes_list: ListState,
+    /// SDO pane selection.
+    pub sdo_list: ListState,
+    /// SDO transaction expanded to its frames.
+    pub sdo_expanded: Option<usize>,
+    /// Stats pane selection.
+    pub stats_list: ListState,
+    /// Plot: index into the series keys.
+    pub series_sel: usize,
+    /// Help popup shown.
+    pub help: bool,
+    /// The prompt being edited.
+    pub prompt: Option<Prompt>,
+    /// Search in force (`n`/`N`).
+    pub search: Option<Filter>,
+    /// A message for the status bar (result of the last command).
+    pub message: Option<String>,
+    /// Palette history, newest last.
+    pub history: Vec<String>,
+    /// The capture source.
+    pub source: SourceInfo,
+    /// Decoded rows of the visible window.
+    pub rows: RowCache,
+    /// The selected frame decoded, with its position.
+    pub detail: Option<(usize, Decoded)>,
+    /// Frames per second over the last rate tick.
+    pub rate: f64,
+    /// Set when the user quits.
+    pub quit: bool,
+    /// Layout of the last draw.
+    pub layout: Layout,
+    /// Node bindings (object names and types for palette previews).
+    pub bindings: Bindings,
+    /// A commander line waiting for `y`.
+    pub confirm: Option<Planned>,
+    /// Drives this session enabled (what stop-all stops).
+    pub enabled: BTreeSet<u8>,
+    pending: Vec<Key>,
+    rate_mark: (Instant, usize),
+    /// Set when something changed since the last draw.
+    pub dirty: bool,
+}
+
+/// Names the palette completes.
+pub const PALETTE_COMMANDS: &[&str] = &[
+    "filter", "search", "goto", "time", "speed", "pause", "resume", "plot", "help", "quit",
+];
+
+impl App {
+    /// An application showing `trace`, fed by `source`.
+    pub fn new(trace: Trace, keymap: Keymap, source: SourceInfo) -> App {
+        let bindings = Bindings::new().expect("the built-in profiles load");
+        App {
+            trace,
+            view: View::default(),
+            keymap,
+            pane: Pane::Trace,
+            trace_list: ListState::default(),
+            follow: true,
+            nodes_list: ListState::default(),
+            sdo_list: ListState::default(),
+            sdo_expanded: None,
+            stats_list: ListState::default(),
+            series_sel: 0,
+            help: false,
+            prompt: None,
+            search: None,
+            message: None,
+            history: Vec::new(),
+            source,
+            rows: RowCache::default(),
+            detail: None,
+            rate: 0.0,
+            quit: false,
+            layout: Layout::default(),
+            confirm: None,
+            bindings,
+            enabled: BTreeSet::new(),
+            pending: Vec::new(),
+            rate_mark: (Instant::now(), 0),
+            dirty: true,
+        }
+    }
+
+    /// Takes frames from the source for up to `budget`; true when more are waiting.
+    pub fn ingest(&mut self, budget: Duration) -> bool {
+        let Some(feed) = &self.source.feed else {
+            return false;
+        };
+        let start = Instant::now();
+        loop {
+            match feed.try_recv() {
+                Ok(Feed::Frames(batch)) => {
+                    for f in &batch {
+                        self.trace.push(f);
+                    }
+                    self.dirty = true;
+                }
+                Ok(Feed::Interfaces(names)) => {
+                    for n in names {
+                        self.trace.ifaces.intern(&n);
+                    }
+                }
+                Ok(Feed::Reset) => {
+                    self.trace.clear();
+                    self.view = View::new(self.view.filter.clone());
+                    self.rows = RowCache::default();
+                    self.detail = None;
+                    self.trace_list = ListState::default();
+                    self.rate_mark = (Instant::now(), 0);
+                    self.dirty = true;
+                }
+                Ok(Feed::Status(s) | Feed::Result(s)) => {
+                    self.message = Some(s);
+                    self.dirty = true;
+                }
+                Ok(Feed::Lost(n)) => {
+                    self.source.drops += n;
+                    self.dirty = true;
+                }
+                Ok(Feed::BusError(e)) => {
+                    self.source.bus_error = Some(e);
+                    self.dirty = true;
+                }
+                Ok(Feed::BusOk) => {
+                    self.source.bus_error = None;
+                    self.dirty = true;
+                }
+                Ok(Feed::Done) | Err(TryRecvError::Disconnected) => {
+                    self.trace.store.shrink();
+                    self.source.done = true;
+                    self.source.feed = None;
+                    self.dirty = true;
+                    return false;
+                }
+                Err(TryRecvError::Empty) => return false,
+            }
+            if start.elapsed() >= budget {
+                return true;
+            }
+        }
+    }
+
+    /// Background work: filter scanning. True when work is left.
+    pub fn work(&mut self, budget: Duration) -> bool {
+        let before = self.view.len(&self.trace);
+        let more = self.view.advance(&self.trace, budget);
+        if self.view.len(&self.trace) != before {
+            self.dirty = true;
+        }
+        more
+    }
+
+    /// Periodic update of the frame rate.
+    pub fn tick(&mut self) {
+        let (t, n) = self.rate_mark;
+        let dt = t.elapsed().as_secs_f64();
+        if dt >= 0.5 {
+            self.rate = self.trace.len().saturating_sub(n) as f64 / dt;
+            self.rate_mark = (Instant::now(), self.trace.len());
+            self.dirty = true;
+        }
+    }
+
+    /// Rows in the trace view.
+    pub fn view_len(&self) -> usize {
+        self.view.len(&self.trace)
+    }
+
+    /// Visible height of the main table.
+    fn page(&self) -> usize {
+        (self.layout.table.height as usize).max(1)
+    }
+
+    /// Handles a key press.
+    pub fn key(&mut self, ev: KeyEvent) {
+        self.dirty = true;
+        if let Some(p) = self.confirm.take() {
+            if ev.code == KeyCode::Char('y') {
+                self.send(p);
+            } else {
+                self.message = Some("not sent".into());
+            }
+            return;
+        }
+        if self.prompt.is_some() {
+            self.prompt_key(ev);
+            self.preview();
+            return;
+        }
+        let Some(k) = Key::from_event(&ev) else { return };
+        self.pending.push(k);
+        match self.keymap.lookup(&self.pending) {
+            Lookup::Action(a) => {
+                self.pending.clear();
+                self.act(a);
+            }
+            Lookup::Pending => {}
+            Lookup::None => {
+                self.pending.clear();
+                if let Lookup::Action(a) = self.keymap.lookup(&[k]) {
+                    self.act(a);
+                }
+            }
+        }
+    }
+
+    fn prompt_key(&mut self, ev: KeyEvent) {
+        let Some(p) = self.prompt.as_mut() else { return };
+        let ctrl = ev.modifiers.contains(KeyModifiers::CONTROL);
+        match ev.code {
+            KeyCode::Esc => self.prompt = None,
+            KeyCode::Char('c') if ctrl => self.prompt = None,
+            KeyCode::Enter => {
+                let p = self
+                    .prompt
+                    .take()
+                    .unwrap_or_else(|| Prompt::new(PromptKind::Palette, ""));
+                self.submit(p);
+            }
+            KeyCode::Char('a') if ctrl => p.jump(false),
+            KeyCode::Char('e') if ctrl => p.jump(true),
+            KeyCode::Char('u') if ctrl => *p = Prompt::new(p.kind, ""),
+            KeyCode::Char(c) => p.insert(c),
+            KeyCode::Backspace => p.backspace(),
+            KeyCode::Delete => p.delete(),
+            KeyCode::Left => p.move_by(-1),
+            KeyCode::Right => p.move_by(1),
+            KeyCode::Home => p.jump(false),
+            KeyCode::End => p.jump(true),
+            KeyCode::Up => p.history(&self.history, true),
+            KeyCode::Down => p.history(&self.history, false),
+            KeyCode::Tab if p.kind == PromptKind::Palette => {
+                let words: Vec<&str> = PALETTE_COMMANDS.iter().chain(COMMANDER_WORDS).copied().collect();
+                let shown = p.complete(&words);
+                if !shown.is_empty() {
+                    self.message = Some(shown.join("  "));
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// While typing a commander line, shows the frames it would send.
+    fn preview(&mut self) {
+        let Some(p) = &self.prompt else { return };
+        let first = p.text.split_whitespace().next().unwrap_or("");
+        if p.kind == PromptKind::Palette && COMMANDER_WORDS.contains(&first) {
+            self.message = Some(match palette::plan(&p.text, &self.bindings, |n| self.drive_state(n)) {
+                Ok(pl) => format!("will send: {}", pl.preview),
+                Err(e) => e,
+            });
+        }
+    }
+
+    fn drive_state(&self, node: u8) -> Option<crate::decode::cia402::DriveState> {
+        self.trace.nodes.get(node).and_then(|n| n.drive)
+    }
+
+    /// Runs a commander line: asks for confirmation first when it needs one.
+    fn commander(&mut self, line: &str) {
+        match palette::plan(line, &self.bindings, |n| self.drive_state(n)) {
+            Ok(p) => match &p.confirm {
+                Some(why) => {
+                    self.message = Some(format!("{why}: {} — press y to send, any other key cancels", p.preview));
+                    self.confirm = Some(p);
+                }
+                None => self.send(p),
+            },
+            Err(e) => self.message = Some(e),
+        }
+    }
+
+    fn send(&mut self, p: Planned) {
+        let Some(req) = &self.source.requests else {
+            self.message = Some("not sent: this source has no bus (use `cotui live IFACE` or `cotui demo`)".into());
+            return;
+        };
+        if let Command::Drive { node, action, .. } = &p.command {
+            match action {
+                DriveAction::Enable => {
+                    self.enabled.insert(*node);
+                }
+                DriveAction::Disable | DriveAction::QuickStop => {
+                    self.enabled.remove(node);
+                }
+                _ => {}
+            }
+        }
+        self.message = Some(format!("sending: {}", p.preview));
+        let _ = req.send(Request::Run(p.command));
+    }
+
+    fn stop_all(&mut self) {
+        let Some(req) = &self.source.requests else {
+            self.message = Some("stop all: this source has no bus".into());
+            return;
+        };
+        if self.enabled.is_empty() {
+            self.message = Some("stop all: no drive was enabled from this session".into());
+            return;
+        }
+        let nodes: Vec<u8> = std::mem::take(&mut self.enabled).into_iter().collect();
+        self.message = Some(format!("stop all: quick stop then disable voltage on nodes {nodes:?}"));
+        let _ = req.send(Request::StopAll(nodes));
+    }
+
+    fn submit(&mut self, p: Prompt) {
+        let text = p.text.trim().to_string();
+        if !text.is_empty() && self.history.last() != Some(&text) {
+            self.history.push(text.clone());
+        }
+        match p.kind {
+            PromptKind::Filter => self.set_filter(&text),
+            PromptKind::Search => self.set_search(&text),
+            PromptKind::Palette => self.run_command(&text),
+        }
+    }
+
+    /// Applies a filter text; a parse error goes to the status bar and keeps the old filter.
+    pub fn set_filter(&mut self, text: &str) {
+        match Filter::parse(text) {
+            Ok(f) => {
+                let pos = self.selected_position();
+                self.view = View::new(f);
+                self.view.advance(&self.trace, Duration::from_millis(30));
+                self.trace_list.selected = pos.map(|p| self.view.row_of(p)).unwrap_or(0);
+                self.message = None;
+                self.rows = RowCache::default();
+            }
+            Err(e) => self.message = Some(format!("filter: {e}")),
+        }
+    }
+
+    fn set_search(&mut self, text: &str) {
+        match Filter::parse(text) {
+            Ok(f) if f.is_empty() => self.search = None,
+            Ok(f) => {
+                self.search = Some(f);
+                self.jump_match(true);
+            }
+            Err(e) => self.message = Some(format!("search: {e}")),
+        }
+    }
+
+    /// Runs a palette command; the result goes to the status bar.
+    pub fn run_command(&mut self, line: &str) {
+        let (cmd, rest) = line.split_once(' ').unwrap_or((line, ""));
+        let rest = rest.trim();
+        let result: Result<String, String> = match cmd {
+            "" => Ok(String::new()),
+            "filter" => {
+                self.set_filter(rest);
+                return;
+            }
+            "search" => {
+                self.set_search(rest);
+                return;
+            }
+            "goto" => rest
+                .parse::<usize>()
+                .map_err(|_| format!("goto: `{rest}` is not a frame number"))
+                .map(|n| {
+                    self.select_position(n.saturating_sub(1));
+                    format!("frame {n}")
+                }),
+            "time" => rest
+                .parse::<f64>()
+                .map_err(|_| format!("time: `{rest}` is not seconds"))
+                .map(|s| {
+                    let t0 = self.start_ns();
+                    let pos = self.trace.store.position_at(t0 + (s.max(0.0) * 1e9) as u64);
+                    self.select_position(pos);
+                    format!("t = {s} s")
+                }),
+            "speed" => match rest.parse::<f64>() {
+                Ok(x) if x >= 0.0 => self.set_speed(x),
+                _ => Err(format!("speed: `{rest}` is not a factor (0 = as fast as possible)")),
+            },
+            "pause" => self.set_paused(true),
+            "resume" => self.set_paused(false),
+            "plot" => self.plot_command(rest),
+            "help" => {
+                self.help = true;
+                Ok(String::new())
+            }
+            "quit" => {
+                self.quit = true;
+                Ok(String::new())
+            }
+            w if COMMANDER_WORDS.contains(&w) => {
+                self.commander(line);
+                return;
+            }
+            other => Err(format!(
+                "unknown command `{other}` (commands: {} {})",
+                PALETTE_COMMANDS.join(" "),
+                COMMANDER_WORDS.join(" ")
+            )),
+        };
+        self.message = match result {
+            Ok(s) if s.is_empty() => None,
+            Ok(s) => Some(s),
+            Err(e) => Some(e),
+        };
+    }
+
+    fn plot_command(&mut self, rest: &str) -> Result<String, String> {
+        let mut it = rest.split_whitespace();
+        let (Some(node), Some(obj)) = (it.next(), it.next()) else {
+            return Err("plot: usage `plot NODE INDEX[:SUB]`, e.g. `plot 1 6064:00`".into());
+        };
+        let node: u8 = node.parse().map_err(|_| format!("plot: `{node}` is not a node-ID"))?;
+        let (i, s) = obj.split_once(':').unwrap_or((obj, "0"));
+        let index =
+            u16::from_str_radix(i.trim_start_matches("0x"), 16).map_err(|_| format!("plot: bad index `{i}`"))?;
+        let sub = u8::from_str_radix(s, 16).map_err(|_| format!("plot: bad sub-index `{s}`"))?;
+        let keys = self.trace.series.keys();
+        match keys.iter().position(|k| *k == (node, index, sub)) {
+            Some(at) => {
+                self.series_sel = at;
+                self.pane = Pane::Plot;
+                Ok(String::new())
+            }
+            None => Err(format!(
+                "plot: no numeric values of node {node} 0x{index:04X}:{sub:02X} seen"
+            )),
+        }
+    }
+
+    fn set_speed(&mut self, x: f64) -> Result<String, String> {
+        match (&mut self.source.kind, &self.source.control) {
+            (SourceKind::Replay { speed }, Some(c)) => {
+                *speed = x;
+                let _ = c.send(Control::Speed(x));
+                Ok(if x == 0.0 {
+                    "speed: as fast as possible".into()
+                } else {
+                    format!("speed ×{x}")
+                })
+            }
+            _ => Err("speed: only a replay has a speed".into()),
+        }
+    }
+
+    fn set_paused(&mut self, p: bool) -> Result<String, String> {
+        self.source.paused = p;
+        if let Some(c) = &self.source.control {
+            let _ = c.send(Control::Pause(p));
+        }
+        if p {
+            self.follow = false;
+        }
+        Ok(String::new())
+    }
+
+    /// The timestamp of the first frame.
+    pub fn start_ns(&self) -> u64 {
+        if self.trace.is_empty() {
+            0
+        } else {
+            self.trace.store.packed(0).ts_ns
+        }
+    }
+
+    /// The trace position of the selected row.
+    pub fn selected_position(&self) -> Option<usize> {
+        (!self.view.is_empty(&self.trace)).then(|| self.view.position(self.trace_list.selected))
+    }
+
+    fn select_position(&mut self, pos: usize) {
+        self.follow = false;
+        self.pane = Pane::Trace;
+        self.trace_list.selected = self.view.row_of(pos);
+        self.trace_list.clamp(self.view_len(), self.page());
+    }
+
+    /// Jumps to the next (or previous) row matching the search.
+    fn jump_match(&mut self, forward: bool) {
+        let Some(f) = self.search.clone() else {
+            self.message = Some("no search: press the search key first".into());
+            return;
+        };
+        let n = self.view_len();
+        if n == 0 {
+            return;
+        }
+        let cur = self.trace_list.selected;
+        let rows: Box<dyn Iterator<Item = usize>> = if forward {
+            Box::new(cur + 1..n)
+        } else {
+            Box::new((0..cur).rev())
+        };
+        let deadline = Instant::now() + Duration::from_millis(500);
+        let needs_label = f.needs_label();
+        let in_transfer = f.has_transfer_terms().then(|| {
+            let mut set = std::collections::HashSet::new();
+            for t in self.trace.transactions.iter().filter(|t| f.transaction_matches(t)) {
+                set.extend(t.frames.iter().map(|s| s.saturating_sub(1) as usize));
+            }
+            set
+        });
+        for r in rows {
+            let pos = self.view.position(r);
+            let label = needs_label
+                .then(|| self.trace.decode_positions(&[pos]).pop().map(|d| d.label))
+                .flatten();
+            let inside = in_transfer.as_ref().is_some_and(|s| s.contains(&pos));
+            if f.matches(self.trace.store.packed(pos), inside, label.as_deref()) {
+                self.follow = false;
+                self.trace_list.selected = r;
+                self.trace_list.clamp(n, self.page());
+                self.message = Some(format!("match at frame {}", pos + 1));
+                return;
+            }
+            if Instant::now() > deadline {
+                self.message = Some(format!("search stopped at frame {} (press again to go on)", pos + 1));
+                self.trace_list.selected = r;
+                return;
+            }
+        }
+        self.message = Some(format!(
+            "no {} match for `{}`",
+            if forward { "later" } else { "earlier" },
+            f.source
+        ));
+    }
+
+    fn list(&mut self) -> Option<(&mut ListState, usize)> {
+        let n = match self.pane {
+            Pane::Trace => self.view_len(),
+            Pane::Nodes => self.trace.nodes.len(),
+            Pane::Sdo => match self.sdo_expanded {
+                Some(t) => self.trace.transactions.get(t).map(|t| t.frames.len()).unwrap_or(0),
+                None => self.trace.transactions.len(),
+            },
+            Pane::Stats => self.trace.stats.len(),
+            Pane::Plot => return None,
+        };
+        let l = match self.pane {
+            Pane::Trace => &mut self.trace_list,
+            Pane::Nodes => &mut self.nodes_list,
+            Pane::Sdo => &mut self.sdo_list,
+            _ => &mut self.stats_list,
+        };
+        Some((l, n))
+    }
+
+    fn scroll(&mut self, delta: isize) {
+        let page = self.page();
+        if self.pane == Pane::Trace {
+            self.follow = false;
+        }
+        if let Some((l, n)) = self.list() {
+            l.selected = (l.selected as isize + delta).clamp(0, n.saturating_sub(1) as isize) as usize;
+            l.clamp(n, page);
+        }
+    }
+
+    /// Does what an action says.
+    pub fn act(&mut self, a: Action) {
+        self.dirty = true;
+        let page = self.page() as isize;
+        match a {
+            Action::Quit => self.quit = true,
+            Action::Help => self.help = !self.help,
+            Action::Down => self.scroll(1),
+            Action::Up => self.scroll(-1),
+            Action::PageDown => self.scroll(page),
+            Action::PageUp => self.scroll(-page),
+            Action::Top => self.scroll(isize::MIN / 2),
+            Action::Bottom => {
+                self.scroll(isize::MAX / 2);
+                if self.pane == Pane::Trace {
+                    self.follow = true;
+                }
+            }
+            Action::Follow => {
+                self.follow = !self.follow;
+                self.pane = Pane::Trace;
+            }
+            Action::Pause => {
+                let p = !self.source.paused;
+                let _ = self.set_paused(p);
+                if !p {
+                    self.follow = true;
+                }
+            }
+            Action::Expand => match self.pane {
+                Pane::Sdo if self.sdo_expanded.is_none() && !self.trace.transactions.is_empty() => {
+                    self.sdo_expanded = Some(self.sdo_list.selected);
+                    self.sdo_list = ListState::default();
+                }
+                Pane::Sdo => {
+                    if let Some(t) = self.sdo_expanded.and_then(|t| self.trace.transactions.get(t))
+                        && let Some(seq) = t.frames.get(self.sdo_list.selected)
+                    {
+                        let pos = seq.saturating_sub(1) as usize;
+                        self.view = View::new(Filter::default());
+                        self.select_position(pos);
+                    }
+                }
+                Pane::Nodes => {
+                    let node = self.trace.nodes.iter().nth(self.nodes_list.selected).map(|(n, _)| *n);
+                    if let Some(n) = node {
+                        self.set_filter(&format!("node {n}"));
+                        self.pane = Pane::Trace;
+                    }
+                }
+                Pane::Stats => {
+                    let id = self.trace.stats.iter().nth(self.stats_list.selected).map(|(k, _)| k.1);
+                    if let Some(id) = id {
+                        self.set_filter(&format!("id {id:X}"));
+                        self.pane = Pane::Trace;
+                    }
+                }
+                _ => {}
+            },
+            Action::Back => {
+                if self.help {
+                    self.help = false;
+                } else if let Some(t) = self.sdo_expanded.take() {
+                    self.sdo_list = ListState {
+                        selected: t,
+                        offset: t.saturating_sub(3),
+                    };
+                } else {
+                    self.search = None;
+                    self.message = None;
+                }
+            }
+            Action::NextPane | Action::PrevPane => {
+                let i = Pane::ALL.iter().position(|p| *p == self.pane).unwrap_or(0);
+                let d = if a == Action::NextPane { 1 } else { Pane::ALL.len() - 1 };
+                self.pane = Pane::ALL[(i + d) % Pane::ALL.len()];
+            }
+            Action::PaneTrace => self.pane = Pane::Trace,
+            Action::PaneNodes => self.pane = Pane::Nodes,
+            Action::PaneSdo => self.pane = Pane::Sdo,
+            Action::PaneStats => self.pane = Pane::Stats,
+            Action::PanePlot => self.pane = Pane::Plot,
+            Action::Filter => self.prompt = Some(Prompt::new(PromptKind::Filter, &self.view.filter.source)),
+            Action::Search => self.prompt = Some(Prompt::new(PromptKind::Search, "")),
+            Action::NextMatch => self.jump_match(true),
+            Action::PrevMatch => self.jump_match(false),
+            Action::ClearFilter => self.set_filter(""),
+            Action::Palette => self.prompt = Some(Prompt::new(PromptKind::Palette, "")),
+            Action::StopAll => self.stop_all(),
+            Action::SpeedUp | Action::SpeedDown => {
+                if let SourceKind::Replay { speed } = self.source.kind {
+                    let base = if speed <= 0.0 { 1.0 } else { speed };
+                    let x = if a == Action::SpeedUp { base * 2.0 } else { base / 2.0 };
+                    self.message = Some(self.set_speed(x).unwrap_or_else(|e| e));
+                }
+            }
+            Action::Step => match &self.source.control {
+                Some(c) if self.source.paused => {
+                    let _ = c.send(Control::Step);
+                    self.follow = true;
+                }
+                _ => self.message = Some("step: pause a replay first".into()),
+            },
+            Action::SeekForward | Action::SeekBack => match &self.source.control {
+                Some(c) => {
+                    let d: i64 = if a == Action::SeekForward {
+                        10_000_000_000
+                    } else {
+                        -10_000_000_000
+                    };
+                    let _ = c.send(Control::Seek(d));
+                    self.follow = true;
+                }
+                None => self.message = Some("seek: only a replay can seek".into()),
+            },
+            Action::NextSeries | Action::PrevSeries => {
+                let n = self.trace.series.keys().len().max(1);
+                self.series_sel = if a == Action::NextSeries {
+                    (self.series_sel + 1) % n
+                } else {
+                    (self.series_sel + n - 1) % n
+                };
+                self.pane = Pane::Plot;
+            }
+        }
+    }
+
+    /// Handles a mouse event: wheel scrolls, left click selects a row.
+    pub fn mouse(&mut self, ev: MouseEvent) {
+        self.dirty = true;
+        match ev.kind {
+            MouseEventKind::ScrollDown => self.scroll(3),
+            MouseEventKind::ScrollUp => self.scroll(-3),
+            MouseEventKind::Down(MouseButton::Left) => {
+                let t = self.layout.table;
+                if ev.column >= t.x && ev.column < t.x + t.width && ev.row >= t.y && ev.row < t.y + t.height {
+                    let page = self.page();
+                    let r = (ev.row - t.y) as usize;
+                    if self.pane == Pane::Trace {
+                        self.follow = false;
+                    }
+                    if let Some((l, n)) = self.list() {
+                        let want = l.offset + r;
+                        if want < n {
+                            l.selected = want;
+                            l.clamp(n, page);
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// Before drawing: pins the selection to the newest row in follow mode and decodes the
+    /// visible window (`height` rows), the tail strip and the selected frame.
+    pub fn prepare(&mut self, height: usize, tail: &[usize]) {
+        let n = self.view_len();
+        if self.follow {
+            self.trace_list.selected = n.saturating_sub(1);
+        }
+        self.trace_list.clamp(n, height);
+        let mut positions: Vec<usize> = (self.trace_list.offset..(self.trace_list.offset + height).min(n))
+            .map(|r| self.view.position(r))
+            .collect();
+        positions.extend_from_slice(tail);
+        positions.sort_unstable();
+        positions.dedup();
+        self.rows.fill(&self.trace, &positions);
+        let sel = self.selected_position();
+        if sel != self.detail.as_ref().map(|(p, _)| *p) {
+            self.detail = sel.and_then(|p| self.trace.decode_positions(&[p]).pop().map(|d| (p, d)));
+        }
+    }
+
+    /// The decoded row for a trace position, when it is in the visible window.
+    pub fn row(&self, pos: usize) -> Option<&Row> {
+        self.rows.get(pos)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tui::panes::testutil::{app, frames};
+    use crossterm::event::KeyEvent;
+
+    fn key(c: char) -> KeyEvent {
+        KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE)
+    }
+
+    #[test]
+    fn replay_keys_send_pause_step_speed_and_seek() {
+        let (_ftx, frx) = std::sync::mpsc::channel();
+        let (ctx, crx) = std::sync::mpsc::channel();
+        let mut a = app();
+        a.source = SourceInfo::new("r.log", SourceKind::Replay { speed: 1.0 }, frx, Some(ctx));
+        a.act(Action::Step);
+        assert_eq!(a.message.as_deref(), Some("step: pause a replay first"));
+        for k in [' ', '.', '+', '+', '-', ' '] {
+            a.key(key(k));
+        }
+        a.act(Action::SeekBack);
+        let sent: Vec<Control> = crx.try_iter().collect();
+        assert_eq!(
+            sent,
+            [
+                Control::Pause(true),
+                Control::Step,
+                Control::Speed(2.0),
+                Control::Speed(4.0),
+                Control::Speed(2.0),
+                Control::Pause(false),
+                Control::Seek(-10_000_000_000),
+            ]
+        );
+        assert_eq!(a.source.kind, SourceKind::Replay { speed: 2.0 });
+    }
+
+    #[test]
+    fn search_jumps_between_matches_and_goto_selects() {
+        let mut a = app();
+        a.layout.table = Rect::new(0, 0, 100, 10);
+        a.run_command("goto 1");
+        a.run_command("search emcy");
+        assert_eq!(a.selected_position(), Some(frames().len() - 1));
+        a.run_command("search \"boot-up node 2\"");
+        assert_eq!(a.message.as_deref(), Some("no later match for `\"boot-up node 2\"`"));
+        a.act(Action::PrevMatch);
+        assert_eq!(a.selected_position(), Some(1));
+        a.run_command("bogus");
+        assert!(
+            a.message
+                .as_deref()
+                .unwrap_or("")
+                .starts_with("unknown command `bogus`")
+        );
+    }
+
+    #[test]
+    fn palette_commander_lines_need_a_bus_and_confirm_broadcasts() {
+        let mut a = app();
+        a.key(key(':'));
+        for c in "nmt reset-node 0".chars() {
+            a.key(key(c));
+        }
+        assert_eq!(a.message.as_deref(), Some("will send: 000#8100"));
+        a.key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
+        assert!(a.confirm.is_some());
+        a.key(key('y'));
+        assert_eq!(
+            a.message.as_deref(),
+            Some("not sent: this source has no bus (use `cotui live IFACE` or `cotui demo`)")
+        );
+        assert_eq!(a.history, ["nmt reset-node 0"]);
+    }
+
+    #[test]
+    fn sdo_pane_expands_and_enter_on_a_frame_jumps_to_it_in_the_trace() {
+        let mut a = app();
+        a.layout.table = Rect::new(0, 0, 100, 10);
+        a.act(Action::PaneSdo);
+        for _ in 0..4 {
+            a.act(Action::Down);
+        }
+        a.act(Action::Expand);
+        assert_eq!(a.sdo_expanded, Some(4));
+        a.act(Action::Down);
+        a.act(Action::Expand);
+        assert_eq!(a.pane, Pane::Trace);
+        assert_eq!(a.selected_position(), Some(12));
+    }
+}

@@ -1,0 +1,494 @@
+//! Key bindings: JSON files mapping key specs to actions, validated at start.
+//!
+//! A keymap file is one JSON object, `{"KEYS": "action", ...}`. KEYS is one key or a
+//! sequence separated by spaces (`"g g"`); a key is a character or a name (`enter esc tab
+//! backtab space up down left right pageup pagedown home end backspace delete f1`..`f12`)
+//! with optional `ctrl-`/`alt-`/`shift-` prefixes. The action `none` unbinds a key.
+//! The embedded `keymaps/default.json` is the base, or `keymaps/vim.json` with `--keymap
+//! vim`, or a file given with `--keymap FILE`; the user's `keymap.json` in the config
+//! directory then overrides key by key. Unknown actions, keys bound twice and keys that
+//! are a prefix of another binding are errors with file, line and column.
+
+use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+use serde::de::{Deserializer, MapAccess, Visitor};
+use std::collections::BTreeMap;
+use std::fmt;
+
+/// The embedded default keymap.
+pub const DEFAULT: &str = include_str!("../../keymaps/default.json");
+/// The embedded vim-style keymap.
+pub const VIM: &str = include_str!("../../keymaps/vim.json");
+
+macro_rules! actions {
+    ($($variant:ident = $name:literal : $help:literal,)*) => {
+        /// Everything a key can do.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        pub enum Action { $(#[doc = $help] $variant,)* }
+
+        impl Action {
+            /// Every action, in help order.
+            pub const ALL: &[Action] = &[$(Action::$variant,)*];
+            /// The name used in keymap files.
+            pub fn name(self) -> &'static str {
+                match self { $(Action::$variant => $name,)* }
+            }
+            /// One-line help.
+            pub fn help(self) -> &'static str {
+                match self { $(Action::$variant => $help,)* }
+            }
+            /// The action with this keymap name.
+            pub fn from_name(s: &str) -> Option<Action> {
+                match s { $($name => Some(Action::$variant),)* _ => None }
+            }
+        }
+    };
+}
+
+actions! {
+    Quit = "quit": "Quit",
+    Help = "help": "Show or hide this help",
+    Down = "down": "Next row",
+    Up = "up": "Previous row",
+    PageDown = "page_down": "Next page",
+    PageUp = "page_up": "Previous page",
+    Top = "top": "First row",
+    Bottom = "bottom": "Last row (and follow)",
+    Follow = "follow": "Toggle follow mode",
+    Pause = "pause": "Pause or resume the capture / replay",
+    Expand = "expand": "Open the selected row (SDO transfer frames, signal to plot)",
+    Back = "back": "Close popup, clear search, leave expanded view",
+    NextPane = "next_pane": "Next pane",
+    PrevPane = "prev_pane": "Previous pane",
+    PaneTrace = "pane_trace": "Trace pane",
+    PaneNodes = "pane_nodes": "Nodes pane",
+    PaneSdo = "pane_sdo": "SDO transactions pane",
+    PaneStats = "pane_stats": "Statistics pane",
+    PanePlot = "pane_plot": "Plot pane",
+    Filter = "filter": "Edit the filter",
+    Search = "search": "Search (same language as the filter)",
+    NextMatch = "next_match": "Jump to the next match",
+    PrevMatch = "prev_match": "Jump to the previous match",
+    ClearFilter = "clear_filter": "Clear the filter",
+    Palette = "palette": "Command palette",
+    StopAll = "stop_all": "Stop all drives this session enabled",
+    SpeedUp = "speed_up": "Replay faster",
+    SpeedDown = "speed_down": "Replay slower",
+    Step = "step": "Replay one frame (when paused)",
+    SeekForward = "seek_forward": "Replay: jump 10 s ahead",
+    SeekBack = "seek_back": "Replay: jump 10 s back",
+    NextSeries = "next_series": "Plot: next signal",
+    PrevSeries = "prev_series": "Plot: previous signal",
+}
+
+/// One key press, normalised (no SHIFT on characters).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Key {
+    code: KeyCodeOrd,
+    mods: u8,
+}
+
+/// `KeyCode` subset that is ordered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+enum KeyCodeOrd {
+    Char(char),
+    F(u8),
+    Named(u8),
+}
+
+const NAMES: [(&str, KeyCode); 14] = [
+    ("enter", KeyCode::Enter),
+    ("esc", KeyCode::Esc),
+    ("tab", KeyCode::Tab),
+    ("backtab", KeyCode::BackTab),
+    ("up", KeyCode::Up),
+    ("down", KeyCode::Down),
+    ("left", KeyCode::Left),
+    ("right", KeyCode::Right),
+    ("pageup", KeyCode::PageUp),
+    ("pagedown", KeyCode::PageDown),
+    ("home", KeyCode::Home),
+    ("end", KeyCode::End),
+    ("backspace", KeyCode::Backspace),
+    ("delete", KeyCode::Delete),
+];
+
+impl Key {
+    /// The key of a crossterm event, if it is one a keymap can name.
+    pub fn from_event(ev: &KeyEvent) -> Option<Key> {
+        let mut mods = ev.modifiers;
+        let code = match ev.code {
+            KeyCode::Char(c) => {
+                mods.remove(KeyModifiers::SHIFT);
+                KeyCodeOrd::Char(c)
+            }
+            KeyCode::F(n) => KeyCodeOrd::F(n),
+            KeyCode::BackTab => {
+                mods.remove(KeyModifiers::SHIFT);
+                KeyCodeOrd::Named(3)
+            }
+            other => KeyCodeOrd::Named(NAMES.iter().position(|(_, c)| *c == other)? as u8),
+        };
+        Some(Key {
+            code,
+            mods: (mods & (KeyModifiers::CONTROL | KeyModifiers::ALT | KeyModifiers::SHIFT)).bits(),
+        })
+    }
+
+    /// Parses one key spec such as `q`, `G`, `ctrl-c`, `pagedown`, `f1`.
+    pub fn parse(spec: &str) -> Result<Key, String> {
+        let mut mods = KeyModifiers::NONE;
+        let mut rest = spec;
+        loop {
+            let lower = rest.to_ascii_lowercase();
+            let (m, len) = if lower.starts_with("ctrl-") && rest.len() > 5 {
+                (KeyModifiers::CONTROL, 5)
+            } else if lower.starts_with("alt-") && rest.len() > 4 {
+                (KeyModifiers::ALT, 4)
+            } else if lower.starts_with("shift-") && rest.len() > 6 {
+                (KeyModifiers::SHIFT, 6)
+            } else {
+                break;
+            };
+            mods |= m;
+            rest = &rest[len..];
+        }
+        let mut chars = rest.chars();
+        let code = match (chars.next(), chars.next()) {
+            (Some(c), None) => KeyCode::Char(c),
+            _ => {
+                let lower = rest.to_ascii_lowercase();
+                if lower == "space" {
+                    KeyCode::Char(' ')
+                } else if let Some(n) = lower.strip_prefix('f').and_then(|n| n.parse::<u8>().ok()) {
+                    if !(1..=12).contains(&n) {
+                        return Err(format!("no key `{rest}` (f1..f12)"));
+                    }
+                    KeyCode::F(n)
+                } else {
+                    NAMES
+                        .iter()
+                        .find(|(n, _)| *n == lower)
+                        .map(|(_, c)| *c)
+                        .ok_or_else(|| format!("unknown key name `{rest}`"))?
+                }
+            }
+        };
+        Key::from_event(&KeyEvent::new(code, mods)).ok_or_else(|| format!("unknown key `{spec}`"))
+    }
+}
+
+impl fmt::Display for Key {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mods = KeyModifiers::from_bits_truncate(self.mods);
+        if mods.contains(KeyModifiers::CONTROL) {
+            f.write_str("ctrl-")?;
+        }
+        if mods.contains(KeyModifiers::ALT) {
+            f.write_str("alt-")?;
+        }
+        if mods.contains(KeyModifiers::SHIFT) {
+            f.write_str("shift-")?;
+        }
+        match self.code {
+            KeyCodeOrd::Char(' ') => f.write_str("space"),
+            KeyCodeOrd::Char(c) => write!(f, "{c}"),
+            KeyCodeOrd::F(n) => write!(f, "f{n}"),
+            KeyCodeOrd::Named(i) => f.write_str(NAMES[i as usize].0),
+        }
+    }
+}
+
+/// A key sequence.
+pub type Keys = Vec<Key>;
+
+/// Formats a key sequence as in keymap files.
+pub fn keys_text(keys: &[Key]) -> String {
+    keys.iter().map(Key::to_string).collect::<Vec<_>>().join(" ")
+}
+
+/// A keymap error, located in its file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct KeymapError {
+    /// File name (or `default`/`vim` for the embedded ones).
+    pub file: String,
+    /// 1-based line.
+    pub line: usize,
+    /// 1-based column.
+    pub column: usize,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for KeymapError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}:{}: {}", self.file, self.line, self.column, self.message)
+    }
+}
+
+impl std::error::Error for KeymapError {}
+
+/// The entries of a JSON object in file order, duplicates kept.
+struct Entries(Vec<(String, String)>);
+
+impl<'de> serde::Deserialize<'de> for Entries {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Entries;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("an object of \"keys\": \"action\" pairs")
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut m: A) -> Result<Entries, A::Error> {
+                let mut v = Vec::new();
+                while let Some(e) = m.next_entry::<String, String>()? {
+                    v.push(e);
+                }
+                Ok(Entries(v))
+            }
+        }
+        d.deserialize_map(V)
+    }
+}
+
+/// Line and column of the `nth` occurrence of `"key"` used as an object key in `text`.
+fn locate(text: &str, key: &str, nth: usize) -> (usize, usize) {
+    let quoted = serde_json::to_string(key).unwrap_or_default();
+    let mut seen = 0;
+    let mut from = 0;
+    while let Some(off) = text[from..].find(&quoted) {
+        let at = from + off;
+        from = at + quoted.len();
+        if text[from..].trim_start().starts_with(':') {
+            if seen == nth {
+                let line = text[..at].matches('\n').count() + 1;
+                let col = at - text[..at].rfind('\n').map(|i| i + 1).unwrap_or(0) + 1;
+                return (line, col);
+            }
+            seen += 1;
+        }
+    }
+    (1, 1)
+}
+
+/// A binding and where it was defined.
+#[derive(Clone, Debug)]
+struct Origin {
+    file: String,
+    line: usize,
+    column: usize,
+}
+
+/// Parses one keymap file into (keys, action or None for `none`, origin).
+fn parse_file(name: &str, text: &str) -> Result<Vec<(Keys, Option<Action>, Origin)>, KeymapError> {
+    let entries: Entries = serde_json::from_str(text).map_err(|e| KeymapError {
+        file: name.to_string(),
+        line: e.line(),
+        column: e.column(),
+        message: e.to_string(),
+    })?;
+    let mut out: Vec<(Keys, Option<Action>, Origin)> = Vec::new();
+    let mut counts: BTreeMap<String, usize> = BTreeMap::new();
+    for (spec, action) in entries.0 {
+        let nth = counts.entry(spec.clone()).or_default();
+        let (line, column) = locate(text, &spec, *nth);
+        *nth += 1;
+        let origin = Origin {
+            file: name.to_string(),
+            line,
+            column,
+        };
+        let err = |message: String| KeymapError {
+            file: name.to_string(),
+            line,
+            column,
+            message,
+        };
+        let keys: Keys = spec
+            .split_whitespace()
+            .map(Key::parse)
+            .collect::<Result<_, _>>()
+            .map_err(|m| err(format!("key \"{spec}\": {m}")))?;
+        if keys.is_empty() {
+            return Err(err("empty key".into()));
+        }
+        let act = if action == "none" {
+            None
+        } else {
+            Some(Action::from_name(&action).ok_or_else(|| err(format!("unknown action \"{action}\"")))?)
+        };
+        if let Some((_, _, o)) = out.iter().find(|(k, _, _)| *k == keys) {
+            return Err(err(format!(
+                "key \"{}\" is already bound at line {}",
+                keys_text(&keys),
+                o.line
+            )));
+        }
+        out.push((keys, act, origin));
+    }
+    Ok(out)
+}
+
+/// A validated keymap.
+#[derive(Clone, Debug)]
+pub struct Keymap {
+    bindings: BTreeMap<Keys, (Action, Origin)>,
+}
+
+/// What a key press did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lookup {
+    /// A complete binding.
+    Action(Action),
+    /// The start of a longer binding: wait for more keys.
+    Pending,
+    /// Nothing bound.
+    None,
+}
+
+impl Keymap {
+    /// Builds a keymap: `base` (name, text) overridden key by key by each of `overrides`.
+    pub fn load(base: (&str, &str), overrides: &[(&str, &str)]) -> Result<Keymap, KeymapError> {
+        let mut bindings: BTreeMap<Keys, (Action, Origin)> = BTreeMap::new();
+        for (i, (name, text)) in std::iter::once(&base).chain(overrides).enumerate() {
+            for (keys, act, origin) in parse_file(name, text)? {
+                match act {
+                    Some(a) => bindings.insert(keys, (a, origin)),
+                    None if i > 0 => bindings.remove(&keys),
+                    None => None,
+                };
+            }
+        }
+        let all: Vec<(&Keys, &Origin)> = bindings.iter().map(|(k, (_, o))| (k, o)).collect();
+        for (a, oa) in &all {
+            for (b, _) in &all {
+                if a.len() < b.len() && b.starts_with(a) {
+                    return Err(KeymapError {
+                        file: oa.file.clone(),
+                        line: oa.line,
+                        column: oa.column,
+                        message: format!(
+                            "key \"{}\" is a prefix of \"{}\": the longer binding could never be typed",
+                            keys_text(a),
+                            keys_text(b)
+                        ),
+                    });
+                }
+            }
+        }
+        Ok(Keymap { bindings })
+    }
+
+    /// The embedded default keymap.
+    pub fn default_map() -> Keymap {
+        Keymap::load(("default", DEFAULT), &[]).expect("the embedded default keymap is valid")
+    }
+
+    /// Looks up the keys typed so far.
+    pub fn lookup(&self, keys: &[Key]) -> Lookup {
+        if let Some((a, _)) = self.bindings.get(keys) {
+            return Lookup::Action(*a);
+        }
+        if self.bindings.keys().any(|k| k.starts_with(keys)) {
+            Lookup::Pending
+        } else {
+            Lookup::None
+        }
+    }
+
+    /// The keys bound to each action, in action order (for the help screen).
+    pub fn help(&self) -> Vec<(Action, Vec<String>)> {
+        Action::ALL
+            .iter()
+            .map(|a| {
+                let keys = self
+                    .bindings
+                    .iter()
+                    .filter(|(_, (b, _))| b == a)
+                    .map(|(k, _)| keys_text(k))
+                    .collect();
+                (*a, keys)
+            })
+            .filter(|(_, k): &(Action, Vec<String>)| !k.is_empty())
+            .collect()
+    }
+
+    /// The first key bound to `action` (for hints in the status bar).
+    pub fn key_for(&self, action: Action) -> Option<String> {
+        self.bindings
+            .iter()
+            .find(|(_, (a, _))| *a == action)
+            .map(|(k, _)| keys_text(k))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn key(c: KeyCode, m: KeyModifiers) -> Key {
+        Key::from_event(&KeyEvent::new(c, m)).unwrap()
+    }
+
+    #[test]
+    fn embedded_keymaps_are_valid() {
+        let d = Keymap::default_map();
+        assert_eq!(
+            d.lookup(&[key(KeyCode::Char('q'), KeyModifiers::NONE)]),
+            Lookup::Action(Action::Quit)
+        );
+        let v = Keymap::load(("vim", VIM), &[]).unwrap();
+        let g = key(KeyCode::Char('g'), KeyModifiers::NONE);
+        assert_eq!(v.lookup(&[g]), Lookup::Pending);
+        assert_eq!(v.lookup(&[g, g]), Lookup::Action(Action::Top));
+        assert_eq!(
+            v.lookup(&[key(KeyCode::Char('G'), KeyModifiers::SHIFT)]),
+            Lookup::Action(Action::Bottom)
+        );
+    }
+
+    #[test]
+    fn user_file_overrides_and_unbinds_per_key() {
+        let user = r#"{"x": "quit", "q": "none"}"#;
+        let m = Keymap::load(("default", DEFAULT), &[("user.json", user)]).unwrap();
+        assert_eq!(
+            m.lookup(&[key(KeyCode::Char('x'), KeyModifiers::NONE)]),
+            Lookup::Action(Action::Quit)
+        );
+        assert_eq!(m.lookup(&[key(KeyCode::Char('q'), KeyModifiers::NONE)]), Lookup::None);
+        assert_eq!(
+            m.lookup(&[key(KeyCode::Char('c'), KeyModifiers::CONTROL)]),
+            Lookup::Action(Action::Quit)
+        );
+    }
+
+    #[test]
+    fn errors_are_located() {
+        let bad = "{\n  \"q\": \"quit\",\n  \"j\": \"jump_around\"\n}";
+        assert_eq!(
+            Keymap::load(("k.json", bad), &[]).unwrap_err().to_string(),
+            "k.json:3:3: unknown action \"jump_around\""
+        );
+        let dup = "{\n  \"ctrl-c\": \"quit\",\n  \"Ctrl-c\": \"help\"\n}";
+        assert_eq!(
+            Keymap::load(("k.json", dup), &[]).unwrap_err().to_string(),
+            "k.json:3:3: key \"ctrl-c\" is already bound at line 2"
+        );
+        let prefix = "{\"g\": \"top\",\n \"g g\": \"bottom\"}";
+        assert_eq!(
+            Keymap::load(("k.json", prefix), &[]).unwrap_err().to_string(),
+            "k.json:1:2: key \"g\" is a prefix of \"g g\": the longer binding could never be typed"
+        );
+        let user_prefix = r#"{"g": "top"}"#;
+        let e = Keymap::load(("vim", VIM), &[("user.json", user_prefix)]).unwrap_err();
+        assert!(e.to_string().starts_with("user.json:1:2: key \"g\" is a prefix"), "{e}");
+        assert!(Keymap::load(("k.json", r#"{"hyper-x": "quit"}"#), &[]).is_err());
+        assert_eq!(Keymap::load(("k.json", "{\"q\": 1}"), &[]).unwrap_err().line, 1);
+    }
+
+    #[test]
+    fn keys_print_as_they_parse() {
+        for s in ["q", "ctrl-c", "pagedown", "f5", "space", "alt-x", "backtab", "G"] {
+            assert_eq!(Key::parse(s).unwrap().to_string(), s);
+        }
+    }
+}

@@ -1,0 +1,232 @@
+//! The Detail pane: the selected frame field by field and bit by bit (SDO command byte,
+//! controlword/statusword bits, PDO signals), or the selected SDO transfer.
+
+use super::{block, duration, kind_color};
+use crate::decode::cia402::{describe_controlword, describe_statusword};
+use crate::decode::sdo::{Outcome, SdoCommand, Side, Transaction};
+use crate::decode::{Body, Decoded};
+use crate::frame::Frame;
+use crate::tui::app::{App, Pane};
+use ratatui::Frame as TermFrame;
+use ratatui::layout::Rect;
+use ratatui::style::{Color, Modifier, Style};
+use ratatui::text::Line;
+use ratatui::widgets::{Paragraph, Wrap};
+
+/// The bits of an SDO command byte, one line each.
+pub fn sdo_command_bits(byte: u8, side: Side) -> Vec<String> {
+    let cs = byte >> 5;
+    let who = if side == Side::Client { "ccs" } else { "scs" };
+    let mut v = vec![
+        format!("command 0x{byte:02X} = {byte:08b}b"),
+        format!("  bits 7-5 {who} = {cs}"),
+    ];
+    match (cs, side) {
+        (1, Side::Client) | (2, Side::Server) => {
+            v.push(format!("  bits 3-2 n = {} (unused bytes)", (byte >> 2) & 3));
+            v.push(format!("  bit 1 e = {} (expedited)", (byte >> 1) & 1));
+            v.push(format!("  bit 0 s = {} (size indicated)", byte & 1));
+        }
+        (0, Side::Client) | (0, Side::Server) => {
+            v.push(format!("  bit 4 t = {} (toggle)", (byte >> 4) & 1));
+            v.push(format!("  bits 3-1 n = {} (unused bytes)", (byte >> 1) & 7));
+            v.push(format!("  bit 0 c = {} (last segment)", byte & 1));
+        }
+        (3, Side::Client) | (1, Side::Server) => v.push(format!("  bit 4 t = {} (toggle)", (byte >> 4) & 1)),
+        _ => {}
+    }
+    v
+}
+
+fn frame_lines(app: &App, f: &Frame, d: &Decoded, pos: usize) -> Vec<Line<'static>> {
+    let mut v = vec![
+        Line::styled(
+            d.label.clone(),
+            Style::default().fg(kind_color(d.kind)).add_modifier(Modifier::BOLD),
+        ),
+        Line::raw(format!(
+            "frame {}  t {:.6} s  {}",
+            pos + 1,
+            f.ts_ns.saturating_sub(app.start_ns()) as f64 / 1e9,
+            app.trace.ifaces.name(f.iface)
+        )),
+        Line::raw(format!(
+            "COB-ID 0x{:X}{}  {}  node {}",
+            f.id,
+            if f.is_ext() { " (29-bit)" } else { "" },
+            d.kind.as_str(),
+            d.node.map(|n| n.to_string()).unwrap_or_else(|| "-".into())
+        )),
+        Line::raw(format!(
+            "len {}{}{}{}",
+            f.len,
+            if f.is_rtr() { "  remote request" } else { "" },
+            if f.is_fd() { "  CAN FD" } else { "" },
+            if f.direction() == crate::frame::Direction::Tx {
+                "  sent by us"
+            } else {
+                ""
+            }
+        )),
+    ];
+    let bytes: Vec<String> = f
+        .payload()
+        .iter()
+        .enumerate()
+        .map(|(i, b)| format!("[{i}] {b:02X} {b:08b}"))
+        .collect();
+    for chunk in bytes.chunks(2) {
+        v.push(Line::raw(chunk.join("   ")));
+    }
+    if let Some(m) = &d.malformed {
+        v.push(Line::styled(
+            format!("malformed: {m}"),
+            Style::default().fg(Color::LightRed),
+        ));
+    }
+    let node = d.node.unwrap_or(0);
+    let mode = app.trace.decoder().mode(node);
+    match &d.body {
+        Body::Sdo(s) => {
+            if let Some(&b) = f.payload().first() {
+                v.extend(sdo_command_bits(b, s.side).into_iter().map(Line::raw));
+            }
+            if let Some((i, sub)) = s.object {
+                v.push(Line::raw(format!(
+                    "object 0x{i:04X}:{sub:02X} {}",
+                    s.name.clone().unwrap_or_default()
+                )));
+                if let (SdoCommand::InitiateDownload { data, .. }, 0x6040) = (s.command, i) {
+                    let cw = u16::from_le_bytes([
+                        data.bytes().first().copied().unwrap_or(0),
+                        data.bytes().get(1).copied().unwrap_or(0),
+                    ]);
+                    v.push(Line::raw(format!("controlword: {}", describe_controlword(cw, mode))));
+                }
+            }
+            if let Some(val) = &s.value {
+                v.push(Line::raw(format!("value {}", val.text)));
+            }
+            for p in &s.problems {
+                v.push(Line::styled(
+                    format!("problem: {p}"),
+                    Style::default().fg(Color::Yellow),
+                ));
+            }
+        }
+        Body::Pdo(p) => {
+            if p.signals.is_empty() {
+                v.push(Line::raw(
+                    "no mapping known (bind a profile or capture the SDO mapping writes)",
+                ));
+            }
+            for s in &p.signals {
+                v.push(Line::raw(format!(
+                    "0x{:04X}:{:02X} {} = {}",
+                    s.index, s.sub, s.name, s.text
+                )));
+                let raw = s.value.as_i64().unwrap_or(0) as u16;
+                match (s.index, s.sub) {
+                    (0x6040, 0) => v.push(Line::raw(format!(
+                        "  {:016b}b {}",
+                        raw,
+                        describe_controlword(raw, mode)
+                    ))),
+                    (0x6041, 0) => v.push(Line::raw(format!("  {:016b}b {}", raw, describe_statusword(raw, mode)))),
+                    _ => {}
+                }
+            }
+        }
+        Body::Emcy(e) => {
+            v.push(Line::raw(format!("error code 0x{:04X} {}", e.code, e.text)));
+            v.push(Line::raw(format!(
+                "register 0x{:02X} [{}]",
+                e.register,
+                e.register_bits().join(", ")
+            )));
+            v.push(Line::raw(format!("manufacturer {}", crate::hex::spaced(&e.mfr))));
+            for (k, val) in &e.mfr_fields {
+                v.push(Line::raw(format!("  {k} = {val}")));
+            }
+        }
+        Body::Nmt(n) => v.push(Line::raw(format!(
+            "command 0x{:02X} {}  target {}",
+            n.cs,
+            n.text(),
+            n.target
+        ))),
+        Body::Heartbeat(h) => v.push(Line::raw(format!(
+            "state {}  toggle {}",
+            h.state.map(|s| s.text()).unwrap_or_else(|| "(request)".into()),
+            h.toggle as u8
+        ))),
+        _ => {}
+    }
+    v
+}
+
+fn transaction_lines(app: &App, t: &Transaction) -> Vec<Line<'static>> {
+    let dict = app.trace.decoder().dictionary(t.node);
+    let mut v = vec![
+        Line::styled(t.label(dict), Style::default().add_modifier(Modifier::BOLD)),
+        Line::raw(format!(
+            "node {}  {} {}  {} frames  {}",
+            t.node,
+            t.direction.as_str(),
+            t.protocol.as_str(),
+            t.frames.len(),
+            duration(t.duration_ns() as f64 / 1e9)
+        )),
+        Line::raw(format!("data {}", crate::hex::spaced(&t.data))),
+    ];
+    if let Outcome::Aborted { code, text, by } = &t.outcome {
+        v.push(Line::styled(
+            format!("aborted by {} 0x{code:08X}: {text}", by.as_str()),
+            Style::default().fg(Color::Red),
+        ));
+    }
+    for p in &t.problems {
+        v.push(Line::styled(
+            format!("problem: {}", p.as_str()),
+            Style::default().fg(Color::Yellow),
+        ));
+    }
+    v
+}
+
+/// Draws the pane.
+pub fn render(app: &App, f: &mut TermFrame, area: Rect) {
+    f.render_widget(block(" Detail ", false), area);
+    let inner = block("", true).inner(area);
+    let lines = match app.pane {
+        Pane::Sdo if app.sdo_expanded.is_none() => match app.trace.transactions.get(app.sdo_list.selected) {
+            Some(t) => transaction_lines(app, t),
+            None => vec![Line::raw("no transfer selected")],
+        },
+        _ => match &app.detail {
+            Some((pos, d)) => frame_lines(app, &app.trace.store.frame(*pos), d, *pos),
+            None => vec![Line::raw("no frame selected")],
+        },
+    };
+    f.render_widget(Paragraph::new(lines).wrap(Wrap { trim: false }), inner);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sdo_command_bits_name_every_field() {
+        assert_eq!(
+            sdo_command_bits(0x4B, Side::Server),
+            [
+                "command 0x4B = 01001011b",
+                "  bits 7-5 scs = 2",
+                "  bits 3-2 n = 2 (unused bytes)",
+                "  bit 1 e = 1 (expedited)",
+                "  bit 0 s = 1 (size indicated)"
+            ]
+        );
+        assert_eq!(sdo_command_bits(0x60, Side::Client)[2], "  bit 4 t = 0 (toggle)");
+    }
+}

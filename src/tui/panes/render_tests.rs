@@ -1,0 +1,135 @@
+//! Rendering tests: every pane on a fixed capture, snapshotted with TestBackend.
+
+use super::testutil::{app, screen};
+use crate::tui::app::Pane;
+use crate::tui::keymap::Action;
+
+#[test]
+fn trace_pane_shows_decoded_rows_and_the_status_bar() {
+    let mut a = app();
+    let s = screen(&mut a, 140, 30);
+    assert!(s.contains("Trace [follow]"), "{s}");
+    assert!(s.contains("Heartbeat node 2: Pre-operational"), "{s}");
+    assert!(s.contains("register 0x11 [generic, communication]"), "{s}");
+    assert!(s.contains("open test.log (end) | 44 frames"), "{s}");
+    insta::assert_snapshot!(s);
+}
+
+#[test]
+fn scrolled_back_trace_keeps_a_tail_strip_of_the_newest_frames() {
+    let mut a = app();
+    let _ = screen(&mut a, 140, 20);
+    a.act(Action::Top);
+    let s = screen(&mut a, 140, 20);
+    assert!(s.contains("Trace [scrolled]"), "{s}");
+    assert!(s.contains("── newest"), "{s}");
+    assert!(s.contains("EMCY node 2"), "{s}");
+    insta::assert_snapshot!(s);
+}
+
+#[test]
+fn nodes_pane_shows_states_heartbeat_and_emcy() {
+    let mut a = app();
+    a.pane = Pane::Nodes;
+    let s = screen(&mut a, 160, 14);
+    assert!(s.contains("Operational"), "{s}");
+    assert!(s.contains("Pre-operational"), "{s}");
+    assert!(s.contains("Operation enabled"), "{s}");
+    insta::assert_snapshot!(s);
+}
+
+#[test]
+fn sdo_pane_lists_transfers_and_expands_to_frames() {
+    let mut a = app();
+    a.pane = Pane::Sdo;
+    let s = screen(&mut a, 140, 14);
+    assert!(s.contains("1017:00"), "{s}");
+    assert!(s.contains("abort 06020000"), "{s}");
+    insta::assert_snapshot!("sdo_list", s);
+    a.act(Action::Expand);
+    let s = screen(&mut a, 140, 14);
+    assert!(s.contains("SDO transfer 1017:00 node 1"), "{s}");
+    insta::assert_snapshot!("sdo_expanded", s);
+}
+
+#[test]
+fn detail_pane_breaks_the_selected_frame_into_fields() {
+    let mut a = app();
+    a.run_command("goto 5");
+    let s = screen(&mut a, 150, 30);
+    assert!(s.contains("bits 7-5 scs = 2"), "{s}");
+    insta::assert_snapshot!(s);
+}
+
+#[test]
+fn detail_pane_shows_statusword_bits_of_a_mapped_pdo() {
+    let mut a = app();
+    a.run_command("search kind tpdo");
+    let s = screen(&mut a, 150, 30);
+    assert!(s.contains("0x6041:00"), "{s}");
+    assert!(s.contains("0000001000110011b Switched on"), "{s}");
+    insta::assert_snapshot!(s);
+}
+
+#[test]
+fn stats_pane_shows_rates_and_bus_load() {
+    let mut a = app();
+    a.pane = Pane::Stats;
+    let s = screen(&mut a, 140, 24);
+    assert!(s.contains("bus load"), "{s}");
+    assert!(s.contains("701"), "{s}");
+    insta::assert_snapshot!(s);
+}
+
+#[test]
+fn plot_pane_draws_a_series() {
+    let mut a = app();
+    a.act(Action::NextSeries);
+    assert_eq!(a.pane, Pane::Plot);
+    let s = screen(&mut a, 100, 20);
+    assert!(s.contains("Plot 2/2: node 1 0x6041:00 (6 points)"), "{s}");
+    insta::assert_snapshot!(s);
+}
+
+#[test]
+fn help_lists_the_keymap_in_force() {
+    let mut a = app();
+    a.act(Action::Help);
+    let s = screen(&mut a, 120, 50);
+    assert!(s.contains("ctrl-c, q"), "{s}");
+    assert!(s.contains("Quit"), "{s}");
+    insta::assert_snapshot!(s);
+}
+
+#[test]
+fn filter_prompt_and_errors_show_in_the_bottom_line() {
+    let mut a = app();
+    a.set_filter("kind bogus");
+    let s = screen(&mut a, 140, 12);
+    assert!(s.contains("filter: column 6: unknown kind `bogus`"), "{s}");
+    a.set_filter("node 2 hb");
+    let s = screen(&mut a, 140, 12);
+    assert!(s.contains("filter: node 2 hb (7 rows)"), "{s}");
+}
+
+#[test]
+fn any_size_renders_without_panicking() {
+    let mut a = app();
+    for pane in Pane::ALL {
+        a.pane = pane;
+        a.help = pane == Pane::Stats;
+        for (w, h) in [
+            (0, 0),
+            (1, 1),
+            (2, 3),
+            (10, 4),
+            (20, 6),
+            (40, 10),
+            (80, 24),
+            (300, 100),
+            (5, 80),
+        ] {
+            let _ = screen(&mut a, w, h);
+        }
+    }
+}

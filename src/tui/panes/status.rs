@@ -1,0 +1,86 @@
+//! The status bar (source, frames, rate, drops, filter, stop-all key) and the prompt line.
+
+use crate::tui::app::{App, SourceKind};
+use crate::tui::keymap::Action;
+use ratatui::Frame;
+use ratatui::layout::{Position, Rect};
+use ratatui::style::{Color, Style};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::Paragraph;
+
+/// The status bar text.
+pub fn text(app: &App) -> String {
+    let src = match app.source.kind {
+        SourceKind::Open => format!("open {}", app.source.name),
+        SourceKind::Replay { speed } if speed <= 0.0 => format!("replay {} ×max", app.source.name),
+        SourceKind::Replay { speed } => format!("replay {} ×{speed}", app.source.name),
+        SourceKind::Live { listen_only } => {
+            format!(
+                "live {}{}",
+                app.source.name,
+                if listen_only { " (listen-only)" } else { "" }
+            )
+        }
+        SourceKind::Demo { listen_only } => {
+            format!("demo bus{}", if listen_only { " (listen-only)" } else { "" })
+        }
+    };
+    let state = if app.source.done {
+        " (end)"
+    } else if app.source.paused {
+        " (paused)"
+    } else {
+        ""
+    };
+    let filter = if app.view.filter.is_empty() {
+        String::new()
+    } else {
+        let p = app.view.progress(&app.trace);
+        let prog = if p < 100 { format!(" {p}%") } else { String::new() };
+        format!(" | filter: {} ({} rows{prog})", app.view.filter.source, app.view_len())
+    };
+    let stop = app
+        .keymap
+        .key_for(Action::StopAll)
+        .map(|k| format!(" | stop all: {k}"))
+        .unwrap_or_default();
+    let help = app
+        .keymap
+        .key_for(Action::Help)
+        .map(|k| format!(" | help: {k}"))
+        .unwrap_or_default();
+    format!(
+        "{src}{state} | {} frames | {:.0} fr/s | drops {}{filter}{stop}{help}",
+        app.trace.len(),
+        app.rate,
+        app.source.drops
+    )
+}
+
+/// Draws the status bar and, below it, the prompt or the last message.
+pub fn render(app: &App, f: &mut Frame, bar: Rect, line: Rect) {
+    let (txt, bg) = match (&app.source.bus_error, &app.prompt, &app.message) {
+        // While typing, the bar shows what the line will do (preview or error).
+        (_, Some(_), Some(m)) => (m.clone(), Color::Magenta),
+        // The error (with its fix) first, so a narrow terminal still shows it.
+        (Some(e), _, _) => (format!("{e} | {}", text(app)), Color::Red),
+        _ => (text(app), Color::Blue),
+    };
+    f.render_widget(Paragraph::new(txt).style(Style::default().bg(bg).fg(Color::White)), bar);
+    if let Some(p) = &app.prompt {
+        let lead = p.kind.lead();
+        f.render_widget(
+            Paragraph::new(Line::from(vec![Span::raw(lead), Span::raw(p.text.clone())])),
+            line,
+        );
+        let x = line.x + (lead.chars().count() + p.cursor) as u16;
+        if x < line.x + line.width {
+            f.set_cursor_position(Position::new(x, line.y));
+        }
+    } else if let Some(m) = &app.message {
+        f.render_widget(
+            Paragraph::new(m.as_str()).style(Style::default().fg(Color::Yellow)),
+            line,
+        );
+    }
+}

@@ -1,0 +1,218 @@
+//! The trace: the store plus everything derived from it while frames come in.
+//!
+//! Decoding is stateful (learned COB-IDs and PDO mappings, modes of operation, SDO transfer
+//! context), so a frame's label depends on everything before it. The indexing pass runs one
+//! [`Decoder`] over every frame as it arrives, but keeps only the frame's kind and node (in
+//! the store), the completed SDO transactions, node and COB-ID statistics and the numeric
+//! signal series. Every [`CHECKPOINT`] frames it keeps a clone of the decoder state. To show
+//! rows `a..b`, [`Trace::decode_range`] clones the checkpoint at or before `a`, replays the
+//! frames up to `a` through it (cheaply: only SDO and PDO frames change state) and decodes
+//! `a..b`. So labels are exact, at most `CHECKPOINT` frames are replayed per window, and
+//! the checkpoints cost well under a byte per frame.
+
+use super::nodes::Nodes;
+use super::series::Series;
+use super::stats::Stats;
+use super::store::Store;
+use crate::decode::sdo::Transaction;
+use crate::decode::{Body, Decoded, Decoder, Kind};
+use crate::frame::{Frame, Interfaces};
+
+/// Frames between two decoder checkpoints.
+pub const CHECKPOINT: usize = 8192;
+
+/// Everything the panes show, built incrementally.
+pub struct Trace {
+    /// The frames.
+    pub store: Store,
+    /// Interface names.
+    pub ifaces: Interfaces,
+    decoder: Decoder,
+    /// The decoder as it was for a fresh start (used when nothing is checkpointed yet).
+    initial: Decoder,
+    checkpoints: Vec<Decoder>,
+    /// Completed SDO transactions, in order of completion.
+    pub transactions: Vec<Transaction>,
+    /// Per-node state.
+    pub nodes: Nodes,
+    /// Per-COB-ID statistics and bus load.
+    pub stats: Stats,
+    /// Numeric values over time (PDO signals, SDO reads).
+    pub series: Series,
+}
+
+impl Trace {
+    /// An empty trace decoded with `decoder`.
+    pub fn new(decoder: Decoder, bitrate: u64) -> Trace {
+        Trace {
+            store: Store::new(),
+            ifaces: Interfaces::default(),
+            initial: decoder.clone(),
+            decoder,
+            checkpoints: Vec::new(),
+            transactions: Vec::new(),
+            nodes: Nodes::default(),
+            stats: Stats::new(bitrate),
+            series: Series::default(),
+        }
+    }
+
+    /// Forgets every frame (a replay seeking backwards starts over).
+    pub fn clear(&mut self) {
+        let bitrate = self.stats.bitrate();
+        *self = Trace::new(self.initial.clone(), bitrate);
+    }
+
+    /// Number of frames.
+    pub fn len(&self) -> usize {
+        self.store.len()
+    }
+
+    /// True when no frame arrived yet.
+    pub fn is_empty(&self) -> bool {
+        self.store.is_empty()
+    }
+
+    /// Adds one frame: classifies it, updates nodes, statistics and series.
+    pub fn push(&mut self, frame: &Frame) {
+        let pos = self.store.len();
+        if pos.is_multiple_of(CHECKPOINT) {
+            self.checkpoints.push(self.decoder.clone());
+        }
+        self.decoder.set_seq(pos as u64);
+        let (kind, node) = match self.decoder.classify(frame) {
+            (k @ (Kind::Tpdo | Kind::Rpdo | Kind::Emcy | Kind::Heartbeat), _) => {
+                self.decoder.set_seq(pos as u64);
+                let d = self.decoder.decode(frame);
+                self.observe(frame, &d);
+                (k, d.node)
+            }
+            other => other,
+        };
+        self.store.push(frame, kind, node);
+        let p = *self.store.packed(pos);
+        self.stats.add(&p, &self.store);
+        if let Some(n) = node {
+            self.nodes.frame(n, frame.ts_ns);
+        }
+        for t in self.decoder.take_transactions() {
+            self.nodes.transaction(&t);
+            self.series.transaction(&t, self.decoder.dictionary(t.node));
+            self.transactions.push(t);
+        }
+    }
+
+    fn observe(&mut self, frame: &Frame, d: &Decoded) {
+        let n = d.node.unwrap_or(0);
+        match &d.body {
+            Body::Heartbeat(h) => self.nodes.heartbeat(n, frame.ts_ns, h),
+            Body::Emcy(e) => self.nodes.emcy(n, frame.ts_ns, e),
+            Body::Pdo(p) => {
+                self.nodes.pdo(n, p, self.decoder.mode(n));
+                self.series.pdo(n, frame.ts_ns, p);
+            }
+            _ => {}
+        }
+        self.nodes
+            .profile(n, self.decoder.dictionary(n).profile_name(), self.decoder.mode(n));
+    }
+
+    /// Decodes the frames `start..end` exactly as the indexing pass did.
+    pub fn decode_range(&self, start: usize, end: usize) -> Vec<Decoded> {
+        let positions: Vec<usize> = (start..end.min(self.len())).collect();
+        self.decode_positions(&positions)
+    }
+
+    /// Decodes the frames at `positions` (rising) exactly as the indexing pass did. One
+    /// decoder walks forward; it restarts from a checkpoint only when that is closer.
+    pub fn decode_positions(&self, positions: &[usize]) -> Vec<Decoded> {
+        self.decode_with(&mut None, positions)
+    }
+
+    /// Like [`Trace::decode_positions`], going on from `walker` (a decoder and the next
+    /// position it would take) when that is closer than a checkpoint, and leaving the
+    /// walker after the last position so the next window can go on from there.
+    pub fn decode_with(&self, walker: &mut Option<(Decoder, usize)>, positions: &[usize]) -> Vec<Decoded> {
+        let mut out = Vec::with_capacity(positions.len());
+        for &pos in positions {
+            if pos >= self.len() {
+                break;
+            }
+            let base = pos / CHECKPOINT * CHECKPOINT;
+            let (dec, next) = match walker.take() {
+                Some((d, next)) if next <= pos && next >= base => (d, next),
+                _ => (
+                    self.checkpoints.get(pos / CHECKPOINT).unwrap_or(&self.initial).clone(),
+                    base,
+                ),
+            };
+            let mut dec = dec;
+            for i in next..pos {
+                let p = self.store.packed(i);
+                if matches!(p.kind(), Kind::SdoRx | Kind::SdoTx | Kind::Tpdo | Kind::Rpdo) {
+                    dec.set_seq(i as u64);
+                    dec.decode(&self.store.frame(i));
+                }
+            }
+            dec.set_seq(pos as u64);
+            out.push(dec.decode(&self.store.frame(pos)));
+            *walker = Some((dec, pos + 1));
+        }
+        out
+    }
+
+    /// The dictionary name the decoder uses for `node`.
+    pub fn object_name(&self, node: u8, index: u16, sub: u8) -> Option<String> {
+        self.decoder.dictionary(node).name(index, sub).map(str::to_string)
+    }
+
+    /// The decoder state after the last frame.
+    pub fn decoder(&self) -> &Decoder {
+        &self.decoder
+    }
+
+    /// Number of decoder checkpoints kept.
+    pub fn checkpoint_count(&self) -> usize {
+        self.checkpoints.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::od::Dictionary;
+
+    fn decoder() -> Decoder {
+        Decoder::new(Dictionary::default(), Vec::new())
+    }
+
+    #[test]
+    fn window_labels_equal_a_full_sequential_decode() {
+        let mut t = Trace::new(decoder(), 500_000);
+        let frames: Vec<Frame> = crate::synth::Traffic::new(3 * CHECKPOINT as u64 + 77, 0).collect();
+        for f in &frames {
+            t.push(f);
+        }
+        let mut full = decoder();
+        let want: Vec<String> = frames
+            .iter()
+            .enumerate()
+            .map(|(i, f)| {
+                full.set_seq(i as u64);
+                full.decode(f).label
+            })
+            .collect();
+        for start in [0, CHECKPOINT - 3, 2 * CHECKPOINT + 40] {
+            let got: Vec<String> = t.decode_range(start, start + 30).into_iter().map(|d| d.label).collect();
+            assert_eq!(got, want[start..start + 30]);
+        }
+        let scattered = [5, 9000, 9001, 2 * CHECKPOINT + 1, 3 * CHECKPOINT + 70];
+        let got: Vec<String> = t.decode_positions(&scattered).into_iter().map(|d| d.label).collect();
+        let want_s: Vec<String> = scattered.iter().map(|&i| want[i].clone()).collect();
+        assert_eq!(got, want_s);
+        assert!(!t.transactions.is_empty());
+        let first = &t.transactions[0];
+        let f = t.store.packed(first.frames[0] as usize - 1);
+        assert!(matches!(f.kind(), Kind::SdoRx | Kind::SdoTx));
+    }
+}

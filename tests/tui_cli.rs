@@ -1,0 +1,66 @@
+//! The interactive commands' checks that run before the terminal is taken: keymap
+//! validation with located errors, user keymap overrides, missing files, no terminal.
+
+use std::process::{Command, Output};
+
+fn cotui(args: &[&str], config_home: &std::path::Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_cotui"))
+        .args(args)
+        .env("XDG_CONFIG_HOME", config_home)
+        .stdin(std::process::Stdio::null())
+        .output()
+        .unwrap()
+}
+
+fn tempdir(tag: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("cotui-cli-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(d.join("cotui")).unwrap();
+    d
+}
+
+#[test]
+fn a_bad_keymap_file_is_refused_with_its_location() {
+    let dir = tempdir("bad");
+    let km = dir.join("k.json");
+    std::fs::write(&km, "{\n  \"q\": \"quit\",\n  \"j\": \"jump_around\"\n}\n").unwrap();
+    let log = dir.join("x.log");
+    std::fs::write(&log, "(1.000000) can0 701#05\n").unwrap();
+    let out = cotui(&["open", log.to_str().unwrap(), "--keymap", km.to_str().unwrap()], &dir);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        err.trim(),
+        format!("cotui: keymap: {}:3:3: unknown action \"jump_around\"", km.display())
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_user_keymap_is_checked_against_the_base_map() {
+    let dir = tempdir("user");
+    let user = dir.join("cotui").join("keymap.json");
+    std::fs::write(&user, "{\"g\": \"top\"}").unwrap();
+    let log = dir.join("x.log");
+    std::fs::write(&log, "(1.000000) can0 701#05\n").unwrap();
+    let out = cotui(&["open", log.to_str().unwrap(), "--keymap", "vim"], &dir);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains(&format!("{}:1:2: key \"g\" is a prefix of \"g g\"", user.display())),
+        "{err}"
+    );
+    // With the default map the same override is fine; without a terminal cotui says so.
+    let out = cotui(&["open", log.to_str().unwrap()], &dir);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("needs a terminal"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_missing_log_is_reported_before_the_screen_changes() {
+    let dir = tempdir("missing");
+    let out = cotui(&["replay", "/nonexistent/cotui.log", "--speed", "2"], &dir);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).starts_with("cotui: /nonexistent/cotui.log: "));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,156 @@
+//! End-to-end: the real binary in a tmux pane. `cotui demo` shows the simulated drives
+//! reach their states, help opens, a filter narrows the trace, `q` quits and the terminal
+//! comes back (the shell after cotui prints and the alternate screen is gone).
+//! Needs tmux (scripts/install-test-deps.sh installs it).
+
+use std::process::Command;
+use std::thread::sleep;
+use std::time::{Duration, Instant};
+
+struct Session(String);
+
+impl Session {
+    fn start(name: &str, cmd: &str) -> Session {
+        let _ = Command::new("tmux").args(["kill-session", "-t", name]).status();
+        let ok = Command::new("tmux")
+            .args(["new-session", "-d", "-s", name, "-x", "150", "-y", "40", cmd])
+            .status()
+            .expect("tmux is installed (scripts/install-test-deps.sh)");
+        assert!(ok.success());
+        Session(name.to_string())
+    }
+    fn keys(&self, keys: &[&str]) {
+        for k in keys {
+            assert!(
+                Command::new("tmux")
+                    .args(["send-keys", "-t", &self.0, k])
+                    .status()
+                    .unwrap()
+                    .success()
+            );
+            sleep(Duration::from_millis(80));
+        }
+    }
+    fn screen(&self) -> String {
+        let out = Command::new("tmux")
+            .args(["capture-pane", "-p", "-t", &self.0])
+            .output()
+            .unwrap();
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    }
+    /// Waits until the screen satisfies `f` (10 s at most); returns the screen.
+    fn wait_for(&self, what: &str, f: impl Fn(&str) -> bool) -> String {
+        let start = Instant::now();
+        loop {
+            let s = self.screen();
+            if f(&s) {
+                return s;
+            }
+            assert!(
+                start.elapsed() < Duration::from_secs(10),
+                "timed out waiting for {what}:\n{s}"
+            );
+            sleep(Duration::from_millis(100));
+        }
+    }
+}
+
+impl Drop for Session {
+    fn drop(&mut self) {
+        let _ = Command::new("tmux").args(["kill-session", "-t", &self.0]).status();
+    }
+}
+
+#[test]
+fn demo_runs_filters_helps_and_quits_cleanly() {
+    let bin = env!("CARGO_BIN_EXE_cotui");
+    let home = std::env::temp_dir().join(format!("cotui-e2e-{}", std::process::id()));
+    std::fs::create_dir_all(&home).unwrap();
+    let cmd = format!(
+        "env XDG_CONFIG_HOME={} {bin} demo; echo cotui-exit=$?; sleep 60",
+        home.display()
+    );
+    let s = Session::start(&format!("cotui-e2e-{}", std::process::id()), &cmd);
+
+    // The simulated drives boot and go operational; the status bar counts frames.
+    s.wait_for("the nodes to be operational", |t| {
+        t.contains("  2 Operational") && t.contains("  3 Operational") && t.contains("demo bus |")
+    });
+
+    // Enable drive 2 from the palette: the preview shows the exact frames, then the result.
+    s.keys(&[":", "drive 2 enable"]);
+    s.wait_for("the frame preview", |t| t.contains("will send: 602#2B40600006000000"));
+    s.keys(&["Enter"]);
+    s.wait_for("the drive to be enabled", |t| {
+        t.contains("node 2: Operation enabled (statusword")
+    });
+    s.wait_for("the nodes pane to show it", |t| {
+        t.contains("2 Operational     Operation enabled")
+    });
+
+    // Help opens from the keymap in force and closes again.
+    s.keys(&["?"]);
+    s.wait_for("help", |t| {
+        t.contains("Show or hide this help") && t.contains("ctrl-c, q")
+    });
+    s.keys(&["Escape"]);
+    s.wait_for("help to close", |t| !t.contains("Show or hide this help"));
+
+    // A filter keeps only matching rows and shows in the status bar.
+    s.keys(&["/", "kind hb node 3", "Enter"]);
+    let t = s.wait_for("the filter", |t| t.contains("filter: kind hb node 3 ("));
+    let rows: Vec<&str> = t.lines().filter(|l| l.contains(" 703 ")).collect();
+    assert!(!rows.is_empty(), "{t}");
+    assert!(!t.contains(" 702 ") && !t.contains(" 080 "), "{t}");
+
+    // Broadcast NMT asks first; `n` cancels.
+    s.keys(&[":", "nmt stop 0", "Enter"]);
+    s.wait_for("the confirmation", |t| {
+        t.contains("broadcast NMT stop to every node: 000#0200")
+    });
+    s.keys(&["n"]);
+    s.wait_for("the cancel", |t| t.contains("not sent"));
+
+    // q quits and the shell gets its screen back.
+    s.keys(&["q"]);
+    let t = s.wait_for("cotui to exit", |t| t.contains("cotui-exit=0"));
+    assert!(!t.contains("Trace ["), "alternate screen left behind:\n{t}");
+    let _ = std::fs::remove_dir_all(&home);
+}
+
+#[test]
+fn sigterm_restores_the_terminal() {
+    let bin = env!("CARGO_BIN_EXE_cotui");
+    let name = format!("cotui-term-{}", std::process::id());
+    let pidfile = std::env::temp_dir().join(format!("{name}.pid"));
+    let cmd = format!(
+        "sh -c 'echo $$ > {}; exec {bin} demo'; echo cotui-exit=$?; sleep 60",
+        pidfile.display()
+    );
+    let s = Session::start(&name, &cmd);
+    s.wait_for("the demo", |t| t.contains("demo bus |"));
+    let pid = std::fs::read_to_string(&pidfile).unwrap();
+    assert!(
+        Command::new("kill")
+            .args(["-TERM", pid.trim()])
+            .status()
+            .unwrap()
+            .success()
+    );
+    let t = s.wait_for("cotui to stop on SIGTERM", |t| t.contains("cotui-exit="));
+    assert!(t.contains("cotui-exit=0"), "{t}");
+    assert!(!t.contains("Trace ["), "{t}");
+    let _ = std::fs::remove_file(&pidfile);
+}
+
+#[test]
+fn a_missing_interface_shows_its_fix_in_the_status_bar() {
+    let bin = env!("CARGO_BIN_EXE_cotui");
+    let name = format!("cotui-live-{}", std::process::id());
+    let s = Session::start(&name, &format!("{bin} live cotuinosuch0; echo cotui-exit=$?; sleep 60"));
+    s.wait_for("the interface error", |t| {
+        t.contains("cotuinosuch0: no such CAN interface; fix: ")
+    });
+    s.keys(&["q"]);
+    s.wait_for("cotui to exit", |t| t.contains("cotui-exit=0"));
+}
