@@ -42,8 +42,27 @@ ln -s /proc/self/fd/1 $r/dev/stdout
 ln -s /proc/self/fd/2 $r/dev/stderr
 mount -t devpts devpts $r/dev/pts
 mount -t tmpfs shm $r/dev/shm
+# Fresh writable /tmp, /run and /var/tmp; the host entries holding the cwd and the harness
+# (a clone in /tmp, say) are bound back in, read-only, from a plain view of the root.
+mkdir -p /hostroot
+mount --bind $r /hostroot
 for d in /tmp /run /var/tmp; do
     [ -d $r$d ] && mount -t tmpfs -o mode=1777 tmp $r$d
+done
+shown=" "
+for p in $VBUS_SHOW; do
+    for d in /tmp /run /var/tmp; do
+        case $p in
+            $d/*)
+                rest=${p#$d/}
+                top=$d/${rest%%/*}
+                case $shown in *" $top "*) continue ;; esac
+                shown="$shown$top "
+                mkdir -p $r$top
+                mount --bind /hostroot$top $r$top || fail "cannot show $top in the guest"
+                ;;
+        esac
+    done
 done
 mkdir -p "$r$VBUS_XDIR" 2>/dev/null
 mount --bind /x "$r$VBUS_XDIR" || fail "cannot mount the exchange dir at $VBUS_XDIR"

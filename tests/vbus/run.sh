@@ -57,6 +57,8 @@ trap 'exit 143' TERM
     printf 'VBUS_GUEST_SCRIPT=%q\n' "$here/guest.sh"
     printf 'VBUS_TIMEOUT=%q\n' "$timeout_s"
     printf 'VBUS_IFACES=%q\n' "${VBUS_IFACES:-vcan0}"
+    # Host paths the guest must see even under its fresh /tmp, /run and /var/tmp.
+    printf 'VBUS_SHOW=%q\n' "$(pwd -P) $here"
 } > "$x/config"
 # A pyenv shim is a shell script that costs seconds per call under TCG: put the directory
 # of the interpreter it resolves to (here, on the host) first on the guest's PATH.
@@ -97,7 +99,7 @@ kvm_usable() {
         (timeout 20 qemu-system-x86_64 -M pc -accel kvm -cpu host -m 256 -nodefaults \
             -no-user-config -display none -no-reboot -kernel "$img/vmlinux" -initrd "$img/initrd.cpio" \
             -append "console=ttyS0 quiet panic=-1 rdinit=/init vbus.probe" -serial "file:$tmp/probe.log" \
-            </dev/null >/dev/null 2>&1; true)
+            </dev/null >/dev/null 2>&1; true) 2>/dev/null
         if grep -q vbus-probe-ok "$tmp/probe.log" 2>/dev/null; then
             echo yes > "$probe"
         else
