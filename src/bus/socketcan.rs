@@ -2,6 +2,10 @@
 //! receive timestamps (`SO_TIMESTAMPNS`), error frames (all error classes) and our own
 //! frames (`CAN_RAW_RECV_OWN_MSGS`, recognised by `MSG_CONFIRM`, marked TX).
 //!
+//! The receive buffer is enlarged to [`RCVBUF_BYTES`] so that a reader that falls behind
+//! for a moment (a burst at full bus load, a busy machine) loses nothing, and the kernel's
+//! count of frames dropped on a full buffer (`SO_RXQ_OVFL`) is kept for [`Bus::dropped`].
+//!
 //! The `socketcan` crate opens the socket and sets its options. Frames are read with
 //! our own `recvmsg` because the crate does not expose `msg_flags`, which is the only
 //! way to tell our own frames from those of other programs.
@@ -12,6 +16,7 @@ use socketcan::{CanFdSocket, Socket, SocketOptions};
 use std::io;
 use std::os::fd::AsRawFd;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicU32, Ordering};
 use tokio::io::Interest;
 use tokio::io::unix::AsyncFd;
 use tokio::sync::broadcast;
@@ -30,6 +35,10 @@ const CANFD_FDF: u8 = 0x04;
 pub const CAN_MTU: usize = 16;
 /// Size of `struct canfd_frame`.
 pub const CANFD_MTU: usize = 72;
+/// The receive buffer asked for: with the kernel's doubling about 8 MB, some 10000 frames.
+/// Root (`CAP_NET_ADMIN`) gets it through `SO_RCVBUFFORCE`; otherwise `SO_RCVBUF` is capped
+/// at `net.core.rmem_max`.
+pub const RCVBUF_BYTES: i32 = 4 << 20;
 /// `ARPHRD_CAN` in `/sys/class/net/IFACE/type`.
 const ARPHRD_CAN: u32 = 280;
 
@@ -122,6 +131,11 @@ pub fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
         sock.set_error_filter(ERR_MASK_ALL)?;
         sock.set_recv_own_msgs(true)?;
         sock.set_recv_timestamp(true)?;
+        let fd = sock.as_raw_fd();
+        if setsockopt_int(fd, libc::SO_RCVBUFFORCE, RCVBUF_BYTES).is_err() {
+            setsockopt_int(fd, libc::SO_RCVBUF, RCVBUF_BYTES)?;
+        }
+        setsockopt_int(fd, libc::SO_RXQ_OVFL, 1)?;
         Ok(())
     };
     configure().map_err(|e| open_error(iface, &e))?;
@@ -129,7 +143,8 @@ pub fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
     let fd = unsafe { AsyncFd::register(sock) }.map_err(|e| open_error(iface, &e.into_parts().1))?;
     let fd = Arc::new(fd);
     let events = broadcast::channel(QUEUE_DEPTH).0;
-    let reader = tokio::spawn(read_loop(fd.clone(), events.clone()));
+    let drops = Arc::new(AtomicU32::new(0));
+    let reader = tokio::spawn(read_loop(fd.clone(), events.clone(), drops.clone()));
     let sender = (!listen_only).then(|| {
         Sender::Socket(Arc::new(Writer {
             iface: iface.to_string(),
@@ -142,7 +157,23 @@ pub fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
         events,
         sender,
         _task: Some(Arc::new(TaskGuard(reader))),
+        drops: Some(drops),
     })
+}
+
+/// Sets an integer `SOL_SOCKET` option.
+fn setsockopt_int(fd: i32, opt: i32, value: i32) -> io::Result<()> {
+    // SAFETY: `value` is a valid c_int for the duration of the call.
+    let r = unsafe {
+        libc::setsockopt(
+            fd,
+            libc::SOL_SOCKET,
+            opt,
+            (&value as *const i32).cast(),
+            std::mem::size_of::<i32>() as libc::socklen_t,
+        )
+    };
+    if r < 0 { Err(io::Error::last_os_error()) } else { Ok(()) }
 }
 
 /// The endpoint number of frames this socket sent.
@@ -158,14 +189,20 @@ impl Drop for TaskGuard {
 }
 
 /// Reads frames until the task is aborted; read errors are passed on and retried after a pause.
-async fn read_loop(fd: Arc<AsyncFd<CanFdSocket>>, events: broadcast::Sender<Carried>) {
+/// `drops` follows the kernel's count of frames dropped on a full receive buffer.
+async fn read_loop(fd: Arc<AsyncFd<CanFdSocket>>, events: broadcast::Sender<Carried>, drops: Arc<AtomicU32>) {
     loop {
         let got = fd.async_io(Interest::READABLE, |s| recv(s.as_raw_fd())).await;
         let carried = match got {
-            Ok((frame, own)) => Carried {
-                origin: if own { OWN } else { 0 },
-                frame: Ok(frame),
-            },
+            Ok(r) => {
+                if let Some(n) = r.drops {
+                    drops.store(n, Ordering::Relaxed);
+                }
+                Carried {
+                    origin: if r.own { OWN } else { 0 },
+                    frame: Ok(r.frame),
+                }
+            }
             Err(e) => Carried {
                 origin: 0,
                 frame: Err(ReadFault {
@@ -231,8 +268,18 @@ impl Writer {
     }
 }
 
-/// One `recvmsg`: the frame with its kernel timestamp, and whether this socket sent it.
-fn recv(fd: i32) -> io::Result<(Frame, bool)> {
+/// What one `recvmsg` gave.
+struct Received {
+    /// The frame with its kernel timestamp.
+    frame: Frame,
+    /// This socket sent it.
+    own: bool,
+    /// The kernel's count of frames dropped on this socket so far (`SO_RXQ_OVFL`).
+    drops: Option<u32>,
+}
+
+/// One `recvmsg`.
+fn recv(fd: i32) -> io::Result<Received> {
     let mut buf = [0u8; CANFD_MTU];
     let mut ctrl = [0u64; 16];
     let mut iov = libc::iovec {
@@ -251,6 +298,7 @@ fn recv(fd: i32) -> io::Result<(Frame, bool)> {
         return Err(io::Error::last_os_error());
     }
     let mut ts_ns = 0u64;
+    let mut drops = None;
     // SAFETY: the CMSG macros walk the control buffer the kernel filled within msg_controllen.
     unsafe {
         let mut c = libc::CMSG_FIRSTHDR(&msg);
@@ -258,6 +306,8 @@ fn recv(fd: i32) -> io::Result<(Frame, bool)> {
             if (*c).cmsg_level == libc::SOL_SOCKET && (*c).cmsg_type == libc::SCM_TIMESTAMPNS {
                 let t: libc::timespec = std::ptr::read_unaligned(libc::CMSG_DATA(c).cast());
                 ts_ns = t.tv_sec as u64 * 1_000_000_000 + t.tv_nsec as u64;
+            } else if (*c).cmsg_level == libc::SOL_SOCKET && (*c).cmsg_type == libc::SO_RXQ_OVFL {
+                drops = Some(std::ptr::read_unaligned(libc::CMSG_DATA(c).cast::<u32>()));
             }
             c = libc::CMSG_NXTHDR(&msg, c);
         }
@@ -265,7 +315,7 @@ fn recv(fd: i32) -> io::Result<(Frame, bool)> {
     let own = msg.msg_flags & libc::MSG_CONFIRM != 0;
     let mut frame = from_raw(&buf[..n as usize]).map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e))?;
     frame.ts_ns = ts_ns;
-    Ok((frame, own))
+    Ok(Received { frame, own, drops })
 }
 
 /// Parses a kernel `can_frame` (16 bytes) or `canfd_frame` (72 bytes).
