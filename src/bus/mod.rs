@@ -13,7 +13,6 @@ pub mod virt;
 use crate::frame::{Flags, Frame};
 use std::fmt;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicU32, Ordering};
 use tokio::sync::broadcast;
 
 /// Frames buffered per subscription before the slowest one starts losing frames.
@@ -75,7 +74,7 @@ pub struct Bus {
     /// Keeps the SocketCAN reader task alive while a handle exists.
     _task: Option<Arc<socketcan::TaskGuard>>,
     /// The kernel's count of frames dropped on a full receive buffer (SocketCAN only).
-    drops: Option<Arc<AtomicU32>>,
+    drops: Option<Arc<socketcan::DropCount>>,
 }
 
 impl fmt::Debug for Bus {
@@ -99,7 +98,7 @@ impl Bus {
     /// Frames the kernel dropped because this handle's socket buffer was full (0 on the
     /// virtual bus, which cannot drop). Frames a slow subscription missed are in [`Subscription::lost`].
     pub fn dropped(&self) -> u64 {
-        self.drops.as_ref().map_or(0, |d| d.load(Ordering::Relaxed) as u64)
+        self.drops.as_ref().map_or(0, |d| d.get())
     }
     /// A new subscription that sees every frame from now on.
     pub fn subscribe(&self) -> Subscription {

@@ -3,8 +3,8 @@
 //! frames (`CAN_RAW_RECV_OWN_MSGS`, recognised by `MSG_CONFIRM`, marked TX).
 //!
 //! The receive buffer is enlarged to [`RCVBUF_BYTES`] so that a reader that falls behind
-//! for a moment (a burst at full bus load, a busy machine) loses nothing, and the kernel's
-//! count of frames dropped on a full buffer (`SO_RXQ_OVFL`) is kept for [`Bus::dropped`].
+//! for a moment (a burst at full bus load, a busy machine) loses nothing; the kernel's
+//! count of frames dropped on a full buffer (`SO_MEMINFO`) is [`Bus::dropped`].
 //!
 //! The `socketcan` crate opens the socket and sets its options. Frames are read with
 //! our own `recvmsg` because the crate does not expose `msg_flags`, which is the only
@@ -16,7 +16,6 @@ use socketcan::{CanFdSocket, Socket, SocketOptions};
 use std::io;
 use std::os::fd::AsRawFd;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicU32, Ordering};
 use tokio::io::Interest;
 use tokio::io::unix::AsyncFd;
 use tokio::sync::broadcast;
@@ -135,7 +134,6 @@ pub fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
         if setsockopt_int(fd, libc::SO_RCVBUFFORCE, RCVBUF_BYTES).is_err() {
             setsockopt_int(fd, libc::SO_RCVBUF, RCVBUF_BYTES)?;
         }
-        setsockopt_int(fd, libc::SO_RXQ_OVFL, 1)?;
         Ok(())
     };
     configure().map_err(|e| open_error(iface, &e))?;
@@ -143,8 +141,7 @@ pub fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
     let fd = unsafe { AsyncFd::register(sock) }.map_err(|e| open_error(iface, &e.into_parts().1))?;
     let fd = Arc::new(fd);
     let events = broadcast::channel(QUEUE_DEPTH).0;
-    let drops = Arc::new(AtomicU32::new(0));
-    let reader = tokio::spawn(read_loop(fd.clone(), events.clone(), drops.clone()));
+    let reader = tokio::spawn(read_loop(fd.clone(), events.clone()));
     let sender = (!listen_only).then(|| {
         Sender::Socket(Arc::new(Writer {
             iface: iface.to_string(),
@@ -157,8 +154,35 @@ pub fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
         events,
         sender,
         _task: Some(Arc::new(TaskGuard(reader))),
-        drops: Some(drops),
+        drops: Some(Arc::new(DropCount(fd))),
     })
+}
+
+/// The kernel's count of frames dropped on a socket's full receive buffer.
+pub(super) struct DropCount(Arc<AsyncFd<CanFdSocket>>);
+
+impl DropCount {
+    /// `SK_MEMINFO_DROPS` of `SO_MEMINFO` (0 if the kernel does not tell).
+    pub(super) fn get(&self) -> u64 {
+        let mut info = [0u32; libc::SK_MEMINFO_DROPS as usize + 1];
+        let mut len = std::mem::size_of_val(&info) as libc::socklen_t;
+        // SAFETY: `info` is a writable buffer of `len` bytes for the duration of the call.
+        let r = unsafe {
+            libc::getsockopt(
+                self.0.as_raw_fd(),
+                libc::SOL_SOCKET,
+                libc::SO_MEMINFO,
+                info.as_mut_ptr().cast(),
+                &mut len,
+            )
+        };
+        let at = libc::SK_MEMINFO_DROPS as usize;
+        if r == 0 && (len as usize) >= (at + 1) * 4 {
+            info[at] as u64
+        } else {
+            0
+        }
+    }
 }
 
 /// Sets an integer `SOL_SOCKET` option.
@@ -189,20 +213,14 @@ impl Drop for TaskGuard {
 }
 
 /// Reads frames until the task is aborted; read errors are passed on and retried after a pause.
-/// `drops` follows the kernel's count of frames dropped on a full receive buffer.
-async fn read_loop(fd: Arc<AsyncFd<CanFdSocket>>, events: broadcast::Sender<Carried>, drops: Arc<AtomicU32>) {
+async fn read_loop(fd: Arc<AsyncFd<CanFdSocket>>, events: broadcast::Sender<Carried>) {
     loop {
         let got = fd.async_io(Interest::READABLE, |s| recv(s.as_raw_fd())).await;
         let carried = match got {
-            Ok(r) => {
-                if let Some(n) = r.drops {
-                    drops.store(n, Ordering::Relaxed);
-                }
-                Carried {
-                    origin: if r.own { OWN } else { 0 },
-                    frame: Ok(r.frame),
-                }
-            }
+            Ok((frame, own)) => Carried {
+                origin: if own { OWN } else { 0 },
+                frame: Ok(frame),
+            },
             Err(e) => Carried {
                 origin: 0,
                 frame: Err(ReadFault {
@@ -268,18 +286,8 @@ impl Writer {
     }
 }
 
-/// What one `recvmsg` gave.
-struct Received {
-    /// The frame with its kernel timestamp.
-    frame: Frame,
-    /// This socket sent it.
-    own: bool,
-    /// The kernel's count of frames dropped on this socket so far (`SO_RXQ_OVFL`).
-    drops: Option<u32>,
-}
-
-/// One `recvmsg`.
-fn recv(fd: i32) -> io::Result<Received> {
+/// One `recvmsg`: the frame with its kernel timestamp, and whether this socket sent it.
+fn recv(fd: i32) -> io::Result<(Frame, bool)> {
     let mut buf = [0u8; CANFD_MTU];
     let mut ctrl = [0u64; 16];
     let mut iov = libc::iovec {
@@ -298,7 +306,6 @@ fn recv(fd: i32) -> io::Result<Received> {
         return Err(io::Error::last_os_error());
     }
     let mut ts_ns = 0u64;
-    let mut drops = None;
     // SAFETY: the CMSG macros walk the control buffer the kernel filled within msg_controllen.
     unsafe {
         let mut c = libc::CMSG_FIRSTHDR(&msg);
@@ -306,8 +313,6 @@ fn recv(fd: i32) -> io::Result<Received> {
             if (*c).cmsg_level == libc::SOL_SOCKET && (*c).cmsg_type == libc::SCM_TIMESTAMPNS {
                 let t: libc::timespec = std::ptr::read_unaligned(libc::CMSG_DATA(c).cast());
                 ts_ns = t.tv_sec as u64 * 1_000_000_000 + t.tv_nsec as u64;
-            } else if (*c).cmsg_level == libc::SOL_SOCKET && (*c).cmsg_type == libc::SO_RXQ_OVFL {
-                drops = Some(std::ptr::read_unaligned(libc::CMSG_DATA(c).cast::<u32>()));
             }
             c = libc::CMSG_NXTHDR(&msg, c);
         }
@@ -315,7 +320,7 @@ fn recv(fd: i32) -> io::Result<Received> {
     let own = msg.msg_flags & libc::MSG_CONFIRM != 0;
     let mut frame = from_raw(&buf[..n as usize]).map_err(|e| io::Error::new(io::ErrorKind::InvalidData, e))?;
     frame.ts_ns = ts_ns;
-    Ok(Received { frame, own, drops })
+    Ok((frame, own))
 }
 
 /// Parses a kernel `can_frame` (16 bytes) or `canfd_frame` (72 bytes).
