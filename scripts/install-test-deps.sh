@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Installs what the test suite needs on a fresh Debian machine: real peers to test
 # against (can-utils, Wireshark's tshark, the python canopen library), tmux for the
-# end-to-end TUI test, and qemu + a Debian kernel for the real SocketCAN bus
-# (tests/vbus/run.sh fetches the kernel itself). Idempotent and quiet when done.
+# end-to-end TUI tests, jq for tests/vbus/e2e.sh, and qemu + busybox for the real
+# SocketCAN bus (tests/vbus/install.sh; tests/vbus/run.sh fetches the kernel itself).
+# Idempotent and quiet when done.
 set -euo pipefail
 
 need_apt=()
-for pkg in can-utils tshark tmux qemu-system-x86 busybox-static; do
+for pkg in can-utils tshark tmux jq qemu-system-x86 busybox-static; do
   dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "ok installed" || need_apt+=("$pkg")
 done
 if [ ${#need_apt[@]} -gt 0 ]; then
@@ -24,3 +25,6 @@ if ! python3 -c "import can, canopen" 2>/dev/null; then
   echo "install-test-deps: pip install python-can canopen"
   python3 -m pip install -q "python-can>=4.3" "canopen>=2.3"
 fi
+
+# The rest of what the vbus guest needs (iproute2, kmod, xz-utils).
+bash "$(dirname "$0")/../tests/vbus/install.sh"

@@ -121,6 +121,13 @@ fn nmt_wait_and_listen_only_and_missing_interface() {
 }
 
 #[test]
+fn sdo_write_takes_a_negative_value_without_double_dash() {
+    let (rc, v, err) = cotui(&["sdo", "write", "demo", "2", "0x6060", "-3", "--type", "i8", "--json"]);
+    assert_eq!(rc, 0, "{err}");
+    assert_eq!(v["data"], "FD");
+}
+
+#[test]
 fn scan_and_record() {
     let (rc, v, _) = cotui(&["scan", "demo", "--json"]);
     assert_eq!(rc, 0);
@@ -136,7 +143,7 @@ fn scan_and_record() {
     assert_eq!(nodes[1]["device_name"], "cotui simulated Syn-tron-like DS servo");
     let path = std::env::temp_dir().join(format!("cotui-rec-{}.log", std::process::id()));
     let (rc, v, _) = cotui(&["record", "demo", "-o", path.to_str().unwrap(), "--count", "5", "--json"]);
-    assert_eq!((rc, v["frames"].as_u64()), (0, Some(5)));
+    assert_eq!((rc, v["frames"].as_u64(), v["dropped"].as_u64()), (0, Some(5), Some(0)));
     let log = std::fs::read_to_string(&path).unwrap();
     let lines: Vec<&str> = log.lines().collect();
     assert_eq!(lines.len(), 5);

@@ -248,6 +248,27 @@ async fn listen_only_sends_nothing_whatever_the_command() {
 }
 
 #[tokio::test(start_paused = true)]
+async fn listen_only_scan_lists_the_nodes_heard_without_asking_them() {
+    let d = Demo::spawn(Simulation::demo(), true);
+    let mut watch = d.vbus.endpoint(true).subscribe();
+    let nodes = cotui::command::scan::scan(&d.bus, 1500, false, T).await.unwrap();
+    let found: Vec<(u8, Option<NmtState>, Option<u32>)> =
+        nodes.iter().map(|n| (n.node, n.nmt, n.device_type)).collect();
+    assert_eq!(
+        found,
+        [
+            (2, Some(NmtState::PreOperational), None),
+            (3, Some(NmtState::PreOperational), None)
+        ]
+    );
+    while let Some(Ok(f)) = watch.try_recv() {
+        assert!(!(0x600..0x680).contains(&f.id), "an SDO request went out: {f:?}");
+    }
+    let probe = cotui::command::scan::scan(&d.bus, 100, true, T).await.unwrap_err();
+    assert_eq!(probe, CommandError::Bus(BusError::ListenOnly));
+}
+
+#[tokio::test(start_paused = true)]
 async fn our_requests_come_back_tx_and_decode_like_received_frames() {
     let d = demo();
     let mut rx = d.bus.subscribe();

@@ -65,3 +65,52 @@ async fn listen_only_socket_never_writes() {
         );
     }
 }
+
+#[tokio::test]
+#[ignore = "needs vcan0 and can-utils' cangen (run through tests/vbus/run.sh)"]
+async fn a_reader_that_falls_behind_counts_what_the_kernel_dropped() {
+    let bus = open("vcan0", true).unwrap();
+    let mut rx = bus.subscribe();
+    // cangen runs while this (current-thread) runtime is blocked: nothing reads the socket,
+    // so the burst overflows even the enlarged receive buffer.
+    let sent = 60_000u64;
+    let status = std::process::Command::new("cangen")
+        .args([
+            "vcan0",
+            "-g",
+            "0",
+            "-n",
+            &sent.to_string(),
+            "-I",
+            "7E0",
+            "-L",
+            "8",
+            "-D",
+            "i",
+        ])
+        .status()
+        .expect("cangen runs");
+    assert!(status.success());
+    let mut got = 0u64;
+    let mut last = None;
+    while let Ok(Ok(f)) = tokio::time::timeout(Duration::from_millis(500), rx.recv()).await {
+        let counter = u64::from_le_bytes(f.payload().try_into().unwrap());
+        assert!(
+            last.is_none_or(|l| counter > l),
+            "frames out of order: {counter} after {last:?}"
+        );
+        last = Some(counter);
+        got += 1;
+    }
+    assert_eq!(rx.lost(), 0, "the subscription kept up");
+    assert!(got > 1000, "the buffer held a good part of the burst: {got}");
+    assert!(
+        bus.dropped() > 0,
+        "{got} frames of {sent} read, none counted as dropped"
+    );
+    assert_eq!(
+        got + bus.dropped(),
+        sent,
+        "every frame is either read or counted as dropped"
+    );
+}

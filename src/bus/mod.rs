@@ -73,6 +73,8 @@ pub struct Bus {
     sender: Option<Sender>,
     /// Keeps the SocketCAN reader task alive while a handle exists.
     _task: Option<Arc<socketcan::TaskGuard>>,
+    /// The kernel's count of frames dropped on a full receive buffer (SocketCAN only).
+    drops: Option<Arc<socketcan::DropCount>>,
 }
 
 impl fmt::Debug for Bus {
@@ -92,6 +94,11 @@ impl Bus {
     /// True when the handle was opened listen-only and cannot send.
     pub fn is_listen_only(&self) -> bool {
         self.sender.is_none()
+    }
+    /// Frames the kernel dropped because this handle's socket buffer was full (0 on the
+    /// virtual bus, which cannot drop). Frames a slow subscription missed are in [`Subscription::lost`].
+    pub fn dropped(&self) -> u64 {
+        self.drops.as_ref().map_or(0, |d| d.get())
     }
     /// A new subscription that sees every frame from now on.
     pub fn subscribe(&self) -> Subscription {

@@ -83,6 +83,7 @@ impl VirtualBus {
                 })
             }),
             _task: None,
+            drops: None,
         }
     }
     /// The bus time now in nanoseconds, as frames sent now would be stamped.

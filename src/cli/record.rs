@@ -50,7 +50,14 @@ pub fn run_record(args: &RecordArgs) -> i32 {
             let mut out = std::io::BufWriter::new(file);
             record(&bus, &mut out, limits, stop).await?
         };
-        let json = serde_json::json!({"ok": true, "frames": n, "output": path});
+        if n.dropped > 0 {
+            eprintln!(
+                "cotui record: {} frames were dropped before they could be logged (the machine was too busy; \
+                 as non-root, raising net.core.rmem_max gives the socket a larger buffer)",
+                n.dropped
+            );
+        }
+        let json = serde_json::json!({"ok": true, "frames": n.frames, "dropped": n.dropped, "output": path});
         Ok(Outcome {
             text: text(&cmd, &json),
             json,

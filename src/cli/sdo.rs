@@ -57,7 +57,8 @@ pub struct SdoReadArgs {
 pub struct SdoWriteArgs {
     #[command(flatten)]
     pub t: Transfer,
-    /// The value (a file path for `--type domain`, hex bytes for `--type octets`).
+    /// The value (a file path for `--type domain`, hex bytes for `--type octets`); negative numbers need no `--`.
+    #[arg(allow_negative_numbers = true)]
     pub value: String,
 }
 

@@ -112,7 +112,7 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
                     .map_err(|e| CommandError::Usage(format!("cannot create {output}: {e}")))?;
                 super::record::record(bus, &mut std::io::BufWriter::new(file), *limits, forever).await?
             };
-            json!({"ok": true, "frames": n, "output": output})
+            json!({"ok": true, "frames": n.frames, "dropped": n.dropped, "output": output})
         }
     };
     let text = text(cmd, &json);

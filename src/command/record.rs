@@ -15,14 +15,24 @@ pub struct Limits {
     pub duration_ms: Option<u64>,
 }
 
-/// Records frames from `bus` into `out` until `stop` resolves or a limit is reached;
-/// returns the number of frames written. Read errors of the interface are skipped.
+/// What a recording wrote and what it missed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Recorded {
+    /// Frames written to the log.
+    pub frames: u64,
+    /// Frames that never reached the log: dropped by the kernel on a full socket buffer,
+    /// or overrun in cotui's queue. A complete recording has 0.
+    pub dropped: u64,
+}
+
+/// Records frames from `bus` into `out` until `stop` resolves or a limit is reached.
+/// Read errors of the interface are skipped.
 pub async fn record<W: Write>(
     bus: &Bus,
     out: &mut W,
     limits: Limits,
     stop: impl Future<Output = ()>,
-) -> Result<u64, CommandError> {
+) -> Result<Recorded, CommandError> {
     let mut rx = bus.subscribe();
     let mut writer = LogWriter::new();
     let iface = bus.name().to_string();
@@ -39,20 +49,31 @@ pub async fn record<W: Write>(
     };
     tokio::pin!(stop);
     tokio::pin!(until);
-    while limits.count.is_none_or(|c| n < c) {
+    let more = |n: u64| limits.count.is_none_or(|c| n < c);
+    'frames: while more(n) {
         tokio::select! {
             _ = &mut stop => break,
             _ = &mut until => break,
-            got = rx.recv() => match got {
-                Ok(f) => {
-                    writer.write_io(out, &f, &iface).map_err(io_err)?;
-                    n += 1;
+            got = rx.recv() => {
+                // Write whatever else is queued before polling the stop conditions again.
+                let mut next = Some(got);
+                while let Some(got) = next {
+                    match got {
+                        Ok(f) => {
+                            writer.write_io(out, &f, &iface).map_err(io_err)?;
+                            n += 1;
+                        }
+                        Err(BusError::Closed) => break 'frames,
+                        Err(_) => {}
+                    }
+                    next = if more(n) { rx.try_recv() } else { None };
                 }
-                Err(BusError::Closed) => break,
-                Err(_) => {}
-            },
+            }
         }
     }
     out.flush().map_err(io_err)?;
-    Ok(n)
+    Ok(Recorded {
+        frames: n,
+        dropped: bus.dropped() + rx.lost(),
+    })
 }

@@ -31,6 +31,19 @@ pub struct NodeInfo {
 }
 
 impl NodeInfo {
+    /// A node known only by its NMT state (nothing read from it yet).
+    pub fn heard(node: u8, nmt: Option<NmtState>) -> NodeInfo {
+        NodeInfo {
+            node,
+            nmt,
+            device_type: None,
+            identity: [None; 4],
+            device_name: None,
+            software_version: None,
+            profile: None,
+            sdo_error: None,
+        }
+    }
     /// The CiA device profile number in the low word of 0x1000 (402 for drives).
     pub fn device_profile(&self) -> Option<u16> {
         self.device_type.map(|t| t as u16)
@@ -56,7 +69,8 @@ impl NodeInfo {
 }
 
 /// Listens `listen_ms` for heartbeats and boot-ups (and, with `probe`, also asks every node
-/// 1..127 for 0x1000), then reads the identification of each node found.
+/// 1..127 for 0x1000), then reads the identification of each node found. On a listen-only
+/// bus nothing is sent: the nodes heard are returned unidentified (and `probe` is refused).
 pub async fn scan(bus: &Bus, listen_ms: u64, probe: bool, timeout_ms: u64) -> Result<Vec<NodeInfo>, CommandError> {
     let mut rx = bus.subscribe();
     let mut heard: BTreeMap<u8, Option<NmtState>> = BTreeMap::new();
@@ -79,6 +93,16 @@ pub async fn scan(bus: &Bus, listen_ms: u64, probe: bool, timeout_ms: u64) -> Re
             }
         }
     }
+    if bus.is_listen_only() {
+        // Nothing may be sent: the nodes heard are the answer, without SDO identification.
+        if probe {
+            return Err(BusError::ListenOnly.into());
+        }
+        return Ok(heard
+            .into_iter()
+            .map(|(node, nmt)| NodeInfo::heard(node, nmt))
+            .collect());
+    }
     if probe {
         for node in 1..=127u8 {
             if !heard.contains_key(&node) && upload(bus, node, 0x1000, 0, false, timeout_ms).await.is_ok() {
@@ -98,16 +122,7 @@ fn le_u32(d: &[u8]) -> u32 {
 }
 
 async fn identify(bus: &Bus, node: u8, nmt: Option<NmtState>, timeout_ms: u64) -> Result<NodeInfo, CommandError> {
-    let mut info = NodeInfo {
-        node,
-        nmt,
-        device_type: None,
-        identity: [None; 4],
-        device_name: None,
-        software_version: None,
-        profile: None,
-        sdo_error: None,
-    };
+    let mut info = NodeInfo::heard(node, nmt);
     let note = |e: CommandError, info: &mut NodeInfo| -> Result<(), CommandError> {
         match e {
             CommandError::Bus(b) => Err(CommandError::Bus(b)),

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs what the vbus harness needs; idempotent and silent when everything is present.
-#   Debian: qemu-system-x86 busybox-static can-utils iproute2 kmod xz-utils
+#   Debian: qemu-system-x86 busybox-static can-utils iproute2 kmod xz-utils, and for the
+#           end-to-end suite (e2e.sh) jq and tmux
 #   PyPI:   python-can canopen (into the python3 found on PATH, which the guest also uses)
 set -euo pipefail
 
@@ -12,6 +13,8 @@ command -v candump >/dev/null || need_apt+=(can-utils)
 command -v ip >/dev/null || need_apt+=(iproute2)
 command -v modprobe >/dev/null || need_apt+=(kmod)
 command -v xz >/dev/null || need_apt+=(xz-utils)
+command -v jq >/dev/null || need_apt+=(jq)
+command -v tmux >/dev/null || need_apt+=(tmux)
 
 if [ ${#need_apt[@]} -gt 0 ]; then
     echo "vbus: installing ${need_apt[*]}" >&2

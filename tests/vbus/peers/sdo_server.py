@@ -5,7 +5,8 @@
 
 Prints "sdo_server ready IFACE NODE" once it listens, sends its boot-up message and
 heartbeats, and serves SDO (expedited, segmented and block transfers, see sdo_block.py)
-until SIGTERM/SIGINT (or --duration seconds). Its objects:
+until SIGTERM/SIGINT (or --duration seconds). Every value a client writes is printed as
+"sdo_server wrote INDEX:SUB HEXBYTES" (what the python side stored). Its objects:
 
     0x1000 u32 0x00000191 ro      0x1008 visible string "vbus sdo peer"
     0x1017 u16 heartbeat ms rw    0x1018 identity record (sub 1..4)
@@ -55,6 +56,11 @@ def make_node(node_id, heartbeat_ms=1000):
     return sdo_block.use_block_sdo(canopen.LocalNode(node_id, build_od(heartbeat_ms)))
 
 
+def print_write(index, subindex, od, data):
+    """Print a value written by a client (a write callback of canopen.LocalNode)."""
+    print(f"sdo_server wrote {index:04X}:{subindex:02X} {bytes(data).hex().upper()}", flush=True)
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("iface")
@@ -63,6 +69,7 @@ def main():
     p.add_argument("--duration", type=float, default=None, help="stop after this many seconds")
     a = p.parse_args()
     node = make_node(a.node, a.heartbeat_ms)
+    node.add_write_callback(print_write)
     network = common.start(node, a.iface)
     common.serve_until_signal(network, f"sdo_server ready {a.iface} {a.node}", a.duration)
 

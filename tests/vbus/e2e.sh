@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# The end-to-end suite (CI runs it from scripts/test.sh): builds cotui and the live
+# SocketCAN test binary on the host, then runs tests/vbus/e2e_guest.sh inside ONE vbus
+# guest with vcan0 (classic) and vcan1 (CAN FD): cotui record against candump -l
+# (incl. a 20000-frame burst), SDO against python canopen's LocalNode, the CiA 402 drive
+# peer, --listen-only against candump, the TUI in tmux, and tests/socketcan_live.rs.
+#
+#   tests/vbus/e2e.sh
+#
+# Prints one line per check. Exits 0 only when every check ran and passed: a guest that
+# cannot start is a failure (with the reason), never a skip.
+set -uo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/../.." || exit 1
+t0=$(date +%s.%N)
+since() { awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }'; }
+fail() {
+    echo "e2e: FAIL: $*" >&2
+    exit 1
+}
+
+bash tests/vbus/install.sh || fail "installing the harness's packages failed"
+for tool in jq tmux cangen cansend candump; do
+    command -v "$tool" > /dev/null || fail "$tool is missing (bash scripts/install-test-deps.sh installs it)"
+done
+
+# Build on the host: CPU work in the guest is ~10x slower.
+cargo build --quiet --bin cotui || fail "cargo build failed"
+live_test=$(cargo test --quiet --test socketcan_live --no-run --message-format=json |
+    jq -r 'select(.reason == "compiler-artifact" and .target.name == "socketcan_live" and .executable != null) | .executable') ||
+    fail "building tests/socketcan_live.rs failed"
+[ -x "$live_test" ] || fail "no socketcan_live test binary found (got '$live_test')"
+echo "e2e: built on the host in $(since) s"
+
+t_vm=$(date +%s.%N)
+VBUS_IFACES="vcan0 vcan1:fd" VBUS_TIMEOUT=${VBUS_TIMEOUT:-480} VBUS_TIMING=1 \
+    tests/vbus/run.sh tests/vbus/e2e_guest.sh target/debug/cotui "$live_test"
+rc=$?
+vm=$(awk -v a="$t_vm" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
+case $rc in
+    0) echo "e2e: passed (guest $vm s, total $(since) s)" ;;
+    124) fail "the guest run timed out or the guest died (after $vm s)" ;;
+    125) fail "no guest could start (reason above)" ;;
+    *) fail "checks failed in the guest (exit $rc, guest $vm s, total $(since) s)" ;;
+esac
