@@ -41,8 +41,23 @@ tmp=$(mktemp -d /tmp/vbus.XXXXXX) || die "mktemp failed"
 x="$tmp/x"
 mkdir -p "$x"
 qpid=
+readers=
+# The FIFO readers below end when qemu closes the FIFOs; if qemu never opened them (it
+# failed, or the script stopped before starting it), a read-write open (which does not
+# block) and close releases them.
+release_fifos() {
+    local f
+    for f in "$tmp/out" "$tmp/err"; do
+        [ -p "$f" ] || continue
+        exec 7<>"$f"
+        exec 7>&-
+    done
+}
 cleanup() {
     [ -n "$qpid" ] && kill "$qpid" 2>/dev/null
+    release_fifos
+    # A reader that had not yet opened its FIFO when the script failed would wait forever.
+    [ -n "$readers" ] && kill $readers 2>/dev/null
     wait 2>/dev/null
     [ -n "${VBUS_CONSOLE:-}" ] && cp "$tmp/console.log" "$VBUS_CONSOLE" 2>/dev/null
     rm -rf "$tmp"
@@ -88,7 +103,9 @@ done
 # they stream live to whatever this script's stdout/stderr are.
 mkfifo "$tmp/out" "$tmp/err"
 cat "$tmp/out" &
+readers=$!
 cat "$tmp/err" >&2 &
+readers="$readers $!"
 
 kvm_usable() {
     [ -r /dev/kvm ] && [ -w /dev/kvm ] || return 1
@@ -142,12 +159,7 @@ wait "$qpid"
 qrc=$?
 qpid=
 t1=$(date +%s.%N)
-# The FIFO readers end when qemu closes the FIFOs; if qemu never opened them, a
-# read-write open (which does not block) and close releases them.
-for f in "$tmp/out" "$tmp/err"; do
-    exec 7<>"$f"
-    exec 7>&-
-done
+release_fifos
 wait
 
 if [ "${VBUS_TIMING:-0}" = 1 ]; then
