@@ -166,7 +166,9 @@ pub fn run_summary(v: &Json) -> String {
 }
 
 /// The bytes to write: a file for domains, else the value encoded as its type.
-fn write_data(
+/// The bytes an SDO write of `value` sends: typed by `ty`, else by the dictionary; a
+/// domain value names the file to send.
+pub fn write_data(
     dict: &Dictionary,
     index: u16,
     sub: u8,

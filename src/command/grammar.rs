@@ -485,19 +485,6 @@ mod tests {
             }
         );
         assert_eq!(
-            parse_command("sdo write 2 0x60FF -100 --type i32")
-                .map(|c| matches!(c, Command::SdoWrite { value, .. } if value == "-100")),
-            Ok(true)
-        );
-        assert_eq!(
-            parse_command("scan --probe --listen 500").unwrap(),
-            Command::Scan {
-                listen_ms: 500,
-                probe: true,
-                timeout_ms: SCAN_TIMEOUT_MS
-            }
-        );
-        assert_eq!(
             parse_command("record -o out.log").unwrap(),
             Command::Record {
                 output: "out.log".into(),

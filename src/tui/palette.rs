@@ -74,13 +74,8 @@ pub fn plan(line: &str, bindings: &Bindings, state: impl Fn(u8) -> Option<DriveS
         } => {
             let dict = bindings.dictionary(*node);
             let (i, s) = resolve_object(dict, object)?;
-            let ty = options
-                .data_type
-                .or_else(|| dict.object(i, s).map(|o| o.data_type))
-                .ok_or(format!(
-                    "the type of {i:04X}:{s:02X} is unknown: give --type (u8..u64, i8..i64, ...)"
-                ))?;
-            let data = crate::command::value::encode(value, ty)?;
+            let data =
+                crate::command::exec::write_data(dict, i, s, value, options.data_type).map_err(|e| e.to_string())?;
             (sdo_initiate(*node, i, s, &data), None)
         }
         Command::Drive { node, action, .. } => {
