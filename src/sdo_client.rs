@@ -5,7 +5,7 @@
 
 use crate::decode::sdo::abort::{abort_text, codes};
 use crate::decode::sdo::crc::crc16;
-use crate::decode::sdo::frame::{Chunk, SdoCommand, Side, decode, encode};
+use crate::decode::sdo::frame::{Chunk, SdoCommand, Side, decode, encode, sub_block};
 use crate::decode::sdo::transaction::Protocol;
 use crate::od::{Dictionary, Value};
 use std::fmt;
@@ -587,9 +587,7 @@ impl SdoClient {
 
     /// Sends the download segment starting at `pos`.
     fn send_download_segment(&self, out: &mut ClientOutput, data: Vec<u8>, pos: usize, toggle: bool) -> State {
-        let end = (pos + 7).min(data.len());
-        let last = end == data.len();
-        let chunk = Chunk::new(&data[pos..end], 7);
+        let (chunk, end, last) = Chunk::segment(&data, pos);
         out.frames.push(encode(&SdoCommand::DownloadSegment {
             toggle,
             last,
@@ -601,19 +599,7 @@ impl SdoClient {
 
 /// Sends up to `blksize` block segments of `data` from `from`; returns the bytes sent.
 fn send_sub_block(out: &mut ClientOutput, data: &[u8], from: usize, blksize: u8) -> usize {
-    let mut pos = from;
-    for seqno in 1..=blksize {
-        let end = (pos + 7).min(data.len());
-        let last = end == data.len();
-        out.frames.push(encode(&SdoCommand::BlockSegment {
-            seqno,
-            last,
-            data: Chunk::new(&data[pos..end], 7),
-        }));
-        pos = end;
-        if last {
-            break;
-        }
-    }
-    pos - from
+    let (segments, sent) = sub_block(data, from, blksize);
+    out.frames.extend(segments.iter().map(encode));
+    sent
 }

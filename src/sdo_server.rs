@@ -4,7 +4,7 @@
 
 use crate::decode::sdo::abort::codes;
 use crate::decode::sdo::crc::crc16;
-use crate::decode::sdo::frame::{Chunk, SdoCommand, Side, decode, encode};
+use crate::decode::sdo::frame::{Chunk, SdoCommand, Side, decode, encode, sub_block};
 use crate::decode::sdo::transaction::Protocol;
 use crate::od::Access;
 use std::collections::BTreeMap;
@@ -461,9 +461,7 @@ impl SdoServer {
                     abort(out, index, sub, codes::TOGGLE);
                     return State::Idle;
                 }
-                let end = (pos + 7).min(data.len());
-                let last = end == data.len();
-                let chunk = Chunk::new(&data[pos..end], 7);
+                let (chunk, end, last) = Chunk::segment(&data, pos);
                 out.frames.push(encode(&C::UploadSegmentResponse {
                     toggle,
                     last,
@@ -696,22 +694,9 @@ impl SdoServer {
 
 /// Sends up to `blksize` segments of `data` from `from`; returns the bytes sent.
 fn send_sub_block(out: &mut ServerOutput, data: &[u8], from: usize, blksize: u8) -> usize {
-    let mut pos = from;
-    for seqno in 1..=blksize {
-        let end = (pos + 7).min(data.len());
-        let last = end == data.len();
-        let chunk = Chunk::new(&data[pos..end], 7);
-        out.frames.push(encode(&SdoCommand::BlockSegment {
-            seqno,
-            last,
-            data: chunk,
-        }));
-        pos = end;
-        if last {
-            break;
-        }
-    }
-    pos - from
+    let (segments, sent) = sub_block(data, from, blksize);
+    out.frames.extend(segments.iter().map(encode));
+    sent
 }
 
 /// Adds an abort frame.

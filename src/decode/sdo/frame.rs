@@ -54,6 +54,32 @@ impl Chunk {
     pub fn bytes(&self) -> &[u8] {
         &self.buf[..self.len as usize]
     }
+    /// The segment of `data` starting at `pos` (up to 7 bytes), where it ends, and
+    /// whether it is the last one.
+    pub fn segment(data: &[u8], pos: usize) -> (Chunk, usize, bool) {
+        let end = (pos + 7).min(data.len());
+        (Chunk::new(&data[pos.min(end)..end], 7), end, end == data.len())
+    }
+}
+
+/// The block-transfer segments of one sub-block: up to `blksize` segments of `data`
+/// from `from`, numbered from 1; returns them and the bytes they carry.
+pub fn sub_block(data: &[u8], from: usize, blksize: u8) -> (Vec<SdoCommand>, usize) {
+    let mut segments = Vec::new();
+    let mut pos = from;
+    for seqno in 1..=blksize {
+        let (chunk, end, last) = Chunk::segment(data, pos);
+        segments.push(SdoCommand::BlockSegment {
+            seqno,
+            last,
+            data: chunk,
+        });
+        pos = end;
+        if last {
+            break;
+        }
+    }
+    (segments, pos - from)
 }
 
 /// One SDO frame's command and fields (CiA 301 section 7.2.4.3).
