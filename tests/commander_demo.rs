@@ -320,3 +320,236 @@ async fn palette_lines_run_through_execute() {
         .unwrap_err();
     assert!(e.to_string().contains("give --type"), "{e}");
 }
+
+/// The frames `rx` has queued.
+fn drain(rx: &mut cotui::bus::Subscription) -> Vec<cotui::frame::Frame> {
+    std::iter::from_fn(|| rx.try_recv()).filter_map(Result::ok).collect()
+}
+
+/// The controlwords we wrote to `node` by SDO among `frames`.
+fn controlwords_sent(frames: &[cotui::frame::Frame], node: u8) -> Vec<u16> {
+    frames
+        .iter()
+        .filter(|f| f.direction() == cotui::frame::Direction::Tx && f.id == 0x600 + node as u32)
+        .filter(|f| f.payload()[..4] == [0x2B, 0x40, 0x60, 0])
+        .map(|f| u16::from_le_bytes([f.payload()[4], f.payload()[5]]))
+        .collect()
+}
+
+#[tokio::test(start_paused = true)]
+async fn stop_finds_every_powered_drive_whatever_enabled_it_and_confirms_each() {
+    use cotui::command::stop::{StopOptions, stop};
+    let d = demo();
+    nmt(&d.bus, NmtAction::Start, 0, false, T).await.unwrap();
+    // Node 2 enabled by the drive command, node 3 by raw controlword writes.
+    drive(&d.bus, 2, DriveAction::Enable, T).await.unwrap();
+    for cw in [6u16, 7, 0x0F] {
+        download(&d.bus, 3, 0x6040, 0, cw.to_le_bytes().to_vec(), false, T)
+            .await
+            .unwrap();
+    }
+    tokio::time::sleep(Duration::from_millis(50)).await;
+    assert_eq!(
+        d.sim.lock().unwrap().drive(3).unwrap().state(),
+        DriveState::OperationEnabled
+    );
+    let mut rx = d.bus.subscribe();
+    let report = stop(&d.bus, &[], 1200, StopOptions::default()).await.unwrap();
+    assert!(report.all_stopped(), "{}", report.text());
+    assert_eq!(report.nodes.iter().map(|n| n.node).collect::<Vec<_>>(), [2, 3]);
+    for n in &report.nodes {
+        assert_eq!(n.state, Some(DriveState::SwitchOnDisabled), "{}", n.text());
+        assert_eq!(n.sent, [0x0002, 0x0000]);
+    }
+    let text = report.text();
+    assert!(text.starts_with("2 drive(s) stopped and confirmed\n"), "{text}");
+    assert!(text.contains("node 3: stopped, Switch on disabled"), "{text}");
+    let frames = drain(&mut rx);
+    for node in [2, 3] {
+        assert_eq!(
+            d.sim.lock().unwrap().drive(node).unwrap().state(),
+            DriveState::SwitchOnDisabled
+        );
+        assert_eq!(controlwords_sent(&frames, node), [0x0002, 0x0000]);
+    }
+    // A second stop finds nothing powered and sends no controlword.
+    let mut rx = d.bus.subscribe();
+    let again = stop(&d.bus, &[], 1200, StopOptions::default()).await.unwrap();
+    assert!(again.nodes.is_empty() && again.idle.len() == 2, "{}", again.text());
+    assert_eq!(controlwords_sent(&drain(&mut rx), 2), Vec::<u16>::new());
+}
+
+#[tokio::test(start_paused = true)]
+async fn stop_waits_for_the_quick_stop_ramp_before_disabling_voltage() {
+    use cotui::command::stop::{StopOptions, stop};
+    let d = demo();
+    nmt(&d.bus, NmtAction::Start, 0, false, T).await.unwrap();
+    drive(&d.bus, 2, DriveAction::Enable, T).await.unwrap();
+    download(&d.bus, 2, 0x60FF, 0, 2000i32.to_le_bytes().to_vec(), false, T)
+        .await
+        .unwrap();
+    tokio::time::sleep(Duration::from_millis(1500)).await;
+    let mut rx = d.bus.subscribe();
+    let r = stop(&d.bus, &[2], 0, StopOptions::default()).await.unwrap();
+    assert!(r.all_stopped(), "{}", r.text());
+    let frames = drain(&mut rx);
+    assert_eq!(controlwords_sent(&frames, 2), [0x0002, 0x0000]);
+    // Between the two controlwords the drive was read braking in Quick stop active: the
+    // stop waited for the ramp instead of cutting the power at speed.
+    let at = |cw: u8| {
+        frames
+            .iter()
+            .position(|f| f.id == 0x602 && f.payload()[..5] == [0x2B, 0x40, 0x60, 0, cw])
+    };
+    let (qs, dv) = (at(2).unwrap(), at(0).unwrap());
+    let braking = frames[qs..dv]
+        .iter()
+        .filter(|f| f.id == 0x582 && f.payload()[..4] == [0x4B, 0x41, 0x60, 0])
+        .map(|f| DriveState::from_statusword(u16::from_le_bytes([f.payload()[4], f.payload()[5]])))
+        .collect::<Vec<_>>();
+    assert_eq!(braking.first(), Some(&DriveState::QuickStopActive), "{braking:?}");
+    assert!(frames[dv].ts_ns - frames[qs].ts_ns >= 50_000_000, "the ramp took time");
+    let drive = d.sim.lock().unwrap().drive(2).unwrap().state();
+    assert_eq!(drive, DriveState::SwitchOnDisabled);
+}
+
+#[tokio::test(start_paused = true)]
+async fn stop_of_a_silent_or_faulted_node_is_not_confirmed_and_exits_5() {
+    use cotui::command::stop::{StopOptions, stop};
+    let d = demo();
+    nmt(&d.bus, NmtAction::Start, 0, false, T).await.unwrap();
+    drive(&d.bus, 3, DriveAction::Enable, T).await.unwrap();
+    d.sim.lock().unwrap().drive_mut(3).unwrap().inject_fault(0x2310);
+    tokio::time::sleep(Duration::from_millis(50)).await;
+    let r = stop(&d.bus, &[3, 9], 0, StopOptions::default()).await.unwrap();
+    assert!(!r.all_stopped());
+    let text = r.text();
+    assert!(text.starts_with("2 of 2 drive(s) NOT confirmed stopped"), "{text}");
+    assert!(
+        text.contains("node 3: NOT confirmed stopped: in Fault (statusword 0x") && text.contains("error code 0x2310"),
+        "{text}"
+    );
+    assert!(
+        text.contains("node 9: NOT confirmed stopped: no SDO answer to controlword 0x0002 and no heartbeat"),
+        "{text}"
+    );
+    let e = r.into_result().unwrap_err();
+    assert_eq!(e.exit_code(), 5);
+    let j = e.to_json();
+    assert_eq!(
+        (j["ok"].as_bool(), j["error"].as_str()),
+        (Some(false), Some("not_stopped"))
+    );
+    assert_eq!(j["nodes"][1]["node"], 9);
+    assert_eq!(j["nodes"][1]["stopped"], false);
+}
+
+#[tokio::test(start_paused = true)]
+async fn listen_only_stop_says_nothing_can_be_sent_and_sends_nothing() {
+    let d = Demo::spawn(Simulation::demo(), true);
+    let mut watch = d.vbus.endpoint(true).subscribe();
+    tokio::time::sleep(Duration::from_millis(50)).await;
+    while watch.try_recv().is_some() {}
+    let b = cotui::od::bind::Bindings::new().unwrap();
+    for line in ["stop", "stop 2 3"] {
+        let cmd = cotui::command::parse_command(line).unwrap();
+        let e = cotui::command::execute(&d.bus, &cmd, &b).await.unwrap_err();
+        assert_eq!(e.exit_code(), 5, "{line}");
+        assert!(e.to_string().contains("listen-only — NOTHING was sent"), "{e}");
+        assert_eq!(e.to_json()["listen_only"], true);
+    }
+    while let Some(Ok(f)) = watch.try_recv() {
+        assert!(!(0x600..0x680).contains(&f.id), "SDO request on the bus: {f:?}");
+    }
+}
+
+/// A profile with a procedure that enables the drive, pauses, and enables it again.
+const SLOW_PROFILE: &str = r#"{
+  "format": 1,
+  "name": "slow-test",
+  "extends": ["cia402"],
+  "procedures": {
+    "slowpv": {
+      "description": "enable, wait, enable again (what stop-all must cancel)",
+      "steps": [
+        { "sdo_write": { "object": "0x6040", "value": "0x06" } },
+        { "sdo_write": { "object": "0x6040", "value": "0x07" } },
+        { "sdo_write": { "object": "0x6040", "value": "0x0F" } },
+        { "delay_ms": 1500 },
+        { "sdo_write": { "object": "0x6040", "value": "0x06" } },
+        { "sdo_write": { "object": "0x6040", "value": "0x07" } },
+        { "sdo_write": { "object": "0x6040", "value": "0x0F" } }
+      ]
+    }
+  }
+}"#;
+
+/// The TUI's live task on the demo bus (a real thread and clock): stop-all during a
+/// procedure's delay cancels the procedure, stops the drive, and nothing of the procedure is
+/// sent afterwards.
+#[test]
+fn stop_all_in_the_live_task_cancels_a_running_procedure_first() {
+    use cotui::command::stop::StopOptions;
+    use cotui::tui::live::{Request, start};
+    use cotui::tui::source::Feed;
+    use std::collections::BTreeSet;
+    use std::time::Instant;
+    let read = |_: &std::path::Path| Ok(SLOW_PROFILE.to_string());
+    let mut b = cotui::od::bind::Bindings::new().unwrap();
+    b.bind_profile(2, "slow.json", &read).unwrap();
+    let (feed, req) = start("demo", false, b);
+    let command = cotui::command::parse_command("run 2 slowpv").unwrap();
+    req.send(Request::Run {
+        line: "run 2 slowpv".into(),
+        command,
+    })
+    .unwrap();
+    // Frames in order; the index of the stop's first controlword and of its result.
+    let mut cws: Vec<(u16, bool)> = Vec::new();
+    let mut results = Vec::new();
+    let (mut stopped_at, mut stop_sent) = (None, false);
+    let give_up = Instant::now() + Duration::from_secs(60);
+    while Instant::now() < give_up {
+        match feed.recv_timeout(Duration::from_millis(100)) {
+            Ok(Feed::Frames(batch)) => {
+                for f in batch {
+                    let p = f.payload();
+                    if f.id == 0x602 && f.direction() == cotui::frame::Direction::Tx && p[..4] == [0x2B, 0x40, 0x60, 0]
+                    {
+                        cws.push((u16::from_le_bytes([p[4], p[5]]), stop_sent));
+                    }
+                }
+            }
+            Ok(Feed::Result(_, text)) => results.push(text),
+            Ok(_) | Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+            Err(e) => panic!("feed ended: {e}"),
+        }
+        // Stop once the procedure's first enable went out (it is in its delay then).
+        if !stop_sent && cws.iter().any(|(cw, _)| *cw == 0x0F) {
+            req.send(Request::StopAll {
+                nodes: BTreeSet::new(),
+                options: StopOptions::default(),
+            })
+            .unwrap();
+            stop_sent = true;
+            stopped_at = Some(Instant::now());
+        }
+        // Watch well past the end of the procedure's delay before judging.
+        if stopped_at.is_some_and(|t| t.elapsed() > Duration::from_millis(2500)) && !results.is_empty() {
+            break;
+        }
+    }
+    let after: Vec<u16> = cws.iter().filter(|(_, after)| *after).map(|(cw, _)| *cw).collect();
+    assert_eq!(
+        after,
+        [0x0002, 0x0000],
+        "only the stop's controlwords after the stop: {cws:?}"
+    );
+    let text = results.join("\n");
+    assert!(text.contains("cancelled: run 2 slowpv"), "{text}");
+    assert!(text.contains("node 2: stopped, Switch on disabled"), "{text}");
+    assert!(
+        !text.contains("slowpv: `slowpv`"),
+        "the procedure never finished: {text}"
+    );
+}

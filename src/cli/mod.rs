@@ -11,6 +11,7 @@ pub mod record;
 pub mod run;
 pub mod scan;
 pub mod sdo;
+pub mod stop;
 pub mod tui;
 
 use clap::{Parser, Subcommand};
@@ -59,6 +60,9 @@ pub enum Command {
     Scan(scan::ScanArgs),
     /// Record the bus to a candump -l log.
     Record(record::RecordArgs),
+    /// Emergency stop: quick stop, then disable voltage, on every CiA 402 drive found powered
+    /// (or the --node ones); reads each statusword back. Exit 0 only when all are confirmed.
+    Stop(stop::StopArgs),
 }
 
 /// Short usage printed by `cotui` without arguments.
@@ -98,5 +102,6 @@ pub fn run() -> i32 {
         Some(Command::Run(args)) => run::run_run(&args),
         Some(Command::Scan(args)) => scan::run_scan(&args),
         Some(Command::Record(args)) => record::run_record(&args),
+        Some(Command::Stop(args)) => stop::run_stop(&args),
     }
 }

@@ -436,6 +436,141 @@ async fn set_mode(bus: &Bus, w: &mut Watch, mode: i8, sw: u16, timeout_ms: u64) 
     }
 }
 
+/// How the stop of one drive ended (see [`stop`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct NodeStop {
+    pub node: u8,
+    /// True when the statusword read back shows the power stage off (Switch on disabled or
+    /// Not ready to switch on) after our controlwords.
+    pub stopped: bool,
+    /// The last statusword read, and the state it shows.
+    pub statusword: Option<u16>,
+    pub state: Option<DriveState>,
+    /// Controlwords written, in order.
+    pub sent: Vec<u16>,
+    /// Why the stop is not confirmed (no answer, refused, fault, state).
+    pub reason: Option<String>,
+}
+
+impl NodeStop {
+    /// The JSON object of one node in a stop report.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "node": self.node,
+            "stopped": self.stopped,
+            "statusword": self.statusword.map(|s| format!("0x{s:04X}")),
+            "state": self.state.map(|s| s.as_str()),
+            "controlwords": self.sent.iter().map(|c| format!("0x{c:04X}")).collect::<Vec<_>>(),
+            "reason": self.reason,
+        })
+    }
+    /// One line: `node 2: stopped, Switch on disabled (0x0250) after 0x0002, 0x0000`.
+    pub fn text(&self) -> String {
+        let sent = self
+            .sent
+            .iter()
+            .map(|c| format!("0x{c:04X}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let shown = match (self.state, self.statusword) {
+            (Some(s), Some(sw)) => format!("{} (statusword 0x{sw:04X})", s.text()),
+            _ => "no statusword".into(),
+        };
+        match &self.reason {
+            None => format!("node {}: stopped, {shown} after controlwords {sent}", self.node),
+            Some(r) => format!("node {}: NOT confirmed stopped: {r}", self.node),
+        }
+    }
+}
+
+/// Quick stop, then disable voltage: the emergency stop of one drive.
+///
+/// Writes controlword 0x0002 at once, waits up to `ramp_ms` for the drive to finish its
+/// quick stop (it leaves Quick stop active by itself, or shows target reached, bit 10),
+/// writes 0x0000 (disable voltage) and reads the statusword back until it shows the power
+/// stage off. Never fails: every problem is in the returned [`NodeStop`].
+pub async fn stop(bus: &Bus, node: u8, timeout_ms: u64, ramp_ms: u64) -> NodeStop {
+    let mut w = Watch {
+        rx: bus.subscribe(),
+        node,
+        obs: Observation::default(),
+        tpdo: None,
+        tpdo_sw: None,
+    };
+    let mut out = NodeStop {
+        node,
+        stopped: false,
+        statusword: None,
+        state: None,
+        sent: Vec::new(),
+        reason: None,
+    };
+    for (cw, wait_ms) in [(0x0002u16, ramp_ms), (0x0000, timeout_ms.max(200) * 2)] {
+        if let Err(e) = download(bus, node, 0x6040, 0, cw.to_le_bytes().to_vec(), false, timeout_ms).await {
+            out.reason = Some(stop_failure(&mut w, cw, e));
+            return out;
+        }
+        out.sent.push(cw);
+        let deadline = tokio::time::Instant::now() + Duration::from_millis(wait_ms);
+        loop {
+            let sw = match statusword(bus, &mut w, timeout_ms).await {
+                Ok((sw, _)) => sw,
+                Err(e) => {
+                    out.reason = Some(format!("statusword not readable after controlword 0x{cw:04X}: {e}"));
+                    return out;
+                }
+            };
+            let state = DriveState::from_statusword(sw);
+            (out.statusword, out.state) = (Some(sw), Some(state));
+            let off = matches!(state, DriveState::SwitchOnDisabled | DriveState::NotReadyToSwitchOn);
+            let faulted = matches!(state, DriveState::Fault | DriveState::FaultReactionActive);
+            let standstill = state == DriveState::QuickStopActive && sw & 0x0400 != 0;
+            if off || faulted || (cw == 0x0002 && standstill) || tokio::time::Instant::now() >= deadline {
+                break;
+            }
+            tokio::time::sleep(Duration::from_millis(10)).await;
+        }
+    }
+    let (Some(sw), Some(state)) = (out.statusword, out.state) else {
+        return out;
+    };
+    out.stopped = matches!(state, DriveState::SwitchOnDisabled | DriveState::NotReadyToSwitchOn);
+    if !out.stopped {
+        out.reason = Some(
+            if matches!(state, DriveState::Fault | DriveState::FaultReactionActive) {
+                let code = read_u16(bus, node, 0x603F, timeout_ms).await.ok();
+                format!(
+                    "in {} (statusword 0x{sw:04X}{}): the fault reaction decides what the motor does;                  check the drive, then `drive {node} fault-reset`",
+                    state.text(),
+                    code.map(|c| format!(", error code 0x{c:04X}")).unwrap_or_default()
+                )
+            } else {
+                format!(
+                    "statusword 0x{sw:04X} still shows {} after disable voltage (0x0000)",
+                    state.text()
+                )
+            },
+        );
+    }
+    out
+}
+
+/// Why writing controlword `cw` during a stop failed, in words.
+fn stop_failure(w: &mut Watch, cw: u16, e: CommandError) -> String {
+    w.drain();
+    match e {
+        CommandError::Abort { code, .. } => format!(
+            "the node refused controlword 0x{cw:04X}: SDO abort 0x{code:08X} {} (not a CiA 402 drive?)",
+            crate::decode::sdo::abort_text(code)
+        ),
+        CommandError::Timeout(_) => match w.obs.nmt {
+            Some(s) => format!("no SDO answer to controlword 0x{cw:04X} (heartbeat says {})", s.text()),
+            None => format!("no SDO answer to controlword 0x{cw:04X} and no heartbeat: check power, wiring, node-ID"),
+        },
+        e => format!("controlword 0x{cw:04X} not written: {e}"),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -44,6 +44,12 @@ pub enum CommandError {
         report: Box<serde_json::Value>,
         cause: Box<CommandError>,
     },
+    /// A stop did not confirm every drive stopped (or could not send at all); `report` is
+    /// the stop's JSON (`nodes` with `stopped` and `reason` each), `text` its text.
+    NotStopped {
+        report: Box<serde_json::Value>,
+        text: String,
+    },
 }
 
 impl CommandError {
@@ -56,6 +62,7 @@ impl CommandError {
             CommandError::Timeout(_) => EXIT_TIMEOUT,
             CommandError::Drive { .. } => EXIT_DRIVE,
             CommandError::Step { cause, .. } => cause.exit_code(),
+            CommandError::NotStopped { .. } => EXIT_DRIVE,
         }
     }
     /// The `--json` object of the failure.
@@ -78,6 +85,15 @@ impl CommandError {
                 "message": self.to_string(),
             }),
             CommandError::Timeout(m) => json!({"ok": false, "error": "timeout", "message": m}),
+            CommandError::NotStopped { report, text } => {
+                let mut v = (**report).clone();
+                if let Some(o) = v.as_object_mut() {
+                    o.insert("ok".into(), false.into());
+                    o.insert("error".into(), "not_stopped".into());
+                    o.insert("message".into(), text.clone().into());
+                }
+                v
+            }
             CommandError::Drive { node, step, reason } => json!({
                 "ok": false, "error": "drive", "node": node, "step": step, "reason": reason,
                 "message": self.to_string(),
@@ -104,6 +120,7 @@ impl std::fmt::Display for CommandError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             CommandError::Usage(m) | CommandError::Timeout(m) => write!(f, "{m}"),
+            CommandError::NotStopped { text, .. } => write!(f, "{text}"),
             CommandError::Bus(e) => write!(f, "{e}"),
             CommandError::Abort {
                 node,

@@ -23,6 +23,11 @@ pub struct Outcome {
 pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Outcome, CommandError> {
     let json = match cmd {
         Command::Run(spec) => return run_procedure(bus, bindings, spec).await,
+        Command::Stop {
+            nodes,
+            listen_ms,
+            options,
+        } => return super::stop::stop(bus, nodes, *listen_ms, *options).await?.into_result(),
         Command::Nmt {
             action,
             node,
@@ -251,6 +256,8 @@ pub fn text(cmd: &Command, v: &Json) -> String {
         Command::Scan { .. } => scan_text(v),
         Command::Record { .. } => format!("{} frames written to {}", v["frames"], s(&v["output"])),
         Command::Run(_) => run_summary(v),
+        // A stop's text comes from its report (see `stop::StopReport::text`).
+        Command::Stop { .. } => String::new(),
     }
 }
 

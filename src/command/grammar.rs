@@ -186,6 +186,13 @@ pub enum Command {
     Record { output: String, limits: Limits },
     /// `run NODE PROCEDURE [NAME=VALUE ...] [--dry-run] [--timeout MS]`, or `run NODE [--list]`.
     Run(RunSpec),
+    /// `stop [NODE ...] [--listen MS] [--ramp MS] [--timeout MS]`: quick stop and disable
+    /// voltage on these nodes, or (none given) on every CiA 402 drive found powered.
+    Stop {
+        nodes: Vec<u8>,
+        listen_ms: u64,
+        options: super::stop::StopOptions,
+    },
 }
 
 /// What `run` runs: a procedure of a node with its parameters, or (no procedure) the list.
@@ -351,7 +358,7 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
     let mut pos: Vec<&str> = Vec::new();
     let mut data_type = None;
     let (mut block, mut wait, mut probe, mut list, mut dry_run) = (false, false, false, false, false);
-    let (mut output, mut timeout, mut listen) = (None, None, None);
+    let (mut output, mut timeout, mut listen, mut ramp) = (None, None, None, None);
     let mut limits = Limits::default();
     let mut it = all.iter();
     while let Some(w) = it.next() {
@@ -365,6 +372,7 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
             "--type" | "-t" => data_type = Some(parse_type(value("--type")?)?),
             "--timeout" => timeout = Some(positive("--timeout", value("--timeout")?)?),
             "--listen" => listen = Some(positive("--listen", value("--listen")?)?),
+            "--ramp" => ramp = Some(positive("--ramp", value("--ramp")?)?),
             "--count" => limits.count = Some(positive("--count", value("--count")?)?),
             "--duration" => limits.duration_ms = Some(positive("--duration", value("--duration")?)?),
             "-o" | "--output" => output = Some(value("-o")?.to_string()),
@@ -380,7 +388,7 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
         timeout_ms: timeout.unwrap_or(DEFAULT_TIMEOUT_MS),
     };
     let usage = "commands: nmt ACTION NODE, sdo read NODE OBJECT, sdo write NODE OBJECT VALUE, \
-                 drive NODE ACTION, run NODE PROCEDURE [NAME=VALUE ...], scan, record -o FILE";
+                 drive NODE ACTION, run NODE PROCEDURE [NAME=VALUE ...], scan, record -o FILE, stop [NODE ...]";
     match pos.as_slice() {
         ["nmt", action, node] => Ok(Command::Nmt {
             action: NmtAction::parse(action)?,
@@ -416,6 +424,14 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
             listen_ms: listen.unwrap_or(SCAN_LISTEN_MS),
             probe,
             timeout_ms: timeout.unwrap_or(SCAN_TIMEOUT_MS),
+        }),
+        ["stop", nodes @ ..] => Ok(Command::Stop {
+            nodes: nodes.iter().map(|n| parse_node(n, false)).collect::<Result<_, _>>()?,
+            listen_ms: listen.unwrap_or(super::stop::DEFAULT_LISTEN_MS),
+            options: super::stop::StopOptions {
+                timeout_ms: timeout.unwrap_or(DEFAULT_TIMEOUT_MS),
+                ramp_ms: ramp.unwrap_or(super::stop::DEFAULT_RAMP_MS),
+            },
         }),
         ["record"] => Ok(Command::Record {
             output: output.ok_or("record needs -o FILE")?,

@@ -10,6 +10,7 @@ pub mod record;
 pub mod run;
 pub mod scan;
 pub mod sdo;
+pub mod stop;
 pub mod value;
 
 pub use error::CommandError;

@@ -4,19 +4,22 @@
 use super::filter::Filter;
 use super::keymap::{Action, Key, Keymap, Lookup};
 use super::live::{Request, Requests};
+use super::messages::{Level, Messages};
 use super::palette::{self, COMMANDER_WORDS, Planned};
 use super::prompt::{Prompt, PromptKind};
 use super::rows::{Row, RowCache};
 use super::source::{Control, Feed};
 use super::trace::Trace;
 use super::view::View;
-use crate::command::{Command, DriveAction};
+use crate::command::Command;
+use crate::command::stop::{Commanded, StopOptions, is_powered};
 use crate::decode::Decoded;
 use crate::od::bind::Bindings;
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers, MouseButton, MouseEvent, MouseEventKind};
 use ratatui::layout::Rect;
 use std::collections::BTreeSet;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError};
+use std::time::SystemTime;
 use std::time::{Duration, Instant};
 
 /// The main-area panes.
@@ -129,6 +132,8 @@ impl ListState {
 pub struct Layout {
     /// Rows of the main table, without header.
     pub table: Rect,
+    /// Lines the message log popup shows at once.
+    pub messages: usize,
 }
 
 /// The whole application state.
@@ -163,6 +168,12 @@ pub struct App {
     pub search: Option<Filter>,
     /// A message for the status bar (result of the last command).
     pub message: Option<String>,
+    /// Every result, event and error of the session (the message log popup).
+    pub messages: Messages,
+    /// The message log popup is shown.
+    pub messages_shown: bool,
+    /// Lines the message log is scrolled up from its end.
+    pub messages_back: usize,
     /// Palette history, newest last.
     pub history: Vec<String>,
     /// The capture source.
@@ -181,8 +192,11 @@ pub struct App {
     pub bindings: Bindings,
     /// A commander line waiting for `y`.
     pub confirm: Option<Planned>,
-    /// Drives this session enabled (what stop-all stops).
-    pub enabled: BTreeSet<u8>,
+    /// Nodes cotui commanded on the bus (from the frames it sent): what stop-all stops,
+    /// besides the drives seen powered.
+    pub commanded: Commanded,
+    /// Quitting waits for `y`: these drives cotui commanded are still powered.
+    pub quit_confirm: Option<Vec<u8>>,
     pending: Vec<Key>,
     rate_mark: (Instant, usize),
     /// Set when something changed since the last draw.
@@ -191,7 +205,7 @@ pub struct App {
 
 /// Names the palette completes.
 pub const PALETTE_COMMANDS: &[&str] = &[
-    "filter", "search", "goto", "time", "speed", "pause", "resume", "plot", "help", "quit",
+    "filter", "search", "goto", "time", "speed", "pause", "resume", "plot", "help", "messages", "quit",
 ];
 
 impl App {
@@ -214,6 +228,9 @@ impl App {
             prompt: None,
             search: None,
             message: None,
+            messages: Messages::default(),
+            messages_shown: false,
+            messages_back: 0,
             history: Vec::new(),
             source,
             rows: RowCache::default(),
@@ -223,7 +240,8 @@ impl App {
             layout: Layout::default(),
             confirm: None,
             bindings,
-            enabled: BTreeSet::new(),
+            commanded: Commanded::default(),
+            quit_confirm: None,
             pending: Vec::new(),
             rate_mark: (Instant::now(), 0),
             dirty: true,
@@ -232,14 +250,15 @@ impl App {
 
     /// Takes frames from the source for up to `budget`; true when more are waiting.
     pub fn ingest(&mut self, budget: Duration) -> bool {
-        let Some(feed) = &self.source.feed else {
-            return false;
-        };
         let start = Instant::now();
         loop {
+            let Some(feed) = &self.source.feed else {
+                return false;
+            };
             match feed.try_recv() {
                 Ok(Feed::Frames(batch)) => {
                     for f in &batch {
+                        self.commanded.observe(f);
                         self.trace.push(f);
                     }
                     self.dirty = true;
@@ -258,20 +277,23 @@ impl App {
                     self.rate_mark = (Instant::now(), 0);
                     self.dirty = true;
                 }
-                Ok(Feed::Status(s) | Feed::Result(s)) => {
-                    self.message = Some(s);
-                    self.dirty = true;
-                }
+                Ok(Feed::Status(s)) => self.say(Level::Info, &s),
+                Ok(Feed::Result(level, s)) => self.say(level, &s),
                 Ok(Feed::Lost(n)) => {
                     self.source.drops += n;
                     self.dirty = true;
                 }
                 Ok(Feed::BusError(e)) => {
+                    if self.source.bus_error.as_ref() != Some(&e) {
+                        self.log(Level::Error, &e);
+                    }
                     self.source.bus_error = Some(e);
                     self.dirty = true;
                 }
                 Ok(Feed::BusOk) => {
-                    self.source.bus_error = None;
+                    if self.source.bus_error.take().is_some() {
+                        self.log(Level::Info, &format!("{}: capturing again", self.source.name));
+                    }
                     self.dirty = true;
                 }
                 Ok(Feed::Done) | Err(TryRecvError::Disconnected) => {
@@ -310,6 +332,26 @@ impl App {
         }
     }
 
+    /// Logs `text` and shows its first line in the status line.
+    pub fn say(&mut self, level: Level, text: &str) {
+        self.log(level, text);
+        let mut lines = text.lines();
+        let first = lines.next().unwrap_or("");
+        let more = lines.count();
+        self.message = Some(if more == 0 {
+            first.to_string()
+        } else {
+            format!("{first} (+{more} lines: `m` shows the message log)")
+        });
+        self.dirty = true;
+    }
+
+    /// Logs `text` without touching the status line.
+    pub fn log(&mut self, level: Level, text: &str) {
+        self.messages.push(SystemTime::now(), level, text);
+        self.dirty = true;
+    }
+
     /// Rows in the trace view.
     pub fn view_len(&self) -> usize {
         self.view.len(&self.trace)
@@ -323,6 +365,14 @@ impl App {
     /// Handles a key press.
     pub fn key(&mut self, ev: KeyEvent) {
         self.dirty = true;
+        if let Some(nodes) = self.quit_confirm.take() {
+            match ev.code {
+                KeyCode::Char('y') => self.quit = true,
+                KeyCode::Char('s') => self.stop_all(&nodes, StopOptions::default()),
+                _ => self.message = Some("not quitting".into()),
+            }
+            return;
+        }
         if let Some(p) = self.confirm.take() {
             if ev.code == KeyCode::Char('y') {
                 self.send(p);
@@ -421,36 +471,90 @@ impl App {
 
     fn send(&mut self, p: Planned) {
         let Some(req) = &self.source.requests else {
-            self.message = Some("not sent: this source has no bus (use `cotui live IFACE` or `cotui demo`)".into());
+            self.say(
+                Level::Error,
+                "not sent: this source has no bus (use `cotui live IFACE` or `cotui demo`)",
+            );
             return;
         };
-        if let Command::Drive { node, action, .. } = &p.command {
-            match action {
-                DriveAction::Enable => {
-                    self.enabled.insert(*node);
-                }
-                DriveAction::Disable | DriveAction::QuickStop => {
-                    self.enabled.remove(node);
-                }
-                _ => {}
-            }
-        }
-        self.message = Some(format!("sending: {}", p.preview));
-        let _ = req.send(Request::Run(p.command));
+        let _ = req.send(Request::Run {
+            line: p.line.clone(),
+            command: p.command,
+        });
+        self.say(Level::Info, &format!("{}: sending {}", p.line, p.preview));
     }
 
-    fn stop_all(&mut self) {
-        let Some(req) = &self.source.requests else {
-            self.message = Some("stop all: this source has no bus".into());
-            return;
-        };
-        if self.enabled.is_empty() {
-            self.message = Some("stop all: no drive was enabled from this session".into());
+    /// True when the source cannot send (listen-only).
+    fn listen_only(&self) -> bool {
+        matches!(
+            self.source.kind,
+            SourceKind::Live { listen_only: true } | SourceKind::Demo { listen_only: true }
+        )
+    }
+
+    /// The drives stop-all stops: those cotui commanded, those seen powered, and `extra`.
+    pub fn stop_targets(&self, extra: &[u8]) -> BTreeSet<u8> {
+        let mut t: BTreeSet<u8> = self.commanded.nodes().chain(extra.iter().copied()).collect();
+        t.extend(
+            self.trace
+                .nodes
+                .iter()
+                .filter(|(_, n)| n.drive.is_some_and(is_powered))
+                .map(|(id, _)| *id),
+        );
+        t
+    }
+
+    /// The emergency stop: the live task cancels everything it runs for us, then stops every
+    /// target (see [`App::stop_targets`]) and reports per node whether it is confirmed.
+    fn stop_all(&mut self, extra: &[u8], options: StopOptions) {
+        if self.listen_only() {
+            self.say(
+                Level::Error,
+                "stop all: listen-only — NOTHING can be sent, no drive was stopped; stop them another way",
+            );
             return;
         }
-        let nodes: Vec<u8> = std::mem::take(&mut self.enabled).into_iter().collect();
-        self.message = Some(format!("stop all: quick stop then disable voltage on nodes {nodes:?}"));
-        let _ = req.send(Request::StopAll(nodes));
+        let Some(req) = &self.source.requests else {
+            self.say(Level::Warn, "stop all: this source has no bus (a log), nothing to stop");
+            return;
+        };
+        let nodes = self.stop_targets(extra);
+        let _ = req.send(Request::StopAll {
+            nodes: nodes.clone(),
+            options,
+        });
+        let list = if nodes.is_empty() {
+            "every drive cotui commanded".to_string()
+        } else {
+            format!(
+                "nodes {}",
+                nodes.iter().map(u8::to_string).collect::<Vec<_>>().join(", ")
+            )
+        };
+        self.say(
+            Level::Warn,
+            &format!("stop all: cancelling running commands; quick stop, then disable voltage on {list}"),
+        );
+    }
+
+    /// Quits, unless a drive cotui commanded is still powered: then asks first.
+    fn request_quit(&mut self) {
+        let powered: Vec<u8> = self
+            .commanded
+            .nodes()
+            .filter(|n| self.trace.nodes.get(*n).and_then(|i| i.drive).is_some_and(is_powered))
+            .collect();
+        if powered.is_empty() || self.source.requests.is_none() {
+            self.quit = true;
+            return;
+        }
+        let stop = self.keymap.key_for(super::keymap::Action::StopAll).unwrap_or_default();
+        self.message = Some(format!(
+            "drive(s) {} that cotui commanded are still powered: y quits anyway, s stops them first ({stop}              any time), any other key stays",
+            powered.iter().map(u8::to_string).collect::<Vec<_>>().join(", ")
+        ));
+        self.quit_confirm = Some(powered);
     }
 
     fn submit(&mut self, p: Prompt) {
@@ -533,9 +637,22 @@ impl App {
                 self.help = true;
                 Ok(String::new())
             }
-            "quit" => {
-                self.quit = true;
+            "messages" => {
+                self.messages_shown = true;
+                self.messages_back = 0;
                 Ok(String::new())
+            }
+            "quit" => {
+                self.request_quit();
+                return;
+            }
+            "stop" => {
+                match crate::command::parse_command(line) {
+                    Ok(Command::Stop { nodes, options, .. }) => self.stop_all(&nodes, options),
+                    Ok(_) => {}
+                    Err(e) => self.say(Level::Error, &format!("stop: {e}")),
+                }
+                return;
             }
             w if COMMANDER_WORDS.contains(&w) => {
                 self.commander(line);
@@ -550,7 +667,10 @@ impl App {
         self.message = match result {
             Ok(s) if s.is_empty() => None,
             Ok(s) => Some(s),
-            Err(e) => Some(e),
+            Err(e) => {
+                self.log(Level::Error, &format!("{line}: {e}"));
+                Some(e)
+            }
         };
     }
 
@@ -711,9 +831,16 @@ impl App {
     pub fn act(&mut self, a: Action) {
         self.dirty = true;
         let page = self.page() as isize;
+        if self.messages_shown && self.messages_key(a) {
+            return;
+        }
         match a {
-            Action::Quit => self.quit = true,
+            Action::Quit => self.request_quit(),
             Action::Help => self.help = !self.help,
+            Action::Messages => {
+                self.messages_shown = !self.messages_shown;
+                self.messages_back = 0;
+            }
             Action::Down => self.scroll(1),
             Action::Up => self.scroll(-1),
             Action::PageDown => self.scroll(page),
@@ -795,7 +922,7 @@ impl App {
             Action::PrevMatch => self.jump_match(false),
             Action::ClearFilter => self.set_filter(""),
             Action::Palette => self.prompt = Some(Prompt::new(PromptKind::Palette, "")),
-            Action::StopAll => self.stop_all(),
+            Action::StopAll => self.stop_all(&[], StopOptions::default()),
             Action::SpeedUp | Action::SpeedDown => {
                 if let SourceKind::Replay { speed } = self.source.kind {
                     let base = if speed <= 0.0 { 1.0 } else { speed };
@@ -832,6 +959,25 @@ impl App {
                 self.pane = Pane::Plot;
             }
         }
+    }
+
+    /// Scrolls or closes the message log popup; false when `a` is not for it.
+    fn messages_key(&mut self, a: Action) -> bool {
+        let page = self.layout.messages.max(1);
+        let most = self.messages.lines().len();
+        let back = &mut self.messages_back;
+        match a {
+            Action::Up => *back += 1,
+            Action::Down => *back = back.saturating_sub(1),
+            Action::PageUp => *back += page,
+            Action::PageDown => *back = back.saturating_sub(page),
+            Action::Top => *back = most,
+            Action::Bottom => *back = 0,
+            Action::Back | Action::Messages => self.messages_shown = false,
+            _ => return false,
+        }
+        self.messages_back = self.messages_back.min(most.saturating_sub(self.layout.messages));
+        true
     }
 
     /// Handles a mouse event: wheel scrolls, left click selects a row.
@@ -962,6 +1108,129 @@ mod tests {
             Some("not sent: this source has no bus (use `cotui live IFACE` or `cotui demo`)")
         );
         assert_eq!(a.history, ["nmt reset-node 0"]);
+    }
+
+    /// `app()` fed by a live source whose requests the test reads.
+    fn live_app(listen_only: bool) -> (App, tokio::sync::mpsc::UnboundedReceiver<Request>) {
+        let (_ftx, frx) = std::sync::mpsc::channel();
+        let (rtx, rrx) = tokio::sync::mpsc::unbounded_channel();
+        let mut a = app();
+        a.source = SourceInfo::live("vcan0", SourceKind::Live { listen_only }, frx, rtx);
+        (a, rrx)
+    }
+
+    fn ctrl(c: char) -> KeyEvent {
+        KeyEvent::new(KeyCode::Char(c), KeyModifiers::CONTROL)
+    }
+
+    #[test]
+    fn stop_all_targets_drives_seen_powered_and_commanded_and_logs_it() {
+        let (mut a, mut req) = live_app(false);
+        // Node 1 shows Operation enabled in its TPDO; node 5 got a controlword from us.
+        let mut cw = crate::frame::Frame::classic(0x605, &[0x2B, 0x40, 0x60, 0, 0x0F, 0, 0, 0]);
+        cw.flags.set(crate::frame::Flags::TX, true);
+        a.commanded.observe(&cw);
+        a.key(ctrl('s'));
+        match req.try_recv() {
+            Ok(Request::StopAll { nodes, options }) => {
+                assert_eq!(nodes.into_iter().collect::<Vec<_>>(), [1, 5]);
+                assert_eq!(options, StopOptions::default());
+            }
+            other => panic!("expected a stop request, got {other:?}"),
+        }
+        assert_eq!(
+            a.message.as_deref(),
+            Some("stop all: cancelling running commands; quick stop, then disable voltage on nodes 1, 5")
+        );
+        assert_eq!(a.messages.iter().last().map(|e| e.level), Some(Level::Warn));
+        // The palette's `stop 7` adds node 7.
+        a.run_command("stop 7 --ramp 300");
+        match req.try_recv() {
+            Ok(Request::StopAll { nodes, options }) => {
+                assert_eq!(nodes.into_iter().collect::<Vec<_>>(), [1, 5, 7]);
+                assert_eq!(options.ramp_ms, 300);
+            }
+            other => panic!("expected a stop request, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn stop_all_in_listen_only_says_nothing_can_be_sent() {
+        let (mut a, mut req) = live_app(true);
+        a.act(Action::StopAll);
+        assert!(req.try_recv().is_err(), "no request in listen-only");
+        assert!(
+            a.message
+                .as_deref()
+                .unwrap_or("")
+                .contains("listen-only — NOTHING can be sent")
+        );
+        assert_eq!(a.messages.iter().last().map(|e| e.level), Some(Level::Error));
+    }
+
+    #[test]
+    fn quitting_with_a_commanded_drive_powered_asks_first() {
+        let (mut a, _req) = live_app(false);
+        a.act(Action::Quit);
+        assert!(a.quit, "nothing commanded: quits at once");
+        let (mut a, mut req) = live_app(false);
+        let mut cw = crate::frame::Frame::classic(0x601, &[0x2B, 0x40, 0x60, 0, 0x0F, 0, 0, 0]);
+        cw.flags.set(crate::frame::Flags::TX, true);
+        a.commanded.observe(&cw);
+        a.act(Action::Quit);
+        assert!(!a.quit);
+        assert!(
+            a.message
+                .as_deref()
+                .unwrap_or("")
+                .starts_with("drive(s) 1 that cotui commanded are still powered")
+        );
+        a.key(key('n'));
+        assert!(!a.quit && a.quit_confirm.is_none());
+        assert!(req.try_recv().is_err(), "nothing sent by asking");
+        a.run_command("quit");
+        a.key(key('s'));
+        assert!(!a.quit);
+        assert!(matches!(req.try_recv(), Ok(Request::StopAll { .. })));
+        a.act(Action::Quit);
+        a.key(key('y'));
+        assert!(a.quit);
+    }
+
+    #[test]
+    fn results_go_to_the_message_log_whole_and_the_status_line_shows_the_first_line() {
+        let (ftx, frx) = std::sync::mpsc::channel();
+        let mut a = app();
+        a.source = SourceInfo::new("demo", SourceKind::Demo { listen_only: false }, frx, None);
+        ftx.send(Feed::Result(
+            Level::Info,
+            "scan: 2 nodes\nnode 2 aimotor\nnode 3 syntron-ds".into(),
+        ))
+        .unwrap();
+        ftx.send(Feed::BusError(
+            "vcan0: interface went down; fix: sudo ip link set vcan0 up".into(),
+        ))
+        .unwrap();
+        ftx.send(Feed::BusOk).unwrap();
+        a.ingest(Duration::from_millis(50));
+        assert_eq!(
+            a.message.as_deref(),
+            Some("scan: 2 nodes (+2 lines: `m` shows the message log)")
+        );
+        let lines: Vec<String> = a.messages.lines().into_iter().map(|(_, l)| l).collect();
+        assert_eq!(lines.len(), 5, "{lines:?}");
+        assert!(lines[2].ends_with("  node 3 syntron-ds"));
+        assert!(lines[3].ends_with("  vcan0: interface went down; fix: sudo ip link set vcan0 up"));
+        assert!(lines[4].ends_with("  demo: capturing again"));
+        a.key(key('m'));
+        assert!(a.messages_shown);
+        let s = crate::tui::panes::testutil::screen(&mut a, 120, 20);
+        assert!(s.contains("Messages (3)"), "{s}");
+        assert!(s.contains("node 3 syntron-ds"), "{s}");
+        a.act(Action::Up);
+        assert_eq!(a.messages_back, 0, "all lines fit: nothing to scroll");
+        a.act(Action::Back);
+        assert!(!a.messages_shown);
     }
 
     #[test]

@@ -1,23 +1,31 @@
 //! The live capture task (`cotui live IFACE`, `cotui demo`): a thread with its own tokio
 //! runtime that opens the bus, forwards every frame in batches, reopens the interface when
-//! it fails, and runs the palette's commands on the same bus.
+//! it fails, and runs the palette's commands on the same bus ([`Jobs`]: cancelled by
+//! stop-all before it stops the drives).
 
+use super::messages::Level;
 use super::source::Feed;
 use crate::bus::{self, Bus, BusError};
+use crate::command::stop::{Commanded, StopOptions, stop_nodes};
 use crate::command::{self, Command};
 use crate::decode::cia402::DriveState;
+use crate::frame::Frame;
 use crate::od::bind::Bindings;
+use std::collections::BTreeSet;
 use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
+use tokio::task::AbortHandle;
 
 /// What the UI asks the live task to do.
 #[derive(Debug)]
 pub enum Request {
-    /// Run a palette command; the result comes back as [`Feed::Result`].
-    Run(Command),
-    /// Stop these drives: quick stop, then disable voltage.
-    StopAll(Vec<u8>),
+    /// Run a palette command (`line` as typed); the result comes back as [`Feed::Result`].
+    Run { line: String, command: Command },
+    /// Stop-all: cancel every command still running, then quick stop and disable voltage on
+    /// `nodes` and on every node this task saw cotui command.
+    StopAll { nodes: BTreeSet<u8>, options: StopOptions },
 }
 
 /// A handle to send requests to the live task.
@@ -72,6 +80,7 @@ async fn capture(
         return;
     }
     let mut lost = 0u64;
+    let mut jobs = Jobs::default();
     loop {
         let bus = match bus::open(&iface, listen_only).await {
             Ok(b) => b,
@@ -86,9 +95,7 @@ async fn capture(
                     tokio::select! {
                         _ = &mut wait => break,
                         r = req.recv() => match r {
-                            Some(_) => {
-                                let _ = tx.send(Feed::Result(format!("not sent: {e}")));
-                            }
+                            Some(r) => jobs.refuse(r, &e, &tx),
                             None => return,
                         },
                     }
@@ -108,6 +115,7 @@ async fn capture(
                 got = sub.recv() => match got {
                     Ok(mut f) => {
                         f.iface = 0;
+                        jobs.observe(&f);
                         batch.push(f);
                         if batch.len() >= BATCH && !offer(&tx, Feed::Frames(std::mem::take(&mut batch)), &mut lost) {
                             return;
@@ -126,14 +134,7 @@ async fn capture(
                     }
                 }
                 r = req.recv() => match r {
-                    Some(r) => {
-                        let bus = bus.clone();
-                        let tx = tx.clone();
-                        let bindings = bindings.clone();
-                        tokio::spawn(async move {
-                            let _ = tx.send(Feed::Result(run(&bus, r, &bindings).await));
-                        });
-                    }
+                    Some(r) => jobs.start(&bus, r, &bindings, &tx),
                     None => return,
                 },
             }
@@ -152,28 +153,96 @@ async fn capture(
     }
 }
 
-/// Runs one request on `bus`; returns the text for the status line.
-async fn run(bus: &Bus, r: Request, bindings: &Bindings) -> String {
-    match r {
-        Request::Run(c) => match command::execute(bus, &c, bindings).await {
-            Ok(o) => o.text,
-            Err(e) => format!("error: {e}"),
-        },
-        Request::StopAll(nodes) => {
-            let mut out = Vec::new();
-            for n in nodes {
-                let r = async {
-                    command::sdo::download(bus, n, 0x6040, 0, 0x0002u16.to_le_bytes().to_vec(), false, 500).await?;
-                    command::sdo::download(bus, n, 0x6040, 0, 0x0000u16.to_le_bytes().to_vec(), false, 500).await
+/// The commands the live task runs for the palette, and the nodes cotui commanded.
+#[derive(Default)]
+struct Jobs {
+    /// Running commands (the palette line and its task), cancelled by stop-all.
+    running: Vec<(String, AbortHandle)>,
+    /// Nodes cotui commanded, from the frames it sent; a confirmed stop forgets a node.
+    commanded: Arc<Mutex<Commanded>>,
+}
+
+impl Jobs {
+    /// Notes a frame on the bus (ours, marked TX, may command a node).
+    fn observe(&self, f: &Frame) {
+        if let Ok(mut c) = self.commanded.lock() {
+            c.observe(f);
+        }
+    }
+
+    /// Starts a request on `bus`; its result goes to `tx` when it ends.
+    fn start(&mut self, bus: &Bus, r: Request, bindings: &Bindings, tx: &SyncSender<Feed>) {
+        self.running.retain(|(_, h)| !h.is_finished());
+        let (bus, tx) = (bus.clone(), tx.clone());
+        match r {
+            Request::Run { line, command } => {
+                let bindings = bindings.clone();
+                let label = line.clone();
+                let task = tokio::spawn(async move {
+                    let (level, text) = match command::execute(&bus, &command, &bindings).await {
+                        Ok(o) => (Level::Info, format!("{line}: {}", o.text)),
+                        Err(e) => (Level::Error, format!("{line}: error: {e}")),
+                    };
+                    let _ = tx.send(Feed::Result(level, text));
+                });
+                self.running.push((label, task.abort_handle()));
+            }
+            Request::StopAll { mut nodes, options } => {
+                // Cancel first: on this single-threaded runtime no cancelled task runs again,
+                // so nothing it would have sent goes out after the stop.
+                let cancelled = self.cancel_all();
+                let commanded = self.commanded.clone();
+                if let Ok(c) = commanded.lock() {
+                    nodes.extend(c.nodes());
                 }
-                .await;
-                out.push(match r {
-                    Ok(()) => format!("node {n}: quick stop, voltage disabled"),
-                    Err(e) => format!("node {n}: {e}"),
+                tokio::spawn(async move {
+                    let (level, text) = match stop_nodes(&bus, &nodes, options).await {
+                        Ok(mut report) => {
+                            report.cancelled = cancelled;
+                            if let Ok(mut c) = commanded.lock() {
+                                report.nodes.iter().filter(|n| n.stopped).for_each(|n| c.forget(n.node));
+                            }
+                            let level = if report.all_stopped() { Level::Info } else { Level::Warn };
+                            (level, report.text())
+                        }
+                        Err(e) => (Level::Error, e.to_string()),
+                    };
+                    let _ = tx.send(Feed::Result(level, text));
                 });
             }
-            format!("stop all: {}", out.join("; "))
         }
+    }
+
+    /// Aborts every running command; returns their lines.
+    fn cancel_all(&mut self) -> Vec<String> {
+        self.running
+            .drain(..)
+            .filter(|(_, h)| !h.is_finished())
+            .map(|(line, h)| {
+                h.abort();
+                line
+            })
+            .collect()
+    }
+
+    /// Answers a request while the bus is unavailable (`why`): nothing can be sent, but a
+    /// stop still cancels what is running.
+    fn refuse(&mut self, r: Request, why: &BusError, tx: &SyncSender<Feed>) {
+        let text = match r {
+            Request::Run { line, .. } => format!("{line}: not sent: {why}"),
+            Request::StopAll { .. } => {
+                let cancelled = self.cancel_all();
+                format!(
+                    "stop all: NOTHING sent, the bus is unavailable ({why}); cancelled: {}",
+                    if cancelled.is_empty() {
+                        "nothing was running".into()
+                    } else {
+                        cancelled.join("; ")
+                    }
+                )
+            }
+        };
+        let _ = tx.send(Feed::Result(Level::Error, text));
     }
 }
 

@@ -8,6 +8,7 @@ pub mod app;
 pub mod filter;
 pub mod keymap;
 pub mod live;
+pub mod messages;
 pub mod nodes;
 pub mod palette;
 pub mod panes;

@@ -10,11 +10,13 @@ use crate::od::alias::resolve_object;
 use crate::od::bind::Bindings;
 
 /// The first words of commander lines.
-pub const COMMANDER_WORDS: &[&str] = &["nmt", "sdo", "drive", "run", "scan"];
+pub const COMMANDER_WORDS: &[&str] = &["nmt", "sdo", "drive", "run", "scan", "stop"];
 
 /// A parsed commander line with its preview.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Planned {
+    /// The line as typed.
+    pub line: String,
     /// The command.
     pub command: Command,
     /// The frames it sends, candump style, or a description when they depend on answers.
@@ -135,11 +137,27 @@ pub fn plan(line: &str, bindings: &Bindings, state: impl Fn(u8) -> Option<DriveS
                 (steps.join(", "), confirm)
             }
         }
+        Command::Stop { nodes, .. } => (
+            format!(
+                "cancels running commands, then 6xx#2B40600002000000 (quick stop) and 6xx#2B40600000000000 \
+                 (disable voltage) to {}",
+                if nodes.is_empty() {
+                    "every drive cotui commanded or sees powered".to_string()
+                } else {
+                    format!(
+                        "nodes {}",
+                        nodes.iter().map(u8::to_string).collect::<Vec<_>>().join(", ")
+                    )
+                }
+            ),
+            None,
+        ),
         Command::Record { .. } => {
             return Err("record runs from the command line (`cotui record IFACE -o FILE`)".into());
         }
     };
     Ok(Planned {
+        line: line.trim().to_string(),
         command,
         preview,
         confirm,

@@ -33,8 +33,8 @@ pub enum Feed {
     BusError(String),
     /// The interface is (again) capturing.
     BusOk,
-    /// The result of a palette command.
-    Result(String),
+    /// The result of a palette command, and how much it matters.
+    Result(super::messages::Level, String),
 }
 
 /// Replay commands.

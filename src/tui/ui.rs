@@ -66,6 +66,7 @@ pub fn draw(f: &mut Frame, app: &mut App) {
     app.stats_list.clamp(n_stats, h);
     app.sdo_list.clamp(n_sdo, h);
 
+    app.layout.messages = panes::messages::height(body);
     let app = &*app;
     match app.pane {
         Pane::Trace => panes::trace::render(app, f, main, true),
@@ -81,6 +82,9 @@ pub fn draw(f: &mut Frame, app: &mut App) {
         panes::detail::render(app, f, detail);
     }
     panes::status::render(app, f, bar, line);
+    if app.messages_shown {
+        panes::messages::render(app, f, body);
+    }
     if app.help {
         panes::help::render(app, f, body);
     }

@@ -2,6 +2,7 @@
 
 pub mod detail;
 pub mod help;
+pub mod messages;
 pub mod nodes;
 pub mod plot;
 pub mod sdo;
