@@ -246,6 +246,60 @@ c nmt vcan0 reset-node 5 --wait --json
 [ $rc = 0 ] && [ "$(echo "$out" | j '.confirmed["5"]')" != null ] && ok "nmt reset-node 5 --wait: boot-up seen ($(echo "$out" | j '.confirmed["5"]'))" ||
     bad "nmt reset-node: rc=$rc $out $err"
 
+# ---- 3b. stop-all: cotui stop and ctrl-s against the drive402 peer ------------------------
+# The peer stays in Quick stop active after 0x02 (no standstill bit), so --ramp bounds the wait.
+slow="$here/peers/slow402.json"
+sw_is_592() { c sdo read vcan0 2 0x6041 --json; [ $rc = 0 ] && [ "$(echo "$out" | j .value)" = 592 ]; }
+# stopped_by_cli HOW: `cotui stop vcan0` finds node 2 powered, stops it and says so.
+stopped_by_cli() {
+    c stop vcan0 --ramp 500 --listen 800 --json
+    [ $rc = 0 ] && [ "$(echo "$out" | j '[.nodes[] | "\(.node) \(.stopped) \(.state)"] | join(",")')" = "2 true switch_on_disabled" ] &&
+        [ "$(echo "$out" | j '.nodes[0].controlwords | join(",")')" = "0x0002,0x0000" ] && sw_is_592 &&
+        ok "stop: a drive enabled by $1 is found, quick-stopped, disabled and confirmed (statusword 0x0250)" ||
+        bad "stop after $1: rc=$rc $out $err"
+}
+c run vcan0 2 enable --profile "2=$slow" --json
+[ $rc = 0 ] || bad "run enable: rc=$rc $out $err"
+stopped_by_cli "run (a procedure)"
+for cw in 6 7 0x0F; do c sdo write vcan0 2 0x6040 $cw --type u16; done
+stopped_by_cli "raw SDO writes of 0x6040"
+c stop vcan0 --listen 800 --json
+[ $rc = 0 ] && [ "$(echo "$out" | j '.nodes | length')" = 0 ] && [ "$(echo "$out" | j '.idle[0].state')" = switch_on_disabled ] &&
+    ok "stop: nothing powered, nothing sent, exit 0 (idle: node 2 switch on disabled)" || bad "stop idle: rc=$rc $out $err"
+c stop vcan0 --node 9 --json
+[ $rc = 5 ] && [ "$(echo "$out" | j .nodes[0].stopped)" = false ] && echo "$out" | j .nodes[0].reason | grep -q "no SDO answer" &&
+    ok "stop --node 9 (absent): NOT confirmed, exit 5, says why" || bad "stop absent: rc=$rc $out $err"
+c stop vcan0 --listen-only --json
+[ $rc = 5 ] && [ "$(echo "$out" | j .listen_only)" = true ] && ok "stop --listen-only: exit 5, says nothing can be sent" ||
+    bad "stop listen-only: rc=$rc $out $err"
+# ctrl-s in the TUI while a procedure waits in its 4 s delay: the procedure is cancelled
+# (nothing of it goes out afterwards) and the drive ends Switch on disabled.
+candump -L vcan0,602:7FF > cw.log 2>&1 &
+cwdump=$!
+wait_socket $cwdump || bad "stop tui: candump opened no socket"
+export TERM=xterm-256color
+tmux new-session -d -s stop -x 160 -y 45 "XDG_CONFIG_HOME=$work $cotui live vcan0 --profile 2=$slow; echo cotui-exit=\$?; sleep 60"
+sscreen() { tmux capture-pane -p -t stop; }
+swait() { for _ in $(seq "$1"); do sscreen > sscreen.txt; grep -qE -- "$2" sscreen.txt && return 0; sleep 0.2; done; return 1; }
+swait 150 "vcan0" || bad "stop tui start: $(cat sscreen.txt)"
+tmux send-keys -t stop ':run 2 slowpv' Enter
+if wait_for cw.log 300 "602#2B4060000F"; then
+    tmux send-keys -t stop C-s
+    swait 300 "node 2: stopped|NOT confirmed" || bad "stop tui result: $(cat sscreen.txt)"
+    sleep 4.5 # past the end of the procedure's 4 s delay, which started before the stop
+    after=$(awk '/602#2B40600002/ { s = 1 } s && /602#2B4060/ { sub(/.*#2B406000/, ""); printf "%s ", substr($0, 1, 2) }' cw.log)
+    tmux send-keys -t stop m
+    swait 50 "cancelled: run 2 slowpv" && [ "$after" = "02 00 " ] && sw_is_592 &&
+        ok "tui ctrl-s during a procedure: procedure cancelled, only 0x02 0x00 after it, drive switch on disabled" ||
+        bad "tui ctrl-s: controlwords after the stop '$after'; $(cat sscreen.txt)"
+else
+    bad "tui ctrl-s: the procedure never enabled the drive: $(cat cw.log) $(sscreen)"
+fi
+tmux send-keys -t stop Escape q
+swait 100 "cotui-exit=0" && ok "tui: quits after the stop without asking (nothing left powered)" || bad "tui quit after stop: $(cat sscreen.txt)"
+tmux kill-session -t stop 2> /dev/null
+kill $cwdump 2> /dev/null
+
 # ---- 4. --listen-only: nothing from us on the bus ----------------------------------------
 candump -l vcan0 > /dev/null 2>&1 &
 dump=$!
