@@ -166,6 +166,12 @@ fn decode_stream(
             c.warnings
         );
     }
+    if let Some(first) = c.first_ignored_tail {
+        eprintln!(
+            "{path}: {} frame lines had text after the frame, not read (comments; first: line {first})",
+            c.ignored_tail
+        );
+    }
     Ok(())
 }
 

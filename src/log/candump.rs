@@ -11,11 +11,14 @@
 //! - `.` between data bytes; `_<raw dlc>` after exactly 8 data bytes;
 //! - `##<flags>` CAN FD frames, where flag bits 1/2/4 become BRS/ESI/FDF (bit 8 is ignored);
 //! - 5-digit CAN XL ids are skipped as [`SkipReason::CanXl`];
-//! - an optional trailing `R` or `T` (candump `-x`); `T` sets [`Flags::TX`].
+//! - an optional trailing `R` or `T` (candump `-x`); `T` sets [`Flags::TX`];
+//! - any other text after a blank behind the frame (a comment, an annotation) is ignored
+//!   as `canplayer` ignores it, and the line is flagged ([`Parser::ignored_tail`]) so the
+//!   reader can say how many lines had text it did not read.
 //!
-//! Unlike `parse_canframe`, text that would be silently ignored there (trailing garbage,
-//! a bad raw DLC, an 11-bit id above 7FF) is reported as an error, so that what parses
-//! is exactly what [`super::writer`] writes back.
+//! Unlike `parse_canframe`, text glued to the frame (`123#1122zz`), a bad raw DLC or an
+//! 11-bit id above 7FF is reported as an error, so that what parses is exactly what
+//! [`super::writer`] writes back.
 
 use super::lex::{self, IfaceCache, err, hex, is_ws, skip_ws, token_end, trim_end};
 use super::{Line, ParseError, SkipReason};
@@ -29,12 +32,18 @@ pub const CAN_ERR_FLAG: u32 = 0x2000_0000;
 #[derive(Debug, Default)]
 pub struct Parser {
     iface: IfaceCache,
+    tail: bool,
 }
 
 impl Parser {
     /// A fresh parser.
     pub fn new() -> Self {
         Parser::default()
+    }
+
+    /// True when the last frame line had text after the frame that was ignored.
+    pub fn ignored_tail(&self) -> bool {
+        self.tail
     }
 
     /// Parses one line (with or without its line end).
@@ -55,6 +64,7 @@ impl Parser {
         frame: &mut Frame,
     ) -> Result<Option<SkipReason>, ParseError> {
         let s = trim_end(line);
+        self.tail = false;
         if s.first() != Some(&b'(') {
             let t = &s[skip_ws(s, 0)..];
             return Ok(Some(if t.is_empty() {
@@ -86,12 +96,10 @@ impl Parser {
             match (s[extra_at], s.len() - extra_at) {
                 (b'T', 1) => frame.flags.set(Flags::TX, true),
                 (b'R', 1) => {}
-                _ => {
-                    return Err(err(
-                        extra_at,
-                        "unexpected text after the frame (only R or T may follow)",
-                    ));
+                _ if extra_at == frame_end => {
+                    return Err(err(extra_at, "unexpected text after the frame"));
                 }
+                _ => self.tail = true,
             }
         }
         frame.ts_ns = ts;
@@ -377,7 +385,16 @@ mod tests {
             "a raw DLC '_<9..F>' is only allowed with length 8"
         );
         assert_eq!(error("(1.000000) can0 123#1122334455667788_5").column, 38);
-        assert_eq!(error("(1.000000) can0 123#11 X").column, 24);
+        // Text after a blank is ignored as canplayer ignores it, and flagged; glued text is an error.
+        let mut p = Parser::new();
+        let mut ifaces = Interfaces::default();
+        assert!(matches!(p.parse_line(b"(1.000000) can0 123#11 X", &mut ifaces), Ok(Line::Frame(f)) if f.len == 1));
+        assert!(p.ignored_tail());
+        assert!(
+            matches!(p.parse_line(b"(1.000000) can0 123#11 T", &mut ifaces), Ok(Line::Frame(f)) if f.flags.has(Flags::TX))
+        );
+        assert!(!p.ignored_tail());
+        assert_eq!(error("(1.000000) can0 123#11X").column, 23);
         assert_eq!(error("(1.000000) can0 800#11").message, "11-bit CAN id above 7FF");
         assert_eq!(
             error("(1.000000) can0").message,

@@ -121,6 +121,10 @@ pub struct Counts {
     pub frames: u64,
     /// Malformed lines.
     pub warnings: u64,
+    /// Frame lines with text after the frame that was not read (comments, annotations).
+    pub ignored_tail: u64,
+    /// The number of the first such line.
+    pub first_ignored_tail: Option<u64>,
     skipped: [u64; SkipReason::ALL.len()],
 }
 
@@ -182,11 +186,16 @@ enum Parser {
     Asc(Box<asc::Parser>),
 }
 
+/// The longest line a reader takes: a longer one (e.g. a file with no line ends) is
+/// skipped with a warning, so no input can exhaust memory.
+pub const MAX_LINE: usize = 1 << 20;
+
 /// Streams a log line by line, yielding `(line_number, Outcome)` for every line.
 ///
 /// Lines are parsed as bytes in place (one reused buffer gathers a line that straddles the
-/// source's buffer), so non-UTF-8 input only gives warnings on the lines concerned. IO
-/// errors end the stream.
+/// source's buffer), so non-UTF-8 input only gives warnings on the lines concerned. A line
+/// longer than [`MAX_LINE`] is a warning, its bytes are read past and not kept. IO errors
+/// end the stream.
 #[derive(Debug)]
 pub struct LogReader<R> {
     src: R,
@@ -262,14 +271,24 @@ impl<R: BufRead> LogReader<R> {
             self.src.consume(pos + 1);
             parsed
         } else {
-            self.buf.clear();
-            self.src.read_until(b'\n', &mut self.buf)?;
+            if !self.gather_line()? {
+                self.line_no += 1;
+                self.counts.warnings += 1;
+                return Ok(Some((
+                    self.line_no,
+                    Outcome::Warning(format!("line longer than {} MiB, skipped", MAX_LINE >> 20)),
+                )));
+            }
             parse(&mut self.parser, &mut self.ifaces, &mut self.frame, &self.buf)
         };
         self.line_no += 1;
         let outcome = match parsed {
             Ok(None) => {
                 self.counts.frames += 1;
+                if self.parser.ignored_tail() {
+                    self.counts.ignored_tail += 1;
+                    self.counts.first_ignored_tail.get_or_insert(self.line_no);
+                }
                 Outcome::Frame(self.frame)
             }
             Ok(Some(r)) => {
@@ -282,6 +301,46 @@ impl<R: BufRead> LogReader<R> {
             }
         };
         Ok(Some((self.line_no, outcome)))
+    }
+}
+
+impl<R: BufRead> LogReader<R> {
+    /// Gathers the next line (through its `\n`) into the line buffer; false when it is longer
+    /// than [`MAX_LINE`]: then its bytes are consumed up to the line end and dropped.
+    fn gather_line(&mut self) -> io::Result<bool> {
+        self.buf.clear();
+        let mut fits = true;
+        loop {
+            let chunk = self.src.fill_buf()?;
+            if chunk.is_empty() {
+                return Ok(fits);
+            }
+            let (take, done) = match memchr::memchr(b'\n', chunk) {
+                Some(p) => (p + 1, true),
+                None => (chunk.len(), false),
+            };
+            if fits && self.buf.len() + take <= MAX_LINE {
+                self.buf.extend_from_slice(&chunk[..take]);
+            } else {
+                fits = false;
+                self.buf.clear();
+            }
+            self.src.consume(take);
+            if done {
+                return Ok(fits);
+            }
+        }
+    }
+}
+
+impl Parser {
+    /// True when the last frame line had text after the frame that was ignored.
+    fn ignored_tail(&self) -> bool {
+        match self {
+            Parser::Candump(p) => p.ignored_tail(),
+            Parser::Screen(p) => p.ignored_tail(),
+            Parser::Asc(_) => false,
+        }
     }
 }
 
@@ -390,6 +449,45 @@ mod tests {
         }
         assert_eq!(whole.len(), 4);
         assert!(matches!(whole[3], (4, Outcome::Frame(f)) if f.raw_dlc == 9));
+    }
+
+    #[test]
+    fn annotations_after_frames_are_read_past_and_counted() {
+        let input: &[u8] = b"can0  70A   [1]  00   # bootup\n\
+            ...\n\
+            can0  60A   [8]  40 17 10 00 00 00 00 00     // SDO request\n\
+            (0.1)  vcan0  603   [2]  A2 7F   '..' < response\n\
+            can0  123   [1]  11 22\n";
+        let mut r = LogReader::with_format(input, Format::Screen);
+        let all: Vec<(u64, Outcome)> = r.by_ref().map(Result::unwrap).collect();
+        assert!(matches!(all[0], (1, Outcome::Frame(f)) if f.id == 0x70A && f.len == 1));
+        assert_eq!(all[1], (2, Outcome::Skip(SkipReason::Comment)), "an elision line");
+        assert!(matches!(all[2], (3, Outcome::Frame(f)) if f.id == 0x60A));
+        assert!(matches!(all[3], (4, Outcome::Frame(f)) if f.id == 0x603 && f.len == 2));
+        // Without # or an ASCII column, extra text may be a wrong length: still an error.
+        assert_eq!(
+            all[4],
+            (
+                5,
+                Outcome::Warning("column 21: unexpected text after the data bytes".into())
+            )
+        );
+        assert_eq!((r.counts().ignored_tail, r.counts().first_ignored_tail), (3, Some(1)));
+    }
+
+    #[test]
+    fn a_line_longer_than_the_cap_is_a_warning_and_reading_goes_on() {
+        let mut input = vec![b'7'; MAX_LINE + 10];
+        input.extend_from_slice(b"\n(1.000000) can0 123#11\n");
+        let r = LogReader::with_format(std::io::BufReader::with_capacity(4096, &input[..]), Format::Candump);
+        let all: Vec<(u64, Outcome)> = r.map(Result::unwrap).collect();
+        assert_eq!(all[0], (1, Outcome::Warning("line longer than 1 MiB, skipped".into())));
+        assert!(matches!(all[1], (2, Outcome::Frame(f)) if f.id == 0x123));
+        // A capped line at the very end (no line end at all, like /dev/zero) ends the same way.
+        let endless = vec![0u8; MAX_LINE * 2];
+        let r = LogReader::with_format(std::io::BufReader::with_capacity(4096, &endless[..]), Format::Candump);
+        let all: Vec<(u64, Outcome)> = r.map(Result::unwrap).collect();
+        assert_eq!(all, [(1, Outcome::Warning("line longer than 1 MiB, skipped".into()))]);
     }
 
     #[test]

@@ -18,7 +18,7 @@
 //! BRS/ESI from the `-x` columns when present. CAN XL lines (`[0003]`) are skipped; the
 //! byte-swapped (`-S`) and binary (`-B`) views are reported as malformed.
 
-use super::lex::{self, IfaceCache, Tokens, err, hex, hex_u32, trim_end};
+use super::lex::{self, IfaceCache, Tokens, err, hex, hex_u32, skip_ws, trim_end};
 use super::{Line, ParseError, SkipReason};
 use crate::frame::{Flags, Frame, Interfaces};
 
@@ -29,12 +29,18 @@ pub struct Parser {
     iface: IfaceCache,
     delta: bool,
     sum_ns: u64,
+    tail: bool,
 }
 
 impl Parser {
     /// A parser for absolute or zero-based timestamps.
     pub fn new() -> Self {
         Parser::default()
+    }
+
+    /// True when the last frame line had an annotation after the frame that was ignored.
+    pub fn ignored_tail(&self) -> bool {
+        self.tail
     }
 
     /// Treats timestamps as deltas to the previous frame (`-t d`) and sums them.
@@ -44,6 +50,7 @@ impl Parser {
 
     /// Parses one line of screen output.
     pub fn parse_line(&mut self, line: &[u8], ifaces: &mut Interfaces) -> Result<Line, ParseError> {
+        self.tail = false;
         if line.first() == Some(&b'\t') {
             return Ok(Line::Skip(SkipReason::ErrorDetail));
         }
@@ -55,7 +62,9 @@ impl Parser {
         if first.starts_with(b"DROPCOUNT") {
             return Ok(Line::Skip(SkipReason::DropCount));
         }
-        if first.starts_with(b"#") || first.starts_with(b"//") {
+        // Comments, and the `...` / `…` that elide frames in pasted captures.
+        let elision = s[at..].iter().all(|&b| b == b'.' || lex::is_ws(b)) || &s[at..] == "…".as_bytes();
+        if first.starts_with(b"#") || first.starts_with(b"//") || elision {
             return Ok(Line::Skip(SkipReason::Comment));
         }
         let mut ts = 0;
@@ -171,9 +180,25 @@ impl Parser {
             }
         }
         if let Some((rest_at, rest)) = toks.peek() {
-            let ok = (rest == b"ERRORFRAME" && f.flags.has(Flags::ERR)) || rest[0] == b'\'';
-            if !ok {
-                return Err(err(rest_at, "unexpected text after the data bytes"));
+            // What may follow the bytes: candump -a's ASCII column (`'..'`, one character per
+            // byte) or ERRORFRAME, then an annotation, ignored and flagged.
+            let after = if rest == b"ERRORFRAME" && f.flags.has(Flags::ERR) {
+                rest_at + rest.len()
+            } else if rest[0] == b'\'' && s.get(rest_at + f.len as usize + 1) == Some(&b'\'') {
+                rest_at + f.len as usize + 2
+            } else {
+                rest_at
+            };
+            let note_at = skip_ws(s, after);
+            if note_at < s.len() {
+                let note = &s[note_at..];
+                // After the ASCII column (which proves the byte count) any text is an annotation
+                // (`'........' < response`); right after the bytes only a marked comment is.
+                let marked = note.starts_with(b"#") || note.starts_with(b"//");
+                if (after == rest_at && !marked) || (note_at == after && after != rest_at) {
+                    return Err(err(note_at, "unexpected text after the data bytes"));
+                }
+                self.tail = true;
             }
         }
         f.iface = self.iface.get(ifaces, name, name_at)?;
