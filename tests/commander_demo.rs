@@ -494,7 +494,7 @@ fn stop_all_in_the_live_task_cancels_a_running_procedure_first() {
     use cotui::tui::source::Feed;
     use std::collections::BTreeSet;
     use std::time::Instant;
-    let read = |_: &std::path::Path| Ok(SLOW_PROFILE.to_string());
+    let read = |_: &std::path::Path| Ok(SLOW_PROFILE.into());
     let mut b = cotui::od::bind::Bindings::new().unwrap();
     b.bind_profile(2, "slow.json", &read).unwrap();
     let (feed, req) = start("demo", false, b);

@@ -180,7 +180,7 @@ fn numbers() {
 
 #[test]
 fn eds_binding_puts_the_eds_first() {
-    let read = |path: &std::path::Path| std::fs::read_to_string(path);
+    let read = |path: &std::path::Path| std::fs::read(path);
     let file = format!("3={}/tests/fixtures/eds/servo-ds.eds", env!("CARGO_MANIFEST_DIR"));
     let b = Bindings::from_args(&[], &[file], &read).unwrap();
     let d = b.dictionary(3);
@@ -190,4 +190,149 @@ fn eds_binding_puts_the_eds_first() {
     assert_eq!(d.default_pdos(true).unwrap()[&1].cob_id, Some(0x183));
     assert_eq!(resolve_object(d, "speed loop gain a"), Ok((0x2318, 0)));
     assert!(b.warnings().is_empty());
+}
+
+#[test]
+fn vendor_quirks_inline_comments_signed_hex_limits_and_latin1_lines() {
+    let text = b"[DeviceInfo]\nProductName=X\n[MandatoryObjects]\nSupportedObjects=1\n1=0x2000\n\
+        [2000]\nParameterName=Offset\nDataType=0x0004\nAccessType=rw\nLowLimit=0x80000000\n\
+        HighLimit=0x7FFFFFFF\nDefaultValue=0xFFFFFFFE ; two below zero\n\
+        [Comments]\nLines=1\nLine1=Copyright \xA9 Gr\xFC\xDFe\n";
+    let mut b = Bindings::new().unwrap();
+    b.bind_eds_bytes(4, "quirks.eds", text);
+    let o = b.dictionary(4).object(0x2000, 0).unwrap();
+    assert_eq!((o.min, o.max), (Some(-2147483648), Some(2147483647)));
+    assert_eq!(o.default, Some(Value::Signed(-2)));
+    let w: Vec<String> = b.warnings().iter().map(|w| w.to_string()).collect();
+    assert_eq!(
+        w,
+        [
+            "quirks.eds: line 15: not UTF-8, read as Windows-1252 (CP1252)",
+            "quirks.eds: line 12: inline comment `; two below zero` after the value, ignored",
+        ]
+    );
+    // Unsigned hex stays unsigned; decimal stays as written; INTEGER8 0xFF is -1.
+    let (p, _) = import(
+        "t.eds",
+        "[MandatoryObjects]\nSupportedObjects=2\n1=0x2001\n2=0x2002\n[2001]\nParameterName=A\nDataType=0x0007\n\
+         DefaultValue=0x80000000\n[2002]\nParameterName=B\nDataType=0x0002\nLowLimit=-128\nDefaultValue=0xFF\n",
+        1,
+    );
+    assert_eq!(p.object(0x2001, 0).unwrap().default, Some(Value::Unsigned(0x8000_0000)));
+    let i8 = p.object(0x2002, 0).unwrap();
+    assert_eq!((i8.min, i8.default.clone()), (Some(-128), Some(Value::Signed(-1))));
+}
+
+/// The public EDS/DCF files in `../shared/realworld/eds/` (not part of this repository).
+fn realworld_eds() -> Vec<std::path::PathBuf> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realworld/eds");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| {
+            panic!(
+                "{}: {e} (the shared real-world files sit beside the checkout)",
+                dir.display()
+            )
+        })
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.extension()
+                .is_some_and(|x| x.eq_ignore_ascii_case("eds") || x.eq_ignore_ascii_case("dcf"))
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+#[test]
+fn every_real_world_eds_and_dcf_imports_with_names_types_and_few_warning_kinds() {
+    let files = realworld_eds();
+    assert!(files.len() >= 40, "{} files", files.len());
+    for path in files {
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        let mut b = Bindings::new().unwrap();
+        b.bind_eds_bytes(5, &name, &std::fs::read(&path).unwrap());
+        let d = b.dictionary(5);
+        // Every file names the mandatory objects from its own text.
+        let dt = d.object(0x1000, 0).unwrap_or_else(|| panic!("{name}: no 0x1000"));
+        assert_eq!(dt.data_type, DataType::U32, "{name}");
+        assert!(!dt.name.is_empty(), "{name}");
+        // Grouped as the command line prints them, a file has a handful of warning lines.
+        let lines = cotui::cli::bind::warning_lines(b.warnings(), false);
+        assert!(lines.len() <= 6, "{name}: {lines:#?}");
+    }
+}
+
+/// The python `canopen` library's reading of the real-world files (tests/realworld/eds_dump.py).
+fn python_reference(files: &[std::path::PathBuf]) -> serde_json::Value {
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/realworld/eds_dump.py");
+    let out = std::process::Command::new("python3")
+        .arg(script)
+        .args(files)
+        .stderr(std::process::Stdio::null())
+        .output()
+        .expect("python3 runs (scripts/install-test-deps.sh installs it with canopen)");
+    assert!(
+        out.status.success(),
+        "eds_dump.py failed: is canopen installed? (scripts/install-test-deps.sh)"
+    );
+    serde_json::from_slice(&out.stdout).expect("eds_dump.py prints JSON")
+}
+
+#[test]
+fn real_world_files_agree_with_python_canopen_on_names_types_and_pdo_mappings() {
+    let files = realworld_eds();
+    let reference = python_reference(&files);
+    let mut compared = 0;
+    let mut mismatches = Vec::new();
+    for path in &files {
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        let py = &reference[path.to_string_lossy().as_ref()];
+        let Some(objects) = py["objects"].as_object() else {
+            continue; // the library cannot read this file: no reference
+        };
+        let mut b = Bindings::new().unwrap();
+        b.bind_eds_bytes(5, &name, &std::fs::read(path).unwrap());
+        let d = b.dictionary(5);
+        compared += 1;
+        for (key, v) in objects {
+            let (i, s) = key.split_once(':').unwrap();
+            let (index, sub) = (u16::from_str_radix(i, 16).unwrap(), u8::from_str_radix(s, 16).unwrap());
+            if index < 0x1000 {
+                continue; // [DummyUsage] data type entries: type definitions, not objects on the bus
+            }
+            let Some(o) = d.object(index, sub) else {
+                mismatches.push(format!("{name} {key}: python has `{}`, cotui has nothing", v[0]));
+                continue;
+            };
+            let py_name = v[0].as_str().unwrap_or("");
+            // Where the file gives no name python has "", cotui "<object> sub N"; array and
+            // CompactSubObj entries python names like the object, cotui adds the sub-index.
+            let numbered = o.name.strip_suffix(&format!(" {sub}")) == Some(py_name);
+            if o.name != py_name && !py_name.is_empty() && !numbered {
+                mismatches.push(format!("{name} {key}: name `{}` vs python `{py_name}`", o.name));
+            }
+            let code = v[1].as_u64().unwrap_or(0) as u16;
+            if DataType::from_code(code).is_some_and(|t| t != o.data_type) {
+                mismatches.push(format!("{name} {key}: type {:?} vs python 0x{code:04X}", o.data_type));
+            }
+        }
+        for (key, v) in py["mapping"].as_object().unwrap() {
+            let (i, s) = key.split_once(':').unwrap();
+            let o = d.object(u16::from_str_radix(i, 16).unwrap(), u8::from_str_radix(s, 16).unwrap());
+            let want = Some(Value::Unsigned(v.as_u64().unwrap()));
+            if o.map(|o| o.default.clone()) != Some(want.clone()) {
+                mismatches.push(format!(
+                    "{name} {key}: mapping {:?} vs python {want:?}",
+                    o.map(|o| &o.default)
+                ));
+            }
+        }
+    }
+    assert!(compared >= 35, "python read only {compared} files");
+    assert!(
+        mismatches.is_empty(),
+        "{} differences:\n{}",
+        mismatches.len(),
+        mismatches.join("\n")
+    );
 }

@@ -9,7 +9,7 @@ use cotui::od::{Bindings, Value, format_value, resolve_object};
 const PATH: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/profiles/example.json");
 
 fn bindings() -> Bindings {
-    let read = |p: &std::path::Path| std::fs::read_to_string(p);
+    let read = |p: &std::path::Path| std::fs::read(p);
     Bindings::from_args(&[format!("4={PATH}")], &[], &read).unwrap()
 }
 

@@ -8,7 +8,7 @@ use cotui::od::{Dictionary, resolve_object};
 
 /// `ID#DATA` lines (data without padding zeros of SDO frames kept: SDO frames are always 8 bytes).
 fn expand(profile: &str, node: u8, procedure: &str) -> Vec<String> {
-    let read = |p: &std::path::Path| std::fs::read_to_string(p);
+    let read = |p: &std::path::Path| std::fs::read(p);
     let b = Bindings::from_args(&[format!("{node}={profile}")], &[], &read).expect("binding");
     let dict: &Dictionary = b.dictionary(node);
     let p = dict

@@ -1,15 +1,82 @@
 //! `--profile NODE=NAME` / `--eds NODE=FILE` to a ready decoder.
 
 use crate::decode::Decoder;
+use crate::od::Warning;
 use crate::od::bind::Bindings;
+use std::io::Read;
+use std::path::Path;
 
-/// Loads the bindings given on the command line; warnings go to stderr.
+/// The largest profile or EDS/DCF file read (the largest real EDS files are a few MB).
+pub const MAX_FILE: u64 = 64 << 20;
+
+/// Reads a file, refusing one larger than [`MAX_FILE`] (or endless, like `/dev/zero`).
+pub fn read_capped(path: &Path) -> std::io::Result<Vec<u8>> {
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?.take(MAX_FILE + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > MAX_FILE {
+        return Err(std::io::Error::other(format!(
+            "larger than {} MiB, not a dictionary file",
+            MAX_FILE >> 20
+        )));
+    }
+    Ok(bytes)
+}
+
+/// Loads the bindings given on the command line; warnings go to stderr, one line per kind
+/// of warning and file (all of them with `--verbose`).
 pub fn bindings(profiles: &[String], eds: &[String]) -> Result<Bindings, String> {
-    let b = Bindings::from_args(profiles, eds, &|p| std::fs::read_to_string(p))?;
-    for w in b.warnings() {
-        eprintln!("cotui: warning: {w}");
+    let b = Bindings::from_args(profiles, eds, &read_capped)?;
+    for line in warning_lines(b.warnings(), super::verbose()) {
+        eprintln!("cotui: warning: {line}");
     }
     Ok(b)
+}
+
+/// The warnings as printed: every one when `all`, else the first of each kind per file with
+/// how many more there are. A kind is the message with its quoted parts and numbers
+/// blanked, so `` `0` is not hex bytes `` and `` `NULL` is not hex bytes `` are one kind.
+pub fn warning_lines(warnings: &[Warning], all: bool) -> Vec<String> {
+    if all {
+        return warnings.iter().map(Warning::to_string).collect();
+    }
+    let mut groups: Vec<((&str, String), &Warning, usize)> = Vec::new();
+    for w in warnings {
+        let key = (w.file.as_str(), kind_of(&w.message));
+        match groups.iter_mut().find(|(k, _, _)| *k == key) {
+            Some((_, _, n)) => *n += 1,
+            None => groups.push((key, w, 0)),
+        }
+    }
+    groups
+        .into_iter()
+        .map(|(_, w, more)| match more {
+            0 => w.to_string(),
+            n => format!("{w} (and {n} more like it; --verbose lists them)"),
+        })
+        .collect()
+}
+
+/// A warning message with `quoted` parts and digits blanked: its kind.
+fn kind_of(message: &str) -> String {
+    let mut out = String::with_capacity(message.len());
+    let mut quoted = false;
+    for c in message.chars() {
+        match c {
+            '`' => {
+                quoted = !quoted;
+                out.push('`');
+            }
+            _ if quoted => {}
+            c if c.is_ascii_hexdigit() && out.ends_with(|p: char| p == '#' || p == 'x') => {}
+            c if c.is_ascii_digit() => {
+                if !out.ends_with('#') {
+                    out.push('#');
+                }
+            }
+            c => out.push(c),
+        }
+    }
+    out
 }
 
 /// The bindings for a bus: on the `demo` bus, the simulated drives are also named by the

@@ -2,7 +2,7 @@
 
 pub mod bench;
 mod bench_tui;
-mod bind;
+pub mod bind;
 pub mod commander;
 pub mod decode;
 pub mod drive;
@@ -29,6 +29,17 @@ pub const EXIT_UNAVAILABLE: i32 = 2;
 pub struct Cli {
     #[command(subcommand)]
     pub command: Option<Command>,
+    /// Print every warning (by default, one line per kind with a count).
+    #[arg(long, global = true)]
+    pub verbose: bool,
+}
+
+/// Set from `--verbose` at start.
+static VERBOSE: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// True when `--verbose` was given.
+pub fn verbose() -> bool {
+    VERBOSE.load(std::sync::atomic::Ordering::Relaxed)
 }
 
 /// The subcommands.
@@ -85,6 +96,7 @@ pub fn run() -> i32 {
             return if e.use_stderr() { EXIT_USAGE } else { EXIT_OK };
         }
     };
+    VERBOSE.store(cli.verbose, std::sync::atomic::Ordering::Relaxed);
     match cli.command {
         None => {
             print!("{USAGE}");

@@ -23,8 +23,8 @@ pub const BUILTIN: &[(&str, &str)] = &[
     ("syntron-ds", include_str!("../../decoders/syntron-ds.json")),
 ];
 
-/// Reads a file for the bindings (the CLI passes `std::fs::read_to_string`).
-pub type ReadFile<'a> = &'a dyn Fn(&Path) -> std::io::Result<String>;
+/// Reads a file's bytes for the bindings (the CLI reads with a size cap).
+pub type ReadFile<'a> = &'a dyn Fn(&Path) -> std::io::Result<Vec<u8>>;
 
 /// The names of the built-in profiles.
 pub fn builtin_names() -> impl Iterator<Item = &'static str> {
@@ -123,8 +123,8 @@ impl Bindings {
         }
         for arg in eds {
             let (node, file) = parse_node_arg(arg)?;
-            let text = read(Path::new(file)).map_err(|e| format!("--eds {arg}: cannot read {file}: {e}"))?;
-            b.bind_eds(node, file, &text);
+            let bytes = read(Path::new(file)).map_err(|e| format!("--eds {arg}: cannot read {file}: {e}"))?;
+            b.bind_eds_bytes(node, file, &bytes);
         }
         Ok(b)
     }
@@ -144,6 +144,18 @@ impl Bindings {
         entry.profile_dir = dir;
         self.rebuild(node, read);
         Ok(())
+    }
+
+    /// Binds an EDS/DCF file as read from disk: UTF-8, or CP1252 for the lines that are not
+    /// (vendor files often have a Latin-1 comment), each such line named in a warning.
+    pub fn bind_eds_bytes(&mut self, node: u8, file: &str, bytes: &[u8]) {
+        let (text, fallback) = super::text::decode(bytes);
+        self.warnings.extend(fallback.into_iter().map(|line| Warning {
+            file: file.to_string(),
+            at: format!("line {line}"),
+            message: "not UTF-8, read as Windows-1252 (CP1252)".into(),
+        }));
+        self.bind_eds(node, file, &text);
     }
 
     /// Binds an EDS/DCF file's contents to a node (its `$NODEID` becomes `node`).
@@ -235,7 +247,12 @@ impl Bindings {
         if let Some(p) = self.loaded.get(&key) {
             return Ok(p.clone());
         }
-        let text = read(path).map_err(|e| format!("cannot read {key}: {e}"))?;
+        let bytes = read(path).map_err(|e| format!("cannot read {key}: {e}"))?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let at = e.utf8_error().valid_up_to();
+            let line = e.as_bytes()[..at].iter().filter(|&&b| b == b'\n').count() + 1;
+            format!("{key}: line {line}: not UTF-8 (JSON profiles are UTF-8)")
+        })?;
         let (p, w) = load_profile(&key, &text).map_err(|e| e.to_string())?;
         self.warnings.extend(w);
         let p = Arc::new(p);
@@ -372,10 +389,10 @@ mod tests {
     const BASE: &str = r#"{ "name": "base", "extends": ["cia301"],
         "objects": { "0x6041": { "name": "Drive status", "type": "u16" } } }"#;
 
-    fn files(path: &Path) -> std::io::Result<String> {
+    fn files(path: &Path) -> std::io::Result<Vec<u8>> {
         match path.to_str() {
-            Some("/p/vendor.json") => Ok(VENDOR.to_string()),
-            Some("/p/base.json") => Ok(BASE.to_string()),
+            Some("/p/vendor.json") => Ok(VENDOR.into()),
+            Some("/p/base.json") => Ok(BASE.into()),
             Some("/p/drive.eds") => {
                 Ok("[DeviceInfo]\nProductName=X\n[1000]\nParameterName=EDS device type\nDataType=7\n".into())
             }

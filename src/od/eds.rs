@@ -2,8 +2,10 @@
 //!
 //! Tolerant by design: sections and keys in any case, `$NODEID+0x180` and
 //! `0x180+$NODEID`, hex/octal/decimal numbers, `CompactSubObj`, both spellings
-//! of `[DeviceComissioning]`. Every problem is a warning with its line number;
-//! nothing here panics or fails.
+//! of `[DeviceComissioning]`, inline ` ; comments` after values (dropped with a warning),
+//! hex limits and defaults of signed types as two's complement (`LowLimit=0x80000000` on
+//! an INTEGER32 is -2147483648). Every problem is a warning with its line number; nothing
+//! here panics or fails.
 
 use std::collections::BTreeMap;
 
@@ -83,6 +85,17 @@ fn parse_ini(text: &str, w: &mut Vec<(usize, String)>) -> Ini {
         let Some((k, v)) = t.split_once('=') else {
             w.push((line, format!("`{t}` is neither [section] nor key=value, skipped")));
             continue;
+        };
+        // `DefaultValue=0x3ED ; prevent homing`: a comment after a blank is not the value.
+        let v = match v.find(" ;").or_else(|| v.find("\t;")) {
+            Some(at) => {
+                w.push((
+                    line,
+                    format!("inline comment `{}` after the value, ignored", v[at..].trim()),
+                ));
+                &v[..at]
+            }
+            None => v,
         };
         match current.as_ref().and_then(|c| sections.get_mut(c)) {
             Some(sec) => sec
@@ -215,8 +228,13 @@ impl Importer<'_> {
                 Access::Rw => PdoMappable::Both,
             };
         }
-        info.min = self.number(sec, "lowlimit");
-        info.max = self.number(sec, "highlimit");
+        let t = info.data_type;
+        info.min = self
+            .number(sec, "lowlimit")
+            .map(|v| twos_complement(sec, "lowlimit", v, t));
+        info.max = self
+            .number(sec, "highlimit")
+            .map(|v| twos_complement(sec, "highlimit", v, t));
         // A DCF's configured value wins over the EDS default.
         let value = sec
             .get("parametervalue")
@@ -256,9 +274,34 @@ impl Importer<'_> {
                 Err(_) => Value::Float(text.trim().parse().map_err(|_| format!("`{text}` is not a number"))?),
             },
             Boolean => Value::Bool(parse_number(text, self.node)? != 0),
-            I8 | I16 | I24 | I32 | I40 | I48 | I56 | I64 => Value::Signed(parse_number(text, self.node)?),
+            I8 | I16 | I24 | I32 | I40 | I48 | I56 | I64 => {
+                Value::Signed(signed_hex(text, parse_number(text, self.node)?, t))
+            }
             _ => Value::Unsigned(parse_number(text, self.node)? as u64),
         })
+    }
+}
+
+/// `v` parsed from `key` of `sec`, as a value of type `t` (see [`signed_hex`]).
+fn twos_complement(sec: &Section, key: &str, v: i64, t: DataType) -> i64 {
+    sec.get(key).map_or(v, |(text, _)| signed_hex(text, v, t))
+}
+
+/// A plain hex number written for a signed type of N bits is its two's complement
+/// (`0x80000000` on INTEGER32 is -2147483648, `0xFF` on INTEGER8 is -1); decimal numbers
+/// and anything beyond N bits stay as written.
+fn signed_hex(text: &str, v: i64, t: DataType) -> i64 {
+    let t_text = text.trim();
+    let hex = t_text.starts_with("0x") || t_text.starts_with("0X");
+    use DataType::*;
+    let bits = match (t, t.size()) {
+        (I8 | I16 | I24 | I32 | I40 | I48 | I56, Some(n)) => n as u32 * 8,
+        _ => return v,
+    };
+    if hex && !t_text.contains('+') && (1i64 << (bits - 1)..1i64 << bits).contains(&v) {
+        v - (1i64 << bits)
+    } else {
+        v
     }
 }
 

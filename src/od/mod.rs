@@ -14,6 +14,7 @@ pub mod expr;
 pub mod fields;
 pub mod json;
 pub mod procedure;
+pub mod text;
 mod value;
 
 pub use alias::{AliasRule, resolve_object};

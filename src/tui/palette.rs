@@ -193,7 +193,7 @@ mod tests {
 
     #[test]
     fn run_previews_every_step_frame() {
-        let read = |p: &std::path::Path| std::fs::read_to_string(p);
+        let read = |p: &std::path::Path| std::fs::read(p);
         let b = Bindings::from_args(&["2=syntron-ds".to_string()], &[], &read).unwrap();
         let p = plan("run 2 pv speed=20", &b, |_| None).unwrap();
         assert_eq!(
