@@ -67,7 +67,7 @@ fn kind_of(message: &str) -> String {
                 out.push('`');
             }
             _ if quoted => {}
-            c if c.is_ascii_hexdigit() && out.ends_with(|p: char| p == '#' || p == 'x') => {}
+            c if c.is_ascii_hexdigit() && out.ends_with(['#', 'x']) => {}
             c if c.is_ascii_digit() => {
                 if !out.ends_with('#') {
                     out.push('#');
