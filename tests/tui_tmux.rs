@@ -111,8 +111,13 @@ fn demo_runs_filters_helps_and_quits_cleanly() {
     s.keys(&["n"]);
     s.wait_for("the cancel", |t| t.contains("not sent"));
 
-    // q quits and the shell gets its screen back.
+    // q asks first while drive 2, which cotui enabled, is still powered; y quits and the
+    // shell gets its screen back.
     s.keys(&["q"]);
+    s.wait_for("the quit confirmation", |t| {
+        t.contains("drive(s) 2 that cotui commanded are still powered: y quits anyway")
+    });
+    s.keys(&["y"]);
     let t = s.wait_for("cotui to exit", |t| t.contains("cotui-exit=0"));
     assert!(!t.contains("Trace ["), "alternate screen left behind:\n{t}");
     let _ = std::fs::remove_dir_all(&home);

@@ -174,10 +174,50 @@ fn hb_state(name: &str) -> u64 {
 #[test]
 fn cotui_agrees_with_wireshark_canopen_dissector() {
     let fixture = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/cia301_mix.log");
-    let frames = frames(fixture);
-    let ours = cotui_jsonl(fixture);
+    let compared = agree_with_wireshark(fixture, "mix");
+    assert!(compared > 40, "only {compared} frames compared");
+}
+
+/// The captures pasted in public issues and docs (`../shared/realworld/logs/`, beside the
+/// checkout): every frame line parses, and Wireshark agrees frame by frame.
+#[test]
+fn real_world_logs_parse_whole_and_agree_with_wireshark() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realworld/logs");
+    let mut logs: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| {
+            panic!(
+                "{}: {e} (the shared real-world files sit beside the checkout)",
+                dir.display()
+            )
+        })
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "txt" || x == "log" || x == "asc"))
+        .collect();
+    logs.sort();
+    assert!(logs.len() >= 8, "{logs:?}");
+    let mut total = 0;
+    for (i, path) in logs.iter().enumerate() {
+        let path = path.to_str().unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_cotui"))
+            .args(["decode", "--summary", path])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        let whole =
+            !err.contains("warning:") && (!err.contains("malformed lines") || err.contains(" 0 malformed lines"));
+        assert!(out.status.success() && whole, "{path}: {err}");
+        total += agree_with_wireshark(path, &format!("rw{i}"));
+    }
+    assert!(total > 150, "only {total} frames compared");
+}
+
+/// Compares cotui's JSONL with Wireshark's dissection of the log at `path`, frame by frame;
+/// returns how many frames Wireshark decoded.
+fn agree_with_wireshark(path: &str, tag: &str) -> usize {
+    let frames = frames(path);
+    let ours = cotui_jsonl(path);
     assert_eq!(frames.len(), ours.len());
-    let dir = std::env::temp_dir().join(format!("cotui-ws-{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("cotui-ws-{}-{tag}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let pcap_path = dir.join("mix.pcap");
     std::fs::File::create(&pcap_path)
@@ -190,7 +230,7 @@ fn cotui_agrees_with_wireshark_canopen_dissector() {
 
     let mut compared = 0;
     for (i, (o, t)) in ours.iter().zip(&theirs).enumerate() {
-        let ctx = format!("frame {} ({})", i + 1, o["label"]);
+        let ctx = format!("{path}: frame {} ({})", i + 1, o["label"]);
         let id = o["id"].as_u64().unwrap();
         let Some(fc) = t[1] else {
             // Wireshark skips remote and 29-bit frames entirely (packet-canopen.c returns 0 when
@@ -260,5 +300,5 @@ fn cotui_agrees_with_wireshark_canopen_dissector() {
             _ => {}
         }
     }
-    assert!(compared > 40, "only {compared} frames compared");
+    compared
 }

@@ -104,9 +104,13 @@ impl DataType {
             Boolean => Value::Bool(le(1) != 0),
             U8 | U16 | U24 | U32 | U40 | U48 | U56 | U64 => Value::Unsigned(le(self.size().unwrap_or(8))),
             I8 | I16 | I24 | I32 | I40 | I48 | I56 | I64 => Value::Signed(signed(self.size().unwrap_or(8))),
-            F32 => Value::Float(f32::from_bits(le(4) as u32) as f64),
+            // The f32's shortest decimal form, so 12.345 stays 12.345 (not 12.345000267028809).
+            F32 => Value::Float(shortest_f32(f32::from_bits(le(4) as u32))),
             F64 => Value::Float(f64::from_bits(le(8))),
-            VisibleString => Value::Text(bytes.iter().take_while(|b| **b != 0).map(|b| *b as char).collect()),
+            VisibleString => {
+                let end = bytes.iter().position(|b| *b == 0).unwrap_or(bytes.len());
+                Value::Text(String::from_utf8_lossy(&bytes[..end]).into_owned())
+            }
             UnicodeString => {
                 let units: Vec<u16> = bytes
                     .chunks_exact(2)
@@ -117,6 +121,37 @@ impl DataType {
             TimeOfDay | TimeDifference | OctetString | Domain => Value::Bytes(bytes.to_vec()),
         }
     }
+}
+
+/// An f32 as the f64 with the same shortest decimal form (`12.345f32` -> `12.345`).
+fn shortest_f32(x: f32) -> f64 {
+    if x.is_finite() {
+        x.to_string().parse().unwrap_or(x as f64)
+    } else {
+        x as f64
+    }
+}
+
+/// `s` in double quotes as a user reads it: UTF-8 as is, `"` and `\` escaped, control
+/// characters as `\n`, `\t`, `\r`, `\xNN` (C0, DEL) or `\u{NNNN}` (C1), so no value can
+/// drive a terminal.
+pub fn quoted(s: &str) -> String {
+    let mut out = String::with_capacity(s.len() + 2);
+    out.push('"');
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            '\n' => out.push_str("\\n"),
+            '\t' => out.push_str("\\t"),
+            '\r' => out.push_str("\\r"),
+            c if (c as u32) < 0x20 || c as u32 == 0x7F => out.push_str(&format!("\\x{:02X}", c as u32)),
+            c if c.is_control() => out.push_str(&format!("\\u{{{:04X}}}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
 }
 
 /// A decoded object value.
@@ -172,8 +207,40 @@ impl fmt::Display for Value {
             Value::Unsigned(u) => write!(f, "{u}"),
             Value::Signed(i) => write!(f, "{i}"),
             Value::Float(x) => write!(f, "{x}"),
-            Value::Text(s) => write!(f, "\"{}\"", s.escape_debug()),
+            Value::Text(s) => write!(f, "{}", quoted(s)),
             Value::Bytes(b) => write!(f, "{}", crate::hex::spaced(b)),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strings_are_utf8_and_shown_as_written_with_controls_escaped() {
+        let v = DataType::VisibleString.decode("€ 5 °C\0junk".as_bytes());
+        assert_eq!(v, Value::Text("€ 5 °C".into()));
+        assert_eq!(v.to_string(), "\"€ 5 °C\"");
+        assert_eq!(v.to_json(), serde_json::json!("€ 5 °C"));
+        // Bytes that are not UTF-8 become U+FFFD, never a panic or Latin-1 mojibake.
+        assert_eq!(
+            DataType::VisibleString.decode(b"ok\xFF"),
+            Value::Text("ok\u{FFFD}".into())
+        );
+        let hostile = Value::Text("a\"b\\\x1b]0;x\x07\u{85}\n".into());
+        assert_eq!(hostile.to_string(), r#""a\"b\\\x1B]0;x\x07\u{0085}\n""#);
+    }
+
+    #[test]
+    fn real32_values_keep_their_shortest_decimal_form() {
+        let v = DataType::F32.decode(&12.345f32.to_le_bytes());
+        assert_eq!(v.to_string(), "12.345");
+        assert_eq!(v.to_json().to_string(), "12.345");
+        assert_eq!(
+            DataType::F32.decode(&f32::NAN.to_le_bytes()).to_json(),
+            serde_json::Value::Null
+        );
+        assert_eq!(DataType::F64.decode(&0.1f64.to_le_bytes()).to_string(), "0.1");
     }
 }

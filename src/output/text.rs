@@ -22,7 +22,7 @@ pub fn write_line(out: &mut String, frame: &Frame, ifaces: &Interfaces, decoded:
     for _ in name.len()..4 {
         out.push(' ');
     }
-    out.push_str(name);
+    super::push_escaped(out, name);
     out.push_str("  ");
     if frame.is_ext() || frame.is_err() {
         push_hex(out, frame.id, 8);
@@ -54,10 +54,10 @@ pub fn write_line(out: &mut String, frame: &Frame, ifaces: &Interfaces, decoded:
         out.push_str("T ");
     }
     out.push(' ');
-    out.push_str(&decoded.label);
+    super::push_escaped(out, &decoded.label);
     if let Some(m) = &decoded.malformed {
         out.push_str("  !! ");
-        out.push_str(m);
+        super::push_escaped(out, m);
     }
     out.push('\n');
 }
