@@ -47,6 +47,14 @@ proptest! {
     }
 
     #[test]
+    fn eds_bytes_of_any_encoding_never_panic(bytes in prop::collection::vec(any::<u8>(), 0..600), node in 1u8..=127) {
+        let (text, fallback) = cotui::od::text::decode(&bytes);
+        prop_assert!(fallback.iter().all(|l| *l >= 1 && *l <= text.lines().count().max(1)));
+        let mut b = cotui::od::Bindings::new().unwrap();
+        b.bind_eds_bytes(node, "fuzz.eds", &bytes);
+    }
+
+    #[test]
     fn eds_like_text_never_panics(lines in prop::collection::vec(eds_line(), 0..60), node in 1u8..=127) {
         let (_, warnings) = import("fuzz.eds", &lines.join("\n"), node);
         for w in warnings {

@@ -81,6 +81,11 @@ pub fn user_keymap_path() -> Option<PathBuf> {
     Some(base.join("cotui").join("keymap.json"))
 }
 
+/// A keymap file's text, read with the dictionary files' size cap.
+fn read_text(path: &std::path::Path) -> std::io::Result<String> {
+    String::from_utf8(super::bind::read_capped(path)?).map_err(|_| std::io::Error::other("not UTF-8"))
+}
+
 /// Loads the keymap named by `--keymap` plus the user's overrides.
 pub fn load_keymap(choice: &str) -> Result<Keymap, String> {
     let file_text;
@@ -88,11 +93,11 @@ pub fn load_keymap(choice: &str) -> Result<Keymap, String> {
         "default" => ("default", keymap::DEFAULT),
         "vim" => ("vim", keymap::VIM),
         path => {
-            file_text = std::fs::read_to_string(path).map_err(|e| format!("--keymap {path}: {e}"))?;
+            file_text = read_text(std::path::Path::new(path)).map_err(|e| format!("--keymap {path}: {e}"))?;
             (path, &file_text)
         }
     };
-    let user = user_keymap_path().and_then(|p| std::fs::read_to_string(&p).ok().map(|t| (p, t)));
+    let user = user_keymap_path().and_then(|p| read_text(&p).ok().map(|t| (p, t)));
     let user_name = user.as_ref().map(|(p, _)| p.display().to_string());
     let overrides: Vec<(&str, &str)> = match (&user, &user_name) {
         (Some((_, t)), Some(n)) => vec![(n.as_str(), t.as_str())],
