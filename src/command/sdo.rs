@@ -210,3 +210,220 @@ async fn feed(
         _ => Ok(None),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    //! The IO loop on the virtual bus with paused time, against scripted servers.
+
+    use super::*;
+    use crate::bus::virt::VirtualBus;
+    use std::sync::{Arc, Mutex};
+    use tokio::time::Instant;
+
+    const NODE: u8 = 9;
+    const MS: u64 = 1_000_000;
+
+    /// What a scripted server answers to one request: (delay, payload) pairs, sent in order.
+    type Script = Box<dyn FnMut(&[u8]) -> Vec<(u64, Vec<u8>)> + Send>;
+
+    /// Runs `script` as node 9's server on its own endpoint; returns the log of the client's
+    /// requests it saw.
+    fn serve(vbus: &VirtualBus, mut script: Script) -> Arc<Mutex<Vec<Vec<u8>>>> {
+        let log = Arc::new(Mutex::new(Vec::new()));
+        let server = vbus.endpoint(false);
+        let mut rx = server.subscribe();
+        let seen = log.clone();
+        tokio::spawn(async move {
+            while let Ok(f) = rx.recv().await {
+                if f.id != 0x600 + NODE as u32 || f.direction() == Direction::Tx {
+                    continue;
+                }
+                seen.lock().unwrap().push(f.payload().to_vec());
+                for (delay_ms, p) in script(f.payload()) {
+                    tokio::time::sleep(Duration::from_millis(delay_ms)).await;
+                    let _ = server.send(&Frame::classic(0x580 + NODE as u32, &p)).await;
+                }
+            }
+        });
+        log
+    }
+
+    fn timing(timeout_ms: u64, deadline_ms: Option<u64>) -> Timing {
+        Timing {
+            timeout_ms,
+            deadline_ms,
+        }
+    }
+
+    /// The abort the client sent: the last request the server saw, once the server task
+    /// had its turns to read it.
+    async fn last_abort(log: &Arc<Mutex<Vec<Vec<u8>>>>) -> Vec<u8> {
+        let last = || log.lock().unwrap().last().cloned().unwrap_or_default();
+        for _ in 0..100 {
+            if last().first() == Some(&0x80) {
+                break;
+            }
+            tokio::time::sleep(Duration::from_millis(10)).await;
+        }
+        last()
+    }
+
+    #[tokio::test(start_paused = true)]
+    async fn truncated_answer_is_a_client_abort_with_exit_3() {
+        let vbus = VirtualBus::new("vbus");
+        // `599#4B002000`: an expedited answer cut after the index.
+        let log = serve(&vbus, Box::new(|_| vec![(4, vec![0x4B, 0x00, 0x20, 0x00])]));
+        let bus = vbus.endpoint(false);
+        let e = upload_within(&bus, NODE, 0x2000, 0, false, timing(1000, None))
+            .await
+            .unwrap_err();
+        assert_eq!(e.exit_code(), 3);
+        let j = e.to_json();
+        assert_eq!(j["error"], "sdo_abort");
+        assert_eq!(j["abort_code"], 0x0504_0001);
+        assert_eq!(j["aborted_by"], "client");
+        assert!(j["reason"].as_str().unwrap().contains("4-byte answer"), "{j}");
+        assert!(e.to_string().contains("SDO frames have 8 bytes"), "{e}");
+        assert_eq!(last_abort(&log).await, [0x80, 0x00, 0x20, 0x00, 0x01, 0x00, 0x04, 0x05]);
+    }
+
+    #[tokio::test(start_paused = true)]
+    async fn endless_segments_past_the_announced_size_are_aborted() {
+        let vbus = VirtualBus::new("vbus");
+        let mut toggle = 0;
+        let log = serve(
+            &vbus,
+            Box::new(move |req| match req[0] {
+                // 8 bytes announced, then 7-byte segments that never end.
+                0x40 => vec![(1, vec![0x41, 0x00, 0x20, 0x00, 8, 0, 0, 0])],
+                0x80 => vec![],
+                _ => {
+                    toggle ^= 0x10;
+                    vec![(1, vec![toggle ^ 0x10, 1, 2, 3, 4, 5, 6, 7])]
+                }
+            }),
+        );
+        let bus = vbus.endpoint(false);
+        let e = upload_within(&bus, NODE, 0x2000, 0, false, timing(1000, None))
+            .await
+            .unwrap_err();
+        assert_eq!(e.exit_code(), 3);
+        assert_eq!(e.to_json()["abort_code"], 0x0607_0012);
+        assert!(e.to_string().contains("announced 8 bytes but sent 14"), "{e}");
+        assert_eq!(last_abort(&log).await, [0x80, 0x00, 0x20, 0x00, 0x12, 0x00, 0x07, 0x06]);
+    }
+
+    #[tokio::test(start_paused = true)]
+    async fn block_upload_that_never_ends_stops_at_the_deadline_with_exit_4() {
+        let vbus = VirtualBus::new("vbus");
+        let log = serve(
+            &vbus,
+            Box::new(|req| match req[0] {
+                // No size announced; every sub-block is full and none is the last.
+                0xA4 => vec![(1, vec![0xC4, 0x00, 0x20, 0x00, 0, 0, 0, 0])],
+                0xA3 | 0xA2 => (1..=127u8)
+                    .map(|s| (if s == 1 { 50 } else { 0 }, vec![s, 0, 0, 0, 0, 0, 0, 0]))
+                    .collect(),
+                _ => vec![],
+            }),
+        );
+        let bus = vbus.endpoint(false);
+        let start = Instant::now();
+        let e = upload_within(&bus, NODE, 0x2000, 0, true, timing(1000, Some(2000)))
+            .await
+            .unwrap_err();
+        assert_eq!(start.elapsed(), Duration::from_millis(2000));
+        assert_eq!(e.exit_code(), 4);
+        assert!(e.to_string().contains("past its 2000 ms deadline"), "{e}");
+        assert_eq!(last_abort(&log).await, [0x80, 0x00, 0x20, 0x00, 0x00, 0x00, 0x04, 0x05]);
+        assert!(log.lock().unwrap().len() > 30, "the server was answering all along");
+    }
+
+    #[tokio::test(start_paused = true)]
+    async fn overall_deadline_holds_while_every_answer_comes_in_time() {
+        let vbus = VirtualBus::new("vbus");
+        let mut toggle = 0x10;
+        let log = serve(
+            &vbus,
+            Box::new(move |req| match req[0] {
+                // Segmented without a size; each answer after 500 ms (the timeout is 1 s).
+                0x40 => vec![(500, vec![0x40, 0x00, 0x20, 0x00, 0, 0, 0, 0])],
+                0x80 => vec![],
+                _ => {
+                    toggle ^= 0x10;
+                    vec![(500, vec![toggle, 1, 2, 3, 4, 5, 6, 7])]
+                }
+            }),
+        );
+        let bus = vbus.endpoint(false);
+        let start = Instant::now();
+        let e = upload_within(&bus, NODE, 0x2000, 0, false, timing(1000, Some(3000)))
+            .await
+            .unwrap_err();
+        assert_eq!(start.elapsed(), Duration::from_millis(3000));
+        assert!(matches!(e, CommandError::Timeout(_)), "{e:?}");
+        assert_eq!(last_abort(&log).await, [0x80, 0x00, 0x20, 0x00, 0x00, 0x00, 0x04, 0x05]);
+    }
+
+    #[tokio::test(start_paused = true)]
+    async fn silent_server_times_out_after_the_answer_timeout() {
+        let vbus = VirtualBus::new("vbus");
+        let log = serve(&vbus, Box::new(|_| vec![]));
+        let bus = vbus.endpoint(false);
+        let start = Instant::now();
+        let e = download_within(&bus, NODE, 0x6040, 0, vec![6, 0], false, timing(700, None))
+            .await
+            .unwrap_err();
+        assert_eq!(start.elapsed(), Duration::from_millis(700));
+        assert_eq!(e.exit_code(), 4);
+        assert!(e.to_string().contains("did not answer within 700 ms"), "{e}");
+        assert_eq!(last_abort(&log).await, [0x80, 0x40, 0x60, 0x00, 0x00, 0x00, 0x04, 0x05]);
+    }
+
+    /// A SocketCAN reader that gets its turn only at the very moment the answer is due passes
+    /// on an answer the kernel stamped 4 ms after the request: it is taken, not timed out.
+    #[tokio::test(start_paused = true)]
+    async fn queued_answer_stamped_in_time_is_taken_at_the_deadline() {
+        let vbus = VirtualBus::new("vbus");
+        let bus = vbus.endpoint(false);
+        let reader = bus.clone();
+        let mut rx = vbus.endpoint(false).subscribe();
+        tokio::spawn(async move {
+            let request = loop {
+                match rx.recv().await {
+                    Ok(f) if f.id == 0x600 + NODE as u32 => break f,
+                    Ok(_) => {}
+                    Err(_) => return,
+                }
+            };
+            tokio::time::sleep(Duration::from_millis(1000)).await;
+            let mut answer = Frame::classic(0x580 + NODE as u32, &[0x4B, 0x41, 0x60, 0x00, 0x37, 0x02, 0, 0]);
+            answer.ts_ns = request.ts_ns + 4 * MS;
+            reader.inject(answer);
+        });
+        let start = Instant::now();
+        let data = upload_within(&bus, NODE, 0x6041, 0, false, timing(1000, None))
+            .await
+            .unwrap();
+        assert_eq!(data, [0x37, 0x02]);
+        assert_eq!(start.elapsed(), Duration::from_millis(1000));
+    }
+
+    /// The same answer stamped after the deadline is late: a timeout.
+    #[tokio::test(start_paused = true)]
+    async fn answer_stamped_after_the_deadline_is_a_timeout() {
+        let vbus = VirtualBus::new("vbus");
+        let bus = vbus.endpoint(false);
+        let reader = bus.clone();
+        let before = vbus.now_ns();
+        reader.inject({
+            let mut f = Frame::classic(0x580 + NODE as u32, &[0x4B, 0x41, 0x60, 0x00, 0x37, 0x02, 0, 0]);
+            f.ts_ns = before + 1500 * MS;
+            f
+        });
+        let e = upload_within(&bus, NODE, 0x6041, 0, false, timing(1000, None))
+            .await
+            .unwrap_err();
+        assert_eq!(e.exit_code(), 4, "{e}");
+    }
+}
