@@ -409,6 +409,17 @@ mod tests {
         assert_eq!(start.elapsed(), Duration::from_millis(1000));
     }
 
+    #[test]
+    fn palette_and_cli_take_a_deadline() {
+        let Ok(crate::command::Command::SdoRead { options, .. }) =
+            crate::command::parse_command("sdo read 2 0x1F50:1 --block --timeout 500 --deadline 60000")
+        else {
+            panic!("not an sdo read")
+        };
+        assert_eq!((options.timeout_ms, options.deadline_ms), (500, Some(60_000)));
+        assert!(crate::command::parse_command("sdo read 2 0x1F50:1 --deadline 0").is_err());
+    }
+
     /// The same answer stamped after the deadline is late: a timeout.
     #[tokio::test(start_paused = true)]
     async fn answer_stamped_after_the_deadline_is_a_timeout() {
