@@ -2,6 +2,27 @@
 //! expedited, segmented or block (with CRC and a configurable block size).
 //! Frames from the server go in through [`SdoClient::on_frame`], time through
 //! `now_ns` arguments; frames to send and the result come out.
+//!
+//! Every transfer ends: each answer must come within [`ClientConfig::timeout_ns`] of the
+//! previous frame, the whole transfer within an overall deadline, and the data received is
+//! bounded by the size the server announced (or [`ClientConfig::max_size`] when it announced
+//! none). Times are receive timestamps: [`SdoClient::on_frame`] judges a frame by when it
+//! arrived, not by when it is processed, so a frame that arrived in time but was read late
+//! is still an answer in time.
+//!
+//! Abort codes the client sends when the server misbehaves (CiA 301):
+//!
+//! | what the server did | code |
+//! | --- | --- |
+//! | silent past the per-answer timeout, or the transfer past the overall deadline | `0x05040000` timed out |
+//! | an answer that is not 8 bytes, a command specifier that is unknown or not expected now | `0x05040001` command specifier |
+//! | toggle bit not alternated (segmented) | `0x05030000` toggle |
+//! | invalid block size (block) | `0x05040002` block size |
+//! | acknowledged a block segment never sent (block download) | `0x05040003` sequence number |
+//! | CRC of a block upload wrong | `0x05040004` CRC |
+//! | announced a size above the cap, or sent more than the cap without announcing a size | `0x05040005` out of memory |
+//! | sent more data than it announced | `0x06070012` length too high |
+//! | ended the transfer with less data than it announced | `0x06070013` length too low |
 
 use crate::decode::sdo::abort::{abort_text, codes};
 use crate::decode::sdo::crc::crc16;
@@ -15,6 +36,12 @@ use std::fmt;
 pub struct ClientConfig {
     /// Abort with 0x05040000 when the server is silent this long.
     pub timeout_ns: u64,
+    /// Abort with 0x05040000 when the whole transfer takes longer than this, however
+    /// promptly the server answers. `None`: [`ClientConfig::default_deadline_ns`].
+    pub deadline_ns: Option<u64>,
+    /// The most bytes an upload may bring: a larger announced size, or more data without an
+    /// announced size, is aborted with 0x05040005 (out of memory).
+    pub max_size: usize,
     /// Block size asked for in block uploads (1..=127).
     pub block_size: u8,
     /// Ask for a CRC in block transfers.
@@ -25,9 +52,33 @@ impl Default for ClientConfig {
     fn default() -> Self {
         ClientConfig {
             timeout_ns: 1_000_000_000,
+            deadline_ns: None,
+            max_size: DEFAULT_MAX_SIZE,
             block_size: 127,
             crc: true,
         }
+    }
+}
+
+/// The default [`ClientConfig::max_size`]: 16 MiB.
+pub const DEFAULT_MAX_SIZE: usize = 16 << 20;
+/// The default overall deadline is at least this long (10 s)...
+const MIN_DEADLINE_NS: u64 = 10_000_000_000;
+/// ...and at least this many per-answer timeouts...
+const DEADLINE_TIMEOUTS: u64 = 10;
+/// ...plus this much per byte of the size known (written, or announced by the server):
+/// 1 ms a byte is far slower than any bus (a 10 kbit/s bus moves about 65 bytes a second
+/// in block mode, a segmented transfer to a slow device about 7 bytes a round trip).
+const DEADLINE_NS_PER_BYTE: u64 = 1_000_000;
+
+impl ClientConfig {
+    /// The overall deadline when none is set: the longer of 10 s and 10 per-answer
+    /// timeouts, plus 1 ms for every byte of `known_size` (the data written, or the size the
+    /// server announced for an upload; 0 while unknown).
+    pub fn default_deadline_ns(&self, known_size: u64) -> u64 {
+        MIN_DEADLINE_NS
+            .max(self.timeout_ns.saturating_mul(DEADLINE_TIMEOUTS))
+            .saturating_add(known_size.saturating_mul(DEADLINE_NS_PER_BYTE))
     }
 }
 
@@ -50,6 +101,9 @@ pub enum SdoError {
     Aborted { code: u32, text: &'static str },
     /// The server was silent past the timeout; the client sent abort 0x05040000.
     Timeout,
+    /// The transfer was still running at its overall deadline, `limit_ns` after it started
+    /// (the server kept it going); the client sent abort 0x05040000.
+    Deadline { limit_ns: u64 },
     /// The server broke the protocol; the client sent an abort with `code`.
     Protocol { code: u32, reason: String },
     /// The caller aborted the transfer with `code`.
@@ -61,6 +115,11 @@ impl fmt::Display for SdoError {
         match self {
             SdoError::Aborted { code, text } => write!(f, "aborted by the server: 0x{code:08X} {text}"),
             SdoError::Timeout => write!(f, "SDO protocol timed out (no answer from the server)"),
+            SdoError::Deadline { limit_ns } => write!(
+                f,
+                "SDO transfer not finished within its overall deadline of {} ms (the server kept it going)",
+                limit_ns / 1_000_000
+            ),
             SdoError::Protocol { code, reason } => write!(f, "{reason} (sent abort 0x{code:08X})"),
             SdoError::Cancelled { code } => write!(f, "cancelled with abort 0x{code:08X} {}", abort_text(*code)),
         }
@@ -178,7 +237,12 @@ pub struct SdoClient {
     state: State,
     index: u16,
     sub: u8,
+    /// When the current answer is due (receive time of the last frame plus the timeout).
     deadline: u64,
+    /// When the transfer started.
+    start: u64,
+    /// When the whole transfer must be done.
+    overall: u64,
 }
 
 impl SdoClient {
@@ -190,6 +254,8 @@ impl SdoClient {
             index: 0,
             sub: 0,
             deadline: 0,
+            start: 0,
+            overall: 0,
         }
     }
 
@@ -220,6 +286,7 @@ impl SdoClient {
     /// Starts writing `data` to (index, sub); returns the first frame to send.
     pub fn download(&mut self, index: u16, sub: u8, data: Vec<u8>, mode: Mode, now_ns: u64) -> Result<[u8; 8], Busy> {
         self.begin(index, sub, now_ns)?;
+        self.size_known(data.len() as u64);
         let size = Some(data.len() as u32);
         let (frame, state) = match mode {
             Mode::Auto if (1..=4).contains(&data.len()) => {
@@ -278,27 +345,74 @@ impl SdoClient {
         out
     }
 
-    /// Checks the timeout: past it, sends abort 0x05040000 and fails the transfer.
+    /// Checks the timeouts at `now_ns`: past the answer's deadline or the overall one, sends
+    /// abort 0x05040000 and fails the transfer. Call it only after every frame received
+    /// before `now_ns` went through [`SdoClient::on_frame`].
     pub fn poll(&mut self, now_ns: u64) -> ClientOutput {
         let mut out = ClientOutput::default();
-        if self.is_busy() && now_ns >= self.deadline {
-            self.fail(&mut out, codes::TIMEOUT, SdoError::Timeout);
-        }
+        self.expire(&mut out, now_ns);
         out
     }
 
-    /// Handles one frame from the server.
-    pub fn on_frame(&mut self, payload: &[u8], now_ns: u64) -> ClientOutput {
+    /// The time at which [`SdoClient::poll`] fails the running transfer (`None` when idle).
+    pub fn next_deadline(&self) -> Option<u64> {
+        self.is_busy().then(|| self.deadline.min(self.overall))
+    }
+
+    /// Notes that a frame of ours reached the bus at `ts_ns` (its own receive timestamp):
+    /// the answer is due a timeout after that, not after the moment the client made the
+    /// frame, in case sending was delayed.
+    pub fn on_sent(&mut self, ts_ns: u64) {
+        if self.is_busy() {
+            self.deadline = self.deadline.max(ts_ns.saturating_add(self.cfg.timeout_ns));
+        }
+    }
+
+    /// Handles one frame from the server, received at `ts_ns`. A frame received after the
+    /// answer was due (or after the overall deadline) ends the transfer as a timeout.
+    pub fn on_frame(&mut self, payload: &[u8], ts_ns: u64) -> ClientOutput {
         let mut out = ClientOutput::default();
-        if !self.is_busy() {
+        if !self.is_busy() || self.expire(&mut out, ts_ns) {
             return out;
         }
-        let in_segments = matches!(self.state, State::BlockUpload { .. });
-        let cmd = decode(Side::Server, payload, in_segments);
         let state = std::mem::replace(&mut self.state, State::Idle);
-        self.state = self.step(state, cmd, &mut out);
-        self.deadline = now_ns.saturating_add(self.cfg.timeout_ns);
+        self.state = if payload.len() != 8 {
+            let reason = format!(
+                "the server sent a {}-byte answer ({}); SDO frames have 8 bytes",
+                payload.len(),
+                crate::hex::spaced(payload)
+            );
+            self.protocol_error(&mut out, codes::UNKNOWN_COMMAND, reason)
+        } else {
+            let in_segments = matches!(state, State::BlockUpload { .. });
+            let cmd = decode(Side::Server, payload, in_segments);
+            self.step(state, cmd, &mut out)
+        };
+        self.deadline = ts_ns.saturating_add(self.cfg.timeout_ns);
         out
+    }
+
+    /// Fails the transfer when `at_ns` is past the overall deadline or the answer's; true if it did.
+    fn expire(&mut self, out: &mut ClientOutput, at_ns: u64) -> bool {
+        if !self.is_busy() {
+            return false;
+        }
+        if at_ns >= self.overall {
+            let limit_ns = self.overall - self.start;
+            self.fail(out, codes::TIMEOUT, SdoError::Deadline { limit_ns });
+        } else if at_ns >= self.deadline {
+            self.fail(out, codes::TIMEOUT, SdoError::Timeout);
+        } else {
+            return false;
+        }
+        true
+    }
+
+    /// Sets the overall deadline once the size of the transfer is known (default deadline only).
+    fn size_known(&mut self, size: u64) {
+        if self.cfg.deadline_ns.is_none() {
+            self.overall = self.start.saturating_add(self.cfg.default_deadline_ns(size));
+        }
     }
 
     fn begin(&mut self, index: u16, sub: u8, now_ns: u64) -> Result<(), Busy> {
@@ -308,6 +422,9 @@ impl SdoClient {
         self.index = index;
         self.sub = sub;
         self.deadline = now_ns.saturating_add(self.cfg.timeout_ns);
+        self.start = now_ns;
+        let overall = self.cfg.deadline_ns.unwrap_or_else(|| self.cfg.default_deadline_ns(0));
+        self.overall = now_ns.saturating_add(overall);
         Ok(())
     }
 
@@ -332,7 +449,7 @@ impl SdoClient {
     }
 
     /// Moves from `state` on one server command.
-    fn step(&self, state: State, cmd: SdoCommand, out: &mut ClientOutput) -> State {
+    fn step(&mut self, state: State, cmd: SdoCommand, out: &mut ClientOutput) -> State {
         use SdoCommand as C;
         let (index, sub) = (self.index, self.sub);
         if let C::Abort { code, .. } = cmd {
@@ -404,6 +521,9 @@ impl SdoClient {
                     });
                     return State::Idle;
                 }
+                if let Err((code, reason)) = self.announced(size) {
+                    return self.protocol_error(out, code, reason);
+                }
                 out.frames.push(encode(&C::UploadSegment { toggle: false }));
                 State::UploadSegment {
                     data: Vec::new(),
@@ -423,6 +543,9 @@ impl SdoClient {
                     return self.protocol_error(out, codes::TOGGLE, "toggle bit not alternated".into());
                 }
                 data.extend_from_slice(d.bytes());
+                if let Err((code, reason)) = self.bounded(data.len(), size, 1) {
+                    return self.protocol_error(out, code, reason);
+                }
                 if !last {
                     out.frames.push(encode(&C::UploadSegment { toggle: !toggle }));
                     return State::UploadSegment {
@@ -431,9 +554,9 @@ impl SdoClient {
                         toggle: !toggle,
                     };
                 }
-                if let Some(n) = size.filter(|n| *n as usize != data.len()) {
-                    let reason = format!("server indicated {n} bytes but sent {}", data.len());
-                    return self.protocol_error(out, codes::LENGTH_MISMATCH, reason);
+                if let Some(n) = size.filter(|n| (*n as usize) > data.len()) {
+                    let reason = format!("the server announced {n} bytes but ended after {}", data.len());
+                    return self.protocol_error(out, codes::LENGTH_TOO_LOW, reason);
                 }
                 out.done = Some(Completion::Uploaded {
                     index,
@@ -505,6 +628,9 @@ impl SdoClient {
                     size,
                 },
             ) if same(i, s) => {
+                if let Err((code, reason)) = self.announced(size) {
+                    return self.protocol_error(out, code, reason);
+                }
                 out.frames.push(encode(&C::BlockUploadStart));
                 let crc = crc && self.cfg.crc;
                 State::BlockUpload {
@@ -537,6 +663,10 @@ impl SdoClient {
                     sub_block.extend_from_slice(d.bytes());
                     next += 1;
                     last = c;
+                    // Block segments carry 7 bytes each, the last one padded.
+                    if let Err((code, reason)) = self.bounded(data.len() + sub_block.len(), size, 7) {
+                        return self.protocol_error(out, code, reason);
+                    }
                 }
                 let blksize = self.cfg.block_size.clamp(1, 127);
                 if c || seqno >= blksize {
@@ -566,8 +696,13 @@ impl SdoClient {
                     return self.protocol_error(out, codes::CRC, "block CRC does not match the data".into());
                 }
                 if let Some(n) = size.filter(|n| *n as usize != data.len()) {
-                    let reason = format!("server indicated {n} bytes but sent {}", data.len());
-                    return self.protocol_error(out, codes::LENGTH_MISMATCH, reason);
+                    let (code, what) = if (n as usize) > data.len() {
+                        (codes::LENGTH_TOO_LOW, "ended after")
+                    } else {
+                        (codes::LENGTH_TOO_HIGH, "sent")
+                    };
+                    let reason = format!("the server announced {n} bytes but {what} {}", data.len());
+                    return self.protocol_error(out, code, reason);
                 }
                 out.frames.push(encode(&C::BlockUploadEndResponse));
                 out.done = Some(Completion::Uploaded {
@@ -582,6 +717,45 @@ impl SdoClient {
                 let reason = format!("unexpected {} frame from the server", cmd.cs_name());
                 self.protocol_error(out, codes::UNKNOWN_COMMAND, reason)
             }
+        }
+    }
+
+    /// Checks the size a server announced for an upload against the cap and sets the default
+    /// deadline from it; `Err` holds the abort code and the reason.
+    fn announced(&mut self, size: Option<u32>) -> Result<(), (u32, String)> {
+        if let Some(n) = size {
+            if n as usize > self.cfg.max_size {
+                let reason = format!(
+                    "the server announced {n} bytes, more than the {} this client takes",
+                    self.cfg.max_size
+                );
+                return Err((codes::OUT_OF_MEMORY, reason));
+            }
+            self.size_known(n.into());
+        }
+        Ok(())
+    }
+
+    /// Checks that `got` bytes received so far stay within the announced `size` (rounded up
+    /// to whole `unit`s of padding) or, without one, within the cap.
+    fn bounded(&self, got: usize, size: Option<u32>, unit: usize) -> Result<(), (u32, String)> {
+        let limit = |n: u32| match unit {
+            1 => n as usize,
+            _ => (n as usize).div_ceil(unit).max(1) * unit,
+        };
+        match size {
+            Some(n) if got > limit(n) => Err((
+                codes::LENGTH_TOO_HIGH,
+                format!("the server announced {n} bytes but sent {got} already"),
+            )),
+            None if got > self.cfg.max_size => Err((
+                codes::OUT_OF_MEMORY,
+                format!(
+                    "the server sent {got} bytes without announcing a size, more than the {} this client takes",
+                    self.cfg.max_size
+                ),
+            )),
+            _ => Ok(()),
         }
     }
 

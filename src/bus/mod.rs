@@ -75,6 +75,8 @@ pub struct Bus {
     _task: Option<Arc<socketcan::TaskGuard>>,
     /// The kernel's count of frames dropped on a full receive buffer (SocketCAN only).
     drops: Option<Arc<socketcan::DropCount>>,
+    /// The virtual bus's clock; `None` on SocketCAN, whose timestamps are `CLOCK_REALTIME`.
+    clock: Option<virt::Clock>,
 }
 
 impl fmt::Debug for Bus {
@@ -99,6 +101,26 @@ impl Bus {
     /// virtual bus, which cannot drop). Frames a slow subscription missed are in [`Subscription::lost`].
     pub fn dropped(&self) -> u64 {
         self.drops.as_ref().map_or(0, |d| d.get())
+    }
+    /// The bus time now in nanoseconds, on the clock of the frames' receive timestamps
+    /// ([`Frame::ts_ns`]): the wall clock (`CLOCK_REALTIME`, as `SO_TIMESTAMPNS`) on SocketCAN,
+    /// the virtual bus's clock (which follows tokio's, paused or not) on a virtual bus.
+    pub fn now_ns(&self) -> u64 {
+        match &self.clock {
+            Some(c) => c.now_ns(),
+            None => std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_nanos() as u64),
+        }
+    }
+    /// Puts `frame` on every subscription as received from another node, keeping its
+    /// timestamp, as the SocketCAN reader does with a frame the kernel stamped earlier.
+    #[cfg(test)]
+    pub(crate) fn inject(&self, frame: Frame) {
+        let _ = self.events.send(Carried {
+            origin: 0,
+            frame: Ok(frame),
+        });
     }
     /// A new subscription that sees every frame from now on.
     pub fn subscribe(&self) -> Subscription {

@@ -154,6 +154,7 @@ pub fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
         events,
         sender,
         _task: Some(Arc::new(TaskGuard(reader))),
+        clock: None,
         drops: Some(Arc::new(DropCount(fd))),
     })
 }

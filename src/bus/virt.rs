@@ -22,13 +22,13 @@ pub struct VirtualBus {
 
 /// The clock of a virtual bus: wall-clock time at creation plus tokio's elapsed time.
 #[derive(Clone, Copy)]
-struct Clock {
+pub(super) struct Clock {
     epoch_ns: u64,
     start: Instant,
 }
 
 impl Clock {
-    fn now_ns(&self) -> u64 {
+    pub(super) fn now_ns(&self) -> u64 {
         self.epoch_ns + self.start.elapsed().as_nanos() as u64
     }
 }
@@ -84,6 +84,7 @@ impl VirtualBus {
             }),
             _task: None,
             drops: None,
+            clock: Some(self.clock),
         }
     }
     /// The bus time now in nanoseconds, as frames sent now would be stamped.

@@ -1,4 +1,4 @@
-//! `cotui sdo read|write IFACE NODE OBJECT [VALUE] [--type T] [--block] [--timeout MS]`.
+//! `cotui sdo read|write IFACE NODE OBJECT [VALUE] [--type T] [--block] [--timeout MS] [--deadline MS]`.
 
 use super::commander::{BusArgs, ms_arg, node_arg, run_command};
 use crate::command::grammar::{DEFAULT_TIMEOUT_MS, parse_type};
@@ -34,6 +34,10 @@ pub struct Transfer {
     /// How long to wait for each server response, in ms.
     #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
     pub timeout: u64,
+    /// How long the whole transfer may take, in ms [default: the longer of 10 s and 10
+    /// timeouts, plus 1 ms per byte of the size written or announced by the server].
+    #[arg(long, value_parser = ms_arg)]
+    pub deadline: Option<u64>,
     /// Bind a device profile to a node: NODE=NAME (names, aliases and types come from it).
     #[arg(long = "profile", value_name = "NODE=NAME")]
     pub profiles: Vec<String>,
@@ -93,5 +97,6 @@ fn options(t: &Transfer) -> SdoOptions {
         data_type: t.data_type,
         block: t.block,
         timeout_ms: t.timeout,
+        deadline_ms: t.deadline,
     }
 }

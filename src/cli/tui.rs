@@ -15,8 +15,8 @@ pub struct UiArgs {
     /// directory then overrides key by key.
     #[arg(long, value_name = "NAME|FILE", default_value = "default")]
     pub keymap: String,
-    /// Bus bit rate for the bus load figure.
-    #[arg(long, default_value_t = 500_000)]
+    /// Nominal bus bit rate for the bus load figure, in bit/s (500000, 500k, 1M).
+    #[arg(long, value_parser = bitrate_arg, default_value_t = 500_000)]
     pub bitrate: u64,
     /// Initial filter (see the filter language in `?`).
     #[arg(long)]
@@ -27,6 +27,29 @@ pub struct UiArgs {
     /// Bind an EDS/DCF file to a node: NODE=FILE.
     #[arg(long = "eds", value_name = "NODE=FILE")]
     pub eds: Vec<String>,
+}
+
+/// The nominal bit rates `--bitrate` takes: CAN's arbitration rate is at most 1 Mbit/s
+/// (ISO 11898-1); below 1 kbit/s no controller runs.
+pub const BITRATES: std::ops::RangeInclusive<u64> = 1_000..=1_000_000;
+
+/// Parses `--bitrate` for clap: bit/s, with an optional `k` or `M` (500k, 1M); anything
+/// outside [`BITRATES`] (0 included) is a usage error.
+pub fn bitrate_arg(text: &str) -> Result<u64, String> {
+    let t = text.trim();
+    let (digits, scale) = match t.strip_suffix(['k', 'K']) {
+        Some(d) => (d, 1_000),
+        None => t.strip_suffix('M').map_or((t, 1), |d| (d, 1_000_000)),
+    };
+    let bad = || {
+        format!(
+            "`{text}` is not a CAN bit rate: give the nominal rate in bit/s, {} to {} (e.g. 500000 or 500k)",
+            BITRATES.start(),
+            BITRATES.end()
+        )
+    };
+    let n: u64 = digits.parse().map_err(|_| bad())?;
+    n.checked_mul(scale).filter(|r| BITRATES.contains(r)).ok_or_else(bad)
 }
 
 /// Arguments of `cotui open`.
@@ -218,4 +241,37 @@ pub fn run_demo(args: &DemoArgs) -> i32 {
     };
     let feed = Feeding::Live(crate::bus::DEMO.to_string(), args.listen_only);
     start(&args.ui, crate::bus::DEMO, kind, feed)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bitrate_takes_bits_per_second_with_k_and_m() {
+        assert_eq!(bitrate_arg("500000"), Ok(500_000));
+        assert_eq!(bitrate_arg("125k"), Ok(125_000));
+        assert_eq!(bitrate_arg("1M"), Ok(1_000_000));
+        assert_eq!(bitrate_arg("1000"), Ok(1_000));
+    }
+
+    #[test]
+    fn bitrate_zero_negative_and_absurd_are_usage_errors() {
+        for bad in [
+            "0",
+            "-500000",
+            "999",
+            "2M",
+            "1000001",
+            "fast",
+            "",
+            "18446744073709551615k",
+        ] {
+            let e = bitrate_arg(bad).unwrap_err();
+            assert!(
+                e.contains("is not a CAN bit rate") && e.contains("1000 to 1000000"),
+                "{bad}: {e}"
+            );
+        }
+    }
 }

@@ -23,13 +23,15 @@ pub enum CommandError {
     Usage(String),
     /// The bus could not be opened or used.
     Bus(BusError),
-    /// The SDO transfer was aborted (by the server, or by us for a protocol error).
+    /// The SDO transfer was aborted (by the server, or by us for a protocol error, when
+    /// `reason` says what the server did wrong).
     Abort {
         node: u8,
         index: u16,
         sub: u8,
         code: u32,
         by_server: bool,
+        reason: Option<String>,
     },
     /// No answer in time.
     Timeout(String),
@@ -77,13 +79,20 @@ impl CommandError {
                 sub,
                 code,
                 by_server,
-            } => json!({
-                "ok": false, "error": "sdo_abort", "node": node,
-                "index": index, "sub": sub,
-                "abort_code": code, "abort_text": abort_text(*code),
-                "aborted_by": if *by_server { "server" } else { "client" },
-                "message": self.to_string(),
-            }),
+                reason,
+            } => {
+                let mut v = json!({
+                    "ok": false, "error": "sdo_abort", "node": node,
+                    "index": index, "sub": sub,
+                    "abort_code": code, "abort_text": abort_text(*code),
+                    "aborted_by": if *by_server { "server" } else { "client" },
+                    "message": self.to_string(),
+                });
+                if let (Some(r), Some(o)) = (reason, v.as_object_mut()) {
+                    o.insert("reason".into(), r.as_str().into());
+                }
+                v
+            }
             CommandError::Timeout(m) => json!({"ok": false, "error": "timeout", "message": m}),
             CommandError::NotStopped { report, text } => {
                 let mut v = (**report).clone();
@@ -128,12 +137,19 @@ impl std::fmt::Display for CommandError {
                 sub,
                 code,
                 by_server,
-            } => write!(
-                f,
-                "SDO {index:04X}:{sub:02X} on node {node} aborted by the {}: 0x{code:08X} {}",
-                if *by_server { "server" } else { "client" },
-                abort_text(*code)
-            ),
+                reason,
+            } => {
+                write!(
+                    f,
+                    "SDO {index:04X}:{sub:02X} on node {node} aborted by the {}: 0x{code:08X} {}",
+                    if *by_server { "server" } else { "client" },
+                    abort_text(*code)
+                )?;
+                match reason {
+                    Some(r) => write!(f, " ({r})"),
+                    None => Ok(()),
+                }
+            }
             CommandError::Drive { node, step, reason } => write!(f, "drive {node}: {step} failed: {reason}"),
             CommandError::Step {
                 procedure,

@@ -2,7 +2,8 @@
 //! TUI palette share. Each result comes as one JSON object plus its text form.
 
 use super::error::CommandError;
-use super::grammar::{Command, RunSpec};
+use super::grammar::{Command, RunSpec, SdoOptions};
+use super::sdo::Timing;
 use super::value::{decode, encode};
 use crate::bus::Bus;
 use crate::decode::cia402::mode_name;
@@ -52,7 +53,7 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
         } => {
             let dict = bindings.dictionary(*node);
             let (index, sub) = resolve_object(dict, object).map_err(CommandError::Usage)?;
-            let data = super::sdo::upload(bus, *node, index, sub, options.block, options.timeout_ms).await?;
+            let data = super::sdo::upload_within(bus, *node, index, sub, options.block, timing(options)).await?;
             if let Some(path) = output {
                 std::fs::write(path, &data).map_err(|e| CommandError::Usage(format!("cannot write {path}: {e}")))?;
             }
@@ -82,7 +83,7 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
             let dict = bindings.dictionary(*node);
             let (index, sub) = resolve_object(dict, object).map_err(CommandError::Usage)?;
             let data = write_data(dict, index, sub, value, options.data_type)?;
-            super::sdo::download(bus, *node, index, sub, data.clone(), options.block, options.timeout_ms).await?;
+            super::sdo::download_within(bus, *node, index, sub, data.clone(), options.block, timing(options)).await?;
             json!({
                 "ok": true,
                 "written": true,
@@ -122,6 +123,14 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
     };
     let text = text(cmd, &json);
     Ok(Outcome { json, text })
+}
+
+/// The timeouts of an SDO command's options.
+fn timing(o: &SdoOptions) -> Timing {
+    Timing {
+        timeout_ms: o.timeout_ms,
+        deadline_ms: o.deadline_ms,
+    }
 }
 
 /// `run`: lists, dry-runs or runs a procedure; the text is a summary line, then every step

@@ -123,6 +123,9 @@ pub struct SdoOptions {
     pub block: bool,
     /// `--timeout`: ms to wait for each server response.
     pub timeout_ms: u64,
+    /// `--deadline`: ms the whole transfer may take (`None`: the client's default, see
+    /// [`crate::sdo_client::ClientConfig::default_deadline_ns`]).
+    pub deadline_ms: Option<u64>,
 }
 
 /// Default SDO response timeout in ms.
@@ -134,6 +137,7 @@ impl Default for SdoOptions {
             data_type: None,
             block: false,
             timeout_ms: DEFAULT_TIMEOUT_MS,
+            deadline_ms: None,
         }
     }
 }
@@ -155,7 +159,7 @@ pub enum Command {
         wait: bool,
         timeout_ms: u64,
     },
-    /// `sdo read NODE OBJECT [--type T] [--block] [--timeout MS] [-o FILE]`.
+    /// `sdo read NODE OBJECT [--type T] [--block] [--timeout MS] [--deadline MS] [-o FILE]`.
     SdoRead {
         node: u8,
         object: String,
@@ -163,7 +167,7 @@ pub enum Command {
         /// Also write the data read to this file (domains).
         output: Option<String>,
     },
-    /// `sdo write NODE OBJECT VALUE [--type T] [--block] [--timeout MS]` (a file path for domains).
+    /// `sdo write NODE OBJECT VALUE [--type T] [--block] [--timeout MS] [--deadline MS]` (a file path for domains).
     SdoWrite {
         node: u8,
         object: String,
@@ -358,7 +362,7 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
     let mut pos: Vec<&str> = Vec::new();
     let mut data_type = None;
     let (mut block, mut wait, mut probe, mut list, mut dry_run) = (false, false, false, false, false);
-    let (mut output, mut timeout, mut listen, mut ramp) = (None, None, None, None);
+    let (mut output, mut timeout, mut listen, mut ramp, mut deadline) = (None, None, None, None, None);
     let mut limits = Limits::default();
     let mut it = all.iter();
     while let Some(w) = it.next() {
@@ -373,6 +377,7 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
             "--timeout" => timeout = Some(positive("--timeout", value("--timeout")?)?),
             "--listen" => listen = Some(positive("--listen", value("--listen")?)?),
             "--ramp" => ramp = Some(positive("--ramp", value("--ramp")?)?),
+            "--deadline" => deadline = Some(positive("--deadline", value("--deadline")?)?),
             "--count" => limits.count = Some(positive("--count", value("--count")?)?),
             "--duration" => limits.duration_ms = Some(positive("--duration", value("--duration")?)?),
             "-o" | "--output" => output = Some(value("-o")?.to_string()),
@@ -386,6 +391,7 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
         data_type,
         block,
         timeout_ms: timeout.unwrap_or(DEFAULT_TIMEOUT_MS),
+        deadline_ms: deadline,
     };
     let usage = "commands: nmt ACTION NODE, sdo read NODE OBJECT, sdo write NODE OBJECT VALUE, \
                  drive NODE ACTION, run NODE PROCEDURE [NAME=VALUE ...], scan, record -o FILE, stop [NODE ...]";
@@ -466,7 +472,8 @@ mod tests {
                 options: SdoOptions {
                     data_type: Some(DataType::VisibleString),
                     block: true,
-                    timeout_ms: 300
+                    timeout_ms: 300,
+                    deadline_ms: None
                 }
             }
         );

@@ -127,7 +127,8 @@ mod tests {
         assert!((s.period().unwrap() - 0.010).abs() < 1e-9);
         assert!(s.jitter().unwrap() > 0.001);
         assert!((s.rate() - 100.0).abs() < 1e-6);
-        let bits = store.packed(0).wire_bits() * 5;
-        assert!((st.load_percent() - bits as f64 * 100.0 / 125_000.0).abs() < 1e-9);
+        // 5 base frames of 8 bytes, 135 bits each at worst (see store::wire_bits), in the
+        // last second: 675 bits of 125000 = 0.54 %.
+        assert!((st.load_percent() - 0.54).abs() < 1e-9, "{}", st.load_percent());
     }
 }

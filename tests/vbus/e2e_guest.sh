@@ -368,6 +368,51 @@ else
     bad "socketcan_live.rs"
 fi
 
+# ---- 6. the SDO client against a misbehaving server (peers/sdo_misbehave.py) -------------
+# A python-can server on vcan0 node 7 that breaks the protocol by index: every read ends
+# with exit 3 (client abort: the code and the reason in the JSON, the abort on the bus) or
+# exit 4 (timeout). How long the transfer took is judged on the bus, by the peer's kernel
+# receive timestamps of the first request and of the abort, not by the guest's wall clock.
+python3 "$here/peers/sdo_misbehave.py" vcan0 7 > misbehave.out 2>&1 &
+misbehave=$!
+if wait_for misbehave.out 900 "sdo_misbehave ready vcan0 7"; then
+    # bad_server INDEX RC CODE MIN MAX LABEL [ARGS]: exit RC, the peer received abort CODE
+    # between MIN and MAX seconds after the request; for exit 3 also CODE in the JSON.
+    bad_server() {
+        local index=$1 want_rc=$2 code=$3 min=$4 max=$5 label=$6
+        shift 6
+        c sdo read vcan0 7 "$index" --json "$@"
+        local got by line after
+        read -r got by < <(echo "$out" | j '"\(.abort_code) \(.aborted_by)"')
+        wait_for misbehave.out 50 "sdo_misbehave abort ${code#0x} ${index#0x}:00"
+        line=$(grep "sdo_misbehave abort ${code#0x} ${index#0x}:00" misbehave.out | tail -1)
+        after=${line##* }
+        if [ $rc != "$want_rc" ]; then
+            bad "misbehaving server: $label: rc=$rc (want $want_rc): $out $err"
+        elif [ "$want_rc" = 3 ] && { [ "$got" != "$((code))" ] || [ "$by" != client ]; }; then
+            bad "misbehaving server: $label: abort_code=$got aborted_by=$by (want $((code)) client): $out"
+        elif [ -z "$line" ] || awk -v t="$after" -v a="$min" -v b="$max" 'BEGIN { exit (t >= a && t <= b) }'; then
+            bad "misbehaving server: $label: abort $code ${after:-not received} s after the request (want $min..$max): $(tail -3 misbehave.out)"
+        else
+            ok "misbehaving server: $label -> exit $rc, abort $code on the bus ${after} s after the request"
+        fi
+    }
+    bad_server 0x2000 3 0x06070012 0 1 "segments past the announced 10 bytes"
+    echo "$out" | grep -q '"reason":"the server announced 10 bytes but sent 14 already"' ||
+        bad "misbehaving server: no reason in the JSON: $out"
+    bad_server 0x2001 3 0x05040001 0 1 "truncated 4-byte answer 587#4B012000"
+    echo "$err" | grep -q "4-byte answer (4B 01 20 00)" ||
+        bad "misbehaving server: the message does not say what the server sent: $err"
+    bad_server 0x2004 3 0x05040001 0 1 "download response to an upload (wrong command)"
+    # The overall deadline (counted from before the request went out): the server keeps
+    # answering, each answer within --timeout.
+    bad_server 0x2002 4 0x05040000 1.9 3 "block upload that never ends, --deadline 2000" --block --deadline 2000
+else
+    bad "sdo_misbehave.py not ready: $(cat misbehave.out)"
+fi
+kill -TERM "$misbehave" 2> /dev/null
+wait "$misbehave" 2> /dev/null
+
 t_end=$(date +%s.%N)
 echo "$passed passed, $failed failed ($(awk -v a="$t_start" -v b="$t_end" 'BEGIN { printf "%.0f", b - a }') s in the guest)"
 [ "$failed" = 0 ]
