@@ -12,14 +12,15 @@
 use super::frame::{Chunk, Side};
 
 /// Whether `byte` is a command byte CiA 301 allows `side` to send, with every reserved
-/// bit zero. Initiate bytes count as valid whatever their size bits say, so that a
-/// sloppy initiate still starts a transfer; `0xE0..=0xFF` (no command specifier 7) is
-/// left to the unknown-command handling.
+/// bit zero (in an initiate, `n` is zero unless both `e` and `s` are set);
+/// `0xE0..=0xFF` (no command specifier 7) is left to the unknown-command handling.
 pub fn valid_command(side: Side, byte: u8) -> bool {
+    let initiate = |b: u8| b & 0x03 == 0x03 || b & 0x0C == 0;
     match (side, byte) {
         (_, 0x00..=0x1F) | (_, 0x80) | (_, 0xE0..=0xFF) => true,
-        (Side::Client, 0x20..=0x2F | 0x40 | 0x60 | 0x70 | 0xA0..=0xA4) => true,
-        (Side::Server, 0x20 | 0x30 | 0x40..=0x4F | 0x60 | 0xA0 | 0xA1 | 0xA2 | 0xA4) => true,
+        (Side::Client, 0x20..=0x2F) | (Side::Server, 0x40..=0x4F) => initiate(byte),
+        (Side::Client, 0x40 | 0x60 | 0x70 | 0xA0..=0xA4) => true,
+        (Side::Server, 0x20 | 0x30 | 0x60 | 0xA0 | 0xA1 | 0xA2 | 0xA4) => true,
         // Block initiates (cs 0, x bits zero) and ends (n, cs 1, bit 1 zero).
         (_, 0xC0..=0xDF) => {
             let initiate = byte & 1 == 0;
@@ -27,6 +28,11 @@ pub fn valid_command(side: Side, byte: u8) -> bool {
         }
         _ => false,
     }
+}
+
+/// An end-of-block command byte (`110 n n n x 1`, either side).
+pub fn end_command(byte: u8) -> bool {
+    byte & 0xE3 == 0xC1
 }
 
 /// A frame that no command explains: the first byte is `c | seqno` with seqno 1..=127.
@@ -50,6 +56,9 @@ pub struct Orphan {
     pub seq: u64,
     /// Its timestamp (ns).
     pub ts_ns: u64,
+    /// It is already part of a listed transaction (an expedited upload response, as it
+    /// looked): a run it began counts from the next frame.
+    pub listed: bool,
 }
 
 impl Orphan {
@@ -61,17 +70,26 @@ impl Orphan {
             data: Chunk::new(&payload[1..], 7),
             seq,
             ts_ns,
+            listed: false,
         })
     }
 
-    /// Its sequence number, if it can be a block segment that is not the last one.
+    /// Its sequence number, if it can be a block segment.
     pub fn seqno(&self) -> Option<u8> {
-        (self.first & 0x80 == 0 && self.first != 0).then_some(self.first)
+        Some(self.first & 0x7F).filter(|s| *s != 0)
+    }
+
+    /// The c bit: the last segment of the transfer, if it is one.
+    pub fn last(&self) -> bool {
+        self.first & 0x80 != 0
     }
 
     /// `payload` from `side` is the next segment of a run this orphan began.
     pub fn continued_by(&self, side: Side, payload: &[u8]) -> bool {
-        payload.len() == 8 && side == self.side && self.seqno().is_some_and(|s| s < 127 && payload[0] & 0x7F == s + 1)
+        payload.len() == 8
+            && side == self.side
+            && !self.last()
+            && self.seqno().is_some_and(|s| s < 127 && payload[0] & 0x7F == s + 1)
     }
 }
 

@@ -11,7 +11,7 @@
 
 use super::crc::crc16_update;
 use super::frame::{Chunk, SdoCommand, SdoFrame, Side};
-use super::resync::{Orphan, impossible_command};
+use super::resync::{Orphan, end_command, impossible_command};
 use super::transaction::{Channel, Outcome, Problem, Protocol, Transaction, TransferDirection};
 use super::value::view;
 use crate::od::Dictionary;
@@ -82,6 +82,9 @@ struct Pending {
     /// A partial transfer seen in one frame only (an impossible command byte): dropped
     /// without a trace if the next frame does not continue it.
     tentative: bool,
+    /// The frame that began it, while it is the only one: if the same side's next frame
+    /// counts on from its first byte, both were block segments, not an initiate.
+    opener: Option<Orphan>,
 }
 
 impl Pending {
@@ -96,6 +99,7 @@ impl Pending {
             held: Chunk::default(),
             partial: false,
             tentative: false,
+            opener: None,
         }
     }
 
@@ -172,8 +176,20 @@ impl SdoTracker {
         dict: &Dictionary,
     ) -> SdoFrame {
         let state = self.channels.entry(channel).or_default();
-        let in_block = block_segment_expected(state, side, payload);
-        let orphan = state.orphan.take();
+        // An "initiate" followed by the next sequence number, or answered by an
+        // acknowledgement of its sequence number, was a block segment.
+        let opener = state
+            .pending
+            .as_ref()
+            .filter(|p| p.txn.frames.len() == 1)
+            .and_then(|p| p.opener);
+        let run = opener.filter(|o| o.continued_by(side, payload));
+        let acked = opener.filter(|o| {
+            o.side == side.other() && payload.len() == 8 && payload[0] == 0xA2 && o.seqno() == Some(payload[1])
+        });
+        let in_block = run.is_some() || (acked.is_none() && block_segment_expected(state, side, payload));
+        let opener = run.or(acked);
+        let orphan = state.orphan.take().or(opener);
         let mut frame = SdoFrame::new(side, payload, in_block);
         let dlc_problem = (payload.len() != 8).then_some(Problem::WrongDlc {
             dlc: payload.len().min(255) as u8,
@@ -214,8 +230,9 @@ impl SdoTracker {
                     frame.object = frame.object.or(p.object());
                     self.completed.push(finalize(p, outcome, dict));
                 }
-                Step::Unexpected if p.tentative => {
-                    // One impossible byte was not the start of a run after all.
+                Step::Unexpected if p.tentative || opener.is_some() => {
+                    // One impossible byte was not the start of a run after all, or one
+                    // seemingly valid command was its start: either way no transaction.
                     start(state, channel, &ctx, &mut notes, &mut self.completed, dict);
                 }
                 Step::Unexpected => {
@@ -286,7 +303,15 @@ fn block_segment_expected(state: &ChannelState, side: Side, payload: &[u8]) -> b
             matches!(p.phase, Phase::BlockDownloadSegments { next, .. } | Phase::BlockUploadSegments { next, .. }
                 if p.phase.segment_sender() == Some(side) && payload.first().map(|b| b & 0x7F) == Some(next))
         }
-        Some(p) if p.phase.segment_sender() == Some(side) => true,
+        // A sub-block starts at seqno 1; an end command there means the last segment
+        // (or its acknowledgement) was not captured.
+        Some(p) if p.phase.segment_sender() == Some(side) => {
+            let fresh = matches!(
+                p.phase,
+                Phase::BlockDownloadSegments { next: 1, .. } | Phase::BlockUploadSegments { next: 1, .. }
+            );
+            !(fresh && !seqno_one && payload.first().is_some_and(|b| end_command(*b)))
+        }
         // The next sub-block began although its acknowledgement was not captured.
         Some(p) if p.phase.acked_sender() == Some(side) => seqno_one,
         Some(p) if p.txn.protocol == Protocol::Block => false,
@@ -390,6 +415,7 @@ fn start(
             notes.push(Problem::UnmatchedResponse.to_string());
         }
         attach(&mut p.txn, ctx);
+        p.opener = ctx.this;
         state.pending = Some(p);
     };
     match (ctx.side, ctx.command) {
@@ -457,6 +483,8 @@ fn start(
             notes.push(Problem::UnmatchedResponse.to_string());
             attach(&mut t, ctx);
             completed.push(finalize(pending(t, Phase::InitUpload, false), Outcome::Ok, dict));
+            // It may also have been a block segment, which the next frame would tell.
+            state.orphan = ctx.this.map(|o| Orphan { listed: true, ..o });
         }
         (Side::Server, InitiateUploadResponse { index, sub, size, .. }) => {
             let mut t = new_txn(channel, ctx, index, sub, Upload, Protocol::Segmented);
@@ -508,8 +536,8 @@ fn start(
                 },
             };
             p.tentative = run.is_none();
-            if let Some(o) = run {
-                p.sub_block.push((o.first, false, o.data));
+            if let Some((o, s)) = run.filter(|o| !o.listed).and_then(|o| Some((o, o.seqno()?))) {
+                p.sub_block.push((s, false, o.data));
             }
             resume(p, ctx, notes, state);
         }
@@ -522,9 +550,11 @@ fn start(
                 Side::Client => Phase::BlockDownloadAck { blksize },
                 Side::Server => Phase::BlockUploadAck { blksize },
             };
-            if let Some(o) = answered {
-                p.sub_block.push((o.first, false, o.data));
+            if let Some((o, s)) = answered.filter(|o| !o.listed).and_then(|o| Some((o, o.seqno()?))) {
+                p.sub_block.push((s, o.last(), o.data));
             }
+            // Confirmed by what follows: a segment, or the end of the transfer.
+            p.tentative = true;
             resume(p, ctx, notes, state);
         }
         _ => {
@@ -543,7 +573,7 @@ fn partial(channel: Channel, ctx: &FrameCtx, sender: Side, first: Option<Orphan>
     };
     let mut t = new_txn(channel, ctx, 0, 0, dir, Protocol::Block);
     t.flag(Problem::StartedBeforeCapture);
-    if let Some(o) = first {
+    if let Some(o) = first.filter(|o| !o.listed) {
         t.start_ns = o.ts_ns;
         t.add_frame(o.seq);
     }
@@ -687,6 +717,16 @@ fn step(p: &mut Pending, ctx: &FrameCtx, notes: &mut Vec<String>) -> Step {
             p.phase = match p.phase {
                 Phase::BlockDownloadAck { .. } => Phase::BlockDownloadSegments { next: 1, blksize },
                 _ => Phase::BlockUploadSegments { next: 1, blksize },
+            };
+            step(p, ctx, notes)
+        }
+        (Phase::BlockDownloadSegments { next: 1, .. }, Side::Client, BlockDownloadEnd { .. })
+        | (Phase::BlockUploadSegments { next: 1, .. }, Side::Server, BlockUploadEnd { .. }) => {
+            // The segment with the c bit, or its acknowledgement, was not captured.
+            flag(t, Problem::SequenceError);
+            p.phase = match p.phase {
+                Phase::BlockDownloadSegments { .. } => Phase::BlockDownloadEnd,
+                _ => Phase::BlockUploadEnd,
             };
             step(p, ctx, notes)
         }
