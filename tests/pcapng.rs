@@ -200,3 +200,73 @@ fn refuses_to_write_binary_to_a_terminal() {
         "no binary bytes reached the terminal: {text}"
     );
 }
+
+mod fuzz {
+    use cotui::frame::{Flags, Frame};
+    use cotui::output::pcapng::PcapngWriter;
+    use proptest::prelude::*;
+
+    fn frame() -> impl Strategy<Value = (u8, Frame)> {
+        (
+            0u8..3,
+            any::<u64>(),
+            any::<u32>(),
+            any::<u8>(),
+            0u8..=64,
+            0u8..16,
+            prop::collection::vec(any::<u8>(), 64),
+        )
+            .prop_map(|(iface, ts_ns, id, flags, len, raw_dlc, data)| {
+                let mut f = Frame {
+                    ts_ns,
+                    id: id & 0x1FFF_FFFF,
+                    flags: Flags(flags),
+                    len,
+                    raw_dlc,
+                    ..Frame::default()
+                };
+                f.data.copy_from_slice(&data);
+                (iface, f)
+            })
+    }
+
+    fn u32le(b: &[u8], at: usize) -> u32 {
+        u32::from_le_bytes(b[at..at + 4].try_into().unwrap())
+    }
+
+    proptest! {
+        /// Any frame, even one no bus produces, gives well-formed blocks: lengths agree at
+        /// both ends, everything is 4-byte aligned, one packet per frame, one interface
+        /// description per name, and packets name an interface described before them.
+        #[test]
+        fn any_frames_give_well_formed_blocks(frames in prop::collection::vec(frame(), 0..40)) {
+            let names = ["can0", "vcan10", "x"];
+            let mut w = PcapngWriter::new(Vec::new()).unwrap();
+            for (i, f) in &frames {
+                w.write_frame(names[*i as usize], f).unwrap();
+            }
+            let b = w.into_inner();
+            let (mut at, mut idbs, mut epbs) = (0usize, 0u32, 0usize);
+            while at < b.len() {
+                let (kind, len) = (u32le(&b, at), u32le(&b, at + 4) as usize);
+                prop_assert!(len >= 12 && len % 4 == 0 && at + len <= b.len());
+                prop_assert_eq!(u32le(&b, at + len - 4) as usize, len);
+                match kind {
+                    0x0A0D_0D0A => prop_assert_eq!(at, 0),
+                    1 => idbs += 1,
+                    6 => {
+                        prop_assert!(u32le(&b, at + 8) < idbs);
+                        let caplen = u32le(&b, at + 20);
+                        prop_assert!(caplen == 16 || caplen == 72);
+                        epbs += 1;
+                    }
+                    other => prop_assert!(false, "block type {other:#x}"),
+                }
+                at += len;
+            }
+            prop_assert_eq!(epbs, frames.len());
+            let distinct: std::collections::HashSet<u8> = frames.iter().map(|(i, _)| *i).collect();
+            prop_assert_eq!(idbs as usize, distinct.len());
+        }
+    }
+}
