@@ -314,8 +314,9 @@ fn block_segment_expected(state: &ChannelState, side: Side, payload: &[u8]) -> b
         }
         // The next sub-block began although its acknowledgement was not captured.
         Some(p) if p.phase.acked_sender() == Some(side) => seqno_one,
-        Some(p) if p.txn.protocol == Protocol::Block => false,
-        _ => impossible_command(side, payload) || state.orphan.is_some_and(|o| o.continued_by(side, payload)),
+        // A transfer awaits an answer: a strange byte is a bad answer, not a segment.
+        Some(_) => false,
+        None => impossible_command(side, payload) || state.orphan.is_some_and(|o| o.continued_by(side, payload)),
     }
 }
 
