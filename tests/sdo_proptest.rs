@@ -156,3 +156,91 @@ proptest! {
         prop_assert!(seen[0].problems.is_empty(), "{:?}", seen[0].problems);
     }
 }
+
+/// The frames of one block transfer between a client and a server: (client to server, bytes).
+fn block_transfer(data: &[u8], upload: bool, cblk: u8, sblk: u8) -> Vec<(bool, [u8; 8])> {
+    let ccfg = ClientConfig {
+        block_size: cblk,
+        crc: true,
+        ..ClientConfig::default()
+    };
+    let scfg = ServerConfig {
+        block_size: sblk,
+        crc: true,
+        ..ServerConfig::default()
+    };
+    let mut store = MemoryStore::default();
+    store.insert(
+        0x2100,
+        3,
+        Access::Rw,
+        None,
+        if upload { data.to_vec() } else { Vec::new() },
+    );
+    let mut client = SdoClient::new(ccfg);
+    let first = if upload {
+        client.upload(0x2100, 3, Mode::Block, 0).unwrap()
+    } else {
+        client.download(0x2100, 3, data.to_vec(), Mode::Block, 0).unwrap()
+    };
+    let mut server = SdoServer::new(scfg);
+    let (mut frames, mut now) = (Vec::new(), 0u64);
+    let mut to_server = vec![first];
+    while !to_server.is_empty() {
+        let mut to_client = Vec::new();
+        for f in std::mem::take(&mut to_server) {
+            now += 1000;
+            frames.push((true, f));
+            to_client.extend(server.on_frame(&f, now, &mut store).frames);
+        }
+        for f in to_client {
+            now += 1000;
+            frames.push((false, f));
+            to_server.extend(client.on_frame(&f, now).frames);
+        }
+    }
+    frames
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+    /// A capture that starts anywhere in a block transfer invents no transaction: what it
+    /// lists is the transfer itself (its object known when the initiate response was
+    /// captured) or one partial transfer whose bytes end the real data.
+    #[test]
+    fn a_block_transfer_caught_mid_way_invents_nothing(
+        data in prop::collection::vec(any::<u8>(), 1..1200),
+        upload in any::<bool>(),
+        cblk in 1u8..=127,
+        sblk in 1u8..=127,
+        cut_at in any::<prop::sample::Index>(),
+    ) {
+        let frames = block_transfer(&data, upload, cblk, sblk);
+        let cut = 1 + cut_at.index(frames.len() - 1);
+        let dict = Dictionary::default();
+        let mut t = SdoTracker::new();
+        let mut labels = Vec::new();
+        for (i, (c2s, f)) in frames[cut..].iter().enumerate() {
+            labels.push(t.on_frame(i as u64 + 1, i as u64 * 1000, 9, *c2s, f, &dict).label());
+        }
+        let txns = t.finish();
+        // A server's first byte 0x42/0x43/0x47/0x4B/0x4F reads as a complete expedited upload
+        // response, listed at once; nothing can take it back (a known limit).
+        let (first_c2s, first) = frames[cut];
+        let expedited_lookalike = !first_c2s && [0x42, 0x43, 0x47, 0x4B, 0x4F].contains(&first[0]);
+        let real: Vec<&Transaction> = txns
+            .iter()
+            .filter(|x| !(expedited_lookalike && x.frames == [1] && x.protocol == P::Expedited))
+            .collect();
+        prop_assert!(real.len() <= 1, "cut {}: {:#?}\n{:#?}", cut, txns, labels);
+        for x in real {
+            prop_assert_eq!(x.direction == cotui::decode::sdo::TransferDirection::Upload, upload);
+            if x.is_partial() {
+                prop_assert_eq!(x.protocol, P::Block);
+                prop_assert!(data.ends_with(&x.data) || x.outcome != Outcome::Ok, "cut {}: {:?}", cut, x);
+            } else {
+                prop_assert_eq!((x.index, x.sub), (0x2100, 3), "cut {}: {:?}\n{:#?}", cut, x, labels);
+            }
+        }
+    }
+}

@@ -16,6 +16,10 @@ pub enum OutputFormat {
     Text,
     /// One JSON object per frame (see README, "JSONL contract").
     Jsonl,
+    /// A pcapng capture for Wireshark (binary: with -o FILE or a redirected stdout).
+    /// `run` hands it to `decode_out` before decoding, so the matches below that pair it
+    /// with `Jsonl` never see it.
+    Pcapng,
 }
 
 /// Arguments of `cotui decode`.
@@ -39,6 +43,9 @@ pub struct DecodeArgs {
     /// Bind an EDS/DCF file to a node: NODE=FILE.
     #[arg(long = "eds", value_name = "NODE=FILE")]
     pub eds: Vec<String>,
+    /// Write to FILE instead of stdout (`-` is stdout).
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    pub output: Option<String>,
 }
 
 /// What a decode run writes, chosen once from the arguments.
@@ -51,6 +58,9 @@ enum Mode {
 
 /// Runs `cotui decode`; returns the exit status.
 pub fn run(args: &DecodeArgs) -> i32 {
+    if args.format == OutputFormat::Pcapng {
+        return super::decode_out::pcapng(args);
+    }
     let mut decoder = match super::bind::decoder(&args.profiles, &args.eds) {
         Ok(d) => d,
         Err(e) => {
@@ -65,8 +75,13 @@ pub fn run(args: &DecodeArgs) -> i32 {
     } else {
         Mode::Frames(args.format)
     };
-    let stdout = io::stdout();
-    let mut out = io::BufWriter::with_capacity(1 << 16, stdout.lock());
+    let mut out = match super::decode_out::open(args.output.as_deref(), false) {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("cotui decode: {e}");
+            return EXIT_USAGE;
+        }
+    };
     let mut summary = Summary::default();
     let mut status = EXIT_OK;
     for path in &args.files {
@@ -134,7 +149,7 @@ fn decode_stream(
                     let d = decoder.decode(frame);
                     text::write_line(&mut buf, frame, &ifaces, &d);
                 }
-                Mode::Frames(OutputFormat::Jsonl) => {
+                Mode::Frames(OutputFormat::Jsonl | OutputFormat::Pcapng) => {
                     let d = decoder.decode(frame);
                     jsonl::write_frame(&mut buf, *line, frame, &ifaces, &d);
                 }
@@ -179,7 +194,7 @@ fn write_transaction(buf: &mut String, t: &Transaction, decoder: &Decoder, fmt: 
     let dict = decoder.dictionary(t.node);
     match fmt {
         OutputFormat::Text => buf.push_str(&t.label(dict)),
-        OutputFormat::Jsonl => buf.push_str(&t.to_json(dict).to_string()),
+        OutputFormat::Jsonl | OutputFormat::Pcapng => buf.push_str(&t.to_json(dict).to_string()),
     }
     buf.push('\n');
 }
@@ -197,7 +212,7 @@ fn finish(decoder: &mut Decoder, mode: Mode, summary: &mut Summary, out: &mut im
             summary.finish();
             match fmt {
                 OutputFormat::Text => buf.push_str(&summary.to_text()),
-                OutputFormat::Jsonl => {
+                OutputFormat::Jsonl | OutputFormat::Pcapng => {
                     buf.push_str(&summary.to_json().to_string());
                     buf.push('\n');
                 }

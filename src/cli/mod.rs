@@ -5,6 +5,7 @@ mod bench_tui;
 pub mod bind;
 pub mod commander;
 pub mod decode;
+mod decode_out;
 pub mod drive;
 pub mod nmt;
 pub mod record;
@@ -45,7 +46,7 @@ pub fn verbose() -> bool {
 /// The subcommands.
 #[derive(Subcommand, Debug)]
 pub enum Command {
-    /// Decode candump / ASC logs to text, JSON lines, SDO transactions or a summary.
+    /// Decode candump / ASC logs to text, JSON lines, SDO transactions, a summary or pcapng.
     Decode(decode::DecodeArgs),
     /// Print throughput and memory figures of the decoder on a generated log.
     Bench(bench::BenchArgs),

@@ -4,6 +4,7 @@
 pub mod abort;
 pub mod crc;
 pub mod frame;
+pub mod resync;
 pub mod tracker;
 pub mod transaction;
 pub mod value;

@@ -644,3 +644,185 @@ fn non_default_channel() {
     assert_eq!((v[1].channel, v[1].data.as_slice()), (ch, &[2u8, 0][..]));
     assert_eq!(v[1].to_json(&d)["request_cob"], 0x640);
 }
+
+/// A block segment frame: `c | seqno` and up to seven bytes.
+fn segment(seqno: u8, last: bool, bytes: &[u8]) -> [u8; 8] {
+    let mut f = [0u8; 8];
+    f[0] = seqno | if last { 0x80 } else { 0 };
+    f[1..1 + bytes.len()].copy_from_slice(bytes);
+    f
+}
+
+#[test]
+fn block_download_caught_mid_sub_block_resynchronises() {
+    // 60 bytes in sub-blocks of 4 segments: 1-4, 1-4, 1 (last, 4 bytes used).
+    let data: Vec<u8> = (100..160u8).collect();
+    let segs: Vec<&[u8]> = data.chunks(7).collect();
+    let mut bus = Bus::new();
+    // The capture starts at segment 3 of the first sub-block. Its first byte 0x03
+    // reads as a valid download segment; the run 3, 4 shows what it is.
+    let f = bus.c(2, &segment(3, false, segs[2]));
+    assert!(f.label().starts_with("Download segment t=0 "), "{}", f.label());
+    assert!(f.label().ends_with(" c=1 [outside any transfer seen]"), "{}", f.label());
+    let f = bus.c(2, &segment(4, false, segs[3]));
+    assert_eq!(
+        f.label(),
+        "Block download segment seqno=4 [resynchronised: block download started before the capture]"
+    );
+    assert_eq!(f.object, None);
+    assert_eq!(
+        bus.s(2, &[0xA2, 4, 4, 0, 0, 0, 0, 0]).label(),
+        "Block download ack ackseq=4 blksize=4"
+    );
+    for (i, s) in segs[4..8].iter().enumerate() {
+        let f = bus.c(2, &segment(i as u8 + 1, false, s));
+        assert_eq!(f.label(), format!("Block download segment seqno={}", i + 1));
+    }
+    bus.s(2, &[0xA2, 4, 4, 0, 0, 0, 0, 0]);
+    assert_eq!(
+        bus.c(2, &segment(1, true, segs[8])).label(),
+        "Block download segment seqno=1 last"
+    );
+    bus.s(2, &[0xA2, 1, 4, 0, 0, 0, 0, 0]);
+    // The CRC covers bytes the capture missed: it cannot be checked, and is not.
+    let f = bus.c(2, &[0xC1 | 3 << 2, 0xEE, 0xEE, 0, 0, 0, 0, 0]);
+    assert_eq!(f.label(), "Block download end n=3 crc=0xEEEE");
+    bus.s(2, &[0xA1, 0, 0, 0, 0, 0, 0, 0]);
+    // The next transfer is tracked from its initiate, as usual.
+    bus.c(2, &[0x2B, 0x40, 0x60, 0x00, 0x0F, 0x00, 0, 0]);
+    bus.s(2, &[0x60, 0x40, 0x60, 0x00, 0, 0, 0, 0]);
+    let v = bus.done();
+    assert_eq!(v.len(), 2, "{v:#?}");
+    let t = &v[0];
+    assert_eq!(t.direction, TransferDirection::Download);
+    assert_eq!(t.protocol, Protocol::Block);
+    assert_eq!(t.data, data[14..].to_vec(), "the bytes seen, from segment 3 on");
+    assert_eq!(t.outcome, Outcome::Ok);
+    assert_eq!(t.problems, vec![Problem::StartedBeforeCapture]);
+    assert!(t.is_partial() && !t.is_ok());
+    assert_eq!(t.frames, (1..=12).collect::<Vec<u64>>());
+    assert_eq!(
+        t.label(&bus.dict),
+        "Download (object not captured) (block, 46 bytes seen, 11.000 ms): ok [partial: started before the capture]"
+    );
+    let j = t.to_json(&bus.dict);
+    assert_eq!((j["partial"].as_bool(), j["index"].is_null()), (Some(true), true));
+    assert_eq!(
+        v[1].label(&bus.dict),
+        "Download 0x6040:00 Controlword = 0x000F (Enable operation) (expedited, 2 bytes, 1.000 ms): ok"
+    );
+}
+
+#[test]
+fn block_upload_caught_mid_way_resynchronises() {
+    let tail = b"0123456789ABCDEFGHIJKLM"; // 23 bytes after the capture starts
+    let segs: Vec<&[u8]> = tail.chunks(7).collect();
+    let mut bus = Bus::new();
+    // 0x7F from a server can only be a sequence number (an initiate download
+    // response has no bits set below 0x60); the client's ack confirms it.
+    let f = bus.s(5, &segment(127, false, segs[0]));
+    assert_eq!(f.label(), "Block upload segment seqno=127");
+    let f = bus.c(5, &[0xA2, 127, 127, 0, 0, 0, 0, 0]);
+    assert_eq!(
+        f.label(),
+        "Block upload ack ackseq=127 blksize=127 [resynchronised: block upload started before the capture]"
+    );
+    bus.s(5, &segment(1, false, segs[1]));
+    bus.s(5, &segment(2, false, segs[2]));
+    assert_eq!(
+        bus.s(5, &segment(3, true, segs[3])).label(),
+        "Block upload segment seqno=3 last"
+    );
+    bus.c(5, &[0xA2, 3, 127, 0, 0, 0, 0, 0]);
+    assert_eq!(
+        bus.s(5, &[0xC1 | 5 << 2, 0x12, 0x34, 0, 0, 0, 0, 0]).label(),
+        "Block upload end n=5 crc=0x3412"
+    );
+    bus.c(5, &[0xA1, 0, 0, 0, 0, 0, 0, 0]);
+    bus.c(5, &[0x40, 0x41, 0x60, 0x00, 0, 0, 0, 0]);
+    bus.s(5, &[0x4B, 0x41, 0x60, 0x00, 0x37, 0x02, 0, 0]);
+    let v = bus.done();
+    assert_eq!(v.len(), 2, "{v:#?}");
+    assert_eq!(v[0].direction, TransferDirection::Upload);
+    assert_eq!(v[0].data, tail.to_vec());
+    assert_eq!(v[0].outcome, Outcome::Ok);
+    assert_eq!(v[0].problems, vec![Problem::StartedBeforeCapture]);
+    assert_eq!(v[0].frames.len(), 8);
+    assert_eq!((v[1].index, v[1].outcome.clone()), (0x6041, Outcome::Ok));
+    assert!(v[1].problems.is_empty());
+}
+
+#[test]
+fn a_missed_acknowledgement_does_not_derail_a_partial_transfer() {
+    let mut bus = Bus::new();
+    bus.s(3, &[0xA2, 127, 127, 0, 0, 0, 0, 0]); // a block download ack: node 3 is receiving
+    for n in 1..=127u8 {
+        let f = bus.c(3, &segment(n, false, &[n; 7]));
+        assert_eq!(f.command.cs_name(), "block_segment", "{}", f.label());
+    }
+    // The server's ack of that sub-block is lost; the next one starts at 1.
+    let f = bus.c(3, &segment(1, false, &[0xAA; 7]));
+    assert_eq!(f.label(), "Block download segment seqno=1 [sequence error]");
+    assert!(bus.done().is_empty());
+    let v = bus.t.finish();
+    assert_eq!(v.len(), 1);
+    assert_eq!(v[0].len(), 127 * 7, "the unacknowledged sub-block still counts as seen");
+    assert_eq!(
+        v[0].problems,
+        vec![Problem::StartedBeforeCapture, Problem::SequenceError]
+    );
+    assert_eq!(v[0].outcome, Outcome::Incomplete);
+}
+
+#[test]
+fn one_impossible_byte_invents_no_transaction() {
+    let mut bus = Bus::new();
+    // A garbage frame whose first byte no command has, then an ordinary exchange.
+    let f = bus.c(1, &[0x6F, 1, 2, 3, 4, 5, 6, 7]);
+    assert_eq!(f.label(), "Block download segment seqno=111");
+    bus.c(1, &[0x40, 0x41, 0x60, 0x00, 0, 0, 0, 0]);
+    bus.s(1, &[0x4B, 0x41, 0x60, 0x00, 0x37, 0x02, 0, 0]);
+    let v = bus.t.finish();
+    assert_eq!(v.len(), 1, "{v:#?}");
+    assert_eq!((v[0].index, v[0].outcome.clone()), (0x6041, Outcome::Ok));
+    // Alone at the end of the input, it is dropped too.
+    let mut bus = Bus::new();
+    bus.s(1, &[0x55, 1, 2, 3, 4, 5, 6, 7]);
+    assert!(bus.t.finish().is_empty());
+}
+
+#[test]
+fn a_transfer_that_never_ends_keeps_memory_flat() {
+    use super::transaction::{DATA_KEPT, FRAMES_KEPT};
+    let mut bus = Bus::new();
+    bus.c(2, &[0xC4, 0x50, 0x1F, 0x01, 0, 0, 0, 0]); // crc, size not indicated
+    bus.s(2, &[0xA4, 0x50, 0x1F, 0x01, 127, 0, 0, 0]);
+    let sub_blocks = DATA_KEPT / (127 * 7) + 2;
+    let byte = |i: usize| (i * 7 % 251) as u8;
+    let mut crc = 0u16;
+    for b in 0..sub_blocks {
+        for n in 1..=127u8 {
+            let bytes = [byte(b * 127 + n as usize); 7];
+            crc = super::crc::crc16_update(crc, &bytes);
+            bus.c(2, &segment(n, b + 1 == sub_blocks && n == 127, &bytes));
+        }
+        bus.s(2, &[0xA2, 127, 127, 0, 0, 0, 0, 0]);
+    }
+    // What is kept stopped growing; what was transferred is still counted.
+    let c = crc.to_le_bytes();
+    bus.c(2, &[0xC1, c[0], c[1], 0, 0, 0, 0, 0]);
+    bus.s(2, &[0xA1, 0, 0, 0, 0, 0, 0, 0]);
+    let t = bus.one();
+    assert_eq!(t.data.len(), DATA_KEPT);
+    assert_eq!(t.len(), sub_blocks * 127 * 7);
+    assert_eq!(t.frames.len(), FRAMES_KEPT);
+    assert_eq!(t.frames.len() as u64 + t.frames_dropped, bus.seq);
+    // The CRC is still checked over every byte.
+    assert_eq!((t.outcome.clone(), t.problems.clone()), (Outcome::Ok, vec![]));
+    assert!(
+        t.label(&bus.dict)
+            .contains(&format!("{} bytes, first {DATA_KEPT} kept", t.len()))
+    );
+    let j = t.to_json(&bus.dict);
+    assert_eq!(j["len"], t.len());
+}

@@ -116,6 +116,9 @@ pub enum Problem {
     SizeMismatch { indicated: u32, actual: usize },
     /// The bytes do not fit the size of the object's type in the dictionary.
     TypeLengthMismatch { expected: usize, actual: usize },
+    /// The capture started in the middle of this (block) transfer: its initiate, object
+    /// and first bytes were not seen, so the data is only the part seen.
+    StartedBeforeCapture,
 }
 
 impl Problem {
@@ -129,6 +132,7 @@ impl Problem {
             Problem::SequenceError => "sequence_error",
             Problem::SizeMismatch { .. } => "size_mismatch",
             Problem::TypeLengthMismatch { .. } => "type_length_mismatch",
+            Problem::StartedBeforeCapture => "partial",
         }
     }
 }
@@ -149,6 +153,7 @@ impl fmt::Display for Problem {
             Problem::TypeLengthMismatch { expected, actual } => {
                 write!(f, "length {actual} does not fit the object's type ({expected} bytes)")
             }
+            Problem::StartedBeforeCapture => write!(f, "partial: started before the capture"),
         }
     }
 }
@@ -168,8 +173,11 @@ pub struct Transaction {
     pub direction: TransferDirection,
     /// Expedited, segmented or block.
     pub protocol: Protocol,
-    /// The bytes transferred (so far, when not complete).
+    /// The bytes transferred (so far, when not complete); at most the first
+    /// [`DATA_KEPT`] bytes, the rest is only counted in `dropped`.
     pub data: Vec<u8>,
+    /// Bytes transferred beyond [`DATA_KEPT`], counted but not kept.
+    pub dropped: usize,
     /// The size the initiating frames indicated.
     pub size: Option<u32>,
     /// Timestamp of the first frame (ns).
@@ -180,9 +188,18 @@ pub struct Transaction {
     pub outcome: Outcome,
     /// What went wrong along the way, each kind once.
     pub problems: Vec<Problem>,
-    /// Sequence numbers of the frames that belong to it.
+    /// Sequence numbers of the frames that belong to it (the first [`FRAMES_KEPT`]).
     pub frames: Vec<u64>,
+    /// Frames that belong to it beyond [`FRAMES_KEPT`], counted but not listed.
+    pub frames_dropped: u64,
 }
+
+/// Bytes of one transfer kept in [`Transaction::data`]; a longer transfer (a firmware
+/// download, or a transfer that never ends) is counted, not kept, so memory stays flat.
+pub const DATA_KEPT: usize = 1 << 20;
+
+/// Frame numbers of one transfer kept in [`Transaction::frames`].
+pub const FRAMES_KEPT: usize = 1 << 14;
 
 impl Transaction {
     /// Duration from first to last frame, in ns.
@@ -190,16 +207,58 @@ impl Transaction {
         self.end_ns.saturating_sub(self.start_ns)
     }
 
-    /// Completed, and its data can be trusted (no bad CRC, toggle error or size mismatch):
-    /// what the decoder may learn COB-IDs and PDO mappings from.
+    /// Completed, and its data can be trusted (no bad CRC, toggle error or size mismatch,
+    /// not partial): what the decoder may learn COB-IDs and PDO mappings from.
     pub fn is_ok(&self) -> bool {
         self.outcome == Outcome::Ok
             && !self.problems.iter().any(|p| {
                 matches!(
                     p,
-                    Problem::BadCrc { .. } | Problem::ToggleError | Problem::SizeMismatch { .. }
+                    Problem::BadCrc { .. }
+                        | Problem::ToggleError
+                        | Problem::SizeMismatch { .. }
+                        | Problem::StartedBeforeCapture
                 )
             })
+    }
+
+    /// The capture started in the middle of it: object unknown, only the bytes seen.
+    pub fn is_partial(&self) -> bool {
+        self.problems.contains(&Problem::StartedBeforeCapture)
+    }
+
+    /// Bytes transferred, kept or not.
+    pub fn len(&self) -> usize {
+        self.data.len() + self.dropped
+    }
+
+    /// No bytes transferred.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Appends transferred bytes, keeping at most [`DATA_KEPT`] of them.
+    pub(crate) fn append(&mut self, bytes: &[u8]) {
+        let room = DATA_KEPT.saturating_sub(self.data.len()).min(bytes.len());
+        self.data.extend_from_slice(&bytes[..room]);
+        self.dropped += bytes.len() - room;
+    }
+
+    /// Removes the last `n` bytes (the unused bytes of a last block segment).
+    pub(crate) fn cut(&mut self, n: usize) {
+        let n = n.min(self.len());
+        let from_dropped = n.min(self.dropped);
+        self.dropped -= from_dropped;
+        self.data.truncate(self.data.len() - (n - from_dropped));
+    }
+
+    /// Records a frame number, keeping at most [`FRAMES_KEPT`] of them.
+    pub(crate) fn add_frame(&mut self, seq: u64) {
+        if self.frames.len() < FRAMES_KEPT {
+            self.frames.push(seq);
+        } else {
+            self.frames_dropped += 1;
+        }
     }
 
     /// Adds a problem once.
@@ -216,12 +275,17 @@ impl Transaction {
             TransferDirection::Upload => "Upload",
             TransferDirection::Download => "Download",
         };
-        let mut s = format!("{dir} 0x{:04X}:{:02X}", self.index, self.sub);
-        if let Some(name) = dict.label_name(self.index, self.sub) {
+        let partial = self.is_partial();
+        let mut s = if partial {
+            format!("{dir} (object not captured)")
+        } else {
+            format!("{dir} 0x{:04X}:{:02X}", self.index, self.sub)
+        };
+        if let Some(name) = dict.label_name(self.index, self.sub).filter(|_| !partial) {
             s.push(' ');
             s.push_str(&name);
         }
-        if self.outcome == Outcome::Ok && !self.data.is_empty() {
+        if self.outcome == Outcome::Ok && !self.data.is_empty() && !partial {
             let v = view(dict, self.index, self.sub, &self.data);
             let text: String = if v.text.chars().count() > 80 {
                 v.text.chars().take(77).chain("...".chars()).collect()
@@ -231,15 +295,21 @@ impl Transaction {
             s.push_str(" = ");
             s.push_str(&text);
         }
-        let n = self.data.len();
+        let n = self.len();
         s.push_str(" (");
         if self.protocol != Protocol::Unknown {
             s.push_str(self.protocol.as_str());
             s.push_str(", ");
         }
         let plural = if n == 1 { "" } else { "s" };
+        let seen = if partial { " seen" } else { "" };
+        let kept = if self.dropped > 0 {
+            format!(", first {} kept", self.data.len())
+        } else {
+            String::new()
+        };
         s.push_str(&format!(
-            "{n} byte{plural}, {:.3} ms): ",
+            "{n} byte{plural}{seen}{kept}, {:.3} ms): ",
             self.duration_ns() as f64 / 1e6
         ));
         match &self.outcome {
@@ -258,7 +328,13 @@ impl Transaction {
 
     /// JSON object with the object, name, typed value, hex data, timing, outcome and problems.
     pub fn to_json(&self, dict: &Dictionary) -> Json {
-        let v = (!self.data.is_empty()).then(|| view(dict, self.index, self.sub, &self.data));
+        let partial = self.is_partial();
+        let v = (!self.data.is_empty() && !partial).then(|| view(dict, self.index, self.sub, &self.data));
+        let (index, sub) = if partial {
+            (Json::Null, Json::Null)
+        } else {
+            (Json::from(self.index), Json::from(self.sub))
+        };
         let (code, text, by, error) = match &self.outcome {
             Outcome::Aborted { code, text, by } => (
                 Json::from(*code),
@@ -273,13 +349,15 @@ impl Transaction {
             "node": self.node,
             "request_cob": self.channel.request_cob,
             "response_cob": self.channel.response_cob,
-            "index": self.index,
-            "sub": self.sub,
-            "name": dict.name(self.index, self.sub),
+            "index": index,
+            "sub": sub,
+            "name": if partial { None } else { dict.name(self.index, self.sub) },
+            "partial": partial,
             "direction": self.direction.as_str(),
             "protocol": self.protocol.as_str(),
             "size": self.size,
             "data": hex::upper(&self.data),
+            "len": self.len(),
             "value": v.as_ref().map_or(Json::Null, |v| v.json.clone()),
             "value_text": v.as_ref().map(|v| v.text.clone()),
             "start_ns": self.start_ns,

@@ -14,7 +14,7 @@ use ratatui::widgets::Paragraph;
 pub fn row_text(app: &App, t: &Transaction, width: usize) -> String {
     let dict = app.trace.decoder().dictionary(t.node);
     let name = dict.name(t.index, t.sub).unwrap_or("");
-    let value = if t.outcome == Outcome::Ok && !t.data.is_empty() {
+    let value = if t.outcome == Outcome::Ok && !t.data.is_empty() && !t.is_partial() {
         crate::decode::sdo::value::view(dict, t.index, t.sub, &t.data).text
     } else {
         String::new()
@@ -29,12 +29,17 @@ pub fn row_text(app: &App, t: &Transaction, width: usize) -> String {
     } else {
         "write"
     };
+    // A transfer the capture caught mid-way: its object was never seen.
+    let (object, name) = if t.is_partial() {
+        ("????:??".to_string(), "(partial: started before the capture)")
+    } else {
+        (format!("{:04X}:{:02X}", t.index, t.sub), name)
+    };
     let text = format!(
-        "{:>3} {} {:04X}:{:02X} {:<24} {:<20} {:>9} {}",
+        "{:>3} {} {} {:<24} {:<20} {:>9} {}",
         t.node,
         dir,
-        t.index,
-        t.sub,
+        object,
         fit(name, 24),
         fit(&value, 20),
         duration(t.duration_ns() as f64 / 1e9),

@@ -1,0 +1,111 @@
+//! Where `cotui decode` writes (`-o FILE`, `-o -` or stdout) and its pcapng export.
+
+use super::decode::DecodeArgs;
+use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
+use crate::frame::Interfaces;
+use crate::log::Outcome;
+use crate::output::pcapng::PcapngWriter;
+use crate::read_ahead;
+use std::io::{self, BufRead, BufReader, IsTerminal, Write};
+
+/// The output stream: `path` (`None` or `-` is stdout). Binary output is refused when
+/// it would go to a terminal.
+pub fn open(path: Option<&str>, binary: bool) -> Result<Box<dyn Write>, String> {
+    match path {
+        None | Some("-") => {
+            let stdout = io::stdout();
+            if binary && stdout.is_terminal() {
+                return Err("pcapng is binary: not writing it to a terminal (use -o FILE, or redirect stdout)".into());
+            }
+            Ok(Box::new(io::BufWriter::with_capacity(1 << 16, stdout.lock())))
+        }
+        Some(p) => match std::fs::File::create(p) {
+            Ok(f) if binary && f.is_terminal() => Err(format!("{p}: pcapng is binary: not writing it to a terminal")),
+            Ok(f) => Ok(Box::new(io::BufWriter::with_capacity(1 << 16, f))),
+            Err(e) => Err(format!("{p}: {e}")),
+        },
+    }
+}
+
+/// `cotui decode FILE... --format pcapng`: every frame of every input, in order, one
+/// interface description per interface name.
+pub fn pcapng(args: &DecodeArgs) -> i32 {
+    if args.transactions || args.summary {
+        eprintln!("cotui decode: --format pcapng writes frames; it does not go with --transactions or --summary");
+        return EXIT_USAGE;
+    }
+    let out = match open(args.output.as_deref(), true) {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("cotui decode: {e}");
+            return EXIT_USAGE;
+        }
+    };
+    let mut w = match PcapngWriter::new(out) {
+        Ok(w) => w,
+        Err(e) => {
+            eprintln!("cotui decode: {e}");
+            return EXIT_UNAVAILABLE;
+        }
+    };
+    let mut status = EXIT_OK;
+    for path in &args.files {
+        let input: Box<dyn BufRead + Send> = if path == "-" {
+            Box::new(BufReader::with_capacity(1 << 16, io::stdin()))
+        } else {
+            match std::fs::File::open(path) {
+                Ok(f) => Box::new(BufReader::with_capacity(1 << 16, f)),
+                Err(e) => {
+                    eprintln!("cotui decode: {path}: {e}");
+                    status = EXIT_UNAVAILABLE;
+                    continue;
+                }
+            }
+        };
+        if let Err(e) = write_stream(path, input, &mut w) {
+            if e.kind() == io::ErrorKind::BrokenPipe {
+                return status;
+            }
+            eprintln!("cotui decode: {path}: {e}");
+            status = EXIT_UNAVAILABLE;
+        }
+    }
+    match w.flush() {
+        Err(e) if e.kind() != io::ErrorKind::BrokenPipe => {
+            eprintln!("cotui decode: {e}");
+            EXIT_UNAVAILABLE
+        }
+        _ => status,
+    }
+}
+
+/// Writes the frames of one input (parsed on a second thread); reports what was skipped.
+fn write_stream(path: &str, input: Box<dyn BufRead + Send>, w: &mut PcapngWriter<impl Write>) -> io::Result<()> {
+    let mut ifaces = Interfaces::default();
+    let finished = read_ahead::for_each_batch(input, |batch| -> io::Result<()> {
+        if let Some(i) = &batch.interfaces {
+            ifaces = i.clone();
+        }
+        for (line, outcome) in &batch.lines {
+            match outcome {
+                Outcome::Frame(f) => w.write_frame(ifaces.name(f.iface), f)?,
+                Outcome::Skip(_) => {}
+                Outcome::Warning(msg) => eprintln!("{path}:{line}: warning: {msg}"),
+            }
+        }
+        Ok(())
+    })??;
+    if let Some(e) = finished.error {
+        return Err(e);
+    }
+    let c = finished.counts;
+    if c.warnings > 0 || c.skipped_total() > 0 {
+        eprintln!(
+            "{path}: {} frames, {} lines skipped, {} malformed lines",
+            c.frames,
+            c.skipped_total(),
+            c.warnings
+        );
+    }
+    Ok(())
+}
