@@ -89,7 +89,7 @@ impl NodeLiveness {
             return None;
         }
         let (p, _) = self.expected()?;
-        Some(self.last_heartbeat_ns? + p + p / 2)
+        Some(self.last_heartbeat_ns?.saturating_add(p).saturating_add(p / 2))
     }
 
     fn add_interval(&mut self, ns: u64) {
@@ -261,8 +261,9 @@ impl EventTracker {
         let prev_state = l.state;
         let gap = l.last_heartbeat_ns.map(|t| ts_ns.saturating_sub(t));
         let back = l.lost_at_ns.take().is_some();
+        // Equal (or out of order) timestamps say nothing about the period.
         match gap {
-            Some(g) if !back => l.add_interval(g),
+            Some(g) if !back && g > 0 => l.add_interval(g),
             _ => {}
         }
         l.last_heartbeat_ns = Some(ts_ns);
@@ -558,6 +559,20 @@ mod tests {
             run(&f, Some(10_000), None),
             ["2 2 state", "300 2 heartbeat_lost", "402 2 heartbeat_back"]
         );
+    }
+
+    #[test]
+    fn extreme_and_out_of_order_timestamps_neither_panic_nor_invent_losses() {
+        let dict = Dictionary::default();
+        let mut tr = EventTracker::new(|_| &dict);
+        let hb = crate::decode::heartbeat::decode(&[0x05], false).0;
+        for t in [0, u64::MAX / 2, u64::MAX - 1, 5, 5, u64::MAX] {
+            tr.heartbeat(9, t, &hb);
+        }
+        tr.tick(u64::MAX);
+        let l = tr.node(9).unwrap();
+        assert_eq!(l.deadline(), Some(u64::MAX));
+        assert!(!l.is_lost());
     }
 
     #[test]
