@@ -310,6 +310,7 @@ impl App {
                 }
                 Ok(Feed::BusError(e)) => {
                     self.source.bus_error = Some(e);
+                    self.capture_clock = None;
                     self.dirty = true;
                 }
                 Ok(Feed::BusOk) => {
@@ -344,14 +345,15 @@ impl App {
     /// The capture time now (ns on the frames' time base) for a live source (the newest
     /// frame's time plus the wall time since it was taken in, so delivery delays only make
     /// it late) or a running replay (times its speed); None for a loaded log, a paused or
-    /// finished source, or before the first frame.
+    /// finished source, an interface in error (its silence says nothing about the nodes),
+    /// or before the first frame.
     fn capture_now_ns(&self, now: Instant) -> Option<u64> {
         let speed = match self.source.kind {
             SourceKind::Live { .. } | SourceKind::Demo { .. } => 1.0,
             SourceKind::Replay { speed } if speed > 0.0 && !self.source.paused => speed,
             _ => return None,
         };
-        if self.source.done {
+        if self.source.done || self.source.bus_error.is_some() {
             return None;
         }
         let (ts, at) = self.capture_clock?;
@@ -1011,7 +1013,10 @@ mod tests {
                 (Some(5), "heartbeat_lost")
             ]
         );
-        // A paused replay's clock stands still.
+        // An interface in error, or a paused replay: the clock stands still.
+        a.source.bus_error = Some("vcan0 is down".into());
+        assert_eq!(a.capture_now_ns(taken + Duration::from_secs(9)), None);
+        a.source.bus_error = None;
         a.source.kind = SourceKind::Replay { speed: 1.0 };
         a.source.paused = true;
         assert_eq!(a.capture_now_ns(taken + Duration::from_secs(9)), None);
