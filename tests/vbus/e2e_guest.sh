@@ -340,7 +340,7 @@ pids+=($hb_pid)
 # Wait until the period is measured (3 heartbeats), then a little longer, then kill.
 if lwait 150 "^.* 5 Operational .* [0-9]+/\? ms"; then
     sleep 1
-    kill -KILL "$hb_pid"
+    { kill -KILL "$hb_pid" && wait "$hb_pid"; } 2> /dev/null
     t_kill=$(date +%s.%N)
     if lwait 50 "^.* 5 LOST [0-9.]+ s"; then
         ok "liveness: Nodes pane marks node 5 LOST (seen $(awk -v a="$t_kill" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }') s after the kill, polling tmux)"
