@@ -4,6 +4,7 @@
 //! and returns values, with no IO, clock or terminal. Sources, panes and the
 //! command line live at the edges and call into it.
 
+pub mod analysis;
 pub mod bus;
 pub mod cli;
 pub mod command;

@@ -162,3 +162,69 @@ fn a_reader_that_stops_early_ends_cotui_quietly() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
+
+#[test]
+fn events_of_nodes_that_die_reboot_and_come_back() {
+    check("node_liveness", "events", &["--events"]);
+    check("node_liveness", "events.jsonl", &["--events", "--format", "jsonl"]);
+    check("heartbeat_stops", "events", &["--events"]);
+    check(
+        "heartbeat_stops",
+        "eds.events",
+        &["--events", "--eds", "7=tests/fixtures/eds/minimal.eds"],
+    );
+}
+
+#[test]
+fn a_lost_event_is_dated_one_and_a_half_periods_after_the_last_heartbeat() {
+    let out = cotui(
+        &[
+            "decode",
+            "--events",
+            "--format",
+            "jsonl",
+            "tests/fixtures/node_liveness.log",
+        ],
+        None,
+    );
+    let events: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let of = |node: u64, event: &str| -> Vec<&serde_json::Value> {
+        events
+            .iter()
+            .filter(|e| e["node"] == node && e["event"] == event)
+            .collect()
+    };
+    // 0x1017 = 300 ms written by SDO at .551; the last heartbeat is at 101.401.
+    let lost = of(5, "heartbeat_lost");
+    assert_eq!(lost.len(), 2, "{events:?}");
+    assert_eq!(lost[0]["period_ms"], 300.0);
+    assert_eq!(lost[0]["period_source"], "sdo");
+    assert_eq!(lost[0]["silent_ms"], 450.0);
+    assert!((lost[0]["t"].as_f64().unwrap() - 1700000101.851).abs() < 1e-6);
+    // The reboot forgets the SDO value: after it the period is measured (100 ms).
+    let boot = of(5, "boot_up");
+    assert_eq!(boot[1]["rebooted"], true);
+    assert_eq!(boot[1]["was_lost"], true);
+    assert_eq!(lost[1]["period_source"], "measured");
+    assert_eq!(lost[1]["period_ms"], 100.0);
+    assert_eq!(of(5, "heartbeat_back")[0]["silent_ms"], 1000.0);
+    let guard = of(2, "heartbeat_lost");
+    assert_eq!(guard[0]["guarding"], true);
+    assert_eq!(of(3, "emcy")[0]["code"], 0x2310);
+    assert_eq!(of(3, "sdo_abort")[0]["code"], 0x0602_0000);
+    let bus: Vec<&str> = events
+        .iter()
+        .filter(|e| e["event"] == "bus_state")
+        .map(|e| e["to"].as_str().unwrap())
+        .collect();
+    assert_eq!(bus, ["error_warning", "bus_off", "error_active"]);
+    assert!(
+        events
+            .iter()
+            .filter(|e| e["event"] == "bus_state")
+            .all(|e| e["node"].is_null())
+    );
+}

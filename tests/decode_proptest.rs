@@ -2,6 +2,7 @@
 //! every text line is one line, and every JSONL line is valid JSON with the
 //! contract fields.
 
+use cotui::analysis::EventTracker;
 use cotui::decode::Decoder;
 use cotui::frame::{Flags, Frame, Interfaces};
 use cotui::od::Dictionary;
@@ -58,5 +59,38 @@ proptest! {
             prop_assert_eq!(v["len"].as_u64(), Some(f.len as u64));
         }
         let _ = decoder.finish();
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+    #[test]
+    fn any_frames_give_events_as_one_line_and_valid_json(
+        frames in prop::collection::vec(frame_strategy(), 1..200),
+        ticks in prop::collection::vec(any::<u64>(), 0..5),
+    ) {
+        let mut decoder = Decoder::new(Dictionary::default(), vec![]);
+        let mut events = EventTracker::new(|n| decoder.dictionary(n));
+        for f in &frames {
+            let d = decoder.decode(f);
+            events.frame(f, "can0", &d);
+            for t in decoder.take_transactions() {
+                events.transaction(&t);
+            }
+        }
+        for t in ticks {
+            events.tick(t);
+        }
+        for e in events.take_events() {
+            let mut line = String::new();
+            e.write_line(&mut line);
+            prop_assert_eq!(line.matches('\n').count(), 1);
+            let mut j = String::new();
+            e.write_json(&mut j);
+            let v: serde_json::Value = serde_json::from_str(&j).expect("valid JSON");
+            prop_assert_eq!(v["event"].as_str(), Some(e.what.name()));
+            prop_assert!(v["t"].is_number());
+            prop_assert_eq!(v["node"].as_u64(), e.node.map(u64::from));
+        }
     }
 }

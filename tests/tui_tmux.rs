@@ -1,6 +1,7 @@
 //! End-to-end: the real binary in a tmux pane. `cotui demo` shows the simulated drives
 //! reach their states, help opens, a filter narrows the trace, `q` quits and the terminal
-//! comes back (the shell after cotui prints and the alternate screen is gone).
+//! comes back (the shell after cotui prints and the alternate screen is gone). A replay
+//! marks a node LOST while its log is silent (the replay clock).
 //! Needs tmux (scripts/install-test-deps.sh installs it).
 
 use std::process::Command;
@@ -158,4 +159,39 @@ fn a_missing_interface_shows_its_fix_in_the_status_bar() {
     });
     s.keys(&["q"]);
     s.wait_for("cotui to exit", |t| t.contains("cotui-exit=0"));
+}
+
+#[test]
+fn a_replay_marks_a_node_lost_while_the_log_is_silent() {
+    // Node 5 heartbeats every 100 ms for 1 s, then nothing until one SYNC at 60 s: between
+    // the two, only the replay clock can find node 5 lost.
+    let bin = env!("CARGO_BIN_EXE_cotui");
+    let name = format!("cotui-lost-{}", std::process::id());
+    let log = std::env::temp_dir().join(format!("{name}.log"));
+    let mut text: String = (0..=10u64)
+        .map(|i| {
+            let us = i * 100_000;
+            format!(
+                "({}.{:06}) can0 705#05\n",
+                1_700_000_000 + us / 1_000_000,
+                us % 1_000_000
+            )
+        })
+        .collect();
+    text.push_str("(1700000060.000000) can0 080#\n");
+    std::fs::write(&log, text).unwrap();
+    let s = Session::start(
+        &name,
+        &format!("{bin} replay {}; echo cotui-exit=$?; sleep 60", log.display()),
+    );
+    s.keys(&["2"]);
+    let t = s.wait_for("node 5 to be marked lost", |t| t.contains("  5 LOST "));
+    assert!(
+        t.contains("node 5 heartbeat lost: no heartbeat for 150.0 ms, expected every 100.0 ms"),
+        "{t}"
+    );
+    assert!(t.contains("| 11 frames |"), "{t}");
+    s.keys(&["q"]);
+    s.wait_for("cotui to exit", |t| t.contains("cotui-exit=0"));
+    let _ = std::fs::remove_file(&log);
 }

@@ -1,7 +1,8 @@
 //! `cotui decode FILE...`: the headless decoder.
 
 use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
-use crate::decode::{Decoder, sdo::Transaction};
+use crate::analysis::EventTracker;
+use crate::decode::{Decoder, Kind, sdo::Transaction};
 use crate::frame::{Frame, Interfaces};
 use crate::log::Outcome;
 use crate::output::{jsonl, summary::Summary, text};
@@ -37,6 +38,10 @@ pub struct DecodeArgs {
     /// Print per-node and per-kind totals only.
     #[arg(long, conflicts_with = "transactions")]
     pub summary: bool,
+    /// Print bus events instead of frames: boot-up, NMT state change, heartbeat lost/back,
+    /// heartbeat period (0x1017), EMCY, SDO abort, controller state (error frames).
+    #[arg(long, conflicts_with_all = ["transactions", "summary"])]
+    pub events: bool,
     /// Bind a device profile to a node: NODE=NAME (a name in decoders/ or a JSON path).
     #[arg(long = "profile", value_name = "NODE=NAME")]
     pub profiles: Vec<String>,
@@ -54,6 +59,7 @@ enum Mode {
     Frames(OutputFormat),
     Transactions(OutputFormat),
     Summary(OutputFormat),
+    Events(OutputFormat),
 }
 
 /// Runs `cotui decode`; returns the exit status.
@@ -68,7 +74,10 @@ pub fn run(args: &DecodeArgs) -> i32 {
             return EXIT_USAGE;
         }
     };
-    let mode = if args.summary {
+    let mut events = EventTracker::new(|n| decoder.dictionary(n));
+    let mode = if args.events {
+        Mode::Events(args.format)
+    } else if args.summary {
         Mode::Summary(args.format)
     } else if args.transactions {
         Mode::Transactions(args.format)
@@ -97,7 +106,11 @@ pub fn run(args: &DecodeArgs) -> i32 {
                 }
             }
         };
-        match decode_stream(path, input, &mut decoder, mode, &mut summary, &mut out) {
+        let mut sinks = Sinks {
+            summary: &mut summary,
+            events: &mut events,
+        };
+        match decode_stream(path, input, &mut decoder, mode, &mut sinks, &mut out) {
             Ok(()) => {}
             Err(e) if e.kind() == io::ErrorKind::BrokenPipe => return status,
             Err(e) => {
@@ -116,13 +129,19 @@ pub fn run(args: &DecodeArgs) -> i32 {
     }
 }
 
+/// What the modes that look at the whole input keep across files.
+struct Sinks<'a> {
+    summary: &'a mut Summary,
+    events: &'a mut EventTracker,
+}
+
 /// Decodes one input into `out` (parsing runs on a second thread).
 fn decode_stream(
     path: &str,
     input: Box<dyn BufRead + Send>,
     decoder: &mut Decoder,
     mode: Mode,
-    summary: &mut Summary,
+    sinks: &mut Sinks,
     out: &mut impl Write,
 ) -> io::Result<()> {
     let mut buf = String::with_capacity(1 << 16);
@@ -143,7 +162,28 @@ fn decode_stream(
             match mode {
                 Mode::Summary(_) => {
                     let (kind, node) = decoder.classify(frame);
-                    summary.add(kind, node);
+                    sinks.summary.add(kind, node);
+                }
+                Mode::Events(fmt) => {
+                    let events = &mut *sinks.events;
+                    // Only these kinds carry events; SDO frames are tracked by classify.
+                    match decoder.classify(frame) {
+                        (Kind::Heartbeat | Kind::Emcy | Kind::ErrorFrame, _) => {
+                            let d = decoder.decode(frame);
+                            events.frame(frame, ifaces.name(frame.iface), &d);
+                        }
+                        _ => events.tick(frame.ts_ns),
+                    }
+                    for t in decoder.take_transactions() {
+                        events.transaction(&t);
+                    }
+                    for e in events.take_events() {
+                        match fmt {
+                            OutputFormat::Text => e.write_line(&mut buf),
+                            // (pcapng never reaches here: decode_out refuses it with --events)
+                            OutputFormat::Jsonl | OutputFormat::Pcapng => e.write_json(&mut buf),
+                        }
+                    }
                 }
                 Mode::Frames(OutputFormat::Text) => {
                     let d = decoder.decode(frame);
@@ -218,7 +258,7 @@ fn finish(decoder: &mut Decoder, mode: Mode, summary: &mut Summary, out: &mut im
                 }
             }
         }
-        Mode::Frames(_) => {}
+        Mode::Frames(_) | Mode::Events(_) => {}
     }
     out.write_all(buf.as_bytes())
 }

@@ -30,8 +30,10 @@ pub fn open(path: Option<&str>, binary: bool) -> Result<Box<dyn Write>, String> 
 /// `cotui decode FILE... --format pcapng`: every frame of every input, in order, one
 /// interface description per interface name.
 pub fn pcapng(args: &DecodeArgs) -> i32 {
-    if args.transactions || args.summary {
-        eprintln!("cotui decode: --format pcapng writes frames; it does not go with --transactions or --summary");
+    if args.transactions || args.summary || args.events {
+        eprintln!(
+            "cotui decode: --format pcapng writes frames; it does not go with --transactions, --summary or --events"
+        );
         return EXIT_USAGE;
     }
     let out = match open(args.output.as_deref(), true) {

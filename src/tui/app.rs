@@ -201,6 +201,27 @@ pub struct App {
     rate_mark: (Instant, usize),
     /// Set when something changed since the last draw.
     pub dirty: bool,
+    // --- node liveness (branch `live`): bus events for the message log, and the clock
+    // that lets a silent node be found lost when no frame arrives.
+    /// Bus events (node lost/back, boot-ups, state changes, EMCY, SDO aborts, controller
+    /// state), oldest first, the newest [`NODE_EVENTS`] kept.
+    pub node_events: Vec<crate::analysis::Event>,
+    /// The newest frame's time and when it was taken in: the capture clock of a live
+    /// source or replay runs on from there.
+    capture_clock: Option<(u64, Instant)>,
+}
+
+/// Bus events kept in [`App::node_events`].
+pub const NODE_EVENTS: usize = 1000;
+
+/// How much a bus event matters in the message log.
+fn event_level(what: &crate::analysis::What) -> Level {
+    use crate::analysis::What;
+    match what {
+        What::HeartbeatLost { .. } | What::BusState { .. } | What::BootUp { rebooted: true, .. } => Level::Warn,
+        What::Emcy { .. } | What::SdoAbort { .. } => Level::Warn,
+        _ => Level::Info,
+    }
 }
 
 /// Names the palette completes.
@@ -245,6 +266,8 @@ impl App {
             pending: Vec::new(),
             rate_mark: (Instant::now(), 0),
             dirty: true,
+            node_events: Vec::new(),
+            capture_clock: None,
         }
     }
 
@@ -261,6 +284,8 @@ impl App {
                         self.commanded.observe(f);
                         self.trace.push(f);
                     }
+                    self.capture_clock = batch.last().map(|f| (f.ts_ns, Instant::now()));
+                    self.collect_node_events();
                     self.dirty = true;
                 }
                 Ok(Feed::Interfaces(names)) => {
@@ -275,6 +300,7 @@ impl App {
                     self.detail = None;
                     self.trace_list = ListState::default();
                     self.rate_mark = (Instant::now(), 0);
+                    self.capture_clock = None;
                     self.dirty = true;
                 }
                 Ok(Feed::Status(s)) => self.say(Level::Info, &s),
@@ -288,6 +314,7 @@ impl App {
                         self.log(Level::Error, &e);
                     }
                     self.source.bus_error = Some(e);
+                    self.capture_clock = None;
                     self.dirty = true;
                 }
                 Ok(Feed::BusOk) => {
@@ -321,8 +348,37 @@ impl App {
         more
     }
 
-    /// Periodic update of the frame rate.
+    /// The capture time now (ns on the frames' time base) for a live source (the newest
+    /// frame's time plus the wall time since it was taken in, so delivery delays only make
+    /// it late) or a running replay (times its speed); None for a loaded log, a paused or
+    /// finished source, an interface in error (its silence says nothing about the nodes),
+    /// or before the first frame.
+    fn capture_now_ns(&self, now: Instant) -> Option<u64> {
+        let speed = match self.source.kind {
+            SourceKind::Live { .. } | SourceKind::Demo { .. } => 1.0,
+            SourceKind::Replay { speed } if speed > 0.0 && !self.source.paused => speed,
+            _ => return None,
+        };
+        if self.source.done || self.source.bus_error.is_some() {
+            return None;
+        }
+        let (ts, at) = self.capture_clock?;
+        Some(ts + (now.saturating_duration_since(at).as_secs_f64() * speed * 1e9) as u64)
+    }
+
+    /// Advances the node table to the capture time at wall time `now` (live and replay).
+    fn liveness_tick(&mut self, now: Instant) {
+        if let Some(t) = self.capture_now_ns(now) {
+            self.trace.nodes.tick(t);
+            if self.collect_node_events() {
+                self.dirty = true;
+            }
+        }
+    }
+
+    /// Periodic update of the frame rate and of node liveness.
     pub fn tick(&mut self) {
+        self.liveness_tick(Instant::now());
         let (t, n) = self.rate_mark;
         let dt = t.elapsed().as_secs_f64();
         if dt >= 0.5 {
@@ -330,6 +386,38 @@ impl App {
             self.rate_mark = (Instant::now(), self.trace.len());
             self.dirty = true;
         }
+    }
+
+    /// Moves new bus events from the node table to the message log (each with its capture
+    /// time) and to [`App::node_events`] (the newest [`NODE_EVENTS`] kept); a lost node, a
+    /// reboot or a controller state change also goes to the status line. True when there
+    /// were any.
+    fn collect_node_events(&mut self) -> bool {
+        use crate::analysis::What;
+        let events = self.trace.nodes.take_events();
+        let t0 = self.start_ns();
+        for e in &events {
+            let at = e.t_ns.saturating_sub(t0) as f64 / 1e9;
+            self.messages.push(
+                SystemTime::now(),
+                event_level(&e.what),
+                &format!("{} (capture t={at:.3} s)", e.text()),
+            );
+        }
+        let notable = events.iter().rev().find(|e| {
+            matches!(
+                e.what,
+                What::HeartbeatLost { .. } | What::BootUp { rebooted: true, .. } | What::BusState { .. }
+            )
+        });
+        if let Some(e) = notable {
+            self.message = Some(e.text());
+        }
+        let any = !events.is_empty();
+        self.node_events.extend(events);
+        let excess = self.node_events.len().saturating_sub(NODE_EVENTS);
+        self.node_events.drain(..excess);
+        any
     }
 
     /// Logs `text` and shows its first line in the status line.
@@ -714,6 +802,8 @@ impl App {
 
     fn set_paused(&mut self, p: bool) -> Result<String, String> {
         self.source.paused = p;
+        // The replay clock restarts from the next frame.
+        self.capture_clock = None;
         if let Some(c) = &self.source.control {
             let _ = c.send(Control::Pause(p));
         }
@@ -1042,6 +1132,56 @@ mod tests {
 
     fn key(c: char) -> KeyEvent {
         KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE)
+    }
+
+    #[test]
+    fn a_live_node_that_falls_silent_is_lost_by_the_capture_clock() {
+        let (ftx, frx) = std::sync::mpsc::channel();
+        let (rtx, _rrx) = tokio::sync::mpsc::unbounded_channel();
+        let mut a = app();
+        a.source = SourceInfo::live("vcan0", SourceKind::Live { listen_only: true }, frx, rtx);
+        let t0 = a.trace.nodes.now_ns();
+        a.trace.nodes.take_events();
+        let batch: Vec<crate::frame::Frame> = (1..=5u64)
+            .map(|i| {
+                let mut f = crate::frame::Frame::classic(0x705, &[0x05]);
+                f.ts_ns = t0 + i * 100_000_000;
+                f
+            })
+            .collect();
+        ftx.send(Feed::Frames(batch)).unwrap();
+        a.ingest(Duration::from_millis(100));
+        let taken = Instant::now();
+        // Node 2 (heartbeats every 14 ms in the capture) was found lost by these frames.
+        assert!(a.trace.nodes.liveness(2).unwrap().is_lost());
+        assert!(!a.trace.nodes.liveness(5).unwrap().is_lost());
+        // No frame comes for a second of wall time: node 5 (every 100 ms) is lost too,
+        // dated 150 ms after its last heartbeat.
+        a.liveness_tick(taken + Duration::from_secs(1));
+        let l = a.trace.nodes.liveness(5).unwrap();
+        assert_eq!(l.lost_at_ns, Some(t0 + 650_000_000));
+        let msg = a.message.clone().unwrap_or_default();
+        assert!(
+            msg.starts_with("node 5 heartbeat lost: no heartbeat for 150.0 ms"),
+            "{msg}"
+        );
+        let names: Vec<(Option<u8>, &str)> = a.node_events.iter().map(|e| (e.node, e.what.name())).collect();
+        assert_eq!(
+            names,
+            [
+                (Some(2), "heartbeat_lost"),
+                (Some(5), "state"),
+                (Some(1), "heartbeat_lost"),
+                (Some(5), "heartbeat_lost")
+            ]
+        );
+        // An interface in error, or a paused replay: the clock stands still.
+        a.source.bus_error = Some("vcan0 is down".into());
+        assert_eq!(a.capture_now_ns(taken + Duration::from_secs(9)), None);
+        a.source.bus_error = None;
+        a.source.kind = SourceKind::Replay { speed: 1.0 };
+        a.source.paused = true;
+        assert_eq!(a.capture_now_ns(taken + Duration::from_secs(9)), None);
     }
 
     #[test]

@@ -44,6 +44,7 @@ pub struct Trace {
 impl Trace {
     /// An empty trace decoded with `decoder`.
     pub fn new(decoder: Decoder, bitrate: u64) -> Trace {
+        let nodes = Nodes::new(&decoder);
         Trace {
             store: Store::new(),
             ifaces: Interfaces::default(),
@@ -51,7 +52,7 @@ impl Trace {
             decoder,
             checkpoints: Vec::new(),
             transactions: Vec::new(),
-            nodes: Nodes::default(),
+            nodes,
             stats: Stats::new(bitrate),
             series: Series::default(),
         }
@@ -80,12 +81,18 @@ impl Trace {
             self.checkpoints.push(self.decoder.clone());
         }
         self.decoder.set_seq(pos as u64);
+        self.nodes.tick(frame.ts_ns);
         let (kind, node) = match self.decoder.classify(frame) {
             (k @ (Kind::Tpdo | Kind::Rpdo | Kind::Emcy | Kind::Heartbeat), _) => {
                 self.decoder.set_seq(pos as u64);
                 let d = self.decoder.decode(frame);
                 self.observe(frame, &d);
                 (k, d.node)
+            }
+            (Kind::ErrorFrame, node) => {
+                let iface = self.ifaces.name(frame.iface);
+                self.nodes.error_frame(frame.ts_ns, iface, frame.id, frame.payload());
+                (Kind::ErrorFrame, node)
             }
             other => other,
         };

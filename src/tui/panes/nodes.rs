@@ -1,40 +1,62 @@
-//! The Nodes pane: one row per node with NMT state, heartbeat timing, boot-ups, the last
-//! EMCY, CiA 402 state and mode, frame rate and profile.
+//! The Nodes pane: one row per node with NMT state (or LOST and for how long), heartbeat
+//! timing, missed deadlines, boot-ups, the last EMCY, CiA 402 state and mode, frame rate
+//! and profile.
 
 use super::{block, duration, fit, header, selected};
+use crate::analysis::NodeLiveness;
 use crate::decode::cia402::mode_name;
 use crate::decode::heartbeat::NmtState;
 use crate::tui::app::App;
 use crate::tui::nodes::NodeInfo;
 use ratatui::Frame;
 use ratatui::layout::Rect;
-use ratatui::style::{Color, Style};
+use ratatui::style::{Color, Modifier, Style};
 use ratatui::text::Line;
 use ratatui::widgets::Paragraph;
 
-fn nmt_color(s: Option<NmtState>) -> Color {
-    match s {
-        Some(NmtState::Operational) => Color::Green,
-        Some(NmtState::PreOperational) => Color::Yellow,
-        Some(NmtState::Stopped) => Color::Red,
-        _ => Color::Gray,
+/// The style of a node's row: white on red while lost, else coloured by NMT state.
+pub fn row_style(live: Option<&NodeLiveness>) -> Style {
+    match live {
+        Some(l) if l.is_lost() => Style::default()
+            .fg(Color::White)
+            .bg(Color::Red)
+            .add_modifier(Modifier::BOLD),
+        _ => Style::default().fg(match live.and_then(|l| l.state) {
+            Some(NmtState::Operational) => Color::Green,
+            Some(NmtState::PreOperational) => Color::Yellow,
+            Some(NmtState::Stopped) => Color::Red,
+            _ => Color::Gray,
+        }),
     }
 }
 
-fn nmt_text(n: &NodeInfo) -> String {
-    n.nmt.map(|s| s.text()).unwrap_or_else(|| "-".into())
+/// The state cell: `LOST 4.2 s` (time since the last heartbeat) while lost, else the
+/// NMT state.
+fn state_text(live: Option<&NodeLiveness>, now_ns: u64) -> String {
+    match live {
+        Some(l) if l.is_lost() => {
+            let since = l.last_heartbeat_ns.or(l.lost_at_ns).unwrap_or(now_ns);
+            format!("LOST {:.1} s", now_ns.saturating_sub(since) as f64 / 1e9)
+        }
+        _ => live
+            .and_then(|l| l.state)
+            .map(|s| s.text())
+            .unwrap_or_else(|| "-".into()),
+    }
 }
 
-/// The row text of one node; `now_ns` is the newest frame's time (for ages).
-pub fn row_text(id: u8, n: &NodeInfo, now_ns: u64) -> String {
-    let hb = match (n.period_ns, n.configured_ms) {
+/// The row text of one node; `now_ns` is the capture time (for ages).
+pub fn row_text(id: u8, n: &NodeInfo, live: Option<&NodeLiveness>, now_ns: u64) -> String {
+    let measured = live.and_then(NodeLiveness::measured_ns);
+    let configured = live.and_then(|l| l.configured_ms.or(l.default_ms));
+    let hb = match (measured, configured) {
         (Some(p), Some(c)) => format!("{}/{} ms", p / 1_000_000, c),
         (Some(p), None) => format!("{}/? ms", p / 1_000_000),
         (None, Some(c)) => format!("-/{c} ms"),
         (None, None) => "-".into(),
     };
-    let age = n
-        .last_heartbeat_ns
+    let age = live
+        .and_then(|l| l.last_heartbeat_ns)
         .map(|t| duration(now_ns.saturating_sub(t) as f64 / 1e9))
         .unwrap_or_else(|| "-".into());
     let emcy = n
@@ -45,11 +67,11 @@ pub fn row_text(id: u8, n: &NodeInfo, now_ns: u64) -> String {
     format!(
         "{:>3} {:<15} {:>11} {:>9} {:>4} {:>4} {:<22} {:<14} {:<18} {:>7.1} {:<10} {}",
         id,
-        nmt_text(n),
+        state_text(live, now_ns),
         hb,
         age,
-        n.missed,
-        n.boot_ups,
+        live.map_or(0, |l| l.missed),
+        live.map_or(0, |l| l.boot_ups),
         n.drive.map(|d| d.text()).unwrap_or("-"),
         fit(n.mode.map(mode_name).unwrap_or("-"), 14),
         fit(&emcy, 18),
@@ -66,13 +88,7 @@ pub fn render(app: &App, f: &mut Frame, area: Rect, focused: bool) {
     if inner.height == 0 {
         return;
     }
-    let now = app
-        .trace
-        .store
-        .len()
-        .checked_sub(1)
-        .map(|i| app.trace.store.packed(i).ts_ns)
-        .unwrap_or(0);
+    let now = app.trace.nodes.now_ns();
     let mut lines = vec![Line::styled(
         format!(
             "{:>3} {:<15} {:>11} {:>9} {:>4} {:>4} {:<22} {:<14} {:<18} {:>7} {:<10}",
@@ -99,7 +115,8 @@ pub fn render(app: &App, f: &mut Frame, area: Rect, focused: bool) {
         .skip(l.offset)
         .take(inner.height as usize - 1)
     {
-        let line = Line::styled(row_text(*id, n, now), Style::default().fg(nmt_color(n.nmt)));
+        let live = app.trace.nodes.liveness(*id);
+        let line = Line::styled(row_text(*id, n, live, now), row_style(live));
         lines.push(if i == l.selected && focused {
             line.style(selected())
         } else {
@@ -116,6 +133,7 @@ pub fn render(app: &App, f: &mut Frame, area: Rect, focused: bool) {
 pub fn render_compact(app: &App, f: &mut Frame, area: Rect) {
     f.render_widget(block(" Nodes ", false), area);
     let inner = block("", true).inner(area);
+    let now = app.trace.nodes.now_ns();
     let lines: Vec<Line> = app
         .trace
         .nodes
@@ -123,18 +141,19 @@ pub fn render_compact(app: &App, f: &mut Frame, area: Rect) {
         .take(inner.height as usize)
         .map(|(id, n)| {
             let emcy = if n.last_emcy.is_some() { " EMCY" } else { "" };
+            let live = app.trace.nodes.liveness(*id);
             Line::styled(
                 fit(
                     &format!(
                         "{:>3} {:<15} {}{}",
                         id,
-                        nmt_text(n),
+                        state_text(live, now),
                         n.drive.map(|d| d.text()).unwrap_or(""),
                         emcy
                     ),
                     inner.width as usize,
                 ),
-                Style::default().fg(nmt_color(n.nmt)),
+                row_style(live),
             )
         })
         .collect();

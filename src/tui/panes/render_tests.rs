@@ -39,6 +39,39 @@ fn nodes_pane_shows_states_heartbeat_and_emcy() {
 }
 
 #[test]
+fn nodes_pane_marks_a_silent_node_lost_in_red_with_its_age() {
+    let mut a = app();
+    a.pane = Pane::Nodes;
+    // 100 ms later node 1 (0x1017 = 100 ms, read by SDO) is on time; node 2 (every 14 ms,
+    // measured) was due 21 ms after its last heartbeat.
+    let mut f = crate::frame::Frame::classic(0x701, &[0x05]);
+    f.ts_ns = a.trace.nodes.now_ns() + 100_000_000;
+    a.trace.push(&f);
+    let s = screen(&mut a, 160, 14);
+    assert!(s.contains("  1 Operational       14/100 ms"), "{s}");
+    assert!(s.contains("  2 LOST 0.1 s          14/? ms  103.0 ms    1    1"), "{s}");
+    insta::assert_snapshot!(s);
+    // The whole row is white on red, in the main pane and in the compact list.
+    let mut term = ratatui::Terminal::new(ratatui::backend::TestBackend::new(160, 14)).unwrap();
+    term.draw(|fr| crate::tui::ui::draw(fr, &mut a)).unwrap();
+    let buf = term.backend().buffer().clone();
+    let lost_cells: Vec<(u16, u16)> = (0..buf.area.height)
+        .flat_map(|y| (0..buf.area.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            buf[(x, y)].symbol() == "L"
+                && buf[(x + 1, y)].symbol() == "O"
+                && buf[(x + 2, y)].symbol() == "S"
+                && buf[(x + 3, y)].symbol() == "T"
+        })
+        .collect();
+    assert_eq!(lost_cells.len(), 2, "{s}");
+    for (x, y) in lost_cells {
+        assert_eq!(buf[(x, y)].bg, ratatui::style::Color::Red);
+        assert_eq!(buf[(x, y)].fg, ratatui::style::Color::White);
+    }
+}
+
+#[test]
 fn sdo_pane_lists_transfers_and_expands_to_frames() {
     let mut a = app();
     a.pane = Pane::Sdo;
