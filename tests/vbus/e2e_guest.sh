@@ -285,11 +285,13 @@ swait 150 "vcan0" || bad "stop tui start: $(cat sscreen.txt)"
 tmux send-keys -t stop ':run 2 slowpv' Enter
 if wait_for cw.log 300 "602#2B4060000F"; then
     tmux send-keys -t stop C-s
-    swait 300 "node 2: stopped|NOT confirmed" || bad "stop tui result: $(cat sscreen.txt)"
+    # The status line shows the report's first line; the per-node lines are in the log (m).
+    swait 300 "drive\(s\) stopped and confirmed|NOT confirmed stopped" || bad "stop tui result: $(cat sscreen.txt)"
     sleep 4.5 # past the end of the procedure's 4 s delay, which started before the stop
     after=$(awk '/602#2B40600002/ { s = 1 } s && /602#2B4060/ { sub(/.*#2B406000/, ""); printf "%s ", substr($0, 1, 2) }' cw.log)
     tmux send-keys -t stop m
-    swait 50 "cancelled: run 2 slowpv" && [ "$after" = "02 00 " ] && sw_is_592 &&
+    swait 50 "cancelled: run 2 slowpv" && grep -q "node 2: stopped, Switch on disabled" sscreen.txt &&
+        [ "$after" = "02 00 " ] && sw_is_592 &&
         ok "tui ctrl-s during a procedure: procedure cancelled, only 0x02 0x00 after it, drive switch on disabled" ||
         bad "tui ctrl-s: controlwords after the stop '$after'; $(cat sscreen.txt)"
 else
