@@ -332,29 +332,41 @@ impl Cx<'_> {
         if e.data_type.is_some() || e.access.is_some() || !e.values.is_empty() || e.unit.is_some() {
             self.warn(at, "type/access/unit/values of a record belong on its subs, ignored");
         }
-        let mut entries = Vec::new();
-        for (key, s) in subs {
+        // Ranges first, then single subs: a single sub wins over a range that covers it.
+        // Two ranges, or two single keys, giving the same sub cannot be resolved.
+        let (ranges, singles): (Vec<_>, Vec<_>) = subs.into_iter().partition(|(k, _)| k.contains(".."));
+        let mut entries: BTreeMap<u8, (ObjectInfo, bool, String)> = BTreeMap::new();
+        for (key, s) in ranges.into_iter().chain(singles) {
             let at = format!("{at}.subs.{key}");
             let Some(range) = self.ok(&at, sub_range(&key)) else {
                 continue;
             };
+            let single = !key.contains("..");
+            if let Some((_, _, other)) = range
+                .clone()
+                .find_map(|n| entries.get(&n).filter(|(_, was_single, _)| *was_single == single))
+            {
+                let what = if single { "sub" } else { "range" };
+                self.warn(&at, format!("{what} `{key}` overlaps `{other}`, skipped"));
+                continue;
+            }
             if s.subs.is_some() {
                 self.warn(&format!("{at}.subs"), "subs cannot nest, ignored");
             }
             let Some(info) = self.entry(&at, s) else { continue };
-            for n in range.clone() {
+            for n in range {
                 let mut info = info.clone();
-                if key.contains("..") {
+                if !single {
                     info.name = info.name.replace("{n}", &n.to_string());
                 }
-                entries.push((n, info));
+                entries.insert(n, (info, single, key.clone()));
             }
         }
         Built {
             record: true,
             name: e.name,
             alias: e.alias,
-            entries,
+            entries: entries.into_iter().map(|(n, (info, _, _))| (n, info)).collect(),
         }
     }
 

@@ -233,3 +233,33 @@ fn unknown_fields_types_and_bad_values_are_warnings() {
     assert!(p.procedures.is_empty());
     assert!(w[0].to_string().starts_with("w.json: "));
 }
+
+#[test]
+fn single_subs_win_over_ranges_and_overlaps_are_located() {
+    // JSON key order puts the single sub first and the range after it; the single sub still wins.
+    let text = r#"{ "name": "x", "objects": {
+        "0x3046": { "name": "Monitor", "subs": {
+            "1": { "name": "Motor State", "type": "u8" },
+            "1..32": { "name": "Monitor Data {n}", "type": "u16" },
+            "0x02": { "name": "Alarm Code", "type": "u8" } } },
+        "0x304A": { "name": "Clash", "subs": {
+            "1..8": { "name": "A {n}", "type": "u8" },
+            "5..9": { "name": "B {n}", "type": "u8" },
+            "3": { "name": "Three", "type": "u8" },
+            "0x03": { "name": "Also three", "type": "u8" } } }
+    } }"#;
+    let (p, w) = load_profile("o.json", text).unwrap();
+    let m = p.object(0x3046, 1).unwrap();
+    assert_eq!((m.name.as_str(), m.data_type), ("Motor State", DataType::U8));
+    assert_eq!(p.object(0x3046, 2).unwrap().name, "Alarm Code");
+    let d = p.object(0x3046, 3).unwrap();
+    assert_eq!((d.name.as_str(), d.data_type), ("Monitor Data 3", DataType::U16));
+    assert_eq!(p.object(0x3046, 32).unwrap().name, "Monitor Data 32");
+    // Overlapping ranges and duplicate single subs: located warnings, the later key skipped.
+    let located: Vec<String> = w.iter().map(|w| w.to_string()).collect();
+    assert_eq!(w.len(), 2, "{located:#?}");
+    assert!(located[0].starts_with("o.json: objects.0x304A.subs.5..9: range `5..9` overlaps `1..8`"));
+    assert!(located[1].starts_with("o.json: objects.0x304A.subs.3: sub `3` overlaps `0x03`"));
+    assert_eq!(p.object(0x304A, 8).unwrap().name, "A 8");
+    assert!(p.object(0x304A, 9).is_none());
+}
