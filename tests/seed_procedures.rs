@@ -3,7 +3,7 @@
 //! manuals' step-by-step frame lists.
 
 use cotui::od::bind::Bindings;
-use cotui::od::procedure::{Step, frame_bytes};
+use cotui::od::procedure::{Step, fill_object, frame_bytes};
 use cotui::od::{Dictionary, resolve_object};
 
 /// `ID#DATA` lines (data without padding zeros of SDO frames kept: SDO frames are always 8 bytes).
@@ -28,7 +28,7 @@ fn expand(profile: &str, node: u8, procedure: &str) -> Vec<String> {
                 value,
                 data_type,
             } => {
-                let (index, sub) = resolve_object(dict, object).expect("object");
+                let (index, sub) = resolve_object(dict, &fill_object(object, &vars).expect("object")).expect("object");
                 let t = data_type
                     .or_else(|| dict.object(index, sub).map(|o| o.data_type))
                     .expect("type");
@@ -46,7 +46,7 @@ fn expand(profile: &str, node: u8, procedure: &str) -> Vec<String> {
                 out.push(format!("{:03X}#{}", 0x600 + u32::from(node), hex(&d)));
             }
             Step::SdoRead { object } => {
-                let (index, sub) = resolve_object(dict, object).expect("object");
+                let (index, sub) = resolve_object(dict, &fill_object(object, &vars).expect("object")).expect("object");
                 let d = [0x40, index as u8, (index >> 8) as u8, sub, 0, 0, 0, 0];
                 out.push(format!("{:03X}#{}", 0x600 + u32::from(node), hex(&d)));
             }
@@ -192,4 +192,76 @@ fn aqmd_and_dexmart_pdo_commands() {
     // "601 2B 03 30 01 B8 0B 00 00" (03-01 = 3000), "601 40 00 30 0A 00 00 00 00" (Dynamic Data 10)
     assert_eq!(expand("dexmart-dev", 1, "write_parameter"), ["601#2B033001B80B0000"]);
     assert_eq!(expand("dexmart-dev", 1, "read_dynamic_data"), ["601#4000300A00000000"]);
+}
+
+/// A Dexmart-like SDO server on node 1 of a virtual bus: 3000h sub 0Ah = 2414 (096Eh) and a
+/// writable 3003h sub 1 (03-01), nothing else. Gives the bus end for the commander.
+fn dexmart_peer() -> cotui::bus::Bus {
+    use cotui::od::Access;
+    use cotui::sdo_server::{MemoryStore, SdoServer, ServerConfig};
+    let vbus = cotui::bus::virt::VirtualBus::new("vcan-test");
+    let peer = vbus.endpoint(false);
+    let mut rx = peer.subscribe();
+    let mut store = MemoryStore::default();
+    store.insert(0x3000, 0x0A, Access::Ro, Some(2), vec![0x6E, 0x09]);
+    store.insert(0x3003, 0x01, Access::Rw, Some(2), vec![0, 0]);
+    tokio::spawn(async move {
+        let mut server = SdoServer::new(ServerConfig::default());
+        while let Ok(f) = rx.recv().await {
+            if f.id != 0x601 {
+                continue;
+            }
+            for reply in server.on_frame(f.payload(), 0, &mut store).frames {
+                let _ = peer.send(&cotui::frame::Frame::classic(0x581, &reply)).await;
+            }
+        }
+    });
+    vbus.endpoint(false)
+}
+
+#[tokio::test(start_paused = true)]
+async fn dexmart_sdo_procedures_show_the_value_and_fail_on_an_abort() {
+    use cotui::command::run::{plan, run};
+    let b = Bindings::from_args(&["1=dexmart-dev".to_string()], &[], &|p| std::fs::read_to_string(p)).unwrap();
+    let dict = b.dictionary(1);
+    let bus = dexmart_peer();
+    // "581 4B 00 30 0A 6E 09": Dynamic Data 10 = 096Eh = 2414, shown with the object's name.
+    let p = plan(dict, 1, "read_dynamic_data", &[]).unwrap();
+    let v = run(&bus, dict, &p, 1000, &mut |_| {}).await.unwrap();
+    assert_eq!(v["steps"][0]["result"]["value"], 2414, "{v}");
+    assert_eq!(v["steps"][0]["result"]["text"], "0x3000:0A = 2414", "{v}");
+    assert_eq!(v["steps"][0]["text"], "sdo read 0x3000:0A Dynamic Data 10");
+    // "601 2B 03 30 01 B8 0B 00 00" answered "581 60 03 30 01": written.
+    let p = plan(dict, 1, "write_parameter", &[]).unwrap();
+    let v = run(&bus, dict, &p, 1000, &mut |_| {}).await.unwrap();
+    assert_eq!(v["steps"][0]["frame"], "601#2B033001B80B0000");
+    assert_eq!(v["steps"][0]["result"], "written");
+    // Objects the drive does not have: the abort fails the run with exit status 3.
+    let args = [("sub".to_string(), "33".to_string())];
+    let e = run(
+        &bus,
+        dict,
+        &plan(dict, 1, "read_dynamic_data", &args).unwrap(),
+        1000,
+        &mut |_| {},
+    )
+    .await
+    .unwrap_err();
+    assert_eq!(e.exit_code(), 3, "{e}");
+    assert_eq!(e.to_json()["failed_step"], 1, "{}", e.to_json());
+    let args = [
+        ("page".to_string(), "3".to_string()),
+        ("number".to_string(), "2".to_string()),
+    ];
+    let e = run(
+        &bus,
+        dict,
+        &plan(dict, 1, "write_parameter", &args).unwrap(),
+        1000,
+        &mut |_| {},
+    )
+    .await
+    .unwrap_err();
+    assert_eq!(e.exit_code(), 3, "{e}");
+    assert!(e.to_string().contains("0x06090011"), "{e}");
 }

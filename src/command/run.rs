@@ -10,7 +10,7 @@ use crate::decode::value_text::object_text;
 use crate::frame::Frame;
 use crate::hex;
 use crate::od::alias::resolve_object;
-use crate::od::procedure::{NmtCommand, Procedure, Step, frame_bytes};
+use crate::od::procedure::{NmtCommand, Procedure, Step, fill_object, frame_bytes};
 use crate::od::{DataType, Dictionary};
 use serde_json::{Value as Json, json};
 use std::time::Duration;
@@ -236,7 +236,7 @@ fn plan_step(
             value,
             data_type,
         } => {
-            let (index, sub) = resolve_object(dict, object)?;
+            let (index, sub) = resolve_object(dict, &fill_object(object, vars)?)?;
             let v = value.eval(vars)?;
             let ty = data_type.or_else(|| typed(index, sub)).ok_or(format!(
                 "the type of {index:04X}:{sub:02X} is unknown (give `type` in the profile)"
@@ -253,7 +253,7 @@ fn plan_step(
             }
         }
         Step::SdoRead { object } => {
-            let (index, sub) = resolve_object(dict, object)?;
+            let (index, sub) = resolve_object(dict, &fill_object(object, vars)?)?;
             PlannedStep {
                 action: Action::SdoRead {
                     index,
@@ -311,7 +311,7 @@ fn plan_step(
             equals,
             timeout_ms,
         } => {
-            let (index, sub) = resolve_object(dict, object)?;
+            let (index, sub) = resolve_object(dict, &fill_object(object, vars)?)?;
             let (mask, equals) = (mask.eval(vars)?, equals.eval(vars)?);
             let shown_mask = if mask == -1 {
                 String::new()

@@ -14,7 +14,7 @@ use serde_json::Value as Json;
 use super::alias::{AliasRule, parse_object_ref};
 use super::expr::{Expr, parse_int};
 use super::fields::{ByteField, SdoCommand, SdoDirection};
-use super::procedure::{NmtCommand, ProcParam, Procedure, Step, parse_frame_data};
+use super::procedure::{NmtCommand, ProcParam, Procedure, Step, object_variables, parse_frame_data};
 use super::{
     Axis, IdCondition, IdTest, IndexRange, MappingSource, ObjectInfo, PdoMappable, PdoSet, PdoTemplate, Profile,
     TextMatch, Warning,
@@ -725,6 +725,15 @@ impl Cx<'_> {
 }
 
 fn step(d: StepDto) -> Result<Step, String> {
+    if let StepDto::SdoWrite { object, .. } | StepDto::SdoRead { object } = &d {
+        object_variables(object)?;
+    }
+    if let StepDto::Wait {
+        object: Some(object), ..
+    } = &d
+    {
+        object_variables(object)?;
+    }
     Ok(match d {
         StepDto::SdoWrite {
             object,

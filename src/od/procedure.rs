@@ -61,10 +61,51 @@ pub enum FrameItem {
     Value(DataType, Expr),
 }
 
+/// Splits an object text into literal pieces and `{EXPR}` placeholders
+/// (`"{page}-{number}"`, `"0x3000:{sub}"`).
+fn object_pieces(text: &str) -> Result<Vec<Result<&str, Expr>>, String> {
+    let mut out = Vec::new();
+    let mut rest = text;
+    while let Some(open) = rest.find('{') {
+        out.push(Ok(&rest[..open]));
+        let after = &rest[open + 1..];
+        let end = after
+            .find('}')
+            .ok_or_else(|| format!("missing `}}` in object `{text}`"))?;
+        out.push(Err(Expr::parse(&after[..end])?));
+        rest = &after[end + 1..];
+    }
+    out.push(Ok(rest));
+    Ok(out)
+}
+
+/// Checks the `{EXPR}` placeholders of a step's object text; gives the variables they use.
+pub fn object_variables(text: &str) -> Result<Vec<String>, String> {
+    Ok(object_pieces(text)?
+        .into_iter()
+        .filter_map(Result::err)
+        .flat_map(|e| e.variables().into_iter().map(str::to_string).collect::<Vec<_>>())
+        .collect())
+}
+
+/// A step's object text with each `{EXPR}` replaced by its value in decimal, e.g.
+/// `"{page}-{number}"` with page 3, number 1 gives `"3-1"` (then resolved like typed text).
+pub fn fill_object(text: &str, vars: &dyn Fn(&str) -> Option<i64>) -> Result<String, String> {
+    let mut out = String::new();
+    for piece in object_pieces(text)? {
+        match piece {
+            Ok(literal) => out.push_str(literal),
+            Err(e) => out.push_str(&e.eval(vars)?.to_string()),
+        }
+    }
+    Ok(out)
+}
+
 /// One step of a procedure.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Step {
-    /// Write `value` to an object (text as typed: index, alias or name).
+    /// Write `value` to an object (text as typed: index, alias or name; `{EXPR}` in it is
+    /// replaced by the value, see [`fill_object`]).
     SdoWrite {
         object: String,
         value: Expr,
@@ -166,6 +207,11 @@ impl Procedure {
         let known = |v: &str| v == "node" || self.params.iter().any(|p| p.name == v);
         let mut exprs: Vec<&Expr> = Vec::new();
         for s in &self.steps {
+            if let Step::SdoWrite { object, .. } | Step::SdoRead { object } | Step::Wait { object, .. } = s
+                && let Some(v) = object_variables(object)?.into_iter().find(|v| !known(v))
+            {
+                return Err(format!("object `{object}` uses unknown variable `{v}`"));
+            }
             match s {
                 Step::SdoWrite { value, .. } => exprs.push(value),
                 Step::Nmt { node: Some(n), .. } => exprs.push(n),
@@ -243,5 +289,20 @@ mod tests {
             Some(NmtCommand::ResetCommunication)
         );
         assert_eq!(NmtCommand::parse("go"), None);
+    }
+
+    #[test]
+    fn object_placeholders() {
+        let vars = |v: &str| match v {
+            "page" => Some(3),
+            "number" => Some(1),
+            _ => None,
+        };
+        assert_eq!(fill_object("{page}-{number}", &vars).unwrap(), "3-1");
+        assert_eq!(fill_object("0x3000:{number + 9}", &vars).unwrap(), "0x3000:10");
+        assert_eq!(fill_object("0x6041", &vars).unwrap(), "0x6041");
+        assert_eq!(object_variables("{page}-{number}").unwrap(), ["page", "number"]);
+        assert!(object_variables("0x3000:{sub").unwrap_err().contains("missing `}`"));
+        assert!(fill_object("{speed}", &vars).is_err());
     }
 }
