@@ -265,3 +265,39 @@ async fn dexmart_sdo_procedures_show_the_value_and_fail_on_an_abort() {
     assert_eq!(e.exit_code(), 3, "{e}");
     assert!(e.to_string().contains("0x06090011"), "{e}");
 }
+
+#[test]
+fn syntron_tpdo_remap_pv_sends_all_13_frames_of_3_7_1_step_4() {
+    // 3.7.1 STEP4: TPDO1 (COB-ID 0x182) = 6069h + 6063h, TPDO2 (0x282) = 6041h, each with
+    // transmission type 1, then sub 3 (inhibit time) = 2 and sub 5 (event timer) = 2. The manual
+    // writes subs 3 and 5 with "2F" (1 byte); CiA 301 has both UNSIGNED16, so cotui writes 2 bytes ("2B").
+    assert_eq!(
+        expand("syntron-ds", 2, "tpdo_remap_pv"),
+        [
+            "602#2F001A0000000000",
+            "602#23001A0120006960",
+            "602#23001A0220006360",
+            "602#2F001A0002000000",
+            "602#2F00180201000000",
+            "602#2B00180302000000",
+            "602#2B00180502000000",
+            "602#2F011A0000000000",
+            "602#23011A0110004160",
+            "602#2F011A0001000000",
+            "602#2F01180201000000",
+            "602#2B01180302000000",
+            "602#2B01180502000000",
+        ]
+    );
+    let read = |p: &std::path::Path| std::fs::read_to_string(p);
+    let b = Bindings::from_args(&["2=syntron-ds".to_string()], &[], &read).unwrap();
+    let d = b
+        .dictionary(2)
+        .procedure("tpdo_remap_pv")
+        .unwrap()
+        .description
+        .clone()
+        .unwrap();
+    assert!(d.contains("transmission type 1 (on every SYNC)"), "{d}");
+    assert!(!d.contains("2nd"), "{d}");
+}
