@@ -263,3 +263,45 @@ fn single_subs_win_over_ranges_and_overlaps_are_located() {
     assert_eq!(p.object(0x304A, 8).unwrap().name, "A 8");
     assert!(p.object(0x304A, 9).is_none());
 }
+
+#[test]
+fn deeply_nested_expressions_are_located_errors() {
+    let parens = format!("{}1{}", "(".repeat(20_000), ")".repeat(20_000));
+    let minus = format!("{}1", "-".repeat(100_000));
+    let conds = format!("{}0", "1 ? 0 : ".repeat(20_000));
+    let text = serde_json::json!({
+        "name": "deep",
+        "alias_rules": [
+            { "pattern": "P{x}", "index": parens },
+            { "pattern": "Q{x}", "index": "0x2000 + x", "sub": conds },
+            { "pattern": "R{x}", "index": "0x2000 + x" }
+        ],
+        "procedures": {
+            "minus": { "steps": [ { "sdo_write": { "object": "0x6040", "value": minus } } ] },
+            "cond": { "steps": [ { "wait": { "equals": conds } } ] },
+            "frame": { "steps": [ { "frame": { "id": "0x600", "data": format!("{{u8:{parens}}}") } } ] },
+            "object": { "steps": [ { "sdo_read": { "object": format!("0x3000:{{{minus}}}") } } ] },
+            "fine": { "steps": [ { "sdo_write": { "object": "0x6040", "value": "-(-(15))" } } ] }
+        }
+    })
+    .to_string();
+    let (p, w) = load_profile("deep.json", &text).unwrap();
+    let at: Vec<&str> = w.iter().map(|w| w.at.as_str()).collect();
+    assert_eq!(
+        at,
+        [
+            "alias_rules.0",
+            "alias_rules.1",
+            "procedures.cond.steps.0",
+            "procedures.frame.steps.0",
+            "procedures.minus.steps.0",
+            "procedures.object.steps.0"
+        ]
+    );
+    assert!(
+        w.iter().all(|w| w.message.contains("nests deeper than 200 levels")),
+        "{w:?}"
+    );
+    assert_eq!(p.alias_rules.len(), 1);
+    assert_eq!(p.procedures.keys().collect::<Vec<_>>(), ["fine"]);
+}
