@@ -7,7 +7,7 @@ use crate::od::{Dictionary, Value, format_value};
 /// and mode of operation `mode`.
 pub fn object_text(dict: &Dictionary, index: u16, sub: u8, value: &Value, mode: Option<i8>) -> String {
     if let Some(raw) = value.as_i64() {
-        if let Some(t) = super::cia402::value_text(index, sub, raw, mode) {
+        if let Some(t) = super::cia402::value_text(index, sub, raw, mode, dict.object(index, sub)) {
             return t;
         }
         if let Some(t) = super::comm_params::describe(index, sub, raw as u64, dict) {

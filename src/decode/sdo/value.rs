@@ -41,7 +41,7 @@ pub fn view(dict: &Dictionary, index: u16, sub: u8, bytes: &[u8]) -> ValueView {
     }
     match le_uint(bytes) {
         Some(n) => ValueView {
-            text: crate::decode::cia402::value_text(index, sub, n as i64, None)
+            text: crate::decode::cia402::value_text(index, sub, n as i64, None, None)
                 .or_else(|| crate::decode::comm_params::describe(index, sub, n as u64, dict))
                 .unwrap_or_else(|| format!("{} ({n})", hex::spaced(bytes))),
             json: n.into(),
