@@ -305,3 +305,17 @@ fn cyclic_mode_statusword_bits() {
     assert!(l.contains("drive follows the command value]"), "{l}");
     assert!(!l.contains("following error"), "{l}");
 }
+
+#[test]
+fn error_history_entries_carry_the_cia402_code_and_the_fault_code() {
+    // 1003h 01h..0Ah: "bit0-bit15 CiA 402 error code, bit16-bit31 AIMOTOR fault code"; fault 0101h -> 6320h.
+    let log = "(0.000) can0 601#4003100100000000\n(0.001) can0 581#4303100120630101\n";
+    let f = seed_common::decode(&["1=aimotor"], log);
+    seed_common::label_has(
+        f.at(2, 0x581, "4303100120630101"),
+        &[
+            "Standard error field 1 = 0x01016320 (error code 0x6320 Parameter error",
+            "AIMOTOR fault code 0x0101 (Fault 0101h: 603Fh/EMCY 0x6320 (Parameter error), class NO.1))",
+        ],
+    );
+}

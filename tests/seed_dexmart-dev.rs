@@ -237,3 +237,32 @@ fn monitor_data_single_subs_win_over_the_range() {
         assert_eq!(o.data_type, cotui::od::DataType::U8);
     }
 }
+
+#[test]
+fn error_history_and_manufacturer_status_are_split() {
+    // 1003h sub 01h: "(alarm_m1 << 24) | (alarm_m0 << 16) | error_code" (m0 = M1, m1 = M2);
+    // 1002h: "Byte0 = Motor State M1, Byte1 = Motor State M2"; 1016h sub 1: node 2, 100 ms.
+    let log = "\
+(0.000) can0 601#4003100100000000
+(0.001) can0 581#4303100110230507
+(0.002) can0 601#4002100000000000
+(0.003) can0 581#4302100003020000
+(0.004) can0 601#4016100100000000
+(0.005) can0 581#4316100164000200
+";
+    let f = decode(&["1=dexmart-dev"], log);
+    label_has(
+        f.at(2, 0x581, "4303100110230507"),
+        &[
+            "Standard error field 1 = 0x07052310 (error code 0x2310 Continuous over-current, M1 alarm code 0x05, M2 alarm code 0x07)",
+        ],
+    );
+    label_has(
+        f.at(4, 0x581, "4302100003020000"),
+        &["Manufacturer status register = 0x00000203 (M1 motor state 3, M2 motor state 2)"],
+    );
+    label_has(
+        f.at(6, 0x581, "4316100164000200"),
+        &["Consumer heartbeat time 1 = 0x00020064 (node 2, time 100 ms)"],
+    );
+}

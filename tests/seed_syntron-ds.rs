@@ -370,17 +370,23 @@ fn pp_pt_hm_procedures() {
 fn mode_specific_bits_follow_the_mode_in_force() {
     let log = "\
 (0.000) can0 602#2B4060005F000000
+(0.0005) can0 582#6040600000000000
 (0.001) can0 602#2F60600001000000
+(0.0015) can0 582#6060600000000000
 (0.002) can0 602#2B4060005F000000
+(0.0025) can0 582#6040600000000000
 (0.003) can0 582#4B41600037160000
 (0.004) can0 582#4B41600037260000
 (0.010) can0 602#2F60600006000000
+(0.0105) can0 582#6060600000000000
 (0.011) can0 602#2B4060001F000000
+(0.0115) can0 582#6040600000000000
 (0.012) can0 582#4B41600037160000
-(0.013) can0 582#4B41600037240000
+(0.013) can0 582#4B41600037260000
 (0.020) can0 602#2F60600003000000
+(0.0205) can0 582#6060600000000000
 (0.021) can0 582#4B41600037120000
-(0.022) can0 582#4B41600037200000
+(0.022) can0 582#4B41600037220000
 ";
     let f = decode(&["2=syntron-ds"], log);
     let value = |line: u64, id: u32, data: &str| f.at(line, id, data)["label"].as_str().unwrap().to_string();
@@ -391,26 +397,26 @@ fn mode_specific_bits_follow_the_mode_in_force() {
         "{l}"
     );
     // PP (3.7.2 step 7 "5F"): new set-point + relative; set-point acknowledge, following error.
-    let l = value(3, 0x602, "2B4060005F000000");
+    let l = value(5, 0x602, "2B4060005F000000");
     assert!(
         l.ends_with("(Enable operation, start relative (bits 4, 6) [new set-point, relative])"),
         "{l}"
     );
-    let l = value(4, 0x582, "4B41600037160000");
+    let l = value(7, 0x582, "4B41600037160000");
     assert!(l.contains("target reached, set-point acknowledge]"), "{l}");
-    let l = value(5, 0x582, "4B41600037260000");
+    let l = value(8, 0x582, "4B41600037260000");
     assert!(l.contains("target reached, following error]"), "{l}");
     // HM (3.7.4): start homing; homing attained / homing error.
-    let l = value(7, 0x602, "2B4060001F000000");
+    let l = value(11, 0x602, "2B4060001F000000");
     assert!(l.ends_with("[start homing])"), "{l}");
-    let l = value(8, 0x582, "4B41600037160000");
+    let l = value(13, 0x582, "4B41600037160000");
     assert!(l.contains("target reached, homing attained]"), "{l}");
-    let l = value(9, 0x582, "4B41600037240000");
-    assert!(l.contains("remote, homing error]"), "{l}");
+    let l = value(14, 0x582, "4B41600037260000");
+    assert!(l.contains("remote, target reached, homing error]"), "{l}");
     // PV: speed is zero / max slippage error.
-    let l = value(11, 0x582, "4B41600037120000");
+    let l = value(17, 0x582, "4B41600037120000");
     assert!(l.contains("remote, speed is zero]"), "{l}");
-    let l = value(12, 0x582, "4B41600037200000");
+    let l = value(18, 0x582, "4B41600037220000");
     assert!(l.contains("remote, max slippage error]"), "{l}");
     assert!(!f.0.iter().any(|x| x["label"].as_str().unwrap().contains("mode bit")));
 }

@@ -437,6 +437,21 @@ impl Cx<'_> {
         if let Some(m) = &e.max {
             info.max = self.ok(&format!("{at}.max"), int(m));
         }
+        for (i, f) in e.fields.into_iter().enumerate() {
+            let at = format!("{at}.fields.{i}");
+            if f.object.is_some() || f.object_sub.is_some() {
+                self.warn(&at, "`object` only applies to sdo_commands fields, ignored");
+            }
+            if let Some(field) = self.field(&at, f, &[]) {
+                match info.data_type.size() {
+                    Some(n) if usize::from(field.offset + field.length) <= n => info.fields.push(field),
+                    _ => self.warn(
+                        &at,
+                        format!("field does not fit the {:?} value, skipped", info.data_type),
+                    ),
+                }
+            }
+        }
         Some(info)
     }
 
@@ -493,12 +508,16 @@ impl Cx<'_> {
             );
             return None;
         }
-        let hex = match f.format.as_deref().map(str::to_ascii_lowercase).as_deref() {
-            None | Some("dec") => false,
-            Some("hex") => true,
+        let (hex, emcy) = match f.format.as_deref().map(str::to_ascii_lowercase).as_deref() {
+            None | Some("dec") => (false, false),
+            Some("hex") => (true, false),
+            Some("emcy") => (true, true),
             Some(other) => {
-                self.warn(&format!("{at}.format"), format!("unknown format `{other}` (dec, hex)"));
-                false
+                self.warn(
+                    &format!("{at}.format"),
+                    format!("unknown format `{other}` (dec, hex, emcy)"),
+                );
+                (false, false)
             }
         };
         let mut values = BTreeMap::new();
@@ -534,6 +553,7 @@ impl Cx<'_> {
             length: length as u8,
             signed: f.signed,
             hex,
+            emcy,
             values,
             unit: f.unit,
             scale,

@@ -70,6 +70,8 @@ pub(super) struct EntryDto {
     pub(super) description: Option<String>,
     #[serde(default)]
     pub(super) subs: Option<BTreeMap<String, EntryDto>>,
+    #[serde(default)]
+    pub(super) fields: Vec<FieldDto>,
 }
 
 #[derive(Deserialize)]

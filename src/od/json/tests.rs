@@ -305,3 +305,27 @@ fn deeply_nested_expressions_are_located_errors() {
     assert_eq!(p.alias_rules.len(), 1);
     assert_eq!(p.procedures.keys().collect::<Vec<_>>(), ["fine"]);
 }
+
+#[test]
+fn value_fields_must_fit_the_type() {
+    let text = r#"{ "name": "f", "objects": {
+        "0x1016:1": { "name": "HB", "type": "u32", "fields": [
+            { "name": "node", "offset": 2 }, { "name": "time", "offset": 0, "length": 2, "unit": "ms" },
+            { "name": "beyond", "offset": 3, "length": 2 }, { "name": "odd", "offset": 0, "format": "bcd" } ] }
+    } }"#;
+    let (p, w) = load_profile("f.json", text).unwrap();
+    let at: Vec<&str> = w.iter().map(|w| w.at.as_str()).collect();
+    assert_eq!(
+        at,
+        ["objects.0x1016:1.fields.2", "objects.0x1016:1.fields.3.format"],
+        "{w:?}"
+    );
+    let names: Vec<&str> = p
+        .object(0x1016, 1)
+        .unwrap()
+        .fields
+        .iter()
+        .map(|f| f.name.as_str())
+        .collect();
+    assert_eq!(names, ["node", "time", "odd"]);
+}
