@@ -14,7 +14,7 @@ use serde_json::Value as Json;
 use super::alias::{AliasRule, parse_object_ref};
 use super::expr::{Expr, parse_int};
 use super::fields::{ByteField, SdoCommand, SdoDirection};
-use super::procedure::{NmtCommand, ProcParam, Procedure, Step, object_variables, parse_frame_data};
+use super::procedure::{FailIf, NmtCommand, ProcParam, Procedure, Step, object_variables, parse_frame_data};
 use super::{
     Axis, IdCondition, IdTest, IndexRange, MappingSource, ObjectInfo, PdoMappable, PdoSet, PdoTemplate, Profile,
     TextMatch, Warning,
@@ -785,7 +785,17 @@ fn step(d: StepDto) -> Result<Step, String> {
             mask,
             equals,
             timeout_ms,
+            fail_if,
         } => Step::Wait {
+            fail_if: fail_if
+                .map(|f| -> Result<FailIf, String> {
+                    Ok(FailIf {
+                        mask: f.mask.as_ref().map(expr).transpose()?.unwrap_or(Expr::constant(-1)),
+                        equals: expr(&f.equals)?,
+                        text: f.text,
+                    })
+                })
+                .transpose()?,
             object: object.unwrap_or_else(|| "0x6041".to_string()),
             mask: mask.as_ref().map(expr).transpose()?.unwrap_or(Expr::constant(-1)),
             equals: expr(&equals)?,

@@ -115,17 +115,30 @@ pub enum Step {
     SdoRead { object: String },
     /// Send an NMT command to `node` (the target node when `None`; 0 = all).
     Nmt { command: NmtCommand, node: Option<Expr> },
-    /// Wait until `(object & mask) == equals`, at most `timeout_ms`.
+    /// Wait until `(object & mask) == equals`, at most `timeout_ms`; fail at once when
+    /// `fail_if` matches (e.g. statusword bit 13 "homing error").
     Wait {
         object: String,
         mask: Expr,
         equals: Expr,
         timeout_ms: u32,
+        fail_if: Option<FailIf>,
     },
     /// Send a raw frame.
     Frame { id: Expr, data: Vec<FrameItem> },
     /// Pause.
     Delay { ms: u32 },
+}
+
+/// When a `wait` step gives up early: `(value & mask) == equals` means `text`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FailIf {
+    /// Bits compared.
+    pub mask: Expr,
+    /// Their failing value.
+    pub equals: Expr,
+    /// What it means, e.g. `homing error`.
+    pub text: String,
 }
 
 /// A named command sequence.
@@ -215,7 +228,14 @@ impl Procedure {
             match s {
                 Step::SdoWrite { value, .. } => exprs.push(value),
                 Step::Nmt { node: Some(n), .. } => exprs.push(n),
-                Step::Wait { mask, equals, .. } => exprs.extend([mask, equals]),
+                Step::Wait {
+                    mask, equals, fail_if, ..
+                } => {
+                    exprs.extend([mask, equals]);
+                    if let Some(f) = fail_if {
+                        exprs.extend([&f.mask, &f.equals]);
+                    }
+                }
                 Step::Frame { id, data } => {
                     exprs.push(id);
                     exprs.extend(data.iter().filter_map(|i| match i {
