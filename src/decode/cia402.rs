@@ -365,6 +365,41 @@ mod tests {
     }
 
     #[test]
+    fn profile_texts_stand_in_when_the_mode_is_unknown() {
+        let mut info = ObjectInfo::default();
+        info.bits
+            .insert(4, "Operation mode specific (new set-point / homing start)".into());
+        info.bits.insert(
+            12,
+            "Operation mode specific (set-point acknowledge / homing attained)".into(),
+        );
+        info.values
+            .insert(0x5F, "Enable operation, start relative (bits 4, 6)".into());
+        let texts = Some(&info);
+        assert_eq!(
+            describe_controlword(0x1F, None, texts),
+            "Enable operation [Operation mode specific (new set-point / homing start)]"
+        );
+        assert_eq!(
+            describe_controlword(0x5F, None, texts),
+            "Enable operation, start relative (bits 4, 6)"
+        );
+        assert_eq!(
+            describe_controlword(0x5F, Some(1), texts),
+            "Enable operation, start relative (bits 4, 6) [new set-point, relative]"
+        );
+        assert_eq!(
+            describe_statusword(0x1237, None, texts),
+            "Operation enabled [ready to switch on, switched on, operation enabled, voltage enabled, quick stop, remote, Operation mode specific (set-point acknowledge / homing attained)]"
+        );
+        // Without profile texts: `mode bit N`.
+        assert_eq!(describe_controlword(0x1F, None, None), "Enable operation [mode bit 4]");
+        // Cyclic modes: bit 12 clear while enabled means the target is ignored.
+        assert!(describe_statusword(0x0237, Some(9), None).ends_with("remote, target ignored]"));
+        assert_eq!(describe(0x6061, 0, 6, None, Some(&info)).unwrap(), "Homing");
+    }
+
+    #[test]
     fn modes() {
         assert_eq!(mode_name(3), "Profile velocity");
         assert_eq!(mode_name(-1), "Manufacturer-specific mode");
