@@ -419,4 +419,16 @@ fn mode_specific_bits_follow_the_mode_in_force() {
     let l = value(18, 0x582, "4B41600037220000");
     assert!(l.contains("remote, max slippage error]"), "{l}");
     assert!(!f.0.iter().any(|x| x["label"].as_str().unwrap().contains("mode bit")));
+    // The reassembled transfers (`--transactions`) name the bits the same way.
+    let t = run(&["--transactions", "--profile", "2=syntron-ds"], log);
+    assert!(
+        t.iter()
+            .any(|l| l.contains("= 0x005F (Enable operation, start relative (bits 4, 6) [new set-point, relative])")),
+        "{t:#?}"
+    );
+    assert!(
+        t.iter()
+            .any(|l| l.contains("= 0x001F (Enable operation, start (bit 4) [start homing])")),
+        "{t:#?}"
+    );
 }

@@ -247,7 +247,8 @@ impl Decoder {
                 {
                     v.text = value_text::object_text(&self.dicts[n as usize], index, 0, typed, Some(mode));
                 }
-                for t in self.sdo.take_completed() {
+                for mut t in self.sdo.take_completed() {
+                    t.mode = self.modes[(t.node & 0x7F) as usize];
                     self.learn(&t);
                     self.completed.push(t);
                 }
@@ -471,7 +472,10 @@ impl Decoder {
     /// Ends the input: returns completed transactions plus those left incomplete.
     pub fn finish(&mut self) -> Vec<Transaction> {
         let mut all = std::mem::take(&mut self.completed);
-        all.extend(self.sdo.finish());
+        all.extend(self.sdo.finish().into_iter().map(|mut t| {
+            t.mode = self.modes[(t.node & 0x7F) as usize];
+            t
+        }));
         all
     }
 }

@@ -278,6 +278,7 @@ fn new_txn(
         outcome: Outcome::Incomplete,
         problems: Vec::new(),
         frames: Vec::new(),
+        mode: None,
     }
 }
 

@@ -1,7 +1,7 @@
 //! A reassembled SDO transfer: what was read or written, how, and how it ended.
 
 use super::frame::Side;
-use super::value::view;
+use super::value::view_in_mode;
 use crate::hex;
 use crate::od::Dictionary;
 use serde_json::{Value as Json, json};
@@ -182,6 +182,9 @@ pub struct Transaction {
     pub problems: Vec<Problem>,
     /// Sequence numbers of the frames that belong to it.
     pub frames: Vec<u64>,
+    /// The node's mode of operation when the transfer ended (known to the decoder from
+    /// 6060h/6061h), so that controlword/statusword bits are named for that mode.
+    pub mode: Option<i8>,
 }
 
 impl Transaction {
@@ -222,7 +225,7 @@ impl Transaction {
             s.push_str(&name);
         }
         if self.outcome == Outcome::Ok && !self.data.is_empty() {
-            let v = view(dict, self.index, self.sub, &self.data);
+            let v = view_in_mode(dict, self.index, self.sub, &self.data, self.mode);
             let text: String = if v.text.chars().count() > 80 {
                 v.text.chars().take(77).chain("...".chars()).collect()
             } else {
@@ -258,7 +261,7 @@ impl Transaction {
 
     /// JSON object with the object, name, typed value, hex data, timing, outcome and problems.
     pub fn to_json(&self, dict: &Dictionary) -> Json {
-        let v = (!self.data.is_empty()).then(|| view(dict, self.index, self.sub, &self.data));
+        let v = (!self.data.is_empty()).then(|| view_in_mode(dict, self.index, self.sub, &self.data, self.mode));
         let (code, text, by, error) = match &self.outcome {
             Outcome::Aborted { code, text, by } => (
                 Json::from(*code),
