@@ -71,14 +71,20 @@ fn text_mode_prints_each_step_before_its_result() {
     let (rc, out, err) = cotui(&["run", "demo", "3", "pv", "--profile", "3=syntron-ds"]);
     assert_eq!(rc, 0, "{err}");
     let lines: Vec<&str> = out.lines().collect();
-    assert_eq!(lines[0], "step 1/8: nmt start to node 3  [000#0103]");
-    assert_eq!(lines[1], "  -> sent");
+    // STEP1 of the manual: F0.1.002 = 20 (CANopen control).
     assert_eq!(
-        lines[10],
-        "step 6/8: sdo write 0x6040:00 Controlword = 0x0006 (Shutdown)  [603#2B40600006000000]"
+        lines[0],
+        "step 1/9: sdo write 0x2102:00 A control mode = 20 (CANopen (CiA 402))  [603#2B02210014000000]"
     );
-    assert_eq!(lines[11], "  -> written (0600)");
-    assert_eq!(lines.last(), Some(&"`pv` on node 3: 8 steps done"));
+    assert_eq!(lines[1], "  -> written (1400)");
+    assert_eq!(lines[2], "step 2/9: nmt start to node 3  [000#0103]");
+    assert_eq!(lines[3], "  -> sent");
+    assert_eq!(
+        lines[12],
+        "step 7/9: sdo write 0x6040:00 Controlword = 0x0006 (Shutdown)  [603#2B40600006000000]"
+    );
+    assert_eq!(lines[13], "  -> written (0600)");
+    assert_eq!(lines.last(), Some(&"`pv` on node 3: 9 steps done"));
 }
 
 #[test]
@@ -128,6 +134,7 @@ fn dry_run_gives_the_syntron_manual_frame_list_without_a_send_path() {
     assert_eq!(
         frames(&v),
         [
+            "602#2B02210014000000",
             "000#0102",
             "602#2F60600003000000",
             "602#23836000E8030000",
@@ -155,7 +162,7 @@ fn dry_run_gives_the_syntron_manual_frame_list_without_a_send_path() {
         "{out}"
     );
     assert!(
-        out.starts_with("dry run of `pv` on node 2: 8 steps, nothing sent\n"),
+        out.starts_with("dry run of `pv` on node 2: 9 steps, nothing sent\n"),
         "{out}"
     );
 }
@@ -219,5 +226,5 @@ fn list_shows_procedures_with_descriptions_and_parameters() {
         .unwrap();
     assert_eq!(pv["params"][1]["name"], "ramp");
     assert_eq!(pv["params"][1]["default"], 1000);
-    assert_eq!(pv["steps"], 8);
+    assert_eq!(pv["steps"], 9);
 }

@@ -273,3 +273,49 @@ fn default_pdo_mapping_of_the_object_table() {
     let x = f.at(9, 0x281, "164E00007D00");
     assert_eq!(signal(x, 0x6077, 0), (json!(125), "12.5 %".to_string()));
 }
+
+/// CSP/CSV/CST statusword bits (mode from the 6060h write): bit 12 "drive follows the command
+/// value" (clear while enabled: "target ignored"), bit 13 following error in CSP; in the
+/// default TPDO1 (6041h) as well as in SDO uploads.
+#[test]
+fn cyclic_mode_statusword_bits() {
+    let log = "\
+(0.000) can0 601#2F60600008000000
+(0.0005) can0 581#6060600000000000
+(0.001) can0 581#4B41600037020000
+(0.002) can0 581#4B41600037360000
+(0.003) can0 181#3716080000000000
+(0.010) can0 601#2F6060000A000000
+(0.0105) can0 581#6060600000000000
+(0.011) can0 581#4B41600037120000
+";
+    let f = seed_common::decode(&["1=aimotor"], log);
+    let label = |line: u64, id: u32, data: &str| f.at(line, id, data)["label"].as_str().unwrap().to_string();
+    let l = label(3, 0x581, "4B41600037020000");
+    assert!(l.contains("remote, target ignored]"), "{l}");
+    let l = label(4, 0x581, "4B41600037360000");
+    assert!(
+        l.contains("remote, bit 10 (reserved in CSP), drive follows the command value, following error]"),
+        "{l}"
+    );
+    let x = f.at(5, 0x181, "3716080000000000");
+    let (_, text) = seed_common::signal(x, 0x6041, 0);
+    assert!(text.contains("drive follows the command value]"), "{text}");
+    let l = label(8, 0x581, "4B41600037120000");
+    assert!(l.contains("drive follows the command value]"), "{l}");
+    assert!(!l.contains("following error"), "{l}");
+}
+
+#[test]
+fn error_history_entries_carry_the_cia402_code_and_the_fault_code() {
+    // 1003h 01h..0Ah: "bit0-bit15 CiA 402 error code, bit16-bit31 AIMOTOR fault code"; fault 0101h -> 6320h.
+    let log = "(0.000) can0 601#4003100100000000\n(0.001) can0 581#4303100120630101\n";
+    let f = seed_common::decode(&["1=aimotor"], log);
+    seed_common::label_has(
+        f.at(2, 0x581, "4303100120630101"),
+        &[
+            "Standard error field 1 = 0x01016320 (error code 0x6320 Parameter error",
+            "AIMOTOR fault code 0x0101 (Fault 0101h: 603Fh/EMCY 0x6320 (Parameter error), class NO.1))",
+        ],
+    );
+}

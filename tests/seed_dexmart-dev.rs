@@ -214,3 +214,55 @@ fn multi_drive_rpdo_commands_and_mapping_sets() {
     let x = f.at(71, 0x301, "01B80B");
     assert_eq!(signal(x, 0x305C, 2).0, json!(3000));
 }
+
+#[test]
+fn monitor_data_single_subs_win_over_the_range() {
+    // TPDO1 of mapping set 0: 3046h sub 1 "M1: Motor State" (u8), sub 2 alarm code, sub 5 speed 3000 (0BB8h),
+    // subs 22/23 encoder index/position; sub 1 must not be taken from the "1..32" Monitor Data range.
+    let f = decode(&["1=dexmart-dev"], "(0.000) can0 181#0300B80B01000200\n");
+    let x = f.at(1, 0x181, "0300B80B01000200");
+    let s = &x["pdo"]["signals"][0];
+    assert_eq!(
+        (s["sub"].as_u64(), s["name"].as_str()),
+        (Some(1), Some("M1: Motor State"))
+    );
+    assert_eq!(signal(x, 0x3046, 5), (json!(3000), "3000 rpm".to_string()));
+    label_has(x, &["M1: Motor State=", "M1: Current Speed=3000 rpm"]);
+    let p = cotui::od::json::load_profile("dexmart-dev", include_str!("../decoders/dexmart-dev.json"))
+        .unwrap()
+        .0;
+    for index in [0x3046, 0x304A] {
+        let o = p.object(index, 1).unwrap();
+        assert!(o.name.ends_with("Motor State"), "{}", o.name);
+        assert_eq!(o.data_type, cotui::od::DataType::U8);
+    }
+}
+
+#[test]
+fn error_history_and_manufacturer_status_are_split() {
+    // 1003h sub 01h: "(alarm_m1 << 24) | (alarm_m0 << 16) | error_code" (m0 = M1, m1 = M2);
+    // 1002h: "Byte0 = Motor State M1, Byte1 = Motor State M2"; 1016h sub 1: node 2, 100 ms.
+    let log = "\
+(0.000) can0 601#4003100100000000
+(0.001) can0 581#4303100110230507
+(0.002) can0 601#4002100000000000
+(0.003) can0 581#4302100003020000
+(0.004) can0 601#4016100100000000
+(0.005) can0 581#4316100164000200
+";
+    let f = decode(&["1=dexmart-dev"], log);
+    label_has(
+        f.at(2, 0x581, "4303100110230507"),
+        &[
+            "Standard error field 1 = 0x07052310 (error code 0x2310 Continuous over-current, M1 alarm code 0x05, M2 alarm code 0x07)",
+        ],
+    );
+    label_has(
+        f.at(4, 0x581, "4302100003020000"),
+        &["Manufacturer status register = 0x00000203 (M1 motor state 3, M2 motor state 2)"],
+    );
+    label_has(
+        f.at(6, 0x581, "4316100164000200"),
+        &["Consumer heartbeat time 1 = 0x00020064 (node 2, time 100 ms)"],
+    );
+}

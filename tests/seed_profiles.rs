@@ -122,3 +122,68 @@ fn identity_values_suggest_the_profile() {
     assert_eq!(suggest(&mut b, 0x1008, "AQMD2405BLS-MT-2").as_deref(), Some("aqmd2405"));
     assert_eq!(suggest(&mut b, 0x1008, "SOMETHING ELSE"), None);
 }
+
+#[test]
+fn named_parameters_from_the_second_pass() {
+    // AIMOTOR 1.3: "Nodeid=1, 500kbps ... H0C-00 / H0C-08" (Hxx-yy -> 0x2000 + xx, sub yy + 1)
+    let d = dict(load("aimotor"));
+    assert_eq!(resolve_object(&d, "H0C-00"), Ok((0x200C, 1)));
+    assert_eq!(d.name(0x200C, 1), Some("CANopen node-ID"));
+    assert_eq!(d.name(0x200C, 9), Some("CAN bit rate"));
+    let rate = d.object(0x200C, 9).unwrap().description.clone().unwrap();
+    assert!(rate.contains("500 kbps") && rate.contains("1 Mbps 25 m"), "{rate}");
+    // Dexmart RPDO3: "303F011 ... M1: Digital Speed 0", "303F111 ... M2: Digital Speed 0"
+    let d = dict(load("dexmart-dev"));
+    assert_eq!(resolve_object(&d, "RAM03-01"), Ok((0x303F, 1)));
+    assert_eq!(d.name(0x303F, 1), Some("M1 digital speed 0 (RAM)"));
+    assert_eq!(d.name(0x303F, 0x11), Some("M2 digital speed 0 (RAM)"));
+    assert_eq!(d.name(0x303F, 2), Some("RAM parameter 3-2"));
+    // Syn-tron 3.6.4: "F0.7.000 ... F0.7.07F" per PDO: count, COB-ID, transmission type,
+    // inhibit/event time, SUB1..SUB4; example "F0.7.041 385" (TPDO1 COB-ID), "F0.7.045 24641" (6041h)
+    let d = dict(load("syntron-ds"));
+    assert_eq!(resolve_object(&d, "F0.7.041"), Ok((0x2741, 0)));
+    for (index, name) in [
+        (0x2700, "A RPDO1 number of mapped objects"),
+        (0x2741, "A TPDO1 COB-ID"),
+        (0x2742, "A TPDO1 transmission type"),
+        (0x2745, "A TPDO1 mapped object 1 index"),
+        (0x277C, "A TPDO4 mapped object 4 sub-index"),
+        (0x3731, "B RPDO4 COB-ID"),
+    ] {
+        assert_eq!(d.name(index, 0), Some(name), "0x{index:04X}");
+    }
+}
+
+#[test]
+fn default_pdo_communication_parameters() {
+    use cotui::od::Value;
+    let default = |d: &Dictionary, index: u16, sub: u8| d.object(index, sub).and_then(|o| o.default.clone());
+    // AIMOTOR 2.1.1: 1401h-1403h sub 2 = 1, 1800h-1803h sub 2 = 1, sub 5 = 0.
+    let d = dict(load("aimotor"));
+    assert_eq!(default(&d, 0x1402, 2), Some(Value::Unsigned(1)));
+    assert_eq!(default(&d, 0x1803, 2), Some(Value::Unsigned(1)));
+    assert_eq!(default(&d, 0x1800, 5), Some(Value::Unsigned(0)));
+    // Dexmart: "02h ... FEh TransmissionType", "03h ... 0Ah InhibitTime", "05h ... 0Ah EventTime"
+    let p = load("dexmart-dev");
+    assert!(
+        p.pdo_sets
+            .iter()
+            .all(|s| s.tpdo.values().all(|t| t.transmission_type == Some(0xFE)))
+    );
+    let d = dict(p);
+    for index in [0x1400, 0x1403, 0x1800, 0x1803] {
+        assert_eq!(default(&d, index, 2), Some(Value::Unsigned(0xFE)));
+        assert_eq!(default(&d, index, 3), Some(Value::Unsigned(0x0A)));
+        assert_eq!(default(&d, index, 5), Some(Value::Unsigned(0x0A)));
+    }
+    assert_eq!(d.name(0x1801, 3), Some("Inhibit time"));
+    // AQMD: RPDOx sub 2 = 0xFE; TPDOx sub 2 = 0xFE, sub 3 = 0 (100 us), sub 5 = 0 ms.
+    let d = dict(load("aqmd2405"));
+    assert_eq!(default(&d, 0x1401, 2), Some(Value::Unsigned(0xFE)));
+    assert_eq!(default(&d, 0x1802, 2), Some(Value::Unsigned(0xFE)));
+    assert_eq!(default(&d, 0x1802, 3), Some(Value::Unsigned(0)));
+    // Syn-tron: the EDS set's TPDOs are event-driven (255).
+    let p = load("syntron-ds");
+    let eds = p.pdo_sets.iter().find(|s| s.name == "eds").unwrap();
+    assert!(eds.tpdo.values().all(|t| t.transmission_type == Some(255)));
+}

@@ -253,7 +253,8 @@ fn syntron_profile_velocity_procedure() {
     );
     assert_eq!(
         t.feed("602 2B 40 60 00 07 00 00 00"),
-        "Download 0x6040:00 Controlword = 0x0007 (Switch on / Disable operation)"
+        // the profile's text for 0x0007, the manual's "switch on"
+        "Download 0x6040:00 Controlword = 0x0007 (Switch on)"
     );
     assert_eq!(
         t.feed("602 2B 40 60 00 0F 00 00 00"),

@@ -265,7 +265,8 @@ fn pv_procedure_reads_like_the_manual() {
         "Download 0x60FF:00 Target velocity = 10 rpm",
         // "602 2B 40 60 00 06 // 6040h = 6", "07 // 6040h = 7", "0F // 6040h = F, enabled"
         "Download 0x6040:00 Controlword = 0x0006 (Shutdown)",
-        "Download 0x6040:00 Controlword = 0x0007 (Switch on / Disable operation)",
+        // (the profile's value text, the manual's "switch on", names the controlword value)
+        "Download 0x6040:00 Controlword = 0x0007 (Switch on)",
         "Download 0x6040:00 Controlword = 0x000F (Enable operation)",
     ];
     assert_eq!(lines.len(), expect.len(), "{lines:#?}");
@@ -361,4 +362,73 @@ fn pp_pt_hm_procedures() {
     // "602 2B 40 60 00 5F // start homing", "602 2B 40 60 00 4F"
     sdo(f.at(70, 0x602, "2B4060005F000000"), "sdo_rx", 2, 0x6040, 0, Some(0x5F));
     sdo(f.at(71, 0x602, "2B4060004F000000"), "sdo_rx", 2, 0x6040, 0, Some(0x4F));
+}
+
+/// Controlword and statusword bits 4/5/6 and 10/12/13 are named per the mode in force
+/// (learned from the 6060h write), with the profile's value texts ("start relative (bits 4, 6)").
+#[test]
+fn mode_specific_bits_follow_the_mode_in_force() {
+    let log = "\
+(0.000) can0 602#2B4060005F000000
+(0.0005) can0 582#6040600000000000
+(0.001) can0 602#2F60600001000000
+(0.0015) can0 582#6060600000000000
+(0.002) can0 602#2B4060005F000000
+(0.0025) can0 582#6040600000000000
+(0.003) can0 582#4B41600037160000
+(0.004) can0 582#4B41600037260000
+(0.010) can0 602#2F60600006000000
+(0.0105) can0 582#6060600000000000
+(0.011) can0 602#2B4060001F000000
+(0.0115) can0 582#6040600000000000
+(0.012) can0 582#4B41600037160000
+(0.013) can0 582#4B41600037260000
+(0.020) can0 602#2F60600003000000
+(0.0205) can0 582#6060600000000000
+(0.021) can0 582#4B41600037120000
+(0.022) can0 582#4B41600037220000
+";
+    let f = decode(&["2=syntron-ds"], log);
+    let value = |line: u64, id: u32, data: &str| f.at(line, id, data)["label"].as_str().unwrap().to_string();
+    // Mode unknown: the profile's text for 0x005F says what bits 4 and 6 do.
+    let l = value(1, 0x602, "2B4060005F000000");
+    assert!(
+        l.ends_with("= 0x005F (Enable operation, start relative (bits 4, 6))"),
+        "{l}"
+    );
+    // PP (3.7.2 step 7 "5F"): new set-point + relative; set-point acknowledge, following error.
+    let l = value(5, 0x602, "2B4060005F000000");
+    assert!(
+        l.ends_with("(Enable operation, start relative (bits 4, 6) [new set-point, relative])"),
+        "{l}"
+    );
+    let l = value(7, 0x582, "4B41600037160000");
+    assert!(l.contains("target reached, set-point acknowledge]"), "{l}");
+    let l = value(8, 0x582, "4B41600037260000");
+    assert!(l.contains("target reached, following error]"), "{l}");
+    // HM (3.7.4): start homing; homing attained / homing error.
+    let l = value(11, 0x602, "2B4060001F000000");
+    assert!(l.ends_with("[start homing])"), "{l}");
+    let l = value(13, 0x582, "4B41600037160000");
+    assert!(l.contains("target reached, homing attained]"), "{l}");
+    let l = value(14, 0x582, "4B41600037260000");
+    assert!(l.contains("remote, target reached, homing error]"), "{l}");
+    // PV: speed is zero / max slippage error.
+    let l = value(17, 0x582, "4B41600037120000");
+    assert!(l.contains("remote, speed is zero]"), "{l}");
+    let l = value(18, 0x582, "4B41600037220000");
+    assert!(l.contains("remote, max slippage error]"), "{l}");
+    assert!(!f.0.iter().any(|x| x["label"].as_str().unwrap().contains("mode bit")));
+    // The reassembled transfers (`--transactions`) name the bits the same way.
+    let t = run(&["--transactions", "--profile", "2=syntron-ds"], log);
+    assert!(
+        t.iter()
+            .any(|l| l.contains("= 0x005F (Enable operation, start relative (bits 4, 6) [new set-point, relative])")),
+        "{t:#?}"
+    );
+    assert!(
+        t.iter()
+            .any(|l| l.contains("= 0x001F (Enable operation, start (bit 4) [start homing])")),
+        "{t:#?}"
+    );
 }

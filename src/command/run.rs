@@ -10,7 +10,7 @@ use crate::decode::value_text::object_text;
 use crate::frame::Frame;
 use crate::hex;
 use crate::od::alias::resolve_object;
-use crate::od::procedure::{NmtCommand, Procedure, Step, frame_bytes};
+use crate::od::procedure::{NmtCommand, Procedure, Step, fill_object, frame_bytes};
 use crate::od::{DataType, Dictionary};
 use serde_json::{Value as Json, json};
 use std::time::Duration;
@@ -34,6 +34,8 @@ pub enum Action {
         mask: i64,
         equals: i64,
         timeout_ms: u32,
+        /// `(value & mask) == equals` fails the step at once with this text.
+        fail_if: Option<(i64, i64, String)>,
     },
     /// Sleep.
     Delay { ms: u32 },
@@ -236,7 +238,7 @@ fn plan_step(
             value,
             data_type,
         } => {
-            let (index, sub) = resolve_object(dict, object)?;
+            let (index, sub) = resolve_object(dict, &fill_object(object, vars)?)?;
             let v = value.eval(vars)?;
             let ty = data_type.or_else(|| typed(index, sub)).ok_or(format!(
                 "the type of {index:04X}:{sub:02X} is unknown (give `type` in the profile)"
@@ -253,7 +255,7 @@ fn plan_step(
             }
         }
         Step::SdoRead { object } => {
-            let (index, sub) = resolve_object(dict, object)?;
+            let (index, sub) = resolve_object(dict, &fill_object(object, vars)?)?;
             PlannedStep {
                 action: Action::SdoRead {
                     index,
@@ -310,9 +312,18 @@ fn plan_step(
             mask,
             equals,
             timeout_ms,
+            fail_if,
         } => {
-            let (index, sub) = resolve_object(dict, object)?;
+            let (index, sub) = resolve_object(dict, &fill_object(object, vars)?)?;
             let (mask, equals) = (mask.eval(vars)?, equals.eval(vars)?);
+            let fail_if = match fail_if {
+                Some(f) => Some((f.mask.eval(vars)?, f.equals.eval(vars)?, f.text.clone())),
+                None => None,
+            };
+            let fails_on = fail_if
+                .as_ref()
+                .map(|f| format!(", fails on {}", f.2))
+                .unwrap_or_default();
             let shown_mask = if mask == -1 {
                 String::new()
             } else {
@@ -326,10 +337,12 @@ fn plan_step(
                     mask,
                     equals,
                     timeout_ms: *timeout_ms,
+                    fail_if,
                 },
                 text: format!(
-                    "wait until {}{shown_mask} == 0x{equals:04X} (at most {timeout_ms} ms)",
-                    object_name(dict, index, sub)
+                    "wait until {}{shown_mask} == 0x{equals:04X} (at most {timeout_ms} ms{})",
+                    object_name(dict, index, sub),
+                    fails_on
                 ),
                 value: Some(equals),
                 frame: Some(candump(&upload_request(node, index, sub))),
@@ -440,9 +453,19 @@ pub async fn run(
     }
     let n = plan.steps.len();
     let mut done = Vec::with_capacity(n);
+    // The mode of operation the run set (6060h), so that statusword bits read back are named for it.
+    let mut mode: Option<i8> = None;
     for (k, s) in (1..).zip(&plan.steps) {
         progress(&s.line(k, n));
-        match run_step(bus, dict, plan.node, s, (k, n), timeout_ms).await {
+        if let Action::SdoWrite {
+            index: 0x6060,
+            sub: 0,
+            data,
+        } = &s.action
+        {
+            mode = data.first().map(|m| *m as i8);
+        }
+        match run_step(bus, dict, plan.node, s, (k, n), timeout_ms, mode).await {
             Ok((result, text)) => {
                 progress(&format!("  -> {text}"));
                 done.push(step_json(s, k, result));
@@ -471,6 +494,7 @@ async fn run_step(
     s: &PlannedStep,
     (k, n): (usize, usize),
     timeout_ms: u64,
+    mode: Option<i8>,
 ) -> Result<(Json, String), CommandError> {
     Ok(match &s.action {
         Action::SdoWrite { index, sub, data } => {
@@ -479,7 +503,7 @@ async fn run_step(
         }
         Action::SdoRead { index, sub, ty } => {
             let data = super::sdo::upload(bus, node, *index, *sub, false, timeout_ms).await?;
-            let text = read_text(dict, *index, *sub, *ty, &data);
+            let text = read_text(dict, *index, *sub, *ty, &data, mode);
             (
                 json!({"value": decode(&data, *ty).to_json(), "text": text, "data": hex::upper(&data)}),
                 text,
@@ -504,13 +528,23 @@ async fn run_step(
             mask,
             equals,
             timeout_ms: limit,
+            fail_if,
         } => {
             let start = tokio::time::Instant::now();
             let limit_d = Duration::from_millis(u64::from(*limit));
             loop {
                 let data = super::sdo::upload(bus, node, *index, *sub, false, timeout_ms).await?;
                 let v = decode(&data, *ty).as_i64().unwrap_or(0);
-                let text = read_text(dict, *index, *sub, *ty, &data);
+                let text = read_text(dict, *index, *sub, *ty, &data, mode);
+                if let Some((fail_mask, fail_equals, what)) = fail_if
+                    && v & fail_mask == *fail_equals
+                {
+                    return Err(CommandError::Drive {
+                        node,
+                        step: format!("step {k}/{n} ({})", s.text),
+                        reason: format!("{what}; read {text}"),
+                    });
+                }
                 if v & mask == *equals {
                     let ms = start.elapsed().as_millis();
                     return Ok((
@@ -531,8 +565,8 @@ async fn run_step(
     })
 }
 
-fn read_text(dict: &Dictionary, index: u16, sub: u8, ty: Option<DataType>, data: &[u8]) -> String {
-    let shown = object_text(dict, index, sub, &decode(data, ty), None);
+fn read_text(dict: &Dictionary, index: u16, sub: u8, ty: Option<DataType>, data: &[u8], mode: Option<i8>) -> String {
+    let shown = object_text(dict, index, sub, &decode(data, ty), mode);
     format!("0x{index:04X}:{sub:02X} = {shown}")
 }
 

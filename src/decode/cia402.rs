@@ -1,5 +1,7 @@
 //! CiA 402 drive profile: controlword, statusword and modes of operation.
 
+use crate::od::ObjectInfo;
+
 /// Drive state decoded from a statusword (CiA 402 table 30).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum DriveState {
@@ -62,7 +64,7 @@ pub fn statusword_is_valid(sw: u16) -> bool {
     matches!(sw & 0x4F, 0x00 | 0x40 | 0x0F | 0x08) || matches!(sw & 0x6F, 0x21 | 0x23 | 0x27 | 0x07)
 }
 
-/// Statusword bit names 0..=15 (bits 12/13 depend on the mode and are named by [`mode_bits`]).
+/// Statusword bit names 0..=15 (bits 10, 12 and 13 depend on the mode and are named by [`status_mode_bits`]).
 const STATUS_BITS: [&str; 16] = [
     "ready to switch on",
     "switched on",
@@ -82,43 +84,87 @@ const STATUS_BITS: [&str; 16] = [
     "manufacturer 15",
 ];
 
-/// Names of statusword bits 10, 12 and 13 in a mode of operation.
-fn mode_bits(mode: Option<i8>) -> [&'static str; 3] {
-    match mode {
-        Some(1) => ["target reached", "set-point acknowledge", "following error"],
-        Some(3) => ["target reached", "speed is zero", "max slippage error"],
-        Some(4) => ["target reached", "mode bit 12", "mode bit 13"],
-        Some(6) => ["target reached", "homing attained", "homing error"],
-        Some(7) => ["target reached", "ip mode active", "mode bit 13"],
-        Some(8) => ["status toggle", "drive follows command value", "following error"],
-        Some(9) | Some(10) => ["status toggle", "drive follows command value", "mode bit 13"],
-        _ => ["target reached", "mode bit 12", "mode bit 13"],
-    }
+/// The profile's texts for a controlword or statusword (`values` for whole words,
+/// `bits` for single bits); `None` when the dictionary has no entry.
+pub type WordTexts<'a> = Option<&'a ObjectInfo>;
+
+/// Names of statusword bits 10, 12 and 13 in a mode of operation (CiA 402-2), `None`
+/// when the mode is unknown.
+fn status_mode_bits(mode: Option<i8>) -> Option<[&'static str; 3]> {
+    Some(match mode? {
+        1 => ["target reached", "set-point acknowledge", "following error"],
+        3 => ["target reached", "speed is zero", "max slippage error"],
+        4 => [
+            "target reached",
+            "mode bit 12 (reserved in PT)",
+            "mode bit 13 (reserved in PT)",
+        ],
+        6 => ["target reached", "homing attained", "homing error"],
+        7 => ["target reached", "ip mode active", "mode bit 13 (reserved in IP)"],
+        8 => [
+            "bit 10 (reserved in CSP)",
+            "drive follows the command value",
+            "following error",
+        ],
+        9 => [
+            "bit 10 (reserved in CSV)",
+            "drive follows the command value",
+            "mode bit 13 (reserved in CSV)",
+        ],
+        10 => [
+            "bit 10 (reserved in CST)",
+            "drive follows the command value",
+            "mode bit 13 (reserved in CST)",
+        ],
+        _ => return None,
+    })
 }
 
-/// Names of the statusword bits that are set, in bit order.
-pub fn statusword_bits(sw: u16, mode: Option<i8>) -> Vec<&'static str> {
-    let m = mode_bits(mode);
-    (0..16)
+/// The name of a bit from the profile's `bits`, else `fallback`.
+fn profile_bit(texts: WordTexts<'_>, bit: u8, fallback: &str) -> String {
+    texts
+        .and_then(|i| i.bits.get(&bit))
+        .cloned()
+        .unwrap_or_else(|| fallback.to_string())
+}
+
+/// Names of the statusword bits that are set, in bit order: bits 10/12/13 per the mode in
+/// force, else the profile's bit names, else `mode bit N`. In the cyclic synchronous modes an
+/// enabled drive with bit 12 clear also shows `target ignored`.
+pub fn statusword_bits(sw: u16, mode: Option<i8>, texts: WordTexts<'_>) -> Vec<String> {
+    let m = status_mode_bits(mode);
+    let mut out: Vec<String> = (0..16u8)
         .filter(|b| sw & (1 << b) != 0)
-        .map(|b| match b {
-            10 => m[0],
-            12 => m[1],
-            13 => m[2],
-            _ => STATUS_BITS[b],
+        .map(|b| match (b, m) {
+            (10, Some(m)) => m[0].to_string(),
+            (12, Some(m)) => m[1].to_string(),
+            (13, Some(m)) => m[2].to_string(),
+            (12 | 13, None) => profile_bit(texts, b, STATUS_BITS[b as usize]),
+            _ => STATUS_BITS[b as usize].to_string(),
         })
-        .collect()
+        .collect();
+    if matches!(mode, Some(8..=10))
+        && sw & (1 << 12) == 0
+        && DriveState::from_statusword(sw) == DriveState::OperationEnabled
+    {
+        out.push("target ignored".to_string());
+    }
+    out
 }
 
 /// Statusword meaning: `Operation enabled [ready to switch on, ...]`.
-pub fn describe_statusword(sw: u16, mode: Option<i8>) -> String {
+pub fn describe_statusword(sw: u16, mode: Option<i8>, texts: WordTexts<'_>) -> String {
     let state = DriveState::from_statusword(sw);
     let valid = if statusword_is_valid(sw) {
         ""
     } else {
         " (invalid state bits)"
     };
-    format!("{}{valid} [{}]", state.text(), statusword_bits(sw, mode).join(", "))
+    format!(
+        "{}{valid} [{}]",
+        state.text(),
+        statusword_bits(sw, mode, texts).join(", ")
+    )
 }
 
 /// The device control command a controlword encodes (CiA 402 table 29).
@@ -138,33 +184,76 @@ pub fn controlword_command(cw: u16) -> &'static str {
     }
 }
 
-/// Names of controlword bits 4, 5, 6 and 9 in a mode of operation.
-fn control_mode_bits(mode: Option<i8>) -> [&'static str; 4] {
-    match mode {
-        Some(1) => [
+/// Names of controlword bits 4, 5, 6 and 9 in a mode of operation (CiA 402-2), `None`
+/// when the mode is unknown.
+fn control_mode_bits(mode: Option<i8>) -> Option<[&'static str; 4]> {
+    Some(match mode? {
+        1 => [
             "new set-point",
             "change set immediately",
             "relative",
             "change on set-point",
         ],
-        Some(6) => ["homing start", "mode bit 5", "mode bit 6", "mode bit 9"],
-        Some(7) => ["enable ip mode", "mode bit 5", "mode bit 6", "mode bit 9"],
-        _ => ["mode bit 4", "mode bit 5", "mode bit 6", "mode bit 9"],
-    }
+        3 => [
+            "mode bit 4 (reserved in PV)",
+            "mode bit 5 (reserved in PV)",
+            "mode bit 6 (reserved in PV)",
+            "mode bit 9 (reserved in PV)",
+        ],
+        4 => [
+            "mode bit 4 (reserved in PT)",
+            "mode bit 5 (reserved in PT)",
+            "mode bit 6 (reserved in PT)",
+            "mode bit 9 (reserved in PT)",
+        ],
+        6 => [
+            "start homing",
+            "mode bit 5 (reserved in HM)",
+            "mode bit 6 (reserved in HM)",
+            "mode bit 9 (reserved in HM)",
+        ],
+        7 => ["enable ip mode", "mode bit 5", "mode bit 6", "mode bit 9"],
+        8..=10 => [
+            "mode bit 4 (reserved in CSP/CSV/CST)",
+            "mode bit 5 (reserved in CSP/CSV/CST)",
+            "mode bit 6 (reserved in CSP/CSV/CST)",
+            "mode bit 9 (reserved in CSP/CSV/CST)",
+        ],
+        _ => return None,
+    })
 }
 
-/// Controlword meaning: `Enable operation [new set-point, halt]`.
-pub fn describe_controlword(cw: u16, mode: Option<i8>) -> String {
+/// Controlword meaning: `Enable operation [new set-point, halt]`. The command is the
+/// profile's text for this exact value when it has one (Syn-tron 0x005F `Enable operation,
+/// start relative (bits 4, 6)`), else the CiA 402 command. Bits 4/5/6/9 are named per the
+/// mode in force; with the mode unknown, a profile text for the value already says what
+/// they do, else the profile's bit names (else `mode bit N`) are shown.
+pub fn describe_controlword(cw: u16, mode: Option<i8>, texts: WordTexts<'_>) -> String {
+    let value_text = texts.and_then(|i| i.values.get(&i64::from(cw)));
     let m = control_mode_bits(mode);
-    let extra: Vec<&str> = [(4, m[0]), (5, m[1]), (6, m[2]), (8, "halt"), (9, m[3])]
+    let extra: Vec<String> = [4u8, 5, 6, 8, 9]
         .iter()
-        .filter(|(b, _)| cw & (1 << b) != 0)
-        .map(|(_, n)| *n)
+        .filter(|b| cw & (1 << *b) != 0)
+        .filter_map(|&b| {
+            let k = match b {
+                4 => 0,
+                5 => 1,
+                6 => 2,
+                9 => 3,
+                _ => return Some("halt".to_string()),
+            };
+            match m {
+                Some(m) => Some(m[k].to_string()),
+                None if value_text.is_some() => None,
+                None => Some(profile_bit(texts, b, &format!("mode bit {b}"))),
+            }
+        })
         .collect();
+    let command = value_text.map_or(controlword_command(cw), String::as_str);
     if extra.is_empty() {
-        controlword_command(cw).to_string()
+        command.to_string()
     } else {
-        format!("{} [{}]", controlword_command(cw), extra.join(", "))
+        format!("{command} [{}]", extra.join(", "))
     }
 }
 
@@ -186,23 +275,29 @@ pub fn mode_name(mode: i8) -> &'static str {
     }
 }
 
-/// CiA 402 meaning of a value of a known object, when it has one.
-pub fn describe(index: u16, sub: u8, raw: i64, mode: Option<i8>) -> Option<String> {
+/// CiA 402 meaning of a value of a known object, when it has one; `texts` are the
+/// dictionary's entry for the object (profile value and bit texts).
+pub fn describe(index: u16, sub: u8, raw: i64, mode: Option<i8>, texts: WordTexts<'_>) -> Option<String> {
     if sub != 0 {
         return None;
     }
     match index {
-        0x6040 => Some(describe_controlword(raw as u16, mode)),
-        0x6041 => Some(describe_statusword(raw as u16, mode)),
-        0x6060 | 0x6061 => Some(mode_name(raw as i8).to_string()),
+        0x6040 => Some(describe_controlword(raw as u16, mode, texts)),
+        0x6041 => Some(describe_statusword(raw as u16, mode, texts)),
+        0x6060 | 0x6061 => Some(
+            texts
+                .and_then(|i| i.values.get(&i64::from(raw as i8)))
+                .cloned()
+                .unwrap_or_else(|| mode_name(raw as i8).to_string()),
+        ),
         _ => None,
     }
 }
 
 /// A value of a CiA 402 word as labels show it: `0x0237 (Operation enabled [...])`,
 /// `3 (Profile velocity)`; `None` for other objects.
-pub fn value_text(index: u16, sub: u8, raw: i64, mode: Option<i8>) -> Option<String> {
-    let meaning = describe(index, sub, raw, mode)?;
+pub fn value_text(index: u16, sub: u8, raw: i64, mode: Option<i8>, texts: WordTexts<'_>) -> Option<String> {
+    let meaning = describe(index, sub, raw, mode, texts)?;
     Some(match index {
         0x6060 | 0x6061 => format!("{} ({meaning})", raw as i8),
         _ => format!("0x{:04X} ({meaning})", raw as u16),
@@ -232,42 +327,86 @@ mod tests {
     #[test]
     fn statusword_text() {
         assert_eq!(
-            describe_statusword(0x0237, None),
+            describe_statusword(0x0237, None, None),
             "Operation enabled [ready to switch on, switched on, operation enabled, voltage enabled, quick stop, remote]"
         );
         assert_eq!(
-            describe_statusword(0x1637, Some(1)),
+            describe_statusword(0x1637, Some(1), None),
             "Operation enabled [ready to switch on, switched on, operation enabled, voltage enabled, quick stop, remote, target reached, set-point acknowledge]"
         );
-        assert_eq!(describe_statusword(0x0088, None), "Fault [fault, warning]");
+        assert_eq!(describe_statusword(0x0088, None, None), "Fault [fault, warning]");
         assert_eq!(
-            describe_statusword(0x0001, None),
+            describe_statusword(0x0001, None, None),
             "Not ready to switch on (invalid state bits) [ready to switch on]"
         );
     }
 
     #[test]
     fn controlword_commands() {
-        assert_eq!(describe_controlword(0x06, None), "Shutdown");
-        assert_eq!(describe_controlword(0x07, None), "Switch on / Disable operation");
-        assert_eq!(describe_controlword(0x0F, None), "Enable operation");
-        assert_eq!(describe_controlword(0x1F, Some(1)), "Enable operation [new set-point]");
+        assert_eq!(describe_controlword(0x06, None, None), "Shutdown");
+        assert_eq!(describe_controlword(0x07, None, None), "Switch on / Disable operation");
+        assert_eq!(describe_controlword(0x0F, None, None), "Enable operation");
         assert_eq!(
-            describe_controlword(0x5F, Some(1)),
+            describe_controlword(0x1F, Some(1), None),
+            "Enable operation [new set-point]"
+        );
+        assert_eq!(
+            describe_controlword(0x5F, Some(1), None),
             "Enable operation [new set-point, relative]"
         );
-        assert_eq!(describe_controlword(0x1F, Some(6)), "Enable operation [homing start]");
-        assert_eq!(describe_controlword(0x80, None), "Fault reset");
-        assert_eq!(describe_controlword(0x02, None), "Quick stop");
-        assert_eq!(describe_controlword(0x00, None), "Disable voltage");
-        assert_eq!(describe_controlword(0x010F, None), "Enable operation [halt]");
+        assert_eq!(
+            describe_controlword(0x1F, Some(6), None),
+            "Enable operation [start homing]"
+        );
+        assert_eq!(describe_controlword(0x80, None, None), "Fault reset");
+        assert_eq!(describe_controlword(0x02, None, None), "Quick stop");
+        assert_eq!(describe_controlword(0x00, None, None), "Disable voltage");
+        assert_eq!(describe_controlword(0x010F, None, None), "Enable operation [halt]");
+    }
+
+    #[test]
+    fn profile_texts_stand_in_when_the_mode_is_unknown() {
+        let mut info = ObjectInfo::default();
+        info.bits
+            .insert(4, "Operation mode specific (new set-point / homing start)".into());
+        info.bits.insert(
+            12,
+            "Operation mode specific (set-point acknowledge / homing attained)".into(),
+        );
+        info.values
+            .insert(0x5F, "Enable operation, start relative (bits 4, 6)".into());
+        let texts = Some(&info);
+        assert_eq!(
+            describe_controlword(0x1F, None, texts),
+            "Enable operation [Operation mode specific (new set-point / homing start)]"
+        );
+        assert_eq!(
+            describe_controlword(0x5F, None, texts),
+            "Enable operation, start relative (bits 4, 6)"
+        );
+        assert_eq!(
+            describe_controlword(0x5F, Some(1), texts),
+            "Enable operation, start relative (bits 4, 6) [new set-point, relative]"
+        );
+        assert_eq!(
+            describe_statusword(0x1237, None, texts),
+            "Operation enabled [ready to switch on, switched on, operation enabled, voltage enabled, quick stop, remote, Operation mode specific (set-point acknowledge / homing attained)]"
+        );
+        // Without profile texts: `mode bit N`.
+        assert_eq!(describe_controlword(0x1F, None, None), "Enable operation [mode bit 4]");
+        // Cyclic modes: bit 12 clear while enabled means the target is ignored.
+        assert!(describe_statusword(0x0237, Some(9), None).ends_with("remote, target ignored]"));
+        assert_eq!(describe(0x6061, 0, 6, None, Some(&info)).unwrap(), "Homing");
     }
 
     #[test]
     fn modes() {
         assert_eq!(mode_name(3), "Profile velocity");
         assert_eq!(mode_name(-1), "Manufacturer-specific mode");
-        assert_eq!(describe(0x6060, 0, 8, None).unwrap(), "Cyclic synchronous position");
-        assert_eq!(describe(0x6041, 1, 8, None), None);
+        assert_eq!(
+            describe(0x6060, 0, 8, None, None).unwrap(),
+            "Cyclic synchronous position"
+        );
+        assert_eq!(describe(0x6041, 1, 8, None, None), None);
     }
 }

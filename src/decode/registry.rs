@@ -6,7 +6,7 @@ use super::cob_id::{CobId, CobTable, Route};
 use super::heartbeat::Heartbeat;
 use super::pdo::{self, Pdo};
 use super::sdo::{SdoFrame, SdoTracker, Transaction};
-use super::{Kind, emcy, error_frame, heartbeat, lss, nmt, sync, time, vendor_sdo};
+use super::{Kind, emcy, error_frame, heartbeat, lss, nmt, sync, time, value_text, vendor_sdo};
 use crate::frame::Frame;
 use crate::od::{Dictionary, MappingSource, PdoMapping, resolve_object};
 use std::collections::HashMap;
@@ -237,10 +237,18 @@ impl Decoder {
             Kind::Tpdo | Kind::Rpdo => self.decode_pdo(frame, route),
             Kind::SdoRx | Kind::SdoTx => {
                 let c2s = route.kind == Kind::SdoRx;
-                let s = self
+                let mut s = self
                     .sdo
                     .on_frame(self.seq, frame.ts_ns, n, c2s, payload, &self.dicts[n as usize]);
-                for t in self.sdo.take_completed() {
+                // Controlword and statusword bits are named per the node's mode in force.
+                if let (Some(mode), Some((index @ (0x6040 | 0x6041), 0)), Some(v)) =
+                    (self.modes[n as usize], s.object, s.value.as_mut())
+                    && let Some(typed) = &v.typed
+                {
+                    v.text = value_text::object_text(&self.dicts[n as usize], index, 0, typed, Some(mode));
+                }
+                for mut t in self.sdo.take_completed() {
+                    t.mode = self.modes[(t.node & 0x7F) as usize];
                     self.learn(&t);
                     self.completed.push(t);
                 }
@@ -464,7 +472,10 @@ impl Decoder {
     /// Ends the input: returns completed transactions plus those left incomplete.
     pub fn finish(&mut self) -> Vec<Transaction> {
         let mut all = std::mem::take(&mut self.completed);
-        all.extend(self.sdo.finish());
+        all.extend(self.sdo.finish().into_iter().map(|mut t| {
+            t.mode = self.modes[(t.node & 0x7F) as usize];
+            t
+        }));
         all
     }
 }

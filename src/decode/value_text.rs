@@ -1,18 +1,49 @@
 //! How an object value is shown wherever it appears (SDO or PDO): CiA 402
 //! meaning, communication parameter meaning, else enum text / scaled value.
 
-use crate::od::{Dictionary, Value, format_value};
+use crate::od::{Dictionary, ObjectInfo, Value, format_value};
 
 /// The text of `value` of object (index, sub) on a node with dictionary `dict`
 /// and mode of operation `mode`.
 pub fn object_text(dict: &Dictionary, index: u16, sub: u8, value: &Value, mode: Option<i8>) -> String {
     if let Some(raw) = value.as_i64() {
-        if let Some(t) = super::cia402::value_text(index, sub, raw, mode) {
+        if let Some(t) = super::cia402::value_text(index, sub, raw, mode, dict.object(index, sub)) {
             return t;
         }
         if let Some(t) = super::comm_params::describe(index, sub, raw as u64, dict) {
             return t;
         }
+        if let Some(info) = dict.object(index, sub).filter(|i| !i.fields.is_empty()) {
+            return split(dict, info, raw);
+        }
     }
     format_value(dict.object(index, sub), value)
+}
+
+/// A structured value split into its fields: `0x00020064 (node 2, time 100 ms)`,
+/// `0x00052310 (error code 0x2310 Continuous over-current, M1 alarm 0x05, M2 alarm 0x00)`.
+fn split(dict: &Dictionary, info: &ObjectInfo, raw: i64) -> String {
+    let bytes = raw.to_le_bytes();
+    let parts: Vec<String> = info
+        .fields
+        .iter()
+        .filter_map(|f| {
+            let v = f.raw(&bytes)?;
+            let shown = if f.emcy {
+                let code = v as u16;
+                let text = dict.emcy_text(code).unwrap_or_else(|| super::emcy::code_text(code));
+                format!("0x{code:04X} {text}")
+            } else {
+                f.format(v)
+            };
+            Some(format!("{} {shown}", f.name))
+        })
+        .collect();
+    let width = 2 * info.data_type.size().unwrap_or(4);
+    let masked = if width >= 16 {
+        raw as u64
+    } else {
+        raw as u64 & ((1u64 << (4 * width)) - 1)
+    };
+    format!("0x{masked:0width$X} ({})", parts.join(", "))
 }

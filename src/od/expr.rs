@@ -80,8 +80,12 @@ impl Expr {
     /// Parses `text`; the error says what is wrong and at which character.
     pub fn parse(text: &str) -> Result<Expr, String> {
         let toks = tokenize(text)?;
-        let mut p = Parser { toks: &toks, pos: 0 };
-        let node = p.conditional()?;
+        let mut p = Parser {
+            toks: &toks,
+            pos: 0,
+            depth: 0,
+        };
+        let (node, _) = p.conditional()?;
         if p.pos < toks.len() {
             return Err(format!("unexpected {:?} in expression `{text}`", toks[p.pos]));
         }
@@ -286,46 +290,84 @@ pub fn parse_int(text: &str) -> Option<i64> {
     }
 }
 
+/// How deep an expression may nest: parentheses, unary operators, `?:` branches and
+/// operator chains each count one level. Profiles need a handful; the limit keeps parsing,
+/// evaluating and dropping far from the end of the stack.
+pub const MAX_DEPTH: usize = 200;
+
+fn too_deep() -> String {
+    format!("expression nests deeper than {MAX_DEPTH} levels (parentheses, unary operators, `?:` or operator chains)")
+}
+
 struct Parser<'a> {
     toks: &'a [Tok],
     pos: usize,
+    /// Levels of recursion now open.
+    depth: usize,
 }
+
+/// A parsed node and its height (1 for a leaf).
+type Parsed = (Node, usize);
 
 impl Parser<'_> {
     fn peek(&self) -> Option<&Tok> {
         self.toks.get(self.pos)
     }
 
-    fn conditional(&mut self) -> Result<Node, String> {
-        let c = self.binary(0)?;
-        if self.peek() == Some(&Tok::Question) {
+    /// Opens one level of recursion; an error past [`MAX_DEPTH`].
+    fn enter(&mut self) -> Result<(), String> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            Err(too_deep())
+        } else {
+            Ok(())
+        }
+    }
+
+    fn conditional(&mut self) -> Result<Parsed, String> {
+        self.enter()?;
+        let (c, hc) = self.binary(0)?;
+        let out = if self.peek() == Some(&Tok::Question) {
             self.pos += 1;
-            let a = self.conditional()?;
+            let (a, ha) = self.conditional()?;
             if self.peek() != Some(&Tok::Colon) {
                 return Err("expected `:` after `?` branch".to_string());
             }
             self.pos += 1;
-            let b = self.conditional()?;
-            return Ok(Node::Cond(Box::new(c), Box::new(a), Box::new(b)));
-        }
-        Ok(c)
+            let (b, hb) = self.conditional()?;
+            let h = hc.max(ha).max(hb) + 1;
+            if h > MAX_DEPTH {
+                return Err(too_deep());
+            }
+            (Node::Cond(Box::new(c), Box::new(a), Box::new(b)), h)
+        } else {
+            (c, hc)
+        };
+        self.depth -= 1;
+        Ok(out)
     }
 
-    fn binary(&mut self, min_power: u8) -> Result<Node, String> {
-        let mut left = self.unary()?;
+    fn binary(&mut self, min_power: u8) -> Result<Parsed, String> {
+        self.enter()?;
+        let (mut left, mut height) = self.unary()?;
         while let Some(Tok::Op(op)) = self.peek() {
             let op = *op;
             if op.power() <= min_power {
                 break;
             }
             self.pos += 1;
-            let right = self.binary(op.power())?;
+            let (right, hr) = self.binary(op.power())?;
+            height = height.max(hr) + 1;
+            if height > MAX_DEPTH {
+                return Err(too_deep());
+            }
             left = Node::Binary(op, Box::new(left), Box::new(right));
         }
-        Ok(left)
+        self.depth -= 1;
+        Ok((left, height))
     }
 
-    fn unary(&mut self) -> Result<Node, String> {
+    fn unary(&mut self) -> Result<Parsed, String> {
         let op = match self.peek() {
             Some(Tok::Op(Op::Sub)) => '-',
             Some(Tok::Op(Op::Add)) => '+',
@@ -334,20 +376,22 @@ impl Parser<'_> {
             _ => return self.primary(),
         };
         self.pos += 1;
-        let inner = self.unary()?;
+        self.enter()?;
+        let (inner, h) = self.unary()?;
+        self.depth -= 1;
         Ok(if op == '+' {
-            inner
+            (inner, h)
         } else {
-            Node::Unary(op, Box::new(inner))
+            (Node::Unary(op, Box::new(inner)), h + 1)
         })
     }
 
-    fn primary(&mut self) -> Result<Node, String> {
+    fn primary(&mut self) -> Result<Parsed, String> {
         let tok = self.peek().cloned();
         self.pos += 1;
         match tok {
-            Some(Tok::Num(v)) => Ok(Node::Num(v)),
-            Some(Tok::Ident(name)) => Ok(Node::Var(name)),
+            Some(Tok::Num(v)) => Ok((Node::Num(v), 1)),
+            Some(Tok::Ident(name)) => Ok((Node::Var(name), 1)),
             Some(Tok::Open) => {
                 let inner = self.conditional()?;
                 if self.peek() != Some(&Tok::Close) {
@@ -400,6 +444,24 @@ mod tests {
         assert!(Expr::parse("2 $ 3").unwrap_err().contains("`$`"));
         assert!(Expr::parse("0xZZ").is_err());
         assert!(ev("1 << 64", &[]).is_err());
+    }
+
+    #[test]
+    fn deep_nesting_is_an_error_not_a_stack_overflow() {
+        let parens = format!("{}1{}", "(".repeat(20_000), ")".repeat(20_000));
+        let minus = format!("{}1", "-".repeat(100_000));
+        let nots = format!("{}1", "!~".repeat(50_000));
+        let conds = format!("{}0", "1 ? 0 : ".repeat(20_000));
+        let chain = format!("1{}", " + 1".repeat(100_000));
+        for text in [&parens, &minus, &nots, &conds, &chain] {
+            let e = Expr::parse(text).unwrap_err();
+            assert!(e.contains("nests deeper than 200 levels"), "{e}");
+        }
+        // Reasonable nesting still parses.
+        assert_eq!(ev(&format!("{}1{}", "(".repeat(50), ")".repeat(50)), &[]), Ok(1));
+        assert_eq!(ev(&format!("{}1", "-".repeat(100)), &[]), Ok(1));
+        assert_eq!(ev(&format!("{}7", "0 ? 1 : ".repeat(40)), &[]), Ok(7));
+        assert_eq!(ev(&format!("0{}", " + 1".repeat(150)), &[]), Ok(150));
     }
 
     #[test]

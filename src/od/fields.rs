@@ -18,6 +18,9 @@ pub struct ByteField {
     pub signed: bool,
     /// Show the raw value in hex.
     pub hex: bool,
+    /// The value is an EMCY error code (`"format": "emcy"`): shown in hex with the code's
+    /// text from the node's dictionary (fields of object values only).
+    pub emcy: bool,
     /// Texts for raw values.
     pub values: BTreeMap<i64, String>,
     /// Unit of raw * scale.

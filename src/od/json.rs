@@ -14,7 +14,7 @@ use serde_json::Value as Json;
 use super::alias::{AliasRule, parse_object_ref};
 use super::expr::{Expr, parse_int};
 use super::fields::{ByteField, SdoCommand, SdoDirection};
-use super::procedure::{NmtCommand, ProcParam, Procedure, Step, parse_frame_data};
+use super::procedure::{FailIf, NmtCommand, ProcParam, Procedure, Step, object_variables, parse_frame_data};
 use super::{
     Axis, IdCondition, IdTest, IndexRange, MappingSource, ObjectInfo, PdoMappable, PdoSet, PdoTemplate, Profile,
     TextMatch, Warning,
@@ -332,29 +332,41 @@ impl Cx<'_> {
         if e.data_type.is_some() || e.access.is_some() || !e.values.is_empty() || e.unit.is_some() {
             self.warn(at, "type/access/unit/values of a record belong on its subs, ignored");
         }
-        let mut entries = Vec::new();
-        for (key, s) in subs {
+        // Ranges first, then single subs: a single sub wins over a range that covers it.
+        // Two ranges, or two single keys, giving the same sub cannot be resolved.
+        let (ranges, singles): (Vec<_>, Vec<_>) = subs.into_iter().partition(|(k, _)| k.contains(".."));
+        let mut entries: BTreeMap<u8, (ObjectInfo, bool, String)> = BTreeMap::new();
+        for (key, s) in ranges.into_iter().chain(singles) {
             let at = format!("{at}.subs.{key}");
             let Some(range) = self.ok(&at, sub_range(&key)) else {
                 continue;
             };
+            let single = !key.contains("..");
+            if let Some((_, _, other)) = range
+                .clone()
+                .find_map(|n| entries.get(&n).filter(|(_, was_single, _)| *was_single == single))
+            {
+                let what = if single { "sub" } else { "range" };
+                self.warn(&at, format!("{what} `{key}` overlaps `{other}`, skipped"));
+                continue;
+            }
             if s.subs.is_some() {
                 self.warn(&format!("{at}.subs"), "subs cannot nest, ignored");
             }
             let Some(info) = self.entry(&at, s) else { continue };
-            for n in range.clone() {
+            for n in range {
                 let mut info = info.clone();
-                if key.contains("..") {
+                if !single {
                     info.name = info.name.replace("{n}", &n.to_string());
                 }
-                entries.push((n, info));
+                entries.insert(n, (info, single, key.clone()));
             }
         }
         Built {
             record: true,
             name: e.name,
             alias: e.alias,
-            entries,
+            entries: entries.into_iter().map(|(n, (info, _, _))| (n, info)).collect(),
         }
     }
 
@@ -425,6 +437,21 @@ impl Cx<'_> {
         if let Some(m) = &e.max {
             info.max = self.ok(&format!("{at}.max"), int(m));
         }
+        for (i, f) in e.fields.into_iter().enumerate() {
+            let at = format!("{at}.fields.{i}");
+            if f.object.is_some() || f.object_sub.is_some() {
+                self.warn(&at, "`object` only applies to sdo_commands fields, ignored");
+            }
+            if let Some(field) = self.field(&at, f, &[]) {
+                match info.data_type.size() {
+                    Some(n) if usize::from(field.offset + field.length) <= n => info.fields.push(field),
+                    _ => self.warn(
+                        &at,
+                        format!("field does not fit the {:?} value, skipped", info.data_type),
+                    ),
+                }
+            }
+        }
         Some(info)
     }
 
@@ -481,12 +508,16 @@ impl Cx<'_> {
             );
             return None;
         }
-        let hex = match f.format.as_deref().map(str::to_ascii_lowercase).as_deref() {
-            None | Some("dec") => false,
-            Some("hex") => true,
+        let (hex, emcy) = match f.format.as_deref().map(str::to_ascii_lowercase).as_deref() {
+            None | Some("dec") => (false, false),
+            Some("hex") => (true, false),
+            Some("emcy") => (true, true),
             Some(other) => {
-                self.warn(&format!("{at}.format"), format!("unknown format `{other}` (dec, hex)"));
-                false
+                self.warn(
+                    &format!("{at}.format"),
+                    format!("unknown format `{other}` (dec, hex, emcy)"),
+                );
+                (false, false)
             }
         };
         let mut values = BTreeMap::new();
@@ -522,6 +553,7 @@ impl Cx<'_> {
             length: length as u8,
             signed: f.signed,
             hex,
+            emcy,
             values,
             unit: f.unit,
             scale,
@@ -713,6 +745,15 @@ impl Cx<'_> {
 }
 
 fn step(d: StepDto) -> Result<Step, String> {
+    if let StepDto::SdoWrite { object, .. } | StepDto::SdoRead { object } = &d {
+        object_variables(object)?;
+    }
+    if let StepDto::Wait {
+        object: Some(object), ..
+    } = &d
+    {
+        object_variables(object)?;
+    }
     Ok(match d {
         StepDto::SdoWrite {
             object,
@@ -744,7 +785,17 @@ fn step(d: StepDto) -> Result<Step, String> {
             mask,
             equals,
             timeout_ms,
+            fail_if,
         } => Step::Wait {
+            fail_if: fail_if
+                .map(|f| -> Result<FailIf, String> {
+                    Ok(FailIf {
+                        mask: f.mask.as_ref().map(expr).transpose()?.unwrap_or(Expr::constant(-1)),
+                        equals: expr(&f.equals)?,
+                        text: f.text,
+                    })
+                })
+                .transpose()?,
             object: object.unwrap_or_else(|| "0x6041".to_string()),
             mask: mask.as_ref().map(expr).transpose()?.unwrap_or(Expr::constant(-1)),
             equals: expr(&equals)?,

@@ -88,6 +88,9 @@ pub struct ObjectInfo {
     pub max: Option<i64>,
     /// Longer help text.
     pub description: Option<String>,
+    /// Parts of a structured value (bytes of its little-endian encoding), e.g. 0x1016's
+    /// node-ID and heartbeat time, 0x1003's error code and manufacturer information.
+    pub fields: Vec<fields::ByteField>,
 }
 
 /// Whether an object may be mapped into PDOs.

@@ -61,10 +61,51 @@ pub enum FrameItem {
     Value(DataType, Expr),
 }
 
+/// Splits an object text into literal pieces and `{EXPR}` placeholders
+/// (`"{page}-{number}"`, `"0x3000:{sub}"`).
+fn object_pieces(text: &str) -> Result<Vec<Result<&str, Expr>>, String> {
+    let mut out = Vec::new();
+    let mut rest = text;
+    while let Some(open) = rest.find('{') {
+        out.push(Ok(&rest[..open]));
+        let after = &rest[open + 1..];
+        let end = after
+            .find('}')
+            .ok_or_else(|| format!("missing `}}` in object `{text}`"))?;
+        out.push(Err(Expr::parse(&after[..end])?));
+        rest = &after[end + 1..];
+    }
+    out.push(Ok(rest));
+    Ok(out)
+}
+
+/// Checks the `{EXPR}` placeholders of a step's object text; gives the variables they use.
+pub fn object_variables(text: &str) -> Result<Vec<String>, String> {
+    Ok(object_pieces(text)?
+        .into_iter()
+        .filter_map(Result::err)
+        .flat_map(|e| e.variables().into_iter().map(str::to_string).collect::<Vec<_>>())
+        .collect())
+}
+
+/// A step's object text with each `{EXPR}` replaced by its value in decimal, e.g.
+/// `"{page}-{number}"` with page 3, number 1 gives `"3-1"` (then resolved like typed text).
+pub fn fill_object(text: &str, vars: &dyn Fn(&str) -> Option<i64>) -> Result<String, String> {
+    let mut out = String::new();
+    for piece in object_pieces(text)? {
+        match piece {
+            Ok(literal) => out.push_str(literal),
+            Err(e) => out.push_str(&e.eval(vars)?.to_string()),
+        }
+    }
+    Ok(out)
+}
+
 /// One step of a procedure.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Step {
-    /// Write `value` to an object (text as typed: index, alias or name).
+    /// Write `value` to an object (text as typed: index, alias or name; `{EXPR}` in it is
+    /// replaced by the value, see [`fill_object`]).
     SdoWrite {
         object: String,
         value: Expr,
@@ -74,17 +115,30 @@ pub enum Step {
     SdoRead { object: String },
     /// Send an NMT command to `node` (the target node when `None`; 0 = all).
     Nmt { command: NmtCommand, node: Option<Expr> },
-    /// Wait until `(object & mask) == equals`, at most `timeout_ms`.
+    /// Wait until `(object & mask) == equals`, at most `timeout_ms`; fail at once when
+    /// `fail_if` matches (e.g. statusword bit 13 "homing error").
     Wait {
         object: String,
         mask: Expr,
         equals: Expr,
         timeout_ms: u32,
+        fail_if: Option<FailIf>,
     },
     /// Send a raw frame.
     Frame { id: Expr, data: Vec<FrameItem> },
     /// Pause.
     Delay { ms: u32 },
+}
+
+/// When a `wait` step gives up early: `(value & mask) == equals` means `text`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FailIf {
+    /// Bits compared.
+    pub mask: Expr,
+    /// Their failing value.
+    pub equals: Expr,
+    /// What it means, e.g. `homing error`.
+    pub text: String,
 }
 
 /// A named command sequence.
@@ -166,10 +220,22 @@ impl Procedure {
         let known = |v: &str| v == "node" || self.params.iter().any(|p| p.name == v);
         let mut exprs: Vec<&Expr> = Vec::new();
         for s in &self.steps {
+            if let Step::SdoWrite { object, .. } | Step::SdoRead { object } | Step::Wait { object, .. } = s
+                && let Some(v) = object_variables(object)?.into_iter().find(|v| !known(v))
+            {
+                return Err(format!("object `{object}` uses unknown variable `{v}`"));
+            }
             match s {
                 Step::SdoWrite { value, .. } => exprs.push(value),
                 Step::Nmt { node: Some(n), .. } => exprs.push(n),
-                Step::Wait { mask, equals, .. } => exprs.extend([mask, equals]),
+                Step::Wait {
+                    mask, equals, fail_if, ..
+                } => {
+                    exprs.extend([mask, equals]);
+                    if let Some(f) = fail_if {
+                        exprs.extend([&f.mask, &f.equals]);
+                    }
+                }
                 Step::Frame { id, data } => {
                     exprs.push(id);
                     exprs.extend(data.iter().filter_map(|i| match i {
@@ -243,5 +309,20 @@ mod tests {
             Some(NmtCommand::ResetCommunication)
         );
         assert_eq!(NmtCommand::parse("go"), None);
+    }
+
+    #[test]
+    fn object_placeholders() {
+        let vars = |v: &str| match v {
+            "page" => Some(3),
+            "number" => Some(1),
+            _ => None,
+        };
+        assert_eq!(fill_object("{page}-{number}", &vars).unwrap(), "3-1");
+        assert_eq!(fill_object("0x3000:{number + 9}", &vars).unwrap(), "0x3000:10");
+        assert_eq!(fill_object("0x6041", &vars).unwrap(), "0x6041");
+        assert_eq!(object_variables("{page}-{number}").unwrap(), ["page", "number"]);
+        assert!(object_variables("0x3000:{sub").unwrap_err().contains("missing `}`"));
+        assert!(fill_object("{speed}", &vars).is_err());
     }
 }

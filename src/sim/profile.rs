@@ -19,6 +19,8 @@ pub struct DriveProfile {
     pub heartbeat_ms: u16,
     /// Position units (0x6064) a velocity of 1 (0x606C / 0x60FF raw) covers per second.
     pub position_per_velocity: f64,
+    /// Vendor parameters (UNSIGNED16, read/write): index, name, value.
+    pub vendor_u16: Vec<(u16, &'static str, i64)>,
 }
 
 impl DriveProfile {
@@ -31,6 +33,7 @@ impl DriveProfile {
             software_version: "cotui-sim 1".to_string(),
             heartbeat_ms: 500,
             position_per_velocity: 1.0,
+            vendor_u16: Vec::new(),
         }
     }
     /// Like the AIMOTOR servo of the seed manuals (profile `aimotor`): identified by a
@@ -46,6 +49,8 @@ impl DriveProfile {
     pub fn syntron_like() -> DriveProfile {
         DriveProfile {
             position_per_velocity: 10_000.0 / 600.0,
+            // F0.1.002 / F1.1.002 control mode: 20 = CANopen (the manual's STEP1).
+            vendor_u16: vec![(0x2102, "A control mode", 20), (0x3102, "B control mode", 20)],
             ..DriveProfile::servo("cotui simulated Syn-tron-like DS servo", 0x0402_0003)
         }
     }
@@ -113,6 +118,9 @@ pub fn drive_objects(node: u8, p: DriveProfile) -> DeviceObjects {
     }
     let block: Vec<u8> = (0..200u32).map(|i| (i * 7 + n as u32) as u8).collect();
     s.add_bytes(0x2000, 0, "Parameter block", Domain, Rw, block);
+    for (index, name, value) in &p.vendor_u16 {
+        s.add(*index, 0, name, U16, Rw, *value);
+    }
     s.add(0x603F, 0, "Error code", U16, Ro, 0);
     s.add(0x6040, 0, "Controlword", U16, Rww, 0);
     s.add(0x6041, 0, "Statusword", U16, Ro, 0x0250);

@@ -395,6 +395,7 @@ fn new_txn(
         frames: Vec::new(),
         frames_dropped: 0,
         dropped: 0,
+        mode: None,
     }
 }
 

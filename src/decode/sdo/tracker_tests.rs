@@ -518,7 +518,7 @@ fn capture_starting_mid_transfer() {
     assert!(t.problems.is_empty());
     assert_eq!(
         t.label(&bus.dict),
-        "Download 0x6040:00 Controlword = 0x0007 (Switch on / Disable operation) (expedited, 2 bytes, 1.000 ms): ok"
+        "Download 0x6040:00 Controlword = 0x0007 (Switch on) (expedited, 2 bytes, 1.000 ms): ok"
     );
 }
 

@@ -1,7 +1,7 @@
 //! A reassembled SDO transfer: what was read or written, how, and how it ended.
 
 use super::frame::Side;
-use super::value::view;
+use super::value::view_in_mode;
 use crate::hex;
 use crate::od::Dictionary;
 use serde_json::{Value as Json, json};
@@ -192,6 +192,9 @@ pub struct Transaction {
     pub frames: Vec<u64>,
     /// Frames that belong to it beyond [`FRAMES_KEPT`], counted but not listed.
     pub frames_dropped: u64,
+    /// The node's mode of operation when the transfer ended (known to the decoder from
+    /// 6060h/6061h), so that controlword/statusword bits are named for that mode.
+    pub mode: Option<i8>,
 }
 
 /// Bytes of one transfer kept in [`Transaction::data`]; a longer transfer (a firmware
@@ -286,7 +289,7 @@ impl Transaction {
             s.push_str(&name);
         }
         if self.outcome == Outcome::Ok && !self.data.is_empty() && !partial {
-            let v = view(dict, self.index, self.sub, &self.data);
+            let v = view_in_mode(dict, self.index, self.sub, &self.data, self.mode);
             let text: String = if v.text.chars().count() > 80 {
                 v.text.chars().take(77).chain("...".chars()).collect()
             } else {
@@ -329,7 +332,8 @@ impl Transaction {
     /// JSON object with the object, name, typed value, hex data, timing, outcome and problems.
     pub fn to_json(&self, dict: &Dictionary) -> Json {
         let partial = self.is_partial();
-        let v = (!self.data.is_empty() && !partial).then(|| view(dict, self.index, self.sub, &self.data));
+        let v = (!self.data.is_empty() && !partial)
+            .then(|| view_in_mode(dict, self.index, self.sub, &self.data, self.mode));
         let (index, sub) = if partial {
             (Json::Null, Json::Null)
         } else {

@@ -28,12 +28,17 @@ pub fn le_uint(bytes: &[u8]) -> Option<u32> {
 
 /// Types `bytes` through the dictionary entry of (index, sub).
 pub fn view(dict: &Dictionary, index: u16, sub: u8, bytes: &[u8]) -> ValueView {
+    view_in_mode(dict, index, sub, bytes, None)
+}
+
+/// [`view`] with the node's mode of operation, which names controlword/statusword bits.
+pub fn view_in_mode(dict: &Dictionary, index: u16, sub: u8, bytes: &[u8], mode: Option<i8>) -> ValueView {
     if let Some(info) = dict.object(index, sub) {
         let size = info.data_type.size();
         let take = size.map_or(bytes.len(), |n| n.min(bytes.len()));
         let typed = info.data_type.decode(&bytes[..take]);
         return ValueView {
-            text: crate::decode::value_text::object_text(dict, index, sub, &typed, None),
+            text: crate::decode::value_text::object_text(dict, index, sub, &typed, mode),
             json: typed.to_json(),
             typed: Some(typed),
             type_len_mismatch: size.filter(|n| *n != bytes.len()),
@@ -41,7 +46,7 @@ pub fn view(dict: &Dictionary, index: u16, sub: u8, bytes: &[u8]) -> ValueView {
     }
     match le_uint(bytes) {
         Some(n) => ValueView {
-            text: crate::decode::cia402::value_text(index, sub, n as i64, None)
+            text: crate::decode::cia402::value_text(index, sub, n as i64, mode, None)
                 .or_else(|| crate::decode::comm_params::describe(index, sub, n as u64, dict))
                 .unwrap_or_else(|| format!("{} ({n})", hex::spaced(bytes))),
             json: n.into(),

@@ -70,6 +70,8 @@ pub(super) struct EntryDto {
     pub(super) description: Option<String>,
     #[serde(default)]
     pub(super) subs: Option<BTreeMap<String, EntryDto>>,
+    #[serde(default)]
+    pub(super) fields: Vec<FieldDto>,
 }
 
 #[derive(Deserialize)]
@@ -207,12 +209,23 @@ pub(super) enum StepDto {
         equals: Json,
         #[serde(default)]
         timeout_ms: Option<Json>,
+        #[serde(default)]
+        fail_if: Option<FailDto>,
     },
     Frame {
         id: Json,
         data: String,
     },
     DelayMs(Json),
+}
+
+/// A `wait` step's failure condition: `(value & mask) == equals` means `text`.
+#[derive(Deserialize)]
+pub(super) struct FailDto {
+    #[serde(default)]
+    pub(super) mask: Option<Json>,
+    pub(super) equals: Json,
+    pub(super) text: String,
 }
 
 #[derive(Deserialize)]

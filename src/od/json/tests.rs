@@ -233,3 +233,99 @@ fn unknown_fields_types_and_bad_values_are_warnings() {
     assert!(p.procedures.is_empty());
     assert!(w[0].to_string().starts_with("w.json: "));
 }
+
+#[test]
+fn single_subs_win_over_ranges_and_overlaps_are_located() {
+    // JSON key order puts the single sub first and the range after it; the single sub still wins.
+    let text = r#"{ "name": "x", "objects": {
+        "0x3046": { "name": "Monitor", "subs": {
+            "1": { "name": "Motor State", "type": "u8" },
+            "1..32": { "name": "Monitor Data {n}", "type": "u16" },
+            "0x02": { "name": "Alarm Code", "type": "u8" } } },
+        "0x304A": { "name": "Clash", "subs": {
+            "1..8": { "name": "A {n}", "type": "u8" },
+            "5..9": { "name": "B {n}", "type": "u8" },
+            "3": { "name": "Three", "type": "u8" },
+            "0x03": { "name": "Also three", "type": "u8" } } }
+    } }"#;
+    let (p, w) = load_profile("o.json", text).unwrap();
+    let m = p.object(0x3046, 1).unwrap();
+    assert_eq!((m.name.as_str(), m.data_type), ("Motor State", DataType::U8));
+    assert_eq!(p.object(0x3046, 2).unwrap().name, "Alarm Code");
+    let d = p.object(0x3046, 3).unwrap();
+    assert_eq!((d.name.as_str(), d.data_type), ("Monitor Data 3", DataType::U16));
+    assert_eq!(p.object(0x3046, 32).unwrap().name, "Monitor Data 32");
+    // Overlapping ranges and duplicate single subs: located warnings, the later key skipped.
+    let located: Vec<String> = w.iter().map(|w| w.to_string()).collect();
+    assert_eq!(w.len(), 2, "{located:#?}");
+    assert!(located[0].starts_with("o.json: objects.0x304A.subs.5..9: range `5..9` overlaps `1..8`"));
+    assert!(located[1].starts_with("o.json: objects.0x304A.subs.3: sub `3` overlaps `0x03`"));
+    assert_eq!(p.object(0x304A, 8).unwrap().name, "A 8");
+    assert!(p.object(0x304A, 9).is_none());
+}
+
+#[test]
+fn deeply_nested_expressions_are_located_errors() {
+    let parens = format!("{}1{}", "(".repeat(20_000), ")".repeat(20_000));
+    let minus = format!("{}1", "-".repeat(100_000));
+    let conds = format!("{}0", "1 ? 0 : ".repeat(20_000));
+    let text = serde_json::json!({
+        "name": "deep",
+        "alias_rules": [
+            { "pattern": "P{x}", "index": parens },
+            { "pattern": "Q{x}", "index": "0x2000 + x", "sub": conds },
+            { "pattern": "R{x}", "index": "0x2000 + x" }
+        ],
+        "procedures": {
+            "minus": { "steps": [ { "sdo_write": { "object": "0x6040", "value": minus } } ] },
+            "cond": { "steps": [ { "wait": { "equals": conds } } ] },
+            "frame": { "steps": [ { "frame": { "id": "0x600", "data": format!("{{u8:{parens}}}") } } ] },
+            "object": { "steps": [ { "sdo_read": { "object": format!("0x3000:{{{minus}}}") } } ] },
+            "fine": { "steps": [ { "sdo_write": { "object": "0x6040", "value": "-(-(15))" } } ] }
+        }
+    })
+    .to_string();
+    let (p, w) = load_profile("deep.json", &text).unwrap();
+    let at: Vec<&str> = w.iter().map(|w| w.at.as_str()).collect();
+    assert_eq!(
+        at,
+        [
+            "alias_rules.0",
+            "alias_rules.1",
+            "procedures.cond.steps.0",
+            "procedures.frame.steps.0",
+            "procedures.minus.steps.0",
+            "procedures.object.steps.0"
+        ]
+    );
+    assert!(
+        w.iter().all(|w| w.message.contains("nests deeper than 200 levels")),
+        "{w:?}"
+    );
+    assert_eq!(p.alias_rules.len(), 1);
+    assert_eq!(p.procedures.keys().collect::<Vec<_>>(), ["fine"]);
+}
+
+#[test]
+fn value_fields_must_fit_the_type() {
+    let text = r#"{ "name": "f", "objects": {
+        "0x1016:1": { "name": "HB", "type": "u32", "fields": [
+            { "name": "node", "offset": 2 }, { "name": "time", "offset": 0, "length": 2, "unit": "ms" },
+            { "name": "beyond", "offset": 3, "length": 2 }, { "name": "odd", "offset": 0, "format": "bcd" } ] }
+    } }"#;
+    let (p, w) = load_profile("f.json", text).unwrap();
+    let at: Vec<&str> = w.iter().map(|w| w.at.as_str()).collect();
+    assert_eq!(
+        at,
+        ["objects.0x1016:1.fields.2", "objects.0x1016:1.fields.3.format"],
+        "{w:?}"
+    );
+    let names: Vec<&str> = p
+        .object(0x1016, 1)
+        .unwrap()
+        .fields
+        .iter()
+        .map(|f| f.name.as_str())
+        .collect();
+    assert_eq!(names, ["node", "time", "odd"]);
+}

@@ -86,6 +86,7 @@ fn frame_lines(app: &App, f: &Frame, d: &Decoded, pos: usize) -> Vec<Line<'stati
     }
     let node = d.node.unwrap_or(0);
     let mode = app.trace.decoder().mode(node);
+    let dict = app.trace.decoder().dictionary(node);
     match &d.body {
         Body::Sdo(s) => {
             if let Some(&b) = f.payload().first() {
@@ -103,14 +104,14 @@ fn frame_lines(app: &App, f: &Frame, d: &Decoded, pos: usize) -> Vec<Line<'stati
                         let cw = word(data.bytes());
                         v.push(Line::raw(format!(
                             "controlword {cw:016b}b: {}",
-                            describe_controlword(cw, mode)
+                            describe_controlword(cw, mode, dict.object(0x6040, 0))
                         )));
                     }
                     (SdoCommand::InitiateUploadResponse { data, .. }, 0x6041) => {
                         let sw = word(data.bytes());
                         v.push(Line::raw(format!(
                             "statusword {sw:016b}b: {}",
-                            describe_statusword(sw, mode)
+                            describe_statusword(sw, mode, dict.object(0x6041, 0))
                         )));
                     }
                     _ => {}
@@ -142,9 +143,13 @@ fn frame_lines(app: &App, f: &Frame, d: &Decoded, pos: usize) -> Vec<Line<'stati
                     (0x6040, 0) => v.push(Line::raw(format!(
                         "  {:016b}b {}",
                         raw,
-                        describe_controlword(raw, mode)
+                        describe_controlword(raw, mode, dict.object(0x6040, 0))
                     ))),
-                    (0x6041, 0) => v.push(Line::raw(format!("  {:016b}b {}", raw, describe_statusword(raw, mode)))),
+                    (0x6041, 0) => v.push(Line::raw(format!(
+                        "  {:016b}b {}",
+                        raw,
+                        describe_statusword(raw, mode, dict.object(0x6041, 0))
+                    ))),
                     _ => {}
                 }
             }
