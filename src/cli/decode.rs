@@ -212,7 +212,12 @@ fn decode_stream(
     if let Some(e) = finished.error {
         return Err(e);
     }
-    let c = finished.counts;
+    report_counts(path, &finished.counts);
+    Ok(())
+}
+
+/// Prints what a reader skipped or could not read in `path` (nothing when every line was a frame).
+pub fn report_counts(path: &str, c: &crate::log::Counts) {
     if c.warnings > 0 || c.skipped_total() > 0 {
         eprintln!(
             "{path}: {} frames, {} lines skipped, {} malformed lines",
@@ -227,7 +232,6 @@ fn decode_stream(
             c.ignored_tail
         );
     }
-    Ok(())
 }
 
 fn write_transaction(buf: &mut String, t: &Transaction, decoder: &Decoder, fmt: OutputFormat) {

@@ -100,14 +100,6 @@ fn write_stream(path: &str, input: Box<dyn BufRead + Send>, w: &mut PcapngWriter
     if let Some(e) = finished.error {
         return Err(e);
     }
-    let c = finished.counts;
-    if c.warnings > 0 || c.skipped_total() > 0 {
-        eprintln!(
-            "{path}: {} frames, {} lines skipped, {} malformed lines",
-            c.frames,
-            c.skipped_total(),
-            c.warnings
-        );
-    }
+    super::decode::report_counts(path, &finished.counts);
     Ok(())
 }

@@ -213,6 +213,17 @@ struct Watch {
 }
 
 impl Watch {
+    /// Watches `node` on `bus` from now on.
+    fn new(bus: &Bus, node: u8) -> Watch {
+        Watch {
+            rx: bus.subscribe(),
+            node,
+            obs: Observation::default(),
+            tpdo: None,
+            tpdo_sw: None,
+        }
+    }
+
     fn drain(&mut self) {
         while let Some(got) = self.rx.try_recv() {
             let Ok(f) = got else { continue };
@@ -307,13 +318,7 @@ async fn statusword(bus: &Bus, w: &mut Watch, timeout_ms: u64) -> Result<(u16, &
 
 /// Runs a drive command on `node`. `timeout_ms` bounds each SDO response and each step.
 pub async fn drive(bus: &Bus, node: u8, action: DriveAction, timeout_ms: u64) -> Result<DriveReport, CommandError> {
-    let mut w = Watch {
-        rx: bus.subscribe(),
-        node,
-        obs: Observation::default(),
-        tpdo: None,
-        tpdo_sw: None,
-    };
+    let mut w = Watch::new(bus, node);
     let probe = Step {
         name: "read statusword",
         controlword: 0,
@@ -490,13 +495,7 @@ impl NodeStop {
 /// writes 0x0000 (disable voltage) and reads the statusword back until it shows the power
 /// stage off. Never fails: every problem is in the returned [`NodeStop`].
 pub async fn stop(bus: &Bus, node: u8, timeout_ms: u64, ramp_ms: u64) -> NodeStop {
-    let mut w = Watch {
-        rx: bus.subscribe(),
-        node,
-        obs: Observation::default(),
-        tpdo: None,
-        tpdo_sw: None,
-    };
+    let mut w = Watch::new(bus, node);
     let mut out = NodeStop {
         node,
         stopped: false,
