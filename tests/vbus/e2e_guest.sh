@@ -452,6 +452,10 @@ if lwait 150 "^.* 5 Operational .* [0-9]+/\? ms"; then
     msg=$(grep -oE "node 5 heartbeat lost: no heartbeat for [0-9.]+ ms, expected every [0-9.]+ ms" lscreen.txt)
     echo "$msg" | awk '{ s = $8; p = $12; exit !(p >= 400 && p <= 700 && s - 1.5 * p < 0.2 && s - 1.5 * p > -0.2) }' &&
         ok "liveness: the status line has the event ($msg)" || bad "liveness: no heartbeat-lost event in the status line: $(cat lscreen.txt)"
+    tmux send-keys -t liveness m
+    lwait 50 "Messages \(" && grep -qE "node 5 heartbeat lost: .*capture t=" lscreen.txt &&
+        ok "liveness: the message log keeps the event with its time" || bad "liveness: message log: $(cat lscreen.txt)"
+    tmux send-keys -t liveness Escape
 else
     bad "liveness: node 5 not shown Operational with a measured heartbeat: $(cat lscreen.txt)"
 fi
