@@ -401,7 +401,7 @@ impl App {
             self.messages.push(
                 SystemTime::now(),
                 event_level(&e.what),
-                &format!("{} (capture t={at:.3} s)", e.text()),
+                &format!("[t={at:.3} s] {}", e.text()),
             );
         }
         let notable = events.iter().rev().find(|e| {

@@ -453,7 +453,7 @@ if lwait 150 "^.* 5 Operational .* [0-9]+/\? ms"; then
     echo "$msg" | awk '{ s = $8; p = $12; exit !(p >= 400 && p <= 700 && s - 1.5 * p < 0.2 && s - 1.5 * p > -0.2) }' &&
         ok "liveness: the status line has the event ($msg)" || bad "liveness: no heartbeat-lost event in the status line: $(cat lscreen.txt)"
     tmux send-keys -t liveness m
-    lwait 50 "Messages \(" && grep -qE "node 5 heartbeat lost: .*capture t=" lscreen.txt &&
+    lwait 50 "Messages \(" && grep -qE "\[t=[0-9.]+ s\] node 5 heartbeat lost" lscreen.txt &&
         ok "liveness: the message log keeps the event with its time" || bad "liveness: message log: $(cat lscreen.txt)"
     tmux send-keys -t liveness Escape
 else
