@@ -270,7 +270,11 @@ impl App {
                     self.source.bus_error = Some(e);
                     self.dirty = true;
                 }
-                Ok(Feed::BusOk) => {
+                Ok(Feed::BusOk(note)) => {
+                    // A recovery is news (the error it ends was shown); the first "capturing" is not.
+                    if self.source.bus_error.is_some() {
+                        self.message = Some(note);
+                    }
                     self.source.bus_error = None;
                     self.dirty = true;
                 }
