@@ -3,7 +3,7 @@
 //! socket given what `/sys/class/net/IFACE` says.
 
 use super::BusError;
-use super::socketcan::{missing_fix, up_fix};
+use super::socketcan::up_fix;
 use crate::decode::error_frame::ControllerState;
 
 /// The state of a bus handle's interface and controller.
@@ -51,18 +51,19 @@ impl BusState {
     }
     /// What the user can do about the state (none when all is well).
     pub fn fix(self, iface: &str) -> Option<String> {
-        let wiring = "check wiring, termination and bitrate";
+        let wiring = "check wiring, termination, bitrate";
         match self {
             BusState::Active => None,
             BusState::Warning | BusState::Passive => Some(format!(
                 "{wiring} (error counters: ip -details -statistics link show {iface})"
             )),
             BusState::BusOff => Some(format!(
-                "{wiring}, then restart the controller: sudo ip link set {iface} down && sudo ip link set {iface} up \
-                 (or restart automatically: sudo ip link set {iface} type can restart-ms 100)"
+                "{wiring}; restart: sudo ip link set {iface} type can restart-ms 100"
             )),
             BusState::Down => Some(up_fix(iface)),
-            BusState::Missing => Some(missing_fix(iface)),
+            BusState::Missing => Some(format!(
+                "plug it back in (a vcan: sudo ip link add dev {iface} type vcan && sudo ip link set {iface} up)"
+            )),
         }
     }
 }
@@ -83,16 +84,14 @@ impl StateChange {
     pub fn text(&self, iface: &str) -> String {
         let counters = self
             .counters
-            .map(|(tx, rx)| format!(" (tx errors {tx}, rx errors {rx})"))
+            .map(|(tx, rx)| format!(" (errors: tx {tx}, rx {rx})"))
             .unwrap_or_default();
         let what = match self.state {
             BusState::Active => format!("{iface}: capturing, controller error-active{counters}"),
             BusState::Warning | BusState::Passive => format!("{iface}: controller {}{counters}", self.state.name()),
-            BusState::BusOff => format!("{iface}: controller bus-off{counters}, nothing is captured"),
-            BusState::Down => format!("{iface}: interface is down, nothing is captured"),
-            BusState::Missing => {
-                format!("{iface}: interface disappeared, nothing is captured until it is back")
-            }
+            BusState::BusOff => format!("{iface}: bus-off{counters}, not capturing"),
+            BusState::Down => format!("{iface}: interface is down, not capturing"),
+            BusState::Missing => format!("{iface}: interface is gone, not capturing"),
         };
         match self.state.fix(iface) {
             Some(fix) => format!("{what}; fix: {fix}"),
@@ -106,7 +105,7 @@ impl StateChange {
             reason: match self.state {
                 BusState::BusOff => "controller is bus-off".to_string(),
                 BusState::Down => "interface is down".to_string(),
-                _ => "interface disappeared".to_string(),
+                _ => "interface is gone".to_string(),
             },
             fix: self.state.fix(iface).unwrap_or_default(),
         })
@@ -169,18 +168,23 @@ mod tests {
             counters,
         };
         let down = at(BusState::Down, None).text("can0");
-        assert!(down.starts_with("can0: interface is down, nothing is captured; fix: "), "{down}");
+        assert!(down.starts_with("can0: interface is down, not capturing; fix: "), "{down}");
         assert!(down.contains("sudo ip link set can0 up"), "{down}");
         let gone = at(BusState::Missing, None).text("vcan0");
         assert!(gone.contains("sudo ip link add dev vcan0 type vcan"), "{gone}");
+        // The status bar of a 160-column terminal shows every state with its fix in full.
+        for s in [BusState::Down, BusState::Missing, BusState::BusOff] {
+            let t = at(s, Some((255, 255))).text("vcan0");
+            assert!(t.len() <= 160, "{} chars: {t}", t.len());
+        }
         let off = at(BusState::BusOff, Some((248, 0))).text("can0");
         assert!(
-            off.starts_with("can0: controller bus-off (tx errors 248, rx errors 0), nothing is captured; fix: check wiring"),
+            off.starts_with("can0: bus-off (errors: tx 248, rx 0), not capturing; fix: check wiring"),
             "{off}"
         );
-        assert!(off.contains("restart-ms"), "{off}");
+        assert!(off.ends_with("restart: sudo ip link set can0 type can restart-ms 100"), "{off}");
         let passive = at(BusState::Passive, Some((128, 3))).text("can0");
-        assert!(passive.starts_with("can0: controller error-passive (tx errors 128, rx errors 3); fix:"));
+        assert!(passive.starts_with("can0: controller error-passive (errors: tx 128, rx 3); fix:"));
         assert_eq!(at(BusState::Active, None).text("can0"), "can0: capturing, controller error-active");
         assert_eq!(at(BusState::Passive, None).error("can0"), None);
         let e = at(BusState::Down, None).error("can0").unwrap().to_string();

@@ -367,9 +367,9 @@ mod tests {
                 gap(6_000_000_000, 6_500_000_000, "bus-off")
             ]
         );
-        assert!(notes[0].starts_with("vcan0: interface is down, nothing is captured; fix: sudo ip link set vcan0 up"));
+        assert!(notes[0].starts_with("vcan0: interface is down, not capturing; fix: sudo ip link set vcan0 up"));
         assert!(notes[0].ends_with("a gap in the recording starts"), "{}", notes[0]);
-        assert!(notes[1].starts_with("vcan0: interface disappeared"), "{}", notes[1]);
+        assert!(notes[1].starts_with("vcan0: interface is gone"), "{}", notes[1]);
         assert_eq!(notes[2], "vcan0: capturing again after 2.0 s (interface down); the gap ends");
         assert!(notes[3].starts_with("vcan0: controller error-passive; fix: check wiring"), "{}", notes[3]);
         let r = Recorded {

@@ -85,7 +85,11 @@ cangen vcan1 -n 10 -g 0 -I 7E7 -L r -D r
 burst_t0=$(date +%s.%N)
 cangen vcan0 -g 0 -n 20000 -I 7E0 -L 8 -D i
 burst_t1=$(date +%s.%N)
-sleep 1
+# Stop once cotui's log (written out at least every 200 ms) holds the burst's last frame
+# (counter 19999): on a loaded machine the readers may be seconds behind cangen, and
+# candump, unlike cotui record, drops what is still queued in its socket when stopped.
+wait_for rec0.log 600 " vcan0 7E0#1F4E000000000000" || bad "burst: cotui record did not write the last burst frame in 60 s"
+sleep 0.5
 kill -INT $rec0 $rec1 $dump
 wait $rec0; rc0=$?
 wait $rec1; rc1=$?
