@@ -178,9 +178,17 @@ fn record_stops_cleanly_on_every_catchable_signal() {
         let out = child.wait_with_output().unwrap();
         let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_default();
         let log = std::fs::read_to_string(&path).unwrap();
-        assert_eq!(out.status.code(), Some(0), "SIG{name}: {v} {}", String::from_utf8_lossy(&out.stderr));
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "SIG{name}: {v} {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         assert_eq!(v["frames"].as_u64(), Some(log.lines().count() as u64), "SIG{name}: {v}");
-        assert_eq!((v["ok"].as_bool(), v["gaps"].as_array().map(Vec::len)), (Some(true), Some(0)));
+        assert_eq!(
+            (v["ok"].as_bool(), v["gaps"].as_array().map(Vec::len)),
+            (Some(true), Some(0))
+        );
         assert!(log.ends_with('\n') && log.lines().all(|l| l.starts_with('(') && l.contains(" demo ")));
         std::fs::remove_file(&path).unwrap();
     }
@@ -193,12 +201,18 @@ fn record_refuses_an_existing_log_unless_force_or_append() {
     let p = path.to_str().unwrap();
     let (rc, v, err) = cotui(&["record", "demo", "-o", p, "--count", "2", "--json"]);
     assert_eq!((rc, v["error"].as_str()), (1, Some("usage")), "{err}");
-    assert!(err.contains("exists; --force overwrites it, --append adds to it"), "{err}");
+    assert!(
+        err.contains("exists; --force overwrites it, --append adds to it"),
+        "{err}"
+    );
     assert_eq!(std::fs::read_to_string(&path).unwrap(), "(1.000000) can0 123#01\n");
     let (rc, v, _) = cotui(&["record", "demo", "-o", p, "--count", "2", "--append", "--json"]);
     assert_eq!((rc, v["frames"].as_u64()), (0, Some(2)));
     let log = std::fs::read_to_string(&path).unwrap();
-    assert!(log.starts_with("(1.000000) can0 123#01\n") && log.lines().count() == 3, "{log}");
+    assert!(
+        log.starts_with("(1.000000) can0 123#01\n") && log.lines().count() == 3,
+        "{log}"
+    );
     let (rc, _, _) = cotui(&["record", "demo", "-o", p, "--count", "1", "--force"]);
     assert_eq!(rc, 0);
     assert_eq!(std::fs::read_to_string(&path).unwrap().lines().count(), 1);

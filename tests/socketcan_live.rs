@@ -124,7 +124,19 @@ async fn catch_up_reads_everything_the_kernel_queued() {
     // 3000 fit the enlarged buffer. catch_up must bring all of them, with no waiting on time.
     let sent = 3000u64;
     let status = std::process::Command::new("cangen")
-        .args(["vcan0", "-g", "0", "-n", &sent.to_string(), "-I", "7E1", "-L", "8", "-D", "i"])
+        .args([
+            "vcan0",
+            "-g",
+            "0",
+            "-n",
+            &sent.to_string(),
+            "-I",
+            "7E1",
+            "-L",
+            "8",
+            "-D",
+            "i",
+        ])
         .status()
         .expect("cangen runs");
     assert!(status.success());

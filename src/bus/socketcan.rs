@@ -154,11 +154,7 @@ pub fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
         endpoint: OWN,
         events,
         sender,
-        socket: Some(Arc::new(Shared {
-            task,
-            link,
-            catch_up,
-        })),
+        socket: Some(Arc::new(Shared { task, link, catch_up })),
     })
 }
 

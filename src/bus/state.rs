@@ -168,7 +168,10 @@ mod tests {
             counters,
         };
         let down = at(BusState::Down, None).text("can0");
-        assert!(down.starts_with("can0: interface is down, not capturing; fix: "), "{down}");
+        assert!(
+            down.starts_with("can0: interface is down, not capturing; fix: "),
+            "{down}"
+        );
         assert!(down.contains("sudo ip link set can0 up"), "{down}");
         let gone = at(BusState::Missing, None).text("vcan0");
         assert!(gone.contains("sudo ip link add dev vcan0 type vcan"), "{gone}");
@@ -182,12 +185,21 @@ mod tests {
             off.starts_with("can0: bus-off (errors: tx 248, rx 0), not capturing; fix: check wiring"),
             "{off}"
         );
-        assert!(off.ends_with("restart: sudo ip link set can0 type can restart-ms 100"), "{off}");
+        assert!(
+            off.ends_with("restart: sudo ip link set can0 type can restart-ms 100"),
+            "{off}"
+        );
         let passive = at(BusState::Passive, Some((128, 3))).text("can0");
         assert!(passive.starts_with("can0: controller error-passive (errors: tx 128, rx 3); fix:"));
-        assert_eq!(at(BusState::Active, None).text("can0"), "can0: capturing, controller error-active");
+        assert_eq!(
+            at(BusState::Active, None).text("can0"),
+            "can0: capturing, controller error-active"
+        );
         assert_eq!(at(BusState::Passive, None).error("can0"), None);
         let e = at(BusState::Down, None).error("can0").unwrap().to_string();
-        assert!(e.starts_with("can0: interface is down; fix: sudo ip link set can0 up"), "{e}");
+        assert!(
+            e.starts_with("can0: interface is down; fix: sudo ip link set can0 up"),
+            "{e}"
+        );
     }
 }

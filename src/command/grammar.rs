@@ -521,7 +521,11 @@ mod tests {
                 ..
             })
         ));
-        assert!(parse_command("record -o x --force --append").unwrap_err().contains("not both"));
+        assert!(
+            parse_command("record -o x --force --append")
+                .unwrap_err()
+                .contains("not both")
+        );
     }
 
     #[test]

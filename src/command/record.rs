@@ -86,7 +86,11 @@ impl Recorded {
                 "{output} has {} gap(s), {:.1} s in all, when nothing could be captured ({})",
                 self.gaps.len(),
                 total as f64 / 1e9,
-                self.gaps.iter().map(|g| g.reason.as_str()).collect::<Vec<_>>().join(", ")
+                self.gaps
+                    .iter()
+                    .map(|g| g.reason.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
             )
         })
     }
@@ -370,8 +374,15 @@ mod tests {
         assert!(notes[0].starts_with("vcan0: interface is down, not capturing; fix: sudo ip link set vcan0 up"));
         assert!(notes[0].ends_with("a gap in the recording starts"), "{}", notes[0]);
         assert!(notes[1].starts_with("vcan0: interface is gone"), "{}", notes[1]);
-        assert_eq!(notes[2], "vcan0: capturing again after 2.0 s (interface down); the gap ends");
-        assert!(notes[3].starts_with("vcan0: controller error-passive; fix: check wiring"), "{}", notes[3]);
+        assert_eq!(
+            notes[2],
+            "vcan0: capturing again after 2.0 s (interface down); the gap ends"
+        );
+        assert!(
+            notes[3].starts_with("vcan0: controller error-passive; fix: check wiring"),
+            "{}",
+            notes[3]
+        );
         let r = Recorded {
             frames: 1,
             dropped: 0,
@@ -386,7 +397,10 @@ mod tests {
             "x.log has 2 gap(s), 2.5 s in all, when nothing could be captured (interface down, bus-off)"
         );
         let clean = Recorded::default().to_json("x.log");
-        assert_eq!((clean["ok"].as_bool(), clean["gaps"].as_array().map(Vec::len)), (Some(true), Some(0)));
+        assert_eq!(
+            (clean["ok"].as_bool(), clean["gaps"].as_array().map(Vec::len)),
+            (Some(true), Some(0))
+        );
     }
 
     #[test]
@@ -395,7 +409,10 @@ mod tests {
         std::fs::write(&path, "(1.000000) can0 123#01\n").unwrap();
         let p = path.to_str().unwrap();
         let e = open_output(p, WriteMode::New).err().unwrap();
-        assert_eq!(e.to_string(), format!("{p} exists; --force overwrites it, --append adds to it"));
+        assert_eq!(
+            e.to_string(),
+            format!("{p} exists; --force overwrites it, --append adds to it")
+        );
         assert_eq!(e.exit_code(), 1);
         let mut out = open_output(p, WriteMode::Append).unwrap();
         out.buffer().extend_from_slice(b"(2.000000) can0 123#02\n");

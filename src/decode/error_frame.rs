@@ -140,9 +140,18 @@ mod tests {
             controller_state(0x240, &[0, 0, 0, 0, 0, 0, 0xF8, 0]),
             (Some(BusOff), Some((0xF8, 0)))
         );
-        assert_eq!(controller_state(0x004, &[0, 0x20, 0, 0, 0, 0, 0, 0]), (Some(Passive), None));
-        assert_eq!(controller_state(0x204, &[0, 0x04, 0, 0, 0, 0, 3, 97]), (Some(Warning), Some((3, 97))));
-        assert_eq!(controller_state(0x004, &[0, 0x40, 0, 0, 0, 0, 0, 0]), (Some(Active), None));
+        assert_eq!(
+            controller_state(0x004, &[0, 0x20, 0, 0, 0, 0, 0, 0]),
+            (Some(Passive), None)
+        );
+        assert_eq!(
+            controller_state(0x204, &[0, 0x04, 0, 0, 0, 0, 3, 97]),
+            (Some(Warning), Some((3, 97)))
+        );
+        assert_eq!(
+            controller_state(0x004, &[0, 0x40, 0, 0, 0, 0, 0, 0]),
+            (Some(Active), None)
+        );
         assert_eq!(controller_state(0x100, &[0; 8]), (Some(Active), None));
         // A protocol violation or a lost arbitration says nothing about the state.
         assert_eq!(controller_state(0x00A, &[3, 0, 0x04, 0, 0, 0, 0, 0]), (None, None));

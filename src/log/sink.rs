@@ -137,7 +137,8 @@ mod tests {
             data: old.clone(),
         };
         let mut sink = LineSink::new(disk, old.len() as u64);
-        sink.buffer().extend_from_slice(b"(2.000000) can0 123#02\n(3.000000) can0 123#03\n");
+        sink.buffer()
+            .extend_from_slice(b"(2.000000) can0 123#02\n(3.000000) can0 123#03\n");
         let e = sink.flush().unwrap_err();
         assert_eq!(e.raw_os_error(), Some(libc::ENOSPC));
         assert_eq!(sink.lines(), 1);
@@ -146,13 +147,23 @@ mod tests {
         sink.out.room = 100;
         sink.flush().unwrap();
         assert_eq!(sink.lines(), 2);
-        assert!(sink.out.data.ends_with(b"(2.000000) can0 123#02\n(3.000000) can0 123#03\n"));
+        assert!(
+            sink.out
+                .data
+                .ends_with(b"(2.000000) can0 123#02\n(3.000000) can0 123#03\n")
+        );
         assert!(!sink.pending());
     }
 
     #[test]
     fn a_disk_full_before_the_first_line_keeps_nothing() {
-        let mut sink = LineSink::new(SmallDisk { room: 5, data: Vec::new() }, 0);
+        let mut sink = LineSink::new(
+            SmallDisk {
+                room: 5,
+                data: Vec::new(),
+            },
+            0,
+        );
         sink.buffer().extend_from_slice(b"(2.000000) can0 123#02\n");
         assert!(sink.flush().is_err());
         assert_eq!((sink.lines(), sink.out.data.len()), (0, 0));
