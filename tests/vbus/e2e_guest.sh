@@ -325,13 +325,14 @@ fi
 # older ones with a downed one), so a fresh candump records each part; cotui record must
 # hold exactly their frames, report the three gaps and exit 2. Then each catchable signal
 # stops a record right after a burst with every frame kept (read from the socket before
-# exiting), and kill -9 after the flush interval keeps every frame too. Then the TUI
+# exiting), and kill -9 after the flush interval keeps every frame too; a full disk leaves
+# whole lines only. Then the TUI
 # (`cotui live vcan0` in tmux) shows each state with its fix and frames flow again.
 # link_burst ID: 100 frames at full rate with a counter payload
 link_burst() { cangen vcan0 -g 0 -n 100 -I "$1" -L 8 -D i; }
-# relink: vcan0 deleted and created again as section 6 left it (CAN FD MTU, up)
 # link_sock PID: waits up to 60 s for PID to open its socket (a program starts slowly in a busy guest)
 link_sock() { for _ in 1 2 3 4 5 6; do wait_socket "$1" && return 0; done; return 1; }
+# relink: vcan0 created again as section 6 left it (CAN FD MTU, up)
 relink() { ip link add dev vcan0 type vcan && ip link set vcan0 mtu 72 && ip link set vcan0 up; }
 # link_counts FILE WORD N: waits up to 60 s for N lines containing WORD in FILE
 link_counts() { for _ in $(seq 600); do [ "$(grep -c -- "$2" "$1" 2> /dev/null)" -ge "$3" ] && return 0; sleep 0.1; done; return 1; }
@@ -416,6 +417,26 @@ c record vcan0 -o sig_INT.log --count 1
 [ $rc = 1 ] && echo "$err" | grep -q -- "--force overwrites it, --append adds to it" &&
     ok "record refuses an existing log, naming --force and --append" || bad "record existing: rc=$rc $err"
 
+# A full disk (a 16 KiB tmpfs): record stops with exit 1 and the log holds whole lines only.
+mkdir -p small && mount -t tmpfs -o size=16k tmpfs small
+"$cotui" record vcan0 -o small/full.log > full.out 2> full.err &
+full=$!
+link_sock $full || bad "disk full: record opened no socket"
+cangen vcan0 -g 0 -n 1000 -I 7C1 -L 8 -D i
+# It stops by itself on the write error; one still running after 60 s is stopped (and fails below).
+for _ in $(seq 600); do kill -0 $full 2> /dev/null || break; sleep 0.1; done
+kill -TERM $full 2> /dev/null
+wait $full
+rc=$?
+kept=$(grep -o "last whole line ([0-9]* frames)" full.err | grep -o "[0-9]*")
+if [ $rc = 1 ] && grep -q "No space left on device" full.err && [ -n "$kept" ] && [ "$(wc -l < small/full.log)" = "$kept" ] &&
+    [ "$(tail -c 1 small/full.log | od -An -c | tr -d ' ')" = '\n' ] &&
+    ! grep -qvE '^\([0-9]+\.[0-9]{6}\) vcan0 7C1#[0-9A-F]{16}$' small/full.log; then
+    ok "disk full: record exits 1 naming the error; the log keeps $kept whole lines, no partial one"
+else
+    bad "disk full: rc=$rc $(cat full.err); $(wc -l < small/full.log) lines, ends: $(tail -c 40 small/full.log | od -c | tail -3)"
+fi
+umount small
 # The TUI: the status bar shows each state with its fix, and frames flow again after it.
 tmux new-session -d -s link -x 160 -y 45 "XDG_CONFIG_HOME=$work $cotui live vcan0; echo cotui-exit=\$?; sleep 60"
 lscreen() { tmux capture-pane -p -t link > lscreen.txt; }
