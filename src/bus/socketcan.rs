@@ -38,10 +38,11 @@ const CANFD_FDF: u8 = 0x04;
 pub const CAN_MTU: usize = 16;
 /// Size of `struct canfd_frame`.
 pub const CANFD_MTU: usize = 72;
-/// The receive buffer asked for: with the kernel's doubling about 8 MB, some 10000 frames.
+/// The receive buffer asked for: with the kernel's doubling about 16 MB, some 20000 frames
+/// (a full-rate burst of 20000 frames while a busy machine lets the reader fall seconds behind).
 /// Root (`CAP_NET_ADMIN`) gets it through `SO_RCVBUFFORCE`; otherwise `SO_RCVBUF` is capped
 /// at `net.core.rmem_max`.
-pub const RCVBUF_BYTES: i32 = 4 << 20;
+pub const RCVBUF_BYTES: i32 = 8 << 20;
 /// `ARPHRD_CAN` in `/sys/class/net/IFACE/type`.
 const ARPHRD_CAN: u32 = 280;
 
@@ -291,7 +292,7 @@ const CHECK_TROUBLED: Duration = Duration::from_millis(100);
 /// socket reports no error on it).
 const CHECK_HEALTHY: Duration = Duration::from_secs(1);
 /// Frames read in a row before the reader lets the subscribers run.
-const READ_RUN: usize = 64;
+const READ_RUN: usize = 256;
 
 /// The reader task: reads the socket into the broadcast channel, follows the interface
 /// (down, deleted, re-created: reopened by name) and the controller state from error frames.

@@ -326,8 +326,8 @@ fi
 # hold exactly their frames, report the three gaps and exit 2. Then each catchable signal
 # stops a record right after a burst with every frame kept (read from the socket before
 # exiting), and kill -9 after the flush interval keeps every frame too; a full disk leaves
-# whole lines only. Then the TUI
-# (`cotui live vcan0` in tmux) shows each state with its fix and frames flow again.
+# whole lines only. Then the TUI (`cotui live vcan0` in tmux) shows each state with its
+# fix, and frames flow again.
 # link_burst ID: 100 frames at full rate with a counter payload
 link_burst() { cangen vcan0 -g 0 -n 100 -I "$1" -L 8 -D i; }
 # link_sock PID: waits up to 60 s for PID to open its socket (a program starts slowly in a busy guest)
