@@ -292,7 +292,7 @@ const CHECK_TROUBLED: Duration = Duration::from_millis(100);
 /// socket reports no error on it).
 const CHECK_HEALTHY: Duration = Duration::from_secs(1);
 /// Frames read in a row before the reader lets the subscribers run.
-const READ_RUN: usize = 256;
+const READ_RUN: usize = 64;
 
 /// The reader task: reads the socket into the broadcast channel, follows the interface
 /// (down, deleted, re-created: reopened by name) and the controller state from error frames.
@@ -356,7 +356,13 @@ impl Reader {
                     run += 1;
                     if run == READ_RUN {
                         run = 0;
-                        tokio::task::yield_now().await;
+                        if self.events.len() > QUEUE_DEPTH / 2 {
+                            // The subscribers are behind: give them time before they lose
+                            // frames (still 64 frames/ms, faster than any CAN bus).
+                            tokio::time::sleep(Duration::from_millis(1)).await;
+                        } else {
+                            tokio::task::yield_now().await;
+                        }
                     }
                 }
                 Err(e) if e.kind() == io::ErrorKind::WouldBlock => return,
