@@ -150,3 +150,74 @@ fn scan_and_record() {
     assert!(lines[0].starts_with('(') && lines[0].ends_with(" demo 702#00"), "{log}");
     std::fs::remove_file(&path).unwrap();
 }
+
+/// `cotui record demo -o FILE --json` stopped by `signal` once FILE holds lines (lines go
+/// out while recording, not only at the end): exit 0 and every frame counted is in the file.
+#[test]
+fn record_stops_cleanly_on_every_catchable_signal() {
+    for (signal, name) in [
+        (libc::SIGINT, "INT"),
+        (libc::SIGTERM, "TERM"),
+        (libc::SIGHUP, "HUP"),
+        (libc::SIGQUIT, "QUIT"),
+    ] {
+        let path = std::env::temp_dir().join(format!("cotui-rec-sig{signal}-{}.log", std::process::id()));
+        let _ = std::fs::remove_file(&path);
+        let child = Command::new(env!("CARGO_BIN_EXE_cotui"))
+            .args(["record", "demo", "-o", path.to_str().unwrap(), "--json"])
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Wait (on the condition, however long the machine needs) for lines on disk.
+        while std::fs::read_to_string(&path).map_or(true, |s| s.lines().count() < 3) {
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        // SAFETY: plain kill(2) on our own child.
+        assert_eq!(unsafe { libc::kill(child.id() as i32, signal) }, 0);
+        let out = child.wait_with_output().unwrap();
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_default();
+        let log = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "SIG{name}: {v} {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert_eq!(v["frames"].as_u64(), Some(log.lines().count() as u64), "SIG{name}: {v}");
+        assert_eq!(
+            (v["ok"].as_bool(), v["gaps"].as_array().map(Vec::len)),
+            (Some(true), Some(0))
+        );
+        assert!(log.ends_with('\n') && log.lines().all(|l| l.starts_with('(') && l.contains(" demo ")));
+        std::fs::remove_file(&path).unwrap();
+    }
+}
+
+#[test]
+fn record_refuses_an_existing_log_unless_force_or_append() {
+    let path = std::env::temp_dir().join(format!("cotui-rec-exists-{}.log", std::process::id()));
+    std::fs::write(&path, "(1.000000) can0 123#01\n").unwrap();
+    let p = path.to_str().unwrap();
+    let (rc, v, err) = cotui(&["record", "demo", "-o", p, "--count", "2", "--json"]);
+    assert_eq!((rc, v["error"].as_str()), (1, Some("usage")), "{err}");
+    assert!(
+        err.contains("exists; --force overwrites it, --append adds to it"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), "(1.000000) can0 123#01\n");
+    let (rc, v, _) = cotui(&["record", "demo", "-o", p, "--count", "2", "--append", "--json"]);
+    assert_eq!((rc, v["frames"].as_u64()), (0, Some(2)));
+    let log = std::fs::read_to_string(&path).unwrap();
+    assert!(
+        log.starts_with("(1.000000) can0 123#01\n") && log.lines().count() == 3,
+        "{log}"
+    );
+    let (rc, _, _) = cotui(&["record", "demo", "-o", p, "--count", "1", "--force"]);
+    assert_eq!(rc, 0);
+    assert_eq!(std::fs::read_to_string(&path).unwrap().lines().count(), 1);
+    let (rc, _, err) = cotui(&["record", "demo", "-o", p, "--force", "--append"]);
+    assert_eq!(rc, 1, "usage error: {err}");
+    assert!(err.contains("cannot be used with"), "{err}");
+    std::fs::remove_file(&path).unwrap();
+}

@@ -114,3 +114,52 @@ async fn a_reader_that_falls_behind_counts_what_the_kernel_dropped() {
         "every frame is either read or counted as dropped"
     );
 }
+
+#[tokio::test]
+#[ignore = "needs vcan0 and can-utils' cangen (run through tests/vbus/run.sh)"]
+async fn catch_up_reads_everything_the_kernel_queued() {
+    let bus = open("vcan0", true).unwrap();
+    let mut rx = bus.subscribe();
+    // As above the runtime is blocked while cangen runs, so the frames wait in the socket;
+    // 3000 fit the enlarged buffer. catch_up must bring all of them, with no waiting on time.
+    let sent = 3000u64;
+    let status = std::process::Command::new("cangen")
+        .args([
+            "vcan0",
+            "-g",
+            "0",
+            "-n",
+            &sent.to_string(),
+            "-I",
+            "7E1",
+            "-L",
+            "8",
+            "-D",
+            "i",
+        ])
+        .status()
+        .expect("cangen runs");
+    assert!(status.success());
+    let mut got = 0u64;
+    let mut count = |e: cotui::bus::Event| {
+        if let cotui::bus::Event::Frame(f) = e
+            && f.id == 0x7E1
+        {
+            assert_eq!(u64::from_le_bytes(f.payload().try_into().unwrap()), got, "in order");
+            got += 1;
+        }
+    };
+    let caught = bus.catch_up();
+    tokio::pin!(caught);
+    loop {
+        tokio::select! {
+            biased;
+            e = rx.next() => count(e.unwrap()),
+            _ = &mut caught => break,
+        }
+    }
+    while let Some(e) = rx.try_next() {
+        count(e.unwrap());
+    }
+    assert_eq!((got, bus.dropped(), rx.lost()), (sent, 0, 0));
+}

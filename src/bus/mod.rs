@@ -6,14 +6,22 @@
 //! consumers decode what we send with the same decoder as what we receive.
 //! A listen-only handle has no send path at all: [`Bus::send`] returns
 //! [`BusError::ListenOnly`] and nothing is written.
+//!
+//! A SocketCAN handle follows its interface by name: down and up, deleted and created
+//! again, bus-off and error-passive from error frames. Each change reaches the
+//! subscriptions as an [`Event::State`] in order with the frames ([`Subscription::next`]);
+//! [`Subscription::recv`] gives frames only and turns a loss of capture into an error.
 
 pub mod socketcan;
+pub mod state;
 pub mod virt;
+
+pub use state::{BusState, StateChange};
 
 use crate::frame::{Flags, Frame};
 use std::fmt;
 use std::sync::Arc;
-use tokio::sync::broadcast;
+use tokio::sync::{broadcast, oneshot};
 
 /// Frames buffered per subscription before the slowest one starts losing frames.
 pub const QUEUE_DEPTH: usize = 8192;
@@ -44,17 +52,29 @@ impl fmt::Display for BusError {
 
 impl std::error::Error for BusError {}
 
-/// One frame on the broadcast channel: the endpoint that sent it (0 = another node) and the frame.
+/// One item on the broadcast channel: the endpoint that sent it (0 = another node or the reader) and what.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Carried {
     pub origin: u32,
-    pub frame: Result<Frame, ReadFault>,
+    pub item: Item,
 }
 
-/// A read error of a SocketCAN reader, passed to subscribers as an event.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct ReadFault {
-    pub errno: i32,
+/// What the broadcast channel carries.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Item {
+    Frame(Frame),
+    State(StateChange),
+    /// A read error (errno) of a SocketCAN reader that is not a change of state.
+    Fault(i32),
+}
+
+/// What a subscription delivers, in bus order.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Event {
+    /// A frame.
+    Frame(Frame),
+    /// The interface or controller changed state (SocketCAN only).
+    State(StateChange),
 }
 
 /// The way a handle writes frames.
@@ -71,10 +91,8 @@ pub struct Bus {
     endpoint: u32,
     events: broadcast::Sender<Carried>,
     sender: Option<Sender>,
-    /// Keeps the SocketCAN reader task alive while a handle exists.
-    _task: Option<Arc<socketcan::TaskGuard>>,
-    /// The kernel's count of frames dropped on a full receive buffer (SocketCAN only).
-    drops: Option<Arc<socketcan::DropCount>>,
+    /// The SocketCAN reader task and its socket (none on the virtual bus).
+    socket: Option<Arc<socketcan::Shared>>,
     /// The virtual bus's clock; `None` on SocketCAN, whose timestamps are `CLOCK_REALTIME`.
     clock: Option<virt::Clock>,
 }
@@ -100,7 +118,18 @@ impl Bus {
     /// Frames the kernel dropped because this handle's socket buffer was full (0 on the
     /// virtual bus, which cannot drop). Frames a slow subscription missed are in [`Subscription::lost`].
     pub fn dropped(&self) -> u64 {
-        self.drops.as_ref().map_or(0, |d| d.get())
+        self.socket.as_ref().map_or(0, |s| s.dropped())
+    }
+    /// Resolves once every frame the kernel had queued for this handle when called (and
+    /// every state change before it) is on the subscriptions; at once on the virtual bus.
+    /// Keep reading the subscriptions while waiting: a full subscription loses frames.
+    pub async fn catch_up(&self) {
+        if let Some(s) = &self.socket {
+            let (tx, rx) = oneshot::channel();
+            if s.catch_up(tx) {
+                let _ = rx.await;
+            }
+        }
     }
     /// The bus time now in nanoseconds, on the clock of the frames' receive timestamps
     /// ([`Frame::ts_ns`]): the wall clock (`CLOCK_REALTIME`, as `SO_TIMESTAMPNS`) on SocketCAN,
@@ -119,7 +148,7 @@ impl Bus {
     pub(crate) fn inject(&self, frame: Frame) {
         let _ = self.events.send(Carried {
             origin: 0,
-            frame: Ok(frame),
+            item: Item::Frame(frame),
         });
     }
     /// A new subscription that sees every frame from now on.
@@ -152,9 +181,9 @@ pub struct Subscription {
 }
 
 impl Subscription {
-    /// The next frame; frames sent through this subscription's handle carry [`Flags::TX`].
-    /// A read error of the interface (e.g. it went down) is returned once and the stream goes on.
-    pub async fn recv(&mut self) -> Result<Frame, BusError> {
+    /// The next frame or state change; frames sent through this subscription's handle carry
+    /// [`Flags::TX`]. A read error of the interface is returned once and the stream goes on.
+    pub async fn next(&mut self) -> Result<Event, BusError> {
         loop {
             match self.rx.recv().await {
                 Ok(c) => return self.unpack(c),
@@ -163,8 +192,8 @@ impl Subscription {
             }
         }
     }
-    /// The next frame if one is queued, without waiting.
-    pub fn try_recv(&mut self) -> Option<Result<Frame, BusError>> {
+    /// The next frame or state change if one is queued, without waiting.
+    pub fn try_next(&mut self) -> Option<Result<Event, BusError>> {
         loop {
             match self.rx.try_recv() {
                 Ok(c) => return Some(self.unpack(c)),
@@ -174,20 +203,49 @@ impl Subscription {
             }
         }
     }
+    /// The next frame. When capture stops (interface down or gone, bus-off) the error,
+    /// naming the fix, is returned once and the stream goes on; the return of capture is skipped.
+    pub async fn recv(&mut self) -> Result<Frame, BusError> {
+        loop {
+            let got = self.next().await;
+            if let Some(r) = self.frame_of(got) {
+                return r;
+            }
+        }
+    }
+    /// The next frame if one is queued, without waiting (as [`Subscription::recv`]).
+    pub fn try_recv(&mut self) -> Option<Result<Frame, BusError>> {
+        loop {
+            let got = self.try_next()?;
+            if let Some(r) = self.frame_of(got) {
+                return Some(r);
+            }
+        }
+    }
+
+    /// The frame or error `recv` returns for an event; none for a return of capture.
+    fn frame_of(&self, got: Result<Event, BusError>) -> Option<Result<Frame, BusError>> {
+        match got {
+            Ok(Event::Frame(f)) => Some(Ok(f)),
+            Ok(Event::State(s)) => s.error(&self.name).map(Err),
+            Err(e) => Some(Err(e)),
+        }
+    }
     /// Frames this subscription missed because it read too slowly.
     pub fn lost(&self) -> u64 {
         self.lost
     }
 
-    fn unpack(&self, c: Carried) -> Result<Frame, BusError> {
-        match c.frame {
-            Ok(mut f) => {
+    fn unpack(&self, c: Carried) -> Result<Event, BusError> {
+        match c.item {
+            Item::Frame(mut f) => {
                 f.flags.set(Flags::TX, c.origin != 0 && c.origin == self.endpoint);
-                Ok(f)
+                Ok(Event::Frame(f))
             }
-            Err(fault) => Err(BusError::Io {
+            Item::State(s) => Ok(Event::State(s)),
+            Item::Fault(errno) => Err(BusError::Io {
                 iface: self.name.clone(),
-                reason: socketcan::errno_text(fault.errno),
+                reason: socketcan::errno_text(errno),
             }),
         }
     }

@@ -10,15 +10,19 @@
 //! our own `recvmsg` because the crate does not expose `msg_flags`, which is the only
 //! way to tell our own frames from those of other programs.
 
-use super::{Bus, BusError, Carried, QUEUE_DEPTH, ReadFault, Sender};
+use super::state::{Action, BusState, StateChange, SysLink, decide};
+use super::{Bus, BusError, Carried, Item, QUEUE_DEPTH, Sender};
+use crate::decode::error_frame::controller_state;
 use crate::frame::{Flags, Frame};
-use socketcan::{CanFdSocket, Socket, SocketOptions};
+use socketcan::{CanFdSocket, Socket as _, SocketOptions};
 use std::io;
 use std::os::fd::AsRawFd;
-use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, RwLock};
+use std::time::Duration;
 use tokio::io::Interest;
 use tokio::io::unix::AsyncFd;
-use tokio::sync::broadcast;
+use tokio::sync::{broadcast, mpsc, oneshot};
 
 const CAN_EFF_FLAG: u32 = 0x8000_0000;
 const CAN_RTR_FLAG: u32 = 0x4000_0000;
@@ -34,10 +38,11 @@ const CANFD_FDF: u8 = 0x04;
 pub const CAN_MTU: usize = 16;
 /// Size of `struct canfd_frame`.
 pub const CANFD_MTU: usize = 72;
-/// The receive buffer asked for: with the kernel's doubling about 8 MB, some 10000 frames.
+/// The receive buffer asked for: with the kernel's doubling about 16 MB, some 20000 frames
+/// (a full-rate burst of 20000 frames while a busy machine lets the reader fall seconds behind).
 /// Root (`CAP_NET_ADMIN`) gets it through `SO_RCVBUFFORCE`; otherwise `SO_RCVBUF` is capped
 /// at `net.core.rmem_max`.
-pub const RCVBUF_BYTES: i32 = 4 << 20;
+pub const RCVBUF_BYTES: i32 = 8 << 20;
 /// `ARPHRD_CAN` in `/sys/class/net/IFACE/type`.
 const ARPHRD_CAN: u32 = 280;
 
@@ -124,7 +129,47 @@ pub fn errno_text(errno: i32) -> String {
 /// Opens a SocketCAN interface. Must be called inside a tokio runtime (a reader task is spawned).
 pub fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
     check_interface(iface)?;
-    let sock = CanFdSocket::open(iface).map_err(|e| open_error(iface, &e))?;
+    let (sock, index) = open_socket(iface)?;
+    let link = Arc::new(Link {
+        iface: iface.to_string(),
+        sock: RwLock::new(Some(Arc::new(sock))),
+        drops_before: AtomicU64::new(0),
+    });
+    let events = broadcast::channel(QUEUE_DEPTH).0;
+    let (catch_up, requests) = mpsc::unbounded_channel();
+    let reader = Reader {
+        link: link.clone(),
+        events: events.clone(),
+        requests,
+        waiting: Vec::new(),
+        bound: Some(index),
+        link_state: BusState::Active,
+        controller: BusState::Active,
+        counters: None,
+        reported: BusState::Active,
+    };
+    let task = tokio::spawn(reader.run());
+    let sender = (!listen_only).then(|| Sender::Socket(Arc::new(Writer { link: link.clone() })));
+    Ok(Bus {
+        name: iface.to_string(),
+        endpoint: OWN,
+        events,
+        sender,
+        socket: Some(Arc::new(Shared { task, link, catch_up })),
+        clock: None,
+    })
+}
+
+type Socket = Arc<AsyncFd<CanFdSocket>>;
+
+/// Opens and configures a socket bound to `iface` by its current index.
+fn open_socket(iface: &str) -> Result<(AsyncFd<CanFdSocket>, u32), BusError> {
+    let index = sys_link(iface).map(|s| s.index).ok_or_else(|| BusError::Unavailable {
+        iface: iface.to_string(),
+        reason: "no such CAN interface".into(),
+        fix: missing_fix(iface),
+    })?;
+    let sock = CanFdSocket::open_iface(index).map_err(|e| open_error(iface, &e))?;
     let configure = || -> io::Result<()> {
         sock.set_nonblocking(true)?;
         sock.set_error_filter(ERR_MASK_ALL)?;
@@ -139,50 +184,89 @@ pub fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
     configure().map_err(|e| open_error(iface, &e))?;
     // SAFETY: the socket owns its descriptor and the AsyncFd owns the socket until it is dropped.
     let fd = unsafe { AsyncFd::register(sock) }.map_err(|e| open_error(iface, &e.into_parts().1))?;
-    let fd = Arc::new(fd);
-    let events = broadcast::channel(QUEUE_DEPTH).0;
-    let reader = tokio::spawn(read_loop(fd.clone(), events.clone()));
-    let sender = (!listen_only).then(|| {
-        Sender::Socket(Arc::new(Writer {
-            iface: iface.to_string(),
-            fd: fd.clone(),
-        }))
-    });
-    Ok(Bus {
-        name: iface.to_string(),
-        endpoint: OWN,
-        events,
-        sender,
-        _task: Some(Arc::new(TaskGuard(reader))),
-        clock: None,
-        drops: Some(Arc::new(DropCount(fd))),
+    Ok((fd, index))
+}
+
+/// `/sys/class/net/IFACE/{ifindex,flags}`; none when there is no such interface.
+fn sys_link(iface: &str) -> Option<SysLink> {
+    let dir = std::path::Path::new("/sys/class/net").join(iface);
+    let read = |file: &str| std::fs::read_to_string(dir.join(file)).ok();
+    let index = read("ifindex")?.trim().parse().ok()?;
+    let flags = read("flags")
+        .and_then(|f| u32::from_str_radix(f.trim().trim_start_matches("0x"), 16).ok())
+        .unwrap_or(0);
+    Some(SysLink {
+        index,
+        up: flags & libc::IFF_UP as u32 != 0,
     })
 }
 
-/// The kernel's count of frames dropped on a socket's full receive buffer.
-pub(super) struct DropCount(Arc<AsyncFd<CanFdSocket>>);
+/// What the reader task and the send path share: the socket in use (none while the
+/// interface is missing) and the drops of the sockets it replaced.
+pub(super) struct Link {
+    iface: String,
+    sock: RwLock<Option<Socket>>,
+    drops_before: AtomicU64,
+}
 
-impl DropCount {
-    /// `SK_MEMINFO_DROPS` of `SO_MEMINFO` (0 if the kernel does not tell).
-    pub(super) fn get(&self) -> u64 {
-        let mut info = [0u32; libc::SK_MEMINFO_DROPS as usize + 1];
-        let mut len = std::mem::size_of_val(&info) as libc::socklen_t;
-        // SAFETY: `info` is a writable buffer of `len` bytes for the duration of the call.
-        let r = unsafe {
-            libc::getsockopt(
-                self.0.as_raw_fd(),
-                libc::SOL_SOCKET,
-                libc::SO_MEMINFO,
-                info.as_mut_ptr().cast(),
-                &mut len,
-            )
-        };
-        let at = libc::SK_MEMINFO_DROPS as usize;
-        if r == 0 && (len as usize) >= (at + 1) * 4 {
-            info[at] as u64
-        } else {
-            0
+impl Link {
+    fn current(&self) -> Option<Socket> {
+        self.sock.read().ok().and_then(|s| s.clone())
+    }
+    /// Puts `new` in place of the socket, keeping the old one's drop count.
+    fn replace(&self, new: Option<Socket>) {
+        if let Ok(mut s) = self.sock.write() {
+            if let Some(old) = s.as_ref() {
+                self.drops_before.fetch_add(drops_of(old), Ordering::Relaxed);
+            }
+            *s = new;
         }
+    }
+}
+
+/// The reader task, its socket, and its catch-up line (SocketCAN handles).
+pub(super) struct Shared {
+    task: tokio::task::JoinHandle<()>,
+    link: Arc<Link>,
+    catch_up: mpsc::UnboundedSender<oneshot::Sender<()>>,
+}
+
+impl Shared {
+    /// Frames the kernel dropped on full receive buffers, over every socket of the handle.
+    pub(super) fn dropped(&self) -> u64 {
+        self.link.drops_before.load(Ordering::Relaxed) + self.link.current().map_or(0, |s| drops_of(&s))
+    }
+    /// Asks the reader to answer on `done` once the socket's queue is read; false if it is gone.
+    pub(super) fn catch_up(&self, done: oneshot::Sender<()>) -> bool {
+        self.catch_up.send(done).is_ok()
+    }
+}
+
+impl Drop for Shared {
+    fn drop(&mut self) {
+        self.task.abort();
+    }
+}
+
+/// `SK_MEMINFO_DROPS` of `SO_MEMINFO`: frames the kernel dropped on the socket's full buffer (0 if it does not tell).
+fn drops_of(sock: &Socket) -> u64 {
+    let mut info = [0u32; libc::SK_MEMINFO_DROPS as usize + 1];
+    let mut len = std::mem::size_of_val(&info) as libc::socklen_t;
+    // SAFETY: `info` is a writable buffer of `len` bytes for the duration of the call.
+    let r = unsafe {
+        libc::getsockopt(
+            sock.as_raw_fd(),
+            libc::SOL_SOCKET,
+            libc::SO_MEMINFO,
+            info.as_mut_ptr().cast(),
+            &mut len,
+        )
+    };
+    let at = libc::SK_MEMINFO_DROPS as usize;
+    if r == 0 && (len as usize) >= (at + 1) * 4 {
+        info[at] as u64
+    } else {
+        0
     }
 }
 
@@ -203,57 +287,256 @@ fn setsockopt_int(fd: i32, opt: i32, value: i32) -> io::Result<()> {
 
 /// The endpoint number of frames this socket sent.
 const OWN: u32 = 1;
+/// How often the reader compares its socket with `/sys/class/net/IFACE` while not capturing.
+const CHECK_TROUBLED: Duration = Duration::from_millis(100);
+/// How often it does while capturing (an interface deleted and re-created under a quiet
+/// socket reports no error on it).
+const CHECK_HEALTHY: Duration = Duration::from_secs(1);
+/// Frames read in a row before the reader lets the subscribers run.
+const READ_RUN: usize = 64;
 
-/// Aborts the reader task when the last handle is dropped.
-pub(super) struct TaskGuard(tokio::task::JoinHandle<()>);
-
-impl Drop for TaskGuard {
-    fn drop(&mut self) {
-        self.0.abort();
-    }
+/// The reader task: reads the socket into the broadcast channel, follows the interface
+/// (down, deleted, re-created: reopened by name) and the controller state from error frames.
+struct Reader {
+    link: Arc<Link>,
+    events: broadcast::Sender<Carried>,
+    requests: mpsc::UnboundedReceiver<oneshot::Sender<()>>,
+    /// Catch-up requests: when asked (ns) and where to answer.
+    waiting: Vec<(u64, oneshot::Sender<()>)>,
+    /// The interface index the socket is bound to (none: no socket).
+    bound: Option<u32>,
+    /// `Active` (up), `Down` or `Missing`.
+    link_state: BusState,
+    /// From error frames: `Active`, `Warning`, `Passive` or `BusOff`.
+    controller: BusState,
+    counters: Option<(u8, u8)>,
+    reported: BusState,
 }
 
-/// Reads frames until the task is aborted; read errors are passed on and retried after a pause.
-async fn read_loop(fd: Arc<AsyncFd<CanFdSocket>>, events: broadcast::Sender<Carried>) {
-    loop {
-        let got = fd.async_io(Interest::READABLE, |s| recv(s.as_raw_fd())).await;
-        let carried = match got {
-            Ok((frame, own)) => Carried {
-                origin: if own { OWN } else { 0 },
-                frame: Ok(frame),
-            },
-            Err(e) => Carried {
-                origin: 0,
-                frame: Err(ReadFault {
-                    errno: e.raw_os_error().unwrap_or(libc::EIO),
-                }),
+impl Reader {
+    async fn run(mut self) {
+        let mut tick = tokio::time::interval(CHECK_TROUBLED);
+        tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+        let mut checked = tokio::time::Instant::now();
+        loop {
+            let sock = self.link.current();
+            if let Some(s) = &sock {
+                self.read_queued(s).await;
+            }
+            // The queue is empty: everyone who asked has every frame queued before they asked.
+            for (_, w) in self.waiting.drain(..) {
+                let _ = w.send(());
+            }
+            tokio::select! {
+                r = readable(sock.as_ref()) => {
+                    if let Err(e) = r {
+                        self.on_error(e).await;
+                    }
+                }
+                req = self.requests.recv() => match req {
+                    Some(w) => self.waiting.push((now_ns(), w)),
+                    None => return,
+                },
+                _ = tick.tick() => {
+                    if self.link_state != BusState::Active || checked.elapsed() >= CHECK_HEALTHY {
+                        checked = tokio::time::Instant::now();
+                        self.reconcile();
+                    }
+                }
+            }
+        }
+    }
+
+    /// Reads until the socket's queue is empty (or fails), letting the subscribers run between runs.
+    async fn read_queued(&mut self, sock: &Socket) {
+        let mut run = 0;
+        loop {
+            match recv(sock.as_raw_fd()) {
+                Ok((frame, own)) => {
+                    self.on_frame(frame, own);
+                    run += 1;
+                    if run == READ_RUN {
+                        run = 0;
+                        if self.events.len() > QUEUE_DEPTH / 2 {
+                            // The subscribers are behind: give them time before they lose
+                            // frames (still 64 frames/ms, faster than any CAN bus).
+                            tokio::time::sleep(Duration::from_millis(1)).await;
+                        } else {
+                            tokio::task::yield_now().await;
+                        }
+                    }
+                }
+                Err(e) if e.kind() == io::ErrorKind::WouldBlock => return,
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+                Err(e) => return self.on_error(e).await,
+            }
+        }
+    }
+
+    fn on_frame(&mut self, frame: Frame, own: bool) {
+        if self.link_state != BusState::Active {
+            // A frame came in: the interface is up again.
+            self.link_state = BusState::Active;
+            self.controller = BusState::Active;
+            self.report(frame.ts_ns);
+        }
+        let _ = self.events.send(Carried {
+            origin: if own { OWN } else { 0 },
+            item: Item::Frame(frame),
+        });
+        if frame.is_err() {
+            let (state, counters) = controller_state(frame.id, frame.payload());
+            if counters.is_some() {
+                self.counters = counters;
+            }
+            if let Some(c) = state {
+                self.controller = BusState::from_controller(c);
+                self.report(frame.ts_ns);
+            }
+        }
+        // A frame stamped after a request proves that everything queued before it was read
+        // (this ends a catch-up even on a bus that never falls quiet).
+        if self.waiting.iter().any(|(asked, _)| *asked < frame.ts_ns) {
+            let (done, wait): (Vec<_>, Vec<_>) = self.waiting.drain(..).partition(|(asked, _)| *asked < frame.ts_ns);
+            self.waiting = wait;
+            for (_, w) in done {
+                let _ = w.send(());
+            }
+        }
+    }
+
+    async fn on_error(&mut self, e: io::Error) {
+        match e.raw_os_error() {
+            Some(libc::ENETDOWN) => {
+                self.link_state = BusState::Down;
+                self.report(now_ns());
+                self.reconcile();
+            }
+            Some(libc::ENODEV) | Some(libc::ENXIO) => {
+                self.link_state = BusState::Missing;
+                self.report(now_ns());
+                self.reconcile();
+            }
+            errno => {
+                let _ = self.events.send(Carried {
+                    origin: 0,
+                    item: Item::Fault(errno.unwrap_or(libc::EIO)),
+                });
+                // Not a change of state: do not spin on an error that repeats.
+                tokio::time::sleep(CHECK_TROUBLED).await;
+            }
+        }
+    }
+
+    /// Brings the socket in line with what `/sys/class/net/IFACE` says.
+    fn reconcile(&mut self) {
+        let sys = sys_link(&self.link.iface);
+        let up = match decide(self.bound, sys) {
+            Action::Keep { up } => up,
+            Action::Close => {
+                self.link.replace(None);
+                self.bound = None;
+                self.link_state = BusState::Missing;
+                return self.report(now_ns());
+            }
+            Action::Reopen { up } => match open_socket(&self.link.iface) {
+                Ok((sock, index)) => {
+                    self.link.replace(Some(Arc::new(sock)));
+                    self.bound = Some(index);
+                    up
+                }
+                // Not there yet (or gone again): tried again on the next tick.
+                Err(_) => {
+                    self.link.replace(None);
+                    self.bound = None;
+                    self.link_state = BusState::Missing;
+                    return self.report(now_ns());
+                }
             },
         };
-        let failed = carried.frame.is_err();
-        let _ = events.send(carried);
-        if failed {
-            tokio::time::sleep(std::time::Duration::from_millis(500)).await;
+        let state = if up { BusState::Active } else { BusState::Down };
+        if state != self.link_state {
+            self.link_state = state;
+            // A controller that was down starts over error-active.
+            self.controller = BusState::Active;
+            self.counters = None;
+        }
+        self.report(now_ns());
+    }
+
+    /// Sends the state in force if it differs from the last one sent.
+    fn report(&mut self, ts_ns: u64) {
+        let state = if self.link_state == BusState::Active {
+            self.controller
+        } else {
+            self.link_state
+        };
+        if state != self.reported {
+            self.reported = state;
+            let _ = self.events.send(Carried {
+                origin: 0,
+                item: Item::State(StateChange {
+                    ts_ns,
+                    state,
+                    counters: self.counters.filter(|_| self.link_state == BusState::Active),
+                }),
+            });
         }
     }
 }
 
+/// Waits until `sock` is readable (forever without a socket) and clears its readiness:
+/// the caller reads until the queue is empty, and data arriving meanwhile sets it again.
+async fn readable(sock: Option<&Socket>) -> io::Result<()> {
+    match sock {
+        Some(s) => {
+            s.readable().await?.clear_ready();
+            Ok(())
+        }
+        None => std::future::pending().await,
+    }
+}
+
+/// Wall-clock time in ns since the Unix epoch (the clock of kernel frame timestamps).
+fn now_ns() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos() as u64)
+}
+
 /// The send path of a SocketCAN handle (absent on listen-only handles).
 pub(super) struct Writer {
-    iface: String,
-    fd: Arc<AsyncFd<CanFdSocket>>,
+    link: Arc<Link>,
 }
 
 impl Writer {
     /// Writes one frame, retrying briefly while the transmit queue is full.
     pub(super) async fn write(&self, frame: &Frame) -> Result<(), BusError> {
+        let iface = &self.link.iface;
         let raw = to_raw(frame).map_err(|reason| BusError::Io {
-            iface: self.iface.clone(),
+            iface: iface.clone(),
             reason,
         })?;
+        let unavailable = |errno| {
+            let state = if errno == libc::ENETDOWN {
+                BusState::Down
+            } else {
+                BusState::Missing
+            };
+            StateChange {
+                ts_ns: 0,
+                state,
+                counters: None,
+            }
+            .error(iface)
+            .unwrap_or(BusError::Closed)
+        };
+        let Some(sock) = self.link.current() else {
+            return Err(unavailable(libc::ENODEV));
+        };
         let mut tries = 0;
         loop {
-            let r = self
-                .fd
+            let r = sock
                 .async_io(Interest::WRITABLE, |s| {
                     // SAFETY: `raw` is a valid buffer of `raw.len()` bytes for the whole call.
                     let n = unsafe { libc::write(s.as_raw_fd(), raw.as_ptr().cast(), raw.len()) };
@@ -268,7 +551,7 @@ impl Writer {
                 Ok(n) if n == raw.len() => return Ok(()),
                 Ok(n) => {
                     return Err(BusError::Io {
-                        iface: self.iface.clone(),
+                        iface: iface.clone(),
                         reason: format!("short write: {n} of {} bytes", raw.len()),
                     });
                 }
@@ -277,9 +560,12 @@ impl Writer {
                     tokio::time::sleep(std::time::Duration::from_millis(5)).await;
                 }
                 Err(e) => {
-                    return Err(BusError::Io {
-                        iface: self.iface.clone(),
-                        reason: errno_text(e.raw_os_error().unwrap_or(libc::EIO)),
+                    return Err(match e.raw_os_error() {
+                        Some(errno @ (libc::ENETDOWN | libc::ENODEV | libc::ENXIO)) => unavailable(errno),
+                        errno => BusError::Io {
+                            iface: iface.clone(),
+                            reason: errno_text(errno.unwrap_or(libc::EIO)),
+                        },
                     });
                 }
             }

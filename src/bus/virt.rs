@@ -4,7 +4,7 @@
 //! stamped when sent with wall-clock time that advances with tokio's clock, so a
 //! test with paused time gets deterministic timestamps.
 
-use super::{Bus, BusError, Carried, QUEUE_DEPTH, Sender};
+use super::{Bus, BusError, Carried, Item, QUEUE_DEPTH, Sender};
 use crate::frame::Frame;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -46,7 +46,7 @@ impl Port {
         // No subscriber is not an error: the frame went out on an idle bus.
         let _ = self.events.send(Carried {
             origin,
-            frame: Ok(frame),
+            item: Item::Frame(frame),
         });
         Ok(())
     }
@@ -82,8 +82,7 @@ impl VirtualBus {
                     clock: self.clock,
                 })
             }),
-            _task: None,
-            drops: None,
+            socket: None,
             clock: Some(self.clock),
         }
     }

@@ -5,7 +5,7 @@ use super::error::CommandError;
 use super::grammar::{Command, RunSpec, SdoOptions};
 use super::sdo::Timing;
 use super::value::{decode, encode};
-use crate::bus::Bus;
+use crate::bus::{Bus, BusError};
 use crate::decode::cia402::mode_name;
 use crate::od::alias::resolve_object;
 use crate::od::bind::Bindings;
@@ -108,17 +108,17 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
             let nodes = super::scan::scan(bus, *listen_ms, *probe, *timeout_ms).await?;
             json!({"ok": true, "nodes": nodes.iter().map(|n| n.to_json()).collect::<Vec<_>>()})
         }
-        Command::Record { output, limits } => {
+        Command::Record { output, limits, mode } => {
+            let mut out = super::record::open_output(output, *mode)?;
             let forever = std::future::pending::<()>();
-            let n = if output == "-" {
-                let mut out = std::io::BufWriter::new(std::io::stdout());
-                super::record::record(bus, &mut out, *limits, forever).await?
-            } else {
-                let file = std::fs::File::create(output)
-                    .map_err(|e| CommandError::Usage(format!("cannot create {output}: {e}")))?;
-                super::record::record(bus, &mut std::io::BufWriter::new(file), *limits, forever).await?
-            };
-            json!({"ok": true, "frames": n.frames, "dropped": n.dropped, "output": output})
+            let n = super::record::record(bus, &mut out, *limits, forever, |_| {}).await?;
+            if let Some(m) = n.gap_message(output) {
+                return Err(CommandError::Bus(BusError::Io {
+                    iface: bus.name().to_string(),
+                    reason: format!("{} frames written, but {m}", n.frames),
+                }));
+            }
+            n.to_json(output)
         }
     };
     let text = text(cmd, &json);

@@ -2,7 +2,7 @@
 //! `parse_command("sdo read 2 0x6041")` gives the same [`Command`] as
 //! `cotui sdo read IFACE 2 0x6041`.
 
-use super::record::Limits;
+use super::record::{Limits, WriteMode};
 use crate::od::DataType;
 
 /// An NMT command.
@@ -186,8 +186,12 @@ pub enum Command {
         probe: bool,
         timeout_ms: u64,
     },
-    /// `record -o FILE [--count N] [--duration MS]`.
-    Record { output: String, limits: Limits },
+    /// `record -o FILE [--count N] [--duration MS] [--force | --append]`.
+    Record {
+        output: String,
+        limits: Limits,
+        mode: WriteMode,
+    },
     /// `run NODE PROCEDURE [NAME=VALUE ...] [--dry-run] [--timeout MS]`, or `run NODE [--list]`.
     Run(RunSpec),
     /// `stop [NODE ...] [--listen MS] [--ramp MS] [--timeout MS]`: quick stop and disable
@@ -364,6 +368,7 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
     let (mut block, mut wait, mut probe, mut list, mut dry_run) = (false, false, false, false, false);
     let (mut output, mut timeout, mut listen, mut ramp, mut deadline) = (None, None, None, None, None);
     let mut limits = Limits::default();
+    let mut mode = WriteMode::New;
     let mut it = all.iter();
     while let Some(w) = it.next() {
         let mut value = |flag: &str| it.next().map(String::as_str).ok_or(format!("{flag} needs a value"));
@@ -373,6 +378,11 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
             "--probe" => probe = true,
             "--list" => list = true,
             "--dry-run" => dry_run = true,
+            "--force" | "--append" if mode != WriteMode::New => {
+                return Err("record takes --force or --append, not both".into());
+            }
+            "--force" => mode = WriteMode::Overwrite,
+            "--append" => mode = WriteMode::Append,
             "--type" | "-t" => data_type = Some(parse_type(value("--type")?)?),
             "--timeout" => timeout = Some(positive("--timeout", value("--timeout")?)?),
             "--listen" => listen = Some(positive("--listen", value("--listen")?)?),
@@ -442,6 +452,7 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
         ["record"] => Ok(Command::Record {
             output: output.ok_or("record needs -o FILE")?,
             limits,
+            mode,
         }),
         [] => Err(format!("empty command; {usage}")),
         [first, ..] => Err(format!("cannot parse `{}` (after `{first}`); {usage}", all.join(" "))),
@@ -512,7 +523,31 @@ mod tests {
             Command::Record {
                 output: "out.log".into(),
                 limits: Limits::default(),
+                mode: WriteMode::New,
             }
+        );
+        assert_eq!(
+            parse_command("record -o out.log --append --count 5").unwrap(),
+            Command::Record {
+                output: "out.log".into(),
+                limits: Limits {
+                    count: Some(5),
+                    duration_ms: None
+                },
+                mode: WriteMode::Append,
+            }
+        );
+        assert!(matches!(
+            parse_command("record --force -o out.log"),
+            Ok(Command::Record {
+                mode: WriteMode::Overwrite,
+                ..
+            })
+        ));
+        assert!(
+            parse_command("record -o x --force --append")
+                .unwrap_err()
+                .contains("not both")
         );
     }
 

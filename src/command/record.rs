@@ -1,10 +1,18 @@
-//! `record`: writes every frame on the bus to a candump `-l` log (our own frames included).
+//! `record`: writes every frame on the bus to a candump `-l` log (our own frames included),
+//! whole lines only, at least every [`FLUSH_MS`] ms; on stop it first reads what the kernel
+//! still holds. Times when nothing could be captured (interface down or gone, bus-off) are
+//! the recording's gaps.
 
 use super::error::CommandError;
-use crate::bus::{Bus, BusError};
+use crate::bus::{Bus, BusError, Event, StateChange};
+use crate::log::sink::{LineSink, Target};
 use crate::log::writer::LogWriter;
+use std::fs::{File, OpenOptions};
 use std::future::Future;
-use std::io::Write;
+use std::time::{Duration, Instant};
+
+/// Written lines never wait longer than this (while frames keep coming) before they go out.
+pub const FLUSH_MS: u64 = 200;
 
 /// When a recording stops (besides `stop` resolving).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -15,32 +23,125 @@ pub struct Limits {
     pub duration_ms: Option<u64>,
 }
 
-/// What a recording wrote and what it missed.
+/// What to do when the output file exists.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum WriteMode {
+    /// Refuse (a usage error naming `--force` and `--append`).
+    #[default]
+    New,
+    /// Overwrite it (`--force`).
+    Overwrite,
+    /// Append to it (`--append`).
+    Append,
+}
+
+/// A time when nothing could be captured.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Gap {
+    /// Start, ns since the Unix epoch.
+    pub from_ns: u64,
+    /// End (capture resumed, or the recording stopped), ns since the Unix epoch.
+    pub to_ns: u64,
+    /// Why (`interface down`, `interface missing`, `bus-off`).
+    pub reason: String,
+}
+
+/// What a recording wrote and what it missed.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Recorded {
     /// Frames written to the log.
     pub frames: u64,
     /// Frames that never reached the log: dropped by the kernel on a full socket buffer,
     /// or overrun in cotui's queue. A complete recording has 0.
     pub dropped: u64,
+    /// Times when the bus could not be captured. A complete recording has none.
+    pub gaps: Vec<Gap>,
 }
 
-/// Records frames from `bus` into `out` until `stop` resolves or a limit is reached.
-/// Read errors of the interface are skipped.
-pub async fn record<W: Write>(
+impl Recorded {
+    /// The JSON summary: `frames`, `dropped`, `gaps: [{from, to, reason}]` (seconds since
+    /// the Unix epoch, as the log's timestamps), `output`; `ok` is false when there are gaps.
+    pub fn to_json(&self, output: &str) -> serde_json::Value {
+        let secs = |ns: u64| ns as f64 / 1e9;
+        let gaps: Vec<_> = self
+            .gaps
+            .iter()
+            .map(|g| serde_json::json!({"from": secs(g.from_ns), "to": secs(g.to_ns), "reason": g.reason}))
+            .collect();
+        let mut v = serde_json::json!({
+            "ok": self.gaps.is_empty(), "frames": self.frames, "dropped": self.dropped,
+            "gaps": gaps, "output": output,
+        });
+        if let Some(m) = self.gap_message(output) {
+            v["error"] = "bus".into();
+            v["message"] = m.into();
+        }
+        v
+    }
+    /// Why the recording is incomplete, if it has gaps.
+    pub fn gap_message(&self, output: &str) -> Option<String> {
+        let total: u64 = self.gaps.iter().map(|g| g.to_ns.saturating_sub(g.from_ns)).sum();
+        (!self.gaps.is_empty()).then(|| {
+            format!(
+                "{output} has {} gap(s), {:.1} s in all, when nothing could be captured ({})",
+                self.gaps.len(),
+                total as f64 / 1e9,
+                self.gaps
+                    .iter()
+                    .map(|g| g.reason.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        })
+    }
+}
+
+/// Opens the log: `-` is stdout; an existing file is refused unless `mode` says overwrite or append.
+pub fn open_output(path: &str, mode: WriteMode) -> Result<LineSink<Box<dyn Target + Send>>, CommandError> {
+    if path == "-" {
+        return Ok(LineSink::new(Box::new(std::io::stdout()), 0));
+    }
+    let mut o = OpenOptions::new();
+    match mode {
+        WriteMode::New => o.write(true).create_new(true),
+        WriteMode::Overwrite => o.write(true).create(true).truncate(true),
+        WriteMode::Append => o.append(true).create(true),
+    };
+    let file: File = o.open(path).map_err(|e| {
+        CommandError::Usage(if e.kind() == std::io::ErrorKind::AlreadyExists {
+            format!("{path} exists; --force overwrites it, --append adds to it")
+        } else {
+            format!("cannot create {path}: {e}")
+        })
+    })?;
+    let len = file.metadata().map(|m| m.len()).unwrap_or(0);
+    Ok(LineSink::new(Box::new(file), len))
+}
+
+/// Records frames from `bus` into `out` until `stop` resolves or a limit is reached; then
+/// reads every frame still queued, writes it, and flushes. Each change of the bus state
+/// goes to `note` as a line for the user. A write error stops the recording (the log keeps
+/// whole lines only).
+pub async fn record<T: Target>(
     bus: &Bus,
-    out: &mut W,
+    out: &mut LineSink<T>,
     limits: Limits,
     stop: impl Future<Output = ()>,
+    mut note: impl FnMut(String),
 ) -> Result<Recorded, CommandError> {
     let mut rx = bus.subscribe();
-    let mut writer = LogWriter::new();
-    let iface = bus.name().to_string();
-    let mut n = 0u64;
-    let io_err = |e: std::io::Error| CommandError::Usage(format!("writing the log failed: {e}"));
+    let mut rec = Recording {
+        writer: LogWriter::new(),
+        iface: bus.name().to_string(),
+        frames: 0,
+        count: limits.count,
+        open_gap: None,
+        gaps: Vec::new(),
+        flushed: Instant::now(),
+    };
     let deadline = limits
         .duration_ms
-        .map(|ms| tokio::time::Instant::now() + std::time::Duration::from_millis(ms));
+        .map(|ms| tokio::time::Instant::now() + Duration::from_millis(ms));
     let until = async {
         match deadline {
             Some(d) => tokio::time::sleep_until(d).await,
@@ -49,31 +150,280 @@ pub async fn record<W: Write>(
     };
     tokio::pin!(stop);
     tokio::pin!(until);
-    let more = |n: u64| limits.count.is_none_or(|c| n < c);
-    'frames: while more(n) {
+    let mut closed = false;
+    while rec.more() {
         tokio::select! {
             _ = &mut stop => break,
             _ = &mut until => break,
-            got = rx.recv() => {
+            got = rx.next() => {
                 // Write whatever else is queued before polling the stop conditions again.
                 let mut next = Some(got);
                 while let Some(got) = next {
-                    match got {
-                        Ok(f) => {
-                            writer.write_io(out, &f, &iface).map_err(io_err)?;
-                            n += 1;
-                        }
-                        Err(BusError::Closed) => break 'frames,
-                        Err(_) => {}
+                    if !rec.take(got, out, &mut note)? {
+                        closed = true;
+                        break;
                     }
-                    next = if more(n) { rx.try_recv() } else { None };
+                    next = if rec.more() { rx.try_next() } else { None };
+                    if next.is_some() && rec.flushed.elapsed() >= Duration::from_millis(FLUSH_MS) {
+                        rec.flush(out)?;
+                    }
+                }
+                rec.flush(out)?;
+                if closed {
+                    break;
                 }
             }
         }
     }
-    out.flush().map_err(io_err)?;
+    if rec.more() && !closed {
+        // Stopped: what the kernel queued before the stop belongs to the recording.
+        let caught = bus.catch_up();
+        tokio::pin!(caught);
+        loop {
+            tokio::select! {
+                biased;
+                got = rx.next() => {
+                    if !rec.take(got, out, &mut note)? || !rec.more() {
+                        break;
+                    }
+                }
+                _ = &mut caught => break,
+            }
+        }
+        while rec.more()
+            && let Some(got) = rx.try_next()
+            && rec.take(got, out, &mut note)?
+        {}
+    }
+    rec.flush(out)?;
+    if let Some((from_ns, reason)) = rec.open_gap.take() {
+        rec.gaps.push(Gap {
+            from_ns,
+            to_ns: now_ns(),
+            reason,
+        });
+    }
     Ok(Recorded {
-        frames: n,
+        frames: out.lines(),
         dropped: bus.dropped() + rx.lost(),
+        gaps: rec.gaps,
     })
+}
+
+/// A recording in progress.
+struct Recording {
+    writer: LogWriter,
+    iface: String,
+    /// Frames taken (written to the sink's buffer).
+    frames: u64,
+    count: Option<u64>,
+    /// Start (ns) and reason of the gap in progress.
+    open_gap: Option<(u64, String)>,
+    gaps: Vec<Gap>,
+    flushed: Instant,
+}
+
+impl Recording {
+    fn more(&self) -> bool {
+        self.count.is_none_or(|c| self.frames < c)
+    }
+
+    /// Takes one event; false when the bus is closed.
+    fn take<T: Target>(
+        &mut self,
+        got: Result<Event, BusError>,
+        out: &mut LineSink<T>,
+        note: &mut impl FnMut(String),
+    ) -> Result<bool, CommandError> {
+        match got {
+            Ok(Event::Frame(f)) => {
+                // Writing to a Vec cannot fail.
+                let _ = self.writer.write_io(out.buffer(), &f, &self.iface);
+                self.frames += 1;
+            }
+            Ok(Event::State(s)) => self.state(s, note),
+            Err(BusError::Closed) => return Ok(false),
+            Err(e) => note(e.to_string()),
+        }
+        Ok(true)
+    }
+
+    fn state(&mut self, s: StateChange, note: &mut impl FnMut(String)) {
+        match (&self.open_gap, s.state.capturing()) {
+            (None, false) => {
+                self.open_gap = Some((s.ts_ns, s.state.name().to_string()));
+                note(format!("{}; a gap in the recording starts", s.text(&self.iface)));
+            }
+            (Some((from, reason)), true) => {
+                note(format!(
+                    "{}: capturing again after {:.1} s ({reason}); the gap ends",
+                    self.iface,
+                    s.ts_ns.saturating_sub(*from) as f64 / 1e9
+                ));
+                self.gaps.push(Gap {
+                    from_ns: *from,
+                    to_ns: s.ts_ns,
+                    reason: reason.clone(),
+                });
+                self.open_gap = None;
+                if s.state != crate::bus::BusState::Active {
+                    note(s.text(&self.iface));
+                }
+            }
+            _ => note(s.text(&self.iface)),
+        }
+    }
+
+    fn flush<T: Target>(&mut self, out: &mut LineSink<T>) -> Result<(), CommandError> {
+        self.flushed = Instant::now();
+        if !out.pending() {
+            return Ok(());
+        }
+        out.flush().map_err(|e| {
+            CommandError::Usage(format!(
+                "writing the log failed: {e}; it ends with the last whole line ({} frames)",
+                out.lines()
+            ))
+        })
+    }
+}
+
+/// Wall-clock time in ns since the Unix epoch (the clock of frame timestamps).
+fn now_ns() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos() as u64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bus::BusState;
+    use crate::frame::Frame;
+
+    struct Mem(Vec<u8>);
+    impl std::io::Write for Mem {
+        fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+            self.0.extend_from_slice(b);
+            Ok(b.len())
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+    impl Target for Mem {
+        fn cut(&mut self, len: u64) -> std::io::Result<()> {
+            self.0.truncate(len as usize);
+            Ok(())
+        }
+    }
+
+    fn state(ts_ns: u64, state: BusState) -> Result<Event, BusError> {
+        Ok(Event::State(StateChange {
+            ts_ns,
+            state,
+            counters: None,
+        }))
+    }
+
+    #[test]
+    fn loss_of_capture_is_a_gap_with_its_reason_and_notes() {
+        let mut rec = Recording {
+            writer: LogWriter::new(),
+            iface: "vcan0".into(),
+            frames: 0,
+            count: None,
+            open_gap: None,
+            gaps: Vec::new(),
+            flushed: Instant::now(),
+        };
+        let mut out = LineSink::new(Mem(Vec::new()), 0);
+        let mut notes = Vec::new();
+        let mut f = Frame::classic(0x123, &[1]);
+        f.ts_ns = 1_000_000_000;
+        let events = [
+            Ok(Event::Frame(f)),
+            state(2_000_000_000, BusState::Down),
+            // Deleted while down: still the same gap, with the first reason.
+            state(2_500_000_000, BusState::Missing),
+            state(4_000_000_000, BusState::Active),
+            state(5_000_000_000, BusState::Passive),
+            state(6_000_000_000, BusState::BusOff),
+            state(6_500_000_000, BusState::Active),
+            Err(BusError::Closed),
+        ];
+        let taken: Vec<bool> = events
+            .into_iter()
+            .map(|e| rec.take(e, &mut out, &mut |n| notes.push(n)).unwrap())
+            .collect();
+        assert_eq!(taken, [true, true, true, true, true, true, true, false]);
+        rec.flush(&mut out).unwrap();
+        assert_eq!(out.lines(), 1);
+        let gap = |from_ns, to_ns, reason: &str| Gap {
+            from_ns,
+            to_ns,
+            reason: reason.into(),
+        };
+        assert_eq!(
+            rec.gaps,
+            [
+                gap(2_000_000_000, 4_000_000_000, "interface down"),
+                gap(6_000_000_000, 6_500_000_000, "bus-off")
+            ]
+        );
+        assert!(notes[0].starts_with("vcan0: interface is down, not capturing; fix: sudo ip link set vcan0 up"));
+        assert!(notes[0].ends_with("a gap in the recording starts"), "{}", notes[0]);
+        assert!(notes[1].starts_with("vcan0: interface is gone"), "{}", notes[1]);
+        assert_eq!(
+            notes[2],
+            "vcan0: capturing again after 2.0 s (interface down); the gap ends"
+        );
+        assert!(
+            notes[3].starts_with("vcan0: controller error-passive; fix: check wiring"),
+            "{}",
+            notes[3]
+        );
+        let r = Recorded {
+            frames: 1,
+            dropped: 0,
+            gaps: rec.gaps,
+        };
+        let v = r.to_json("x.log");
+        assert_eq!((v["ok"].as_bool(), v["error"].as_str()), (Some(false), Some("bus")));
+        assert_eq!(v["gaps"][0]["from"], 2.0);
+        assert_eq!(v["gaps"][1]["reason"], "bus-off");
+        assert_eq!(
+            v["message"],
+            "x.log has 2 gap(s), 2.5 s in all, when nothing could be captured (interface down, bus-off)"
+        );
+        let clean = Recorded::default().to_json("x.log");
+        assert_eq!(
+            (clean["ok"].as_bool(), clean["gaps"].as_array().map(Vec::len)),
+            (Some(true), Some(0))
+        );
+    }
+
+    #[test]
+    fn an_existing_log_is_kept_unless_forced_or_appended() {
+        let path = std::env::temp_dir().join(format!("cotui-rec-mode-{}.log", std::process::id()));
+        std::fs::write(&path, "(1.000000) can0 123#01\n").unwrap();
+        let p = path.to_str().unwrap();
+        let e = open_output(p, WriteMode::New).err().unwrap();
+        assert_eq!(
+            e.to_string(),
+            format!("{p} exists; --force overwrites it, --append adds to it")
+        );
+        assert_eq!(e.exit_code(), 1);
+        let mut out = open_output(p, WriteMode::Append).unwrap();
+        out.buffer().extend_from_slice(b"(2.000000) can0 123#02\n");
+        out.flush().unwrap();
+        drop(out);
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            "(1.000000) can0 123#01\n(2.000000) can0 123#02\n"
+        );
+        drop(open_output(p, WriteMode::Overwrite).unwrap());
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "");
+        std::fs::remove_file(&path).unwrap();
+    }
 }

@@ -78,6 +78,39 @@ pub fn label(class: u32, data: &[u8]) -> String {
     }
 }
 
+/// The state of a CAN controller as its error frames tell it (ISO 11898 fault confinement).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ControllerState {
+    /// Error-active: normal operation (also after a restart).
+    Active,
+    /// An error counter reached the warning level (96).
+    Warning,
+    /// An error counter passed 127: the controller may only send passive error flags.
+    Passive,
+    /// The transmit error counter passed 255: the controller is off the bus until restarted.
+    BusOff,
+}
+
+/// What an error frame says about the controller: the state it entered (if it tells) and
+/// the transmit/receive error counters (if the frame carries them, class 0x200, bytes 6 and 7).
+pub fn controller_state(class: u32, data: &[u8]) -> (Option<ControllerState>, Option<(u8, u8)>) {
+    let byte = |i: usize| data.get(i).copied().unwrap_or(0);
+    let counters = (class & 0x200 != 0).then(|| (byte(6), byte(7)));
+    let ctrl = if class & 0x004 != 0 { byte(1) } else { 0 };
+    let state = if class & 0x040 != 0 {
+        Some(ControllerState::BusOff)
+    } else if ctrl & 0x30 != 0 {
+        Some(ControllerState::Passive)
+    } else if ctrl & 0x0C != 0 {
+        Some(ControllerState::Warning)
+    } else if class & 0x100 != 0 || ctrl & 0x40 != 0 {
+        Some(ControllerState::Active)
+    } else {
+        None
+    };
+    (state, counters)
+}
+
 /// The kind-specific JSON object.
 pub fn to_json(class: u32, data: &[u8]) -> serde_json::Value {
     json!({"class": class, "details": describe(class, data)})
@@ -97,5 +130,33 @@ mod tests {
         assert_eq!(label(0x040, &[0; 8]), "Error frame: bus off");
         assert_eq!(label(0, &[]), "Error frame 0x00000000");
         assert_eq!(to_json(0x20, &[])["details"], json!(["no ACK on transmission"]));
+    }
+
+    #[test]
+    fn controller_states_and_counters() {
+        use ControllerState::*;
+        // Bus-off (class 0x040), with counters: tx 255 (well, 0xF8 as drivers cap it), rx 0.
+        assert_eq!(
+            controller_state(0x240, &[0, 0, 0, 0, 0, 0, 0xF8, 0]),
+            (Some(BusOff), Some((0xF8, 0)))
+        );
+        assert_eq!(
+            controller_state(0x004, &[0, 0x20, 0, 0, 0, 0, 0, 0]),
+            (Some(Passive), None)
+        );
+        assert_eq!(
+            controller_state(0x204, &[0, 0x04, 0, 0, 0, 0, 3, 97]),
+            (Some(Warning), Some((3, 97)))
+        );
+        assert_eq!(
+            controller_state(0x004, &[0, 0x40, 0, 0, 0, 0, 0, 0]),
+            (Some(Active), None)
+        );
+        assert_eq!(controller_state(0x100, &[0; 8]), (Some(Active), None));
+        // A protocol violation or a lost arbitration says nothing about the state.
+        assert_eq!(controller_state(0x00A, &[3, 0, 0x04, 0, 0, 0, 0, 0]), (None, None));
+        // Controller bits without the controller class are not read; short frames are fine.
+        assert_eq!(controller_state(0x008, &[0, 0x30]), (None, None));
+        assert_eq!(controller_state(0x204, &[0, 0x10]), (Some(Passive), Some((0, 0))));
     }
 }

@@ -10,6 +10,7 @@ pub mod asc;
 pub mod candump;
 mod lex;
 pub mod screen;
+pub mod sink;
 pub mod writer;
 
 use std::fmt;

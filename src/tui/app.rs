@@ -317,9 +317,10 @@ impl App {
                     self.capture_clock = None;
                     self.dirty = true;
                 }
-                Ok(Feed::BusOk) => {
+                Ok(Feed::BusOk(note)) => {
+                    // A recovery is news (the error it ends was shown); the first "capturing" is not.
                     if self.source.bus_error.take().is_some() {
-                        self.log(Level::Info, &format!("{}: capturing again", self.source.name));
+                        self.say(Level::Info, &note);
                     }
                     self.dirty = true;
                 }
@@ -1351,17 +1352,19 @@ mod tests {
             "vcan0: interface went down; fix: sudo ip link set vcan0 up".into(),
         ))
         .unwrap();
-        ftx.send(Feed::BusOk).unwrap();
+        ftx.send(Feed::BusOk("vcan0: capturing again after 2.0 s without capture".into()))
+            .unwrap();
         a.ingest(Duration::from_millis(50));
+        // The recovery is the latest news on the status line; the log has all three.
         assert_eq!(
             a.message.as_deref(),
-            Some("scan: 2 nodes (+2 lines: `m` shows the message log)")
+            Some("vcan0: capturing again after 2.0 s without capture")
         );
         let lines: Vec<String> = a.messages.lines().into_iter().map(|(_, l)| l).collect();
         assert_eq!(lines.len(), 5, "{lines:?}");
         assert!(lines[2].ends_with("  node 3 syntron-ds"));
         assert!(lines[3].ends_with("  vcan0: interface went down; fix: sudo ip link set vcan0 up"));
-        assert!(lines[4].ends_with("  demo: capturing again"));
+        assert!(lines[4].ends_with("  vcan0: capturing again after 2.0 s without capture"));
         a.key(key('m'));
         assert!(a.messages_shown);
         let s = crate::tui::panes::testutil::screen(&mut a, 120, 20);

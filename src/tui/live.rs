@@ -5,7 +5,7 @@
 
 use super::messages::Level;
 use super::source::Feed;
-use crate::bus::{self, Bus, BusError};
+use crate::bus::{self, Bus, BusError, BusState, Event, StateChange};
 use crate::command::stop::{Commanded, StopOptions, stop_nodes};
 use crate::command::{self, Command};
 use crate::decode::cia402::DriveState;
@@ -69,6 +69,10 @@ fn offer(tx: &SyncSender<Feed>, item: Feed, lost: &mut u64) -> bool {
     }
 }
 
+/// Opens the bus (retrying every second until it can), then forwards frames in batches
+/// and every change of the interface or controller state: [`Feed::BusError`] (with the
+/// fix) when capture stops or the controller is in trouble, [`Feed::BusOk`] when it is
+/// back. The bus handle follows the interface by name, so capture resumes by itself.
 async fn capture(
     iface: String,
     listen_only: bool,
@@ -79,11 +83,10 @@ async fn capture(
     if tx.send(Feed::Interfaces(vec![iface.clone()])).is_err() {
         return;
     }
-    let mut lost = 0u64;
     let mut jobs = Jobs::default();
-    loop {
-        let bus = match bus::open(&iface, listen_only).await {
-            Ok(b) => b,
+    let bus = loop {
+        match bus::open(&iface, listen_only).await {
+            Ok(b) => break b,
             Err(e) => {
                 if tx.send(Feed::BusError(e.to_string())).is_err() {
                     return;
@@ -100,56 +103,84 @@ async fn capture(
                         },
                     }
                 }
-                continue;
             }
-        };
-        if tx.send(Feed::BusOk).is_err() {
-            return;
         }
-        let mut sub = bus.subscribe();
-        let mut reported = 0u64;
-        let mut batch = Vec::with_capacity(BATCH);
-        let mut flush = tokio::time::interval(Duration::from_millis(10));
-        let failed = loop {
-            tokio::select! {
-                got = sub.recv() => match got {
-                    Ok(mut f) => {
-                        f.iface = 0;
-                        jobs.observe(&f);
-                        batch.push(f);
-                        if batch.len() >= BATCH && !offer(&tx, Feed::Frames(std::mem::take(&mut batch)), &mut lost) {
-                            return;
-                        }
+    };
+    if tx.send(Feed::BusOk(format!("{iface}: capturing"))).is_err() {
+        return;
+    }
+    let mut lost = 0u64;
+    let mut sub = bus.subscribe();
+    let mut reported = 0u64;
+    let mut batch = Vec::with_capacity(BATCH);
+    let mut flush = tokio::time::interval(Duration::from_millis(10));
+    // When capture stopped (ns), while it is stopped.
+    let mut stopped_at: Option<u64> = None;
+    loop {
+        tokio::select! {
+            got = sub.next() => match got {
+                Ok(Event::Frame(mut f)) => {
+                    f.iface = 0;
+                    jobs.observe(&f);
+                    batch.push(f);
+                    if batch.len() >= BATCH && !offer(&tx, Feed::Frames(std::mem::take(&mut batch)), &mut lost) {
+                        return;
                     }
-                    Err(e) => break e,
-                },
-                _ = flush.tick() => {
+                }
+                Ok(Event::State(s)) => {
+                    // Frames before the change first, so the trace and the notice agree.
                     if !batch.is_empty() && !offer(&tx, Feed::Frames(std::mem::take(&mut batch)), &mut lost) {
                         return;
                     }
-                    let total = lost + sub.lost() - reported;
-                    if total > 0 && tx.try_send(Feed::Lost(total)).is_ok() {
-                        lost = 0;
-                        reported = sub.lost();
+                    if tx.send(state_feed(&iface, &s, &mut stopped_at)).is_err() {
+                        return;
                     }
                 }
-                r = req.recv() => match r {
-                    Some(r) => jobs.start(&bus, r, &bindings, &tx),
-                    None => return,
-                },
+                Err(BusError::Closed) => {
+                    offer(&tx, Feed::Frames(std::mem::take(&mut batch)), &mut lost);
+                    let _ = tx.send(Feed::BusError(BusError::Closed.to_string()));
+                    let _ = tx.send(Feed::Done);
+                    return;
+                }
+                Err(e) => {
+                    if tx.send(Feed::Status(e.to_string())).is_err() {
+                        return;
+                    }
+                }
+            },
+            _ = flush.tick() => {
+                if !batch.is_empty() && !offer(&tx, Feed::Frames(std::mem::take(&mut batch)), &mut lost) {
+                    return;
+                }
+                let total = lost + sub.lost() - reported;
+                if total > 0 && tx.try_send(Feed::Lost(total)).is_ok() {
+                    lost = 0;
+                    reported = sub.lost();
+                }
             }
-        };
-        if !batch.is_empty() {
-            offer(&tx, Feed::Frames(std::mem::take(&mut batch)), &mut lost);
+            r = req.recv() => match r {
+                Some(r) => jobs.start(&bus, r, &bindings, &tx),
+                None => return,
+            },
         }
-        if tx.send(Feed::BusError(failed.to_string())).is_err() {
-            return;
-        }
-        if failed == BusError::Closed {
-            let _ = tx.send(Feed::Done);
-            return;
-        }
-        tokio::time::sleep(Duration::from_secs(1)).await;
+    }
+}
+
+/// The feed item for a change of state: trouble (with the fix) or all well again (saying
+/// how long capture was stopped, if it was).
+fn state_feed(iface: &str, s: &StateChange, stopped_at: &mut Option<u64>) -> Feed {
+    if !s.state.capturing() {
+        stopped_at.get_or_insert(s.ts_ns);
+    }
+    if s.state != BusState::Active {
+        return Feed::BusError(s.text(iface));
+    }
+    match stopped_at.take() {
+        Some(t) => Feed::BusOk(format!(
+            "{iface}: capturing again after {:.1} s without capture",
+            s.ts_ns.saturating_sub(t) as f64 / 1e9
+        )),
+        None => Feed::BusOk(s.text(iface)),
     }
 }
 

@@ -29,10 +29,12 @@ pub enum Feed {
     Done,
     /// Frames lost before reaching the UI (queue full, reader too slow).
     Lost(u64),
-    /// The interface failed or is unavailable; the text names the command that fixes it.
+    /// The interface is unavailable, down, gone, or its controller is bus-off, error-passive
+    /// or warning; the text says so, whether frames are captured, and the command that fixes it.
     BusError(String),
-    /// The interface is (again) capturing.
-    BusOk,
+    /// The interface is (again) capturing with an error-active controller; the text says so
+    /// (and for how long capture had stopped).
+    BusOk(String),
     /// The result of a palette command, and how much it matters.
     Result(super::messages::Level, String),
 }

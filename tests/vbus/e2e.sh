@@ -3,7 +3,8 @@
 # SocketCAN test binary on the host, then runs tests/vbus/e2e_guest.sh inside ONE vbus
 # guest with vcan0 (classic) and vcan1 (CAN FD): cotui record against candump -l
 # (incl. a 20000-frame burst), SDO against python canopen's LocalNode, the CiA 402 drive
-# peer, --listen-only against candump, the TUI in tmux, and tests/socketcan_live.rs.
+# peer, --listen-only against candump, the TUI in tmux, tests/socketcan_live.rs, and
+# record/live through interface down/up, del/add, bus-off and every stop signal.
 #
 #   tests/vbus/e2e.sh
 #

@@ -85,7 +85,11 @@ cangen vcan1 -n 10 -g 0 -I 7E7 -L r -D r
 burst_t0=$(date +%s.%N)
 cangen vcan0 -g 0 -n 20000 -I 7E0 -L 8 -D i
 burst_t1=$(date +%s.%N)
-sleep 1
+# Stop once cotui's log (written out at least every 200 ms) holds the burst's last frame
+# (counter 19999): on a loaded machine the readers may be seconds behind cangen, and
+# candump, unlike cotui record, drops what is still queued in its socket when stopped.
+wait_for rec0.log 600 " vcan0 7E0#1F4E000000000000" || bad "burst: cotui record did not write the last burst frame in 60 s"
+sleep 0.5
 kill -INT $rec0 $rec1 $dump
 wait $rec0; rc0=$?
 wait $rec1; rc1=$?
@@ -479,6 +483,155 @@ if [ $rc = 0 ] && [ -n "$last_hb" ] && echo "$out" | jq -se --argjson last "$las
 else
     bad "liveness: decode --events: rc=$rc, last heartbeat $last_hb: $out $err"
 fi
+
+# ---- 8. interface and bus state: record and live follow vcan0 (down/up, del/add, bus-off) ----
+# One cotui record and candump -l capture counter bursts (ids 7D0..7D3) while vcan0 is
+# taken down and up, deleted and created again, then a bus-off error frame (cansend
+# 20000040#...) and its restart (20000100#...). candump dies with a deleted interface (and
+# older ones with a downed one), so a fresh candump records each part; cotui record must
+# hold exactly their frames, report the three gaps and exit 2. Then each catchable signal
+# stops a record right after a burst with every frame kept (read from the socket before
+# exiting), and kill -9 after the flush interval keeps every frame too; a full disk leaves
+# whole lines only. Then the TUI (`cotui live vcan0` in tmux) shows each state with its
+# fix, and frames flow again.
+# link_burst ID: 100 frames at full rate with a counter payload
+link_burst() { cangen vcan0 -g 0 -n 100 -I "$1" -L 8 -D i; }
+# link_sock PID: waits up to 60 s for PID to open its socket (a program starts slowly in a busy guest)
+link_sock() { for _ in 1 2 3 4 5 6; do wait_socket "$1" && return 0; done; return 1; }
+# relink: vcan0 created again as section 6 left it (CAN FD MTU, up)
+relink() { ip link add dev vcan0 type vcan && ip link set vcan0 mtu 72 && ip link set vcan0 up; }
+# link_counts FILE WORD N: waits up to 60 s for N lines containing WORD in FILE
+link_counts() { for _ in $(seq 600); do [ "$(grep -c -- "$2" "$1" 2> /dev/null)" -ge "$3" ] && return 0; sleep 0.1; done; return 1; }
+# link_dump DIR: candump -l vcan0 in DIR (each candump logs to its own candump-DATE.log)
+link_dump() {
+    mkdir -p "$1"
+    (cd "$1" && exec candump -l vcan0) > /dev/null 2>&1 &
+}
+link_dump link_a
+dump_a=$!
+"$cotui" record vcan0 -o link.log --json > link.json 2> link.err &
+rec=$!
+link_sock $dump_a && link_sock $rec || bad "link: a recorder opened no socket in 60 s"
+link_burst 7D0
+ip link set vcan0 down
+link_counts link.err "interface is down, not capturing; fix: sudo ip link set vcan0 up" 1 &&
+    ok "record: interface down reported on stderr with the fix" || bad "record down: $(cat link.err)"
+ip link set vcan0 up
+link_counts link.err "the gap ends" 1 && ok "record: capturing again after ip link set up" || bad "record up: $(cat link.err)"
+# Older candumps exit on a downed interface: a new one for each part, each part's ids from its own.
+link_dump link_b
+dump_b=$!
+link_sock $dump_b || bad "link: candump b opened no socket"
+link_burst 7D1
+ip link del vcan0
+link_counts link.err "interface is gone, not capturing; fix: plug it back in (a vcan: sudo ip link add dev vcan0 type vcan" 1 &&
+    ok "record: deleted interface reported with the fix" || bad "record del: $(cat link.err)"
+relink
+link_counts link.err "the gap ends" 2 && ok "record: reopened vcan0 by name after ip link add" || bad "record re-add: $(cat link.err)"
+link_dump link_c
+dump_c=$!
+link_sock $dump_c || bad "link: candump c opened no socket"
+link_burst 7D2
+cansend vcan0 20000040#0000000000000000
+link_counts link.err "bus-off, not capturing; fix: check wiring" 1 && ok "record: bus-off from an error frame, with the fix" ||
+    bad "record bus-off: $(cat link.err)"
+cansend vcan0 20000100#0000000000000000
+link_counts link.err "the gap ends" 3 || bad "record: no end of the bus-off gap: $(cat link.err)"
+link_burst 7D3
+kill -TERM $rec
+wait $rec
+rc=$?
+kill -INT $dump_a $dump_b $dump_c 2> /dev/null
+wait $dump_a $dump_b $dump_c
+link_ids() { grep -h " vcan0 $1#" "${@:2}" | cut -d' ' -f2-; }
+{ link_ids 7D0 link_a/*.log; link_ids 7D1 link_b/*.log; link_ids '7D[23]' link_c/*.log; } > link_ref.txt
+link_ids '7D[0-3]' link.log > link_got.txt
+reasons=$(j '[.gaps[].reason] | join(",")' < link.json)
+if [ $rc = 2 ] && [ "$(wc -l < link_ref.txt)" = 400 ] && cmp -s link_ref.txt link_got.txt &&
+    [ "$reasons" = "interface down,interface missing,bus-off" ] && [ "$(j .ok < link.json)" = false ]; then
+    ok "record = candump on all 400 frames outside the gaps; exit 2, gaps: $reasons"
+else
+    bad "record across down/del/bus-off: rc=$rc $(cat link.json); candump $(wc -l < link_ref.txt) cotui $(wc -l < link_got.txt): $(diff link_ref.txt link_got.txt | head -4 | tr '\n' ' ')"
+fi
+# Signals: one recorder per signal, all on one burst; each stops with every frame kept.
+declare -A sig_pid
+for s in INT TERM HUP QUIT KILL; do
+    "$cotui" record vcan0 -o "sig_$s.log" --json > "sig_$s.json" 2> "sig_$s.err" &
+    sig_pid[$s]=$!
+done
+for s in INT TERM HUP QUIT KILL; do link_sock "${sig_pid[$s]}" || bad "signals: record for SIG$s opened no socket"; done
+cangen vcan0 -g 0 -n 1000 -I 7C0 -L 8 -D i
+# The catchable ones right away: what is still queued in their sockets must be read first.
+for s in INT TERM HUP QUIT; do kill -s "$s" "${sig_pid[$s]}"; done
+for s in INT TERM HUP QUIT; do
+    wait "${sig_pid[$s]}"
+    rc=$?
+    n=$(grep -c " vcan0 7C0#" "sig_$s.log")
+    [ $rc = 0 ] && [ "$n" = 1000 ] && [ "$(j .frames < "sig_$s.json")" = 1000 ] &&
+        ok "record stopped by SIG$s: exit 0, all 1000 frames of the burst on disk" ||
+        bad "record SIG$s: rc=$rc $n of 1000 frames: $(cat "sig_$s.json" "sig_$s.err")"
+done
+# kill -9 cannot be caught: once the flush interval has passed the lines are on disk.
+link_counts sig_KILL.log " vcan0 7C0#" 1000 || bad "record (to be killed): $(grep -c 7C0 sig_KILL.log) of 1000 lines on disk"
+sleep 0.3
+kill -9 "${sig_pid[KILL]}"
+wait "${sig_pid[KILL]}" 2> /dev/null
+[ "$(grep -c " vcan0 7C0#" sig_KILL.log)" = 1000 ] && [ "$(tail -c 1 sig_KILL.log | od -An -c | tr -d ' ')" = '\n' ] &&
+    ok "record killed by SIGKILL after the flush interval: all 1000 frames on disk, whole lines" ||
+    bad "record SIGKILL: $(grep -c 7C0 sig_KILL.log) of 1000"
+c record vcan0 -o sig_INT.log --count 1
+[ $rc = 1 ] && echo "$err" | grep -q -- "--force overwrites it, --append adds to it" &&
+    ok "record refuses an existing log, naming --force and --append" || bad "record existing: rc=$rc $err"
+
+# A full disk (a 16 KiB tmpfs): record stops with exit 1 and the log holds whole lines only.
+mkdir -p small && mount -t tmpfs -o size=16k tmpfs small
+"$cotui" record vcan0 -o small/full.log > full.out 2> full.err &
+full=$!
+link_sock $full || bad "disk full: record opened no socket"
+cangen vcan0 -g 0 -n 1000 -I 7C1 -L 8 -D i
+# It stops by itself on the write error; one still running after 60 s is stopped (and fails below).
+for _ in $(seq 600); do kill -0 $full 2> /dev/null || break; sleep 0.1; done
+kill -TERM $full 2> /dev/null
+wait $full
+rc=$?
+kept=$(grep -o "last whole line ([0-9]* frames)" full.err | grep -o "[0-9]*")
+if [ $rc = 1 ] && grep -q "No space left on device" full.err && [ -n "$kept" ] && [ "$(wc -l < small/full.log)" = "$kept" ] &&
+    [ "$(tail -c 1 small/full.log | od -An -c | tr -d ' ')" = '\n' ] &&
+    ! grep -qvE '^\([0-9]+\.[0-9]{6}\) vcan0 7C1#[0-9A-F]{16}$' small/full.log; then
+    ok "disk full: record exits 1 naming the error; the log keeps $kept whole lines, no partial one"
+else
+    bad "disk full: rc=$rc $(cat full.err); $(wc -l < small/full.log) lines, ends: $(tail -c 40 small/full.log | od -c | tail -3)"
+fi
+umount small
+# The TUI: the status bar shows each state with its fix, and frames flow again after it.
+tmux new-session -d -s link -x 160 -y 45 "XDG_CONFIG_HOME=$work $cotui live vcan0; echo cotui-exit=\$?; sleep 60"
+lscreen() { tmux capture-pane -p -t link > lscreen.txt; }
+# link_wait PATTERN: up to 30 s for the screen to show PATTERN; link_gone: for it to stop showing it
+link_wait() { for _ in $(seq 150); do lscreen; grep -qE -- "$1" lscreen.txt && return 0; sleep 0.2; done; return 1; }
+link_gone() { for _ in $(seq 150); do lscreen; grep -qE -- "$1" lscreen.txt || return 0; sleep 0.2; done; return 1; }
+# link_flows ID: sends ID#01 until the trace shows it (up to 30 s): capture works
+link_flows() { for _ in $(seq 100); do cansend vcan0 "$1#01" 2> /dev/null; lscreen; grep -q "$1" lscreen.txt && return 0; sleep 0.3; done; return 1; }
+link_flows 7B0 || bad "tui link: live vcan0 shows no frame: $(cat lscreen.txt)"
+ip link set vcan0 down
+link_wait "interface is down, not capturing; fix: sudo ip link set vcan0 up" &&
+    ok "tui: ip link set down -> status bar shows 'interface is down' and the fix" || bad "tui down: $(cat lscreen.txt)"
+ip link set vcan0 up
+link_wait "capturing again after" && link_flows 7B1 && ok "tui: up again -> 'capturing again', new frames in the trace" ||
+    bad "tui up: $(cat lscreen.txt)"
+ip link del vcan0
+link_wait "interface is gone, not capturing; fix: .*sudo ip link add dev vcan0 type vcan" &&
+    ok "tui: ip link del -> 'interface is gone' and the fix" || bad "tui del: $(cat lscreen.txt)"
+relink
+link_gone "interface is gone" && link_flows 7B2 && ok "tui: ip link add -> reopened by name, new frames in the trace" ||
+    bad "tui re-add: $(cat lscreen.txt)"
+cansend vcan0 20000240#000000000000F800
+link_wait "bus-off \(errors: tx 248, rx 0\), not capturing; fix: check wiring" &&
+    ok "tui: bus-off error frame -> state, error counters and fix in the status bar" || bad "tui bus-off: $(cat lscreen.txt)"
+cansend vcan0 20000100#0000000000000000
+link_gone "bus-off" && link_flows 7B3 && ok "tui: controller restarted -> bar clear, frames flow" || bad "tui restart: $(cat lscreen.txt)"
+tmux send-keys -t link q
+link_wait "cotui-exit=0" || bad "tui link quit: $(cat lscreen.txt)"
+tmux kill-server 2> /dev/null
 
 t_end=$(date +%s.%N)
 echo "$passed passed, $failed failed ($(awk -v a="$t_start" -v b="$t_end" 'BEGIN { printf "%.0f", b - a }') s in the guest)"
