@@ -270,3 +270,38 @@ mod fuzz {
         }
     }
 }
+
+/// `record --format pcapng` and a candump recording of the same bus at the same time: tshark
+/// reads the pcapng back frame for frame as the candump log has them.
+#[tokio::test(start_paused = true)]
+async fn a_pcapng_recording_holds_what_a_candump_recording_of_the_same_bus_holds() {
+    use cotui::command::record::{Limits, LogFormat, WriteMode, open_output, record};
+    let dir = std::env::temp_dir().join(format!("cotui-rec-pcapng-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (log, cap) = (dir.join("demo.log"), dir.join("demo.pcapng"));
+    let demo = cotui::sim::demo::Demo::spawn(cotui::sim::Simulation::demo(), false);
+    let limits = Limits {
+        count: Some(80),
+        duration_ms: None,
+    };
+    let mut a = open_output(log.to_str().unwrap(), WriteMode::New).unwrap();
+    let mut b = open_output(cap.to_str().unwrap(), WriteMode::New).unwrap();
+    let never = || std::future::pending::<()>();
+    let (ra, rb) = tokio::join!(
+        record(&demo.bus, &mut a, limits, LogFormat::Candump, never(), |_| {}),
+        record(&demo.bus, &mut b, limits, LogFormat::Pcapng, never(), |_| {}),
+    );
+    assert_eq!((ra.unwrap().frames, rb.unwrap().frames), (80, 80));
+    drop((a, b));
+    let ours = frames(&log);
+    let theirs = tshark(&cap);
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!((ours.len(), theirs.len()), (80, 80));
+    for (i, ((iface, f), got)) in ours.iter().zip(&theirs).enumerate() {
+        // The candump log has microseconds, the pcapng the bus's nanoseconds.
+        let mut got = got.clone();
+        let keep = got[0].len() - 3;
+        got[0].replace_range(keep.., "000");
+        assert_eq!(got, expected(iface, f), "frame {}: {f:?}", i + 1);
+    }
+}

@@ -7,7 +7,7 @@
 use super::commander::{BusArgs, ms_arg, report};
 use crate::command::error::{EXIT_BUS, EXIT_OK};
 use crate::command::exec::text;
-use crate::command::record::{Limits, Recorded, WriteMode, open_output, record};
+use crate::command::record::{Limits, LogFormat, Recorded, WriteMode, open_output, record};
 use crate::command::{Command, CommandError};
 use clap::Args;
 use std::io::Write;
@@ -34,6 +34,9 @@ pub struct RecordArgs {
     /// Append to an existing output file.
     #[arg(long)]
     pub append: bool,
+    /// The file format: candump (-l lines) or pcapng (for Wireshark; not to a terminal).
+    #[arg(long, default_value = "candump", value_parser = LogFormat::parse)]
+    pub format: LogFormat,
 }
 
 /// Runs `cotui record`; returns the exit status: 0 complete, 2 when the bus could not be
@@ -51,11 +54,20 @@ pub fn run_record(args: &RecordArgs) -> i32 {
         WriteMode::New
     };
     let path = args.output.clone();
+    if args.format == LogFormat::Pcapng && path == "-" && std::io::IsTerminal::is_terminal(&std::io::stdout()) {
+        return report(
+            &args.bus,
+            "record",
+            Err(CommandError::Usage(
+                "pcapng is binary: write it to a file (-o FILE) or a pipe, not to a terminal".into(),
+            )),
+        );
+    }
     let result = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()
         .map_err(|e| CommandError::Usage(format!("cannot start the runtime: {e}")))
-        .and_then(|rt| rt.block_on(capture(&args.bus, &path, limits, mode)));
+        .and_then(|rt| rt.block_on(capture(&args.bus, &path, (limits, args.format), mode)));
     let n = match result {
         Ok(n) => n,
         Err(e) => return report(&args.bus, "record", Err(e)),
@@ -64,6 +76,7 @@ pub fn run_record(args: &RecordArgs) -> i32 {
         output: path.clone(),
         limits,
         mode,
+        format: args.format,
     };
     let json = n.to_json(&path);
     // After SIGHUP the terminal may be gone: printing must not fail the recording.
@@ -89,7 +102,12 @@ pub fn run_record(args: &RecordArgs) -> i32 {
 }
 
 /// Opens the bus and the log, and records until a signal or a limit.
-async fn capture(args: &BusArgs, path: &str, limits: Limits, mode: WriteMode) -> Result<Recorded, CommandError> {
+async fn capture(
+    args: &BusArgs,
+    path: &str,
+    (limits, format): (Limits, LogFormat),
+    mode: WriteMode,
+) -> Result<Recorded, CommandError> {
     // Handlers first: from here on a signal stops the recording cleanly instead of killing it.
     let handler = |kind: SignalKind| {
         signal(kind).map_err(|e| CommandError::Usage(format!("cannot install a signal handler: {e}")))
@@ -111,7 +129,7 @@ async fn capture(args: &BusArgs, path: &str, limits: Limits, mode: WriteMode) ->
             _ = quit.recv() => {}
         }
     };
-    record(&bus, &mut out, limits, stop, |line| say(&line)).await
+    record(&bus, &mut out, limits, format, stop, |line| say(&line)).await
 }
 
 /// One line on stderr; a closed terminal is not an error.

@@ -108,10 +108,15 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
             let nodes = super::scan::scan(bus, *listen_ms, *probe, *timeout_ms).await?;
             json!({"ok": true, "nodes": nodes.iter().map(|n| n.to_json()).collect::<Vec<_>>()})
         }
-        Command::Record { output, limits, mode } => {
+        Command::Record {
+            output,
+            limits,
+            mode,
+            format,
+        } => {
             let mut out = super::record::open_output(output, *mode)?;
             let forever = std::future::pending::<()>();
-            let n = super::record::record(bus, &mut out, *limits, forever, |_| {}).await?;
+            let n = super::record::record(bus, &mut out, *limits, *format, forever, |_| {}).await?;
             if let Some(m) = n.gap_message(output) {
                 return Err(CommandError::Bus(BusError::Io {
                     iface: bus.name().to_string(),

@@ -2,7 +2,7 @@
 //! `parse_command("sdo read 2 0x6041")` gives the same [`Command`] as
 //! `cotui sdo read IFACE 2 0x6041`.
 
-use super::record::{Limits, WriteMode};
+use super::record::{Limits, LogFormat, WriteMode};
 use crate::od::DataType;
 
 /// An NMT command.
@@ -186,11 +186,12 @@ pub enum Command {
         probe: bool,
         timeout_ms: u64,
     },
-    /// `record -o FILE [--count N] [--duration MS] [--force | --append]`.
+    /// `record -o FILE [--count N] [--duration MS] [--force | --append] [--format candump|pcapng]`.
     Record {
         output: String,
         limits: Limits,
         mode: WriteMode,
+        format: LogFormat,
     },
     /// `run NODE PROCEDURE [NAME=VALUE ...] [--dry-run] [--timeout MS]`, or `run NODE [--list]`.
     Run(RunSpec),
@@ -369,6 +370,7 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
     let (mut output, mut timeout, mut listen, mut ramp, mut deadline) = (None, None, None, None, None);
     let mut limits = Limits::default();
     let mut mode = WriteMode::New;
+    let mut format = LogFormat::Candump;
     let mut it = all.iter();
     while let Some(w) = it.next() {
         let mut value = |flag: &str| it.next().map(String::as_str).ok_or(format!("{flag} needs a value"));
@@ -381,6 +383,7 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
             "--force" | "--append" if mode != WriteMode::New => {
                 return Err("record takes --force or --append, not both".into());
             }
+            "--format" => format = LogFormat::parse(value("--format")?)?,
             "--force" => mode = WriteMode::Overwrite,
             "--append" => mode = WriteMode::Append,
             "--type" | "-t" => data_type = Some(parse_type(value("--type")?)?),
@@ -453,6 +456,7 @@ pub fn parse_command(line: &str) -> Result<Command, String> {
             output: output.ok_or("record needs -o FILE")?,
             limits,
             mode,
+            format,
         }),
         [] => Err(format!("empty command; {usage}")),
         [first, ..] => Err(format!("cannot parse `{}` (after `{first}`); {usage}", all.join(" "))),
@@ -524,6 +528,7 @@ mod tests {
                 output: "out.log".into(),
                 limits: Limits::default(),
                 mode: WriteMode::New,
+                format: LogFormat::Candump,
             }
         );
         assert_eq!(
@@ -535,6 +540,7 @@ mod tests {
                     duration_ms: None
                 },
                 mode: WriteMode::Append,
+                format: LogFormat::Candump,
             }
         );
         assert!(matches!(

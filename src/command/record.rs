@@ -5,6 +5,7 @@
 
 use super::error::CommandError;
 use crate::bus::{Bus, BusError, Event, StateChange};
+use crate::frame::Frame;
 use crate::log::sink::{LineSink, Target};
 use crate::log::writer::LogWriter;
 use std::fs::{File, OpenOptions};
@@ -126,12 +127,13 @@ pub async fn record<T: Target>(
     bus: &Bus,
     out: &mut LineSink<T>,
     limits: Limits,
+    format: LogFormat,
     stop: impl Future<Output = ()>,
     mut note: impl FnMut(String),
 ) -> Result<Recorded, CommandError> {
     let mut rx = bus.subscribe();
     let mut rec = Recording {
-        writer: LogWriter::new(),
+        writer: Encoder::start(format, out),
         iface: bus.name().to_string(),
         frames: 0,
         count: limits.count,
@@ -210,9 +212,76 @@ pub async fn record<T: Target>(
     })
 }
 
+/// The file format of a recording.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LogFormat {
+    /// candump `-l` lines.
+    #[default]
+    Candump,
+    /// pcapng for Wireshark (LINKTYPE_CAN_SOCKETCAN, nanosecond timestamps).
+    Pcapng,
+}
+
+impl LogFormat {
+    /// Parses `candump` or `pcapng`.
+    pub fn parse(word: &str) -> Result<LogFormat, String> {
+        match word {
+            "candump" | "log" => Ok(LogFormat::Candump),
+            "pcapng" => Ok(LogFormat::Pcapng),
+            _ => Err(format!("unknown record format `{word}`: use candump or pcapng")),
+        }
+    }
+}
+
+/// Turns frames into the records of a log format.
+enum Encoder {
+    Candump(LogWriter),
+    /// The interfaces described so far (a pcapng interface block precedes an interface's
+    /// first frame).
+    Pcapng(Vec<String>),
+}
+
+impl Encoder {
+    /// A fresh encoder; a pcapng one starts the file with its section header.
+    fn start<T: Target>(format: LogFormat, out: &mut LineSink<T>) -> Encoder {
+        match format {
+            LogFormat::Candump => Encoder::Candump(LogWriter::new()),
+            LogFormat::Pcapng => {
+                out.buffer().extend_from_slice(&crate::output::pcapng::section_header());
+                out.end_record(false);
+                Encoder::Pcapng(Vec::new())
+            }
+        }
+    }
+
+    /// Appends `f` (seen on `iface`) to `out` as one record.
+    fn frame<T: Target>(&mut self, out: &mut LineSink<T>, f: &Frame, iface: &str) {
+        match self {
+            // Writing to a Vec cannot fail.
+            Encoder::Candump(w) => {
+                let _ = w.write_io(out.buffer(), f, iface);
+            }
+            Encoder::Pcapng(seen) => {
+                let id = match seen.iter().position(|n| n == iface) {
+                    Some(i) => i,
+                    None => {
+                        out.buffer()
+                            .extend_from_slice(&crate::output::pcapng::interface_description(iface));
+                        seen.push(iface.to_string());
+                        seen.len() - 1
+                    }
+                };
+                out.buffer()
+                    .extend_from_slice(&crate::output::pcapng::enhanced_packet(id as u32, f));
+            }
+        }
+        out.end_record(true);
+    }
+}
+
 /// A recording in progress.
 struct Recording {
-    writer: LogWriter,
+    writer: Encoder,
     iface: String,
     /// Frames taken (written to the sink's buffer).
     frames: u64,
@@ -237,8 +306,7 @@ impl Recording {
     ) -> Result<bool, CommandError> {
         match got {
             Ok(Event::Frame(f)) => {
-                // Writing to a Vec cannot fail.
-                let _ = self.writer.write_io(out.buffer(), &f, &self.iface);
+                self.writer.frame(out, &f, &self.iface);
                 self.frames += 1;
             }
             Ok(Event::State(s)) => self.state(s, note),
@@ -329,7 +397,7 @@ mod tests {
     #[test]
     fn loss_of_capture_is_a_gap_with_its_reason_and_notes() {
         let mut rec = Recording {
-            writer: LogWriter::new(),
+            writer: Encoder::Candump(LogWriter::new()),
             iface: "vcan0".into(),
             frames: 0,
             count: None,

@@ -1,6 +1,6 @@
-//! Whole lines out: [`LineSink`] collects log lines and writes them when told; when a
-//! write fails part-way (a full disk), it cuts the output back to the last whole line,
-//! so a log never ends in half a line.
+//! Whole records out: [`LineSink`] collects log records (candump lines, pcapng blocks) and
+//! writes them when told; when a write fails part-way (a full disk), it cuts the output
+//! back to the last whole record, so a log never ends in half a line or half a block.
 
 use std::fs::File;
 use std::io::{self, Seek, SeekFrom, Write};
@@ -36,8 +36,10 @@ pub struct LineSink<T: Target> {
     buf: Vec<u8>,
     /// Bytes of whole lines in the output (its length before we wrote, for appends).
     kept: u64,
-    /// Lines this sink wrote out.
+    /// Frame records this sink wrote out.
     lines: u64,
+    /// Where each record in `buf` ends, and whether it holds a frame (a pcapng header does not).
+    ends: std::collections::VecDeque<(usize, bool)>,
 }
 
 impl<T: Target> LineSink<T> {
@@ -48,17 +50,23 @@ impl<T: Target> LineSink<T> {
             buf: Vec::with_capacity(1 << 16),
             kept: len,
             lines: 0,
+            ends: std::collections::VecDeque::new(),
         }
     }
-    /// The buffer to append whole lines (each ending in `\n`) to.
+    /// The buffer to append a record to; [`LineSink::end_record`] marks its end.
     pub fn buffer(&mut self) -> &mut Vec<u8> {
         &mut self.buf
+    }
+    /// Marks the end of the record just appended; `frame` when it holds a frame (counted
+    /// in [`LineSink::lines`]).
+    pub fn end_record(&mut self, frame: bool) {
+        self.ends.push_back((self.buf.len(), frame));
     }
     /// True when lines are waiting to be written.
     pub fn pending(&self) -> bool {
         !self.buf.is_empty()
     }
-    /// Lines written out so far.
+    /// Frame records written out so far.
     pub fn lines(&self) -> u64 {
         self.lines
     }
@@ -78,13 +86,25 @@ impl<T: Target> LineSink<T> {
                 Err(e) => break Some(e),
             }
         };
-        let whole = match failed {
-            None => done,
-            Some(_) => self.buf[..done].iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1),
-        };
-        self.lines += self.buf[..whole].iter().filter(|&&b| b == b'\n').count() as u64;
+        // The output keeps the records written whole; bytes past the last marked end (none
+        // when the caller marks every record) count as one record.
+        let mut whole = 0;
+        while let Some(&(end, frame)) = self.ends.front() {
+            if end > done {
+                break;
+            }
+            whole = end;
+            self.lines += frame as u64;
+            self.ends.pop_front();
+        }
+        if failed.is_none() {
+            whole = done;
+        }
         self.kept += whole as u64;
         self.buf.drain(..whole);
+        for (end, _) in self.ends.iter_mut() {
+            *end -= whole;
+        }
         match failed {
             None => self.out.flush(),
             Some(e) => {
@@ -137,8 +157,10 @@ mod tests {
             data: old.clone(),
         };
         let mut sink = LineSink::new(disk, old.len() as u64);
-        sink.buffer()
-            .extend_from_slice(b"(2.000000) can0 123#02\n(3.000000) can0 123#03\n");
+        for line in [&b"(2.000000) can0 123#02\n"[..], b"(3.000000) can0 123#03\n"] {
+            sink.buffer().extend_from_slice(line);
+            sink.end_record(true);
+        }
         let e = sink.flush().unwrap_err();
         assert_eq!(e.raw_os_error(), Some(libc::ENOSPC));
         assert_eq!(sink.lines(), 1);
@@ -156,6 +178,27 @@ mod tests {
     }
 
     #[test]
+    fn binary_records_are_kept_whole_and_headers_are_not_counted() {
+        let mut sink = LineSink::new(
+            SmallDisk {
+                room: 10,
+                data: Vec::new(),
+            },
+            0,
+        );
+        sink.buffer().extend_from_slice(&[1; 4]);
+        sink.end_record(false);
+        sink.buffer().extend_from_slice(&[2; 8]);
+        sink.end_record(true);
+        assert!(sink.flush().is_err());
+        assert_eq!((sink.lines(), sink.out.data.clone()), (0, vec![1; 4]));
+        sink.out.room = 100;
+        sink.flush().unwrap();
+        assert_eq!(sink.lines(), 1);
+        assert_eq!(sink.out.data.len(), 12);
+    }
+
+    #[test]
     fn a_disk_full_before_the_first_line_keeps_nothing() {
         let mut sink = LineSink::new(
             SmallDisk {
@@ -165,6 +208,7 @@ mod tests {
             0,
         );
         sink.buffer().extend_from_slice(b"(2.000000) can0 123#02\n");
+        sink.end_record(true);
         assert!(sink.flush().is_err());
         assert_eq!((sink.lines(), sink.out.data.len()), (0, 0));
     }
