@@ -303,7 +303,8 @@ else
 fi
 # Escape and q as two key events: sent together they read as alt-q.
 tmux send-keys -t stop Escape
-swait 50 "Trace \[" && ! grep -q "Messages (" sscreen.txt || bad "tui: the message log did not close: $(cat sscreen.txt)"
+for _ in $(seq 50); do sscreen > sscreen.txt; grep -q "Messages (" sscreen.txt || break; sleep 0.2; done
+grep -q "Messages (" sscreen.txt && bad "tui: the message log did not close: $(cat sscreen.txt)"
 tmux send-keys -t stop q
 swait 100 "cotui-exit=0" && ok "tui: quits after the stop without asking (nothing left powered)" || bad "tui quit after stop: $(cat sscreen.txt)"
 tmux kill-session -t stop 2> /dev/null
