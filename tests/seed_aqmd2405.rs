@@ -310,3 +310,37 @@ fn object_table_defaults_and_access() {
     assert_eq!(o(0x1A01, 0).max, Some(8));
     assert_eq!(o(0x1001, 0).bits[&3], "Temperature");
 }
+
+#[test]
+fn vendor_object_ranges_bits_and_factory_settings() {
+    let f = frames();
+    // 7.6.2 / 7.6.3 / 7.6.1 frames
+    let x = f.at(116, 0x581, "4F16210005000000");
+    sdo(x, "sdo_tx", 1, 0x2116, 0, Some(5));
+    label_has(x, &["Output states = 5"]);
+    label_has(f.at(117, 0x581, "4B04220007000000"), &["0x2204:00 SYNC counter = 7"]);
+    assert_eq!(f.at(118, 0x601, "2F0A200001000000")["sdo"]["value_text"], "1 (rpm)");
+
+    use cotui::od::json::load_profile;
+    use cotui::od::{Dictionary, Value};
+    use std::sync::Arc;
+    let path = format!("{}/decoders/aqmd2405.json", env!("CARGO_MANIFEST_DIR"));
+    let (p, _) = load_profile(&path, &std::fs::read_to_string(&path).unwrap()).unwrap();
+    let d = Dictionary::new(vec![Arc::new(p)]);
+    let o = |i: u16| d.object(i, 0).unwrap_or_else(|| panic!("0x{i:04X}"));
+    // 7.6.2: "0x2116 U8 0x00~0xFF bits 0~7 outputs 1~8"; "0x2114 0x00~0x03"; "0x2115 0x00~0x07"
+    assert_eq!(o(0x2116).bits.len(), 8);
+    assert_eq!(o(0x2116).bits[&7], "Output 8 on");
+    assert_eq!(
+        (o(0x2114).max, o(0x2115).max, o(0x2111).max),
+        (Some(3), Some(7), Some(2))
+    );
+    // 7.1: "factory: 500 kbps, node ID 0x01, CANopen off until register 0x0120 = 1"
+    for (i, v) in [(0x2201, 1), (0x2202, 5), (0x4121, 1), (0x4122, 5), (0x4120, 0)] {
+        assert_eq!(o(i).default, Some(Value::Unsigned(v)), "0x{i:04X}");
+    }
+    // "RW/E" objects are stored with 0x1010
+    for i in [0x200A, 0x200B, 0x2201, 0x2202] {
+        assert!(o(i).description.as_deref().unwrap().contains("0x1010"), "0x{i:04X}");
+    }
+}
