@@ -365,3 +365,73 @@ fn pdo_cob_ids_read_only_and_communication_defaults() {
     assert_eq!(o(0x1017, 0).default, Some(Value::Unsigned(0)));
     assert_eq!(o(0x1008, 0).default, Some(Value::Text("DEV-N050CQ".into())));
 }
+
+#[test]
+fn sdo_abort_code_table_in_the_manuals_words() {
+    let f = frames();
+    // "Abort code | Description": each row, the manual's text without its final period
+    // (OCR "e.g.object" is "e.g. object")
+    let rows: [(u32, &str); 31] = [
+        (0x0503_0000, "Toggle bit not alternated"),
+        (0x0504_0000, "SDO protocol timed out"),
+        (0x0504_0001, "Client/server command specifier not valid or unknown"),
+        (0x0504_0002, "Invalid block size (block mode only)"),
+        (0x0504_0003, "Invalid sequence number (block mode only)"),
+        (0x0504_0004, "CRC error (block mode only)"),
+        (0x0504_0005, "Out of memory"),
+        (0x0601_0000, "Unsupported access to an object"),
+        (0x0601_0001, "Attempt to read a write only object"),
+        (0x0601_0002, "Attempt to write a read only object"),
+        (0x0602_0000, "Object does not exist in the object dictionary"),
+        (0x0604_0041, "Object cannot be mapped to the PDO"),
+        (
+            0x0604_0042,
+            "The number and length of the objects to be mapped would exceed PDO length",
+        ),
+        (0x0604_0043, "General parameter incompatibility reason"),
+        (0x0604_0047, "General internal incompatibility in the device"),
+        (0x0606_0000, "Access failed due to an hardware error"),
+        (
+            0x0607_0010,
+            "Data type does not match, length of service parameter does not match",
+        ),
+        (
+            0x0607_0012,
+            "Data type does not match, length of service parameter too high",
+        ),
+        (
+            0x0607_0013,
+            "Data type does not match, length of service parameter too low",
+        ),
+        (0x0609_0011, "Sub-index does not exist"),
+        (0x0609_0030, "Invalid value for parameter (download only)"),
+        (0x0609_0031, "Value of parameter written too high (download only)"),
+        (0x0609_0032, "Value of parameter written too low (download only)"),
+        (0x0609_0036, "Maximum value is less than minimum value"),
+        (0x060A_0023, "Resource not available: SDO connection"),
+        (0x0800_0000, "General error"),
+        (0x0800_0020, "Data cannot be transferred or stored to the application"),
+        (
+            0x0800_0021,
+            "Data cannot be transferred or stored to the application because of local control",
+        ),
+        (
+            0x0800_0022,
+            "Data cannot be transferred or stored to the application because of the present device state",
+        ),
+        (
+            0x0800_0023,
+            "Object dictionary dynamic generation fails or no object dictionary is present (e.g. object dictionary is generated from file and generation fails because of an file error)",
+        ),
+        (0x0800_0024, "No data available"),
+    ];
+    for (i, (code, text)) in rows.into_iter().enumerate() {
+        let b = code.to_le_bytes();
+        let data = format!("80003021{:02X}{:02X}{:02X}{:02X}", b[0], b[1], b[2], b[3]);
+        let x = f.at(122 + i as u64, 0x581, &data);
+        sdo(x, "sdo_tx", 1, 0x3000, 0x21, None);
+        assert_eq!(x["sdo"]["cs"], "abort");
+        assert_eq!(x["sdo"]["abort_code"], code);
+        assert_eq!(x["sdo"]["abort_text"], text, "0x{code:08X}");
+    }
+}
