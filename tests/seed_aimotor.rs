@@ -418,3 +418,45 @@ fn cia301_object_table_of_section_2_1_1() {
         "1017h is UNSIGNED16 as 100Ch"
     );
 }
+
+#[test]
+fn cia402_object_table_ranges_and_digital_outputs() {
+    let f = frames();
+    // 2.11: mask bit 0 in 60FEh sub 2, then 60FEh sub 1 bit 0 drives the output
+    label_has(f.at(192, 0x601, "23FE600201000000"), &["0x60FE:02 Bit mask = 1"]);
+    label_has(
+        f.at(193, 0x601, "23FE600101000000"),
+        &["0x60FE:01 Physical outputs = 1"],
+    );
+    // 2.1.3: "607D 0 ... Uint8 RO 2"
+    sdo(f.at(194, 0x581, "4F7D600002000000"), "sdo_tx", 1, 0x607D, 0, Some(2));
+
+    use cotui::od::json::load_profile;
+    use cotui::od::{Dictionary, Value};
+    use std::sync::Arc;
+    let path = format!("{}/decoders/aimotor.json", env!("CARGO_MANIFEST_DIR"));
+    let (p, _) = load_profile(&path, &std::fs::read_to_string(&path).unwrap()).unwrap();
+    let d = Dictionary::new(vec![Arc::new(p)]);
+    let o = |i: u16, s: u8| d.object(i, s).unwrap_or_else(|| panic!("0x{i:04X}:{s}"));
+    // "6071 ... Int16 RW 0 -3000~3000", "6074/6077 ... -3000~3000", "6078 ... -32767~32767"
+    assert_eq!((o(0x6071, 0).min, o(0x6071, 0).max), (Some(-3000), Some(3000)));
+    assert_eq!((o(0x6074, 0).min, o(0x6077, 0).max), (Some(-3000), Some(3000)));
+    assert_eq!(o(0x6078, 0).max, Some(32767));
+    // defaults 0 of 607A/607C/607E/607F/6081/60FF/6071; 60FEh sub 2 = 0
+    for i in [0x607A, 0x607C, 0x607E, 0x607F, 0x6081, 0x60FF, 0x6071] {
+        let v = o(i, 0).default.clone();
+        assert!(
+            matches!(v, Some(Value::Unsigned(0) | Value::Signed(0))),
+            "0x{i:04X}: {v:?}"
+        );
+    }
+    assert_eq!(o(0x60FE, 0).default, Some(Value::Unsigned(2)));
+    assert_eq!(o(0x60FE, 1).bits[&0], "Set brake");
+    assert!(
+        o(0x60FE, 1)
+            .description
+            .as_deref()
+            .unwrap()
+            .contains("60FEh sub 2 is 1")
+    );
+}
