@@ -370,28 +370,32 @@ fn fault_table_of_section_6_1_row_by_row() {
 fn cia301_object_table_of_section_2_1_1() {
     let f = frames();
     // "1014 ... Uint32 RO 0x80+ID"
-    let x = f.at(184, 0x581, "4314100081000000");
+    let x = f.at(185, 0x581, "4314100081000000");
     sdo(x, "sdo_tx", 1, 0x1014, 0, Some(0x81));
     assert_eq!(x["sdo"]["value_text"], "0x00000081 (COB-ID 0x081)");
     // 3.2 guarding example: 100Ch = 50 ms, 100Dh = 2
     assert_eq!(
-        f.at(185, 0x601, "2B0C100032000000")["label"],
+        f.at(186, 0x601, "2B0C100032000000")["label"],
         "Download 0x100C:00 Guard time = 50 ms"
     );
     assert_eq!(
-        f.at(186, 0x601, "2F0D100002000000")["label"],
+        f.at(187, 0x601, "2F0D100002000000")["label"],
         "Download 0x100D:00 Life time factor = 2"
     );
     // "1016 sub 1: bit0-bit15 ms, bit16-bit23 node-ID"
-    let x = f.at(187, 0x601, "23161001F4010200");
+    let x = f.at(188, 0x601, "23161001F4010200");
     assert_eq!(x["sdo"]["value_text"], "0x000201F4 (node 2, time 500 ms)");
-    // "1800 sub 1 TPDO1 COB-ID Uint32 RO 0x180+ID": read 0x181, a write is refused
+    // "1800 sub 1 TPDO1 COB-ID ... 0x180+ID": read 0x181; printed RO, but the drive accepts the
+    // write of 5.4 (bit 31 set to disable TPDO1) with 60h
     label_has(
-        f.at(188, 0x581, "4300180181010000"),
+        f.at(189, 0x581, "4300180181010000"),
         &["COB-ID used by TPDO = 0x00000181 (COB-ID 0x181)"],
     );
-    let x = f.at(190, 0x581, "8000180102000106");
-    assert_eq!(x["sdo"]["abort_text"], "Attempt to write a read only object");
+    label_has(
+        f.at(190, 0x601, "2300180181010080"),
+        &["COB-ID 0x181, invalid/disabled"],
+    );
+    assert_eq!(f.at(191, 0x581, "6000180100000000")["sdo"]["cs"], "initiate_download");
 
     use cotui::od::json::load_profile;
     use cotui::od::{Access, Dictionary, Value};
@@ -409,7 +413,7 @@ fn cia301_object_table_of_section_2_1_1() {
     assert_eq!(o(0x1200, 0).default, Some(Value::Unsigned(2)));
     assert_eq!((o(0x100C, 0).max, o(0x100D, 0).max), (Some(32767), Some(255)));
     for i in [0x1400, 0x1403, 0x1800, 0x1803] {
-        assert_eq!(o(i, 1).access, Access::Ro, "0x{i:04X}:1");
+        assert_eq!(o(i, 1).access, Access::Rw, "0x{i:04X}:1 is written by the 5.4 list");
     }
     assert_eq!((o(0x1014, 0).access, o(0x1200, 1).access), (Access::Ro, Access::Ro));
     assert_eq!(
@@ -423,13 +427,13 @@ fn cia301_object_table_of_section_2_1_1() {
 fn cia402_object_table_ranges_and_digital_outputs() {
     let f = frames();
     // 2.11: mask bit 0 in 60FEh sub 2, then 60FEh sub 1 bit 0 drives the output
-    label_has(f.at(192, 0x601, "23FE600201000000"), &["0x60FE:02 Bit mask = 1"]);
+    label_has(f.at(193, 0x601, "23FE600201000000"), &["0x60FE:02 Bit mask = 1"]);
     label_has(
-        f.at(193, 0x601, "23FE600101000000"),
+        f.at(194, 0x601, "23FE600101000000"),
         &["0x60FE:01 Physical outputs = 1"],
     );
     // 2.1.3: "607D 0 ... Uint8 RO 2"
-    sdo(f.at(194, 0x581, "4F7D600002000000"), "sdo_tx", 1, 0x607D, 0, Some(2));
+    sdo(f.at(195, 0x581, "4F7D600002000000"), "sdo_tx", 1, 0x607D, 0, Some(2));
 
     use cotui::od::json::load_profile;
     use cotui::od::{Dictionary, Value};
