@@ -319,3 +319,148 @@ fn error_history_entries_carry_the_cia402_code_and_the_fault_code() {
         ],
     );
 }
+
+#[test]
+fn fault_table_of_section_6_1_row_by_row() {
+    let f = frames();
+    // "fault name | H0B_34 | 603Fh | ... | class": every row, read back from H0B-34 and from 603Fh
+    let rows: [(u16, u16, &str, u8); 27] = [
+        (0x0101, 0x6320, "Parameter error", 1),
+        (0x0102, 0x6320, "Parameter error", 1),
+        (0x0104, 0x6320, "Parameter error", 1),
+        (0x0105, 0x6320, "Parameter error", 1),
+        (0x0130, 0x6320, "Parameter error", 1),
+        (0x0201, 0x2312, "Continuous over-current no. 2", 1),
+        (0x0208, 0xFF00, "Device specific", 1),
+        (0x0207, 0x2311, "Continuous over-current no. 1", 1),
+        (0x0234, 0xFF00, "Device specific", 1),
+        (0x0A33, 0x7306, "Incremental sensor 2 fault", 1),
+        (0x0400, 0x3210, "DC link over-voltage", 1),
+        (0x0410, 0x3220, "DC link under-voltage", 1),
+        (0x0620, 0x3230, "Load error", 1),
+        (0x0650, 0x4210, "Excess temperature device", 1),
+        (0x0B00, 0x8611, "Following error", 1),
+        (0x0668, 0xFF00, "Device specific", 2),
+        (0x0601, 0x8610, "Positioning controller", 2),
+        (0x0900, 0x5442, "Contacts", 3),
+        (0x0950, 0x5443, "Contacts", 3),
+        (0x0952, 0x5444, "Contacts", 3),
+        (0x0731, 0x7306, "Incremental sensor 2 fault", 2),
+        (0x0733, 0x7306, "Incremental sensor 2 fault", 2),
+        (0x0735, 0x7306, "Incremental sensor 2 fault", 2),
+        (0x0730, 0x7307, "Incremental sensor 3 fault", 3),
+        (0x0D03, 0x8130, "Life guard error or heartbeat error", 2),
+        (0x0941, 0xFF00, "Device specific", 3),
+        (0x0942, 0x7600, "Data storage", 3),
+    ];
+    for (i, (fault, code, text, class)) in rows.into_iter().enumerate() {
+        let data = format!("4B0B2023{:02X}{:02X}0000", fault & 0xFF, fault >> 8);
+        let x = f.at(128 + i as u64, 0x581, &data);
+        sdo(x, "sdo_tx", 1, 0x200B, 0x23, Some(i64::from(fault)));
+        let want = format!("Fault {fault:04X}h: 603Fh/EMCY 0x{code:04X} ({text}), class NO.{class}");
+        assert_eq!(x["sdo"]["value_text"], format!("{fault} ({want})"));
+        let data = format!("4B3F6000{:02X}{:02X}0000", code & 0xFF, code >> 8);
+        let x = f.at(155 + i as u64, 0x581, &data);
+        sdo(x, "sdo_tx", 1, 0x603F, 0, Some(i64::from(code)));
+        assert_eq!(x["sdo"]["value_text"], format!("{code} ({text})"));
+    }
+}
+
+#[test]
+fn cia301_object_table_of_section_2_1_1() {
+    let f = frames();
+    // "1014 ... Uint32 RO 0x80+ID"
+    let x = f.at(185, 0x581, "4314100081000000");
+    sdo(x, "sdo_tx", 1, 0x1014, 0, Some(0x81));
+    assert_eq!(x["sdo"]["value_text"], "0x00000081 (COB-ID 0x081)");
+    // 3.2 guarding example: 100Ch = 50 ms, 100Dh = 2
+    assert_eq!(
+        f.at(186, 0x601, "2B0C100032000000")["label"],
+        "Download 0x100C:00 Guard time = 50 ms"
+    );
+    assert_eq!(
+        f.at(187, 0x601, "2F0D100002000000")["label"],
+        "Download 0x100D:00 Life time factor = 2"
+    );
+    // "1016 sub 1: bit0-bit15 ms, bit16-bit23 node-ID"
+    let x = f.at(188, 0x601, "23161001F4010200");
+    assert_eq!(x["sdo"]["value_text"], "0x000201F4 (node 2, time 500 ms)");
+    // "1800 sub 1 TPDO1 COB-ID ... 0x180+ID": read 0x181; printed RO, but the drive accepts the
+    // write of 5.4 (bit 31 set to disable TPDO1) with 60h
+    label_has(
+        f.at(189, 0x581, "4300180181010000"),
+        &["COB-ID used by TPDO = 0x00000181 (COB-ID 0x181)"],
+    );
+    label_has(
+        f.at(190, 0x601, "2300180181010080"),
+        &["COB-ID 0x181, invalid/disabled"],
+    );
+    assert_eq!(f.at(191, 0x581, "6000180100000000")["sdo"]["cs"], "initiate_download");
+
+    use cotui::od::json::load_profile;
+    use cotui::od::{Access, Dictionary, Value};
+    use std::sync::Arc;
+    let path = format!("{}/decoders/aimotor.json", env!("CARGO_MANIFEST_DIR"));
+    let (p, _) = load_profile(&path, &std::fs::read_to_string(&path).unwrap()).unwrap();
+    let d = Dictionary::new(vec![Arc::new(p)]);
+    let o = |i: u16, s: u8| d.object(i, s).unwrap_or_else(|| panic!("0x{i:04X}:{s}"));
+    // "1005 0 ... Uint32 RO 0x80", "1016 0 ... Uint8 RO 1", "1200 0 Uint8 RO 2", "100C ... 0~32767"
+    assert_eq!(
+        (o(0x1005, 0).access, o(0x1005, 0).default.clone()),
+        (Access::Ro, Some(Value::Unsigned(0x80)))
+    );
+    assert_eq!(o(0x1016, 0).default, Some(Value::Unsigned(1)));
+    assert_eq!(o(0x1200, 0).default, Some(Value::Unsigned(2)));
+    assert_eq!((o(0x100C, 0).max, o(0x100D, 0).max), (Some(32767), Some(255)));
+    for i in [0x1400, 0x1403, 0x1800, 0x1803] {
+        assert_eq!(o(i, 1).access, Access::Rw, "0x{i:04X}:1 is written by the 5.4 list");
+    }
+    assert_eq!((o(0x1014, 0).access, o(0x1200, 1).access), (Access::Ro, Access::Ro));
+    assert_eq!(
+        o(0x1017, 0).data_type,
+        o(0x100C, 0).data_type,
+        "1017h is UNSIGNED16 as 100Ch"
+    );
+}
+
+#[test]
+fn cia402_object_table_ranges_and_digital_outputs() {
+    let f = frames();
+    // 2.11: mask bit 0 in 60FEh sub 2, then 60FEh sub 1 bit 0 drives the output
+    label_has(f.at(193, 0x601, "23FE600201000000"), &["0x60FE:02 Bit mask = 1"]);
+    label_has(
+        f.at(194, 0x601, "23FE600101000000"),
+        &["0x60FE:01 Physical outputs = 1"],
+    );
+    // 2.1.3: "607D 0 ... Uint8 RO 2"
+    sdo(f.at(195, 0x581, "4F7D600002000000"), "sdo_tx", 1, 0x607D, 0, Some(2));
+
+    use cotui::od::json::load_profile;
+    use cotui::od::{Dictionary, Value};
+    use std::sync::Arc;
+    let path = format!("{}/decoders/aimotor.json", env!("CARGO_MANIFEST_DIR"));
+    let (p, _) = load_profile(&path, &std::fs::read_to_string(&path).unwrap()).unwrap();
+    let d = Dictionary::new(vec![Arc::new(p)]);
+    let o = |i: u16, s: u8| d.object(i, s).unwrap_or_else(|| panic!("0x{i:04X}:{s}"));
+    // "6071 ... Int16 RW 0 -3000~3000", "6074/6077 ... -3000~3000", "6078 ... -32767~32767"
+    assert_eq!((o(0x6071, 0).min, o(0x6071, 0).max), (Some(-3000), Some(3000)));
+    assert_eq!((o(0x6074, 0).min, o(0x6077, 0).max), (Some(-3000), Some(3000)));
+    assert_eq!(o(0x6078, 0).max, Some(32767));
+    // defaults 0 of 607A/607C/607E/607F/6081/60FF/6071; 60FEh sub 2 = 0
+    for i in [0x607A, 0x607C, 0x607E, 0x607F, 0x6081, 0x60FF, 0x6071] {
+        let v = o(i, 0).default.clone();
+        assert!(
+            matches!(v, Some(Value::Unsigned(0) | Value::Signed(0))),
+            "0x{i:04X}: {v:?}"
+        );
+    }
+    assert_eq!(o(0x60FE, 0).default, Some(Value::Unsigned(2)));
+    assert_eq!(o(0x60FE, 1).bits[&0], "Set brake");
+    assert!(
+        o(0x60FE, 1)
+            .description
+            .as_deref()
+            .unwrap()
+            .contains("60FEh sub 2 is 1")
+    );
+}

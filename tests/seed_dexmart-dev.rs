@@ -266,3 +266,172 @@ fn error_history_and_manufacturer_status_are_split() {
         &["Consumer heartbeat time 1 = 0x00020064 (node 2, time 100 ms)"],
     );
 }
+
+#[test]
+fn emcy_error_code_table() {
+    let f = frames();
+    // The manual's EMCY Error Code table, row by row (class rows "... — generic" show the class name)
+    let rows = [
+        (0x0000, "No error"),
+        (0x1000, "Generic error"),
+        (0x2000, "Current"),
+        (0x2100, "Current, device input side"),
+        (0x2200, "Current inside the device"),
+        (0x2300, "Current, device output side"),
+        (0x3000, "Voltage"),
+        (0x3100, "Mains voltage"),
+        (0x3200, "Voltage inside the device"),
+        (0x3300, "Output voltage"),
+        (0x4000, "Temperature"),
+        (0x4100, "Ambient temperature"),
+        (0x4200, "Device temperature"),
+        (0x5000, "Device hardware"),
+        (0x6000, "Device software"),
+        (0x6100, "Internal software"),
+        (0x6200, "User software"),
+        (0x6300, "Data set"),
+        (0x7000, "Additional modules"),
+        (0x8000, "Monitoring"),
+        (0x8100, "Communication"),
+        (0x8110, "CAN overrun (objects lost)"),
+        (0x8120, "CAN in error passive mode"),
+        (0x8130, "Life guard error or heartbeat error"),
+        (0x8140, "Recovered from bus off"),
+        (0x8150, "CAN-ID collision"),
+        (0x8200, "Protocol error"),
+        (0x8210, "PDO not processed due to length error"),
+        (0x8220, "PDO length exceeded"),
+        (0x8230, "DAM MPDO not processed, destination object not available"),
+        (0x8240, "Unexpected SYNC data length"),
+        (0x8250, "RPDO timeout"),
+        (0x9000, "External error"),
+        (0xF000, "Additional functions"),
+        (0xFF00, "Device specific"),
+    ];
+    for (i, (code, text)) in rows.into_iter().enumerate() {
+        let data = format!("{:02X}{:02X}010000000102", code & 0xFF, code >> 8);
+        let x = f.at(74 + i as u64, 0x081, &data);
+        assert_eq!(x["emcy"]["code"], code, "{x}");
+        assert_eq!(x["emcy"]["text"], text, "{x}");
+        // "Byte 2 Error Register", "Byte 6 M1 Alarm Code, Byte 7 M2 Alarm Code"
+        assert_eq!(x["emcy"]["register_bits"], json!(["generic"]));
+        assert_eq!(
+            x["emcy"]["mfr_fields"],
+            json!({"M1 alarm code": "0x01", "M2 alarm code": "0x02"})
+        );
+    }
+}
+
+#[test]
+fn pdo_cob_ids_read_only_and_communication_defaults() {
+    let f = frames();
+    // "1401h 01h Read Only unsigned32 00000300h + Node-ID": read 0x301; a write is refused
+    let x = f.at(113, 0x581, "4301140101030000");
+    sdo(x, "sdo_tx", 1, 0x1401, 1, Some(0x301));
+    assert_eq!(x["sdo"]["value_text"], "0x00000301 (COB-ID 0x301)");
+    label_has(x, &["COB-ID used by RPDO"]);
+    let x = f.at(115, 0x581, "8001140102000106");
+    assert_eq!(x["sdo"]["abort_text"], "Attempt to write a read only object");
+    // "29Bits-ID : 20000180h + Node-ID"
+    let x = f.at(116, 0x581, "4300180181010020");
+    assert_eq!(x["sdo"]["value_text"], "0x20000181 (COB-ID 0x00000181, 29-bit)");
+    // "06h ... 00h SYNC_StartValue" in the RPDO table
+    label_has(
+        f.at(117, 0x581, "4F00140600000000"),
+        &["0x1400:06 SYNC start value = 0"],
+    );
+    // "1005h ... 11Bits-ID : 00000080h"
+    assert_eq!(
+        f.at(119, 0x581, "4305100080000000")["sdo"]["value_text"],
+        "0x00000080 (COB-ID 0x080)"
+    );
+
+    use cotui::od::json::load_profile;
+    use cotui::od::{Access, Dictionary, Value};
+    use std::sync::Arc;
+    let path = format!("{}/decoders/dexmart-dev.json", env!("CARGO_MANIFEST_DIR"));
+    let (p, _) = load_profile(&path, &std::fs::read_to_string(&path).unwrap()).unwrap();
+    let d = Dictionary::new(vec![Arc::new(p)]);
+    let o = |i: u16, s: u8| d.object(i, s).unwrap_or_else(|| panic!("0x{i:04X}:{s}"));
+    for i in [0x1400, 0x1403, 0x1800, 0x1803] {
+        assert_eq!(o(i, 1).access, Access::Ro, "0x{i:04X}:1");
+        assert_eq!(
+            (o(i, 4).access, o(i, 4).default.clone()),
+            (Access::Ro, Some(Value::Unsigned(0)))
+        );
+    }
+    assert_eq!(o(0x1001, 0).bits[&6], "Reserved (always 0)");
+    assert_eq!(o(0x1005, 0).default, Some(Value::Unsigned(0x80)));
+    assert_eq!(o(0x1017, 0).default, Some(Value::Unsigned(0)));
+    assert_eq!(o(0x1008, 0).default, Some(Value::Text("DEV-N050CQ".into())));
+}
+
+#[test]
+fn sdo_abort_code_table_in_the_manuals_words() {
+    let f = frames();
+    // "Abort code | Description": each row, the manual's text without its final period
+    // (OCR "e.g.object" is "e.g. object")
+    let rows: [(u32, &str); 31] = [
+        (0x0503_0000, "Toggle bit not alternated"),
+        (0x0504_0000, "SDO protocol timed out"),
+        (0x0504_0001, "Client/server command specifier not valid or unknown"),
+        (0x0504_0002, "Invalid block size (block mode only)"),
+        (0x0504_0003, "Invalid sequence number (block mode only)"),
+        (0x0504_0004, "CRC error (block mode only)"),
+        (0x0504_0005, "Out of memory"),
+        (0x0601_0000, "Unsupported access to an object"),
+        (0x0601_0001, "Attempt to read a write only object"),
+        (0x0601_0002, "Attempt to write a read only object"),
+        (0x0602_0000, "Object does not exist in the object dictionary"),
+        (0x0604_0041, "Object cannot be mapped to the PDO"),
+        (
+            0x0604_0042,
+            "The number and length of the objects to be mapped would exceed PDO length",
+        ),
+        (0x0604_0043, "General parameter incompatibility reason"),
+        (0x0604_0047, "General internal incompatibility in the device"),
+        (0x0606_0000, "Access failed due to an hardware error"),
+        (
+            0x0607_0010,
+            "Data type does not match, length of service parameter does not match",
+        ),
+        (
+            0x0607_0012,
+            "Data type does not match, length of service parameter too high",
+        ),
+        (
+            0x0607_0013,
+            "Data type does not match, length of service parameter too low",
+        ),
+        (0x0609_0011, "Sub-index does not exist"),
+        (0x0609_0030, "Invalid value for parameter (download only)"),
+        (0x0609_0031, "Value of parameter written too high (download only)"),
+        (0x0609_0032, "Value of parameter written too low (download only)"),
+        (0x0609_0036, "Maximum value is less than minimum value"),
+        (0x060A_0023, "Resource not available: SDO connection"),
+        (0x0800_0000, "General error"),
+        (0x0800_0020, "Data cannot be transferred or stored to the application"),
+        (
+            0x0800_0021,
+            "Data cannot be transferred or stored to the application because of local control",
+        ),
+        (
+            0x0800_0022,
+            "Data cannot be transferred or stored to the application because of the present device state",
+        ),
+        (
+            0x0800_0023,
+            "Object dictionary dynamic generation fails or no object dictionary is present (e.g. object dictionary is generated from file and generation fails because of an file error)",
+        ),
+        (0x0800_0024, "No data available"),
+    ];
+    for (i, (code, text)) in rows.into_iter().enumerate() {
+        let b = code.to_le_bytes();
+        let data = format!("80003021{:02X}{:02X}{:02X}{:02X}", b[0], b[1], b[2], b[3]);
+        let x = f.at(122 + i as u64, 0x581, &data);
+        sdo(x, "sdo_tx", 1, 0x3000, 0x21, None);
+        assert_eq!(x["sdo"]["cs"], "abort");
+        assert_eq!(x["sdo"]["abort_code"], code);
+        assert_eq!(x["sdo"]["abort_text"], text, "0x{code:08X}");
+    }
+}

@@ -187,3 +187,34 @@ fn default_pdo_communication_parameters() {
     let eds = p.pdo_sets.iter().find(|s| s.name == "eds").unwrap();
     assert!(eds.tpdo.values().all(|t| t.transmission_type == Some(255)));
 }
+
+#[test]
+fn procedures_write_only_objects_their_profile_lets_them_write() {
+    use cotui::od::Access;
+    // A manual's object table and its own worked lists can disagree (AIMOTOR 2.1.1 prints the PDO
+    // COB-IDs RO while 5.4 writes them and the drive answers 60h): the profile must follow the frames.
+    for name in ["dexmart-dev", "aqmd2405", "syntron-ds", "aimotor"] {
+        let path = format!("{}/decoders/{name}.json", env!("CARGO_MANIFEST_DIR"));
+        let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        let d = dict(load(name));
+        let mut writes = 0;
+        for (proc_name, p) in json["procedures"].as_object().unwrap() {
+            for step in p["steps"].as_array().unwrap() {
+                let Some(object) = step["sdo_write"]["object"].as_str() else {
+                    continue;
+                };
+                if object.contains('{') {
+                    continue; // a parameter chooses the object
+                }
+                let (index, sub) = resolve_object(&d, object).unwrap_or_else(|e| panic!("{name} {proc_name}: {e}"));
+                let access = d.object(index, sub).map(|o| o.access);
+                assert!(
+                    !matches!(access, Some(Access::Ro | Access::Const)),
+                    "{name} {proc_name} writes 0x{index:04X}:{sub}, which the profile marks {access:?}"
+                );
+                writes += 1;
+            }
+        }
+        assert!(writes > 0, "{name}: no procedure writes anything");
+    }
+}

@@ -432,3 +432,22 @@ fn mode_specific_bits_follow_the_mode_in_force() {
         "{t:#?}"
     );
 }
+
+#[test]
+fn statusword_values_of_section_3_4_2() {
+    let f = frames();
+    // "6041H = 0x0050" at power on (bit 9 remote with it), "0x31" after controlword 6, "0x33" after 7,
+    // "0x37" after F, "0x0088" on a fault
+    for (line, data, value, state) in [
+        (86, "4B41600050020000", 0x0250, "Switch on disabled"),
+        (87, "4B41600031020000", 0x0231, "Ready to switch on"),
+        (88, "4B41600033020000", 0x0233, "Switched on"),
+        (89, "4B41600037020000", 0x0237, "Operation enabled"),
+        (90, "4B41600088000000", 0x0088, "Fault"),
+    ] {
+        let x = f.at(line, 0x582, data);
+        sdo(x, "sdo_tx", 2, 0x6041, 0, Some(value));
+        let text = x["sdo"]["value_text"].as_str().unwrap();
+        assert!(text.starts_with(&format!("0x{value:04X} ({state} [")), "{text}");
+    }
+}
