@@ -226,7 +226,7 @@ fn event_level(what: &crate::analysis::What) -> Level {
 
 /// Names the palette completes.
 pub const PALETTE_COMMANDS: &[&str] = &[
-    "filter", "search", "goto", "time", "speed", "pause", "resume", "plot", "help", "messages", "quit",
+    "filter", "search", "goto", "time", "speed", "pause", "resume", "plot", "export", "help", "messages", "quit",
 ];
 
 impl App {
@@ -726,6 +726,7 @@ impl App {
                 self.help = true;
                 Ok(String::new())
             }
+            "export" => self.export_command(rest),
             "messages" => {
                 self.messages_shown = true;
                 self.messages_back = 0;
@@ -761,6 +762,47 @@ impl App {
                 Some(e)
             }
         };
+    }
+
+    /// `export FILE [--format candump|jsonl|pcapng] [--force]`: the rows the view shows.
+    fn export_command(&mut self, rest: &str) -> Result<String, String> {
+        use super::export::{ExportFormat, export};
+        let (mut file, mut format, mut force) = (None, None, false);
+        let mut words = rest.split_whitespace();
+        while let Some(w) = words.next() {
+            match w {
+                "--force" => force = true,
+                "--format" => {
+                    let f = words.next().ok_or("export: --format needs candump, jsonl or pcapng")?;
+                    format = Some(ExportFormat::parse(f).map_err(|e| format!("export: {e}"))?);
+                }
+                w if w.starts_with("--") => return Err(format!("export: unknown option `{w}`")),
+                w if file.is_none() => file = Some(w.to_string()),
+                w => return Err(format!("export: one FILE only (`{w}` is extra)")),
+            }
+        }
+        let file = file.ok_or("export: usage `export FILE [--format candump|jsonl|pcapng] [--force]`")?;
+        let path = std::path::Path::new(&file);
+        let format = format.unwrap_or_else(|| ExportFormat::of_path(path));
+        let scanned = self.view.progress(&self.trace);
+        let n = export(&self.trace, &self.view, path, format, force).map_err(|e| {
+            let hint = if e.kind() == std::io::ErrorKind::AlreadyExists {
+                " (add --force to overwrite)"
+            } else {
+                ""
+            };
+            format!("export: {file}: {e}{hint}")
+        })?;
+        let text = format!(
+            "exported {n} frames to {file} ({format:?}){}",
+            if scanned < 100 {
+                format!("; the filter had scanned {scanned}% of the trace")
+            } else {
+                String::new()
+            }
+        );
+        self.log(Level::Info, &text);
+        Ok(text)
     }
 
     fn plot_command(&mut self, rest: &str) -> Result<String, String> {

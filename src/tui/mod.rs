@@ -5,6 +5,7 @@
 //! and redraws at most 30 times a second and only when something changed.
 
 pub mod app;
+pub mod export;
 pub mod filter;
 pub mod keymap;
 pub mod live;
