@@ -1,5 +1,6 @@
 //! A Parquet table written in row groups: rows are buffered column by column and
-//! flushed every [`ROW_GROUP_ROWS`] rows, so memory stays flat whatever the input size.
+//! flushed every [`ROW_GROUP_ROWS`] rows or [`ROW_GROUP_BYTES`] buffered bytes, whichever
+//! comes first, so memory stays flat whatever the input size.
 //!
 //! The schema is a list of [`Col`]umns (name, type, nullable); rows are pushed value by
 //! value in schema order through [`Table::row`]. The file is Snappy-compressed.
@@ -15,6 +16,12 @@ use std::sync::Arc;
 /// Rows per row group (a row group is the unit a reader skips or reads in parallel).
 pub const ROW_GROUP_ROWS: usize = 65_536;
 
+/// Buffered bytes (estimated) after which a row group is written even if it has fewer
+/// rows: a table whose rows trickle in (SDO transactions) must not grow until 65536.
+pub const ROW_GROUP_BYTES: usize = 16 << 20;
+
+/// Estimated buffer cost of one value besides its bytes (the `ByteArray` handle).
+const VALUE_OVERHEAD: usize = 48;
 /// Physical and logical type of a column.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Ty {
@@ -82,14 +89,19 @@ impl Column {
         }
     }
 
-    /// Appends one value; a value of the wrong type or a null in a required column is
-    /// an error naming the column.
-    fn push(&mut self, v: Option<V>) -> io::Result<()> {
+    /// Appends one value and returns its estimated buffer cost; a value of the wrong type
+    /// or a null in a required column is an error naming the column.
+    fn push(&mut self, v: Option<V>) -> io::Result<usize> {
+        let cost = match &v {
+            Some(V::Str(s)) => VALUE_OVERHEAD + s.len(),
+            Some(V::Bin(b)) => VALUE_OVERHEAD + b.len(),
+            _ => 8,
+        };
         let ok = match (&mut self.values, v) {
             (_, None) if !self.col.null => false,
             (_, None) => {
                 self.defs.push(0);
-                return Ok(());
+                return Ok(2);
             }
             (Values::Bool(b), Some(V::Bool(x))) => {
                 b.push(x);
@@ -126,7 +138,7 @@ impl Column {
         if self.col.null {
             self.defs.push(1);
         }
-        Ok(())
+        Ok(cost)
     }
 
     fn clear(&mut self) {
@@ -169,12 +181,15 @@ pub struct Table<W: Write + Send> {
     writer: SerializedFileWriter<W>,
     columns: Vec<Column>,
     rows: usize,
+    /// Estimated bytes buffered in `columns`.
+    bytes: usize,
 }
 
 /// One row being pushed: values go to the columns in schema order.
 pub struct Row<'t> {
     columns: &'t mut [Column],
     at: usize,
+    bytes: usize,
 }
 
 impl Row<'_> {
@@ -183,7 +198,7 @@ impl Row<'_> {
         let Some(c) = self.columns.get_mut(self.at) else {
             return Err(io::Error::other("parquet: more values than columns in a row"));
         };
-        c.push(v)?;
+        self.bytes += c.push(v)?;
         self.at += 1;
         Ok(self)
     }
@@ -207,6 +222,7 @@ impl<W: Write + Send> Table<W> {
             writer,
             columns: cols.iter().map(|c| Column::new(*c)).collect(),
             rows: 0,
+            bytes: 0,
         })
     }
 
@@ -215,9 +231,10 @@ impl<W: Write + Send> Table<W> {
         let mut row = Row {
             columns: &mut self.columns,
             at: 0,
+            bytes: 0,
         };
         fill(&mut row)?;
-        let pushed = row.at;
+        let (pushed, bytes) = (row.at, row.bytes);
         if pushed != self.columns.len() {
             return Err(io::Error::other(format!(
                 "parquet: a row has {pushed} values for {} columns",
@@ -225,7 +242,8 @@ impl<W: Write + Send> Table<W> {
             )));
         }
         self.rows += 1;
-        if self.rows == ROW_GROUP_ROWS {
+        self.bytes += bytes;
+        if self.rows == ROW_GROUP_ROWS || self.bytes >= ROW_GROUP_BYTES {
             self.flush_group()?;
         }
         Ok(())
@@ -257,6 +275,7 @@ impl<W: Write + Send> Table<W> {
         }
         group.close().map_err(pq_err)?;
         self.rows = 0;
+        self.bytes = 0;
         Ok(())
     }
 
@@ -306,6 +325,33 @@ mod tests {
         t.finish().unwrap();
         assert_eq!(&out[..4], b"PAR1");
         assert_eq!(&out[out.len() - 4..], b"PAR1");
+    }
+
+    #[test]
+    fn row_groups_are_cut_by_bytes_as_well_as_rows() {
+        use parquet::file::reader::{FileReader, SerializedFileReader};
+        let path = std::env::temp_dir().join(format!("cotui-parquet-groups-{}.parquet", std::process::id()));
+        let mut t = Table::new(std::fs::File::create(&path).unwrap(), "t", &COLS).unwrap();
+        let big = "x".repeat(100_000);
+        for i in 0..300 {
+            t.row(|r| {
+                r.push(Some(V::I32(i)))?
+                    .push(Some(V::Str(&big)))?
+                    .push(Some(V::I64(0)))?;
+                Ok(())
+            })
+            .unwrap();
+        }
+        t.finish().unwrap();
+        let meta = SerializedFileReader::new(std::fs::File::open(&path).unwrap())
+            .unwrap()
+            .metadata()
+            .clone();
+        std::fs::remove_file(&path).unwrap();
+        // 300 rows of 100 kB: about 30 MB, so two row groups of at most 16 MiB, not one.
+        assert_eq!(meta.file_metadata().num_rows(), 300);
+        assert_eq!(meta.num_row_groups(), 2);
+        assert!(meta.row_groups().iter().all(|g| g.num_rows() < 300));
     }
 
     #[test]
