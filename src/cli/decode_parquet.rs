@@ -13,7 +13,7 @@ use crate::od::Dictionary;
 use crate::output::parquet::{Col, Table, Ty, V};
 use crate::read_ahead;
 use std::fs::File;
-use std::io::{self, BufRead, BufReader, BufWriter};
+use std::io::{self, BufRead, BufReader, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 const fn col(name: &'static str, ty: Ty, null: bool) -> Col {
@@ -242,7 +242,14 @@ fn ts(ns: u64) -> i64 {
     i64::try_from(ns).unwrap_or(i64::MAX)
 }
 
-fn frame_row(t: &mut Writer, file: &str, line: u64, f: &Frame, iface: &str, d: &Decoded) -> io::Result<()> {
+fn frame_row<W: Write + Send>(
+    t: &mut Table<W>,
+    file: &str,
+    line: u64,
+    f: &Frame,
+    iface: &str,
+    d: &Decoded,
+) -> io::Result<()> {
     let i32v = |v: i32| Some(V::I32(v));
     let (mut nmt_command, mut nmt_target, mut nmt_state) = (None, None, None);
     let (mut emcy_code, mut emcy_register, mut emcy_text) = (None, None, None);
@@ -310,7 +317,12 @@ fn frame_row(t: &mut Writer, file: &str, line: u64, f: &Frame, iface: &str, d: &
 
 /// One row of `values.parquet` for an SDO transaction; the decoded value, name and
 /// abort text are the ones `--transactions --format jsonl` gives.
-fn transaction_row(t: &mut Writer, file: &str, tr: &Transaction, dict: &Dictionary) -> io::Result<()> {
+fn transaction_row<W: Write + Send>(
+    t: &mut Table<W>,
+    file: &str,
+    tr: &Transaction,
+    dict: &Dictionary,
+) -> io::Result<()> {
     let j = tr.to_json(dict);
     let s = |k: &str| j[k].as_str().map(V::Str);
     let partial = tr.is_partial();
@@ -342,6 +354,44 @@ fn transaction_row(t: &mut Writer, file: &str, tr: &Transaction, dict: &Dictiona
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+
+        /// Arbitrary frames (any id, flags, length, bytes, time) decode into both tables
+        /// without an error or a panic, and the file is complete.
+        #[test]
+        fn arbitrary_frames_make_valid_tables(
+            frames in proptest::collection::vec(
+                (prop_oneof![0u32..0x800, any::<u32>()], any::<u8>(), proptest::collection::vec(any::<u8>(), 0..9), any::<u64>()),
+                0..40,
+            )
+        ) {
+            let mut decoder = Decoder::new(Dictionary::default(), vec![]);
+            let mut out = Vec::new();
+            let mut t = Table::new(&mut out, "frames", &FRAME_COLS).unwrap();
+            let mut v = Table::new(Vec::new(), "values", &VALUE_COLS).unwrap();
+            let mut ifaces = Interfaces::default();
+            ifaces.intern("can\u{1b}0");
+            for (i, (id, flags, data, ts_ns)) in frames.iter().enumerate() {
+                let mut f = Frame::classic(id & 0x1FFF_FFFF, data);
+                f.flags = Flags(*flags);
+                f.ts_ns = *ts_ns;
+                let d = decoder.decode(&f);
+                frame_row(&mut t, "fuzz", i as u64, &f, ifaces.name(0), &d).unwrap();
+                for tr in decoder.take_transactions() {
+                    transaction_row(&mut v, "fuzz", &tr, decoder.dictionary(tr.node)).unwrap();
+                }
+            }
+            for tr in decoder.finish() {
+                transaction_row(&mut v, "fuzz", &tr, decoder.dictionary(tr.node)).unwrap();
+            }
+            t.finish().unwrap();
+            v.finish().unwrap();
+            prop_assert_eq!(&out[out.len() - 4..], b"PAR1");
+        }
+    }
 
     #[test]
     fn output_layout() {
