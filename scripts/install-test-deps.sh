@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs what the test suite needs on a fresh Debian machine: real peers to test
-# against (can-utils, Wireshark's tshark, the python canopen library), tmux for the
+# against (can-utils, Wireshark's tshark, the python canopen library, DuckDB for the Parquet tests), tmux for the
 # end-to-end TUI tests, jq for tests/vbus/e2e.sh, and qemu + busybox for the real
 # SocketCAN bus (tests/vbus/install.sh; tests/vbus/run.sh fetches the kernel itself).
 # Idempotent and quiet when done.
@@ -21,9 +21,9 @@ if [ ${#need_apt[@]} -gt 0 ]; then
   $SUDO apt-get install -y -qq "${need_apt[@]}" >/dev/null
 fi
 
-if ! python3 -c "import can, canopen" 2>/dev/null; then
-  echo "install-test-deps: pip install python-can canopen"
-  python3 -m pip install -q "python-can>=4.3" "canopen>=2.3"
+if ! python3 -c "import can, canopen, duckdb" 2>/dev/null; then
+  echo "install-test-deps: pip install python-can canopen duckdb"
+  python3 -m pip install -q "python-can>=4.3" "canopen>=2.3" "duckdb>=1.1"
 fi
 
 # The rest of what the vbus guest needs (iproute2, kmod, xz-utils).

@@ -336,3 +336,41 @@ fn real_world_files_agree_with_python_canopen_on_names_types_and_pdo_mappings() 
         mismatches.join("\n")
     );
 }
+
+/// Label of an expedited SDO download of `value` (u16) to 0x6072 on node 3.
+fn max_torque_label(dict: &cotui::od::Dictionary, value: u16) -> String {
+    let [lo, hi] = value.to_le_bytes();
+    let frame = cotui::frame::Frame::classic(0x603, &[0x2B, 0x72, 0x60, 0x00, lo, hi, 0, 0]);
+    cotui::decode::Decoder::new(dict.clone(), vec![]).decode(&frame).label
+}
+
+#[test]
+fn an_eds_without_units_takes_them_from_cia402() {
+    let read = |path: &std::path::Path| std::fs::read(path);
+    // A real vendor EDS (no units, like every EDS) and a minimal one written here.
+    let dir = std::env::temp_dir().join(format!("cotui-eds-units-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let small = dir.join("small.eds");
+    std::fs::write(
+        &small,
+        "[MandatoryObjects]\nSupportedObjects=1\n1=0x1000\n[1000]\nParameterName=Device type\nObjectType=0x7\nDataType=0x0007\nAccessType=ro\n\
+         [OptionalObjects]\nSupportedObjects=1\n1=0x6072\n[6072]\nParameterName=Max torque (vendor)\nObjectType=0x7\nDataType=0x0006\nAccessType=rw\nDefaultValue=1000\n",
+    )
+    .unwrap();
+    let real = format!(
+        "{}/../shared/realworld/eds/kacanopen_cia402.eds",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    for file in [small.display().to_string(), real] {
+        let b = Bindings::from_args(&[], &[format!("3={file}")], &read).unwrap();
+        let d = b.dictionary(3);
+        let o = d.object(0x6072, 0).unwrap();
+        assert_eq!((o.unit.as_deref(), o.scale), (Some("%"), Some(0.1)), "{file}");
+        let label = max_torque_label(d, 10000);
+        assert!(label.contains("1000 %"), "{file}: {label}");
+    }
+    // The EDS's own name stays: only presentation is merged.
+    let b = Bindings::from_args(&[], &[format!("3={}", small.display())], &read).unwrap();
+    assert_eq!(b.dictionary(3).name(0x6072, 0), Some("Max torque (vendor)"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

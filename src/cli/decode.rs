@@ -21,6 +21,9 @@ pub enum OutputFormat {
     /// `run` hands it to `decode_out` before decoding, so the matches below that pair it
     /// with `Jsonl` never see it.
     Pcapng,
+    /// Two Parquet tables, frames and decoded values (with -o DIR or -o NAME.parquet;
+    /// see README, "Parquet tables"). `run` hands it to `decode_parquet` before decoding.
+    Parquet,
 }
 
 /// Arguments of `cotui decode`.
@@ -66,6 +69,9 @@ enum Mode {
 pub fn run(args: &DecodeArgs) -> i32 {
     if args.format == OutputFormat::Pcapng {
         return super::decode_out::pcapng(args);
+    }
+    if args.format == OutputFormat::Parquet {
+        return super::decode_parquet::run(args);
     }
     let mut decoder = match super::bind::decoder(&args.profiles, &args.eds) {
         Ok(d) => d,
@@ -180,8 +186,10 @@ fn decode_stream(
                     for e in events.take_events() {
                         match fmt {
                             OutputFormat::Text => e.write_line(&mut buf),
-                            // (pcapng never reaches here: decode_out refuses it with --events)
-                            OutputFormat::Jsonl | OutputFormat::Pcapng => e.write_json(&mut buf),
+                            // (pcapng and parquet never reach here: they are refused with --events)
+                            OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => {
+                                e.write_json(&mut buf)
+                            }
                         }
                     }
                 }
@@ -189,7 +197,7 @@ fn decode_stream(
                     let d = decoder.decode(frame);
                     text::write_line(&mut buf, frame, &ifaces, &d);
                 }
-                Mode::Frames(OutputFormat::Jsonl | OutputFormat::Pcapng) => {
+                Mode::Frames(OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet) => {
                     let d = decoder.decode(frame);
                     jsonl::write_frame(&mut buf, *line, frame, &ifaces, &d);
                 }
@@ -238,7 +246,9 @@ fn write_transaction(buf: &mut String, t: &Transaction, decoder: &Decoder, fmt: 
     let dict = decoder.dictionary(t.node);
     match fmt {
         OutputFormat::Text => buf.push_str(&t.label(dict)),
-        OutputFormat::Jsonl | OutputFormat::Pcapng => buf.push_str(&t.to_json(dict).to_string()),
+        OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => {
+            buf.push_str(&t.to_json(dict).to_string())
+        }
     }
     buf.push('\n');
 }
@@ -256,7 +266,7 @@ fn finish(decoder: &mut Decoder, mode: Mode, summary: &mut Summary, out: &mut im
             summary.finish();
             match fmt {
                 OutputFormat::Text => buf.push_str(&summary.to_text()),
-                OutputFormat::Jsonl | OutputFormat::Pcapng => {
+                OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => {
                     buf.push_str(&summary.to_json().to_string());
                     buf.push('\n');
                 }

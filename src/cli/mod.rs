@@ -6,6 +6,7 @@ pub mod bind;
 pub mod commander;
 pub mod decode;
 mod decode_out;
+mod decode_parquet;
 pub mod drive;
 pub mod nmt;
 pub mod record;

@@ -307,6 +307,11 @@ impl Bindings {
                 layers.push(base.clone());
             }
         }
+        if binding.eds.is_some()
+            && let Some(top) = super::merge::enriched(&layers[0], &layers[1..])
+        {
+            layers[0] = Arc::new(top);
+        }
         self.dictionaries.insert(node, Dictionary::new(layers));
     }
 }

@@ -13,6 +13,7 @@ pub mod eds;
 pub mod expr;
 pub mod fields;
 pub mod json;
+pub mod merge;
 pub mod procedure;
 pub mod text;
 mod value;

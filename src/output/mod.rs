@@ -1,7 +1,8 @@
 //! Headless renderings of decoded frames: text lines, JSON lines, SDO
-//! transactions and summaries, and pcapng capture files. Pure formatting; the caller writes.
+//! transactions and summaries, pcapng capture files and Parquet tables. Pure formatting; the caller writes.
 
 pub mod jsonl;
+pub mod parquet;
 pub mod pcapng;
 pub mod summary;
 pub mod text;

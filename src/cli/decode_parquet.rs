@@ -1,0 +1,407 @@
+//! `cotui decode --format parquet -o DIR_OR_FILE`: the decoded frames and the decoded
+//! values (SDO transactions and PDO signals) as two Parquet tables, for DuckDB, Spark or
+//! Trino. Column names and types are a public contract, listed in the README
+//! ("Parquet tables").
+
+use super::decode::DecodeArgs;
+use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
+use crate::decode::sdo::{SdoCommand, Transaction};
+use crate::decode::{Body, Decoded, Decoder};
+use crate::frame::{Flags, Frame, Interfaces};
+use crate::log::Outcome;
+use crate::od::Dictionary;
+use crate::output::parquet::{Col, Table, Ty, V};
+use crate::read_ahead;
+use std::fs::File;
+use std::io::{self, BufRead, BufReader, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+const fn col(name: &'static str, ty: Ty, null: bool) -> Col {
+    Col { name, ty, null }
+}
+
+/// Columns of `frames.parquet`, one row per frame.
+pub const FRAME_COLS: [Col; 28] = [
+    col("file", Ty::Str, false),
+    col("line", Ty::I64, false),
+    col("ts", Ty::TimestampNs, false),
+    col("iface", Ty::Str, false),
+    col("id", Ty::I32, false),
+    col("ext", Ty::Bool, false),
+    col("rtr", Ty::Bool, false),
+    col("fd", Ty::Bool, false),
+    col("err", Ty::Bool, false),
+    col("dir", Ty::Str, false),
+    col("len", Ty::I32, false),
+    col("data", Ty::Bin, false),
+    col("kind", Ty::Str, false),
+    col("node", Ty::I32, true),
+    col("label", Ty::Str, false),
+    col("malformed", Ty::Str, true),
+    col("nmt_command", Ty::Str, true),
+    col("nmt_target", Ty::I32, true),
+    col("nmt_state", Ty::Str, true),
+    col("emcy_code", Ty::I32, true),
+    col("emcy_register", Ty::I32, true),
+    col("emcy_text", Ty::Str, true),
+    col("sdo_command", Ty::Str, true),
+    col("sdo_index", Ty::I32, true),
+    col("sdo_sub", Ty::I32, true),
+    col("abort_code", Ty::I64, true),
+    col("pdo_num", Ty::I32, true),
+    col("pdo_transmit", Ty::Bool, true),
+];
+
+/// Columns of `values.parquet`: one row per SDO transaction and per PDO signal.
+pub const VALUE_COLS: [Col; 19] = [
+    col("file", Ty::Str, false),
+    col("source", Ty::Str, false),
+    col("ts", Ty::TimestampNs, false),
+    col("start_ts", Ty::TimestampNs, false),
+    col("node", Ty::I32, false),
+    col("index", Ty::I32, true),
+    col("sub", Ty::I32, true),
+    col("name", Ty::Str, true),
+    col("value", Ty::F64, true),
+    col("value_text", Ty::Str, true),
+    col("data", Ty::Bin, true),
+    col("direction", Ty::Str, false),
+    col("protocol", Ty::Str, true),
+    col("outcome", Ty::Str, true),
+    col("abort_code", Ty::I64, true),
+    col("abort_text", Ty::Str, true),
+    col("partial", Ty::Bool, false),
+    col("pdo_num", Ty::I32, true),
+    col("frames", Ty::I64, false),
+];
+
+type Writer = Table<BufWriter<File>>;
+
+/// Where the two tables go: `-o DIR` gives `DIR/frames.parquet` and `DIR/values.parquet`;
+/// `-o NAME.parquet` gives `NAME.parquet` (frames) and `NAME.values.parquet`.
+pub fn paths(output: &str) -> (PathBuf, PathBuf) {
+    match output.strip_suffix(".parquet") {
+        Some(stem) => (PathBuf::from(output), PathBuf::from(format!("{stem}.values.parquet"))),
+        None => {
+            let dir = Path::new(output);
+            (dir.join("frames.parquet"), dir.join("values.parquet"))
+        }
+    }
+}
+
+fn create(path: &Path, name: &str, cols: &[Col]) -> Result<Writer, String> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
+    let f = File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    Table::new(BufWriter::with_capacity(1 << 16, f), name, cols).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Runs `cotui decode --format parquet`; returns the exit status.
+pub fn run(args: &DecodeArgs) -> i32 {
+    if args.transactions || args.summary || args.events {
+        eprintln!(
+            "cotui decode: --format parquet writes the frame and value tables; it does not go with --transactions, --summary or --events"
+        );
+        return EXIT_USAGE;
+    }
+    let Some(output) = args.output.as_deref().filter(|o| *o != "-") else {
+        eprintln!(
+            "cotui decode: parquet is binary and written as two files: give -o DIR (DIR/frames.parquet, DIR/values.parquet) or -o NAME.parquet, not stdout"
+        );
+        return EXIT_USAGE;
+    };
+    let mut decoder = match super::bind::decoder(&args.profiles, &args.eds) {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("cotui decode: {e}");
+            return EXIT_USAGE;
+        }
+    };
+    let (frames_path, values_path) = paths(output);
+    let tables =
+        create(&frames_path, "frames", &FRAME_COLS).and_then(|f| Ok((f, create(&values_path, "values", &VALUE_COLS)?)));
+    let (mut frames, mut values) = match tables {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!("cotui decode: {e}");
+            return EXIT_USAGE;
+        }
+    };
+    let mut status = EXIT_OK;
+    let mut last_file = String::new();
+    for path in &args.files {
+        let input: Box<dyn BufRead + Send> = if path == "-" {
+            Box::new(BufReader::with_capacity(1 << 16, io::stdin()))
+        } else {
+            match File::open(path) {
+                Ok(f) => Box::new(BufReader::with_capacity(1 << 16, f)),
+                Err(e) => {
+                    eprintln!("cotui decode: {path}: {e}");
+                    status = EXIT_UNAVAILABLE;
+                    continue;
+                }
+            }
+        };
+        last_file.clone_from(path);
+        if let Err(e) = write_stream(path, input, &mut decoder, &mut frames, &mut values) {
+            eprintln!("cotui decode: {path}: {e}");
+            status = EXIT_UNAVAILABLE;
+        }
+    }
+    let mut end = || -> io::Result<()> {
+        for t in decoder.finish() {
+            transaction_row(&mut values, &last_file, &t, decoder.dictionary(t.node))?;
+        }
+        Ok(())
+    };
+    let result = end().and_then(|_| frames.finish()).and_then(|_| values.finish());
+    match result {
+        Err(e) => {
+            eprintln!("cotui decode: {output}: {e}");
+            EXIT_UNAVAILABLE
+        }
+        Ok(()) => status,
+    }
+}
+
+/// Decodes one input into the two tables (parsing runs on a second thread).
+fn write_stream(
+    path: &str,
+    input: Box<dyn BufRead + Send>,
+    decoder: &mut Decoder,
+    frames: &mut Writer,
+    values: &mut Writer,
+) -> io::Result<()> {
+    let mut ifaces = Interfaces::default();
+    let finished = read_ahead::for_each_batch(input, |batch| -> io::Result<()> {
+        if let Some(i) = &batch.interfaces {
+            ifaces = i.clone();
+        }
+        for (line, outcome) in &batch.lines {
+            let frame = match outcome {
+                Outcome::Frame(f) => f,
+                Outcome::Skip(_) => continue,
+                Outcome::Warning(msg) => {
+                    eprintln!("{path}:{line}: warning: {msg}");
+                    continue;
+                }
+            };
+            let d = decoder.decode(frame);
+            frame_row(frames, path, *line, frame, ifaces.name(frame.iface), &d)?;
+            if let (Body::Pdo(p), Some(node)) = (&d.body, d.node) {
+                for s in &p.signals {
+                    values.row(|r| {
+                        let ts = V::I64(ts(frame.ts_ns));
+                        r.push(Some(V::Str(path)))?
+                            .push(Some(V::Str("pdo")))?
+                            .push(Some(ts.clone()))?
+                            .push(Some(ts))?
+                            .push(Some(V::I32(node as i32)))?
+                            .push(Some(V::I32(s.index as i32)))?
+                            .push(Some(V::I32(s.sub as i32)))?
+                            .push(Some(V::Str(&s.name)))?
+                            .push(s.value.as_f64().map(V::F64))?
+                            .push(Some(V::Str(&s.text)))?
+                            .push(None)?
+                            .push(Some(V::Str(if p.transmit { "transmit" } else { "receive" })))?
+                            .push(None)?
+                            .push(None)?
+                            .push(None)?
+                            .push(None)?
+                            .push(Some(V::Bool(false)))?
+                            .push(Some(V::I32(p.num as i32)))?
+                            .push(Some(V::I64(1)))?;
+                        Ok(())
+                    })?;
+                }
+            }
+            for t in decoder.take_transactions() {
+                transaction_row(values, path, &t, decoder.dictionary(t.node))?;
+            }
+        }
+        Ok(())
+    })??;
+    if let Some(e) = finished.error {
+        return Err(e);
+    }
+    let c = finished.counts;
+    if c.warnings > 0 || c.skipped_total() > 0 {
+        eprintln!(
+            "{path}: {} frames, {} lines skipped, {} malformed lines",
+            c.frames,
+            c.skipped_total(),
+            c.warnings
+        );
+    }
+    Ok(())
+}
+
+/// A timestamp in ns as Parquet's signed INT64 (saturating past year 2262).
+fn ts(ns: u64) -> i64 {
+    i64::try_from(ns).unwrap_or(i64::MAX)
+}
+
+fn frame_row<W: Write + Send>(
+    t: &mut Table<W>,
+    file: &str,
+    line: u64,
+    f: &Frame,
+    iface: &str,
+    d: &Decoded,
+) -> io::Result<()> {
+    let i32v = |v: i32| Some(V::I32(v));
+    let (mut nmt_command, mut nmt_target, mut nmt_state) = (None, None, None);
+    let (mut emcy_code, mut emcy_register, mut emcy_text) = (None, None, None);
+    let (mut sdo_command, mut sdo_index, mut sdo_sub, mut abort_code) = (None, None, None, None);
+    let (mut pdo_num, mut pdo_transmit) = (None, None);
+    match &d.body {
+        Body::Nmt(n) => {
+            nmt_command = Some(V::Str(n.command()));
+            nmt_target = i32v(n.target as i32);
+        }
+        Body::Heartbeat(h) => nmt_state = h.state.map(|s| V::Str(s.as_str())),
+        Body::Emcy(e) => {
+            emcy_code = i32v(e.code as i32);
+            emcy_register = i32v(e.register as i32);
+            emcy_text = Some(V::Str(&e.text));
+        }
+        Body::Sdo(s) => {
+            sdo_command = Some(V::Str(s.command.cs_name()));
+            if let Some((index, sub)) = s.object {
+                sdo_index = i32v(index as i32);
+                sdo_sub = i32v(sub as i32);
+            }
+            if let SdoCommand::Abort { code, .. } = s.command {
+                abort_code = Some(V::I64(code as i64));
+            }
+        }
+        Body::Pdo(p) => {
+            pdo_num = i32v(p.num as i32);
+            pdo_transmit = Some(V::Bool(p.transmit));
+        }
+        _ => {}
+    }
+    t.row(|r| {
+        r.push(Some(V::Str(file)))?
+            .push(Some(V::I64(line as i64)))?
+            .push(Some(V::I64(ts(f.ts_ns))))?
+            .push(Some(V::Str(iface)))?
+            .push(i32v(f.id as i32))?
+            .push(Some(V::Bool(f.is_ext())))?
+            .push(Some(V::Bool(f.is_rtr())))?
+            .push(Some(V::Bool(f.is_fd())))?
+            .push(Some(V::Bool(f.is_err())))?
+            .push(Some(V::Str(if f.flags.has(Flags::TX) { "tx" } else { "rx" })))?
+            .push(i32v(f.len as i32))?
+            .push(Some(V::Bin(f.payload())))?
+            .push(Some(V::Str(d.kind.as_str())))?
+            .push(d.node.map(|n| V::I32(n as i32)))?
+            .push(Some(V::Str(&d.label)))?
+            .push(d.malformed.as_deref().map(V::Str))?
+            .push(nmt_command)?
+            .push(nmt_target)?
+            .push(nmt_state)?
+            .push(emcy_code)?
+            .push(emcy_register)?
+            .push(emcy_text)?
+            .push(sdo_command)?
+            .push(sdo_index)?
+            .push(sdo_sub)?
+            .push(abort_code)?
+            .push(pdo_num)?
+            .push(pdo_transmit)?;
+        Ok(())
+    })
+}
+
+/// One row of `values.parquet` for an SDO transaction; the decoded value, name and
+/// abort text are the ones `--transactions --format jsonl` gives.
+fn transaction_row<W: Write + Send>(
+    t: &mut Table<W>,
+    file: &str,
+    tr: &Transaction,
+    dict: &Dictionary,
+) -> io::Result<()> {
+    let j = tr.to_json(dict);
+    let s = |k: &str| j[k].as_str().map(V::Str);
+    let partial = tr.is_partial();
+    let frames = tr.frames.len() as u64 + tr.frames_dropped;
+    t.row(|r| {
+        r.push(Some(V::Str(file)))?
+            .push(Some(V::Str("sdo")))?
+            .push(Some(V::I64(ts(tr.end_ns))))?
+            .push(Some(V::I64(ts(tr.start_ns))))?
+            .push(Some(V::I32(tr.node as i32)))?
+            .push((!partial).then_some(V::I32(tr.index as i32)))?
+            .push((!partial).then_some(V::I32(tr.sub as i32)))?
+            .push(s("name"))?
+            .push(j["value"].as_f64().map(V::F64))?
+            .push(s("value_text"))?
+            .push(Some(V::Bin(&tr.data)))?
+            .push(Some(V::Str(tr.direction.as_str())))?
+            .push(Some(V::Str(tr.protocol.as_str())))?
+            .push(Some(V::Str(tr.outcome.as_str())))?
+            .push(j["abort_code"].as_i64().map(V::I64))?
+            .push(s("abort_text"))?
+            .push(Some(V::Bool(partial)))?
+            .push(None)?
+            .push(Some(V::I64(frames as i64)))?;
+        Ok(())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+
+        /// Arbitrary frames (any id, flags, length, bytes, time) decode into both tables
+        /// without an error or a panic, and the file is complete.
+        #[test]
+        fn arbitrary_frames_make_valid_tables(
+            frames in proptest::collection::vec(
+                (prop_oneof![0u32..0x800, any::<u32>()], any::<u8>(), proptest::collection::vec(any::<u8>(), 0..9), any::<u64>()),
+                0..40,
+            )
+        ) {
+            let mut decoder = Decoder::new(Dictionary::default(), vec![]);
+            let mut out = Vec::new();
+            let mut t = Table::new(&mut out, "frames", &FRAME_COLS).unwrap();
+            let mut v = Table::new(Vec::new(), "values", &VALUE_COLS).unwrap();
+            let mut ifaces = Interfaces::default();
+            ifaces.intern("can\u{1b}0");
+            for (i, (id, flags, data, ts_ns)) in frames.iter().enumerate() {
+                let mut f = Frame::classic(id & 0x1FFF_FFFF, data);
+                f.flags = Flags(*flags);
+                f.ts_ns = *ts_ns;
+                let d = decoder.decode(&f);
+                frame_row(&mut t, "fuzz", i as u64, &f, ifaces.name(0), &d).unwrap();
+                for tr in decoder.take_transactions() {
+                    transaction_row(&mut v, "fuzz", &tr, decoder.dictionary(tr.node)).unwrap();
+                }
+            }
+            for tr in decoder.finish() {
+                transaction_row(&mut v, "fuzz", &tr, decoder.dictionary(tr.node)).unwrap();
+            }
+            t.finish().unwrap();
+            v.finish().unwrap();
+            prop_assert_eq!(&out[out.len() - 4..], b"PAR1");
+        }
+    }
+
+    #[test]
+    fn output_layout() {
+        assert_eq!(
+            paths("out/run1.parquet"),
+            ("out/run1.parquet".into(), "out/run1.values.parquet".into())
+        );
+        assert_eq!(
+            paths("pq/run1"),
+            ("pq/run1/frames.parquet".into(), "pq/run1/values.parquet".into())
+        );
+    }
+}
