@@ -553,3 +553,32 @@ fn stop_all_in_the_live_task_cancels_a_running_procedure_first() {
         "the procedure never finished: {text}"
     );
 }
+
+#[tokio::test(start_paused = true)]
+async fn scan_probe_asks_every_node_id_once_all_at_once() {
+    let d = demo();
+    let mut rx = d.bus.subscribe();
+    let start = tokio::time::Instant::now();
+    // No listening: every node is found by the probe.
+    let nodes = cotui::command::scan::scan(&d.bus, 0, true, T).await.unwrap();
+    let took = start.elapsed();
+    let found: Vec<(u8, Option<u32>, bool)> = nodes
+        .iter()
+        .map(|n| (n.node, n.device_type.map(|t| t & 0xFFFF), n.identity[0].is_some()))
+        .collect();
+    assert_eq!(found, [(2, Some(402), true), (3, Some(402), true)]);
+    // One timeout for the silent node-IDs, then the two identifications at once.
+    assert!(
+        took >= Duration::from_millis(T) && took < Duration::from_millis(2 * T),
+        "{took:?}"
+    );
+    let frames = drain(&mut rx);
+    for node in 1..=127u32 {
+        let asks = frames
+            .iter()
+            .filter(|f| f.direction() == cotui::frame::Direction::Tx && f.id == 0x600 + node)
+            .filter(|f| f.payload()[..4] == [0x40, 0x00, 0x10, 0])
+            .count();
+        assert_eq!(asks, 1, "0x1000 reads sent to node {node}");
+    }
+}

@@ -1,7 +1,9 @@
 //! `cotui bench`: decoder throughput and peak memory on a generated log.
 //!
 //! Each figure comes from a child `cotui decode` process (so peak RSS is that
-//! run's alone), reading a synthetic candump log and writing to /dev/null.
+//! run's alone), reading a synthetic candump log and writing to /dev/null; the
+//! runs are interleaved round by round and the median of the rounds reported,
+//! beside can-utils' `log2asc` on the same log and the targets.
 
 use super::{EXIT_OK, EXIT_UNAVAILABLE};
 use crate::log::writer::LogWriter;
@@ -30,27 +32,78 @@ pub struct BenchArgs {
     pub tui: bool,
 }
 
-/// One measured run.
-struct Figure {
-    name: String,
+/// Interleaved rounds per figure; the median is reported.
+const ROUNDS: usize = 5;
+/// Runs of the start-up figure (decode of a 10-line log); the median is reported.
+const STARTUP_RUNS: usize = 21;
+/// Target start-up time (ms).
+const STARTUP_TARGET_MS: f64 = 3.0;
+/// One garbage line (tool chatter the decoder must skip) every this many frames.
+const GARBAGE_EVERY: u64 = 5_000;
+
+/// One way of running the decoder, and its measurements.
+struct Run {
+    /// The program, when not `cotui` itself.
+    program: Option<PathBuf>,
+    name: &'static str,
+    title: &'static str,
+    args: Vec<String>,
     frames: u64,
-    seconds: f64,
+    /// Target throughput as a multiple of log2asc's.
+    target: Option<f64>,
+    seconds: Vec<f64>,
     peak_rss_kib: u64,
 }
 
-impl Figure {
-    fn rate(&self) -> f64 {
-        self.frames as f64 / self.seconds
+impl Run {
+    fn new(name: &'static str, title: &'static str, args: &[&str], frames: u64, target: Option<f64>) -> Run {
+        Run {
+            program: None,
+            name,
+            title,
+            args: args.iter().map(|a| a.to_string()).collect(),
+            frames,
+            target,
+            seconds: Vec::new(),
+            peak_rss_kib: 0,
+        }
     }
+    /// Median wall time of the rounds.
+    fn seconds(&self) -> f64 {
+        median(&self.seconds)
+    }
+    fn rate(&self) -> f64 {
+        self.frames as f64 / self.seconds()
+    }
+}
+
+/// The median of `v` (0 when empty).
+fn median(v: &[f64]) -> f64 {
+    let mut v = v.to_vec();
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(0.0)
 }
 
 /// Writes a candump `-l` log of `frames` synthetic frames to `path`.
 pub fn write_log(path: &Path, frames: u64) -> std::io::Result<()> {
+    write_frames(path, frames, None)
+}
+
+/// Writes the bench log: `frames` synthetic frames with a garbage line (a tool's
+/// message, as in logs captured by hand) every [`GARBAGE_EVERY`] frames.
+fn write_bench_log(path: &Path, frames: u64) -> std::io::Result<()> {
+    write_frames(path, frames, Some(GARBAGE_EVERY))
+}
+
+fn write_frames(path: &Path, frames: u64, garbage_every: Option<u64>) -> std::io::Result<()> {
     let file = std::fs::File::create(path)?;
     let mut out = std::io::BufWriter::with_capacity(1 << 20, file);
     let mut writer = LogWriter::new();
     let mut line = String::with_capacity(1 << 16);
-    for frame in Traffic::new(frames, 1_700_000_000_000_000_000) {
+    for (i, frame) in Traffic::new(frames, 1_700_000_000_000_000_000).enumerate() {
+        if garbage_every.is_some_and(|g| i as u64 % g == g - 1) {
+            line.push_str(GARBAGE[i / 5_000 % GARBAGE.len()]);
+        }
         writer.write_line(&mut line, &frame, "can0");
         if line.len() > 1 << 15 {
             out.write_all(line.as_bytes())?;
@@ -60,6 +113,13 @@ pub fn write_log(path: &Path, frames: u64) -> std::io::Result<()> {
     out.write_all(line.as_bytes())?;
     out.flush()
 }
+
+/// Lines found in hand-captured logs that are not frames (log2asc skips them too).
+const GARBAGE: [&str; 3] = [
+    "candump: interface can0 down\n",
+    "# restarted capture after bus-off\n",
+    "read: Network is down\n",
+];
 
 /// Runs `program args`, discarding output; returns wall seconds and peak RSS (KiB).
 fn measure(program: &Path, args: &[&str]) -> std::io::Result<(f64, u64)> {
@@ -111,7 +171,7 @@ pub fn run(args: &BenchArgs) -> i32 {
 
 fn bench(args: &BenchArgs) -> std::io::Result<()> {
     if let Some(path) = &args.write_log {
-        return write_log(path, args.frames);
+        return write_bench_log(path, args.frames);
     }
     if args.tui {
         return super::bench_tui::bench(args.frames, args.json);
@@ -119,90 +179,163 @@ fn bench(args: &BenchArgs) -> std::io::Result<()> {
     let exe = std::env::current_exe()?;
     let dir = std::env::temp_dir().join(format!("cotui-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
-    let big = dir.join("bench.log");
-    let small = dir.join("bench-quarter.log");
-    write_log(&big, args.frames)?;
-    write_log(&small, args.frames / 4)?;
-    let (b, s) = (big.to_string_lossy().to_string(), small.to_string_lossy().to_string());
-    let mut figures = Vec::new();
-    let runs: [(&str, Vec<&str>, &str, u64); 4] = [
-        (
-            "text",
-            vec!["decode", "--format", "text", &b],
-            "decode --format text",
-            args.frames,
-        ),
-        (
-            "jsonl",
-            vec!["decode", "--format", "jsonl", &b],
-            "decode --format jsonl",
-            args.frames,
-        ),
-        (
-            "summary",
-            vec!["decode", "--summary", &b],
-            "decode --summary",
-            args.frames,
-        ),
-        (
-            "text-quarter",
-            vec!["decode", "--format", "text", &s],
-            "decode --format text (1/4 log)",
-            args.frames / 4,
-        ),
-    ];
-    for (name, argv, _, frames) in &runs {
-        let (seconds, peak_rss_kib) = measure(&exe, argv)?;
-        figures.push(Figure {
-            name: name.to_string(),
-            frames: *frames,
-            seconds,
-            peak_rss_kib,
-        });
-    }
-    let log2asc = which("log2asc").and_then(|p| {
-        let out = dir.join("bench.asc");
-        let o = out.to_string_lossy().to_string();
-        measure(&p, &["-I", &b, "-O", &o, "can0"]).ok()
-    });
+    let result = measure_all(args, &exe, &dir);
     let _ = std::fs::remove_dir_all(&dir);
-    report(args, &runs.map(|r| r.2), &figures, log2asc);
+    report(args, &result?);
     Ok(())
 }
 
-fn report(args: &BenchArgs, titles: &[&str; 4], figures: &[Figure], log2asc: Option<(f64, u64)>) {
-    let base = log2asc.map(|(secs, _)| args.frames as f64 / secs);
+/// Runs every figure `ROUNDS` times, interleaved (so a load change hits all alike).
+fn measure_all(args: &BenchArgs, exe: &Path, dir: &Path) -> std::io::Result<Figures> {
+    let load_before = load_average();
+    let (big, small, tiny) = (
+        dir.join("bench.log"),
+        dir.join("bench-quarter.log"),
+        dir.join("tiny.log"),
+    );
+    write_bench_log(&big, args.frames)?;
+    write_bench_log(&small, args.frames / 4)?;
+    write_bench_log(&tiny, 10)?;
+    let (b, s, t) = (big.to_string_lossy(), small.to_string_lossy(), tiny.to_string_lossy());
+    let n = args.frames;
+    let mut runs = vec![
+        Run::new(
+            "summary",
+            "decode --summary",
+            &["decode", "--summary", &b],
+            n,
+            Some(15.0),
+        ),
+        Run::new(
+            "text",
+            "decode --format text",
+            &["decode", "--format", "text", &b],
+            n,
+            Some(7.0),
+        ),
+        Run::new(
+            "transactions",
+            "decode --transactions",
+            &["decode", "--transactions", &b],
+            n,
+            Some(8.0),
+        ),
+        Run::new(
+            "jsonl",
+            "decode --format jsonl",
+            &["decode", "--format", "jsonl", &b],
+            n,
+            Some(4.0),
+        ),
+        Run::new(
+            "text-quarter",
+            "decode --format text (1/4 log)",
+            &["decode", "--format", "text", &s],
+            n / 4,
+            None,
+        ),
+    ];
+    let log2asc = which("log2asc").map(|p| Run {
+        program: Some(p),
+        ..Run::new("log2asc", "log2asc", &["-I", &b, "-O", "/dev/null", "can0"], n, None)
+    });
+    let has_base = log2asc.is_some();
+    runs.extend(log2asc);
+    for _ in 0..ROUNDS {
+        for run in runs.iter_mut() {
+            measure_into(exe, run)?;
+        }
+    }
+    let log2asc = if has_base { runs.pop() } else { None };
+    let startup: Vec<f64> = (0..STARTUP_RUNS)
+        .map(|_| measure(exe, &["decode", &t]).map(|(secs, _)| secs))
+        .collect::<std::io::Result<_>>()?;
+    Ok(Figures {
+        runs,
+        log2asc,
+        startup_s: median(&startup),
+        load: [load_before, load_average()],
+    })
+}
+
+/// What `cotui bench` measured.
+struct Figures {
+    runs: Vec<Run>,
+    log2asc: Option<Run>,
+    /// Median start-up time (decode of a 10-line log).
+    startup_s: f64,
+    /// The 1-minute load average before and after.
+    load: [Option<String>; 2],
+}
+
+/// Measures one round of `run` (a `cotui` child unless it names its program).
+fn measure_into(exe: &Path, run: &mut Run) -> std::io::Result<()> {
+    let args: Vec<&str> = run.args.iter().map(String::as_str).collect();
+    let (secs, rss) = measure(run.program.as_deref().unwrap_or(exe), &args)?;
+    run.seconds.push(secs);
+    run.peak_rss_kib = run.peak_rss_kib.max(rss);
+    Ok(())
+}
+
+/// The 1-minute load average (from /proc/loadavg), when known.
+fn load_average() -> Option<String> {
+    let text = std::fs::read_to_string("/proc/loadavg").ok()?;
+    text.split_whitespace().next().map(str::to_string)
+}
+
+fn report(args: &BenchArgs, f: &Figures) {
+    let (runs, base) = (&f.runs, f.log2asc.as_ref().map(Run::rate));
+    let startup_ms = f.startup_s * 1e3;
+    let [before, after] = f.load.clone().map(|l| l.unwrap_or_else(|| "unknown".into()));
     if args.json {
-        let runs: Vec<serde_json::Value> = figures
+        let figures: Vec<serde_json::Value> = runs
             .iter()
-            .map(|f| {
+            .map(|r| {
                 serde_json::json!({
-                    "name": f.name, "frames": f.frames, "seconds": f.seconds,
-                    "frames_per_s": f.rate(), "peak_rss_kib": f.peak_rss_kib,
-                    "vs_log2asc": base.map(|b| f.rate() / b),
+                    "name": r.name, "frames": r.frames, "seconds": r.seconds(),
+                    "frames_per_s": r.rate(), "peak_rss_kib": r.peak_rss_kib,
+                    "vs_log2asc": base.map(|b| r.rate() / b), "target_vs_log2asc": r.target,
                 })
             })
             .collect();
         println!(
             "{}",
-            serde_json::json!({"frames": args.frames, "runs": runs, "log2asc_frames_per_s": base})
+            serde_json::json!({
+                "frames": args.frames, "rounds": ROUNDS, "runs": figures,
+                "log2asc_frames_per_s": base, "load_average": [before, after],
+                "startup_ms": startup_ms, "startup_target_ms": STARTUP_TARGET_MS,
+            })
         );
         return;
     }
-    println!("cotui bench: {} generated frames (candump -l log)", args.frames);
-    for (f, title) in figures.iter().zip(titles) {
-        let vs = base
-            .map(|b| format!("  {:5.1}x log2asc", f.rate() / b))
-            .unwrap_or_default();
+    println!(
+        "cotui bench: {} generated frames (candump -l log, ~12 % SDO), median of {ROUNDS} \
+         interleaved runs; load average {before} before, {after} after",
+        args.frames
+    );
+    for r in runs {
+        let vs = match (base, r.target) {
+            (Some(b), Some(t)) => format!("  {:5.1}x log2asc (target >= {t}x)", r.rate() / b),
+            (Some(b), None) => format!("  {:5.1}x log2asc", r.rate() / b),
+            (None, _) => String::new(),
+        };
         println!(
-            "  {title:<32} {:>12.0} frames/s  {:>7.3} s  peak RSS {:>7} KiB{vs}",
-            f.rate(),
-            f.seconds,
-            f.peak_rss_kib
+            "  {:<32} {:>12.0} frames/s  {:>7.3} s  peak RSS {:>7} KiB{vs}",
+            r.title,
+            r.rate(),
+            r.seconds(),
+            r.peak_rss_kib
         );
     }
     match base {
-        Some(b) => println!("  {:<32} {b:>12.0} frames/s (can-utils, same log)", "log2asc"),
+        Some(b) => println!(
+            "  {:<32} {b:>12.0} frames/s (can-utils, same log, to /dev/null)",
+            "log2asc"
+        ),
         None => println!("  log2asc not found (install can-utils) - no baseline"),
     }
+    println!(
+        "  {:<32} {startup_ms:>12.2} ms (target < {STARTUP_TARGET_MS} ms)",
+        "start-up (decode of a 10-line log)"
+    );
 }

@@ -9,6 +9,7 @@ use crate::frame::Direction;
 use crate::od::Value;
 use std::collections::BTreeMap;
 use std::time::Duration;
+use tokio::task::JoinSet;
 
 /// What a scan found out about one node.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -68,8 +69,9 @@ impl NodeInfo {
     }
 }
 
-/// Listens `listen_ms` for heartbeats and boot-ups (and, with `probe`, also asks every node
-/// 1..127 for 0x1000), then reads the identification of each node found. On a listen-only
+/// Listens `listen_ms` for heartbeats and boot-ups (and, with `probe`, also asks every silent
+/// node-ID 1..127 for 0x1000, all at once), then reads the identification of each node found
+/// (all nodes at once; 0x1000 is asked once per node-ID). On a listen-only
 /// bus nothing is sent: the nodes heard are returned unidentified (and `probe` is refused).
 pub async fn scan(bus: &Bus, listen_ms: u64, probe: bool, timeout_ms: u64) -> Result<Vec<NodeInfo>, CommandError> {
     let mut rx = bus.subscribe();
@@ -103,25 +105,54 @@ pub async fn scan(bus: &Bus, listen_ms: u64, probe: bool, timeout_ms: u64) -> Re
             .map(|(node, nmt)| NodeInfo::heard(node, nmt))
             .collect());
     }
+    // Node-IDs answering 0x1000, with the answer (so identification does not ask again).
+    let mut probed: BTreeMap<u8, Vec<u8>> = BTreeMap::new();
     if probe {
-        for node in 1..=127u8 {
-            if !heard.contains_key(&node) && upload(bus, node, 0x1000, 0, false, timeout_ms).await.is_ok() {
-                heard.insert(node, None);
+        // Every silent node-ID at once: the probe takes one timeout, not 127.
+        let mut set = JoinSet::new();
+        for node in (1..=127u8).filter(|n| !heard.contains_key(n)) {
+            let bus = bus.clone();
+            set.spawn(async move { (node, upload(&bus, node, 0x1000, 0, false, timeout_ms).await) });
+        }
+        while let Some(r) = set.join_next().await {
+            match r.map_err(|e| CommandError::Usage(format!("a probe task failed: {e}")))? {
+                (node, Ok(d)) => {
+                    heard.insert(node, None);
+                    probed.insert(node, d);
+                }
+                (_, Err(CommandError::Bus(BusError::Closed))) => return Err(BusError::Closed.into()),
+                // No answer, or not a CANopen SDO server: no node there.
+                (_, Err(_)) => {}
             }
         }
     }
-    let mut out = Vec::new();
+    // The identification of every node at once.
+    let mut set = JoinSet::new();
     for (node, nmt) in heard {
-        out.push(identify(bus, node, nmt, timeout_ms).await?);
+        let bus = bus.clone();
+        let device_type = probed.remove(&node);
+        set.spawn(async move { identify(&bus, node, nmt, device_type, timeout_ms).await });
     }
-    Ok(out)
+    let mut out = BTreeMap::new();
+    while let Some(r) = set.join_next().await {
+        let info = r.map_err(|e| CommandError::Usage(format!("an identification task failed: {e}")))??;
+        out.insert(info.node, info);
+    }
+    Ok(out.into_values().collect())
 }
 
 fn le_u32(d: &[u8]) -> u32 {
     d.iter().take(4).rev().fold(0u32, |a, b| (a << 8) | *b as u32)
 }
 
-async fn identify(bus: &Bus, node: u8, nmt: Option<NmtState>, timeout_ms: u64) -> Result<NodeInfo, CommandError> {
+/// Reads the identification of `node`; `device_type` is its 0x1000 answer when the probe already has it.
+async fn identify(
+    bus: &Bus,
+    node: u8,
+    nmt: Option<NmtState>,
+    device_type: Option<Vec<u8>>,
+    timeout_ms: u64,
+) -> Result<NodeInfo, CommandError> {
     let mut info = NodeInfo::heard(node, nmt);
     let note = |e: CommandError, info: &mut NodeInfo| -> Result<(), CommandError> {
         match e {
@@ -132,7 +163,11 @@ async fn identify(bus: &Bus, node: u8, nmt: Option<NmtState>, timeout_ms: u64) -
             }
         }
     };
-    match upload(bus, node, 0x1000, 0, false, timeout_ms).await {
+    let first = match device_type {
+        Some(d) => Ok(d),
+        None => upload(bus, node, 0x1000, 0, false, timeout_ms).await,
+    };
+    match first {
         Ok(d) => info.device_type = Some(le_u32(&d)),
         Err(e) => {
             note(e, &mut info)?;

@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, OnceLock};
 
-use super::json::{LoadError, load_profile};
+use super::json::{LoadError, load_builtin_profile, load_profile};
 use super::{Dictionary, MappingSource, Profile, Value, Warning};
 
 /// The profiles built into the binary: name and JSON text. To add one, put
@@ -51,7 +51,8 @@ pub fn shared_builtin(name: &str) -> Option<Result<SharedProfile, LoadError>> {
     if let Some((p, w)) = cache.lock().ok()?.get(name) {
         return Some(Ok((p.clone(), w.clone())));
     }
-    let loaded = load_builtin(name)?.map(|(p, w)| (Arc::new(p), w));
+    let (n, text) = BUILTIN.iter().find(|(n, _)| *n == name)?;
+    let loaded = load_builtin_profile(&format!("built-in {n}"), text).map(|(p, w)| (Arc::new(p), w));
     if let (Ok(entry), Ok(mut c)) = (&loaded, cache.lock()) {
         c.insert(name.to_string(), entry.clone());
     }

@@ -8,22 +8,30 @@ use crate::decode::{Body, Decoded};
 use crate::frame::{Flags, Frame, Interfaces};
 use std::fmt::Write;
 
-/// Appends a JSON string literal.
+/// Appends a JSON string literal: unescaped runs are copied whole (escapes are ASCII,
+/// so every cut falls on a char boundary).
 fn push_str_lit(out: &mut String, s: &str) {
     out.push('"');
-    for c in s.chars() {
-        match c {
-            '"' => out.push_str("\\\""),
-            '\\' => out.push_str("\\\\"),
-            '\n' => out.push_str("\\n"),
-            '\r' => out.push_str("\\r"),
-            '\t' => out.push_str("\\t"),
-            c if (c as u32) < 0x20 => {
-                let _ = write!(out, "\\u{:04x}", c as u32);
-            }
-            c => out.push(c),
+    let mut from = 0;
+    for (i, b) in s.bytes().enumerate() {
+        let escape = match b {
+            b'"' => "\\\"",
+            b'\\' => "\\\\",
+            b'\n' => "\\n",
+            b'\r' => "\\r",
+            b'\t' => "\\t",
+            0..0x20 => "",
+            _ => continue,
+        };
+        out.push_str(&s[from..i]);
+        if escape.is_empty() {
+            let _ = write!(out, "\\u{b:04x}");
+        } else {
+            out.push_str(escape);
         }
+        from = i + 1;
     }
+    out.push_str(&s[from..]);
     out.push('"');
 }
 
@@ -76,7 +84,11 @@ pub fn write_frame(out: &mut String, line: u64, frame: &Frame, ifaces: &Interfac
     out.push_str(",\"label\":");
     push_str_lit(out, &decoded.label);
     if let Some((key, value)) = body_json(decoded, frame) {
-        let _ = write!(out, ",\"{key}\":{value}");
+        // serde_json writes to a byte buffer much faster than through `Display`.
+        if let Ok(text) = serde_json::to_string(&value) {
+            let _ = write!(out, ",\"{key}\":");
+            out.push_str(&text);
+        }
     }
     if let Some(m) = &decoded.malformed {
         out.push_str(",\"malformed\":");
@@ -133,5 +145,8 @@ mod tests {
         let mut s = String::new();
         push_str_lit(&mut s, "a\"b\\c\u{1}");
         assert_eq!(s, r#""a\"b\\c\u0001""#);
+        s.clear();
+        push_str_lit(&mut s, "µ\tz\n°");
+        assert_eq!(s, r#""µ\tz\n°""#);
     }
 }

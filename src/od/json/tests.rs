@@ -329,3 +329,11 @@ fn value_fields_must_fit_the_type() {
         .collect();
     assert_eq!(names, ["node", "time", "odd"]);
 }
+
+#[test]
+fn range_names_fill_every_slot_and_keep_other_braces() {
+    assert_eq!(super::fill("TPDO{i} map {i}", "{i}", 512), "TPDO512 map 512");
+    assert_eq!(super::fill("A {n} {x} {", "{n}", 0), "A 0 {x} {");
+    assert_eq!(super::fill("none", "{n}", 7), "none");
+    assert_eq!(super::fill("{n}", "{n}", u32::MAX), "4294967295");
+}
