@@ -5,6 +5,7 @@ mod bench_tui;
 pub mod bind;
 pub mod commander;
 pub mod decode;
+pub mod diagnose;
 mod decode_out;
 pub mod drive;
 pub mod nmt;
@@ -48,6 +49,8 @@ pub fn verbose() -> bool {
 pub enum Command {
     /// Decode candump / ASC logs to text, JSON lines, SDO transactions, a summary or pcapng.
     Decode(decode::DecodeArgs),
+    /// What went wrong on the bus, in plain words: incidents with cause, timeline and what to check.
+    Diagnose(diagnose::DiagnoseArgs),
     /// Print throughput and memory figures of the decoder on a generated log.
     Bench(bench::BenchArgs),
     /// Open a log in the interactive analyzer (loads at once; browse, filter, search).
@@ -85,6 +88,7 @@ Try it without hardware:   cotui demo
 Browse a log:              cotui open FILE
 Replay a log:              cotui replay FILE [--speed 2]
 Decode a candump log:      cotui decode FILE [--format jsonl] [--transactions] [--summary]
+What went wrong:           cotui diagnose FILE [--format jsonl] [--check]
 All commands:              cotui --help
 ";
 
@@ -104,6 +108,7 @@ pub fn run() -> i32 {
             EXIT_OK
         }
         Some(Command::Decode(args)) => decode::run(&args),
+        Some(Command::Diagnose(args)) => diagnose::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
         Some(Command::Open(args)) => tui::run_open(&args),
         Some(Command::Replay(args)) => tui::run_replay(&args),
