@@ -14,7 +14,8 @@ use super::liveness::EventTracker;
 use crate::decode::cia402::DriveState;
 use crate::decode::emcy::Emcy;
 use crate::decode::heartbeat::NmtState;
-use crate::decode::sdo::frame::Side;
+use crate::decode::sdo::abort::abort_text;
+use crate::decode::sdo::frame::{SdoCommand, Side};
 use crate::decode::sdo::transaction::{Outcome, TransferDirection, Transaction};
 use crate::decode::{Body, Decoded, Kind};
 use crate::frame::Frame;
@@ -49,6 +50,8 @@ struct At {
 #[derive(Clone, Copy, Debug)]
 struct Request {
     at: At,
+    /// A new request went out before this one was answered.
+    replaced: bool,
     index: u16,
     sub: u8,
 }
@@ -84,6 +87,13 @@ struct Node {
     last_boot: Option<u64>,
     reset_asked: Option<u64>,
     pending: Option<Request>,
+    /// The last SDO request was a write.
+    download: bool,
+    /// Last frame of any kind sent by the node.
+    last_any: Option<At>,
+    /// 0x1017 = 0 seen on the bus, and when.
+    heartbeat_off: Option<At>,
+    guarded: bool,
     unanswered: Vec<Request>,
     n_unanswered: u64,
     answered_after: bool,
@@ -219,6 +229,12 @@ impl Diagnoser {
             return;
         };
         let at = self.at;
+        if matches!(d.kind, Kind::Tpdo | Kind::SdoTx | Kind::Emcy) || matches!(&d.body, Body::Heartbeat(h) if !h.request) {
+            self.node(n).last_any = Some(at);
+        }
+        if matches!(&d.body, Body::Heartbeat(h) if h.request) {
+            self.node(n).guarded = true;
+        }
         match &d.body {
             Body::Nmt(nmt) => self.nmt(nmt.cs, nmt.target),
             Body::Heartbeat(h) if !h.request => {
@@ -236,13 +252,27 @@ impl Diagnoser {
                 node.heard = true;
                 node.pending = None;
                 node.answered_after = true;
+                if let SdoCommand::Abort { index, sub, code } = s.command {
+                    self.refused(n, index, sub, code);
+                } else if s.problems.iter().any(|p| p == "outside any transfer seen") {
+                    self.garbled(n, format!("{} frame outside any transfer", s.command.cs_name()));
+                }
             }
             Body::Sdo(s) => {
-                if let Some((index, sub)) = s.object {
+                // Only initiate frames start a request (segments carry no object themselves).
+                if let Some((index, sub)) = s.command.object()
+                    && s.command.cs_name() != "abort"
+                {
+                    self.node(n).download = matches!(s.command.cs_name(), "initiate_download" | "block_download");
                     if let Some(old) = self.node(n).pending.take() {
-                        self.unanswered(n, old);
+                        self.unanswered(n, Request { replaced: true, ..old });
                     }
-                    self.node(n).pending = Some(Request { at, index, sub });
+                    self.node(n).pending = Some(Request {
+                        at,
+                        replaced: false,
+                        index,
+                        sub,
+                    });
                     let dl = at.t + SDO_TIMEOUT_NS;
                     self.sdo_deadline = Some(self.sdo_deadline.map_or(dl, |d| d.min(dl)));
                 }
@@ -576,7 +606,10 @@ impl Diagnoser {
                 ..
             } => {
                 let node = self.node(n);
-                let close = node.last_boot.is_some_and(|t| at.t.saturating_sub(t) <= DUPLICATE_BOOT_NS);
+                // (Equal times say nothing: logs without timestamps.)
+                let close = node
+                    .last_boot
+                    .is_some_and(|t| at.t > t && at.t - t <= DUPLICATE_BOOT_NS);
                 let asked = node.reset_asked.is_some_and(|t| at.t.saturating_sub(t) <= RESET_BOOT_NS);
                 node.last_boot = Some(at.t);
                 node.expect = None;
@@ -597,24 +630,31 @@ impl Diagnoser {
                     self.node(n).reset_asked = None;
                 }
             }
-            What::SdoAbort {
-                direction,
-                index,
-                sub,
-                text,
-                code,
-                by: "server",
-            } => {
-                let detail = (u32::from(*index) << 8) | u32::from(*sub);
-                let i = self.grouped(Some(n), Problem::SdoRefused, detail, at.t);
-                let inc = &mut self.incidents[i];
-                inc.status = Status::Open;
-                inc.cause = Some(format!("0x{index:04X}:{sub:02X}: {text} (abort 0x{code:08X})"));
-                let what = if *direction == "download" { "Write" } else { "Read" };
-                self.step(i, at, format!("{what} of 0x{index:04X}:{sub:02X} refused: {text} (0x{code:08X})"));
-            }
             _ => {}
         }
+    }
+
+    fn refused(&mut self, n: u8, index: u16, sub: u8, code: u32) {
+        let at = self.at;
+        let text = abort_text(code);
+        let detail = (u32::from(index) << 8) | u32::from(sub);
+        let write = self.node(n).download;
+        let i = self.grouped(Some(n), Problem::SdoRefused, detail, at.t);
+        let inc = &mut self.incidents[i];
+        inc.status = Status::Open;
+        inc.cause = Some(format!("0x{index:04X}:{sub:02X}: {text} (abort 0x{code:08X})"));
+        let what = if write { "Write" } else { "Read" };
+        self.step(i, at, format!("{what} of 0x{index:04X}:{sub:02X} refused: {text} (0x{code:08X})"));
+    }
+
+    fn garbled(&mut self, n: u8, what: String) {
+        let at = self.at;
+        let i = self.grouped(Some(n), Problem::SdoGarbled, 0, at.t);
+        self.incidents[i].status = Status::Open;
+        if self.incidents[i].cause.is_none() {
+            self.incidents[i].cause = Some(what.clone());
+        }
+        self.step(i, at, format!("Node sent an SDO {what}"));
     }
 
     fn back(&mut self, n: u8, at: At, silent_ms: f64, reboot: bool) {
@@ -680,6 +720,9 @@ impl Diagnoser {
         for e in self.tracker.take_events() {
             self.event(&e);
         }
+        if let Outcome::ProtocolError(why) = &t.outcome {
+            self.garbled(t.node, format!("transfer of 0x{:04X}:{:02X} broke the protocol: {why}", t.index, t.sub));
+        }
         if t.outcome != Outcome::Ok || t.data.is_empty() {
             return;
         }
@@ -690,6 +733,10 @@ impl Diagnoser {
         }
         if t.sub == 0 {
             self.drive_word(t.node, t.index, v as u16);
+        }
+        if (t.index, t.sub) == (0x1017, 0) {
+            let at = self.at;
+            self.node(t.node).heartbeat_off = (v & 0xFFFF == 0).then_some(at);
         }
         let key = (Some(t.node), Problem::SdoRefused, (u32::from(t.index) << 8) | u32::from(t.sub));
         if let Some(&i) = self.keyed.get(&key)
@@ -716,10 +763,19 @@ impl Diagnoser {
             if let Some((last, lost, _)) = self.node(n).silence.take() {
                 let i = self.grouped(Some(n), Problem::Silent, 0, lost);
                 self.step(i, last, "Last heartbeat");
+                if let Some(other) = self.nodes[&n].last_any.filter(|a| a.t > lost) {
+                    self.incidents[i].cause = Some("the heartbeat stopped, other messages of the node go on".into());
+                    self.step(i, other, "The node still sends other messages (PDO, SDO or EMCY)");
+                }
                 self.step(i, end, "Nothing after that, until the end of the capture");
                 self.incidents[i].last_ns = end.t;
             }
             let node = self.nodes[&n].clone();
+            if let Some(at) = node.heartbeat_off.filter(|_| !node.guarded) {
+                let i = self.grouped(Some(n), Problem::Unmonitored, 0, at.t);
+                self.incidents[i].status = Status::Warning;
+                self.step(i, at, "Heartbeat producer time 0x1017 = 0: heartbeat off");
+            }
             if node.n_unanswered > 0 {
                 let problem = if node.heard { Problem::SdoTimeout } else { Problem::Missing };
                 let i = self.grouped(Some(n), problem, 0, node.unanswered[0].at.t);
@@ -730,11 +786,12 @@ impl Diagnoser {
                     Status::Open
                 };
                 for r in &node.unanswered {
-                    self.step(
-                        i,
-                        r.at,
-                        format!("Request for 0x{:04X}:{:02X}: no answer within 1 s", r.index, r.sub),
-                    );
+                    let how = if r.replaced {
+                        "no answer before the next request"
+                    } else {
+                        "no answer within 1 s"
+                    };
+                    self.step(i, r.at, format!("Request for 0x{:04X}:{:02X}: {how}", r.index, r.sub));
                 }
                 self.incidents[i].last_ns = node.unanswered.last().map_or(end.t, |r| r.at.t);
             }

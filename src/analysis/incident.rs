@@ -43,6 +43,10 @@ pub enum Problem {
     Rebooted,
     /// An SDO transfer refused (abort), per object.
     SdoRefused,
+    /// SDO frames from the node that follow no transfer, or break the protocol.
+    SdoGarbled,
+    /// Heartbeat off (0x1017 = 0) and no node guarding: a lost node goes unnoticed.
+    Unmonitored,
     /// SDO requests with no answer from a node that is otherwise alive.
     SdoTimeout,
     /// CiA 402 drive fault (statusword bit 3).
@@ -67,6 +71,8 @@ impl Problem {
             Problem::Rebooted => "rebooted",
             Problem::SdoRefused => "sdo_refused",
             Problem::SdoTimeout => "sdo_timeout",
+            Problem::SdoGarbled => "sdo_garbled",
+            Problem::Unmonitored => "unmonitored",
             Problem::DriveFault => "drive_fault",
             Problem::Emcy => "emcy",
             Problem::BusErrors => "bus_errors",

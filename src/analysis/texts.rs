@@ -34,6 +34,16 @@ pub fn fill(inc: &mut Incident, resets: u32, emcy: Option<u16>, error_frames: u6
             inc.why = "The node is off or unreachable, and the master cannot know whether its settings took effect."
                 .into();
         }
+        Problem::Silent if inc.cause.is_some() => {
+            inc.title = "Heartbeat stopped for good, while the node still sends other messages".into();
+            inc.check = strings(&[
+                "Check whether the master wrote 0x1017 (heartbeat time) or reset it to 0.",
+                "The node's heartbeat task may have hung while the rest runs: check its firmware and error log.",
+                "The master's heartbeat consumer will soon report the node as lost.",
+            ]);
+            inc.why = "The master judges the node by its heartbeat: it may stop the machine although the node runs."
+                .into();
+        }
         Problem::Silent => {
             inc.title = "Went silent and never came back".into();
             inc.check = strings(&[
@@ -99,6 +109,23 @@ pub fn fill(inc: &mut Incident, resets: u32, emcy: Option<u16>, error_frames: u6
                 "Check the master's SDO timeout against the device manual.",
             ]);
             inc.why = "The master cannot tell whether the setting took effect.".into();
+        }
+        Problem::SdoGarbled => {
+            inc.title = format!("Sent {} that make no sense", plural(inc.count, "SDO frame"));
+            inc.check = vec![
+                "Update or report the node's firmware: its SDO server answers outside the protocol.".into(),
+                format!("Check that no second device answers on node-ID {node}."),
+                "Check the transfer the master was doing at that moment (object, size) against the manual.".into(),
+            ];
+            inc.why = "The transfer fails or, worse, writes wrong data; the master may retry or give up.".into();
+        }
+        Problem::Unmonitored => {
+            inc.title = "Not monitored: heartbeat is off and no node guarding".into();
+            inc.check = strings(&[
+                "Set the heartbeat producer time 0x1017 (e.g. 100 ms) in the master's configuration.",
+                "Or enable node guarding (0x100C/0x100D) if the master uses it.",
+            ]);
+            inc.why = "If this node fails or is unplugged, nothing on the bus tells the master.".into();
         }
         Problem::DriveFault => {
             let cause = match (&inc.cause, emcy) {
