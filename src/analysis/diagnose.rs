@@ -83,6 +83,8 @@ struct Node {
     beating: bool,
     last_hb: Option<At>,
     last_state: Option<(u64, NmtState)>,
+    /// The heartbeat state before the last change.
+    state_before: Option<NmtState>,
     conflicts: u32,
     last_boot: Option<u64>,
     reset_asked: Option<u64>,
@@ -486,30 +488,29 @@ impl Diagnoser {
 
     fn heartbeat(&mut self, n: u8, s: NmtState) {
         let at = self.at;
-        let period = self
-            .tracker
-            .node(n)
-            .and_then(|l| l.expected())
-            .map(|(p, _)| p);
         let node = self.node(n);
         node.last_hb = Some(at);
         node.beating = s != NmtState::BootUp;
         if s != NmtState::BootUp {
-            // Two devices with one node-ID: heartbeats with different states, closer
-            // together than the period allows.
-            if let (Some((t0, s0)), Some(p)) = (node.last_state, period)
-                && s0 != s
-                && at.t.saturating_sub(t0) < p / 2
+            // Two devices with one node-ID: heartbeat states that flip back and forth
+            // (A, B, A, B...), which one node changing state never does.
+            if let (Some((_, s1)), Some(s2)) = (node.last_state, node.state_before)
+                && s != s1
+                && s == s2
             {
                 node.conflicts += 1;
-                if node.conflicts == 2 {
+                if node.conflicts == 3 {
                     let i = self.grouped(Some(n), Problem::DuplicateId, 0, at.t);
                     self.step(
                         i,
                         at,
-                        format!("Heartbeats say {} and {} at once", s0.text(), s.text()),
+                        format!("Heartbeats keep flipping between {} and {}", s1.text(), s.text()),
                     );
                 }
+            }
+            let node = self.node(n);
+            if node.last_state.is_some_and(|(_, s1)| s1 != s) {
+                node.state_before = node.last_state.map(|(_, s1)| s1);
             }
             self.node(n).last_state = Some((at.t, s));
         }
@@ -614,6 +615,7 @@ impl Diagnoser {
                 node.last_boot = Some(at.t);
                 node.expect = None;
                 node.last_state = None;
+                node.state_before = None;
                 if *was_lost {
                     let silent = self.node(n).silence.map_or(0.0, |(l, _, _)| (at.t - l.t.min(at.t)) as f64 / 1e6);
                     self.back(n, at, silent, true);
@@ -720,9 +722,6 @@ impl Diagnoser {
         for e in self.tracker.take_events() {
             self.event(&e);
         }
-        if let Outcome::ProtocolError(why) = &t.outcome {
-            self.garbled(t.node, format!("transfer of 0x{:04X}:{:02X} broke the protocol: {why}", t.index, t.sub));
-        }
         if t.outcome != Outcome::Ok || t.data.is_empty() {
             return;
         }
@@ -811,6 +810,9 @@ impl Diagnoser {
             super::texts::fill(inc, meta.resets, meta.emcy, self.error_frames);
         }
         let mut out = merge_faults(self.incidents);
+        for inc in &mut out {
+            inc.events.sort_by_key(|e| e.frame);
+        }
         out.retain(|i| i.count > 0 || !i.events.is_empty());
         out.sort_by_key(|i| (i.status, i.first_ns));
         out

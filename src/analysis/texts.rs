@@ -111,7 +111,7 @@ pub fn fill(inc: &mut Incident, resets: u32, emcy: Option<u16>, error_frames: u6
             inc.why = "The master cannot tell whether the setting took effect.".into();
         }
         Problem::SdoGarbled => {
-            inc.title = format!("Sent {} that make no sense", plural(inc.count, "SDO frame"));
+            inc.title = format!("Sent SDO frames that make no sense ({})", inc.count);
             inc.check = vec![
                 "Update or report the node's firmware: its SDO server answers outside the protocol.".into(),
                 format!("Check that no second device answers on node-ID {node}."),
