@@ -71,7 +71,12 @@ fn s(node: Option<u64>, kind: &str, status: &str) -> (Option<u64>, String, Strin
 }
 
 fn frames(inc: &Value) -> Vec<u64> {
-    inc["events"].as_array().unwrap().iter().map(|e| e["frame"].as_u64().unwrap()).collect()
+    inc["events"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["frame"].as_u64().unwrap())
+        .collect()
 }
 
 #[test]
@@ -120,15 +125,26 @@ fn drive_fault_cause_resets_and_recovery() {
     let inc = golden("drive_fault");
     assert_eq!(
         summary(&inc),
-        [s(Some(1), "drive_fault", "open"), s(Some(5), "drive_fault", "recovered")]
+        [
+            s(Some(1), "drive_fault", "open"),
+            s(Some(5), "drive_fault", "recovered")
+        ]
     );
     assert_eq!(
         inc[1]["title"],
         "Stopped: continuous over-current → recovered on reset #2 (1 failed reset)"
     );
     let cause = inc[1]["cause"].as_str().unwrap();
-    assert!(cause.contains("EMCY 0x2310") && cause.contains("0x2310 (0x603F)"), "{cause}");
-    let texts: Vec<&str> = inc[1]["events"].as_array().unwrap().iter().map(|e| e["text"].as_str().unwrap()).collect();
+    assert!(
+        cause.contains("EMCY 0x2310") && cause.contains("0x2310 (0x603F)"),
+        "{cause}"
+    );
+    let texts: Vec<&str> = inc[1]["events"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["text"].as_str().unwrap())
+        .collect();
     assert!(texts.iter().any(|t| t.starts_with("Running again")), "{texts:?}");
     assert!(
         inc[0]["title"].as_str().unwrap().contains("still in fault at the end"),
@@ -149,7 +165,11 @@ fn bus_errors_up_to_bus_off() {
 fn duplicate_node_id() {
     let inc = golden("duplicate_id");
     assert_eq!(summary(&inc), [s(Some(7), "duplicate_id", "open")]);
-    assert_eq!(inc[0]["events"].as_array().unwrap().len(), 2, "boot-ups and flipping states");
+    assert_eq!(
+        inc[0]["events"].as_array().unwrap().len(),
+        2,
+        "boot-ups and flipping states"
+    );
 }
 
 #[test]
@@ -178,12 +198,26 @@ fn emcy_flood_reset_and_unmonitored_node() {
 fn text_report_and_check_status() {
     let out = cotui(&["diagnose", "tests/fixtures/diagnose/sdo.log"]);
     let text = String::from_utf8(out.stdout).unwrap();
-    assert!(text.starts_with("Needs attention: 1 open, 0 recovered, 1 warnings"), "{text}");
-    assert!(text.contains(" 1. OPEN       Node 2: A setting was not applied\n"), "{text}");
+    assert!(
+        text.starts_with("Needs attention: 1 open, 0 recovered, 1 warnings"),
+        "{text}"
+    );
+    assert!(
+        text.contains(" 1. OPEN       Node 2: A setting was not applied\n"),
+        "{text}"
+    );
     assert!(text.contains("    Check first:\n      1. "), "{text}");
     assert!(text.contains("    Why it matters: "), "{text}");
-    assert_eq!(out.status.code(), Some(0), "without --check, open incidents do not fail");
-    assert_eq!(diagnose("tests/fixtures/diagnose/sdo.log").1, 1, "--check: an open incident");
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "without --check, open incidents do not fail"
+    );
+    assert_eq!(
+        diagnose("tests/fixtures/diagnose/sdo.log").1,
+        1,
+        "--check: an open incident"
+    );
     // Only warnings (a node that stopped answering once, then answered): --check passes.
     let (inc, code) = diagnose("../shared/realworld/logs/ros2_canopen_issue46_boot.txt");
     assert!(inc.iter().all(|i| i["status"] != "open"), "{inc:?}");
@@ -191,7 +225,9 @@ fn text_report_and_check_status() {
 }
 
 fn realworld(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realworld/logs").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/realworld/logs")
+        .join(name)
 }
 
 #[test]

@@ -16,7 +16,7 @@ use crate::decode::emcy::Emcy;
 use crate::decode::heartbeat::NmtState;
 use crate::decode::sdo::abort::abort_text;
 use crate::decode::sdo::frame::{SdoCommand, Side};
-use crate::decode::sdo::transaction::{Outcome, TransferDirection, Transaction};
+use crate::decode::sdo::transaction::{Outcome, Transaction, TransferDirection};
 use crate::decode::{Body, Decoded, Kind};
 use crate::frame::Frame;
 use std::collections::{BTreeMap, HashMap};
@@ -127,6 +127,8 @@ pub struct Diagnoser {
     error_frames: u64,
     bus_state: BTreeMap<String, &'static str>,
     sdo_deadline: Option<u64>,
+    /// The last NMT reset addressed to all nodes.
+    reset_all: Option<u64>,
     /// Longest silence per node that came back (ms).
     silent_max: BTreeMap<u8, f64>,
 }
@@ -152,6 +154,7 @@ impl Diagnoser {
             bus_state: BTreeMap::new(),
             sdo_deadline: None,
             silent_max: BTreeMap::new(),
+            reset_all: None,
         }
     }
 
@@ -231,7 +234,9 @@ impl Diagnoser {
             return;
         };
         let at = self.at;
-        if matches!(d.kind, Kind::Tpdo | Kind::SdoTx | Kind::Emcy) || matches!(&d.body, Body::Heartbeat(h) if !h.request) {
+        if matches!(d.kind, Kind::Tpdo | Kind::SdoTx | Kind::Emcy)
+            || matches!(&d.body, Body::Heartbeat(h) if !h.request)
+        {
             self.node(n).last_any = Some(at);
         }
         if matches!(&d.body, Body::Heartbeat(h) if h.request) {
@@ -376,7 +381,11 @@ impl Diagnoser {
                 if !still {
                     self.incidents[i].status = Status::Recovered;
                     self.incidents[i].last_ns = at.t;
-                    self.step(i, at, format!("Fault cleared (statusword 0x{sw:04X}, {})", state.text()));
+                    self.step(
+                        i,
+                        at,
+                        format!("Fault cleared (statusword 0x{sw:04X}, {})", state.text()),
+                    );
                 }
             }
             _ => {}
@@ -475,7 +484,11 @@ impl Diagnoser {
     /// EMCY of `n` older than `before` become EMCY incidents (grouped per code).
     fn flush_emcy(&mut self, n: u8, before: u64) {
         let node = self.node(n);
-        let keep = node.emcy.iter().position(|(at, _)| at.t >= before).unwrap_or(node.emcy.len());
+        let keep = node
+            .emcy
+            .iter()
+            .position(|(at, _)| at.t >= before)
+            .unwrap_or(node.emcy.len());
         let old: Vec<(At, Emcy)> = node.emcy.drain(..keep).collect();
         for (at, e) in old {
             let i = self.grouped(Some(n), Problem::Emcy, u32::from(e.code), at.t);
@@ -535,7 +548,12 @@ impl Diagnoser {
         node.expect = Some(ex);
         if ex.wrong >= 2 && at.t.saturating_sub(ex.at.t) >= NMT_GRACE_NS {
             node.expect = None;
-            let i = self.grouped(Some(n), Problem::NmtIgnored, u32::from(ex.target.as_str().len() as u8), at.t);
+            let i = self.grouped(
+                Some(n),
+                Problem::NmtIgnored,
+                u32::from(ex.target.as_str().len() as u8),
+                at.t,
+            );
             self.incidents[i].status = Status::Open;
             self.incidents[i].cause = Some(format!("NMT {} sent, node stays {}", ex.command, s.text()));
             self.step(i, ex.at, format!("NMT {} sent", ex.command));
@@ -561,11 +579,10 @@ impl Diagnoser {
             .map(|(n, _)| *n)
             .collect();
         if state == NmtState::BootUp {
-            let all: Vec<u8> = if target == 0 { (1..=127).collect() } else { vec![target] };
-            for n in all {
-                if target != 0 && !self.nodes.contains_key(&n) || target == 0 {
-                    self.node(n).reset_asked = Some(at.t);
-                }
+            if target == 0 {
+                self.reset_all = Some(at.t);
+            } else {
+                self.node(target).reset_asked = Some(at.t);
             }
         }
         for n in known {
@@ -584,8 +601,15 @@ impl Diagnoser {
                 self.bus_state.insert(iface.clone(), to);
                 let i = self.grouped(None, Problem::BusErrors, 0, e.t_ns);
                 self.incidents[i].count -= 1;
-                let at = At { frame: self.at.frame, t: e.t_ns };
-                self.step(i, at, format!("{iface}: controller now {} ({detail})", to.replace('_', " ")));
+                let at = At {
+                    frame: self.at.frame,
+                    t: e.t_ns,
+                };
+                self.step(
+                    i,
+                    at,
+                    format!("{iface}: controller now {} ({detail})", to.replace('_', " ")),
+                );
             }
             return;
         };
@@ -601,23 +625,24 @@ impl Diagnoser {
                 self.node(n).silence = Some((last, e.t_ns, *silent_ms));
             }
             What::HeartbeatBack { silent_ms } => self.back(n, at, *silent_ms, false),
-            What::BootUp {
-                rebooted,
-                was_lost,
-                ..
-            } => {
+            What::BootUp { rebooted, was_lost, .. } => {
                 let node = self.node(n);
                 // (Equal times say nothing: logs without timestamps.)
                 let close = node
                     .last_boot
                     .is_some_and(|t| at.t > t && at.t - t <= DUPLICATE_BOOT_NS);
-                let asked = node.reset_asked.is_some_and(|t| at.t.saturating_sub(t) <= RESET_BOOT_NS);
+                let asked = node
+                    .reset_asked
+                    .is_some_and(|t| at.t.saturating_sub(t) <= RESET_BOOT_NS);
                 node.last_boot = Some(at.t);
                 node.expect = None;
                 node.last_state = None;
                 node.state_before = None;
                 if *was_lost {
-                    let silent = self.node(n).silence.map_or(0.0, |(l, _, _)| (at.t - l.t.min(at.t)) as f64 / 1e6);
+                    let silent = self
+                        .node(n)
+                        .silence
+                        .map_or(0.0, |(l, _, _)| (at.t - l.t.min(at.t)) as f64 / 1e6);
                     self.back(n, at, silent, true);
                 }
                 if close {
@@ -646,7 +671,11 @@ impl Diagnoser {
         inc.status = Status::Open;
         inc.cause = Some(format!("0x{index:04X}:{sub:02X}: {text} (abort 0x{code:08X})"));
         let what = if write { "Write" } else { "Read" };
-        self.step(i, at, format!("{what} of 0x{index:04X}:{sub:02X} refused: {text} (0x{code:08X})"));
+        self.step(
+            i,
+            at,
+            format!("{what} of 0x{index:04X}:{sub:02X} refused: {text} (0x{code:08X})"),
+        );
     }
 
     fn garbled(&mut self, n: u8, what: String) {
@@ -660,7 +689,9 @@ impl Diagnoser {
     }
 
     fn back(&mut self, n: u8, at: At, silent_ms: f64, reboot: bool) {
-        let Some((last, lost, _)) = self.node(n).silence.take() else { return };
+        let Some((last, lost, _)) = self.node(n).silence.take() else {
+            return;
+        };
         let i = self.grouped(Some(n), Problem::SilentBack, 0, lost);
         let longest = self.silent_max.entry(n).or_insert(0.0);
         *longest = longest.max(silent_ms);
@@ -674,7 +705,11 @@ impl Diagnoser {
                 "No heartbeat for {:.2} s (last #{}), then {}",
                 silent_ms / 1000.0,
                 last.frame,
-                if reboot { "a boot-up: it restarted" } else { "it came back" }
+                if reboot {
+                    "a boot-up: it restarted"
+                } else {
+                    "it came back"
+                }
             ),
         );
     }
@@ -737,7 +772,11 @@ impl Diagnoser {
             let at = self.at;
             self.node(t.node).heartbeat_off = (v & 0xFFFF == 0).then_some(at);
         }
-        let key = (Some(t.node), Problem::SdoRefused, (u32::from(t.index) << 8) | u32::from(t.sub));
+        let key = (
+            Some(t.node),
+            Problem::SdoRefused,
+            (u32::from(t.index) << 8) | u32::from(t.sub),
+        );
         if let Some(&i) = self.keyed.get(&key)
             && self.incidents[i].status == Status::Open
         {
@@ -776,7 +815,11 @@ impl Diagnoser {
                 self.step(i, at, "Heartbeat producer time 0x1017 = 0: heartbeat off");
             }
             if node.n_unanswered > 0 {
-                let problem = if node.heard { Problem::SdoTimeout } else { Problem::Missing };
+                let problem = if node.heard {
+                    Problem::SdoTimeout
+                } else {
+                    Problem::Missing
+                };
                 let i = self.grouped(Some(n), problem, 0, node.unanswered[0].at.t);
                 self.incidents[i].count = node.n_unanswered;
                 self.incidents[i].status = if node.heard && node.answered_after {
@@ -799,9 +842,12 @@ impl Diagnoser {
             let i = self.grouped(None, Problem::BusErrors, 0, end.t);
             let inc = &mut self.incidents[i];
             inc.count = self.error_frames;
-            let worst = self.bus_state.values().copied().find(|s| *s == "bus_off").or_else(|| {
-                self.bus_state.values().copied().find(|s| *s == "error_passive")
-            });
+            let worst = self
+                .bus_state
+                .values()
+                .copied()
+                .find(|s| *s == "bus_off")
+                .or_else(|| self.bus_state.values().copied().find(|s| *s == "error_passive"));
             inc.status = if worst.is_some() { Status::Open } else { Status::Warning };
             inc.last_ns = inc.last_ns.min(end.t).max(inc.first_ns);
         }

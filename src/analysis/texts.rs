@@ -4,7 +4,11 @@
 use super::incident::{Incident, Problem, Status};
 
 fn plural(n: u64, one: &str) -> String {
-    if n == 1 { format!("1 {one}") } else { format!("{n} {one}s") }
+    if n == 1 {
+        format!("1 {one}")
+    } else {
+        format!("{n} {one}s")
+    }
 }
 
 fn lower_first(s: &str) -> String {
@@ -31,8 +35,8 @@ pub fn fill(inc: &mut Incident, resets: u32, emcy: Option<u16>, error_frames: u6
                 "Check the node's power, CAN connector and bit rate.".into(),
                 "Nothing at all came from this node (no heartbeat, no answer): it is not on the bus.".into(),
             ];
-            inc.why = "The node is off or unreachable, and the master cannot know whether its settings took effect."
-                .into();
+            inc.why =
+                "The node is off or unreachable, and the master cannot know whether its settings took effect.".into();
         }
         Problem::Silent if inc.cause.is_some() => {
             inc.title = "Heartbeat stopped for good, while the node still sends other messages".into();
@@ -41,8 +45,8 @@ pub fn fill(inc: &mut Incident, resets: u32, emcy: Option<u16>, error_frames: u6
                 "The node's heartbeat task may have hung while the rest runs: check its firmware and error log.",
                 "The master's heartbeat consumer will soon report the node as lost.",
             ]);
-            inc.why = "The master judges the node by its heartbeat: it may stop the machine although the node runs."
-                .into();
+            inc.why =
+                "The master judges the node by its heartbeat: it may stop the machine although the node runs.".into();
         }
         Problem::Silent => {
             inc.title = "Went silent and never came back".into();
@@ -77,8 +81,7 @@ pub fn fill(inc: &mut Incident, resets: u32, emcy: Option<u16>, error_frames: u6
                 "Check the node's watchdog and error log: a firmware crash restarts it.",
                 "Check for loose power connectors.",
             ]);
-            inc.why = "A restarted node forgets what the master configured and starts again in pre-operational."
-                .into();
+            inc.why = "A restarted node forgets what the master configured and starts again in pre-operational.".into();
         }
         Problem::SdoRefused => {
             let write = inc.events.first().is_some_and(|e| e.text.starts_with("Write"));
@@ -163,8 +166,9 @@ pub fn fill(inc: &mut Incident, resets: u32, emcy: Option<u16>, error_frames: u6
             ));
             check.push("Remove the cause, then reset the fault: controlword 0x80, then 0x06 → 0x07 → 0x0F.".into());
             inc.check = check;
-            inc.why = "A faulted drive switches the motor torque off and ignores motion commands until the fault is reset."
-                .into();
+            inc.why =
+                "A faulted drive switches the motor torque off and ignores motion commands until the fault is reset."
+                    .into();
         }
         Problem::Emcy => {
             let text = inc.cause.clone().unwrap_or_default();
@@ -222,8 +226,9 @@ pub fn fill(inc: &mut Incident, resets: u32, emcy: Option<u16>, error_frames: u6
                 "Check the node's error state: some devices refuse to start while they have an error.",
                 "Check the device manual for conditions on NMT start (e.g. a required parameter set).",
             ]);
-            inc.why = "The master thinks the node is in one state while it is in another: PDOs may not be sent or used."
-                .into();
+            inc.why =
+                "The master thinks the node is in one state while it is in another: PDOs may not be sent or used."
+                    .into();
         }
     }
 }
