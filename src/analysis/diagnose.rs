@@ -624,8 +624,9 @@ impl Diagnoser {
                 let last = self.node(n).last_hb.unwrap_or(at);
                 self.node(n).silence = Some((last, e.t_ns, *silent_ms));
             }
-            What::HeartbeatBack { silent_ms } => self.back(n, at, *silent_ms, false),
-            What::BootUp { rebooted, was_lost, .. } => {
+            What::HeartbeatBack { silent_ms } => self.back(n, at, *silent_ms),
+            What::BootUp { rebooted, .. } => {
+                let reset_all = self.reset_all;
                 let node = self.node(n);
                 // (Equal times say nothing: logs without timestamps.)
                 let close = node
@@ -633,17 +634,17 @@ impl Diagnoser {
                     .is_some_and(|t| at.t > t && at.t - t <= DUPLICATE_BOOT_NS);
                 let asked = node
                     .reset_asked
+                    .max(reset_all)
                     .is_some_and(|t| at.t.saturating_sub(t) <= RESET_BOOT_NS);
                 node.last_boot = Some(at.t);
                 node.expect = None;
                 node.last_state = None;
                 node.state_before = None;
-                if *was_lost {
-                    let silent = self
-                        .node(n)
-                        .silence
-                        .map_or(0.0, |(l, _, _)| (at.t - l.t.min(at.t)) as f64 / 1e6);
-                    self.back(n, at, silent, true);
+                // A silence that ends in a boot-up is part of the restart (expected when
+                // a reset was asked for).
+                let silence = node.silence.take();
+                if asked {
+                    node.reset_asked = None;
                 }
                 if close {
                     let i = self.grouped(Some(n), Problem::DuplicateId, 0, at.t);
@@ -651,14 +652,35 @@ impl Diagnoser {
                 } else if *rebooted && !asked {
                     let i = self.grouped(Some(n), Problem::Rebooted, 0, at.t);
                     self.incidents[i].status = Status::Warning;
+                    if let Some((last, _, _)) = silence {
+                        self.step(i, last, "Last heartbeat before the restart");
+                    }
                     self.step(i, at, "Boot-up: the node restarted, no NMT reset was sent before");
-                }
-                if asked {
-                    self.node(n).reset_asked = None;
                 }
             }
             _ => {}
         }
+    }
+
+    fn back(&mut self, n: u8, at: At, silent_ms: f64) {
+        let Some((last, lost, _)) = self.node(n).silence.take() else {
+            return;
+        };
+        let i = self.grouped(Some(n), Problem::SilentBack, 0, lost);
+        let longest = self.silent_max.entry(n).or_insert(0.0);
+        *longest = longest.max(silent_ms);
+        let inc = &mut self.incidents[i];
+        inc.status = Status::Warning;
+        inc.cause = Some(format!("no heartbeat for up to {:.2} s", *longest / 1000.0));
+        self.step(
+            i,
+            at,
+            format!(
+                "No heartbeat for {:.2} s (last #{}), then it came back",
+                silent_ms / 1000.0,
+                last.frame
+            ),
+        );
     }
 
     fn refused(&mut self, n: u8, index: u16, sub: u8, code: u32) {
@@ -686,32 +708,6 @@ impl Diagnoser {
             self.incidents[i].cause = Some(what.clone());
         }
         self.step(i, at, format!("Node sent an SDO {what}"));
-    }
-
-    fn back(&mut self, n: u8, at: At, silent_ms: f64, reboot: bool) {
-        let Some((last, lost, _)) = self.node(n).silence.take() else {
-            return;
-        };
-        let i = self.grouped(Some(n), Problem::SilentBack, 0, lost);
-        let longest = self.silent_max.entry(n).or_insert(0.0);
-        *longest = longest.max(silent_ms);
-        let inc = &mut self.incidents[i];
-        inc.status = Status::Warning;
-        inc.cause = Some(format!("no heartbeat for up to {:.2} s", *longest / 1000.0));
-        self.step(
-            i,
-            at,
-            format!(
-                "No heartbeat for {:.2} s (last #{}), then {}",
-                silent_ms / 1000.0,
-                last.frame,
-                if reboot {
-                    "a boot-up: it restarted"
-                } else {
-                    "it came back"
-                }
-            ),
-        );
     }
 
     fn error_frame(&mut self, label: &str) {
@@ -886,4 +882,95 @@ fn merge_faults(all: Vec<Incident>) -> Vec<Incident> {
         out.push(inc);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::decode::Decoder;
+    use crate::od::Dictionary;
+
+    /// Runs `frames` (ms, COB-ID, hex data) through a decoder and a diagnoser; returns
+    /// `node kind status count` per incident.
+    fn run(frames: &[(u64, u32, &str)]) -> Vec<String> {
+        let mut dec = Decoder::new(Dictionary::default(), Vec::new());
+        let mut diag = Diagnoser::new(EventTracker::new(|n| dec.dictionary(n)));
+        for (ms, id, data) in frames {
+            let bytes: Vec<u8> = (0..data.len() / 2)
+                .map(|i| u8::from_str_radix(&data[2 * i..2 * i + 2], 16).unwrap())
+                .collect();
+            let mut f = Frame::classic(*id, &bytes);
+            f.ts_ns = ms * MS;
+            let d = dec.decode(&f);
+            diag.frame(&f, "can0", &d);
+            for t in dec.take_transactions() {
+                diag.transaction(&t);
+            }
+        }
+        diag.finish()
+            .iter()
+            .map(|i| {
+                let node = i.node.map_or("-".into(), |n| n.to_string());
+                format!("{node} {} {} {}", i.problem.as_str(), i.status.as_str(), i.count)
+            })
+            .collect()
+    }
+
+    fn heartbeats(node: u32, from_ms: u64, to_ms: u64, state: &'static str) -> Vec<(u64, u32, &'static str)> {
+        (from_ms..to_ms)
+            .step_by(100)
+            .map(|t| (t, 0x700 + node, state))
+            .collect()
+    }
+
+    #[test]
+    fn a_heartbeat_that_has_not_started_since_boot_up_did_not_stop() {
+        // 0x1017 = 100 ms is written right after the boot-up; heartbeats start 500 ms later.
+        let mut f = vec![
+            (0, 0x701, "00"),
+            (10, 0x601, "2B17100064000000"),
+            (11, 0x581, "6017100000000000"),
+        ];
+        f.extend(heartbeats(1, 500, 1500, "05"));
+        assert!(run(&f).is_empty(), "{:?}", run(&f));
+        // Once it beats, a gap is a silence.
+        f.extend(heartbeats(1, 2500, 3000, "05"));
+        assert_eq!(run(&f), ["1 silent_back warning 1"]);
+    }
+
+    #[test]
+    fn emcy_right_before_a_fault_is_its_cause_not_a_separate_incident() {
+        // Node 2 reads as a CiA 402 device (0x1000 = 0x00020192): TPDO1 starts with the statusword.
+        let f = [
+            (0, 0x602, "4000100000000000"),
+            (1, 0x582, "4300100092010200"),
+            (100, 0x182, "3702"),
+            (200, 0x082, "2171010000000000"),
+            (201, 0x182, "0800"),
+            (300, 0x202, "8000"),
+            (301, 0x182, "4002"),
+            (400, 0x182, "3702"),
+        ];
+        assert_eq!(run(&f), ["2 drive_fault recovered 1"]);
+    }
+
+    #[test]
+    fn boot_ups_with_equal_times_are_not_a_duplicate_id() {
+        // Logs without timestamps give every frame time 0: two boot-ups say nothing there.
+        let f = [(0, 0x000, "8100"), (0, 0x705, "00"), (0, 0x705, "00")];
+        assert!(run(&f).is_empty(), "{:?}", run(&f));
+        let f = [(0, 0x000, "8100"), (10, 0x705, "00"), (30, 0x705, "00")];
+        assert_eq!(run(&f), ["5 duplicate_id open 1"]);
+    }
+
+    #[test]
+    fn a_reset_asked_for_is_not_an_unexpected_reboot() {
+        let mut f = heartbeats(3, 0, 500, "05");
+        f.push((550, 0x000, "8203"));
+        f.push((560, 0x703, "00"));
+        assert!(run(&f).is_empty(), "{:?}", run(&f));
+        let mut f = heartbeats(3, 0, 500, "05");
+        f.push((560, 0x703, "00"));
+        assert_eq!(run(&f), ["3 rebooted warning 1"]);
+    }
 }
