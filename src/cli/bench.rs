@@ -1,7 +1,9 @@
 //! `cotui bench`: decoder throughput and peak memory on a generated log.
 //!
-//! Each figure comes from a child `cotui decode` process (so peak RSS is that
-//! run's alone), reading a synthetic candump log and writing to /dev/null.
+//! Each figure comes from a child `cotui decode` or `cotui diagnose` process (so peak RSS
+//! is that run's alone), reading a synthetic candump log and writing to /dev/null. The
+//! peers run on the same log: can-utils' `log2asc` (the baseline) and, for the diagnosis,
+//! `canopen-lens` when installed.
 
 use super::{EXIT_OK, EXIT_UNAVAILABLE};
 use crate::log::writer::LogWriter;
@@ -125,7 +127,7 @@ fn bench(args: &BenchArgs) -> std::io::Result<()> {
     write_log(&small, args.frames / 4)?;
     let (b, s) = (big.to_string_lossy().to_string(), small.to_string_lossy().to_string());
     let mut figures = Vec::new();
-    let runs: [(&str, Vec<&str>, &str, u64); 4] = [
+    let runs: [(&str, Vec<&str>, &str, u64); 5] = [
         (
             "text",
             vec!["decode", "--format", "text", &b],
@@ -142,6 +144,12 @@ fn bench(args: &BenchArgs) -> std::io::Result<()> {
             "summary",
             vec!["decode", "--summary", &b],
             "decode --summary",
+            args.frames,
+        ),
+        (
+            "diagnose",
+            vec!["diagnose", "--format", "jsonl", &b],
+            "diagnose",
             args.frames,
         ),
         (
@@ -165,12 +173,15 @@ fn bench(args: &BenchArgs) -> std::io::Result<()> {
         let o = out.to_string_lossy().to_string();
         measure(&p, &["-I", &b, "-O", &o, "can0"]).ok()
     });
+    let lens = which("canopen-lens").and_then(|p| measure(&p, &[&b]).ok());
     let _ = std::fs::remove_dir_all(&dir);
-    report(args, &runs.map(|r| r.2), &figures, log2asc);
+    let lens_rate = lens.map(|(secs, _)| args.frames as f64 / secs);
+    report(args, &runs.map(|r| r.2), &figures, log2asc, lens_rate);
     Ok(())
 }
 
-fn report(args: &BenchArgs, titles: &[&str; 4], figures: &[Figure], log2asc: Option<(f64, u64)>) {
+/// Prints the figures; `lens` is canopen-lens's rate on the same log (frames/s).
+fn report(args: &BenchArgs, titles: &[&str; 5], figures: &[Figure], log2asc: Option<(f64, u64)>, lens: Option<f64>) {
     let base = log2asc.map(|(secs, _)| args.frames as f64 / secs);
     if args.json {
         let runs: Vec<serde_json::Value> = figures
@@ -185,7 +196,8 @@ fn report(args: &BenchArgs, titles: &[&str; 4], figures: &[Figure], log2asc: Opt
             .collect();
         println!(
             "{}",
-            serde_json::json!({"frames": args.frames, "runs": runs, "log2asc_frames_per_s": base})
+            serde_json::json!({"frames": args.frames, "runs": runs, "log2asc_frames_per_s": base,
+                               "canopen_lens_frames_per_s": lens})
         );
         return;
     }
@@ -204,5 +216,12 @@ fn report(args: &BenchArgs, titles: &[&str; 4], figures: &[Figure], log2asc: Opt
     match base {
         Some(b) => println!("  {:<32} {b:>12.0} frames/s (can-utils, same log)", "log2asc"),
         None => println!("  log2asc not found (install can-utils) - no baseline"),
+    }
+    match lens {
+        Some(r) => println!(
+            "  {:<32} {r:>12.0} frames/s (the diagnose peer, same log)",
+            "canopen-lens"
+        ),
+        None => println!("  canopen-lens not found (scripts/install-test-deps.sh) - no diagnose peer figure"),
     }
 }
