@@ -30,8 +30,16 @@ fn diagnose(path: &str) -> (Vec<Value>, i32) {
 /// Compares `cotui diagnose --format jsonl` of fixture `name` with its golden file and
 /// returns the incidents.
 fn golden(name: &str) -> Vec<Value> {
+    golden_with(name, &[])
+}
+
+/// [`golden`] with more arguments (profiles).
+fn golden_with(name: &str, args: &[&str]) -> Vec<Value> {
     let log = format!("tests/fixtures/diagnose/{name}.log");
-    let out = cotui(&["diagnose", "--format", "jsonl", &log]);
+    let mut all = vec!["diagnose", "--format", "jsonl"];
+    all.extend_from_slice(args);
+    all.push(&log);
+    let out = cotui(&all);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let got = String::from_utf8(out.stdout).unwrap();
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/fixtures/golden/diagnose_{name}.jsonl"));
@@ -192,6 +200,28 @@ fn emcy_flood_reset_and_unmonitored_node() {
         ]
     );
     assert_eq!(inc[0]["count"], 5, "five EMCY of one code are one incident");
+}
+
+#[test]
+fn causes_through_the_profiles() {
+    let inc = golden_with(
+        "profile_emcy",
+        &["--profile", "3=dexmart-dev", "--profile", "5=aimotor"],
+    );
+    assert_eq!(
+        summary(&inc),
+        [s(Some(3), "emcy", "open"), s(Some(5), "drive_fault", "open")]
+    );
+    // The vendor bytes of the EMCY, named by the dexmart-dev profile.
+    assert_eq!(
+        inc[0]["cause"],
+        "Generic error (EMCY 0x1000), M1 alarm code=0x12, M2 alarm code=0x00"
+    );
+    // The AIMOTOR code text names the drive's own fault number.
+    assert_eq!(
+        inc[1]["title"],
+        "Stopped: continuous over-current no. 2 (AIMOTOR fault 0201h; read H0B-34); still in fault at the end"
+    );
 }
 
 #[test]
