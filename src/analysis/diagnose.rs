@@ -243,7 +243,6 @@ impl Diagnoser {
             self.node(n).guarded = true;
         }
         match &d.body {
-            Body::Nmt(nmt) => self.nmt(nmt.cs, nmt.target),
             Body::Heartbeat(h) if !h.request => {
                 self.node(n).heard = true;
                 if let Some(s) = h.state {
