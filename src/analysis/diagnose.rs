@@ -19,6 +19,7 @@ use crate::decode::sdo::frame::{SdoCommand, Side};
 use crate::decode::sdo::transaction::{Outcome, Transaction, TransferDirection};
 use crate::decode::{Body, Decoded, Kind};
 use crate::frame::Frame;
+use crate::od::PdoMapping;
 use std::collections::{BTreeMap, HashMap};
 
 const MS: u64 = 1_000_000;
@@ -210,8 +211,8 @@ impl Diagnoser {
         self.incidents[i].step(at.frame, at.t, text);
     }
 
-    /// One frame, in capture order, with its decoding; `iface` names its interface.
-    pub fn frame(&mut self, frame: &Frame, iface: &str, d: &Decoded) {
+    /// Frame number and time advance to `frame`'s.
+    fn advance(&mut self, frame: &Frame) {
         self.at = At {
             frame: self.at.frame + 1,
             t: frame.ts_ns,
@@ -220,6 +221,41 @@ impl Diagnoser {
         if self.sdo_deadline.is_some_and(|dl| frame.ts_ns > dl) {
             self.sdo_timeouts(frame.ts_ns);
         }
+    }
+
+    /// True when a PDO of `node` can tell the diagnosis something: its `mapping` holds a
+    /// CiA 402 controlword, statusword or error code, or (mapping unknown) it is the
+    /// predefined TPDO1/RPDO1 of a CiA 402 device. Other PDOs need no decoding.
+    pub fn wants_pdo(&self, node: u8, num: u16, mapping: Option<&PdoMapping>) -> bool {
+        match mapping {
+            Some(m) => m
+                .entries
+                .iter()
+                .any(|e| [0x6040, 0x6041, 0x603F].iter().any(|b| axis_of(e.index, *b).is_some())),
+            None => num == 1 && self.nodes.get(&node).is_some_and(|d| d.cia402),
+        }
+    }
+
+    /// A frame left undecoded (SYNC, TIME, LSS, unknown COB-IDs, PDOs that
+    /// [`Diagnoser::wants_pdo`] declines): time and frame number advance, and a TPDO
+    /// still shows that its node is there.
+    pub fn skip(&mut self, frame: &Frame, kind: Kind, node: Option<u8>) {
+        self.advance(frame);
+        self.tracker.tick(frame.ts_ns);
+        for e in self.tracker.take_events() {
+            self.event(&e);
+        }
+        if let (Kind::Tpdo, Some(n)) = (kind, node) {
+            let at = self.at;
+            let node = self.node(n);
+            node.heard = true;
+            node.last_any = Some(at);
+        }
+    }
+
+    /// One frame, in capture order, with its decoding; `iface` names its interface.
+    pub fn frame(&mut self, frame: &Frame, iface: &str, d: &Decoded) {
+        self.advance(frame);
         self.tracker.frame(frame, iface, d);
         for e in self.tracker.take_events() {
             self.event(&e);

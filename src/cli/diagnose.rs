@@ -2,6 +2,7 @@
 
 use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
 use crate::analysis::{Diagnoser, EventTracker, Incident, Status};
+use crate::decode::Kind;
 use crate::frame::{Frame, Interfaces};
 use crate::log::Outcome;
 use crate::read_ahead;
@@ -76,6 +77,20 @@ pub fn run(args: &DiagnoseArgs) -> i32 {
                         continue;
                     }
                 };
+                // Frames that cannot tell the diagnosis anything are not decoded.
+                let (kind, node, pdo) = decoder.peek(frame);
+                let skip = match kind {
+                    Kind::Sync | Kind::Time | Kind::Lss | Kind::Other => true,
+                    Kind::Tpdo | Kind::Rpdo => {
+                        let n = node.unwrap_or(0);
+                        !diag.wants_pdo(n, pdo, decoder.mapping(n, kind == Kind::Tpdo, pdo))
+                    }
+                    _ => false,
+                };
+                if skip {
+                    diag.skip(frame, kind, node);
+                    continue;
+                }
                 let d = decoder.decode(frame);
                 diag.frame(frame, ifaces.name(frame.iface), &d);
                 for t in decoder.take_transactions() {
