@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs what the test suite needs on a fresh Debian machine: real peers to test
-# against (can-utils, Wireshark's tshark, the python canopen library, DuckDB for the Parquet tests), tmux for the
-# end-to-end TUI tests, jq for tests/vbus/e2e.sh, and qemu + busybox for the real
-# SocketCAN bus (tests/vbus/install.sh; tests/vbus/run.sh fetches the kernel itself).
+# against (can-utils, Wireshark's tshark, the python canopen library, DuckDB for the Parquet
+# tests, canopen-lens for `cotui diagnose`), tmux for the end-to-end TUI tests, jq for
+# tests/vbus/e2e.sh, and qemu + busybox for the real SocketCAN bus (tests/vbus/install.sh;
+# tests/vbus/run.sh fetches the kernel itself).
 # Idempotent and quiet when done.
 set -euo pipefail
 
@@ -24,6 +25,12 @@ fi
 if ! python3 -c "import can, canopen, duckdb" 2>/dev/null; then
   echo "install-test-deps: pip install python-can canopen duckdb"
   python3 -m pip install -q "python-can>=4.3" "canopen>=2.3" "duckdb>=1.1"
+fi
+
+# canopen-lens: a peer for `cotui diagnose` (tests/diagnose_peer.rs compares incidents).
+if ! command -v canopen-lens >/dev/null 2>&1; then
+  echo "install-test-deps: pip install canopen-lens"
+  python3 -m pip install -q "canopen-lens==0.5.1"
 fi
 
 # The rest of what the vbus guest needs (iproute2, kmod, xz-utils).

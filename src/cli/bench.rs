@@ -1,9 +1,10 @@
 //! `cotui bench`: decoder throughput and peak memory on a generated log.
 //!
-//! Each figure comes from a child `cotui decode` process (so peak RSS is that
-//! run's alone), reading a synthetic candump log and writing to /dev/null; the
-//! runs are interleaved round by round and the median of the rounds reported,
-//! beside can-utils' `log2asc` on the same log and the targets.
+//! Each figure comes from a child `cotui decode` or `cotui diagnose` process (so peak RSS
+//! is that run's alone), reading a synthetic candump log and writing to /dev/null; the
+//! runs are interleaved round by round and the median of the rounds reported, beside
+//! can-utils' `log2asc` on the same log (the baseline) and the targets, and, for the
+//! diagnosis, `canopen-lens` when installed.
 
 use super::{EXIT_OK, EXIT_UNAVAILABLE};
 use crate::log::writer::LogWriter;
@@ -228,6 +229,13 @@ fn measure_all(args: &BenchArgs, exe: &Path, dir: &Path) -> std::io::Result<Figu
             Some(4.0),
         ),
         Run::new(
+            "diagnose",
+            "diagnose (target: within 2x of --summary)",
+            &["diagnose", "--format", "jsonl", &b],
+            n,
+            None,
+        ),
+        Run::new(
             "text-quarter",
             "decode --format text (1/4 log)",
             &["decode", "--format", "text", &s],
@@ -247,6 +255,10 @@ fn measure_all(args: &BenchArgs, exe: &Path, dir: &Path) -> std::io::Result<Figu
         }
     }
     let log2asc = if has_base { runs.pop() } else { None };
+    // canopen-lens is slow (about 10 k frames/s): the quarter log keeps the run short.
+    let lens_rate = which("canopen-lens")
+        .and_then(|p| measure(&p, &[&s]).ok())
+        .map(|(secs, _)| (n / 4) as f64 / secs);
     let startup: Vec<f64> = (0..STARTUP_RUNS)
         .map(|_| measure(exe, &["decode", &t]).map(|(secs, _)| secs))
         .collect::<std::io::Result<_>>()?;
@@ -255,6 +267,7 @@ fn measure_all(args: &BenchArgs, exe: &Path, dir: &Path) -> std::io::Result<Figu
         log2asc,
         startup_s: median(&startup),
         load: [load_before, load_average()],
+        lens_rate,
     })
 }
 
@@ -266,6 +279,8 @@ struct Figures {
     startup_s: f64,
     /// The 1-minute load average before and after.
     load: [Option<String>; 2],
+    /// canopen-lens's rate on the quarter log (frames/s), when it is installed.
+    lens_rate: Option<f64>,
 }
 
 /// Measures one round of `run` (a `cotui` child unless it names its program).
@@ -304,6 +319,7 @@ fn report(args: &BenchArgs, f: &Figures) {
                 "frames": args.frames, "rounds": ROUNDS, "runs": figures,
                 "log2asc_frames_per_s": base, "load_average": [before, after],
                 "startup_ms": startup_ms, "startup_target_ms": STARTUP_TARGET_MS,
+                "canopen_lens_frames_per_s": f.lens_rate,
             })
         );
         return;
@@ -338,4 +354,11 @@ fn report(args: &BenchArgs, f: &Figures) {
         "  {:<32} {startup_ms:>12.2} ms (target < {STARTUP_TARGET_MS} ms)",
         "start-up (decode of a 10-line log)"
     );
+    match f.lens_rate {
+        Some(r) => println!(
+            "  {:<32} {r:>12.0} frames/s (the diagnose peer, 1/4 log)",
+            "canopen-lens"
+        ),
+        None => println!("  canopen-lens not found (scripts/install-test-deps.sh) - no diagnose peer figure"),
+    }
 }

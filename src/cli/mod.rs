@@ -7,6 +7,7 @@ pub mod commander;
 pub mod decode;
 mod decode_out;
 mod decode_parquet;
+pub mod diagnose;
 pub mod drive;
 pub mod nmt;
 pub mod record;
@@ -49,6 +50,8 @@ pub fn verbose() -> bool {
 pub enum Command {
     /// Decode candump / ASC logs to text, JSON lines, SDO transactions, a summary or pcapng.
     Decode(decode::DecodeArgs),
+    /// What went wrong on the bus, in plain words: incidents with cause, timeline and what to check.
+    Diagnose(diagnose::DiagnoseArgs),
     /// Print throughput and memory figures of the decoder on a generated log.
     Bench(bench::BenchArgs),
     /// Open a log in the interactive analyzer (loads at once; browse, filter, search).
@@ -86,6 +89,7 @@ Try it without hardware:   cotui demo
 Browse a log:              cotui open FILE
 Replay a log:              cotui replay FILE [--speed 2]
 Decode a candump log:      cotui decode FILE [--format jsonl] [--transactions] [--summary]
+What went wrong:           cotui diagnose FILE [--format jsonl] [--check]
 All commands:              cotui --help
 ";
 
@@ -105,6 +109,7 @@ pub fn run() -> i32 {
             EXIT_OK
         }
         Some(Command::Decode(args)) => decode::run(&args),
+        Some(Command::Diagnose(args)) => diagnose::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
         Some(Command::Open(args)) => tui::run_open(&args),
         Some(Command::Replay(args)) => tui::run_replay(&args),

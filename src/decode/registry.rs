@@ -149,6 +149,13 @@ impl Decoder {
         self.mappings.get(&(node, transmit, num))
     }
 
+    /// Where a frame goes: kind, node and PDO number (0 when not a PDO), without decoding
+    /// it or changing any state (for callers that decode only some frames).
+    pub fn peek(&self, frame: &Frame) -> (Kind, Option<u8>, u16) {
+        let r = self.route(frame);
+        (r.kind, r.node, r.pdo)
+    }
+
     /// The last mode of operation seen for `node`.
     pub fn mode(&self, node: u8) -> Option<i8> {
         self.modes[(node & 0x7F) as usize]

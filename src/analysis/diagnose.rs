@@ -1,0 +1,1011 @@
+//! The incident builder: decoded frames, SDO transactions and bus events in, a short
+//! ranked list of [`Incident`]s out. Pure: time only comes from frame timestamps.
+//!
+//! What it finds: nodes that never answer (missing), heartbeats that stop (for good, or
+//! for a while), unexpected reboots, refused SDO transfers (grouped per object), SDO
+//! requests left unanswered, CiA 402 faults with their cause (EMCY, 0x603F) and the fault
+//! resets that followed, EMCY not tied to a fault, CAN error frames and controller states,
+//! duplicate node-IDs (boot-ups close together, conflicting heartbeat states) and NMT
+//! commands a node did not follow.
+
+use super::events::{Event, What};
+use super::incident::{Incident, Problem, Status};
+use super::liveness::EventTracker;
+use crate::decode::cia402::DriveState;
+use crate::decode::emcy::Emcy;
+use crate::decode::heartbeat::NmtState;
+use crate::decode::sdo::abort::abort_text;
+use crate::decode::sdo::frame::{SdoCommand, Side};
+use crate::decode::sdo::transaction::{Outcome, Transaction, TransferDirection};
+use crate::decode::{Body, Decoded, Kind};
+use crate::frame::Frame;
+use crate::od::PdoMapping;
+use std::collections::{BTreeMap, HashMap};
+
+const MS: u64 = 1_000_000;
+/// An SDO request still unanswered this long after it went out counts as not answered.
+const SDO_TIMEOUT_NS: u64 = 1_000 * MS;
+/// An EMCY this close before a fault is taken as its cause.
+const EMCY_CAUSE_NS: u64 = 100 * MS;
+/// Faults on several axes of one node this close together are one incident.
+const AXES_TOGETHER_NS: u64 = 50 * MS;
+/// Two boot-ups of one node-ID this close together come from two devices.
+const DUPLICATE_BOOT_NS: u64 = 100 * MS;
+/// A boot-up this soon after an NMT reset was asked for.
+const RESET_BOOT_NS: u64 = 5_000 * MS;
+/// A node has this long (and two heartbeats) to follow an NMT command.
+const NMT_GRACE_NS: u64 = 100 * MS;
+/// A fault reset this soon after the fault cleared belongs to it (one SYNC cycle).
+const SAME_CYCLE_NS: u64 = 20 * MS;
+/// Axes of a multi-axis drive (objects 0x6000 + 0x800 * (axis - 1)).
+const AXES: u16 = 8;
+
+/// A frame seen: its number and time.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct At {
+    frame: u64,
+    t: u64,
+}
+
+/// An SDO request waiting for its answer.
+#[derive(Clone, Copy, Debug)]
+struct Request {
+    at: At,
+    /// A new request went out before this one was answered.
+    replaced: bool,
+    index: u16,
+    sub: u8,
+}
+
+/// An NMT command a node should follow.
+#[derive(Clone, Copy, Debug)]
+struct Expect {
+    at: At,
+    target: NmtState,
+    command: &'static str,
+    wrong: u8,
+}
+
+/// A CiA 402 axis.
+#[derive(Clone, Debug, Default)]
+struct Axis {
+    cw: Option<u16>,
+    /// The open fault incident.
+    fault: Option<usize>,
+    /// A cleared fault waiting for "operation enabled".
+    cleared: Option<usize>,
+}
+
+/// What one node has shown so far.
+#[derive(Clone, Debug, Default)]
+struct Node {
+    heard: bool,
+    /// A heartbeat (not a boot-up) came since the last boot-up.
+    beating: bool,
+    last_hb: Option<At>,
+    last_state: Option<(u64, NmtState)>,
+    /// The heartbeat state before the last change.
+    state_before: Option<NmtState>,
+    conflicts: u32,
+    last_boot: Option<u64>,
+    reset_asked: Option<u64>,
+    pending: Option<Request>,
+    /// The last SDO request was a write.
+    download: bool,
+    /// Last frame of any kind sent by the node.
+    last_any: Option<At>,
+    /// 0x1017 = 0 seen on the bus, and when.
+    heartbeat_off: Option<At>,
+    guarded: bool,
+    unanswered: Vec<Request>,
+    n_unanswered: u64,
+    answered_after: bool,
+    expect: Option<Expect>,
+    ignored: Option<(usize, NmtState)>,
+    cia402: bool,
+    axes: BTreeMap<u8, Axis>,
+    /// EMCY not yet given to an incident (a fault may follow at once).
+    emcy: Vec<(At, Emcy)>,
+    silence: Option<(At, u64, f64)>,
+}
+
+/// Drive-fault details used for its title.
+#[derive(Clone, Debug, Default)]
+struct FaultMeta {
+    resets: u32,
+    emcy: Option<u16>,
+}
+
+/// Builds incidents from the frames of one capture, in order.
+pub struct Diagnoser {
+    tracker: EventTracker,
+    at: At,
+    first_ns: Option<u64>,
+    nodes: BTreeMap<u8, Node>,
+    incidents: Vec<Incident>,
+    keyed: HashMap<(Option<u8>, Problem, u32), usize>,
+    faults: HashMap<usize, FaultMeta>,
+    error_frames: u64,
+    bus_state: BTreeMap<String, &'static str>,
+    sdo_deadline: Option<u64>,
+    /// The last NMT reset addressed to all nodes.
+    reset_all: Option<u64>,
+    /// Longest silence per node that came back (ms).
+    silent_max: BTreeMap<u8, f64>,
+}
+
+/// Index offset of `axis` (1-based) in the CiA 402 range.
+fn axis_of(index: u16, base: u16) -> Option<u8> {
+    let off = index.checked_sub(base)?;
+    (off % 0x800 == 0 && off / 0x800 < AXES).then(|| (off / 0x800 + 1) as u8)
+}
+
+impl Diagnoser {
+    /// A builder over `tracker` (made with the nodes' dictionaries for their heartbeat periods).
+    pub fn new(tracker: EventTracker) -> Diagnoser {
+        Diagnoser {
+            tracker,
+            at: At::default(),
+            first_ns: None,
+            nodes: BTreeMap::new(),
+            incidents: Vec::new(),
+            keyed: HashMap::new(),
+            faults: HashMap::new(),
+            error_frames: 0,
+            bus_state: BTreeMap::new(),
+            sdo_deadline: None,
+            silent_max: BTreeMap::new(),
+            reset_all: None,
+        }
+    }
+
+    /// Time of the first frame (ns): the origin of the times in the report.
+    pub fn origin_ns(&self) -> u64 {
+        self.first_ns.unwrap_or(0)
+    }
+
+    /// Frames seen so far.
+    pub fn frames(&self) -> u64 {
+        self.at.frame
+    }
+
+    fn node(&mut self, n: u8) -> &mut Node {
+        self.nodes.entry(n).or_default()
+    }
+
+    fn open(&mut self, node: Option<u8>, problem: Problem, t: u64) -> usize {
+        self.incidents.push(Incident {
+            node,
+            axes: Vec::new(),
+            problem,
+            status: Status::Open,
+            title: String::new(),
+            cause: None,
+            events: Vec::new(),
+            check: Vec::new(),
+            why: String::new(),
+            count: 0,
+            first_ns: t,
+            last_ns: t,
+        });
+        self.incidents.len() - 1
+    }
+
+    /// The incident for `key`, made on first use; counts one more occurrence at `t`.
+    fn grouped(&mut self, node: Option<u8>, problem: Problem, detail: u32, t: u64) -> usize {
+        let i = match self.keyed.get(&(node, problem, detail)) {
+            Some(i) => *i,
+            None => {
+                let i = self.open(node, problem, t);
+                self.keyed.insert((node, problem, detail), i);
+                i
+            }
+        };
+        let inc = &mut self.incidents[i];
+        inc.count += 1;
+        inc.last_ns = inc.last_ns.max(t);
+        i
+    }
+
+    fn step(&mut self, i: usize, at: At, text: impl Into<String>) {
+        self.incidents[i].step(at.frame, at.t, text);
+    }
+
+    /// Frame number and time advance to `frame`'s.
+    fn advance(&mut self, frame: &Frame) {
+        self.at = At {
+            frame: self.at.frame + 1,
+            t: frame.ts_ns,
+        };
+        self.first_ns.get_or_insert(frame.ts_ns);
+        if self.sdo_deadline.is_some_and(|dl| frame.ts_ns > dl) {
+            self.sdo_timeouts(frame.ts_ns);
+        }
+    }
+
+    /// True when a PDO of `node` can tell the diagnosis something: its `mapping` holds a
+    /// CiA 402 controlword, statusword or error code, or (mapping unknown) it is the
+    /// predefined TPDO1/RPDO1 of a CiA 402 device. Other PDOs need no decoding.
+    pub fn wants_pdo(&self, node: u8, num: u16, mapping: Option<&PdoMapping>) -> bool {
+        match mapping {
+            Some(m) => m
+                .entries
+                .iter()
+                .any(|e| [0x6040, 0x6041, 0x603F].iter().any(|b| axis_of(e.index, *b).is_some())),
+            None => num == 1 && self.nodes.get(&node).is_some_and(|d| d.cia402),
+        }
+    }
+
+    /// A frame left undecoded (SYNC, TIME, LSS, unknown COB-IDs, PDOs that
+    /// [`Diagnoser::wants_pdo`] declines): time and frame number advance, and a TPDO
+    /// still shows that its node is there.
+    pub fn skip(&mut self, frame: &Frame, kind: Kind, node: Option<u8>) {
+        self.advance(frame);
+        self.tracker.tick(frame.ts_ns);
+        for e in self.tracker.take_events() {
+            self.event(&e);
+        }
+        if let (Kind::Tpdo, Some(n)) = (kind, node) {
+            let at = self.at;
+            let node = self.node(n);
+            node.heard = true;
+            node.last_any = Some(at);
+        }
+    }
+
+    /// One frame, in capture order, with its decoding; `iface` names its interface.
+    pub fn frame(&mut self, frame: &Frame, iface: &str, d: &Decoded) {
+        self.advance(frame);
+        self.tracker.frame(frame, iface, d);
+        for e in self.tracker.take_events() {
+            self.event(&e);
+        }
+        let Some(n) = d.node else {
+            if let Body::Nmt(nmt) = &d.body {
+                self.nmt(nmt.cs, nmt.target);
+            }
+            if d.kind == Kind::ErrorFrame {
+                self.error_frame(&d.label);
+            }
+            return;
+        };
+        let at = self.at;
+        if matches!(d.kind, Kind::Tpdo | Kind::SdoTx | Kind::Emcy)
+            || matches!(&d.body, Body::Heartbeat(h) if !h.request)
+        {
+            self.node(n).last_any = Some(at);
+        }
+        if matches!(&d.body, Body::Heartbeat(h) if h.request) {
+            self.node(n).guarded = true;
+        }
+        match &d.body {
+            Body::Heartbeat(h) if !h.request => {
+                self.node(n).heard = true;
+                if let Some(s) = h.state {
+                    self.heartbeat(n, s);
+                }
+            }
+            Body::Emcy(e) => {
+                self.node(n).heard = true;
+                self.emcy(n, e);
+            }
+            Body::Sdo(s) if s.side == Side::Server => {
+                let node = self.node(n);
+                node.heard = true;
+                node.pending = None;
+                node.answered_after = true;
+                if let SdoCommand::Abort { index, sub, code } = s.command {
+                    self.refused(n, index, sub, code);
+                } else if s.problems.iter().any(|p| p == "outside any transfer seen") {
+                    self.garbled(n, format!("{} frame outside any transfer", s.command.cs_name()));
+                }
+            }
+            Body::Sdo(s) => {
+                // Only initiate frames start a request (segments carry no object themselves).
+                if let Some((index, sub)) = s.command.object()
+                    && s.command.cs_name() != "abort"
+                {
+                    self.node(n).download = matches!(s.command.cs_name(), "initiate_download" | "block_download");
+                    if let Some(old) = self.node(n).pending.take() {
+                        self.unanswered(n, Request { replaced: true, ..old });
+                    }
+                    self.node(n).pending = Some(Request {
+                        at,
+                        replaced: false,
+                        index,
+                        sub,
+                    });
+                    let dl = at.t + SDO_TIMEOUT_NS;
+                    self.sdo_deadline = Some(self.sdo_deadline.map_or(dl, |d| d.min(dl)));
+                }
+            }
+            Body::Pdo(p) => {
+                if p.transmit {
+                    self.node(n).heard = true;
+                }
+                let mut words = Vec::new();
+                for s in &p.signals {
+                    let Some(v) = s.value.as_i64() else { continue };
+                    words.push((s.index, v as u16));
+                }
+                if p.signals.is_empty() && p.num == 1 && self.node(n).cia402 && frame.payload().len() >= 2 {
+                    // CiA 402 predefined mapping: TPDO1 starts with the statusword, RPDO1
+                    // with the controlword.
+                    let w = u16::from_le_bytes([frame.payload()[0], frame.payload()[1]]);
+                    words.push((if p.transmit { 0x6041 } else { 0x6040 }, w));
+                }
+                for (index, w) in words {
+                    self.drive_word(n, index, w);
+                }
+            }
+            _ => {
+                if matches!(d.kind, Kind::Tpdo | Kind::SdoTx) {
+                    self.node(n).heard = true;
+                }
+            }
+        }
+    }
+
+    /// A CiA 402 object value of `node` (from a PDO or an SDO transfer).
+    fn drive_word(&mut self, n: u8, index: u16, w: u16) {
+        if let Some(axis) = axis_of(index, 0x6041) {
+            self.statusword(n, axis, w);
+        } else if let Some(axis) = axis_of(index, 0x6040) {
+            self.controlword(n, axis, w);
+        } else if let Some(axis) = axis_of(index, 0x603F) {
+            let fault = self.node(n).axes.get(&axis).and_then(|a| a.fault);
+            if let Some(i) = fault
+                && w != 0
+            {
+                let text = format!("drive error code 0x{w:04X} (0x{index:04X})");
+                let inc = &mut self.incidents[i];
+                if !inc.cause.as_deref().is_some_and(|c| c.contains(&text)) {
+                    inc.cause = Some(match inc.cause.take() {
+                        Some(c) => format!("{c}; {text}"),
+                        None => text.clone(),
+                    });
+                    let at = self.at;
+                    self.step(i, at, format!("Drive reports {text}"));
+                }
+            }
+        }
+    }
+
+    fn statusword(&mut self, n: u8, axis: u8, sw: u16) {
+        let at = self.at;
+        let state = DriveState::from_statusword(sw);
+        let faulted = matches!(state, DriveState::Fault | DriveState::FaultReactionActive);
+        let a = self.node(n).axes.entry(axis).or_default().clone();
+        match (a.fault, faulted) {
+            (None, true) => {
+                // Another axis of the node faulted just now: one incident.
+                let together = self.nodes[&n].axes.values().filter_map(|x| x.fault).find(|i| {
+                    at.t.saturating_sub(self.incidents[*i].first_ns) <= AXES_TOGETHER_NS
+                        && self.incidents[*i].status == Status::Open
+                });
+                let i = match together {
+                    Some(i) => {
+                        self.incidents[i].axes.push(axis);
+                        self.step(i, at, format!("Axis {axis} faulted too (statusword 0x{sw:04X})"));
+                        i
+                    }
+                    None => {
+                        let i = self.open(Some(n), Problem::DriveFault, at.t);
+                        self.incidents[i].count = 1;
+                        self.incidents[i].axes.push(axis);
+                        self.faults.insert(i, FaultMeta::default());
+                        self.step(
+                            i,
+                            at,
+                            format!("Fault: the drive switched the motor torque off (statusword 0x{sw:04X})"),
+                        );
+                        self.absorb_emcy(n, i);
+                        i
+                    }
+                };
+                let ax = self.node(n).axes.entry(axis).or_default();
+                ax.fault = Some(i);
+                ax.cleared = None;
+            }
+            (Some(i), false) => {
+                let ax = self.node(n).axes.entry(axis).or_default();
+                ax.fault = None;
+                ax.cleared = Some(i);
+                // The incident is recovered once every faulted axis is clear.
+                let still = self.nodes[&n].axes.values().any(|x| x.fault == Some(i));
+                if !still {
+                    self.incidents[i].status = Status::Recovered;
+                    self.incidents[i].last_ns = at.t;
+                    self.step(
+                        i,
+                        at,
+                        format!("Fault cleared (statusword 0x{sw:04X}, {})", state.text()),
+                    );
+                }
+            }
+            _ => {}
+        }
+        if state == DriveState::OperationEnabled
+            && let Some(i) = self.node(n).axes.get_mut(&axis).and_then(|a| a.cleared.take())
+        {
+            let others_running = self.nodes[&n].axes.values().any(|x| x.cleared == Some(i));
+            if !others_running {
+                self.step(i, at, "Running again (operation enabled)");
+            }
+        }
+    }
+
+    fn controlword(&mut self, n: u8, axis: u8, cw: u16) {
+        let at = self.at;
+        let ax = self.node(n).axes.entry(axis).or_default().clone();
+        let rising = cw & 0x80 != 0 && ax.cw.is_none_or(|p| p & 0x80 == 0);
+        self.node(n).axes.entry(axis).or_default().cw = Some(cw);
+        // A reset in the same cycle as the clear (the statusword went out first) counts too.
+        let just_cleared = ax
+            .cleared
+            .filter(|i| at.t.saturating_sub(self.incidents[*i].last_ns) <= SAME_CYCLE_NS);
+        let Some(i) = ax.fault.or(just_cleared).filter(|_| rising) else {
+            return;
+        };
+        let meta = self.faults.entry(i).or_default();
+        meta.resets += 1;
+        let r = meta.resets;
+        let text = if ax.fault.is_none() {
+            format!("Fault reset #{r} sent, in the same cycle as the clear")
+        } else if r > 1 {
+            format!(
+                "Fault reset #{r} sent; reset #{} did not work, the fault was still there",
+                r - 1
+            )
+        } else {
+            "Fault reset #1 sent (controlword bit 7)".to_string()
+        };
+        self.step(i, at, text);
+    }
+
+    fn emcy(&mut self, n: u8, e: &Emcy) {
+        let at = self.at;
+        self.flush_emcy(n, at.t.saturating_sub(EMCY_CAUSE_NS));
+        if e.code == 0 {
+            // "Error reset or no error": the node's EMCY incidents are over.
+            self.flush_emcy(n, u64::MAX);
+            let mine: Vec<usize> = (0..self.incidents.len())
+                .filter(|i| {
+                    let inc = &self.incidents[*i];
+                    inc.node == Some(n) && inc.problem == Problem::Emcy && inc.status == Status::Open
+                })
+                .collect();
+            for i in mine {
+                self.incidents[i].status = Status::Recovered;
+                self.step(i, at, "Error reset: the node reports no error any more (EMCY 0x0000)");
+            }
+            return;
+        }
+        let fault = self.nodes[&n]
+            .axes
+            .values()
+            .filter_map(|a| a.fault)
+            .find(|i| self.incidents[*i].cause.is_none());
+        match fault {
+            Some(i) => self.give_cause(i, at, e),
+            None => self.node(n).emcy.push((at, e.clone())),
+        }
+    }
+
+    fn emcy_text(e: &Emcy) -> String {
+        let mut s = format!("{} (EMCY 0x{:04X})", e.text, e.code);
+        for (k, v) in &e.mfr_fields {
+            s.push_str(&format!(", {k}={v}"));
+        }
+        s
+    }
+
+    fn give_cause(&mut self, i: usize, at: At, e: &Emcy) {
+        self.incidents[i].cause = Some(Self::emcy_text(e));
+        self.faults.entry(i).or_default().emcy = Some(e.code);
+        self.step(i, at, format!("Cause reported: {}", Self::emcy_text(e)));
+    }
+
+    /// A fault just started: a recent EMCY of the node is its cause.
+    fn absorb_emcy(&mut self, n: u8, i: usize) {
+        let t = self.at.t;
+        self.flush_emcy(n, t.saturating_sub(EMCY_CAUSE_NS));
+        if let Some((at, e)) = self.node(n).emcy.pop() {
+            self.give_cause(i, at, &e);
+        }
+        self.flush_emcy(n, u64::MAX);
+    }
+
+    /// EMCY of `n` older than `before` become EMCY incidents (grouped per code).
+    fn flush_emcy(&mut self, n: u8, before: u64) {
+        let node = self.node(n);
+        let keep = node
+            .emcy
+            .iter()
+            .position(|(at, _)| at.t >= before)
+            .unwrap_or(node.emcy.len());
+        let old: Vec<(At, Emcy)> = node.emcy.drain(..keep).collect();
+        for (at, e) in old {
+            let i = self.grouped(Some(n), Problem::Emcy, u32::from(e.code), at.t);
+            let inc = &mut self.incidents[i];
+            inc.status = Status::Open;
+            inc.cause = Some(Self::emcy_text(&e));
+            self.step(i, at, format!("EMCY {}", Self::emcy_text(&e)));
+        }
+    }
+
+    fn heartbeat(&mut self, n: u8, s: NmtState) {
+        let at = self.at;
+        let node = self.node(n);
+        node.last_hb = Some(at);
+        node.beating = s != NmtState::BootUp;
+        if s != NmtState::BootUp {
+            // Two devices with one node-ID: heartbeat states that flip back and forth
+            // (A, B, A, B...), which one node changing state never does.
+            if let (Some((_, s1)), Some(s2)) = (node.last_state, node.state_before)
+                && s != s1
+                && s == s2
+            {
+                node.conflicts += 1;
+                if node.conflicts == 3 {
+                    let i = self.grouped(Some(n), Problem::DuplicateId, 0, at.t);
+                    self.step(
+                        i,
+                        at,
+                        format!("Heartbeats keep flipping between {} and {}", s1.text(), s.text()),
+                    );
+                }
+            }
+            let node = self.node(n);
+            if node.last_state.is_some_and(|(_, s1)| s1 != s) {
+                node.state_before = node.last_state.map(|(_, s1)| s1);
+            }
+            self.node(n).last_state = Some((at.t, s));
+        }
+        let node = self.node(n);
+        if let Some((i, target)) = node.ignored
+            && target == s
+        {
+            node.ignored = None;
+            self.incidents[i].status = Status::Warning;
+            self.step(i, at, format!("Reached {} later", s.text()));
+        }
+        let node = self.node(n);
+        let Some(mut ex) = node.expect else { return };
+        if ex.target == s {
+            node.expect = None;
+            return;
+        }
+        if s == NmtState::BootUp {
+            return;
+        }
+        ex.wrong += 1;
+        node.expect = Some(ex);
+        if ex.wrong >= 2 && at.t.saturating_sub(ex.at.t) >= NMT_GRACE_NS {
+            node.expect = None;
+            let i = self.grouped(
+                Some(n),
+                Problem::NmtIgnored,
+                u32::from(ex.target.as_str().len() as u8),
+                at.t,
+            );
+            self.incidents[i].status = Status::Open;
+            self.incidents[i].cause = Some(format!("NMT {} sent, node stays {}", ex.command, s.text()));
+            self.step(i, ex.at, format!("NMT {} sent", ex.command));
+            self.step(i, at, format!("Node still says {}", s.text()));
+            self.node(n).ignored = Some((i, ex.target));
+        }
+    }
+
+    fn nmt(&mut self, cs: u8, target: u8) {
+        let (command, state) = match cs {
+            0x01 => ("start", NmtState::Operational),
+            0x02 => ("stop", NmtState::Stopped),
+            0x80 => ("enter pre-operational", NmtState::PreOperational),
+            0x81 => ("reset node", NmtState::BootUp),
+            0x82 => ("reset communication", NmtState::BootUp),
+            _ => return,
+        };
+        let at = self.at;
+        let known: Vec<u8> = self
+            .nodes
+            .iter()
+            .filter(|(n, d)| (target == 0 || **n == target) && d.last_state.is_some())
+            .map(|(n, _)| *n)
+            .collect();
+        if state == NmtState::BootUp {
+            if target == 0 {
+                self.reset_all = Some(at.t);
+            } else {
+                self.node(target).reset_asked = Some(at.t);
+            }
+        }
+        for n in known {
+            self.node(n).expect = Some(Expect {
+                at,
+                target: state,
+                command,
+                wrong: 0,
+            });
+        }
+    }
+
+    fn event(&mut self, e: &Event) {
+        let Some(n) = e.node else {
+            if let What::BusState { iface, to, detail, .. } = &e.what {
+                self.bus_state.insert(iface.clone(), to);
+                let i = self.grouped(None, Problem::BusErrors, 0, e.t_ns);
+                self.incidents[i].count -= 1;
+                let at = At {
+                    frame: self.at.frame,
+                    t: e.t_ns,
+                };
+                self.step(
+                    i,
+                    at,
+                    format!("{iface}: controller now {} ({detail})", to.replace('_', " ")),
+                );
+            }
+            return;
+        };
+        let at = At {
+            frame: self.at.frame,
+            t: e.t_ns,
+        };
+        match &e.what {
+            // A heartbeat that has not started since the boot-up did not stop.
+            What::HeartbeatLost { .. } if !self.node(n).beating => {}
+            What::HeartbeatLost { silent_ms, .. } => {
+                let last = self.node(n).last_hb.unwrap_or(at);
+                self.node(n).silence = Some((last, e.t_ns, *silent_ms));
+            }
+            What::HeartbeatBack { silent_ms } => self.back(n, at, *silent_ms),
+            What::BootUp { rebooted, .. } => {
+                let reset_all = self.reset_all;
+                let node = self.node(n);
+                // (Equal times say nothing: logs without timestamps.)
+                let close = node
+                    .last_boot
+                    .is_some_and(|t| at.t > t && at.t - t <= DUPLICATE_BOOT_NS);
+                let asked = node
+                    .reset_asked
+                    .max(reset_all)
+                    .is_some_and(|t| at.t.saturating_sub(t) <= RESET_BOOT_NS);
+                node.last_boot = Some(at.t);
+                node.expect = None;
+                node.last_state = None;
+                node.state_before = None;
+                // A silence that ends in a boot-up is part of the restart (expected when
+                // a reset was asked for).
+                let silence = node.silence.take();
+                if asked {
+                    node.reset_asked = None;
+                }
+                if close {
+                    let i = self.grouped(Some(n), Problem::DuplicateId, 0, at.t);
+                    self.step(i, at, "A second boot-up with the same node-ID right after the first");
+                } else if *rebooted && !asked {
+                    let i = self.grouped(Some(n), Problem::Rebooted, 0, at.t);
+                    self.incidents[i].status = Status::Warning;
+                    if let Some((last, _, _)) = silence {
+                        self.step(i, last, "Last heartbeat before the restart");
+                    }
+                    self.step(i, at, "Boot-up: the node restarted, no NMT reset was sent before");
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn back(&mut self, n: u8, at: At, silent_ms: f64) {
+        let Some((last, lost, _)) = self.node(n).silence.take() else {
+            return;
+        };
+        let i = self.grouped(Some(n), Problem::SilentBack, 0, lost);
+        let longest = self.silent_max.entry(n).or_insert(0.0);
+        *longest = longest.max(silent_ms);
+        let inc = &mut self.incidents[i];
+        inc.status = Status::Warning;
+        inc.cause = Some(format!("no heartbeat for up to {:.2} s", *longest / 1000.0));
+        self.step(
+            i,
+            at,
+            format!(
+                "No heartbeat for {:.2} s (last #{}), then it came back",
+                silent_ms / 1000.0,
+                last.frame
+            ),
+        );
+    }
+
+    fn refused(&mut self, n: u8, index: u16, sub: u8, code: u32) {
+        let at = self.at;
+        let text = abort_text(code);
+        let detail = (u32::from(index) << 8) | u32::from(sub);
+        let write = self.node(n).download;
+        let i = self.grouped(Some(n), Problem::SdoRefused, detail, at.t);
+        let inc = &mut self.incidents[i];
+        inc.status = Status::Open;
+        inc.cause = Some(format!("0x{index:04X}:{sub:02X}: {text} (abort 0x{code:08X})"));
+        let what = if write { "Write" } else { "Read" };
+        self.step(
+            i,
+            at,
+            format!("{what} of 0x{index:04X}:{sub:02X} refused: {text} (0x{code:08X})"),
+        );
+    }
+
+    fn garbled(&mut self, n: u8, what: String) {
+        let at = self.at;
+        let i = self.grouped(Some(n), Problem::SdoGarbled, 0, at.t);
+        self.incidents[i].status = Status::Open;
+        if self.incidents[i].cause.is_none() {
+            self.incidents[i].cause = Some(what.clone());
+        }
+        self.step(i, at, format!("Node sent an SDO {what}"));
+    }
+
+    fn error_frame(&mut self, label: &str) {
+        self.error_frames += 1;
+        let at = self.at;
+        let i = self.grouped(None, Problem::BusErrors, 0, at.t);
+        if self.incidents[i].count == 1 {
+            self.incidents[i].cause = Some(label.to_string());
+            self.step(i, at, format!("CAN bus errors detected: {label}"));
+        }
+    }
+
+    /// Requests unanswered for longer than the SDO timeout at `now`.
+    fn sdo_timeouts(&mut self, now: u64) {
+        let late: Vec<(u8, Request)> = self
+            .nodes
+            .iter()
+            .filter_map(|(n, d)| d.pending.filter(|r| r.at.t + SDO_TIMEOUT_NS < now).map(|r| (*n, r)))
+            .collect();
+        for (n, r) in late {
+            self.node(n).pending = None;
+            self.unanswered(n, r);
+        }
+        self.sdo_deadline = self
+            .nodes
+            .values()
+            .filter_map(|d| d.pending.map(|r| r.at.t + SDO_TIMEOUT_NS))
+            .min();
+    }
+
+    fn unanswered(&mut self, n: u8, r: Request) {
+        let node = self.node(n);
+        node.n_unanswered += 1;
+        node.answered_after = false;
+        if node.unanswered.len() < super::incident::TIMELINE_KEPT {
+            node.unanswered.push(r);
+        }
+    }
+
+    /// A completed SDO transfer (in order, right after the frame that ended it).
+    pub fn transaction(&mut self, t: &Transaction) {
+        self.tracker.transaction(t);
+        for e in self.tracker.take_events() {
+            self.event(&e);
+        }
+        if t.outcome != Outcome::Ok || t.data.is_empty() {
+            return;
+        }
+        let le = |d: &[u8]| d.iter().take(4).rev().fold(0u32, |a, b| a << 8 | u32::from(*b));
+        let v = le(&t.data);
+        if (t.index, t.sub, t.direction) == (0x1000, 0, TransferDirection::Upload) {
+            self.node(t.node).cia402 = v & 0xFFFF == 402;
+        }
+        if t.sub == 0 {
+            self.drive_word(t.node, t.index, v as u16);
+        }
+        if (t.index, t.sub) == (0x1017, 0) {
+            let at = self.at;
+            self.node(t.node).heartbeat_off = (v & 0xFFFF == 0).then_some(at);
+        }
+        let key = (
+            Some(t.node),
+            Problem::SdoRefused,
+            (u32::from(t.index) << 8) | u32::from(t.sub),
+        );
+        if let Some(&i) = self.keyed.get(&key)
+            && self.incidents[i].status == Status::Open
+        {
+            self.incidents[i].status = Status::Recovered;
+            let at = self.at;
+            self.step(i, at, "A later transfer of the same object worked");
+        }
+    }
+
+    /// The end of the capture: what is still wrong is open. Returns the incidents ranked,
+    /// open first, then recovered, then warnings; each by time.
+    pub fn finish(mut self) -> Vec<Incident> {
+        let end = self.at;
+        self.tracker.tick(end.t);
+        for e in self.tracker.take_events() {
+            self.event(&e);
+        }
+        self.sdo_timeouts(end.t);
+        let nodes: Vec<u8> = self.nodes.keys().copied().collect();
+        for n in nodes {
+            self.flush_emcy(n, u64::MAX);
+            if let Some((last, lost, _)) = self.node(n).silence.take() {
+                let i = self.grouped(Some(n), Problem::Silent, 0, lost);
+                self.step(i, last, "Last heartbeat");
+                if let Some(other) = self.nodes[&n].last_any.filter(|a| a.t > lost) {
+                    self.incidents[i].cause = Some("the heartbeat stopped, other messages of the node go on".into());
+                    self.step(i, other, "The node still sends other messages (PDO, SDO or EMCY)");
+                }
+                self.step(i, end, "Nothing after that, until the end of the capture");
+                self.incidents[i].last_ns = end.t;
+            }
+            let node = self.nodes[&n].clone();
+            if let Some(at) = node.heartbeat_off.filter(|_| !node.guarded) {
+                let i = self.grouped(Some(n), Problem::Unmonitored, 0, at.t);
+                self.incidents[i].status = Status::Warning;
+                self.step(i, at, "Heartbeat producer time 0x1017 = 0: heartbeat off");
+            }
+            if node.n_unanswered > 0 {
+                let problem = if node.heard {
+                    Problem::SdoTimeout
+                } else {
+                    Problem::Missing
+                };
+                let i = self.grouped(Some(n), problem, 0, node.unanswered[0].at.t);
+                self.incidents[i].count = node.n_unanswered;
+                self.incidents[i].status = if node.heard && node.answered_after {
+                    Status::Warning
+                } else {
+                    Status::Open
+                };
+                for r in &node.unanswered {
+                    let how = if r.replaced {
+                        "no answer before the next request"
+                    } else {
+                        "no answer within 1 s"
+                    };
+                    self.step(i, r.at, format!("Request for 0x{:04X}:{:02X}: {how}", r.index, r.sub));
+                }
+                self.incidents[i].last_ns = node.unanswered.last().map_or(end.t, |r| r.at.t);
+            }
+        }
+        if self.error_frames > 0 || !self.bus_state.is_empty() {
+            let i = self.grouped(None, Problem::BusErrors, 0, end.t);
+            let inc = &mut self.incidents[i];
+            inc.count = self.error_frames;
+            let worst = self
+                .bus_state
+                .values()
+                .copied()
+                .find(|s| *s == "bus_off")
+                .or_else(|| self.bus_state.values().copied().find(|s| *s == "error_passive"));
+            inc.status = if worst.is_some() { Status::Open } else { Status::Warning };
+            inc.last_ns = inc.last_ns.min(end.t).max(inc.first_ns);
+        }
+        for (i, inc) in self.incidents.iter_mut().enumerate() {
+            let meta = self.faults.get(&i).cloned().unwrap_or_default();
+            super::texts::fill(inc, meta.resets, meta.emcy, self.error_frames);
+        }
+        let mut out = merge_faults(self.incidents);
+        for inc in &mut out {
+            inc.events.sort_by_key(|e| e.frame);
+        }
+        out.retain(|i| i.count > 0 || !i.events.is_empty());
+        out.sort_by_key(|i| (i.status, i.first_ns));
+        out
+    }
+}
+
+/// Drive faults of one node and axes with the same title become one incident with a count.
+fn merge_faults(all: Vec<Incident>) -> Vec<Incident> {
+    let mut out: Vec<Incident> = Vec::with_capacity(all.len());
+    for inc in all {
+        if inc.problem == Problem::DriveFault
+            && let Some(prev) = out.iter_mut().find(|p| {
+                p.problem == Problem::DriveFault && p.node == inc.node && p.axes == inc.axes && p.cause == inc.cause
+            })
+        {
+            prev.count += inc.count;
+            prev.last_ns = inc.last_ns;
+            prev.status = inc.status;
+            prev.title = inc.title;
+            for s in inc.events {
+                prev.step(s.frame, s.t_ns, s.text);
+            }
+            continue;
+        }
+        out.push(inc);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::decode::Decoder;
+    use crate::od::Dictionary;
+
+    /// Runs `frames` (ms, COB-ID, hex data) through a decoder and a diagnoser; returns
+    /// `node kind status count` per incident.
+    fn run(frames: &[(u64, u32, &str)]) -> Vec<String> {
+        let mut dec = Decoder::new(Dictionary::default(), Vec::new());
+        let mut diag = Diagnoser::new(EventTracker::new(|n| dec.dictionary(n)));
+        for (ms, id, data) in frames {
+            let bytes: Vec<u8> = (0..data.len() / 2)
+                .map(|i| u8::from_str_radix(&data[2 * i..2 * i + 2], 16).unwrap())
+                .collect();
+            let mut f = Frame::classic(*id, &bytes);
+            f.ts_ns = ms * MS;
+            let d = dec.decode(&f);
+            diag.frame(&f, "can0", &d);
+            for t in dec.take_transactions() {
+                diag.transaction(&t);
+            }
+        }
+        diag.finish()
+            .iter()
+            .map(|i| {
+                let node = i.node.map_or("-".into(), |n| n.to_string());
+                format!("{node} {} {} {}", i.problem.as_str(), i.status.as_str(), i.count)
+            })
+            .collect()
+    }
+
+    fn heartbeats(node: u32, from_ms: u64, to_ms: u64, state: &'static str) -> Vec<(u64, u32, &'static str)> {
+        (from_ms..to_ms)
+            .step_by(100)
+            .map(|t| (t, 0x700 + node, state))
+            .collect()
+    }
+
+    #[test]
+    fn a_heartbeat_that_has_not_started_since_boot_up_did_not_stop() {
+        // 0x1017 = 100 ms is written right after the boot-up; heartbeats start 500 ms later.
+        let mut f = vec![
+            (0, 0x701, "00"),
+            (10, 0x601, "2B17100064000000"),
+            (11, 0x581, "6017100000000000"),
+        ];
+        f.extend(heartbeats(1, 500, 1500, "05"));
+        assert!(run(&f).is_empty(), "{:?}", run(&f));
+        // Once it beats, a gap is a silence.
+        f.extend(heartbeats(1, 2500, 3000, "05"));
+        assert_eq!(run(&f), ["1 silent_back warning 1"]);
+    }
+
+    #[test]
+    fn emcy_right_before_a_fault_is_its_cause_not_a_separate_incident() {
+        // Node 2 reads as a CiA 402 device (0x1000 = 0x00020192): TPDO1 starts with the statusword.
+        let f = [
+            (0, 0x602, "4000100000000000"),
+            (1, 0x582, "4300100092010200"),
+            (100, 0x182, "3702"),
+            (200, 0x082, "2171010000000000"),
+            (201, 0x182, "0800"),
+            (300, 0x202, "8000"),
+            (301, 0x182, "4002"),
+            (400, 0x182, "3702"),
+        ];
+        assert_eq!(run(&f), ["2 drive_fault recovered 1"]);
+    }
+
+    #[test]
+    fn boot_ups_with_equal_times_are_not_a_duplicate_id() {
+        // Logs without timestamps give every frame time 0: two boot-ups say nothing there.
+        let f = [(0, 0x000, "8100"), (0, 0x705, "00"), (0, 0x705, "00")];
+        assert!(run(&f).is_empty(), "{:?}", run(&f));
+        let f = [(0, 0x000, "8100"), (10, 0x705, "00"), (30, 0x705, "00")];
+        assert_eq!(run(&f), ["5 duplicate_id open 1"]);
+    }
+
+    #[test]
+    fn a_reset_asked_for_is_not_an_unexpected_reboot() {
+        let mut f = heartbeats(3, 0, 500, "05");
+        f.push((550, 0x000, "8203"));
+        f.push((560, 0x703, "00"));
+        assert!(run(&f).is_empty(), "{:?}", run(&f));
+        let mut f = heartbeats(3, 0, 500, "05");
+        f.push((560, 0x703, "00"));
+        assert_eq!(run(&f), ["3 rebooted warning 1"]);
+    }
+}

@@ -1,0 +1,214 @@
+//! Incidents: what went wrong on the bus, in plain words, with the frames that tell it.
+//! Built by [`super::diagnose::Diagnoser`]; rendered as text (`cotui diagnose`) and as one
+//! JSON object per incident (`--format jsonl`, field names are a public API).
+
+use serde_json::{Value as Json, json};
+use std::fmt::Write;
+
+/// Timeline entries kept per incident; further ones are counted in `count`, not listed.
+pub const TIMELINE_KEPT: usize = 12;
+
+/// Whether an incident still needs attention at the end of the capture.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Status {
+    /// Still wrong at the end of the capture.
+    Open,
+    /// Went wrong, then came right again.
+    Recovered,
+    /// Worth knowing, did not stop anything that the bus shows.
+    Warning,
+}
+
+impl Status {
+    /// JSON name: `open`, `recovered`, `warning`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Open => "open",
+            Status::Recovered => "recovered",
+            Status::Warning => "warning",
+        }
+    }
+}
+
+/// The kind of problem (the JSON `kind`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Problem {
+    /// SDO requests unanswered and nothing at all heard from the node.
+    Missing,
+    /// No heartbeat any more until the end of the capture.
+    Silent,
+    /// Heartbeat stopped for a while and came back.
+    SilentBack,
+    /// A boot-up nobody asked for (no NMT reset before it).
+    Rebooted,
+    /// An SDO transfer refused (abort), per object.
+    SdoRefused,
+    /// SDO frames from the node that follow no transfer, or break the protocol.
+    SdoGarbled,
+    /// Heartbeat off (0x1017 = 0) and no node guarding: a lost node goes unnoticed.
+    Unmonitored,
+    /// SDO requests with no answer from a node that is otherwise alive.
+    SdoTimeout,
+    /// CiA 402 drive fault (statusword bit 3).
+    DriveFault,
+    /// An emergency message not tied to a drive fault.
+    Emcy,
+    /// CAN error frames: errors, error passive, bus off.
+    BusErrors,
+    /// Two devices answer with one node-ID.
+    DuplicateId,
+    /// An NMT command the node did not follow.
+    NmtIgnored,
+}
+
+impl Problem {
+    /// JSON name, e.g. `sdo_refused`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Problem::Missing => "missing",
+            Problem::Silent => "silent",
+            Problem::SilentBack => "silent_back",
+            Problem::Rebooted => "rebooted",
+            Problem::SdoRefused => "sdo_refused",
+            Problem::SdoTimeout => "sdo_timeout",
+            Problem::SdoGarbled => "sdo_garbled",
+            Problem::Unmonitored => "unmonitored",
+            Problem::DriveFault => "drive_fault",
+            Problem::Emcy => "emcy",
+            Problem::BusErrors => "bus_errors",
+            Problem::DuplicateId => "duplicate_id",
+            Problem::NmtIgnored => "nmt_ignored",
+        }
+    }
+}
+
+/// One line of an incident's timeline: the frame that tells it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Step {
+    /// Frame number, 1-based over all inputs.
+    pub frame: u64,
+    /// Frame time (ns, the capture's time base).
+    pub t_ns: u64,
+    /// What the frame shows, in words.
+    pub text: String,
+}
+
+/// One problem on one node (or on the bus), repeats grouped.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Incident {
+    /// The node, None for the bus itself.
+    pub node: Option<u8>,
+    /// Axes of a multi-axis drive (1-based), empty when not axis-specific.
+    pub axes: Vec<u8>,
+    /// The kind of problem.
+    pub problem: Problem,
+    /// Open, recovered or warning.
+    pub status: Status,
+    /// One line in plain words.
+    pub title: String,
+    /// The cause as the bus shows it (EMCY text, abort text, error code), when it does.
+    pub cause: Option<String>,
+    /// The frames that tell the story (the first [`TIMELINE_KEPT`]).
+    pub events: Vec<Step>,
+    /// What to check first, most likely first.
+    pub check: Vec<String>,
+    /// Why it matters.
+    pub why: String,
+    /// How many times it happened.
+    pub count: u64,
+    /// First occurrence (ns).
+    pub first_ns: u64,
+    /// Last occurrence (ns).
+    pub last_ns: u64,
+}
+
+/// Seconds since `origin` with µs precision, for JSON.
+fn secs(t_ns: u64, origin: u64) -> f64 {
+    (t_ns.saturating_sub(origin) / 1000) as f64 / 1e6
+}
+
+impl Incident {
+    /// Adds a timeline step (kept up to [`TIMELINE_KEPT`]).
+    pub fn step(&mut self, frame: u64, t_ns: u64, text: impl Into<String>) {
+        if self.events.len() < TIMELINE_KEPT {
+            self.events.push(Step {
+                frame,
+                t_ns,
+                text: text.into(),
+            });
+        }
+    }
+
+    /// `Node 5 · axis 2`, `Node 4` or `CAN bus`.
+    pub fn place(&self) -> String {
+        let mut s = match self.node {
+            Some(n) => format!("Node {n}"),
+            None => "CAN bus".to_string(),
+        };
+        match self.axes.as_slice() {
+            [] | [1] => {}
+            [a] => {
+                let _ = write!(s, " · axis {a}");
+            }
+            many => {
+                let list: Vec<String> = many.iter().map(u8::to_string).collect();
+                let _ = write!(s, " · axes {}", list.join("+"));
+            }
+        }
+        s
+    }
+
+    /// The JSON object; times are seconds since `origin` (the capture's first frame).
+    pub fn to_json(&self, origin: u64) -> Json {
+        let events: Vec<Json> = self
+            .events
+            .iter()
+            .map(|e| json!({"frame": e.frame, "t": secs(e.t_ns, origin), "text": e.text}))
+            .collect();
+        json!({
+            "node": self.node,
+            "axes": self.axes,
+            "kind": self.problem.as_str(),
+            "status": self.status.as_str(),
+            "title": self.title,
+            "cause": self.cause,
+            "events": events,
+            "check": self.check,
+            "why": self.why,
+            "count": self.count,
+            "first": secs(self.first_ns, origin),
+            "last": secs(self.last_ns, origin),
+        })
+    }
+
+    /// The text block of `cotui diagnose` (numbered `n`), times since `origin`.
+    pub fn write_text(&self, n: usize, origin: u64, out: &mut String) {
+        let status = match self.status {
+            Status::Open => "OPEN",
+            Status::Recovered => "RECOVERED",
+            Status::Warning => "WARNING",
+        };
+        let _ = writeln!(out, "{n:>2}. {status:<9}  {}: {}", self.place(), self.title);
+        if let Some(c) = &self.cause {
+            let _ = writeln!(out, "    Cause: {c}");
+        }
+        if self.count > 1 {
+            let _ = writeln!(
+                out,
+                "    {} times, first {:.3} s, last {:.3} s",
+                self.count,
+                secs(self.first_ns, origin),
+                secs(self.last_ns, origin)
+            );
+        }
+        out.push_str("    What happened:\n");
+        for e in &self.events {
+            let _ = writeln!(out, "      {:>9.3} s  #{:<7} {}", secs(e.t_ns, origin), e.frame, e.text);
+        }
+        out.push_str("    Check first:\n");
+        for (i, c) in self.check.iter().enumerate() {
+            let _ = writeln!(out, "      {}. {c}", i + 1);
+        }
+        let _ = writeln!(out, "    Why it matters: {}", self.why);
+    }
+}

@@ -1,0 +1,234 @@
+//! The words of an incident: title, "check first" steps and why it matters, written for a
+//! technician at the machine rather than a protocol expert.
+
+use super::incident::{Incident, Problem, Status};
+
+fn plural(n: u64, one: &str) -> String {
+    if n == 1 {
+        format!("1 {one}")
+    } else {
+        format!("{n} {one}s")
+    }
+}
+
+fn lower_first(s: &str) -> String {
+    let mut c = s.chars();
+    match c.next() {
+        Some(f) => f.to_lowercase().chain(c).collect(),
+        None => String::new(),
+    }
+}
+
+fn strings(v: &[&str]) -> Vec<String> {
+    v.iter().map(|s| s.to_string()).collect()
+}
+
+/// Sets `inc`'s title, check steps and why; `resets` and `emcy` are a drive fault's fault
+/// resets and EMCY code, `error_frames` the capture's CAN error frames.
+pub fn fill(inc: &mut Incident, resets: u32, emcy: Option<u16>, error_frames: u64) {
+    let node = inc.node.map_or(String::new(), |n| n.to_string());
+    match inc.problem {
+        Problem::Missing => {
+            inc.title = "No answer: the device seems to be missing".into();
+            inc.check = vec![
+                format!("Check that the device really has node-ID {node} (switches or its configuration tool)."),
+                "Check the node's power, CAN connector and bit rate.".into(),
+                "Nothing at all came from this node (no heartbeat, no answer): it is not on the bus.".into(),
+            ];
+            inc.why =
+                "The node is off or unreachable, and the master cannot know whether its settings took effect.".into();
+        }
+        Problem::Silent if inc.cause.is_some() => {
+            inc.title = "Heartbeat stopped for good, while the node still sends other messages".into();
+            inc.check = strings(&[
+                "Check whether the master wrote 0x1017 (heartbeat time) or reset it to 0.",
+                "The node's heartbeat task may have hung while the rest runs: check its firmware and error log.",
+                "The master's heartbeat consumer will soon report the node as lost.",
+            ]);
+            inc.why =
+                "The master judges the node by its heartbeat: it may stop the machine although the node runs.".into();
+        }
+        Problem::Silent => {
+            inc.title = "Went silent and never came back".into();
+            inc.check = strings(&[
+                "Check the node's power and status LEDs.",
+                "Check that the CAN connector and cable are not loose or broken.",
+                "If the node was resetting, a boot-up message should follow: record a longer capture.",
+            ]);
+            inc.why = "The node looks switched off, hung, or disconnected from the bus.".into();
+        }
+        Problem::SilentBack => {
+            inc.title = if inc.count == 1 {
+                "Went silent for a while, then came back".into()
+            } else {
+                format!("Went silent {} times, came back each time", inc.count)
+            };
+            inc.check = strings(&[
+                "Look for CAN error frames at the same time: if there are any, suspect wiring or termination.",
+                "Check whether moving the connector reproduces it, and whether the cable runs through moving parts.",
+                "Some firmware stops its heartbeat while busy (e.g. writing flash).",
+            ]);
+            inc.why = "Even a short silence can make the master think the node is gone and stop the machine.".into();
+        }
+        Problem::Rebooted => {
+            inc.title = if inc.count == 1 {
+                "Restarted without being told to".into()
+            } else {
+                format!("Restarted {} times without being told to", inc.count)
+            };
+            inc.check = strings(&[
+                "Check the node's supply voltage for dips (brake release, motor start).",
+                "Check the node's watchdog and error log: a firmware crash restarts it.",
+                "Check for loose power connectors.",
+            ]);
+            inc.why = "A restarted node forgets what the master configured and starts again in pre-operational.".into();
+        }
+        Problem::SdoRefused => {
+            let write = inc.events.first().is_some_and(|e| e.text.starts_with("Write"));
+            inc.title = if write {
+                "A setting was not applied".into()
+            } else {
+                "A value could not be read".into()
+            };
+            if inc.status == Status::Recovered {
+                inc.title.push_str(" (a later try worked)");
+            }
+            inc.check = strings(&[
+                "Compare index, sub-index, data size and access rights with the device manual or EDS.",
+                "Check that the node is in the right state for this object (some are writable only when disabled).",
+                "Fix the master's configuration that sends it, then record a new capture.",
+            ]);
+            inc.why = if write {
+                "The device keeps running with its old or default value.".into()
+            } else {
+                "The master does not know this value.".into()
+            };
+        }
+        Problem::SdoTimeout => {
+            inc.title = format!("{} not answered", plural(inc.count, "SDO request"));
+            inc.check = strings(&[
+                "Check that the request goes to the right node-ID and SDO channel.",
+                "Check the bus load and whether the node is busy (some firmware answers late while writing flash).",
+                "Check the master's SDO timeout against the device manual.",
+            ]);
+            inc.why = "The master cannot tell whether the setting took effect.".into();
+        }
+        Problem::SdoGarbled => {
+            inc.title = format!("Sent SDO frames that make no sense ({})", inc.count);
+            inc.check = vec![
+                "Update or report the node's firmware: its SDO server answers outside the protocol.".into(),
+                format!("Check that no second device answers on node-ID {node}."),
+                "Check the transfer the master was doing at that moment (object, size) against the manual.".into(),
+            ];
+            inc.why = "The transfer fails or, worse, writes wrong data; the master may retry or give up.".into();
+        }
+        Problem::Unmonitored => {
+            inc.title = "Not monitored: heartbeat is off and no node guarding".into();
+            inc.check = strings(&[
+                "Set the heartbeat producer time 0x1017 (e.g. 100 ms) in the master's configuration.",
+                "Or enable node guarding (0x100C/0x100D) if the master uses it.",
+            ]);
+            inc.why = "If this node fails or is unplugged, nothing on the bus tells the master.".into();
+        }
+        Problem::DriveFault => {
+            let cause = match (&inc.cause, emcy) {
+                (Some(c), Some(_)) => lower_first(c.split(" (EMCY").next().unwrap_or(c)),
+                (Some(c), None) => lower_first(c),
+                (None, _) if inc.axes.len() > 1 => "all axes stopped together (no cause reported)".into(),
+                (None, _) => "a fault (no cause reported)".into(),
+            };
+            let failed = resets.saturating_sub(1);
+            inc.title = match inc.status {
+                Status::Recovered if resets > 1 => format!(
+                    "Stopped: {cause} → recovered on reset #{resets} ({})",
+                    plural(u64::from(failed), "failed reset")
+                ),
+                Status::Recovered if resets == 1 => format!("Stopped: {cause} → recovered after a reset"),
+                Status::Recovered => format!("Stopped: {cause} → recovered"),
+                _ if resets > 0 => format!(
+                    "Stopped: {cause}; still in fault at the end ({} did not work)",
+                    plural(u64::from(resets), "fault reset")
+                ),
+                _ => format!("Stopped: {cause}; still in fault at the end"),
+            };
+            let mut check = Vec::new();
+            match emcy {
+                Some(c) => check.push(format!("Look up EMCY 0x{c:04X} in the drive manual's error table.")),
+                None if inc.axes.len() > 1 => {
+                    check.push("Check what stops the whole device: E-stop, STO (safe torque off), power.".into())
+                }
+                None => check.push("The drive sent no EMCY: check its display or error log.".into()),
+            }
+            let axis = inc.axes.first().copied().unwrap_or(1);
+            check.push(format!(
+                "Read the drive's error code 0x{:04X} for the exact cause.",
+                0x603F + 0x800 * (u16::from(axis) - 1)
+            ));
+            check.push("Remove the cause, then reset the fault: controlword 0x80, then 0x06 → 0x07 → 0x0F.".into());
+            inc.check = check;
+            inc.why =
+                "A faulted drive switches the motor torque off and ignores motion commands until the fault is reset."
+                    .into();
+        }
+        Problem::Emcy => {
+            let text = inc.cause.clone().unwrap_or_default();
+            inc.title = match inc.status {
+                Status::Recovered => format!("Reported an error: {text}, later reset"),
+                _ => format!("Reported an error: {text}"),
+            };
+            if inc.count > 1 {
+                inc.title.push_str(&format!(" ({} times)", inc.count));
+            }
+            inc.check = strings(&[
+                "Look up the EMCY code in the device manual's error table.",
+                "Read the node's error register 0x1001 and error history 0x1003.",
+                "A flood of EMCY from one node can also be a faulty device or a node-ID clash.",
+            ]);
+            inc.why = "The node says something is wrong; it may stop or behave differently until it is fixed.".into();
+        }
+        Problem::BusErrors => {
+            let worst = inc.events.iter().rev().find_map(|e| {
+                if e.text.contains("bus off") {
+                    Some("bus off")
+                } else if e.text.contains("error passive") {
+                    Some("error passive")
+                } else {
+                    None
+                }
+            });
+            inc.title = match worst {
+                Some(w) => format!("{} (the controller went {w})", plural(error_frames, "CAN error frame")),
+                None => plural(error_frames, "CAN error frame"),
+            };
+            inc.check = strings(&[
+                "Check for exactly one 120 Ω terminator at each end (about 60 Ω between CAN_H and CAN_L, power off).",
+                "Check that every node uses the same bit rate.",
+                "Check CAN_GND, cable length and the distance from motor power cables.",
+            ]);
+            inc.why = "Bus errors cause retransmissions or lost messages, seen as heartbeat gaps or SDO failures; bus off stops sending altogether."
+                .into();
+        }
+        Problem::DuplicateId => {
+            inc.title = "Two devices seem to use the same node-ID".into();
+            inc.check = vec![
+                format!("Check the node-ID switches or settings of every device: two have {node}."),
+                "Disconnect devices one by one and watch which boot-ups or heartbeats remain.".into(),
+            ];
+            inc.why = "Two devices on one ID answer each other's requests and collide on the bus.".into();
+        }
+        Problem::NmtIgnored => {
+            inc.title = match inc.status {
+                Status::Open => "Did not follow an NMT command".into(),
+                _ => "Followed an NMT command late".into(),
+            };
+            inc.check = strings(&[
+                "Check that the command addresses the right node-ID.",
+                "Check the node's error state: some devices refuse to start while they have an error.",
+                "Check the device manual for conditions on NMT start (e.g. a required parameter set).",
+            ]);
+            inc.why =
+                "The master thinks the node is in one state while it is in another: PDOs may not be sent or used."
+                    .into();
+        }
+    }
+}
