@@ -100,17 +100,9 @@ pub fn run(args: &DecodeArgs) -> i32 {
     let mut summary = Summary::default();
     let mut status = EXIT_OK;
     for path in &args.files {
-        let input: Box<dyn BufRead + Send> = if path == "-" {
-            Box::new(BufReader::with_capacity(1 << 16, io::stdin()))
-        } else {
-            match std::fs::File::open(path) {
-                Ok(f) => Box::new(BufReader::with_capacity(1 << 16, f)),
-                Err(e) => {
-                    eprintln!("cotui decode: {path}: {e}");
-                    status = EXIT_UNAVAILABLE;
-                    continue;
-                }
-            }
+        let Some(input) = open_input(path, "decode") else {
+            status = EXIT_UNAVAILABLE;
+            continue;
         };
         let mut sinks = Sinks {
             summary: &mut summary,
@@ -222,6 +214,21 @@ fn decode_stream(
     }
     report_counts(path, &finished.counts);
     Ok(())
+}
+
+/// A log to read: stdin for `-`, else the file; `None` (with the message on stderr, `what`
+/// naming the command) when it cannot be opened.
+pub fn open_input(path: &str, what: &str) -> Option<Box<dyn BufRead + Send>> {
+    if path == "-" {
+        return Some(Box::new(BufReader::with_capacity(1 << 16, io::stdin())));
+    }
+    match std::fs::File::open(path) {
+        Ok(f) => Some(Box::new(BufReader::with_capacity(1 << 16, f))),
+        Err(e) => {
+            eprintln!("cotui {what}: {path}: {e}");
+            None
+        }
+    }
 }
 
 /// Prints what a reader skipped or could not read in `path` (nothing when every line was a frame).

@@ -6,7 +6,7 @@ use crate::frame::Interfaces;
 use crate::log::Outcome;
 use crate::output::pcapng::PcapngWriter;
 use crate::read_ahead;
-use std::io::{self, BufRead, BufReader, IsTerminal, Write};
+use std::io::{self, BufRead, IsTerminal, Write};
 
 /// The output stream: `path` (`None` or `-` is stdout). Binary output is refused when
 /// it would go to a terminal.
@@ -52,17 +52,9 @@ pub fn pcapng(args: &DecodeArgs) -> i32 {
     };
     let mut status = EXIT_OK;
     for path in &args.files {
-        let input: Box<dyn BufRead + Send> = if path == "-" {
-            Box::new(BufReader::with_capacity(1 << 16, io::stdin()))
-        } else {
-            match std::fs::File::open(path) {
-                Ok(f) => Box::new(BufReader::with_capacity(1 << 16, f)),
-                Err(e) => {
-                    eprintln!("cotui decode: {path}: {e}");
-                    status = EXIT_UNAVAILABLE;
-                    continue;
-                }
-            }
+        let Some(input) = super::decode::open_input(path, "decode") else {
+            status = EXIT_UNAVAILABLE;
+            continue;
         };
         if let Err(e) = write_stream(path, input, &mut w) {
             if e.kind() == io::ErrorKind::BrokenPipe {

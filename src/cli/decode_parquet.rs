@@ -13,7 +13,7 @@ use crate::od::Dictionary;
 use crate::output::parquet::{Col, Table, Ty, V};
 use crate::read_ahead;
 use std::fs::File;
-use std::io::{self, BufRead, BufReader, BufWriter, Write};
+use std::io::{self, BufRead, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 const fn col(name: &'static str, ty: Ty, null: bool) -> Col {
@@ -131,17 +131,9 @@ pub fn run(args: &DecodeArgs) -> i32 {
     let mut status = EXIT_OK;
     let mut last_file = String::new();
     for path in &args.files {
-        let input: Box<dyn BufRead + Send> = if path == "-" {
-            Box::new(BufReader::with_capacity(1 << 16, io::stdin()))
-        } else {
-            match File::open(path) {
-                Ok(f) => Box::new(BufReader::with_capacity(1 << 16, f)),
-                Err(e) => {
-                    eprintln!("cotui decode: {path}: {e}");
-                    status = EXIT_UNAVAILABLE;
-                    continue;
-                }
-            }
+        let Some(input) = super::decode::open_input(path, "decode") else {
+            status = EXIT_UNAVAILABLE;
+            continue;
         };
         last_file.clone_from(path);
         if let Err(e) = write_stream(path, input, &mut decoder, &mut frames, &mut values) {

@@ -7,7 +7,7 @@ use crate::frame::{Frame, Interfaces};
 use crate::log::Outcome;
 use crate::read_ahead;
 use clap::{Args, ValueEnum};
-use std::io::{self, BufRead, BufReader, Write};
+use std::io::{self, Write};
 
 /// Output formats of `cotui diagnose`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -51,17 +51,9 @@ pub fn run(args: &DiagnoseArgs) -> i32 {
     let mut diag = Diagnoser::new(EventTracker::new(|n| decoder.dictionary(n)));
     let mut status = EXIT_OK;
     for path in &args.files {
-        let input: Box<dyn BufRead + Send> = if path == "-" {
-            Box::new(BufReader::with_capacity(1 << 16, io::stdin()))
-        } else {
-            match std::fs::File::open(path) {
-                Ok(f) => Box::new(BufReader::with_capacity(1 << 16, f)),
-                Err(e) => {
-                    eprintln!("cotui diagnose: {path}: {e}");
-                    status = EXIT_UNAVAILABLE;
-                    continue;
-                }
-            }
+        let Some(input) = super::decode::open_input(path, "diagnose") else {
+            status = EXIT_UNAVAILABLE;
+            continue;
         };
         let mut ifaces = Interfaces::default();
         let result = read_ahead::for_each_batch(input, |batch| -> io::Result<()> {
