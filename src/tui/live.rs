@@ -234,7 +234,7 @@ impl Jobs {
                                 report.nodes.iter().filter(|n| n.stopped).for_each(|n| c.forget(n.node));
                             }
                             let level = if report.all_stopped() { Level::Info } else { Level::Warn };
-                            (level, report.text())
+                            (level, format!("stop all: {}", report.text()))
                         }
                         Err(e) => (Level::Error, e.to_string()),
                     };
