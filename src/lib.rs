@@ -5,18 +5,16 @@
 //! command line live at the edges and call into it.
 
 pub mod analysis;
+pub mod bench;
 pub mod bus;
 pub mod cli;
 pub mod command;
+pub mod connect;
 pub mod decode;
 pub mod frame;
-pub mod hex;
 pub mod log;
 pub mod od;
 pub mod output;
-pub mod read_ahead;
-pub mod sdo_client;
-pub mod sdo_server;
+pub mod sdo;
 pub mod sim;
-pub mod synth;
 pub mod tui;

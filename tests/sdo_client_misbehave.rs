@@ -1,7 +1,7 @@
 //! The pure SDO client against servers that misbehave: every transfer ends, with the
 //! abort frame on the bus and the reason, however the server breaks the protocol.
 
-use cotui::sdo_client::{ClientConfig, ClientOutput, Completion, Mode, SdoClient, SdoError};
+use cotui::sdo::client::{ClientConfig, ClientOutput, Completion, Mode, SdoClient, SdoError};
 
 const MS: u64 = 1_000_000;
 

@@ -3,8 +3,8 @@
 
 use cotui::decode::sdo::{Outcome, Problem, Protocol, SdoTracker, Transaction, TransferDirection};
 use cotui::od::{Access, DataType, Dictionary, ObjectInfo, Profile, Value};
-use cotui::sdo_client::{ClientConfig, Completion, Mode, SdoClient, SdoError};
-use cotui::sdo_server::{MemoryStore, ObjectStore, SdoServer, ServerConfig, ServerEvent};
+use cotui::sdo::client::{ClientConfig, Completion, Mode, SdoClient, SdoError};
+use cotui::sdo::server::{MemoryStore, ObjectStore, SdoServer, ServerConfig, ServerEvent};
 use std::sync::Arc;
 
 const NODE: u8 = 5;

@@ -4,8 +4,8 @@
 
 use cotui::decode::sdo::{Outcome, Protocol as P, SdoTracker, Transaction};
 use cotui::od::{Access, Dictionary};
-use cotui::sdo_client::{ClientConfig, Completion, Mode, SdoClient};
-use cotui::sdo_server::{MemoryStore, SdoServer, ServerConfig};
+use cotui::sdo::client::{ClientConfig, Completion, Mode, SdoClient};
+use cotui::sdo::server::{MemoryStore, SdoServer, ServerConfig};
 use proptest::prelude::*;
 use std::collections::HashSet;
 

@@ -233,15 +233,15 @@ fn aqmd_and_dexmart_pdo_commands() {
 /// writable 3003h sub 1 (03-01), nothing else. Gives the bus end for the commander.
 fn dexmart_peer() -> cotui::bus::Bus {
     use cotui::od::Access;
-    let mut store = cotui::sdo_server::MemoryStore::default();
+    let mut store = cotui::sdo::server::MemoryStore::default();
     store.insert(0x3000, 0x0A, Access::Ro, Some(2), vec![0x6E, 0x09]);
     store.insert(0x3003, 0x01, Access::Rw, Some(2), vec![0, 0]);
     sdo_peer(store)
 }
 
 /// An SDO server on node 1 of a virtual bus answering from `store`; gives the commander's end.
-fn sdo_peer(mut store: cotui::sdo_server::MemoryStore) -> cotui::bus::Bus {
-    use cotui::sdo_server::{SdoServer, ServerConfig};
+fn sdo_peer(mut store: cotui::sdo::server::MemoryStore) -> cotui::bus::Bus {
+    use cotui::sdo::server::{SdoServer, ServerConfig};
     let vbus = cotui::bus::virt::VirtualBus::new("vcan-test");
     let peer = vbus.endpoint(false);
     let mut rx = peer.subscribe();
@@ -499,7 +499,7 @@ fn aimotor_sdo_procedures_match_section_4_and_2_3() {
 /// and fails with "homing error" (exit 5) when bit 13 is set.
 async fn aimotor_homing(sw: u16) -> Result<serde_json::Value, cotui::command::CommandError> {
     use cotui::od::Access;
-    let mut store = cotui::sdo_server::MemoryStore::default();
+    let mut store = cotui::sdo::server::MemoryStore::default();
     for (index, sub, size) in [
         (0x6060, 0, 1),
         (0x6098, 0, 1),

@@ -1,13 +1,22 @@
-//! Analyses over the decoded stream that span many frames: node liveness, the bus events
-//! derived from it, and the incidents a diagnosis makes of them. Pure like the decoders:
+//! Analyses over the decoded stream that span many frames, usable without a terminal:
+//! the trace store and its filtered views, the node table, statistics and plot series
+//! (what the TUI panes show), node liveness, the bus events derived from it, and the
+//! incidents a diagnosis makes of them. Pure like the decoders:
 //! frames and their timestamps in, typed events and incidents out; time only advances
 //! through frame timestamps and explicit ticks.
 
 pub mod diagnose;
 pub mod events;
+pub mod filter;
 pub mod incident;
 pub mod liveness;
+pub mod nodes;
+pub mod series;
+pub mod stats;
+pub mod store;
 mod texts;
+pub mod trace;
+pub mod view;
 
 pub use diagnose::Diagnoser;
 pub use events::{Event, PeriodSource, What};

@@ -250,17 +250,3 @@ impl Subscription {
         }
     }
 }
-
-/// Opens `iface`: `demo` gives a fresh virtual bus with the simulated drives
-/// (see [`crate::sim::demo`]), anything else is a SocketCAN interface.
-/// Must be called inside a tokio runtime.
-pub async fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
-    if iface == DEMO {
-        Ok(crate::sim::demo::start(listen_only))
-    } else {
-        socketcan::open(iface, listen_only)
-    }
-}
-
-/// The interface name of the in-process simulated bus.
-pub const DEMO: &str = "demo";

@@ -83,7 +83,7 @@ fn kind_of(message: &str) -> String {
 /// seed profiles they are built after (unless the user bound others to those nodes) and
 /// their start-up PDO mappings are known, so PDOs decode from the first frame.
 pub fn bindings_on(iface: &str, profiles: &[String], eds: &[String]) -> Result<Bindings, String> {
-    if iface != crate::bus::DEMO {
+    if iface != crate::connect::DEMO {
         return bindings(profiles, eds);
     }
     let mut profiles = profiles.to_vec();

@@ -38,7 +38,7 @@ where
         }
     };
     let result = rt.block_on(async {
-        let bus = crate::bus::open(&args.iface, args.listen_only).await?;
+        let bus = crate::connect::open(&args.iface, args.listen_only).await?;
         body(bus).await
     });
     report(args, what, result)

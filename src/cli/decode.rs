@@ -5,8 +5,8 @@ use crate::analysis::EventTracker;
 use crate::decode::{Decoder, Kind, sdo::Transaction};
 use crate::frame::{Frame, Interfaces};
 use crate::log::Outcome;
+use crate::log::read_ahead;
 use crate::output::{jsonl, summary::Summary, text};
-use crate::read_ahead;
 use clap::{Args, ValueEnum};
 use std::io::{self, BufRead, BufReader, Write};
 

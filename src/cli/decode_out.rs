@@ -4,8 +4,8 @@ use super::decode::DecodeArgs;
 use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
 use crate::frame::Interfaces;
 use crate::log::Outcome;
+use crate::log::read_ahead;
 use crate::output::pcapng::PcapngWriter;
-use crate::read_ahead;
 use std::io::{self, BufRead, IsTerminal, Write};
 
 /// The output stream: `path` (`None` or `-` is stdout). Binary output is refused when

@@ -5,7 +5,7 @@ use crate::analysis::{Diagnoser, EventTracker, Incident, Status};
 use crate::decode::Kind;
 use crate::frame::{Frame, Interfaces};
 use crate::log::Outcome;
-use crate::read_ahead;
+use crate::log::read_ahead;
 use clap::{Args, ValueEnum};
 use std::io::{self, Write};
 

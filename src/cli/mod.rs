@@ -1,7 +1,5 @@
 //! The command line: clap definitions and one module per subcommand.
 
-pub mod bench;
-mod bench_tui;
 pub mod bind;
 pub mod commander;
 pub mod decode;
@@ -53,7 +51,7 @@ pub enum Command {
     /// What went wrong on the bus, in plain words: incidents with cause, timeline and what to check.
     Diagnose(diagnose::DiagnoseArgs),
     /// Print throughput and memory figures of the decoder on a generated log.
-    Bench(bench::BenchArgs),
+    Bench(crate::bench::BenchArgs),
     /// Open a log in the interactive analyzer (loads at once; browse, filter, search).
     Open(tui::OpenArgs),
     /// Replay a log in the interactive analyzer, paced by its timestamps.
@@ -110,7 +108,7 @@ pub fn run() -> i32 {
         }
         Some(Command::Decode(args)) => decode::run(&args),
         Some(Command::Diagnose(args)) => diagnose::run(&args),
-        Some(Command::Bench(args)) => bench::run(&args),
+        Some(Command::Bench(args)) => crate::bench::run(&args),
         Some(Command::Open(args)) => tui::run_open(&args),
         Some(Command::Replay(args)) => tui::run_replay(&args),
         Some(Command::Live(args)) => tui::run_live(&args),

@@ -118,7 +118,7 @@ async fn capture(
         handler(SignalKind::hangup())?,
         handler(SignalKind::quit())?,
     ];
-    let bus = crate::bus::open(&args.iface, args.listen_only).await?;
+    let bus = crate::connect::open(&args.iface, args.listen_only).await?;
     let mut out = open_output(path, mode)?;
     let [int, term, hup, quit] = &mut signals;
     let stop = async {

@@ -1,10 +1,10 @@
 //! `cotui open FILE` and `cotui replay FILE`: the interactive analyzer on a log.
 
 use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
+use crate::analysis::trace::Trace;
 use crate::tui::app::{App, SourceInfo, SourceKind};
 use crate::tui::keymap::{self, Keymap, KeymapError};
 use crate::tui::source;
-use crate::tui::trace::Trace;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -239,8 +239,8 @@ pub fn run_demo(args: &DemoArgs) -> i32 {
     let kind = SourceKind::Demo {
         listen_only: args.listen_only,
     };
-    let feed = Feeding::Live(crate::bus::DEMO.to_string(), args.listen_only);
-    start(&args.ui, crate::bus::DEMO, kind, feed)
+    let feed = Feeding::Live(crate::connect::DEMO.to_string(), args.listen_only);
+    start(&args.ui, crate::connect::DEMO, kind, feed)
 }
 
 #[cfg(test)]

@@ -70,7 +70,7 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
                 "name": dict.name(index, sub),
                 "value": value.to_json(),
                 "text": text,
-                "data": crate::hex::upper(&data),
+                "data": crate::frame::hex::upper(&data),
                 "len": data.len(),
             })
         }
@@ -91,7 +91,7 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
                 "index": index,
                 "sub": sub,
                 "name": dict.name(index, sub),
-                "data": crate::hex::upper(&data),
+                "data": crate::frame::hex::upper(&data),
                 "len": data.len(),
             })
         }

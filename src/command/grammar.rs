@@ -124,7 +124,7 @@ pub struct SdoOptions {
     /// `--timeout`: ms to wait for each server response.
     pub timeout_ms: u64,
     /// `--deadline`: ms the whole transfer may take (`None`: the client's default, see
-    /// [`crate::sdo_client::ClientConfig::default_deadline_ns`]).
+    /// [`crate::sdo::client::ClientConfig::default_deadline_ns`]).
     pub deadline_ms: Option<u64>,
 }
 

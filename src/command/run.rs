@@ -8,7 +8,7 @@ use super::value::{decode, encode};
 use crate::bus::{Bus, BusError};
 use crate::decode::value_text::object_text;
 use crate::frame::Frame;
-use crate::hex;
+use crate::frame::hex;
 use crate::od::alias::resolve_object;
 use crate::od::procedure::{NmtCommand, Procedure, Step, fill_object, frame_bytes};
 use crate::od::{DataType, Dictionary};

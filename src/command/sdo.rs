@@ -9,7 +9,7 @@
 use super::error::CommandError;
 use crate::bus::{Bus, BusError, Subscription};
 use crate::frame::{Direction, Frame};
-use crate::sdo_client::{ClientConfig, Completion, Mode, SdoClient, SdoError};
+use crate::sdo::client::{ClientConfig, Completion, Mode, SdoClient, SdoError};
 use std::time::Duration;
 
 /// How long an SDO transfer may take.

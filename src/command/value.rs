@@ -59,10 +59,12 @@ pub fn parse_hex(text: &str) -> Result<Vec<u8>, String> {
     }
     digits
         .chunks(2)
-        .map(|p| match (crate::hex::nibble(p[0]), crate::hex::nibble(p[1])) {
-            (Some(h), Some(l)) => Ok(h << 4 | l),
-            _ => Err(format!("`{text}` is not hex")),
-        })
+        .map(
+            |p| match (crate::frame::hex::nibble(p[0]), crate::frame::hex::nibble(p[1])) {
+                (Some(h), Some(l)) => Ok(h << 4 | l),
+                _ => Err(format!("`{text}` is not hex")),
+            },
+        )
         .collect()
 }
 

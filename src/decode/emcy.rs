@@ -48,7 +48,7 @@ impl Emcy {
         }
         if self.mfr_fields.is_empty() {
             if self.mfr != [0; 5] {
-                s.push_str(&format!("; mfr {}", crate::hex::spaced(&self.mfr)));
+                s.push_str(&format!("; mfr {}", crate::frame::hex::spaced(&self.mfr)));
             }
         } else {
             let fields: Vec<String> = self.mfr_fields.iter().map(|(k, v)| format!("{k}={v}")).collect();
@@ -68,7 +68,7 @@ impl Emcy {
             "text": self.text,
             "register": self.register,
             "register_bits": self.register_bits(),
-            "mfr": crate::hex::upper(&self.mfr),
+            "mfr": crate::frame::hex::upper(&self.mfr),
             "mfr_fields": fields,
         })
     }

@@ -34,12 +34,12 @@ impl Pdo {
     pub fn label(&self, node: u8, payload: &[u8]) -> String {
         let mut s = String::with_capacity(64);
         s.push_str(if self.transmit { "TPDO" } else { "RPDO" });
-        crate::hex::push_decimal(&mut s, self.num as u64, 1);
+        crate::frame::hex::push_decimal(&mut s, self.num as u64, 1);
         s.push_str(" node ");
-        crate::hex::push_decimal(&mut s, node as u64, 1);
+        crate::frame::hex::push_decimal(&mut s, node as u64, 1);
         s.push_str(": ");
         if self.signals.is_empty() {
-            crate::hex::push_spaced(&mut s, payload);
+            crate::frame::hex::push_spaced(&mut s, payload);
         }
         for (i, sig) in self.signals.iter().enumerate() {
             if i > 0 {

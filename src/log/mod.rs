@@ -9,6 +9,7 @@
 pub mod asc;
 pub mod candump;
 mod lex;
+pub mod read_ahead;
 pub mod screen;
 pub mod sink;
 pub mod writer;

@@ -265,7 +265,7 @@ impl Importer<'_> {
                     digits
                         .as_bytes()
                         .chunks(2)
-                        .filter_map(|p| Some(crate::hex::nibble(p[0])? << 4 | crate::hex::nibble(p[1])?))
+                        .filter_map(|p| Some(crate::frame::hex::nibble(p[0])? << 4 | crate::frame::hex::nibble(p[1])?))
                         .collect(),
                 )
             }

@@ -195,7 +195,7 @@ impl Value {
                 .map(Into::into)
                 .unwrap_or(serde_json::Value::Null),
             Value::Text(s) => s.clone().into(),
-            Value::Bytes(b) => crate::hex::upper(b).into(),
+            Value::Bytes(b) => crate::frame::hex::upper(b).into(),
         }
     }
 }
@@ -208,7 +208,7 @@ impl fmt::Display for Value {
             Value::Signed(i) => write!(f, "{i}"),
             Value::Float(x) => write!(f, "{x}"),
             Value::Text(s) => write!(f, "{}", quoted(s)),
-            Value::Bytes(b) => write!(f, "{}", crate::hex::spaced(b)),
+            Value::Bytes(b) => write!(f, "{}", crate::frame::hex::spaced(b)),
         }
     }
 }

@@ -69,7 +69,7 @@ pub fn write_frame(out: &mut String, line: u64, frame: &Frame, ifaces: &Interfac
     push_bool(out, ",\"fd\":", frame.is_fd());
     push_bool(out, ",\"err\":", frame.is_err());
     let _ = write!(out, ",\"len\":{},\"data\":\"", frame.len);
-    crate::hex::push_upper(out, frame.payload());
+    crate::frame::hex::push_upper(out, frame.payload());
     out.push_str("\",\"dir\":");
     out.push_str(if frame.flags.has(Flags::TX) { "\"tx\"" } else { "\"rx\"" });
     out.push_str(",\"kind\":\"");

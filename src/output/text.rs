@@ -3,7 +3,7 @@
 use crate::decode::Decoded;
 use crate::frame::{Frame, Interfaces};
 
-use crate::hex::{push_decimal, push_hex};
+use crate::frame::hex::{push_decimal, push_hex};
 
 /// Spaces for column padding.
 const PADDING: &str = "                                ";
@@ -43,7 +43,7 @@ pub fn write_line(out: &mut String, frame: &Frame, ifaces: &Interfaces, decoded:
     if frame.is_rtr() {
         out.push_str("remote request");
     } else {
-        crate::hex::push_spaced(out, frame.payload());
+        crate::frame::hex::push_spaced(out, frame.payload());
         if frame.len > 0 {
             out.push(' ');
         }

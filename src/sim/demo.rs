@@ -24,7 +24,7 @@ pub struct Demo {
 impl Demo {
     /// Starts `sim` on a new virtual bus called `demo`. Must be called inside a tokio runtime.
     pub fn spawn(sim: Simulation, listen_only: bool) -> Demo {
-        let vbus = VirtualBus::new(crate::bus::DEMO);
+        let vbus = VirtualBus::new(crate::connect::DEMO);
         let node_side = vbus.endpoint(false);
         let sim = Arc::new(Mutex::new(sim));
         // Subscribe before the task starts so no frame sent from now on is missed.

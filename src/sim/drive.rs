@@ -8,7 +8,7 @@ use super::od::DeviceObjects;
 use super::profile;
 use crate::decode::cia402::DriveState;
 use crate::frame::Frame;
-use crate::sdo_server::{SdoServer, ServerConfig};
+use crate::sdo::server::{SdoServer, ServerConfig};
 
 /// NMT state of a simulated node.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -6,6 +6,7 @@ pub mod demo;
 pub mod drive;
 pub mod od;
 pub mod profile;
+pub mod synth;
 
 use crate::decode::pdo::entry_from_u32;
 use crate::frame::Frame;

@@ -3,7 +3,7 @@
 
 use crate::decode::sdo::abort::codes;
 use crate::od::{Access, DataType};
-use crate::sdo_server::ObjectStore;
+use crate::sdo::server::ObjectStore;
 use std::collections::BTreeMap;
 
 /// One entry of a simulated object dictionary.

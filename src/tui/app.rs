@@ -1,7 +1,6 @@
 //! The application state and what every action does to it. Pure state transitions:
 //! no terminal here, so tests drive it directly.
 
-use super::filter::Filter;
 use super::keymap::{Action, Key, Keymap, Lookup};
 use super::live::{Request, Requests};
 use super::messages::{Level, Messages};
@@ -9,8 +8,9 @@ use super::palette::{self, COMMANDER_WORDS, Planned};
 use super::prompt::{Prompt, PromptKind};
 use super::rows::{Row, RowCache};
 use super::source::{Control, Feed};
-use super::trace::Trace;
-use super::view::View;
+use crate::analysis::filter::Filter;
+use crate::analysis::trace::Trace;
+use crate::analysis::view::View;
 use crate::command::Command;
 use crate::command::stop::{Commanded, StopOptions, is_powered};
 use crate::decode::Decoded;

@@ -1,8 +1,8 @@
 //! Export of the trace view (the rows the filter in force shows) to a file: candump `-l`,
 //! JSON lines (decoded, as `cotui decode --format jsonl`) or pcapng for Wireshark.
 
-use super::trace::Trace;
-use super::view::View;
+use crate::analysis::trace::Trace;
+use crate::analysis::view::View;
 use crate::log::writer::LogWriter;
 use crate::output::jsonl;
 use crate::output::pcapng::PcapngWriter;
@@ -89,8 +89,8 @@ pub fn export(trace: &Trace, view: &View, path: &Path, format: ExportFormat, for
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::analysis::filter::Filter;
     use crate::log::{LogReader, Outcome};
-    use crate::tui::filter::Filter;
     use crate::tui::panes::testutil::{app, frames};
     use std::time::Duration;
 

@@ -5,7 +5,7 @@
 
 use super::messages::Level;
 use super::source::Feed;
-use crate::bus::{self, Bus, BusError, BusState, Event, StateChange};
+use crate::bus::{Bus, BusError, BusState, Event, StateChange};
 use crate::command::stop::{Commanded, StopOptions, stop_nodes};
 use crate::command::{self, Command};
 use crate::decode::cia402::DriveState;
@@ -85,7 +85,7 @@ async fn capture(
     }
     let mut jobs = Jobs::default();
     let bus = loop {
-        match bus::open(&iface, listen_only).await {
+        match crate::connect::open(&iface, listen_only).await {
             Ok(b) => break b,
             Err(e) => {
                 if tx.send(Feed::BusError(e.to_string())).is_err() {

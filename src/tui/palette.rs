@@ -5,7 +5,7 @@ use super::live::UNKNOWN_STATE;
 use crate::command::run::Action;
 use crate::command::{Command, DriveAction, NmtAction, RunSpec, parse_command};
 use crate::decode::cia402::DriveState;
-use crate::hex;
+use crate::frame::hex;
 use crate::od::alias::resolve_object;
 use crate::od::bind::Bindings;
 

@@ -4,9 +4,9 @@
 //! new frames are kept; new positions are decoded by a decoder that goes on from where the
 //! last window ended, so following the tail decodes only the new frames.
 
-use super::trace::Trace;
+use crate::analysis::trace::Trace;
 use crate::decode::{Decoder, Kind};
-use crate::hex;
+use crate::frame::hex;
 use std::collections::HashMap;
 
 /// One formatted row.

@@ -298,7 +298,7 @@ mod tests {
         impl TempLog {
             pub fn new(frames: u64) -> TempLog {
                 let p = std::env::temp_dir().join(format!("cotui-src-{}-{frames}.log", std::process::id()));
-                crate::cli::bench::write_log(&p, frames).unwrap();
+                crate::bench::log::write_log(&p, frames).unwrap();
                 TempLog(p)
             }
         }

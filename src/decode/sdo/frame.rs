@@ -6,7 +6,7 @@
 
 use super::abort::abort_text;
 use super::value::{ValueView, segment_text};
-use crate::hex;
+use crate::frame::hex;
 use serde_json::{Value as Json, json};
 
 /// Which end of an SDO channel sent a frame.

@@ -2,7 +2,7 @@
 
 use super::frame::Side;
 use super::value::view_in_mode;
-use crate::hex;
+use crate::frame::hex;
 use crate::od::Dictionary;
 use serde_json::{Value as Json, json};
 use std::fmt;

@@ -1,6 +1,6 @@
 //! Object values as SDO labels and JSON show them, typed through the dictionary.
 
-use crate::hex;
+use crate::frame::hex;
 use crate::od::{Dictionary, Value};
 
 /// A value ready for a label and for JSON.

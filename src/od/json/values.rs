@@ -68,7 +68,7 @@ pub(super) fn hex_bytes(s: &str) -> Option<Vec<u8>> {
     }
     digits
         .chunks(2)
-        .map(|p| Some(crate::hex::nibble(p[0])? << 4 | crate::hex::nibble(p[1])?))
+        .map(|p| Some(crate::frame::hex::nibble(p[0])? << 4 | crate::frame::hex::nibble(p[1])?))
         .collect()
 }
 

@@ -161,7 +161,7 @@ fn frame_lines(app: &App, f: &Frame, d: &Decoded, pos: usize) -> Vec<Line<'stati
                 e.register,
                 e.register_bits().join(", ")
             )));
-            v.push(Line::raw(format!("manufacturer {}", crate::hex::spaced(&e.mfr))));
+            v.push(Line::raw(format!("manufacturer {}", crate::frame::hex::spaced(&e.mfr))));
             for (k, val) in &e.mfr_fields {
                 v.push(Line::raw(format!("  {k} = {val}")));
             }
@@ -194,7 +194,7 @@ fn transaction_lines(app: &App, t: &Transaction) -> Vec<Line<'static>> {
             t.frames.len(),
             duration(t.duration_ns() as f64 / 1e9)
         )),
-        Line::raw(format!("data {}", crate::hex::spaced(&t.data))),
+        Line::raw(format!("data {}", crate::frame::hex::spaced(&t.data))),
     ];
     if let Outcome::Aborted { code, text, by } = &t.outcome {
         v.push(Line::styled(
@@ -250,7 +250,8 @@ mod tests {
     #[test]
     fn sdo_controlword_and_statusword_values_are_broken_into_bits() {
         let mut a = crate::tui::panes::testutil::app();
-        let mut t = crate::tui::trace::Trace::new(crate::decode::Decoder::new(Default::default(), Vec::new()), 500_000);
+        let mut t =
+            crate::analysis::trace::Trace::new(crate::decode::Decoder::new(Default::default(), Vec::new()), 500_000);
         for (id, data) in [
             (0x602u32, [0x2B, 0x40, 0x60, 0x00, 0x0F, 0x00, 0, 0]),
             (0x602, [0x40, 0x41, 0x60, 0x00, 0, 0, 0, 0]),

@@ -75,12 +75,12 @@ pub fn fit(s: &str, width: usize) -> String {
 #[cfg(test)]
 pub(crate) mod testutil {
     //! Helpers for the pane rendering tests.
+    use crate::analysis::trace::Trace;
     use crate::decode::Decoder;
     use crate::frame::Frame;
     use crate::od::Dictionary;
     use crate::tui::app::{App, SourceInfo, SourceKind};
     use crate::tui::keymap::Keymap;
-    use crate::tui::trace::Trace;
     use ratatui::Terminal;
     use ratatui::backend::TestBackend;
 

@@ -4,10 +4,10 @@
 
 use super::{block, duration, fit, header, selected};
 use crate::analysis::NodeLiveness;
+use crate::analysis::nodes::NodeInfo;
 use crate::decode::cia402::mode_name;
 use crate::decode::heartbeat::NmtState;
 use crate::tui::app::App;
-use crate::tui::nodes::NodeInfo;
 use ratatui::Frame;
 use ratatui::layout::Rect;
 use ratatui::style::{Color, Modifier, Style};

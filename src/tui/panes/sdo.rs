@@ -83,7 +83,7 @@ pub fn render(app: &App, f: &mut Frame, area: Rect, focused: bool) {
                     "{:>12.6} {:03X} {:<23} {}",
                     fr.ts_ns.saturating_sub(t0) as f64 / 1e9,
                     fr.id,
-                    crate::hex::spaced(fr.payload()),
+                    crate::frame::hex::spaced(fr.payload()),
                     d.label
                 );
                 let line = Line::raw(fit(&text, inner.width as usize));

@@ -380,7 +380,7 @@ impl SdoClient {
             let reason = format!(
                 "the server sent a {}-byte answer ({}); SDO frames have 8 bytes",
                 payload.len(),
-                crate::hex::spaced(payload)
+                crate::frame::hex::spaced(payload)
             );
             self.protocol_error(&mut out, codes::UNKNOWN_COMMAND, reason)
         } else {

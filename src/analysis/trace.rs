@@ -196,7 +196,7 @@ mod tests {
     #[test]
     fn window_labels_equal_a_full_sequential_decode() {
         let mut t = Trace::new(decoder(), 500_000);
-        let frames: Vec<Frame> = crate::synth::Traffic::new(3 * CHECKPOINT as u64 + 77, 0).collect();
+        let frames: Vec<Frame> = crate::sim::synth::Traffic::new(3 * CHECKPOINT as u64 + 77, 0).collect();
         for f in &frames {
             t.push(f);
         }

@@ -6,11 +6,11 @@
 //! can-utils' `log2asc` on the same log (the baseline) and the targets, and, for the
 //! diagnosis, `canopen-lens` when installed.
 
-use super::{EXIT_OK, EXIT_UNAVAILABLE};
-use crate::log::writer::LogWriter;
-use crate::synth::Traffic;
+pub mod log;
+mod tui;
+
+use crate::cli::{EXIT_OK, EXIT_UNAVAILABLE};
 use clap::Args;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Instant;
@@ -39,8 +39,6 @@ const ROUNDS: usize = 5;
 const STARTUP_RUNS: usize = 21;
 /// Target start-up time (ms).
 const STARTUP_TARGET_MS: f64 = 3.0;
-/// One garbage line (tool chatter the decoder must skip) every this many frames.
-const GARBAGE_EVERY: u64 = 5_000;
 
 /// One way of running the decoder, and its measurements.
 struct Run {
@@ -84,43 +82,6 @@ fn median(v: &[f64]) -> f64 {
     v.sort_by(f64::total_cmp);
     v.get(v.len() / 2).copied().unwrap_or(0.0)
 }
-
-/// Writes a candump `-l` log of `frames` synthetic frames to `path`.
-pub fn write_log(path: &Path, frames: u64) -> std::io::Result<()> {
-    write_frames(path, frames, None)
-}
-
-/// Writes the bench log: `frames` synthetic frames with a garbage line (a tool's
-/// message, as in logs captured by hand) every [`GARBAGE_EVERY`] frames.
-fn write_bench_log(path: &Path, frames: u64) -> std::io::Result<()> {
-    write_frames(path, frames, Some(GARBAGE_EVERY))
-}
-
-fn write_frames(path: &Path, frames: u64, garbage_every: Option<u64>) -> std::io::Result<()> {
-    let file = std::fs::File::create(path)?;
-    let mut out = std::io::BufWriter::with_capacity(1 << 20, file);
-    let mut writer = LogWriter::new();
-    let mut line = String::with_capacity(1 << 16);
-    for (i, frame) in Traffic::new(frames, 1_700_000_000_000_000_000).enumerate() {
-        if garbage_every.is_some_and(|g| i as u64 % g == g - 1) {
-            line.push_str(GARBAGE[i / 5_000 % GARBAGE.len()]);
-        }
-        writer.write_line(&mut line, &frame, "can0");
-        if line.len() > 1 << 15 {
-            out.write_all(line.as_bytes())?;
-            line.clear();
-        }
-    }
-    out.write_all(line.as_bytes())?;
-    out.flush()
-}
-
-/// Lines found in hand-captured logs that are not frames (log2asc skips them too).
-const GARBAGE: [&str; 3] = [
-    "candump: interface can0 down\n",
-    "# restarted capture after bus-off\n",
-    "read: Network is down\n",
-];
 
 /// Runs `program args`, discarding output; returns wall seconds and peak RSS (KiB).
 fn measure(program: &Path, args: &[&str]) -> std::io::Result<(f64, u64)> {
@@ -172,10 +133,10 @@ pub fn run(args: &BenchArgs) -> i32 {
 
 fn bench(args: &BenchArgs) -> std::io::Result<()> {
     if let Some(path) = &args.write_log {
-        return write_bench_log(path, args.frames);
+        return log::write_bench_log(path, args.frames);
     }
     if args.tui {
-        return super::bench_tui::bench(args.frames, args.json);
+        return tui::bench(args.frames, args.json);
     }
     let exe = std::env::current_exe()?;
     let dir = std::env::temp_dir().join(format!("cotui-bench-{}", std::process::id()));
@@ -194,9 +155,9 @@ fn measure_all(args: &BenchArgs, exe: &Path, dir: &Path) -> std::io::Result<Figu
         dir.join("bench-quarter.log"),
         dir.join("tiny.log"),
     );
-    write_bench_log(&big, args.frames)?;
-    write_bench_log(&small, args.frames / 4)?;
-    write_bench_log(&tiny, 10)?;
+    log::write_bench_log(&big, args.frames)?;
+    log::write_bench_log(&small, args.frames / 4)?;
+    log::write_bench_log(&tiny, 10)?;
     let (b, s, t) = (big.to_string_lossy(), small.to_string_lossy(), tiny.to_string_lossy());
     let n = args.frames;
     let mut runs = vec![

@@ -10,13 +10,13 @@
 //! - key response while replaying at full speed: from a key press to the end of the
 //!   draw that shows it, i.e. one loop turn (ingest budget, filter budget, draw).
 
+use crate::analysis::trace::Trace;
 use crate::decode::Decoder;
 use crate::od::Dictionary;
 use crate::tui::app::{App, SourceInfo, SourceKind};
 use crate::tui::keymap::{Action, Keymap};
 use crate::tui::source;
 use crate::tui::term::step;
-use crate::tui::trace::Trace;
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::Terminal;
 use ratatui::backend::TestBackend;
@@ -56,7 +56,7 @@ pub fn bench(frames: u64, json: bool) -> std::io::Result<()> {
     let dir = std::env::temp_dir().join(format!("cotui-bench-tui-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;
     let log = dir.join("bench.log");
-    super::bench::write_log(&log, frames)?;
+    super::log::write_log(&log, frames)?;
     let rss_before = peak_rss_kib();
     let mut term = Terminal::new(TestBackend::new(160, 50)).map_err(std::io::Error::other)?;
     let draw = |term: &mut Terminal<TestBackend>, app: &mut App| {

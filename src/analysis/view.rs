@@ -144,7 +144,7 @@ mod tests {
 
     fn trace(n: u64) -> Trace {
         let mut t = Trace::new(Decoder::new(Dictionary::default(), Vec::new()), 500_000);
-        for f in crate::synth::Traffic::new(n, 0) {
+        for f in crate::sim::synth::Traffic::new(n, 0) {
             t.push(&f);
         }
         t

@@ -4,6 +4,8 @@
 //! instant. It is a plain `Copy` value with no heap data so that parsers and
 //! decoders never allocate per frame; the trace store packs it further.
 
+pub mod hex;
+
 /// Flag bits of a [`Frame`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct Flags(pub u8);

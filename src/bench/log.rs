@@ -1,0 +1,46 @@
+//! The generated bench log: synthetic commissioning traffic written as candump `-l`.
+
+use crate::log::writer::LogWriter;
+use crate::sim::synth::Traffic;
+use std::io::Write;
+use std::path::Path;
+
+/// One garbage line (tool chatter the decoder must skip) every this many frames.
+const GARBAGE_EVERY: u64 = 5_000;
+
+/// Writes a candump `-l` log of `frames` synthetic frames to `path`.
+pub fn write_log(path: &Path, frames: u64) -> std::io::Result<()> {
+    write_frames(path, frames, None)
+}
+
+/// Writes the bench log: `frames` synthetic frames with a garbage line (a tool's
+/// message, as in logs captured by hand) every [`GARBAGE_EVERY`] frames.
+pub fn write_bench_log(path: &Path, frames: u64) -> std::io::Result<()> {
+    write_frames(path, frames, Some(GARBAGE_EVERY))
+}
+
+fn write_frames(path: &Path, frames: u64, garbage_every: Option<u64>) -> std::io::Result<()> {
+    let file = std::fs::File::create(path)?;
+    let mut out = std::io::BufWriter::with_capacity(1 << 20, file);
+    let mut writer = LogWriter::new();
+    let mut line = String::with_capacity(1 << 16);
+    for (i, frame) in Traffic::new(frames, 1_700_000_000_000_000_000).enumerate() {
+        if garbage_every.is_some_and(|g| i as u64 % g == g - 1) {
+            line.push_str(GARBAGE[i / 5_000 % GARBAGE.len()]);
+        }
+        writer.write_line(&mut line, &frame, "can0");
+        if line.len() > 1 << 15 {
+            out.write_all(line.as_bytes())?;
+            line.clear();
+        }
+    }
+    out.write_all(line.as_bytes())?;
+    out.flush()
+}
+
+/// Lines found in hand-captured logs that are not frames (log2asc skips them too).
+const GARBAGE: [&str; 3] = [
+    "candump: interface can0 down\n",
+    "# restarted capture after bus-off\n",
+    "read: Network is down\n",
+];

@@ -1,0 +1,17 @@
+//! Picks the bus behind an interface name: `demo` is the in-process virtual bus with the
+//! simulated drives ([`crate::sim::demo`]), anything else a SocketCAN interface. The one
+//! place that knows both, so the bus layer does not depend on the simulator.
+
+use crate::bus::{Bus, BusError, socketcan};
+
+/// The interface name of the in-process simulated bus.
+pub const DEMO: &str = "demo";
+
+/// Opens `iface` (see the module doc). Must be called inside a tokio runtime.
+pub async fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
+    if iface == DEMO {
+        Ok(crate::sim::demo::start(listen_only))
+    } else {
+        socketcan::open(iface, listen_only)
+    }
+}
