@@ -27,7 +27,7 @@ if ! python3 -c "import can, canopen, duckdb" 2>/dev/null; then
   python3 -m pip install -q "python-can>=4.3" "canopen>=2.3" "duckdb>=1.1"
 fi
 
-# canopen-lens: a peer for `cotui diagnose` (tests/diagnose_peer.rs compares incidents).
+# canopen-lens: a peer for `cotui diagnose` (tests/decode/diagnose_peer.rs compares incidents).
 if ! command -v canopen-lens >/dev/null 2>&1; then
   echo "install-test-deps: pip install canopen-lens"
   python3 -m pip install -q "canopen-lens==0.5.1"

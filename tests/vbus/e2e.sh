@@ -3,7 +3,7 @@
 # SocketCAN test binary on the host, then runs tests/vbus/e2e_guest.sh inside ONE vbus
 # guest with vcan0 (classic) and vcan1 (CAN FD): cotui record against candump -l
 # (incl. a 20000-frame burst), SDO against python canopen's LocalNode, the CiA 402 drive
-# peer, --listen-only against candump, the TUI in tmux, tests/socketcan_live.rs, and
+# peer, --listen-only against candump, the TUI in tmux, tests/commander/socketcan_live.rs, and
 # record/live through interface down/up, del/add, bus-off and every stop signal.
 #
 #   tests/vbus/e2e.sh
@@ -28,10 +28,10 @@ done
 # benchmarks use too) starts in a fraction of the debug build's time under TCG, and every
 # check runs cotui several times.
 cargo build --release --quiet --bin cotui || fail "cargo build --release failed"
-live_test=$(cargo test --quiet --test socketcan_live --no-run --message-format=json |
-    jq -r 'select(.reason == "compiler-artifact" and .target.name == "socketcan_live" and .executable != null) | .executable') ||
-    fail "building tests/socketcan_live.rs failed"
-[ -x "$live_test" ] || fail "no socketcan_live test binary found (got '$live_test')"
+live_test=$(cargo test --quiet --test commander --no-run --message-format=json |
+    jq -r 'select(.reason == "compiler-artifact" and .target.name == "commander" and .executable != null) | .executable') ||
+    fail "building tests/commander/ failed"
+[ -x "$live_test" ] || fail "no commander test binary found (got '$live_test')"
 echo "e2e: built on the host in $(since) s"
 
 t_vm=$(date +%s.%N)

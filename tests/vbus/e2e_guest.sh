@@ -366,12 +366,12 @@ kill -TERM "${pids[@]}"
 wait "${pids[0]}" && wait "${pids[1]}" && ok "peers stop on SIGTERM with status 0" || bad "peers' exit status"
 pids=()
 
-# ---- tests/socketcan_live.rs (#[ignore] tests; they need an FD-capable vcan0) -------------
+# ---- tests/commander/socketcan_live.rs (#[ignore] tests; they need an FD-capable vcan0) -------------
 ip link set vcan0 down
 c scan vcan0
 [ $rc = 2 ] && echo "$err" | grep -q "sudo ip link set vcan0 up" && ok "interface down: exit 2, names the fix" || bad "down: rc=$rc $err"
 ip link set vcan0 mtu 72 && ip link set vcan0 up
-if timeout 120 "$live_test" --ignored --test-threads 1 > live.out 2>&1; then
+if timeout 120 "$live_test" socketcan_live:: --ignored --test-threads 1 > live.out 2>&1; then
     ok "socketcan_live.rs: $(grep -o '[0-9]* passed' live.out | tail -1) (--ignored)"
 else
     cat live.out

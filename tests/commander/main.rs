@@ -1,0 +1,13 @@
+//! The commander: the CLI and the palette's commands against the demo bus, the SDO client
+//! against the SDO server and misbehaving peers, and (ignored here, run in the vbus guest:
+//! `socketcan_live::`) the SocketCAN layer on a real vcan.
+
+mod cli_bitrate;
+mod cli_commander;
+mod cli_run;
+mod commander_demo;
+mod procedure_run;
+mod sdo_client_misbehave;
+mod sdo_client_server;
+mod sdo_proptest;
+mod socketcan_live;

@@ -1,0 +1,295 @@
+//! `cotui diagnose`: the real binary over small logs with one kind of problem each
+//! (tests/fixtures/diagnose/), compared with reviewed JSON lines (insta snapshots in tests/decode/snapshots/),
+//! plus what a technician reads first (node, kind, status, title) asserted directly, and a
+//! run over the real-world logs in ../shared/realworld/logs/.
+//! After an intended change: `cargo insta test --test decode --review`.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+fn cotui(args: &[&str]) -> Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_cotui"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("run cotui")
+}
+
+/// `cotui diagnose --format jsonl FILE`, parsed, with the exit status of `--check`.
+fn diagnose(path: &str) -> (Vec<Value>, i32) {
+    let out = cotui(&["diagnose", "--format", "jsonl", "--check", path]);
+    let text = String::from_utf8(out.stdout).expect("UTF-8");
+    let incidents = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{path}: bad JSON line {l}: {e}")))
+        .collect();
+    (incidents, out.status.code().unwrap_or(-1))
+}
+
+/// Compares `cotui diagnose --format jsonl` of fixture `name` with its snapshot and
+/// returns the incidents.
+fn golden(name: &str) -> Vec<Value> {
+    golden_with(name, &[])
+}
+
+/// [`golden`] with more arguments (profiles).
+fn golden_with(name: &str, args: &[&str]) -> Vec<Value> {
+    let log = format!("tests/fixtures/diagnose/{name}.log");
+    let mut all = vec!["diagnose", "--format", "jsonl"];
+    all.extend_from_slice(args);
+    all.push(&log);
+    let out = cotui(&all);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let got = String::from_utf8(out.stdout).unwrap();
+    assert!(got.is_empty() || got.ends_with('\n'), "output ends without a newline");
+    insta::assert_snapshot!(format!("diagnose_{name}"), got);
+    got.lines().map(|l| serde_json::from_str(l).unwrap()).collect()
+}
+
+/// (node, kind, status) of each incident, in report order.
+fn summary(incidents: &[Value]) -> Vec<(Option<u64>, String, String)> {
+    incidents
+        .iter()
+        .map(|i| {
+            (
+                i["node"].as_u64(),
+                i["kind"].as_str().unwrap().to_string(),
+                i["status"].as_str().unwrap().to_string(),
+            )
+        })
+        .collect()
+}
+
+fn s(node: Option<u64>, kind: &str, status: &str) -> (Option<u64>, String, String) {
+    (node, kind.to_string(), status.to_string())
+}
+
+fn frames(inc: &Value) -> Vec<u64> {
+    inc["events"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["frame"].as_u64().unwrap())
+        .collect()
+}
+
+#[test]
+fn missing_node() {
+    let inc = golden("missing");
+    assert_eq!(summary(&inc), [s(Some(4), "missing", "open")]);
+    assert_eq!(inc[0]["title"], "No answer: the device seems to be missing");
+    assert_eq!(frames(&inc[0]), [5, 21], "both unanswered requests, by frame number");
+    assert_eq!(inc[0]["count"], 2);
+}
+
+#[test]
+fn heartbeat_silent_back_and_unexpected_reboot() {
+    let inc = golden("heartbeat");
+    assert_eq!(
+        summary(&inc),
+        [
+            s(Some(3), "silent", "open"),
+            s(Some(3), "silent_back", "warning"),
+            // Node 6's short silence ends in a boot-up: one restart, not a silence too.
+            s(Some(6), "rebooted", "warning"),
+        ]
+    );
+    assert_eq!(inc[0]["title"], "Went silent and never came back");
+    assert_eq!(inc[0]["events"][0]["text"], "Last heartbeat");
+    assert_eq!(inc[1]["cause"], "no heartbeat for up to 0.80 s");
+}
+
+#[test]
+fn sdo_refused_grouped_per_object_and_timeout() {
+    let inc = golden("sdo");
+    assert_eq!(
+        summary(&inc),
+        [s(Some(2), "sdo_refused", "open"), s(Some(2), "sdo_timeout", "warning")]
+    );
+    assert_eq!(inc[0]["count"], 2, "two refusals of 0x2001:00 are one incident");
+    assert_eq!(
+        inc[0]["cause"],
+        "0x2001:00: Object does not exist in the object dictionary (abort 0x06020000)"
+    );
+    assert_eq!(inc[0]["title"], "A setting was not applied");
+}
+
+#[test]
+fn drive_fault_cause_resets_and_recovery() {
+    let inc = golden("drive_fault");
+    assert_eq!(
+        summary(&inc),
+        [
+            s(Some(1), "drive_fault", "open"),
+            s(Some(5), "drive_fault", "recovered")
+        ]
+    );
+    assert_eq!(
+        inc[1]["title"],
+        "Stopped: continuous over-current → recovered on reset #2 (1 failed reset)"
+    );
+    let cause = inc[1]["cause"].as_str().unwrap();
+    assert!(
+        cause.contains("EMCY 0x2310") && cause.contains("0x2310 (0x603F)"),
+        "{cause}"
+    );
+    let texts: Vec<&str> = inc[1]["events"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["text"].as_str().unwrap())
+        .collect();
+    assert!(texts.iter().any(|t| t.starts_with("Running again")), "{texts:?}");
+    assert!(
+        inc[0]["title"].as_str().unwrap().contains("still in fault at the end"),
+        "{}",
+        inc[0]["title"]
+    );
+}
+
+#[test]
+fn bus_errors_up_to_bus_off() {
+    let inc = golden("bus_errors");
+    assert_eq!(summary(&inc), [s(None, "bus_errors", "open")]);
+    assert_eq!(inc[0]["title"], "3 CAN error frames (the controller went bus off)");
+    assert_eq!(inc[0]["count"], 3);
+}
+
+#[test]
+fn duplicate_node_id() {
+    let inc = golden("duplicate_id");
+    assert_eq!(summary(&inc), [s(Some(7), "duplicate_id", "open")]);
+    assert_eq!(
+        inc[0]["events"].as_array().unwrap().len(),
+        2,
+        "boot-ups and flipping states"
+    );
+}
+
+#[test]
+fn nmt_command_not_followed() {
+    let inc = golden("nmt_ignored");
+    // Node 9 got its start and followed it: nothing to report about it.
+    assert_eq!(summary(&inc), [s(Some(8), "nmt_ignored", "open")]);
+    assert_eq!(inc[0]["cause"], "NMT start sent, node stays Pre-operational");
+}
+
+#[test]
+fn emcy_flood_reset_and_unmonitored_node() {
+    let inc = golden("emcy");
+    assert_eq!(
+        summary(&inc),
+        [
+            s(Some(10), "emcy", "open"),
+            s(Some(9), "emcy", "recovered"),
+            s(Some(11), "unmonitored", "warning"),
+        ]
+    );
+    assert_eq!(inc[0]["count"], 5, "five EMCY of one code are one incident");
+}
+
+#[test]
+fn causes_through_the_profiles() {
+    let inc = golden_with(
+        "profile_emcy",
+        &["--profile", "3=dexmart-dev", "--profile", "5=aimotor"],
+    );
+    assert_eq!(
+        summary(&inc),
+        [s(Some(3), "emcy", "open"), s(Some(5), "drive_fault", "open")]
+    );
+    // The vendor bytes of the EMCY, named by the dexmart-dev profile.
+    assert_eq!(
+        inc[0]["cause"],
+        "Generic error (EMCY 0x1000), M1 alarm code=0x12, M2 alarm code=0x00"
+    );
+    // The AIMOTOR code text names the drive's own fault number.
+    assert_eq!(
+        inc[1]["title"],
+        "Stopped: continuous over-current no. 2 (AIMOTOR fault 0201h; read H0B-34); still in fault at the end"
+    );
+}
+
+#[test]
+fn text_report_and_check_status() {
+    let out = cotui(&["diagnose", "tests/fixtures/diagnose/sdo.log"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.starts_with("Needs attention: 1 open, 0 recovered, 1 warnings"),
+        "{text}"
+    );
+    assert!(
+        text.contains(" 1. OPEN       Node 2: A setting was not applied\n"),
+        "{text}"
+    );
+    assert!(text.contains("    Check first:\n      1. "), "{text}");
+    assert!(text.contains("    Why it matters: "), "{text}");
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "without --check, open incidents do not fail"
+    );
+    assert_eq!(
+        diagnose("tests/fixtures/diagnose/sdo.log").1,
+        1,
+        "--check: an open incident"
+    );
+    // Only warnings (a node that stopped answering once, then answered): --check passes.
+    let (inc, code) = diagnose("../shared/realworld/logs/ros2_canopen_issue46_boot.txt");
+    assert!(inc.iter().all(|i| i["status"] != "open"), "{inc:?}");
+    assert_eq!(code, 0);
+}
+
+fn realworld(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/realworld/logs")
+        .join(name)
+}
+
+#[test]
+fn realworld_logs() {
+    let dir = realworld("");
+    let mut seen = 0;
+    for entry in std::fs::read_dir(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
+        let path = entry.unwrap().path();
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+        if !matches!(ext, "txt" | "log" | "asc") {
+            continue;
+        }
+        let out = cotui(&["diagnose", "--format", "jsonl", path.to_str().unwrap()]);
+        assert!(
+            out.status.success(),
+            "{}: {}",
+            path.display(),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        seen += 1;
+    }
+    assert!(seen >= 8, "only {seen} logs in {}", dir.display());
+
+    let get = |n: &str| diagnose(realworld(n).to_str().unwrap()).0;
+    // CANopenNode issue 486: node 3 answers a segmented download with garbage, then aborts.
+    let inc = get("canopennode_issue486_flood.txt");
+    assert_eq!(
+        summary(&inc),
+        [s(Some(3), "sdo_garbled", "open"), s(Some(3), "sdo_refused", "open")]
+    );
+    assert!(inc[1]["cause"].as_str().unwrap().starts_with("0x7000:01"), "{}", inc[1]);
+    // ros_canopen issue 317: the master resets node 10 (boot-up follows: asked for, so no
+    // "restarted" incident) and reads 0x1017 = 0: the node is not monitored at all.
+    let inc = get("ros_canopen_issue317_annotated.txt");
+    assert_eq!(summary(&inc), [s(Some(10), "unmonitored", "warning")]);
+    // Oriental Motor BLV-D: two writes refused as read-only, one incident per object.
+    let inc = get("orientalmotor_pitakuru_tz.txt");
+    assert_eq!(
+        summary(&inc),
+        [s(Some(1), "sdo_refused", "open"), s(Some(1), "sdo_refused", "open")]
+    );
+    assert!(inc.iter().all(|i| i["cause"].as_str().unwrap().contains("read only")));
+    // ros2_canopen issue 46: requests to node 2 go unanswered before it answers.
+    let inc = get("ros2_canopen_issue46_boot.txt");
+    assert_eq!(summary(&inc), [s(Some(2), "sdo_timeout", "warning")]);
+    // A J1939 log is not CANopen: nothing to report, and no crash.
+    assert!(get("python-can_logfile.asc").is_empty());
+}

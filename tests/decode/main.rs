@@ -1,0 +1,18 @@
+//! Integration tests of the headless decoder and its inputs and outputs: golden output of
+//! `cotui decode`/`diagnose`, log formats against can-utils, Wireshark's dissector, EDS import
+//! against python canopen, pcapng/Parquet read back by their own tools, fuzzing.
+
+mod decode_golden;
+mod decode_proptest;
+mod diagnose_golden;
+mod diagnose_peer;
+mod eds_import;
+mod log_can_utils;
+mod log_formats;
+mod log_fuzz;
+mod no_panic;
+mod parquet_duckdb;
+mod pcapng;
+mod profile_example;
+mod realworld_block;
+mod wireshark;

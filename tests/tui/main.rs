@@ -1,0 +1,4 @@
+//! The interactive analyzer end to end: the real binary in tmux, and its command line.
+
+mod tui_cli;
+mod tui_tmux;
