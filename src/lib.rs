@@ -13,6 +13,7 @@ pub mod connect;
 pub mod decode;
 pub mod frame;
 pub mod log;
+pub mod lss;
 pub mod od;
 pub mod output;
 pub mod sdo;
