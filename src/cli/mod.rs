@@ -12,6 +12,7 @@ pub mod record;
 pub mod run;
 pub mod scan;
 pub mod sdo;
+pub mod sim;
 pub mod stop;
 pub mod tui;
 
@@ -77,6 +78,9 @@ pub enum Command {
     /// Emergency stop: quick stop, then disable voltage, on every CiA 402 drive found powered
     /// (or the --node ones); reads each statusword back. Exit 0 only when all are confirmed.
     Stop(stop::StopArgs),
+    /// Simulated CiA 402 drives on a SocketCAN interface for other tools to talk to (SDO,
+    /// NMT, PDO, SYNC, EMCY, LSS); stdin lines make them fail: fault/silence/reboot NODE.
+    Sim(sim::SimArgs),
 }
 
 /// Short usage printed by `cotui` without arguments.
@@ -120,5 +124,6 @@ pub fn run() -> i32 {
         Some(Command::Scan(args)) => scan::run_scan(&args),
         Some(Command::Record(args)) => record::run_record(&args),
         Some(Command::Stop(args)) => stop::run_stop(&args),
+        Some(Command::Sim(args)) => sim::run_sim(&args),
     }
 }

@@ -8,6 +8,7 @@
 
 pub mod alias;
 pub mod bind;
+pub mod dcf;
 mod device;
 pub mod eds;
 pub mod expr;

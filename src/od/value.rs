@@ -84,6 +84,13 @@ impl DataType {
         })
     }
 
+    /// The CiA 301 DataType code (inverse of [`DataType::from_code`]).
+    pub fn code(self) -> u16 {
+        (0x01..=0x1B)
+            .find(|c| DataType::from_code(*c) == Some(self))
+            .unwrap_or(0x0F)
+    }
+
     /// Decodes little-endian bytes as this type. Short input decodes what is
     /// there (zero-extended); the caller flags the length mismatch.
     pub fn decode(self, bytes: &[u8]) -> Value {

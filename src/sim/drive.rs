@@ -1,6 +1,7 @@
 //! A simulated CiA 402 drive: NMT slave with boot-up and heartbeat, SDO server,
 //! TPDOs on SYNC and RPDOs from its mapping objects, the CiA 402 state machine
-//! (transitions 0..16), profile velocity motion and EMCY on faults.
+//! (transitions 0..16), profile velocity motion and EMCY on faults, and an LSS slave
+//! (a drive made with node-ID 0xFF only answers LSS until it is given one and reset).
 //!
 //! Pure: frames and the current time in, frames out.
 
@@ -8,6 +9,7 @@ use super::od::DeviceObjects;
 use super::profile;
 use crate::decode::cia402::DriveState;
 use crate::frame::Frame;
+use crate::lss::{self, Address, UNCONFIGURED};
 use crate::sdo::server::{SdoServer, ServerConfig};
 
 /// NMT state of a simulated node.
@@ -38,6 +40,10 @@ pub const MODE_CSV: i8 = 9;
 #[derive(Clone, Debug)]
 pub struct Drive {
     node: u8,
+    profile: profile::DriveProfile,
+    lss: lss::slave::Slave,
+    /// Sends nothing at all (a node that died or lost its bus connection).
+    silent: bool,
     od: DeviceObjects,
     sdo: SdoServer,
     nmt: NmtState,
@@ -58,11 +64,22 @@ pub struct Drive {
 
 impl Drive {
     /// A drive at `node` with the object dictionary of `profile` (see [`profile::drive_objects`]).
+    /// `node` 0xFF makes a drive without a node-ID that answers only LSS.
     pub fn new(node: u8, profile: profile::DriveProfile) -> Drive {
+        let od = profile::drive_objects(node, profile.clone());
+        let address = Address {
+            vendor: od.uint(0x1018, 1) as u32,
+            product: od.uint(0x1018, 2) as u32,
+            revision: od.uint(0x1018, 3) as u32,
+            serial: od.uint(0x1018, 4) as u32,
+        };
         Drive {
             node,
+            lss: lss::slave::Slave::new(address, node),
+            silent: false,
             position_per_velocity: profile.position_per_velocity,
-            od: profile::drive_objects(node, profile),
+            profile,
+            od,
             sdo: SdoServer::new(ServerConfig::default()),
             nmt: NmtState::PreOperational,
             state: DriveState::SwitchOnDisabled,
@@ -100,6 +117,33 @@ impl Drive {
         }
         self.update_statusword();
     }
+    /// The drive's dictionary as an EDS (the objects it answers, with their defaults), for
+    /// tools that need one to talk to it.
+    pub fn eds(&self) -> String {
+        let o = &self.od;
+        let info = crate::od::dcf::DeviceInfo {
+            vendor_name: "cotui simulation".into(),
+            vendor_number: o.uint(0x1018, 1) as u32,
+            product_name: self.profile.device_name.clone(),
+            product_number: o.uint(0x1018, 2) as u32,
+            revision_number: o.uint(0x1018, 3) as u32,
+            node_id: None,
+            description: format!("{} as simulated by cotui sim", self.profile.device_name),
+        };
+        crate::od::dcf::write(&info, &o.dcf_entries())
+    }
+    /// Silences the node (nothing sent, nothing answered) or brings it back.
+    pub fn set_silent(&mut self, silent: bool) {
+        self.silent = silent;
+    }
+    /// Is the node silenced?
+    pub fn is_silent(&self) -> bool {
+        self.silent
+    }
+    /// Has the node a node-ID (not 0xFF)?
+    fn configured(&self) -> bool {
+        self.node != UNCONFIGURED
+    }
     /// Makes the drive go to Fault at its next step with this EMCY error code.
     pub fn inject_fault(&mut self, code: u16) {
         self.pending_fault = Some(code);
@@ -127,8 +171,22 @@ impl Drive {
 
     fn boot(&mut self, now_ns: u64) -> Vec<Frame> {
         self.nmt = NmtState::PreOperational;
+        if !self.configured() {
+            self.next_heartbeat_ns = None;
+            return Vec::new();
+        }
         self.next_heartbeat_ns = self.heartbeat_period_ns().map(|p| now_ns + p);
         vec![Frame::classic(0x700 + self.node as u32, &[0])]
+    }
+
+    /// NMT reset: a node-ID configured by LSS comes into use, with the communication
+    /// objects of the new node-ID.
+    fn take_lss_node_id(&mut self) {
+        let node = self.lss.reset_communication();
+        if node != self.node {
+            self.node = node;
+            self.od = profile::drive_objects(node, self.profile.clone());
+        }
     }
 
     fn heartbeat_period_ns(&self) -> Option<u64> {
@@ -138,7 +196,16 @@ impl Drive {
 
     /// Handles one frame from the bus at `now_ns`; returns the frames the drive sends.
     pub fn on_frame(&mut self, f: &Frame, now_ns: u64) -> Vec<Frame> {
-        if f.is_err() || f.is_ext() || f.is_fd() {
+        if self.silent || f.is_err() || f.is_ext() || f.is_fd() {
+            return Vec::new();
+        }
+        if f.id == lss::MASTER_ID && !f.is_rtr() {
+            return self
+                .lss
+                .on_request(f.payload())
+                .map_or_else(Vec::new, |r| vec![Frame::classic(lss::SLAVE_ID, &r)]);
+        }
+        if !self.configured() && f.id != 0x000 {
             return Vec::new();
         }
         let node = self.node as u32;
@@ -163,7 +230,7 @@ impl Drive {
 
     fn on_nmt(&mut self, p: &[u8], now_ns: u64) -> Vec<Frame> {
         let [cs, target, ..] = p else { return Vec::new() };
-        if *target != 0 && *target != self.node {
+        if *target != 0 && (*target != self.node || !self.configured()) {
             return Vec::new();
         }
         match cs {
@@ -171,10 +238,12 @@ impl Drive {
             0x02 => self.nmt = NmtState::Stopped,
             0x80 => self.nmt = NmtState::PreOperational,
             0x81 => {
+                self.take_lss_node_id();
                 self.reset(0x1000..=0xFFFF);
                 return self.boot(now_ns);
             }
             0x82 => {
+                self.take_lss_node_id();
                 self.reset(0x1000..=0x1FFF);
                 return self.boot(now_ns);
             }
@@ -348,7 +417,7 @@ impl Drive {
             self.od.set_int(0x1001, 0, error_register(code) as i64);
             self.od.set_int(0x1003, 1, code as i64);
             self.od.set_int(0x1003, 0, 1);
-            if self.nmt != NmtState::Stopped {
+            if self.nmt != NmtState::Stopped && self.configured() {
                 out.push(self.emcy(code));
             }
         } else if self.state == DriveState::FaultReactionActive {
@@ -358,6 +427,12 @@ impl Drive {
         }
         self.move_axis(dt);
         self.update_statusword();
+        if self.silent {
+            return Vec::new();
+        }
+        if !self.configured() {
+            return out;
+        }
         if let Some(next) = self.next_heartbeat_ns {
             if now_ns >= next {
                 out.push(Frame::classic(0x700 + self.node as u32, &[self.nmt.byte()]));
@@ -424,6 +499,45 @@ mod tests {
         let out = d.on_frame(&Frame::classic(0x602, &[0x2B, 0x40, 0x60, 0, v[0], v[1], 0, 0]), 0);
         assert_eq!(out[0].payload()[0], 0x60, "SDO download answered");
         d.objects().uint(0x6041, 0) as u16
+    }
+
+    #[test]
+    fn an_unconfigured_drive_answers_only_lss_until_given_a_node_id_and_reset() {
+        use crate::lss::Request;
+        let profile = DriveProfile {
+            serial_number: Some(77),
+            ..DriveProfile::servo("test", 1)
+        };
+        let mut d = Drive::new(0xFF, profile);
+        assert!(d.power_on(0).is_empty(), "no boot-up without a node-ID");
+        assert!(d.tick(2_000_000_000).is_empty(), "no heartbeat without a node-ID");
+        let lss = |d: &mut Drive, r: Request| d.on_frame(&Frame::classic(0x7E5, &r.encode()), 0);
+        assert!(lss(&mut d, Request::SwitchGlobal(true)).is_empty());
+        let serial = lss(&mut d, Request::Inquire(crate::lss::Part::Serial));
+        assert_eq!(
+            (serial[0].id, serial[0].payload()),
+            (0x7E4, &[0x5D, 77, 0, 0, 0, 0, 0, 0][..])
+        );
+        let ok = lss(&mut d, Request::ConfigureNodeId(9));
+        assert_eq!(ok[0].payload()[..2], [0x11, 0]);
+        let boot = d.on_frame(&Frame::classic(0x000, &[0x82, 0]), 0);
+        assert_eq!(
+            (boot[0].id, boot[0].payload()),
+            (0x709, &[0u8][..]),
+            "boot-up as node 9"
+        );
+        let sdo = d.on_frame(&Frame::classic(0x609, &[0x40, 0x18, 0x10, 4, 0, 0, 0, 0]), 0);
+        assert_eq!(
+            (sdo[0].id, sdo[0].payload()[4]),
+            (0x589, 77),
+            "SDO as node 9, same serial"
+        );
+        d.set_silent(true);
+        assert!(
+            d.tick(4_000_000_000).is_empty()
+                && d.on_frame(&Frame::classic(0x609, &[0x40, 0x18, 0x10, 4, 0, 0, 0, 0]), 0)
+                    .is_empty()
+        );
     }
 
     #[test]

@@ -1,11 +1,13 @@
 //! Simulated CANopen devices for `cotui demo` and the tests: CiA 402 drives,
 //! a SYNC producer and a minimal NMT master, all pure (frames and time in, frames
-//! out). [`demo`] runs them on a virtual bus on a tokio interval.
+//! out). [`serve`] runs them on a bus on a tokio interval: [`demo`] on an in-process
+//! virtual bus, `cotui sim` on a SocketCAN interface.
 
 pub mod demo;
 pub mod drive;
 pub mod od;
 pub mod profile;
+pub mod serve;
 pub mod synth;
 
 use crate::decode::pdo::entry_from_u32;
@@ -91,6 +93,10 @@ impl Simulation {
             .collect()
     }
 
+    /// Every simulated drive.
+    pub fn drives(&self) -> &[Drive] {
+        &self.drives
+    }
     /// The drive at `node`.
     pub fn drive(&self, node: u8) -> Option<&Drive> {
         self.drives.iter().find(|d| d.node() == node)

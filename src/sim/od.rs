@@ -44,6 +44,21 @@ impl DeviceObjects {
             },
         );
     }
+    /// Every entry for an EDS/DCF ([`crate::od::dcf`]): default and current value.
+    pub fn dcf_entries(&self) -> Vec<crate::od::dcf::DcfEntry> {
+        self.entries
+            .iter()
+            .map(|(&(index, sub), e)| crate::od::dcf::DcfEntry {
+                index,
+                sub,
+                name: e.name.clone(),
+                data_type: e.data_type,
+                access: e.access,
+                default: self.defaults.get(&(index, sub)).cloned(),
+                value: Some(e.data.clone()),
+            })
+            .collect()
+    }
     /// The entry at (index, sub).
     pub fn entry(&self, index: u16, sub: u8) -> Option<&Entry> {
         self.entries.get(&(index, sub))

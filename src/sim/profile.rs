@@ -21,6 +21,8 @@ pub struct DriveProfile {
     pub position_per_velocity: f64,
     /// Vendor parameters (UNSIGNED16, read/write): index, name, value.
     pub vendor_u16: Vec<(u16, &'static str, i64)>,
+    /// 0x1018:4 serial number (default: 1000 + node-ID); part of the LSS address.
+    pub serial_number: Option<u32>,
 }
 
 impl DriveProfile {
@@ -34,6 +36,7 @@ impl DriveProfile {
             heartbeat_ms: 500,
             position_per_velocity: 1.0,
             vendor_u16: Vec::new(),
+            serial_number: None,
         }
     }
     /// Like the AIMOTOR servo of the seed manuals (profile `aimotor`): identified by a
@@ -96,7 +99,14 @@ pub fn drive_objects(node: u8, p: DriveProfile) -> DeviceObjects {
     s.add(0x1018, 1, "Vendor-ID", U32, Ro, p.vendor_id as i64);
     s.add(0x1018, 2, "Product code", U32, Ro, p.product_code as i64);
     s.add(0x1018, 3, "Revision number", U32, Ro, 0x0001_0000);
-    s.add(0x1018, 4, "Serial number", U32, Ro, 1000 + n);
+    s.add(
+        0x1018,
+        4,
+        "Serial number",
+        U32,
+        Ro,
+        p.serial_number.map_or(1000 + n, i64::from),
+    );
     // RPDO1: controlword + target velocity.
     s.add(0x1400, 0, "Highest sub-index supported", U8, Const, 2);
     s.add(0x1400, 1, "COB-ID used by RPDO", U32, Rw, 0x200 + n);

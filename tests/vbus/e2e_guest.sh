@@ -640,6 +640,36 @@ tmux send-keys -t link q
 link_wait "cotui-exit=0" || bad "tui link quit: $(cat lscreen.txt)"
 tmux kill-server 2> /dev/null
 
+# ---- 9. cotui sim: the python canopen library as master against simulated drives ---------
+# peers/sim_master.py: RemoteNode SDO (expedited, segmented, block, abort), BaseNode402 to
+# OPERATION ENABLED and back, LssMaster fastscan / configure node-ID / store / selective
+# switch / inquire. Then faults injected on cotui sim's stdin, seen by candump.
+rm -rf simeds; mkfifo sim.in
+"$cotui" sim vcan0 --node 2=aimotor --node ff=servo@0x99 --node ff=servo@0x1234 --write-eds simeds < sim.in > sim.out 2>&1 &
+sim=$!
+pids+=($sim)
+exec 7> sim.in
+wait_for sim.out 300 "commands on stdin" && [ -f simeds/node2.eds ] && ok "cotui sim vcan0: 3 simulated nodes up, EDS written" ||
+    bad "cotui sim start: $(cat sim.out)"
+timeout 600 python3 "$here/peers/sim_master.py" vcan0 simeds sdo 402 lss > master.out 2>&1
+while read -r status what; do
+    case $status in ok) ok "sim: python canopen: $what" ;; FAIL) bad "sim: python canopen: $what" ;; esac
+done < master.out
+grep -qE "^(ok|FAIL) " master.out || bad "sim_master.py printed no checks: $(cat master.out)"
+candump -L vcan0,082:7FF,702:7FF > simdump.txt 2> /dev/null &
+simdump=$!
+wait_socket $simdump
+echo "fault 2 0x2310" >&7
+wait_for simdump.txt 100 "082#1023" && wait_for sim.out 50 "node 2: fault 0x2310" &&
+    ok "sim: 'fault 2 0x2310' on stdin -> EMCY 082#1023... on the bus" || bad "sim fault: $(cat simdump.txt) $(cat sim.out)"
+echo "silence 2" >&7
+wait_for sim.out 50 "node 2: silenced" && sleep 1.5 && : > simdump.txt && sleep 1.5 &&
+    ! grep -q "702#" simdump.txt && ok "sim: 'silence 2' -> no heartbeat from node 2 for 1.5 s" || bad "sim silence: $(cat simdump.txt)"
+echo "reboot 2" >&7
+wait_for simdump.txt 100 "702#00" && ok "sim: 'reboot 2' -> boot-up 702#00" || bad "sim reboot: $(cat simdump.txt)"
+kill $simdump; exec 7>&-
+kill -TERM $sim; wait $sim && ok "sim: SIGTERM ends cotui sim with status 0" || bad "sim exit status"
+
 t_end=$(date +%s.%N)
 echo "$passed passed, $failed failed ($(awk -v a="$t_start" -v b="$t_end" 'BEGIN { printf "%.0f", b - a }') s in the guest)"
 [ "$failed" = 0 ]
