@@ -88,6 +88,9 @@ fn write_var(out: &mut String, e: &DcfEntry, dcf: bool) {
     out.push('\n');
 }
 
+/// Which indexes belong in an object list section.
+type IndexGroup = fn(u16) -> bool;
+
 /// The EDS (no values) or DCF (values and node-ID) text of `entries`.
 pub fn write(info: &DeviceInfo, entries: &[DcfEntry]) -> String {
     let dcf = info.node_id.is_some();
@@ -125,7 +128,7 @@ pub fn write(info: &DeviceInfo, entries: &[DcfEntry]) -> String {
         let _ = writeln!(out, "Dummy000{t}=0");
     }
     out.push('\n');
-    let groups: [(&str, fn(u16) -> bool); 3] = [
+    let groups: [(&str, IndexGroup); 3] = [
         ("MandatoryObjects", |i| matches!(i, 0x1000 | 0x1001 | 0x1018)),
         ("OptionalObjects", |i| {
             ((0x1000..=0x1FFF).contains(&i) && !matches!(i, 0x1000 | 0x1001 | 0x1018)) || i >= 0x6000
