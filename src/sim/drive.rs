@@ -31,10 +31,22 @@ impl NmtState {
     }
 }
 
+/// Mode of operation: profile position.
+pub const MODE_PP: i8 = 1;
 /// Mode of operation: profile velocity.
 pub const MODE_PV: i8 = 3;
+/// Mode of operation: profile torque.
+pub const MODE_PT: i8 = 4;
+/// Mode of operation: homing.
+pub const MODE_HM: i8 = 6;
+/// Mode of operation: cyclic synchronous position.
+pub const MODE_CSP: i8 = 8;
 /// Mode of operation: cyclic synchronous velocity.
 pub const MODE_CSV: i8 = 9;
+/// Mode of operation: cyclic synchronous torque.
+pub const MODE_CST: i8 = 10;
+/// Time a simulated homing run takes (s).
+const HOMING_S: f64 = 0.5;
 
 /// One simulated drive.
 #[derive(Clone, Debug)]
@@ -50,6 +62,14 @@ pub struct Drive {
     state: DriveState,
     /// Controlword bit 7 as last seen, for the rising edge of fault reset.
     reset_bit: bool,
+    /// Controlword bit 4 as last seen (new set-point / homing start).
+    setpoint_bit: bool,
+    /// Profile position: the position the drive is moving to.
+    pp_target: Option<f64>,
+    /// Homing: seconds left of the homing run.
+    homing_left: Option<f64>,
+    /// Homing attained.
+    homed: bool,
     /// DC link voltage present (statusword bit 4; needed for Switch on).
     mains: bool,
     /// Velocity in raw 0x606C units (fractional part kept here, 0x606C holds the integer).
@@ -84,6 +104,10 @@ impl Drive {
             nmt: NmtState::PreOperational,
             state: DriveState::SwitchOnDisabled,
             reset_bit: false,
+            setpoint_bit: false,
+            pp_target: None,
+            homing_left: None,
+            homed: false,
             mains: true,
             velocity: 0.0,
             position: 0.0,
@@ -164,6 +188,10 @@ impl Drive {
             self.velocity = 0.0;
             self.position = 0.0;
             self.reset_bit = false;
+            self.setpoint_bit = false;
+            self.pp_target = None;
+            self.homing_left = None;
+            self.homed = false;
         }
         self.od.set_int(0x6061, 0, self.od.int(0x6060, 0));
         self.update_statusword();
@@ -350,13 +378,71 @@ impl Drive {
         };
         if !matches!(self.state, OperationEnabled | QuickStopActive) {
             self.velocity = 0.0;
+            self.pp_target = None;
+            self.homing_left = None;
         }
+        self.setpoint(cw);
         out
+    }
+
+    /// Controlword bit 4 in operation enabled: a new set-point (profile position, bit 6 =
+    /// relative) or the start of homing.
+    fn setpoint(&mut self, cw: u16) {
+        let rising = cw & 0x10 != 0 && !self.setpoint_bit;
+        self.setpoint_bit = cw & 0x10 != 0;
+        if !rising || self.state != DriveState::OperationEnabled {
+            return;
+        }
+        match self.mode() {
+            MODE_PP => {
+                let target = self.od.int(0x607A, 0) as f64;
+                let base = if cw & 0x40 != 0 {
+                    self.pp_target.unwrap_or(self.position)
+                } else {
+                    0.0
+                };
+                self.pp_target = Some(base + target);
+            }
+            MODE_HM => {
+                self.homed = false;
+                self.homing_left = Some(HOMING_S);
+            }
+            _ => {}
+        }
+    }
+
+    fn mode(&self) -> i8 {
+        self.od.int(0x6061, 0) as i8
     }
 
     /// A mode of operation the simulator can run (CiA 402 leaves "no mode" refusals to the vendor).
     fn mode_ok(&self) -> bool {
-        matches!(self.od.int(0x6061, 0) as i8, MODE_PV | MODE_CSV)
+        matches!(
+            self.mode(),
+            MODE_PP | MODE_PV | MODE_PT | MODE_HM | MODE_CSP | MODE_CSV | MODE_CST
+        )
+    }
+
+    /// Statusword bits 10 (target reached) and 12 (mode-specific) in operation enabled.
+    fn mode_bits(&self) -> u16 {
+        const REACHED: u16 = 0x0400;
+        const BIT12: u16 = 0x1000;
+        match self.mode() {
+            MODE_PV | MODE_CSV => {
+                let reached = (self.velocity - self.target_velocity()).abs() < 0.5;
+                // Bit 12 in profile velocity: speed is zero; cyclic modes: following the target.
+                let bit12 = self.mode() == MODE_CSV || self.velocity.abs() < 0.5;
+                (u16::from(reached) * REACHED) | (u16::from(bit12) * BIT12)
+            }
+            MODE_PP => {
+                let reached = self.pp_target.is_none_or(|t| (t - self.position).abs() < 0.5);
+                (u16::from(reached) * REACHED) | (u16::from(self.setpoint_bit) * BIT12)
+            }
+            MODE_HM if self.homed => REACHED | BIT12,
+            MODE_HM => 0,
+            MODE_CSP | MODE_CST => REACHED | BIT12,
+            _ => REACHED,
+        }
     }
 
     fn emcy(&self, code: u16) -> Frame {
@@ -381,13 +467,8 @@ impl Drive {
         if self.mains {
             sw |= 0x0010;
         }
-        let target = self.target_velocity();
-        if self.state == OperationEnabled && (self.velocity - target).abs() < 0.5 {
-            sw |= 0x0400;
-        }
-        if self.state == OperationEnabled && self.velocity.abs() < 0.5 {
-            // Profile velocity mode bit 12: speed is zero.
-            sw |= 0x1000;
+        if self.state == OperationEnabled {
+            sw |= self.mode_bits();
         }
         self.od.set_int(0x6041, 0, sw as i64);
         self.od.set_int(0x606C, 0, self.velocity.round() as i64);
@@ -397,8 +478,18 @@ impl Drive {
     /// The velocity the drive is heading for now.
     fn target_velocity(&self) -> f64 {
         let halt = self.od.uint(0x6040, 0) & 0x100 != 0;
-        match self.state {
-            DriveState::OperationEnabled if !halt && self.mode_ok() => self.od.int(0x60FF, 0) as f64,
+        if halt || self.state != DriveState::OperationEnabled {
+            return 0.0;
+        }
+        match self.mode() {
+            MODE_PV | MODE_CSV => self.od.int(0x60FF, 0) as f64,
+            MODE_PP => match self.pp_target {
+                Some(t) if (t - self.position).abs() >= 0.5 => {
+                    let speed = (self.od.uint(0x6081, 0) as f64).max(1.0);
+                    speed.copysign(t - self.position) / self.position_per_velocity
+                }
+                _ => 0.0,
+            },
             _ => 0.0,
         }
     }
@@ -458,7 +549,27 @@ impl Drive {
         let dv = (target - self.velocity).clamp(-step, step);
         let v0 = self.velocity;
         self.velocity += dv;
+        let before = self.position;
         self.position += (v0 + self.velocity) / 2.0 * dt * self.position_per_velocity;
+        if let Some(t) = self.pp_target
+            && (before - t).signum() != (self.position - t).signum()
+        {
+            // Reached the set-point within this step: stop on it.
+            self.position = t;
+            self.velocity = 0.0;
+        }
+        if self.mode() == MODE_CSP && self.state == DriveState::OperationEnabled {
+            self.position = self.od.int(0x607A, 0) as f64;
+        }
+        if let Some(left) = self.homing_left {
+            if left <= dt {
+                self.homing_left = None;
+                self.homed = true;
+                self.position = self.od.int(0x607C, 0) as f64;
+            } else {
+                self.homing_left = Some(left - dt);
+            }
+        }
         if self.state == DriveState::QuickStopActive
             && self.velocity == 0.0
             && (1..=4).contains(&self.od.int(0x605A, 0))

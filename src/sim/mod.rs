@@ -64,7 +64,7 @@ impl Simulation {
                 let source = MappingSource::Profile("demo simulator".into());
                 let read = |comm: u16, map: u16| -> BTreeMap<u8, PdoMapping> {
                     (0..4u16)
-                        .filter(|n| od.has_index(map + n))
+                        .filter(|n| od.has_index(map + n) && od.uint(map + n, 0) > 0)
                         .map(|n| {
                             let count = od.uint(map + n, 0) as u8;
                             let entries = (1..=count)

@@ -22,6 +22,9 @@ pub struct Entry {
 pub struct DeviceObjects {
     entries: BTreeMap<(u16, u8), Entry>,
     defaults: BTreeMap<(u16, u8), Vec<u8>>,
+    /// Vendor quirk: a write shorter than an unsigned integer object is zero-extended
+    /// instead of refused (the Syn-tron manual's own examples write 2 bytes to UNSIGNED32).
+    pub short_writes_extend: bool,
 }
 
 impl DeviceObjects {
@@ -59,6 +62,17 @@ impl DeviceObjects {
             })
             .collect()
     }
+    /// Every index with its highest sub-index.
+    pub fn highest_subs(&self) -> Vec<(u16, u8)> {
+        let mut out: Vec<(u16, u8)> = Vec::new();
+        for &(index, sub) in self.entries.keys() {
+            match out.last_mut() {
+                Some((i, max)) if *i == index => *max = (*max).max(sub),
+                _ => out.push((index, sub)),
+            }
+        }
+        out
+    }
     /// The entry at (index, sub).
     pub fn entry(&self, index: u16, sub: u8) -> Option<&Entry> {
         self.entries.get(&(index, sub))
@@ -77,9 +91,27 @@ impl DeviceObjects {
     }
     /// Writes an entry for an SDO download; `Err` is the abort code.
     pub fn write(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), u32> {
-        self.writable(index, sub, Some(data.len()))?;
-        self.set(index, sub, data);
+        let size = self.lookup(index, sub)?.data_type.size();
+        match size {
+            Some(size) if self.short_writes_extend && data.len() < size && self.is_unsigned(index, sub) => {
+                self.writable(index, sub, Some(size))?;
+                let mut full = data.to_vec();
+                full.resize(size, 0);
+                self.set(index, sub, &full);
+            }
+            _ => {
+                self.writable(index, sub, Some(data.len()))?;
+                self.set(index, sub, data);
+            }
+        }
         Ok(())
+    }
+
+    fn is_unsigned(&self, index: u16, sub: u8) -> bool {
+        use DataType::*;
+        self.entries
+            .get(&(index, sub))
+            .is_some_and(|e| matches!(e.data_type, U8 | U16 | U24 | U32 | U40 | U48 | U56 | U64))
     }
     /// Sets a value from inside the device (no access check); unknown entries are ignored.
     pub fn set(&mut self, index: u16, sub: u8, data: &[u8]) {

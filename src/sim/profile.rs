@@ -23,6 +23,12 @@ pub struct DriveProfile {
     pub vendor_u16: Vec<(u16, &'static str, i64)>,
     /// 0x1018:4 serial number (default: 1000 + node-ID); part of the LSS address.
     pub serial_number: Option<u32>,
+    /// The built-in profile whose objects (and those of the profiles it extends, CiA 402)
+    /// the drive also has, with their defaults: vendor parameters answer as on the real drive.
+    pub dictionary: &'static str,
+    /// Accepts writes shorter than an unsigned object (see
+    /// [`DeviceObjects::short_writes_extend`]).
+    pub short_writes_extend: bool,
 }
 
 impl DriveProfile {
@@ -37,6 +43,8 @@ impl DriveProfile {
             position_per_velocity: 1.0,
             vendor_u16: Vec::new(),
             serial_number: None,
+            dictionary: "cia402",
+            short_writes_extend: false,
         }
     }
     /// Like the AIMOTOR servo of the seed manuals (profile `aimotor`): identified by a
@@ -44,6 +52,7 @@ impl DriveProfile {
     pub fn aimotor_like() -> DriveProfile {
         DriveProfile {
             software_version: "AIMOTOR (cotui simulation)".to_string(),
+            dictionary: "aimotor",
             ..DriveProfile::servo("cotui simulated AIMOTOR-like servo", 0x0402_0002)
         }
     }
@@ -54,6 +63,9 @@ impl DriveProfile {
             position_per_velocity: 10_000.0 / 600.0,
             // F0.1.002 / F1.1.002 control mode: 20 = CANopen (the manual's STEP1).
             vendor_u16: vec![(0x2102, "A control mode", 20), (0x3102, "B control mode", 20)],
+            dictionary: "syntron-ds",
+            // The manual's PP example writes 6093h sub 1/2 with 2 bytes ("602 2B 93 60 01 01").
+            short_writes_extend: true,
             ..DriveProfile::servo("cotui simulated Syn-tron-like DS servo", 0x0402_0003)
         }
     }
@@ -65,6 +77,7 @@ pub fn drive_objects(node: u8, p: DriveProfile) -> DeviceObjects {
     use DataType::*;
     let n = node as i64;
     let mut s = DeviceObjects::default();
+    s.short_writes_extend = p.short_writes_extend;
     s.add(0x1000, 0, "Device type", U32, Ro, 0x0002_0192);
     s.add(0x1001, 0, "Error register", U8, Ro, 0);
     s.add(0x1003, 0, "Number of errors", U8, Rw, 0);
@@ -107,25 +120,36 @@ pub fn drive_objects(node: u8, p: DriveProfile) -> DeviceObjects {
         Ro,
         p.serial_number.map_or(1000 + n, i64::from),
     );
-    // RPDO1: controlword + target velocity.
-    s.add(0x1400, 0, "Highest sub-index supported", U8, Const, 2);
-    s.add(0x1400, 1, "COB-ID used by RPDO", U32, Rw, 0x200 + n);
-    s.add(0x1400, 2, "Transmission type", U8, Rw, 0xFF);
-    s.add(0x1600, 0, "Number of mapped objects", U8, Rw, 2);
-    s.add(0x1600, 1, "Mapping entry 1", U32, Rw, 0x6040_0010);
-    s.add(0x1600, 2, "Mapping entry 2", U32, Rw, 0x60FF_0020);
-    // TPDO1: statusword + mode display; TPDO2: position + velocity; both on every SYNC.
-    for (k, cob, entries) in [
-        (0u16, 0x180, [0x6041_0010u32, 0x6061_0008]),
-        (1, 0x280, [0x6064_0020, 0x606C_0020]),
+    // Four RPDOs and TPDOs with every communication and mapping sub-index. RPDO1:
+    // controlword + target velocity; TPDO1: statusword + mode display; TPDO2: position +
+    // velocity, both on every SYNC; the others unused (COB-ID invalid, nothing mapped).
+    let rpdo: [&[u32]; 4] = [&[0x6040_0010, 0x60FF_0020], &[], &[], &[]];
+    let tpdo: [&[u32]; 4] = [&[0x6041_0010, 0x6061_0008], &[0x6064_0020, 0x606C_0020], &[], &[]];
+    for (comm, map, base, maps, kind) in [
+        (0x1400u16, 0x1600u16, 0x200, rpdo, 0xFF),
+        (0x1800, 0x1A00, 0x180, tpdo, 1),
     ] {
-        s.add(0x1800 + k, 0, "Highest sub-index supported", U8, Const, 2);
-        s.add(0x1800 + k, 1, "COB-ID used by TPDO", U32, Rw, cob + n);
-        s.add(0x1800 + k, 2, "Transmission type", U8, Rw, 1);
-        s.add(0x1A00 + k, 0, "Number of mapped objects", U8, Rw, 2);
-        s.add(0x1A00 + k, 1, "Mapping entry 1", U32, Rw, entries[0] as i64);
-        s.add(0x1A00 + k, 2, "Mapping entry 2", U32, Rw, entries[1] as i64);
+        let what = if comm == 0x1400 { "RPDO" } else { "TPDO" };
+        for (k, entries) in maps.iter().enumerate() {
+            let (comm, map) = (comm + k as u16, map + k as u16);
+            let cob = base + 0x100 * k as i64 + n;
+            let cob = if entries.is_empty() { cob | 0x8000_0000 } else { cob };
+            s.add(comm, 0, "Highest sub-index supported", U8, Const, 5);
+            s.add(comm, 1, &format!("COB-ID used by {what}"), U32, Rw, cob);
+            s.add(comm, 2, "Transmission type", U8, Rw, kind);
+            s.add(comm, 3, "Inhibit time", U16, Rw, 0);
+            s.add(comm, 5, "Event timer", U16, Rw, 0);
+            s.add(map, 0, "Number of mapped objects", U8, Rw, entries.len() as i64);
+            for sub in 1..=8u8 {
+                let e = entries.get(sub as usize - 1).copied().unwrap_or(0);
+                s.add(map, sub, &format!("Mapping entry {sub}"), U32, Rw, e as i64);
+            }
+        }
     }
+    s.add(0x1010, 0, "Highest sub-index supported", U8, Const, 1);
+    s.add(0x1010, 1, "Save all parameters", U32, Rw, 1);
+    s.add(0x1011, 0, "Highest sub-index supported", U8, Const, 1);
+    s.add(0x1011, 1, "Restore all default parameters", U32, Rw, 1);
     let block: Vec<u8> = (0..200u32).map(|i| (i * 7 + n as u32) as u8).collect();
     s.add_bytes(0x2000, 0, "Parameter block", Domain, Rw, block);
     for (index, name, value) in &p.vendor_u16 {
@@ -143,6 +167,54 @@ pub fn drive_objects(node: u8, p: DriveProfile) -> DeviceObjects {
     s.add(0x6084, 0, "Profile deceleration", U32, Rw, 20_000);
     s.add(0x6085, 0, "Quick stop deceleration", U32, Rw, 100_000);
     s.add(0x60FF, 0, "Target velocity", I32, Rww, 0);
-    s.add(0x6502, 0, "Supported drive modes", U32, Ro, (1 << 2) | (1 << 8));
+    // PP, PV, PT, HM, CSP, CSV, CST.
+    s.add(0x6502, 0, "Supported drive modes", U32, Ro, 0b11_1010_1101);
+    add_profile_objects(&mut s, p.dictionary);
     s
+}
+
+/// Adds the objects of built-in profile `name` and of the profiles it extends (not CiA 301:
+/// the communication objects above are the simulator's own) that `s` lacks, with the
+/// profile's default or 0, plus sub-index 0 of records that have none.
+fn add_profile_objects(s: &mut DeviceObjects, name: &str) {
+    let mut names = vec![name.to_string()];
+    let mut i = 0;
+    while let Some(name) = names.get(i).cloned() {
+        i += 1;
+        let Some(Ok((profile, _))) = crate::od::bind::shared_builtin(&name) else {
+            continue;
+        };
+        for e in &profile.extends {
+            if e != "cia301" && !names.contains(e) {
+                names.push(e.clone());
+            }
+        }
+        for (&(index, sub), info) in &profile.objects {
+            if index < 0x2000 || s.entry(index, sub).is_some() {
+                continue;
+            }
+            match info.data_type.size() {
+                Some(_) => {
+                    let v = info.default.as_ref().and_then(|v| v.as_i64()).unwrap_or(0);
+                    s.add(index, sub, &info.name, info.data_type, info.access, v);
+                }
+                None => s.add_bytes(index, sub, &info.name, info.data_type, info.access, Vec::new()),
+            }
+        }
+    }
+    let records: Vec<(u16, u8)> = s
+        .highest_subs()
+        .into_iter()
+        .filter(|(i, max)| *max > 0 && s.entry(*i, 0).is_none())
+        .collect();
+    for (index, max) in records {
+        s.add(
+            index,
+            0,
+            "Highest sub-index supported",
+            DataType::U8,
+            Access::Const,
+            max as i64,
+        );
+    }
 }

@@ -89,29 +89,29 @@ fn text_mode_prints_each_step_before_its_result() {
 
 #[test]
 fn a_step_on_a_missing_object_stops_with_abort_0x06020000_and_exit_3() {
-    // The simulated drive has no 0x607A (target position): aimotor `pp` stops at step 2.
-    let (rc, out, err) = cotui(&["run", "demo", "2", "pp", "--profile", "2=aimotor", "--json"]);
+    // AIMOTOR's manual example run on the Syn-tron-like drive (node 3), which has no
+    // AIMOTOR vendor object H02-00 (0x2002:01): it stops at step 1, nothing after it runs.
+    let (rc, out, err) = cotui(&["run", "demo", "3", "pp_example", "--profile", "3=aimotor", "--json"]);
     assert_eq!(rc, 3, "{err}");
     let v = json(&out);
     assert_eq!(v["ok"], false);
     assert_eq!(v["error"], "sdo_abort");
     assert_eq!(v["abort_code"], 0x0602_0000);
     assert_eq!(v["abort_text"], "Object does not exist in the object dictionary");
-    assert_eq!(v["failed_step"], 2);
-    assert_eq!(v["steps"].as_array().map(Vec::len), Some(2));
-    assert_eq!(v["steps"][0]["result"], "written");
+    assert_eq!(v["failed_step"], 1);
+    assert_eq!(v["steps"].as_array().map(Vec::len), Some(1));
     assert!(
-        err.contains("`pp` stopped at step 2/11: SDO 607A:00 on node 2 aborted by the server: 0x06020000"),
+        err.contains("`pp_example` stopped at step 1/11: SDO 2002:01 on node 3 aborted by the server: 0x06020000"),
         "{err}"
     );
-    let (rc, out, _) = cotui(&["run", "demo", "2", "pp", "--profile", "2=aimotor"]);
+    let (rc, out, _) = cotui(&["run", "demo", "3", "pp_example", "--profile", "3=aimotor"]);
     assert_eq!(rc, 3);
     assert!(
         out.lines()
-            .any(|l| l.starts_with("step 2/11: sdo write 0x607A:00 Target position = 100500")),
+            .any(|l| l.starts_with("step 1/11: sdo write 0x2002:01 Control mode = 8")),
         "{out}"
     );
-    assert!(!out.contains("step 3/11"), "{out}");
+    assert!(!out.contains("step 2/11"), "{out}");
 }
 
 #[test]
@@ -227,4 +227,40 @@ fn list_shows_procedures_with_descriptions_and_parameters() {
     assert_eq!(pv["params"][1]["name"], "ramp");
     assert_eq!(pv["params"][1]["default"], 1000);
     assert_eq!(pv["steps"], 9);
+}
+
+/// Every procedure of the demo drives' profiles runs to completion on the demo bus: the
+/// simulated drives have the profiles' whole dictionaries and the modes the procedures use
+/// (PP set-point, PV, PT, HM homing attained, cyclic modes, PDO remapping).
+#[test]
+fn every_procedure_of_the_demo_drives_runs_to_completion() {
+    for (node, profile) in [("2", "aimotor"), ("3", "syntron-ds")] {
+        let (rc, out, err) = cotui(&["run", "demo", node, "--list", "--json"]);
+        assert_eq!(rc, 0, "{err}");
+        let list = json(&out);
+        let names: Vec<String> = list["procedures"]
+            .as_array()
+            .unwrap_or_else(|| panic!("no procedures in {list}"))
+            .iter()
+            .map(|p| p["name"].as_str().unwrap().to_string())
+            .collect();
+        assert!(names.len() >= 6, "{profile}: {names:?}");
+        let planned: Vec<u64> = list["procedures"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| p["steps"].as_u64().unwrap())
+            .collect();
+        for (name, steps) in names.iter().zip(planned) {
+            let (rc, out, err) = cotui(&["run", "demo", node, name, "--json"]);
+            assert_eq!(rc, 0, "{profile} {name}: exit {rc}\n{out}\n{err}");
+            let v = json(&out);
+            assert_eq!(v["ok"], true, "{profile} {name}: {v}");
+            assert_eq!(
+                v["steps"].as_array().map(Vec::len),
+                Some(steps as usize),
+                "{profile} {name}: every step done"
+            );
+        }
+    }
 }
