@@ -45,6 +45,25 @@ const ENABLE_OPERATION: Step = Step {
     target: DriveState::OperationEnabled,
 };
 
+/// The controlwords of the emergency stop, in order: quick stop, then disable voltage.
+pub const STOP_CONTROLWORDS: [u16; 2] = [0x0002, 0x0000];
+
+/// The frame that writes `controlword` to `node` (an expedited SDO download of 0x6040:00),
+/// as the SDO client sends it.
+pub fn controlword_frame(node: u8, controlword: u16) -> crate::frame::Frame {
+    super::sdo::first_download_frame(node, 0x6040, 0, &controlword.to_le_bytes(), false).0
+}
+
+/// The frames a drive command on `node` in `state` writes, in order: a controlword per step
+/// of [`plan`], or the 0x6060 write of `mode` (then read back; `status` only reads).
+pub fn frames(node: u8, action: DriveAction, state: DriveState) -> Vec<crate::frame::Frame> {
+    match action {
+        DriveAction::Status => Vec::new(),
+        DriveAction::Mode(m) => vec![super::sdo::first_download_frame(node, 0x6060, 0, &[m as u8], false).0],
+        a => plan(a, state).iter().map(|s| controlword_frame(node, s.controlword)).collect(),
+    }
+}
+
 /// The steps that take a drive in `state` through `action` (empty: nothing to do).
 pub fn plan(action: DriveAction, state: DriveState) -> Vec<Step> {
     use DriveState::*;
@@ -504,7 +523,8 @@ pub async fn stop(bus: &Bus, node: u8, timeout_ms: u64, ramp_ms: u64) -> NodeSto
         sent: Vec::new(),
         reason: None,
     };
-    for (cw, wait_ms) in [(0x0002u16, ramp_ms), (0x0000, timeout_ms.max(200) * 2)] {
+    let [quick_stop, disable_voltage] = STOP_CONTROLWORDS;
+    for (cw, wait_ms) in [(quick_stop, ramp_ms), (disable_voltage, timeout_ms.max(200) * 2)] {
         if let Err(e) = download(bus, node, 0x6040, 0, cw.to_le_bytes().to_vec(), false, timeout_ms).await {
             out.reason = Some(stop_failure(&mut w, cw, e));
             return out;
@@ -524,7 +544,7 @@ pub async fn stop(bus: &Bus, node: u8, timeout_ms: u64, ramp_ms: u64) -> NodeSto
             let off = matches!(state, DriveState::SwitchOnDisabled | DriveState::NotReadyToSwitchOn);
             let faulted = matches!(state, DriveState::Fault | DriveState::FaultReactionActive);
             let standstill = state == DriveState::QuickStopActive && sw & 0x0400 != 0;
-            if off || faulted || (cw == 0x0002 && standstill) || tokio::time::Instant::now() >= deadline {
+            if off || faulted || (cw == quick_stop && standstill) || tokio::time::Instant::now() >= deadline {
                 break;
             }
             tokio::time::sleep(Duration::from_millis(10)).await;

@@ -52,7 +52,7 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
             output,
         } => {
             let dict = bindings.dictionary(*node);
-            let (index, sub) = resolve_object(dict, object).map_err(CommandError::Usage)?;
+            let (index, sub) = resolve_object(dict, object).map_err(|e| CommandError::Usage(e.to_string()))?;
             let data = super::sdo::upload_within(bus, *node, index, sub, options.block, timing(options)).await?;
             if let Some(path) = output {
                 std::fs::write(path, &data).map_err(|e| CommandError::Usage(format!("cannot write {path}: {e}")))?;
@@ -81,7 +81,7 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
             options,
         } => {
             let dict = bindings.dictionary(*node);
-            let (index, sub) = resolve_object(dict, object).map_err(CommandError::Usage)?;
+            let (index, sub) = resolve_object(dict, object).map_err(|e| CommandError::Usage(e.to_string()))?;
             let data = write_data(dict, index, sub, value, options.data_type)?;
             super::sdo::download_within(bus, *node, index, sub, data.clone(), options.block, timing(options)).await?;
             json!({
@@ -141,12 +141,12 @@ fn timing(o: &SdoOptions) -> Timing {
 /// `run`: lists, dry-runs or runs a procedure; the text is a summary line, then every step
 /// line and result.
 async fn run_procedure(bus: &Bus, bindings: &Bindings, spec: &RunSpec) -> Result<Outcome, CommandError> {
-    let (json, text) = offline_run(bindings, spec).map_err(CommandError::Usage)?;
+    let (json, text) = offline_run(bindings, spec)?;
     let Some(name) = spec.procedure.as_deref().filter(|_| !spec.dry_run) else {
         return Ok(Outcome { json, text });
     };
     let dict = bindings.dictionary(spec.node);
-    let plan = super::run::plan(dict, spec.node, name, &spec.args).map_err(CommandError::Usage)?;
+    let plan = super::run::plan(dict, spec.node, name, &spec.args)?;
     let mut lines = Vec::new();
     let json = super::run::run(bus, dict, &plan, spec.timeout_ms, &mut |l| lines.push(l.to_string())).await?;
     // The summary first: the palette's message line shows one line.
@@ -159,7 +159,7 @@ async fn run_procedure(bus: &Bus, bindings: &Bindings, spec: &RunSpec) -> Result
 
 /// What `run` gives without a bus: the listing (no procedure) or the dry run (also used to
 /// check a procedure and its parameters before opening the bus).
-pub fn offline_run(bindings: &Bindings, spec: &RunSpec) -> Result<(Json, String), String> {
+pub fn offline_run(bindings: &Bindings, spec: &RunSpec) -> Result<(Json, String), super::run::PlanError> {
     let dict = bindings.dictionary(spec.node);
     match &spec.procedure {
         None => Ok(super::run::list(dict, spec.node)),
@@ -198,7 +198,7 @@ pub fn write_data(
         Some(DataType::Domain) => {
             std::fs::read(value).map_err(|e| CommandError::Usage(format!("cannot read {value}: {e}")))
         }
-        Some(t) => encode(value, t).map_err(CommandError::Usage),
+        Some(t) => Ok(encode(value, t)?),
         None => Err(CommandError::Usage(format!(
             "the type of {index:04X}:{sub:02X} is unknown: give --type (u8..u64, i8..i64, f32, f64, bool, string, octets, domain)"
         ))),

@@ -224,11 +224,13 @@ pub enum LogFormat {
 
 impl LogFormat {
     /// Parses `candump` or `pcapng`.
-    pub fn parse(word: &str) -> Result<LogFormat, String> {
+    pub fn parse(word: &str) -> Result<LogFormat, super::syntax::ParseError> {
         match word {
             "candump" | "log" => Ok(LogFormat::Candump),
             "pcapng" => Ok(LogFormat::Pcapng),
-            _ => Err(format!("unknown record format `{word}`: use candump or pcapng")),
+            _ => Err(super::syntax::ParseError::Invalid(format!(
+                "unknown record format `{word}`: use candump or pcapng"
+            ))),
         }
     }
 }

@@ -107,50 +107,58 @@ pub struct RunPlan {
     pub steps: Vec<PlannedStep>,
 }
 
-fn candump(f: &Frame) -> String {
-    if f.is_ext() {
-        format!("{:08X}#{}", f.id, hex::upper(f.payload()))
-    } else {
-        format!("{:03X}#{}", f.id, hex::upper(f.payload()))
+/// Why a procedure cannot be planned (a usage error: nothing was sent).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum PlanError {
+    /// The node's dictionary has no procedure of that name (`known`: the ones it has).
+    #[error(
+        "node {node} has no procedure `{name}`{}",
+        if known.is_empty() {
+            format!(": its dictionary has no procedures (bind a profile: --profile {node}=NAME)")
+        } else {
+            format!("; its procedures: {}", known.join(", "))
+        }
+    )]
+    NoProcedure { node: u8, name: String, known: Vec<String> },
+    /// A parameter the procedure does not take (`params`: the ones it takes).
+    #[error("`{procedure}` has no parameter `{name}`; {params}")]
+    UnknownParam {
+        procedure: String,
+        name: String,
+        params: String,
+    },
+    /// A parameter value that is not a number.
+    #[error("{name}=`{text}` is not a number (decimal or 0x hex)")]
+    NotANumber { name: String, text: String },
+    /// A parameter without default not given.
+    #[error("`{procedure}` needs {name}=VALUE; {params}")]
+    MissingParam {
+        procedure: String,
+        name: String,
+        params: String,
+    },
+    /// A step that cannot be built (object, expression, value, frame).
+    #[error("`{procedure}` step {step}/{of}: {reason}")]
+    Step {
+        procedure: String,
+        step: usize,
+        of: usize,
+        reason: String,
+    },
+}
+
+impl From<PlanError> for CommandError {
+    fn from(e: PlanError) -> Self {
+        CommandError::Usage(e.to_string())
     }
 }
 
-/// The first frame of an SDO download: expedited up to 4 bytes, else the segmented initiate.
-fn download_initiate(node: u8, index: u16, sub: u8, data: &[u8]) -> Frame {
-    let [lo, hi] = index.to_le_bytes();
-    let mut b = if data.len() <= 4 {
-        let mut b = vec![0x23 | (((4 - data.len()) as u8) << 2), lo, hi, sub];
-        b.extend_from_slice(data);
-        b
-    } else {
-        let mut b = vec![0x21, lo, hi, sub];
-        b.extend_from_slice(&(data.len() as u32).to_le_bytes());
-        b
-    };
-    b.resize(8, 0);
-    Frame::classic(0x600 + u32::from(node), &b)
-}
-
-fn upload_request(node: u8, index: u16, sub: u8) -> Frame {
-    let [lo, hi] = index.to_le_bytes();
-    Frame::classic(0x600 + u32::from(node), &[0x40, lo, hi, sub, 0, 0, 0, 0])
-}
-
-/// The procedure `name` of `dict`, or a usage message naming the ones there are.
-pub fn find<'a>(dict: &'a Dictionary, node: u8, name: &str) -> Result<&'a Procedure, String> {
-    if let Some(p) = dict.procedure(name) {
-        return Ok(p);
-    }
-    let names: Vec<&str> = dict.procedures().iter().map(|p| p.name.as_str()).collect();
-    Err(if names.is_empty() {
-        format!(
-            "node {node} has no procedure `{name}`: its dictionary has no procedures (bind a profile: --profile {node}=NAME)"
-        )
-    } else {
-        format!(
-            "node {node} has no procedure `{name}`; its procedures: {}",
-            names.join(", ")
-        )
+/// The procedure `name` of `dict`, or an error naming the ones there are.
+pub fn find<'a>(dict: &'a Dictionary, node: u8, name: &str) -> Result<&'a Procedure, PlanError> {
+    dict.procedure(name).ok_or_else(|| PlanError::NoProcedure {
+        node,
+        name: name.to_string(),
+        known: dict.procedures().iter().map(|p| p.name.clone()).collect(),
     })
 }
 
@@ -171,10 +179,14 @@ fn param_list(p: &Procedure) -> String {
 
 /// Binds `args` to the parameters of `p` (defaults for the rest): unknown, unparsable or
 /// missing parameters are errors naming the valid ones.
-pub fn bind_params(p: &Procedure, args: &[(String, String)]) -> Result<Vec<(String, i64)>, String> {
+pub fn bind_params(p: &Procedure, args: &[(String, String)]) -> Result<Vec<(String, i64)>, PlanError> {
     for (name, _) in args {
         if !p.params.iter().any(|q| &q.name == name) {
-            return Err(format!("`{}` has no parameter `{name}`; {}", p.name, param_list(p)));
+            return Err(PlanError::UnknownParam {
+                procedure: p.name.clone(),
+                name: name.clone(),
+                params: param_list(p),
+            });
         }
     }
     p.params
@@ -182,11 +194,18 @@ pub fn bind_params(p: &Procedure, args: &[(String, String)]) -> Result<Vec<(Stri
         .map(|q| {
             let given = args.iter().rev().find(|(n, _)| n == &q.name);
             let v = match (given, q.default) {
-                (Some((_, text)), _) => {
-                    parse_int(text).ok_or_else(|| format!("{}=`{text}` is not a number (decimal or 0x hex)", q.name))?
-                }
+                (Some((_, text)), _) => parse_int(text).ok_or_else(|| PlanError::NotANumber {
+                    name: q.name.clone(),
+                    text: text.clone(),
+                })?,
                 (None, Some(d)) => d,
-                (None, None) => return Err(format!("`{}` needs {}=VALUE; {}", p.name, q.name, param_list(p))),
+                (None, None) => {
+                    return Err(PlanError::MissingParam {
+                        procedure: p.name.clone(),
+                        name: q.name.clone(),
+                        params: param_list(p),
+                    });
+                }
             };
             Ok((q.name.clone(), v))
         })
@@ -195,7 +214,7 @@ pub fn bind_params(p: &Procedure, args: &[(String, String)]) -> Result<Vec<(Stri
 
 /// Plans procedure `name` of node `node` with dictionary `dict` and parameters `args`:
 /// resolves every object, evaluates every expression and builds every frame, without IO.
-pub fn plan(dict: &Dictionary, node: u8, name: &str, args: &[(String, String)]) -> Result<RunPlan, String> {
+pub fn plan(dict: &Dictionary, node: u8, name: &str, args: &[(String, String)]) -> Result<RunPlan, PlanError> {
     let p = find(dict, node, name)?;
     let params = bind_params(p, args)?;
     let vars = |v: &str| {
@@ -207,7 +226,12 @@ pub fn plan(dict: &Dictionary, node: u8, name: &str, args: &[(String, String)]) 
     let n = p.steps.len();
     let mut steps = Vec::with_capacity(n);
     for (i, step) in p.steps.iter().enumerate() {
-        let at = |e: String| format!("`{name}` step {}/{n}: {e}", i + 1);
+        let at = |reason: String| PlanError::Step {
+            procedure: name.to_string(),
+            step: i + 1,
+            of: n,
+            reason,
+        };
         steps.push(plan_step(dict, node, step, &vars).map_err(at)?);
     }
     Ok(RunPlan {
@@ -243,10 +267,10 @@ fn plan_step(
             let ty = data_type.or_else(|| typed(index, sub)).ok_or(format!(
                 "the type of {index:04X}:{sub:02X} is unknown (give `type` in the profile)"
             ))?;
-            let data = encode(&v.to_string(), ty)?;
+            let data = encode(&v.to_string(), ty).map_err(|e| e.to_string())?;
             let shown = object_text(dict, index, sub, &ty.decode(&data), None);
             let text = format!("sdo write {} = {shown}", object_name(dict, index, sub));
-            let frame = candump(&download_initiate(node, index, sub, &data));
+            let frame = super::candump(&super::sdo::first_download_frame(node, index, sub, &data, false).0);
             PlannedStep {
                 action: Action::SdoWrite { index, sub, data },
                 text,
@@ -264,7 +288,7 @@ fn plan_step(
                 },
                 text: format!("sdo read {}", object_name(dict, index, sub)),
                 value: None,
-                frame: Some(candump(&upload_request(node, index, sub))),
+                frame: Some(super::candump(&super::sdo::first_upload_frame(node, index, sub, false))),
             }
         }
         Step::Nmt { command, node: to } => {
@@ -279,7 +303,7 @@ fn plan_step(
                 None => node,
             };
             let action = nmt_action(*command);
-            let f = Frame::classic(0x000, &[action.cs(), target]);
+            let f = super::nmt::frame(action, target);
             let whom = if target == 0 {
                 "all nodes".to_string()
             } else {
@@ -289,7 +313,7 @@ fn plan_step(
                 action: Action::Nmt { action, target },
                 text: format!("nmt {} to {whom}", nmt_word(*command)),
                 value: None,
-                frame: Some(candump(&f)),
+                frame: Some(super::candump(&f)),
             }
         }
         Step::Frame { id, data } => {
@@ -299,7 +323,7 @@ fn plan_step(
                 .filter(|i| *i <= 0x1FFF_FFFF)
                 .ok_or(format!("frame id {id} is not a CAN id"))?;
             let f = Frame::classic(id, &frame_bytes(data, vars)?);
-            let c = candump(&f);
+            let c = super::candump(&f);
             PlannedStep {
                 action: Action::Frame(f),
                 text: format!("frame {c}"),
@@ -345,7 +369,7 @@ fn plan_step(
                     fails_on
                 ),
                 value: Some(equals),
-                frame: Some(candump(&upload_request(node, index, sub))),
+                frame: Some(super::candump(&super::sdo::first_upload_frame(node, index, sub, false))),
             }
         }
         Step::Delay { ms } => PlannedStep {
