@@ -1,7 +1,7 @@
 //! `cotui decode FILE...`: the headless decoder.
 
-use crate::command::ExitCode;
 use crate::analysis::EventTracker;
+use crate::command::ExitCode;
 use crate::decode::{Decoder, Kind, sdo::Transaction};
 use crate::frame::{Frame, Interfaces};
 use crate::log::Outcome;

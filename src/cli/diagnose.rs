@@ -1,7 +1,7 @@
 //! `cotui diagnose FILE...`: what went wrong on the bus, as a short ranked list of incidents.
 
-use crate::command::ExitCode;
 use crate::analysis::{Diagnoser, EventTracker, Incident, Status};
+use crate::command::ExitCode;
 use crate::decode::Kind;
 use crate::frame::{Frame, Interfaces};
 use crate::log::Outcome;

@@ -1,7 +1,7 @@
 //! `cotui open FILE` and `cotui replay FILE`: the interactive analyzer on a log.
 
-use crate::command::ExitCode;
 use crate::analysis::trace::Trace;
+use crate::command::ExitCode;
 use crate::tui::app::{App, SourceInfo, SourceKind};
 use crate::tui::keymap::{self, Keymap, KeymapError};
 use crate::tui::source;

@@ -60,7 +60,10 @@ pub fn frames(node: u8, action: DriveAction, state: DriveState) -> Vec<crate::fr
     match action {
         DriveAction::Status => Vec::new(),
         DriveAction::Mode(m) => vec![super::sdo::first_download_frame(node, 0x6060, 0, &[m as u8], false).0],
-        a => plan(a, state).iter().map(|s| controlword_frame(node, s.controlword)).collect(),
+        a => plan(a, state)
+            .iter()
+            .map(|s| controlword_frame(node, s.controlword))
+            .collect(),
     }
 }
 

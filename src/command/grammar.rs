@@ -94,9 +94,9 @@ impl DriveAction {
             "fault-reset" => DriveAction::FaultReset,
             "status" => DriveAction::Status,
             _ => {
-                return Ok(DriveAction::Mode(parse_mode(
-                    arg.ok_or_else(|| ParseError::Invalid("drive mode needs a MODE (e.g. pv, csp, 3)".into()))?,
-                )?));
+                return Ok(DriveAction::Mode(parse_mode(arg.ok_or_else(|| {
+                    ParseError::Invalid("drive mode needs a MODE (e.g. pv, csp, 3)".into())
+                })?)?));
             }
         };
         match arg {

@@ -53,6 +53,8 @@ impl From<clap::Error> for ParseError {
         for l in lines {
             if let Some(u) = l.strip_prefix("Usage: ") {
                 usage = u.to_string();
+            } else if l.starts_with("For more information") {
+                break;
             } else if l.starts_with("tip: to pass") {
                 // `-- --flag`: no line of ours takes a value that starts with `-`.
             } else if usage.is_empty() {
@@ -375,7 +377,12 @@ impl<B: Args, D: Args> Commander<B, D> {
 
 /// The palette's parser: the commander declaration with nothing in front.
 #[derive(Parser, Debug)]
-#[command(name = ":", no_binary_name = true, disable_help_subcommand = true, disable_version_flag = true)]
+#[command(
+    name = ":",
+    no_binary_name = true,
+    disable_help_subcommand = true,
+    disable_version_flag = true
+)]
 struct Palette {
     #[command(subcommand)]
     command: Commander<Session, Session>,
@@ -658,7 +665,10 @@ mod tests {
         assert!(err("record").contains("--output <OUTPUT>"));
         assert!(err("").starts_with("empty command"));
         assert_eq!(err("nmt start 2 --block"), "unexpected argument '--block' found");
-        assert_eq!(err("drive 2 enable extra"), "`drive enable` takes no MODE (got `extra`)");
+        assert_eq!(
+            err("drive 2 enable extra"),
+            "`drive enable` takes no MODE (got `extra`)"
+        );
         assert_eq!(err("scan extra"), "unexpected argument 'extra' found");
         assert_eq!(parse_command("sdo read 2 \"0x6041"), Err(ParseError::Quote));
     }

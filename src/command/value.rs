@@ -112,10 +112,20 @@ mod tests {
         assert_eq!(encode("0x0F", DataType::U16), Ok(vec![0x0F, 0]));
         assert_eq!(encode("-2", DataType::I16), Ok(vec![0xFE, 0xFF]));
         assert_eq!(encode("0xFF", DataType::I8), Ok(vec![0xFF]));
-        assert!(encode("256", DataType::U8).unwrap_err().to_string().contains("does not fit"));
+        assert!(
+            encode("256", DataType::U8)
+                .unwrap_err()
+                .to_string()
+                .contains("does not fit")
+        );
         assert_eq!(encode("1.5", DataType::F32), Ok(1.5f32.to_le_bytes().to_vec()));
         assert_eq!(encode("abc", DataType::VisibleString), Ok(b"abc".to_vec()));
         assert_eq!(encode("01 2a", DataType::OctetString), Ok(vec![1, 0x2A]));
-        assert!(encode("1x", DataType::U32).unwrap_err().to_string().contains("not a number"));
+        assert!(
+            encode("1x", DataType::U32)
+                .unwrap_err()
+                .to_string()
+                .contains("not a number")
+        );
     }
 }

@@ -522,7 +522,11 @@ impl App {
                 let words: Vec<String> = if before.contains(' ') {
                     crate::command::syntax::completions(&before)
                 } else {
-                    PALETTE_COMMANDS.iter().chain(commander_words()).map(|w| w.to_string()).collect()
+                    PALETTE_COMMANDS
+                        .iter()
+                        .chain(commander_words())
+                        .map(|w| w.to_string())
+                        .collect()
                 };
                 let shown = p.complete(&words.iter().map(String::as_str).collect::<Vec<_>>());
                 if !shown.is_empty() {

@@ -57,7 +57,10 @@ pub fn plan(
             (f, confirm)
         }
         Command::SdoRead {
-            node, object: o, options, ..
+            node,
+            object: o,
+            options,
+            ..
         } => {
             let (i, s) = object(*node, o)?;
             let first = candump(&sdo::first_upload_frame(*node, i, s, options.block));
@@ -92,7 +95,9 @@ pub fn plan(
                 .unwrap_or("state unknown, assumed Switch on disabled");
             let text = match action {
                 crate::command::DriveAction::Status => format!("reads 0x6041 of node {node}"),
-                crate::command::DriveAction::Mode(m) => format!("{} (0x6060 = {m}), then reads 0x6061", listed(&frames)),
+                crate::command::DriveAction::Mode(m) => {
+                    format!("{} (0x6060 = {m}), then reads 0x6061", listed(&frames))
+                }
                 _ if frames.is_empty() => format!("nothing to send (node {node}: {from})"),
                 _ => format!("{} (from {from})", listed(&frames)),
             };
@@ -129,7 +134,12 @@ pub fn plan(
             }
         }
         Command::Stop { nodes, .. } => {
-            let words = |cws: &[u16]| cws.iter().map(|c| format!("0x{c:04X}")).collect::<Vec<_>>().join(" then ");
+            let words = |cws: &[u16]| {
+                cws.iter()
+                    .map(|c| format!("0x{c:04X}"))
+                    .collect::<Vec<_>>()
+                    .join(" then ")
+            };
             let frames: Vec<Frame> = nodes
                 .iter()
                 .flat_map(|n| drive::STOP_CONTROLWORDS.map(|cw| drive::controlword_frame(*n, cw)))
