@@ -3,6 +3,7 @@
 use super::syntax::ParseError;
 use crate::bus::BusError;
 use crate::decode::sdo::abort_text;
+use serde::Serialize;
 
 /// The process exit status of cotui, one value per kind of outcome (docs/COMMANDER.md,
 /// "Exit status").
@@ -105,11 +106,23 @@ impl CommandError {
     }
     /// The `--json` object of the failure.
     pub fn to_json(&self) -> serde_json::Value {
-        use serde_json::json;
+        let message = self.to_string();
         match self {
-            CommandError::Syntax(e) => json!({"ok": false, "error": "usage", "message": e.to_string()}),
-            CommandError::Usage(m) => json!({"ok": false, "error": "usage", "message": m}),
-            CommandError::Bus(e) => json!({"ok": false, "error": "bus", "message": e.to_string()}),
+            CommandError::Syntax(_) | CommandError::Usage(_) => to_json(&Failure {
+                ok: false,
+                error: "usage",
+                message,
+            }),
+            CommandError::Bus(_) => to_json(&Failure {
+                ok: false,
+                error: "bus",
+                message,
+            }),
+            CommandError::Timeout(_) => to_json(&Failure {
+                ok: false,
+                error: "timeout",
+                message,
+            }),
             CommandError::Abort {
                 node,
                 index,
@@ -117,32 +130,34 @@ impl CommandError {
                 code,
                 by_server,
                 reason,
-            } => {
-                let mut v = json!({
-                    "ok": false, "error": "sdo_abort", "node": node,
-                    "index": index, "sub": sub,
-                    "abort_code": code, "abort_text": abort_text(*code),
-                    "aborted_by": if *by_server { "server" } else { "client" },
-                    "message": self.to_string(),
-                });
-                if let (Some(r), Some(o)) = (reason, v.as_object_mut()) {
-                    o.insert("reason".into(), r.as_str().into());
-                }
-                v
-            }
-            CommandError::Timeout(m) => json!({"ok": false, "error": "timeout", "message": m}),
-            CommandError::NotStopped { report, text } => {
+            } => to_json(&Aborted {
+                ok: false,
+                error: "sdo_abort",
+                node: *node,
+                index: *index,
+                sub: *sub,
+                abort_code: *code,
+                abort_text: abort_text(*code),
+                aborted_by: if *by_server { "server" } else { "client" },
+                message,
+                reason: reason.as_deref(),
+            }),
+            CommandError::NotStopped { report, .. } => {
                 let mut v = (**report).clone();
                 if let Some(o) = v.as_object_mut() {
                     o.insert("ok".into(), false.into());
                     o.insert("error".into(), "not_stopped".into());
-                    o.insert("message".into(), text.clone().into());
+                    o.insert("message".into(), message.into());
                 }
                 v
             }
-            CommandError::Drive { node, step, reason } => json!({
-                "ok": false, "error": "drive", "node": node, "step": step, "reason": reason,
-                "message": self.to_string(),
+            CommandError::Drive { node, step, reason } => to_json(&DriveFailed {
+                ok: false,
+                error: "drive",
+                node: *node,
+                step,
+                reason,
+                message,
             }),
             CommandError::Step {
                 step, report, cause, ..
@@ -154,10 +169,51 @@ impl CommandError {
                     }
                     out.insert("ok".into(), false.into());
                     out.insert("failed_step".into(), (*step).into());
-                    out.insert("message".into(), self.to_string().into());
+                    out.insert("message".into(), message.into());
                 }
                 v
             }
         }
     }
+}
+
+/// The JSON of a usage, bus or timeout failure.
+#[derive(Serialize)]
+struct Failure {
+    ok: bool,
+    error: &'static str,
+    message: String,
+}
+
+/// The JSON of an SDO abort.
+#[derive(Serialize)]
+struct Aborted<'a> {
+    ok: bool,
+    error: &'static str,
+    node: u8,
+    index: u16,
+    sub: u8,
+    abort_code: u32,
+    abort_text: &'static str,
+    aborted_by: &'static str,
+    message: String,
+    /// What the server did wrong, when the client aborted.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    reason: Option<&'a str>,
+}
+
+/// The JSON of a failed drive step.
+#[derive(Serialize)]
+struct DriveFailed<'a> {
+    ok: bool,
+    error: &'static str,
+    node: u8,
+    step: &'a str,
+    reason: &'a str,
+    message: String,
+}
+
+/// A failure as its JSON object (serializing these plain structs cannot fail).
+fn to_json(v: &impl Serialize) -> serde_json::Value {
+    serde_json::to_value(v).unwrap_or_default()
 }

@@ -10,7 +10,9 @@ use crate::decode::cia402::mode_name;
 use crate::od::alias::resolve_object;
 use crate::od::bind::Bindings;
 use crate::od::{DataType, Dictionary};
-use serde_json::{Value as Json, json};
+use serde::Serialize;
+use serde_json::Value as Json;
+use std::collections::BTreeMap;
 
 /// The result of a command: the `--json` object and the human text.
 #[derive(Clone, Debug, PartialEq)]
@@ -36,13 +38,11 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
             timeout_ms,
         } => {
             let seen = super::nmt::nmt(bus, *action, *node, *wait, *timeout_ms).await?;
-            let confirmed: serde_json::Map<String, Json> =
-                seen.iter().map(|(n, s)| (n.to_string(), s.as_str().into())).collect();
-            json!({
-                "ok": true,
-                "action": action.as_str(),
-                "node": node,
-                "confirmed": if *wait { Json::Object(confirmed) } else { Json::Null },
+            to_json(&NmtSent {
+                ok: true,
+                action: action.as_str(),
+                node: *node,
+                confirmed: wait.then(|| seen.iter().map(|(n, s)| (n.to_string(), s.as_str())).collect()),
             })
         }
         Command::SdoRead {
@@ -62,16 +62,16 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
                 .or_else(|| dict.object(index, sub).map(|o| o.data_type));
             let value = decode(&data, ty);
             let text = crate::decode::value_text::object_text(dict, index, sub, &value, None);
-            json!({
-                "ok": true,
-                "node": node,
-                "index": index,
-                "sub": sub,
-                "name": dict.name(index, sub),
-                "value": value.to_json(),
-                "text": text,
-                "data": crate::frame::hex::upper(&data),
-                "len": data.len(),
+            to_json(&SdoRead {
+                ok: true,
+                node: *node,
+                index,
+                sub,
+                name: dict.name(index, sub),
+                value: value.to_json(),
+                text,
+                data: crate::frame::hex::upper(&data),
+                len: data.len(),
             })
         }
         Command::SdoWrite {
@@ -84,15 +84,15 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
             let (index, sub) = resolve_object(dict, object).map_err(|e| CommandError::Usage(e.to_string()))?;
             let data = write_data(dict, index, sub, value, options.data_type)?;
             super::sdo::download_within(bus, *node, index, sub, data.clone(), options.block, timing(options)).await?;
-            json!({
-                "ok": true,
-                "written": true,
-                "node": node,
-                "index": index,
-                "sub": sub,
-                "name": dict.name(index, sub),
-                "data": crate::frame::hex::upper(&data),
-                "len": data.len(),
+            to_json(&SdoWritten {
+                ok: true,
+                written: true,
+                node: *node,
+                index,
+                sub,
+                name: dict.name(index, sub),
+                data: crate::frame::hex::upper(&data),
+                len: data.len(),
             })
         }
         Command::Drive {
@@ -106,7 +106,10 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
             timeout_ms,
         } => {
             let nodes = super::scan::scan(bus, *listen_ms, *probe, *timeout_ms).await?;
-            json!({"ok": true, "nodes": nodes.iter().map(|n| n.to_json()).collect::<Vec<_>>()})
+            to_json(&Scanned {
+                ok: true,
+                nodes: nodes.iter().map(|n| n.to_json()).collect(),
+            })
         }
         Command::Record {
             output,
@@ -128,6 +131,55 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
     };
     let text = text(cmd, &json);
     Ok(Outcome { json, text })
+}
+
+/// `nmt --json`.
+#[derive(Serialize)]
+struct NmtSent {
+    ok: bool,
+    action: &'static str,
+    node: u8,
+    /// With `--wait`: node -> the state that confirmed the command; else null.
+    confirmed: Option<BTreeMap<String, &'static str>>,
+}
+
+/// `sdo read --json`.
+#[derive(Serialize)]
+struct SdoRead<'a> {
+    ok: bool,
+    node: u8,
+    index: u16,
+    sub: u8,
+    name: Option<&'a str>,
+    value: Json,
+    text: String,
+    data: String,
+    len: usize,
+}
+
+/// `sdo write --json`.
+#[derive(Serialize)]
+struct SdoWritten<'a> {
+    ok: bool,
+    written: bool,
+    node: u8,
+    index: u16,
+    sub: u8,
+    name: Option<&'a str>,
+    data: String,
+    len: usize,
+}
+
+/// `scan --json`.
+#[derive(Serialize)]
+struct Scanned {
+    ok: bool,
+    nodes: Vec<Json>,
+}
+
+/// A result as its JSON object (serializing these plain structs cannot fail).
+fn to_json(v: &impl Serialize) -> Json {
+    serde_json::to_value(v).unwrap_or_default()
 }
 
 /// The timeouts of an SDO command's options.
