@@ -209,17 +209,17 @@ pub struct DriveReport {
 impl DriveReport {
     /// The `--json` object.
     pub fn to_json(&self) -> serde_json::Value {
-        serde_json::json!({
-            "ok": true,
-            "node": self.node,
-            "action": self.action.as_str(),
-            "statusword": format!("0x{:04X}", self.statusword),
-            "state": self.state.as_str(),
-            "state_text": self.state.text(),
-            "controlwords": self.steps.iter().map(|s| format!("0x{:04X}", s.controlword)).collect::<Vec<_>>(),
-            "mode_display": self.mode_display,
-            "error_code": self.error_code.map(|c| format!("0x{c:04X}")),
-            "source": self.source,
+        super::to_json(&DriveJson {
+            ok: true,
+            node: self.node,
+            action: self.action.as_str(),
+            statusword: format!("0x{:04X}", self.statusword),
+            state: self.state.as_str(),
+            state_text: self.state.text(),
+            controlwords: self.steps.iter().map(|s| format!("0x{:04X}", s.controlword)).collect(),
+            mode_display: self.mode_display,
+            error_code: self.error_code.map(|c| format!("0x{c:04X}")),
+            source: self.source,
         })
     }
 }
@@ -482,13 +482,13 @@ pub struct NodeStop {
 impl NodeStop {
     /// The JSON object of one node in a stop report.
     pub fn to_json(&self) -> serde_json::Value {
-        serde_json::json!({
-            "node": self.node,
-            "stopped": self.stopped,
-            "statusword": self.statusword.map(|s| format!("0x{s:04X}")),
-            "state": self.state.map(|s| s.as_str()),
-            "controlwords": self.sent.iter().map(|c| format!("0x{c:04X}")).collect::<Vec<_>>(),
-            "reason": self.reason,
+        super::to_json(&NodeStopJson {
+            node: self.node,
+            stopped: self.stopped,
+            statusword: self.statusword.map(|s| format!("0x{s:04X}")),
+            state: self.state.map(|s| s.as_str()),
+            controlwords: self.sent.iter().map(|c| format!("0x{c:04X}")).collect(),
+            reason: self.reason.as_deref(),
         })
     }
     /// One line: `node 2: stopped, Switch on disabled (0x0250) after 0x0002, 0x0000`.
@@ -508,6 +508,32 @@ impl NodeStop {
             Some(r) => format!("node {}: NOT confirmed stopped: {r}", self.node),
         }
     }
+}
+
+/// `drive --json`: the outcome of a drive command.
+#[derive(serde::Serialize)]
+struct DriveJson {
+    ok: bool,
+    node: u8,
+    action: &'static str,
+    statusword: String,
+    state: &'static str,
+    state_text: &'static str,
+    controlwords: Vec<String>,
+    mode_display: Option<i8>,
+    error_code: Option<String>,
+    source: &'static str,
+}
+
+/// One node of a stop report.
+#[derive(serde::Serialize)]
+struct NodeStopJson<'a> {
+    node: u8,
+    stopped: bool,
+    statusword: Option<String>,
+    state: Option<&'static str>,
+    controlwords: Vec<String>,
+    reason: Option<&'a str>,
 }
 
 /// Quick stop, then disable voltage: the emergency stop of one drive.

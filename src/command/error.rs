@@ -1,6 +1,7 @@
 //! Why a command failed, with the exit status of each case.
 
 use super::syntax::ParseError;
+use super::to_json;
 use crate::bus::BusError;
 use crate::decode::sdo::abort_text;
 use serde::Serialize;
@@ -211,9 +212,4 @@ struct DriveFailed<'a> {
     step: &'a str,
     reason: &'a str,
     message: String,
-}
-
-/// A failure as its JSON object (serializing these plain structs cannot fail).
-fn to_json(v: &impl Serialize) -> serde_json::Value {
-    serde_json::to_value(v).unwrap_or_default()
 }

@@ -4,6 +4,7 @@
 use super::error::CommandError;
 use super::grammar::{Command, RunSpec, SdoOptions};
 use super::sdo::Timing;
+use super::to_json;
 use super::value::{decode, encode};
 use crate::bus::{Bus, BusError};
 use crate::decode::cia402::mode_name;
@@ -175,11 +176,6 @@ struct SdoWritten<'a> {
 struct Scanned {
     ok: bool,
     nodes: Vec<Json>,
-}
-
-/// A result as its JSON object (serializing these plain structs cannot fail).
-fn to_json(v: &impl Serialize) -> Json {
-    serde_json::to_value(v).unwrap_or_default()
 }
 
 /// The timeouts of an SDO command's options.

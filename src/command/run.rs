@@ -12,7 +12,9 @@ use crate::frame::hex;
 use crate::od::alias::resolve_object;
 use crate::od::procedure::{NmtCommand, Procedure, Step, fill_object, frame_bytes};
 use crate::od::{DataType, Dictionary};
-use serde_json::{Value as Json, json};
+use serde::Serialize;
+use serde_json::Value as Json;
+use std::collections::BTreeMap;
 use std::time::Duration;
 
 /// What a planned step does on the bus.
@@ -381,27 +383,92 @@ fn plan_step(
     })
 }
 
-fn step_json(s: &PlannedStep, number: usize, result: Json) -> Json {
-    json!({
-        "step": number,
-        "kind": s.kind(),
-        "object": s.object(),
-        "value": s.value,
-        "frame": s.frame,
-        "text": s.text,
-        "result": result,
-    })
+/// What a step did, its `result` in the JSON of a run.
+#[derive(Serialize)]
+#[serde(untagged)]
+enum StepResult {
+    /// `"written"`, `"sent"`, `"done"`, `"not sent"`.
+    Word(&'static str),
+    /// An SDO read: the value, its meaning, the bytes.
+    Read { value: Json, text: String, data: String },
+    /// A wait reached: the value read, its meaning, after how long.
+    Reached { value: i64, text: String, after_ms: u64 },
+    /// The step that failed.
+    Failed { error: String },
 }
 
-fn plan_json(plan: &RunPlan, steps: Vec<Json>, ok: bool) -> Json {
-    let params: serde_json::Map<String, Json> = plan.params.iter().map(|(n, v)| (n.clone(), json!(v))).collect();
-    json!({
-        "ok": ok,
-        "procedure": plan.procedure,
-        "node": plan.node,
-        "params": params,
-        "steps": steps,
-    })
+/// One step in the JSON of a run.
+#[derive(Serialize)]
+struct StepJson<'a> {
+    step: usize,
+    kind: &'static str,
+    object: Option<String>,
+    value: Option<i64>,
+    frame: Option<&'a str>,
+    text: &'a str,
+    result: StepResult,
+}
+
+fn step_json(s: &PlannedStep, number: usize, result: StepResult) -> StepJson<'_> {
+    StepJson {
+        step: number,
+        kind: s.kind(),
+        object: s.object(),
+        value: s.value,
+        frame: s.frame.as_deref(),
+        text: &s.text,
+        result,
+    }
+}
+
+/// The JSON of a run (or dry run) of a procedure.
+#[derive(Serialize)]
+struct RunJson<'a> {
+    ok: bool,
+    procedure: &'a str,
+    node: u8,
+    /// Every parameter with the value used.
+    params: BTreeMap<&'a str, i64>,
+    steps: Vec<StepJson<'a>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    dry_run: Option<bool>,
+}
+
+fn plan_json<'a>(plan: &'a RunPlan, steps: Vec<StepJson<'a>>, ok: bool) -> RunJson<'a> {
+    RunJson {
+        ok,
+        procedure: &plan.procedure,
+        node: plan.node,
+        params: plan.params.iter().map(|(n, v)| (n.as_str(), *v)).collect(),
+        steps,
+        dry_run: None,
+    }
+}
+
+/// `run --list --json`.
+#[derive(Serialize)]
+struct ListJson<'a> {
+    ok: bool,
+    node: u8,
+    procedures: Vec<ProcedureJson<'a>>,
+}
+
+/// One procedure of a listing.
+#[derive(Serialize)]
+struct ProcedureJson<'a> {
+    name: &'a str,
+    description: Option<&'a str>,
+    steps: usize,
+    params: Vec<ParamJson<'a>>,
+}
+
+/// One parameter of a procedure.
+#[derive(Serialize)]
+struct ParamJson<'a> {
+    name: &'a str,
+    unit: Option<&'a str>,
+    description: Option<&'a str>,
+    default: Option<i64>,
 }
 
 /// The outcome of `--dry-run`: every step with its frame, `result` "not sent"; the text's
@@ -410,10 +477,12 @@ pub fn dry_run(plan: &RunPlan) -> (Json, String) {
     let n = plan.steps.len();
     let steps = (1..)
         .zip(&plan.steps)
-        .map(|(k, s)| step_json(s, k, json!("not sent")))
+        .map(|(k, s)| step_json(s, k, StepResult::Word("not sent")))
         .collect();
-    let mut v = plan_json(plan, steps, true);
-    v["dry_run"] = json!(true);
+    let v = super::to_json(&RunJson {
+        dry_run: Some(true),
+        ..plan_json(plan, steps, true)
+    });
     let mut lines = vec![format!(
         "dry run of `{}` on node {}: {n} steps, nothing sent",
         plan.procedure, plan.node
@@ -426,17 +495,22 @@ pub fn dry_run(plan: &RunPlan) -> (Json, String) {
 /// text's first line names them all).
 pub fn list(dict: &Dictionary, node: u8) -> (Json, String) {
     let procs = dict.procedures();
-    let items: Vec<Json> = procs
+    let items: Vec<ProcedureJson> = procs
         .iter()
-        .map(|p| {
-            json!({
-                "name": p.name,
-                "description": p.description,
-                "steps": p.steps.len(),
-                "params": p.params.iter().map(|q| json!({
-                    "name": q.name, "unit": q.unit, "description": q.description, "default": q.default,
-                })).collect::<Vec<_>>(),
-            })
+        .map(|p| ProcedureJson {
+            name: &p.name,
+            description: p.description.as_deref(),
+            steps: p.steps.len(),
+            params: p
+                .params
+                .iter()
+                .map(|q| ParamJson {
+                    name: &q.name,
+                    unit: q.unit.as_deref(),
+                    description: q.description.as_deref(),
+                    default: q.default,
+                })
+                .collect(),
         })
         .collect();
     let text = if procs.is_empty() {
@@ -458,7 +532,12 @@ pub fn list(dict: &Dictionary, node: u8) -> (Json, String) {
             .collect::<Vec<_>>()
             .join("\n")
     };
-    (json!({"ok": true, "node": node, "procedures": items}), text)
+    let json = super::to_json(&ListJson {
+        ok: true,
+        node,
+        procedures: items,
+    });
+    (json, text)
 }
 
 /// Runs `plan` on `bus` step by step (`dict` gives the meaning of values read): `progress`
@@ -496,18 +575,18 @@ pub async fn run(
             }
             Err(e) => {
                 progress(&format!("  -> failed: {e}"));
-                done.push(step_json(s, k, json!({"error": e.to_string()})));
+                done.push(step_json(s, k, StepResult::Failed { error: e.to_string() }));
                 return Err(CommandError::Step {
                     procedure: plan.procedure.clone(),
                     step: k,
                     of: n,
-                    report: Box::new(plan_json(plan, done, false)),
+                    report: Box::new(super::to_json(&plan_json(plan, done, false))),
                     cause: Box::new(e),
                 });
             }
         }
     }
-    Ok(plan_json(plan, done, true))
+    Ok(super::to_json(&plan_json(plan, done, true)))
 }
 
 /// Runs one step; gives its `result` JSON and text.
@@ -519,31 +598,35 @@ async fn run_step(
     (k, n): (usize, usize),
     timeout_ms: u64,
     mode: Option<i8>,
-) -> Result<(Json, String), CommandError> {
+) -> Result<(StepResult, String), CommandError> {
     Ok(match &s.action {
         Action::SdoWrite { index, sub, data } => {
             super::sdo::download(bus, node, *index, *sub, data.clone(), false, timeout_ms).await?;
-            (json!("written"), format!("written ({})", hex::upper(data)))
+            (StepResult::Word("written"), format!("written ({})", hex::upper(data)))
         }
         Action::SdoRead { index, sub, ty } => {
             let data = super::sdo::upload(bus, node, *index, *sub, false, timeout_ms).await?;
             let text = read_text(dict, *index, *sub, *ty, &data, mode);
             (
-                json!({"value": decode(&data, *ty).to_json(), "text": text, "data": hex::upper(&data)}),
+                StepResult::Read {
+                    value: decode(&data, *ty).to_json(),
+                    text: text.clone(),
+                    data: hex::upper(&data),
+                },
                 text,
             )
         }
         Action::Nmt { action, target } => {
             super::nmt::nmt(bus, *action, *target, false, 0).await?;
-            (json!("sent"), "sent".into())
+            (StepResult::Word("sent"), "sent".into())
         }
         Action::Frame(f) => {
             bus.send(f).await?;
-            (json!("sent"), "sent".into())
+            (StepResult::Word("sent"), "sent".into())
         }
         Action::Delay { ms } => {
             tokio::time::sleep(Duration::from_millis(u64::from(*ms))).await;
-            (json!("done"), format!("waited {ms} ms"))
+            (StepResult::Word("done"), format!("waited {ms} ms"))
         }
         Action::Wait {
             index,
@@ -570,9 +653,13 @@ async fn run_step(
                     });
                 }
                 if v & mask == *equals {
-                    let ms = start.elapsed().as_millis();
+                    let ms = u64::try_from(start.elapsed().as_millis()).unwrap_or(u64::MAX);
                     return Ok((
-                        json!({"value": v, "text": text, "after_ms": ms}),
+                        StepResult::Reached {
+                            value: v,
+                            text: text.clone(),
+                            after_ms: ms,
+                        },
                         format!("{text} after {ms} ms"),
                     ));
                 }
