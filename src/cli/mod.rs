@@ -102,3 +102,29 @@ pub fn refused(e: clap::Error, args: impl IntoIterator<Item = std::ffi::OsString
     }
     ExitCode::Usage
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn the_command_line_declaration_is_consistent() {
+        // Duplicate names, flags or argument groups (e.g. from flattening the commander's
+        // declaration) would only panic when that subcommand is parsed.
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn a_refused_line_gives_exit_status_1_and_help_0() {
+        let refused_with = |args: &[&str]| {
+            let e = Cli::try_parse_from(args).unwrap_err();
+            refused(e, args.iter().map(std::ffi::OsString::from))
+        };
+        assert_eq!(
+            refused_with(&["cotui", "nmt", "demo", "start", "2", "--block", "--json"]),
+            ExitCode::Usage
+        );
+        assert_eq!(refused_with(&["cotui", "nmt", "--help"]), ExitCode::Ok);
+    }
+}
