@@ -152,8 +152,8 @@ pub fn plan(
                 )
             } else {
                 format!(
-                    "cancels running commands, then {} (quick stop, disable voltage) and more drives cotui \
-                     commanded or sees powered",
+                    "cancels running commands, then {} (quick stop, then disable voltage, per node), also to \
+                     every drive cotui commanded or sees powered",
                     listed(&frames)
                 )
             };
@@ -197,6 +197,30 @@ mod tests {
         assert_eq!(
             d.preview,
             "602#2B40600006000000, 602#2B40600007000000, 602#2B4060000F000000 (from Switch on disabled)"
+        );
+    }
+
+    #[test]
+    fn block_and_segmented_previews_say_what_follows() {
+        let preview = |line: &str| plan(line, &b(), |_| None).unwrap().preview;
+        // Block download initiate (client command 6, CRC and size indicated), not the expedited write.
+        assert_eq!(
+            preview("sdo write 2 0x6060 3 --type i8 --block"),
+            "602#C660600001000000 then 1 block segments (1 bytes) and the block end"
+        );
+        assert_eq!(
+            preview("sdo write 2 0x1008 \"drive one\" --type string"),
+            "602#2108100009000000 then 2 segments"
+        );
+        assert_eq!(
+            preview("sdo read 2 0x1008 --block"),
+            "602#A40810007F000000 then the server's block segments"
+        );
+        assert_eq!(
+            preview("stop 2 3"),
+            "cancels running commands, then 602#2B40600002000000, 602#2B40600000000000, 603#2B40600002000000, \
+             603#2B40600000000000 (quick stop, then disable voltage, per node), also to every drive cotui \
+             commanded or sees powered"
         );
     }
 
