@@ -650,7 +650,9 @@ wait_socket $lang_dump || bad "palette: candump opened no socket"
 tmux new-session -d -s lang -x 160 -y 45 "XDG_CONFIG_HOME=$work $cotui live vcan0; echo cotui-exit=\$?; sleep 60"
 gscreen() { tmux capture-pane -p -t lang > gscreen.txt; }
 gwait() { for _ in $(seq "$1"); do gscreen; grep -qE -- "$2" gscreen.txt && return 0; sleep 0.2; done; return 1; }
-gwait 150 "capturing" || bad "palette: cotui live vcan0 did not start: $(cat gscreen.txt)"
+# Capturing once a frame sent from outside shows in the trace (up to 30 s).
+gflows() { for _ in $(seq 100); do cansend vcan0 7C0#01 2> /dev/null; gscreen; grep -q "7C0" gscreen.txt && return 0; sleep 0.3; done; return 1; }
+gflows || bad "palette: cotui live vcan0 shows no frame: $(cat gscreen.txt)"
 tmux send-keys -t lang ':nmt start 2 --block'
 gwait 50 "unexpected argument '--block' found" && tmux send-keys -t lang Enter &&
     gwait 50 "unexpected argument '--block' found" &&
