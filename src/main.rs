@@ -5,5 +5,5 @@ fn main() {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
-    std::process::exit(cotui::cli::run());
+    std::process::exit(cotui::cli::run().code());
 }

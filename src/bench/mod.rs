@@ -9,7 +9,7 @@
 pub mod log;
 mod tui;
 
-use crate::cli::{EXIT_OK, EXIT_UNAVAILABLE};
+use crate::command::ExitCode;
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -121,12 +121,12 @@ fn which(name: &str) -> Option<PathBuf> {
 }
 
 /// Runs `cotui bench`; returns the exit status.
-pub fn run(args: &BenchArgs) -> i32 {
+pub fn run(args: &BenchArgs) -> ExitCode {
     match bench(args) {
-        Ok(()) => EXIT_OK,
+        Ok(()) => ExitCode::Ok,
         Err(e) => {
             eprintln!("cotui bench: {e}");
-            EXIT_UNAVAILABLE
+            ExitCode::Unavailable
         }
     }
 }

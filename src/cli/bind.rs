@@ -22,10 +22,24 @@ pub fn read_capped(path: &Path) -> std::io::Result<Vec<u8>> {
     Ok(bytes)
 }
 
+/// Why the dictionaries given on the command line cannot be used.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum BindError {
+    /// A `--profile` or `--eds` argument, or the file it names, is not usable.
+    #[error("{0}")]
+    Dictionary(String),
+}
+
+impl From<BindError> for crate::command::CommandError {
+    fn from(e: BindError) -> Self {
+        crate::command::CommandError::Usage(e.to_string())
+    }
+}
+
 /// Loads the bindings given on the command line; warnings go to stderr, one line per kind
 /// of warning and file (all of them with `--verbose`).
-pub fn bindings(profiles: &[String], eds: &[String]) -> Result<Bindings, String> {
-    let b = Bindings::from_args(profiles, eds, &read_capped)?;
+pub fn bindings(profiles: &[String], eds: &[String]) -> Result<Bindings, BindError> {
+    let b = Bindings::from_args(profiles, eds, &read_capped).map_err(|e| BindError::Dictionary(e.to_string()))?;
     for line in warning_lines(b.warnings(), super::verbose()) {
         eprintln!("cotui: warning: {line}");
     }
@@ -82,7 +96,7 @@ fn kind_of(message: &str) -> String {
 /// The bindings for a bus: on the `demo` bus, the simulated drives are also named by the
 /// seed profiles they are built after (unless the user bound others to those nodes) and
 /// their start-up PDO mappings are known, so PDOs decode from the first frame.
-pub fn bindings_on(iface: &str, profiles: &[String], eds: &[String]) -> Result<Bindings, String> {
+pub fn bindings_on(iface: &str, profiles: &[String], eds: &[String]) -> Result<Bindings, BindError> {
     if iface != crate::connect::DEMO {
         return bindings(profiles, eds);
     }
@@ -104,6 +118,6 @@ pub fn bindings_on(iface: &str, profiles: &[String], eds: &[String]) -> Result<B
 }
 
 /// A decoder with the node bindings given on the command line.
-pub fn decoder(profiles: &[String], eds: &[String]) -> Result<Decoder, String> {
+pub fn decoder(profiles: &[String], eds: &[String]) -> Result<Decoder, BindError> {
     Ok(Decoder::from_bindings(&bindings(profiles, eds)?))
 }

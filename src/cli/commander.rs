@@ -1,13 +1,17 @@
-//! What the commander subcommands share: `IFACE`, `--listen-only`, `--json`, the tokio
+//! The commander subcommands (`cotui nmt|sdo|drive|run|scan|record|stop IFACE ...`): the
+//! declaration of [`crate::command::syntax`] with the bus options in front, the tokio
 //! runtime, opening the bus and printing one result or failure.
 
 use crate::bus::Bus;
-use crate::command::error::EXIT_OK;
-use crate::command::{Command, CommandError, Outcome};
+use crate::command::syntax::Commander;
+use crate::command::{Command, CommandError, ExitCode, Outcome};
 use clap::Args;
 use std::future::Future;
 
-/// Options every commander subcommand takes.
+/// The commander subcommands as the command line takes them.
+pub type CliCommander = Commander<BusArgs, DictArgs>;
+
+/// Options every commander subcommand takes, before its own.
 #[derive(Args, Debug, Clone)]
 pub struct BusArgs {
     /// SocketCAN interface (e.g. can0, vcan0), or `demo` for the built-in simulated bus.
@@ -15,14 +19,64 @@ pub struct BusArgs {
     /// Open the bus without a send path: nothing is ever written to it.
     #[arg(long)]
     pub listen_only: bool,
-    /// Print one JSON object instead of text.
+    /// Print one JSON object instead of text (failures included).
     #[arg(long)]
     pub json: bool,
 }
 
+/// The node dictionaries of the commands that name objects (`sdo`, `run`).
+#[derive(Args, Debug, Clone, Default)]
+pub struct DictArgs {
+    /// Bind a device profile to a node: NODE=NAME (names, aliases, types and procedures come from it).
+    #[arg(long = "profile", value_name = "NODE=NAME")]
+    pub profiles: Vec<String>,
+    /// Bind an EDS/DCF file to a node: NODE=FILE.
+    #[arg(long = "eds", value_name = "NODE=FILE")]
+    pub eds: Vec<String>,
+}
+
+/// Runs a commander subcommand; returns the exit status.
+pub fn run_commander(c: &CliCommander) -> ExitCode {
+    let (bus, dict) = (c.bus(), c.dict().cloned().unwrap_or_default());
+    let cmd = match c.command() {
+        Ok(cmd) => cmd,
+        Err(e) => return report(bus, what(c), Err(e.into())),
+    };
+    match cmd {
+        Command::Run(spec) => super::run::run_run(bus, &dict, &spec),
+        Command::Record {
+            output,
+            limits,
+            mode,
+            format,
+        } => super::record::run_record(bus, &output, limits, mode, format),
+        cmd => {
+            let bindings = super::bind::bindings_on(&bus.iface, &dict.profiles, &dict.eds);
+            run(bus, what(c), |bus| async move {
+                crate::command::execute(&bus, &cmd, &bindings?).await
+            })
+        }
+    }
+}
+
+/// The subcommand's name, as failures are prefixed (`cotui sdo read: ...`).
+fn what(c: &CliCommander) -> &'static str {
+    use crate::command::syntax::SdoCommand;
+    match c {
+        Commander::Nmt(_) => "nmt",
+        Commander::Sdo(SdoCommand::Read(_)) => "sdo read",
+        Commander::Sdo(SdoCommand::Write(_)) => "sdo write",
+        Commander::Drive(_) => "drive",
+        Commander::Run(_) => "run",
+        Commander::Scan(_) => "scan",
+        Commander::Record(_) => "record",
+        Commander::Stop(_) => "stop",
+    }
+}
+
 /// Runs `body` on a fresh single-threaded tokio runtime with the bus of `args` open, then
 /// prints its outcome (text, or the JSON object with `--json`) or its failure; returns the exit status.
-pub fn run<F, Fut>(args: &BusArgs, what: &str, body: F) -> i32
+pub fn run<F, Fut>(args: &BusArgs, what: &str, body: F) -> ExitCode
 where
     F: FnOnce(Bus) -> Fut,
     Fut: Future<Output = Result<Outcome, CommandError>>,
@@ -44,28 +98,8 @@ where
     report(args, what, result)
 }
 
-/// Runs one parsed command (see [`crate::command::execute`]) with `--profile`/`--eds` bindings.
-pub fn run_command(
-    args: &BusArgs,
-    what: &str,
-    cmd: Result<Command, String>,
-    profiles: &[String],
-    eds: &[String],
-) -> i32 {
-    let prepared = cmd.map_err(CommandError::Usage).and_then(|c| {
-        Ok((
-            c,
-            super::bind::bindings_on(&args.iface, profiles, eds).map_err(CommandError::Usage)?,
-        ))
-    });
-    run(args, what, |bus| async move {
-        let (cmd, bindings) = prepared?;
-        crate::command::execute(&bus, &cmd, &bindings).await
-    })
-}
-
 /// Prints `result` (text, or JSON with `--json`; failures also to stderr) and gives the exit status.
-pub fn report(args: &BusArgs, what: &str, result: Result<Outcome, CommandError>) -> i32 {
+pub fn report(args: &BusArgs, what: &str, result: Result<Outcome, CommandError>) -> ExitCode {
     match result {
         Ok(o) => {
             if args.json {
@@ -73,7 +107,7 @@ pub fn report(args: &BusArgs, what: &str, result: Result<Outcome, CommandError>)
             } else if !o.text.is_empty() {
                 println!("{}", o.text);
             }
-            EXIT_OK
+            ExitCode::Ok
         }
         Err(e) => {
             if args.json {
@@ -83,22 +117,4 @@ pub fn report(args: &BusArgs, what: &str, result: Result<Outcome, CommandError>)
             e.exit_code()
         }
     }
-}
-
-/// Parses NODE (decimal or 0x hex; 0 = all where allowed) for clap.
-pub fn node_arg(text: &str) -> Result<u8, String> {
-    crate::command::grammar::parse_node(text, false)
-}
-
-/// Parses NODE allowing 0 (all nodes) for clap.
-pub fn node_or_all_arg(text: &str) -> Result<u8, String> {
-    crate::command::grammar::parse_node(text, true)
-}
-
-/// Parses a positive number of ms for clap.
-pub fn ms_arg(text: &str) -> Result<u64, String> {
-    crate::command::grammar::parse_int(text)
-        .filter(|v| *v > 0)
-        .map(|v| v as u64)
-        .ok_or(format!("`{text}` must be a positive number of ms"))
 }

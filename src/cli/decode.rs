@@ -1,7 +1,7 @@
 //! `cotui decode FILE...`: the headless decoder.
 
-use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
 use crate::analysis::EventTracker;
+use crate::command::ExitCode;
 use crate::decode::{Decoder, Kind, sdo::Transaction};
 use crate::frame::{Frame, Interfaces};
 use crate::log::Outcome;
@@ -66,7 +66,7 @@ enum Mode {
 }
 
 /// Runs `cotui decode`; returns the exit status.
-pub fn run(args: &DecodeArgs) -> i32 {
+pub fn run(args: &DecodeArgs) -> ExitCode {
     if args.format == OutputFormat::Pcapng {
         return super::decode_out::pcapng(args);
     }
@@ -77,7 +77,7 @@ pub fn run(args: &DecodeArgs) -> i32 {
         Ok(d) => d,
         Err(e) => {
             eprintln!("cotui decode: {e}");
-            return EXIT_USAGE;
+            return ExitCode::Usage;
         }
     };
     let mut events = EventTracker::new(|n| decoder.dictionary(n));
@@ -94,14 +94,14 @@ pub fn run(args: &DecodeArgs) -> i32 {
         Ok(o) => o,
         Err(e) => {
             eprintln!("cotui decode: {e}");
-            return EXIT_USAGE;
+            return ExitCode::Usage;
         }
     };
     let mut summary = Summary::default();
-    let mut status = EXIT_OK;
+    let mut status = ExitCode::Ok;
     for path in &args.files {
         let Some(input) = open_input(path, "decode") else {
-            status = EXIT_UNAVAILABLE;
+            status = ExitCode::Unavailable;
             continue;
         };
         let mut sinks = Sinks {
@@ -113,7 +113,7 @@ pub fn run(args: &DecodeArgs) -> i32 {
             Err(e) if e.kind() == io::ErrorKind::BrokenPipe => return status,
             Err(e) => {
                 eprintln!("cotui decode: {path}: {e}");
-                status = EXIT_UNAVAILABLE;
+                status = ExitCode::Unavailable;
             }
         }
     }
@@ -121,7 +121,7 @@ pub fn run(args: &DecodeArgs) -> i32 {
     match result {
         Err(e) if e.kind() != io::ErrorKind::BrokenPipe => {
             eprintln!("cotui decode: {e}");
-            EXIT_UNAVAILABLE
+            ExitCode::Unavailable
         }
         _ => status,
     }

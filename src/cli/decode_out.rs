@@ -1,7 +1,7 @@
 //! Where `cotui decode` writes (`-o FILE`, `-o -` or stdout) and its pcapng export.
 
 use super::decode::DecodeArgs;
-use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
+use crate::command::ExitCode;
 use crate::frame::Interfaces;
 use crate::log::Outcome;
 use crate::log::read_ahead;
@@ -29,31 +29,31 @@ pub fn open(path: Option<&str>, binary: bool) -> Result<Box<dyn Write>, String> 
 
 /// `cotui decode FILE... --format pcapng`: every frame of every input, in order, one
 /// interface description per interface name.
-pub fn pcapng(args: &DecodeArgs) -> i32 {
+pub fn pcapng(args: &DecodeArgs) -> ExitCode {
     if args.transactions || args.summary || args.events {
         eprintln!(
             "cotui decode: --format pcapng writes frames; it does not go with --transactions, --summary or --events"
         );
-        return EXIT_USAGE;
+        return ExitCode::Usage;
     }
     let out = match open(args.output.as_deref(), true) {
         Ok(o) => o,
         Err(e) => {
             eprintln!("cotui decode: {e}");
-            return EXIT_USAGE;
+            return ExitCode::Usage;
         }
     };
     let mut w = match PcapngWriter::new(out) {
         Ok(w) => w,
         Err(e) => {
             eprintln!("cotui decode: {e}");
-            return EXIT_UNAVAILABLE;
+            return ExitCode::Unavailable;
         }
     };
-    let mut status = EXIT_OK;
+    let mut status = ExitCode::Ok;
     for path in &args.files {
         let Some(input) = super::decode::open_input(path, "decode") else {
-            status = EXIT_UNAVAILABLE;
+            status = ExitCode::Unavailable;
             continue;
         };
         if let Err(e) = write_stream(path, input, &mut w) {
@@ -61,13 +61,13 @@ pub fn pcapng(args: &DecodeArgs) -> i32 {
                 return status;
             }
             eprintln!("cotui decode: {path}: {e}");
-            status = EXIT_UNAVAILABLE;
+            status = ExitCode::Unavailable;
         }
     }
     match w.flush() {
         Err(e) if e.kind() != io::ErrorKind::BrokenPipe => {
             eprintln!("cotui decode: {e}");
-            EXIT_UNAVAILABLE
+            ExitCode::Unavailable
         }
         _ => status,
     }

@@ -4,7 +4,7 @@
 //! ("Parquet tables").
 
 use super::decode::DecodeArgs;
-use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
+use crate::command::ExitCode;
 use crate::decode::sdo::{SdoCommand, Transaction};
 use crate::decode::{Body, Decoded, Decoder};
 use crate::frame::{Flags, Frame, Interfaces};
@@ -98,24 +98,24 @@ fn create(path: &Path, name: &str, cols: &[Col]) -> Result<Writer, String> {
 }
 
 /// Runs `cotui decode --format parquet`; returns the exit status.
-pub fn run(args: &DecodeArgs) -> i32 {
+pub fn run(args: &DecodeArgs) -> ExitCode {
     if args.transactions || args.summary || args.events {
         eprintln!(
             "cotui decode: --format parquet writes the frame and value tables; it does not go with --transactions, --summary or --events"
         );
-        return EXIT_USAGE;
+        return ExitCode::Usage;
     }
     let Some(output) = args.output.as_deref().filter(|o| *o != "-") else {
         eprintln!(
             "cotui decode: parquet is binary and written as two files: give -o DIR (DIR/frames.parquet, DIR/values.parquet) or -o NAME.parquet, not stdout"
         );
-        return EXIT_USAGE;
+        return ExitCode::Usage;
     };
     let mut decoder = match super::bind::decoder(&args.profiles, &args.eds) {
         Ok(d) => d,
         Err(e) => {
             eprintln!("cotui decode: {e}");
-            return EXIT_USAGE;
+            return ExitCode::Usage;
         }
     };
     let (frames_path, values_path) = paths(output);
@@ -125,20 +125,20 @@ pub fn run(args: &DecodeArgs) -> i32 {
         Ok(t) => t,
         Err(e) => {
             eprintln!("cotui decode: {e}");
-            return EXIT_USAGE;
+            return ExitCode::Usage;
         }
     };
-    let mut status = EXIT_OK;
+    let mut status = ExitCode::Ok;
     let mut last_file = String::new();
     for path in &args.files {
         let Some(input) = super::decode::open_input(path, "decode") else {
-            status = EXIT_UNAVAILABLE;
+            status = ExitCode::Unavailable;
             continue;
         };
         last_file.clone_from(path);
         if let Err(e) = write_stream(path, input, &mut decoder, &mut frames, &mut values) {
             eprintln!("cotui decode: {path}: {e}");
-            status = EXIT_UNAVAILABLE;
+            status = ExitCode::Unavailable;
         }
     }
     let mut end = || -> io::Result<()> {
@@ -151,7 +151,7 @@ pub fn run(args: &DecodeArgs) -> i32 {
     match result {
         Err(e) => {
             eprintln!("cotui decode: {output}: {e}");
-            EXIT_UNAVAILABLE
+            ExitCode::Unavailable
         }
         Ok(()) => status,
     }

@@ -1,7 +1,7 @@
 //! `cotui diagnose FILE...`: what went wrong on the bus, as a short ranked list of incidents.
 
-use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
 use crate::analysis::{Diagnoser, EventTracker, Incident, Status};
+use crate::command::ExitCode;
 use crate::decode::Kind;
 use crate::frame::{Frame, Interfaces};
 use crate::log::Outcome;
@@ -40,19 +40,19 @@ pub struct DiagnoseArgs {
 }
 
 /// Runs `cotui diagnose`; returns the exit status.
-pub fn run(args: &DiagnoseArgs) -> i32 {
+pub fn run(args: &DiagnoseArgs) -> ExitCode {
     let mut decoder = match super::bind::decoder(&args.profiles, &args.eds) {
         Ok(d) => d,
         Err(e) => {
             eprintln!("cotui diagnose: {e}");
-            return EXIT_USAGE;
+            return ExitCode::Usage;
         }
     };
     let mut diag = Diagnoser::new(EventTracker::new(|n| decoder.dictionary(n)));
-    let mut status = EXIT_OK;
+    let mut status = ExitCode::Ok;
     for path in &args.files {
         let Some(input) = super::decode::open_input(path, "diagnose") else {
-            status = EXIT_UNAVAILABLE;
+            status = ExitCode::Unavailable;
             continue;
         };
         let mut ifaces = Interfaces::default();
@@ -97,7 +97,7 @@ pub fn run(args: &DiagnoseArgs) -> i32 {
         };
         if let Some(e) = err {
             eprintln!("cotui diagnose: {path}: {e}");
-            status = EXIT_UNAVAILABLE;
+            status = ExitCode::Unavailable;
         }
     }
     for t in decoder.finish() {
@@ -115,10 +115,10 @@ pub fn run(args: &DiagnoseArgs) -> i32 {
         && e.kind() != io::ErrorKind::BrokenPipe
     {
         eprintln!("cotui diagnose: {e}");
-        return EXIT_UNAVAILABLE;
+        return ExitCode::Unavailable;
     }
-    if status == EXIT_OK && args.check && incidents.iter().any(|i| i.status == Status::Open) {
-        return 1;
+    if status == ExitCode::Ok && args.check && incidents.iter().any(|i| i.status == Status::Open) {
+        return ExitCode::Usage;
     }
     status
 }

@@ -6,24 +6,13 @@ pub mod decode;
 mod decode_out;
 mod decode_parquet;
 pub mod diagnose;
-pub mod drive;
-pub mod nmt;
 pub mod record;
 pub mod run;
-pub mod scan;
-pub mod sdo;
 pub mod sim;
-pub mod stop;
 pub mod tui;
 
+use crate::command::{CommandError, ExitCode, ParseError};
 use clap::{Parser, Subcommand};
-
-/// Exit status: done.
-pub const EXIT_OK: i32 = 0;
-/// Exit status: usage or internal error.
-pub const EXIT_USAGE: i32 = 1;
-/// Exit status: input or bus unavailable.
-pub const EXIT_UNAVAILABLE: i32 = 2;
 
 /// cotui: a terminal CANopen bus analyzer and commander.
 #[derive(Parser, Debug)]
@@ -61,23 +50,9 @@ pub enum Command {
     Live(tui::LiveArgs),
     /// The interactive analyzer on an in-process bus with simulated CiA 402 drives.
     Demo(tui::DemoArgs),
-    /// Send an NMT command: cotui nmt IFACE start|stop|preop|reset-node|reset-comm NODE [--wait].
-    Nmt(nmt::NmtArgs),
-    /// Read or write an object by SDO (IFACE `demo` for the simulated bus).
-    #[command(subcommand)]
-    Sdo(sdo::SdoCommand),
-    /// CiA 402 drive: cotui drive IFACE NODE enable|disable|quick-stop|fault-reset|status|mode MODE.
-    Drive(drive::DriveArgs),
-    /// Run a profile's procedure step by step: cotui run IFACE NODE PROCEDURE [NAME=VALUE ...] [--dry-run];
-    /// without PROCEDURE (or with --list), list the node's procedures.
-    Run(run::RunArgs),
-    /// List the nodes on the bus with their identity.
-    Scan(scan::ScanArgs),
-    /// Record the bus to a candump -l log.
-    Record(record::RecordArgs),
-    /// Emergency stop: quick stop, then disable voltage, on every CiA 402 drive found powered
-    /// (or the --node ones); reads each statusword back. Exit 0 only when all are confirmed.
-    Stop(stop::StopArgs),
+    /// The commander: nmt, sdo, drive, run, scan, record, stop (see docs/COMMANDER.md).
+    #[command(flatten)]
+    Commander(commander::CliCommander),
     /// Simulated CiA 402 drives on a SocketCAN interface for other tools to talk to (SDO,
     /// NMT, PDO, SYNC, EMCY, LSS); stdin lines make them fail: fault/silence/reboot NODE.
     Sim(sim::SimArgs),
@@ -96,19 +71,16 @@ All commands:              cotui --help
 ";
 
 /// Runs the command line and returns the process exit status.
-pub fn run() -> i32 {
+pub fn run() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
-        Err(e) => {
-            let _ = e.print();
-            return if e.use_stderr() { EXIT_USAGE } else { EXIT_OK };
-        }
+        Err(e) => return refused(e, std::env::args_os().skip(1)),
     };
     VERBOSE.store(cli.verbose, std::sync::atomic::Ordering::Relaxed);
     match cli.command {
         None => {
             print!("{USAGE}");
-            EXIT_OK
+            ExitCode::Ok
         }
         Some(Command::Decode(args)) => decode::run(&args),
         Some(Command::Diagnose(args)) => diagnose::run(&args),
@@ -117,13 +89,47 @@ pub fn run() -> i32 {
         Some(Command::Replay(args)) => tui::run_replay(&args),
         Some(Command::Live(args)) => tui::run_live(&args),
         Some(Command::Demo(args)) => tui::run_demo(&args),
-        Some(Command::Nmt(args)) => nmt::run_nmt(&args),
-        Some(Command::Sdo(cmd)) => sdo::run_sdo(&cmd),
-        Some(Command::Drive(args)) => drive::run_drive(&args),
-        Some(Command::Run(args)) => run::run_run(&args),
-        Some(Command::Scan(args)) => scan::run_scan(&args),
-        Some(Command::Record(args)) => record::run_record(&args),
-        Some(Command::Stop(args)) => stop::run_stop(&args),
         Some(Command::Sim(args)) => sim::run_sim(&args),
+        Some(Command::Commander(c)) => commander::run_commander(&c),
+    }
+}
+
+/// Prints why the command line was refused (or the help it asked for) and gives the exit
+/// status. With `--json` among the `args` a refusal is also one JSON object on stdout, as
+/// every other failure of a command that takes `--json`.
+pub fn refused(e: clap::Error, args: impl IntoIterator<Item = std::ffi::OsString>) -> ExitCode {
+    let _ = e.print();
+    if !e.use_stderr() {
+        return ExitCode::Ok;
+    }
+    if args.into_iter().take_while(|a| a != "--").any(|a| a == "--json") {
+        println!("{}", CommandError::Syntax(ParseError::from(e)).to_json());
+    }
+    ExitCode::Usage
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn the_command_line_declaration_is_consistent() {
+        // Duplicate names, flags or argument groups (e.g. from flattening the commander's
+        // declaration) would only panic when that subcommand is parsed.
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn a_refused_line_gives_exit_status_1_and_help_0() {
+        let refused_with = |args: &[&str]| {
+            let e = Cli::try_parse_from(args).unwrap_err();
+            refused(e, args.iter().map(std::ffi::OsString::from))
+        };
+        assert_eq!(
+            refused_with(&["cotui", "nmt", "demo", "start", "2", "--block", "--json"]),
+            ExitCode::Usage
+        );
+        assert_eq!(refused_with(&["cotui", "nmt", "--help"]), ExitCode::Ok);
     }
 }

@@ -4,59 +4,20 @@
 //! loses at most that much. Gaps (interface down or gone, bus-off) are reported on stderr as
 //! they happen and make the exit status 2.
 
-use super::commander::{BusArgs, ms_arg, report};
-use crate::command::error::{EXIT_BUS, EXIT_OK};
+use super::commander::{BusArgs, report};
 use crate::command::exec::text;
 use crate::command::record::{Limits, LogFormat, Recorded, WriteMode, open_output, record};
-use crate::command::{Command, CommandError};
-use clap::Args;
+use crate::command::{Command, CommandError, ExitCode};
 use std::io::Write;
 use tokio::signal::unix::{SignalKind, signal};
 
-/// Arguments of `cotui record`.
-#[derive(Args, Debug)]
-pub struct RecordArgs {
-    #[command(flatten)]
-    pub bus: BusArgs,
-    /// The log file to write (candump -l format; `-` for stdout). An existing file is
-    /// refused unless --force or --append.
-    #[arg(short = 'o', long)]
-    pub output: String,
-    /// Stop after this many frames.
-    #[arg(long)]
-    pub count: Option<u64>,
-    /// Stop after this many ms (else at Ctrl-C, SIGTERM, SIGHUP or SIGQUIT).
-    #[arg(long, value_parser = ms_arg)]
-    pub duration: Option<u64>,
-    /// Overwrite an existing output file.
-    #[arg(long, conflicts_with = "append")]
-    pub force: bool,
-    /// Append to an existing output file.
-    #[arg(long)]
-    pub append: bool,
-    /// The file format: candump (-l lines) or pcapng (for Wireshark; not to a terminal).
-    #[arg(long, default_value = "candump", value_parser = LogFormat::parse)]
-    pub format: LogFormat,
-}
-
-/// Runs `cotui record`; returns the exit status: 0 complete, 2 when the bus could not be
-/// opened or the recording has gaps, 1 for a usage or write error.
-pub fn run_record(args: &RecordArgs) -> i32 {
-    let limits = Limits {
-        count: args.count,
-        duration_ms: args.duration,
-    };
-    let mode = if args.force {
-        WriteMode::Overwrite
-    } else if args.append {
-        WriteMode::Append
-    } else {
-        WriteMode::New
-    };
-    let path = args.output.clone();
-    if args.format == LogFormat::Pcapng && path == "-" && std::io::IsTerminal::is_terminal(&std::io::stdout()) {
+/// Runs `cotui record` (its arguments: [`crate::command::syntax::RecordArgs`]); returns the
+/// exit status: 0 complete, 2 when the bus could not be opened or the recording has gaps, 1
+/// for a usage or write error.
+pub fn run_record(bus: &BusArgs, path: &str, limits: Limits, mode: WriteMode, format: LogFormat) -> ExitCode {
+    if format == LogFormat::Pcapng && path == "-" && std::io::IsTerminal::is_terminal(&std::io::stdout()) {
         return report(
-            &args.bus,
+            bus,
             "record",
             Err(CommandError::Usage(
                 "pcapng is binary: write it to a file (-o FILE) or a pipe, not to a terminal".into(),
@@ -67,20 +28,20 @@ pub fn run_record(args: &RecordArgs) -> i32 {
         .enable_all()
         .build()
         .map_err(|e| CommandError::Usage(format!("cannot start the runtime: {e}")))
-        .and_then(|rt| rt.block_on(capture(&args.bus, &path, (limits, args.format), mode)));
+        .and_then(|rt| rt.block_on(capture(bus, path, (limits, format), mode)));
     let n = match result {
         Ok(n) => n,
-        Err(e) => return report(&args.bus, "record", Err(e)),
+        Err(e) => return report(bus, "record", Err(e)),
     };
     let cmd = Command::Record {
-        output: path.clone(),
+        output: path.to_string(),
         limits,
         mode,
-        format: args.format,
+        format,
     };
-    let json = n.to_json(&path);
+    let json = n.to_json(path);
     // After SIGHUP the terminal may be gone: printing must not fail the recording.
-    if args.bus.json {
+    if bus.json {
         let _ = writeln!(std::io::stdout(), "{json}");
     } else {
         let _ = writeln!(std::io::stdout(), "{}", text(&cmd, &json));
@@ -92,12 +53,12 @@ pub fn run_record(args: &RecordArgs) -> i32 {
             n.dropped
         ));
     }
-    match n.gap_message(&path) {
+    match n.gap_message(path) {
         Some(m) => {
             say(&m);
-            EXIT_BUS
+            ExitCode::Unavailable
         }
-        None => EXIT_OK,
+        None => ExitCode::Ok,
     }
 }
 

@@ -5,8 +5,8 @@
 //! make nodes fail: `fault NODE CODE`, `silence NODE`, `resume NODE`, `reboot NODE`,
 //! `mains NODE on|off`, `status`.
 
-use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
 use crate::bus::Bus;
+use crate::command::ExitCode;
 use crate::sim::Simulation;
 use crate::sim::drive::Drive;
 use crate::sim::profile::DriveProfile;
@@ -77,7 +77,7 @@ pub fn parse_node(spec: &str) -> Result<(u8, DriveProfile), String> {
 }
 
 /// Runs `cotui sim`; returns the exit status.
-pub fn run_sim(args: &SimArgs) -> i32 {
+pub fn run_sim(args: &SimArgs) -> ExitCode {
     let specs: Vec<String> = if args.nodes.is_empty() {
         vec!["2=aimotor".into(), "3=syntron-ds".into()]
     } else {
@@ -89,13 +89,13 @@ pub fn run_sim(args: &SimArgs) -> i32 {
             Ok((node, profile)) => {
                 if node != 0xFF && drives.iter().any(|d: &Drive| d.node() == node) {
                     eprintln!("cotui sim: node {node} given twice");
-                    return EXIT_USAGE;
+                    return ExitCode::Usage;
                 }
                 drives.push(Drive::new(node, profile));
             }
             Err(e) => {
                 eprintln!("cotui sim: {e}");
-                return EXIT_USAGE;
+                return ExitCode::Usage;
             }
         }
     }
@@ -103,25 +103,25 @@ pub fn run_sim(args: &SimArgs) -> i32 {
         && let Err(e) = write_eds(dir, &drives)
     {
         eprintln!("cotui sim: {e}");
-        return EXIT_UNAVAILABLE;
+        return ExitCode::Unavailable;
     }
     if args.iface == crate::connect::DEMO {
         eprintln!("cotui sim: give a SocketCAN interface (`cotui demo` runs the simulation on its own bus)");
-        return EXIT_USAGE;
+        return ExitCode::Usage;
     }
     let sim = Arc::new(Mutex::new(Simulation::new(drives, args.sync)));
     let rt = match tokio::runtime::Builder::new_current_thread().enable_all().build() {
         Ok(rt) => rt,
         Err(e) => {
             eprintln!("cotui sim: cannot start the runtime: {e}");
-            return EXIT_USAGE;
+            return ExitCode::Usage;
         }
     };
     match rt.block_on(serve(&args.iface, sim)) {
-        Ok(()) => EXIT_OK,
+        Ok(()) => ExitCode::Ok,
         Err(e) => {
             eprintln!("cotui sim: {e}");
-            EXIT_UNAVAILABLE
+            ExitCode::Unavailable
         }
     }
 }

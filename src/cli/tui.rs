@@ -1,7 +1,7 @@
 //! `cotui open FILE` and `cotui replay FILE`: the interactive analyzer on a log.
 
-use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
 use crate::analysis::trace::Trace;
+use crate::command::ExitCode;
 use crate::tui::app::{App, SourceInfo, SourceKind};
 use crate::tui::keymap::{self, Keymap, KeymapError};
 use crate::tui::source;
@@ -137,19 +137,19 @@ enum Feeding {
     Live(String, bool),
 }
 
-fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> i32 {
+fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> ExitCode {
     let keymap = match load_keymap(&ui.keymap) {
         Ok(k) => k,
         Err(e) => {
             eprintln!("cotui: {e}");
-            return EXIT_USAGE;
+            return ExitCode::Usage;
         }
     };
     let bindings = match super::bind::bindings_on(name, &ui.profiles, &ui.eds) {
         Ok(b) => b,
         Err(e) => {
             eprintln!("cotui: {e}");
-            return EXIT_USAGE;
+            return ExitCode::Usage;
         }
     };
     let decoder = crate::decode::Decoder::from_bindings(&bindings);
@@ -166,34 +166,34 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> i32 {
         app.set_filter(f);
         if let Some(m) = app.message.take() {
             eprintln!("cotui: --filter: {m}");
-            return EXIT_USAGE;
+            return ExitCode::Usage;
         }
     }
     match crate::tui::term::run(app) {
-        Ok(()) => EXIT_OK,
+        Ok(()) => ExitCode::Ok,
         Err(e) => {
             eprintln!("cotui: {e}");
-            EXIT_UNAVAILABLE
+            ExitCode::Unavailable
         }
     }
 }
 
-fn check_file(path: &std::path::Path) -> Result<(), i32> {
+fn check_file(path: &std::path::Path) -> Result<(), ExitCode> {
     match std::fs::metadata(path) {
         Ok(m) if m.is_file() => Ok(()),
         Ok(_) => {
             eprintln!("cotui: {}: not a file", path.display());
-            Err(EXIT_UNAVAILABLE)
+            Err(ExitCode::Unavailable)
         }
         Err(e) => {
             eprintln!("cotui: {}: {e}", path.display());
-            Err(EXIT_UNAVAILABLE)
+            Err(ExitCode::Unavailable)
         }
     }
 }
 
 /// Runs `cotui open`.
-pub fn run_open(args: &OpenArgs) -> i32 {
+pub fn run_open(args: &OpenArgs) -> ExitCode {
     if let Err(code) = check_file(&args.file) {
         return code;
     }
@@ -207,13 +207,13 @@ pub fn run_open(args: &OpenArgs) -> i32 {
 }
 
 /// Runs `cotui replay`.
-pub fn run_replay(args: &ReplayArgs) -> i32 {
+pub fn run_replay(args: &ReplayArgs) -> ExitCode {
     if let Err(code) = check_file(&args.file) {
         return code;
     }
     if !(args.speed >= 0.0 && args.speed.is_finite()) {
         eprintln!("cotui replay: --speed must be 0 or more");
-        return EXIT_USAGE;
+        return ExitCode::Usage;
     }
     let name = args.file.display().to_string();
     let (rx, ctl) = source::replay(args.file.clone(), args.speed);
@@ -226,7 +226,7 @@ pub fn run_replay(args: &ReplayArgs) -> i32 {
 }
 
 /// Runs `cotui live IFACE`.
-pub fn run_live(args: &LiveArgs) -> i32 {
+pub fn run_live(args: &LiveArgs) -> ExitCode {
     let kind = SourceKind::Live {
         listen_only: args.listen_only,
     };
@@ -235,7 +235,7 @@ pub fn run_live(args: &LiveArgs) -> i32 {
 }
 
 /// Runs `cotui demo`.
-pub fn run_demo(args: &DemoArgs) -> i32 {
+pub fn run_demo(args: &DemoArgs) -> ExitCode {
     let kind = SourceKind::Demo {
         listen_only: args.listen_only,
     };

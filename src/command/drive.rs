@@ -45,6 +45,28 @@ const ENABLE_OPERATION: Step = Step {
     target: DriveState::OperationEnabled,
 };
 
+/// The controlwords of the emergency stop, in order: quick stop, then disable voltage.
+pub const STOP_CONTROLWORDS: [u16; 2] = [0x0002, 0x0000];
+
+/// The frame that writes `controlword` to `node` (an expedited SDO download of 0x6040:00),
+/// as the SDO client sends it.
+pub fn controlword_frame(node: u8, controlword: u16) -> crate::frame::Frame {
+    super::sdo::first_download_frame(node, 0x6040, 0, &controlword.to_le_bytes(), false).0
+}
+
+/// The frames a drive command on `node` in `state` writes, in order: a controlword per step
+/// of [`plan`], or the 0x6060 write of `mode` (then read back; `status` only reads).
+pub fn frames(node: u8, action: DriveAction, state: DriveState) -> Vec<crate::frame::Frame> {
+    match action {
+        DriveAction::Status => Vec::new(),
+        DriveAction::Mode(m) => vec![super::sdo::first_download_frame(node, 0x6060, 0, &[m as u8], false).0],
+        a => plan(a, state)
+            .iter()
+            .map(|s| controlword_frame(node, s.controlword))
+            .collect(),
+    }
+}
+
 /// The steps that take a drive in `state` through `action` (empty: nothing to do).
 pub fn plan(action: DriveAction, state: DriveState) -> Vec<Step> {
     use DriveState::*;
@@ -187,17 +209,17 @@ pub struct DriveReport {
 impl DriveReport {
     /// The `--json` object.
     pub fn to_json(&self) -> serde_json::Value {
-        serde_json::json!({
-            "ok": true,
-            "node": self.node,
-            "action": self.action.as_str(),
-            "statusword": format!("0x{:04X}", self.statusword),
-            "state": self.state.as_str(),
-            "state_text": self.state.text(),
-            "controlwords": self.steps.iter().map(|s| format!("0x{:04X}", s.controlword)).collect::<Vec<_>>(),
-            "mode_display": self.mode_display,
-            "error_code": self.error_code.map(|c| format!("0x{c:04X}")),
-            "source": self.source,
+        super::to_json(&DriveJson {
+            ok: true,
+            node: self.node,
+            action: self.action.as_str(),
+            statusword: format!("0x{:04X}", self.statusword),
+            state: self.state.as_str(),
+            state_text: self.state.text(),
+            controlwords: self.steps.iter().map(|s| format!("0x{:04X}", s.controlword)).collect(),
+            mode_display: self.mode_display,
+            error_code: self.error_code.map(|c| format!("0x{c:04X}")),
+            source: self.source,
         })
     }
 }
@@ -460,13 +482,13 @@ pub struct NodeStop {
 impl NodeStop {
     /// The JSON object of one node in a stop report.
     pub fn to_json(&self) -> serde_json::Value {
-        serde_json::json!({
-            "node": self.node,
-            "stopped": self.stopped,
-            "statusword": self.statusword.map(|s| format!("0x{s:04X}")),
-            "state": self.state.map(|s| s.as_str()),
-            "controlwords": self.sent.iter().map(|c| format!("0x{c:04X}")).collect::<Vec<_>>(),
-            "reason": self.reason,
+        super::to_json(&NodeStopJson {
+            node: self.node,
+            stopped: self.stopped,
+            statusword: self.statusword.map(|s| format!("0x{s:04X}")),
+            state: self.state.map(|s| s.as_str()),
+            controlwords: self.sent.iter().map(|c| format!("0x{c:04X}")).collect(),
+            reason: self.reason.as_deref(),
         })
     }
     /// One line: `node 2: stopped, Switch on disabled (0x0250) after 0x0002, 0x0000`.
@@ -488,6 +510,32 @@ impl NodeStop {
     }
 }
 
+/// `drive --json`: the outcome of a drive command.
+#[derive(serde::Serialize)]
+struct DriveJson {
+    ok: bool,
+    node: u8,
+    action: &'static str,
+    statusword: String,
+    state: &'static str,
+    state_text: &'static str,
+    controlwords: Vec<String>,
+    mode_display: Option<i8>,
+    error_code: Option<String>,
+    source: &'static str,
+}
+
+/// One node of a stop report.
+#[derive(serde::Serialize)]
+struct NodeStopJson<'a> {
+    node: u8,
+    stopped: bool,
+    statusword: Option<String>,
+    state: Option<&'static str>,
+    controlwords: Vec<String>,
+    reason: Option<&'a str>,
+}
+
 /// Quick stop, then disable voltage: the emergency stop of one drive.
 ///
 /// Writes controlword 0x0002 at once, waits up to `ramp_ms` for the drive to finish its
@@ -504,7 +552,8 @@ pub async fn stop(bus: &Bus, node: u8, timeout_ms: u64, ramp_ms: u64) -> NodeSto
         sent: Vec::new(),
         reason: None,
     };
-    for (cw, wait_ms) in [(0x0002u16, ramp_ms), (0x0000, timeout_ms.max(200) * 2)] {
+    let [quick_stop, disable_voltage] = STOP_CONTROLWORDS;
+    for (cw, wait_ms) in [(quick_stop, ramp_ms), (disable_voltage, timeout_ms.max(200) * 2)] {
         if let Err(e) = download(bus, node, 0x6040, 0, cw.to_le_bytes().to_vec(), false, timeout_ms).await {
             out.reason = Some(stop_failure(&mut w, cw, e));
             return out;
@@ -524,7 +573,7 @@ pub async fn stop(bus: &Bus, node: u8, timeout_ms: u64, ramp_ms: u64) -> NodeSto
             let off = matches!(state, DriveState::SwitchOnDisabled | DriveState::NotReadyToSwitchOn);
             let faulted = matches!(state, DriveState::Fault | DriveState::FaultReactionActive);
             let standstill = state == DriveState::QuickStopActive && sw & 0x0400 != 0;
-            if off || faulted || (cw == 0x0002 && standstill) || tokio::time::Instant::now() >= deadline {
+            if off || faulted || (cw == quick_stop && standstill) || tokio::time::Instant::now() >= deadline {
                 break;
             }
             tokio::time::sleep(Duration::from_millis(10)).await;

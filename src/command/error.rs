@@ -1,30 +1,64 @@
 //! Why a command failed, with the exit status of each case.
 
+use super::syntax::ParseError;
+use super::to_json;
 use crate::bus::BusError;
 use crate::decode::sdo::abort_text;
+use serde::Serialize;
 
-/// Exit status: done.
-pub const EXIT_OK: i32 = 0;
-/// Exit status: usage or internal error.
-pub const EXIT_USAGE: i32 = 1;
-/// Exit status: bus unavailable.
-pub const EXIT_BUS: i32 = 2;
-/// Exit status: SDO abort.
-pub const EXIT_ABORT: i32 = 3;
-/// Exit status: timeout.
-pub const EXIT_TIMEOUT: i32 = 4;
-/// Exit status: drive sequence failed.
-pub const EXIT_DRIVE: i32 = 5;
+/// The process exit status of cotui, one value per kind of outcome (docs/COMMANDER.md,
+/// "Exit status").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ExitCode {
+    /// 0: done.
+    Ok = 0,
+    /// 1: usage or internal error (bad arguments, a file that cannot be written...).
+    Usage = 1,
+    /// 2: input or bus unavailable (missing, down, no permission, listen-only), or a
+    /// recording with gaps.
+    Unavailable = 2,
+    /// 3: SDO abort.
+    Abort = 3,
+    /// 4: timeout (an SDO answer, or a transfer's deadline).
+    Timeout = 4,
+    /// 5: a drive sequence or a procedure's wait failed, or a stop was not confirmed.
+    Drive = 5,
+}
+
+impl ExitCode {
+    /// The number the process exits with.
+    pub fn code(self) -> i32 {
+        self as i32
+    }
+}
+
+/// The status compares with its number: `assert_eq!(e.exit_code(), 3)`.
+impl PartialEq<i32> for ExitCode {
+    fn eq(&self, other: &i32) -> bool {
+        self.code() == *other
+    }
+}
 
 /// A failed command.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum CommandError {
-    /// Bad arguments or a local problem (file, type).
+    /// The words are not a command (see [`ParseError`]).
+    #[error(transparent)]
+    Syntax(#[from] ParseError),
+    /// Bad arguments or a local problem (object, value, file, type).
+    #[error("{0}")]
     Usage(String),
     /// The bus could not be opened or used.
-    Bus(BusError),
+    #[error(transparent)]
+    Bus(#[from] BusError),
     /// The SDO transfer was aborted (by the server, or by us for a protocol error, when
     /// `reason` says what the server did wrong).
+    #[error(
+        "SDO {index:04X}:{sub:02X} on node {node} aborted by the {}: 0x{code:08X} {}{}",
+        if *.by_server { "server" } else { "client" },
+        abort_text(*.code),
+        .reason.as_ref().map(|r| format!(" ({r})")).unwrap_or_default()
+    )]
     Abort {
         node: u8,
         index: u16,
@@ -34,11 +68,14 @@ pub enum CommandError {
         reason: Option<String>,
     },
     /// No answer in time.
+    #[error("{0}")]
     Timeout(String),
     /// A drive sequence step did not happen; `reason` says why, from what the bus shows.
+    #[error("drive {node}: {step} failed: {reason}")]
     Drive { node: u8, step: String, reason: String },
     /// A procedure stopped at step `step` of `of` because of `cause`; `report` is the run's
     /// JSON so far (`procedure`, `node`, `steps` done, the failed one last).
+    #[error("`{procedure}` stopped at step {step}/{of}: {cause}")]
     Step {
         procedure: String,
         step: usize,
@@ -48,6 +85,7 @@ pub enum CommandError {
     },
     /// A stop did not confirm every drive stopped (or could not send at all); `report` is
     /// the stop's JSON (`nodes` with `stopped` and `reason` each), `text` its text.
+    #[error("{text}")]
     NotStopped {
         report: Box<serde_json::Value>,
         text: String,
@@ -56,23 +94,36 @@ pub enum CommandError {
 
 impl CommandError {
     /// The process exit status for this failure.
-    pub fn exit_code(&self) -> i32 {
+    pub fn exit_code(&self) -> ExitCode {
         match self {
-            CommandError::Usage(_) => EXIT_USAGE,
-            CommandError::Bus(_) => EXIT_BUS,
-            CommandError::Abort { .. } => EXIT_ABORT,
-            CommandError::Timeout(_) => EXIT_TIMEOUT,
-            CommandError::Drive { .. } => EXIT_DRIVE,
+            CommandError::Syntax(_) | CommandError::Usage(_) => ExitCode::Usage,
+            CommandError::Bus(_) => ExitCode::Unavailable,
+            CommandError::Abort { .. } => ExitCode::Abort,
+            CommandError::Timeout(_) => ExitCode::Timeout,
+            CommandError::Drive { .. } => ExitCode::Drive,
             CommandError::Step { cause, .. } => cause.exit_code(),
-            CommandError::NotStopped { .. } => EXIT_DRIVE,
+            CommandError::NotStopped { .. } => ExitCode::Drive,
         }
     }
     /// The `--json` object of the failure.
     pub fn to_json(&self) -> serde_json::Value {
-        use serde_json::json;
+        let message = self.to_string();
         match self {
-            CommandError::Usage(m) => json!({"ok": false, "error": "usage", "message": m}),
-            CommandError::Bus(e) => json!({"ok": false, "error": "bus", "message": e.to_string()}),
+            CommandError::Syntax(_) | CommandError::Usage(_) => to_json(&Failure {
+                ok: false,
+                error: "usage",
+                message,
+            }),
+            CommandError::Bus(_) => to_json(&Failure {
+                ok: false,
+                error: "bus",
+                message,
+            }),
+            CommandError::Timeout(_) => to_json(&Failure {
+                ok: false,
+                error: "timeout",
+                message,
+            }),
             CommandError::Abort {
                 node,
                 index,
@@ -80,32 +131,34 @@ impl CommandError {
                 code,
                 by_server,
                 reason,
-            } => {
-                let mut v = json!({
-                    "ok": false, "error": "sdo_abort", "node": node,
-                    "index": index, "sub": sub,
-                    "abort_code": code, "abort_text": abort_text(*code),
-                    "aborted_by": if *by_server { "server" } else { "client" },
-                    "message": self.to_string(),
-                });
-                if let (Some(r), Some(o)) = (reason, v.as_object_mut()) {
-                    o.insert("reason".into(), r.as_str().into());
-                }
-                v
-            }
-            CommandError::Timeout(m) => json!({"ok": false, "error": "timeout", "message": m}),
-            CommandError::NotStopped { report, text } => {
+            } => to_json(&Aborted {
+                ok: false,
+                error: "sdo_abort",
+                node: *node,
+                index: *index,
+                sub: *sub,
+                abort_code: *code,
+                abort_text: abort_text(*code),
+                aborted_by: if *by_server { "server" } else { "client" },
+                message,
+                reason: reason.as_deref(),
+            }),
+            CommandError::NotStopped { report, .. } => {
                 let mut v = (**report).clone();
                 if let Some(o) = v.as_object_mut() {
                     o.insert("ok".into(), false.into());
                     o.insert("error".into(), "not_stopped".into());
-                    o.insert("message".into(), text.clone().into());
+                    o.insert("message".into(), message.into());
                 }
                 v
             }
-            CommandError::Drive { node, step, reason } => json!({
-                "ok": false, "error": "drive", "node": node, "step": step, "reason": reason,
-                "message": self.to_string(),
+            CommandError::Drive { node, step, reason } => to_json(&DriveFailed {
+                ok: false,
+                error: "drive",
+                node: *node,
+                step,
+                reason,
+                message,
             }),
             CommandError::Step {
                 step, report, cause, ..
@@ -117,7 +170,7 @@ impl CommandError {
                     }
                     out.insert("ok".into(), false.into());
                     out.insert("failed_step".into(), (*step).into());
-                    out.insert("message".into(), self.to_string().into());
+                    out.insert("message".into(), message.into());
                 }
                 v
             }
@@ -125,45 +178,38 @@ impl CommandError {
     }
 }
 
-impl std::fmt::Display for CommandError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            CommandError::Usage(m) | CommandError::Timeout(m) => write!(f, "{m}"),
-            CommandError::NotStopped { text, .. } => write!(f, "{text}"),
-            CommandError::Bus(e) => write!(f, "{e}"),
-            CommandError::Abort {
-                node,
-                index,
-                sub,
-                code,
-                by_server,
-                reason,
-            } => {
-                write!(
-                    f,
-                    "SDO {index:04X}:{sub:02X} on node {node} aborted by the {}: 0x{code:08X} {}",
-                    if *by_server { "server" } else { "client" },
-                    abort_text(*code)
-                )?;
-                match reason {
-                    Some(r) => write!(f, " ({r})"),
-                    None => Ok(()),
-                }
-            }
-            CommandError::Drive { node, step, reason } => write!(f, "drive {node}: {step} failed: {reason}"),
-            CommandError::Step {
-                procedure,
-                step,
-                of,
-                cause,
-                ..
-            } => write!(f, "`{procedure}` stopped at step {step}/{of}: {cause}"),
-        }
-    }
+/// The JSON of a usage, bus or timeout failure.
+#[derive(Serialize)]
+struct Failure {
+    ok: bool,
+    error: &'static str,
+    message: String,
 }
 
-impl From<BusError> for CommandError {
-    fn from(e: BusError) -> Self {
-        CommandError::Bus(e)
-    }
+/// The JSON of an SDO abort.
+#[derive(Serialize)]
+struct Aborted<'a> {
+    ok: bool,
+    error: &'static str,
+    node: u8,
+    index: u16,
+    sub: u8,
+    abort_code: u32,
+    abort_text: &'static str,
+    aborted_by: &'static str,
+    message: String,
+    /// What the server did wrong, when the client aborted.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    reason: Option<&'a str>,
+}
+
+/// The JSON of a failed drive step.
+#[derive(Serialize)]
+struct DriveFailed<'a> {
+    ok: bool,
+    error: &'static str,
+    node: u8,
+    step: &'a str,
+    reason: &'a str,
+    message: String,
 }

@@ -4,13 +4,16 @@
 use super::error::CommandError;
 use super::grammar::{Command, RunSpec, SdoOptions};
 use super::sdo::Timing;
+use super::to_json;
 use super::value::{decode, encode};
 use crate::bus::{Bus, BusError};
 use crate::decode::cia402::mode_name;
 use crate::od::alias::resolve_object;
 use crate::od::bind::Bindings;
 use crate::od::{DataType, Dictionary};
-use serde_json::{Value as Json, json};
+use serde::Serialize;
+use serde_json::Value as Json;
+use std::collections::BTreeMap;
 
 /// The result of a command: the `--json` object and the human text.
 #[derive(Clone, Debug, PartialEq)]
@@ -36,13 +39,11 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
             timeout_ms,
         } => {
             let seen = super::nmt::nmt(bus, *action, *node, *wait, *timeout_ms).await?;
-            let confirmed: serde_json::Map<String, Json> =
-                seen.iter().map(|(n, s)| (n.to_string(), s.as_str().into())).collect();
-            json!({
-                "ok": true,
-                "action": action.as_str(),
-                "node": node,
-                "confirmed": if *wait { Json::Object(confirmed) } else { Json::Null },
+            to_json(&NmtSent {
+                ok: true,
+                action: action.as_str(),
+                node: *node,
+                confirmed: wait.then(|| seen.iter().map(|(n, s)| (n.to_string(), s.as_str())).collect()),
             })
         }
         Command::SdoRead {
@@ -52,7 +53,7 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
             output,
         } => {
             let dict = bindings.dictionary(*node);
-            let (index, sub) = resolve_object(dict, object).map_err(CommandError::Usage)?;
+            let (index, sub) = resolve_object(dict, object).map_err(|e| CommandError::Usage(e.to_string()))?;
             let data = super::sdo::upload_within(bus, *node, index, sub, options.block, timing(options)).await?;
             if let Some(path) = output {
                 std::fs::write(path, &data).map_err(|e| CommandError::Usage(format!("cannot write {path}: {e}")))?;
@@ -62,16 +63,16 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
                 .or_else(|| dict.object(index, sub).map(|o| o.data_type));
             let value = decode(&data, ty);
             let text = crate::decode::value_text::object_text(dict, index, sub, &value, None);
-            json!({
-                "ok": true,
-                "node": node,
-                "index": index,
-                "sub": sub,
-                "name": dict.name(index, sub),
-                "value": value.to_json(),
-                "text": text,
-                "data": crate::frame::hex::upper(&data),
-                "len": data.len(),
+            to_json(&SdoRead {
+                ok: true,
+                node: *node,
+                index,
+                sub,
+                name: dict.name(index, sub),
+                value: value.to_json(),
+                text,
+                data: crate::frame::hex::upper(&data),
+                len: data.len(),
             })
         }
         Command::SdoWrite {
@@ -81,18 +82,18 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
             options,
         } => {
             let dict = bindings.dictionary(*node);
-            let (index, sub) = resolve_object(dict, object).map_err(CommandError::Usage)?;
+            let (index, sub) = resolve_object(dict, object).map_err(|e| CommandError::Usage(e.to_string()))?;
             let data = write_data(dict, index, sub, value, options.data_type)?;
             super::sdo::download_within(bus, *node, index, sub, data.clone(), options.block, timing(options)).await?;
-            json!({
-                "ok": true,
-                "written": true,
-                "node": node,
-                "index": index,
-                "sub": sub,
-                "name": dict.name(index, sub),
-                "data": crate::frame::hex::upper(&data),
-                "len": data.len(),
+            to_json(&SdoWritten {
+                ok: true,
+                written: true,
+                node: *node,
+                index,
+                sub,
+                name: dict.name(index, sub),
+                data: crate::frame::hex::upper(&data),
+                len: data.len(),
             })
         }
         Command::Drive {
@@ -106,7 +107,10 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
             timeout_ms,
         } => {
             let nodes = super::scan::scan(bus, *listen_ms, *probe, *timeout_ms).await?;
-            json!({"ok": true, "nodes": nodes.iter().map(|n| n.to_json()).collect::<Vec<_>>()})
+            to_json(&Scanned {
+                ok: true,
+                nodes: nodes.iter().map(|n| n.to_json()).collect(),
+            })
         }
         Command::Record {
             output,
@@ -130,6 +134,50 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
     Ok(Outcome { json, text })
 }
 
+/// `nmt --json`.
+#[derive(Serialize)]
+struct NmtSent {
+    ok: bool,
+    action: &'static str,
+    node: u8,
+    /// With `--wait`: node -> the state that confirmed the command; else null.
+    confirmed: Option<BTreeMap<String, &'static str>>,
+}
+
+/// `sdo read --json`.
+#[derive(Serialize)]
+struct SdoRead<'a> {
+    ok: bool,
+    node: u8,
+    index: u16,
+    sub: u8,
+    name: Option<&'a str>,
+    value: Json,
+    text: String,
+    data: String,
+    len: usize,
+}
+
+/// `sdo write --json`.
+#[derive(Serialize)]
+struct SdoWritten<'a> {
+    ok: bool,
+    written: bool,
+    node: u8,
+    index: u16,
+    sub: u8,
+    name: Option<&'a str>,
+    data: String,
+    len: usize,
+}
+
+/// `scan --json`.
+#[derive(Serialize)]
+struct Scanned {
+    ok: bool,
+    nodes: Vec<Json>,
+}
+
 /// The timeouts of an SDO command's options.
 fn timing(o: &SdoOptions) -> Timing {
     Timing {
@@ -141,12 +189,12 @@ fn timing(o: &SdoOptions) -> Timing {
 /// `run`: lists, dry-runs or runs a procedure; the text is a summary line, then every step
 /// line and result.
 async fn run_procedure(bus: &Bus, bindings: &Bindings, spec: &RunSpec) -> Result<Outcome, CommandError> {
-    let (json, text) = offline_run(bindings, spec).map_err(CommandError::Usage)?;
+    let (json, text) = offline_run(bindings, spec)?;
     let Some(name) = spec.procedure.as_deref().filter(|_| !spec.dry_run) else {
         return Ok(Outcome { json, text });
     };
     let dict = bindings.dictionary(spec.node);
-    let plan = super::run::plan(dict, spec.node, name, &spec.args).map_err(CommandError::Usage)?;
+    let plan = super::run::plan(dict, spec.node, name, &spec.args)?;
     let mut lines = Vec::new();
     let json = super::run::run(bus, dict, &plan, spec.timeout_ms, &mut |l| lines.push(l.to_string())).await?;
     // The summary first: the palette's message line shows one line.
@@ -159,7 +207,7 @@ async fn run_procedure(bus: &Bus, bindings: &Bindings, spec: &RunSpec) -> Result
 
 /// What `run` gives without a bus: the listing (no procedure) or the dry run (also used to
 /// check a procedure and its parameters before opening the bus).
-pub fn offline_run(bindings: &Bindings, spec: &RunSpec) -> Result<(Json, String), String> {
+pub fn offline_run(bindings: &Bindings, spec: &RunSpec) -> Result<(Json, String), super::run::PlanError> {
     let dict = bindings.dictionary(spec.node);
     match &spec.procedure {
         None => Ok(super::run::list(dict, spec.node)),
@@ -198,7 +246,7 @@ pub fn write_data(
         Some(DataType::Domain) => {
             std::fs::read(value).map_err(|e| CommandError::Usage(format!("cannot read {value}: {e}")))
         }
-        Some(t) => encode(value, t).map_err(CommandError::Usage),
+        Some(t) => Ok(encode(value, t)?),
         None => Err(CommandError::Usage(format!(
             "the type of {index:04X}:{sub:02X} is unknown: give --type (u8..u64, i8..i64, f32, f64, bool, string, octets, domain)"
         ))),

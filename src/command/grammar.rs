@@ -1,8 +1,9 @@
-//! The command grammar shared by the command line and the TUI palette:
-//! `parse_command("sdo read 2 0x6041")` gives the same [`Command`] as
-//! `cotui sdo read IFACE 2 0x6041`.
+//! What the commander's command language means: the [`Command`] a line parses into (see
+//! [`super::syntax`] for the words), its actions and options, and the number, node and type
+//! parsers the declaration uses.
 
 use super::record::{Limits, LogFormat, WriteMode};
+use super::syntax::ParseError;
 use crate::od::DataType;
 
 /// An NMT command.
@@ -37,7 +38,7 @@ impl NmtAction {
         }
     }
     /// Parses `start|stop|preop|reset-node|reset-comm`.
-    pub fn parse(word: &str) -> Result<NmtAction, String> {
+    pub fn parse(word: &str) -> Result<NmtAction, ParseError> {
         Ok(match word {
             "start" => NmtAction::Start,
             "stop" => NmtAction::Stop,
@@ -45,9 +46,9 @@ impl NmtAction {
             "reset-node" => NmtAction::ResetNode,
             "reset-comm" => NmtAction::ResetComm,
             _ => {
-                return Err(format!(
+                return Err(ParseError::Invalid(format!(
                     "unknown NMT command `{word}`: use start, stop, preop, reset-node or reset-comm"
-                ));
+                )));
             }
         })
     }
@@ -66,21 +67,45 @@ pub enum DriveAction {
 }
 
 impl DriveAction {
-    /// Parses `enable|disable|quick-stop|fault-reset|status|mode MODE`.
-    pub fn parse(word: &str, arg: Option<&str>) -> Result<DriveAction, String> {
+    /// Checks an action word: `enable|disable|quick-stop|fault-reset|status|mode`; gives
+    /// its usual spelling.
+    pub fn verb(word: &str) -> Result<&'static str, ParseError> {
         Ok(match word {
-            "enable" => DriveAction::Enable,
-            "disable" => DriveAction::Disable,
-            "quick-stop" | "quickstop" => DriveAction::QuickStop,
-            "fault-reset" => DriveAction::FaultReset,
-            "status" => DriveAction::Status,
-            "mode" => DriveAction::Mode(parse_mode(arg.ok_or("drive mode needs a MODE (e.g. pv, csp, 3)")?)?),
+            "enable" => "enable",
+            "disable" => "disable",
+            "quick-stop" | "quickstop" => "quick-stop",
+            "fault-reset" => "fault-reset",
+            "status" => "status",
+            "mode" => "mode",
             _ => {
-                return Err(format!(
+                return Err(ParseError::Invalid(format!(
                     "unknown drive command `{word}`: use enable, disable, quick-stop, fault-reset, status or mode MODE"
-                ));
+                )));
             }
         })
+    }
+    /// Parses `enable|disable|quick-stop|fault-reset|status|mode MODE`: `arg` is the MODE,
+    /// which only `mode` takes.
+    pub fn parse(word: &str, arg: Option<&str>) -> Result<DriveAction, ParseError> {
+        let action = match Self::verb(word)? {
+            "enable" => DriveAction::Enable,
+            "disable" => DriveAction::Disable,
+            "quick-stop" => DriveAction::QuickStop,
+            "fault-reset" => DriveAction::FaultReset,
+            "status" => DriveAction::Status,
+            _ => {
+                return Ok(DriveAction::Mode(parse_mode(arg.ok_or_else(|| {
+                    ParseError::Invalid("drive mode needs a MODE (e.g. pv, csp, 3)".into())
+                })?)?));
+            }
+        };
+        match arg {
+            Some(extra) => Err(ParseError::Invalid(format!(
+                "`drive {}` takes no MODE (got `{extra}`)",
+                action.as_str()
+            ))),
+            None => Ok(action),
+        }
     }
     /// The word used on the command line.
     pub fn as_str(self) -> &'static str {
@@ -96,7 +121,7 @@ impl DriveAction {
 }
 
 /// A mode of operation by CiA 402 abbreviation (`pp`, `pv`, `pt`, `hm`, `ip`, `csp`, `csv`, `cst`) or number.
-pub fn parse_mode(text: &str) -> Result<i8, String> {
+pub fn parse_mode(text: &str) -> Result<i8, ParseError> {
     Ok(match text.to_ascii_lowercase().as_str() {
         "pp" => 1,
         "vl" => 2,
@@ -110,7 +135,11 @@ pub fn parse_mode(text: &str) -> Result<i8, String> {
         other => parse_int(other)
             .filter(|v| (-128..=127).contains(v))
             .map(|v| v as i8)
-            .ok_or_else(|| format!("unknown mode `{text}`: use pp, pv, pt, hm, ip, csp, csv, cst or a number"))?,
+            .ok_or_else(|| {
+                ParseError::Invalid(format!(
+                    "unknown mode `{text}`: use pp, pv, pt, hm, ip, csp, csv, cst or a number"
+                ))
+            })?,
     })
 }
 
@@ -220,28 +249,32 @@ pub struct RunSpec {
 }
 
 /// Splits `NAME=VALUE` procedure arguments.
-pub fn parse_assignments(words: &[&str]) -> Result<Vec<(String, String)>, String> {
+pub fn parse_assignments(words: &[&str]) -> Result<Vec<(String, String)>, ParseError> {
     words
         .iter()
         .map(|w| match w.split_once('=') {
             Some((n, v)) if !n.is_empty() => Ok((n.to_string(), v.to_string())),
-            _ => Err(format!("`{w}` is not a parameter: write NAME=VALUE, e.g. speed=100")),
+            _ => Err(ParseError::Invalid(format!(
+                "`{w}` is not a parameter: write NAME=VALUE, e.g. speed=100"
+            ))),
         })
         .collect()
 }
 
 /// The `run` command from its words after NODE: `[PROCEDURE] [NAME=VALUE ...]`.
-pub fn run_spec(node: u8, rest: &[&str], list: bool, dry_run: bool, timeout_ms: u64) -> Result<RunSpec, String> {
+pub fn run_spec(node: u8, rest: &[&str], list: bool, dry_run: bool, timeout_ms: u64) -> Result<RunSpec, ParseError> {
     let (procedure, assignments) = match rest.split_first() {
         Some((p, more)) if !p.contains('=') => (Some(p.to_string()), more),
         _ => (None, rest),
     };
     let args = parse_assignments(assignments)?;
     if procedure.is_none() && !args.is_empty() {
-        return Err("run: give the PROCEDURE before its NAME=VALUE parameters".into());
+        return Err(ParseError::Invalid(
+            "run: give the PROCEDURE before its NAME=VALUE parameters".into(),
+        ));
     }
     if list && procedure.is_some() {
-        return Err("run: give a PROCEDURE or --list, not both".into());
+        return Err(ParseError::Invalid("run: give a PROCEDURE or --list, not both".into()));
     }
     Ok(RunSpec {
         node,
@@ -278,16 +311,18 @@ pub fn parse_int(text: &str) -> Option<i64> {
 }
 
 /// Parses a node id: 0..=127 where `allow_all`, else 1..=127.
-pub fn parse_node(text: &str, allow_all: bool) -> Result<u8, String> {
+pub fn parse_node(text: &str, allow_all: bool) -> Result<u8, ParseError> {
     let lo = if allow_all { 0 } else { 1 };
     match parse_int(text) {
         Some(n) if (lo..=127).contains(&n) => Ok(n as u8),
-        _ => Err(format!("node `{text}` must be a number {lo}..127 (decimal or 0x hex)")),
+        _ => Err(ParseError::Invalid(format!(
+            "node `{text}` must be a number {lo}..127 (decimal or 0x hex)"
+        ))),
     }
 }
 
 /// Parses a `--type` name: u8..u64, i8..i64, f32, f64, bool, string, octets (hex), domain.
-pub fn parse_type(name: &str) -> Result<DataType, String> {
+pub fn parse_type(name: &str) -> Result<DataType, ParseError> {
     use DataType::*;
     Ok(match name.to_ascii_lowercase().as_str() {
         "u8" => U8,
@@ -313,299 +348,16 @@ pub fn parse_type(name: &str) -> Result<DataType, String> {
         "octets" | "octet_string" | "hex" | "os" => OctetString,
         "domain" => Domain,
         _ => {
-            return Err(format!(
+            return Err(ParseError::Invalid(format!(
                 "unknown type `{name}`: use u8..u64, i8..i64, f32, f64, bool, string, octets or domain"
-            ));
+            )));
         }
     })
-}
-
-/// Splits a palette line into words, keeping `"quoted strings"` together.
-fn words(line: &str) -> Result<Vec<String>, String> {
-    let mut out = Vec::new();
-    let mut cur = String::new();
-    let mut quoted = false;
-    let mut any = false;
-    for c in line.chars() {
-        match c {
-            '"' => {
-                quoted = !quoted;
-                any = true;
-            }
-            c if c.is_whitespace() && !quoted => {
-                if any {
-                    out.push(std::mem::take(&mut cur));
-                    any = false;
-                }
-            }
-            c => {
-                cur.push(c);
-                any = true;
-            }
-        }
-    }
-    if quoted {
-        return Err("unterminated quote".into());
-    }
-    if any {
-        out.push(cur);
-    }
-    Ok(out)
-}
-
-fn positive(flag: &str, v: &str) -> Result<u64, String> {
-    parse_int(v)
-        .filter(|t| *t > 0)
-        .map(|t| t as u64)
-        .ok_or(format!("{flag} `{v}` must be a positive number"))
-}
-
-/// Parses one palette line, e.g. `sdo read 2 0x6041`, `nmt start 0 --wait`,
-/// `sdo write 2 0x6060 3 --type i8`, `drive 2 enable`, `drive 2 mode pv`, `scan`, `record -o f.log`.
-pub fn parse_command(line: &str) -> Result<Command, String> {
-    let all = words(line)?;
-    let mut pos: Vec<&str> = Vec::new();
-    let mut data_type = None;
-    let (mut block, mut wait, mut probe, mut list, mut dry_run) = (false, false, false, false, false);
-    let (mut output, mut timeout, mut listen, mut ramp, mut deadline) = (None, None, None, None, None);
-    let mut limits = Limits::default();
-    let mut mode = WriteMode::New;
-    let mut format = LogFormat::Candump;
-    let mut it = all.iter();
-    while let Some(w) = it.next() {
-        let mut value = |flag: &str| it.next().map(String::as_str).ok_or(format!("{flag} needs a value"));
-        match w.as_str() {
-            "--wait" => wait = true,
-            "--block" => block = true,
-            "--probe" => probe = true,
-            "--list" => list = true,
-            "--dry-run" => dry_run = true,
-            "--force" | "--append" if mode != WriteMode::New => {
-                return Err("record takes --force or --append, not both".into());
-            }
-            "--format" => format = LogFormat::parse(value("--format")?)?,
-            "--force" => mode = WriteMode::Overwrite,
-            "--append" => mode = WriteMode::Append,
-            "--type" | "-t" => data_type = Some(parse_type(value("--type")?)?),
-            "--timeout" => timeout = Some(positive("--timeout", value("--timeout")?)?),
-            "--listen" => listen = Some(positive("--listen", value("--listen")?)?),
-            "--ramp" => ramp = Some(positive("--ramp", value("--ramp")?)?),
-            "--deadline" => deadline = Some(positive("--deadline", value("--deadline")?)?),
-            "--count" => limits.count = Some(positive("--count", value("--count")?)?),
-            "--duration" => limits.duration_ms = Some(positive("--duration", value("--duration")?)?),
-            "-o" | "--output" => output = Some(value("-o")?.to_string()),
-            w if w.starts_with('-') && w.len() > 1 && parse_int(w).is_none() => {
-                return Err(format!("unknown option `{w}`"));
-            }
-            w => pos.push(w),
-        }
-    }
-    let options = SdoOptions {
-        data_type,
-        block,
-        timeout_ms: timeout.unwrap_or(DEFAULT_TIMEOUT_MS),
-        deadline_ms: deadline,
-    };
-    let usage = "commands: nmt ACTION NODE, sdo read NODE OBJECT, sdo write NODE OBJECT VALUE, \
-                 drive NODE ACTION, run NODE PROCEDURE [NAME=VALUE ...], scan, record -o FILE, stop [NODE ...]";
-    match pos.as_slice() {
-        ["nmt", action, node] => Ok(Command::Nmt {
-            action: NmtAction::parse(action)?,
-            node: parse_node(node, true)?,
-            wait,
-            timeout_ms: timeout.unwrap_or(NMT_WAIT_MS),
-        }),
-        ["sdo", "read", node, object] => Ok(Command::SdoRead {
-            node: parse_node(node, false)?,
-            object: object.to_string(),
-            options,
-            output,
-        }),
-        ["sdo", "write", node, object, value] => Ok(Command::SdoWrite {
-            node: parse_node(node, false)?,
-            object: object.to_string(),
-            value: value.to_string(),
-            options,
-        }),
-        ["drive", node, action, rest @ ..] if rest.len() <= 1 => Ok(Command::Drive {
-            node: parse_node(node, false)?,
-            action: DriveAction::parse(action, rest.first().copied())?,
-            timeout_ms: timeout.unwrap_or(DEFAULT_TIMEOUT_MS),
-        }),
-        ["run", node, rest @ ..] => Ok(Command::Run(run_spec(
-            parse_node(node, false)?,
-            rest,
-            list,
-            dry_run,
-            timeout.unwrap_or(DEFAULT_TIMEOUT_MS),
-        )?)),
-        ["scan"] => Ok(Command::Scan {
-            listen_ms: listen.unwrap_or(SCAN_LISTEN_MS),
-            probe,
-            timeout_ms: timeout.unwrap_or(SCAN_TIMEOUT_MS),
-        }),
-        ["stop", nodes @ ..] => Ok(Command::Stop {
-            nodes: nodes.iter().map(|n| parse_node(n, false)).collect::<Result<_, _>>()?,
-            listen_ms: listen.unwrap_or(super::stop::DEFAULT_LISTEN_MS),
-            options: super::stop::StopOptions {
-                timeout_ms: timeout.unwrap_or(DEFAULT_TIMEOUT_MS),
-                ramp_ms: ramp.unwrap_or(super::stop::DEFAULT_RAMP_MS),
-            },
-        }),
-        ["record"] => Ok(Command::Record {
-            output: output.ok_or("record needs -o FILE")?,
-            limits,
-            mode,
-            format,
-        }),
-        [] => Err(format!("empty command; {usage}")),
-        [first, ..] => Err(format!("cannot parse `{}` (after `{first}`); {usage}", all.join(" "))),
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn palette_lines() {
-        assert_eq!(
-            parse_command("sdo read 2 0x6041").unwrap(),
-            Command::SdoRead {
-                node: 2,
-                object: "0x6041".into(),
-                options: SdoOptions::default(),
-                output: None,
-            }
-        );
-        assert_eq!(
-            parse_command("sdo write 0x02 0x1008 \"my drive\" --type string --block --timeout 300").unwrap(),
-            Command::SdoWrite {
-                node: 2,
-                object: "0x1008".into(),
-                value: "my drive".into(),
-                options: SdoOptions {
-                    data_type: Some(DataType::VisibleString),
-                    block: true,
-                    timeout_ms: 300,
-                    deadline_ms: None
-                }
-            }
-        );
-        assert_eq!(
-            parse_command("nmt reset-node 0 --wait").unwrap(),
-            Command::Nmt {
-                action: NmtAction::ResetNode,
-                node: 0,
-                wait: true,
-                timeout_ms: NMT_WAIT_MS,
-            }
-        );
-        assert_eq!(
-            parse_command("drive 3 mode csv").unwrap(),
-            Command::Drive {
-                node: 3,
-                action: DriveAction::Mode(9),
-                timeout_ms: DEFAULT_TIMEOUT_MS
-            }
-        );
-        assert_eq!(
-            parse_command("sdo write 2 0x60FF -100 --type i32")
-                .map(|c| matches!(c, Command::SdoWrite { value, .. } if value == "-100")),
-            Ok(true)
-        );
-        assert_eq!(
-            parse_command("scan --probe --listen 500").unwrap(),
-            Command::Scan {
-                listen_ms: 500,
-                probe: true,
-                timeout_ms: SCAN_TIMEOUT_MS
-            }
-        );
-        assert_eq!(
-            parse_command("record -o out.log").unwrap(),
-            Command::Record {
-                output: "out.log".into(),
-                limits: Limits::default(),
-                mode: WriteMode::New,
-                format: LogFormat::Candump,
-            }
-        );
-        assert_eq!(
-            parse_command("record -o out.log --append --count 5").unwrap(),
-            Command::Record {
-                output: "out.log".into(),
-                limits: Limits {
-                    count: Some(5),
-                    duration_ms: None
-                },
-                mode: WriteMode::Append,
-                format: LogFormat::Candump,
-            }
-        );
-        assert!(matches!(
-            parse_command("record --force -o out.log"),
-            Ok(Command::Record {
-                mode: WriteMode::Overwrite,
-                ..
-            })
-        ));
-        assert!(
-            parse_command("record -o x --force --append")
-                .unwrap_err()
-                .contains("not both")
-        );
-    }
-
-    #[test]
-    fn errors_say_what_is_wrong() {
-        assert_eq!(
-            parse_command("sdo read 0 0x6041").unwrap_err(),
-            "node `0` must be a number 1..127 (decimal or 0x hex)"
-        );
-        assert!(
-            parse_command("nmt go 2")
-                .unwrap_err()
-                .contains("unknown NMT command `go`")
-        );
-        assert!(
-            parse_command("sdo read 2 0x6041 --type u7")
-                .unwrap_err()
-                .contains("unknown type `u7`")
-        );
-        assert!(
-            parse_command("drive 2 fly")
-                .unwrap_err()
-                .contains("unknown drive command")
-        );
-        assert!(parse_command("record").unwrap_err().contains("-o FILE"));
-        assert!(parse_command("").unwrap_err().starts_with("empty command"));
-    }
-
-    #[test]
-    fn run_lines() {
-        assert_eq!(
-            parse_command("run 2 pv speed=100 accel=0x10 --dry-run").unwrap(),
-            Command::Run(RunSpec {
-                node: 2,
-                procedure: Some("pv".into()),
-                args: vec![("speed".into(), "100".into()), ("accel".into(), "0x10".into())],
-                dry_run: true,
-                timeout_ms: DEFAULT_TIMEOUT_MS,
-            })
-        );
-        assert!(matches!(
-            parse_command("run 3 --list").unwrap(),
-            Command::Run(RunSpec {
-                node: 3,
-                procedure: None,
-                ..
-            })
-        ));
-        assert!(parse_command("run 2 pv speed").unwrap_err().contains("NAME=VALUE"));
-        assert!(parse_command("run 2 speed=1").unwrap_err().contains("PROCEDURE before"));
-        assert!(parse_command("run 2 pv --list").unwrap_err().contains("not both"));
-    }
 
     #[test]
     fn numbers() {

@@ -11,8 +11,23 @@ pub mod run;
 pub mod scan;
 pub mod sdo;
 pub mod stop;
+pub mod syntax;
 pub mod value;
 
-pub use error::CommandError;
+pub use error::{CommandError, ExitCode};
 pub use exec::{Outcome, execute};
-pub use grammar::{Command, DriveAction, NmtAction, RunSpec, SdoOptions, parse_command};
+pub use grammar::{Command, DriveAction, NmtAction, RunSpec, SdoOptions};
+pub use syntax::{ParseError, parse_command};
+
+/// A command's `--json` object from its `#[derive(Serialize)]` form (serializing these plain
+/// structs cannot fail; a failure would give null).
+pub(crate) fn to_json(v: &impl serde::Serialize) -> serde_json::Value {
+    serde_json::to_value(v).unwrap_or_default()
+}
+
+/// A frame in candump's compact form (`602#2B40600006000000`), as previews show frames.
+pub fn candump(f: &crate::frame::Frame) -> String {
+    let mut s = String::new();
+    crate::log::writer::push_compact(&mut s, f);
+    s
+}

@@ -21,6 +21,11 @@ pub fn expected_state(action: NmtAction) -> NmtState {
     }
 }
 
+/// The NMT frame of `action` to `node` (0 = all).
+pub fn frame(action: NmtAction, node: u8) -> Frame {
+    Frame::classic(0x000, &[action.cs(), node])
+}
+
 /// Sends `action` to `node` (0 = all). With `wait`, waits up to `timeout_ms` for the heartbeat
 /// or boot-up that confirms it (node 0: every node that answers in that time).
 pub async fn nmt(
@@ -31,7 +36,7 @@ pub async fn nmt(
     timeout_ms: u64,
 ) -> Result<Confirmed, CommandError> {
     let mut rx = bus.subscribe();
-    bus.send(&Frame::classic(0x000, &[action.cs(), node])).await?;
+    bus.send(&frame(action, node)).await?;
     let mut seen = Confirmed::new();
     if !wait {
         return Ok(seen);

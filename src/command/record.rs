@@ -64,20 +64,24 @@ impl Recorded {
     /// the Unix epoch, as the log's timestamps), `output`; `ok` is false when there are gaps.
     pub fn to_json(&self, output: &str) -> serde_json::Value {
         let secs = |ns: u64| ns as f64 / 1e9;
-        let gaps: Vec<_> = self
-            .gaps
-            .iter()
-            .map(|g| serde_json::json!({"from": secs(g.from_ns), "to": secs(g.to_ns), "reason": g.reason}))
-            .collect();
-        let mut v = serde_json::json!({
-            "ok": self.gaps.is_empty(), "frames": self.frames, "dropped": self.dropped,
-            "gaps": gaps, "output": output,
-        });
-        if let Some(m) = self.gap_message(output) {
-            v["error"] = "bus".into();
-            v["message"] = m.into();
-        }
-        v
+        let message = self.gap_message(output);
+        super::to_json(&RecordedJson {
+            ok: self.gaps.is_empty(),
+            frames: self.frames,
+            dropped: self.dropped,
+            gaps: self
+                .gaps
+                .iter()
+                .map(|g| GapJson {
+                    from: secs(g.from_ns),
+                    to: secs(g.to_ns),
+                    reason: &g.reason,
+                })
+                .collect(),
+            output,
+            error: message.as_ref().map(|_| "bus"),
+            message,
+        })
     }
     /// Why the recording is incomplete, if it has gaps.
     pub fn gap_message(&self, output: &str) -> Option<String> {
@@ -95,6 +99,30 @@ impl Recorded {
             )
         })
     }
+}
+
+/// `record --json`: the summary of a recording.
+#[derive(serde::Serialize)]
+struct RecordedJson<'a> {
+    ok: bool,
+    frames: u64,
+    dropped: u64,
+    gaps: Vec<GapJson<'a>>,
+    output: &'a str,
+    /// `bus` when the recording has gaps.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    error: Option<&'static str>,
+    /// What the gaps were, when there are any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    message: Option<String>,
+}
+
+/// A time nothing could be captured, in seconds since the Unix epoch.
+#[derive(serde::Serialize)]
+struct GapJson<'a> {
+    from: f64,
+    to: f64,
+    reason: &'a str,
 }
 
 /// Opens the log: `-` is stdout; an existing file is refused unless `mode` says overwrite or append.
@@ -224,11 +252,13 @@ pub enum LogFormat {
 
 impl LogFormat {
     /// Parses `candump` or `pcapng`.
-    pub fn parse(word: &str) -> Result<LogFormat, String> {
+    pub fn parse(word: &str) -> Result<LogFormat, super::syntax::ParseError> {
         match word {
             "candump" | "log" => Ok(LogFormat::Candump),
             "pcapng" => Ok(LogFormat::Pcapng),
-            _ => Err(format!("unknown record format `{word}`: use candump or pcapng")),
+            _ => Err(super::syntax::ParseError::Invalid(format!(
+                "unknown record format `{word}`: use candump or pcapng"
+            ))),
         }
     }
 }

@@ -12,7 +12,9 @@ use crate::frame::hex;
 use crate::od::alias::resolve_object;
 use crate::od::procedure::{NmtCommand, Procedure, Step, fill_object, frame_bytes};
 use crate::od::{DataType, Dictionary};
-use serde_json::{Value as Json, json};
+use serde::Serialize;
+use serde_json::Value as Json;
+use std::collections::BTreeMap;
 use std::time::Duration;
 
 /// What a planned step does on the bus.
@@ -107,50 +109,58 @@ pub struct RunPlan {
     pub steps: Vec<PlannedStep>,
 }
 
-fn candump(f: &Frame) -> String {
-    if f.is_ext() {
-        format!("{:08X}#{}", f.id, hex::upper(f.payload()))
-    } else {
-        format!("{:03X}#{}", f.id, hex::upper(f.payload()))
+/// Why a procedure cannot be planned (a usage error: nothing was sent).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum PlanError {
+    /// The node's dictionary has no procedure of that name (`known`: the ones it has).
+    #[error(
+        "node {node} has no procedure `{name}`{}",
+        if known.is_empty() {
+            format!(": its dictionary has no procedures (bind a profile: --profile {node}=NAME)")
+        } else {
+            format!("; its procedures: {}", known.join(", "))
+        }
+    )]
+    NoProcedure { node: u8, name: String, known: Vec<String> },
+    /// A parameter the procedure does not take (`params`: the ones it takes).
+    #[error("`{procedure}` has no parameter `{name}`; {params}")]
+    UnknownParam {
+        procedure: String,
+        name: String,
+        params: String,
+    },
+    /// A parameter value that is not a number.
+    #[error("{name}=`{text}` is not a number (decimal or 0x hex)")]
+    NotANumber { name: String, text: String },
+    /// A parameter without default not given.
+    #[error("`{procedure}` needs {name}=VALUE; {params}")]
+    MissingParam {
+        procedure: String,
+        name: String,
+        params: String,
+    },
+    /// A step that cannot be built (object, expression, value, frame).
+    #[error("`{procedure}` step {step}/{of}: {reason}")]
+    Step {
+        procedure: String,
+        step: usize,
+        of: usize,
+        reason: String,
+    },
+}
+
+impl From<PlanError> for CommandError {
+    fn from(e: PlanError) -> Self {
+        CommandError::Usage(e.to_string())
     }
 }
 
-/// The first frame of an SDO download: expedited up to 4 bytes, else the segmented initiate.
-fn download_initiate(node: u8, index: u16, sub: u8, data: &[u8]) -> Frame {
-    let [lo, hi] = index.to_le_bytes();
-    let mut b = if data.len() <= 4 {
-        let mut b = vec![0x23 | (((4 - data.len()) as u8) << 2), lo, hi, sub];
-        b.extend_from_slice(data);
-        b
-    } else {
-        let mut b = vec![0x21, lo, hi, sub];
-        b.extend_from_slice(&(data.len() as u32).to_le_bytes());
-        b
-    };
-    b.resize(8, 0);
-    Frame::classic(0x600 + u32::from(node), &b)
-}
-
-fn upload_request(node: u8, index: u16, sub: u8) -> Frame {
-    let [lo, hi] = index.to_le_bytes();
-    Frame::classic(0x600 + u32::from(node), &[0x40, lo, hi, sub, 0, 0, 0, 0])
-}
-
-/// The procedure `name` of `dict`, or a usage message naming the ones there are.
-pub fn find<'a>(dict: &'a Dictionary, node: u8, name: &str) -> Result<&'a Procedure, String> {
-    if let Some(p) = dict.procedure(name) {
-        return Ok(p);
-    }
-    let names: Vec<&str> = dict.procedures().iter().map(|p| p.name.as_str()).collect();
-    Err(if names.is_empty() {
-        format!(
-            "node {node} has no procedure `{name}`: its dictionary has no procedures (bind a profile: --profile {node}=NAME)"
-        )
-    } else {
-        format!(
-            "node {node} has no procedure `{name}`; its procedures: {}",
-            names.join(", ")
-        )
+/// The procedure `name` of `dict`, or an error naming the ones there are.
+pub fn find<'a>(dict: &'a Dictionary, node: u8, name: &str) -> Result<&'a Procedure, PlanError> {
+    dict.procedure(name).ok_or_else(|| PlanError::NoProcedure {
+        node,
+        name: name.to_string(),
+        known: dict.procedures().iter().map(|p| p.name.clone()).collect(),
     })
 }
 
@@ -171,10 +181,14 @@ fn param_list(p: &Procedure) -> String {
 
 /// Binds `args` to the parameters of `p` (defaults for the rest): unknown, unparsable or
 /// missing parameters are errors naming the valid ones.
-pub fn bind_params(p: &Procedure, args: &[(String, String)]) -> Result<Vec<(String, i64)>, String> {
+pub fn bind_params(p: &Procedure, args: &[(String, String)]) -> Result<Vec<(String, i64)>, PlanError> {
     for (name, _) in args {
         if !p.params.iter().any(|q| &q.name == name) {
-            return Err(format!("`{}` has no parameter `{name}`; {}", p.name, param_list(p)));
+            return Err(PlanError::UnknownParam {
+                procedure: p.name.clone(),
+                name: name.clone(),
+                params: param_list(p),
+            });
         }
     }
     p.params
@@ -182,11 +196,18 @@ pub fn bind_params(p: &Procedure, args: &[(String, String)]) -> Result<Vec<(Stri
         .map(|q| {
             let given = args.iter().rev().find(|(n, _)| n == &q.name);
             let v = match (given, q.default) {
-                (Some((_, text)), _) => {
-                    parse_int(text).ok_or_else(|| format!("{}=`{text}` is not a number (decimal or 0x hex)", q.name))?
-                }
+                (Some((_, text)), _) => parse_int(text).ok_or_else(|| PlanError::NotANumber {
+                    name: q.name.clone(),
+                    text: text.clone(),
+                })?,
                 (None, Some(d)) => d,
-                (None, None) => return Err(format!("`{}` needs {}=VALUE; {}", p.name, q.name, param_list(p))),
+                (None, None) => {
+                    return Err(PlanError::MissingParam {
+                        procedure: p.name.clone(),
+                        name: q.name.clone(),
+                        params: param_list(p),
+                    });
+                }
             };
             Ok((q.name.clone(), v))
         })
@@ -195,7 +216,7 @@ pub fn bind_params(p: &Procedure, args: &[(String, String)]) -> Result<Vec<(Stri
 
 /// Plans procedure `name` of node `node` with dictionary `dict` and parameters `args`:
 /// resolves every object, evaluates every expression and builds every frame, without IO.
-pub fn plan(dict: &Dictionary, node: u8, name: &str, args: &[(String, String)]) -> Result<RunPlan, String> {
+pub fn plan(dict: &Dictionary, node: u8, name: &str, args: &[(String, String)]) -> Result<RunPlan, PlanError> {
     let p = find(dict, node, name)?;
     let params = bind_params(p, args)?;
     let vars = |v: &str| {
@@ -207,7 +228,12 @@ pub fn plan(dict: &Dictionary, node: u8, name: &str, args: &[(String, String)]) 
     let n = p.steps.len();
     let mut steps = Vec::with_capacity(n);
     for (i, step) in p.steps.iter().enumerate() {
-        let at = |e: String| format!("`{name}` step {}/{n}: {e}", i + 1);
+        let at = |reason: String| PlanError::Step {
+            procedure: name.to_string(),
+            step: i + 1,
+            of: n,
+            reason,
+        };
         steps.push(plan_step(dict, node, step, &vars).map_err(at)?);
     }
     Ok(RunPlan {
@@ -243,10 +269,10 @@ fn plan_step(
             let ty = data_type.or_else(|| typed(index, sub)).ok_or(format!(
                 "the type of {index:04X}:{sub:02X} is unknown (give `type` in the profile)"
             ))?;
-            let data = encode(&v.to_string(), ty)?;
+            let data = encode(&v.to_string(), ty).map_err(|e| e.to_string())?;
             let shown = object_text(dict, index, sub, &ty.decode(&data), None);
             let text = format!("sdo write {} = {shown}", object_name(dict, index, sub));
-            let frame = candump(&download_initiate(node, index, sub, &data));
+            let frame = super::candump(&super::sdo::first_download_frame(node, index, sub, &data, false).0);
             PlannedStep {
                 action: Action::SdoWrite { index, sub, data },
                 text,
@@ -264,7 +290,7 @@ fn plan_step(
                 },
                 text: format!("sdo read {}", object_name(dict, index, sub)),
                 value: None,
-                frame: Some(candump(&upload_request(node, index, sub))),
+                frame: Some(super::candump(&super::sdo::first_upload_frame(node, index, sub, false))),
             }
         }
         Step::Nmt { command, node: to } => {
@@ -279,7 +305,7 @@ fn plan_step(
                 None => node,
             };
             let action = nmt_action(*command);
-            let f = Frame::classic(0x000, &[action.cs(), target]);
+            let f = super::nmt::frame(action, target);
             let whom = if target == 0 {
                 "all nodes".to_string()
             } else {
@@ -289,7 +315,7 @@ fn plan_step(
                 action: Action::Nmt { action, target },
                 text: format!("nmt {} to {whom}", nmt_word(*command)),
                 value: None,
-                frame: Some(candump(&f)),
+                frame: Some(super::candump(&f)),
             }
         }
         Step::Frame { id, data } => {
@@ -299,7 +325,7 @@ fn plan_step(
                 .filter(|i| *i <= 0x1FFF_FFFF)
                 .ok_or(format!("frame id {id} is not a CAN id"))?;
             let f = Frame::classic(id, &frame_bytes(data, vars)?);
-            let c = candump(&f);
+            let c = super::candump(&f);
             PlannedStep {
                 action: Action::Frame(f),
                 text: format!("frame {c}"),
@@ -345,7 +371,7 @@ fn plan_step(
                     fails_on
                 ),
                 value: Some(equals),
-                frame: Some(candump(&upload_request(node, index, sub))),
+                frame: Some(super::candump(&super::sdo::first_upload_frame(node, index, sub, false))),
             }
         }
         Step::Delay { ms } => PlannedStep {
@@ -357,27 +383,92 @@ fn plan_step(
     })
 }
 
-fn step_json(s: &PlannedStep, number: usize, result: Json) -> Json {
-    json!({
-        "step": number,
-        "kind": s.kind(),
-        "object": s.object(),
-        "value": s.value,
-        "frame": s.frame,
-        "text": s.text,
-        "result": result,
-    })
+/// What a step did, its `result` in the JSON of a run.
+#[derive(Serialize)]
+#[serde(untagged)]
+enum StepResult {
+    /// `"written"`, `"sent"`, `"done"`, `"not sent"`.
+    Word(&'static str),
+    /// An SDO read: the value, its meaning, the bytes.
+    Read { value: Json, text: String, data: String },
+    /// A wait reached: the value read, its meaning, after how long.
+    Reached { value: i64, text: String, after_ms: u64 },
+    /// The step that failed.
+    Failed { error: String },
 }
 
-fn plan_json(plan: &RunPlan, steps: Vec<Json>, ok: bool) -> Json {
-    let params: serde_json::Map<String, Json> = plan.params.iter().map(|(n, v)| (n.clone(), json!(v))).collect();
-    json!({
-        "ok": ok,
-        "procedure": plan.procedure,
-        "node": plan.node,
-        "params": params,
-        "steps": steps,
-    })
+/// One step in the JSON of a run.
+#[derive(Serialize)]
+struct StepJson<'a> {
+    step: usize,
+    kind: &'static str,
+    object: Option<String>,
+    value: Option<i64>,
+    frame: Option<&'a str>,
+    text: &'a str,
+    result: StepResult,
+}
+
+fn step_json(s: &PlannedStep, number: usize, result: StepResult) -> StepJson<'_> {
+    StepJson {
+        step: number,
+        kind: s.kind(),
+        object: s.object(),
+        value: s.value,
+        frame: s.frame.as_deref(),
+        text: &s.text,
+        result,
+    }
+}
+
+/// The JSON of a run (or dry run) of a procedure.
+#[derive(Serialize)]
+struct RunJson<'a> {
+    ok: bool,
+    procedure: &'a str,
+    node: u8,
+    /// Every parameter with the value used.
+    params: BTreeMap<&'a str, i64>,
+    steps: Vec<StepJson<'a>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    dry_run: Option<bool>,
+}
+
+fn plan_json<'a>(plan: &'a RunPlan, steps: Vec<StepJson<'a>>, ok: bool) -> RunJson<'a> {
+    RunJson {
+        ok,
+        procedure: &plan.procedure,
+        node: plan.node,
+        params: plan.params.iter().map(|(n, v)| (n.as_str(), *v)).collect(),
+        steps,
+        dry_run: None,
+    }
+}
+
+/// `run --list --json`.
+#[derive(Serialize)]
+struct ListJson<'a> {
+    ok: bool,
+    node: u8,
+    procedures: Vec<ProcedureJson<'a>>,
+}
+
+/// One procedure of a listing.
+#[derive(Serialize)]
+struct ProcedureJson<'a> {
+    name: &'a str,
+    description: Option<&'a str>,
+    steps: usize,
+    params: Vec<ParamJson<'a>>,
+}
+
+/// One parameter of a procedure.
+#[derive(Serialize)]
+struct ParamJson<'a> {
+    name: &'a str,
+    unit: Option<&'a str>,
+    description: Option<&'a str>,
+    default: Option<i64>,
 }
 
 /// The outcome of `--dry-run`: every step with its frame, `result` "not sent"; the text's
@@ -386,10 +477,12 @@ pub fn dry_run(plan: &RunPlan) -> (Json, String) {
     let n = plan.steps.len();
     let steps = (1..)
         .zip(&plan.steps)
-        .map(|(k, s)| step_json(s, k, json!("not sent")))
+        .map(|(k, s)| step_json(s, k, StepResult::Word("not sent")))
         .collect();
-    let mut v = plan_json(plan, steps, true);
-    v["dry_run"] = json!(true);
+    let v = super::to_json(&RunJson {
+        dry_run: Some(true),
+        ..plan_json(plan, steps, true)
+    });
     let mut lines = vec![format!(
         "dry run of `{}` on node {}: {n} steps, nothing sent",
         plan.procedure, plan.node
@@ -402,17 +495,22 @@ pub fn dry_run(plan: &RunPlan) -> (Json, String) {
 /// text's first line names them all).
 pub fn list(dict: &Dictionary, node: u8) -> (Json, String) {
     let procs = dict.procedures();
-    let items: Vec<Json> = procs
+    let items: Vec<ProcedureJson> = procs
         .iter()
-        .map(|p| {
-            json!({
-                "name": p.name,
-                "description": p.description,
-                "steps": p.steps.len(),
-                "params": p.params.iter().map(|q| json!({
-                    "name": q.name, "unit": q.unit, "description": q.description, "default": q.default,
-                })).collect::<Vec<_>>(),
-            })
+        .map(|p| ProcedureJson {
+            name: &p.name,
+            description: p.description.as_deref(),
+            steps: p.steps.len(),
+            params: p
+                .params
+                .iter()
+                .map(|q| ParamJson {
+                    name: &q.name,
+                    unit: q.unit.as_deref(),
+                    description: q.description.as_deref(),
+                    default: q.default,
+                })
+                .collect(),
         })
         .collect();
     let text = if procs.is_empty() {
@@ -434,7 +532,12 @@ pub fn list(dict: &Dictionary, node: u8) -> (Json, String) {
             .collect::<Vec<_>>()
             .join("\n")
     };
-    (json!({"ok": true, "node": node, "procedures": items}), text)
+    let json = super::to_json(&ListJson {
+        ok: true,
+        node,
+        procedures: items,
+    });
+    (json, text)
 }
 
 /// Runs `plan` on `bus` step by step (`dict` gives the meaning of values read): `progress`
@@ -472,18 +575,18 @@ pub async fn run(
             }
             Err(e) => {
                 progress(&format!("  -> failed: {e}"));
-                done.push(step_json(s, k, json!({"error": e.to_string()})));
+                done.push(step_json(s, k, StepResult::Failed { error: e.to_string() }));
                 return Err(CommandError::Step {
                     procedure: plan.procedure.clone(),
                     step: k,
                     of: n,
-                    report: Box::new(plan_json(plan, done, false)),
+                    report: Box::new(super::to_json(&plan_json(plan, done, false))),
                     cause: Box::new(e),
                 });
             }
         }
     }
-    Ok(plan_json(plan, done, true))
+    Ok(super::to_json(&plan_json(plan, done, true)))
 }
 
 /// Runs one step; gives its `result` JSON and text.
@@ -495,31 +598,35 @@ async fn run_step(
     (k, n): (usize, usize),
     timeout_ms: u64,
     mode: Option<i8>,
-) -> Result<(Json, String), CommandError> {
+) -> Result<(StepResult, String), CommandError> {
     Ok(match &s.action {
         Action::SdoWrite { index, sub, data } => {
             super::sdo::download(bus, node, *index, *sub, data.clone(), false, timeout_ms).await?;
-            (json!("written"), format!("written ({})", hex::upper(data)))
+            (StepResult::Word("written"), format!("written ({})", hex::upper(data)))
         }
         Action::SdoRead { index, sub, ty } => {
             let data = super::sdo::upload(bus, node, *index, *sub, false, timeout_ms).await?;
             let text = read_text(dict, *index, *sub, *ty, &data, mode);
             (
-                json!({"value": decode(&data, *ty).to_json(), "text": text, "data": hex::upper(&data)}),
+                StepResult::Read {
+                    value: decode(&data, *ty).to_json(),
+                    text: text.clone(),
+                    data: hex::upper(&data),
+                },
                 text,
             )
         }
         Action::Nmt { action, target } => {
             super::nmt::nmt(bus, *action, *target, false, 0).await?;
-            (json!("sent"), "sent".into())
+            (StepResult::Word("sent"), "sent".into())
         }
         Action::Frame(f) => {
             bus.send(f).await?;
-            (json!("sent"), "sent".into())
+            (StepResult::Word("sent"), "sent".into())
         }
         Action::Delay { ms } => {
             tokio::time::sleep(Duration::from_millis(u64::from(*ms))).await;
-            (json!("done"), format!("waited {ms} ms"))
+            (StepResult::Word("done"), format!("waited {ms} ms"))
         }
         Action::Wait {
             index,
@@ -546,9 +653,13 @@ async fn run_step(
                     });
                 }
                 if v & mask == *equals {
-                    let ms = start.elapsed().as_millis();
+                    let ms = u64::try_from(start.elapsed().as_millis()).unwrap_or(u64::MAX);
                     return Ok((
-                        json!({"value": v, "text": text, "after_ms": ms}),
+                        StepResult::Reached {
+                            value: v,
+                            text: text.clone(),
+                            after_ms: ms,
+                        },
                         format!("{text} after {ms} ms"),
                     ));
                 }

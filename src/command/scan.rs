@@ -52,21 +52,38 @@ impl NodeInfo {
     /// The `--json` object of the node.
     pub fn to_json(&self) -> serde_json::Value {
         let hex = |v: Option<u32>| v.map(|x| format!("0x{x:08X}"));
-        serde_json::json!({
-            "node": self.node,
-            "nmt": self.nmt.map(|s| s.as_str()),
-            "device_type": hex(self.device_type),
-            "device_profile": self.device_profile(),
-            "vendor_id": hex(self.identity[0]),
-            "product_code": hex(self.identity[1]),
-            "revision": hex(self.identity[2]),
-            "serial": hex(self.identity[3]),
-            "device_name": self.device_name,
-            "software_version": self.software_version,
-            "profile": self.profile,
-            "sdo_error": self.sdo_error,
+        super::to_json(&NodeJson {
+            node: self.node,
+            nmt: self.nmt.map(|s| s.as_str()),
+            device_type: hex(self.device_type),
+            device_profile: self.device_profile(),
+            vendor_id: hex(self.identity[0]),
+            product_code: hex(self.identity[1]),
+            revision: hex(self.identity[2]),
+            serial: hex(self.identity[3]),
+            device_name: self.device_name.as_deref(),
+            software_version: self.software_version.as_deref(),
+            profile: self.profile.as_deref(),
+            sdo_error: self.sdo_error.as_deref(),
         })
     }
+}
+
+/// One node of `scan --json`.
+#[derive(serde::Serialize)]
+struct NodeJson<'a> {
+    node: u8,
+    nmt: Option<&'static str>,
+    device_type: Option<String>,
+    device_profile: Option<u16>,
+    vendor_id: Option<String>,
+    product_code: Option<String>,
+    revision: Option<String>,
+    serial: Option<String>,
+    device_name: Option<&'a str>,
+    software_version: Option<&'a str>,
+    profile: Option<&'a str>,
+    sdo_error: Option<&'a str>,
 }
 
 /// Listens `listen_ms` for heartbeats and boot-ups (and, with `probe`, also asks every silent

@@ -99,6 +99,41 @@ pub async fn download_within(
     }
 }
 
+/// The first frame an SDO read of (index, sub) of `node` sends: the one the client itself
+/// starts the transfer with (initiate upload, or block upload initiate with `block`).
+pub fn first_upload_frame(node: u8, index: u16, sub: u8, block: bool) -> Frame {
+    let mut client = SdoClient::new(ClientConfig::default());
+    let first = client.upload(index, sub, mode(block), 0).unwrap_or_default();
+    request_frame(node, &first)
+}
+
+/// The first frame an SDO write of `data` to (index, sub) of `node` sends (expedited up to
+/// 4 bytes, segmented initiate above, block download initiate with `block`), built by the
+/// client itself; with what follows it, when more follows.
+pub fn first_download_frame(node: u8, index: u16, sub: u8, data: &[u8], block: bool) -> (Frame, Option<String>) {
+    let mut client = SdoClient::new(ClientConfig::default());
+    let first = client
+        .download(index, sub, data.to_vec(), mode(block), 0)
+        .unwrap_or_default();
+    let segments = data.len().div_ceil(7).max(1);
+    let then = if block {
+        Some(format!(
+            "then {segments} block segments ({} bytes) and the block end",
+            data.len()
+        ))
+    } else if data.len() > 4 || data.is_empty() {
+        Some(format!("then {segments} segments"))
+    } else {
+        None
+    };
+    (request_frame(node, &first), then)
+}
+
+/// A request of the client to `node`'s server (COB-ID 0x600 + node).
+fn request_frame(node: u8, payload: &[u8; 8]) -> Frame {
+    Frame::classic(0x600 + u32::from(node), payload)
+}
+
 fn config(timing: Timing) -> ClientConfig {
     ClientConfig {
         timeout_ns: timing.timeout_ms.saturating_mul(1_000_000),

@@ -12,7 +12,8 @@ use super::sdo::upload;
 use crate::bus::{Bus, BusError};
 use crate::decode::cia402::DriveState;
 use crate::frame::{Direction, Frame};
-use serde_json::{Value as Json, json};
+use serde::Serialize;
+use serde_json::Value as Json;
 use std::collections::{BTreeMap, BTreeSet};
 use std::time::Duration;
 use tokio::task::JoinSet;
@@ -123,11 +124,18 @@ impl StopReport {
     }
     /// The `--json` object.
     pub fn to_json(&self) -> Json {
-        json!({
-            "ok": self.all_stopped(),
-            "nodes": self.nodes.iter().map(NodeStop::to_json).collect::<Vec<_>>(),
-            "idle": self.idle.iter().map(|(n, s)| json!({"node": n, "state": s.as_str()})).collect::<Vec<_>>(),
-            "cancelled": self.cancelled,
+        super::to_json(&StopJson {
+            ok: self.all_stopped(),
+            nodes: self.nodes.iter().map(NodeStop::to_json).collect(),
+            idle: self
+                .idle
+                .iter()
+                .map(|(n, s)| IdleJson {
+                    node: *n,
+                    state: s.as_str(),
+                })
+                .collect(),
+            cancelled: &self.cancelled,
         })
     }
     /// The text: a summary line, then one line per node.
@@ -164,6 +172,31 @@ impl StopReport {
     }
 }
 
+/// `stop --json`.
+#[derive(Serialize)]
+struct StopJson<'a> {
+    ok: bool,
+    nodes: Vec<Json>,
+    idle: Vec<IdleJson>,
+    cancelled: &'a [String],
+}
+
+/// A CiA 402 node a stop left alone (not powered).
+#[derive(Serialize)]
+struct IdleJson {
+    node: u8,
+    state: &'static str,
+}
+
+/// `stop --json` on a listen-only handle.
+#[derive(Serialize)]
+struct ListenOnlyJson<'a> {
+    ok: bool,
+    listen_only: bool,
+    nodes: [u8; 0],
+    message: &'a str,
+}
+
 /// Stops `nodes`, all at once; the report lists them in node order.
 pub async fn stop_nodes(bus: &Bus, nodes: &BTreeSet<u8>, opts: StopOptions) -> Result<StopReport, CommandError> {
     if bus.is_listen_only() {
@@ -197,7 +230,12 @@ fn listen_only(nodes: &BTreeSet<u8>) -> CommandError {
         }
     );
     CommandError::NotStopped {
-        report: Box::new(json!({"ok": false, "listen_only": true, "nodes": [], "message": text})),
+        report: Box::new(super::to_json(&ListenOnlyJson {
+            ok: false,
+            listen_only: true,
+            nodes: [],
+            message: &text,
+        })),
         text,
     }
 }

@@ -4,7 +4,7 @@
 use super::keymap::{Action, Key, Keymap, Lookup};
 use super::live::{Request, Requests};
 use super::messages::{Level, Messages};
-use super::palette::{self, COMMANDER_WORDS, Planned};
+use super::palette::{self, Planned, commander_words};
 use super::prompt::{Prompt, PromptKind};
 use super::rows::{Row, RowCache};
 use super::source::{Control, Feed};
@@ -518,8 +518,17 @@ impl App {
             KeyCode::Up => p.history(&self.history, true),
             KeyCode::Down => p.history(&self.history, false),
             KeyCode::Tab if p.kind == PromptKind::Palette => {
-                let words: Vec<&str> = PALETTE_COMMANDS.iter().chain(COMMANDER_WORDS).copied().collect();
-                let shown = p.complete(&words);
+                let before: String = p.text.chars().take(p.cursor).collect();
+                let words: Vec<String> = if before.contains(' ') {
+                    crate::command::syntax::completions(&before)
+                } else {
+                    PALETTE_COMMANDS
+                        .iter()
+                        .chain(commander_words())
+                        .map(|w| w.to_string())
+                        .collect()
+                };
+                let shown = p.complete(&words.iter().map(String::as_str).collect::<Vec<_>>());
                 if !shown.is_empty() {
                     self.message = Some(shown.join("  "));
                 }
@@ -532,10 +541,10 @@ impl App {
     fn preview(&mut self) {
         let Some(p) = &self.prompt else { return };
         let first = p.text.split_whitespace().next().unwrap_or("");
-        if p.kind == PromptKind::Palette && COMMANDER_WORDS.contains(&first) {
+        if p.kind == PromptKind::Palette && commander_words().contains(&first) {
             self.message = Some(match palette::plan(&p.text, &self.bindings, |n| self.drive_state(n)) {
                 Ok(pl) => format!("will send: {}", pl.preview),
-                Err(e) => e,
+                Err(e) => e.to_string(),
             });
         }
     }
@@ -554,7 +563,7 @@ impl App {
                 }
                 None => self.send(p),
             },
-            Err(e) => self.message = Some(e),
+            Err(e) => self.message = Some(e.to_string()),
         }
     }
 
@@ -744,14 +753,14 @@ impl App {
                 }
                 return;
             }
-            w if COMMANDER_WORDS.contains(&w) => {
+            w if commander_words().contains(&w) => {
                 self.commander(line);
                 return;
             }
             other => Err(format!(
                 "unknown command `{other}` (commands: {} {})",
                 PALETTE_COMMANDS.join(" "),
-                COMMANDER_WORDS.join(" ")
+                commander_words().join(" ")
             )),
         };
         self.message = match result {

@@ -13,7 +13,6 @@ use crate::frame::Frame;
 use crate::od::bind::Bindings;
 use std::collections::BTreeSet;
 use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
-use std::sync::{Arc, Mutex};
 use std::time::Duration;
 use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
 use tokio::task::AbortHandle;
@@ -83,7 +82,9 @@ async fn capture(
     if tx.send(Feed::Interfaces(vec![iface.clone()])).is_err() {
         return;
     }
-    let mut jobs = Jobs::default();
+    // Nodes a stop confirmed stopped, from the stop task back to this loop.
+    let (stopped_tx, mut stopped) = unbounded_channel();
+    let mut jobs = Jobs::new(stopped_tx);
     let bus = loop {
         match crate::connect::open(&iface, listen_only).await {
             Ok(b) => break b,
@@ -162,6 +163,7 @@ async fn capture(
                 Some(r) => jobs.start(&bus, r, &bindings, &tx),
                 None => return,
             },
+            Some(nodes) = stopped.recv() => jobs.stopped(&nodes),
         }
     }
 }
@@ -184,21 +186,34 @@ fn state_feed(iface: &str, s: &StateChange, stopped_at: &mut Option<u64>) -> Fee
     }
 }
 
-/// The commands the live task runs for the palette, and the nodes cotui commanded.
-#[derive(Default)]
+/// The commands the live task runs for the palette, and the nodes cotui commanded. Owned
+/// by the capture loop: it sees every frame first, so no lock is taken per frame.
 struct Jobs {
     /// Running commands (the palette line and its task), cancelled by stop-all.
     running: Vec<(String, AbortHandle)>,
     /// Nodes cotui commanded, from the frames it sent; a confirmed stop forgets a node.
-    commanded: Arc<Mutex<Commanded>>,
+    commanded: Commanded,
+    /// Where a stop task sends the nodes it confirmed stopped (see [`Jobs::stopped`]).
+    stopped_tx: UnboundedSender<Vec<u8>>,
 }
 
 impl Jobs {
-    /// Notes a frame on the bus (ours, marked TX, may command a node).
-    fn observe(&self, f: &Frame) {
-        if let Ok(mut c) = self.commanded.lock() {
-            c.observe(f);
+    fn new(stopped_tx: UnboundedSender<Vec<u8>>) -> Jobs {
+        Jobs {
+            running: Vec::new(),
+            commanded: Commanded::default(),
+            stopped_tx,
         }
+    }
+
+    /// Notes a frame on the bus (ours, marked TX, may command a node).
+    fn observe(&mut self, f: &Frame) {
+        self.commanded.observe(f);
+    }
+
+    /// Forgets the nodes a stop confirmed stopped.
+    fn stopped(&mut self, nodes: &[u8]) {
+        nodes.iter().for_each(|n| self.commanded.forget(*n));
     }
 
     /// Starts a request on `bus`; its result goes to `tx` when it ends.
@@ -222,17 +237,14 @@ impl Jobs {
                 // Cancel first: on this single-threaded runtime no cancelled task runs again,
                 // so nothing it would have sent goes out after the stop.
                 let cancelled = self.cancel_all();
-                let commanded = self.commanded.clone();
-                if let Ok(c) = commanded.lock() {
-                    nodes.extend(c.nodes());
-                }
+                nodes.extend(self.commanded.nodes());
+                let stopped_tx = self.stopped_tx.clone();
                 tokio::spawn(async move {
                     let (level, text) = match stop_nodes(&bus, &nodes, options).await {
                         Ok(mut report) => {
                             report.cancelled = cancelled;
-                            if let Ok(mut c) = commanded.lock() {
-                                report.nodes.iter().filter(|n| n.stopped).for_each(|n| c.forget(n.node));
-                            }
+                            let _ =
+                                stopped_tx.send(report.nodes.iter().filter(|n| n.stopped).map(|n| n.node).collect());
                             let level = if report.all_stopped() { Level::Info } else { Level::Warn };
                             (level, format!("stop all: {}", report.text()))
                         }

@@ -1,16 +1,20 @@
-//! What a commander line in the palette will do before it is sent: the exact frames, and
-//! whether it needs confirming (broadcast NMT, resets, node 0).
+//! What a commander line in the palette will do before it is sent: the exact frames, as
+//! the protocol layer builds them (the SDO client's first frame, the NMT frame, the CiA 402
+//! controlwords), and whether it needs confirming (broadcast NMT, resets, node 0).
 
 use super::live::UNKNOWN_STATE;
 use crate::command::run::Action;
-use crate::command::{Command, DriveAction, NmtAction, RunSpec, parse_command};
+use crate::command::{Command, CommandError, NmtAction, RunSpec, candump, drive, nmt, parse_command, sdo};
 use crate::decode::cia402::DriveState;
-use crate::frame::hex;
+use crate::frame::Frame;
 use crate::od::alias::resolve_object;
 use crate::od::bind::Bindings;
 
-/// The first words of commander lines.
-pub const COMMANDER_WORDS: &[&str] = &["nmt", "sdo", "drive", "run", "scan", "stop"];
+/// The first words of commander lines, from the command declaration.
+pub fn commander_words() -> &'static [&'static str] {
+    static WORDS: std::sync::OnceLock<Vec<&'static str>> = std::sync::OnceLock::new();
+    WORDS.get_or_init(crate::command::syntax::commander_words)
+}
 
 /// A parsed commander line with its preview.
 #[derive(Clone, Debug, PartialEq)]
@@ -25,36 +29,25 @@ pub struct Planned {
     pub confirm: Option<String>,
 }
 
-fn candump(id: u32, data: &[u8]) -> String {
-    format!("{id:03X}#{}", hex::upper(data))
-}
-
-fn sdo_initiate(node: u8, index: u16, sub: u8, data: &[u8]) -> String {
-    let [lo, hi] = index.to_le_bytes();
-    if data.len() <= 4 {
-        let cmd = 0x23 | (((4 - data.len()) as u8) << 2);
-        let mut b = vec![cmd, lo, hi, sub];
-        b.extend_from_slice(data);
-        b.resize(8, 0);
-        candump(0x600 + node as u32, &b)
-    } else {
-        let size = (data.len() as u32).to_le_bytes();
-        let b = [0x21, lo, hi, sub, size[0], size[1], size[2], size[3]];
-        format!(
-            "{} then {} segments",
-            candump(0x600 + node as u32, &b),
-            data.len().div_ceil(7)
-        )
-    }
+/// A list of frames, candump style.
+fn listed(frames: &[Frame]) -> String {
+    frames.iter().map(candump).collect::<Vec<_>>().join(", ")
 }
 
 /// Plans a commander line; `bindings` give object names and types, `state` a node's known
 /// CiA 402 state for drive previews.
-pub fn plan(line: &str, bindings: &Bindings, state: impl Fn(u8) -> Option<DriveState>) -> Result<Planned, String> {
+pub fn plan(
+    line: &str,
+    bindings: &Bindings,
+    state: impl Fn(u8) -> Option<DriveState>,
+) -> Result<Planned, CommandError> {
     let command = parse_command(line)?;
+    let object = |node: u8, object: &str| {
+        resolve_object(bindings.dictionary(node), object).map_err(|e| CommandError::Usage(e.to_string()))
+    };
     let (preview, confirm) = match &command {
         Command::Nmt { action, node, .. } => {
-            let f = candump(0x000, &[action.cs(), *node]);
+            let f = candump(&nmt::frame(*action, *node));
             let reset = matches!(action, NmtAction::ResetNode | NmtAction::ResetComm);
             let confirm = match (*node, reset) {
                 (0, _) => Some(format!("broadcast NMT {} to every node", action.as_str())),
@@ -63,47 +56,50 @@ pub fn plan(line: &str, bindings: &Bindings, state: impl Fn(u8) -> Option<DriveS
             };
             (f, confirm)
         }
-        Command::SdoRead { node, object, .. } => {
-            let (i, s) = resolve_object(bindings.dictionary(*node), object)?;
-            let [lo, hi] = i.to_le_bytes();
-            (candump(0x600 + *node as u32, &[0x40, lo, hi, s, 0, 0, 0, 0]), None)
+        Command::SdoRead {
+            node,
+            object: o,
+            options,
+            ..
+        } => {
+            let (i, s) = object(*node, o)?;
+            let first = candump(&sdo::first_upload_frame(*node, i, s, options.block));
+            let text = if options.block {
+                format!("{first} then the server's block segments")
+            } else {
+                first
+            };
+            (text, None)
         }
         Command::SdoWrite {
             node,
-            object,
+            object: o,
             value,
             options,
         } => {
             let dict = bindings.dictionary(*node);
-            let (i, s) = resolve_object(dict, object)?;
-            let data =
-                crate::command::exec::write_data(dict, i, s, value, options.data_type).map_err(|e| e.to_string())?;
-            (sdo_initiate(*node, i, s, &data), None)
+            let (i, s) = object(*node, o)?;
+            let data = crate::command::exec::write_data(dict, i, s, value, options.data_type)?;
+            let (first, then) = sdo::first_download_frame(*node, i, s, &data, options.block);
+            let text = match then {
+                Some(t) => format!("{} {t}", candump(&first)),
+                None => candump(&first),
+            };
+            (text, None)
         }
         Command::Drive { node, action, .. } => {
             let st = state(*node);
-            let steps = match action {
-                DriveAction::Status => Vec::new(),
-                DriveAction::Mode(_) => Vec::new(),
-                a => crate::command::drive::plan(*a, st.unwrap_or(UNKNOWN_STATE)),
-            };
-            let frames: Vec<String> = steps
-                .iter()
-                .map(|s| sdo_initiate(*node, 0x6040, 0, &s.controlword.to_le_bytes()))
-                .collect();
+            let frames = drive::frames(*node, *action, st.unwrap_or(UNKNOWN_STATE));
             let from = st
                 .map(|s| s.text())
                 .unwrap_or("state unknown, assumed Switch on disabled");
             let text = match action {
-                DriveAction::Status => format!("reads 0x6041 of node {node}"),
-                DriveAction::Mode(m) => {
-                    format!(
-                        "{} (0x6060 = {m}), then reads 0x6061",
-                        sdo_initiate(*node, 0x6060, 0, &[*m as u8])
-                    )
+                crate::command::DriveAction::Status => format!("reads 0x6041 of node {node}"),
+                crate::command::DriveAction::Mode(m) => {
+                    format!("{} (0x6060 = {m}), then reads 0x6061", listed(&frames))
                 }
                 _ if frames.is_empty() => format!("nothing to send (node {node}: {from})"),
-                _ => format!("{} (from {from})", frames.join(", ")),
+                _ => format!("{} (from {from})", listed(&frames)),
             };
             (text, None)
         }
@@ -137,23 +133,36 @@ pub fn plan(line: &str, bindings: &Bindings, state: impl Fn(u8) -> Option<DriveS
                 (steps.join(", "), confirm)
             }
         }
-        Command::Stop { nodes, .. } => (
-            format!(
-                "cancels running commands, then 6xx#2B40600002000000 (quick stop) and 6xx#2B40600000000000 \
-                 (disable voltage) to {}",
-                if nodes.is_empty() {
-                    "every drive cotui commanded or sees powered".to_string()
-                } else {
-                    format!(
-                        "nodes {}",
-                        nodes.iter().map(u8::to_string).collect::<Vec<_>>().join(", ")
-                    )
-                }
-            ),
-            None,
-        ),
+        Command::Stop { nodes, .. } => {
+            let words = |cws: &[u16]| {
+                cws.iter()
+                    .map(|c| format!("0x{c:04X}"))
+                    .collect::<Vec<_>>()
+                    .join(" then ")
+            };
+            let frames: Vec<Frame> = nodes
+                .iter()
+                .flat_map(|n| drive::STOP_CONTROLWORDS.map(|cw| drive::controlword_frame(*n, cw)))
+                .collect();
+            let text = if nodes.is_empty() {
+                format!(
+                    "cancels running commands, then controlwords {} (quick stop, disable voltage) to every \
+                     drive cotui commanded or sees powered",
+                    words(&drive::STOP_CONTROLWORDS)
+                )
+            } else {
+                format!(
+                    "cancels running commands, then {} (quick stop, then disable voltage, per node), also to \
+                     every drive cotui commanded or sees powered",
+                    listed(&frames)
+                )
+            };
+            (text, None)
+        }
         Command::Record { .. } => {
-            return Err("record runs from the command line (`cotui record IFACE -o FILE`)".into());
+            return Err(CommandError::Usage(
+                "record runs from the command line (`cotui record IFACE -o FILE`)".into(),
+            ));
         }
     };
     Ok(Planned {
@@ -192,6 +201,30 @@ mod tests {
     }
 
     #[test]
+    fn block_and_segmented_previews_say_what_follows() {
+        let preview = |line: &str| plan(line, &b(), |_| None).unwrap().preview;
+        // Block download initiate (client command 6, CRC and size indicated), not the expedited write.
+        assert_eq!(
+            preview("sdo write 2 0x6060 3 --type i8 --block"),
+            "602#C660600001000000 then 1 block segments (1 bytes) and the block end"
+        );
+        assert_eq!(
+            preview("sdo write 2 0x1008 \"drive one\" --type string"),
+            "602#2108100009000000 then 2 segments"
+        );
+        assert_eq!(
+            preview("sdo read 2 0x1008 --block"),
+            "602#A40810007F000000 then the server's block segments"
+        );
+        assert_eq!(
+            preview("stop 2 3"),
+            "cancels running commands, then 602#2B40600002000000, 602#2B40600000000000, 603#2B40600002000000, \
+             603#2B40600000000000 (quick stop, then disable voltage, per node), also to every drive cotui \
+             commanded or sees powered"
+        );
+    }
+
+    #[test]
     fn run_previews_every_step_frame() {
         let read = |p: &std::path::Path| std::fs::read(p);
         let b = Bindings::from_args(&["2=syntron-ds".to_string()], &[], &read).unwrap();
@@ -210,11 +243,13 @@ mod tests {
         assert!(
             plan("run 2 pv rpm=3", &b, |_| None)
                 .unwrap_err()
+                .to_string()
                 .contains("no parameter `rpm`")
         );
         assert!(
             plan("run 2 fly", &b, |_| None)
                 .unwrap_err()
+                .to_string()
                 .contains("its procedures: ")
         );
     }

@@ -5,6 +5,7 @@
 mod cli_bitrate;
 mod cli_commander;
 mod cli_run;
+mod command_language;
 mod commander_demo;
 mod procedure_run;
 mod sdo_client_misbehave;

@@ -163,7 +163,7 @@ fn a_required_parameter_must_be_given() {
     let b = bindings();
     let dict = b.dictionary(2);
     assert_eq!(
-        plan(dict, 2, "velocity", &[]).unwrap_err(),
+        plan(dict, 2, "velocity", &[]).unwrap_err().to_string(),
         "`velocity` needs speed=VALUE; its parameters: speed=(required), accel=100"
     );
     let p = plan(dict, 2, "velocity", &[("speed".into(), "-1".into())]).unwrap();

@@ -1,0 +1,716 @@
+//! The commander's command language, declared once. Each command (nmt, sdo read/write,
+//! drive, run, scan, record, stop) is a clap declaration here: its words, flags, help text,
+//! checks and completion. The command line parses [`Commander`] with its bus options in
+//! front (`cotui sdo read IFACE 2 0x6041`, see `crate::cli`); the TUI palette parses the same
+//! declaration with nothing in front ([`parse_command`]: `sdo read 2 0x6041`, split like a
+//! shell line). So both accept the same lines and refuse the same ones with the same error:
+//! unknown flags, extra words, missing words, bad numbers.
+
+use super::grammar::{
+    Command, DEFAULT_TIMEOUT_MS, DriveAction, NMT_WAIT_MS, NmtAction, SCAN_LISTEN_MS, SCAN_TIMEOUT_MS, SdoOptions,
+    parse_int, parse_node, parse_type, run_spec,
+};
+use super::record::{Limits, LogFormat, WriteMode};
+use super::stop::{DEFAULT_LISTEN_MS, DEFAULT_RAMP_MS, StopOptions};
+use crate::od::DataType;
+use clap::builder::{PossibleValue, TypedValueParser};
+use clap::error::ErrorKind;
+use clap::{Args, CommandFactory, Parser, Subcommand};
+use std::sync::OnceLock;
+
+/// Why a command line is not a command.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ParseError {
+    /// A palette line with an unbalanced quote.
+    #[error("unterminated quote")]
+    Quote,
+    /// An empty palette line.
+    #[error("empty command; commands: {}", commander_words().join(", "))]
+    Empty,
+    /// The declaration refused the words: an unknown flag, an extra or missing word, a bad
+    /// value. `message` is clap's error line (with its tips), `usage` the command's usage.
+    #[error("{message}")]
+    Rejected { message: String, usage: String },
+    /// `--help`: the help text.
+    #[error("{0}")]
+    Help(String),
+    /// Words the declaration accepts that do not make a command (e.g. a MODE after
+    /// `drive N enable`, a parameter before the procedure).
+    #[error("{0}")]
+    Invalid(String),
+}
+
+impl From<clap::Error> for ParseError {
+    fn from(e: clap::Error) -> Self {
+        let text = e.render().to_string();
+        if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+            return ParseError::Help(text.trim_end().to_string());
+        }
+        let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
+        let first = lines.next().unwrap_or("");
+        let mut message = first.strip_prefix("error: ").unwrap_or(first).to_string();
+        let mut usage = String::new();
+        for l in lines {
+            if let Some(u) = l.strip_prefix("Usage: ") {
+                usage = u.to_string();
+            } else if l.starts_with("For more information") {
+                break;
+            } else if l.starts_with("tip: to pass") {
+                // `-- --flag`: no line of ours takes a value that starts with `-`.
+            } else if usage.is_empty() {
+                // The arguments missing, the tips: part of the message.
+                message.push_str(if l.starts_with("tip: ") { "; " } else { " " });
+                message.push_str(l);
+            }
+        }
+        ParseError::Rejected { message, usage }
+    }
+}
+
+/// Nothing: what a palette line has where the command line has its bus options (IFACE,
+/// `--listen-only`, `--json`) and dictionary options (`--profile`, `--eds`). The palette
+/// runs on the session's bus with the session's dictionaries.
+#[derive(Args, Clone, Debug, Default, PartialEq, Eq)]
+#[group(skip)]
+pub struct Session {}
+
+/// A command's own arguments `A` after the options `B` every command takes where it is
+/// parsed (the command line's IFACE and flags; nothing in the palette).
+#[derive(Args, Clone, Debug)]
+#[group(skip)]
+pub struct On<B: Args, A: Args> {
+    #[command(flatten)]
+    pub bus: B,
+    #[command(flatten)]
+    pub args: A,
+}
+
+/// The commander commands. `B`: the options in front of every command (see [`Session`]),
+/// `D`: the dictionary options of the commands that name objects (`sdo`, `run`).
+#[derive(Subcommand, Clone, Debug)]
+pub enum Commander<B: Args, D: Args> {
+    /// Send an NMT command to a node (0 = all): start, stop, preop, reset-node, reset-comm.
+    Nmt(On<B, NmtArgs>),
+    /// Read or write an object by SDO.
+    #[command(subcommand)]
+    Sdo(SdoCommand<B, D>),
+    /// CiA 402 drive: enable, disable, quick-stop, fault-reset, status, or mode MODE.
+    Drive(On<B, DriveArgs>),
+    /// Run a profile's procedure step by step (NAME=VALUE parameters); without PROCEDURE (or
+    /// with --list), list the node's procedures.
+    Run(On<B, RunArgs<D>>),
+    /// List the nodes on the bus with their identity.
+    Scan(On<B, ScanArgs>),
+    /// Record the bus to a candump -l log (or pcapng).
+    Record(On<B, RecordArgs>),
+    /// Emergency stop: quick stop, then disable voltage, on every CiA 402 drive found powered
+    /// (or the nodes named); reads each statusword back. Exit 0 only when all are confirmed.
+    Stop(On<B, StopArgs>),
+}
+
+/// `sdo read` and `sdo write`.
+#[derive(Subcommand, Clone, Debug)]
+pub enum SdoCommand<B: Args, D: Args> {
+    /// Read an object: `sdo read 2 0x6041`.
+    Read(On<B, SdoReadArgs<D>>),
+    /// Write an object: `sdo write 2 0x6060 3 --type i8`.
+    Write(On<B, SdoWriteArgs<D>>),
+}
+
+/// `nmt ACTION NODE [--wait] [--timeout MS]`.
+#[derive(Args, Clone, Debug)]
+pub struct NmtArgs {
+    /// start, stop, preop, reset-node or reset-comm.
+    #[arg(value_parser = Words::new(NMT_WORDS, NmtAction::parse))]
+    pub action: NmtAction,
+    /// Node id 1..127, or 0 for all nodes.
+    #[arg(value_parser = node_or_all_arg)]
+    pub node: u8,
+    /// Wait for the heartbeat (or boot-up after a reset) that confirms the command.
+    #[arg(long)]
+    pub wait: bool,
+    /// How long --wait waits, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = NMT_WAIT_MS)]
+    pub timeout: u64,
+}
+
+/// What `sdo read` and `sdo write` share.
+#[derive(Args, Clone, Debug)]
+pub struct Transfer<D: Args> {
+    /// Node id 1..127 (decimal or 0x hex).
+    #[arg(value_parser = node_arg)]
+    pub node: u8,
+    /// Object: 0x6041, 0x1018:1, or an object name from the node's profile.
+    pub object: String,
+    /// Value type: u8..u64, i8..i64, f32, f64, bool, string, octets (hex), domain (a file).
+    #[arg(long = "type", short = 't', value_parser = Words::new(TYPE_WORDS, parse_type))]
+    pub data_type: Option<DataType>,
+    /// Force a block transfer.
+    #[arg(long)]
+    pub block: bool,
+    /// How long to wait for each server response, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
+    pub timeout: u64,
+    /// How long the whole transfer may take, in ms [default: the longer of 10 s and 10
+    /// timeouts, plus 1 ms per byte of the size written or announced by the server].
+    #[arg(long, value_parser = ms_arg)]
+    pub deadline: Option<u64>,
+    #[command(flatten)]
+    pub dict: D,
+}
+
+impl<D: Args> Transfer<D> {
+    fn options(&self) -> SdoOptions {
+        SdoOptions {
+            data_type: self.data_type,
+            block: self.block,
+            timeout_ms: self.timeout,
+            deadline_ms: self.deadline,
+        }
+    }
+}
+
+/// `sdo read NODE OBJECT [-o FILE] [transfer options]`.
+#[derive(Args, Clone, Debug)]
+pub struct SdoReadArgs<D: Args> {
+    #[command(flatten)]
+    pub t: Transfer<D>,
+    /// Write the data read to this file (for domains).
+    #[arg(long = "output", short = 'o')]
+    pub output: Option<String>,
+}
+
+/// `sdo write NODE OBJECT VALUE [transfer options]`.
+#[derive(Args, Clone, Debug)]
+pub struct SdoWriteArgs<D: Args> {
+    #[command(flatten)]
+    pub t: Transfer<D>,
+    /// The value (a file path for `--type domain`, hex bytes for `--type octets`); negative numbers need no `--`.
+    #[arg(allow_negative_numbers = true)]
+    pub value: String,
+}
+
+/// `drive NODE ACTION [MODE] [--timeout MS]`.
+#[derive(Args, Clone, Debug)]
+pub struct DriveArgs {
+    /// Node id 1..127 (decimal or 0x hex).
+    #[arg(value_parser = node_arg)]
+    pub node: u8,
+    /// enable, disable, quick-stop, fault-reset, status, or mode.
+    #[arg(value_parser = Words::new(DRIVE_WORDS, drive_word))]
+    pub action: String,
+    /// The mode for `mode`: pp, pv, pt, hm, ip, csp, csv, cst or a number.
+    #[arg(allow_negative_numbers = true)]
+    pub mode: Option<String>,
+    /// How long to wait for each SDO answer, and half of how long each step may take, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
+    pub timeout: u64,
+}
+
+/// `run NODE [PROCEDURE] [NAME=VALUE ...] [--list] [--dry-run] [--timeout MS]`.
+#[derive(Args, Clone, Debug)]
+pub struct RunArgs<D: Args> {
+    /// Node id 1..127 (decimal or 0x hex).
+    #[arg(value_parser = node_arg)]
+    pub node: u8,
+    /// The procedure (e.g. `pv`), then its parameters as NAME=VALUE; none: list the procedures.
+    pub words: Vec<String>,
+    /// List the node's procedures with their descriptions and parameters.
+    #[arg(long)]
+    pub list: bool,
+    /// Print the steps and their frames without sending anything.
+    #[arg(long)]
+    pub dry_run: bool,
+    /// How long to wait for each SDO answer, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
+    pub timeout: u64,
+    #[command(flatten)]
+    pub dict: D,
+}
+
+/// `scan [--listen MS] [--probe] [--timeout MS]`.
+#[derive(Args, Clone, Debug)]
+pub struct ScanArgs {
+    /// How long to listen for heartbeats and boot-ups, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = SCAN_LISTEN_MS)]
+    pub listen: u64,
+    /// Also ask every node 1..127 for 0x1000 (finds nodes without heartbeat).
+    #[arg(long)]
+    pub probe: bool,
+    /// How long to wait for each SDO answer, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = SCAN_TIMEOUT_MS)]
+    pub timeout: u64,
+}
+
+/// `record -o FILE [--count N] [--duration MS] [--force | --append] [--format F]`.
+#[derive(Args, Clone, Debug)]
+pub struct RecordArgs {
+    /// The log file to write (candump -l format; `-` for stdout). An existing file is
+    /// refused unless --force or --append.
+    #[arg(short = 'o', long)]
+    pub output: String,
+    /// Stop after this many frames.
+    #[arg(long, value_parser = count_arg)]
+    pub count: Option<u64>,
+    /// Stop after this many ms (else at Ctrl-C, SIGTERM, SIGHUP or SIGQUIT).
+    #[arg(long, value_parser = ms_arg)]
+    pub duration: Option<u64>,
+    /// Overwrite an existing output file.
+    #[arg(long, conflicts_with = "append")]
+    pub force: bool,
+    /// Append to an existing output file.
+    #[arg(long)]
+    pub append: bool,
+    /// The file format: candump (-l lines) or pcapng (for Wireshark; not to a terminal).
+    #[arg(long, default_value = "candump", value_parser = Words::new(&["candump", "pcapng"], LogFormat::parse))]
+    pub format: LogFormat,
+}
+
+/// `stop [NODE ...] [--node N]... [--listen MS] [--ramp MS] [--timeout MS]`.
+#[derive(Args, Clone, Debug)]
+pub struct StopArgs {
+    /// Stop these nodes. Without any, every CiA 402 drive found powered is stopped.
+    #[arg(value_parser = node_arg)]
+    pub nodes: Vec<u8>,
+    /// Stop this node too (repeatable; the same as naming it).
+    #[arg(long = "node", value_name = "N", value_parser = node_arg)]
+    pub node_flags: Vec<u8>,
+    /// How long to listen for nodes before reading their statuswords, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_LISTEN_MS)]
+    pub listen: u64,
+    /// How long a drive may take to finish its quick stop ramp before voltage is disabled, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_RAMP_MS)]
+    pub ramp: u64,
+    /// How long to wait for each SDO answer, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
+    pub timeout: u64,
+}
+
+impl<B: Args, D: Args> Commander<B, D> {
+    /// The options in front of the command (the command line's bus options).
+    pub fn bus(&self) -> &B {
+        match self {
+            Commander::Nmt(o) => &o.bus,
+            Commander::Sdo(SdoCommand::Read(o)) => &o.bus,
+            Commander::Sdo(SdoCommand::Write(o)) => &o.bus,
+            Commander::Drive(o) => &o.bus,
+            Commander::Run(o) => &o.bus,
+            Commander::Scan(o) => &o.bus,
+            Commander::Record(o) => &o.bus,
+            Commander::Stop(o) => &o.bus,
+        }
+    }
+
+    /// The dictionary options, for the commands that take them.
+    pub fn dict(&self) -> Option<&D> {
+        match self {
+            Commander::Sdo(SdoCommand::Read(o)) => Some(&o.args.t.dict),
+            Commander::Sdo(SdoCommand::Write(o)) => Some(&o.args.t.dict),
+            Commander::Run(o) => Some(&o.args.dict),
+            _ => None,
+        }
+    }
+
+    /// The command the words make, or why they make none.
+    pub fn command(&self) -> Result<Command, ParseError> {
+        Ok(match self {
+            Commander::Nmt(On { args: a, .. }) => Command::Nmt {
+                action: a.action,
+                node: a.node,
+                wait: a.wait,
+                timeout_ms: a.timeout,
+            },
+            Commander::Sdo(SdoCommand::Read(On { args: a, .. })) => Command::SdoRead {
+                node: a.t.node,
+                object: a.t.object.clone(),
+                options: a.t.options(),
+                output: a.output.clone(),
+            },
+            Commander::Sdo(SdoCommand::Write(On { args: a, .. })) => Command::SdoWrite {
+                node: a.t.node,
+                object: a.t.object.clone(),
+                value: a.value.clone(),
+                options: a.t.options(),
+            },
+            Commander::Drive(On { args: a, .. }) => Command::Drive {
+                node: a.node,
+                action: DriveAction::parse(&a.action, a.mode.as_deref())?,
+                timeout_ms: a.timeout,
+            },
+            Commander::Run(On { args: a, .. }) => {
+                let words: Vec<&str> = a.words.iter().map(String::as_str).collect();
+                Command::Run(run_spec(a.node, &words, a.list, a.dry_run, a.timeout)?)
+            }
+            Commander::Scan(On { args: a, .. }) => Command::Scan {
+                listen_ms: a.listen,
+                probe: a.probe,
+                timeout_ms: a.timeout,
+            },
+            Commander::Record(On { args: a, .. }) => Command::Record {
+                output: a.output.clone(),
+                limits: Limits {
+                    count: a.count,
+                    duration_ms: a.duration,
+                },
+                mode: match (a.force, a.append) {
+                    (true, _) => WriteMode::Overwrite,
+                    (_, true) => WriteMode::Append,
+                    _ => WriteMode::New,
+                },
+                format: a.format,
+            },
+            Commander::Stop(On { args: a, .. }) => {
+                let mut nodes = a.nodes.clone();
+                nodes.extend(a.node_flags.iter().filter(|n| !a.nodes.contains(n)));
+                Command::Stop {
+                    nodes,
+                    listen_ms: a.listen,
+                    options: StopOptions {
+                        timeout_ms: a.timeout,
+                        ramp_ms: a.ramp,
+                    },
+                }
+            }
+        })
+    }
+}
+
+/// The palette's parser: the commander declaration with nothing in front.
+#[derive(Parser, Debug)]
+#[command(
+    name = ":",
+    no_binary_name = true,
+    disable_help_subcommand = true,
+    disable_version_flag = true
+)]
+struct Palette {
+    #[command(subcommand)]
+    command: Commander<Session, Session>,
+}
+
+/// The palette's clap command, built once.
+fn palette() -> &'static clap::Command {
+    static CMD: OnceLock<clap::Command> = OnceLock::new();
+    CMD.get_or_init(|| {
+        let mut c = Palette::command();
+        c.build();
+        c
+    })
+}
+
+/// Parses one palette line (the command line's words without IFACE and its flags), e.g.
+/// `sdo read 2 0x6041`, `nmt start 0 --wait`, `sdo write 2 0x6060 3 --type i8`,
+/// `drive 2 mode pv`, `run 2 pv speed=100`, `stop 2 3`. Split like a shell line (quotes
+/// keep words together: `sdo write 2 0x1008 "my drive" --type string`).
+pub fn parse_command(line: &str) -> Result<Command, ParseError> {
+    let words = shlex::split(line).ok_or(ParseError::Quote)?;
+    if words.is_empty() {
+        return Err(ParseError::Empty);
+    }
+    let matches = palette().clone().try_get_matches_from(words)?;
+    let parsed = <Palette as clap::FromArgMatches>::from_arg_matches(&matches)?;
+    parsed.command.command()
+}
+
+/// The first words of the commander commands, from the declaration.
+pub fn commander_words() -> Vec<&'static str> {
+    palette().get_subcommands().map(clap::Command::get_name).collect()
+}
+
+/// The words that may complete the last (partial) word of `before`, a palette line up to
+/// the cursor: subcommands, flags (when the word starts with `-`), the values of the flag
+/// before it or of the positional argument it stands for (NMT and drive actions, types).
+pub fn completions(before: &str) -> Vec<String> {
+    let mut words: Vec<&str> = before.split_whitespace().collect();
+    let partial = if before.ends_with(char::is_whitespace) || words.is_empty() {
+        ""
+    } else {
+        words.pop().unwrap_or("")
+    };
+    let mut cmd = palette();
+    let mut positional = 0;
+    let mut expecting: Option<&clap::Arg> = None;
+    for w in &words {
+        if expecting.take().is_some() {
+            continue;
+        }
+        if let Some(sub) = cmd.find_subcommand(w) {
+            cmd = sub;
+            positional = 0;
+        } else if let Some(long) = w.strip_prefix("--") {
+            expecting = cmd
+                .get_arguments()
+                .find(|a| a.get_long() == Some(long))
+                .filter(|a| a.get_action().takes_values());
+        } else if w.starts_with('-') && w.len() == 2 && parse_int(w).is_none() {
+            let short = w.chars().nth(1);
+            expecting = cmd
+                .get_arguments()
+                .find(|a| a.get_short() == short)
+                .filter(|a| a.get_action().takes_values());
+        } else {
+            positional += 1;
+        }
+    }
+    if std::ptr::eq(cmd, palette()) && !words.is_empty() {
+        return Vec::new();
+    }
+    let values = |a: &clap::Arg| -> Vec<String> {
+        a.get_possible_values()
+            .iter()
+            .map(|v| v.get_name().to_string())
+            .collect()
+    };
+    if let Some(arg) = expecting {
+        return values(arg);
+    }
+    if partial.starts_with('-') {
+        return cmd
+            .get_arguments()
+            .filter_map(|a| a.get_long())
+            .filter(|l| *l != "help")
+            .map(|l| format!("--{l}"))
+            .collect();
+    }
+    if cmd.has_subcommands() {
+        return cmd.get_subcommands().map(|s| s.get_name().to_string()).collect();
+    }
+    cmd.get_positionals().nth(positional).map(values).unwrap_or_default()
+}
+
+/// A value parser that checks a word with `parse` and offers `words` for help and completion.
+#[derive(Clone)]
+struct Words<T> {
+    words: &'static [&'static str],
+    parse: fn(&str) -> Result<T, ParseError>,
+}
+
+impl<T> Words<T> {
+    fn new(words: &'static [&'static str], parse: fn(&str) -> Result<T, ParseError>) -> Words<T> {
+        Words { words, parse }
+    }
+}
+
+impl<T: Clone + Send + Sync + 'static> TypedValueParser for Words<T> {
+    type Value = T;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<T, clap::Error> {
+        self.parse.parse_ref(cmd, arg, value)
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
+        Some(Box::new(self.words.iter().map(|w| PossibleValue::new(*w))))
+    }
+}
+
+const NMT_WORDS: &[&str] = &["start", "stop", "preop", "reset-node", "reset-comm"];
+const DRIVE_WORDS: &[&str] = &["enable", "disable", "quick-stop", "fault-reset", "status", "mode"];
+const TYPE_WORDS: &[&str] = &[
+    "u8", "u16", "u32", "u64", "i8", "i16", "i32", "i64", "f32", "f64", "bool", "string", "octets", "domain",
+];
+
+/// A drive action word (its MODE is checked with it, see [`DriveAction::parse`]).
+fn drive_word(word: &str) -> Result<String, ParseError> {
+    DriveAction::verb(word).map(str::to_string)
+}
+
+/// Parses NODE 1..127 (decimal or 0x hex).
+pub fn node_arg(text: &str) -> Result<u8, ParseError> {
+    parse_node(text, false)
+}
+
+/// Parses NODE allowing 0 (all nodes).
+pub fn node_or_all_arg(text: &str) -> Result<u8, ParseError> {
+    parse_node(text, true)
+}
+
+/// Parses a positive number of ms.
+pub fn ms_arg(text: &str) -> Result<u64, ParseError> {
+    parse_int(text)
+        .filter(|v| *v > 0)
+        .map(|v| v as u64)
+        .ok_or_else(|| ParseError::Invalid(format!("`{text}` must be a positive number of ms")))
+}
+
+/// Parses a positive count.
+fn count_arg(text: &str) -> Result<u64, ParseError> {
+    parse_int(text)
+        .filter(|v| *v > 0)
+        .map(|v| v as u64)
+        .ok_or_else(|| ParseError::Invalid(format!("`{text}` must be a positive number")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn palette_lines() {
+        assert_eq!(
+            parse_command("sdo read 2 0x6041").unwrap(),
+            Command::SdoRead {
+                node: 2,
+                object: "0x6041".into(),
+                options: SdoOptions::default(),
+                output: None,
+            }
+        );
+        assert_eq!(
+            parse_command("sdo write 0x02 0x1008 \"my drive\" --type string --block --timeout 300").unwrap(),
+            Command::SdoWrite {
+                node: 2,
+                object: "0x1008".into(),
+                value: "my drive".into(),
+                options: SdoOptions {
+                    data_type: Some(DataType::VisibleString),
+                    block: true,
+                    timeout_ms: 300,
+                    deadline_ms: None
+                }
+            }
+        );
+        assert_eq!(
+            parse_command("nmt reset-node 0 --wait").unwrap(),
+            Command::Nmt {
+                action: NmtAction::ResetNode,
+                node: 0,
+                wait: true,
+                timeout_ms: NMT_WAIT_MS,
+            }
+        );
+        assert_eq!(
+            parse_command("drive 3 mode csv").unwrap(),
+            Command::Drive {
+                node: 3,
+                action: DriveAction::Mode(9),
+                timeout_ms: DEFAULT_TIMEOUT_MS
+            }
+        );
+        assert_eq!(
+            parse_command("sdo write 2 0x60FF -100 --type i32")
+                .map(|c| matches!(c, Command::SdoWrite { value, .. } if value == "-100")),
+            Ok(true)
+        );
+        assert_eq!(
+            parse_command("scan --probe --listen 500").unwrap(),
+            Command::Scan {
+                listen_ms: 500,
+                probe: true,
+                timeout_ms: SCAN_TIMEOUT_MS
+            }
+        );
+        assert_eq!(
+            parse_command("record -o out.log").unwrap(),
+            Command::Record {
+                output: "out.log".into(),
+                limits: Limits::default(),
+                mode: WriteMode::New,
+                format: LogFormat::Candump,
+            }
+        );
+        assert_eq!(
+            parse_command("record -o out.log --append --count 5").unwrap(),
+            Command::Record {
+                output: "out.log".into(),
+                limits: Limits {
+                    count: Some(5),
+                    duration_ms: None
+                },
+                mode: WriteMode::Append,
+                format: LogFormat::Candump,
+            }
+        );
+        assert!(matches!(
+            parse_command("record --force -o out.log"),
+            Ok(Command::Record {
+                mode: WriteMode::Overwrite,
+                ..
+            })
+        ));
+        assert!(
+            parse_command("record -o x --force --append")
+                .unwrap_err()
+                .to_string()
+                .contains("cannot be used with")
+        );
+        assert_eq!(
+            parse_command("stop 2 --node 3 --ramp 300").unwrap(),
+            Command::Stop {
+                nodes: vec![2, 3],
+                listen_ms: DEFAULT_LISTEN_MS,
+                options: StopOptions {
+                    timeout_ms: DEFAULT_TIMEOUT_MS,
+                    ramp_ms: 300
+                }
+            }
+        );
+    }
+
+    #[test]
+    fn errors_say_what_is_wrong() {
+        let err = |line: &str| parse_command(line).unwrap_err().to_string();
+        assert!(
+            err("sdo read 0 0x6041").contains("node `0` must be a number 1..127 (decimal or 0x hex)"),
+            "{}",
+            err("sdo read 0 0x6041")
+        );
+        assert!(err("nmt go 2").contains("unknown NMT command `go`"));
+        assert!(err("sdo read 2 0x6041 --type u7").contains("unknown type `u7`"));
+        assert!(err("drive 2 fly").contains("unknown drive command"));
+        assert!(err("record").contains("--output <OUTPUT>"));
+        assert!(err("").starts_with("empty command"));
+        assert_eq!(err("nmt start 2 --block"), "unexpected argument '--block' found");
+        assert_eq!(
+            err("drive 2 enable extra"),
+            "`drive enable` takes no MODE (got `extra`)"
+        );
+        assert_eq!(err("scan extra"), "unexpected argument 'extra' found");
+        assert_eq!(parse_command("sdo read 2 \"0x6041"), Err(ParseError::Quote));
+    }
+
+    #[test]
+    fn run_lines() {
+        assert_eq!(
+            parse_command("run 2 pv speed=100 accel=0x10 --dry-run").unwrap(),
+            Command::Run(super::super::RunSpec {
+                node: 2,
+                procedure: Some("pv".into()),
+                args: vec![("speed".into(), "100".into()), ("accel".into(), "0x10".into())],
+                dry_run: true,
+                timeout_ms: DEFAULT_TIMEOUT_MS,
+            })
+        );
+        assert!(matches!(
+            parse_command("run 3 --list").unwrap(),
+            Command::Run(super::super::RunSpec {
+                node: 3,
+                procedure: None,
+                ..
+            })
+        ));
+        let err = |line: &str| parse_command(line).unwrap_err().to_string();
+        assert!(err("run 2 pv speed").contains("NAME=VALUE"));
+        assert!(err("run 2 speed=1").contains("PROCEDURE before"));
+        assert!(err("run 2 pv --list").contains("not both"));
+    }
+
+    #[test]
+    fn completion_comes_from_the_declaration() {
+        assert_eq!(
+            commander_words(),
+            ["nmt", "sdo", "drive", "run", "scan", "record", "stop"]
+        );
+        assert_eq!(completions("sdo "), ["read", "write"]);
+        assert_eq!(completions("nmt re"), NMT_WORDS);
+        assert_eq!(completions("drive 2 "), DRIVE_WORDS);
+        assert!(completions("sdo write 2 0x6060 3 --t").contains(&"--type".to_string()));
+        assert!(completions("sdo write 2 0x6060 3 --type ").contains(&"i8".to_string()));
+        assert!(!completions("nmt start 2 --").contains(&"--block".to_string()));
+        assert!(completions("filter x").is_empty());
+    }
+}
