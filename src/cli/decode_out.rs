@@ -1,10 +1,8 @@
 //! Where `cotui decode` writes (`-o FILE`, `-o -` or stdout) and its pcapng export.
 
 use super::decode::DecodeArgs;
+use super::input;
 use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
-use crate::frame::Interfaces;
-use crate::log::Outcome;
-use crate::log::read_ahead;
 use crate::output::pcapng::PcapngWriter;
 use std::io::{self, BufRead, IsTerminal, Write};
 
@@ -52,7 +50,7 @@ pub fn pcapng(args: &DecodeArgs) -> i32 {
     };
     let mut status = EXIT_OK;
     for path in &args.files {
-        let Some(input) = super::decode::open_input(path, "decode") else {
+        let Some(input) = input::open_input(path, "decode") else {
             status = EXIT_UNAVAILABLE;
             continue;
         };
@@ -75,23 +73,13 @@ pub fn pcapng(args: &DecodeArgs) -> i32 {
 
 /// Writes the frames of one input (parsed on a second thread); reports what was skipped.
 fn write_stream(path: &str, input: Box<dyn BufRead + Send>, w: &mut PcapngWriter<impl Write>) -> io::Result<()> {
-    let mut ifaces = Interfaces::default();
-    let finished = read_ahead::for_each_batch(input, |batch| -> io::Result<()> {
-        if let Some(i) = &batch.interfaces {
-            ifaces = i.clone();
-        }
-        for (line, outcome) in &batch.lines {
-            match outcome {
-                Outcome::Frame(f) => w.write_frame(ifaces.name(f.iface), f)?,
-                Outcome::Skip(_) => {}
-                Outcome::Warning(msg) => eprintln!("{path}:{line}: warning: {msg}"),
-            }
+    let counts = input::for_each_frame(path, input, |frames| {
+        let ifaces = frames.ifaces;
+        for (_, f) in frames {
+            w.write_frame(ifaces.name(f.iface), f)?;
         }
         Ok(())
-    })??;
-    if let Some(e) = finished.error {
-        return Err(e);
-    }
-    super::decode::report_counts(path, &finished.counts);
+    })?;
+    input::report_counts(path, &counts);
     Ok(())
 }

@@ -7,6 +7,7 @@ mod decode_out;
 mod decode_parquet;
 pub mod diagnose;
 pub mod drive;
+pub mod input;
 pub mod nmt;
 pub mod record;
 pub mod run;
