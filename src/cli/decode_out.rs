@@ -6,21 +6,35 @@ use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
 use crate::output::pcapng::PcapngWriter;
 use std::io::{self, BufRead, IsTerminal, Write};
 
+/// Why the output of `cotui decode` cannot be opened.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    #[error("pcapng is binary: not writing it to a terminal (use -o FILE, or redirect stdout)")]
+    BinaryToTerminal,
+    #[error("{0}: pcapng is binary: not writing it to a terminal")]
+    BinaryToTerminalFile(String),
+    #[error("{path}: {source}")]
+    Create { path: String, source: io::Error },
+}
+
 /// The output stream: `path` (`None` or `-` is stdout). Binary output is refused when
 /// it would go to a terminal.
-pub fn open(path: Option<&str>, binary: bool) -> Result<Box<dyn Write>, String> {
+pub fn open(path: Option<&str>, binary: bool) -> Result<Box<dyn Write>, OutputError> {
     match path {
         None | Some("-") => {
             let stdout = io::stdout();
             if binary && stdout.is_terminal() {
-                return Err("pcapng is binary: not writing it to a terminal (use -o FILE, or redirect stdout)".into());
+                return Err(OutputError::BinaryToTerminal);
             }
             Ok(Box::new(io::BufWriter::with_capacity(1 << 16, stdout.lock())))
         }
         Some(p) => match std::fs::File::create(p) {
-            Ok(f) if binary && f.is_terminal() => Err(format!("{p}: pcapng is binary: not writing it to a terminal")),
+            Ok(f) if binary && f.is_terminal() => Err(OutputError::BinaryToTerminalFile(p.to_string())),
             Ok(f) => Ok(Box::new(io::BufWriter::with_capacity(1 << 16, f))),
-            Err(e) => Err(format!("{p}: {e}")),
+            Err(source) => Err(OutputError::Create {
+                path: p.to_string(),
+                source,
+            }),
         },
     }
 }

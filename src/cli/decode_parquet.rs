@@ -88,12 +88,24 @@ pub fn paths(output: &str) -> (PathBuf, PathBuf) {
     }
 }
 
-fn create(path: &Path, name: &str, cols: &[Col]) -> Result<Writer, String> {
+/// A file of the Parquet output that cannot be made, named in the message.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {source}", path.display())]
+struct CreateError {
+    path: PathBuf,
+    source: io::Error,
+}
+
+fn create(path: &Path, name: &str, cols: &[Col]) -> Result<Writer, CreateError> {
+    let at = |p: &Path| {
+        let path = p.to_path_buf();
+        move |source| CreateError { path, source }
+    };
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir).map_err(at(dir))?;
     }
-    let f = File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    Table::new(BufWriter::with_capacity(1 << 16, f), name, cols).map_err(|e| format!("{}: {e}", path.display()))
+    let f = File::create(path).map_err(at(path))?;
+    Table::new(BufWriter::with_capacity(1 << 16, f), name, cols).map_err(at(path))
 }
 
 /// Runs `cotui decode --format parquet`; returns the exit status.

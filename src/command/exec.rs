@@ -52,7 +52,7 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
             output,
         } => {
             let dict = bindings.dictionary(*node);
-            let (index, sub) = resolve_object(dict, object).map_err(CommandError::Usage)?;
+            let (index, sub) = resolve_object(dict, object).map_err(|e| CommandError::Usage(e.to_string()))?;
             let data = super::sdo::upload_within(bus, *node, index, sub, options.block, timing(options)).await?;
             if let Some(path) = output {
                 std::fs::write(path, &data).map_err(|e| CommandError::Usage(format!("cannot write {path}: {e}")))?;
@@ -81,7 +81,7 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
             options,
         } => {
             let dict = bindings.dictionary(*node);
-            let (index, sub) = resolve_object(dict, object).map_err(CommandError::Usage)?;
+            let (index, sub) = resolve_object(dict, object).map_err(|e| CommandError::Usage(e.to_string()))?;
             let data = write_data(dict, index, sub, value, options.data_type)?;
             super::sdo::download_within(bus, *node, index, sub, data.clone(), options.block, timing(options)).await?;
             json!({
