@@ -3,6 +3,7 @@
 //! public API) and a message for the analyzer's message log.
 
 use crate::decode::heartbeat::NmtState;
+use crate::frame::json::Seconds;
 use serde::{Serialize, Serializer};
 use std::fmt::Write;
 
@@ -279,27 +280,30 @@ impl Event {
         let _ = writeln!(out, "  {:<16}  {}", self.what.name(), self.what.detail());
     }
 
-    /// Appends the JSON line (with `\n`): `t` (seconds, exact to the ns like the frame
-    /// JSONL), `node` (null for the bus), `event`, then the details of [`What`].
-    pub fn write_json(&self, out: &mut String) {
-        let _ = write!(
-            out,
-            "{{\"t\":{}.{:09},\"node\":",
-            self.t_ns / 1_000_000_000,
-            self.t_ns % 1_000_000_000
-        );
-        match self.node {
-            Some(n) => {
-                let _ = write!(out, "{n}");
-            }
-            None => out.push_str("null"),
-        }
-        // The tagged enum serializes as `{"event":..., details...}`: splice it in.
-        let rest = serde_json::to_string(&self.what).unwrap_or_else(|_| "{}".into());
-        out.push(',');
-        out.push_str(rest.strip_prefix('{').unwrap_or(&rest));
-        out.push('\n');
+    /// Appends the JSON line (with `\n`) of [`Event::to_json`].
+    pub fn write_json(&self, out: &mut Vec<u8>) {
+        crate::frame::json::write_line(out, &self.to_json());
     }
+
+    /// The JSONL record: `t` (seconds, exact to the ns like the frame JSONL), `node` (null
+    /// for the bus), `event`, then the details of [`What`].
+    pub fn to_json(&self) -> EventJson<'_> {
+        EventJson {
+            t: Seconds(self.t_ns),
+            node: self.node,
+            what: &self.what,
+        }
+    }
+}
+
+/// One event as a JSONL record (`cotui decode --events --format jsonl`).
+#[derive(Clone, Debug, Serialize)]
+pub struct EventJson<'a> {
+    pub t: Seconds,
+    pub node: Option<u8>,
+    /// `event` (the variant name) and its details, flat.
+    #[serde(flatten)]
+    pub what: &'a What,
 }
 
 #[cfg(test)]
@@ -323,8 +327,9 @@ mod tests {
 
     #[test]
     fn json_line_has_the_contract_fields() {
-        let mut s = String::new();
+        let mut s = Vec::new();
         lost().write_json(&mut s);
+        let s = String::from_utf8(s).unwrap();
         assert!(s.starts_with("{\"t\":1700000000.450000000,\"node\":5,\"event\":\"heartbeat_lost\""));
         let mut j: serde_json::Value = serde_json::from_str(&s).unwrap();
         // `t` is checked exactly in the text above (a parsed f64 rounds it).
@@ -342,9 +347,9 @@ mod tests {
                 to: NmtState::PreOperational,
             },
         };
-        let mut s = String::new();
+        let mut s = Vec::new();
         state.write_json(&mut s);
-        let j: serde_json::Value = serde_json::from_str(&s).unwrap();
+        let j: serde_json::Value = serde_json::from_slice(&s).unwrap();
         assert_eq!(j["from"], json!(null));
         assert_eq!(j["to"], "pre_operational");
         assert_eq!(j["t"], 1e-9);

@@ -2,7 +2,7 @@
 //! Built by [`super::diagnose::Diagnoser`]; rendered as text (`cotui diagnose`) and as one
 //! JSON object per incident (`--format jsonl`, field names are a public API).
 
-use serde_json::{Value as Json, json};
+use serde::Serialize;
 use std::fmt::Write;
 
 /// Timeline entries kept per incident; further ones are counted in `count`, not listed.
@@ -158,27 +158,31 @@ impl Incident {
         s
     }
 
-    /// The JSON object; times are seconds since `origin` (the capture's first frame).
-    pub fn to_json(&self, origin: u64) -> Json {
-        let events: Vec<Json> = self
-            .events
-            .iter()
-            .map(|e| json!({"frame": e.frame, "t": secs(e.t_ns, origin), "text": e.text}))
-            .collect();
-        json!({
-            "node": self.node,
-            "axes": self.axes,
-            "kind": self.problem.as_str(),
-            "status": self.status.as_str(),
-            "title": self.title,
-            "cause": self.cause,
-            "events": events,
-            "check": self.check,
-            "why": self.why,
-            "count": self.count,
-            "first": secs(self.first_ns, origin),
-            "last": secs(self.last_ns, origin),
-        })
+    /// The JSON object of `cotui diagnose --format jsonl`; times are seconds since
+    /// `origin` (the capture's first frame).
+    pub fn to_json(&self, origin: u64) -> IncidentJson<'_> {
+        IncidentJson {
+            axes: &self.axes,
+            cause: self.cause.as_deref(),
+            check: &self.check,
+            count: self.count,
+            events: self
+                .events
+                .iter()
+                .map(|e| StepJson {
+                    frame: e.frame,
+                    t: secs(e.t_ns, origin),
+                    text: &e.text,
+                })
+                .collect(),
+            first: secs(self.first_ns, origin),
+            kind: self.problem.as_str(),
+            last: secs(self.last_ns, origin),
+            node: self.node,
+            status: self.status.as_str(),
+            title: &self.title,
+            why: &self.why,
+        }
     }
 
     /// The text block of `cotui diagnose` (numbered `n`), times since `origin`.
@@ -211,4 +215,38 @@ impl Incident {
         }
         let _ = writeln!(out, "    Why it matters: {}", self.why);
     }
+}
+
+/// One incident as a JSONL record (fields in key order).
+#[derive(Clone, Debug, Serialize)]
+pub struct IncidentJson<'a> {
+    /// The drive axes it concerns (empty when none).
+    pub axes: &'a [u8],
+    pub cause: Option<&'a str>,
+    /// What to check, in order.
+    pub check: &'a [String],
+    /// How many times it happened.
+    pub count: u64,
+    /// The timeline (the first steps).
+    pub events: Vec<StepJson<'a>>,
+    /// Seconds since the capture's first frame.
+    pub first: f64,
+    /// The [`Problem`] name.
+    pub kind: &'static str,
+    pub last: f64,
+    /// `null` for the whole bus.
+    pub node: Option<u8>,
+    pub status: &'static str,
+    pub title: &'a str,
+    pub why: &'a str,
+}
+
+/// One timeline step of [`IncidentJson`] (fields in key order).
+#[derive(Clone, Debug, Serialize)]
+pub struct StepJson<'a> {
+    /// Frame number, 1-based over all inputs.
+    pub frame: u64,
+    /// Seconds since the capture's first frame.
+    pub t: f64,
+    pub text: &'a str,
 }

@@ -513,9 +513,9 @@ impl Writer {
     /// Writes one frame, retrying briefly while the transmit queue is full.
     pub(super) async fn write(&self, frame: &Frame) -> Result<(), BusError> {
         let iface = &self.link.iface;
-        let raw = to_raw(frame).map_err(|reason| BusError::Io {
+        let raw = to_raw(frame).map_err(|e| BusError::Io {
             iface: iface.clone(),
-            reason,
+            reason: e.to_string(),
         })?;
         let unavailable = |errno| {
             let state = if errno == libc::ENETDOWN {
@@ -610,13 +610,25 @@ fn recv(fd: i32) -> io::Result<(Frame, bool)> {
     Ok((frame, own))
 }
 
+/// Why bytes are not a kernel CAN frame, or a frame cannot become one.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum RawFrameError {
+    #[error("read {0} bytes, expected {CAN_MTU} (CAN) or {CANFD_MTU} (CAN FD)")]
+    Size(usize),
+    #[error("error frames cannot be sent")]
+    ErrorFrame,
+    #[error("id 0x{0:X} does not fit 11 bits; mark the frame extended")]
+    IdTooLarge(u32),
+    #[error("{0} bytes is not a CAN FD length")]
+    FdLength(usize),
+    #[error("{0} bytes do not fit a classic CAN frame")]
+    ClassicLength(usize),
+}
+
 /// Parses a kernel `can_frame` (16 bytes) or `canfd_frame` (72 bytes).
-pub fn from_raw(raw: &[u8]) -> Result<Frame, String> {
+pub fn from_raw(raw: &[u8]) -> Result<Frame, RawFrameError> {
     if raw.len() != CAN_MTU && raw.len() != CANFD_MTU {
-        return Err(format!(
-            "read {} bytes, expected {CAN_MTU} (CAN) or {CANFD_MTU} (CAN FD)",
-            raw.len()
-        ));
+        return Err(RawFrameError::Size(raw.len()));
     }
     let can_id = u32::from_ne_bytes([raw[0], raw[1], raw[2], raw[3]]);
     let mut f = Frame::default();
@@ -652,21 +664,21 @@ pub fn from_raw(raw: &[u8]) -> Result<Frame, String> {
 }
 
 /// The kernel `can_frame` / `canfd_frame` bytes of a frame to send.
-pub fn to_raw(f: &Frame) -> Result<Vec<u8>, String> {
+pub fn to_raw(f: &Frame) -> Result<Vec<u8>, RawFrameError> {
     if f.is_err() {
-        return Err("error frames cannot be sent".into());
+        return Err(RawFrameError::ErrorFrame);
     }
     let mut can_id = if f.is_ext() {
         (f.id & CAN_EFF_MASK) | CAN_EFF_FLAG
     } else if f.id <= 0x7FF {
         f.id
     } else {
-        return Err(format!("id 0x{:X} does not fit 11 bits; mark the frame extended", f.id));
+        return Err(RawFrameError::IdTooLarge(f.id));
     };
     let len = f.len as usize;
     if f.is_fd() {
         if len > 64 || !matches!(len, 0..=8 | 12 | 16 | 20 | 24 | 32 | 48 | 64) {
-            return Err(format!("{len} bytes is not a CAN FD length"));
+            return Err(RawFrameError::FdLength(len));
         }
         let mut raw = vec![0u8; CANFD_MTU];
         raw[..4].copy_from_slice(&can_id.to_ne_bytes());
@@ -683,7 +695,7 @@ pub fn to_raw(f: &Frame) -> Result<Vec<u8>, String> {
         Ok(raw)
     } else {
         if len > 8 {
-            return Err(format!("{len} bytes do not fit a classic CAN frame"));
+            return Err(RawFrameError::ClassicLength(len));
         }
         if f.is_rtr() {
             can_id |= CAN_RTR_FLAG;
@@ -741,8 +753,11 @@ mod tests {
         let e = from_raw(&err).unwrap();
         assert!(e.is_err());
         assert_eq!((e.id, e.payload()[1]), (4, 0x0C));
-        assert_eq!(to_raw(&e), Err("error frames cannot be sent".into()));
-        assert!(from_raw(&[0; 10]).unwrap_err().contains("read 10 bytes"));
+        assert_eq!(
+            to_raw(&e).map_err(|e| e.to_string()),
+            Err("error frames cannot be sent".into())
+        );
+        assert!(from_raw(&[0; 10]).unwrap_err().to_string().contains("read 10 bytes"));
     }
 
     #[test]

@@ -1,14 +1,13 @@
 //! `cotui decode FILE...`: the headless decoder.
 
+use super::input;
 use crate::analysis::EventTracker;
 use crate::command::ExitCode;
 use crate::decode::{Decoder, Kind, sdo::Transaction};
-use crate::frame::{Frame, Interfaces};
-use crate::log::Outcome;
-use crate::log::read_ahead;
+use crate::frame::json::write_line;
 use crate::output::{jsonl, summary::Summary, text};
 use clap::{Args, ValueEnum};
-use std::io::{self, BufRead, BufReader, Write};
+use std::io::{self, BufRead, Write};
 
 /// Output formats of `cotui decode`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -100,7 +99,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
     let mut summary = Summary::default();
     let mut status = ExitCode::Ok;
     for path in &args.files {
-        let Some(input) = open_input(path, "decode") else {
+        let Some(input) = input::open_input(path, "decode") else {
             status = ExitCode::Unavailable;
             continue;
         };
@@ -142,21 +141,12 @@ fn decode_stream(
     sinks: &mut Sinks,
     out: &mut impl Write,
 ) -> io::Result<()> {
+    // Text lines go to `buf`, JSON lines to `json`; a run writes only one of them.
     let mut buf = String::with_capacity(1 << 16);
-    let mut ifaces = Interfaces::default();
-    let finished = read_ahead::for_each_batch(input, |batch| -> io::Result<()> {
-        if let Some(i) = &batch.interfaces {
-            ifaces = i.clone();
-        }
-        for (line, outcome) in &batch.lines {
-            let frame: &Frame = match outcome {
-                Outcome::Frame(f) => f,
-                Outcome::Skip(_) => continue,
-                Outcome::Warning(msg) => {
-                    eprintln!("{path}:{line}: warning: {msg}");
-                    continue;
-                }
-            };
+    let mut json = Vec::with_capacity(1 << 16);
+    let counts = input::for_each_frame(path, input, |frames| {
+        let ifaces = frames.ifaces;
+        for (line, frame) in frames {
             match mode {
                 Mode::Summary(_) => {
                     let (kind, node) = decoder.classify(frame);
@@ -180,23 +170,23 @@ fn decode_stream(
                             OutputFormat::Text => e.write_line(&mut buf),
                             // (pcapng and parquet never reach here: they are refused with --events)
                             OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => {
-                                e.write_json(&mut buf)
+                                e.write_json(&mut json)
                             }
                         }
                     }
                 }
                 Mode::Frames(OutputFormat::Text) => {
                     let d = decoder.decode(frame);
-                    text::write_line(&mut buf, frame, &ifaces, &d);
+                    text::write_line(&mut buf, frame, ifaces, &d);
                 }
                 Mode::Frames(OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet) => {
                     let d = decoder.decode(frame);
-                    jsonl::write_frame(&mut buf, *line, frame, &ifaces, &d);
+                    jsonl::write_frame(&mut json, line, frame, ifaces, &d);
                 }
                 Mode::Transactions(fmt) => {
                     decoder.decode(frame);
                     for t in decoder.take_transactions() {
-                        write_transaction(&mut buf, &t, decoder, fmt);
+                        write_transaction(&mut buf, &mut json, &t, decoder, fmt);
                     }
                 }
             }
@@ -206,67 +196,35 @@ fn decode_stream(
             decoder.take_transactions();
         }
         out.write_all(buf.as_bytes())?;
+        out.write_all(&json)?;
         buf.clear();
+        json.clear();
         Ok(())
-    })??;
-    if let Some(e) = finished.error {
-        return Err(e);
-    }
-    report_counts(path, &finished.counts);
+    })?;
+    input::report_counts(path, &counts);
     Ok(())
 }
 
-/// A log to read: stdin for `-`, else the file; `None` (with the message on stderr, `what`
-/// naming the command) when it cannot be opened.
-pub fn open_input(path: &str, what: &str) -> Option<Box<dyn BufRead + Send>> {
-    if path == "-" {
-        return Some(Box::new(BufReader::with_capacity(1 << 16, io::stdin())));
-    }
-    match std::fs::File::open(path) {
-        Ok(f) => Some(Box::new(BufReader::with_capacity(1 << 16, f))),
-        Err(e) => {
-            eprintln!("cotui {what}: {path}: {e}");
-            None
-        }
-    }
-}
-
-/// Prints what a reader skipped or could not read in `path` (nothing when every line was a frame).
-pub fn report_counts(path: &str, c: &crate::log::Counts) {
-    if c.warnings > 0 || c.skipped_total() > 0 {
-        eprintln!(
-            "{path}: {} frames, {} lines skipped, {} malformed lines",
-            c.frames,
-            c.skipped_total(),
-            c.warnings
-        );
-    }
-    if let Some(first) = c.first_ignored_tail {
-        eprintln!(
-            "{path}: {} frame lines had text after the frame, not read (comments; first: line {first})",
-            c.ignored_tail
-        );
-    }
-}
-
-fn write_transaction(buf: &mut String, t: &Transaction, decoder: &Decoder, fmt: OutputFormat) {
+/// Appends one transaction: a text line to `text`, a JSON line to `json`.
+fn write_transaction(text: &mut String, json: &mut Vec<u8>, t: &Transaction, decoder: &Decoder, fmt: OutputFormat) {
     let dict = decoder.dictionary(t.node);
     match fmt {
-        OutputFormat::Text => buf.push_str(&t.label(dict)),
-        OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => {
-            buf.push_str(&t.to_json(dict).to_string())
+        OutputFormat::Text => {
+            text.push_str(&t.label(dict));
+            text.push('\n');
         }
+        OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => write_line(json, &t.to_json(dict)),
     }
-    buf.push('\n');
 }
 
 /// Writes what is due at the end of all inputs.
 fn finish(decoder: &mut Decoder, mode: Mode, summary: &mut Summary, out: &mut impl Write) -> io::Result<()> {
     let mut buf = String::new();
+    let mut json = Vec::new();
     match mode {
         Mode::Transactions(fmt) => {
             for t in decoder.finish() {
-                write_transaction(&mut buf, &t, decoder, fmt);
+                write_transaction(&mut buf, &mut json, &t, decoder, fmt);
             }
         }
         Mode::Summary(fmt) => {
@@ -274,12 +232,12 @@ fn finish(decoder: &mut Decoder, mode: Mode, summary: &mut Summary, out: &mut im
             match fmt {
                 OutputFormat::Text => buf.push_str(&summary.to_text()),
                 OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => {
-                    buf.push_str(&summary.to_json().to_string());
-                    buf.push('\n');
+                    write_line(&mut json, &summary.to_json())
                 }
             }
         }
         Mode::Frames(_) | Mode::Events(_) => {}
     }
-    out.write_all(buf.as_bytes())
+    out.write_all(buf.as_bytes())?;
+    out.write_all(&json)
 }

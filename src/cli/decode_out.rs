@@ -1,28 +1,40 @@
 //! Where `cotui decode` writes (`-o FILE`, `-o -` or stdout) and its pcapng export.
 
 use super::decode::DecodeArgs;
+use super::input;
 use crate::command::ExitCode;
-use crate::frame::Interfaces;
-use crate::log::Outcome;
-use crate::log::read_ahead;
 use crate::output::pcapng::PcapngWriter;
 use std::io::{self, BufRead, IsTerminal, Write};
 
+/// Why the output of `cotui decode` cannot be opened.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    #[error("pcapng is binary: not writing it to a terminal (use -o FILE, or redirect stdout)")]
+    BinaryToTerminal,
+    #[error("{0}: pcapng is binary: not writing it to a terminal")]
+    BinaryToTerminalFile(String),
+    #[error("{path}: {source}")]
+    Create { path: String, source: io::Error },
+}
+
 /// The output stream: `path` (`None` or `-` is stdout). Binary output is refused when
 /// it would go to a terminal.
-pub fn open(path: Option<&str>, binary: bool) -> Result<Box<dyn Write>, String> {
+pub fn open(path: Option<&str>, binary: bool) -> Result<Box<dyn Write>, OutputError> {
     match path {
         None | Some("-") => {
             let stdout = io::stdout();
             if binary && stdout.is_terminal() {
-                return Err("pcapng is binary: not writing it to a terminal (use -o FILE, or redirect stdout)".into());
+                return Err(OutputError::BinaryToTerminal);
             }
             Ok(Box::new(io::BufWriter::with_capacity(1 << 16, stdout.lock())))
         }
         Some(p) => match std::fs::File::create(p) {
-            Ok(f) if binary && f.is_terminal() => Err(format!("{p}: pcapng is binary: not writing it to a terminal")),
+            Ok(f) if binary && f.is_terminal() => Err(OutputError::BinaryToTerminalFile(p.to_string())),
             Ok(f) => Ok(Box::new(io::BufWriter::with_capacity(1 << 16, f))),
-            Err(e) => Err(format!("{p}: {e}")),
+            Err(source) => Err(OutputError::Create {
+                path: p.to_string(),
+                source,
+            }),
         },
     }
 }
@@ -52,7 +64,7 @@ pub fn pcapng(args: &DecodeArgs) -> ExitCode {
     };
     let mut status = ExitCode::Ok;
     for path in &args.files {
-        let Some(input) = super::decode::open_input(path, "decode") else {
+        let Some(input) = input::open_input(path, "decode") else {
             status = ExitCode::Unavailable;
             continue;
         };
@@ -75,23 +87,13 @@ pub fn pcapng(args: &DecodeArgs) -> ExitCode {
 
 /// Writes the frames of one input (parsed on a second thread); reports what was skipped.
 fn write_stream(path: &str, input: Box<dyn BufRead + Send>, w: &mut PcapngWriter<impl Write>) -> io::Result<()> {
-    let mut ifaces = Interfaces::default();
-    let finished = read_ahead::for_each_batch(input, |batch| -> io::Result<()> {
-        if let Some(i) = &batch.interfaces {
-            ifaces = i.clone();
-        }
-        for (line, outcome) in &batch.lines {
-            match outcome {
-                Outcome::Frame(f) => w.write_frame(ifaces.name(f.iface), f)?,
-                Outcome::Skip(_) => {}
-                Outcome::Warning(msg) => eprintln!("{path}:{line}: warning: {msg}"),
-            }
+    let counts = input::for_each_frame(path, input, |frames| {
+        let ifaces = frames.ifaces;
+        for (_, f) in frames {
+            w.write_frame(ifaces.name(f.iface), f)?;
         }
         Ok(())
-    })??;
-    if let Some(e) = finished.error {
-        return Err(e);
-    }
-    super::decode::report_counts(path, &finished.counts);
+    })?;
+    input::report_counts(path, &counts);
     Ok(())
 }

@@ -4,12 +4,11 @@
 //! ("Parquet tables").
 
 use super::decode::DecodeArgs;
+use super::input;
 use crate::command::ExitCode;
 use crate::decode::sdo::{SdoCommand, Transaction};
 use crate::decode::{Body, Decoded, Decoder};
-use crate::frame::{Flags, Frame, Interfaces};
-use crate::log::Outcome;
-use crate::log::read_ahead;
+use crate::frame::{Flags, Frame};
 use crate::od::Dictionary;
 use crate::output::parquet::{Col, Table, Ty, V};
 use std::fs::File;
@@ -89,12 +88,24 @@ pub fn paths(output: &str) -> (PathBuf, PathBuf) {
     }
 }
 
-fn create(path: &Path, name: &str, cols: &[Col]) -> Result<Writer, String> {
+/// A file of the Parquet output that cannot be made, named in the message.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {source}", path.display())]
+struct CreateError {
+    path: PathBuf,
+    source: io::Error,
+}
+
+fn create(path: &Path, name: &str, cols: &[Col]) -> Result<Writer, CreateError> {
+    let at = |p: &Path| {
+        let path = p.to_path_buf();
+        move |source| CreateError { path, source }
+    };
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir).map_err(at(dir))?;
     }
-    let f = File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    Table::new(BufWriter::with_capacity(1 << 16, f), name, cols).map_err(|e| format!("{}: {e}", path.display()))
+    let f = File::create(path).map_err(at(path))?;
+    Table::new(BufWriter::with_capacity(1 << 16, f), name, cols).map_err(at(path))
 }
 
 /// Runs `cotui decode --format parquet`; returns the exit status.
@@ -131,7 +142,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
     let mut status = ExitCode::Ok;
     let mut last_file = String::new();
     for path in &args.files {
-        let Some(input) = super::decode::open_input(path, "decode") else {
+        let Some(input) = input::open_input(path, "decode") else {
             status = ExitCode::Unavailable;
             continue;
         };
@@ -165,22 +176,11 @@ fn write_stream(
     frames: &mut Writer,
     values: &mut Writer,
 ) -> io::Result<()> {
-    let mut ifaces = Interfaces::default();
-    let finished = read_ahead::for_each_batch(input, |batch| -> io::Result<()> {
-        if let Some(i) = &batch.interfaces {
-            ifaces = i.clone();
-        }
-        for (line, outcome) in &batch.lines {
-            let frame = match outcome {
-                Outcome::Frame(f) => f,
-                Outcome::Skip(_) => continue,
-                Outcome::Warning(msg) => {
-                    eprintln!("{path}:{line}: warning: {msg}");
-                    continue;
-                }
-            };
+    let counts = input::for_each_frame(path, input, |batch| {
+        let ifaces = batch.ifaces;
+        for (line, frame) in batch {
             let d = decoder.decode(frame);
-            frame_row(frames, path, *line, frame, ifaces.name(frame.iface), &d)?;
+            frame_row(frames, path, line, frame, ifaces.name(frame.iface), &d)?;
             if let (Body::Pdo(p), Some(node)) = (&d.body, d.node) {
                 for s in &p.signals {
                     values.row(|r| {
@@ -213,19 +213,8 @@ fn write_stream(
             }
         }
         Ok(())
-    })??;
-    if let Some(e) = finished.error {
-        return Err(e);
-    }
-    let c = finished.counts;
-    if c.warnings > 0 || c.skipped_total() > 0 {
-        eprintln!(
-            "{path}: {} frames, {} lines skipped, {} malformed lines",
-            c.frames,
-            c.skipped_total(),
-            c.warnings
-        );
-    }
+    })?;
+    input::report_counts(path, &counts);
     Ok(())
 }
 
@@ -316,7 +305,6 @@ fn transaction_row<W: Write + Send>(
     dict: &Dictionary,
 ) -> io::Result<()> {
     let j = tr.to_json(dict);
-    let s = |k: &str| j[k].as_str().map(V::Str);
     let partial = tr.is_partial();
     let frames = tr.frames.len() as u64 + tr.frames_dropped;
     t.row(|r| {
@@ -327,15 +315,15 @@ fn transaction_row<W: Write + Send>(
             .push(Some(V::I32(tr.node as i32)))?
             .push((!partial).then_some(V::I32(tr.index as i32)))?
             .push((!partial).then_some(V::I32(tr.sub as i32)))?
-            .push(s("name"))?
-            .push(j["value"].as_f64().map(V::F64))?
-            .push(s("value_text"))?
+            .push(j.name.map(V::Str))?
+            .push(j.value.as_ref().and_then(|v| v.json.as_f64()).map(V::F64))?
+            .push(j.value_text.as_deref().map(V::Str))?
             .push(Some(V::Bin(&tr.data)))?
             .push(Some(V::Str(tr.direction.as_str())))?
             .push(Some(V::Str(tr.protocol.as_str())))?
             .push(Some(V::Str(tr.outcome.as_str())))?
-            .push(j["abort_code"].as_i64().map(V::I64))?
-            .push(s("abort_text"))?
+            .push(j.abort_code.map(|c| V::I64(c.into())))?
+            .push(j.abort_text.map(V::Str))?
             .push(Some(V::Bool(partial)))?
             .push(None)?
             .push(Some(V::I64(frames as i64)))?;
@@ -346,6 +334,7 @@ fn transaction_row<W: Write + Send>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::frame::Interfaces;
     use proptest::prelude::*;
 
     proptest! {

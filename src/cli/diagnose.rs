@@ -1,11 +1,10 @@
 //! `cotui diagnose FILE...`: what went wrong on the bus, as a short ranked list of incidents.
 
+use super::input;
 use crate::analysis::{Diagnoser, EventTracker, Incident, Status};
 use crate::command::ExitCode;
 use crate::decode::Kind;
-use crate::frame::{Frame, Interfaces};
-use crate::log::Outcome;
-use crate::log::read_ahead;
+use crate::frame::json::write_line;
 use clap::{Args, ValueEnum};
 use std::io::{self, Write};
 
@@ -51,24 +50,13 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
     let mut diag = Diagnoser::new(EventTracker::new(|n| decoder.dictionary(n)));
     let mut status = ExitCode::Ok;
     for path in &args.files {
-        let Some(input) = super::decode::open_input(path, "diagnose") else {
+        let Some(input) = input::open_input(path, "diagnose") else {
             status = ExitCode::Unavailable;
             continue;
         };
-        let mut ifaces = Interfaces::default();
-        let result = read_ahead::for_each_batch(input, |batch| -> io::Result<()> {
-            if let Some(i) = &batch.interfaces {
-                ifaces = i.clone();
-            }
-            for (line, outcome) in &batch.lines {
-                let frame: &Frame = match outcome {
-                    Outcome::Frame(f) => f,
-                    Outcome::Skip(_) => continue,
-                    Outcome::Warning(msg) => {
-                        eprintln!("{path}:{line}: warning: {msg}");
-                        continue;
-                    }
-                };
+        let result = input::for_each_frame(path, input, |frames| {
+            let ifaces = frames.ifaces;
+            for (_, frame) in frames {
                 // Frames that cannot tell the diagnosis anything are not decoded.
                 let (kind, node, pdo) = decoder.peek(frame);
                 let skip = match kind {
@@ -91,11 +79,7 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
             }
             Ok(())
         });
-        let err = match result {
-            Ok(Ok(finished)) => finished.error,
-            Ok(Err(e)) | Err(e) => Some(e),
-        };
-        if let Some(e) = err {
+        if let Err(e) = result {
             eprintln!("cotui diagnose: {path}: {e}");
             status = ExitCode::Unavailable;
         }
@@ -107,11 +91,17 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
     let frames = diag.frames();
     let incidents = diag.finish();
     let out = match args.format {
-        DiagnoseFormat::Text => report(&incidents, origin, frames),
-        DiagnoseFormat::Jsonl => incidents.iter().map(|i| format!("{}\n", i.to_json(origin))).collect(),
+        DiagnoseFormat::Text => report(&incidents, origin, frames).into_bytes(),
+        DiagnoseFormat::Jsonl => {
+            let mut out = Vec::new();
+            for i in &incidents {
+                write_line(&mut out, &i.to_json(origin));
+            }
+            out
+        }
     };
     let mut stdout = io::stdout().lock();
-    if let Err(e) = stdout.write_all(out.as_bytes()).and_then(|_| stdout.flush())
+    if let Err(e) = stdout.write_all(&out).and_then(|_| stdout.flush())
         && e.kind() != io::ErrorKind::BrokenPipe
     {
         eprintln!("cotui diagnose: {e}");

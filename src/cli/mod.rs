@@ -6,6 +6,7 @@ pub mod decode;
 mod decode_out;
 mod decode_parquet;
 pub mod diagnose;
+pub mod input;
 pub mod record;
 pub mod run;
 pub mod sim;

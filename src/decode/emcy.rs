@@ -1,7 +1,9 @@
 //! EMCY (0x080 + node): error code text, error register bits, manufacturer bytes.
 
+use crate::frame::json::Hex;
 use crate::od::Dictionary;
-use serde_json::json;
+use serde::Serialize;
+use std::collections::BTreeMap;
 
 /// An emergency frame.
 #[derive(Clone, Debug, PartialEq)]
@@ -57,21 +59,30 @@ impl Emcy {
         s
     }
     /// The kind-specific JSON object.
-    pub fn to_json(&self) -> serde_json::Value {
-        let fields: serde_json::Map<String, serde_json::Value> = self
-            .mfr_fields
-            .iter()
-            .map(|(k, v)| (k.clone(), v.clone().into()))
-            .collect();
-        json!({
-            "code": self.code,
-            "text": self.text,
-            "register": self.register,
-            "register_bits": self.register_bits(),
-            "mfr": crate::frame::hex::upper(&self.mfr),
-            "mfr_fields": fields,
-        })
+    pub fn to_json(&self) -> EmcyJson<'_> {
+        EmcyJson {
+            code: self.code,
+            mfr: Hex(&self.mfr),
+            // A map, so a name given twice keeps its last value.
+            mfr_fields: self.mfr_fields.iter().map(|(k, v)| (k.as_str(), v.as_str())).collect(),
+            register: self.register,
+            register_bits: self.register_bits(),
+            text: &self.text,
+        }
     }
+}
+
+/// The `emcy` object of a JSONL frame record (fields in key order).
+#[derive(Clone, Debug, Serialize)]
+pub struct EmcyJson<'a> {
+    pub code: u16,
+    /// The manufacturer bytes, upper-case hex.
+    pub mfr: Hex<'a>,
+    /// The manufacturer bytes decoded through the profile's layout, by name.
+    pub mfr_fields: BTreeMap<&'a str, &'a str>,
+    pub register: u8,
+    pub register_bits: Vec<&'static str>,
+    pub text: &'a str,
 }
 
 /// Decodes an EMCY payload with the node's dictionary; the second value explains a rule broken.
@@ -207,6 +218,7 @@ const EXACT: &[(u16, &str)] = &[
 #[cfg(test)]
 mod tests {
     use super::*;
+    use serde_json::json;
 
     #[test]
     fn exact_then_class_text() {
@@ -229,7 +241,7 @@ mod tests {
             e.label(3),
             "EMCY node 3: 0x8130 Life guard error or heartbeat error; register 0x11 [generic, communication]"
         );
-        let j = e.to_json();
+        let j = serde_json::to_value(e.to_json()).unwrap();
         assert_eq!(j["code"], 0x8130);
         assert_eq!(j["register_bits"], json!(["generic", "communication"]));
     }

@@ -1,6 +1,6 @@
 //! SocketCAN error frames (CAN_ERR_FLAG): error class bits and details (linux/can/error.h).
 
-use serde_json::json;
+use serde::Serialize;
 
 /// Error class names by bit of the error frame's id.
 const CLASSES: [(u32, &str); 10] = [
@@ -112,13 +112,26 @@ pub fn controller_state(class: u32, data: &[u8]) -> (Option<ControllerState>, Op
 }
 
 /// The kind-specific JSON object.
-pub fn to_json(class: u32, data: &[u8]) -> serde_json::Value {
-    json!({"class": class, "details": describe(class, data)})
+pub fn to_json(class: u32, data: &[u8]) -> ErrorFrameJson {
+    ErrorFrameJson {
+        class,
+        details: describe(class, data),
+    }
+}
+
+/// The `error` object of a JSONL frame record (fields in key order).
+#[derive(Clone, Debug, Serialize)]
+pub struct ErrorFrameJson {
+    /// The CAN_ERR class bits.
+    pub class: u32,
+    /// One text per class bit set, with the details the data bytes give.
+    pub details: Vec<String>,
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use serde_json::json;
 
     #[test]
     fn controller_and_counters() {
@@ -129,7 +142,10 @@ mod tests {
         );
         assert_eq!(label(0x040, &[0; 8]), "Error frame: bus off");
         assert_eq!(label(0, &[]), "Error frame 0x00000000");
-        assert_eq!(to_json(0x20, &[])["details"], json!(["no ACK on transmission"]));
+        assert_eq!(
+            serde_json::to_value(to_json(0x20, &[])).unwrap()["details"],
+            json!(["no ACK on transmission"])
+        );
     }
 
     #[test]

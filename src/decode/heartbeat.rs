@@ -1,6 +1,6 @@
 //! NMT error control (0x700 + node): heartbeat, boot-up and node guarding.
 
-use serde_json::json;
+use serde::Serialize;
 
 /// NMT state as carried by heartbeat and guarding frames.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -67,9 +67,22 @@ impl Heartbeat {
         }
     }
     /// The kind-specific JSON object.
-    pub fn to_json(&self) -> serde_json::Value {
-        json!({"state": self.state.map(NmtState::as_str), "toggle": self.toggle, "request": self.request})
+    pub fn to_json(&self) -> HeartbeatJson {
+        HeartbeatJson {
+            request: self.request,
+            state: self.state.map(NmtState::as_str),
+            toggle: self.toggle,
+        }
     }
+}
+
+/// The `heartbeat` object of a JSONL frame record (fields in key order).
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct HeartbeatJson {
+    pub request: bool,
+    /// `null` for a guarding request.
+    pub state: Option<&'static str>,
+    pub toggle: bool,
 }
 
 /// Decodes an error-control frame; the second value explains a rule broken.
@@ -114,6 +127,7 @@ pub fn decode(payload: &[u8], rtr: bool) -> (Heartbeat, Option<String>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use serde_json::json;
 
     #[test]
     fn states() {
@@ -122,7 +136,7 @@ mod tests {
         assert_eq!(decode(&[0x04], false).0.label(5), "Heartbeat node 5: Stopped");
         assert_eq!(decode(&[0x00], false).0.label(5), "Boot-up node 5");
         assert_eq!(
-            decode(&[0x00], false).0.to_json(),
+            serde_json::to_value(decode(&[0x00], false).0.to_json()).unwrap(),
             json!({"state": "boot_up", "toggle": false, "request": false})
         );
     }
@@ -136,7 +150,10 @@ mod tests {
         assert_eq!(p, None);
         let (req, _) = decode(&[], true);
         assert_eq!(req.label(2), "Node guarding request node 2");
-        assert_eq!(req.to_json(), json!({"state": null, "toggle": false, "request": true}));
+        assert_eq!(
+            serde_json::to_value(req.to_json()).unwrap(),
+            json!({"state": null, "toggle": false, "request": true})
+        );
     }
 
     #[test]

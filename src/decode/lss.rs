@@ -1,6 +1,6 @@
 //! LSS (CiA 305, 0x7E5 master -> slave, 0x7E4 slave -> master).
 
-use serde_json::json;
+use serde::Serialize;
 
 /// An LSS frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -133,9 +133,21 @@ impl Lss {
     }
 
     /// The kind-specific JSON object.
-    pub fn to_json(&self) -> serde_json::Value {
-        json!({"cs": self.cs, "service": self.service(), "from_master": self.from_master})
+    pub fn to_json(&self) -> LssJson {
+        LssJson {
+            cs: self.cs,
+            from_master: self.from_master,
+            service: self.service(),
+        }
     }
+}
+
+/// The `lss` object of a JSONL frame record (fields in key order).
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct LssJson {
+    pub cs: u8,
+    pub from_master: bool,
+    pub service: &'static str,
 }
 
 /// Decodes an LSS payload; the second value explains a rule broken.

@@ -1,6 +1,6 @@
 //! NMT module control (COB-ID 0x000): start, stop, pre-operational, resets.
 
-use serde_json::json;
+use serde::Serialize;
 
 /// An NMT command frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -51,9 +51,19 @@ impl Nmt {
     }
 
     /// The kind-specific JSON object.
-    pub fn to_json(&self) -> serde_json::Value {
-        json!({"command": self.command(), "target": self.target})
+    pub fn to_json(&self) -> NmtJson {
+        NmtJson {
+            command: self.command(),
+            target: self.target,
+        }
     }
+}
+
+/// The `nmt` object of a JSONL frame record (fields in key order).
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct NmtJson {
+    pub command: &'static str,
+    pub target: u8,
 }
 
 /// Decodes an NMT payload; the second value explains a rule broken (DLC, command byte).
@@ -77,6 +87,7 @@ pub fn decode(payload: &[u8]) -> (Nmt, Option<String>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use serde_json::json;
 
     #[test]
     fn all_five_commands() {
@@ -99,7 +110,10 @@ mod tests {
     fn broadcast_and_rule_breaks() {
         let (n, _) = decode(&[0x01, 0]);
         assert_eq!(n.label(), "NMT Start remote node -> all nodes");
-        assert_eq!(n.to_json(), json!({"command": "start", "target": 0}));
+        assert_eq!(
+            serde_json::to_value(n.to_json()).unwrap(),
+            json!({"command": "start", "target": 0})
+        );
         assert!(decode(&[0x01]).1.unwrap().contains("1 data bytes"));
         let (n, p) = decode(&[0x33, 1]);
         assert_eq!(n.command(), "unknown");

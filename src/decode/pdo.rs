@@ -1,7 +1,7 @@
 //! PDO payloads decoded into named, typed, scaled signals through the mapping in force.
 
 use crate::od::{DataType, Dictionary, MappedEntry, MappingSource, PdoMapping, Value};
-use serde_json::json;
+use serde::Serialize;
 
 /// One mapped signal taken out of a PDO payload.
 #[derive(Clone, Debug, PartialEq)]
@@ -53,16 +53,44 @@ impl Pdo {
     }
 
     /// The kind-specific JSON object.
-    pub fn to_json(&self) -> serde_json::Value {
-        let signals: Vec<serde_json::Value> = self
-            .signals
-            .iter()
-            .map(
-                |s| json!({"index": s.index, "sub": s.sub, "name": s.name, "value": s.value.to_json(), "text": s.text}),
-            )
-            .collect();
-        json!({"num": self.num, "signals": signals, "mapping_source": self.source.as_ref().map(source_text)})
+    pub fn to_json(&self) -> PdoJson<'_> {
+        PdoJson {
+            mapping_source: self.source.as_ref().map(source_text),
+            num: self.num,
+            signals: self
+                .signals
+                .iter()
+                .map(|s| SignalJson {
+                    index: s.index,
+                    name: &s.name,
+                    sub: s.sub,
+                    text: &s.text,
+                    value: &s.value,
+                })
+                .collect(),
+        }
     }
+}
+
+/// The `pdo` object of a JSONL frame record (fields in key order).
+#[derive(Clone, Debug, Serialize)]
+pub struct PdoJson<'a> {
+    /// Where the mapping came from ([`source_text`]), `null` when none is known.
+    pub mapping_source: Option<String>,
+    pub num: u16,
+    /// Empty when no mapping is known.
+    pub signals: Vec<SignalJson<'a>>,
+}
+
+/// One signal of [`PdoJson`] (fields in key order).
+#[derive(Clone, Debug, Serialize)]
+pub struct SignalJson<'a> {
+    pub index: u16,
+    pub name: &'a str,
+    pub sub: u8,
+    pub text: &'a str,
+    /// The raw typed value: a number, a string, or hex for bytes.
+    pub value: &'a Value,
 }
 
 /// Short text of a mapping source: `profile syntron-ds`, `eds drive.eds`, `sniffed @ 12.345678 s`.
@@ -167,6 +195,7 @@ pub fn entry_from_u32(v: u32) -> MappedEntry {
 mod tests {
     use super::*;
     use crate::od::{ObjectInfo, Profile};
+    use serde_json::json;
     use std::sync::Arc;
 
     fn dict() -> Dictionary {
@@ -225,8 +254,14 @@ mod tests {
             pdo.label(2, &payload)
                 .starts_with("TPDO1 node 2: Statusword=0x0237 (Operation enabled")
         );
-        assert_eq!(pdo.to_json()["signals"][1]["value"], 15000);
-        assert_eq!(pdo.to_json()["mapping_source"], "profile test");
+        assert_eq!(
+            serde_json::to_value(pdo.to_json()).unwrap()["signals"][1]["value"],
+            15000
+        );
+        assert_eq!(
+            serde_json::to_value(pdo.to_json()).unwrap()["mapping_source"],
+            "profile test"
+        );
     }
 
     #[test]
@@ -253,6 +288,6 @@ mod tests {
             source: None,
         };
         assert_eq!(pdo.label(3, &[1, 2]), "RPDO2 node 3: 01 02");
-        assert_eq!(pdo.to_json()["signals"], json!([]));
+        assert_eq!(serde_json::to_value(pdo.to_json()).unwrap()["signals"], json!([]));
     }
 }

@@ -1,6 +1,6 @@
 //! TIME (0x100): TIME_OF_DAY, milliseconds after midnight and days since 1984-01-01.
 
-use serde_json::json;
+use serde::Serialize;
 
 /// A TIME stamp frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -29,9 +29,22 @@ impl Time {
         format!("TIME {}", self.datetime())
     }
     /// The kind-specific JSON object.
-    pub fn to_json(&self) -> serde_json::Value {
-        json!({"ms": self.ms, "days": self.days, "datetime": self.datetime()})
+    pub fn to_json(&self) -> TimeJson {
+        TimeJson {
+            datetime: self.datetime(),
+            days: self.days,
+            ms: self.ms,
+        }
     }
+}
+
+/// The `time` object of a JSONL frame record (fields in key order).
+#[derive(Clone, Debug, Serialize)]
+pub struct TimeJson {
+    /// `YYYY-MM-DD hh:mm:ss.mmm`.
+    pub datetime: String,
+    pub days: u16,
+    pub ms: u32,
 }
 
 /// Days from 1970-01-01 to 1984-01-01.

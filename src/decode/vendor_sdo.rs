@@ -2,7 +2,7 @@
 //! 0xE8/0xE9 pair that reads or writes the same parameter of axes A and B in one frame.
 
 use crate::od::{Dictionary, SdoDirection, Value, format_value};
-use serde_json::json;
+use serde::Serialize;
 
 /// One decoded field of a vendor SDO frame.
 #[derive(Clone, Debug, PartialEq)]
@@ -92,23 +92,44 @@ impl VendorSdo {
     }
 
     /// The JSON object of the `vendor_sdo` key.
-    pub fn to_json(&self) -> serde_json::Value {
-        let fields: Vec<serde_json::Value> = self
-            .fields
-            .iter()
-            .map(|f| {
-                json!({
-                    "name": f.name,
-                    "raw": f.raw,
-                    "index": f.object.map(|o| o.0),
-                    "sub": f.object.map(|o| o.1),
-                    "object_name": f.object_name,
-                    "text": f.text,
+    pub fn to_json(&self) -> VendorSdoJson<'_> {
+        VendorSdoJson {
+            command: self.command,
+            fields: self
+                .fields
+                .iter()
+                .map(|f| VendorFieldJson {
+                    index: f.object.map(|o| o.0),
+                    name: &f.name,
+                    object_name: f.object_name.as_deref(),
+                    raw: f.raw,
+                    sub: f.object.map(|o| o.1),
+                    text: &f.text,
                 })
-            })
-            .collect();
-        json!({"command": self.command, "name": self.name, "fields": fields})
+                .collect(),
+            name: &self.name,
+        }
     }
+}
+
+/// The `vendor_sdo` object of a JSONL frame record (fields in key order).
+#[derive(Clone, Debug, Serialize)]
+pub struct VendorSdoJson<'a> {
+    pub command: u8,
+    pub fields: Vec<VendorFieldJson<'a>>,
+    pub name: &'a str,
+}
+
+/// One field of [`VendorSdoJson`] (fields in key order); `index`, `sub` and
+/// `object_name` are `null` when the field belongs to no object.
+#[derive(Clone, Debug, Serialize)]
+pub struct VendorFieldJson<'a> {
+    pub index: Option<u16>,
+    pub name: &'a str,
+    pub object_name: Option<&'a str>,
+    pub raw: i64,
+    pub sub: Option<u8>,
+    pub text: &'a str,
 }
 
 #[cfg(test)]
@@ -165,7 +186,7 @@ mod tests {
             "Write axis A and B: A 0x2318:00 A speed command (F0.3.018) = 54 rpm; \
              B 0x3318:00 B speed command (F1.3.018) = -54 rpm"
         );
-        assert_eq!(v.to_json()["fields"][3]["index"], 0x3318);
+        assert_eq!(serde_json::to_value(v.to_json()).unwrap()["fields"][3]["index"], 0x3318);
     }
 
     #[test]

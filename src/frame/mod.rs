@@ -5,6 +5,7 @@
 //! decoders never allocate per frame; the trace store packs it further.
 
 pub mod hex;
+pub mod json;
 
 /// Flag bits of a [`Frame`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

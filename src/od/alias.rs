@@ -28,10 +28,39 @@ pub struct AliasRule {
     pub description: Option<String>,
 }
 
+/// What is wrong with an alias rule of a profile.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum AliasError {
+    #[error("`{expr}` uses `{variable}`, which is not a placeholder of `{pattern}`")]
+    NotAPlaceholder {
+        expr: String,
+        variable: String,
+        pattern: String,
+    },
+    #[error("placeholder kind `{kind}` in `{pattern}` (use dec or hex)")]
+    PlaceholderKind { kind: String, pattern: String },
+    /// `inner` is the text between the braces.
+    #[error("bad placeholder `{{{inner}}}` in `{pattern}`")]
+    BadPlaceholder { inner: String, pattern: String },
+    #[error("placeholders need a separator between them in `{0}`")]
+    NoSeparator(String),
+    #[error("pattern `{0}` has no placeholder")]
+    NoPlaceholder(String),
+}
+
+/// Why a typed object does not resolve to (index, sub).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ObjectError {
+    #[error("empty object")]
+    Empty,
+    #[error("unknown object `{text}` (use 0xINDEX[:SUB], a name or a vendor alias of profile {profile})")]
+    Unknown { text: String, profile: String },
+}
+
 impl AliasRule {
     /// A rule from its pattern and expressions; checks that the expressions
     /// only use the pattern's placeholders.
-    pub fn new(pattern: &str, index: Expr, sub: Expr, description: Option<String>) -> Result<AliasRule, String> {
+    pub fn new(pattern: &str, index: Expr, sub: Expr, description: Option<String>) -> Result<AliasRule, AliasError> {
         let pieces = parse_pattern(pattern)?;
         let names: Vec<&str> = pieces
             .iter()
@@ -42,7 +71,11 @@ impl AliasRule {
             .collect();
         for e in [&index, &sub] {
             if let Some(v) = e.variables().into_iter().find(|v| !names.contains(v)) {
-                return Err(format!("`{e}` uses `{v}`, which is not a placeholder of `{pattern}`"));
+                return Err(AliasError::NotAPlaceholder {
+                    expr: e.to_string(),
+                    variable: v.to_string(),
+                    pattern: pattern.to_string(),
+                });
             }
         }
         Ok(AliasRule {
@@ -64,7 +97,7 @@ impl AliasRule {
     }
 }
 
-fn parse_pattern(pattern: &str) -> Result<Vec<Piece>, String> {
+fn parse_pattern(pattern: &str) -> Result<Vec<Piece>, AliasError> {
     let mut pieces = Vec::new();
     let mut chars = pattern.chars();
     while let Some(c) = chars.next() {
@@ -77,19 +110,27 @@ fn parse_pattern(pattern: &str) -> Result<Vec<Piece>, String> {
         let radix = match kind.trim() {
             "dec" => 10,
             "hex" => 16,
-            other => return Err(format!("placeholder kind `{other}` in `{pattern}` (use dec or hex)")),
+            other => {
+                return Err(AliasError::PlaceholderKind {
+                    kind: other.to_string(),
+                    pattern: pattern.to_string(),
+                });
+            }
         };
         let name = name.trim();
         if name.is_empty() || !name.chars().all(|c| c.is_alphanumeric() || c == '_') {
-            return Err(format!("bad placeholder `{{{inner}}}` in `{pattern}`"));
+            return Err(AliasError::BadPlaceholder {
+                inner,
+                pattern: pattern.to_string(),
+            });
         }
         if matches!(pieces.last(), Some(Piece::Var(..))) {
-            return Err(format!("placeholders need a separator between them in `{pattern}`"));
+            return Err(AliasError::NoSeparator(pattern.to_string()));
         }
         pieces.push(Piece::Var(name.to_string(), radix));
     }
     if !pieces.iter().any(|p| matches!(p, Piece::Var(..))) {
-        return Err(format!("pattern `{pattern}` has no placeholder"));
+        return Err(AliasError::NoPlaceholder(pattern.to_string()));
     }
     Ok(pieces)
 }
@@ -170,10 +211,10 @@ fn parse_hexish(t: &str, bare_is_hex: bool) -> Option<u32> {
 /// `alias_rules`; each searched from the most specific layer), then an object
 /// name (case-insensitive, the first layer that has it; `Identity object:1`
 /// names a sub by number).
-pub fn resolve_object(dict: &Dictionary, text: &str) -> Result<(u16, u8), String> {
+pub fn resolve_object(dict: &Dictionary, text: &str) -> Result<(u16, u8), ObjectError> {
     let t = text.trim();
     if t.is_empty() {
-        return Err("empty object".to_string());
+        return Err(ObjectError::Empty);
     }
     if let Some(r) = parse_object_ref(t) {
         return Ok(r);
@@ -210,10 +251,10 @@ pub fn resolve_object(dict: &Dictionary, text: &str) -> Result<(u16, u8), String
             return Ok((*i, sub.unwrap_or(*s)));
         }
     }
-    Err(format!(
-        "unknown object `{t}` (use 0xINDEX[:SUB], a name or a vendor alias of profile {})",
-        dict.profile_name()
-    ))
+    Err(ObjectError::Unknown {
+        text: t.to_string(),
+        profile: dict.profile_name().to_string(),
+    })
 }
 
 #[cfg(test)]
@@ -250,10 +291,10 @@ mod tests {
     #[test]
     fn bad_rules_are_errors() {
         let e = |p: &str, i: &str| AliasRule::new(p, Expr::parse(i).unwrap(), Expr::constant(0), None);
-        assert!(e("F{x}{y}", "x").unwrap_err().contains("separator"));
-        assert!(e("F{x:oct}", "x").unwrap_err().contains("oct"));
-        assert!(e("F{x}", "x + q").unwrap_err().contains("`q`"));
-        assert!(e("F", "1").unwrap_err().contains("no placeholder"));
+        assert!(e("F{x}{y}", "x").unwrap_err().to_string().contains("separator"));
+        assert!(e("F{x:oct}", "x").unwrap_err().to_string().contains("oct"));
+        assert!(e("F{x}", "x + q").unwrap_err().to_string().contains("`q`"));
+        assert!(e("F", "1").unwrap_err().to_string().contains("no placeholder"));
     }
 
     #[test]

@@ -59,11 +59,48 @@ pub fn shared_builtin(name: &str) -> Option<Result<SharedProfile, LoadError>> {
     Some(loaded)
 }
 
+/// Why a `NODE=VALUE` argument does not read.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum NodeArgError {
+    #[error("`{0}`: expected NODE=VALUE, e.g. 2=cia402")]
+    NoEquals(String),
+    #[error("`{arg}`: node `{node}` is not 1..127")]
+    BadNode { arg: String, node: String },
+    #[error("`{0}`: nothing after `=`")]
+    NothingAfter(String),
+}
+
+/// Why `--profile NODE=NAME` / `--eds NODE=FILE` (or a profile's `extends`) cannot be bound.
+#[derive(Debug, thiserror::Error)]
+pub enum BindError {
+    #[error(transparent)]
+    NodeArg(#[from] NodeArgError),
+    /// The profile given as `--profile ARG` did not load.
+    #[error("--profile {arg}: {error}")]
+    Profile { arg: String, error: Box<BindError> },
+    #[error("--eds {arg}: cannot read {file}: {source}")]
+    ReadEds {
+        arg: String,
+        file: String,
+        source: std::io::Error,
+    },
+    /// `builtin` lists the built-in names.
+    #[error("unknown profile `{name}` (built-in: {builtin}; or give a path to a .json file)")]
+    UnknownProfile { name: String, builtin: String },
+    #[error("cannot read {file}: {source}")]
+    Read { file: String, source: std::io::Error },
+    #[error("{file}: line {line}: not UTF-8 (JSON profiles are UTF-8)")]
+    NotUtf8 { file: String, line: usize },
+    /// The profile file is not a valid profile (located message).
+    #[error(transparent)]
+    Load(#[from] LoadError),
+}
+
 /// Parses `NODE=VALUE` with NODE decimal or `0x` hex in 1..=127.
-pub fn parse_node_arg(arg: &str) -> Result<(u8, &str), String> {
+pub fn parse_node_arg(arg: &str) -> Result<(u8, &str), NodeArgError> {
     let (node, value) = arg
         .split_once('=')
-        .ok_or_else(|| format!("`{arg}`: expected NODE=VALUE, e.g. 2=cia402"))?;
+        .ok_or_else(|| NodeArgError::NoEquals(arg.to_string()))?;
     let n = node.trim();
     let parsed = match n.strip_prefix("0x").or_else(|| n.strip_prefix("0X")) {
         Some(h) => u8::from_str_radix(h, 16).ok(),
@@ -71,10 +108,13 @@ pub fn parse_node_arg(arg: &str) -> Result<(u8, &str), String> {
     };
     let node = parsed
         .filter(|v| (1..=127).contains(v))
-        .ok_or_else(|| format!("`{arg}`: node `{n}` is not 1..127"))?;
+        .ok_or_else(|| NodeArgError::BadNode {
+            arg: arg.to_string(),
+            node: n.to_string(),
+        })?;
     let value = value.trim();
     if value.is_empty() {
-        return Err(format!("`{arg}`: nothing after `=`"));
+        return Err(NodeArgError::NothingAfter(arg.to_string()));
     }
     Ok((node, value))
 }
@@ -100,7 +140,7 @@ pub struct Bindings {
 
 impl Bindings {
     /// Bindings with no node bound: every node uses CiA 402 + CiA 301.
-    pub fn new() -> Result<Bindings, String> {
+    pub fn new() -> Result<Bindings, BindError> {
         let mut b = Bindings {
             loaded: BTreeMap::new(),
             nodes: BTreeMap::new(),
@@ -115,23 +155,29 @@ impl Bindings {
     }
 
     /// Bindings from `--profile NODE=NAME` and `--eds NODE=FILE` arguments.
-    pub fn from_args(profiles: &[String], eds: &[String], read: ReadFile) -> Result<Bindings, String> {
+    pub fn from_args(profiles: &[String], eds: &[String], read: ReadFile) -> Result<Bindings, BindError> {
         let mut b = Bindings::new()?;
         for arg in profiles {
             let (node, name) = parse_node_arg(arg)?;
-            b.bind_profile(node, name, read)
-                .map_err(|e| format!("--profile {arg}: {e}"))?;
+            b.bind_profile(node, name, read).map_err(|e| BindError::Profile {
+                arg: arg.clone(),
+                error: Box::new(e),
+            })?;
         }
         for arg in eds {
             let (node, file) = parse_node_arg(arg)?;
-            let bytes = read(Path::new(file)).map_err(|e| format!("--eds {arg}: cannot read {file}: {e}"))?;
+            let bytes = read(Path::new(file)).map_err(|source| BindError::ReadEds {
+                arg: arg.clone(),
+                file: file.to_string(),
+                source,
+            })?;
             b.bind_eds_bytes(node, file, &bytes);
         }
         Ok(b)
     }
 
     /// Binds a profile (built-in name, or path to a JSON file) to a node.
-    pub fn bind_profile(&mut self, node: u8, name: &str, read: ReadFile) -> Result<(), String> {
+    pub fn bind_profile(&mut self, node: u8, name: &str, read: ReadFile) -> Result<(), BindError> {
         let is_file = name.ends_with(".json") || name.contains('/') || name.contains('\\');
         let (profile, dir) = if is_file {
             let path = Path::new(name);
@@ -224,37 +270,43 @@ impl Bindings {
     }
 
     /// A profile by name: already loaded, built-in, or `dir/NAME.json`.
-    fn named(&mut self, name: &str, dir: Option<&Path>, read: Option<ReadFile>) -> Result<Arc<Profile>, String> {
+    fn named(&mut self, name: &str, dir: Option<&Path>, read: Option<ReadFile>) -> Result<Arc<Profile>, BindError> {
         if let Some(p) = self.loaded.get(name) {
             return Ok(p.clone());
         }
         if let Some(result) = shared_builtin(name) {
-            let (p, w) = result.map_err(|e| e.to_string())?;
+            let (p, w) = result?;
             self.warnings.extend(w);
             self.loaded.insert(name.to_string(), p.clone());
             return Ok(p);
         }
         match (dir, read) {
             (Some(dir), Some(read)) => self.load_file(&dir.join(format!("{name}.json")), read),
-            _ => Err(format!(
-                "unknown profile `{name}` (built-in: {}; or give a path to a .json file)",
-                builtin_names().collect::<Vec<_>>().join(", ")
-            )),
+            _ => Err(BindError::UnknownProfile {
+                name: name.to_string(),
+                builtin: builtin_names().collect::<Vec<_>>().join(", "),
+            }),
         }
     }
 
-    fn load_file(&mut self, path: &Path, read: ReadFile) -> Result<Arc<Profile>, String> {
+    fn load_file(&mut self, path: &Path, read: ReadFile) -> Result<Arc<Profile>, BindError> {
         let key = path.display().to_string();
         if let Some(p) = self.loaded.get(&key) {
             return Ok(p.clone());
         }
-        let bytes = read(path).map_err(|e| format!("cannot read {key}: {e}"))?;
+        let bytes = read(path).map_err(|source| BindError::Read {
+            file: key.clone(),
+            source,
+        })?;
         let text = String::from_utf8(bytes).map_err(|e| {
             let at = e.utf8_error().valid_up_to();
             let line = e.as_bytes()[..at].iter().filter(|&&b| b == b'\n').count() + 1;
-            format!("{key}: line {line}: not UTF-8 (JSON profiles are UTF-8)")
+            BindError::NotUtf8 {
+                file: key.clone(),
+                line,
+            }
         })?;
-        let (p, w) = load_profile(&key, &text).map_err(|e| e.to_string())?;
+        let (p, w) = load_profile(&key, &text)?;
         self.warnings.extend(w);
         let p = Arc::new(p);
         self.loaded.insert(key, p.clone());
@@ -297,7 +349,7 @@ impl Bindings {
                         Err(e) => self.warnings.push(Warning {
                             file: p.name.clone(),
                             at: "extends".into(),
-                            message: e,
+                            message: e.to_string(),
                         }),
                     }
                 }
@@ -381,10 +433,20 @@ mod tests {
     fn node_args() {
         assert_eq!(parse_node_arg("2=cia402"), Ok((2, "cia402")));
         assert_eq!(parse_node_arg("0x7F = drive.eds"), Ok((127, "drive.eds")));
-        assert!(parse_node_arg("0=cia402").unwrap_err().contains("not 1..127"));
-        assert!(parse_node_arg("128=cia402").unwrap_err().contains("not 1..127"));
-        assert!(parse_node_arg("cia402").unwrap_err().contains("NODE=VALUE"));
-        assert!(parse_node_arg("3=").unwrap_err().contains("nothing after"));
+        assert!(
+            parse_node_arg("0=cia402")
+                .unwrap_err()
+                .to_string()
+                .contains("not 1..127")
+        );
+        assert!(
+            parse_node_arg("128=cia402")
+                .unwrap_err()
+                .to_string()
+                .contains("not 1..127")
+        );
+        assert!(parse_node_arg("cia402").unwrap_err().to_string().contains("NODE=VALUE"));
+        assert!(parse_node_arg("3=").unwrap_err().to_string().contains("nothing after"));
     }
 
     const VENDOR: &str = r#"{ "name": "vendor", "extends": ["base", "cia402"],
@@ -426,6 +488,7 @@ mod tests {
         assert!(
             resolve_object(b.dictionary(3), "F1.3.018")
                 .unwrap_err()
+                .to_string()
                 .contains("unknown object")
         );
     }
@@ -441,18 +504,24 @@ mod tests {
         assert_eq!(resolve_object(d, "Vendor-ID"), Ok((0x1018, 1)));
         assert_eq!(resolve_object(d, "identity object:2"), Ok((0x1018, 2)));
         assert_eq!(resolve_object(d, "producer heartbeat time"), Ok((0x1017, 0)));
-        let e = resolve_object(d, "warp drive").unwrap_err();
+        let e = resolve_object(d, "warp drive").unwrap_err().to_string();
         assert!(e.contains("unknown object `warp drive`") && e.contains("cia402"), "{e}");
         assert!(resolve_object(d, "  ").is_err());
     }
 
     #[test]
     fn bad_bindings_are_errors() {
-        let e = Bindings::from_args(&["2=nosuch".into()], &[], &files).unwrap_err();
+        let e = Bindings::from_args(&["2=nosuch".into()], &[], &files)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("unknown profile `nosuch`") && e.contains("cia402"), "{e}");
-        let e = Bindings::from_args(&["2=/p/missing.json".into()], &[], &files).unwrap_err();
+        let e = Bindings::from_args(&["2=/p/missing.json".into()], &[], &files)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("cannot read /p/missing.json"), "{e}");
-        let e = Bindings::from_args(&[], &["2=/p/missing.eds".into()], &files).unwrap_err();
+        let e = Bindings::from_args(&[], &["2=/p/missing.eds".into()], &files)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("--eds 2=/p/missing.eds"), "{e}");
     }
 

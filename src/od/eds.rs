@@ -107,12 +107,25 @@ fn parse_ini(text: &str, w: &mut Vec<(usize, String)>) -> Ini {
     Ini { sections }
 }
 
+/// A value in an EDS/DCF that does not read as its type.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum EdsValueError {
+    #[error("empty number")]
+    Empty,
+    #[error("`{0}` is not a number")]
+    NotANumber(String),
+    #[error("`{0}` overflows")]
+    Overflow(String),
+    #[error("`{0}` is not hex bytes")]
+    NotHex(String),
+}
+
 /// Parses a CiA 306 number: `0x1A` hex, `017` octal, `42` decimal, `-5`, and
 /// sums with `$NODEID` (`$NODEID+0x180`, `0x180+$NODEID`, `$NODEID`).
-pub fn parse_number(text: &str, node: u8) -> Result<i64, String> {
+pub fn parse_number(text: &str, node: u8) -> Result<i64, EdsValueError> {
     let t = text.trim();
     if t.is_empty() {
-        return Err("empty number".to_string());
+        return Err(EdsValueError::Empty);
     }
     let mut total: i64 = 0;
     for term in t.split('+') {
@@ -120,9 +133,11 @@ pub fn parse_number(text: &str, node: u8) -> Result<i64, String> {
         let v = if term.eq_ignore_ascii_case("$nodeid") {
             i64::from(node)
         } else {
-            parse_plain(term).ok_or_else(|| format!("`{t}` is not a number"))?
+            parse_plain(term).ok_or_else(|| EdsValueError::NotANumber(t.to_string()))?
         };
-        total = total.checked_add(v).ok_or_else(|| format!("`{t}` overflows"))?;
+        total = total
+            .checked_add(v)
+            .ok_or_else(|| EdsValueError::Overflow(t.to_string()))?;
     }
     Ok(total)
 }
@@ -243,7 +258,7 @@ impl Importer<'_> {
         if let Some((v, line)) = value {
             match self.value(v, info.data_type) {
                 Ok(v) => info.default = Some(v),
-                Err(e) => self.warn(line, e),
+                Err(e) => self.warn(line, e.to_string()),
             }
         }
         if let Some((d, _)) = sec.get("denotation").filter(|(d, _)| !d.is_empty()) {
@@ -252,14 +267,14 @@ impl Importer<'_> {
         info
     }
 
-    fn value(&self, text: &str, t: DataType) -> Result<Value, String> {
+    fn value(&self, text: &str, t: DataType) -> Result<Value, EdsValueError> {
         use DataType::*;
         Ok(match t {
             VisibleString | UnicodeString => Value::Text(text.to_string()),
             OctetString | Domain | TimeOfDay | TimeDifference => {
                 let digits = text.trim().trim_start_matches("0x").trim_start_matches("0X");
                 if !digits.len().is_multiple_of(2) || !digits.bytes().all(|b| b.is_ascii_hexdigit()) {
-                    return Err(format!("`{text}` is not hex bytes"));
+                    return Err(EdsValueError::NotHex(text.to_string()));
                 }
                 Value::Bytes(
                     digits
@@ -271,7 +286,11 @@ impl Importer<'_> {
             }
             F32 | F64 => match parse_number(text, self.node) {
                 Ok(i) => Value::Float(i as f64),
-                Err(_) => Value::Float(text.trim().parse().map_err(|_| format!("`{text}` is not a number"))?),
+                Err(_) => Value::Float(
+                    text.trim()
+                        .parse()
+                        .map_err(|_| EdsValueError::NotANumber(text.to_string()))?,
+                ),
             },
             Boolean => Value::Bool(parse_number(text, self.node)? != 0),
             I8 | I16 | I24 | I32 | I40 | I48 | I56 | I64 => {
@@ -494,7 +513,7 @@ fn compact_subs(im: &mut Importer, ini: &Ini, p: &mut Profile, index: u16, sec: 
         if let Some((v, line)) = values.and_then(|s| s.get(&sub.to_string())) {
             match im.value(v, info.data_type) {
                 Ok(v) => info.default = Some(v),
-                Err(e) => im.warn(line, e),
+                Err(e) => im.warn(line, e.to_string()),
             }
         }
         p.objects.insert((index, sub), info);

@@ -6,6 +6,46 @@
 
 use std::fmt;
 
+/// What is wrong with an expression: its text (parsing) or its value (evaluating).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ExprError {
+    /// A character no token starts with (`at` counts from 1).
+    #[error("unexpected `{ch}` at character {at} of expression `{text}`")]
+    BadCharacter { ch: char, at: usize, text: String },
+    #[error("bad number `{literal}` in expression `{text}`")]
+    BadNumber { literal: String, text: String },
+    /// A token after a complete expression.
+    #[error("unexpected {token} in expression `{text}`")]
+    Trailing { token: String, text: String },
+    /// A token where an operand belongs.
+    #[error("unexpected {0}")]
+    Unexpected(String),
+    #[error("expected `:` after `?` branch")]
+    ExpectedColon,
+    #[error("missing `)`")]
+    MissingClose,
+    #[error("expression ends too early")]
+    EndsEarly,
+    #[error("expression nests deeper than {MAX_DEPTH} levels (parentheses, unary operators, `?:` or operator chains)")]
+    TooDeep,
+    /// Evaluating the expression `expr` failed.
+    #[error("{fault} in `{expr}`")]
+    Eval { fault: EvalFault, expr: String },
+}
+
+/// Why evaluating an expression failed.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum EvalFault {
+    #[error("unknown variable `{0}`")]
+    UnknownVariable(String),
+    #[error("arithmetic overflow")]
+    Overflow,
+    #[error("bad shift {0}")]
+    BadShift(i64),
+    #[error("division by zero")]
+    DivisionByZero,
+}
+
 /// A parsed expression, keeping its source text for messages.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Expr {
@@ -78,7 +118,7 @@ enum Tok {
 
 impl Expr {
     /// Parses `text`; the error says what is wrong and at which character.
-    pub fn parse(text: &str) -> Result<Expr, String> {
+    pub fn parse(text: &str) -> Result<Expr, ExprError> {
         let toks = tokenize(text)?;
         let mut p = Parser {
             toks: &toks,
@@ -87,7 +127,10 @@ impl Expr {
         };
         let (node, _) = p.conditional()?;
         if p.pos < toks.len() {
-            return Err(format!("unexpected {:?} in expression `{text}`", toks[p.pos]));
+            return Err(ExprError::Trailing {
+                token: format!("{:?}", toks[p.pos]),
+                text: text.to_string(),
+            });
         }
         Ok(Expr {
             src: text.trim().to_string(),
@@ -131,8 +174,11 @@ impl Expr {
     }
 
     /// Evaluates with `vars` giving each variable's value.
-    pub fn eval(&self, vars: &dyn Fn(&str) -> Option<i64>) -> Result<i64, String> {
-        eval(&self.node, vars).map_err(|e| format!("{e} in `{}`", self.src))
+    pub fn eval(&self, vars: &dyn Fn(&str) -> Option<i64>) -> Result<i64, ExprError> {
+        eval(&self.node, vars).map_err(|fault| ExprError::Eval {
+            fault,
+            expr: self.src.clone(),
+        })
     }
 }
 
@@ -142,11 +188,11 @@ impl fmt::Display for Expr {
     }
 }
 
-fn eval(n: &Node, vars: &dyn Fn(&str) -> Option<i64>) -> Result<i64, String> {
-    let overflow = || "arithmetic overflow".to_string();
+fn eval(n: &Node, vars: &dyn Fn(&str) -> Option<i64>) -> Result<i64, EvalFault> {
+    let overflow = || EvalFault::Overflow;
     Ok(match n {
         Node::Num(v) => *v,
-        Node::Var(name) => vars(name).ok_or_else(|| format!("unknown variable `{name}`"))?,
+        Node::Var(name) => vars(name).ok_or_else(|| EvalFault::UnknownVariable(name.clone()))?,
         Node::Unary(op, a) => {
             let a = eval(a, vars)?;
             match op {
@@ -171,16 +217,11 @@ fn eval(n: &Node, vars: &dyn Fn(&str) -> Option<i64>) -> Result<i64, String> {
                 _ => {}
             }
             let y = eval(b, vars)?;
-            let shift = |y: i64| {
-                u32::try_from(y)
-                    .ok()
-                    .filter(|s| *s < 64)
-                    .ok_or_else(|| format!("bad shift {y}"))
-            };
+            let shift = |y: i64| u32::try_from(y).ok().filter(|s| *s < 64).ok_or(EvalFault::BadShift(y));
             match op {
                 Op::Mul => x.checked_mul(y).ok_or_else(overflow)?,
-                Op::Div => x.checked_div(y).ok_or_else(|| "division by zero".to_string())?,
-                Op::Rem => x.checked_rem(y).ok_or_else(|| "division by zero".to_string())?,
+                Op::Div => x.checked_div(y).ok_or(EvalFault::DivisionByZero)?,
+                Op::Rem => x.checked_rem(y).ok_or(EvalFault::DivisionByZero)?,
                 Op::Add => x.checked_add(y).ok_or_else(overflow)?,
                 Op::Sub => x.checked_sub(y).ok_or_else(overflow)?,
                 Op::Shl => x.checked_shl(shift(y)?).ok_or_else(overflow)?,
@@ -200,7 +241,7 @@ fn eval(n: &Node, vars: &dyn Fn(&str) -> Option<i64>) -> Result<i64, String> {
     })
 }
 
-fn tokenize(text: &str) -> Result<Vec<Tok>, String> {
+fn tokenize(text: &str) -> Result<Vec<Tok>, ExprError> {
     let chars: Vec<char> = text.chars().collect();
     let mut out = Vec::new();
     let mut i = 0;
@@ -216,7 +257,10 @@ fn tokenize(text: &str) -> Result<Vec<Tok>, String> {
                 i += 1;
             }
             let lit: String = chars[start..i].iter().collect();
-            let v = parse_int(&lit).ok_or_else(|| format!("bad number `{lit}` in expression `{text}`"))?;
+            let v = parse_int(&lit).ok_or_else(|| ExprError::BadNumber {
+                literal: lit.clone(),
+                text: text.to_string(),
+            })?;
             out.push(Tok::Num(v));
             continue;
         }
@@ -255,10 +299,11 @@ fn tokenize(text: &str) -> Result<Vec<Tok>, String> {
             ('(', _) => (Tok::Open, 1),
             (')', _) => (Tok::Close, 1),
             _ => {
-                return Err(format!(
-                    "unexpected `{c}` at character {} of expression `{text}`",
-                    i + 1
-                ));
+                return Err(ExprError::BadCharacter {
+                    ch: c,
+                    at: i + 1,
+                    text: text.to_string(),
+                });
             }
         };
         out.push(tok);
@@ -295,10 +340,6 @@ pub fn parse_int(text: &str) -> Option<i64> {
 /// evaluating and dropping far from the end of the stack.
 pub const MAX_DEPTH: usize = 200;
 
-fn too_deep() -> String {
-    format!("expression nests deeper than {MAX_DEPTH} levels (parentheses, unary operators, `?:` or operator chains)")
-}
-
 struct Parser<'a> {
     toks: &'a [Tok],
     pos: usize,
@@ -315,29 +356,29 @@ impl Parser<'_> {
     }
 
     /// Opens one level of recursion; an error past [`MAX_DEPTH`].
-    fn enter(&mut self) -> Result<(), String> {
+    fn enter(&mut self) -> Result<(), ExprError> {
         self.depth += 1;
         if self.depth > MAX_DEPTH {
-            Err(too_deep())
+            Err(ExprError::TooDeep)
         } else {
             Ok(())
         }
     }
 
-    fn conditional(&mut self) -> Result<Parsed, String> {
+    fn conditional(&mut self) -> Result<Parsed, ExprError> {
         self.enter()?;
         let (c, hc) = self.binary(0)?;
         let out = if self.peek() == Some(&Tok::Question) {
             self.pos += 1;
             let (a, ha) = self.conditional()?;
             if self.peek() != Some(&Tok::Colon) {
-                return Err("expected `:` after `?` branch".to_string());
+                return Err(ExprError::ExpectedColon);
             }
             self.pos += 1;
             let (b, hb) = self.conditional()?;
             let h = hc.max(ha).max(hb) + 1;
             if h > MAX_DEPTH {
-                return Err(too_deep());
+                return Err(ExprError::TooDeep);
             }
             (Node::Cond(Box::new(c), Box::new(a), Box::new(b)), h)
         } else {
@@ -347,7 +388,7 @@ impl Parser<'_> {
         Ok(out)
     }
 
-    fn binary(&mut self, min_power: u8) -> Result<Parsed, String> {
+    fn binary(&mut self, min_power: u8) -> Result<Parsed, ExprError> {
         self.enter()?;
         let (mut left, mut height) = self.unary()?;
         while let Some(Tok::Op(op)) = self.peek() {
@@ -359,7 +400,7 @@ impl Parser<'_> {
             let (right, hr) = self.binary(op.power())?;
             height = height.max(hr) + 1;
             if height > MAX_DEPTH {
-                return Err(too_deep());
+                return Err(ExprError::TooDeep);
             }
             left = Node::Binary(op, Box::new(left), Box::new(right));
         }
@@ -367,7 +408,7 @@ impl Parser<'_> {
         Ok((left, height))
     }
 
-    fn unary(&mut self) -> Result<Parsed, String> {
+    fn unary(&mut self) -> Result<Parsed, ExprError> {
         let op = match self.peek() {
             Some(Tok::Op(Op::Sub)) => '-',
             Some(Tok::Op(Op::Add)) => '+',
@@ -386,7 +427,7 @@ impl Parser<'_> {
         })
     }
 
-    fn primary(&mut self) -> Result<Parsed, String> {
+    fn primary(&mut self) -> Result<Parsed, ExprError> {
         let tok = self.peek().cloned();
         self.pos += 1;
         match tok {
@@ -395,13 +436,13 @@ impl Parser<'_> {
             Some(Tok::Open) => {
                 let inner = self.conditional()?;
                 if self.peek() != Some(&Tok::Close) {
-                    return Err("missing `)`".to_string());
+                    return Err(ExprError::MissingClose);
                 }
                 self.pos += 1;
                 Ok(inner)
             }
-            Some(t) => Err(format!("unexpected {t:?}")),
-            None => Err("expression ends too early".to_string()),
+            Some(t) => Err(ExprError::Unexpected(format!("{t:?}"))),
+            None => Err(ExprError::EndsEarly),
         }
     }
 }
@@ -410,7 +451,7 @@ impl Parser<'_> {
 mod tests {
     use super::*;
 
-    fn ev(text: &str, vars: &[(&str, i64)]) -> Result<i64, String> {
+    fn ev(text: &str, vars: &[(&str, i64)]) -> Result<i64, ExprError> {
         let e = Expr::parse(text)?;
         e.eval(&|n| vars.iter().find(|(k, _)| *k == n).map(|(_, v)| *v))
     }
@@ -436,14 +477,44 @@ mod tests {
 
     #[test]
     fn errors_are_messages() {
-        assert!(ev("1 / 0", &[]).unwrap_err().contains("division by zero"));
-        assert!(ev("speed * 10", &[]).unwrap_err().contains("unknown variable `speed`"));
-        assert!(ev("0x7FFFFFFFFFFFFFFF + 1", &[]).unwrap_err().contains("overflow"));
+        assert!(ev("1 / 0", &[]).unwrap_err().to_string().contains("division by zero"));
+        assert!(
+            ev("speed * 10", &[])
+                .unwrap_err()
+                .to_string()
+                .contains("unknown variable `speed`")
+        );
+        assert!(
+            ev("0x7FFFFFFFFFFFFFFF + 1", &[])
+                .unwrap_err()
+                .to_string()
+                .contains("overflow")
+        );
         assert!(Expr::parse("1 +").is_err());
         assert!(Expr::parse("(1").is_err());
-        assert!(Expr::parse("2 $ 3").unwrap_err().contains("`$`"));
+        assert!(Expr::parse("2 $ 3").unwrap_err().to_string().contains("`$`"));
         assert!(Expr::parse("0xZZ").is_err());
         assert!(ev("1 << 64", &[]).is_err());
+    }
+
+    #[test]
+    fn typed_errors_keep_their_messages() {
+        let text = |r: Result<i64, ExprError>| r.unwrap_err().to_string();
+        assert_eq!(
+            text(ev("2 $ 3", &[])),
+            "unexpected `$` at character 3 of expression `2 $ 3`"
+        );
+        assert_eq!(text(ev("0x1G", &[])), "bad number `0x1G` in expression `0x1G`");
+        assert_eq!(text(ev("speed * 10", &[])), "unknown variable `speed` in `speed * 10`");
+        assert_eq!(text(ev("1 << 64", &[])), "bad shift 64 in `1 << 64`");
+        assert_eq!(text(ev("(1", &[])), "missing `)`");
+        assert_eq!(
+            ev("x / 0", &[("x", 1)]),
+            Err(ExprError::Eval {
+                fault: EvalFault::DivisionByZero,
+                expr: "x / 0".into()
+            })
+        );
     }
 
     #[test]
@@ -455,7 +526,7 @@ mod tests {
         let chain = format!("1{}", " + 1".repeat(100_000));
         for text in [&parens, &minus, &nots, &conds, &chain] {
             let e = Expr::parse(text).unwrap_err();
-            assert!(e.contains("nests deeper than 200 levels"), "{e}");
+            assert!(e.to_string().contains("nests deeper than 200 levels"), "{e}");
         }
         // Reasonable nesting still parses.
         assert_eq!(ev(&format!("{}1{}", "(".repeat(50), ")".repeat(50)), &[]), Ok(1));

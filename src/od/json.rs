@@ -14,7 +14,9 @@ use serde_json::Value as Json;
 use super::alias::{AliasRule, parse_object_ref};
 use super::expr::{Expr, parse_int};
 use super::fields::{ByteField, SdoCommand, SdoDirection};
-use super::procedure::{FailIf, NmtCommand, ProcParam, Procedure, Step, object_variables, parse_frame_data};
+use super::procedure::{
+    FailIf, NmtCommand, ProcParam, Procedure, ProcedureError, Step, object_variables, parse_frame_data,
+};
 use super::{
     Axis, IdCondition, IdTest, IndexRange, MappingSource, ObjectInfo, PdoMappable, PdoSet, PdoTemplate, Profile,
     TextMatch, Warning,
@@ -56,7 +58,7 @@ mod tests;
 mod values;
 
 use dto::*;
-use values::{byte, default_value, expr, float, index_range, int, mapped_entry, object_range, sub_range};
+use values::{ValueError, byte, default_value, expr, float, index_range, int, mapped_entry, object_range, sub_range};
 pub use values::{parse_access, parse_type};
 
 /// Loads a profile from JSON text. `file` names the source in messages.
@@ -212,8 +214,8 @@ impl Cx<'_> {
     }
 
     /// Runs a conversion; an error becomes a warning at `at` and `None`.
-    fn ok<T>(&mut self, at: &str, r: Result<T, String>) -> Option<T> {
-        r.map_err(|e| self.warn(at, e)).ok()
+    fn ok<T, E: std::fmt::Display>(&mut self, at: &str, r: Result<T, E>) -> Option<T> {
+        r.map_err(|e| self.warn(at, e.to_string())).ok()
     }
 
     fn profile(&mut self, d: ProfileDto) -> Profile {
@@ -790,7 +792,7 @@ impl Cx<'_> {
             for u in unknown {
                 self.warn(&format!("{step_at}.{u}"), "unknown field, ignored");
             }
-            let step = dto.map_err(|e| e.to_string()).and_then(step);
+            let step = dto.map_err(StepError::from).and_then(step);
             match step {
                 Ok(s) => steps.push(s),
                 Err(e) => {
@@ -813,7 +815,26 @@ impl Cx<'_> {
     }
 }
 
-fn step(d: StepDto) -> Result<Step, String> {
+/// What is wrong with a procedure step of a profile.
+#[derive(Debug, thiserror::Error)]
+enum StepError {
+    /// Not the shape of a step.
+    #[error(transparent)]
+    Shape(#[from] serde_json::Error),
+    #[error("unknown type `{0}`")]
+    UnknownType(String),
+    #[error("unknown NMT command `{0}`")]
+    UnknownNmt(String),
+    /// The named number does not fit.
+    #[error("{0} out of range")]
+    OutOfRange(&'static str),
+    #[error(transparent)]
+    Value(#[from] ValueError),
+    #[error(transparent)]
+    Procedure(#[from] ProcedureError),
+}
+
+fn step(d: StepDto) -> Result<Step, StepError> {
     if let StepDto::SdoWrite { object, .. } | StepDto::SdoRead { object } = &d {
         object_variables(object)?;
     }
@@ -830,7 +851,7 @@ fn step(d: StepDto) -> Result<Step, String> {
             data_type,
         } => {
             let data_type = match data_type {
-                Some(t) => Some(parse_type(&t).ok_or_else(|| format!("unknown type `{t}`"))?),
+                Some(t) => Some(parse_type(&t).ok_or(StepError::UnknownType(t))?),
                 None => None,
             };
             Step::SdoWrite {
@@ -845,7 +866,7 @@ fn step(d: StepDto) -> Result<Step, String> {
                 NmtDto::Name(c) => (c, None),
                 NmtDto::Full { command, node } => (command, node),
             };
-            let command = NmtCommand::parse(&command).ok_or_else(|| format!("unknown NMT command `{command}`"))?;
+            let command = NmtCommand::parse(&command).ok_or(StepError::UnknownNmt(command))?;
             let node = node.as_ref().map(expr).transpose()?;
             Step::Nmt { command, node }
         }
@@ -857,7 +878,7 @@ fn step(d: StepDto) -> Result<Step, String> {
             fail_if,
         } => Step::Wait {
             fail_if: fail_if
-                .map(|f| -> Result<FailIf, String> {
+                .map(|f| -> Result<FailIf, StepError> {
                     Ok(FailIf {
                         mask: f.mask.as_ref().map(expr).transpose()?.unwrap_or(Expr::constant(-1)),
                         equals: expr(&f.equals)?,
@@ -869,7 +890,7 @@ fn step(d: StepDto) -> Result<Step, String> {
             mask: mask.as_ref().map(expr).transpose()?.unwrap_or(Expr::constant(-1)),
             equals: expr(&equals)?,
             timeout_ms: match timeout_ms {
-                Some(t) => u32::try_from(int(&t)?).map_err(|_| "timeout_ms out of range".to_string())?,
+                Some(t) => u32::try_from(int(&t)?).map_err(|_| StepError::OutOfRange("timeout_ms"))?,
                 None => 1000,
             },
         },
@@ -878,7 +899,7 @@ fn step(d: StepDto) -> Result<Step, String> {
             data: parse_frame_data(&data)?,
         },
         StepDto::DelayMs(ms) => Step::Delay {
-            ms: u32::try_from(int(&ms)?).map_err(|_| "delay out of range")?,
+            ms: u32::try_from(int(&ms)?).map_err(|_| StepError::OutOfRange("delay"))?,
         },
     })
 }

@@ -2,7 +2,30 @@
 //! in profile velocity mode", as data for the commander to execute.
 
 use super::DataType;
-use super::expr::Expr;
+use super::expr::{Expr, ExprError};
+
+/// What is wrong with a procedure step in a profile.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ProcedureError {
+    #[error("missing `}}` in object `{0}`")]
+    ObjectBrace(String),
+    #[error("missing `}}` in `{0}`")]
+    DataBrace(String),
+    #[error("bad field type `{ty}` in `{text}`")]
+    FieldType { ty: String, text: String },
+    #[error("`{token}` is not a byte (two hex digits) in `{text}`")]
+    NotAByte { token: String, text: String },
+    #[error("`{token}` is not a hex byte in `{text}`")]
+    NotHex { token: String, text: String },
+    #[error("frame data `{text}` is {len} bytes, at most 8")]
+    TooLong { text: String, len: usize },
+    #[error("object `{object}` uses unknown variable `{variable}`")]
+    ObjectVariable { object: String, variable: String },
+    #[error("`{expr}` uses unknown variable `{variable}`")]
+    Variable { expr: String, variable: String },
+    #[error(transparent)]
+    Expr(#[from] ExprError),
+}
 
 /// A parameter of a procedure (`speed`, `position`); `node` always exists.
 #[derive(Clone, Debug, PartialEq)]
@@ -63,7 +86,7 @@ pub enum FrameItem {
 
 /// Splits an object text into literal pieces and `{EXPR}` placeholders
 /// (`"{page}-{number}"`, `"0x3000:{sub}"`).
-fn object_pieces(text: &str) -> Result<Vec<Result<&str, Expr>>, String> {
+fn object_pieces(text: &str) -> Result<Vec<Result<&str, Expr>>, ProcedureError> {
     let mut out = Vec::new();
     let mut rest = text;
     while let Some(open) = rest.find('{') {
@@ -71,7 +94,7 @@ fn object_pieces(text: &str) -> Result<Vec<Result<&str, Expr>>, String> {
         let after = &rest[open + 1..];
         let end = after
             .find('}')
-            .ok_or_else(|| format!("missing `}}` in object `{text}`"))?;
+            .ok_or_else(|| ProcedureError::ObjectBrace(text.to_string()))?;
         out.push(Err(Expr::parse(&after[..end])?));
         rest = &after[end + 1..];
     }
@@ -80,7 +103,7 @@ fn object_pieces(text: &str) -> Result<Vec<Result<&str, Expr>>, String> {
 }
 
 /// Checks the `{EXPR}` placeholders of a step's object text; gives the variables they use.
-pub fn object_variables(text: &str) -> Result<Vec<String>, String> {
+pub fn object_variables(text: &str) -> Result<Vec<String>, ProcedureError> {
     Ok(object_pieces(text)?
         .into_iter()
         .filter_map(Result::err)
@@ -90,7 +113,7 @@ pub fn object_variables(text: &str) -> Result<Vec<String>, String> {
 
 /// A step's object text with each `{EXPR}` replaced by its value in decimal, e.g.
 /// `"{page}-{number}"` with page 3, number 1 gives `"3-1"` (then resolved like typed text).
-pub fn fill_object(text: &str, vars: &dyn Fn(&str) -> Option<i64>) -> Result<String, String> {
+pub fn fill_object(text: &str, vars: &dyn Fn(&str) -> Option<i64>) -> Result<String, ProcedureError> {
     let mut out = String::new();
     for piece in object_pieces(text)? {
         match piece {
@@ -165,16 +188,21 @@ impl FrameItem {
 }
 
 /// Parses frame data: `2B 40 60 00 {u16:ctrl} 00 00`; at most 8 bytes.
-pub fn parse_frame_data(text: &str) -> Result<Vec<FrameItem>, String> {
+pub fn parse_frame_data(text: &str) -> Result<Vec<FrameItem>, ProcedureError> {
     let mut items = Vec::new();
     let mut rest = text.trim();
     while !rest.is_empty() {
         if let Some(after) = rest.strip_prefix('{') {
-            let end = after.find('}').ok_or_else(|| format!("missing `}}` in `{text}`"))?;
+            let end = after
+                .find('}')
+                .ok_or_else(|| ProcedureError::DataBrace(text.to_string()))?;
             let inner = &after[..end];
             let (ty, expr) = match inner.split_once(':') {
                 Some((t, e)) => (
-                    int_type(t.trim()).ok_or_else(|| format!("bad field type `{t}` in `{text}`"))?,
+                    int_type(t.trim()).ok_or_else(|| ProcedureError::FieldType {
+                        ty: t.to_string(),
+                        text: text.to_string(),
+                    })?,
                     e,
                 ),
                 None => (DataType::U8, inner),
@@ -185,17 +213,26 @@ pub fn parse_frame_data(text: &str) -> Result<Vec<FrameItem>, String> {
             let end = rest.find(char::is_whitespace).unwrap_or(rest.len());
             let tok = &rest[..end];
             if tok.len() != 2 {
-                return Err(format!("`{tok}` is not a byte (two hex digits) in `{text}`"));
+                return Err(ProcedureError::NotAByte {
+                    token: tok.to_string(),
+                    text: text.to_string(),
+                });
             }
-            items.push(FrameItem::Byte(
-                u8::from_str_radix(tok, 16).map_err(|_| format!("`{tok}` is not a hex byte in `{text}`"))?,
-            ));
+            items.push(FrameItem::Byte(u8::from_str_radix(tok, 16).map_err(|_| {
+                ProcedureError::NotHex {
+                    token: tok.to_string(),
+                    text: text.to_string(),
+                }
+            })?));
             rest = rest[end..].trim_start();
         }
     }
     let len: usize = items.iter().map(FrameItem::size).sum();
     if len > 8 {
-        return Err(format!("frame data `{text}` is {len} bytes, at most 8"));
+        return Err(ProcedureError::TooLong {
+            text: text.to_string(),
+            len,
+        });
     }
     Ok(items)
 }
@@ -216,14 +253,17 @@ fn int_type(t: &str) -> Option<DataType> {
 
 impl Procedure {
     /// Every variable a step uses must be `node` or a parameter.
-    pub fn check_variables(&self) -> Result<(), String> {
+    pub fn check_variables(&self) -> Result<(), ProcedureError> {
         let known = |v: &str| v == "node" || self.params.iter().any(|p| p.name == v);
         let mut exprs: Vec<&Expr> = Vec::new();
         for s in &self.steps {
             if let Step::SdoWrite { object, .. } | Step::SdoRead { object } | Step::Wait { object, .. } = s
                 && let Some(v) = object_variables(object)?.into_iter().find(|v| !known(v))
             {
-                return Err(format!("object `{object}` uses unknown variable `{v}`"));
+                return Err(ProcedureError::ObjectVariable {
+                    object: object.clone(),
+                    variable: v,
+                });
             }
             match s {
                 Step::SdoWrite { value, .. } => exprs.push(value),
@@ -248,7 +288,10 @@ impl Procedure {
         }
         for e in exprs {
             if let Some(v) = e.variables().into_iter().find(|v| !known(v)) {
-                return Err(format!("`{e}` uses unknown variable `{v}`"));
+                return Err(ProcedureError::Variable {
+                    expr: e.to_string(),
+                    variable: v.to_string(),
+                });
             }
         }
         Ok(())
@@ -256,7 +299,7 @@ impl Procedure {
 }
 
 /// Builds the bytes of a `Frame` step's data with the given variables.
-pub fn frame_bytes(items: &[FrameItem], vars: &dyn Fn(&str) -> Option<i64>) -> Result<Vec<u8>, String> {
+pub fn frame_bytes(items: &[FrameItem], vars: &dyn Fn(&str) -> Option<i64>) -> Result<Vec<u8>, ExprError> {
     let mut out = Vec::new();
     for item in items {
         match item {
@@ -290,11 +333,12 @@ mod tests {
         assert!(
             parse_frame_data("2B 40 60 00 {u32:1} 00")
                 .unwrap_err()
+                .to_string()
                 .contains("at most 8")
         );
         assert!(parse_frame_data("2B4").is_err());
         assert!(parse_frame_data("GG").is_err());
-        assert!(parse_frame_data("{f32:1}").unwrap_err().contains("f32"));
+        assert!(parse_frame_data("{f32:1}").unwrap_err().to_string().contains("f32"));
         assert!(parse_frame_data("{u8:1").is_err());
     }
 
@@ -322,7 +366,12 @@ mod tests {
         assert_eq!(fill_object("0x3000:{number + 9}", &vars).unwrap(), "0x3000:10");
         assert_eq!(fill_object("0x6041", &vars).unwrap(), "0x6041");
         assert_eq!(object_variables("{page}-{number}").unwrap(), ["page", "number"]);
-        assert!(object_variables("0x3000:{sub").unwrap_err().contains("missing `}`"));
+        assert!(
+            object_variables("0x3000:{sub")
+                .unwrap_err()
+                .to_string()
+                .contains("missing `}`")
+        );
         assert!(fill_object("{speed}", &vars).is_err());
     }
 }

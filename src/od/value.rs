@@ -1,5 +1,6 @@
 //! CANopen data types and decoded values.
 
+use serde::{Serialize, Serializer};
 use std::fmt;
 
 /// CiA 301 basic data types (codes 0x0001..0x001B) we decode.
@@ -192,17 +193,25 @@ impl Value {
             _ => None,
         }
     }
-    /// JSON form: numbers stay numbers, text stays text, bytes become upper-case hex.
+    /// JSON form: numbers stay numbers, text stays text, bytes become upper-case hex
+    /// (the [`Serialize`] form as a value).
     pub fn to_json(&self) -> serde_json::Value {
+        serde_json::to_value(self).unwrap_or(serde_json::Value::Null)
+    }
+}
+
+/// Numbers stay numbers (a float that is not finite is `null`), text stays text, bytes
+/// become upper-case hex.
+impl Serialize for Value {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         match self {
-            Value::Bool(b) => (*b).into(),
-            Value::Unsigned(u) => (*u).into(),
-            Value::Signed(i) => (*i).into(),
-            Value::Float(f) => serde_json::Number::from_f64(*f)
-                .map(Into::into)
-                .unwrap_or(serde_json::Value::Null),
-            Value::Text(s) => s.clone().into(),
-            Value::Bytes(b) => crate::frame::hex::upper(b).into(),
+            Value::Bool(b) => s.serialize_bool(*b),
+            Value::Unsigned(u) => s.serialize_u64(*u),
+            Value::Signed(i) => s.serialize_i64(*i),
+            Value::Float(f) if f.is_finite() => s.serialize_f64(*f),
+            Value::Float(_) => s.serialize_unit(),
+            Value::Text(t) => s.serialize_str(t),
+            Value::Bytes(b) => crate::frame::json::Hex(b).serialize(s),
         }
     }
 }

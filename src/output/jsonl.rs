@@ -1,100 +1,117 @@
 //! The JSONL contract: one JSON object per frame (field names are a public API).
 //!
-//! The common fields are written straight into the output buffer (this is the
-//! hot path of `cotui decode --format jsonl`); kind-specific objects come from
-//! each decoder's `to_json`.
+//! [`FrameRecord`] holds the common fields and [`BodyJson`] the kind-specific object,
+//! each decoder's `to_json`; serde writes the record straight into the output buffer
+//! (this is the hot path of `cotui decode --format jsonl`).
 
+use crate::decode::emcy::EmcyJson;
+use crate::decode::error_frame::{self, ErrorFrameJson};
+use crate::decode::heartbeat::HeartbeatJson;
+use crate::decode::lss::LssJson;
+use crate::decode::nmt::NmtJson;
+use crate::decode::pdo::PdoJson;
+use crate::decode::sdo::frame::SdoJson;
+use crate::decode::sync::SyncJson;
+use crate::decode::time::TimeJson;
+use crate::decode::vendor_sdo::VendorSdoJson;
 use crate::decode::{Body, Decoded};
+use crate::frame::json::{Hex, Seconds, Text, write_line};
 use crate::frame::{Flags, Frame, Interfaces};
-use std::fmt::Write;
+use serde::Serialize;
 
-/// Appends a JSON string literal: unescaped runs are copied whole (escapes are ASCII,
-/// so every cut falls on a char boundary).
-fn push_str_lit(out: &mut String, s: &str) {
-    out.push('"');
-    let mut from = 0;
-    for (i, b) in s.bytes().enumerate() {
-        let escape = match b {
-            b'"' => "\\\"",
-            b'\\' => "\\\\",
-            b'\n' => "\\n",
-            b'\r' => "\\r",
-            b'\t' => "\\t",
-            0..0x20 => "",
-            _ => continue,
-        };
-        out.push_str(&s[from..i]);
-        if escape.is_empty() {
-            let _ = write!(out, "\\u{b:04x}");
-        } else {
-            out.push_str(escape);
-        }
-        from = i + 1;
+/// One frame as a JSONL record (fields in contract order).
+#[derive(Clone, Debug, Serialize)]
+pub struct FrameRecord<'a> {
+    /// Input line number (1-based).
+    pub line: u64,
+    /// Seconds, exact to the ns.
+    pub t: Seconds,
+    pub iface: Text<'a>,
+    pub id: u32,
+    pub ext: bool,
+    pub rtr: bool,
+    pub fd: bool,
+    pub err: bool,
+    pub len: u8,
+    /// The payload, upper-case hex.
+    pub data: Hex<'a>,
+    /// `rx` or `tx`.
+    pub dir: &'static str,
+    /// The [`crate::decode::Kind`] name.
+    pub kind: &'static str,
+    pub node: Option<u8>,
+    pub label: Text<'a>,
+    /// The kind-specific object under its key (absent for kinds without one).
+    #[serde(flatten)]
+    pub body: Option<BodyJson<'a>>,
+    /// Why the frame breaks a rule (absent when it does not).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub malformed: Option<Text<'a>>,
+}
+
+/// The kind-specific object of a frame record, under its key (`nmt`, `heartbeat`, ...).
+#[derive(Clone, Debug, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BodyJson<'a> {
+    Nmt(NmtJson),
+    Heartbeat(HeartbeatJson),
+    Sync(SyncJson),
+    Time(TimeJson),
+    Emcy(EmcyJson<'a>),
+    Pdo(PdoJson<'a>),
+    Sdo(SdoJson<'a>),
+    Lss(LssJson),
+    VendorSdo(VendorSdoJson<'a>),
+    /// Error frames (kind `error_frame`) carry theirs under `error`.
+    Error(ErrorFrameJson),
+}
+
+impl<'a> BodyJson<'a> {
+    /// The kind-specific object of a decoded frame, `None` for kinds without one.
+    pub fn new(decoded: &'a Decoded, frame: &Frame) -> Option<BodyJson<'a>> {
+        Some(match &decoded.body {
+            Body::None => return None,
+            Body::Nmt(n) => BodyJson::Nmt(n.to_json()),
+            Body::Heartbeat(h) => BodyJson::Heartbeat(h.to_json()),
+            Body::Sync(s) => BodyJson::Sync(s.to_json()),
+            Body::Time(t) => BodyJson::Time(t.to_json()),
+            Body::Emcy(e) => BodyJson::Emcy(e.to_json()),
+            Body::Pdo(p) => BodyJson::Pdo(p.to_json()),
+            Body::Sdo(s) => BodyJson::Sdo(s.to_json()),
+            Body::Lss(l) => BodyJson::Lss(l.to_json()),
+            Body::VendorSdo(v) => BodyJson::VendorSdo(v.to_json()),
+            Body::ErrorFrame { class } => BodyJson::Error(error_frame::to_json(*class, frame.payload())),
+        })
     }
-    out.push_str(&s[from..]);
-    out.push('"');
 }
 
-fn push_bool(out: &mut String, key: &str, v: bool) {
-    out.push_str(key);
-    out.push_str(if v { "true" } else { "false" });
-}
-
-/// The kind-specific object of a decoded frame: its JSON key and value.
-pub fn body_json(decoded: &Decoded, frame: &Frame) -> Option<(&'static str, serde_json::Value)> {
-    Some(match &decoded.body {
-        Body::None => return None,
-        Body::Nmt(n) => ("nmt", n.to_json()),
-        Body::Heartbeat(h) => ("heartbeat", h.to_json()),
-        Body::Sync(s) => ("sync", s.to_json()),
-        Body::Time(t) => ("time", t.to_json()),
-        Body::Emcy(e) => ("emcy", e.to_json()),
-        Body::Pdo(p) => ("pdo", p.to_json()),
-        Body::Sdo(s) => ("sdo", s.to_json()),
-        Body::Lss(l) => ("lss", l.to_json()),
-        Body::VendorSdo(v) => ("vendor_sdo", v.to_json()),
-        Body::ErrorFrame { class } => ("error", crate::decode::error_frame::to_json(*class, frame.payload())),
-    })
+impl<'a> FrameRecord<'a> {
+    /// The record of one frame read from input line `line`.
+    pub fn new(line: u64, frame: &'a Frame, ifaces: &'a Interfaces, decoded: &'a Decoded) -> FrameRecord<'a> {
+        FrameRecord {
+            line,
+            t: Seconds(frame.ts_ns),
+            iface: Text(ifaces.name(frame.iface)),
+            id: frame.id,
+            ext: frame.is_ext(),
+            rtr: frame.is_rtr(),
+            fd: frame.is_fd(),
+            err: frame.is_err(),
+            len: frame.len,
+            data: Hex(frame.payload()),
+            dir: if frame.flags.has(Flags::TX) { "tx" } else { "rx" },
+            kind: decoded.kind.as_str(),
+            node: decoded.node,
+            label: Text(&decoded.label),
+            body: BodyJson::new(decoded, frame),
+            malformed: decoded.malformed.as_deref().map(Text),
+        }
+    }
 }
 
 /// Appends the JSON object (and a newline) for one frame read from input line `line`.
-pub fn write_frame(out: &mut String, line: u64, frame: &Frame, ifaces: &Interfaces, decoded: &Decoded) {
-    let secs = frame.ts_ns / 1_000_000_000;
-    let frac = frame.ts_ns % 1_000_000_000;
-    let _ = write!(out, "{{\"line\":{line},\"t\":{secs}.{frac:09},\"iface\":");
-    push_str_lit(out, ifaces.name(frame.iface));
-    let _ = write!(out, ",\"id\":{}", frame.id);
-    push_bool(out, ",\"ext\":", frame.is_ext());
-    push_bool(out, ",\"rtr\":", frame.is_rtr());
-    push_bool(out, ",\"fd\":", frame.is_fd());
-    push_bool(out, ",\"err\":", frame.is_err());
-    let _ = write!(out, ",\"len\":{},\"data\":\"", frame.len);
-    crate::frame::hex::push_upper(out, frame.payload());
-    out.push_str("\",\"dir\":");
-    out.push_str(if frame.flags.has(Flags::TX) { "\"tx\"" } else { "\"rx\"" });
-    out.push_str(",\"kind\":\"");
-    out.push_str(decoded.kind.as_str());
-    out.push_str("\",\"node\":");
-    match decoded.node {
-        Some(n) => {
-            let _ = write!(out, "{n}");
-        }
-        None => out.push_str("null"),
-    }
-    out.push_str(",\"label\":");
-    push_str_lit(out, &decoded.label);
-    if let Some((key, value)) = body_json(decoded, frame) {
-        // serde_json writes to a byte buffer much faster than through `Display`.
-        if let Ok(text) = serde_json::to_string(&value) {
-            let _ = write!(out, ",\"{key}\":");
-            out.push_str(&text);
-        }
-    }
-    if let Some(m) = &decoded.malformed {
-        out.push_str(",\"malformed\":");
-        push_str_lit(out, m);
-    }
-    out.push_str("}\n");
+pub fn write_frame(out: &mut Vec<u8>, line: u64, frame: &Frame, ifaces: &Interfaces, decoded: &Decoded) {
+    write_line(out, &FrameRecord::new(line, frame, ifaces, decoded));
 }
 
 #[cfg(test)]
@@ -108,10 +125,10 @@ mod tests {
         let mut ifaces = Interfaces::default();
         ifaces.intern("can0");
         let d = Decoder::new(Dictionary::default(), vec![]).decode(frame);
-        let mut s = String::new();
+        let mut s = Vec::new();
         write_frame(&mut s, line, frame, &ifaces, &d);
-        assert!(s.ends_with("}\n"));
-        serde_json::from_str(&s).expect("valid JSON")
+        assert!(s.ends_with(b"}\n"));
+        serde_json::from_slice(&s).expect("valid JSON")
     }
 
     #[test]
@@ -142,11 +159,8 @@ mod tests {
         assert_eq!(j["node"], 5);
         assert_eq!(j["heartbeat"]["state"], "operational");
         assert_eq!(j["malformed"], "heartbeat frame has 2 data bytes, expected 1");
-        let mut s = String::new();
-        push_str_lit(&mut s, "a\"b\\c\u{1}");
-        assert_eq!(s, r#""a\"b\\c\u0001""#);
-        s.clear();
-        push_str_lit(&mut s, "µ\tz\n°");
-        assert_eq!(s, r#""µ\tz\n°""#);
+        let lit = |s| serde_json::to_string(&Text(s)).unwrap();
+        assert_eq!(lit("a\"b\\c\u{1}"), r#""a\"b\\c\u0001""#);
+        assert_eq!(lit("µ\tz\n°"), r#""µ\tz\n°""#);
     }
 }

@@ -1,6 +1,7 @@
 //! `--summary`: per-node and per-kind totals.
 
 use crate::decode::Kind;
+use serde::Serialize;
 use std::collections::BTreeMap;
 
 /// Running totals of frames by kind and by node.
@@ -64,26 +65,31 @@ impl Summary {
         s
     }
 
-    /// JSON report.
-    pub fn to_json(&self) -> serde_json::Value {
-        let kinds: serde_json::Map<String, serde_json::Value> = self
-            .by_kind
-            .iter()
-            .map(|(k, n)| (k.as_str().to_string(), (*n).into()))
-            .collect();
-        let nodes: serde_json::Map<String, serde_json::Value> = self
-            .by_node
-            .iter()
-            .map(|(node, kinds)| {
-                let m: serde_json::Map<String, serde_json::Value> = kinds
-                    .iter()
-                    .map(|(k, n)| (k.as_str().to_string(), (*n).into()))
-                    .collect();
-                (node.to_string(), m.into())
-            })
-            .collect();
-        serde_json::json!({"frames": self.frames, "by_kind": kinds, "by_node": nodes})
+    /// The JSON report of `--summary --format jsonl`.
+    pub fn to_json(&self) -> SummaryJson {
+        let named = |kinds: &BTreeMap<Kind, u64>| kinds.iter().map(|(k, n)| (k.as_str(), *n)).collect();
+        SummaryJson {
+            by_kind: named(&self.by_kind),
+            by_node: self
+                .by_node
+                .iter()
+                .map(|(node, kinds)| (node.to_string(), named(kinds)))
+                .collect(),
+            frames: self.frames,
+        }
     }
+}
+
+/// The summary as a JSON record (fields in key order). Maps are ordered by their JSON
+/// keys, so nodes are in text order (`"10"` before `"2"`).
+#[derive(Clone, Debug, Serialize)]
+pub struct SummaryJson {
+    /// Frames per kind name.
+    pub by_kind: BTreeMap<&'static str, u64>,
+    /// Frames per node (its number as text), per kind name.
+    pub by_node: BTreeMap<String, BTreeMap<&'static str, u64>>,
+    /// Frames in all.
+    pub frames: u64,
 }
 
 #[cfg(test)]
@@ -104,6 +110,6 @@ mod tests {
         let t = s.to_text();
         assert!(t.contains("  heartbeat    2"), "{t}");
         assert!(t.contains("node 5            2  heartbeat=2"), "{t}");
-        assert_eq!(s.to_json()["by_node"]["2"]["tpdo"], 1);
+        assert_eq!(serde_json::to_value(s.to_json()).unwrap()["by_node"]["2"]["tpdo"], 1);
     }
 }

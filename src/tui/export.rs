@@ -71,13 +71,13 @@ pub fn export(trace: &Trace, view: &View, path: &Path, format: ExportFormat, for
         ExportFormat::Jsonl => {
             let all: Vec<usize> = positions.collect();
             let mut walker = None;
-            let mut buf = String::new();
+            let mut buf = Vec::new();
             for chunk in all.chunks(CHUNK) {
                 for (pos, d) in chunk.iter().zip(trace.decode_with(&mut walker, chunk)) {
                     let f = trace.store.frame(*pos);
                     jsonl::write_frame(&mut buf, *pos as u64 + 1, &f, &trace.ifaces, &d);
                 }
-                out.write_all(buf.as_bytes())?;
+                out.write_all(&buf)?;
                 buf.clear();
             }
         }

@@ -52,9 +52,9 @@ proptest! {
             let mut line = String::new();
             text::write_line(&mut line, f, &ifaces, &d);
             prop_assert_eq!(line.matches('\n').count(), 1);
-            let mut j = String::new();
+            let mut j = Vec::new();
             jsonl::write_frame(&mut j, i as u64 + 1, f, &ifaces, &d);
-            let v: serde_json::Value = serde_json::from_str(&j).expect("valid JSON");
+            let v: serde_json::Value = serde_json::from_slice(&j).expect("valid JSON");
             prop_assert_eq!(v["kind"].as_str(), Some(d.kind.as_str()));
             prop_assert_eq!(v["len"].as_u64(), Some(f.len as u64));
         }
@@ -85,9 +85,9 @@ proptest! {
             let mut line = String::new();
             e.write_line(&mut line);
             prop_assert_eq!(line.matches('\n').count(), 1);
-            let mut j = String::new();
+            let mut j = Vec::new();
             e.write_json(&mut j);
-            let v: serde_json::Value = serde_json::from_str(&j).expect("valid JSON");
+            let v: serde_json::Value = serde_json::from_slice(&j).expect("valid JSON");
             prop_assert_eq!(v["event"].as_str(), Some(e.what.name()));
             prop_assert!(v["t"].is_number());
             prop_assert_eq!(v["node"].as_u64(), e.node.map(u64::from));

@@ -7,6 +7,7 @@ mod decode_proptest;
 mod diagnose_golden;
 mod diagnose_peer;
 mod eds_import;
+mod json_contract;
 mod log_can_utils;
 mod log_formats;
 mod log_fuzz;

@@ -7,7 +7,8 @@
 use super::abort::abort_text;
 use super::value::{ValueView, segment_text};
 use crate::frame::hex;
-use serde_json::{Value as Json, json};
+use crate::frame::json::Hex;
+use serde::Serialize;
 
 /// Which end of an SDO channel sent a frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -684,95 +685,146 @@ impl SdoFrame {
         s
     }
 
-    /// JSON fragment: `cs`, `side`, `index`, `sub`, `abort_code`, `abort_text`, `malformed` and the
-    /// decoded fields (`expedited`, `size`, `toggle`, `last`, `data`, `seqno`, `ackseq`, `blksize`,
-    /// `pst`, `crc_supported`, `unused`, `crc`, `block_step`, `name`, `value`, `value_text`,
-    /// `problems`). `index`/`sub` are the frame's own or, for segments and block steps, those of
-    /// the transfer the tracker puts the frame in (null when unknown).
-    pub fn to_json(&self) -> Json {
+    /// The `sdo` object of the frame's JSONL record: `cs`, `side`, `index`, `sub`,
+    /// `abort_code`, `abort_text`, `malformed` and the decoded fields (`expedited`, `size`,
+    /// `toggle`, `last`, `data`, `seqno`, `ackseq`, `blksize`, `pst`, `crc_supported`,
+    /// `unused`, `crc`, `block_step`, `name`, `value`, `value_text`, `problems`).
+    /// `index`/`sub` are the frame's own or, for segments and block steps, those of the
+    /// transfer the tracker puts the frame in (null when unknown).
+    pub fn to_json(&self) -> SdoJson<'_> {
         use SdoCommand::*;
-        let (index, sub) = match self.object {
-            Some((i, s)) => (Json::from(i), Json::from(s)),
-            None => (Json::Null, Json::Null),
+        let mut j = SdoJson {
+            abort_code: None,
+            abort_text: None,
+            ackseq: None,
+            blksize: None,
+            block_step: self.command.block_step(),
+            command: None,
+            crc: None,
+            crc_supported: None,
+            cs: self.command.cs_name(),
+            data: None,
+            expedited: None,
+            index: self.object.map(|o| o.0),
+            last: None,
+            malformed: self.malformed_reason.is_some(),
+            malformed_reason: self.malformed_reason.as_deref(),
+            name: self.name.as_deref(),
+            problems: (!self.problems.is_empty()).then_some(&self.problems),
+            pst: None,
+            seqno: None,
+            side: self.side.as_str(),
+            size: None,
+            sub: self.object.map(|o| o.1),
+            toggle: None,
+            unused: None,
+            value: self.value.as_ref().map(|v| &v.json),
+            value_text: self.value.as_ref().map(|v| v.text.as_str()),
         };
-        let (abort_code, abort) = match self.command {
-            Abort { code, .. } => (Json::from(code), Json::from(abort_text(code))),
-            _ => (Json::Null, Json::Null),
-        };
-        let mut j = json!({
-            "cs": self.command.cs_name(),
-            "side": self.side.as_str(),
-            "index": index,
-            "sub": sub,
-            "abort_code": abort_code,
-            "abort_text": abort,
-            "malformed": self.malformed_reason.is_some(),
-        });
-        let o = j.as_object_mut().expect("json! object");
-        let mut put = |k: &str, v: Json| {
-            o.insert(k.to_string(), v);
-        };
-        if let Some(step) = self.command.block_step() {
-            put("block_step", step.into());
-        }
-        match self.command {
+        match &self.command {
+            Abort { code, .. } => {
+                j.abort_code = Some(*code);
+                j.abort_text = Some(abort_text(*code));
+            }
             InitiateDownload { expedited, size, .. } | InitiateUploadResponse { expedited, size, .. } => {
-                put("expedited", expedited.into());
-                put("size", size.map_or(Json::Null, Json::from));
+                j.expedited = Some(*expedited);
+                j.size = Some(*size);
             }
             DownloadSegment { toggle, last, data } | UploadSegmentResponse { toggle, last, data } => {
-                put("toggle", (toggle as u8).into());
-                put("last", last.into());
-                put("data", hex::upper(data.bytes()).into());
+                j.toggle = Some(*toggle as u8);
+                j.last = Some(*last);
+                j.data = Some(Hex(data.bytes()));
             }
-            DownloadSegmentResponse { toggle } | UploadSegment { toggle } => put("toggle", (toggle as u8).into()),
+            DownloadSegmentResponse { toggle } | UploadSegment { toggle } => j.toggle = Some(*toggle as u8),
             BlockDownloadInitiate { crc, size, .. } | BlockUploadInitiateResponse { crc, size, .. } => {
-                put("crc_supported", crc.into());
-                put("size", size.map_or(Json::Null, Json::from));
+                j.crc_supported = Some(*crc);
+                j.size = Some(*size);
             }
             BlockDownloadInitiateResponse { crc, blksize, .. } => {
-                put("crc_supported", crc.into());
-                put("blksize", blksize.into());
+                j.crc_supported = Some(*crc);
+                j.blksize = Some(*blksize);
             }
             BlockUploadInitiate { crc, blksize, pst, .. } => {
-                put("crc_supported", crc.into());
-                put("blksize", blksize.into());
-                put("pst", pst.into());
+                j.crc_supported = Some(*crc);
+                j.blksize = Some(*blksize);
+                j.pst = Some(*pst);
             }
             BlockDownloadAck { ackseq, blksize } | BlockUploadAck { ackseq, blksize } => {
-                put("ackseq", ackseq.into());
-                put("blksize", blksize.into());
+                j.ackseq = Some(*ackseq);
+                j.blksize = Some(*blksize);
             }
             BlockDownloadEnd { unused, crc } | BlockUploadEnd { unused, crc } => {
-                put("unused", unused.into());
-                put("crc", crc.into());
+                j.unused = Some(*unused);
+                j.crc = Some(*crc);
             }
             BlockSegment { seqno, last, data } => {
-                put("seqno", seqno.into());
-                put("last", last.into());
-                put("data", hex::upper(data.bytes()).into());
+                j.seqno = Some(*seqno);
+                j.last = Some(*last);
+                j.data = Some(Hex(data.bytes()));
             }
-            Unknown { command } => put("command", command.into()),
+            Unknown { command } => j.command = Some(*command),
             _ => {}
         }
-        if let Some(name) = &self.name {
-            put("name", name.clone().into());
-        }
-        if let Some(v) = &self.value {
-            put("value", v.json.clone());
-            put("value_text", v.text.clone().into());
-        }
         if let Some(data) = self.command.data().filter(|_| self.value.is_some()) {
-            put("data", hex::upper(data).into());
-        }
-        if let Some(m) = &self.malformed_reason {
-            put("malformed_reason", m.clone().into());
-        }
-        if !self.problems.is_empty() {
-            put("problems", self.problems.clone().into());
+            j.data = Some(Hex(data));
         }
         j
     }
+}
+
+/// The `sdo` object of a JSONL frame record, fields in key order. `abort_code`,
+/// `abort_text`, `cs`, `index`, `malformed`, `side` and `sub` are always there (null when
+/// they do not apply); the others only when the command carries them.
+#[derive(Clone, Debug, Serialize)]
+pub struct SdoJson<'a> {
+    pub abort_code: Option<u32>,
+    pub abort_text: Option<&'static str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ackseq: Option<u8>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blksize: Option<u8>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub block_step: Option<&'static str>,
+    /// The command byte of an unknown command.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub command: Option<u8>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub crc: Option<u16>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub crc_supported: Option<bool>,
+    pub cs: &'static str,
+    /// Segment data, or the expedited data when it has a value.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub data: Option<Hex<'a>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub expedited: Option<bool>,
+    pub index: Option<u16>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub last: Option<bool>,
+    pub malformed: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub malformed_reason: Option<&'a str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub name: Option<&'a str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub problems: Option<&'a Vec<String>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pst: Option<u8>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub seqno: Option<u8>,
+    pub side: &'static str,
+    /// Present (null when not indicated) for the commands that can indicate a size.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub size: Option<Option<u32>>,
+    pub sub: Option<u8>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub toggle: Option<u8>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unused: Option<u8>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub value: Option<&'a serde_json::Value>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub value_text: Option<&'a str>,
 }
 
 /// `segmented, 16 bytes` or `segmented, size not indicated`.
@@ -1035,7 +1087,7 @@ mod tests {
             frame.label(),
             "Abort 0x6041:00: 0x06020000 Object does not exist in the object dictionary"
         );
-        let j = frame.to_json();
+        let j = serde_json::to_value(frame.to_json()).unwrap();
         assert_eq!(j["cs"], "abort");
         assert_eq!(j["abort_code"], 0x0602_0000);
         assert_eq!(j["abort_text"], "Object does not exist in the object dictionary");
@@ -1091,8 +1143,8 @@ mod tests {
         );
         let f = SdoFrame::new(Side::Client, &[0x03, 1, 2, 3, 4, 5, 6, 7], true);
         assert_eq!(f.label(), "Block download segment seqno=3");
-        assert_eq!(f.to_json()["cs"], "block_segment");
-        assert_eq!(f.to_json()["seqno"], 3);
+        assert_eq!(serde_json::to_value(f.to_json()).unwrap()["cs"], "block_segment");
+        assert_eq!(serde_json::to_value(f.to_json()).unwrap()["seqno"], 3);
         // Inside a sub-block 0x80 (seqno 0) can only be an abort.
         assert_eq!(
             decode(Side::Client, &[0x80, 0, 0, 0, 0, 0, 4, 5], true),
@@ -1150,8 +1202,8 @@ mod tests {
         assert!(f.malformed().is_some());
         assert_eq!(f.label(), "Unknown SDO command 0xE8: E8 04 50 00 00 00 00 00");
         assert_eq!(f.malformed().as_deref(), Some("unknown client command specifier 0xE8"));
-        assert_eq!(f.to_json()["cs"], "unknown");
-        assert_eq!(f.to_json()["malformed"], true);
+        assert_eq!(serde_json::to_value(f.to_json()).unwrap()["cs"], "unknown");
+        assert_eq!(serde_json::to_value(f.to_json()).unwrap()["malformed"], true);
         assert_eq!(
             server(&[0xE8, 0x04, 0x50, 0, 0xB7, 0x13, 0xAB, 0x12]),
             Unknown { command: 0xE8 }
@@ -1197,8 +1249,8 @@ mod tests {
         assert_eq!(f.label(), "Upload segment t=1 \"DEXMART\" c=0");
         let f = SdoFrame::new(Side::Client, &[0x01, 0xFF, 0x00, 0x10, 0, 0, 0, 0], false);
         assert_eq!(f.label(), "Download segment t=0 FF 00 10 00 00 00 00 c=1");
-        assert_eq!(f.to_json()["toggle"], 0);
-        assert_eq!(f.to_json()["last"], true);
+        assert_eq!(serde_json::to_value(f.to_json()).unwrap()["toggle"], 0);
+        assert_eq!(serde_json::to_value(f.to_json()).unwrap()["last"], true);
     }
 
     #[test]

@@ -1,10 +1,10 @@
 //! A reassembled SDO transfer: what was read or written, how, and how it ended.
 
 use super::frame::Side;
-use super::value::view_in_mode;
-use crate::frame::hex;
+use super::value::{ValueView, view_in_mode};
+use crate::frame::json::Hex;
 use crate::od::Dictionary;
-use serde_json::{Value as Json, json};
+use serde::Serialize;
 use std::fmt;
 
 /// An SDO channel: a node and the COB-ID pair its client and server use.
@@ -329,51 +329,99 @@ impl Transaction {
         s
     }
 
-    /// JSON object with the object, name, typed value, hex data, timing, outcome and problems.
-    pub fn to_json(&self, dict: &Dictionary) -> Json {
+    /// The JSONL record of `--transactions --format jsonl`: the object, name, typed value,
+    /// hex data, timing, outcome and problems.
+    pub fn to_json<'a>(&'a self, dict: &'a Dictionary) -> TransactionJson<'a> {
         let partial = self.is_partial();
-        let v = (!self.data.is_empty() && !partial)
+        let value = (!self.data.is_empty() && !partial)
             .then(|| view_in_mode(dict, self.index, self.sub, &self.data, self.mode));
-        let (index, sub) = if partial {
-            (Json::Null, Json::Null)
-        } else {
-            (Json::from(self.index), Json::from(self.sub))
+        let (abort_code, abort_text, aborted_by, error) = match &self.outcome {
+            Outcome::Aborted { code, text, by } => (Some(*code), Some(*text), Some(by.as_str()), None),
+            Outcome::ProtocolError(e) => (None, None, None, Some(e.as_str())),
+            _ => (None, None, None, None),
         };
-        let (code, text, by, error) = match &self.outcome {
-            Outcome::Aborted { code, text, by } => (
-                Json::from(*code),
-                Json::from(*text),
-                Json::from(by.as_str()),
-                Json::Null,
-            ),
-            Outcome::ProtocolError(e) => (Json::Null, Json::Null, Json::Null, Json::from(e.clone())),
-            _ => (Json::Null, Json::Null, Json::Null, Json::Null),
-        };
-        json!({
-            "node": self.node,
-            "request_cob": self.channel.request_cob,
-            "response_cob": self.channel.response_cob,
-            "index": index,
-            "sub": sub,
-            "name": if partial { None } else { dict.name(self.index, self.sub) },
-            "partial": partial,
-            "direction": self.direction.as_str(),
-            "protocol": self.protocol.as_str(),
-            "size": self.size,
-            "data": hex::upper(&self.data),
-            "len": self.len(),
-            "value": v.as_ref().map_or(Json::Null, |v| v.json.clone()),
-            "value_text": v.as_ref().map(|v| v.text.clone()),
-            "start_ns": self.start_ns,
-            "end_ns": self.end_ns,
-            "duration_ns": self.duration_ns(),
-            "outcome": self.outcome.as_str(),
-            "abort_code": code,
-            "abort_text": text,
-            "aborted_by": by,
-            "error": error,
-            "problems": self.problems.iter().map(|p| json!({"kind": p.as_str(), "text": p.to_string()})).collect::<Vec<_>>(),
-            "frames": self.frames,
-        })
+        TransactionJson {
+            abort_code,
+            abort_text,
+            aborted_by,
+            data: Hex(&self.data),
+            direction: self.direction.as_str(),
+            duration_ns: self.duration_ns(),
+            end_ns: self.end_ns,
+            error,
+            frames: &self.frames,
+            index: (!partial).then_some(self.index),
+            len: self.len(),
+            name: if partial { None } else { dict.name(self.index, self.sub) },
+            node: self.node,
+            outcome: self.outcome.as_str(),
+            partial,
+            problems: self
+                .problems
+                .iter()
+                .map(|p| ProblemJson {
+                    kind: p.as_str(),
+                    text: p.to_string(),
+                })
+                .collect(),
+            protocol: self.protocol.as_str(),
+            request_cob: self.channel.request_cob,
+            response_cob: self.channel.response_cob,
+            size: self.size,
+            start_ns: self.start_ns,
+            sub: (!partial).then_some(self.sub),
+            value_text: value.as_ref().map(|v| v.text.clone()),
+            value,
+        }
     }
+}
+
+/// One SDO transaction as a JSONL record (fields in key order). `index`, `sub` and `name`
+/// are null for a transfer seen only in part; the abort fields and `error` are null unless
+/// it ended that way.
+#[derive(Clone, Debug, Serialize)]
+pub struct TransactionJson<'a> {
+    pub abort_code: Option<u32>,
+    pub abort_text: Option<&'static str>,
+    /// `client` or `server`.
+    pub aborted_by: Option<&'static str>,
+    pub data: Hex<'a>,
+    pub direction: &'static str,
+    pub duration_ns: u64,
+    pub end_ns: u64,
+    /// What broke the protocol.
+    pub error: Option<&'a str>,
+    /// Sequence numbers of the frames (the first ones).
+    pub frames: &'a [u64],
+    pub index: Option<u16>,
+    pub len: usize,
+    pub name: Option<&'a str>,
+    pub node: u8,
+    pub outcome: &'static str,
+    pub partial: bool,
+    pub problems: Vec<ProblemJson>,
+    pub protocol: &'static str,
+    pub request_cob: u32,
+    pub response_cob: u32,
+    pub size: Option<u32>,
+    pub start_ns: u64,
+    pub sub: Option<u8>,
+    /// The typed value (`null` without data or for a partial transfer).
+    #[serde(serialize_with = "view_json")]
+    pub value: Option<ValueView>,
+    pub value_text: Option<String>,
+}
+
+/// The JSON value of a [`ValueView`], `null` without one.
+fn view_json<S: serde::Serializer>(v: &Option<ValueView>, s: S) -> Result<S::Ok, S::Error> {
+    v.as_ref().map(|v| &v.json).serialize(s)
+}
+
+/// One problem of [`TransactionJson`].
+#[derive(Clone, Debug, Serialize)]
+pub struct ProblemJson {
+    /// Its name, e.g. `toggle_error`.
+    pub kind: &'static str,
+    /// Its text.
+    pub text: String,
 }

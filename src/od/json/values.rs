@@ -5,47 +5,81 @@
 use serde_json::Value as Json;
 
 use crate::od::alias::parse_object_ref;
-use crate::od::expr::{Expr, parse_int};
+use crate::od::expr::{Expr, ExprError, parse_int};
 use crate::od::{Access, DataType, MappedEntry, ObjectRange, Value};
+use std::fmt::Display;
+
+/// A value in a profile file that does not read as what its place needs.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ValueError {
+    /// A JSON value (or a number) of the wrong kind, e.g. `true is not a number`.
+    #[error("{value} is not {expected}")]
+    Not { value: String, expected: &'static str },
+    /// A text that does not parse, e.g. ``` `0xZZ` is not a number ```.
+    #[error("`{text}` is not {expected}")]
+    NotText { text: String, expected: &'static str },
+    #[error("bit length {bits} of 0x{index:04X}:{sub} is not 1..64")]
+    BitLength { bits: u8, index: u16, sub: u8 },
+    #[error("empty sub range `{0}`")]
+    EmptySubRange(String),
+    #[error(transparent)]
+    Expr(#[from] ExprError),
+}
+
+impl ValueError {
+    fn not(value: impl Display, expected: &'static str) -> ValueError {
+        ValueError::Not {
+            value: value.to_string(),
+            expected,
+        }
+    }
+
+    fn not_text(text: impl Display, expected: &'static str) -> ValueError {
+        ValueError::NotText {
+            text: text.to_string(),
+            expected,
+        }
+    }
+}
 
 /// A number given as a JSON number or a string (`0x..`, `0b..`, decimal).
-pub(super) fn int(v: &Json) -> Result<i64, String> {
+pub(super) fn int(v: &Json) -> Result<i64, ValueError> {
     match v {
         Json::Number(n) => n
             .as_i64()
             .or_else(|| n.as_u64().map(|u| u as i64))
-            .ok_or_else(|| format!("{n} is not an integer")),
-        Json::String(s) => parse_int(s).ok_or_else(|| format!("`{s}` is not a number")),
-        other => Err(format!("{other} is not a number")),
+            .ok_or_else(|| ValueError::not(n, "an integer")),
+        Json::String(s) => parse_int(s).ok_or_else(|| ValueError::not_text(s, "a number")),
+        other => Err(ValueError::not(other, "a number")),
     }
 }
 
-pub(super) fn byte(v: i64) -> Result<u8, String> {
-    u8::try_from(v).map_err(|_| format!("{v} is not a byte (0..255)"))
+pub(super) fn byte(v: i64) -> Result<u8, ValueError> {
+    u8::try_from(v).map_err(|_| ValueError::not(v, "a byte (0..255)"))
 }
 
-pub(super) fn float(v: &Json) -> Result<f64, String> {
+pub(super) fn float(v: &Json) -> Result<f64, ValueError> {
     match v {
-        Json::Number(n) => n.as_f64().ok_or_else(|| format!("{n} is not a number")),
-        Json::String(s) => s.trim().parse().map_err(|_| format!("`{s}` is not a number")),
-        other => Err(format!("{other} is not a number")),
+        Json::Number(n) => n.as_f64().ok_or_else(|| ValueError::not(n, "a number")),
+        Json::String(s) => s.trim().parse().map_err(|_| ValueError::not_text(s, "a number")),
+        other => Err(ValueError::not(other, "a number")),
     }
 }
 
-pub(super) fn expr(v: &Json) -> Result<Expr, String> {
+pub(super) fn expr(v: &Json) -> Result<Expr, ValueError> {
     match v {
-        Json::String(s) => Expr::parse(s),
+        Json::String(s) => Ok(Expr::parse(s)?),
         Json::Number(_) => int(v).map(Expr::constant),
-        other => Err(format!("{other} is not an expression")),
+        other => Err(ValueError::not(other, "an expression")),
     }
 }
 
-pub(super) fn default_value(v: &Json, t: DataType) -> Result<Value, String> {
+pub(super) fn default_value(v: &Json, t: DataType) -> Result<Value, ValueError> {
     use DataType::*;
     match t {
         VisibleString | UnicodeString => match v {
             Json::String(s) => Ok(Value::Text(s.clone())),
-            other => Err(format!("{other} is not a text")),
+            other => Err(ValueError::not(other, "a text")),
         },
         F32 | F64 => float(v).map(Value::Float),
         Boolean => int(v).map(|x| Value::Bool(x != 0)),
@@ -53,8 +87,8 @@ pub(super) fn default_value(v: &Json, t: DataType) -> Result<Value, String> {
         OctetString | Domain | TimeOfDay | TimeDifference => match v {
             Json::String(s) => hex_bytes(s)
                 .map(Value::Bytes)
-                .ok_or_else(|| format!("`{s}` is not hex bytes")),
-            other => Err(format!("{other} is not hex bytes")),
+                .ok_or_else(|| ValueError::not_text(s, "hex bytes")),
+            other => Err(ValueError::not(other, "hex bytes")),
         },
         _ => int(v).map(|x| Value::Unsigned(x as u64)),
     }
@@ -73,9 +107,9 @@ pub(super) fn hex_bytes(s: &str) -> Option<Vec<u8>> {
 }
 
 /// `"0x6041:0/16"`, `"0x6041/16"` or a CiA mapping value `"0x60410010"` / number.
-pub(super) fn mapped_entry(v: &Json) -> Result<MappedEntry, String> {
-    let from_raw = |raw: i64| -> Result<MappedEntry, String> {
-        let raw = u32::try_from(raw).map_err(|_| format!("{raw} is not a 32-bit mapping value"))?;
+pub(super) fn mapped_entry(v: &Json) -> Result<MappedEntry, ValueError> {
+    let from_raw = |raw: i64| -> Result<MappedEntry, ValueError> {
+        let raw = u32::try_from(raw).map_err(|_| ValueError::not(raw, "a 32-bit mapping value"))?;
         Ok(MappedEntry {
             index: (raw >> 16) as u16,
             sub: (raw >> 8) as u8,
@@ -86,22 +120,23 @@ pub(super) fn mapped_entry(v: &Json) -> Result<MappedEntry, String> {
         Json::Number(_) => from_raw(int(v)?)?,
         Json::String(s) => match s.split_once('/') {
             Some((obj, bits)) => {
-                let (index, sub) = parse_object_ref(obj).ok_or_else(|| format!("`{obj}` is not an object"))?;
+                let (index, sub) = parse_object_ref(obj).ok_or_else(|| ValueError::not_text(obj, "an object"))?;
                 let bits = bits
                     .trim()
                     .parse::<u8>()
-                    .map_err(|_| format!("`{bits}` is not a bit length"))?;
+                    .map_err(|_| ValueError::not_text(bits, "a bit length"))?;
                 MappedEntry { index, sub, bits }
             }
-            None => from_raw(parse_int(s).ok_or_else(|| format!("`{s}` is not a mapping (use 0xINDEX:SUB/BITS)"))?)?,
+            None => from_raw(parse_int(s).ok_or_else(|| ValueError::not_text(s, "a mapping (use 0xINDEX:SUB/BITS)"))?)?,
         },
-        other => return Err(format!("{other} is not a mapping entry")),
+        other => return Err(ValueError::not(other, "a mapping entry")),
     };
     if e.bits == 0 || e.bits > 64 {
-        return Err(format!(
-            "bit length {} of 0x{:04X}:{} is not 1..64",
-            e.bits, e.index, e.sub
-        ));
+        return Err(ValueError::BitLength {
+            bits: e.bits,
+            index: e.index,
+            sub: e.sub,
+        });
     }
     Ok(e)
 }
@@ -119,17 +154,17 @@ pub(super) fn index_range(key: &str) -> Option<(u16, u16)> {
 }
 
 /// `"3"`, `"0x1A"` or `"1..127"`.
-pub(super) fn sub_range(key: &str) -> Result<std::ops::RangeInclusive<u8>, String> {
+pub(super) fn sub_range(key: &str) -> Result<std::ops::RangeInclusive<u8>, ValueError> {
     let one = |t: &str| {
         parse_int(t)
             .and_then(|v| u8::try_from(v).ok())
-            .ok_or_else(|| format!("`{t}` is not a sub 0..255"))
+            .ok_or_else(|| ValueError::not_text(t, "a sub 0..255"))
     };
     match key.split_once("..") {
         Some((a, b)) => {
             let (a, b) = (one(a)?, one(b)?);
             if a > b {
-                return Err(format!("empty sub range `{key}`"));
+                return Err(ValueError::EmptySubRange(key.to_string()));
             }
             Ok(a..=b)
         }
@@ -138,13 +173,13 @@ pub(super) fn sub_range(key: &str) -> Result<std::ops::RangeInclusive<u8>, Strin
 }
 
 /// `"0x3046"` (all subs), `"0x303F:0x11"` (one sub) or `"0x6000..0x67FF"`.
-pub(super) fn object_range(text: &str) -> Result<ObjectRange, String> {
+pub(super) fn object_range(text: &str) -> Result<ObjectRange, ValueError> {
     if text.contains("..") {
         let (first, last) =
-            index_range(text).ok_or_else(|| format!("`{text}` is not an index range (0xFIRST..0xLAST)"))?;
+            index_range(text).ok_or_else(|| ValueError::not_text(text, "an index range (0xFIRST..0xLAST)"))?;
         return Ok(ObjectRange { first, last, sub: None });
     }
-    let (index, sub) = parse_object_ref(text).ok_or_else(|| format!("`{text}` is not an object"))?;
+    let (index, sub) = parse_object_ref(text).ok_or_else(|| ValueError::not_text(text, "an object"))?;
     let one_sub = text.contains(':') || text.to_ascii_lowercase().contains("sub");
     Ok(ObjectRange {
         first: index,

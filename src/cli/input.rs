@@ -1,0 +1,89 @@
+//! The logs that `decode` and `diagnose` read: opening one, walking its frames batch by
+//! batch (parsed on a second thread, bad lines reported on stderr as `FILE:LINE: warning:`)
+//! and the closing counts of what was skipped.
+
+use crate::frame::{Frame, Interfaces};
+use crate::log::{Counts, Outcome, read_ahead};
+use std::io::{self, BufRead, BufReader};
+
+/// A log to read: stdin for `-`, else the file; `None` (with the message on stderr, `what`
+/// naming the command) when it cannot be opened.
+pub fn open_input(path: &str, what: &str) -> Option<Box<dyn BufRead + Send>> {
+    if path == "-" {
+        return Some(Box::new(BufReader::with_capacity(1 << 16, io::stdin())));
+    }
+    match std::fs::File::open(path) {
+        Ok(f) => Some(Box::new(BufReader::with_capacity(1 << 16, f))),
+        Err(e) => {
+            eprintln!("cotui {what}: {path}: {e}");
+            None
+        }
+    }
+}
+
+/// The frames of one batch, in input order: an iterator of (1-based line, frame) that
+/// prints each malformed line's warning as it passes it.
+pub struct Frames<'a> {
+    path: &'a str,
+    lines: std::slice::Iter<'a, (u64, Outcome)>,
+    /// The interface names the frames' `iface` indices refer to.
+    pub ifaces: &'a Interfaces,
+}
+
+impl<'a> Iterator for Frames<'a> {
+    type Item = (u64, &'a Frame);
+
+    fn next(&mut self) -> Option<(u64, &'a Frame)> {
+        for (line, outcome) in self.lines.by_ref() {
+            match outcome {
+                Outcome::Frame(f) => return Some((*line, f)),
+                Outcome::Skip(_) => {}
+                Outcome::Warning(msg) => eprintln!("{}:{line}: warning: {msg}", self.path),
+            }
+        }
+        None
+    }
+}
+
+/// Reads `input` (named `path` in warnings) and calls `consume` with the frames of each
+/// batch, in order. Returns what the reader counted; a read error, or the first error of
+/// `consume` (which stops reading), is returned instead.
+pub fn for_each_frame(
+    path: &str,
+    input: Box<dyn BufRead + Send>,
+    mut consume: impl FnMut(Frames<'_>) -> io::Result<()>,
+) -> io::Result<Counts> {
+    let mut ifaces = Interfaces::default();
+    let finished = read_ahead::for_each_batch(input, |batch| {
+        if let Some(i) = &batch.interfaces {
+            ifaces = i.clone();
+        }
+        consume(Frames {
+            path,
+            lines: batch.lines.iter(),
+            ifaces: &ifaces,
+        })
+    })??;
+    match finished.error {
+        Some(e) => Err(e),
+        None => Ok(finished.counts),
+    }
+}
+
+/// Prints what a reader skipped or could not read in `path` (nothing when every line was a frame).
+pub fn report_counts(path: &str, c: &Counts) {
+    if c.warnings > 0 || c.skipped_total() > 0 {
+        eprintln!(
+            "{path}: {} frames, {} lines skipped, {} malformed lines",
+            c.frames,
+            c.skipped_total(),
+            c.warnings
+        );
+    }
+    if let Some(first) = c.first_ignored_tail {
+        eprintln!(
+            "{path}: {} frame lines had text after the frame, not read (comments; first: line {first})",
+            c.ignored_tail
+        );
+    }
+}

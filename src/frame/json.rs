@@ -1,0 +1,135 @@
+//! JSON forms of frame fields that every record type shares: exact seconds, upper-case
+//! hex and the contract's string escaping. Each is a `Serialize` wrapper, so the record
+//! types derive `Serialize` and write straight into the output buffer.
+
+use serde::ser::{Error, Serialize, Serializer};
+use serde_json::value::RawValue;
+
+/// Writes already formatted JSON text (checked by serde_json, which is cheap for the
+/// short texts here) into the record.
+fn raw<S: Serializer>(text: &str, s: S) -> Result<S::Ok, S::Error> {
+    let raw: &RawValue = serde_json::from_str(text).map_err(S::Error::custom)?;
+    raw.serialize(s)
+}
+
+/// A time in ns as a JSON number of seconds with all nine decimals, exact to the ns
+/// (`1700000000.450000000`): a float would round it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Seconds(pub u64);
+
+impl Serialize for Seconds {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        // u64::MAX ns is 18446744073.709551615 s: 21 characters.
+        let mut buf = [b'0'; 32];
+        let (mut secs, mut frac) = (self.0 / 1_000_000_000, self.0 % 1_000_000_000);
+        let mut i = buf.len();
+        for _ in 0..9 {
+            i -= 1;
+            buf[i] = b'0' + (frac % 10) as u8;
+            frac /= 10;
+        }
+        i -= 1;
+        buf[i] = b'.';
+        loop {
+            i -= 1;
+            buf[i] = b'0' + (secs % 10) as u8;
+            secs /= 10;
+            if secs == 0 {
+                break;
+            }
+        }
+        raw(std::str::from_utf8(&buf[i..]).map_err(S::Error::custom)?, s)
+    }
+}
+
+/// Bytes as upper-case hex without separators: `[0x1A, 0x2B]` -> `"1A2B"`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Hex<'a>(pub &'a [u8]);
+
+impl Serialize for Hex<'_> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        const DIGITS: &[u8; 16] = b"0123456789ABCDEF";
+        // Frame payloads (up to 64 bytes) are written from the stack; transfers allocate.
+        if self.0.len() > 64 {
+            return s.serialize_str(&super::hex::upper(self.0));
+        }
+        let mut buf = [0u8; 128];
+        for (i, b) in self.0.iter().enumerate() {
+            buf[2 * i] = DIGITS[(b >> 4) as usize];
+            buf[2 * i + 1] = DIGITS[(b & 15) as usize];
+        }
+        s.serialize_str(std::str::from_utf8(&buf[..2 * self.0.len()]).map_err(S::Error::custom)?)
+    }
+}
+
+/// A string with the escaping of the frame record's own fields (`iface`, `label`,
+/// `malformed`): as serde_json escapes, except that backspace and form feed are written
+/// `\u0008` and `\u000c`, as the JSONL contract always has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Text<'a>(pub &'a str);
+
+impl Serialize for Text<'_> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        if memchr::memchr2(0x08, 0x0C, self.0.as_bytes()).is_none() {
+            return s.serialize_str(self.0);
+        }
+        let mut lit = String::with_capacity(self.0.len() + 16);
+        lit.push('"');
+        for c in self.0.chars() {
+            match c {
+                '"' => lit.push_str("\\\""),
+                '\\' => lit.push_str("\\\\"),
+                '\n' => lit.push_str("\\n"),
+                '\r' => lit.push_str("\\r"),
+                '\t' => lit.push_str("\\t"),
+                '\0'..='\x1f' => lit.push_str(&format!("\\u{:04x}", c as u32)),
+                c => lit.push(c),
+            }
+        }
+        lit.push('"');
+        raw(&lit, s)
+    }
+}
+
+/// Appends `record` as one JSON line; nothing when it cannot be written (the record
+/// types hold only what JSON can carry, so this does not happen).
+pub fn write_line(out: &mut Vec<u8>, record: &impl Serialize) {
+    let start = out.len();
+    match serde_json::to_writer(&mut *out, record) {
+        Ok(()) => out.push(b'\n'),
+        Err(_) => out.truncate(start),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn json(v: impl Serialize) -> String {
+        serde_json::to_string(&v).unwrap()
+    }
+
+    #[test]
+    fn seconds_keep_every_nanosecond() {
+        assert_eq!(json(Seconds(1_700_000_000_450_000_001)), "1700000000.450000001");
+        assert_eq!(json(Seconds(0)), "0.000000000");
+        assert_eq!(json(Seconds(u64::MAX)), "18446744073.709551615");
+    }
+
+    #[test]
+    fn hex_is_upper_case_at_any_length() {
+        assert_eq!(json(Hex(&[0x1A, 0x2B])), r#""1A2B""#);
+        assert_eq!(json(Hex(&[])), r#""""#);
+        let long = [0xABu8; 100];
+        assert_eq!(json(Hex(&long)), format!("\"{}\"", "AB".repeat(100)));
+    }
+
+    #[test]
+    fn text_escapes_as_the_contract_does() {
+        assert_eq!(json(Text("a\"b\\c\u{1}")), r#""a\"b\\c\u0001""#);
+        assert_eq!(json(Text("µ\tz\n°")), r#""µ\tz\n°""#);
+        assert_eq!(json(Text("\u{8}x\u{c}\u{1b}\r")), r#""\u0008x\u000c\u001b\r""#);
+        // The same text as serde_json would write it, apart from \b and \f.
+        assert_eq!(json("\u{8}\u{c}"), r#""\b\f""#);
+    }
+}
