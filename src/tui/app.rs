@@ -1,51 +1,29 @@
-//! The application state and what every action does to it. Pure state transitions:
-//! no terminal here, so tests drive it directly.
+//! The application: the state the panes share (the trace, the source, the focus, the
+//! messages, the key map) and the routing of keys and actions to the focused pane
+//! ([`crate::tui::panes`]) and the popups. Pure state transitions: no terminal here, so
+//! tests drive it directly.
 
 use super::keymap::{Action, Key, Keymap, Lookup};
 use super::live::{Request, Requests};
 use super::messages::{Level, Messages};
 use super::palette::{self, COMMANDER_WORDS, Planned};
-use super::prompt::{Prompt, PromptKind};
-use super::rows::{Row, RowCache};
+use super::panes::detail::DetailPane;
+use super::panes::help::HelpPopup;
+use super::panes::messages::MessagesPopup;
+use super::panes::{Ctx, Outcome, Pane, Panes, Selected};
+use super::prompt::{Edit, PromptBar, PromptKind};
 use super::source::{Control, Feed};
 use crate::analysis::filter::Filter;
 use crate::analysis::trace::Trace;
-use crate::analysis::view::View;
 use crate::command::Command;
 use crate::command::stop::{Commanded, StopOptions, is_powered};
-use crate::decode::Decoded;
 use crate::od::bind::Bindings;
-use crossterm::event::{KeyCode, KeyEvent, KeyModifiers, MouseButton, MouseEvent, MouseEventKind};
+use crossterm::event::{KeyCode, KeyEvent, MouseButton, MouseEvent, MouseEventKind};
 use ratatui::layout::Rect;
 use std::collections::BTreeSet;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError};
 use std::time::SystemTime;
 use std::time::{Duration, Instant};
-
-/// The main-area panes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Pane {
-    Trace,
-    Nodes,
-    Sdo,
-    Stats,
-    Plot,
-}
-
-impl Pane {
-    /// Every pane in tab order.
-    pub const ALL: [Pane; 5] = [Pane::Trace, Pane::Nodes, Pane::Sdo, Pane::Stats, Pane::Plot];
-    /// Tab title.
-    pub fn title(self) -> &'static str {
-        match self {
-            Pane::Trace => "Trace",
-            Pane::Nodes => "Nodes",
-            Pane::Sdo => "SDO",
-            Pane::Stats => "Stats",
-            Pane::Plot => "Plot",
-        }
-    }
-}
 
 /// How the frames come in.
 #[derive(Clone, Debug, PartialEq)]
@@ -104,84 +82,39 @@ impl SourceInfo {
     }
 }
 
-/// Scroll state of a list pane.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct ListState {
-    /// Selected row.
-    pub selected: usize,
-    /// First visible row.
-    pub offset: usize,
-}
-
-impl ListState {
-    /// Keeps `selected` within `len` rows and visible in `height` rows.
-    pub fn clamp(&mut self, len: usize, height: usize) {
-        self.selected = self.selected.min(len.saturating_sub(1));
-        let h = height.max(1);
-        if self.selected < self.offset {
-            self.offset = self.selected;
-        } else if self.selected >= self.offset + h {
-            self.offset = self.selected + 1 - h;
-        }
-        self.offset = self.offset.min(len.saturating_sub(h));
-    }
-}
-
 /// Where the last draw put things (for mouse clicks and page sizes).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Layout {
     /// Rows of the main table, without header.
     pub table: Rect,
-    /// Lines the message log popup shows at once.
-    pub messages: usize,
+    /// The side column (compact nodes, Detail) was shown: the terminal is wide enough.
+    pub side: bool,
 }
 
 /// The whole application state.
 pub struct App {
     /// Frames and what is derived from them.
     pub trace: Trace,
-    /// The filtered view of the trace.
-    pub view: View,
     /// Key bindings.
     pub keymap: Keymap,
-    /// The pane in the main area.
-    pub pane: Pane,
-    /// Trace pane scroll state (rows of the view).
-    pub trace_list: ListState,
-    /// Follow the newest frame.
-    pub follow: bool,
-    /// Nodes pane selection.
-    pub nodes_list: ListState,
-    /// SDO pane selection.
-    pub sdo_list: ListState,
-    /// SDO transaction expanded to its frames.
-    pub sdo_expanded: Option<usize>,
-    /// Stats pane selection.
-    pub stats_list: ListState,
-    /// Plot: index into the series keys.
-    pub series_sel: usize,
-    /// Help popup shown.
-    pub help: bool,
-    /// The prompt being edited.
-    pub prompt: Option<Prompt>,
-    /// Search in force (`n`/`N`).
-    pub search: Option<Filter>,
+    /// The pane in the main area (the one keys go to).
+    pub focus: Pane,
+    /// The main-area panes (each owns its selection and what it shows).
+    pub panes: Panes,
+    /// The Detail pane (beside the main pane, or toggled below it on a narrow terminal).
+    pub detail: DetailPane,
+    /// The help popup.
+    pub help: HelpPopup,
+    /// The prompt line (filter, search, palette) and its history.
+    pub prompt: PromptBar,
     /// A message for the status bar (result of the last command).
     pub message: Option<String>,
-    /// Every result, event and error of the session (the message log popup).
+    /// Every result, event and error of the session.
     pub messages: Messages,
-    /// The message log popup is shown.
-    pub messages_shown: bool,
-    /// Lines the message log is scrolled up from its end.
-    pub messages_back: usize,
-    /// Palette history, newest last.
-    pub history: Vec<String>,
+    /// The message log popup.
+    pub log_popup: MessagesPopup,
     /// The capture source.
     pub source: SourceInfo,
-    /// Decoded rows of the visible window.
-    pub rows: RowCache,
-    /// The selected frame decoded, with its position.
-    pub detail: Option<(usize, Decoded)>,
     /// Frames per second over the last rate tick.
     pub rate: f64,
     /// Set when the user quits.
@@ -235,27 +168,16 @@ impl App {
         let bindings = Bindings::new().expect("the built-in profiles load");
         App {
             trace,
-            view: View::default(),
             keymap,
-            pane: Pane::Trace,
-            trace_list: ListState::default(),
-            follow: true,
-            nodes_list: ListState::default(),
-            sdo_list: ListState::default(),
-            sdo_expanded: None,
-            stats_list: ListState::default(),
-            series_sel: 0,
-            help: false,
-            prompt: None,
-            search: None,
+            focus: Pane::Trace,
+            panes: Panes::default(),
+            detail: DetailPane::default(),
+            help: HelpPopup::default(),
+            prompt: PromptBar::default(),
             message: None,
             messages: Messages::default(),
-            messages_shown: false,
-            messages_back: 0,
-            history: Vec::new(),
+            log_popup: MessagesPopup::default(),
             source,
-            rows: RowCache::default(),
-            detail: None,
             rate: 0.0,
             quit: false,
             layout: Layout::default(),
@@ -295,10 +217,8 @@ impl App {
                 }
                 Ok(Feed::Reset) => {
                     self.trace.clear();
-                    self.view = View::new(self.view.filter.clone());
-                    self.rows = RowCache::default();
-                    self.detail = None;
-                    self.trace_list = ListState::default();
+                    self.panes.trace.reset();
+                    self.detail.reset();
                     self.rate_mark = (Instant::now(), 0);
                     self.capture_clock = None;
                     self.dirty = true;
@@ -341,9 +261,10 @@ impl App {
 
     /// Background work: filter scanning. True when work is left.
     pub fn work(&mut self, budget: Duration) -> bool {
-        let before = self.view.len(&self.trace);
-        let more = self.view.advance(&self.trace, budget);
-        if self.view.len(&self.trace) != before {
+        let view = &mut self.panes.trace.view;
+        let before = view.len(&self.trace);
+        let more = view.advance(&self.trace, budget);
+        if view.len(&self.trace) != before {
             self.dirty = true;
         }
         more
@@ -441,14 +362,18 @@ impl App {
         self.dirty = true;
     }
 
-    /// Rows in the trace view.
-    pub fn view_len(&self) -> usize {
-        self.view.len(&self.trace)
-    }
-
     /// Visible height of the main table.
     fn page(&self) -> usize {
         (self.layout.table.height as usize).max(1)
+    }
+
+    /// What the panes see: the trace, the page height, whether the capture is paused.
+    fn ctx(&self) -> Ctx<'_> {
+        Ctx {
+            trace: &self.trace,
+            page: self.page(),
+            paused: self.source.paused,
+        }
     }
 
     /// Handles a key press.
@@ -470,7 +395,7 @@ impl App {
             }
             return;
         }
-        if self.prompt.is_some() {
+        if self.prompt.editing.is_some() {
             self.prompt_key(ev);
             self.preview();
             return;
@@ -493,44 +418,22 @@ impl App {
     }
 
     fn prompt_key(&mut self, ev: KeyEvent) {
-        let Some(p) = self.prompt.as_mut() else { return };
-        let ctrl = ev.modifiers.contains(KeyModifiers::CONTROL);
-        match ev.code {
-            KeyCode::Esc => self.prompt = None,
-            KeyCode::Char('c') if ctrl => self.prompt = None,
-            KeyCode::Enter => {
-                let p = self
-                    .prompt
-                    .take()
-                    .unwrap_or_else(|| Prompt::new(PromptKind::Palette, ""));
-                self.submit(p);
-            }
-            KeyCode::Char('a') if ctrl => p.jump(false),
-            KeyCode::Char('e') if ctrl => p.jump(true),
-            KeyCode::Char('u') if ctrl => *p = Prompt::new(p.kind, ""),
-            KeyCode::Char(c) => p.insert(c),
-            KeyCode::Backspace => p.backspace(),
-            KeyCode::Delete => p.delete(),
-            KeyCode::Left => p.move_by(-1),
-            KeyCode::Right => p.move_by(1),
-            KeyCode::Home => p.jump(false),
-            KeyCode::End => p.jump(true),
-            KeyCode::Up => p.history(&self.history, true),
-            KeyCode::Down => p.history(&self.history, false),
-            KeyCode::Tab if p.kind == PromptKind::Palette => {
+        match self.prompt.key(ev) {
+            Edit::Submit(kind, text) => self.submit(kind, &text),
+            Edit::Complete => {
                 let words: Vec<&str> = PALETTE_COMMANDS.iter().chain(COMMANDER_WORDS).copied().collect();
-                let shown = p.complete(&words);
+                let shown = self.prompt.complete(&words);
                 if !shown.is_empty() {
                     self.message = Some(shown.join("  "));
                 }
             }
-            _ => {}
+            Edit::Editing | Edit::Cancelled => {}
         }
     }
 
     /// While typing a commander line, shows the frames it would send.
     fn preview(&mut self) {
-        let Some(p) = &self.prompt else { return };
+        let Some(p) = &self.prompt.editing else { return };
         let first = p.text.split_whitespace().next().unwrap_or("");
         if p.kind == PromptKind::Palette && COMMANDER_WORDS.contains(&first) {
             self.message = Some(match palette::plan(&p.text, &self.bindings, |n| self.drive_state(n)) {
@@ -646,15 +549,12 @@ impl App {
         self.quit_confirm = Some(powered);
     }
 
-    fn submit(&mut self, p: Prompt) {
-        let text = p.text.trim().to_string();
-        if !text.is_empty() && self.history.last() != Some(&text) {
-            self.history.push(text.clone());
-        }
-        match p.kind {
-            PromptKind::Filter => self.set_filter(&text),
-            PromptKind::Search => self.set_search(&text),
-            PromptKind::Palette => self.run_command(&text),
+    /// Runs a line entered at a prompt (the filter, search or palette prompt).
+    fn submit(&mut self, kind: PromptKind, text: &str) {
+        match kind {
+            PromptKind::Filter => self.set_filter(text),
+            PromptKind::Search => self.set_search(text),
+            PromptKind::Palette => self.run_command(text),
         }
     }
 
@@ -662,13 +562,9 @@ impl App {
     pub fn set_filter(&mut self, text: &str) {
         match Filter::parse(text) {
             Ok(f) => {
-                let pos = self.selected_position();
-                self.view = View::new(f);
-                self.view.advance(&self.trace, Duration::from_millis(30));
-                self.trace_list.selected = pos.map(|p| self.view.row_of(p)).unwrap_or(0);
-                self.trace_list.clamp(self.view_len(), self.page());
+                let page = self.page();
+                self.panes.trace.set_filter(&self.trace, f, page);
                 self.message = None;
-                self.rows = RowCache::default();
             }
             Err(e) => self.message = Some(format!("filter: {e}")),
         }
@@ -676,9 +572,9 @@ impl App {
 
     fn set_search(&mut self, text: &str) {
         match Filter::parse(text) {
-            Ok(f) if f.is_empty() => self.search = None,
+            Ok(f) if f.is_empty() => self.panes.trace.search = None,
             Ok(f) => {
-                self.search = Some(f);
+                self.panes.trace.search = Some(f);
                 self.jump_match(true);
             }
             Err(e) => self.message = Some(format!("search: {e}")),
@@ -723,13 +619,12 @@ impl App {
             "resume" => self.set_paused(false),
             "plot" => self.plot_command(rest),
             "help" => {
-                self.help = true;
+                self.help.shown = true;
                 Ok(String::new())
             }
             "export" => self.export_command(rest),
             "messages" => {
-                self.messages_shown = true;
-                self.messages_back = 0;
+                self.log_popup.open();
                 Ok(String::new())
             }
             "quit" => {
@@ -784,8 +679,9 @@ impl App {
         let file = file.ok_or("export: usage `export FILE [--format candump|jsonl|pcapng] [--force]`")?;
         let path = std::path::Path::new(&file);
         let format = format.unwrap_or_else(|| ExportFormat::of_path(path));
-        let scanned = self.view.progress(&self.trace);
-        let n = export(&self.trace, &self.view, path, format, force).map_err(|e| {
+        let view = &self.panes.trace.view;
+        let scanned = view.progress(&self.trace);
+        let n = export(&self.trace, view, path, format, force).map_err(|e| {
             let hint = if e.kind() == std::io::ErrorKind::AlreadyExists {
                 " (add --force to overwrite)"
             } else {
@@ -815,16 +711,13 @@ impl App {
         let index =
             u16::from_str_radix(i.trim_start_matches("0x"), 16).map_err(|_| format!("plot: bad index `{i}`"))?;
         let sub = u8::from_str_radix(s, 16).map_err(|_| format!("plot: bad sub-index `{s}`"))?;
-        let keys = self.trace.series.keys();
-        match keys.iter().position(|k| *k == (node, index, sub)) {
-            Some(at) => {
-                self.series_sel = at;
-                self.pane = Pane::Plot;
-                Ok(String::new())
-            }
-            None => Err(format!(
+        if self.panes.plot.select(&self.trace, node, index, sub) {
+            self.focus = Pane::Plot;
+            Ok(String::new())
+        } else {
+            Err(format!(
                 "plot: no numeric values of node {node} 0x{index:04X}:{sub:02X} seen"
-            )),
+            ))
         }
     }
 
@@ -851,210 +744,128 @@ impl App {
             let _ = c.send(Control::Pause(p));
         }
         if p {
-            self.follow = false;
+            self.panes.trace.follow = false;
         }
         Ok(String::new())
     }
 
     /// The timestamp of the first frame.
     pub fn start_ns(&self) -> u64 {
-        if self.trace.is_empty() {
-            0
-        } else {
-            self.trace.store.packed(0).ts_ns
-        }
+        super::panes::start_ns(&self.trace)
     }
 
-    /// The trace position of the selected row.
+    /// The trace position of the selected row of the trace.
     pub fn selected_position(&self) -> Option<usize> {
-        let n = self.view_len();
-        (n > 0).then(|| self.view.position(self.trace_list.selected.min(n - 1)))
+        self.panes.trace.selected_position(&self.trace)
     }
 
+    /// Shows trace position `pos` in the Trace pane.
     fn select_position(&mut self, pos: usize) {
-        self.follow = false;
-        self.pane = Pane::Trace;
-        self.trace_list.selected = self.view.row_of(pos);
-        self.trace_list.clamp(self.view_len(), self.page());
+        let page = self.page();
+        self.focus = Pane::Trace;
+        self.panes.trace.select_position(&self.trace, pos, page);
     }
 
     /// Jumps to the next (or previous) row matching the search.
     fn jump_match(&mut self, forward: bool) {
-        let Some(f) = self.search.clone() else {
-            self.message = Some("no search: press the search key first".into());
-            return;
-        };
-        let n = self.view_len();
-        if n == 0 {
-            return;
-        }
-        let cur = self.trace_list.selected;
-        let rows: Box<dyn Iterator<Item = usize>> = if forward {
-            Box::new(cur + 1..n)
-        } else {
-            Box::new((0..cur).rev())
-        };
-        let deadline = Instant::now() + Duration::from_millis(500);
-        let needs_label = f.needs_label();
-        let in_transfer = f.has_transfer_terms().then(|| {
-            let mut set = std::collections::HashSet::new();
-            for t in self.trace.transactions.iter().filter(|t| f.transaction_matches(t)) {
-                set.extend(t.frames.iter().map(|s| s.saturating_sub(1) as usize));
-            }
-            set
-        });
-        for r in rows {
-            let pos = self.view.position(r);
-            let label = needs_label
-                .then(|| self.trace.decode_positions(&[pos]).pop().map(|d| d.label))
-                .flatten();
-            let inside = in_transfer.as_ref().is_some_and(|s| s.contains(&pos));
-            if f.matches(self.trace.store.packed(pos), inside, label.as_deref()) {
-                self.follow = false;
-                self.trace_list.selected = r;
-                self.trace_list.clamp(n, self.page());
-                self.message = Some(format!("match at frame {}", pos + 1));
-                return;
-            }
-            if Instant::now() > deadline {
-                self.message = Some(format!("search stopped at frame {} (press again to go on)", pos + 1));
-                self.trace_list.selected = r;
-                return;
-            }
-        }
-        self.message = Some(format!(
-            "no {} match for `{}`",
-            if forward { "later" } else { "earlier" },
-            f.source
-        ));
-    }
-
-    fn list(&mut self) -> Option<(&mut ListState, usize)> {
-        let n = match self.pane {
-            Pane::Trace => self.view_len(),
-            Pane::Nodes => self.trace.nodes.len(),
-            Pane::Sdo => match self.sdo_expanded {
-                Some(t) => self.trace.transactions.get(t).map(|t| t.frames.len()).unwrap_or(0),
-                None => self.trace.transactions.len(),
-            },
-            Pane::Stats => self.trace.stats.len(),
-            Pane::Plot => return None,
-        };
-        let l = match self.pane {
-            Pane::Trace => &mut self.trace_list,
-            Pane::Nodes => &mut self.nodes_list,
-            Pane::Sdo => &mut self.sdo_list,
-            _ => &mut self.stats_list,
-        };
-        Some((l, n))
-    }
-
-    fn scroll(&mut self, delta: isize) {
         let page = self.page();
-        if self.pane == Pane::Trace {
-            self.follow = false;
-        }
-        if let Some((l, n)) = self.list() {
-            l.selected = (l.selected as isize + delta).clamp(0, n.saturating_sub(1) as isize) as usize;
-            l.clamp(n, page);
+        if let Some(m) = self.panes.trace.jump_match(&self.trace, forward, page) {
+            self.message = Some(m);
         }
     }
 
-    /// Does what an action says.
+    /// What the Detail pane shows: the focused pane's selection, else the trace's.
+    pub fn selected(&self) -> Option<Selected> {
+        self.panes
+            .get(self.focus)
+            .selected(&self.ctx())
+            .or_else(|| self.selected_position().map(Selected::Frame))
+    }
+
+    /// The Detail pane is toggled in below the main pane (a narrow terminal).
+    fn detail_below(&self) -> bool {
+        self.detail.shown && !self.layout.side
+    }
+
+    /// Does what an action says: the message log popup takes it first while shown, then
+    /// the help popup and the Detail pane below, then the focused pane; what none of them
+    /// takes is for the application.
     pub fn act(&mut self, a: Action) {
         self.dirty = true;
-        let page = self.page() as isize;
-        if self.messages_shown && self.messages_key(a) {
+        if self.log_popup.shown && self.log_popup.handle(a, self.messages.lines().len()) {
             return;
+        }
+        if self.help.handle(a) {
+            return;
+        }
+        if a == Action::Back && self.detail_below() {
+            self.detail.shown = false;
+            return;
+        }
+        let page = self.page();
+        let ctx = Ctx {
+            trace: &self.trace,
+            page,
+            paused: self.source.paused,
+        };
+        match self.panes.get_mut(self.focus).handle(a, &ctx) {
+            Outcome::Done => return,
+            Outcome::Ignored => {}
+            Outcome::Detail => {
+                // Beside the main pane on a wide terminal; toggled below it on a narrow one.
+                if !self.layout.side {
+                    self.detail.shown = !self.detail.shown;
+                }
+                return;
+            }
+            Outcome::Filter(text) => {
+                self.set_filter(&text);
+                self.focus = Pane::Trace;
+                return;
+            }
+            Outcome::Show(pos) => {
+                self.panes.trace.show(&self.trace, pos, page);
+                self.focus = Pane::Trace;
+                return;
+            }
         }
         match a {
             Action::Quit => self.request_quit(),
-            Action::Help => self.help = !self.help,
-            Action::Messages => {
-                self.messages_shown = !self.messages_shown;
-                self.messages_back = 0;
-            }
-            Action::Down => self.scroll(1),
-            Action::Up => self.scroll(-1),
-            Action::PageDown => self.scroll(page),
-            Action::PageUp => self.scroll(-page),
-            Action::Top => self.scroll(isize::MIN / 2),
-            Action::Bottom => {
-                self.scroll(isize::MAX / 2);
-                if self.pane == Pane::Trace {
-                    self.follow = true;
-                }
+            Action::Messages => self.log_popup.toggle(),
+            Action::Back => {
+                self.panes.trace.search = None;
+                self.message = None;
             }
             Action::Follow => {
-                self.follow = !self.follow;
-                self.pane = Pane::Trace;
+                self.panes.trace.follow = !self.panes.trace.follow;
+                self.focus = Pane::Trace;
             }
             Action::Pause => {
                 let p = !self.source.paused;
                 let _ = self.set_paused(p);
                 if !p {
-                    self.follow = true;
-                }
-            }
-            Action::Expand => match self.pane {
-                Pane::Sdo if self.sdo_expanded.is_none() && !self.trace.transactions.is_empty() => {
-                    self.sdo_expanded = Some(self.sdo_list.selected);
-                    self.sdo_list = ListState::default();
-                }
-                Pane::Sdo => {
-                    if let Some(t) = self.sdo_expanded.and_then(|t| self.trace.transactions.get(t))
-                        && let Some(seq) = t.frames.get(self.sdo_list.selected)
-                    {
-                        let pos = seq.saturating_sub(1) as usize;
-                        self.view = View::new(Filter::default());
-                        self.select_position(pos);
-                    }
-                }
-                Pane::Nodes => {
-                    let node = self.trace.nodes.iter().nth(self.nodes_list.selected).map(|(n, _)| *n);
-                    if let Some(n) = node {
-                        self.set_filter(&format!("node {n}"));
-                        self.pane = Pane::Trace;
-                    }
-                }
-                Pane::Stats => {
-                    let id = self.trace.stats.iter().nth(self.stats_list.selected).map(|(k, _)| k.1);
-                    if let Some(id) = id {
-                        self.set_filter(&format!("id {id:X}"));
-                        self.pane = Pane::Trace;
-                    }
-                }
-                _ => {}
-            },
-            Action::Back => {
-                if self.help {
-                    self.help = false;
-                } else if let Some(t) = self.sdo_expanded.take() {
-                    self.sdo_list = ListState {
-                        selected: t,
-                        offset: t.saturating_sub(3),
-                    };
-                } else {
-                    self.search = None;
-                    self.message = None;
+                    self.panes.trace.follow = true;
                 }
             }
             Action::NextPane | Action::PrevPane => {
-                let i = Pane::ALL.iter().position(|p| *p == self.pane).unwrap_or(0);
+                let i = Pane::ALL.iter().position(|p| *p == self.focus).unwrap_or(0);
                 let d = if a == Action::NextPane { 1 } else { Pane::ALL.len() - 1 };
-                self.pane = Pane::ALL[(i + d) % Pane::ALL.len()];
+                self.focus = Pane::ALL[(i + d) % Pane::ALL.len()];
             }
-            Action::PaneTrace => self.pane = Pane::Trace,
-            Action::PaneNodes => self.pane = Pane::Nodes,
-            Action::PaneSdo => self.pane = Pane::Sdo,
-            Action::PaneStats => self.pane = Pane::Stats,
-            Action::PanePlot => self.pane = Pane::Plot,
-            Action::Filter => self.prompt = Some(Prompt::new(PromptKind::Filter, &self.view.filter.source)),
-            Action::Search => self.prompt = Some(Prompt::new(PromptKind::Search, "")),
+            Action::PaneTrace => self.focus = Pane::Trace,
+            Action::PaneNodes => self.focus = Pane::Nodes,
+            Action::PaneSdo => self.focus = Pane::Sdo,
+            Action::PaneStats => self.focus = Pane::Stats,
+            Action::PanePlot => self.focus = Pane::Plot,
+            Action::Filter => {
+                let text = self.panes.trace.view.filter.source.clone();
+                self.prompt.open(PromptKind::Filter, &text);
+            }
+            Action::Search => self.prompt.open(PromptKind::Search, ""),
             Action::NextMatch => self.jump_match(true),
             Action::PrevMatch => self.jump_match(false),
             Action::ClearFilter => self.set_filter(""),
-            Action::Palette => self.prompt = Some(Prompt::new(PromptKind::Palette, "")),
+            Action::Palette => self.prompt.open(PromptKind::Palette, ""),
             Action::StopAll => self.stop_all(&[], StopOptions::default()),
             Action::SpeedUp | Action::SpeedDown => {
                 if let SourceKind::Replay { speed } = self.source.kind {
@@ -1066,7 +877,7 @@ impl App {
             Action::Step => match &self.source.control {
                 Some(c) if self.source.paused => {
                     let _ = c.send(Control::Step);
-                    self.follow = true;
+                    self.panes.trace.follow = true;
                 }
                 _ => self.message = Some("step: pause a replay first".into()),
             },
@@ -1078,92 +889,63 @@ impl App {
                         -10_000_000_000
                     };
                     let _ = c.send(Control::Seek(d));
-                    self.follow = true;
+                    self.panes.trace.follow = true;
                 }
                 None => self.message = Some("seek: only a replay can seek".into()),
             },
             Action::NextSeries | Action::PrevSeries => {
-                let n = self.trace.series.keys().len().max(1);
-                self.series_sel = if a == Action::NextSeries {
-                    (self.series_sel + 1) % n
-                } else {
-                    (self.series_sel + n - 1) % n
-                };
-                self.pane = Pane::Plot;
+                self.panes.plot.step(&self.trace, a == Action::NextSeries);
+                self.focus = Pane::Plot;
             }
+            // Taken by the help popup; row movement and `expand` in a pane without rows.
+            Action::Help
+            | Action::Down
+            | Action::Up
+            | Action::PageDown
+            | Action::PageUp
+            | Action::Top
+            | Action::Bottom
+            | Action::Expand => {}
         }
     }
 
-    /// Scrolls or closes the message log popup; false when `a` is not for it.
-    fn messages_key(&mut self, a: Action) -> bool {
-        let page = self.layout.messages.max(1);
-        let most = self.messages.lines().len();
-        let back = &mut self.messages_back;
-        match a {
-            Action::Up => *back += 1,
-            Action::Down => *back = back.saturating_sub(1),
-            Action::PageUp => *back += page,
-            Action::PageDown => *back = back.saturating_sub(page),
-            Action::Top => *back = most,
-            Action::Bottom => *back = 0,
-            Action::Back | Action::Messages => self.messages_shown = false,
-            _ => return false,
-        }
-        self.messages_back = self.messages_back.min(most.saturating_sub(self.layout.messages));
-        true
-    }
-
-    /// Handles a mouse event: wheel scrolls, left click selects a row.
+    /// Handles a mouse event: the wheel scrolls the focused pane, a left click selects a row.
     pub fn mouse(&mut self, ev: MouseEvent) {
         self.dirty = true;
+        let ctx = Ctx {
+            trace: &self.trace,
+            page: self.page(),
+            paused: self.source.paused,
+        };
+        let pane = self.panes.get_mut(self.focus);
         match ev.kind {
-            MouseEventKind::ScrollDown => self.scroll(3),
-            MouseEventKind::ScrollUp => self.scroll(-3),
+            MouseEventKind::ScrollDown => pane.scroll(3, &ctx),
+            MouseEventKind::ScrollUp => pane.scroll(-3, &ctx),
             MouseEventKind::Down(MouseButton::Left) => {
                 let t = self.layout.table;
                 if ev.column >= t.x && ev.column < t.x + t.width && ev.row >= t.y && ev.row < t.y + t.height {
-                    let page = self.page();
-                    let r = (ev.row - t.y) as usize;
-                    if self.pane == Pane::Trace {
-                        self.follow = false;
-                    }
-                    if let Some((l, n)) = self.list() {
-                        let want = l.offset + r;
-                        if want < n {
-                            l.selected = want;
-                            l.clamp(n, page);
-                        }
-                    }
+                    pane.click((ev.row - t.y) as usize, &ctx);
                 }
             }
             _ => {}
         }
     }
 
-    /// Before drawing: pins the selection to the newest row in follow mode and decodes the
-    /// visible window (`height` rows), the tail strip and the selected frame.
-    pub fn prepare(&mut self, height: usize, tail: &[usize]) {
-        let n = self.view_len();
-        if self.follow {
-            self.trace_list.selected = n.saturating_sub(1);
+    /// Before drawing: keeps the list panes' selections within their rows and visible in
+    /// `height` rows, pins the trace selection to the newest row in follow mode, decodes the
+    /// visible trace window (`rows` rows), the tail strip and what the Detail pane shows.
+    pub fn prepare(&mut self, height: usize, rows: usize, tail: &[usize]) {
+        let ctx = Ctx {
+            trace: &self.trace,
+            page: self.page(),
+            paused: self.source.paused,
+        };
+        for p in [Pane::Nodes, Pane::Stats, Pane::Sdo] {
+            self.panes.get_mut(p).fit(height, &ctx);
         }
-        self.trace_list.clamp(n, height);
-        let mut positions: Vec<usize> = (self.trace_list.offset..(self.trace_list.offset + height).min(n))
-            .map(|r| self.view.position(r))
-            .collect();
-        positions.extend_from_slice(tail);
-        positions.sort_unstable();
-        positions.dedup();
-        self.rows.fill(&self.trace, &positions);
-        let sel = self.selected_position();
-        if sel != self.detail.as_ref().map(|(p, _)| *p) {
-            self.detail = sel.and_then(|p| self.trace.decode_positions(&[p]).pop().map(|d| (p, d)));
-        }
-    }
-
-    /// The decoded row for a trace position, when it is in the visible window.
-    pub fn row(&self, pos: usize) -> Option<&Row> {
-        self.rows.get(pos)
+        self.panes.trace.prepare(&self.trace, rows, tail);
+        let selected = self.selected();
+        self.detail.update(&self.trace, selected);
     }
 }
 
@@ -1171,7 +953,7 @@ impl App {
 mod tests {
     use super::*;
     use crate::tui::panes::testutil::{app, frames};
-    use crossterm::event::KeyEvent;
+    use crossterm::event::{KeyEvent, KeyModifiers};
 
     fn key(c: char) -> KeyEvent {
         KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE)
@@ -1290,7 +1072,7 @@ mod tests {
             a.message.as_deref(),
             Some("not sent: this source has no bus (use `cotui live IFACE` or `cotui demo`)")
         );
-        assert_eq!(a.history, ["nmt reset-node 0"]);
+        assert_eq!(a.prompt.history, ["nmt reset-node 0"]);
     }
 
     /// `app()` fed by a live source whose requests the test reads.
@@ -1408,14 +1190,14 @@ mod tests {
         assert!(lines[3].ends_with("  vcan0: interface went down; fix: sudo ip link set vcan0 up"));
         assert!(lines[4].ends_with("  vcan0: capturing again after 2.0 s without capture"));
         a.key(key('m'));
-        assert!(a.messages_shown);
+        assert!(a.log_popup.shown);
         let s = crate::tui::panes::testutil::screen(&mut a, 120, 20);
         assert!(s.contains("Messages (3)"), "{s}");
         assert!(s.contains("node 3 syntron-ds"), "{s}");
         a.act(Action::Up);
-        assert_eq!(a.messages_back, 0, "all lines fit: nothing to scroll");
+        assert_eq!(a.log_popup.back, 0, "all lines fit: nothing to scroll");
         a.act(Action::Back);
-        assert!(!a.messages_shown);
+        assert!(!a.log_popup.shown);
     }
 
     #[test]
@@ -1427,10 +1209,10 @@ mod tests {
             a.act(Action::Down);
         }
         a.act(Action::Expand);
-        assert_eq!(a.sdo_expanded, Some(4));
+        assert_eq!(a.panes.sdo.expanded, Some(4));
         a.act(Action::Down);
         a.act(Action::Expand);
-        assert_eq!(a.pane, Pane::Trace);
+        assert_eq!(a.focus, Pane::Trace);
         assert_eq!(a.selected_position(), Some(12));
     }
 }
