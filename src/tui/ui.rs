@@ -32,7 +32,7 @@ pub fn draw(f: &mut Frame, app: &mut App) {
     app.layout.side = side.is_some();
     // Too narrow for the side column: the Detail pane, when toggled, goes below the main pane.
     let (main, below) = if side.is_none() && app.detail.shown {
-        let [m, d] = Layout::vertical([Constraint::Percentage(50), Constraint::Percentage(50)]).areas(main);
+        let [m, d] = Layout::vertical([Constraint::Percentage(40), Constraint::Percentage(60)]).areas(main);
         (m, Some(d))
     } else {
         (main, None)

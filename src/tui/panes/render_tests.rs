@@ -82,7 +82,49 @@ fn sdo_pane_lists_transfers_and_expands_to_frames() {
     a.act(Action::Expand);
     let s = screen(&mut a, 140, 14);
     assert!(s.contains("SDO transfer 1017:00 node 1"), "{s}");
+    // Detail shows the selected frame of the transfer, not the newest frame of the trace.
+    assert!(s.contains("frame 4  t 0.007000 s"), "{s}");
     insta::assert_snapshot!("sdo_expanded", s);
+    a.act(Action::Down);
+    let s = screen(&mut a, 140, 14);
+    assert!(s.contains("frame 5  t 0.008000 s"), "{s}");
+}
+
+#[test]
+fn at_80x24_enter_toggles_the_detail_pane_below_the_trace() {
+    let mut a = app();
+    let s = screen(&mut a, 80, 24);
+    assert!(!s.contains("Detail"), "{s}");
+    a.run_command("goto 5");
+    a.act(Action::Expand);
+    let s = screen(&mut a, 80, 24);
+    assert!(s.contains("Detail"), "{s}");
+    assert!(s.contains("frame 5  t 0.008000 s"), "{s}");
+    assert!(s.contains("bits 7-5 scs = 2"), "{s}");
+    insta::assert_snapshot!(s);
+    // The selection moves under it; esc closes it.
+    a.act(Action::Down);
+    let s = screen(&mut a, 80, 24);
+    assert!(s.contains("frame 6  t 0.009000 s"), "{s}");
+    a.act(Action::Back);
+    let s = screen(&mut a, 80, 24);
+    assert!(!s.contains("Detail"), "{s}");
+}
+
+#[test]
+fn at_80x24_the_detail_pane_follows_the_sdo_pane_selection() {
+    let mut a = app();
+    let _ = screen(&mut a, 80, 24);
+    a.act(Action::Expand);
+    a.act(Action::PaneSdo);
+    let s = screen(&mut a, 80, 24);
+    assert!(s.contains("Upload 0x1017:00"), "{s}");
+    a.act(Action::Expand);
+    a.act(Action::Down);
+    let s = screen(&mut a, 80, 24);
+    assert!(s.contains("SDO transfer 1017:00 node 1"), "{s}");
+    assert!(s.contains("frame 5  t 0.008000 s"), "{s}");
+    insta::assert_snapshot!(s);
 }
 
 #[test]

@@ -134,10 +134,10 @@ impl Component for SdoPane {
         self.list.clamp(self.len(ctx.trace), height);
     }
 
-    /// The selected transfer (an opened one shows the trace's selected frame).
-    fn selected(&self, _ctx: &Ctx) -> Option<Selected> {
+    /// The selected transfer, or the selected frame of the opened one.
+    fn selected(&self, ctx: &Ctx) -> Option<Selected> {
         match self.expanded {
-            Some(_) => None,
+            Some(_) => self.selected_frame(ctx.trace).map(Selected::Frame),
             None => Some(Selected::Transfer(self.list.selected)),
         }
     }
