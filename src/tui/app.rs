@@ -162,6 +162,53 @@ pub const PALETTE_COMMANDS: &[&str] = &[
     "filter", "search", "goto", "time", "speed", "pause", "resume", "plot", "export", "help", "messages", "quit",
 ];
 
+/// Why a built-in palette command (`goto`, `time`, `speed`, `plot`, `export`, ...) failed;
+/// the text is what the status bar shows.
+#[derive(Debug, thiserror::Error)]
+pub enum CommandError {
+    #[error("goto: `{0}` is not a frame number")]
+    NotAFrame(String),
+    #[error("time: `{0}` is not seconds")]
+    NotSeconds(String),
+    #[error("speed: `{0}` is not a factor (0 = as fast as possible)")]
+    NotAFactor(String),
+    #[error("speed: only a replay has a speed")]
+    NoSpeed,
+    #[error("plot: usage `plot NODE INDEX[:SUB]`, e.g. `plot 1 6064:00`")]
+    PlotUsage,
+    #[error("plot: `{0}` is not a node-ID")]
+    NotANode(String),
+    #[error("plot: bad index `{0}`")]
+    BadIndex(String),
+    #[error("plot: bad sub-index `{0}`")]
+    BadSub(String),
+    #[error("plot: no numeric values of node {node} 0x{index:04X}:{sub:02X} seen")]
+    NoSeries { node: u8, index: u16, sub: u8 },
+    #[error("export: --format needs candump, jsonl or pcapng")]
+    FormatMissing,
+    #[error("export: {0}")]
+    Format(#[from] super::export::UnknownFormat),
+    #[error("export: unknown option `{0}`")]
+    ExportOption(String),
+    #[error("export: one FILE only (`{0}` is extra)")]
+    ExtraFile(String),
+    #[error("export: usage `export FILE [--format candump|jsonl|pcapng] [--force]`")]
+    ExportUsage,
+    #[error("export: {file}: {source}{hint}", hint = overwrite_hint(source))]
+    Export { file: String, source: std::io::Error },
+    #[error("unknown command `{0}` (commands: {palette} {commander})", palette = PALETTE_COMMANDS.join(" "), commander = COMMANDER_WORDS.join(" "))]
+    Unknown(String),
+}
+
+/// What to add to an export error: how to overwrite an existing file.
+fn overwrite_hint(e: &std::io::Error) -> &'static str {
+    if e.kind() == std::io::ErrorKind::AlreadyExists {
+        " (add --force to overwrite)"
+    } else {
+        ""
+    }
+}
+
 impl App {
     /// An application showing `trace`, fed by `source`.
     pub fn new(trace: Trace, keymap: Keymap, source: SourceInfo) -> App {
@@ -585,7 +632,7 @@ impl App {
     pub fn run_command(&mut self, line: &str) {
         let (cmd, rest) = line.split_once(' ').unwrap_or((line, ""));
         let rest = rest.trim();
-        let result: Result<String, String> = match cmd {
+        let result: Result<String, CommandError> = match cmd {
             "" => Ok(String::new()),
             "filter" => {
                 self.set_filter(rest);
@@ -597,14 +644,14 @@ impl App {
             }
             "goto" => rest
                 .parse::<usize>()
-                .map_err(|_| format!("goto: `{rest}` is not a frame number"))
+                .map_err(|_| CommandError::NotAFrame(rest.to_string()))
                 .map(|n| {
                     self.select_position(n.saturating_sub(1));
                     format!("frame {n}")
                 }),
             "time" => rest
                 .parse::<f64>()
-                .map_err(|_| format!("time: `{rest}` is not seconds"))
+                .map_err(|_| CommandError::NotSeconds(rest.to_string()))
                 .map(|s| {
                     let t0 = self.start_ns();
                     let pos = self.trace.store.position_at(t0 + (s.max(0.0) * 1e9) as u64);
@@ -613,10 +660,16 @@ impl App {
                 }),
             "speed" => match rest.parse::<f64>() {
                 Ok(x) if x >= 0.0 => self.set_speed(x),
-                _ => Err(format!("speed: `{rest}` is not a factor (0 = as fast as possible)")),
+                _ => Err(CommandError::NotAFactor(rest.to_string())),
             },
-            "pause" => self.set_paused(true),
-            "resume" => self.set_paused(false),
+            "pause" => {
+                self.set_paused(true);
+                Ok(String::new())
+            }
+            "resume" => {
+                self.set_paused(false);
+                Ok(String::new())
+            }
             "plot" => self.plot_command(rest),
             "help" => {
                 self.help.shown = true;
@@ -643,24 +696,20 @@ impl App {
                 self.commander(line);
                 return;
             }
-            other => Err(format!(
-                "unknown command `{other}` (commands: {} {})",
-                PALETTE_COMMANDS.join(" "),
-                COMMANDER_WORDS.join(" ")
-            )),
+            other => Err(CommandError::Unknown(other.to_string())),
         };
         self.message = match result {
             Ok(s) if s.is_empty() => None,
             Ok(s) => Some(s),
             Err(e) => {
                 self.log(Level::Error, &format!("{line}: {e}"));
-                Some(e)
+                Some(e.to_string())
             }
         };
     }
 
     /// `export FILE [--format candump|jsonl|pcapng] [--force]`: the rows the view shows.
-    fn export_command(&mut self, rest: &str) -> Result<String, String> {
+    fn export_command(&mut self, rest: &str) -> Result<String, CommandError> {
         use super::export::{ExportFormat, export};
         let (mut file, mut format, mut force) = (None, None, false);
         let mut words = rest.split_whitespace();
@@ -668,26 +717,22 @@ impl App {
             match w {
                 "--force" => force = true,
                 "--format" => {
-                    let f = words.next().ok_or("export: --format needs candump, jsonl or pcapng")?;
-                    format = Some(ExportFormat::parse(f).map_err(|e| format!("export: {e}"))?);
+                    let f = words.next().ok_or(CommandError::FormatMissing)?;
+                    format = Some(ExportFormat::parse(f)?);
                 }
-                w if w.starts_with("--") => return Err(format!("export: unknown option `{w}`")),
+                w if w.starts_with("--") => return Err(CommandError::ExportOption(w.to_string())),
                 w if file.is_none() => file = Some(w.to_string()),
-                w => return Err(format!("export: one FILE only (`{w}` is extra)")),
+                w => return Err(CommandError::ExtraFile(w.to_string())),
             }
         }
-        let file = file.ok_or("export: usage `export FILE [--format candump|jsonl|pcapng] [--force]`")?;
+        let file = file.ok_or(CommandError::ExportUsage)?;
         let path = std::path::Path::new(&file);
         let format = format.unwrap_or_else(|| ExportFormat::of_path(path));
         let view = &self.panes.trace.view;
         let scanned = view.progress(&self.trace);
-        let n = export(&self.trace, view, path, format, force).map_err(|e| {
-            let hint = if e.kind() == std::io::ErrorKind::AlreadyExists {
-                " (add --force to overwrite)"
-            } else {
-                ""
-            };
-            format!("export: {file}: {e}{hint}")
+        let n = export(&self.trace, view, path, format, force).map_err(|source| CommandError::Export {
+            file: file.clone(),
+            source,
         })?;
         let text = format!(
             "exported {n} frames to {file} ({format:?}){}",
@@ -701,27 +746,25 @@ impl App {
         Ok(text)
     }
 
-    fn plot_command(&mut self, rest: &str) -> Result<String, String> {
+    fn plot_command(&mut self, rest: &str) -> Result<String, CommandError> {
         let mut it = rest.split_whitespace();
         let (Some(node), Some(obj)) = (it.next(), it.next()) else {
-            return Err("plot: usage `plot NODE INDEX[:SUB]`, e.g. `plot 1 6064:00`".into());
+            return Err(CommandError::PlotUsage);
         };
-        let node: u8 = node.parse().map_err(|_| format!("plot: `{node}` is not a node-ID"))?;
+        let node: u8 = node.parse().map_err(|_| CommandError::NotANode(node.to_string()))?;
         let (i, s) = obj.split_once(':').unwrap_or((obj, "0"));
         let index =
-            u16::from_str_radix(i.trim_start_matches("0x"), 16).map_err(|_| format!("plot: bad index `{i}`"))?;
-        let sub = u8::from_str_radix(s, 16).map_err(|_| format!("plot: bad sub-index `{s}`"))?;
+            u16::from_str_radix(i.trim_start_matches("0x"), 16).map_err(|_| CommandError::BadIndex(i.to_string()))?;
+        let sub = u8::from_str_radix(s, 16).map_err(|_| CommandError::BadSub(s.to_string()))?;
         if self.panes.plot.select(&self.trace, node, index, sub) {
             self.focus = Pane::Plot;
             Ok(String::new())
         } else {
-            Err(format!(
-                "plot: no numeric values of node {node} 0x{index:04X}:{sub:02X} seen"
-            ))
+            Err(CommandError::NoSeries { node, index, sub })
         }
     }
 
-    fn set_speed(&mut self, x: f64) -> Result<String, String> {
+    fn set_speed(&mut self, x: f64) -> Result<String, CommandError> {
         match (&mut self.source.kind, &self.source.control) {
             (SourceKind::Replay { speed }, Some(c)) => {
                 *speed = x;
@@ -732,11 +775,11 @@ impl App {
                     format!("speed ×{x}")
                 })
             }
-            _ => Err("speed: only a replay has a speed".into()),
+            _ => Err(CommandError::NoSpeed),
         }
     }
 
-    fn set_paused(&mut self, p: bool) -> Result<String, String> {
+    fn set_paused(&mut self, p: bool) {
         self.source.paused = p;
         // The replay clock restarts from the next frame.
         self.capture_clock = None;
@@ -746,7 +789,6 @@ impl App {
         if p {
             self.panes.trace.follow = false;
         }
-        Ok(String::new())
     }
 
     /// The timestamp of the first frame.
@@ -842,7 +884,7 @@ impl App {
             }
             Action::Pause => {
                 let p = !self.source.paused;
-                let _ = self.set_paused(p);
+                self.set_paused(p);
                 if !p {
                     self.panes.trace.follow = true;
                 }
@@ -871,7 +913,7 @@ impl App {
                 if let SourceKind::Replay { speed } = self.source.kind {
                     let base = if speed <= 0.0 { 1.0 } else { speed };
                     let x = if a == Action::SpeedUp { base * 2.0 } else { base / 2.0 };
-                    self.message = Some(self.set_speed(x).unwrap_or_else(|e| e));
+                    self.message = Some(self.set_speed(x).unwrap_or_else(|e| e.to_string()));
                 }
             }
             Action::Step => match &self.source.control {
@@ -1055,6 +1097,41 @@ mod tests {
                 .unwrap_or("")
                 .starts_with("unknown command `bogus`")
         );
+    }
+
+    #[test]
+    fn built_in_command_errors_say_what_is_wrong_and_go_to_the_log() {
+        let mut a = app();
+        let dir = std::env::temp_dir().join(format!("cotui-app-export-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("x.log");
+        std::fs::write(&file, "").unwrap();
+        let file = file.display().to_string();
+        for (line, want) in [
+            ("goto x", "goto: `x` is not a frame number".to_string()),
+            ("speed 2", "speed: only a replay has a speed".into()),
+            (
+                "plot 1",
+                "plot: usage `plot NODE INDEX[:SUB]`, e.g. `plot 1 6064:00`".into(),
+            ),
+            ("plot 1 60z1", "plot: bad index `60z1`".into()),
+            ("plot 9 6041", "plot: no numeric values of node 9 0x6041:00 seen".into()),
+            (
+                "export a.log --format xml",
+                "export: unknown export format `xml`: use candump, jsonl or pcapng".into(),
+            ),
+            ("export a.log b.log", "export: one FILE only (`b.log` is extra)".into()),
+            (
+                &format!("export {file}"),
+                format!("export: {file}: File exists (os error 17) (add --force to overwrite)"),
+            ),
+        ] {
+            a.run_command(line);
+            assert_eq!(a.message.as_deref(), Some(want.as_str()), "{line}");
+            let logged = a.messages.iter().last().map(|e| e.text.clone()).unwrap_or_default();
+            assert_eq!(logged, format!("{line}: {want}"));
+        }
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

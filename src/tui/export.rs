@@ -10,6 +10,11 @@ use std::fs::OpenOptions;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
+/// A format name that is not one of the export formats.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("unknown export format `{0}`: use candump, jsonl or pcapng")]
+pub struct UnknownFormat(pub String);
+
 /// The formats the view exports to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ExportFormat {
@@ -20,12 +25,12 @@ pub enum ExportFormat {
 
 impl ExportFormat {
     /// Parses `candump`, `jsonl` or `pcapng`.
-    pub fn parse(word: &str) -> Result<ExportFormat, String> {
+    pub fn parse(word: &str) -> Result<ExportFormat, UnknownFormat> {
         match word {
             "candump" | "log" => Ok(ExportFormat::Candump),
             "jsonl" | "json" => Ok(ExportFormat::Jsonl),
             "pcapng" => Ok(ExportFormat::Pcapng),
-            _ => Err(format!("unknown export format `{word}`: use candump, jsonl or pcapng")),
+            _ => Err(UnknownFormat(word.to_string())),
         }
     }
     /// The format a file name suggests: `.pcapng`, `.jsonl`/`.json`, else candump.
