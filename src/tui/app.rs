@@ -415,12 +415,22 @@ impl App {
     }
 
     /// What the panes see: the trace, the page height, whether the capture is paused.
-    fn ctx(&self) -> Ctx<'_> {
+    pub fn ctx(&self) -> Ctx<'_> {
         Ctx {
             trace: &self.trace,
             page: self.page(),
             paused: self.source.paused,
         }
+    }
+
+    /// The panes, to change, and what they see.
+    fn panes_mut(&mut self) -> (&mut Panes, Ctx<'_>) {
+        let ctx = Ctx {
+            trace: &self.trace,
+            page: self.page(),
+            paused: self.source.paused,
+        };
+        (&mut self.panes, ctx)
     }
 
     /// Handles a key press.
@@ -844,13 +854,9 @@ impl App {
             self.detail.shown = false;
             return;
         }
-        let page = self.page();
-        let ctx = Ctx {
-            trace: &self.trace,
-            page,
-            paused: self.source.paused,
-        };
-        match self.panes.get_mut(self.focus).handle(a, &ctx) {
+        let focus = self.focus;
+        let (panes, ctx) = self.panes_mut();
+        match panes.get_mut(focus).handle(a, &ctx) {
             Outcome::Done => return,
             Outcome::Ignored => {}
             Outcome::Detail => {
@@ -866,6 +872,7 @@ impl App {
                 return;
             }
             Outcome::Show(pos) => {
+                let page = self.page();
                 self.panes.trace.show(&self.trace, pos, page);
                 self.focus = Pane::Trace;
                 return;
@@ -954,20 +961,16 @@ impl App {
     /// Handles a mouse event: the wheel scrolls the focused pane, a left click selects a row.
     pub fn mouse(&mut self, ev: MouseEvent) {
         self.dirty = true;
-        let ctx = Ctx {
-            trace: &self.trace,
-            page: self.page(),
-            paused: self.source.paused,
-        };
-        let pane = self.panes.get_mut(self.focus);
+        let (t, focus) = (self.layout.table, self.focus);
+        let (panes, ctx) = self.panes_mut();
+        let pane = panes.get_mut(focus);
         match ev.kind {
             MouseEventKind::ScrollDown => pane.scroll(3, &ctx),
             MouseEventKind::ScrollUp => pane.scroll(-3, &ctx),
-            MouseEventKind::Down(MouseButton::Left) => {
-                let t = self.layout.table;
-                if ev.column >= t.x && ev.column < t.x + t.width && ev.row >= t.y && ev.row < t.y + t.height {
-                    pane.click((ev.row - t.y) as usize, &ctx);
-                }
+            MouseEventKind::Down(MouseButton::Left)
+                if ev.column >= t.x && ev.column < t.x + t.width && ev.row >= t.y && ev.row < t.y + t.height =>
+            {
+                pane.click((ev.row - t.y) as usize, &ctx)
             }
             _ => {}
         }
@@ -977,13 +980,9 @@ impl App {
     /// `height` rows, pins the trace selection to the newest row in follow mode, decodes the
     /// visible trace window (`rows` rows), the tail strip and what the Detail pane shows.
     pub fn prepare(&mut self, height: usize, rows: usize, tail: &[usize]) {
-        let ctx = Ctx {
-            trace: &self.trace,
-            page: self.page(),
-            paused: self.source.paused,
-        };
+        let (panes, ctx) = self.panes_mut();
         for p in [Pane::Nodes, Pane::Stats, Pane::Sdo] {
-            self.panes.get_mut(p).fit(height, &ctx);
+            panes.get_mut(p).fit(height, &ctx);
         }
         self.panes.trace.prepare(&self.trace, rows, tail);
         let selected = self.selected();
@@ -1275,6 +1274,30 @@ mod tests {
         assert_eq!(a.log_popup.back, 0, "all lines fit: nothing to scroll");
         a.act(Action::Back);
         assert!(!a.log_popup.shown);
+    }
+
+    #[test]
+    fn the_mouse_scrolls_and_selects_in_the_focused_pane() {
+        let mut a = app();
+        let _ = crate::tui::panes::testutil::screen(&mut a, 140, 20);
+        let mouse = |kind, row| MouseEvent {
+            kind,
+            column: 5,
+            row,
+            modifiers: KeyModifiers::NONE,
+        };
+        let last = a.selected_position();
+        a.mouse(mouse(MouseEventKind::ScrollUp, 0));
+        assert!(!a.panes.trace.follow);
+        assert_eq!(a.selected_position(), last.map(|p| p - 3));
+        a.act(Action::PaneNodes);
+        let _ = crate::tui::panes::testutil::screen(&mut a, 140, 20);
+        let t = a.layout.table;
+        a.mouse(mouse(MouseEventKind::Down(MouseButton::Left), t.y + 1));
+        assert_eq!(a.panes.nodes.list.selected, 1);
+        // A click below the last node selects nothing new.
+        a.mouse(mouse(MouseEventKind::Down(MouseButton::Left), t.y + 5));
+        assert_eq!(a.panes.nodes.list.selected, 1);
     }
 
     #[test]

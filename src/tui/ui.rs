@@ -3,7 +3,7 @@
 //! prompt line at the bottom.
 
 use super::app::App;
-use super::panes::{self, Ctx, Pane};
+use super::panes::{self, Pane};
 use ratatui::Frame;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::{Color, Style};
@@ -68,11 +68,7 @@ pub fn draw(f: &mut Frame, app: &mut App) {
     app.log_popup.page = panes::messages::height(body);
 
     let app = &*app;
-    let ctx = Ctx {
-        trace: &app.trace,
-        page: (app.layout.table.height as usize).max(1),
-        paused: app.source.paused,
-    };
+    let ctx = app.ctx();
     app.panes.get(app.focus).render(f, main, &ctx, true);
     let selected = app.selected();
     if let Some(side) = side {
