@@ -47,10 +47,15 @@ impl Pane {
 /// The main-area panes' states, one of each.
 #[derive(Default)]
 pub struct Panes {
+    /// One row per frame of the filtered view.
     pub trace: trace::TracePane,
+    /// One row per node.
     pub nodes: nodes::NodesPane,
+    /// One row per SDO transfer, or the frames of one.
     pub sdo: sdo::SdoPane,
+    /// One row per COB-ID.
     pub stats: stats::StatsPane,
+    /// One numeric series over time.
     pub plot: plot::PlotPane,
 }
 
