@@ -1293,6 +1293,30 @@ mod tests {
     }
 
     #[test]
+    fn vim_keys_go_to_the_focused_pane_and_the_prompts() {
+        let mut a = app();
+        a.keymap = Keymap::load(("vim", crate::tui::keymap::VIM), &[]).unwrap();
+        let _ = crate::tui::panes::testutil::screen(&mut a, 140, 20);
+        for c in ['g', 'g'] {
+            a.key(key(c));
+        }
+        assert_eq!((a.selected_position(), a.panes.trace.follow), (Some(0), false));
+        a.key(key('j'));
+        assert_eq!(a.selected_position(), Some(1));
+        a.key(key('2'));
+        a.key(key('j'));
+        assert_eq!((a.focus, a.panes.nodes.list.selected), (Pane::Nodes, 1));
+        a.key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
+        assert_eq!(a.focus, Pane::Trace);
+        assert_eq!(a.panes.trace.view.filter.source, "node 2");
+        a.key(key('F'));
+        assert_eq!(a.prompt.editing.as_ref().map(|p| p.text.as_str()), Some("node 2"));
+        a.key(KeyEvent::new(KeyCode::Esc, KeyModifiers::NONE));
+        a.key(key('G'));
+        assert!(a.panes.trace.follow);
+    }
+
+    #[test]
     fn the_mouse_scrolls_and_selects_in_the_focused_pane() {
         let mut a = app();
         let _ = crate::tui::panes::testutil::screen(&mut a, 140, 20);
