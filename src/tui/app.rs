@@ -1,51 +1,29 @@
-//! The application state and what every action does to it. Pure state transitions:
-//! no terminal here, so tests drive it directly.
+//! The application: the state the panes share (the trace, the source, the focus, the
+//! messages, the key map) and the routing of keys and actions to the focused pane
+//! ([`crate::tui::panes`]) and the popups. Pure state transitions: no terminal here, so
+//! tests drive it directly.
 
 use super::keymap::{Action, Key, Keymap, Lookup};
 use super::live::{Request, Requests};
 use super::messages::{Level, Messages};
 use super::palette::{self, Planned, commander_words};
-use super::prompt::{Prompt, PromptKind};
-use super::rows::{Row, RowCache};
+use super::panes::detail::DetailPane;
+use super::panes::help::HelpPopup;
+use super::panes::messages::MessagesPopup;
+use super::panes::{Ctx, Outcome, Pane, Panes, Selected};
+use super::prompt::{Edit, PromptBar, PromptKind};
 use super::source::{Control, Feed};
 use crate::analysis::filter::Filter;
 use crate::analysis::trace::Trace;
-use crate::analysis::view::View;
 use crate::command::Command;
 use crate::command::stop::{Commanded, StopOptions, is_powered};
-use crate::decode::Decoded;
 use crate::od::bind::Bindings;
-use crossterm::event::{KeyCode, KeyEvent, KeyModifiers, MouseButton, MouseEvent, MouseEventKind};
+use crossterm::event::{KeyCode, KeyEvent, MouseButton, MouseEvent, MouseEventKind};
 use ratatui::layout::Rect;
 use std::collections::BTreeSet;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError};
 use std::time::SystemTime;
 use std::time::{Duration, Instant};
-
-/// The main-area panes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Pane {
-    Trace,
-    Nodes,
-    Sdo,
-    Stats,
-    Plot,
-}
-
-impl Pane {
-    /// Every pane in tab order.
-    pub const ALL: [Pane; 5] = [Pane::Trace, Pane::Nodes, Pane::Sdo, Pane::Stats, Pane::Plot];
-    /// Tab title.
-    pub fn title(self) -> &'static str {
-        match self {
-            Pane::Trace => "Trace",
-            Pane::Nodes => "Nodes",
-            Pane::Sdo => "SDO",
-            Pane::Stats => "Stats",
-            Pane::Plot => "Plot",
-        }
-    }
-}
 
 /// How the frames come in.
 #[derive(Clone, Debug, PartialEq)]
@@ -104,84 +82,39 @@ impl SourceInfo {
     }
 }
 
-/// Scroll state of a list pane.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct ListState {
-    /// Selected row.
-    pub selected: usize,
-    /// First visible row.
-    pub offset: usize,
-}
-
-impl ListState {
-    /// Keeps `selected` within `len` rows and visible in `height` rows.
-    pub fn clamp(&mut self, len: usize, height: usize) {
-        self.selected = self.selected.min(len.saturating_sub(1));
-        let h = height.max(1);
-        if self.selected < self.offset {
-            self.offset = self.selected;
-        } else if self.selected >= self.offset + h {
-            self.offset = self.selected + 1 - h;
-        }
-        self.offset = self.offset.min(len.saturating_sub(h));
-    }
-}
-
 /// Where the last draw put things (for mouse clicks and page sizes).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Layout {
     /// Rows of the main table, without header.
     pub table: Rect,
-    /// Lines the message log popup shows at once.
-    pub messages: usize,
+    /// The side column (compact nodes, Detail) was shown: the terminal is wide enough.
+    pub side: bool,
 }
 
 /// The whole application state.
 pub struct App {
     /// Frames and what is derived from them.
     pub trace: Trace,
-    /// The filtered view of the trace.
-    pub view: View,
     /// Key bindings.
     pub keymap: Keymap,
-    /// The pane in the main area.
-    pub pane: Pane,
-    /// Trace pane scroll state (rows of the view).
-    pub trace_list: ListState,
-    /// Follow the newest frame.
-    pub follow: bool,
-    /// Nodes pane selection.
-    pub nodes_list: ListState,
-    /// SDO pane selection.
-    pub sdo_list: ListState,
-    /// SDO transaction expanded to its frames.
-    pub sdo_expanded: Option<usize>,
-    /// Stats pane selection.
-    pub stats_list: ListState,
-    /// Plot: index into the series keys.
-    pub series_sel: usize,
-    /// Help popup shown.
-    pub help: bool,
-    /// The prompt being edited.
-    pub prompt: Option<Prompt>,
-    /// Search in force (`n`/`N`).
-    pub search: Option<Filter>,
+    /// The pane in the main area (the one keys go to).
+    pub focus: Pane,
+    /// The main-area panes (each owns its selection and what it shows).
+    pub panes: Panes,
+    /// The Detail pane (beside the main pane, or toggled below it on a narrow terminal).
+    pub detail: DetailPane,
+    /// The help popup.
+    pub help: HelpPopup,
+    /// The prompt line (filter, search, palette) and its history.
+    pub prompt: PromptBar,
     /// A message for the status bar (result of the last command).
     pub message: Option<String>,
-    /// Every result, event and error of the session (the message log popup).
+    /// Every result, event and error of the session.
     pub messages: Messages,
-    /// The message log popup is shown.
-    pub messages_shown: bool,
-    /// Lines the message log is scrolled up from its end.
-    pub messages_back: usize,
-    /// Palette history, newest last.
-    pub history: Vec<String>,
+    /// The message log popup.
+    pub log_popup: MessagesPopup,
     /// The capture source.
     pub source: SourceInfo,
-    /// Decoded rows of the visible window.
-    pub rows: RowCache,
-    /// The selected frame decoded, with its position.
-    pub detail: Option<(usize, Decoded)>,
     /// Frames per second over the last rate tick.
     pub rate: f64,
     /// Set when the user quits.
@@ -229,33 +162,85 @@ pub const PALETTE_COMMANDS: &[&str] = &[
     "filter", "search", "goto", "time", "speed", "pause", "resume", "plot", "export", "help", "messages", "quit",
 ];
 
+/// Why a built-in palette command (`goto`, `time`, `speed`, `plot`, `export`, ...) failed;
+/// the text is what the status bar shows.
+#[derive(Debug, thiserror::Error)]
+pub enum CommandError {
+    /// `goto` without a frame number.
+    #[error("goto: `{0}` is not a frame number")]
+    NotAFrame(String),
+    /// `time` without seconds.
+    #[error("time: `{0}` is not seconds")]
+    NotSeconds(String),
+    /// `speed` without a factor.
+    #[error("speed: `{0}` is not a factor (0 = as fast as possible)")]
+    NotAFactor(String),
+    /// `speed` on a source that is not a replay.
+    #[error("speed: only a replay has a speed")]
+    NoSpeed,
+    /// `plot` without a node and an object.
+    #[error("plot: usage `plot NODE INDEX[:SUB]`, e.g. `plot 1 6064:00`")]
+    PlotUsage,
+    /// `plot` with a bad node-ID.
+    #[error("plot: `{0}` is not a node-ID")]
+    NotANode(String),
+    /// `plot` with a bad index.
+    #[error("plot: bad index `{0}`")]
+    BadIndex(String),
+    /// `plot` with a bad sub-index.
+    #[error("plot: bad sub-index `{0}`")]
+    BadSub(String),
+    /// `plot` of an object with no numeric value seen.
+    #[error("plot: no numeric values of node {node} 0x{index:04X}:{sub:02X} seen")]
+    NoSeries { node: u8, index: u16, sub: u8 },
+    /// `export --format` without a format.
+    #[error("export: --format needs candump, jsonl or pcapng")]
+    FormatMissing,
+    /// `export --format` with an unknown format.
+    #[error("export: {0}")]
+    Format(#[from] super::export::UnknownFormat),
+    /// `export` with an unknown option.
+    #[error("export: unknown option `{0}`")]
+    ExportOption(String),
+    /// `export` with more than one file.
+    #[error("export: one FILE only (`{0}` is extra)")]
+    ExtraFile(String),
+    /// `export` without a file.
+    #[error("export: usage `export FILE [--format candump|jsonl|pcapng] [--force]`")]
+    ExportUsage,
+    /// The export file could not be written.
+    #[error("export: {file}: {source}{hint}", hint = overwrite_hint(source))]
+    Export { file: String, source: std::io::Error },
+    /// A word that is no command.
+    #[error("unknown command `{0}` (commands: {palette} {commander})", palette = PALETTE_COMMANDS.join(" "), commander = commander_words().join(" "))]
+    Unknown(String),
+}
+
+/// What to add to an export error: how to overwrite an existing file.
+fn overwrite_hint(e: &std::io::Error) -> &'static str {
+    if e.kind() == std::io::ErrorKind::AlreadyExists {
+        " (add --force to overwrite)"
+    } else {
+        ""
+    }
+}
+
 impl App {
     /// An application showing `trace`, fed by `source`.
     pub fn new(trace: Trace, keymap: Keymap, source: SourceInfo) -> App {
         let bindings = Bindings::new().expect("the built-in profiles load");
         App {
             trace,
-            view: View::default(),
             keymap,
-            pane: Pane::Trace,
-            trace_list: ListState::default(),
-            follow: true,
-            nodes_list: ListState::default(),
-            sdo_list: ListState::default(),
-            sdo_expanded: None,
-            stats_list: ListState::default(),
-            series_sel: 0,
-            help: false,
-            prompt: None,
-            search: None,
+            focus: Pane::Trace,
+            panes: Panes::default(),
+            detail: DetailPane::default(),
+            help: HelpPopup::default(),
+            prompt: PromptBar::default(),
             message: None,
             messages: Messages::default(),
-            messages_shown: false,
-            messages_back: 0,
-            history: Vec::new(),
+            log_popup: MessagesPopup::default(),
             source,
-            rows: RowCache::default(),
-            detail: None,
             rate: 0.0,
             quit: false,
             layout: Layout::default(),
@@ -295,10 +280,8 @@ impl App {
                 }
                 Ok(Feed::Reset) => {
                     self.trace.clear();
-                    self.view = View::new(self.view.filter.clone());
-                    self.rows = RowCache::default();
-                    self.detail = None;
-                    self.trace_list = ListState::default();
+                    self.panes.trace.reset();
+                    self.detail.reset();
                     self.rate_mark = (Instant::now(), 0);
                     self.capture_clock = None;
                     self.dirty = true;
@@ -341,9 +324,10 @@ impl App {
 
     /// Background work: filter scanning. True when work is left.
     pub fn work(&mut self, budget: Duration) -> bool {
-        let before = self.view.len(&self.trace);
-        let more = self.view.advance(&self.trace, budget);
-        if self.view.len(&self.trace) != before {
+        let view = &mut self.panes.trace.view;
+        let before = view.len(&self.trace);
+        let more = view.advance(&self.trace, budget);
+        if view.len(&self.trace) != before {
             self.dirty = true;
         }
         more
@@ -441,14 +425,28 @@ impl App {
         self.dirty = true;
     }
 
-    /// Rows in the trace view.
-    pub fn view_len(&self) -> usize {
-        self.view.len(&self.trace)
-    }
-
     /// Visible height of the main table.
     fn page(&self) -> usize {
         (self.layout.table.height as usize).max(1)
+    }
+
+    /// What the panes see: the trace, the page height, whether the capture is paused.
+    pub fn ctx(&self) -> Ctx<'_> {
+        Ctx {
+            trace: &self.trace,
+            page: self.page(),
+            paused: self.source.paused,
+        }
+    }
+
+    /// The panes, to change, and what they see.
+    fn panes_mut(&mut self) -> (&mut Panes, Ctx<'_>) {
+        let ctx = Ctx {
+            trace: &self.trace,
+            page: self.page(),
+            paused: self.source.paused,
+        };
+        (&mut self.panes, ctx)
     }
 
     /// Handles a key press.
@@ -470,7 +468,7 @@ impl App {
             }
             return;
         }
-        if self.prompt.is_some() {
+        if self.prompt.editing.is_some() {
             self.prompt_key(ev);
             self.preview();
             return;
@@ -493,32 +491,15 @@ impl App {
     }
 
     fn prompt_key(&mut self, ev: KeyEvent) {
-        let Some(p) = self.prompt.as_mut() else { return };
-        let ctrl = ev.modifiers.contains(KeyModifiers::CONTROL);
-        match ev.code {
-            KeyCode::Esc => self.prompt = None,
-            KeyCode::Char('c') if ctrl => self.prompt = None,
-            KeyCode::Enter => {
-                let p = self
+        match self.prompt.key(ev) {
+            Edit::Submit(kind, text) => self.submit(kind, &text),
+            Edit::Complete => {
+                let before: String = self
                     .prompt
-                    .take()
-                    .unwrap_or_else(|| Prompt::new(PromptKind::Palette, ""));
-                self.submit(p);
-            }
-            KeyCode::Char('a') if ctrl => p.jump(false),
-            KeyCode::Char('e') if ctrl => p.jump(true),
-            KeyCode::Char('u') if ctrl => *p = Prompt::new(p.kind, ""),
-            KeyCode::Char(c) => p.insert(c),
-            KeyCode::Backspace => p.backspace(),
-            KeyCode::Delete => p.delete(),
-            KeyCode::Left => p.move_by(-1),
-            KeyCode::Right => p.move_by(1),
-            KeyCode::Home => p.jump(false),
-            KeyCode::End => p.jump(true),
-            KeyCode::Up => p.history(&self.history, true),
-            KeyCode::Down => p.history(&self.history, false),
-            KeyCode::Tab if p.kind == PromptKind::Palette => {
-                let before: String = p.text.chars().take(p.cursor).collect();
+                    .editing
+                    .as_ref()
+                    .map(|p| p.text.chars().take(p.cursor).collect())
+                    .unwrap_or_default();
                 let words: Vec<String> = if before.contains(' ') {
                     crate::command::syntax::completions(&before)
                 } else {
@@ -528,18 +509,20 @@ impl App {
                         .map(|w| w.to_string())
                         .collect()
                 };
-                let shown = p.complete(&words.iter().map(String::as_str).collect::<Vec<_>>());
+                let shown = self
+                    .prompt
+                    .complete(&words.iter().map(String::as_str).collect::<Vec<_>>());
                 if !shown.is_empty() {
                     self.message = Some(shown.join("  "));
                 }
             }
-            _ => {}
+            Edit::Editing | Edit::Cancelled => {}
         }
     }
 
     /// While typing a commander line, shows the frames it would send.
     fn preview(&mut self) {
-        let Some(p) = &self.prompt else { return };
+        let Some(p) = &self.prompt.editing else { return };
         let first = p.text.split_whitespace().next().unwrap_or("");
         if p.kind == PromptKind::Palette && commander_words().contains(&first) {
             self.message = Some(match palette::plan(&p.text, &self.bindings, |n| self.drive_state(n)) {
@@ -655,15 +638,12 @@ impl App {
         self.quit_confirm = Some(powered);
     }
 
-    fn submit(&mut self, p: Prompt) {
-        let text = p.text.trim().to_string();
-        if !text.is_empty() && self.history.last() != Some(&text) {
-            self.history.push(text.clone());
-        }
-        match p.kind {
-            PromptKind::Filter => self.set_filter(&text),
-            PromptKind::Search => self.set_search(&text),
-            PromptKind::Palette => self.run_command(&text),
+    /// Runs a line entered at a prompt (the filter, search or palette prompt).
+    fn submit(&mut self, kind: PromptKind, text: &str) {
+        match kind {
+            PromptKind::Filter => self.set_filter(text),
+            PromptKind::Search => self.set_search(text),
+            PromptKind::Palette => self.run_command(text),
         }
     }
 
@@ -671,13 +651,9 @@ impl App {
     pub fn set_filter(&mut self, text: &str) {
         match Filter::parse(text) {
             Ok(f) => {
-                let pos = self.selected_position();
-                self.view = View::new(f);
-                self.view.advance(&self.trace, Duration::from_millis(30));
-                self.trace_list.selected = pos.map(|p| self.view.row_of(p)).unwrap_or(0);
-                self.trace_list.clamp(self.view_len(), self.page());
+                let page = self.page();
+                self.panes.trace.set_filter(&self.trace, f, page);
                 self.message = None;
-                self.rows = RowCache::default();
             }
             Err(e) => self.message = Some(format!("filter: {e}")),
         }
@@ -685,9 +661,9 @@ impl App {
 
     fn set_search(&mut self, text: &str) {
         match Filter::parse(text) {
-            Ok(f) if f.is_empty() => self.search = None,
+            Ok(f) if f.is_empty() => self.panes.trace.search = None,
             Ok(f) => {
-                self.search = Some(f);
+                self.panes.trace.search = Some(f);
                 self.jump_match(true);
             }
             Err(e) => self.message = Some(format!("search: {e}")),
@@ -698,7 +674,7 @@ impl App {
     pub fn run_command(&mut self, line: &str) {
         let (cmd, rest) = line.split_once(' ').unwrap_or((line, ""));
         let rest = rest.trim();
-        let result: Result<String, String> = match cmd {
+        let result: Result<String, CommandError> = match cmd {
             "" => Ok(String::new()),
             "filter" => {
                 self.set_filter(rest);
@@ -710,14 +686,14 @@ impl App {
             }
             "goto" => rest
                 .parse::<usize>()
-                .map_err(|_| format!("goto: `{rest}` is not a frame number"))
+                .map_err(|_| CommandError::NotAFrame(rest.to_string()))
                 .map(|n| {
                     self.select_position(n.saturating_sub(1));
                     format!("frame {n}")
                 }),
             "time" => rest
                 .parse::<f64>()
-                .map_err(|_| format!("time: `{rest}` is not seconds"))
+                .map_err(|_| CommandError::NotSeconds(rest.to_string()))
                 .map(|s| {
                     let t0 = self.start_ns();
                     let pos = self.trace.store.position_at(t0 + (s.max(0.0) * 1e9) as u64);
@@ -726,19 +702,24 @@ impl App {
                 }),
             "speed" => match rest.parse::<f64>() {
                 Ok(x) if x >= 0.0 => self.set_speed(x),
-                _ => Err(format!("speed: `{rest}` is not a factor (0 = as fast as possible)")),
+                _ => Err(CommandError::NotAFactor(rest.to_string())),
             },
-            "pause" => self.set_paused(true),
-            "resume" => self.set_paused(false),
+            "pause" => {
+                self.set_paused(true);
+                Ok(String::new())
+            }
+            "resume" => {
+                self.set_paused(false);
+                Ok(String::new())
+            }
             "plot" => self.plot_command(rest),
             "help" => {
-                self.help = true;
+                self.help.shown = true;
                 Ok(String::new())
             }
             "export" => self.export_command(rest),
             "messages" => {
-                self.messages_shown = true;
-                self.messages_back = 0;
+                self.log_popup.open();
                 Ok(String::new())
             }
             "quit" => {
@@ -757,24 +738,20 @@ impl App {
                 self.commander(line);
                 return;
             }
-            other => Err(format!(
-                "unknown command `{other}` (commands: {} {})",
-                PALETTE_COMMANDS.join(" "),
-                commander_words().join(" ")
-            )),
+            other => Err(CommandError::Unknown(other.to_string())),
         };
         self.message = match result {
             Ok(s) if s.is_empty() => None,
             Ok(s) => Some(s),
             Err(e) => {
                 self.log(Level::Error, &format!("{line}: {e}"));
-                Some(e)
+                Some(e.to_string())
             }
         };
     }
 
     /// `export FILE [--format candump|jsonl|pcapng] [--force]`: the rows the view shows.
-    fn export_command(&mut self, rest: &str) -> Result<String, String> {
+    fn export_command(&mut self, rest: &str) -> Result<String, CommandError> {
         use super::export::{ExportFormat, export};
         let (mut file, mut format, mut force) = (None, None, false);
         let mut words = rest.split_whitespace();
@@ -782,25 +759,22 @@ impl App {
             match w {
                 "--force" => force = true,
                 "--format" => {
-                    let f = words.next().ok_or("export: --format needs candump, jsonl or pcapng")?;
-                    format = Some(ExportFormat::parse(f).map_err(|e| format!("export: {e}"))?);
+                    let f = words.next().ok_or(CommandError::FormatMissing)?;
+                    format = Some(ExportFormat::parse(f)?);
                 }
-                w if w.starts_with("--") => return Err(format!("export: unknown option `{w}`")),
+                w if w.starts_with("--") => return Err(CommandError::ExportOption(w.to_string())),
                 w if file.is_none() => file = Some(w.to_string()),
-                w => return Err(format!("export: one FILE only (`{w}` is extra)")),
+                w => return Err(CommandError::ExtraFile(w.to_string())),
             }
         }
-        let file = file.ok_or("export: usage `export FILE [--format candump|jsonl|pcapng] [--force]`")?;
+        let file = file.ok_or(CommandError::ExportUsage)?;
         let path = std::path::Path::new(&file);
         let format = format.unwrap_or_else(|| ExportFormat::of_path(path));
-        let scanned = self.view.progress(&self.trace);
-        let n = export(&self.trace, &self.view, path, format, force).map_err(|e| {
-            let hint = if e.kind() == std::io::ErrorKind::AlreadyExists {
-                " (add --force to overwrite)"
-            } else {
-                ""
-            };
-            format!("export: {file}: {e}{hint}")
+        let view = &self.panes.trace.view;
+        let scanned = view.progress(&self.trace);
+        let n = export(&self.trace, view, path, format, force).map_err(|source| CommandError::Export {
+            file: file.clone(),
+            source,
         })?;
         let text = format!(
             "exported {n} frames to {file} ({format:?}){}",
@@ -814,30 +788,25 @@ impl App {
         Ok(text)
     }
 
-    fn plot_command(&mut self, rest: &str) -> Result<String, String> {
+    fn plot_command(&mut self, rest: &str) -> Result<String, CommandError> {
         let mut it = rest.split_whitespace();
         let (Some(node), Some(obj)) = (it.next(), it.next()) else {
-            return Err("plot: usage `plot NODE INDEX[:SUB]`, e.g. `plot 1 6064:00`".into());
+            return Err(CommandError::PlotUsage);
         };
-        let node: u8 = node.parse().map_err(|_| format!("plot: `{node}` is not a node-ID"))?;
+        let node: u8 = node.parse().map_err(|_| CommandError::NotANode(node.to_string()))?;
         let (i, s) = obj.split_once(':').unwrap_or((obj, "0"));
         let index =
-            u16::from_str_radix(i.trim_start_matches("0x"), 16).map_err(|_| format!("plot: bad index `{i}`"))?;
-        let sub = u8::from_str_radix(s, 16).map_err(|_| format!("plot: bad sub-index `{s}`"))?;
-        let keys = self.trace.series.keys();
-        match keys.iter().position(|k| *k == (node, index, sub)) {
-            Some(at) => {
-                self.series_sel = at;
-                self.pane = Pane::Plot;
-                Ok(String::new())
-            }
-            None => Err(format!(
-                "plot: no numeric values of node {node} 0x{index:04X}:{sub:02X} seen"
-            )),
+            u16::from_str_radix(i.trim_start_matches("0x"), 16).map_err(|_| CommandError::BadIndex(i.to_string()))?;
+        let sub = u8::from_str_radix(s, 16).map_err(|_| CommandError::BadSub(s.to_string()))?;
+        if self.panes.plot.select(&self.trace, node, index, sub) {
+            self.focus = Pane::Plot;
+            Ok(String::new())
+        } else {
+            Err(CommandError::NoSeries { node, index, sub })
         }
     }
 
-    fn set_speed(&mut self, x: f64) -> Result<String, String> {
+    fn set_speed(&mut self, x: f64) -> Result<String, CommandError> {
         match (&mut self.source.kind, &self.source.control) {
             (SourceKind::Replay { speed }, Some(c)) => {
                 *speed = x;
@@ -848,11 +817,11 @@ impl App {
                     format!("speed ×{x}")
                 })
             }
-            _ => Err("speed: only a replay has a speed".into()),
+            _ => Err(CommandError::NoSpeed),
         }
     }
 
-    fn set_paused(&mut self, p: bool) -> Result<String, String> {
+    fn set_paused(&mut self, p: bool) {
         self.source.paused = p;
         // The replay clock restarts from the next frame.
         self.capture_clock = None;
@@ -860,222 +829,136 @@ impl App {
             let _ = c.send(Control::Pause(p));
         }
         if p {
-            self.follow = false;
+            self.panes.trace.follow = false;
         }
-        Ok(String::new())
     }
 
     /// The timestamp of the first frame.
     pub fn start_ns(&self) -> u64 {
-        if self.trace.is_empty() {
-            0
-        } else {
-            self.trace.store.packed(0).ts_ns
-        }
+        super::panes::start_ns(&self.trace)
     }
 
-    /// The trace position of the selected row.
+    /// The trace position of the selected row of the trace.
     pub fn selected_position(&self) -> Option<usize> {
-        let n = self.view_len();
-        (n > 0).then(|| self.view.position(self.trace_list.selected.min(n - 1)))
+        self.panes.trace.selected_position(&self.trace)
     }
 
+    /// Shows trace position `pos` in the Trace pane.
     fn select_position(&mut self, pos: usize) {
-        self.follow = false;
-        self.pane = Pane::Trace;
-        self.trace_list.selected = self.view.row_of(pos);
-        self.trace_list.clamp(self.view_len(), self.page());
+        let page = self.page();
+        self.focus = Pane::Trace;
+        self.panes.trace.select_position(&self.trace, pos, page);
     }
 
     /// Jumps to the next (or previous) row matching the search.
     fn jump_match(&mut self, forward: bool) {
-        let Some(f) = self.search.clone() else {
-            self.message = Some("no search: press the search key first".into());
-            return;
-        };
-        let n = self.view_len();
-        if n == 0 {
-            return;
-        }
-        let cur = self.trace_list.selected;
-        let rows: Box<dyn Iterator<Item = usize>> = if forward {
-            Box::new(cur + 1..n)
-        } else {
-            Box::new((0..cur).rev())
-        };
-        let deadline = Instant::now() + Duration::from_millis(500);
-        let needs_label = f.needs_label();
-        let in_transfer = f.has_transfer_terms().then(|| {
-            let mut set = std::collections::HashSet::new();
-            for t in self.trace.transactions.iter().filter(|t| f.transaction_matches(t)) {
-                set.extend(t.frames.iter().map(|s| s.saturating_sub(1) as usize));
-            }
-            set
-        });
-        for r in rows {
-            let pos = self.view.position(r);
-            let label = needs_label
-                .then(|| self.trace.decode_positions(&[pos]).pop().map(|d| d.label))
-                .flatten();
-            let inside = in_transfer.as_ref().is_some_and(|s| s.contains(&pos));
-            if f.matches(self.trace.store.packed(pos), inside, label.as_deref()) {
-                self.follow = false;
-                self.trace_list.selected = r;
-                self.trace_list.clamp(n, self.page());
-                self.message = Some(format!("match at frame {}", pos + 1));
-                return;
-            }
-            if Instant::now() > deadline {
-                self.message = Some(format!("search stopped at frame {} (press again to go on)", pos + 1));
-                self.trace_list.selected = r;
-                return;
-            }
-        }
-        self.message = Some(format!(
-            "no {} match for `{}`",
-            if forward { "later" } else { "earlier" },
-            f.source
-        ));
-    }
-
-    fn list(&mut self) -> Option<(&mut ListState, usize)> {
-        let n = match self.pane {
-            Pane::Trace => self.view_len(),
-            Pane::Nodes => self.trace.nodes.len(),
-            Pane::Sdo => match self.sdo_expanded {
-                Some(t) => self.trace.transactions.get(t).map(|t| t.frames.len()).unwrap_or(0),
-                None => self.trace.transactions.len(),
-            },
-            Pane::Stats => self.trace.stats.len(),
-            Pane::Plot => return None,
-        };
-        let l = match self.pane {
-            Pane::Trace => &mut self.trace_list,
-            Pane::Nodes => &mut self.nodes_list,
-            Pane::Sdo => &mut self.sdo_list,
-            _ => &mut self.stats_list,
-        };
-        Some((l, n))
-    }
-
-    fn scroll(&mut self, delta: isize) {
         let page = self.page();
-        if self.pane == Pane::Trace {
-            self.follow = false;
-        }
-        if let Some((l, n)) = self.list() {
-            l.selected = (l.selected as isize + delta).clamp(0, n.saturating_sub(1) as isize) as usize;
-            l.clamp(n, page);
+        if let Some(m) = self.panes.trace.jump_match(&self.trace, forward, page) {
+            self.message = Some(m);
         }
     }
 
-    /// Does what an action says.
+    /// What the Detail pane shows: the focused pane's selection, else the trace's.
+    pub fn selected(&self) -> Option<Selected> {
+        self.panes
+            .get(self.focus)
+            .selected(&self.ctx())
+            .or_else(|| self.selected_position().map(Selected::Frame))
+    }
+
+    /// The Detail pane is toggled in below the main pane (a narrow terminal).
+    fn detail_below(&self) -> bool {
+        self.detail.shown && !self.layout.side
+    }
+
+    /// Does what an action says: the message log popup takes it first while shown, then
+    /// the help popup and the Detail pane below, then the focused pane; what none of them
+    /// takes is for the application.
     pub fn act(&mut self, a: Action) {
         self.dirty = true;
-        let page = self.page() as isize;
-        if self.messages_shown && self.messages_key(a) {
+        if self.log_popup.shown && self.log_popup.handle(a, self.messages.lines().len()) {
             return;
+        }
+        if self.help.handle(a) {
+            return;
+        }
+        if a == Action::Back && self.detail_below() {
+            self.detail.shown = false;
+            return;
+        }
+        let focus = self.focus;
+        let (panes, ctx) = self.panes_mut();
+        match panes.get_mut(focus).handle(a, &ctx) {
+            Outcome::Done => return,
+            Outcome::Ignored => {}
+            Outcome::Detail => {
+                // Beside the main pane on a wide terminal; toggled below it on a narrow one.
+                if !self.layout.side {
+                    self.detail.shown = !self.detail.shown;
+                }
+                return;
+            }
+            Outcome::Filter(text) => {
+                self.set_filter(&text);
+                self.focus = Pane::Trace;
+                return;
+            }
+            Outcome::Show(pos) => {
+                let page = self.page();
+                self.panes.trace.show(&self.trace, pos, page);
+                self.focus = Pane::Trace;
+                return;
+            }
         }
         match a {
             Action::Quit => self.request_quit(),
-            Action::Help => self.help = !self.help,
-            Action::Messages => {
-                self.messages_shown = !self.messages_shown;
-                self.messages_back = 0;
-            }
-            Action::Down => self.scroll(1),
-            Action::Up => self.scroll(-1),
-            Action::PageDown => self.scroll(page),
-            Action::PageUp => self.scroll(-page),
-            Action::Top => self.scroll(isize::MIN / 2),
-            Action::Bottom => {
-                self.scroll(isize::MAX / 2);
-                if self.pane == Pane::Trace {
-                    self.follow = true;
-                }
+            Action::Messages => self.log_popup.toggle(),
+            Action::Back => {
+                self.panes.trace.search = None;
+                self.message = None;
             }
             Action::Follow => {
-                self.follow = !self.follow;
-                self.pane = Pane::Trace;
+                self.panes.trace.follow = !self.panes.trace.follow;
+                self.focus = Pane::Trace;
             }
             Action::Pause => {
                 let p = !self.source.paused;
-                let _ = self.set_paused(p);
+                self.set_paused(p);
                 if !p {
-                    self.follow = true;
-                }
-            }
-            Action::Expand => match self.pane {
-                Pane::Sdo if self.sdo_expanded.is_none() && !self.trace.transactions.is_empty() => {
-                    self.sdo_expanded = Some(self.sdo_list.selected);
-                    self.sdo_list = ListState::default();
-                }
-                Pane::Sdo => {
-                    if let Some(t) = self.sdo_expanded.and_then(|t| self.trace.transactions.get(t))
-                        && let Some(seq) = t.frames.get(self.sdo_list.selected)
-                    {
-                        let pos = seq.saturating_sub(1) as usize;
-                        self.view = View::new(Filter::default());
-                        self.select_position(pos);
-                    }
-                }
-                Pane::Nodes => {
-                    let node = self.trace.nodes.iter().nth(self.nodes_list.selected).map(|(n, _)| *n);
-                    if let Some(n) = node {
-                        self.set_filter(&format!("node {n}"));
-                        self.pane = Pane::Trace;
-                    }
-                }
-                Pane::Stats => {
-                    let id = self.trace.stats.iter().nth(self.stats_list.selected).map(|(k, _)| k.1);
-                    if let Some(id) = id {
-                        self.set_filter(&format!("id {id:X}"));
-                        self.pane = Pane::Trace;
-                    }
-                }
-                _ => {}
-            },
-            Action::Back => {
-                if self.help {
-                    self.help = false;
-                } else if let Some(t) = self.sdo_expanded.take() {
-                    self.sdo_list = ListState {
-                        selected: t,
-                        offset: t.saturating_sub(3),
-                    };
-                } else {
-                    self.search = None;
-                    self.message = None;
+                    self.panes.trace.follow = true;
                 }
             }
             Action::NextPane | Action::PrevPane => {
-                let i = Pane::ALL.iter().position(|p| *p == self.pane).unwrap_or(0);
+                let i = Pane::ALL.iter().position(|p| *p == self.focus).unwrap_or(0);
                 let d = if a == Action::NextPane { 1 } else { Pane::ALL.len() - 1 };
-                self.pane = Pane::ALL[(i + d) % Pane::ALL.len()];
+                self.focus = Pane::ALL[(i + d) % Pane::ALL.len()];
             }
-            Action::PaneTrace => self.pane = Pane::Trace,
-            Action::PaneNodes => self.pane = Pane::Nodes,
-            Action::PaneSdo => self.pane = Pane::Sdo,
-            Action::PaneStats => self.pane = Pane::Stats,
-            Action::PanePlot => self.pane = Pane::Plot,
-            Action::Filter => self.prompt = Some(Prompt::new(PromptKind::Filter, &self.view.filter.source)),
-            Action::Search => self.prompt = Some(Prompt::new(PromptKind::Search, "")),
+            Action::PaneTrace => self.focus = Pane::Trace,
+            Action::PaneNodes => self.focus = Pane::Nodes,
+            Action::PaneSdo => self.focus = Pane::Sdo,
+            Action::PaneStats => self.focus = Pane::Stats,
+            Action::PanePlot => self.focus = Pane::Plot,
+            Action::Filter => {
+                let text = self.panes.trace.view.filter.source.clone();
+                self.prompt.open(PromptKind::Filter, &text);
+            }
+            Action::Search => self.prompt.open(PromptKind::Search, ""),
             Action::NextMatch => self.jump_match(true),
             Action::PrevMatch => self.jump_match(false),
             Action::ClearFilter => self.set_filter(""),
-            Action::Palette => self.prompt = Some(Prompt::new(PromptKind::Palette, "")),
+            Action::Palette => self.prompt.open(PromptKind::Palette, ""),
             Action::StopAll => self.stop_all(&[], StopOptions::default()),
             Action::SpeedUp | Action::SpeedDown => {
                 if let SourceKind::Replay { speed } = self.source.kind {
                     let base = if speed <= 0.0 { 1.0 } else { speed };
                     let x = if a == Action::SpeedUp { base * 2.0 } else { base / 2.0 };
-                    self.message = Some(self.set_speed(x).unwrap_or_else(|e| e));
+                    self.message = Some(self.set_speed(x).unwrap_or_else(|e| e.to_string()));
                 }
             }
             Action::Step => match &self.source.control {
                 Some(c) if self.source.paused => {
                     let _ = c.send(Control::Step);
-                    self.follow = true;
+                    self.panes.trace.follow = true;
                 }
                 _ => self.message = Some("step: pause a replay first".into()),
             },
@@ -1087,92 +970,55 @@ impl App {
                         -10_000_000_000
                     };
                     let _ = c.send(Control::Seek(d));
-                    self.follow = true;
+                    self.panes.trace.follow = true;
                 }
                 None => self.message = Some("seek: only a replay can seek".into()),
             },
             Action::NextSeries | Action::PrevSeries => {
-                let n = self.trace.series.keys().len().max(1);
-                self.series_sel = if a == Action::NextSeries {
-                    (self.series_sel + 1) % n
-                } else {
-                    (self.series_sel + n - 1) % n
-                };
-                self.pane = Pane::Plot;
+                self.panes.plot.step(&self.trace, a == Action::NextSeries);
+                self.focus = Pane::Plot;
             }
+            // Taken by the help popup; row movement and `expand` in a pane without rows.
+            Action::Help
+            | Action::Down
+            | Action::Up
+            | Action::PageDown
+            | Action::PageUp
+            | Action::Top
+            | Action::Bottom
+            | Action::Expand => {}
         }
     }
 
-    /// Scrolls or closes the message log popup; false when `a` is not for it.
-    fn messages_key(&mut self, a: Action) -> bool {
-        let page = self.layout.messages.max(1);
-        let most = self.messages.lines().len();
-        let back = &mut self.messages_back;
-        match a {
-            Action::Up => *back += 1,
-            Action::Down => *back = back.saturating_sub(1),
-            Action::PageUp => *back += page,
-            Action::PageDown => *back = back.saturating_sub(page),
-            Action::Top => *back = most,
-            Action::Bottom => *back = 0,
-            Action::Back | Action::Messages => self.messages_shown = false,
-            _ => return false,
-        }
-        self.messages_back = self.messages_back.min(most.saturating_sub(self.layout.messages));
-        true
-    }
-
-    /// Handles a mouse event: wheel scrolls, left click selects a row.
+    /// Handles a mouse event: the wheel scrolls the focused pane, a left click selects a row.
     pub fn mouse(&mut self, ev: MouseEvent) {
         self.dirty = true;
+        let (t, focus) = (self.layout.table, self.focus);
+        let (panes, ctx) = self.panes_mut();
+        let pane = panes.get_mut(focus);
         match ev.kind {
-            MouseEventKind::ScrollDown => self.scroll(3),
-            MouseEventKind::ScrollUp => self.scroll(-3),
-            MouseEventKind::Down(MouseButton::Left) => {
-                let t = self.layout.table;
-                if ev.column >= t.x && ev.column < t.x + t.width && ev.row >= t.y && ev.row < t.y + t.height {
-                    let page = self.page();
-                    let r = (ev.row - t.y) as usize;
-                    if self.pane == Pane::Trace {
-                        self.follow = false;
-                    }
-                    if let Some((l, n)) = self.list() {
-                        let want = l.offset + r;
-                        if want < n {
-                            l.selected = want;
-                            l.clamp(n, page);
-                        }
-                    }
-                }
+            MouseEventKind::ScrollDown => pane.scroll(3, &ctx),
+            MouseEventKind::ScrollUp => pane.scroll(-3, &ctx),
+            MouseEventKind::Down(MouseButton::Left)
+                if ev.column >= t.x && ev.column < t.x + t.width && ev.row >= t.y && ev.row < t.y + t.height =>
+            {
+                pane.click((ev.row - t.y) as usize, &ctx)
             }
             _ => {}
         }
     }
 
-    /// Before drawing: pins the selection to the newest row in follow mode and decodes the
-    /// visible window (`height` rows), the tail strip and the selected frame.
-    pub fn prepare(&mut self, height: usize, tail: &[usize]) {
-        let n = self.view_len();
-        if self.follow {
-            self.trace_list.selected = n.saturating_sub(1);
+    /// Before drawing: keeps the list panes' selections within their rows and visible in
+    /// `height` rows, pins the trace selection to the newest row in follow mode, decodes the
+    /// visible trace window (`rows` rows), the tail strip and what the Detail pane shows.
+    pub fn prepare(&mut self, height: usize, rows: usize, tail: &[usize]) {
+        let (panes, ctx) = self.panes_mut();
+        for p in [Pane::Nodes, Pane::Stats, Pane::Sdo] {
+            panes.get_mut(p).fit(height, &ctx);
         }
-        self.trace_list.clamp(n, height);
-        let mut positions: Vec<usize> = (self.trace_list.offset..(self.trace_list.offset + height).min(n))
-            .map(|r| self.view.position(r))
-            .collect();
-        positions.extend_from_slice(tail);
-        positions.sort_unstable();
-        positions.dedup();
-        self.rows.fill(&self.trace, &positions);
-        let sel = self.selected_position();
-        if sel != self.detail.as_ref().map(|(p, _)| *p) {
-            self.detail = sel.and_then(|p| self.trace.decode_positions(&[p]).pop().map(|d| (p, d)));
-        }
-    }
-
-    /// The decoded row for a trace position, when it is in the visible window.
-    pub fn row(&self, pos: usize) -> Option<&Row> {
-        self.rows.get(pos)
+        self.panes.trace.prepare(&self.trace, rows, tail);
+        let selected = self.selected();
+        self.detail.update(&self.trace, selected);
     }
 }
 
@@ -1180,7 +1026,7 @@ impl App {
 mod tests {
     use super::*;
     use crate::tui::panes::testutil::{app, frames};
-    use crossterm::event::KeyEvent;
+    use crossterm::event::{KeyEvent, KeyModifiers};
 
     fn key(c: char) -> KeyEvent {
         KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE)
@@ -1285,6 +1131,41 @@ mod tests {
     }
 
     #[test]
+    fn built_in_command_errors_say_what_is_wrong_and_go_to_the_log() {
+        let mut a = app();
+        let dir = std::env::temp_dir().join(format!("cotui-app-export-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("x.log");
+        std::fs::write(&file, "").unwrap();
+        let file = file.display().to_string();
+        for (line, want) in [
+            ("goto x", "goto: `x` is not a frame number".to_string()),
+            ("speed 2", "speed: only a replay has a speed".into()),
+            (
+                "plot 1",
+                "plot: usage `plot NODE INDEX[:SUB]`, e.g. `plot 1 6064:00`".into(),
+            ),
+            ("plot 1 60z1", "plot: bad index `60z1`".into()),
+            ("plot 9 6041", "plot: no numeric values of node 9 0x6041:00 seen".into()),
+            (
+                "export a.log --format xml",
+                "export: unknown export format `xml`: use candump, jsonl or pcapng".into(),
+            ),
+            ("export a.log b.log", "export: one FILE only (`b.log` is extra)".into()),
+            (
+                &format!("export {file}"),
+                format!("export: {file}: File exists (os error 17) (add --force to overwrite)"),
+            ),
+        ] {
+            a.run_command(line);
+            assert_eq!(a.message.as_deref(), Some(want.as_str()), "{line}");
+            let logged = a.messages.iter().last().map(|e| e.text.clone()).unwrap_or_default();
+            assert_eq!(logged, format!("{line}: {want}"));
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
     fn palette_commander_lines_need_a_bus_and_confirm_broadcasts() {
         let mut a = app();
         a.key(key(':'));
@@ -1299,7 +1180,7 @@ mod tests {
             a.message.as_deref(),
             Some("not sent: this source has no bus (use `cotui live IFACE` or `cotui demo`)")
         );
-        assert_eq!(a.history, ["nmt reset-node 0"]);
+        assert_eq!(a.prompt.history, ["nmt reset-node 0"]);
     }
 
     /// `app()` fed by a live source whose requests the test reads.
@@ -1417,14 +1298,62 @@ mod tests {
         assert!(lines[3].ends_with("  vcan0: interface went down; fix: sudo ip link set vcan0 up"));
         assert!(lines[4].ends_with("  vcan0: capturing again after 2.0 s without capture"));
         a.key(key('m'));
-        assert!(a.messages_shown);
+        assert!(a.log_popup.shown);
         let s = crate::tui::panes::testutil::screen(&mut a, 120, 20);
         assert!(s.contains("Messages (3)"), "{s}");
         assert!(s.contains("node 3 syntron-ds"), "{s}");
         a.act(Action::Up);
-        assert_eq!(a.messages_back, 0, "all lines fit: nothing to scroll");
+        assert_eq!(a.log_popup.back, 0, "all lines fit: nothing to scroll");
         a.act(Action::Back);
-        assert!(!a.messages_shown);
+        assert!(!a.log_popup.shown);
+    }
+
+    #[test]
+    fn vim_keys_go_to_the_focused_pane_and_the_prompts() {
+        let mut a = app();
+        a.keymap = Keymap::load(("vim", crate::tui::keymap::VIM), &[]).unwrap();
+        let _ = crate::tui::panes::testutil::screen(&mut a, 140, 20);
+        for c in ['g', 'g'] {
+            a.key(key(c));
+        }
+        assert_eq!((a.selected_position(), a.panes.trace.follow), (Some(0), false));
+        a.key(key('j'));
+        assert_eq!(a.selected_position(), Some(1));
+        a.key(key('2'));
+        a.key(key('j'));
+        assert_eq!((a.focus, a.panes.nodes.list.selected), (Pane::Nodes, 1));
+        a.key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
+        assert_eq!(a.focus, Pane::Trace);
+        assert_eq!(a.panes.trace.view.filter.source, "node 2");
+        a.key(key('F'));
+        assert_eq!(a.prompt.editing.as_ref().map(|p| p.text.as_str()), Some("node 2"));
+        a.key(KeyEvent::new(KeyCode::Esc, KeyModifiers::NONE));
+        a.key(key('G'));
+        assert!(a.panes.trace.follow);
+    }
+
+    #[test]
+    fn the_mouse_scrolls_and_selects_in_the_focused_pane() {
+        let mut a = app();
+        let _ = crate::tui::panes::testutil::screen(&mut a, 140, 20);
+        let mouse = |kind, row| MouseEvent {
+            kind,
+            column: 5,
+            row,
+            modifiers: KeyModifiers::NONE,
+        };
+        let last = a.selected_position();
+        a.mouse(mouse(MouseEventKind::ScrollUp, 0));
+        assert!(!a.panes.trace.follow);
+        assert_eq!(a.selected_position(), last.map(|p| p - 3));
+        a.act(Action::PaneNodes);
+        let _ = crate::tui::panes::testutil::screen(&mut a, 140, 20);
+        let t = a.layout.table;
+        a.mouse(mouse(MouseEventKind::Down(MouseButton::Left), t.y + 1));
+        assert_eq!(a.panes.nodes.list.selected, 1);
+        // A click below the last node selects nothing new.
+        a.mouse(mouse(MouseEventKind::Down(MouseButton::Left), t.y + 5));
+        assert_eq!(a.panes.nodes.list.selected, 1);
     }
 
     #[test]
@@ -1436,10 +1365,10 @@ mod tests {
             a.act(Action::Down);
         }
         a.act(Action::Expand);
-        assert_eq!(a.sdo_expanded, Some(4));
+        assert_eq!(a.panes.sdo.expanded, Some(4));
         a.act(Action::Down);
         a.act(Action::Expand);
-        assert_eq!(a.pane, Pane::Trace);
+        assert_eq!(a.focus, Pane::Trace);
         assert_eq!(a.selected_position(), Some(12));
     }
 }

@@ -10,6 +10,11 @@ use std::fs::OpenOptions;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
+/// A format name that is not one of the export formats.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("unknown export format `{0}`: use candump, jsonl or pcapng")]
+pub struct UnknownFormat(pub String);
+
 /// The formats the view exports to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ExportFormat {
@@ -20,12 +25,12 @@ pub enum ExportFormat {
 
 impl ExportFormat {
     /// Parses `candump`, `jsonl` or `pcapng`.
-    pub fn parse(word: &str) -> Result<ExportFormat, String> {
+    pub fn parse(word: &str) -> Result<ExportFormat, UnknownFormat> {
         match word {
             "candump" | "log" => Ok(ExportFormat::Candump),
             "jsonl" | "json" => Ok(ExportFormat::Jsonl),
             "pcapng" => Ok(ExportFormat::Pcapng),
-            _ => Err(format!("unknown export format `{word}`: use candump, jsonl or pcapng")),
+            _ => Err(UnknownFormat(word.to_string())),
         }
     }
     /// The format a file name suggests: `.pcapng`, `.jsonl`/`.json`, else candump.
@@ -102,7 +107,7 @@ mod tests {
         // All frames as candump: read back, they are the frames.
         let log = dir.join("all.log");
         assert_eq!(
-            export(&a.trace, &a.view, &log, ExportFormat::Candump, false).unwrap(),
+            export(&a.trace, &a.panes.trace.view, &log, ExportFormat::Candump, false).unwrap(),
             frames().len()
         );
         let back: Vec<_> = LogReader::new(io::BufReader::new(std::fs::File::open(&log).unwrap()))
@@ -118,8 +123,8 @@ mod tests {
             .collect();
         assert_eq!(back, want);
         // An existing file is refused unless forced.
-        assert!(export(&a.trace, &a.view, &log, ExportFormat::Candump, false).is_err());
-        assert!(export(&a.trace, &a.view, &log, ExportFormat::Candump, true).is_ok());
+        assert!(export(&a.trace, &a.panes.trace.view, &log, ExportFormat::Candump, false).is_err());
+        assert!(export(&a.trace, &a.panes.trace.view, &log, ExportFormat::Candump, true).is_ok());
         // The heartbeats of node 2 only, decoded, as JSON lines.
         let mut view = View::new(Filter::parse("node 2 kind hb").unwrap());
         view.advance(&a.trace, Duration::from_secs(5));

@@ -136,7 +136,7 @@ impl Key {
     }
 
     /// Parses one key spec such as `q`, `G`, `ctrl-c`, `pagedown`, `f1`.
-    pub fn parse(spec: &str) -> Result<Key, String> {
+    pub fn parse(spec: &str) -> Result<Key, KeyError> {
         let mut mods = KeyModifiers::NONE;
         let mut rest = spec;
         loop {
@@ -162,7 +162,7 @@ impl Key {
                     KeyCode::Char(' ')
                 } else if let Some(n) = lower.strip_prefix('f').and_then(|n| n.parse::<u8>().ok()) {
                     if !(1..=12).contains(&n) {
-                        return Err(format!("no key `{rest}` (f1..f12)"));
+                        return Err(KeyError::NoFunctionKey(rest.to_string()));
                     }
                     KeyCode::F(n)
                 } else {
@@ -170,11 +170,11 @@ impl Key {
                         .iter()
                         .find(|(n, _)| *n == lower)
                         .map(|(_, c)| *c)
-                        .ok_or_else(|| format!("unknown key name `{rest}`"))?
+                        .ok_or_else(|| KeyError::UnknownName(rest.to_string()))?
                 }
             }
         };
-        Key::from_event(&KeyEvent::new(code, mods)).ok_or_else(|| format!("unknown key `{spec}`"))
+        Key::from_event(&KeyEvent::new(code, mods)).ok_or_else(|| KeyError::Unknown(spec.to_string()))
     }
 }
 
@@ -207,8 +207,23 @@ pub fn keys_text(keys: &[Key]) -> String {
     keys.iter().map(Key::to_string).collect::<Vec<_>>().join(" ")
 }
 
+/// A key spec that names no key.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum KeyError {
+    /// `f` and a number outside 1..12.
+    #[error("no key `{0}` (f1..f12)")]
+    NoFunctionKey(String),
+    /// A name that is not a key name.
+    #[error("unknown key name `{0}`")]
+    UnknownName(String),
+    /// A key the terminal cannot report.
+    #[error("unknown key `{0}`")]
+    Unknown(String),
+}
+
 /// A keymap error, located in its file.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{file}:{line}:{column}: {message}")]
 pub struct KeymapError {
     /// File name (or `default`/`vim` for the embedded ones).
     pub file: String,
@@ -219,14 +234,6 @@ pub struct KeymapError {
     /// What is wrong.
     pub message: String,
 }
-
-impl fmt::Display for KeymapError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}:{}: {}", self.file, self.line, self.column, self.message)
-    }
-}
-
-impl std::error::Error for KeymapError {}
 
 /// The entries of a JSON object in file order, duplicates kept.
 struct Entries(Vec<(String, String)>);
@@ -491,5 +498,13 @@ mod tests {
         for s in ["q", "ctrl-c", "pagedown", "f5", "space", "alt-x", "backtab", "G"] {
             assert_eq!(Key::parse(s).unwrap().to_string(), s);
         }
+        let bad = |s: &str| Key::parse(s).unwrap_err().to_string();
+        assert_eq!(bad("f13"), "no key `f13` (f1..f12)");
+        assert_eq!(bad("ctrl-hyper"), "unknown key name `hyper`");
+        let located = Keymap::load(("k.json", "{\"ctrl-hyper\": \"quit\"}"), &[]).unwrap_err();
+        assert_eq!(
+            located.to_string(),
+            "k.json:1:2: key \"ctrl-hyper\": unknown key name `hyper`"
+        );
     }
 }

@@ -1,5 +1,11 @@
 //! The one-line editor of the filter, search and palette prompts, with history and
-//! completion.
+//! completion, and the prompt bar that owns it.
+
+use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+use ratatui::Frame;
+use ratatui::layout::{Position, Rect};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::Paragraph;
 
 /// What a prompt is for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -134,6 +140,101 @@ impl Prompt {
         } else {
             Vec::new()
         }
+    }
+}
+
+/// What a key did to the prompt bar.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Edit {
+    /// The line changed, or nothing happened.
+    Editing,
+    /// The prompt was closed without a line.
+    Cancelled,
+    /// `enter`: the line (trimmed) is to be run.
+    Submit(PromptKind, String),
+    /// `tab` in the palette: complete the word under the cursor.
+    Complete,
+}
+
+/// The prompt line at the bottom: the line being edited, if any, and the history the
+/// prompts share.
+#[derive(Default)]
+pub struct PromptBar {
+    /// The line being edited.
+    pub editing: Option<Prompt>,
+    /// Lines entered, newest last.
+    pub history: Vec<String>,
+}
+
+impl PromptBar {
+    /// Opens a `kind` prompt holding `text`.
+    pub fn open(&mut self, kind: PromptKind, text: &str) {
+        self.editing = Some(Prompt::new(kind, text));
+    }
+
+    /// Handles a key while a prompt is open; `enter` keeps the line in the history.
+    pub fn key(&mut self, ev: KeyEvent) -> Edit {
+        let Some(p) = self.editing.as_mut() else {
+            return Edit::Cancelled;
+        };
+        let ctrl = ev.modifiers.contains(KeyModifiers::CONTROL);
+        match ev.code {
+            KeyCode::Esc => self.editing = None,
+            KeyCode::Char('c') if ctrl => self.editing = None,
+            KeyCode::Enter => {
+                let kind = p.kind;
+                let text = p.text.trim().to_string();
+                self.editing = None;
+                if !text.is_empty() && self.history.last() != Some(&text) {
+                    self.history.push(text.clone());
+                }
+                return Edit::Submit(kind, text);
+            }
+            KeyCode::Char('a') if ctrl => p.jump(false),
+            KeyCode::Char('e') if ctrl => p.jump(true),
+            KeyCode::Char('u') if ctrl => *p = Prompt::new(p.kind, ""),
+            KeyCode::Char(c) => p.insert(c),
+            KeyCode::Backspace => p.backspace(),
+            KeyCode::Delete => p.delete(),
+            KeyCode::Left => p.move_by(-1),
+            KeyCode::Right => p.move_by(1),
+            KeyCode::Home => p.jump(false),
+            KeyCode::End => p.jump(true),
+            KeyCode::Up => p.history(&self.history, true),
+            KeyCode::Down => p.history(&self.history, false),
+            KeyCode::Tab if p.kind == PromptKind::Palette => return Edit::Complete,
+            _ => {}
+        }
+        if self.editing.is_some() {
+            Edit::Editing
+        } else {
+            Edit::Cancelled
+        }
+    }
+
+    /// Completes the word under the cursor from `candidates` (see [`Prompt::complete`]).
+    pub fn complete(&mut self, candidates: &[&str]) -> Vec<String> {
+        self.editing
+            .as_mut()
+            .map(|p| p.complete(candidates))
+            .unwrap_or_default()
+    }
+
+    /// Draws the line being edited into `line`, with the cursor; false when none is.
+    pub fn render(&self, f: &mut Frame, line: Rect) -> bool {
+        let Some(p) = &self.editing else {
+            return false;
+        };
+        let lead = p.kind.lead();
+        f.render_widget(
+            Paragraph::new(Line::from(vec![Span::raw(lead), Span::raw(p.text.clone())])),
+            line,
+        );
+        let x = line.x + (lead.chars().count() + p.cursor) as u16;
+        if x < line.x + line.width {
+            f.set_cursor_position(Position::new(x, line.y));
+        }
+        true
     }
 }
 

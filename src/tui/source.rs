@@ -58,9 +58,28 @@ pub type Feeds = (Receiver<Feed>, Option<Sender<Control>>);
 /// Capacity of the feed channel in batches; a full channel makes the reader wait.
 const QUEUE: usize = 64;
 
-fn reader(path: &Path) -> Result<LogReader<BufReader<File>>, String> {
-    let file = File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    LogReader::new(BufReader::with_capacity(1 << 20, file)).map_err(|e| format!("{}: {e}", path.display()))
+/// A log that cannot be read, with its path.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {source}", path.display())]
+pub struct ReadError {
+    /// The log.
+    pub path: PathBuf,
+    /// Why.
+    pub source: std::io::Error,
+}
+
+impl ReadError {
+    fn new(path: &Path, source: std::io::Error) -> ReadError {
+        ReadError {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+}
+
+fn reader(path: &Path) -> Result<LogReader<BufReader<File>>, ReadError> {
+    let file = File::open(path).map_err(|e| ReadError::new(path, e))?;
+    LogReader::new(BufReader::with_capacity(1 << 20, file)).map_err(|e| ReadError::new(path, e))
 }
 
 /// Reads `path` as fast as possible.
@@ -70,7 +89,7 @@ pub fn open(path: PathBuf) -> Receiver<Feed> {
         let mut r = match reader(&path) {
             Ok(r) => r,
             Err(e) => {
-                let _ = tx.send(Feed::Status(e));
+                let _ = tx.send(Feed::Status(e.to_string()));
                 let _ = tx.send(Feed::Done);
                 return;
             }
@@ -86,7 +105,7 @@ pub fn open(path: PathBuf) -> Receiver<Feed> {
                 }
                 Ok(_) => {}
                 Err(e) => {
-                    let _ = tx.send(Feed::Status(format!("{}: {e}", path.display())));
+                    let _ = tx.send(Feed::Status(ReadError::new(&path, e).to_string()));
                     break;
                 }
             }
@@ -139,7 +158,7 @@ pub fn replay(path: PathBuf, speed: f64) -> (Receiver<Feed>, Sender<Control>) {
             paused: false,
         };
         if let Err(e) = player.run() {
-            let _ = player.tx.send(Feed::Status(e));
+            let _ = player.tx.send(Feed::Status(e.to_string()));
         }
         let _ = player.tx.send(Feed::Done);
     });
@@ -164,7 +183,7 @@ enum Stop {
 }
 
 impl Player {
-    fn run(&mut self) -> Result<(), String> {
+    fn run(&mut self) -> Result<(), ReadError> {
         let mut skip_to = 0u64;
         loop {
             match self.play(skip_to)? {
@@ -184,7 +203,7 @@ impl Player {
     }
 
     /// Plays the log from the start; frames before `skip_to` go out at once.
-    fn play(&mut self, mut skip_to: u64) -> Result<Option<Stop>, String> {
+    fn play(&mut self, mut skip_to: u64) -> Result<Option<Stop>, ReadError> {
         let mut r = reader(&self.path)?;
         let mut names = 0;
         let mut batch = Vec::with_capacity(256);
@@ -196,7 +215,7 @@ impl Player {
             let f = match item {
                 Ok((_, Outcome::Frame(f))) => f,
                 Ok(_) => continue,
-                Err(e) => return Err(format!("{}: {e}", self.path.display())),
+                Err(e) => return Err(ReadError::new(&self.path, e)),
             };
             let fast = f.ts_ns < skip_to || self.speed <= 0.0;
             if !fast {

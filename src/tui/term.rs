@@ -16,13 +16,27 @@ extern "C" fn on_signal(_: libc::c_int) {
     STOP.store(true, Ordering::SeqCst);
 }
 
+/// Why the terminal loop could not run or stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum TermError {
+    /// Stdin or stdout is not a terminal.
+    #[error("the interactive analyzer needs a terminal (use `cotui decode` for pipes)")]
+    NotATerminal,
+    /// Raw mode or the alternate screen could not be set up.
+    #[error("cannot set up the terminal: {0}")]
+    Setup(std::io::Error),
+    /// Drawing or reading input failed.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+}
+
 /// Least time between two draws.
 const FRAME: Duration = Duration::from_millis(33);
 
 /// Runs `app` in the terminal until the user quits; the terminal is restored on every way out.
-pub fn run(mut app: App) -> Result<(), String> {
+pub fn run(mut app: App) -> Result<(), TermError> {
     if !std::io::stdin().is_terminal() || !stdout().is_terminal() {
-        return Err("the interactive analyzer needs a terminal (use `cotui decode` for pipes)".into());
+        return Err(TermError::NotATerminal);
     }
     for sig in [libc::SIGTERM, libc::SIGINT, libc::SIGHUP] {
         // SAFETY: the handler only stores to an atomic, which is async-signal-safe.
@@ -42,7 +56,7 @@ pub fn run(mut app: App) -> Result<(), String> {
         std::process::exit(0);
     });
     // ratatui::try_init installs a panic hook that restores the terminal before the message.
-    let mut terminal = ratatui::try_init().map_err(|e| format!("cannot set up the terminal: {e}"))?;
+    let mut terminal = ratatui::try_init().map_err(TermError::Setup)?;
     let ratatui_hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
         let _ = execute!(stdout(), DisableMouseCapture);
@@ -69,14 +83,14 @@ pub fn step(app: &mut App) -> bool {
     more_input || more_work
 }
 
-fn event_loop(terminal: &mut ratatui::DefaultTerminal, app: &mut App) -> Result<(), String> {
+fn event_loop(terminal: &mut ratatui::DefaultTerminal, app: &mut App) -> Result<(), TermError> {
     let mut last_draw = Instant::now() - FRAME;
     // Input is answered at once; frames alone redraw at most every FRAME.
     let mut input = false;
     loop {
         let busy = step(app);
         if app.dirty && (input || last_draw.elapsed() >= FRAME) {
-            terminal.draw(|f| ui::draw(f, app)).map_err(|e| e.to_string())?;
+            terminal.draw(|f| ui::draw(f, app))?;
             app.dirty = false;
             input = false;
             last_draw = Instant::now();
@@ -86,10 +100,10 @@ fn event_loop(terminal: &mut ratatui::DefaultTerminal, app: &mut App) -> Result<
         } else {
             Duration::from_millis(20)
         };
-        if event::poll(wait).map_err(|e| e.to_string())? {
+        if event::poll(wait)? {
             // Take every pending event before the next draw.
             loop {
-                match event::read().map_err(|e| e.to_string())? {
+                match event::read()? {
                     Event::Key(k) if k.kind != KeyEventKind::Release => {
                         app.key(k);
                         input = true;
@@ -101,7 +115,7 @@ fn event_loop(terminal: &mut ratatui::DefaultTerminal, app: &mut App) -> Result<
                     Event::Resize(..) => app.dirty = true,
                     _ => {}
                 }
-                if !event::poll(Duration::ZERO).map_err(|e| e.to_string())? {
+                if !event::poll(Duration::ZERO)? {
                     break;
                 }
             }

@@ -1,8 +1,9 @@
-//! Screen layout: the main pane (tabs) on the left, compact nodes and detail on the right,
-//! status bar and prompt line at the bottom.
+//! Screen layout: the main pane (tabs) on the left, compact nodes and detail on the right
+//! (or the Detail pane toggled in below the main pane on a narrow terminal), status bar and
+//! prompt line at the bottom.
 
-use super::app::{App, Pane};
-use super::panes;
+use super::app::App;
+use super::panes::{self, Pane};
 use ratatui::Frame;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::{Color, Style};
@@ -28,12 +29,20 @@ pub fn draw(f: &mut Frame, app: &mut App) {
     } else {
         (body, None)
     };
+    app.layout.side = side.is_some();
+    // Too narrow for the side column: the Detail pane, when toggled, goes below the main pane.
+    let (main, below) = if side.is_none() && app.detail.shown {
+        let [m, d] = Layout::vertical([Constraint::Percentage(40), Constraint::Percentage(60)]).areas(main);
+        (m, Some(d))
+    } else {
+        (main, None)
+    };
     let spans: Vec<Span> = Pane::ALL
         .iter()
         .enumerate()
         .map(|(i, p)| {
             let s = format!(" {} {} ", i + 1, p.title());
-            if *p == app.pane {
+            if *p == app.focus {
                 Span::styled(s, Style::default().bg(Color::White).fg(Color::Black))
             } else {
                 Span::raw(s)
@@ -44,8 +53,9 @@ pub fn draw(f: &mut Frame, app: &mut App) {
 
     // Where the selectable rows are, for paging and mouse clicks.
     let inner = panes::block("", true).inner(main);
-    app.layout.table = match app.pane {
-        Pane::Trace => panes::trace::split(app, main).0,
+    let (rows, strip) = app.panes.trace.split(&app.trace, main);
+    app.layout.table = match app.focus {
+        Pane::Trace => rows,
         Pane::Plot => Rect::default(),
         _ => Rect {
             y: inner.y.saturating_add(1),
@@ -53,39 +63,28 @@ pub fn draw(f: &mut Frame, app: &mut App) {
             ..inner
         },
     };
-    let (rows, strip) = panes::trace::split(app, main);
-    app.prepare(rows.height as usize, &panes::trace::tail_positions(app, strip));
-    let n_nodes = app.trace.nodes.len();
-    let n_stats = app.trace.stats.len();
-    let n_sdo = match app.sdo_expanded.and_then(|t| app.trace.transactions.get(t)) {
-        Some(t) => t.frames.len(),
-        None => app.trace.transactions.len(),
-    };
-    let h = app.layout.table.height as usize;
-    app.nodes_list.clamp(n_nodes, h);
-    app.stats_list.clamp(n_stats, h);
-    app.sdo_list.clamp(n_sdo, h);
+    let tail = app.panes.trace.tail_positions(&app.trace, strip);
+    app.prepare(app.layout.table.height as usize, rows.height as usize, &tail);
+    app.log_popup.page = panes::messages::height(body);
 
-    app.layout.messages = panes::messages::height(body);
     let app = &*app;
-    match app.pane {
-        Pane::Trace => panes::trace::render(app, f, main, true),
-        Pane::Nodes => panes::nodes::render(app, f, main, true),
-        Pane::Sdo => panes::sdo::render(app, f, main, true),
-        Pane::Stats => panes::stats::render(app, f, main, true),
-        Pane::Plot => panes::plot::render(app, f, main, true),
-    }
+    let ctx = app.ctx();
+    app.panes.get(app.focus).render(f, main, &ctx, true);
+    let selected = app.selected();
     if let Some(side) = side {
         let n = app.trace.nodes.len().clamp(1, 12) as u16 + 2;
         let [nodes, detail] = Layout::vertical([Constraint::Length(n), Constraint::Min(0)]).areas(side);
-        panes::nodes::render_compact(app, f, nodes);
-        panes::detail::render(app, f, detail);
+        panes::nodes::render_compact(&app.trace, f, nodes);
+        app.detail.render(&app.trace, selected, f, detail);
+    }
+    if let Some(below) = below {
+        app.detail.render(&app.trace, selected, f, below);
     }
     panes::status::render(app, f, bar, line);
-    if app.messages_shown {
-        panes::messages::render(app, f, body);
+    if app.log_popup.shown {
+        app.log_popup.render(&app.messages, f, body);
     }
-    if app.help {
-        panes::help::render(app, f, body);
+    if app.help.shown {
+        panes::help::render(&app.keymap, f, body);
     }
 }

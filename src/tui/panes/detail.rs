@@ -1,12 +1,13 @@
 //! The Detail pane: the selected frame field by field and bit by bit (SDO command byte,
-//! controlword/statusword bits, PDO signals), or the selected SDO transfer.
+//! controlword/statusword bits, PDO signals), or the selected SDO transfer. Beside the main
+//! pane on a wide terminal; on a narrow one `expand` on the trace toggles it below.
 
-use super::{block, duration, kind_color};
+use super::{Selected, block, duration, kind_color};
+use crate::analysis::trace::Trace;
 use crate::decode::cia402::{describe_controlword, describe_statusword};
 use crate::decode::sdo::{Outcome, SdoCommand, Side, Transaction};
 use crate::decode::{Body, Decoded};
 use crate::frame::Frame;
-use crate::tui::app::{App, Pane};
 use ratatui::Frame as TermFrame;
 use ratatui::layout::Rect;
 use ratatui::style::{Color, Modifier, Style};
@@ -38,7 +39,7 @@ pub fn sdo_command_bits(byte: u8, side: Side) -> Vec<String> {
     v
 }
 
-fn frame_lines(app: &App, f: &Frame, d: &Decoded, pos: usize) -> Vec<Line<'static>> {
+fn frame_lines(trace: &Trace, f: &Frame, d: &Decoded, pos: usize) -> Vec<Line<'static>> {
     let mut v = vec![
         Line::styled(
             d.label.clone(),
@@ -47,8 +48,8 @@ fn frame_lines(app: &App, f: &Frame, d: &Decoded, pos: usize) -> Vec<Line<'stati
         Line::raw(format!(
             "frame {}  t {:.6} s  {}",
             pos + 1,
-            f.ts_ns.saturating_sub(app.start_ns()) as f64 / 1e9,
-            app.trace.ifaces.name(f.iface)
+            f.ts_ns.saturating_sub(super::start_ns(trace)) as f64 / 1e9,
+            trace.ifaces.name(f.iface)
         )),
         Line::raw(format!(
             "COB-ID 0x{:X}{}  {}  node {}",
@@ -85,8 +86,8 @@ fn frame_lines(app: &App, f: &Frame, d: &Decoded, pos: usize) -> Vec<Line<'stati
         ));
     }
     let node = d.node.unwrap_or(0);
-    let mode = app.trace.decoder().mode(node);
-    let dict = app.trace.decoder().dictionary(node);
+    let mode = trace.decoder().mode(node);
+    let dict = trace.decoder().dictionary(node);
     match &d.body {
         Body::Sdo(s) => {
             if let Some(&b) = f.payload().first() {
@@ -182,8 +183,8 @@ fn frame_lines(app: &App, f: &Frame, d: &Decoded, pos: usize) -> Vec<Line<'stati
     v
 }
 
-fn transaction_lines(app: &App, t: &Transaction) -> Vec<Line<'static>> {
-    let dict = app.trace.decoder().dictionary(t.node);
+fn transaction_lines(trace: &Trace, t: &Transaction) -> Vec<Line<'static>> {
+    let dict = trace.decoder().dictionary(t.node);
     let mut v = vec![
         Line::styled(t.label(dict), Style::default().add_modifier(Modifier::BOLD)),
         Line::raw(format!(
@@ -211,21 +212,50 @@ fn transaction_lines(app: &App, t: &Transaction) -> Vec<Line<'static>> {
     v
 }
 
-/// Draws the pane.
-pub fn render(app: &App, f: &mut TermFrame, area: Rect) {
-    f.render_widget(block(" Detail ", false), area);
-    let inner = block("", true).inner(area);
-    let lines = match app.pane {
-        Pane::Sdo if app.sdo_expanded.is_none() => match app.trace.transactions.get(app.sdo_list.selected) {
-            Some(t) => transaction_lines(app, t),
-            None => vec![Line::raw("no transfer selected")],
-        },
-        _ => match &app.detail {
-            Some((pos, d)) => frame_lines(app, &app.trace.store.frame(*pos), d, *pos),
+/// The Detail pane's state: the selected frame decoded, and whether it is shown on a
+/// narrow terminal.
+#[derive(Default)]
+pub struct DetailPane {
+    /// The frame shown, decoded, with its trace position.
+    decoded: Option<(usize, Decoded)>,
+    /// Shown below the main pane when the terminal is too narrow for the side column.
+    pub shown: bool,
+}
+
+impl DetailPane {
+    /// Decodes the frame `selected` names, unless it is the one decoded already.
+    pub fn update(&mut self, trace: &Trace, selected: Option<Selected>) {
+        let pos = match selected {
+            Some(Selected::Frame(p)) => Some(p),
+            _ => None,
+        };
+        if pos != self.decoded.as_ref().map(|(p, _)| *p) {
+            self.decoded = pos.and_then(|p| trace.decode_positions(&[p]).pop().map(|d| (p, d)));
+        }
+    }
+
+    /// Forgets the decoded frame (the trace started over).
+    pub fn reset(&mut self) {
+        self.decoded = None;
+    }
+
+    /// Draws the pane for `selected` ([`DetailPane::update`] must have decoded it).
+    pub fn render(&self, trace: &Trace, selected: Option<Selected>, f: &mut TermFrame, area: Rect) {
+        f.render_widget(block(" Detail ", false), area);
+        let inner = block("", true).inner(area);
+        let lines = match selected {
+            Some(Selected::Transfer(i)) => match trace.transactions.get(i) {
+                Some(t) => transaction_lines(trace, t),
+                None => vec![Line::raw("no transfer selected")],
+            },
+            Some(Selected::Frame(pos)) => match &self.decoded {
+                Some((p, d)) if *p == pos => frame_lines(trace, &trace.store.frame(pos), d, pos),
+                _ => vec![Line::raw("no frame selected")],
+            },
             None => vec![Line::raw("no frame selected")],
-        },
-    };
-    f.render_widget(Paragraph::new(lines).wrap(Wrap { trim: false }), inner);
+        };
+        f.render_widget(Paragraph::new(lines).wrap(Wrap { trim: false }), inner);
+    }
 }
 
 #[cfg(test)]
@@ -260,9 +290,9 @@ mod tests {
             t.push(&Frame::classic(id, &data));
         }
         a.trace = t;
-        let lines = |a: &App, pos: usize| -> Vec<String> {
+        let lines = |a: &crate::tui::app::App, pos: usize| -> Vec<String> {
             let d = a.trace.decode_positions(&[pos]).pop().unwrap();
-            frame_lines(a, &a.trace.store.frame(pos), &d, pos)
+            frame_lines(&a.trace, &a.trace.store.frame(pos), &d, pos)
                 .iter()
                 .map(|l| l.spans.iter().map(|s| s.content.to_string()).collect())
                 .collect()

@@ -2,8 +2,8 @@
 //! bottom, scrollable.
 
 use super::block;
-use crate::tui::app::App;
-use crate::tui::messages::Level;
+use crate::tui::keymap::Action;
+use crate::tui::messages::{Level, Messages};
 use ratatui::Frame;
 use ratatui::layout::Rect;
 use ratatui::style::{Color, Style};
@@ -31,13 +31,61 @@ pub fn height(area: Rect) -> usize {
     popup(area).height.saturating_sub(2) as usize
 }
 
-/// Draws the popup over `area`.
-pub fn render(app: &App, f: &mut Frame, area: Rect) {
+/// The message log popup's state.
+#[derive(Default)]
+pub struct MessagesPopup {
+    /// The popup is shown.
+    pub shown: bool,
+    /// Lines the log is scrolled up from its end.
+    pub back: usize,
+    /// Lines the popup showed at once in the last draw.
+    pub page: usize,
+}
+
+impl MessagesPopup {
+    /// Shows the popup at the newest lines.
+    pub fn open(&mut self) {
+        self.shown = true;
+        self.back = 0;
+    }
+
+    /// Shows or hides the popup (at the newest lines).
+    pub fn toggle(&mut self) {
+        self.shown = !self.shown;
+        self.back = 0;
+    }
+
+    /// Scrolls or closes the popup over a log of `len` lines; false when `action` is not for it.
+    pub fn handle(&mut self, action: Action, len: usize) -> bool {
+        let page = self.page.max(1);
+        let back = &mut self.back;
+        match action {
+            Action::Up => *back += 1,
+            Action::Down => *back = back.saturating_sub(1),
+            Action::PageUp => *back += page,
+            Action::PageDown => *back = back.saturating_sub(page),
+            Action::Top => *back = len,
+            Action::Bottom => *back = 0,
+            Action::Back | Action::Messages => self.shown = false,
+            _ => return false,
+        }
+        self.back = self.back.min(len.saturating_sub(self.page));
+        true
+    }
+
+    /// Draws the popup showing `log` over `area`.
+    pub fn render(&self, log: &Messages, f: &mut Frame, area: Rect) {
+        render(log, self.back, f, area);
+    }
+}
+
+/// Draws `log`, scrolled `back` lines up from its end, in a popup over `area`.
+fn render(log: &Messages, back: usize, f: &mut Frame, area: Rect) {
     let r = popup(area);
     f.render_widget(Clear, r);
-    let lines = app.messages.lines();
+    let lines = log.lines();
     let height = height(area);
-    let first = first_line(lines.len(), height, app.messages_back);
+    let first = first_line(lines.len(), height, back);
     let body: Vec<Line> = if lines.is_empty() {
         vec![Line::raw(
             "no messages yet: command results, node and bus events appear here",
@@ -59,9 +107,9 @@ pub fn render(app: &App, f: &mut Frame, area: Rect) {
     };
     let title = format!(
         " Messages ({}{}) — ↑↓ scroll, esc closes ",
-        app.messages.len(),
-        if app.messages.dropped > 0 {
-            format!(", {} oldest dropped", app.messages.dropped)
+        log.len(),
+        if log.dropped > 0 {
+            format!(", {} oldest dropped", log.dropped)
         } else {
             String::new()
         }

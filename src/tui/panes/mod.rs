@@ -1,4 +1,5 @@
-//! The panes, one module each, plus the shared styles.
+//! The panes, one module each: each owns its state, handles the actions meant for it
+//! ([`Component::handle`]) and draws itself; plus the shared styles.
 
 pub mod detail;
 pub mod help;
@@ -10,9 +11,182 @@ pub mod stats;
 pub mod status;
 pub mod trace;
 
+use crate::analysis::trace::Trace;
 use crate::decode::Kind;
+use crate::tui::keymap::Action;
+use ratatui::Frame;
+use ratatui::layout::Rect;
 use ratatui::style::{Color, Modifier, Style};
 use ratatui::widgets::{Block, BorderType, Borders};
+
+/// The main-area panes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pane {
+    Trace,
+    Nodes,
+    Sdo,
+    Stats,
+    Plot,
+}
+
+impl Pane {
+    /// Every pane in tab order.
+    pub const ALL: [Pane; 5] = [Pane::Trace, Pane::Nodes, Pane::Sdo, Pane::Stats, Pane::Plot];
+    /// Tab title.
+    pub fn title(self) -> &'static str {
+        match self {
+            Pane::Trace => "Trace",
+            Pane::Nodes => "Nodes",
+            Pane::Sdo => "SDO",
+            Pane::Stats => "Stats",
+            Pane::Plot => "Plot",
+        }
+    }
+}
+
+/// The main-area panes' states, one of each.
+#[derive(Default)]
+pub struct Panes {
+    /// One row per frame of the filtered view.
+    pub trace: trace::TracePane,
+    /// One row per node.
+    pub nodes: nodes::NodesPane,
+    /// One row per SDO transfer, or the frames of one.
+    pub sdo: sdo::SdoPane,
+    /// One row per COB-ID.
+    pub stats: stats::StatsPane,
+    /// One numeric series over time.
+    pub plot: plot::PlotPane,
+}
+
+impl Panes {
+    /// The pane `p`.
+    pub fn get(&self, p: Pane) -> &dyn Component {
+        match p {
+            Pane::Trace => &self.trace,
+            Pane::Nodes => &self.nodes,
+            Pane::Sdo => &self.sdo,
+            Pane::Stats => &self.stats,
+            Pane::Plot => &self.plot,
+        }
+    }
+
+    /// The pane `p`, to change.
+    pub fn get_mut(&mut self, p: Pane) -> &mut dyn Component {
+        match p {
+            Pane::Trace => &mut self.trace,
+            Pane::Nodes => &mut self.nodes,
+            Pane::Sdo => &mut self.sdo,
+            Pane::Stats => &mut self.stats,
+            Pane::Plot => &mut self.plot,
+        }
+    }
+}
+
+/// What a pane sees of the application when it handles an action or draws.
+#[derive(Clone, Copy)]
+pub struct Ctx<'a> {
+    /// Frames and what is derived from them.
+    pub trace: &'a Trace,
+    /// Rows a page holds (the visible height of the main table).
+    pub page: usize,
+    /// The capture is paused.
+    pub paused: bool,
+}
+
+/// What handling an action asks of the application.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// The pane did it.
+    Done,
+    /// Not for this pane: the application handles it.
+    Ignored,
+    /// Open the selected row in the Detail view.
+    Detail,
+    /// Show the trace with this filter.
+    Filter(String),
+    /// Show this trace position in the Trace pane, unfiltered.
+    Show(usize),
+}
+
+/// What the selected row of a pane is, for the Detail view.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Selected {
+    /// A frame (trace position).
+    Frame(usize),
+    /// An SDO transfer (index into the transactions).
+    Transfer(usize),
+}
+
+/// A main-area pane.
+pub trait Component {
+    /// Handles `action` while the pane has the focus.
+    fn handle(&mut self, action: Action, ctx: &Ctx) -> Outcome;
+    /// Moves the selection by `delta` rows (mouse wheel); panes without rows ignore it.
+    fn scroll(&mut self, _delta: isize, _ctx: &Ctx) {}
+    /// Selects the `row`-th visible row (mouse click); panes without rows ignore it.
+    fn click(&mut self, _row: usize, _ctx: &Ctx) {}
+    /// Keeps the selection within the rows and visible in `height` rows (before drawing).
+    fn fit(&mut self, _height: usize, _ctx: &Ctx) {}
+    /// What the Detail view shows for this pane; None: the trace's selected frame.
+    fn selected(&self, _ctx: &Ctx) -> Option<Selected> {
+        None
+    }
+    /// Draws the pane into `area`.
+    fn render(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool);
+}
+
+/// Scroll state of a list pane.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ListState {
+    /// Selected row.
+    pub selected: usize,
+    /// First visible row.
+    pub offset: usize,
+}
+
+impl ListState {
+    /// Keeps `selected` within `len` rows and visible in `height` rows.
+    pub fn clamp(&mut self, len: usize, height: usize) {
+        self.selected = self.selected.min(len.saturating_sub(1));
+        let h = height.max(1);
+        if self.selected < self.offset {
+            self.offset = self.selected;
+        } else if self.selected >= self.offset + h {
+            self.offset = self.selected + 1 - h;
+        }
+        self.offset = self.offset.min(len.saturating_sub(h));
+    }
+
+    /// Moves the selection by `delta` rows within `len`, visible in `page` rows.
+    pub fn scroll(&mut self, delta: isize, len: usize, page: usize) {
+        self.selected = (self.selected as isize + delta).clamp(0, len.saturating_sub(1) as isize) as usize;
+        self.clamp(len, page);
+    }
+
+    /// Selects the `row`-th visible row, if there is one.
+    pub fn click(&mut self, row: usize, len: usize, page: usize) {
+        let want = self.offset + row;
+        if want < len {
+            self.selected = want;
+            self.clamp(len, page);
+        }
+    }
+
+    /// The list movement an action asks for, if it is one: Some(delta in rows).
+    pub fn movement(action: Action, page: usize) -> Option<isize> {
+        let page = page as isize;
+        Some(match action {
+            Action::Down => 1,
+            Action::Up => -1,
+            Action::PageDown => page,
+            Action::PageUp => -page,
+            Action::Top => isize::MIN / 2,
+            Action::Bottom => isize::MAX / 2,
+            _ => return None,
+        })
+    }
+}
 
 /// The colour of a kind in the trace.
 pub fn kind_color(kind: Kind) -> Color {
@@ -29,6 +203,15 @@ pub fn kind_color(kind: Kind) -> Color {
         Kind::Lss => Color::Yellow,
         Kind::ErrorFrame => Color::LightRed,
         Kind::Other => Color::White,
+    }
+}
+
+/// The timestamp of the first frame (0 while there is none).
+pub fn start_ns(trace: &Trace) -> u64 {
+    if trace.is_empty() {
+        0
+    } else {
+        trace.store.packed(0).ts_ns
     }
 }
 

@@ -2,12 +2,13 @@
 //! timing, missed deadlines, boot-ups, the last EMCY, CiA 402 state and mode, frame rate
 //! and profile.
 
-use super::{block, duration, fit, header, selected};
+use super::{Component, Ctx, ListState, Outcome, block, duration, fit, header, selected};
 use crate::analysis::NodeLiveness;
 use crate::analysis::nodes::NodeInfo;
+use crate::analysis::trace::Trace;
 use crate::decode::cia402::mode_name;
 use crate::decode::heartbeat::NmtState;
-use crate::tui::app::App;
+use crate::tui::keymap::Action;
 use ratatui::Frame;
 use ratatui::layout::Rect;
 use ratatui::style::{Color, Modifier, Style};
@@ -81,67 +82,101 @@ pub fn row_text(id: u8, n: &NodeInfo, live: Option<&NodeLiveness>, now_ns: u64) 
     )
 }
 
-/// Draws the full pane.
-pub fn render(app: &App, f: &mut Frame, area: Rect, focused: bool) {
-    f.render_widget(block(" Nodes ", focused), area);
-    let inner = block("", true).inner(area);
-    if inner.height == 0 {
-        return;
+/// The Nodes pane's state: the selection.
+#[derive(Default)]
+pub struct NodesPane {
+    /// Scroll state.
+    pub list: ListState,
+}
+
+impl Component for NodesPane {
+    /// Moves the selection; `expand` shows the selected node's frames in the trace.
+    fn handle(&mut self, action: Action, ctx: &Ctx) -> Outcome {
+        if let Some(delta) = ListState::movement(action, ctx.page) {
+            self.scroll(delta, ctx);
+            return Outcome::Done;
+        }
+        match action {
+            Action::Expand => match ctx.trace.nodes.iter().nth(self.list.selected) {
+                Some((n, _)) => Outcome::Filter(format!("node {n}")),
+                None => Outcome::Done,
+            },
+            _ => Outcome::Ignored,
+        }
     }
-    let now = app.trace.nodes.now_ns();
-    let mut lines = vec![Line::styled(
-        format!(
-            "{:>3} {:<15} {:>11} {:>9} {:>4} {:>4} {:<22} {:<14} {:<18} {:>7} {:<10}",
-            "id",
-            "nmt",
-            "hb meas/cfg",
-            "hb age",
-            "miss",
-            "boot",
-            "cia402 state",
-            "mode",
-            "last emcy",
-            "fr/s",
-            "profile"
-        ),
-        header(),
-    )];
-    let l = app.nodes_list;
-    for (i, (id, n)) in app
-        .trace
-        .nodes
-        .iter()
-        .enumerate()
-        .skip(l.offset)
-        .take(inner.height as usize - 1)
-    {
-        let live = app.trace.nodes.liveness(*id);
-        let line = Line::styled(row_text(*id, n, live, now), row_style(live));
-        lines.push(if i == l.selected && focused {
-            line.style(selected())
-        } else {
-            line
-        });
+
+    fn scroll(&mut self, delta: isize, ctx: &Ctx) {
+        self.list.scroll(delta, ctx.trace.nodes.len(), ctx.page);
     }
-    if app.trace.nodes.is_empty() {
-        lines.push(Line::raw("no node seen yet"));
+
+    fn click(&mut self, row: usize, ctx: &Ctx) {
+        self.list.click(row, ctx.trace.nodes.len(), ctx.page);
     }
-    f.render_widget(Paragraph::new(lines), inner);
+
+    fn fit(&mut self, height: usize, ctx: &Ctx) {
+        self.list.clamp(ctx.trace.nodes.len(), height);
+    }
+
+    fn render(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
+        f.render_widget(block(" Nodes ", focused), area);
+        let inner = block("", true).inner(area);
+        if inner.height == 0 {
+            return;
+        }
+        let trace = ctx.trace;
+        let now = trace.nodes.now_ns();
+        let mut lines = vec![Line::styled(
+            format!(
+                "{:>3} {:<15} {:>11} {:>9} {:>4} {:>4} {:<22} {:<14} {:<18} {:>7} {:<10}",
+                "id",
+                "nmt",
+                "hb meas/cfg",
+                "hb age",
+                "miss",
+                "boot",
+                "cia402 state",
+                "mode",
+                "last emcy",
+                "fr/s",
+                "profile"
+            ),
+            header(),
+        )];
+        let l = self.list;
+        for (i, (id, n)) in trace
+            .nodes
+            .iter()
+            .enumerate()
+            .skip(l.offset)
+            .take(inner.height as usize - 1)
+        {
+            let live = trace.nodes.liveness(*id);
+            let line = Line::styled(row_text(*id, n, live, now), row_style(live));
+            lines.push(if i == l.selected && focused {
+                line.style(selected())
+            } else {
+                line
+            });
+        }
+        if trace.nodes.is_empty() {
+            lines.push(Line::raw("no node seen yet"));
+        }
+        f.render_widget(Paragraph::new(lines), inner);
+    }
 }
 
 /// Draws the compact list beside the main pane: id, NMT state, drive state.
-pub fn render_compact(app: &App, f: &mut Frame, area: Rect) {
+pub fn render_compact(trace: &Trace, f: &mut Frame, area: Rect) {
     f.render_widget(block(" Nodes ", false), area);
     let inner = block("", true).inner(area);
-    let now = app.trace.nodes.now_ns();
-    let lines: Vec<Line> = app
-        .trace
+    let now = trace.nodes.now_ns();
+    let lines: Vec<Line> = trace
         .nodes
         .iter()
         .take(inner.height as usize)
         .map(|(id, n)| {
             let emcy = if n.last_emcy.is_some() { " EMCY" } else { "" };
-            let live = app.trace.nodes.liveness(*id);
+            let live = trace.nodes.liveness(*id);
             Line::styled(
                 fit(
                     &format!(

@@ -1,7 +1,8 @@
 //! The Plot pane: a numeric PDO signal or SDO-read value over time.
 
-use super::block;
-use crate::tui::app::App;
+use super::{Component, Ctx, Outcome, block};
+use crate::analysis::trace::Trace;
+use crate::tui::keymap::Action;
 use ratatui::Frame;
 use ratatui::layout::Rect;
 use ratatui::style::{Color, Style};
@@ -9,10 +10,52 @@ use ratatui::symbols::Marker;
 use ratatui::text::Line;
 use ratatui::widgets::{Axis, Chart, Dataset, GraphType, Paragraph};
 
-/// Draws the pane.
-pub fn render(app: &App, f: &mut Frame, area: Rect, focused: bool) {
-    let keys = app.trace.series.keys();
-    let Some(key) = keys.get(app.series_sel.min(keys.len().saturating_sub(1))) else {
+/// The Plot pane's state: which series it shows.
+#[derive(Default)]
+pub struct PlotPane {
+    /// Index into the series keys.
+    pub series: usize,
+}
+
+impl PlotPane {
+    /// Shows the next (or previous) series, going round.
+    pub fn step(&mut self, trace: &Trace, forward: bool) {
+        let n = trace.series.keys().len().max(1);
+        self.series = if forward {
+            (self.series + 1) % n
+        } else {
+            (self.series + n - 1) % n
+        };
+    }
+
+    /// Shows the series of `node` `index`:`sub`; false when no such series was seen.
+    pub fn select(&mut self, trace: &Trace, node: u8, index: u16, sub: u8) -> bool {
+        match trace.series.keys().iter().position(|k| *k == (node, index, sub)) {
+            Some(at) => {
+                self.series = at;
+                true
+            }
+            None => false,
+        }
+    }
+}
+
+impl Component for PlotPane {
+    /// The plot has no rows: `[`/`]` choose the series (handled by the application).
+    fn handle(&mut self, _action: Action, _ctx: &Ctx) -> Outcome {
+        Outcome::Ignored
+    }
+
+    fn render(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
+        render(self.series, ctx, f, area, focused);
+    }
+}
+
+/// Draws series number `sel`.
+fn render(sel: usize, ctx: &Ctx, f: &mut Frame, area: Rect, focused: bool) {
+    let trace = ctx.trace;
+    let keys = trace.series.keys();
+    let Some(key) = keys.get(sel.min(keys.len().saturating_sub(1))) else {
         f.render_widget(block(" Plot ", focused), area);
         let inner = block("", true).inner(area);
         f.render_widget(
@@ -21,8 +64,8 @@ pub fn render(app: &App, f: &mut Frame, area: Rect, focused: bool) {
         );
         return;
     };
-    let Some(line) = app.trace.series.get(key) else { return };
-    let t0 = app.start_ns() as f64 / 1e9;
+    let Some(line) = trace.series.get(key) else { return };
+    let t0 = super::start_ns(trace) as f64 / 1e9;
     let points: Vec<(f64, f64)> = line.points.iter().map(|(t, v)| (t - t0, *v)).collect();
     let (mut lo, mut hi) = points
         .iter()
@@ -50,7 +93,7 @@ pub fn render(app: &App, f: &mut Frame, area: Rect, focused: bool) {
     };
     let title = format!(
         " Plot {}/{}: node {} {object}{name} ({} points) ",
-        app.series_sel.min(keys.len() - 1) + 1,
+        sel.min(keys.len() - 1) + 1,
         keys.len(),
         key.0,
         points.len()

@@ -1,8 +1,8 @@
 //! Rendering tests: every pane on a fixed capture, snapshotted with TestBackend.
 
 use super::testutil::{app, screen};
-use crate::tui::app::Pane;
 use crate::tui::keymap::Action;
+use crate::tui::panes::Pane;
 
 #[test]
 fn trace_pane_shows_decoded_rows_and_the_status_bar() {
@@ -30,7 +30,7 @@ fn scrolled_back_trace_keeps_a_tail_strip_of_the_newest_frames() {
 #[test]
 fn nodes_pane_shows_states_heartbeat_and_emcy() {
     let mut a = app();
-    a.pane = Pane::Nodes;
+    a.focus = Pane::Nodes;
     let s = screen(&mut a, 160, 14);
     assert!(s.contains("Operational"), "{s}");
     assert!(s.contains("Pre-operational"), "{s}");
@@ -41,7 +41,7 @@ fn nodes_pane_shows_states_heartbeat_and_emcy() {
 #[test]
 fn nodes_pane_marks_a_silent_node_lost_in_red_with_its_age() {
     let mut a = app();
-    a.pane = Pane::Nodes;
+    a.focus = Pane::Nodes;
     // 100 ms later node 1 (0x1017 = 100 ms, read by SDO) is on time; node 2 (every 14 ms,
     // measured) was due 21 ms after its last heartbeat.
     let mut f = crate::frame::Frame::classic(0x701, &[0x05]);
@@ -74,7 +74,7 @@ fn nodes_pane_marks_a_silent_node_lost_in_red_with_its_age() {
 #[test]
 fn sdo_pane_lists_transfers_and_expands_to_frames() {
     let mut a = app();
-    a.pane = Pane::Sdo;
+    a.focus = Pane::Sdo;
     let s = screen(&mut a, 140, 14);
     assert!(s.contains("1017:00"), "{s}");
     assert!(s.contains("abort 06020000"), "{s}");
@@ -82,7 +82,49 @@ fn sdo_pane_lists_transfers_and_expands_to_frames() {
     a.act(Action::Expand);
     let s = screen(&mut a, 140, 14);
     assert!(s.contains("SDO transfer 1017:00 node 1"), "{s}");
+    // Detail shows the selected frame of the transfer, not the newest frame of the trace.
+    assert!(s.contains("frame 4  t 0.007000 s"), "{s}");
     insta::assert_snapshot!("sdo_expanded", s);
+    a.act(Action::Down);
+    let s = screen(&mut a, 140, 14);
+    assert!(s.contains("frame 5  t 0.008000 s"), "{s}");
+}
+
+#[test]
+fn at_80x24_enter_toggles_the_detail_pane_below_the_trace() {
+    let mut a = app();
+    let s = screen(&mut a, 80, 24);
+    assert!(!s.contains("Detail"), "{s}");
+    a.run_command("goto 5");
+    a.act(Action::Expand);
+    let s = screen(&mut a, 80, 24);
+    assert!(s.contains("Detail"), "{s}");
+    assert!(s.contains("frame 5  t 0.008000 s"), "{s}");
+    assert!(s.contains("bits 7-5 scs = 2"), "{s}");
+    insta::assert_snapshot!(s);
+    // The selection moves under it; esc closes it.
+    a.act(Action::Down);
+    let s = screen(&mut a, 80, 24);
+    assert!(s.contains("frame 6  t 0.009000 s"), "{s}");
+    a.act(Action::Back);
+    let s = screen(&mut a, 80, 24);
+    assert!(!s.contains("Detail"), "{s}");
+}
+
+#[test]
+fn at_80x24_the_detail_pane_follows_the_sdo_pane_selection() {
+    let mut a = app();
+    let _ = screen(&mut a, 80, 24);
+    a.act(Action::Expand);
+    a.act(Action::PaneSdo);
+    let s = screen(&mut a, 80, 24);
+    assert!(s.contains("Upload 0x1017:00"), "{s}");
+    a.act(Action::Expand);
+    a.act(Action::Down);
+    let s = screen(&mut a, 80, 24);
+    assert!(s.contains("SDO transfer 1017:00 node 1"), "{s}");
+    assert!(s.contains("frame 5  t 0.008000 s"), "{s}");
+    insta::assert_snapshot!(s);
 }
 
 #[test]
@@ -107,7 +149,7 @@ fn detail_pane_shows_statusword_bits_of_a_mapped_pdo() {
 #[test]
 fn stats_pane_shows_rates_and_bus_load() {
     let mut a = app();
-    a.pane = Pane::Stats;
+    a.focus = Pane::Stats;
     let s = screen(&mut a, 140, 24);
     assert!(s.contains("bus load"), "{s}");
     assert!(s.contains("701"), "{s}");
@@ -118,7 +160,7 @@ fn stats_pane_shows_rates_and_bus_load() {
 fn plot_pane_draws_a_series() {
     let mut a = app();
     a.act(Action::NextSeries);
-    assert_eq!(a.pane, Pane::Plot);
+    assert_eq!(a.focus, Pane::Plot);
     let s = screen(&mut a, 100, 20);
     assert!(s.contains("Plot 2/2: node 1 0x6041:00 (6 points)"), "{s}");
     insta::assert_snapshot!(s);
@@ -149,8 +191,8 @@ fn filter_prompt_and_errors_show_in_the_bottom_line() {
 fn any_size_renders_without_panicking() {
     let mut a = app();
     for pane in Pane::ALL {
-        a.pane = pane;
-        a.help = pane == Pane::Stats;
+        a.focus = pane;
+        a.help.shown = pane == Pane::Stats;
         for (w, h) in [
             (0, 0),
             (1, 1),

@@ -1,9 +1,10 @@
 //! The SDO pane: one row per transfer (object, value, duration, outcome, abort text);
 //! `expand` opens a transfer's frames.
 
-use super::{block, duration, fit, header, selected};
+use super::{Component, Ctx, ListState, Selected, block, duration, fit, header, selected};
+use crate::analysis::trace::Trace;
 use crate::decode::sdo::{Outcome, Transaction};
-use crate::tui::app::App;
+use crate::tui::keymap::Action;
 use ratatui::Frame;
 use ratatui::layout::Rect;
 use ratatui::style::{Color, Style};
@@ -11,8 +12,8 @@ use ratatui::text::Line;
 use ratatui::widgets::Paragraph;
 
 /// One transfer as a table row.
-pub fn row_text(app: &App, t: &Transaction, width: usize) -> String {
-    let dict = app.trace.decoder().dictionary(t.node);
+pub fn row_text(trace: &Trace, t: &Transaction, width: usize) -> String {
+    let dict = trace.decoder().dictionary(t.node);
     let name = dict.name(t.index, t.sub).unwrap_or("");
     let value = if t.outcome == Outcome::Ok && !t.data.is_empty() && !t.is_partial() {
         crate::decode::sdo::value::view(dict, t.index, t.sub, &t.data).text
@@ -57,10 +58,102 @@ fn color(t: &Transaction) -> Color {
     }
 }
 
-/// Draws the pane.
-pub fn render(app: &App, f: &mut Frame, area: Rect, focused: bool) {
-    let l = app.sdo_list;
-    if let Some(t) = app.sdo_expanded.and_then(|i| app.trace.transactions.get(i)) {
+/// The SDO pane's state: the selection, and the transfer opened to its frames.
+#[derive(Default)]
+pub struct SdoPane {
+    /// Scroll state (transfers, or the frames of the opened transfer).
+    pub list: ListState,
+    /// The transfer opened to its frames (index into the transactions).
+    pub expanded: Option<usize>,
+}
+
+impl SdoPane {
+    /// The opened transfer, if any.
+    fn opened<'t>(&self, trace: &'t Trace) -> Option<&'t Transaction> {
+        self.expanded.and_then(|i| trace.transactions.get(i))
+    }
+
+    /// Rows of the list: transfers, or the frames of the opened transfer.
+    fn len(&self, trace: &Trace) -> usize {
+        match self.expanded {
+            Some(_) => self.opened(trace).map(|t| t.frames.len()).unwrap_or(0),
+            None => trace.transactions.len(),
+        }
+    }
+
+    /// The trace position of the selected frame of the opened transfer.
+    fn selected_frame(&self, trace: &Trace) -> Option<usize> {
+        let seq = self.opened(trace)?.frames.get(self.list.selected)?;
+        Some(seq.saturating_sub(1) as usize)
+    }
+}
+
+impl Component for SdoPane {
+    /// Moves the selection; `expand` opens the selected transfer to its frames, and on a
+    /// frame shows it in the trace; `back` closes the transfer.
+    fn handle(&mut self, action: Action, ctx: &Ctx) -> super::Outcome {
+        if let Some(delta) = ListState::movement(action, ctx.page) {
+            self.scroll(delta, ctx);
+            return super::Outcome::Done;
+        }
+        match action {
+            Action::Expand if self.expanded.is_none() => {
+                if !ctx.trace.transactions.is_empty() {
+                    self.expanded = Some(self.list.selected);
+                    self.list = ListState::default();
+                }
+                super::Outcome::Done
+            }
+            Action::Expand => match self.selected_frame(ctx.trace) {
+                Some(pos) => super::Outcome::Show(pos),
+                None => super::Outcome::Done,
+            },
+            Action::Back => match self.expanded.take() {
+                Some(t) => {
+                    self.list = ListState {
+                        selected: t,
+                        offset: t.saturating_sub(3),
+                    };
+                    super::Outcome::Done
+                }
+                None => super::Outcome::Ignored,
+            },
+            _ => super::Outcome::Ignored,
+        }
+    }
+
+    fn scroll(&mut self, delta: isize, ctx: &Ctx) {
+        self.list.scroll(delta, self.len(ctx.trace), ctx.page);
+    }
+
+    fn click(&mut self, row: usize, ctx: &Ctx) {
+        self.list.click(row, self.len(ctx.trace), ctx.page);
+    }
+
+    fn fit(&mut self, height: usize, ctx: &Ctx) {
+        self.list.clamp(self.len(ctx.trace), height);
+    }
+
+    /// The selected transfer, or the selected frame of the opened one.
+    fn selected(&self, ctx: &Ctx) -> Option<Selected> {
+        match self.expanded {
+            Some(_) => self.selected_frame(ctx.trace).map(Selected::Frame),
+            None => Some(Selected::Transfer(self.list.selected)),
+        }
+    }
+
+    fn render(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
+        match self.opened(ctx.trace) {
+            Some(t) => self.render_frames(t, f, area, ctx, focused),
+            None => self.render_transfers(f, area, ctx, focused),
+        }
+    }
+}
+
+impl SdoPane {
+    /// Draws the frames of the opened transfer `t`.
+    fn render_frames(&self, t: &Transaction, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
+        let l = self.list;
         let title = format!(" SDO transfer {:04X}:{:02X} node {} — frames ", t.index, t.sub, t.node);
         f.render_widget(block(&title, focused), area);
         let inner = block("", true).inner(area);
@@ -71,14 +164,14 @@ pub fn render(app: &App, f: &mut Frame, area: Rect, focused: bool) {
             .take(inner.height as usize)
             .map(|s| s.saturating_sub(1) as usize)
             .collect();
-        let t0 = app.start_ns();
-        let decoded = app.trace.decode_positions(&positions);
+        let t0 = super::start_ns(ctx.trace);
+        let decoded = ctx.trace.decode_positions(&positions);
         let lines: Vec<Line> = positions
             .iter()
             .zip(decoded)
             .enumerate()
             .map(|(i, (p, d))| {
-                let fr = app.trace.store.frame(*p);
+                let fr = ctx.trace.store.frame(*p);
                 let text = format!(
                     "{:>12.6} {:03X} {:<23} {}",
                     fr.ts_ns.saturating_sub(t0) as f64 / 1e9,
@@ -95,37 +188,41 @@ pub fn render(app: &App, f: &mut Frame, area: Rect, focused: bool) {
             })
             .collect();
         f.render_widget(Paragraph::new(lines), inner);
-        return;
     }
-    let title = format!(" SDO transfers ({}) ", app.trace.transactions.len());
-    f.render_widget(block(&title, focused), area);
-    let inner = block("", true).inner(area);
-    if inner.height == 0 {
-        return;
-    }
-    let mut lines = vec![Line::styled(
-        fit(
-            &format!(
-                "{:>3} {} {:<7} {:<24} {:<20} {:>9} outcome",
-                "nd", "dir  ", "object", "name", "value", "duration"
+
+    /// Draws the list of transfers.
+    fn render_transfers(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
+        let l = self.list;
+        let trace = ctx.trace;
+        let title = format!(" SDO transfers ({}) ", trace.transactions.len());
+        f.render_widget(block(&title, focused), area);
+        let inner = block("", true).inner(area);
+        if inner.height == 0 {
+            return;
+        }
+        let mut lines = vec![Line::styled(
+            fit(
+                &format!(
+                    "{:>3} {} {:<7} {:<24} {:<20} {:>9} outcome",
+                    "nd", "dir  ", "object", "name", "value", "duration"
+                ),
+                inner.width as usize,
             ),
-            inner.width as usize,
-        ),
-        header(),
-    )];
-    for (i, t) in app
-        .trace
-        .transactions
-        .iter()
-        .enumerate()
-        .skip(l.offset)
-        .take(inner.height as usize - 1)
-    {
-        let line = Line::styled(row_text(app, t, inner.width as usize), Style::default().fg(color(t)));
-        lines.push(if i == l.selected { line.style(selected()) } else { line });
+            header(),
+        )];
+        for (i, t) in trace
+            .transactions
+            .iter()
+            .enumerate()
+            .skip(l.offset)
+            .take(inner.height as usize - 1)
+        {
+            let line = Line::styled(row_text(trace, t, inner.width as usize), Style::default().fg(color(t)));
+            lines.push(if i == l.selected { line.style(selected()) } else { line });
+        }
+        if trace.transactions.is_empty() {
+            lines.push(Line::raw("no SDO transfer seen yet"));
+        }
+        f.render_widget(Paragraph::new(lines), inner);
     }
-    if app.trace.transactions.is_empty() {
-        lines.push(Line::raw("no SDO transfer seen yet"));
-    }
-    f.render_widget(Paragraph::new(lines), inner);
 }

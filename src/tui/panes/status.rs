@@ -3,9 +3,8 @@
 use crate::tui::app::{App, SourceKind};
 use crate::tui::keymap::Action;
 use ratatui::Frame;
-use ratatui::layout::{Position, Rect};
+use ratatui::layout::Rect;
 use ratatui::style::{Color, Style};
-use ratatui::text::{Line, Span};
 use ratatui::widgets::Paragraph;
 
 /// The status bar text.
@@ -32,12 +31,17 @@ pub fn text(app: &App) -> String {
     } else {
         ""
     };
-    let filter = if app.view.filter.is_empty() {
+    let view = &app.panes.trace.view;
+    let filter = if view.filter.is_empty() {
         String::new()
     } else {
-        let p = app.view.progress(&app.trace);
+        let p = view.progress(&app.trace);
         let prog = if p < 100 { format!(" {p}%") } else { String::new() };
-        format!(" | filter: {} ({} rows{prog})", app.view.filter.source, app.view_len())
+        format!(
+            " | filter: {} ({} rows{prog})",
+            view.filter.source,
+            app.panes.trace.len(&app.trace)
+        )
     };
     let stop = app
         .keymap
@@ -59,7 +63,7 @@ pub fn text(app: &App) -> String {
 
 /// Draws the status bar and, below it, the prompt or the last message.
 pub fn render(app: &App, f: &mut Frame, bar: Rect, line: Rect) {
-    let (txt, bg) = match (&app.source.bus_error, &app.prompt, &app.message) {
+    let (txt, bg) = match (&app.source.bus_error, &app.prompt.editing, &app.message) {
         // While typing, the bar shows what the line will do (preview or error).
         (_, Some(_), Some(m)) => (m.clone(), Color::Magenta),
         // The error (with its fix) first, so a narrow terminal still shows it.
@@ -67,17 +71,10 @@ pub fn render(app: &App, f: &mut Frame, bar: Rect, line: Rect) {
         _ => (text(app), Color::Blue),
     };
     f.render_widget(Paragraph::new(txt).style(Style::default().bg(bg).fg(Color::White)), bar);
-    if let Some(p) = &app.prompt {
-        let lead = p.kind.lead();
-        f.render_widget(
-            Paragraph::new(Line::from(vec![Span::raw(lead), Span::raw(p.text.clone())])),
-            line,
-        );
-        let x = line.x + (lead.chars().count() + p.cursor) as u16;
-        if x < line.x + line.width {
-            f.set_cursor_position(Position::new(x, line.y));
-        }
-    } else if let Some(m) = &app.message {
+    if app.prompt.render(f, line) {
+        return;
+    }
+    if let Some(m) = &app.message {
         f.render_widget(
             Paragraph::new(m.as_str()).style(Style::default().fg(Color::Yellow)),
             line,

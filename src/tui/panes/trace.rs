@@ -1,45 +1,267 @@
 //! The Trace pane: one row per frame of the view, coloured by kind, with a tail strip of
-//! the newest frames while scrolled back.
+//! the newest frames while scrolled back. It owns the view (the filter in force), the
+//! search, the selection and follow mode, and the decoded rows of the visible window.
 
-use super::{block, fit, header, kind_color, selected};
-use crate::tui::app::App;
+use super::{Component, Ctx, ListState, Outcome, block, fit, header, kind_color, selected};
+use crate::analysis::filter::Filter;
+use crate::analysis::trace::Trace;
+use crate::analysis::view::View;
+use crate::tui::keymap::Action;
+use crate::tui::rows::{Row, RowCache};
 use ratatui::Frame;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::{Color, Style};
 use ratatui::text::{Line, Span};
 use ratatui::widgets::Paragraph;
+use std::time::{Duration, Instant};
 
 /// Rows of the tail strip.
 pub const TAIL: usize = 3;
 
-/// Splits the pane into the table rows and the tail strip (empty when following).
-pub fn split(app: &App, area: Rect) -> (Rect, Rect) {
-    let inner = block("", true).inner(area);
-    let body = Rect {
-        y: inner.y.saturating_add(1),
-        height: inner.height.saturating_sub(1),
-        ..inner
-    };
-    let tail = if !app.follow && app.view_len() > body.height as usize && body.height as usize > TAIL * 3 {
-        TAIL as u16 + 1
-    } else {
-        0
-    };
-    let [rows, strip] = Layout::vertical([Constraint::Min(0), Constraint::Length(tail)]).areas(body);
-    (rows, strip)
+/// The Trace pane's state.
+pub struct TracePane {
+    /// The filtered view of the trace.
+    pub view: View,
+    /// Scroll state (rows of the view).
+    pub list: ListState,
+    /// Follow the newest frame.
+    pub follow: bool,
+    /// Search in force (`n`/`N`).
+    pub search: Option<Filter>,
+    /// Decoded rows of the visible window.
+    rows: RowCache,
 }
 
-/// Trace positions shown in the tail strip.
-pub fn tail_positions(app: &App, strip: Rect) -> Vec<usize> {
-    if strip.height == 0 {
-        return Vec::new();
+impl Default for TracePane {
+    fn default() -> TracePane {
+        TracePane {
+            view: View::default(),
+            list: ListState::default(),
+            follow: true,
+            search: None,
+            rows: RowCache::default(),
+        }
     }
-    let n = app.view_len();
-    (n.saturating_sub(TAIL)..n).map(|r| app.view.position(r)).collect()
 }
 
-fn cells(app: &App, pos: usize, width: u16) -> Vec<Span<'static>> {
-    let Some(r) = app.row(pos) else {
+impl TracePane {
+    /// Rows in the view.
+    pub fn len(&self, trace: &Trace) -> usize {
+        self.view.len(trace)
+    }
+
+    /// Forgets every frame (the source started over); the filter stays.
+    pub fn reset(&mut self) {
+        self.view = View::new(self.view.filter.clone());
+        self.rows = RowCache::default();
+        self.list = ListState::default();
+    }
+
+    /// The trace position of the selected row.
+    pub fn selected_position(&self, trace: &Trace) -> Option<usize> {
+        let n = self.len(trace);
+        (n > 0).then(|| self.view.position(self.list.selected.min(n - 1)))
+    }
+
+    /// Selects the row of trace position `pos` (or the nearest before it) and stops following.
+    pub fn select_position(&mut self, trace: &Trace, pos: usize, page: usize) {
+        self.follow = false;
+        self.list.selected = self.view.row_of(pos);
+        self.list.clamp(self.len(trace), page);
+    }
+
+    /// Shows the rows `filter` keeps, the selected frame staying selected when it still shows.
+    pub fn set_filter(&mut self, trace: &Trace, filter: Filter, page: usize) {
+        let pos = self.selected_position(trace);
+        self.view = View::new(filter);
+        self.view.advance(trace, Duration::from_millis(30));
+        self.list.selected = pos.map(|p| self.view.row_of(p)).unwrap_or(0);
+        self.list.clamp(self.len(trace), page);
+        self.rows = RowCache::default();
+    }
+
+    /// Shows every frame and selects trace position `pos`.
+    pub fn show(&mut self, trace: &Trace, pos: usize, page: usize) {
+        self.view = View::new(Filter::default());
+        self.select_position(trace, pos, page);
+    }
+
+    /// Jumps to the next (or previous) row matching the search; returns what to tell the user.
+    pub fn jump_match(&mut self, trace: &Trace, forward: bool, page: usize) -> Option<String> {
+        let Some(f) = self.search.clone() else {
+            return Some("no search: press the search key first".into());
+        };
+        let n = self.len(trace);
+        if n == 0 {
+            return None;
+        }
+        let cur = self.list.selected;
+        let rows: Box<dyn Iterator<Item = usize>> = if forward {
+            Box::new(cur + 1..n)
+        } else {
+            Box::new((0..cur).rev())
+        };
+        let deadline = Instant::now() + Duration::from_millis(500);
+        let needs_label = f.needs_label();
+        let in_transfer = f.has_transfer_terms().then(|| {
+            let mut set = std::collections::HashSet::new();
+            for t in trace.transactions.iter().filter(|t| f.transaction_matches(t)) {
+                set.extend(t.frames.iter().map(|s| s.saturating_sub(1) as usize));
+            }
+            set
+        });
+        for r in rows {
+            let pos = self.view.position(r);
+            let label = needs_label
+                .then(|| trace.decode_positions(&[pos]).pop().map(|d| d.label))
+                .flatten();
+            let inside = in_transfer.as_ref().is_some_and(|s| s.contains(&pos));
+            if f.matches(trace.store.packed(pos), inside, label.as_deref()) {
+                self.follow = false;
+                self.list.selected = r;
+                self.list.clamp(n, page);
+                return Some(format!("match at frame {}", pos + 1));
+            }
+            if Instant::now() > deadline {
+                self.list.selected = r;
+                return Some(format!("search stopped at frame {} (press again to go on)", pos + 1));
+            }
+        }
+        Some(format!(
+            "no {} match for `{}`",
+            if forward { "later" } else { "earlier" },
+            f.source
+        ))
+    }
+
+    /// Before drawing: pins the selection to the newest row in follow mode and decodes the
+    /// visible window (`height` rows) and the tail strip.
+    pub fn prepare(&mut self, trace: &Trace, height: usize, tail: &[usize]) {
+        let n = self.len(trace);
+        if self.follow {
+            self.list.selected = n.saturating_sub(1);
+        }
+        self.list.clamp(n, height);
+        let mut positions: Vec<usize> = (self.list.offset..(self.list.offset + height).min(n))
+            .map(|r| self.view.position(r))
+            .collect();
+        positions.extend_from_slice(tail);
+        positions.sort_unstable();
+        positions.dedup();
+        self.rows.fill(trace, &positions);
+    }
+
+    /// The decoded row for a trace position, when it is in the visible window.
+    pub fn row(&self, pos: usize) -> Option<&Row> {
+        self.rows.get(pos)
+    }
+
+    /// Splits the pane into the table rows and the tail strip (empty when following).
+    pub fn split(&self, trace: &Trace, area: Rect) -> (Rect, Rect) {
+        let inner = block("", true).inner(area);
+        let body = Rect {
+            y: inner.y.saturating_add(1),
+            height: inner.height.saturating_sub(1),
+            ..inner
+        };
+        let tail = if !self.follow && self.len(trace) > body.height as usize && body.height as usize > TAIL * 3 {
+            TAIL as u16 + 1
+        } else {
+            0
+        };
+        let [rows, strip] = Layout::vertical([Constraint::Min(0), Constraint::Length(tail)]).areas(body);
+        (rows, strip)
+    }
+
+    /// Trace positions shown in the tail strip.
+    pub fn tail_positions(&self, trace: &Trace, strip: Rect) -> Vec<usize> {
+        if strip.height == 0 {
+            return Vec::new();
+        }
+        let n = self.len(trace);
+        (n.saturating_sub(TAIL)..n).map(|r| self.view.position(r)).collect()
+    }
+
+    fn cells(&self, pos: usize, width: u16) -> Vec<Span<'static>> {
+        cells(self.row(pos), pos, width)
+    }
+}
+
+impl Component for TracePane {
+    fn handle(&mut self, action: Action, ctx: &Ctx) -> Outcome {
+        if let Some(delta) = ListState::movement(action, ctx.page) {
+            self.scroll(delta, ctx);
+            if action == Action::Bottom {
+                self.follow = true;
+            }
+            return Outcome::Done;
+        }
+        match action {
+            Action::Expand => Outcome::Detail,
+            _ => Outcome::Ignored,
+        }
+    }
+
+    fn scroll(&mut self, delta: isize, ctx: &Ctx) {
+        self.follow = false;
+        self.list.scroll(delta, self.len(ctx.trace), ctx.page);
+    }
+
+    fn click(&mut self, row: usize, ctx: &Ctx) {
+        self.follow = false;
+        self.list.click(row, self.len(ctx.trace), ctx.page);
+    }
+
+    /// Draws the pane; [`TracePane::prepare`] must have made the rows.
+    fn render(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
+        let title = format!(
+            " Trace {}{} ",
+            if self.follow { "[follow]" } else { "[scrolled]" },
+            if ctx.paused { " [paused]" } else { "" }
+        );
+        f.render_widget(block(&title, focused), area);
+        let inner = block("", true).inner(area);
+        if inner.height == 0 {
+            return;
+        }
+        let head = Rect { height: 1, ..inner };
+        f.render_widget(
+            Paragraph::new(Line::styled(
+                format!(
+                    "{:>12} {:<9} {:<9} {:>3} {:<23} label",
+                    "time", "cob-id", "kind", "nd", "data"
+                ),
+                header(),
+            )),
+            head,
+        );
+        let (rows, strip) = self.split(ctx.trace, area);
+        let l = self.list;
+        let lines: Vec<Line> = (l.offset..(l.offset + rows.height as usize).min(self.len(ctx.trace)))
+            .map(|r| {
+                let line = Line::from(self.cells(self.view.position(r), rows.width));
+                if r == l.selected { line.style(selected()) } else { line }
+            })
+            .collect();
+        f.render_widget(Paragraph::new(lines), rows);
+        if strip.height > 0 {
+            let mut lines = vec![Line::styled(
+                fit(&format!("── newest {:─<200}", " "), strip.width as usize),
+                Style::default().fg(Color::DarkGray),
+            )];
+            lines.extend(
+                self.tail_positions(ctx.trace, strip)
+                    .into_iter()
+                    .map(|p| Line::from(self.cells(p, strip.width))),
+            );
+            f.render_widget(Paragraph::new(lines), strip);
+        }
+    }
+}
+
+/// The cells of one row: the decoded `row` of trace position `pos`, or just its number.
+fn cells(row: Option<&Row>, pos: usize, width: u16) -> Vec<Span<'static>> {
+    let Some(r) = row else {
         return vec![Span::raw(format!("{:>12}", pos + 1))];
     };
     let color = kind_color(r.kind);
@@ -60,50 +282,4 @@ fn cells(app: &App, pos: usize, width: u16) -> Vec<Span<'static>> {
             Style::default().fg(if r.malformed.is_some() { Color::LightRed } else { color }),
         ),
     ]
-}
-
-/// Draws the pane; `App::prepare` must have made the rows.
-pub fn render(app: &App, f: &mut Frame, area: Rect, focused: bool) {
-    let title = format!(
-        " Trace {}{} ",
-        if app.follow { "[follow]" } else { "[scrolled]" },
-        if app.source.paused { " [paused]" } else { "" }
-    );
-    f.render_widget(block(&title, focused), area);
-    let inner = block("", true).inner(area);
-    if inner.height == 0 {
-        return;
-    }
-    let head = Rect { height: 1, ..inner };
-    f.render_widget(
-        Paragraph::new(Line::styled(
-            format!(
-                "{:>12} {:<9} {:<9} {:>3} {:<23} label",
-                "time", "cob-id", "kind", "nd", "data"
-            ),
-            header(),
-        )),
-        head,
-    );
-    let (rows, strip) = split(app, area);
-    let l = app.trace_list;
-    let lines: Vec<Line> = (l.offset..(l.offset + rows.height as usize).min(app.view_len()))
-        .map(|r| {
-            let line = Line::from(cells(app, app.view.position(r), rows.width));
-            if r == l.selected { line.style(selected()) } else { line }
-        })
-        .collect();
-    f.render_widget(Paragraph::new(lines), rows);
-    if strip.height > 0 {
-        let mut lines = vec![Line::styled(
-            fit(&format!("── newest {:─<200}", " "), strip.width as usize),
-            Style::default().fg(Color::DarkGray),
-        )];
-        lines.extend(
-            tail_positions(app, strip)
-                .into_iter()
-                .map(|p| Line::from(cells(app, p, strip.width))),
-        );
-        f.render_widget(Paragraph::new(lines), strip);
-    }
 }
