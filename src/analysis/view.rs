@@ -3,11 +3,15 @@
 //! With no filter the view is the whole trace and holds no vector. Otherwise `rows` holds
 //! the matching positions in order (4 bytes per match). Scanning runs in slices under a
 //! time budget so the screen stays live while a filter goes through tens of millions of
-//! frames. Filters on SDO objects or aborts are fed from completed transactions instead
-//! of scanning, since a transfer's outcome is known only at its end.
+//! frames. A frame is judged first on what the store keeps (kind, node, ID, time); only
+//! frames whose result depends on their decoded form are decoded, one decoder walking
+//! forward through the slice. With an `abort` condition, an SDO frame whose transfer has
+//! not ended yet waits until it has (or until the source ends: [`View::settle`]).
 
-use super::filter::Filter;
+use super::filter::{Facts, Filter, Subject, Transfer, Tri};
 use super::trace::{CHECKPOINT, Trace};
+use crate::decode::{Decoded, Kind};
+use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
 /// A filtered view.
@@ -17,7 +21,13 @@ pub struct View {
     pub filter: Filter,
     rows: Vec<u32>,
     scanned: usize,
+    /// Trace position -> index of the completed transaction it belongs to (`abort` only).
+    transfers: HashMap<u32, u32>,
     transactions_seen: usize,
+    /// SDO frames waiting for their transfer to end.
+    pending: Vec<u32>,
+    /// No more frames will come: a transfer not ended now never will.
+    settled: bool,
 }
 
 impl View {
@@ -52,6 +62,11 @@ impl View {
         }
     }
 
+    /// The matching positions found so far (empty for the empty filter).
+    pub fn positions(&self) -> &[u32] {
+        &self.rows
+    }
+
     /// The row showing trace position `pos`, or the first row after it.
     pub fn row_of(&self, pos: usize) -> usize {
         if self.filter.is_empty() {
@@ -63,39 +78,77 @@ impl View {
 
     /// Percent of the trace scanned so far (100 when up to date).
     pub fn progress(&self, trace: &Trace) -> u8 {
-        if self.filter.is_empty() || self.filter.has_transfer_terms() || trace.is_empty() {
+        if self.filter.is_empty() || trace.is_empty() {
             return 100;
         }
         (self.scanned * 100 / trace.len()) as u8
     }
 
-    /// Scans new frames for up to `budget`; returns true when work is left.
-    pub fn advance(&mut self, trace: &Trace, budget: Duration) -> bool {
-        if self.filter.is_empty() {
-            return false;
+    /// Frames scanned so far.
+    pub fn scanned(&self) -> usize {
+        self.scanned
+    }
+
+    /// Says that no more frames will come (the log is loaded, the replay ended): SDO
+    /// frames of transfers that never ended are judged as in no transfer.
+    pub fn settle(&mut self) {
+        self.settled = true;
+    }
+
+    fn subject<'a>(&self, trace: &'a Trace, pos: usize, t0_ns: u64, decoded: Option<&'a Decoded>) -> Subject<'a> {
+        let facts = Facts::from(trace.store.packed(pos));
+        let transfer = if !self.filter.needs_transfer() || !matches!(facts.kind, Kind::SdoTx | Kind::SdoRx) {
+            Transfer::Known(None)
+        } else if let Some(&k) = self.transfers.get(&(pos as u32)) {
+            Transfer::Known(trace.transactions.get(k as usize))
+        } else if self.settled {
+            Transfer::Known(None)
+        } else {
+            Transfer::Unknown
+        };
+        Subject {
+            facts,
+            t0_ns,
+            decoded,
+            transfer,
         }
-        if self.filter.has_transfer_terms() {
-            self.add_transfers(trace);
+    }
+
+    /// Scans new frames for up to `budget` (at least one slice); returns true when work is left.
+    pub fn advance(&mut self, trace: &Trace, budget: Duration) -> bool {
+        if self.filter.is_empty() || trace.is_empty() {
             return false;
         }
         let start = Instant::now();
+        let t0 = trace.store.packed(0).ts_ns;
+        if self.filter.needs_transfer() {
+            self.index_transfers(trace);
+            self.resolve_pending(trace, t0);
+        }
+        let mut walker = None;
         while self.scanned < trace.len() {
             let end = ((self.scanned / CHECKPOINT + 1) * CHECKPOINT).min(trace.len());
-            if self.filter.needs_label() {
-                let decoded = trace.decode_range(self.scanned, end);
-                for (k, d) in decoded.iter().enumerate() {
-                    let pos = self.scanned + k;
-                    if self.filter.matches(trace.store.packed(pos), false, Some(&d.label)) {
-                        self.rows.push(pos as u32);
-                    }
-                }
-            } else {
-                for pos in self.scanned..end {
-                    if self.filter.matches(trace.store.packed(pos), false, None) {
-                        self.rows.push(pos as u32);
-                    }
+            let mut undecided = Vec::new();
+            let mut hits = Vec::new();
+            for pos in self.scanned..end {
+                match self.filter.eval(&self.subject(trace, pos, t0, None)) {
+                    Tri::True => hits.push(pos as u32),
+                    Tri::Unknown => undecided.push(pos),
+                    Tri::False => {}
                 }
             }
+            if !undecided.is_empty() {
+                let decoded = trace.decode_with(&mut walker, &undecided);
+                for (&pos, d) in undecided.iter().zip(&decoded) {
+                    match self.filter.eval(&self.subject(trace, pos, t0, Some(d))) {
+                        Tri::True => hits.push(pos as u32),
+                        Tri::Unknown => self.pending.push(pos as u32),
+                        Tri::False => {}
+                    }
+                }
+                hits.sort_unstable();
+            }
+            self.rows.extend_from_slice(&hits);
             self.scanned = end;
             if start.elapsed() >= budget {
                 break;
@@ -104,30 +157,36 @@ impl View {
         self.scanned < trace.len()
     }
 
-    fn add_transfers(&mut self, trace: &Trace) {
-        for t in &trace.transactions[self.transactions_seen..] {
-            if !self.filter.transaction_matches(t) {
-                continue;
-            }
+    /// Adds the frames of newly completed transactions to the position index.
+    fn index_transfers(&mut self, trace: &Trace) {
+        for (k, t) in trace.transactions.iter().enumerate().skip(self.transactions_seen) {
             for &seq in &t.frames {
-                let pos = seq.saturating_sub(1) as usize;
-                if pos >= trace.len() {
-                    continue;
-                }
-                let label = if self.filter.needs_label() {
-                    trace.decode_range(pos, pos + 1).pop().map(|d| d.label)
-                } else {
-                    None
-                };
-                if self.filter.matches(trace.store.packed(pos), true, label.as_deref()) {
-                    let at = self.rows.partition_point(|&p| (p as usize) < pos);
-                    if self.rows.get(at) != Some(&(pos as u32)) {
-                        self.rows.insert(at, pos as u32);
-                    }
-                }
+                self.transfers.insert(seq.saturating_sub(1) as u32, k as u32);
             }
         }
         self.transactions_seen = trace.transactions.len();
+    }
+
+    /// Judges the waiting SDO frames whose transfer has ended (all of them once settled).
+    fn resolve_pending(&mut self, trace: &Trace, t0: u64) {
+        let ready: Vec<usize> = self
+            .pending
+            .iter()
+            .filter(|p| self.settled || self.transfers.contains_key(p))
+            .map(|&p| p as usize)
+            .collect();
+        if ready.is_empty() {
+            return;
+        }
+        self.pending
+            .retain(|p| !(self.settled || self.transfers.contains_key(p)));
+        let decoded = trace.decode_positions(&ready);
+        for (&pos, d) in ready.iter().zip(&decoded) {
+            if self.filter.eval(&self.subject(trace, pos, t0, Some(d))) == Tri::True {
+                let at = self.rows.partition_point(|&p| (p as usize) < pos);
+                self.rows.insert(at, pos as u32);
+            }
+        }
     }
 
     /// Bytes held by the row vector.

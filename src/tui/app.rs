@@ -8,7 +8,8 @@ use super::palette::{self, COMMANDER_WORDS, Planned};
 use super::prompt::{Prompt, PromptKind};
 use super::rows::{Row, RowCache};
 use super::source::{Control, Feed};
-use crate::analysis::filter::Filter;
+use crate::analysis::filter::{Filter, FilterError};
+use crate::analysis::search::{Found, Search};
 use crate::analysis::trace::Trace;
 use crate::analysis::view::View;
 use crate::command::Command;
@@ -164,8 +165,8 @@ pub struct App {
     pub help: bool,
     /// The prompt being edited.
     pub prompt: Option<Prompt>,
-    /// Search in force (`n`/`N`).
-    pub search: Option<Filter>,
+    /// The search in force (`n`/`N`), running over the trace in the background.
+    pub search: Option<Search>,
     /// A message for the status bar (result of the last command).
     pub message: Option<String>,
     /// Every result, event and error of the session (the message log popup).
@@ -296,6 +297,7 @@ impl App {
                 Ok(Feed::Reset) => {
                     self.trace.clear();
                     self.view = View::new(self.view.filter.clone());
+                    self.restart_search();
                     self.rows = RowCache::default();
                     self.detail = None;
                     self.trace_list = ListState::default();
@@ -339,12 +341,32 @@ impl App {
         }
     }
 
-    /// Background work: filter scanning. True when work is left.
+    /// Background work: filter scanning and the search. True when work is left.
     pub fn work(&mut self, budget: Duration) -> bool {
+        if self.source.done {
+            self.view.settle();
+        }
         let before = self.view.len(&self.trace);
         let more = self.view.advance(&self.trace, budget);
         if self.view.len(&self.trace) != before {
             self.dirty = true;
+        }
+        self.search_work(budget) || more
+    }
+
+    /// Searches on; a jump that waited for its match goes there now.
+    fn search_work(&mut self, budget: Duration) -> bool {
+        let Some(s) = &mut self.search else { return false };
+        if self.source.done {
+            s.settle();
+        }
+        let before = (s.count(), s.progress(&self.trace));
+        let more = s.advance(&self.trace, budget);
+        if (s.count(), s.progress(&self.trace)) != before {
+            self.dirty = true;
+        }
+        if let Some(found) = s.poll(&self.trace) {
+            self.show_found(found);
         }
         more
     }
@@ -651,37 +673,67 @@ impl App {
         if !text.is_empty() && self.history.last() != Some(&text) {
             self.history.push(text.clone());
         }
-        match p.kind {
-            PromptKind::Filter => self.set_filter(&text),
-            PromptKind::Search => self.set_search(&text),
-            PromptKind::Palette => self.run_command(&text),
+        let applied = match p.kind {
+            PromptKind::Filter => self.apply_filter(&p.text),
+            PromptKind::Search => self.apply_search(&p.text),
+            PromptKind::Palette => {
+                self.run_command(&text);
+                Ok(())
+            }
+        };
+        // A bad expression keeps the prompt open with the text, the cursor where it is wrong.
+        if let Err(e) = applied {
+            let mut again = Prompt::new(p.kind, &p.text);
+            again.cursor = (e.column - 1).min(again.cursor);
+            self.prompt = Some(again);
         }
     }
 
     /// Applies a filter text; a parse error goes to the status bar and keeps the old filter.
     pub fn set_filter(&mut self, text: &str) {
-        match Filter::parse(text) {
-            Ok(f) => {
-                let pos = self.selected_position();
-                self.view = View::new(f);
-                self.view.advance(&self.trace, Duration::from_millis(30));
-                self.trace_list.selected = pos.map(|p| self.view.row_of(p)).unwrap_or(0);
-                self.trace_list.clamp(self.view_len(), self.page());
-                self.message = None;
-                self.rows = RowCache::default();
-            }
-            Err(e) => self.message = Some(format!("filter: {e}")),
-        }
+        let _ = self.apply_filter(text);
+    }
+
+    /// Parses a filter or search with the object names of the dictionaries in use.
+    fn parse_expr(&mut self, what: &str, text: &str) -> Result<Filter, FilterError> {
+        Filter::parse_with(text, self.trace.decoder()).inspect_err(|e| self.message = Some(format!("{what}: {e}")))
+    }
+
+    fn apply_filter(&mut self, text: &str) -> Result<(), FilterError> {
+        let f = self.parse_expr("filter", text)?;
+        let pos = self.selected_position();
+        self.view = View::new(f);
+        self.view.advance(&self.trace, Duration::from_millis(30));
+        self.trace_list.selected = pos.map(|p| self.view.row_of(p)).unwrap_or(0);
+        self.trace_list.clamp(self.view_len(), self.page());
+        self.message = None;
+        self.rows = RowCache::default();
+        self.restart_search();
+        Ok(())
     }
 
     fn set_search(&mut self, text: &str) {
-        match Filter::parse(text) {
-            Ok(f) if f.is_empty() => self.search = None,
-            Ok(f) => {
-                self.search = Some(f);
-                self.jump_match(true);
-            }
-            Err(e) => self.message = Some(format!("search: {e}")),
+        let _ = self.apply_search(text);
+    }
+
+    /// Starts a search and jumps to its first match after the selection (when found).
+    fn apply_search(&mut self, text: &str) -> Result<(), FilterError> {
+        let f = self.parse_expr("search", text)?;
+        if f.is_empty() {
+            self.search = None;
+            return Ok(());
+        }
+        let mut s = Search::new(f, &self.view.filter);
+        s.advance(&self.trace, Duration::from_millis(30));
+        self.search = Some(s);
+        self.jump_match(true);
+        Ok(())
+    }
+
+    /// The search in force starts over (the filter it searches within changed).
+    fn restart_search(&mut self) {
+        if let Some(s) = self.search.take() {
+            self.search = Some(Search::new(s.filter, &self.view.filter));
         }
     }
 
@@ -878,55 +930,45 @@ impl App {
         self.trace_list.clamp(self.view_len(), self.page());
     }
 
-    /// Jumps to the next (or previous) row matching the search.
+    /// Jumps to the next (or previous) match of the search; when the search has not got
+    /// there yet, the jump waits for it and the selection stays.
     fn jump_match(&mut self, forward: bool) {
-        let Some(f) = self.search.clone() else {
+        let from = self.selected_position();
+        let Some(s) = &mut self.search else {
             self.message = Some("no search: press the search key first".into());
             return;
         };
-        let n = self.view_len();
-        if n == 0 {
+        let found = s.find(&self.trace, from, forward);
+        if found == Found::Searching {
+            s.ask(from, forward);
+            self.message = Some(format!(
+                "searching `{}`: {}% searched, the selection stays until a match is found",
+                s.filter.source,
+                s.progress(&self.trace)
+            ));
             return;
         }
-        let cur = self.trace_list.selected;
-        let rows: Box<dyn Iterator<Item = usize>> = if forward {
-            Box::new(cur + 1..n)
-        } else {
-            Box::new((0..cur).rev())
-        };
-        let deadline = Instant::now() + Duration::from_millis(500);
-        let needs_label = f.needs_label();
-        let in_transfer = f.has_transfer_terms().then(|| {
-            let mut set = std::collections::HashSet::new();
-            for t in self.trace.transactions.iter().filter(|t| f.transaction_matches(t)) {
-                set.extend(t.frames.iter().map(|s| s.saturating_sub(1) as usize));
+        self.show_found(found);
+    }
+
+    /// Selects a match the search found and says which one it is.
+    fn show_found(&mut self, found: Found) {
+        let Some(s) = &self.search else { return };
+        self.dirty = true;
+        match found {
+            Found::At { pos, wrapped } => {
+                let of = if s.complete(&self.trace) {
+                    format!("{} of {}", s.rank(pos), s.count())
+                } else {
+                    format!("{} of {} so far", s.rank(pos), s.count())
+                };
+                let wrap = if wrapped { " (wrapped around)" } else { "" };
+                self.message = Some(format!("match {of} at frame {}{wrap}", pos + 1));
+                self.select_position(pos);
             }
-            set
-        });
-        for r in rows {
-            let pos = self.view.position(r);
-            let label = needs_label
-                .then(|| self.trace.decode_positions(&[pos]).pop().map(|d| d.label))
-                .flatten();
-            let inside = in_transfer.as_ref().is_some_and(|s| s.contains(&pos));
-            if f.matches(self.trace.store.packed(pos), inside, label.as_deref()) {
-                self.follow = false;
-                self.trace_list.selected = r;
-                self.trace_list.clamp(n, self.page());
-                self.message = Some(format!("match at frame {}", pos + 1));
-                return;
-            }
-            if Instant::now() > deadline {
-                self.message = Some(format!("search stopped at frame {} (press again to go on)", pos + 1));
-                self.trace_list.selected = r;
-                return;
-            }
+            Found::Nothing => self.message = Some(format!("no match for `{}`", s.filter.source)),
+            Found::Searching => {}
         }
-        self.message = Some(format!(
-            "no {} match for `{}`",
-            if forward { "later" } else { "earlier" },
-            f.source
-        ));
     }
 
     fn list(&mut self) -> Option<(&mut ListState, usize)> {
@@ -1050,7 +1092,14 @@ impl App {
             Action::PaneStats => self.pane = Pane::Stats,
             Action::PanePlot => self.pane = Pane::Plot,
             Action::Filter => self.prompt = Some(Prompt::new(PromptKind::Filter, &self.view.filter.source)),
-            Action::Search => self.prompt = Some(Prompt::new(PromptKind::Search, "")),
+            Action::Search => {
+                let text = self
+                    .search
+                    .as_ref()
+                    .map(|s| s.filter.source.clone())
+                    .unwrap_or_default();
+                self.prompt = Some(Prompt::new(PromptKind::Search, &text));
+            }
             Action::NextMatch => self.jump_match(true),
             Action::PrevMatch => self.jump_match(false),
             Action::ClearFilter => self.set_filter(""),
@@ -1262,10 +1311,16 @@ mod tests {
         a.run_command("goto 1");
         a.run_command("search emcy");
         assert_eq!(a.selected_position(), Some(frames().len() - 1));
+        assert_eq!(a.message.as_deref(), Some("match 1 of 1 at frame 44"));
+        // No later match: the search wraps around to the first one.
         a.run_command("search \"boot-up node 2\"");
-        assert_eq!(a.message.as_deref(), Some("no later match for `\"boot-up node 2\"`"));
+        assert_eq!(a.message.as_deref(), Some("match 1 of 1 at frame 2 (wrapped around)"));
+        assert_eq!(a.selected_position(), Some(1));
         a.act(Action::PrevMatch);
         assert_eq!(a.selected_position(), Some(1));
+        a.run_command("search \"no such label\"");
+        assert_eq!(a.message.as_deref(), Some("no match for `\"no such label\"`"));
+        assert_eq!(a.selected_position(), Some(1), "no match: the selection stays");
         a.run_command("bogus");
         assert!(
             a.message

@@ -39,6 +39,11 @@ pub fn text(app: &App) -> String {
         let prog = if p < 100 { format!(" {p}%") } else { String::new() };
         format!(" | filter: {} ({} rows{prog})", app.view.filter.source, app.view_len())
     };
+    let search = app
+        .search
+        .as_ref()
+        .map(|s| format!(" | {}", s.summary(&app.trace)))
+        .unwrap_or_default();
     let stop = app
         .keymap
         .key_for(Action::StopAll)
@@ -50,7 +55,7 @@ pub fn text(app: &App) -> String {
         .map(|k| format!(" | help: {k}"))
         .unwrap_or_default();
     format!(
-        "{src}{state} | {} frames | {:.0} fr/s | drops {}{filter}{stop}{help}",
+        "{src}{state} | {} frames | {:.0} fr/s | drops {}{filter}{search}{stop}{help}",
         app.trace.len(),
         app.rate,
         app.source.drops
