@@ -21,6 +21,7 @@
 mod eval;
 mod lex;
 mod parse;
+pub mod stream;
 
 pub use eval::{Facts, Subject, Transfer, Tri};
 pub use lex::Cmp;
