@@ -233,4 +233,28 @@ mod tests {
         }
         assert_eq!(v.row_of(v.position(3)), 3);
     }
+
+    #[test]
+    fn an_abort_filter_waits_for_the_transfer_to_end() {
+        let mut t = Trace::new(Decoder::new(Dictionary::default(), Vec::new()), 500_000);
+        let up = crate::frame::Frame::classic(0x602, &[0x40, 0x41, 0x60, 0, 0, 0, 0, 0]);
+        t.push(&crate::frame::Frame::classic(0x702, &[0x05]));
+        t.push(&up);
+        let mut aborted = View::new(Filter::parse("abort").unwrap());
+        let mut other = View::new(Filter::parse("not abort").unwrap());
+        aborted.advance(&t, Duration::from_millis(50));
+        other.advance(&t, Duration::from_millis(50));
+        // The upload has no answer yet: only the heartbeat is judged.
+        assert_eq!((aborted.len(&t), other.positions()), (0, &[0u32][..]));
+        t.push(&crate::frame::Frame::classic(0x582, &[0x80, 0x41, 0x60, 0, 0, 0, 2, 6]));
+        t.push(&up);
+        aborted.advance(&t, Duration::from_millis(50));
+        other.advance(&t, Duration::from_millis(50));
+        assert_eq!(aborted.positions(), [1, 2]);
+        // The second upload never ends: judged as in no transfer once the source ended.
+        assert_eq!(other.positions(), [0]);
+        other.settle();
+        other.advance(&t, Duration::from_millis(50));
+        assert_eq!(other.positions(), [0, 3]);
+    }
 }
