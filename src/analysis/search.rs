@@ -165,7 +165,7 @@ mod tests {
         s.ask(Some(10), true);
         assert_eq!(s.poll(&t), None);
         assert!(s.waiting());
-        // One slice searched (8192 frames): the first match after 10 is known.
+        // One slice searched (2048 frames): the first match after 10 is known.
         s.advance(&t, Duration::ZERO);
         assert!(!s.complete(&t));
         let Some(Found::At {

@@ -9,8 +9,8 @@
 //! not ended yet waits until it has (or until the source ends: [`View::settle`]).
 
 use super::filter::{Facts, Filter, Subject, Transfer, Tri};
-use super::trace::{CHECKPOINT, Trace};
-use crate::decode::{Decoded, Kind};
+use super::trace::Trace;
+use crate::decode::{Decoded, Decoder, Kind};
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
@@ -28,7 +28,13 @@ pub struct View {
     pending: Vec<u32>,
     /// No more frames will come: a transfer not ended now never will.
     settled: bool,
+    /// The decoder that decoded the last frames judged, and the next position it takes.
+    walker: Option<(Decoder, usize)>,
 }
+
+/// Frames judged between two looks at the time budget (a few milliseconds when every
+/// frame is decoded).
+const SLICE: usize = 2048;
 
 impl View {
     /// A view with `filter`, not scanned yet.
@@ -125,9 +131,9 @@ impl View {
             self.index_transfers(trace);
             self.resolve_pending(trace, t0);
         }
-        let mut walker = None;
+        let mut walker = self.walker.take();
         while self.scanned < trace.len() {
-            let end = ((self.scanned / CHECKPOINT + 1) * CHECKPOINT).min(trace.len());
+            let end = ((self.scanned / SLICE + 1) * SLICE).min(trace.len());
             let mut undecided = Vec::new();
             let mut hits = Vec::new();
             for pos in self.scanned..end {
@@ -154,6 +160,7 @@ impl View {
                 break;
             }
         }
+        self.walker = walker;
         self.scanned < trace.len()
     }
 
