@@ -182,23 +182,21 @@ fn a_search_through_a_million_frames_runs_in_the_background() {
     // The label text needs every frame decoded: the slowest kind of search.
     s.key("C-f");
     s.keys(&["\"node 125\""]);
+    // `?` right behind `enter`: it is answered while the search has just started.
     s.key("Enter");
-    let t = s.wait_for("the search to start", 60, |t| t.contains("search: \"node 125\" ("));
-    assert!(t.contains("the selection stays until a match is found"), "{t}");
-    // While it searches, keys are answered: help opens and closes.
     s.key("?");
     let t = s.wait_for("help", 60, |t| t.contains("Show or hide this help"));
     assert!(
         t.contains("0 matches so far"),
         "the search ended before help opened:\n{t}"
     );
+    assert!(t.contains("the selection stays until a match is found"), "{t}");
     s.key("?");
-    s.wait_for("help to close", 60, |t| !t.contains("Show or hide this help"));
-    let t = s.screen();
-    assert!(
-        t.contains("0 matches so far") && t.contains("frame 1  t 0.000000 s"),
-        "the selection moved before a match was found:\n{t}"
-    );
+    let t = s.wait_for("help to close", 60, |t| !t.contains("Show or hide this help"));
+    // Until the match is found, the selection stays on the first frame.
+    if t.contains("0 matches so far") {
+        assert!(t.contains("frame 1  t 0.000000 s"), "the selection moved:\n{t}");
+    }
     // The match is found at the end, the selection goes there.
     let t = s.wait_for("the match", 600, |t| t.contains("match 1 of 1 at frame 1000001"));
     assert!(t.contains("search: \"node 125\" (1 match)"), "{t}");
