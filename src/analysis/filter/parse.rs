@@ -159,7 +159,9 @@ fn hex_object(w: &str) -> Result<Option<ObjectRef>, (usize, String)> {
     if i.len() != 4 || !i.chars().all(|c| c.is_ascii_hexdigit()) {
         return Ok(None);
     }
-    let index = u16::from_str_radix(i, 16).map_err(|_| (0, String::new()))?;
+    let Ok(index) = u16::from_str_radix(i, 16) else {
+        return Ok(None);
+    };
     let sub = match s {
         Some(s) => {
             let t = s.strip_prefix("0x").unwrap_or(s);
