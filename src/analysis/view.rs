@@ -3,11 +3,15 @@
 //! With no filter the view is the whole trace and holds no vector. Otherwise `rows` holds
 //! the matching positions in order (4 bytes per match). Scanning runs in slices under a
 //! time budget so the screen stays live while a filter goes through tens of millions of
-//! frames. Filters on SDO objects or aborts are fed from completed transactions instead
-//! of scanning, since a transfer's outcome is known only at its end.
+//! frames. A frame is judged first on what the store keeps (kind, node, ID, time); only
+//! frames whose result depends on their decoded form are decoded, one decoder walking
+//! forward through the slice. With an `abort` condition, an SDO frame whose transfer has
+//! not ended yet waits until it has (or until the source ends: [`View::settle`]).
 
-use super::filter::Filter;
-use super::trace::{CHECKPOINT, Trace};
+use super::filter::{Facts, Filter, Subject, Transfer, Tri};
+use super::trace::Trace;
+use crate::decode::{Decoded, Decoder, Kind};
+use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
 /// A filtered view.
@@ -17,8 +21,20 @@ pub struct View {
     pub filter: Filter,
     rows: Vec<u32>,
     scanned: usize,
+    /// Trace position -> index of the completed transaction it belongs to (`abort` only).
+    transfers: HashMap<u32, u32>,
     transactions_seen: usize,
+    /// SDO frames waiting for their transfer to end.
+    pending: Vec<u32>,
+    /// No more frames will come: a transfer not ended now never will.
+    settled: bool,
+    /// The decoder that decoded the last frames judged, and the next position it takes.
+    walker: Option<(Decoder, usize)>,
 }
+
+/// Frames judged between two looks at the time budget (a few milliseconds when every
+/// frame is decoded).
+const SLICE: usize = 2048;
 
 impl View {
     /// A view with `filter`, not scanned yet.
@@ -52,6 +68,11 @@ impl View {
         }
     }
 
+    /// The matching positions found so far (empty for the empty filter).
+    pub fn positions(&self) -> &[u32] {
+        &self.rows
+    }
+
     /// The row showing trace position `pos`, or the first row after it.
     pub fn row_of(&self, pos: usize) -> usize {
         if self.filter.is_empty() {
@@ -63,71 +84,116 @@ impl View {
 
     /// Percent of the trace scanned so far (100 when up to date).
     pub fn progress(&self, trace: &Trace) -> u8 {
-        if self.filter.is_empty() || self.filter.has_transfer_terms() || trace.is_empty() {
+        if self.filter.is_empty() || trace.is_empty() {
             return 100;
         }
         (self.scanned * 100 / trace.len()) as u8
     }
 
-    /// Scans new frames for up to `budget`; returns true when work is left.
-    pub fn advance(&mut self, trace: &Trace, budget: Duration) -> bool {
-        if self.filter.is_empty() {
-            return false;
+    /// Frames scanned so far.
+    pub fn scanned(&self) -> usize {
+        self.scanned
+    }
+
+    /// Says that no more frames will come (the log is loaded, the replay ended): SDO
+    /// frames of transfers that never ended are judged as in no transfer.
+    pub fn settle(&mut self) {
+        self.settled = true;
+    }
+
+    fn subject<'a>(&self, trace: &'a Trace, pos: usize, t0_ns: u64, decoded: Option<&'a Decoded>) -> Subject<'a> {
+        let facts = Facts::from(trace.store.packed(pos));
+        let transfer = if !self.filter.needs_transfer() || !matches!(facts.kind, Kind::SdoTx | Kind::SdoRx) {
+            Transfer::Known(None)
+        } else if let Some(&k) = self.transfers.get(&(pos as u32)) {
+            Transfer::Known(trace.transactions.get(k as usize))
+        } else if self.settled {
+            Transfer::Known(None)
+        } else {
+            Transfer::Unknown
+        };
+        Subject {
+            facts,
+            t0_ns,
+            decoded,
+            transfer,
         }
-        if self.filter.has_transfer_terms() {
-            self.add_transfers(trace);
+    }
+
+    /// Scans new frames for up to `budget` (at least one slice); returns true when work is left.
+    pub fn advance(&mut self, trace: &Trace, budget: Duration) -> bool {
+        if self.filter.is_empty() || trace.is_empty() {
             return false;
         }
         let start = Instant::now();
+        let t0 = trace.store.packed(0).ts_ns;
+        if self.filter.needs_transfer() {
+            self.index_transfers(trace);
+            self.resolve_pending(trace, t0);
+        }
+        let mut walker = self.walker.take();
         while self.scanned < trace.len() {
-            let end = ((self.scanned / CHECKPOINT + 1) * CHECKPOINT).min(trace.len());
-            if self.filter.needs_label() {
-                let decoded = trace.decode_range(self.scanned, end);
-                for (k, d) in decoded.iter().enumerate() {
-                    let pos = self.scanned + k;
-                    if self.filter.matches(trace.store.packed(pos), false, Some(&d.label)) {
-                        self.rows.push(pos as u32);
-                    }
-                }
-            } else {
-                for pos in self.scanned..end {
-                    if self.filter.matches(trace.store.packed(pos), false, None) {
-                        self.rows.push(pos as u32);
-                    }
+            let end = ((self.scanned / SLICE + 1) * SLICE).min(trace.len());
+            let mut undecided = Vec::new();
+            let mut hits = Vec::new();
+            for pos in self.scanned..end {
+                match self.filter.eval(&self.subject(trace, pos, t0, None)) {
+                    Tri::True => hits.push(pos as u32),
+                    Tri::Unknown => undecided.push(pos),
+                    Tri::False => {}
                 }
             }
+            if !undecided.is_empty() {
+                let decoded = trace.decode_with(&mut walker, &undecided);
+                for (&pos, d) in undecided.iter().zip(&decoded) {
+                    match self.filter.eval(&self.subject(trace, pos, t0, Some(d))) {
+                        Tri::True => hits.push(pos as u32),
+                        Tri::Unknown => self.pending.push(pos as u32),
+                        Tri::False => {}
+                    }
+                }
+                hits.sort_unstable();
+            }
+            self.rows.extend_from_slice(&hits);
             self.scanned = end;
             if start.elapsed() >= budget {
                 break;
             }
         }
+        self.walker = walker;
         self.scanned < trace.len()
     }
 
-    fn add_transfers(&mut self, trace: &Trace) {
-        for t in &trace.transactions[self.transactions_seen..] {
-            if !self.filter.transaction_matches(t) {
-                continue;
-            }
+    /// Adds the frames of newly completed transactions to the position index.
+    fn index_transfers(&mut self, trace: &Trace) {
+        for (k, t) in trace.transactions.iter().enumerate().skip(self.transactions_seen) {
             for &seq in &t.frames {
-                let pos = seq.saturating_sub(1) as usize;
-                if pos >= trace.len() {
-                    continue;
-                }
-                let label = if self.filter.needs_label() {
-                    trace.decode_range(pos, pos + 1).pop().map(|d| d.label)
-                } else {
-                    None
-                };
-                if self.filter.matches(trace.store.packed(pos), true, label.as_deref()) {
-                    let at = self.rows.partition_point(|&p| (p as usize) < pos);
-                    if self.rows.get(at) != Some(&(pos as u32)) {
-                        self.rows.insert(at, pos as u32);
-                    }
-                }
+                self.transfers.insert(seq.saturating_sub(1) as u32, k as u32);
             }
         }
         self.transactions_seen = trace.transactions.len();
+    }
+
+    /// Judges the waiting SDO frames whose transfer has ended (all of them once settled).
+    fn resolve_pending(&mut self, trace: &Trace, t0: u64) {
+        let ready: Vec<usize> = self
+            .pending
+            .iter()
+            .filter(|p| self.settled || self.transfers.contains_key(p))
+            .map(|&p| p as usize)
+            .collect();
+        if ready.is_empty() {
+            return;
+        }
+        self.pending
+            .retain(|p| !(self.settled || self.transfers.contains_key(p)));
+        let decoded = trace.decode_positions(&ready);
+        for (&pos, d) in ready.iter().zip(&decoded) {
+            if self.filter.eval(&self.subject(trace, pos, t0, Some(d))) == Tri::True {
+                let at = self.rows.partition_point(|&p| (p as usize) < pos);
+                self.rows.insert(at, pos as u32);
+            }
+        }
     }
 
     /// Bytes held by the row vector.
@@ -173,5 +239,29 @@ mod tests {
             ));
         }
         assert_eq!(v.row_of(v.position(3)), 3);
+    }
+
+    #[test]
+    fn an_abort_filter_waits_for_the_transfer_to_end() {
+        let mut t = Trace::new(Decoder::new(Dictionary::default(), Vec::new()), 500_000);
+        let up = crate::frame::Frame::classic(0x602, &[0x40, 0x41, 0x60, 0, 0, 0, 0, 0]);
+        t.push(&crate::frame::Frame::classic(0x702, &[0x05]));
+        t.push(&up);
+        let mut aborted = View::new(Filter::parse("abort").unwrap());
+        let mut other = View::new(Filter::parse("not abort").unwrap());
+        aborted.advance(&t, Duration::from_millis(50));
+        other.advance(&t, Duration::from_millis(50));
+        // The upload has no answer yet: only the heartbeat is judged.
+        assert_eq!((aborted.len(&t), other.positions()), (0, &[0u32][..]));
+        t.push(&crate::frame::Frame::classic(0x582, &[0x80, 0x41, 0x60, 0, 0, 0, 2, 6]));
+        t.push(&up);
+        aborted.advance(&t, Duration::from_millis(50));
+        other.advance(&t, Duration::from_millis(50));
+        assert_eq!(aborted.positions(), [1, 2]);
+        // The second upload never ends: judged as in no transfer once the source ended.
+        assert_eq!(other.positions(), [0]);
+        other.settle();
+        other.advance(&t, Duration::from_millis(50));
+        assert_eq!(other.positions(), [0, 3]);
     }
 }

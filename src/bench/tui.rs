@@ -7,6 +7,12 @@
 //! - memory: store bytes per frame, and the process's peak RSS per frame;
 //! - redraw: a draw with nothing new, a draw after paging back (rows decoded anew), a
 //!   draw with a filter in force;
+//! - filter over the whole log: from setting a filter to its last row, for a filter on
+//!   stored fields (`node 2 or id 700-77f`) and one that decodes SDO and PDO frames
+//!   (`6041 or 6060`);
+//! - search over the whole log for a label text no frame has (every frame decoded), in
+//!   the background: its time and the loop turns (draw included) meanwhile, 99th
+//!   percentile and longest;
 //! - key response while replaying at full speed: from a key press to the end of the
 //!   draw that shows it, i.e. one loop turn (ingest budget, filter budget, draw).
 
@@ -16,7 +22,7 @@ use crate::od::Dictionary;
 use crate::tui::app::{App, SourceInfo, SourceKind};
 use crate::tui::keymap::{Action, Keymap};
 use crate::tui::source;
-use crate::tui::term::step;
+use crate::tui::term::{WORK_BUDGET, step};
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::Terminal;
 use ratatui::backend::TestBackend;
@@ -28,6 +34,24 @@ fn app_for(feed: source::Feeds, kind: SourceKind) -> App {
         trace,
         Keymap::default_map(),
         SourceInfo::new("bench.log", kind, feed.0, feed.1),
+    )
+}
+
+/// CPU time of this thread in milliseconds (what a loop turn costs, whatever the load).
+fn thread_cpu_ms() -> f64 {
+    // SAFETY: timespec is plain data that clock_gettime fills.
+    let mut ts: libc::timespec = unsafe { std::mem::zeroed() };
+    // SAFETY: a valid clock id and a valid pointer.
+    unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    ts.tv_sec as f64 * 1e3 + ts.tv_nsec as f64 / 1e6
+}
+
+/// 99th percentile and maximum of `v` (sorted in place).
+fn p99_max(v: &mut [f64]) -> (f64, f64) {
+    v.sort_by(f64::total_cmp);
+    (
+        v.get(v.len() * 99 / 100).copied().unwrap_or(0.0),
+        v.last().copied().unwrap_or(0.0),
     )
 }
 
@@ -49,6 +73,14 @@ fn time_ms(n: usize, mut f: impl FnMut()) -> (f64, f64) {
         max = max.max(t.elapsed().as_secs_f64() * 1e3);
     }
     (start.elapsed().as_secs_f64() * 1e3 / n as f64, max)
+}
+
+/// Seconds from setting `filter` until the whole trace is scanned, in the loop's slices.
+fn filter_seconds(app: &mut App, filter: &str) -> f64 {
+    let start = Instant::now();
+    app.set_filter(filter);
+    while app.work(WORK_BUDGET) {}
+    start.elapsed().as_secs_f64()
 }
 
 /// Runs the benchmark on `frames` generated frames.
@@ -97,6 +129,23 @@ pub fn bench(frames: u64, json: bool) -> std::io::Result<()> {
         app.act(Action::PageUp);
         let _ = draw(&mut term, &mut app);
     });
+    let filter_fields = filter_seconds(&mut app, "node 2 or id 700-77f");
+    let filter_decoded = filter_seconds(&mut app, "6041 or 6060");
+    app.set_filter("");
+    app.act(Action::Top);
+    let start = Instant::now();
+    app.run_command("search \"no such label\"");
+    let (mut turns, mut cpu) = (Vec::new(), Vec::new());
+    while app.search.as_ref().is_some_and(|s| !s.complete(&app.trace)) {
+        let (t, c) = (Instant::now(), thread_cpu_ms());
+        step(&mut app);
+        draw(&mut term, &mut app)?;
+        turns.push(t.elapsed().as_secs_f64() * 1e3);
+        cpu.push(thread_cpu_ms() - c);
+    }
+    let search = start.elapsed().as_secs_f64();
+    let search_turn = p99_max(&mut turns);
+    let search_cpu = p99_max(&mut cpu);
     drop(app);
 
     // Key response while replaying as fast as possible.
@@ -129,6 +178,10 @@ pub fn bench(frames: u64, json: bool) -> std::io::Result<()> {
                 "redraw_idle_ms": {"mean": idle.0, "max": idle.1},
                 "redraw_page_back_ms": {"mean": page_back.0, "max": page_back.1},
                 "redraw_filtered_ms": {"mean": filtered.0, "max": filtered.1},
+                "filter_fields_s": filter_fields, "filter_decoded_s": filter_decoded,
+                "search_s": search,
+                "search_loop_turn_ms": {"p99": search_turn.0, "max": search_turn.1},
+                "search_loop_turn_cpu_ms": {"p99": search_cpu.0, "max": search_cpu.1},
                 "key_response_ms": {"mean": key_mean, "max": key_max, "samples": responses.len()},
                 "replay_frames_per_s": replay_rate,
             })
@@ -161,6 +214,25 @@ pub fn bench(frames: u64, json: bool) -> std::io::Result<()> {
     println!(
         "  redraw, filter in force {:>9.3} ms mean {:>8.3} ms max",
         filtered.0, filtered.1
+    );
+    println!(
+        "  filter, stored fields   {:>9.3} s   ({:.0} frames/s; node 2 or id 700-77f)",
+        filter_fields,
+        n as f64 / filter_fields
+    );
+    println!(
+        "  filter, decoded objects {:>9.3} s   ({:.0} frames/s; 6041 or 6060)",
+        filter_decoded,
+        n as f64 / filter_decoded
+    );
+    println!(
+        "  search, every label     {:>9.3} s   ({:.0} frames/s; loop turn meanwhile {:.1} ms p99, {:.1} ms max; CPU {:.1} ms p99, {:.1} ms max)",
+        search,
+        n as f64 / search,
+        search_turn.0,
+        search_turn.1,
+        search_cpu.0,
+        search_cpu.1
     );
     println!(
         "  key response, replaying {:>9.3} ms mean {:>8.3} ms max over {} keys at {:.0} frames/s (target < 50 ms)",

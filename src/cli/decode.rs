@@ -50,6 +50,10 @@ pub struct DecodeArgs {
     /// Bind an EDS/DCF file to a node: NODE=FILE.
     #[arg(long = "eds", value_name = "NODE=FILE")]
     pub eds: Vec<String>,
+    /// Only frames (or with --transactions, SDO transfers; with --summary, the totals of
+    /// frames) matching EXPR, in the TUI's filter language (docs/TUI.md, "Filter and search").
+    #[arg(long, value_name = "EXPR")]
+    pub filter: Option<String>,
     /// Write to FILE instead of stdout (`-` is stdout).
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     pub output: Option<String>,
@@ -66,6 +70,9 @@ enum Mode {
 
 /// Runs `cotui decode`; returns the exit status.
 pub fn run(args: &DecodeArgs) -> ExitCode {
+    if let Some(expr) = &args.filter {
+        return super::decode_filter::run(args, expr);
+    }
     if args.format == OutputFormat::Pcapng {
         return super::decode_out::pcapng(args);
     }

@@ -3,6 +3,7 @@
 pub mod bind;
 pub mod commander;
 pub mod decode;
+mod decode_filter;
 mod decode_out;
 mod decode_parquet;
 pub mod diagnose;

@@ -13,7 +13,8 @@ use super::panes::messages::MessagesPopup;
 use super::panes::{Ctx, Outcome, Pane, Panes, Selected};
 use super::prompt::{Edit, PromptBar, PromptKind};
 use super::source::{Control, Feed};
-use crate::analysis::filter::Filter;
+use crate::analysis::filter::{Filter, FilterError};
+use crate::analysis::search::{Found, Search};
 use crate::analysis::trace::Trace;
 use crate::command::Command;
 use crate::command::stop::{Commanded, StopOptions, is_powered};
@@ -107,6 +108,8 @@ pub struct App {
     pub help: HelpPopup,
     /// The prompt line (filter, search, palette) and its history.
     pub prompt: PromptBar,
+    /// The search in force (`n`/`N`), running over the trace pane's view in the background.
+    pub search: Option<Search>,
     /// A message for the status bar (result of the last command).
     pub message: Option<String>,
     /// Every result, event and error of the session.
@@ -237,6 +240,7 @@ impl App {
             detail: DetailPane::default(),
             help: HelpPopup::default(),
             prompt: PromptBar::default(),
+            search: None,
             message: None,
             messages: Messages::default(),
             log_popup: MessagesPopup::default(),
@@ -281,6 +285,7 @@ impl App {
                 Ok(Feed::Reset) => {
                     self.trace.clear();
                     self.panes.trace.reset();
+                    self.restart_search();
                     self.detail.reset();
                     self.rate_mark = (Instant::now(), 0);
                     self.capture_clock = None;
@@ -322,13 +327,33 @@ impl App {
         }
     }
 
-    /// Background work: filter scanning. True when work is left.
+    /// Background work: filter scanning and the search. True when work is left.
     pub fn work(&mut self, budget: Duration) -> bool {
         let view = &mut self.panes.trace.view;
+        if self.source.done {
+            view.settle();
+        }
         let before = view.len(&self.trace);
         let more = view.advance(&self.trace, budget);
         if view.len(&self.trace) != before {
             self.dirty = true;
+        }
+        self.search_work(budget) || more
+    }
+
+    /// Searches on; a jump that waited for its match goes there now.
+    fn search_work(&mut self, budget: Duration) -> bool {
+        let Some(s) = &mut self.search else { return false };
+        if self.source.done {
+            s.settle();
+        }
+        let before = (s.count(), s.progress(&self.trace));
+        let more = s.advance(&self.trace, budget);
+        if (s.count(), s.progress(&self.trace)) != before {
+            self.dirty = true;
+        }
+        if let Some(found) = s.poll(&self.trace) {
+            self.show_found(found);
         }
         more
     }
@@ -640,33 +665,64 @@ impl App {
 
     /// Runs a line entered at a prompt (the filter, search or palette prompt).
     fn submit(&mut self, kind: PromptKind, text: &str) {
-        match kind {
-            PromptKind::Filter => self.set_filter(text),
-            PromptKind::Search => self.set_search(text),
-            PromptKind::Palette => self.run_command(text),
+        let applied = match kind {
+            PromptKind::Filter => self.apply_filter(text),
+            PromptKind::Search => self.apply_search(text),
+            PromptKind::Palette => {
+                self.run_command(text);
+                Ok(())
+            }
+        };
+        // A bad expression keeps the prompt open with the text, the cursor where it is wrong.
+        if let Err(e) = applied {
+            self.prompt.open(kind, text);
+            if let Some(p) = self.prompt.editing.as_mut() {
+                p.cursor = (e.column - 1).min(p.cursor);
+            }
         }
     }
 
     /// Applies a filter text; a parse error goes to the status bar and keeps the old filter.
     pub fn set_filter(&mut self, text: &str) {
-        match Filter::parse(text) {
-            Ok(f) => {
-                let page = self.page();
-                self.panes.trace.set_filter(&self.trace, f, page);
-                self.message = None;
-            }
-            Err(e) => self.message = Some(format!("filter: {e}")),
-        }
+        let _ = self.apply_filter(text);
+    }
+
+    /// Parses a filter or search with the object names of the dictionaries in use.
+    fn parse_expr(&mut self, what: &str, text: &str) -> Result<Filter, FilterError> {
+        Filter::parse_with(text, self.trace.decoder()).inspect_err(|e| self.message = Some(format!("{what}: {e}")))
+    }
+
+    fn apply_filter(&mut self, text: &str) -> Result<(), FilterError> {
+        let f = self.parse_expr("filter", text)?;
+        let page = self.page();
+        self.panes.trace.set_filter(&self.trace, f, page);
+        self.message = None;
+        self.restart_search();
+        Ok(())
     }
 
     fn set_search(&mut self, text: &str) {
-        match Filter::parse(text) {
-            Ok(f) if f.is_empty() => self.panes.trace.search = None,
-            Ok(f) => {
-                self.panes.trace.search = Some(f);
-                self.jump_match(true);
-            }
-            Err(e) => self.message = Some(format!("search: {e}")),
+        let _ = self.apply_search(text);
+    }
+
+    /// Starts a search and jumps to its first match after the selection (when found).
+    fn apply_search(&mut self, text: &str) -> Result<(), FilterError> {
+        let f = self.parse_expr("search", text)?;
+        if f.is_empty() {
+            self.search = None;
+            return Ok(());
+        }
+        let mut s = Search::new(f, &self.panes.trace.view.filter);
+        s.advance(&self.trace, Duration::from_millis(30));
+        self.search = Some(s);
+        self.jump_match(true);
+        Ok(())
+    }
+
+    /// The search in force starts over (the filter it searches within changed).
+    fn restart_search(&mut self) {
+        if let Some(s) = self.search.take() {
+            self.search = Some(Search::new(s.filter, &self.panes.trace.view.filter));
         }
     }
 
@@ -850,11 +906,44 @@ impl App {
         self.panes.trace.select_position(&self.trace, pos, page);
     }
 
-    /// Jumps to the next (or previous) row matching the search.
+    /// Jumps to the next (or previous) match of the search; when the search has not got
+    /// there yet, the jump waits for it and the selection stays.
     fn jump_match(&mut self, forward: bool) {
-        let page = self.page();
-        if let Some(m) = self.panes.trace.jump_match(&self.trace, forward, page) {
-            self.message = Some(m);
+        let from = self.selected_position();
+        let Some(s) = &mut self.search else {
+            self.message = Some("no search: press the search key first".into());
+            return;
+        };
+        let found = s.find(&self.trace, from, forward);
+        if found == Found::Searching {
+            s.ask(from, forward);
+            self.message = Some(format!(
+                "searching `{}`: {}% searched, the selection stays until a match is found",
+                s.filter.source,
+                s.progress(&self.trace)
+            ));
+            return;
+        }
+        self.show_found(found);
+    }
+
+    /// Selects a match the search found and says which one it is.
+    fn show_found(&mut self, found: Found) {
+        let Some(s) = &self.search else { return };
+        self.dirty = true;
+        match found {
+            Found::At { pos, wrapped } => {
+                let of = if s.complete(&self.trace) {
+                    format!("{} of {}", s.rank(pos), s.count())
+                } else {
+                    format!("{} of {} so far", s.rank(pos), s.count())
+                };
+                let wrap = if wrapped { " (wrapped around)" } else { "" };
+                self.message = Some(format!("match {of} at frame {}{wrap}", pos + 1));
+                self.select_position(pos);
+            }
+            Found::Nothing => self.message = Some(format!("no match for `{}`", s.filter.source)),
+            Found::Searching => {}
         }
     }
 
@@ -914,7 +1003,7 @@ impl App {
             Action::Quit => self.request_quit(),
             Action::Messages => self.log_popup.toggle(),
             Action::Back => {
-                self.panes.trace.search = None;
+                self.search = None;
                 self.message = None;
             }
             Action::Follow => {
@@ -942,7 +1031,14 @@ impl App {
                 let text = self.panes.trace.view.filter.source.clone();
                 self.prompt.open(PromptKind::Filter, &text);
             }
-            Action::Search => self.prompt.open(PromptKind::Search, ""),
+            Action::Search => {
+                let text = self
+                    .search
+                    .as_ref()
+                    .map(|s| s.filter.source.clone())
+                    .unwrap_or_default();
+                self.prompt.open(PromptKind::Search, &text);
+            }
             Action::NextMatch => self.jump_match(true),
             Action::PrevMatch => self.jump_match(false),
             Action::ClearFilter => self.set_filter(""),
@@ -1117,10 +1213,16 @@ mod tests {
         a.run_command("goto 1");
         a.run_command("search emcy");
         assert_eq!(a.selected_position(), Some(frames().len() - 1));
+        assert_eq!(a.message.as_deref(), Some("match 1 of 1 at frame 44"));
+        // No later match: the search wraps around to the first one.
         a.run_command("search \"boot-up node 2\"");
-        assert_eq!(a.message.as_deref(), Some("no later match for `\"boot-up node 2\"`"));
+        assert_eq!(a.message.as_deref(), Some("match 1 of 1 at frame 2 (wrapped around)"));
+        assert_eq!(a.selected_position(), Some(1));
         a.act(Action::PrevMatch);
         assert_eq!(a.selected_position(), Some(1));
+        a.run_command("search \"no such label\"");
+        assert_eq!(a.message.as_deref(), Some("no match for `\"no such label\"`"));
+        assert_eq!(a.selected_position(), Some(1), "no match: the selection stays");
         a.run_command("bogus");
         assert!(
             a.message

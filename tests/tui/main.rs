@@ -1,4 +1,5 @@
 //! The interactive analyzer end to end: the real binary in tmux, and its command line.
 
+mod filter_search;
 mod tui_cli;
 mod tui_tmux;

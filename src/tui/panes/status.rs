@@ -43,6 +43,11 @@ pub fn text(app: &App) -> String {
             app.panes.trace.len(&app.trace)
         )
     };
+    let search = app
+        .search
+        .as_ref()
+        .map(|s| format!(" | {}", s.summary(&app.trace)))
+        .unwrap_or_default();
     let stop = app
         .keymap
         .key_for(Action::StopAll)
@@ -54,7 +59,7 @@ pub fn text(app: &App) -> String {
         .map(|k| format!(" | help: {k}"))
         .unwrap_or_default();
     format!(
-        "{src}{state} | {} frames | {:.0} fr/s | drops {}{filter}{stop}{help}",
+        "{src}{state} | {} frames | {:.0} fr/s | drops {}{filter}{search}{stop}{help}",
         app.trace.len(),
         app.rate,
         app.source.drops

@@ -13,7 +13,7 @@ use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::{Color, Style};
 use ratatui::text::{Line, Span};
 use ratatui::widgets::Paragraph;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// Rows of the tail strip.
 pub const TAIL: usize = 3;
@@ -26,8 +26,6 @@ pub struct TracePane {
     pub list: ListState,
     /// Follow the newest frame.
     pub follow: bool,
-    /// Search in force (`n`/`N`).
-    pub search: Option<Filter>,
     /// Decoded rows of the visible window.
     rows: RowCache,
 }
@@ -38,7 +36,6 @@ impl Default for TracePane {
             view: View::default(),
             list: ListState::default(),
             follow: true,
-            search: None,
             rows: RowCache::default(),
         }
     }
@@ -84,54 +81,6 @@ impl TracePane {
     pub fn show(&mut self, trace: &Trace, pos: usize, page: usize) {
         self.view = View::new(Filter::default());
         self.select_position(trace, pos, page);
-    }
-
-    /// Jumps to the next (or previous) row matching the search; returns what to tell the user.
-    pub fn jump_match(&mut self, trace: &Trace, forward: bool, page: usize) -> Option<String> {
-        let Some(f) = self.search.clone() else {
-            return Some("no search: press the search key first".into());
-        };
-        let n = self.len(trace);
-        if n == 0 {
-            return None;
-        }
-        let cur = self.list.selected;
-        let rows: Box<dyn Iterator<Item = usize>> = if forward {
-            Box::new(cur + 1..n)
-        } else {
-            Box::new((0..cur).rev())
-        };
-        let deadline = Instant::now() + Duration::from_millis(500);
-        let needs_label = f.needs_label();
-        let in_transfer = f.has_transfer_terms().then(|| {
-            let mut set = std::collections::HashSet::new();
-            for t in trace.transactions.iter().filter(|t| f.transaction_matches(t)) {
-                set.extend(t.frames.iter().map(|s| s.saturating_sub(1) as usize));
-            }
-            set
-        });
-        for r in rows {
-            let pos = self.view.position(r);
-            let label = needs_label
-                .then(|| trace.decode_positions(&[pos]).pop().map(|d| d.label))
-                .flatten();
-            let inside = in_transfer.as_ref().is_some_and(|s| s.contains(&pos));
-            if f.matches(trace.store.packed(pos), inside, label.as_deref()) {
-                self.follow = false;
-                self.list.selected = r;
-                self.list.clamp(n, page);
-                return Some(format!("match at frame {}", pos + 1));
-            }
-            if Instant::now() > deadline {
-                self.list.selected = r;
-                return Some(format!("search stopped at frame {} (press again to go on)", pos + 1));
-            }
-        }
-        Some(format!(
-            "no {} match for `{}`",
-            if forward { "later" } else { "earlier" },
-            f.source
-        ))
     }
 
     /// Before drawing: pins the selection to the newest row in follow mode and decodes the

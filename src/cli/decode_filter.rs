@@ -1,0 +1,208 @@
+//! `cotui decode --filter EXPR`: the frames (or, with `--transactions`, the SDO transfers,
+//! or with `--summary` the totals of the frames) that match an expression of the TUI's
+//! filter language, judged as the TUI's filtered view judges them.
+
+use super::decode::{DecodeArgs, OutputFormat};
+use super::input::{for_each_frame, open_input, report_counts};
+use crate::analysis::filter::stream::Stream;
+use crate::analysis::filter::{Facts, Filter};
+use crate::command::ExitCode;
+use crate::decode::{Decoder, Kind};
+use crate::frame::json::write_line;
+use crate::output::{jsonl, summary::Summary, text};
+use std::io::{self, Write};
+
+/// What a matching frame gives: its output line, or its kind and node for the totals.
+enum Out {
+    Line(Vec<u8>),
+    Count(Kind, Option<u8>),
+}
+
+/// What a filtered run writes.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    Frames,
+    Transactions,
+    Summary,
+}
+
+/// State carried across input files.
+struct Run {
+    decoder: Decoder,
+    filter: Filter,
+    mode: Mode,
+    format: OutputFormat,
+    stream: Stream<Out>,
+    summary: Summary,
+    /// Frames taken so far (the decoder's sequence numbers).
+    pos: u64,
+    t0_ns: Option<u64>,
+}
+
+/// Runs a filtered `cotui decode`; returns the exit status.
+pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
+    if args.events || matches!(args.format, OutputFormat::Pcapng | OutputFormat::Parquet) {
+        eprintln!("cotui decode: --filter goes with text or jsonl frames, --transactions or --summary");
+        return ExitCode::Usage;
+    }
+    let decoder = match super::bind::decoder(&args.profiles, &args.eds) {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("cotui decode: {e}");
+            return ExitCode::Usage;
+        }
+    };
+    let filter = match Filter::parse_with(expr, &decoder) {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!("cotui decode: --filter {expr:?}: {e}");
+            return ExitCode::Usage;
+        }
+    };
+    let mode = if args.transactions {
+        Mode::Transactions
+    } else if args.summary {
+        Mode::Summary
+    } else {
+        Mode::Frames
+    };
+    let mut out = match super::decode_out::open(args.output.as_deref(), false) {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("cotui decode: {e}");
+            return ExitCode::Usage;
+        }
+    };
+    let mut run = Run {
+        decoder,
+        stream: Stream::new(filter.clone()),
+        filter,
+        mode,
+        format: args.format,
+        summary: Summary::default(),
+        pos: 0,
+        t0_ns: None,
+    };
+    let mut status = ExitCode::Ok;
+    for path in &args.files {
+        let Some(input) = open_input(path, "decode") else {
+            status = ExitCode::Unavailable;
+            continue;
+        };
+        match run.file(path, input, &mut out) {
+            Ok(()) => {}
+            Err(e) if e.kind() == io::ErrorKind::BrokenPipe => return status,
+            Err(e) => {
+                eprintln!("cotui decode: {path}: {e}");
+                status = ExitCode::Unavailable;
+            }
+        }
+    }
+    match run.finish(&mut out).and_then(|_| out.flush()) {
+        Err(e) if e.kind() != io::ErrorKind::BrokenPipe => {
+            eprintln!("cotui decode: {e}");
+            ExitCode::Unavailable
+        }
+        _ => status,
+    }
+}
+
+impl Run {
+    fn file(&mut self, path: &str, input: Box<dyn io::BufRead + Send>, out: &mut impl Write) -> io::Result<()> {
+        let mut buf = Vec::with_capacity(1 << 16);
+        let counts = for_each_frame(path, input, |frames| {
+            let ifaces = frames.ifaces;
+            for (line, frame) in frames {
+                let t0 = *self.t0_ns.get_or_insert(frame.ts_ns);
+                self.decoder.set_seq(self.pos);
+                let d = self.decoder.decode(frame);
+                let done = self.decoder.take_transactions();
+                if self.mode == Mode::Transactions {
+                    for t in &done {
+                        self.transaction(&mut buf, t, t0);
+                    }
+                    self.pos += 1;
+                    continue;
+                }
+                let facts = Facts {
+                    ts_ns: frame.ts_ns,
+                    id: frame.id,
+                    flags: frame.flags.0,
+                    kind: d.kind,
+                    node: d.node,
+                };
+                let (mode, format) = (self.mode, self.format);
+                self.stream.frame(self.pos, facts, d, &done, |d| {
+                    let mut s = Vec::new();
+                    match (mode, format) {
+                        (Mode::Summary, _) => return Out::Count(d.kind, d.node),
+                        (_, OutputFormat::Text) => {
+                            let mut t = String::new();
+                            text::write_line(&mut t, frame, ifaces, d);
+                            s = t.into_bytes();
+                        }
+                        _ => jsonl::write_frame(&mut s, line, frame, ifaces, d),
+                    }
+                    Out::Line(s)
+                });
+                self.pos += 1;
+                let ready = self.stream.ready();
+                self.take(&mut buf, ready);
+            }
+            out.write_all(&buf)?;
+            buf.clear();
+            Ok(())
+        })?;
+        report_counts(path, &counts);
+        Ok(())
+    }
+
+    /// Writes (or counts) matching frames.
+    fn take(&mut self, buf: &mut Vec<u8>, ready: Vec<Out>) {
+        for o in ready {
+            match o {
+                Out::Count(kind, node) => self.summary.add(kind, node),
+                Out::Line(s) => buf.extend_from_slice(&s),
+            }
+        }
+    }
+
+    fn transaction(&self, buf: &mut Vec<u8>, t: &crate::decode::sdo::Transaction, t0: u64) {
+        let dict = self.decoder.dictionary(t.node);
+        if !self.filter.matches_transaction(t, dict, t0) {
+            return;
+        }
+        match self.format {
+            OutputFormat::Text => {
+                buf.extend_from_slice(t.label(dict).as_bytes());
+                buf.push(b'\n');
+            }
+            _ => write_line(buf, &t.to_json(dict)),
+        }
+    }
+
+    /// Writes what waited for the end of the input.
+    fn finish(&mut self, out: &mut impl Write) -> io::Result<()> {
+        let mut buf = Vec::new();
+        match self.mode {
+            Mode::Transactions => {
+                let t0 = self.t0_ns.unwrap_or(0);
+                for t in self.decoder.finish() {
+                    self.transaction(&mut buf, &t, t0);
+                }
+            }
+            Mode::Frames | Mode::Summary => {
+                let rest = self.stream.finish();
+                self.take(&mut buf, rest);
+            }
+        }
+        if self.mode == Mode::Summary {
+            self.summary.finish();
+            match self.format {
+                OutputFormat::Text => buf.extend_from_slice(self.summary.to_text().as_bytes()),
+                _ => write_line(&mut buf, &self.summary.to_json()),
+            }
+        }
+        out.write_all(&buf)
+    }
+}
