@@ -14,7 +14,7 @@
 
 use super::store::Packed;
 use crate::decode::Kind;
-use crate::decode::sdo::{Outcome, Transaction};
+use crate::sdo::{Outcome, Transaction};
 
 /// One condition of a filter.
 #[derive(Clone, Debug, PartialEq)]

@@ -2,11 +2,12 @@
 
 use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
 use crate::analysis::EventTracker;
-use crate::decode::{Decoder, Kind, sdo::Transaction};
+use crate::decode::{Decoder, Kind};
 use crate::frame::{Frame, Interfaces};
 use crate::log::Outcome;
 use crate::log::read_ahead;
 use crate::output::{jsonl, summary::Summary, text};
+use crate::sdo::Transaction;
 use clap::{Args, ValueEnum};
 use std::io::{self, BufRead, BufReader, Write};
 

@@ -5,13 +5,13 @@
 
 use super::decode::DecodeArgs;
 use super::{EXIT_OK, EXIT_UNAVAILABLE, EXIT_USAGE};
-use crate::decode::sdo::{SdoCommand, Transaction};
 use crate::decode::{Body, Decoded, Decoder};
 use crate::frame::{Flags, Frame, Interfaces};
 use crate::log::Outcome;
 use crate::log::read_ahead;
 use crate::od::Dictionary;
 use crate::output::parquet::{Col, Table, Ty, V};
+use crate::sdo::{SdoCommand, Transaction};
 use std::fs::File;
 use std::io::{self, BufRead, BufWriter, Write};
 use std::path::{Path, PathBuf};

@@ -1,7 +1,7 @@
 //! Why a command failed, with the exit status of each case.
 
 use crate::bus::BusError;
-use crate::decode::sdo::abort_text;
+use crate::sdo::abort_text;
 
 /// Exit status: done.
 pub const EXIT_OK: i32 = 0;

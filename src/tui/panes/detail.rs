@@ -3,9 +3,9 @@
 
 use super::{block, duration, kind_color};
 use crate::decode::cia402::{describe_controlword, describe_statusword};
-use crate::decode::sdo::{Outcome, SdoCommand, Side, Transaction};
 use crate::decode::{Body, Decoded};
 use crate::frame::Frame;
+use crate::sdo::{Outcome, SdoCommand, Side, Transaction};
 use crate::tui::app::{App, Pane};
 use ratatui::Frame as TermFrame;
 use ratatui::layout::Rect;

@@ -2,7 +2,7 @@
 //! `expand` opens a transfer's frames.
 
 use super::{block, duration, fit, header, selected};
-use crate::decode::sdo::{Outcome, Transaction};
+use crate::sdo::{Outcome, Transaction};
 use crate::tui::app::App;
 use ratatui::Frame;
 use ratatui::layout::Rect;
@@ -24,7 +24,7 @@ pub fn row_text(app: &App, t: &Transaction, width: usize) -> String {
         Outcome::ProtocolError(e) => format!("error: {e}"),
         o => o.as_str().to_string(),
     };
-    let dir = if t.direction == crate::decode::sdo::TransferDirection::Upload {
+    let dir = if t.direction == crate::sdo::TransferDirection::Upload {
         "read "
     } else {
         "write"
