@@ -289,91 +289,50 @@ impl SdoServer {
         out
     }
 
-    /// Moves from `state` on one client command: a request starts a transfer whatever ran,
-    /// else (state, command) goes to the step of the transfer type running; a command that
-    /// fits no step is aborted.
+    /// Moves from `state` on one client command: an abort ends the transfer, a request
+    /// starts one whatever ran, anything else goes on with the transfer running.
     fn step(&self, state: State, cmd: SdoCommand, store: &mut dyn ObjectStore, out: &mut ServerOutput) -> State {
-        use SdoCommand as C;
-        match (state, cmd) {
-            (state, C::Abort { code, .. }) => {
-                if !matches!(state, State::Idle) {
-                    let (index, sub) = state.object();
-                    let by = Side::Client;
-                    out.event = Some(ServerEvent::Aborted { index, sub, code, by });
-                }
-                State::Idle
+        if let SdoCommand::Abort { code, .. } = cmd {
+            if !matches!(state, State::Idle) {
+                let ((index, sub), by) = (state.object(), Side::Client);
+                out.event = Some(ServerEvent::Aborted { index, sub, code, by });
             }
-            (
-                _,
-                C::InitiateDownload {
-                    index,
-                    sub,
-                    expedited: true,
-                    size,
-                    data,
-                },
-            ) => expedited_download((index, sub), size, data, store, out),
-            (_, C::InitiateDownload { index, sub, size, .. }) => segmented_download((index, sub), size, store, out),
-            (_, C::InitiateUpload { index, sub }) => match store.read(index, sub) {
+            return State::Idle;
+        }
+        match self.request(cmd, store, out) {
+            Some(next) => next,
+            None => continued(state, cmd, store, out),
+        }
+    }
+
+    /// Starts the transfer a request asks for (`None`: not a request).
+    fn request(&self, cmd: SdoCommand, store: &mut dyn ObjectStore, out: &mut ServerOutput) -> Option<State> {
+        use SdoCommand as C;
+        Some(match cmd {
+            C::InitiateDownload {
+                index,
+                sub,
+                expedited: true,
+                size,
+                data,
+            } => expedited_download((index, sub), size, data, store, out),
+            C::InitiateDownload { index, sub, size, .. } => segmented_download((index, sub), size, store, out),
+            C::InitiateUpload { index, sub } => match store.read(index, sub) {
                 Ok(data) => start_upload((index, sub), data, out),
                 Err(code) => abort(out, (index, sub), code),
             },
-            (_, C::BlockDownloadInitiate { index, sub, crc, size }) => {
+            C::BlockDownloadInitiate { index, sub, crc, size } => {
                 self.block_download((index, sub), crc, size, store, out)
             }
-            (
-                _,
-                C::BlockUploadInitiate {
-                    index,
-                    sub,
-                    crc,
-                    blksize,
-                    pst,
-                },
-            ) => self.block_upload((index, sub), (crc, blksize, pst), store, out),
-            (State::Download(d), C::DownloadSegment { toggle, last, data }) => {
-                download_segment(d, (toggle, last, data), store, out)
-            }
-            (State::Upload(u), C::UploadSegment { toggle }) => upload_segment(u, toggle, out),
-            (State::BlockDownload(b), C::BlockSegment { seqno, last, data }) => {
-                block_download_segment(b, (seqno, last, data), out)
-            }
-            (State::BlockDownloadEnd(b), C::BlockDownloadEnd { unused, crc }) => {
-                block_download_end(b, unused, crc, store, out)
-            }
-            (State::BlockUploadStart { at, crc, data, blksize }, C::BlockUploadStart) => {
-                let sent = send_sub_block(out, &data, 0, blksize);
-                State::BlockUpload(BlockOut {
-                    at,
-                    crc,
-                    data,
-                    acked: 0,
-                    sent,
-                })
-            }
-            (State::BlockUpload(b), C::BlockUploadAck { ackseq, blksize }) => {
-                block_upload_acked(b, ackseq, blksize, out)
-            }
-            (State::BlockUploadEnd { at: (index, sub), len }, C::BlockUploadEndResponse) => {
-                let protocol = Protocol::Block;
-                out.event = Some(ServerEvent::Read {
-                    index,
-                    sub,
-                    protocol,
-                    len,
-                });
-                State::Idle
-            }
-            (state, _) => {
-                let (index, sub) = state.object();
-                abort(out, (index, sub), codes::UNKNOWN_COMMAND);
-                if !matches!(state, State::Idle) {
-                    let (code, by) = (codes::UNKNOWN_COMMAND, Side::Server);
-                    out.event = Some(ServerEvent::Aborted { index, sub, code, by });
-                }
-                State::Idle
-            }
-        }
+            C::BlockUploadInitiate {
+                index,
+                sub,
+                crc,
+                blksize,
+                pst,
+            } => self.block_upload((index, sub), (crc, blksize, pst), store, out),
+            _ => return None,
+        })
     }
 
     /// An initiate block download: accepted with our block size, or aborted.
@@ -434,6 +393,54 @@ impl SdoServer {
                 State::BlockUploadStart { at, crc, data, blksize }
             }
             Err(code) => abort(out, at, code),
+        }
+    }
+}
+
+/// (state, command) to the step of the transfer type running; a command that fits no step
+/// is aborted.
+fn continued(state: State, cmd: SdoCommand, store: &mut dyn ObjectStore, out: &mut ServerOutput) -> State {
+    use SdoCommand as C;
+    match (state, cmd) {
+        (State::Download(d), C::DownloadSegment { toggle, last, data }) => {
+            download_segment(d, (toggle, last, data), store, out)
+        }
+        (State::Upload(u), C::UploadSegment { toggle }) => upload_segment(u, toggle, out),
+        (State::BlockDownload(b), C::BlockSegment { seqno, last, data }) => {
+            block_download_segment(b, (seqno, last, data), out)
+        }
+        (State::BlockDownloadEnd(b), C::BlockDownloadEnd { unused, crc }) => {
+            block_download_end(b, unused, crc, store, out)
+        }
+        (State::BlockUploadStart { at, crc, data, blksize }, C::BlockUploadStart) => {
+            let sent = send_sub_block(out, &data, 0, blksize);
+            State::BlockUpload(BlockOut {
+                at,
+                crc,
+                data,
+                acked: 0,
+                sent,
+            })
+        }
+        (State::BlockUpload(b), C::BlockUploadAck { ackseq, blksize }) => block_upload_acked(b, ackseq, blksize, out),
+        (State::BlockUploadEnd { at: (index, sub), len }, C::BlockUploadEndResponse) => {
+            let protocol = Protocol::Block;
+            out.event = Some(ServerEvent::Read {
+                index,
+                sub,
+                protocol,
+                len,
+            });
+            State::Idle
+        }
+        (state, _) => {
+            let (index, sub) = state.object();
+            abort(out, (index, sub), codes::UNKNOWN_COMMAND);
+            if !matches!(state, State::Idle) {
+                let (code, by) = (codes::UNKNOWN_COMMAND, Side::Server);
+                out.event = Some(ServerEvent::Aborted { index, sub, code, by });
+            }
+            State::Idle
         }
     }
 }

@@ -493,93 +493,107 @@ fn start(state: &mut ChannelState, ctx: &FrameCtx, out: &mut Out) {
 }
 
 /// The transfer a frame opens, and whether it opens it unmatched (a response whose request
-/// was not seen): every initiate request, and every initiate response but an expedited
-/// upload's, which ends its transfer at once.
+/// was not seen).
 fn opened(ctx: &FrameCtx) -> Option<(Pending, bool)> {
-    use Side::*;
+    match ctx.side {
+        Side::Client => requested(ctx).map(|p| (p, false)),
+        Side::Server => answered(ctx).map(|p| (p, true)),
+    }
+}
+
+/// The transfer an initiate request opens.
+fn requested(ctx: &FrameCtx) -> Option<Pending> {
     use TransferDirection::*;
-    let txn = |index, sub, dir, proto, size| Transaction {
-        size,
-        ..new_txn(ctx, index, sub, dir, proto)
-    };
-    Some(match (ctx.side, ctx.command) {
-        (
-            Client,
-            SdoCommand::InitiateDownload {
-                index,
-                sub,
-                expedited,
-                size,
-                data,
-            },
-        ) => {
+    let (t, phase, crc) = match ctx.command {
+        SdoCommand::InitiateDownload {
+            index,
+            sub,
+            expedited,
+            size,
+            data,
+        } => {
             let proto = if expedited {
                 Protocol::Expedited
             } else {
                 Protocol::Segmented
             };
-            let mut t = txn(index, sub, Download, proto, size);
+            let mut t = opening(ctx, (index, sub), Download, proto, size);
             t.append(data.bytes());
-            (Pending::new(t, Phase::InitDownload, false), false)
+            (t, Phase::InitDownload, false)
         }
-        (Client, SdoCommand::InitiateUpload { index, sub }) => {
-            let t = txn(index, sub, Upload, Protocol::Unknown, None);
-            (Pending::new(t, Phase::InitUpload, false), false)
+        SdoCommand::InitiateUpload { index, sub } => {
+            let t = opening(ctx, (index, sub), Upload, Protocol::Unknown, None);
+            (t, Phase::InitUpload, false)
         }
-        (Client, SdoCommand::BlockDownloadInitiate { index, sub, crc, size }) => {
-            let t = txn(index, sub, Download, Protocol::Block, size);
-            (Pending::new(t, Phase::BlockDownloadInit, crc), false)
+        SdoCommand::BlockDownloadInitiate { index, sub, crc, size } => {
+            let t = opening(ctx, (index, sub), Download, Protocol::Block, size);
+            (t, Phase::BlockDownloadInit, crc)
         }
-        (
-            Client,
-            SdoCommand::BlockUploadInitiate {
-                index,
-                sub,
-                crc,
-                blksize,
-                ..
-            },
-        ) => {
-            let t = txn(index, sub, Upload, Protocol::Block, None);
-            (Pending::new(t, Phase::BlockUploadInit { blksize }, crc), false)
-        }
-        (
-            Server,
-            SdoCommand::InitiateUploadResponse {
-                index,
-                sub,
-                expedited: false,
-                size,
-                ..
-            },
-        ) => {
-            let t = txn(index, sub, Upload, Protocol::Segmented, size);
-            (Pending::new(t, Phase::UploadSegment { toggle: false }, false), true)
-        }
-        (Server, SdoCommand::BlockUploadInitiateResponse { index, sub, crc, size }) => {
-            let t = txn(index, sub, Upload, Protocol::Block, size);
-            (Pending::new(t, Phase::BlockUploadStart { blksize: 127 }, crc), true)
-        }
-        (
-            Server,
-            SdoCommand::BlockDownloadInitiateResponse {
-                index,
-                sub,
-                crc,
-                blksize,
-            },
-        ) => {
-            let t = txn(index, sub, Download, Protocol::Block, None);
-            let phase = Phase::BlockDownloadSegments { next: 1, blksize };
-            (Pending::new(t, phase, crc), true)
-        }
-        (Server, SdoCommand::InitiateDownloadResponse { index, sub }) => {
-            // Expedited or the start of a segmented download: only the next frame tells.
-            let t = txn(index, sub, Download, Protocol::Unknown, None);
-            (Pending::new(t, Phase::DownloadSegment { toggle: false }, false), true)
+        SdoCommand::BlockUploadInitiate {
+            index,
+            sub,
+            crc,
+            blksize,
+            ..
+        } => {
+            let t = opening(ctx, (index, sub), Upload, Protocol::Block, None);
+            (t, Phase::BlockUploadInit { blksize }, crc)
         }
         _ => return None,
-    })
+    };
+    Some(Pending::new(t, phase, crc))
+}
+
+/// The transfer an initiate response opens when its request was not seen: every one but an
+/// expedited upload's, which is a whole transfer.
+fn answered(ctx: &FrameCtx) -> Option<Pending> {
+    use TransferDirection::*;
+    let (t, phase, crc) = match ctx.command {
+        SdoCommand::InitiateUploadResponse {
+            index,
+            sub,
+            expedited: false,
+            size,
+            ..
+        } => {
+            let t = opening(ctx, (index, sub), Upload, Protocol::Segmented, size);
+            (t, Phase::UploadSegment { toggle: false }, false)
+        }
+        SdoCommand::BlockUploadInitiateResponse { index, sub, crc, size } => {
+            let t = opening(ctx, (index, sub), Upload, Protocol::Block, size);
+            (t, Phase::BlockUploadStart { blksize: 127 }, crc)
+        }
+        SdoCommand::BlockDownloadInitiateResponse {
+            index,
+            sub,
+            crc,
+            blksize,
+        } => {
+            let t = opening(ctx, (index, sub), Download, Protocol::Block, None);
+            (t, Phase::BlockDownloadSegments { next: 1, blksize }, crc)
+        }
+        SdoCommand::InitiateDownloadResponse { index, sub } => {
+            // Expedited or the start of a segmented download: only the next frame tells.
+            let t = opening(ctx, (index, sub), Download, Protocol::Unknown, None);
+            (t, Phase::DownloadSegment { toggle: false }, false)
+        }
+        _ => return None,
+    };
+    Some(Pending::new(t, phase, crc))
+}
+
+/// The transaction an initiate opens, with the size it indicates.
+fn opening(
+    ctx: &FrameCtx,
+    (index, sub): (u16, u8),
+    dir: TransferDirection,
+    proto: Protocol,
+    size: Option<u32>,
+) -> Transaction {
+    Transaction {
+        size,
+        ..new_txn(ctx, index, sub, dir, proto)
+    }
 }
 
 /// An expedited upload response whose request was not seen: a whole transaction.
