@@ -325,52 +325,31 @@ impl SdoClient {
         self.begin(index, sub, now_ns)?;
         self.size_known(data.len() as u64);
         let size = Some(data.len() as u32);
-        let (frame, state) = match mode {
-            Mode::Auto if (1..=4).contains(&data.len()) => {
-                let chunk = Chunk::new(&data, 4);
+        let expedited = mode == Mode::Auto && (1..=4).contains(&data.len());
+        let (cmd, state) = match mode {
+            Mode::Block => {
+                let crc = self.cfg.crc;
+                let cmd = SdoCommand::BlockDownloadInitiate { index, sub, crc, size };
+                (cmd, State::BlockDownloadInit { data })
+            }
+            Mode::Auto | Mode::Segmented => {
+                let (protocol, chunk) = if expedited {
+                    (Protocol::Expedited, Chunk::new(&data, 4))
+                } else {
+                    (Protocol::Segmented, Chunk::default())
+                };
                 let cmd = SdoCommand::InitiateDownload {
                     index,
                     sub,
-                    expedited: true,
+                    expedited,
                     size,
                     data: chunk,
                 };
-                (
-                    encode(&cmd),
-                    State::InitDownload {
-                        data,
-                        protocol: Protocol::Expedited,
-                    },
-                )
-            }
-            Mode::Auto | Mode::Segmented => {
-                let cmd = SdoCommand::InitiateDownload {
-                    index,
-                    sub,
-                    expedited: false,
-                    size,
-                    data: Chunk::default(),
-                };
-                (
-                    encode(&cmd),
-                    State::InitDownload {
-                        data,
-                        protocol: Protocol::Segmented,
-                    },
-                )
-            }
-            Mode::Block => {
-                let cmd = SdoCommand::BlockDownloadInitiate {
-                    index,
-                    sub,
-                    crc: self.cfg.crc,
-                    size,
-                };
-                (encode(&cmd), State::BlockDownloadInit { data })
+                (cmd, State::InitDownload { data, protocol })
             }
         };
         self.state = state;
-        Ok(frame)
+        Ok(encode(&cmd))
     }
 
     /// Aborts the running transfer with `code`; returns the abort frame and the failure.

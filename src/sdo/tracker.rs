@@ -8,6 +8,13 @@
 //! block CRCs, and never lets an unrecognised command byte disturb a running transfer.
 //! What it keeps per transfer is capped ([`super::transaction::DATA_KEPT`]), so a
 //! transfer that never ends does not grow memory.
+//!
+//! How to read it: [`TransferTracker::on_channel_frame`] decides how to read the frame
+//! (command or block segment), then either `start`s a transfer on an idle channel or
+//! `advance`s the pending one. `step` matches (phase, command) and hands the frame to
+//! the step of the transfer type running: `download` and `upload` (expedited and
+//! segmented) or `block` (both directions, which mirror each other). Each returns
+//! whether the transfer goes on, completes, or did not expect the frame.
 
 use super::abort::abort_text;
 use super::codec::{Chunk, SdoCommand, Side, decode, end_command, parse};
