@@ -504,7 +504,9 @@ impl SdoClient {
             (State::BlockDownloadAck(b), C::BlockDownloadAck { ackseq, blksize }) => {
                 self.block_download_acked(b, ackseq, blksize, out)
             }
-            (State::BlockDownloadEnd { len }, C::BlockDownloadEndResponse) => self.done(out, Protocol::Block, Ok(len)),
+            (State::BlockDownloadEnd { len }, C::BlockDownloadEndResponse) => {
+                self.downloaded(out, Protocol::Block, len)
+            }
             (State::BlockUploadInit, C::BlockUploadInitiateResponse { index, sub, crc, size }) if same(index, sub) => {
                 self.block_upload_initiated(crc, size, out)
             }
@@ -535,22 +537,26 @@ impl SdoClient {
         State::Idle
     }
 
-    /// Ends the transfer: `Ok(len)` downloaded, `Err(data)` uploaded.
-    fn done(&self, out: &mut ClientOutput, protocol: Protocol, result: Result<usize, Vec<u8>>) -> State {
+    /// Ends the transfer: `len` bytes written.
+    fn downloaded(&self, out: &mut ClientOutput, protocol: Protocol, len: usize) -> State {
         let (index, sub) = (self.index, self.sub);
-        out.done = Some(match result {
-            Ok(len) => Completion::Downloaded {
-                index,
-                sub,
-                protocol,
-                len,
-            },
-            Err(data) => Completion::Uploaded {
-                index,
-                sub,
-                protocol,
-                data,
-            },
+        out.done = Some(Completion::Downloaded {
+            index,
+            sub,
+            protocol,
+            len,
+        });
+        State::Idle
+    }
+
+    /// Ends the transfer: `data` read.
+    fn uploaded(&self, out: &mut ClientOutput, protocol: Protocol, data: Vec<u8>) -> State {
+        let (index, sub) = (self.index, self.sub);
+        out.done = Some(Completion::Uploaded {
+            index,
+            sub,
+            protocol,
+            data,
         });
         State::Idle
     }
@@ -560,7 +566,7 @@ impl SdoClient {
     /// The server accepted the download: done if expedited, else the first segment.
     fn download_initiated(&self, data: Vec<u8>, protocol: Protocol, out: &mut ClientOutput) -> State {
         if protocol == Protocol::Expedited {
-            return self.done(out, protocol, Ok(data.len()));
+            return self.downloaded(out, protocol, data.len());
         }
         self.send_download_segment(out, data, 0, false)
     }
@@ -571,7 +577,7 @@ impl SdoClient {
             return self.protocol_error(out, codes::TOGGLE, "toggle bit not alternated".into());
         }
         if s.pos >= s.data.len() {
-            return self.done(out, Protocol::Segmented, Ok(s.data.len()));
+            return self.downloaded(out, Protocol::Segmented, s.data.len());
         }
         self.send_download_segment(out, s.data, s.pos, !toggle)
     }
@@ -597,7 +603,7 @@ impl SdoClient {
             if let Some(n) = size {
                 bytes.truncate(n as usize);
             }
-            return self.done(out, Protocol::Expedited, Err(bytes));
+            return self.uploaded(out, Protocol::Expedited, bytes);
         }
         if let Err((code, reason)) = self.announced(size) {
             return self.protocol_error(out, code, reason);
@@ -633,7 +639,7 @@ impl SdoClient {
             let reason = format!("the server announced {n} bytes but ended after {}", r.data.len());
             return self.protocol_error(out, codes::LENGTH_TOO_LOW, reason);
         }
-        self.done(out, Protocol::Segmented, Err(r.data))
+        self.uploaded(out, Protocol::Segmented, r.data)
     }
 
     // Block download.
@@ -748,7 +754,7 @@ impl SdoClient {
             return self.protocol_error(out, code, reason);
         }
         out.frames.push(encode(&SdoCommand::BlockUploadEndResponse));
-        self.done(out, Protocol::Block, Err(data))
+        self.uploaded(out, Protocol::Block, data)
     }
 
     /// Checks the size a server announced for an upload against the cap and sets the default

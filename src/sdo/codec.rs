@@ -1,7 +1,7 @@
 //! The SDO command-byte codec (CiA 301 section 7.2.4.3): one frame's eight bytes to a
 //! typed [`SdoCommand`] and back. Every part of cotui that reads or writes SDO frames (the
 //! client, the server, the passive tracker, the labels) goes through [`decode`] (or the
-//! strict [`parse`]) and [`encode`]; nothing else takes command bytes apart.
+//! strict [`parse`]) and [`encode`]; none of them builds or takes apart command bytes itself.
 //!
 //! Block transfer sub-block segments carry a sequence number where other frames carry a
 //! command byte, so decoding needs to know whether the sender is inside a sub-block (the
