@@ -14,12 +14,12 @@ use super::liveness::EventTracker;
 use crate::decode::cia402::DriveState;
 use crate::decode::emcy::Emcy;
 use crate::decode::heartbeat::NmtState;
-use crate::decode::sdo::abort::abort_text;
-use crate::decode::sdo::frame::{SdoCommand, Side};
-use crate::decode::sdo::transaction::{Outcome, Transaction, TransferDirection};
 use crate::decode::{Body, Decoded, Kind};
 use crate::frame::Frame;
 use crate::od::PdoMapping;
+use crate::sdo::abort::abort_text;
+use crate::sdo::codec::{SdoCommand, Side};
+use crate::sdo::transaction::{Outcome, Transaction, TransferDirection};
 use std::collections::{BTreeMap, HashMap};
 
 const MS: u64 = 1_000_000;

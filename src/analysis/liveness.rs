@@ -15,10 +15,10 @@ use super::events::{Event, PeriodSource, What};
 use crate::decode::emcy::Emcy;
 use crate::decode::error_frame;
 use crate::decode::heartbeat::{Heartbeat, NmtState};
-use crate::decode::sdo::{Outcome, Transaction};
 use crate::decode::{Body, Decoded};
 use crate::frame::Frame;
 use crate::od::Dictionary;
+use crate::sdo::{Outcome, Transaction};
 use std::collections::BTreeMap;
 
 /// Heartbeat intervals kept per node for the measured period.

@@ -8,7 +8,7 @@ use crate::decode::cia402::DriveState;
 use crate::decode::emcy::Emcy;
 use crate::decode::heartbeat::Heartbeat;
 use crate::decode::pdo::Pdo;
-use crate::decode::sdo::Transaction;
+use crate::sdo::Transaction;
 use std::collections::{BTreeMap, VecDeque};
 
 /// Events kept for [`Nodes::take_events`] when nobody takes them (oldest dropped).

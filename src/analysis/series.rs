@@ -6,8 +6,8 @@
 //! a coarser step and memory stays bounded.
 
 use crate::decode::pdo::Pdo;
-use crate::decode::sdo::{Transaction, TransferDirection};
 use crate::od::Dictionary;
+use crate::sdo::{Transaction, TransferDirection};
 use std::collections::BTreeMap;
 
 /// Points kept per series.

@@ -14,9 +14,9 @@ use super::nodes::Nodes;
 use super::series::Series;
 use super::stats::Stats;
 use super::store::Store;
-use crate::decode::sdo::Transaction;
 use crate::decode::{Body, Decoded, Decoder, Kind};
 use crate::frame::{Frame, Interfaces};
+use crate::sdo::Transaction;
 
 /// Frames between two decoder checkpoints.
 pub const CHECKPOINT: usize = 8192;

@@ -3,9 +3,10 @@
 use super::input;
 use crate::analysis::EventTracker;
 use crate::command::ExitCode;
-use crate::decode::{Decoder, Kind, sdo::Transaction};
+use crate::decode::{Decoder, Kind};
 use crate::frame::json::write_line;
 use crate::output::{jsonl, summary::Summary, text};
+use crate::sdo::Transaction;
 use clap::{Args, ValueEnum};
 use std::io::{self, BufRead, Write};
 

@@ -167,7 +167,7 @@ impl Run {
         }
     }
 
-    fn transaction(&self, buf: &mut Vec<u8>, t: &crate::decode::sdo::Transaction, t0: u64) {
+    fn transaction(&self, buf: &mut Vec<u8>, t: &crate::sdo::Transaction, t0: u64) {
         let dict = self.decoder.dictionary(t.node);
         if !self.filter.matches_transaction(t, dict, t0) {
             return;

@@ -6,11 +6,11 @@
 use super::decode::DecodeArgs;
 use super::input;
 use crate::command::ExitCode;
-use crate::decode::sdo::{SdoCommand, Transaction};
 use crate::decode::{Body, Decoded, Decoder};
 use crate::frame::{Flags, Frame};
 use crate::od::Dictionary;
 use crate::output::parquet::{Col, Table, Ty, V};
+use crate::sdo::{SdoCommand, Transaction};
 use std::fs::File;
 use std::io::{self, BufRead, BufWriter, Write};
 use std::path::{Path, PathBuf};

@@ -383,7 +383,7 @@ pub async fn drive(bus: &Bus, node: u8, action: DriveAction, timeout_ms: u64) ->
                     reason: format!(
                         "the drive refused controlword 0x{:04X}: SDO abort 0x{code:08X} {}",
                         step.controlword,
-                        crate::decode::sdo::abort_text(code)
+                        crate::sdo::abort_text(code)
                     ),
                 },
                 CommandError::Timeout(_) => {
@@ -609,7 +609,7 @@ fn stop_failure(w: &mut Watch, cw: u16, e: CommandError) -> String {
     match e {
         CommandError::Abort { code, .. } => format!(
             "the node refused controlword 0x{cw:04X}: SDO abort 0x{code:08X} {} (not a CiA 402 drive?)",
-            crate::decode::sdo::abort_text(code)
+            crate::sdo::abort_text(code)
         ),
         CommandError::Timeout(_) => match w.obs.nmt {
             Some(s) => format!("no SDO answer to controlword 0x{cw:04X} (heartbeat says {})", s.text()),

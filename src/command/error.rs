@@ -3,7 +3,7 @@
 use super::syntax::ParseError;
 use super::to_json;
 use crate::bus::BusError;
-use crate::decode::sdo::abort_text;
+use crate::sdo::abort_text;
 use serde::Serialize;
 
 /// The process exit status of cotui, one value per kind of outcome (docs/COMMANDER.md,

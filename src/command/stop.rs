@@ -12,6 +12,7 @@ use super::sdo::upload;
 use crate::bus::{Bus, BusError};
 use crate::decode::cia402::DriveState;
 use crate::frame::{Direction, Frame};
+use crate::sdo::codec::{SdoCommand, Side, decode};
 use serde::Serialize;
 use serde_json::Value as Json;
 use std::collections::{BTreeMap, BTreeSet};
@@ -83,17 +84,17 @@ fn commanded_node(f: &Frame) -> Option<u8> {
     match base {
         // RPDO1..4 of the predefined connection set.
         0x200 | 0x300 | 0x400 | 0x500 => Some(node),
-        0x600 => {
-            let cs = *p.first()? >> 5;
-            let index = u16::from_le_bytes([*p.get(1)?, *p.get(2)?]);
-            match cs {
-                // Download initiate (expedited or segmented) and block download initiate.
-                1 | 6 if index >= 0x2000 => Some(node),
-                // Not an SDO client command specifier: a vendor command (e.g. 0xE8 moves).
-                7 => Some(node),
-                _ => None,
+        0x600 if p.len() >= 3 => match decode(Side::Client, p, false) {
+            // Download initiate (expedited or segmented) and block download initiate.
+            SdoCommand::InitiateDownload { index, .. } | SdoCommand::BlockDownloadInitiate { index, .. }
+                if index >= 0x2000 =>
+            {
+                Some(node)
             }
-        }
+            // Not an SDO client command specifier: a vendor command (e.g. 0xE8 moves).
+            SdoCommand::Unknown { .. } => Some(node),
+            _ => None,
+        },
         _ => None,
     }
 }

@@ -5,10 +5,11 @@
 use super::cob_id::{CobId, CobTable, Route};
 use super::heartbeat::Heartbeat;
 use super::pdo::{self, Pdo};
-use super::sdo::{SdoFrame, SdoTracker, Transaction};
+use super::sdo::{SdoFrame, SdoTracker};
 use super::{Kind, emcy, error_frame, heartbeat, lss, nmt, sync, time, value_text, vendor_sdo};
 use crate::frame::Frame;
 use crate::od::{Dictionary, MappingSource, PdoMapping, resolve_object};
+use crate::sdo::Transaction;
 use std::collections::HashMap;
 
 /// The decoded meaning of one frame.

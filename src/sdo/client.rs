@@ -24,10 +24,10 @@
 //! | sent more data than it announced | `0x06070012` length too high |
 //! | ended the transfer with less data than it announced | `0x06070013` length too low |
 
-use crate::decode::sdo::abort::{abort_text, codes};
-use crate::decode::sdo::crc::crc16;
-use crate::decode::sdo::frame::{Chunk, SdoCommand, Side, decode, encode, sub_block};
-use crate::decode::sdo::transaction::Protocol;
+use super::abort::{abort_text, codes};
+use super::codec::{Chunk, SdoCommand, Side, decode, encode, sub_block};
+use super::crc::crc16;
+use super::transaction::Protocol;
 use crate::od::{Dictionary, Value};
 use std::fmt;
 
@@ -187,47 +187,84 @@ impl std::error::Error for Busy {}
 #[derive(Clone, Debug)]
 enum State {
     Idle,
+    /// The answer to an initiate download (expedited or segmented).
     InitDownload {
         data: Vec<u8>,
         protocol: Protocol,
     },
-    DownloadSegment {
-        data: Vec<u8>,
-        pos: usize,
-        toggle: bool,
-    },
+    /// The confirmation of the download segment before `pos`.
+    DownloadSegment(Sending),
+    /// The answer to an initiate upload.
     InitUpload,
-    UploadSegment {
-        data: Vec<u8>,
-        size: Option<u32>,
-        toggle: bool,
-    },
+    /// The next upload segment.
+    UploadSegment(Receiving),
+    /// The answer to an initiate block download.
     BlockDownloadInit {
         data: Vec<u8>,
     },
-    BlockDownloadAck {
-        data: Vec<u8>,
-        crc: bool,
-        acked: usize,
-        sent: usize,
-    },
+    /// The acknowledgement of the sub-block sent.
+    BlockDownloadAck(SubBlocksOut),
+    /// The answer to the end of a block download.
     BlockDownloadEnd {
         len: usize,
     },
+    /// The answer to an initiate block upload.
     BlockUploadInit,
-    BlockUpload {
-        data: Vec<u8>,
-        crc: bool,
-        size: Option<u32>,
-        next: u8,
-        sub_block: Vec<u8>,
-        last: bool,
-    },
+    /// The segments of a sub-block.
+    BlockUpload(SubBlocksIn),
+    /// The end of a block upload.
     BlockUploadEnd {
         data: Vec<u8>,
         crc: bool,
         size: Option<u32>,
     },
+}
+
+/// A segmented download under way.
+#[derive(Clone, Debug)]
+struct Sending {
+    data: Vec<u8>,
+    /// Bytes sent so far.
+    pos: usize,
+    /// Toggle bit of the segment sent last.
+    toggle: bool,
+}
+
+/// A segmented upload under way.
+#[derive(Clone, Debug)]
+struct Receiving {
+    data: Vec<u8>,
+    /// The size the server announced.
+    size: Option<u32>,
+    /// Toggle bit of the segment asked for.
+    toggle: bool,
+}
+
+/// A block download under way.
+#[derive(Clone, Debug)]
+struct SubBlocksOut {
+    data: Vec<u8>,
+    crc: bool,
+    /// Bytes acknowledged.
+    acked: usize,
+    /// Bytes sent.
+    sent: usize,
+}
+
+/// A block upload under way.
+#[derive(Clone, Debug)]
+struct SubBlocksIn {
+    /// Bytes of acknowledged sub-blocks.
+    data: Vec<u8>,
+    crc: bool,
+    /// The size the server announced.
+    size: Option<u32>,
+    /// The sequence number expected next.
+    next: u8,
+    /// Bytes of the current sub-block.
+    sub_block: Vec<u8>,
+    /// The segment with the c bit arrived.
+    last: bool,
 }
 
 /// An SDO client for one channel.
@@ -288,52 +325,31 @@ impl SdoClient {
         self.begin(index, sub, now_ns)?;
         self.size_known(data.len() as u64);
         let size = Some(data.len() as u32);
-        let (frame, state) = match mode {
-            Mode::Auto if (1..=4).contains(&data.len()) => {
-                let chunk = Chunk::new(&data, 4);
+        let expedited = mode == Mode::Auto && (1..=4).contains(&data.len());
+        let (cmd, state) = match mode {
+            Mode::Block => {
+                let crc = self.cfg.crc;
+                let cmd = SdoCommand::BlockDownloadInitiate { index, sub, crc, size };
+                (cmd, State::BlockDownloadInit { data })
+            }
+            Mode::Auto | Mode::Segmented => {
+                let (protocol, chunk) = if expedited {
+                    (Protocol::Expedited, Chunk::new(&data, 4))
+                } else {
+                    (Protocol::Segmented, Chunk::default())
+                };
                 let cmd = SdoCommand::InitiateDownload {
                     index,
                     sub,
-                    expedited: true,
+                    expedited,
                     size,
                     data: chunk,
                 };
-                (
-                    encode(&cmd),
-                    State::InitDownload {
-                        data,
-                        protocol: Protocol::Expedited,
-                    },
-                )
-            }
-            Mode::Auto | Mode::Segmented => {
-                let cmd = SdoCommand::InitiateDownload {
-                    index,
-                    sub,
-                    expedited: false,
-                    size,
-                    data: Chunk::default(),
-                };
-                (
-                    encode(&cmd),
-                    State::InitDownload {
-                        data,
-                        protocol: Protocol::Segmented,
-                    },
-                )
-            }
-            Mode::Block => {
-                let cmd = SdoCommand::BlockDownloadInitiate {
-                    index,
-                    sub,
-                    crc: self.cfg.crc,
-                    size,
-                };
-                (encode(&cmd), State::BlockDownloadInit { data })
+                (cmd, State::InitDownload { data, protocol })
             }
         };
         self.state = state;
-        Ok(frame)
+        Ok(encode(&cmd))
     }
 
     /// Aborts the running transfer with `code`; returns the abort frame and the failure.
@@ -448,276 +464,297 @@ impl SdoClient {
         State::Idle
     }
 
-    /// Moves from `state` on one server command.
+    /// Moves from `state` on one server command: (state, command) to the step of the
+    /// transfer type running; a command that fits no step is a protocol error.
     fn step(&mut self, state: State, cmd: SdoCommand, out: &mut ClientOutput) -> State {
         use SdoCommand as C;
-        let (index, sub) = (self.index, self.sub);
-        if let C::Abort { code, .. } = cmd {
-            let error = SdoError::Aborted {
-                code,
-                text: abort_text(code),
-            };
-            out.done = Some(Completion::Failed { index, sub, error });
-            return State::Idle;
-        }
-        let same = |i: u16, s: u8| (i, s) == (index, sub);
+        let same = |i: u16, s: u8| (i, s) == (self.index, self.sub);
         match (state, cmd) {
-            (State::InitDownload { data, protocol }, C::InitiateDownloadResponse { index: i, sub: s })
-                if same(i, s) =>
+            (_, C::Abort { code, .. }) => self.aborted(code, out),
+            (State::InitDownload { data, protocol }, C::InitiateDownloadResponse { index, sub })
+                if same(index, sub) =>
             {
-                if protocol == Protocol::Expedited {
-                    out.done = Some(Completion::Downloaded {
-                        index,
-                        sub,
-                        protocol,
-                        len: data.len(),
-                    });
-                    return State::Idle;
-                }
-                self.send_download_segment(out, data, 0, false)
+                self.download_initiated(data, protocol, out)
             }
-            (
-                State::DownloadSegment {
-                    data,
-                    pos,
-                    toggle: want,
-                },
-                C::DownloadSegmentResponse { toggle },
-            ) => {
-                if toggle != want {
-                    return self.protocol_error(out, codes::TOGGLE, "toggle bit not alternated".into());
-                }
-                if pos >= data.len() {
-                    out.done = Some(Completion::Downloaded {
-                        index,
-                        sub,
-                        protocol: Protocol::Segmented,
-                        len: data.len(),
-                    });
-                    return State::Idle;
-                }
-                self.send_download_segment(out, data, pos, !toggle)
+            (State::DownloadSegment(s), C::DownloadSegmentResponse { toggle }) => {
+                self.download_segment_confirmed(s, toggle, out)
             }
             (
                 State::InitUpload | State::BlockUploadInit,
                 C::InitiateUploadResponse {
-                    index: i,
-                    sub: s,
+                    index,
+                    sub,
                     expedited,
                     size,
                     data,
                 },
-            ) if same(i, s) => {
-                if expedited {
-                    let mut bytes = data.bytes().to_vec();
-                    if let Some(n) = size {
-                        bytes.truncate(n as usize);
-                    }
-                    out.done = Some(Completion::Uploaded {
-                        index,
-                        sub,
-                        protocol: Protocol::Expedited,
-                        data: bytes,
-                    });
-                    return State::Idle;
-                }
-                if let Err((code, reason)) = self.announced(size) {
-                    return self.protocol_error(out, code, reason);
-                }
-                out.frames.push(encode(&C::UploadSegment { toggle: false }));
-                State::UploadSegment {
-                    data: Vec::new(),
-                    size,
-                    toggle: false,
-                }
-            }
-            (
-                State::UploadSegment {
-                    mut data,
-                    size,
-                    toggle: want,
-                },
-                C::UploadSegmentResponse { toggle, last, data: d },
-            ) => {
-                if toggle != want {
-                    return self.protocol_error(out, codes::TOGGLE, "toggle bit not alternated".into());
-                }
-                data.extend_from_slice(d.bytes());
-                if let Err((code, reason)) = self.bounded(data.len(), size, 1) {
-                    return self.protocol_error(out, code, reason);
-                }
-                if !last {
-                    out.frames.push(encode(&C::UploadSegment { toggle: !toggle }));
-                    return State::UploadSegment {
-                        data,
-                        size,
-                        toggle: !toggle,
-                    };
-                }
-                if let Some(n) = size.filter(|n| (*n as usize) > data.len()) {
-                    let reason = format!("the server announced {n} bytes but ended after {}", data.len());
-                    return self.protocol_error(out, codes::LENGTH_TOO_LOW, reason);
-                }
-                out.done = Some(Completion::Uploaded {
-                    index,
-                    sub,
-                    protocol: Protocol::Segmented,
-                    data,
-                });
-                State::Idle
+            ) if same(index, sub) => self.upload_initiated(expedited, size, data, out),
+            (State::UploadSegment(r), C::UploadSegmentResponse { toggle, last, data }) => {
+                self.upload_segment(r, (toggle, last, data), out)
             }
             (
                 State::BlockDownloadInit { data },
                 C::BlockDownloadInitiateResponse {
-                    index: i,
-                    sub: s,
+                    index,
+                    sub,
                     crc,
                     blksize,
                 },
-            ) if same(i, s) => {
-                if !(1..=127).contains(&blksize) {
-                    return self.protocol_error(out, codes::BLOCK_SIZE, format!("invalid block size {blksize}"));
-                }
-                let crc = crc && self.cfg.crc;
-                let sent = send_sub_block(out, &data, 0, blksize);
-                State::BlockDownloadAck {
-                    data,
-                    crc,
-                    acked: 0,
-                    sent,
-                }
-            }
-            (State::BlockDownloadAck { data, crc, acked, sent }, C::BlockDownloadAck { ackseq, blksize }) => {
-                // Segments of the last sub-block (an empty transfer still sends one).
-                let in_flight = (sent - acked).div_ceil(7).max(1);
-                if ackseq as usize > in_flight {
-                    return self.protocol_error(
-                        out,
-                        codes::SEQUENCE,
-                        format!("acknowledged segment {ackseq} not sent"),
-                    );
-                }
-                if !(1..=127).contains(&blksize) {
-                    return self.protocol_error(out, codes::BLOCK_SIZE, format!("invalid block size {blksize}"));
-                }
-                if sent == data.len() && ackseq as usize == in_flight {
-                    let unused = (data.len().div_ceil(7).max(1) * 7 - data.len()) as u8;
-                    let crc = if crc { crc16(&data) } else { 0 };
-                    out.frames.push(encode(&C::BlockDownloadEnd { unused, crc }));
-                    return State::BlockDownloadEnd { len: data.len() };
-                }
-                let acked = (acked + ackseq as usize * 7).min(data.len());
-                let sent = acked + send_sub_block(out, &data, acked, blksize);
-                State::BlockDownloadAck { data, crc, acked, sent }
+            ) if same(index, sub) => self.block_download_initiated(data, crc, blksize, out),
+            (State::BlockDownloadAck(b), C::BlockDownloadAck { ackseq, blksize }) => {
+                self.block_download_acked(b, ackseq, blksize, out)
             }
             (State::BlockDownloadEnd { len }, C::BlockDownloadEndResponse) => {
-                out.done = Some(Completion::Downloaded {
-                    index,
-                    sub,
-                    protocol: Protocol::Block,
-                    len,
-                });
-                State::Idle
+                self.downloaded(out, Protocol::Block, len)
             }
-            (
-                State::BlockUploadInit,
-                C::BlockUploadInitiateResponse {
-                    index: i,
-                    sub: s,
-                    crc,
-                    size,
-                },
-            ) if same(i, s) => {
-                if let Err((code, reason)) = self.announced(size) {
-                    return self.protocol_error(out, code, reason);
-                }
-                out.frames.push(encode(&C::BlockUploadStart));
-                let crc = crc && self.cfg.crc;
-                State::BlockUpload {
-                    data: Vec::new(),
-                    crc,
-                    size,
-                    next: 1,
-                    sub_block: Vec::new(),
-                    last: false,
-                }
+            (State::BlockUploadInit, C::BlockUploadInitiateResponse { index, sub, crc, size }) if same(index, sub) => {
+                self.block_upload_initiated(crc, size, out)
             }
-            (
-                State::BlockUpload {
-                    mut data,
-                    crc,
-                    size,
-                    next,
-                    mut sub_block,
-                    last,
-                },
-                C::BlockSegment {
-                    seqno,
-                    last: c,
-                    data: d,
-                },
-            ) => {
-                let mut next = next;
-                let mut last = last;
-                if seqno == next && !last {
-                    sub_block.extend_from_slice(d.bytes());
-                    next += 1;
-                    last = c;
-                    // Block segments carry 7 bytes each, the last one padded.
-                    if let Err((code, reason)) = self.bounded(data.len() + sub_block.len(), size, 7) {
-                        return self.protocol_error(out, code, reason);
-                    }
-                }
-                let blksize = self.cfg.block_size.clamp(1, 127);
-                if c || seqno >= blksize {
-                    out.frames.push(encode(&C::BlockUploadAck {
-                        ackseq: next - 1,
-                        blksize,
-                    }));
-                    data.append(&mut sub_block);
-                    if last {
-                        return State::BlockUploadEnd { data, crc, size };
-                    }
-                    next = 1;
-                }
-                State::BlockUpload {
-                    data,
-                    crc,
-                    size,
-                    next,
-                    sub_block,
-                    last,
-                }
+            (State::BlockUpload(b), C::BlockSegment { seqno, last, data }) => {
+                self.block_upload_segment(b, (seqno, last, data), out)
             }
-            (State::BlockUploadEnd { mut data, crc, size }, C::BlockUploadEnd { unused, crc: sent }) => {
-                let keep = data.len().saturating_sub(unused as usize);
-                data.truncate(keep);
-                if crc && crc16(&data) != sent {
-                    return self.protocol_error(out, codes::CRC, "block CRC does not match the data".into());
-                }
-                if let Some(n) = size.filter(|n| *n as usize != data.len()) {
-                    let (code, what) = if (n as usize) > data.len() {
-                        (codes::LENGTH_TOO_LOW, "ended after")
-                    } else {
-                        (codes::LENGTH_TOO_HIGH, "sent")
-                    };
-                    let reason = format!("the server announced {n} bytes but {what} {}", data.len());
-                    return self.protocol_error(out, code, reason);
-                }
-                out.frames.push(encode(&C::BlockUploadEndResponse));
-                out.done = Some(Completion::Uploaded {
-                    index,
-                    sub,
-                    protocol: Protocol::Block,
-                    data,
-                });
-                State::Idle
+            (State::BlockUploadEnd { data, crc, size }, C::BlockUploadEnd { unused, crc: sent }) => {
+                self.block_upload_ended(data, (crc, size), (unused, sent), out)
             }
             (_, cmd) => {
                 let reason = format!("unexpected {} frame from the server", cmd.cs_name());
                 self.protocol_error(out, codes::UNKNOWN_COMMAND, reason)
             }
         }
+    }
+
+    /// The server aborted.
+    fn aborted(&self, code: u32, out: &mut ClientOutput) -> State {
+        let error = SdoError::Aborted {
+            code,
+            text: abort_text(code),
+        };
+        out.done = Some(Completion::Failed {
+            index: self.index,
+            sub: self.sub,
+            error,
+        });
+        State::Idle
+    }
+
+    /// Ends the transfer: `len` bytes written.
+    fn downloaded(&self, out: &mut ClientOutput, protocol: Protocol, len: usize) -> State {
+        let (index, sub) = (self.index, self.sub);
+        out.done = Some(Completion::Downloaded {
+            index,
+            sub,
+            protocol,
+            len,
+        });
+        State::Idle
+    }
+
+    /// Ends the transfer: `data` read.
+    fn uploaded(&self, out: &mut ClientOutput, protocol: Protocol, data: Vec<u8>) -> State {
+        let (index, sub) = (self.index, self.sub);
+        out.done = Some(Completion::Uploaded {
+            index,
+            sub,
+            protocol,
+            data,
+        });
+        State::Idle
+    }
+
+    // Expedited and segmented download.
+
+    /// The server accepted the download: done if expedited, else the first segment.
+    fn download_initiated(&self, data: Vec<u8>, protocol: Protocol, out: &mut ClientOutput) -> State {
+        if protocol == Protocol::Expedited {
+            return self.downloaded(out, protocol, data.len());
+        }
+        self.send_download_segment(out, data, 0, false)
+    }
+
+    /// The server confirmed a segment: the next one, or done.
+    fn download_segment_confirmed(&self, s: Sending, toggle: bool, out: &mut ClientOutput) -> State {
+        if toggle != s.toggle {
+            return self.protocol_error(out, codes::TOGGLE, "toggle bit not alternated".into());
+        }
+        if s.pos >= s.data.len() {
+            return self.downloaded(out, Protocol::Segmented, s.data.len());
+        }
+        self.send_download_segment(out, s.data, s.pos, !toggle)
+    }
+
+    /// Sends the download segment starting at `pos`.
+    fn send_download_segment(&self, out: &mut ClientOutput, data: Vec<u8>, pos: usize, toggle: bool) -> State {
+        let (chunk, end, last) = Chunk::segment(&data, pos);
+        out.frames.push(encode(&SdoCommand::DownloadSegment {
+            toggle,
+            last,
+            data: chunk,
+        }));
+        State::DownloadSegment(Sending { data, pos: end, toggle })
+    }
+
+    // Expedited and segmented upload.
+
+    /// The server answered an upload (also a block upload it answered this way): the data
+    /// if expedited, else the first segment request.
+    fn upload_initiated(&mut self, expedited: bool, size: Option<u32>, data: Chunk, out: &mut ClientOutput) -> State {
+        if expedited {
+            let mut bytes = data.bytes().to_vec();
+            if let Some(n) = size {
+                bytes.truncate(n as usize);
+            }
+            return self.uploaded(out, Protocol::Expedited, bytes);
+        }
+        if let Err((code, reason)) = self.announced(size) {
+            return self.protocol_error(out, code, reason);
+        }
+        out.frames.push(encode(&SdoCommand::UploadSegment { toggle: false }));
+        State::UploadSegment(Receiving {
+            data: Vec::new(),
+            size,
+            toggle: false,
+        })
+    }
+
+    /// One upload segment: ask for the next, or done.
+    fn upload_segment(
+        &self,
+        mut r: Receiving,
+        (toggle, last, d): (bool, bool, Chunk),
+        out: &mut ClientOutput,
+    ) -> State {
+        if toggle != r.toggle {
+            return self.protocol_error(out, codes::TOGGLE, "toggle bit not alternated".into());
+        }
+        r.data.extend_from_slice(d.bytes());
+        if let Err((code, reason)) = self.bounded(r.data.len(), r.size, 1) {
+            return self.protocol_error(out, code, reason);
+        }
+        if !last {
+            out.frames.push(encode(&SdoCommand::UploadSegment { toggle: !toggle }));
+            r.toggle = !toggle;
+            return State::UploadSegment(r);
+        }
+        if let Some(n) = r.size.filter(|n| (*n as usize) > r.data.len()) {
+            let reason = format!("the server announced {n} bytes but ended after {}", r.data.len());
+            return self.protocol_error(out, codes::LENGTH_TOO_LOW, reason);
+        }
+        self.uploaded(out, Protocol::Segmented, r.data)
+    }
+
+    // Block download.
+
+    /// The server accepted the block download: the first sub-block.
+    fn block_download_initiated(&self, data: Vec<u8>, crc: bool, blksize: u8, out: &mut ClientOutput) -> State {
+        if !(1..=127).contains(&blksize) {
+            return self.protocol_error(out, codes::BLOCK_SIZE, format!("invalid block size {blksize}"));
+        }
+        let crc = crc && self.cfg.crc;
+        let sent = send_sub_block(out, &data, 0, blksize);
+        State::BlockDownloadAck(SubBlocksOut {
+            data,
+            crc,
+            acked: 0,
+            sent,
+        })
+    }
+
+    /// The server acknowledged a sub-block: the next one, or the end.
+    fn block_download_acked(&self, b: SubBlocksOut, ackseq: u8, blksize: u8, out: &mut ClientOutput) -> State {
+        let SubBlocksOut { data, crc, acked, sent } = b;
+        // Segments of the last sub-block (an empty transfer still sends one).
+        let in_flight = (sent - acked).div_ceil(7).max(1);
+        if ackseq as usize > in_flight {
+            return self.protocol_error(out, codes::SEQUENCE, format!("acknowledged segment {ackseq} not sent"));
+        }
+        if !(1..=127).contains(&blksize) {
+            return self.protocol_error(out, codes::BLOCK_SIZE, format!("invalid block size {blksize}"));
+        }
+        if sent == data.len() && ackseq as usize == in_flight {
+            let unused = (data.len().div_ceil(7).max(1) * 7 - data.len()) as u8;
+            let crc = if crc { crc16(&data) } else { 0 };
+            out.frames.push(encode(&SdoCommand::BlockDownloadEnd { unused, crc }));
+            return State::BlockDownloadEnd { len: data.len() };
+        }
+        let acked = (acked + ackseq as usize * 7).min(data.len());
+        let sent = acked + send_sub_block(out, &data, acked, blksize);
+        State::BlockDownloadAck(SubBlocksOut { data, crc, acked, sent })
+    }
+
+    // Block upload.
+
+    /// The server accepted the block upload: start it.
+    fn block_upload_initiated(&mut self, crc: bool, size: Option<u32>, out: &mut ClientOutput) -> State {
+        if let Err((code, reason)) = self.announced(size) {
+            return self.protocol_error(out, code, reason);
+        }
+        out.frames.push(encode(&SdoCommand::BlockUploadStart));
+        State::BlockUpload(SubBlocksIn {
+            data: Vec::new(),
+            crc: crc && self.cfg.crc,
+            size,
+            next: 1,
+            sub_block: Vec::new(),
+            last: false,
+        })
+    }
+
+    /// One segment of a sub-block; acknowledges the sub-block at its end.
+    fn block_upload_segment(
+        &self,
+        mut b: SubBlocksIn,
+        (seqno, c, d): (u8, bool, Chunk),
+        out: &mut ClientOutput,
+    ) -> State {
+        if seqno == b.next && !b.last {
+            b.sub_block.extend_from_slice(d.bytes());
+            b.next += 1;
+            b.last = c;
+            // Block segments carry 7 bytes each, the last one padded.
+            if let Err((code, reason)) = self.bounded(b.data.len() + b.sub_block.len(), b.size, 7) {
+                return self.protocol_error(out, code, reason);
+            }
+        }
+        let blksize = self.cfg.block_size.clamp(1, 127);
+        if c || seqno >= blksize {
+            out.frames.push(encode(&SdoCommand::BlockUploadAck {
+                ackseq: b.next - 1,
+                blksize,
+            }));
+            b.data.append(&mut b.sub_block);
+            if b.last {
+                let SubBlocksIn { data, crc, size, .. } = b;
+                return State::BlockUploadEnd { data, crc, size };
+            }
+            b.next = 1;
+        }
+        State::BlockUpload(b)
+    }
+
+    /// The end of a block upload: the unused tail, the CRC and the size checked.
+    fn block_upload_ended(
+        &self,
+        mut data: Vec<u8>,
+        (crc, size): (bool, Option<u32>),
+        (unused, sent): (u8, u16),
+        out: &mut ClientOutput,
+    ) -> State {
+        let keep = data.len().saturating_sub(unused as usize);
+        data.truncate(keep);
+        if crc && crc16(&data) != sent {
+            return self.protocol_error(out, codes::CRC, "block CRC does not match the data".into());
+        }
+        if let Some(n) = size.filter(|n| *n as usize != data.len()) {
+            let (code, what) = if (n as usize) > data.len() {
+                (codes::LENGTH_TOO_LOW, "ended after")
+            } else {
+                (codes::LENGTH_TOO_HIGH, "sent")
+            };
+            let reason = format!("the server announced {n} bytes but {what} {}", data.len());
+            return self.protocol_error(out, code, reason);
+        }
+        out.frames.push(encode(&SdoCommand::BlockUploadEndResponse));
+        self.uploaded(out, Protocol::Block, data)
     }
 
     /// Checks the size a server announced for an upload against the cap and sets the default
@@ -757,17 +794,6 @@ impl SdoClient {
             )),
             _ => Ok(()),
         }
-    }
-
-    /// Sends the download segment starting at `pos`.
-    fn send_download_segment(&self, out: &mut ClientOutput, data: Vec<u8>, pos: usize, toggle: bool) -> State {
-        let (chunk, end, last) = Chunk::segment(&data, pos);
-        out.frames.push(encode(&SdoCommand::DownloadSegment {
-            toggle,
-            last,
-            data: chunk,
-        }));
-        State::DownloadSegment { data, pos: end, toggle }
     }
 }
 

@@ -1,8 +1,8 @@
 //! The object dictionary of a simulated device: typed entries with access rights,
 //! read and written by SDO and PDO with CiA 301 abort codes for bad requests.
 
-use crate::decode::sdo::abort::codes;
 use crate::od::{Access, DataType};
+use crate::sdo::abort::codes;
 use crate::sdo::server::ObjectStore;
 use std::collections::BTreeMap;
 

@@ -4,6 +4,7 @@
 //! Pure: the same frame count always gives the same frames.
 
 use crate::frame::Frame;
+use crate::sdo::codec::{Chunk, SdoCommand, encode, sub_block};
 
 /// Generates `count` frames, 100 µs apart, starting at `start_ns`.
 pub struct Traffic {
@@ -51,12 +52,7 @@ impl Traffic {
         expedited_upload(s, node, index, sub, value);
         if c.is_multiple_of(2) {
             let mode = [1u8, 3, 8][(c / 2 % 3) as usize];
-            sdo_pair(
-                s,
-                node,
-                [0x2F, 0x60, 0x60, 0, mode, 0, 0, 0],
-                [0x60, 0x60, 0x60, 0, 0, 0, 0, 0],
-            );
+            expedited_download(s, node, 0x6060, 0, &[mode]);
         }
         if c % 8 == 3 {
             segmented_upload(s, node);
@@ -66,12 +62,13 @@ impl Traffic {
         }
         if c % 50 == 7 {
             // A read of an object the drive does not have: abort 0x06020000.
-            sdo_pair(
-                s,
-                node,
-                [0x40, 0x00, 0x30, 0, 0, 0, 0, 0],
-                [0x80, 0x00, 0x30, 0, 0, 0, 2, 6],
-            );
+            let (index, sub) = (0x3000, 0);
+            let abort = SdoCommand::Abort {
+                index,
+                sub,
+                code: 0x0602_0000,
+            };
+            sdo_pair(s, node, SdoCommand::InitiateUpload { index, sub }, abort);
         }
         if c % 997 == 11 {
             // EMCY: overcurrent, then its reset.
@@ -127,71 +124,91 @@ fn pdos(s: &mut Vec<Frame>, c: u64, node: u32) {
 }
 
 /// One SDO request from the master and the node's answer.
-fn sdo_pair(s: &mut Vec<Frame>, node: u32, request: [u8; 8], answer: [u8; 8]) {
-    s.push(Frame::classic(0x600 + node, &request));
-    s.push(Frame::classic(0x580 + node, &answer));
+fn sdo_pair(s: &mut Vec<Frame>, node: u32, request: SdoCommand, answer: SdoCommand) {
+    s.push(Frame::classic(0x600 + node, &encode(&request)));
+    s.push(Frame::classic(0x580 + node, &encode(&answer)));
+}
+
+/// An expedited download of `value` (1-4 bytes) to (index, sub), confirmed.
+fn expedited_download(s: &mut Vec<Frame>, node: u32, index: u16, sub: u8, value: &[u8]) {
+    let request = SdoCommand::InitiateDownload {
+        index,
+        sub,
+        expedited: true,
+        size: Some(value.len() as u32),
+        data: Chunk::new(value, 4),
+    };
+    sdo_pair(s, node, request, SdoCommand::InitiateDownloadResponse { index, sub });
 }
 
 /// An expedited 4-byte upload of (index, sub) answering `value`.
 fn expedited_upload(s: &mut Vec<Frame>, node: u32, index: u16, sub: u8, value: u32) {
-    let [i0, i1] = index.to_le_bytes();
-    let [v0, v1, v2, v3] = value.to_le_bytes();
-    sdo_pair(
-        s,
-        node,
-        [0x40, i0, i1, sub, 0, 0, 0, 0],
-        [0x43, i0, i1, sub, v0, v1, v2, v3],
-    );
+    let answer = SdoCommand::InitiateUploadResponse {
+        index,
+        sub,
+        expedited: true,
+        size: Some(4),
+        data: Chunk::new(&value.to_le_bytes(), 4),
+    };
+    sdo_pair(s, node, SdoCommand::InitiateUpload { index, sub }, answer);
 }
 
 /// A segmented upload of the 16-byte device name (0x1008).
 fn segmented_upload(s: &mut Vec<Frame>, node: u32) {
-    sdo_pair(
-        s,
-        node,
-        [0x40, 0x08, 0x10, 0, 0, 0, 0, 0],
-        [0x41, 0x08, 0x10, 0, 16, 0, 0, 0],
-    );
-    sdo_pair(
-        s,
-        node,
-        [0x60, 0, 0, 0, 0, 0, 0, 0],
-        [0x00, b'C', b'O', b'T', b'U', b'I', b' ', b'D'],
-    );
-    sdo_pair(
-        s,
-        node,
-        [0x70, 0, 0, 0, 0, 0, 0, 0],
-        [0x10, b'R', b'I', b'V', b'E', b' ', b'0', b'1'],
-    );
-    sdo_pair(s, node, [0x60, 0, 0, 0, 0, 0, 0, 0], [0x0D, b'!', b'!', 0, 0, 0, 0, 0]);
+    let name = b"COTUI DRIVE 01!!";
+    let (index, sub) = (0x1008, 0);
+    let answer = SdoCommand::InitiateUploadResponse {
+        index,
+        sub,
+        expedited: false,
+        size: Some(name.len() as u32),
+        data: Chunk::default(),
+    };
+    sdo_pair(s, node, SdoCommand::InitiateUpload { index, sub }, answer);
+    let (mut pos, mut toggle) = (0, false);
+    loop {
+        let (data, end, last) = Chunk::segment(name, pos);
+        let segment = SdoCommand::UploadSegmentResponse { toggle, last, data };
+        sdo_pair(s, node, SdoCommand::UploadSegment { toggle }, segment);
+        if last {
+            break;
+        }
+        (pos, toggle) = (end, !toggle);
+    }
 }
 
 /// A block upload (no CRC) of 20 bytes of 0x1008: three segments, one block.
 fn block_upload(s: &mut Vec<Frame>, node: u32) {
-    sdo_pair(
-        s,
-        node,
-        [0xA0, 0x08, 0x10, 0, 127, 0, 0, 0],
-        [0xC2, 0x08, 0x10, 0, 20, 0, 0, 0],
-    );
-    s.push(Frame::classic(0x600 + node, &[0xA3, 0, 0, 0, 0, 0, 0, 0]));
-    s.push(Frame::classic(
-        0x580 + node,
-        &[0x01, b'c', b'o', b't', b'u', b'i', b' '],
-    ));
-    s.push(Frame::classic(
-        0x580 + node,
-        &[0x02, b'b', b'e', b'n', b'c', b'h', b' '],
-    ));
-    // Last segment: 6 data bytes, the 7th unused (n = 1 in the end frame).
-    s.push(Frame::classic(
-        0x580 + node,
-        &[0x83, b'd', b'r', b'i', b'v', b'e', b'!', 0],
-    ));
-    s.push(Frame::classic(0x600 + node, &[0xA2, 3, 127, 0, 0, 0, 0, 0]));
-    s.push(Frame::classic(0x580 + node, &[0xC5, 0, 0, 0, 0, 0, 0, 0]));
-    s.push(Frame::classic(0x600 + node, &[0xA1, 0, 0, 0, 0, 0, 0, 0]));
+    let data = b"cotui bench drive 01";
+    let (index, sub) = (0x1008, 0);
+    let request = SdoCommand::BlockUploadInitiate {
+        index,
+        sub,
+        crc: false,
+        blksize: 127,
+        pst: 0,
+    };
+    let size = Some(data.len() as u32);
+    let answer = SdoCommand::BlockUploadInitiateResponse {
+        index,
+        sub,
+        crc: false,
+        size,
+    };
+    sdo_pair(s, node, request, answer);
+    let client = |cmd: SdoCommand| Frame::classic(0x600 + node, &encode(&cmd));
+    s.push(client(SdoCommand::BlockUploadStart));
+    let (segments, _) = sub_block(data, 0, 127);
+    s.extend(segments.iter().map(|seg| Frame::classic(0x580 + node, &encode(seg))));
+    s.push(client(SdoCommand::BlockUploadAck {
+        ackseq: segments.len() as u8,
+        blksize: 127,
+    }));
+    // The last segment carries 6 data bytes, the 7th unused (n = 1 in the end frame).
+    let unused = (segments.len() * 7 - data.len()) as u8;
+    let end = SdoCommand::BlockUploadEnd { unused, crc: 0 };
+    s.push(Frame::classic(0x580 + node, &encode(&end)));
+    s.push(client(SdoCommand::BlockUploadEndResponse));
 }
 
 impl Iterator for Traffic {
@@ -248,5 +265,28 @@ mod tests {
             "EMCY"
         );
         assert!(count(&|f| (0x701..=0x704).contains(&f.id)) > 0, "heartbeats");
+    }
+
+    #[test]
+    fn its_sdo_transfers_are_well_formed() {
+        use crate::sdo::tracker::TransferTracker;
+        use crate::sdo::{Outcome, Protocol};
+        let dict = crate::od::Dictionary::default();
+        let mut tracker = TransferTracker::new();
+        for (seq, f) in Traffic::new(20_000, 0).enumerate() {
+            let (base, node) = (f.id & 0x780, (f.id & 0x7F) as u8);
+            if base == 0x580 || base == 0x600 {
+                let t = tracker.on_frame(seq as u64, f.ts_ns, node, base == 0x600, f.payload(), &dict);
+                assert!(t.problems.is_empty(), "frame {seq}: {t:?}");
+            }
+        }
+        let done = tracker.finish();
+        let protocols = |p| done.iter().filter(|t| t.protocol == p).count();
+        assert!(protocols(Protocol::Segmented) > 0 && protocols(Protocol::Block) > 0);
+        for t in &done {
+            assert!(t.problems.is_empty(), "{t:?}");
+            let aborted = matches!(t.outcome, Outcome::Aborted { code: 0x0602_0000, .. });
+            assert!(t.outcome == Outcome::Ok || aborted, "{t:?}");
+        }
     }
 }

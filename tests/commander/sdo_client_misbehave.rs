@@ -267,7 +267,7 @@ fn answers_are_judged_by_their_receive_time() {
         Some(Completion::Uploaded {
             index: 0x6041,
             sub: 0,
-            protocol: cotui::decode::sdo::Protocol::Expedited,
+            protocol: cotui::sdo::Protocol::Expedited,
             data: vec![0x37, 0x02],
         })
     );

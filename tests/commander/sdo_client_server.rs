@@ -1,10 +1,11 @@
 //! The SDO client against the SDO server, with the passive tracker listening:
 //! every transfer type both ways, aborts, CRC errors, lost segments and timeouts.
 
-use cotui::decode::sdo::{Outcome, Problem, Protocol, SdoTracker, Transaction, TransferDirection};
+use cotui::decode::sdo::SdoTracker;
 use cotui::od::{Access, DataType, Dictionary, ObjectInfo, Profile, Value};
 use cotui::sdo::client::{ClientConfig, Completion, Mode, SdoClient, SdoError};
 use cotui::sdo::server::{MemoryStore, ObjectStore, SdoServer, ServerConfig, ServerEvent};
+use cotui::sdo::{Outcome, Problem, Protocol, Transaction, TransferDirection};
 use std::sync::Arc;
 
 const NODE: u8 = 5;
@@ -264,7 +265,7 @@ fn server_aborts_reach_the_client_and_the_tracker() {
             Some(d) => l.download(index, sub, d, Mode::Auto),
             None => l.upload(index, sub, Mode::Auto),
         };
-        let text = cotui::decode::sdo::abort_text(code);
+        let text = cotui::sdo::abort_text(code);
         assert_eq!(
             c,
             Some(Completion::Failed {
@@ -280,7 +281,7 @@ fn server_aborts_reach_the_client_and_the_tracker() {
             Outcome::Aborted {
                 code,
                 text,
-                by: cotui::decode::sdo::Side::Server
+                by: cotui::sdo::Side::Server
             }
         );
         assert!(!l.server.is_busy());
@@ -344,7 +345,7 @@ fn bad_block_download_crc_is_aborted_by_the_server() {
         Outcome::Aborted {
             code,
             text,
-            by: cotui::decode::sdo::Side::Server
+            by: cotui::sdo::Side::Server
         }
     );
 }
@@ -376,7 +377,7 @@ fn bad_block_upload_crc_is_aborted_by_the_client() {
         t.outcome,
         Outcome::Aborted {
             code: 0x0504_0004,
-            by: cotui::decode::sdo::Side::Client,
+            by: cotui::sdo::Side::Client,
             ..
         }
     ));

@@ -2,10 +2,11 @@
 //! transaction; random transfers between client and server arrive intact, and the passive
 //! tracker reassembles exactly what was transferred.
 
-use cotui::decode::sdo::{Outcome, Protocol as P, SdoTracker, Transaction};
+use cotui::decode::sdo::SdoTracker;
 use cotui::od::{Access, Dictionary};
 use cotui::sdo::client::{ClientConfig, Completion, Mode, SdoClient};
 use cotui::sdo::server::{MemoryStore, SdoServer, ServerConfig};
+use cotui::sdo::{Outcome, Protocol as P, Transaction};
 use proptest::prelude::*;
 use std::collections::HashSet;
 
@@ -234,7 +235,7 @@ proptest! {
             .collect();
         prop_assert!(real.len() <= 1, "cut {}: {:#?}\n{:#?}", cut, txns, labels);
         for x in real {
-            prop_assert_eq!(x.direction == cotui::decode::sdo::TransferDirection::Upload, upload);
+            prop_assert_eq!(x.direction == cotui::sdo::TransferDirection::Upload, upload);
             if x.is_partial() {
                 prop_assert_eq!(x.protocol, P::Block);
                 prop_assert!(data.ends_with(&x.data) || x.outcome != Outcome::Ok, "cut {}: {:?}", cut, x);

@@ -1,8 +1,9 @@
 //! The SDO example frames of the four seed manuals (/work/shared/seeds/) decode
 //! as the manuals say. Each case quotes the manual line(s) it comes from.
 
-use cotui::decode::sdo::{Outcome, Problem, Protocol, SdoTracker, Transaction, TransferDirection};
+use cotui::decode::sdo::SdoTracker;
 use cotui::od::{DataType, Dictionary, ObjectInfo, Profile};
+use cotui::sdo::{Outcome, Problem, Protocol, Transaction, TransferDirection};
 use std::sync::Arc;
 
 /// A few standard objects, named as CiA 301 / CiA 402 name them.

@@ -7,11 +7,11 @@
 //! depends on it, and keeps back only the SDO frames whose transfer has not ended yet.
 
 use super::parse::{Expr, IdMatch, Term, Test};
-use crate::decode::sdo::frame::SdoCommand;
-use crate::decode::sdo::{Outcome, Transaction};
 use crate::decode::{Body, Decoded, Kind};
 use crate::frame::Flags;
 use crate::od::{Dictionary, Value};
+use crate::sdo::SdoCommand;
+use crate::sdo::{Outcome, Transaction};
 
 /// True, false, or not decidable from what is known yet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

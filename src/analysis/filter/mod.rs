@@ -28,8 +28,8 @@ pub use lex::Cmp;
 pub use parse::{CodePrefix, Expr, IdMatch, Term, Test, kinds};
 
 use crate::decode::Decoder;
-use crate::decode::sdo::Transaction;
 use crate::od::Dictionary;
+use crate::sdo::Transaction;
 
 /// Resolves object names and vendor aliases to (index, sub).
 pub trait Names {

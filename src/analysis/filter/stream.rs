@@ -5,8 +5,8 @@
 //! frames ([`crate::analysis::view::View`]).
 
 use super::{Facts, Filter, Subject, Transfer, Tri};
-use crate::decode::sdo::Transaction;
 use crate::decode::{Decoded, Kind};
+use crate::sdo::Transaction;
 use std::collections::{HashMap, VecDeque};
 
 /// One frame in the queue: its output when it matches, or what it takes to judge it.

@@ -1,18 +1,13 @@
-//! SDO (service data object) decoding: abort codes, per-frame meaning and
-//! passive reassembly of expedited, segmented and block transfers.
+//! SDO frames and transfers as the trace shows them: labels, JSON and values typed through
+//! the dictionary. The protocol itself (codec, tracker, transactions) is [`crate::sdo`].
 
-pub mod abort;
-pub mod crc;
 pub mod frame;
-pub mod resync;
 pub mod tracker;
 pub mod transaction;
 pub mod value;
 
-pub use abort::{abort_text, known_abort_text};
-pub use frame::{SdoCommand, SdoFrame, Side};
+pub use frame::SdoFrame;
 pub use tracker::SdoTracker;
-pub use transaction::{Channel, Outcome, Problem, Protocol, Transaction, TransferDirection};
 
 #[cfg(test)]
 mod tracker_tests;

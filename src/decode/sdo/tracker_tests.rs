@@ -1,8 +1,9 @@
 //! Tracker tests: every transfer path, as a user reading the trace would see it.
 
-use super::crc::crc16;
 use super::*;
 use crate::od::{DataType, Dictionary, ObjectInfo, Profile};
+use crate::sdo::crc::crc16;
+use crate::sdo::{Channel, Outcome, Problem, Protocol, Side, Transaction, TransferDirection};
 use std::sync::Arc;
 
 fn dict() -> Dictionary {
@@ -796,7 +797,7 @@ fn one_impossible_byte_invents_no_transaction() {
 
 #[test]
 fn a_transfer_that_never_ends_keeps_memory_flat() {
-    use super::transaction::{DATA_KEPT, FRAMES_KEPT};
+    use crate::sdo::transaction::{DATA_KEPT, FRAMES_KEPT};
     let mut bus = Bus::new();
     bus.c(2, &[0xC4, 0x50, 0x1F, 0x01, 0, 0, 0, 0]); // crc, size not indicated
     bus.s(2, &[0xA4, 0x50, 0x1F, 0x01, 127, 0, 0, 0]);
@@ -806,7 +807,7 @@ fn a_transfer_that_never_ends_keeps_memory_flat() {
     for b in 0..sub_blocks {
         for n in 1..=127u8 {
             let bytes = [byte(b * 127 + n as usize); 7];
-            crc = super::crc::crc16_update(crc, &bytes);
+            crc = crate::sdo::crc::crc16_update(crc, &bytes);
             bus.c(2, &segment(n, b + 1 == sub_blocks && n == 127, &bytes));
         }
         bus.s(2, &[0xA2, 127, 127, 0, 0, 0, 0, 0]);

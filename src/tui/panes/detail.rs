@@ -5,9 +5,9 @@
 use super::{Selected, block, duration, kind_color};
 use crate::analysis::trace::Trace;
 use crate::decode::cia402::{describe_controlword, describe_statusword};
-use crate::decode::sdo::{Outcome, SdoCommand, Side, Transaction};
 use crate::decode::{Body, Decoded};
 use crate::frame::Frame;
+use crate::sdo::{Outcome, SdoCommand, Side, Transaction};
 use ratatui::Frame as TermFrame;
 use ratatui::layout::Rect;
 use ratatui::style::{Color, Modifier, Style};

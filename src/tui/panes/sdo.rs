@@ -3,7 +3,7 @@
 
 use super::{Component, Ctx, ListState, Selected, block, duration, fit, header, selected};
 use crate::analysis::trace::Trace;
-use crate::decode::sdo::{Outcome, Transaction};
+use crate::sdo::{Outcome, Transaction};
 use crate::tui::keymap::Action;
 use ratatui::Frame;
 use ratatui::layout::Rect;
@@ -25,7 +25,7 @@ pub fn row_text(trace: &Trace, t: &Transaction, width: usize) -> String {
         Outcome::ProtocolError(e) => format!("error: {e}"),
         o => o.as_str().to_string(),
     };
-    let dir = if t.direction == crate::decode::sdo::TransferDirection::Upload {
+    let dir = if t.direction == crate::sdo::TransferDirection::Upload {
         "read "
     } else {
         "write"

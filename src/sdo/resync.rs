@@ -9,36 +9,12 @@
 //!   first bytes count up by one (segmented transfers alternate sides and toggle bit 4);
 //! - a block acknowledgement (`A2 ackseq blksize`) with no transfer running.
 
-use super::frame::{Chunk, Side};
-
-/// Whether `byte` is a command byte CiA 301 allows `side` to send, with every reserved
-/// bit zero (in an initiate, `n` is zero unless both `e` and `s` are set);
-/// `0xE0..=0xFF` (no command specifier 7) is left to the unknown-command handling.
-pub fn valid_command(side: Side, byte: u8) -> bool {
-    let initiate = |b: u8| b & 0x03 == 0x03 || b & 0x0C == 0;
-    match (side, byte) {
-        (_, 0x00..=0x1F) | (_, 0x80) | (_, 0xE0..=0xFF) => true,
-        (Side::Client, 0x20..=0x2F) | (Side::Server, 0x40..=0x4F) => initiate(byte),
-        (Side::Client, 0x40 | 0x60 | 0x70 | 0xA0..=0xA4) => true,
-        (Side::Server, 0x20 | 0x30 | 0x60 | 0xA0 | 0xA1 | 0xA2 | 0xA4) => true,
-        // Block initiates (cs 0, x bits zero) and ends (n, cs 1, bit 1 zero).
-        (_, 0xC0..=0xDF) => {
-            let initiate = byte & 1 == 0;
-            if initiate { byte & 0x19 == 0 } else { byte & 0x02 == 0 }
-        }
-        _ => false,
-    }
-}
-
-/// An end-of-block command byte (`110 n n n x 1`, either side).
-pub fn end_command(byte: u8) -> bool {
-    byte & 0xE3 == 0xC1
-}
+use super::codec::{Chunk, Side, command_allowed};
 
 /// A frame that no command explains: the first byte is `c | seqno` with seqno 1..=127.
 pub fn impossible_command(side: Side, payload: &[u8]) -> bool {
     match payload {
-        [first, ..] if payload.len() == 8 => first & 0x7F != 0 && !valid_command(side, *first),
+        [first, ..] if payload.len() == 8 => first & 0x7F != 0 && !command_allowed(side, *first),
         _ => false,
     }
 }
@@ -99,7 +75,7 @@ mod tests {
 
     #[test]
     fn every_command_the_codec_builds_is_valid() {
-        use super::super::frame::{SdoCommand, encode};
+        use crate::sdo::codec::{SdoCommand, encode};
         let c = Chunk::new(&[1, 2], 2);
         let cmds = [
             (Side::Client, SdoCommand::InitiateUpload { index: 1, sub: 0 }),
@@ -161,7 +137,7 @@ mod tests {
         ];
         for (side, cmd) in cmds {
             let p = encode(&cmd);
-            assert!(valid_command(side, p[0]), "{cmd:?} -> {:02X}", p[0]);
+            assert!(command_allowed(side, p[0]), "{cmd:?} -> {:02X}", p[0]);
             assert!(!impossible_command(side, &p), "{cmd:?}");
         }
     }
