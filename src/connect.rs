@@ -5,7 +5,7 @@
 use crate::bus::{Bus, BusError, socketcan};
 
 /// The interface name of the in-process simulated bus.
-pub const DEMO: &str = "demo";
+pub const DEMO: &str = crate::sim::demo::BUS_NAME;
 
 /// Opens `iface` (see the module doc). Must be called inside a tokio runtime.
 pub async fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {

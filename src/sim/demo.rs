@@ -5,6 +5,9 @@ use crate::bus::Bus;
 use crate::bus::virt::VirtualBus;
 use std::sync::{Arc, Mutex};
 
+/// The name of the demo bus (the IFACE that selects it, see [`crate::connect`]).
+pub const BUS_NAME: &str = "demo";
+
 /// A running demo bus: a handle for the user and the simulation behind it.
 #[derive(Clone)]
 pub struct Demo {
@@ -19,7 +22,7 @@ pub struct Demo {
 impl Demo {
     /// Starts `sim` on a new virtual bus called `demo`. Must be called inside a tokio runtime.
     pub fn spawn(sim: Simulation, listen_only: bool) -> Demo {
-        let vbus = VirtualBus::new(crate::connect::DEMO);
+        let vbus = VirtualBus::new(BUS_NAME);
         let node_side = vbus.endpoint(false);
         let sim = Arc::new(Mutex::new(sim));
         // Subscribe before the task starts so no frame sent from now on is missed.

@@ -2,6 +2,7 @@
 //! `cotui decode`/`diagnose`, log formats against can-utils, Wireshark's dissector, EDS import
 //! against python canopen, pcapng/Parquet read back by their own tools, fuzzing.
 
+mod architecture;
 mod decode_golden;
 mod decode_proptest;
 mod diagnose_golden;
