@@ -52,26 +52,59 @@ fn number(s: &str) -> Option<u32> {
     }
 }
 
+/// Why a `--node` does not parse.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum NodeSpecError {
+    #[error("--node {0}: expected NODE=MODEL[@SERIAL], e.g. 2=aimotor")]
+    Form(String),
+    #[error("--node {spec}: node-ID `{node}` is not 1..127 or ff")]
+    NodeId { spec: String, node: String },
+    #[error("--node {spec}: serial `{serial}` is not a number")]
+    Serial { spec: String, serial: String },
+    #[error("--node {spec}: unknown model `{model}` (use {MODELS})")]
+    Model { spec: String, model: String },
+}
+
+/// Why `cotui sim` stopped.
+#[derive(Debug, thiserror::Error)]
+enum SimError {
+    #[error("{path}: {source}")]
+    Eds { path: String, source: std::io::Error },
+    #[error("cannot install a signal handler: {0}")]
+    Signal(std::io::Error),
+    #[error(transparent)]
+    Bus(#[from] crate::bus::BusError),
+}
+
 /// Parses `NODE=MODEL[@SERIAL]`.
-pub fn parse_node(spec: &str) -> Result<(u8, DriveProfile), String> {
-    let (node, rest) = spec
-        .split_once('=')
-        .ok_or_else(|| format!("--node {spec}: expected NODE=MODEL[@SERIAL], e.g. 2=aimotor"))?;
+pub fn parse_node(spec: &str) -> Result<(u8, DriveProfile), NodeSpecError> {
+    let (node, rest) = spec.split_once('=').ok_or_else(|| NodeSpecError::Form(spec.into()))?;
     let node = match node.to_ascii_lowercase().as_str() {
         "ff" | "0xff" => 0xFF,
         n => match n.parse::<u8>() {
             Ok(v @ (1..=127 | 255)) => v,
-            _ => return Err(format!("--node {spec}: node-ID `{node}` is not 1..127 or ff")),
+            _ => {
+                return Err(NodeSpecError::NodeId {
+                    spec: spec.into(),
+                    node: node.into(),
+                });
+            }
         },
     };
     let (name, serial) = match rest.split_once('@') {
-        Some((m, s)) => (
-            m,
-            Some(number(s).ok_or_else(|| format!("--node {spec}: serial `{s}` is not a number"))?),
-        ),
+        Some((m, s)) => {
+            let serial = number(s).ok_or_else(|| NodeSpecError::Serial {
+                spec: spec.into(),
+                serial: s.into(),
+            })?;
+            (m, Some(serial))
+        }
         None => (rest, None),
     };
-    let mut profile = model(name).ok_or_else(|| format!("--node {spec}: unknown model `{name}` (use {MODELS})"))?;
+    let mut profile = model(name).ok_or_else(|| NodeSpecError::Model {
+        spec: spec.into(),
+        model: name.into(),
+    })?;
     profile.serial_number = serial;
     Ok((node, profile))
 }
@@ -127,24 +160,28 @@ pub fn run_sim(args: &SimArgs) -> ExitCode {
 }
 
 /// Writes every drive's EDS into `dir`.
-fn write_eds(dir: &std::path::Path, drives: &[Drive]) -> Result<(), String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+fn write_eds(dir: &std::path::Path, drives: &[Drive]) -> Result<(), SimError> {
+    let failed = |path: &std::path::Path| {
+        let path = path.display().to_string();
+        move |source| SimError::Eds { path, source }
+    };
+    std::fs::create_dir_all(dir).map_err(failed(dir))?;
     for d in drives {
         let name = match d.node() {
             0xFF => format!("lss-{}.eds", d.objects().uint(0x1018, 4)),
             n => format!("node{n}.eds"),
         };
         let path = dir.join(name);
-        std::fs::write(&path, d.eds()).map_err(|e| format!("{}: {e}", path.display()))?;
+        std::fs::write(&path, d.eds()).map_err(failed(&path))?;
     }
     Ok(())
 }
 
 /// Serves the simulation on `iface` until SIGINT/SIGTERM or a bus failure.
-async fn serve(iface: &str, sim: Arc<Mutex<Simulation>>) -> Result<(), String> {
-    let mut int = signal(SignalKind::interrupt()).map_err(|e| e.to_string())?;
-    let mut term = signal(SignalKind::terminate()).map_err(|e| e.to_string())?;
-    let bus = crate::connect::open(iface, false).await.map_err(|e| e.to_string())?;
+async fn serve(iface: &str, sim: Arc<Mutex<Simulation>>) -> Result<(), SimError> {
+    let mut int = signal(SignalKind::interrupt()).map_err(SimError::Signal)?;
+    let mut term = signal(SignalKind::terminate()).map_err(SimError::Signal)?;
+    let bus = crate::connect::open(iface, false).await?;
     let rx = bus.subscribe();
     if let Ok(s) = sim.lock() {
         for d in s.drives() {
@@ -178,11 +215,11 @@ async fn serve(iface: &str, sim: Arc<Mutex<Simulation>>) -> Result<(), String> {
     tokio::pin!(serving);
     loop {
         tokio::select! {
-            r = &mut serving => return r.map_err(|e| e.to_string()),
+            r = &mut serving => return Ok(r?),
             Some(line) = lines.recv() => {
                 let (text, frames) = control(&sim, &line, bus.now_ns());
                 println!("{text}");
-                send_all(&bus, &frames).await.map_err(|e| e.to_string())?;
+                send_all(&bus, &frames).await?;
             }
             _ = int.recv() => return Ok(()),
             _ = term.recv() => return Ok(()),
@@ -268,11 +305,16 @@ mod tests {
         assert_eq!((n, p.serial_number), (0xFF, Some(0x1234)));
         assert_eq!(parse_node("3=syntron-ds").unwrap().0, 3);
         assert_eq!(
-            parse_node("200=aimotor").unwrap_err(),
+            parse_node("200=aimotor").unwrap_err().to_string(),
             "--node 200=aimotor: node-ID `200` is not 1..127 or ff"
         );
-        assert!(parse_node("2=plc").unwrap_err().contains("unknown model `plc`"));
-        assert!(parse_node("2").unwrap_err().contains("expected NODE=MODEL"));
+        assert!(
+            parse_node("2=plc")
+                .unwrap_err()
+                .to_string()
+                .contains("unknown model `plc`")
+        );
+        assert!(parse_node("2").unwrap_err().to_string().contains("expected NODE=MODEL"));
     }
 
     #[test]

@@ -145,8 +145,27 @@ pub enum PlanError {
         procedure: String,
         step: usize,
         of: usize,
-        reason: String,
+        reason: StepError,
     },
+}
+
+/// Why one step of a procedure cannot be built.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum StepError {
+    #[error(transparent)]
+    Expr(#[from] crate::od::expr::ExprError),
+    #[error(transparent)]
+    Object(#[from] crate::od::alias::ObjectError),
+    #[error(transparent)]
+    Procedure(#[from] crate::od::procedure::ProcedureError),
+    #[error(transparent)]
+    Value(#[from] super::value::ValueError),
+    #[error("the type of {index:04X}:{sub:02X} is unknown (give `type` in the profile)")]
+    UnknownType { index: u16, sub: u8 },
+    #[error("NMT node {0} is not 0..127")]
+    NmtNode(i64),
+    #[error("frame id {0} is not a CAN id")]
+    FrameId(i64),
 }
 
 impl From<PlanError> for CommandError {
@@ -228,7 +247,7 @@ pub fn plan(dict: &Dictionary, node: u8, name: &str, args: &[(String, String)]) 
     let n = p.steps.len();
     let mut steps = Vec::with_capacity(n);
     for (i, step) in p.steps.iter().enumerate() {
-        let at = |reason: String| PlanError::Step {
+        let at = |reason: StepError| PlanError::Step {
             procedure: name.to_string(),
             step: i + 1,
             of: n,
@@ -256,7 +275,7 @@ fn plan_step(
     node: u8,
     step: &Step,
     vars: &dyn Fn(&str) -> Option<i64>,
-) -> Result<PlannedStep, String> {
+) -> Result<PlannedStep, StepError> {
     let typed = |index: u16, sub: u8| dict.object(index, sub).map(|o| o.data_type);
     Ok(match step {
         Step::SdoWrite {
@@ -266,10 +285,10 @@ fn plan_step(
         } => {
             let (index, sub) = resolve_object(dict, &fill_object(object, vars)?)?;
             let v = value.eval(vars)?;
-            let ty = data_type.or_else(|| typed(index, sub)).ok_or(format!(
-                "the type of {index:04X}:{sub:02X} is unknown (give `type` in the profile)"
-            ))?;
-            let data = encode(&v.to_string(), ty).map_err(|e| e.to_string())?;
+            let ty = data_type
+                .or_else(|| typed(index, sub))
+                .ok_or(StepError::UnknownType { index, sub })?;
+            let data = encode(&v.to_string(), ty)?;
             let shown = object_text(dict, index, sub, &ty.decode(&data), None);
             let text = format!("sdo write {} = {shown}", object_name(dict, index, sub));
             let frame = super::candump(&super::sdo::first_download_frame(node, index, sub, &data, false).0);
@@ -300,7 +319,7 @@ fn plan_step(
                     u8::try_from(t)
                         .ok()
                         .filter(|t| *t <= 127)
-                        .ok_or(format!("NMT node {t} is not 0..127"))?
+                        .ok_or(StepError::NmtNode(t))?
                 }
                 None => node,
             };
@@ -323,7 +342,7 @@ fn plan_step(
             let id = u32::try_from(id)
                 .ok()
                 .filter(|i| *i <= 0x1FFF_FFFF)
-                .ok_or(format!("frame id {id} is not a CAN id"))?;
+                .ok_or(StepError::FrameId(id))?;
             let f = Frame::classic(id, &frame_bytes(data, vars)?);
             let c = super::candump(&f);
             PlannedStep {

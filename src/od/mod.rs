@@ -27,24 +27,6 @@ pub use fields::{ByteField, SdoCommand, SdoDirection};
 pub use procedure::{Procedure, Step};
 pub use value::{DataType, Value};
 
-/// Lets the callers that still return `Result<_, String>` (the command runner, the
-/// palette, the CLI's binding loader) use `?` on this module's typed errors.
-macro_rules! message_from {
-    ($($t:ty),*) => {$(
-        impl From<$t> for String {
-            fn from(e: $t) -> String {
-                e.to_string()
-            }
-        }
-    )*};
-}
-message_from!(
-    expr::ExprError,
-    procedure::ProcedureError,
-    alias::ObjectError,
-    bind::BindError
-);
-
 use std::collections::BTreeMap;
 
 /// A problem found while loading a profile or EDS that did not stop the load.

@@ -55,7 +55,10 @@ fn rust_files(dir: &Path) -> Vec<PathBuf> {
 /// The code of a source file without its tests and comments.
 fn non_test(text: &str) -> String {
     let code = text.split("#[cfg(test)]").next().unwrap_or(text);
-    code.lines().filter(|l| !l.trim_start().starts_with("//")).collect::<Vec<_>>().join("\n")
+    code.lines()
+        .filter(|l| !l.trim_start().starts_with("//"))
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 #[test]
