@@ -13,20 +13,6 @@ pub struct Lss {
     pub args: [u8; 7],
 }
 
-/// CiA 305 bit timing table (table selector 0).
-const BIT_TIMING: [&str; 10] = [
-    "1000 kbit/s",
-    "800 kbit/s",
-    "500 kbit/s",
-    "250 kbit/s",
-    "125 kbit/s",
-    "reserved",
-    "50 kbit/s",
-    "20 kbit/s",
-    "10 kbit/s",
-    "auto",
-];
-
 impl Lss {
     fn u32_at1(&self) -> u32 {
         u32::from_le_bytes([self.args[0], self.args[1], self.args[2], self.args[3]])
@@ -77,11 +63,7 @@ impl Lss {
             (0x44, false) => "Switch state selective response".to_string(),
             (0x11, true) => format!("Configure node-id {}", self.args[0]),
             (0x13, true) => {
-                let rate = if self.args[0] == 0 {
-                    BIT_TIMING.get(self.args[1] as usize).copied()
-                } else {
-                    None
-                };
+                let rate = crate::lss::bit_rate_text(self.args[0], self.args[1]);
                 match rate {
                     Some(r) => format!("Configure bit timing: {r}"),
                     None => format!("Configure bit timing: table {} index {}", self.args[0], self.args[1]),
