@@ -159,6 +159,13 @@ pub fn plan(
             };
             (text, None)
         }
+        Command::Lss { action, .. } => (
+            action.preview(),
+            Some(format!(
+                "LSS {} addresses every LSS slave (in configuration state, or not yet configured)",
+                action.as_str()
+            )),
+        ),
         Command::Record { .. } => {
             return Err(CommandError::Usage(
                 "record runs from the command line (`cotui record IFACE -o FILE`)".into(),
@@ -261,6 +268,9 @@ mod tests {
             Some("broadcast NMT start to every node")
         );
         assert!(plan("nmt reset-node 4", &b(), |_| None).unwrap().confirm.is_some());
+        let p = plan("lss set-node 10", &b(), |_| None).unwrap();
+        assert_eq!(p.preview, "7E5#110A000000000000");
+        assert!(p.confirm.unwrap().contains("every LSS slave"));
         assert!(plan("sdo read 2 nonsense_object", &b(), |_| None).is_err());
     }
 }
