@@ -1,4 +1,4 @@
-//! The commander's command language, declared once. Each command (nmt, sdo read/write,
+//! The commander's command language, declared once. Each command (nmt, sdo read/write, lss,
 //! drive, run, scan, record, stop) is a clap declaration here: its words, flags, help text,
 //! checks and completion. The command line parses [`Commander`] with its bus options in
 //! front (`cotui sdo read IFACE 2 0x6041`, see `crate::cli`); the TUI palette parses the same
