@@ -293,8 +293,7 @@ pub struct StopArgs {
 /// `lss ACTION [WORDS...] [--timeout MS] [--vendor V] [--product P] [--store]`.
 #[derive(Args, Clone, Debug)]
 pub struct LssArgs {
-    /// switch, select, set-node, set-bitrate, activate-bitrate, store, inquire, identify,
-    /// identify-unconfigured, fastscan or assign.
+    /// The LSS service (its words follow).
     #[arg(value_parser = Words::new(LSS_WORDS, LssAction::verb))]
     pub action: String,
     /// The action's words: `switch [global] config|wait`, `select VENDOR PRODUCT REVISION

@@ -1,8 +1,10 @@
 //! What a commander line in the palette will do before it is sent: the exact frames, as
 //! the protocol layer builds them (the SDO client's first frame, the NMT frame, the CiA 402
-//! controlwords), and whether it needs confirming (broadcast NMT, resets, node 0).
+//! controlwords, the LSS requests), and whether it needs confirming (broadcast NMT, resets,
+//! node 0, LSS services that change state).
 
 use super::live::UNKNOWN_STATE;
+use crate::command::lss::LssAction;
 use crate::command::run::Action;
 use crate::command::{Command, CommandError, NmtAction, RunSpec, candump, drive, nmt, parse_command, sdo};
 use crate::decode::cia402::DriveState;
@@ -159,13 +161,20 @@ pub fn plan(
             };
             (text, None)
         }
-        Command::Lss { action, .. } => (
-            action.preview(),
-            Some(format!(
-                "LSS {} addresses every LSS slave (in configuration state, or not yet configured)",
-                action.as_str()
-            )),
-        ),
+        Command::Lss { action, .. } => {
+            // Inquire and identify only ask; the others change the state of every slave they reach.
+            let asks = matches!(
+                action,
+                LssAction::Inquire(_) | LssAction::Identify { .. } | LssAction::IdentifyUnconfigured
+            );
+            let confirm = (!asks).then(|| {
+                format!(
+                    "LSS {} addresses every LSS slave (in configuration state, or not yet configured)",
+                    action.as_str()
+                )
+            });
+            (action.preview(), confirm)
+        }
         Command::Record { .. } => {
             return Err(CommandError::Usage(
                 "record runs from the command line (`cotui record IFACE -o FILE`)".into(),
@@ -271,6 +280,8 @@ mod tests {
         let p = plan("lss set-node 10", &b(), |_| None).unwrap();
         assert_eq!(p.preview, "7E5#110A000000000000");
         assert!(p.confirm.unwrap().contains("every LSS slave"));
+        let p = plan("lss inquire serial", &b(), |_| None).unwrap();
+        assert_eq!((p.preview.as_str(), p.confirm), ("7E5#5D00000000000000", None));
         assert!(plan("sdo read 2 nonsense_object", &b(), |_| None).is_err());
     }
 }
