@@ -63,8 +63,14 @@ pub enum LssAction {
     /// `fastscan [--vendor V] [--product P]`: find one non-configured slave, leave it in
     /// configuration state.
     Fastscan { vendor: Option<u32>, product: Option<u32> },
-    /// `assign N [--store]`: fastscan, configure node-ID N, (store,) switch global waiting.
-    Assign { node: u8, store: bool },
+    /// `assign N [--store] [--vendor V] [--product P]`: fastscan (narrowed like `fastscan`),
+    /// configure node-ID N, (store,) switch global waiting.
+    Assign {
+        node: u8,
+        store: bool,
+        vendor: Option<u32>,
+        product: Option<u32>,
+    },
 }
 
 /// The words of the LSS commands, for help and completion.
@@ -85,9 +91,9 @@ pub const LSS_WORDS: &[&str] = &[
 /// The flags of `lss` that only some commands take.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct LssFlags {
-    /// `--vendor V` (fastscan).
+    /// `--vendor V` (fastscan, assign).
     pub vendor: Option<u32>,
-    /// `--product P` (fastscan).
+    /// `--product P` (fastscan, assign).
     pub product: Option<u32>,
     /// `--store` (assign).
     pub store: bool,
@@ -217,6 +223,8 @@ impl LssAction {
                 LssAction::Assign {
                     node,
                     store: flags.store,
+                    vendor: flags.vendor,
+                    product: flags.product,
                 }
             }
             other => return Err(Self::verb(other).err().unwrap_or(ParseError::Invalid(other.into()))),
@@ -224,9 +232,10 @@ impl LssAction {
         if flags.store && !matches!(action, LssAction::Assign { .. }) {
             return Err(ParseError::Invalid("--store goes with `lss assign`".into()));
         }
-        if (flags.vendor.is_some() || flags.product.is_some()) && !matches!(action, LssAction::Fastscan { .. }) {
+        let scans = matches!(action, LssAction::Fastscan { .. } | LssAction::Assign { .. });
+        if (flags.vendor.is_some() || flags.product.is_some()) && !scans {
             return Err(ParseError::Invalid(
-                "--vendor and --product go with `lss fastscan`".into(),
+                "--vendor and --product go with `lss fastscan` and `lss assign`".into(),
             ));
         }
         Ok(action)
@@ -286,7 +295,7 @@ impl LssAction {
                  left in configuration state"
                     .into()
             }
-            LssAction::Assign { node, store } => format!(
+            LssAction::Assign { node, store, .. } => format!(
                 "fastscan (about 130 frames 7E5#51..), then 7E5#11{node:02X}000000000000{}, then 7E5#0400000000000000",
                 if *store { ", 7E5#1700000000000000" } else { "" }
             ),
@@ -400,13 +409,21 @@ pub async fn lss(bus: &Bus, action: LssAction, timeout_ms: u64) -> Result<LssRep
                 None => "no non-configured LSS slave answered the fastscan".into(),
             };
         }
-        LssAction::Assign { node, store } => {
+        LssAction::Assign {
+            node,
+            store,
+            vendor,
+            product,
+        } => {
             r.services.push("fastscan");
-            let a = fastscan(bus, [None; 4], timeout_ms).await?.ok_or_else(|| {
-                CommandError::Timeout(
-                    "LSS assign: no non-configured LSS slave answered the fastscan (every slave has a node-ID?)".into(),
-                )
-            })?;
+            let a = fastscan(bus, [vendor, product, None, None], timeout_ms)
+                .await?
+                .ok_or_else(|| {
+                    CommandError::Timeout(
+                        "LSS assign: no non-configured LSS slave answered the fastscan (every slave has a node-ID?)"
+                            .into(),
+                    )
+                })?;
             r.address = Some(a);
             let mut services = vec![Service::ConfigureNodeId(node)];
             if store {
@@ -686,12 +703,30 @@ mod tests {
             ],
         );
         let bus = vbus.endpoint(false);
-        let first = lss(&bus, LssAction::Assign { node: 10, store: true }, 30)
-            .await
-            .unwrap();
-        let second = lss(&bus, LssAction::Assign { node: 11, store: false }, 30)
-            .await
-            .unwrap();
+        let first = lss(
+            &bus,
+            LssAction::Assign {
+                node: 10,
+                store: true,
+                vendor: None,
+                product: None,
+            },
+            30,
+        )
+        .await
+        .unwrap();
+        let second = lss(
+            &bus,
+            LssAction::Assign {
+                node: 11,
+                store: false,
+                vendor: Some(0x3A),
+                product: None,
+            },
+            30,
+        )
+        .await
+        .unwrap();
         let none = lss(
             &bus,
             LssAction::Fastscan {

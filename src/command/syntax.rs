@@ -301,10 +301,10 @@ pub struct LssArgs {
     /// [vendor|product|revision|serial|node|all]`, `identify VENDOR PRODUCT REV_LO REV_HI
     /// SER_LO SER_HI`, `assign N`.
     pub words: Vec<String>,
-    /// fastscan: only a slave with this vendor-ID.
+    /// fastscan, assign: only a slave with this vendor-ID.
     #[arg(long, value_parser = u32_arg)]
     pub vendor: Option<u32>,
-    /// fastscan: only a slave with this product code.
+    /// fastscan, assign: only a slave with this product code.
     #[arg(long, value_parser = u32_arg)]
     pub product: Option<u32>,
     /// assign: also store the configuration.
@@ -744,7 +744,12 @@ mod tests {
         assert_eq!(
             parse_command("lss assign 10 --store").unwrap(),
             Command::Lss {
-                action: LssAction::Assign { node: 10, store: true },
+                action: LssAction::Assign {
+                    node: 10,
+                    store: true,
+                    vendor: None,
+                    product: None
+                },
                 timeout_ms: FASTSCAN_TIMEOUT_MS
             }
         );

@@ -67,6 +67,7 @@ fn the_palette_and_the_command_line_give_the_same_command_or_the_same_error() {
         "lss inquire",
         "lss fastscan --vendor 0x3A --product 0x1234",
         "lss assign 10 --store",
+        "lss assign 12 --vendor 0 --product 0x04020001",
     ];
     for line in good {
         let (p, c) = (palette(line), cli(line));
@@ -143,7 +144,10 @@ fn the_palette_and_the_command_line_give_the_same_command_or_the_same_error() {
             "lss set-node 200",
             "node-ID `200` must be 1..127 (or 255 = unconfigured for set-node)",
         ),
-        ("lss store --vendor 1", "--vendor and --product go with `lss fastscan`"),
+        (
+            "lss store --vendor 1",
+            "--vendor and --product go with `lss fastscan` and `lss assign`",
+        ),
         (
             "lss select 1 2 3",
             "`lss select` takes VENDOR PRODUCT REVISION SERIAL (got 3 words)",

@@ -710,11 +710,14 @@ kill -TERM $sim; wait $sim && ok "sim: SIGTERM ends cotui sim with status 0" || 
 # (serial 0x99) and leaves it in configuration state: set-node 10, switch wait; assign 11
 # --store gives the other one its node-ID. candump sees the frames;
 # after NMT reset communication both answer SDO at their new node-IDs with their serials.
-# --timeout 60: the simulator under TCG may answer a fastscan request late.
+# Under TCG on a loaded machine the simulator answers late: --timeout 150 per fastscan
+# request, and the vendor and product cotui sim prints are given so that only revision and
+# serial are scanned (about 70 requests).
 "$cotui" sim vcan0 --node ff=servo@0x99 --node ff=servo@0x1234 < /dev/null > lsim.out 2>&1 &
 lsim=$!
 pids+=($lsim)
 wait_for lsim.out 300 "commands on stdin" || bad "lss: cotui sim start: $(cat lsim.out)"
+known="--vendor $(grep -m1 -oE 'vendor 0x[0-9A-F]+' lsim.out | cut -d' ' -f2) --product $(grep -m1 -oE 'product 0x[0-9A-F]+' lsim.out | cut -d' ' -f2)"
 candump -L vcan0,7E4:7FE > lss.log 2> /dev/null &
 lss_dump=$!
 wait_socket $lss_dump || bad "lss: candump opened no socket"
@@ -722,12 +725,12 @@ c lss vcan0 inquire node --json
 [ $rc = 4 ] && [ "$(j .error <<< "$out")" = timeout ] && grep -q "no answer from an LSS slave within 100 ms" cmd.err &&
     ok "lss: inquire node with no slave in configuration -> exit 4, 'no answer from an LSS slave within 100 ms'" ||
     bad "lss inquire without configuration: rc=$rc $out $err"
-c lss vcan0 fastscan --json --timeout 60
+c lss vcan0 fastscan $known --json --timeout 150
 [ $rc = 0 ] && [ "$(j .found <<< "$out")" = true ] && [ "$(j .address.serial <<< "$out")" = 153 ] &&
     ok "lss: fastscan finds the drive with serial 0x99" || bad "lss fastscan: rc=$rc $out $err"
 c lss vcan0 set-node 10 && c2=$rc && c lss vcan0 switch wait
 [ "$c2$rc" = 00 ] && ok "lss: set-node 10 on the slave found, switch wait" || bad "lss set-node/switch: $c2 $rc $out $err"
-c lss vcan0 assign 11 --store --json --timeout 60
+c lss vcan0 assign 11 --store $known --json --timeout 150
 [ $rc = 0 ] && [ "$(j .address.serial <<< "$out")" = 4660 ] && [ "$(j .stored <<< "$out")" = true ] &&
     ok "lss: assign 11 --store finds the drive with serial 0x1234 and configures it" || bad "lss assign: rc=$rc $out $err"
 c lss vcan0 --listen-only switch config
