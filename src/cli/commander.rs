@@ -1,4 +1,4 @@
-//! The commander subcommands (`cotui nmt|sdo|drive|run|scan|record|stop IFACE ...`): the
+//! The commander subcommands (`cotui nmt|sdo|drive|run|scan|record|stop|lss IFACE ...`): the
 //! declaration of [`crate::command::syntax`] with the bus options in front, the tokio
 //! runtime, opening the bus and printing one result or failure.
 
@@ -71,6 +71,7 @@ fn what(c: &CliCommander) -> &'static str {
         Commander::Scan(_) => "scan",
         Commander::Record(_) => "record",
         Commander::Stop(_) => "stop",
+        Commander::Lss(_) => "lss",
     }
 }
 

@@ -52,7 +52,7 @@ pub enum Command {
     Live(tui::LiveArgs),
     /// The interactive analyzer on an in-process bus with simulated CiA 402 drives.
     Demo(tui::DemoArgs),
-    /// The commander: nmt, sdo, drive, run, scan, record, stop (see docs/COMMANDER.md).
+    /// The commander: nmt, sdo, drive, run, scan, record, stop, lss (see docs/COMMANDER.md).
     #[command(flatten)]
     Commander(commander::CliCommander),
     /// Simulated CiA 402 drives on a SocketCAN interface for other tools to talk to (SDO,

@@ -17,7 +17,7 @@ pub enum ExitCode {
     /// 2: input or bus unavailable (missing, down, no permission, listen-only), or a
     /// recording with gaps.
     Unavailable = 2,
-    /// 3: SDO abort.
+    /// 3: SDO abort, or an LSS slave refused a configuration.
     Abort = 3,
     /// 4: timeout (an SDO answer, or a transfer's deadline).
     Timeout = 4,
@@ -70,6 +70,14 @@ pub enum CommandError {
     /// No answer in time.
     #[error("{0}")]
     Timeout(String),
+    /// An LSS slave answered a configure or store service with an error code.
+    #[error("LSS {service}: the slave refused: {text} (error code {error})")]
+    LssRefused {
+        service: &'static str,
+        error: u8,
+        spec: u8,
+        text: String,
+    },
     /// A drive sequence step did not happen; `reason` says why, from what the bus shows.
     #[error("drive {node}: {step} failed: {reason}")]
     Drive { node: u8, step: String, reason: String },
@@ -98,7 +106,7 @@ impl CommandError {
         match self {
             CommandError::Syntax(_) | CommandError::Usage(_) => ExitCode::Usage,
             CommandError::Bus(_) => ExitCode::Unavailable,
-            CommandError::Abort { .. } => ExitCode::Abort,
+            CommandError::Abort { .. } | CommandError::LssRefused { .. } => ExitCode::Abort,
             CommandError::Timeout(_) => ExitCode::Timeout,
             CommandError::Drive { .. } => ExitCode::Drive,
             CommandError::Step { cause, .. } => cause.exit_code(),
@@ -142,6 +150,20 @@ impl CommandError {
                 aborted_by: if *by_server { "server" } else { "client" },
                 message,
                 reason: reason.as_deref(),
+            }),
+            CommandError::LssRefused {
+                service,
+                error,
+                spec,
+                text,
+            } => to_json(&LssRefused {
+                ok: false,
+                error: "lss_refused",
+                service,
+                error_code: *error,
+                spec_error: *spec,
+                reason: text,
+                message,
             }),
             CommandError::NotStopped { report, .. } => {
                 let mut v = (**report).clone();
@@ -210,6 +232,18 @@ struct DriveFailed<'a> {
     error: &'static str,
     node: u8,
     step: &'a str,
+    reason: &'a str,
+    message: String,
+}
+
+/// The JSON of an LSS configuration the slave refused.
+#[derive(Serialize)]
+struct LssRefused<'a> {
+    ok: bool,
+    error: &'static str,
+    service: &'a str,
+    error_code: u8,
+    spec_error: u8,
     reason: &'a str,
     message: String,
 }

@@ -112,6 +112,7 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
                 nodes: nodes.iter().map(|n| n.to_json()).collect(),
             })
         }
+        Command::Lss { action, timeout_ms } => to_json(&super::lss::lss(bus, *action, *timeout_ms).await?),
         Command::Record {
             output,
             limits,
@@ -316,6 +317,7 @@ pub fn text(cmd: &Command, v: &Json) -> String {
             t
         }
         Command::Scan { .. } => scan_text(v),
+        Command::Lss { .. } => s(&v["text"]).to_string(),
         Command::Record { .. } => format!("{} frames written to {}", v["frames"], s(&v["output"])),
         Command::Run(_) => run_summary(v),
         // A stop's text comes from its report (see `stop::StopReport::text`).

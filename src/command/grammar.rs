@@ -231,6 +231,12 @@ pub enum Command {
         listen_ms: u64,
         options: super::stop::StopOptions,
     },
+    /// `lss ACTION [WORDS...] [--timeout MS] [--vendor V] [--product P] [--store]`: an LSS
+    /// master service (CiA 305), addressed to every slave in configuration state.
+    Lss {
+        action: super::lss::LssAction,
+        timeout_ms: u64,
+    },
 }
 
 /// What `run` runs: a procedure of a node with its parameters, or (no procedure) the list.

@@ -1,10 +1,11 @@
-//! The commander: NMT, SDO, CiA 402 drive sequences, scan and record, as a library
+//! The commander: NMT, SDO, LSS, CiA 402 drive sequences, scan and record, as a library
 //! API shared by the command line and the TUI palette.
 
 pub mod drive;
 pub mod error;
 pub mod exec;
 pub mod grammar;
+pub mod lss;
 pub mod nmt;
 pub mod record;
 pub mod run;

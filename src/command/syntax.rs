@@ -1,4 +1,4 @@
-//! The commander's command language, declared once. Each command (nmt, sdo read/write,
+//! The commander's command language, declared once. Each command (nmt, sdo read/write, lss,
 //! drive, run, scan, record, stop) is a clap declaration here: its words, flags, help text,
 //! checks and completion. The command line parses [`Commander`] with its bus options in
 //! front (`cotui sdo read IFACE 2 0x6041`, see `crate::cli`); the TUI palette parses the same
@@ -10,6 +10,7 @@ use super::grammar::{
     Command, DEFAULT_TIMEOUT_MS, DriveAction, NMT_WAIT_MS, NmtAction, SCAN_LISTEN_MS, SCAN_TIMEOUT_MS, SdoOptions,
     parse_int, parse_node, parse_type, run_spec,
 };
+use super::lss::{FASTSCAN_TIMEOUT_MS, LSS_TIMEOUT_MS, LSS_WORDS, LssAction, LssFlags};
 use super::record::{Limits, LogFormat, WriteMode};
 use super::stop::{DEFAULT_LISTEN_MS, DEFAULT_RAMP_MS, StopOptions};
 use crate::od::DataType;
@@ -106,6 +107,9 @@ pub enum Commander<B: Args, D: Args> {
     /// Emergency stop: quick stop, then disable voltage, on every CiA 402 drive found powered
     /// (or the nodes named); reads each statusword back. Exit 0 only when all are confirmed.
     Stop(On<B, StopArgs>),
+    /// LSS master (CiA 305): switch, select, set-node, set-bitrate, activate-bitrate, store,
+    /// inquire, identify, identify-unconfigured, fastscan, or assign N (fastscan + set-node).
+    Lss(On<B, LssArgs>),
 }
 
 /// `sdo read` and `sdo write`.
@@ -286,6 +290,59 @@ pub struct StopArgs {
     pub timeout: u64,
 }
 
+/// `lss ACTION [WORDS...] [--timeout MS] [--vendor V] [--product P] [--store]`.
+#[derive(Args, Clone, Debug)]
+pub struct LssArgs {
+    /// The LSS service (its words follow).
+    #[arg(value_parser = Words::new(LSS_WORDS, LssAction::verb))]
+    pub action: String,
+    /// The action's words: `switch [global] config|wait`, `select VENDOR PRODUCT REVISION
+    /// SERIAL`, `set-node N`, `set-bitrate KBIT`, `activate-bitrate DELAY_MS`, `inquire
+    /// [vendor|product|revision|serial|node|all]`, `identify VENDOR PRODUCT REV_LO REV_HI
+    /// SER_LO SER_HI`, `assign N`.
+    pub words: Vec<String>,
+    /// fastscan, assign: only a slave with this vendor-ID.
+    #[arg(long, value_parser = u32_arg)]
+    pub vendor: Option<u32>,
+    /// fastscan, assign: only a slave with this product code.
+    #[arg(long, value_parser = u32_arg)]
+    pub product: Option<u32>,
+    /// assign: also store the configuration.
+    #[arg(long)]
+    pub store: bool,
+    /// How long to wait for each answer, in ms [default: 100; fastscan and assign: 30 per
+    /// fastscan request].
+    #[arg(long, value_parser = ms_arg)]
+    pub timeout: Option<u64>,
+}
+
+impl LssArgs {
+    fn command(&self) -> Result<Command, ParseError> {
+        let flags = LssFlags {
+            vendor: self.vendor,
+            product: self.product,
+            store: self.store,
+        };
+        let action = LssAction::parse(&self.action, &self.words, flags)?;
+        let default = match action {
+            LssAction::Fastscan { .. } | LssAction::Assign { .. } => FASTSCAN_TIMEOUT_MS,
+            _ => LSS_TIMEOUT_MS,
+        };
+        Ok(Command::Lss {
+            action,
+            timeout_ms: self.timeout.unwrap_or(default),
+        })
+    }
+}
+
+/// Parses a 32-bit number (decimal or 0x hex).
+fn u32_arg(text: &str) -> Result<u32, ParseError> {
+    parse_int(text)
+        .filter(|v| (0..=i64::from(u32::MAX)).contains(v))
+        .map(|v| v as u32)
+        .ok_or_else(|| ParseError::Invalid(format!("`{text}` must be a number 0..0xFFFFFFFF")))
+}
+
 impl<B: Args, D: Args> Commander<B, D> {
     /// The options in front of the command (the command line's bus options).
     pub fn bus(&self) -> &B {
@@ -298,6 +355,7 @@ impl<B: Args, D: Args> Commander<B, D> {
             Commander::Scan(o) => &o.bus,
             Commander::Record(o) => &o.bus,
             Commander::Stop(o) => &o.bus,
+            Commander::Lss(o) => &o.bus,
         }
     }
 
@@ -371,6 +429,7 @@ impl<B: Args, D: Args> Commander<B, D> {
                     },
                 }
             }
+            Commander::Lss(On { args: a, .. }) => a.command()?,
         })
     }
 }
@@ -671,6 +730,37 @@ mod tests {
         );
         assert_eq!(err("scan extra"), "unexpected argument 'extra' found");
         assert_eq!(parse_command("sdo read 2 \"0x6041"), Err(ParseError::Quote));
+        assert!(err("lss fly").contains("unknown LSS command `fly`"));
+        assert_eq!(
+            err("lss set-node"),
+            "`lss set-node` takes a node-ID N (1..127, 255 = unconfigured) (got 0 words)"
+        );
+        assert_eq!(err("lss inquire node --store"), "--store goes with `lss assign`");
+    }
+
+    #[test]
+    fn lss_lines() {
+        use crate::command::lss::{FASTSCAN_TIMEOUT_MS, Inquiry, LssAction};
+        assert_eq!(
+            parse_command("lss assign 10 --store").unwrap(),
+            Command::Lss {
+                action: LssAction::Assign {
+                    node: 10,
+                    store: true,
+                    vendor: None,
+                    product: None
+                },
+                timeout_ms: FASTSCAN_TIMEOUT_MS
+            }
+        );
+        assert_eq!(
+            parse_command("lss inquire serial --timeout 50").unwrap(),
+            Command::Lss {
+                action: LssAction::Inquire(Inquiry::Part(crate::lss::Part::Serial)),
+                timeout_ms: 50
+            }
+        );
+        assert!(completions("lss ").contains(&"fastscan".to_string()));
     }
 
     #[test]
@@ -703,7 +793,7 @@ mod tests {
     fn completion_comes_from_the_declaration() {
         assert_eq!(
             commander_words(),
-            ["nmt", "sdo", "drive", "run", "scan", "record", "stop"]
+            ["nmt", "sdo", "drive", "run", "scan", "record", "stop", "lss"]
         );
         assert_eq!(completions("sdo "), ["read", "write"]);
         assert_eq!(completions("nmt re"), NMT_WORDS);

@@ -33,7 +33,8 @@ impl Lss {
             (0x4F, false) => "identify_slave",
             (0x50, false) => "identify_non_configured_slave",
             (0x51, true) => "fastscan",
-            (0x5A..=0x5E, _) => "inquire_identity",
+            (0x5A..=0x5D, _) => "inquire_identity",
+            (0x5E, _) => "inquire_node_id",
             _ => "unknown",
         }
     }
@@ -62,25 +63,18 @@ impl Lss {
             (0x40..=0x43, true) => format!("Switch state selective {} = 0x{:08X}", field(self.cs), self.u32_at1()),
             (0x44, false) => "Switch state selective response".to_string(),
             (0x11, true) => format!("Configure node-id {}", self.args[0]),
-            (0x13, true) => {
-                let rate = crate::lss::bit_rate_text(self.args[0], self.args[1]);
-                match rate {
-                    Some(r) => format!("Configure bit timing: {r}"),
-                    None => format!("Configure bit timing: table {} index {}", self.args[0], self.args[1]),
-                }
-            }
+            (0x13, true) => match crate::lss::bit_rate_text(self.args[0], self.args[1]) {
+                Some(r) => format!("Configure bit timing: {r}"),
+                None => format!("Configure bit timing: table {} index {}", self.args[0], self.args[1]),
+            },
             (0x11 | 0x13 | 0x17, false) => {
                 let what = match self.cs {
                     0x11 => "Configure node-id",
                     0x13 => "Configure bit timing",
                     _ => "Store configuration",
                 };
-                match self.args[0] {
-                    0 => format!("{what} response: success"),
-                    1 => format!("{what} response: not supported/out of range"),
-                    0xFF => format!("{what} response: manufacturer error 0x{:02X}", self.args[1]),
-                    e => format!("{what} response: error {e}"),
-                }
+                let text = crate::lss::configure_error_text(self.cs, self.args[0], self.args[1]);
+                format!("{what} response: {text}")
             }
             (0x15, true) => format!(
                 "Activate bit timing, switch delay {} ms",
@@ -96,8 +90,11 @@ impl Lss {
                 )
             }
             (0x4C, true) => "Identify non-configured remote slave".to_string(),
-            (0x4F, false) => "Identify slave response".to_string(),
+            (0x4F, false) => "Identify slave response (identify remote slave, fastscan)".to_string(),
             (0x50, false) => "Identify non-configured slave response".to_string(),
+            (0x51, true) if self.args[4] == crate::lss::FASTSCAN_RESET => {
+                "Fastscan reset (every non-configured slave answers)".to_string()
+            }
             (0x51, true) => format!(
                 "Fastscan id 0x{:08X} bitcheck {} sub {} next {}",
                 self.u32_at1(),
@@ -181,6 +178,10 @@ mod tests {
             "LSS master: Inquire node-id"
         );
         assert_eq!(
+            decode(&[0x51, 0, 0, 0, 0, 0x80, 0, 0], true).0.label(),
+            "LSS master: Fastscan reset (every non-configured slave answers)"
+        );
+        assert_eq!(
             decode(&[0x51, 0, 0, 0, 0x80, 31, 0, 0], true).0.label(),
             "LSS master: Fastscan id 0x80000000 bitcheck 31 sub 0 next 0"
         );
@@ -191,6 +192,18 @@ mod tests {
         assert_eq!(
             decode(&[0x11, 0, 0, 0, 0, 0, 0, 0], false).0.label(),
             "LSS slave: Configure node-id response: success"
+        );
+        assert_eq!(
+            decode(&[0x11, 1, 0, 0, 0, 0, 0, 0], false).0.label(),
+            "LSS slave: Configure node-id response: node-ID out of range (1..127 or 255)"
+        );
+        assert_eq!(
+            decode(&[0x17, 0xFF, 0x21, 0, 0, 0, 0, 0], false).0.label(),
+            "LSS slave: Store configuration response: manufacturer-specific error 0x21"
+        );
+        assert_eq!(
+            decode(&[0x5E, 7, 0, 0, 0, 0, 0, 0], false).0.service(),
+            "inquire_node_id"
         );
         assert_eq!(
             decode(&[0x5E, 7, 0, 0, 0, 0, 0, 0], false).0.label(),

@@ -1,8 +1,10 @@
 //! What a commander line in the palette will do before it is sent: the exact frames, as
 //! the protocol layer builds them (the SDO client's first frame, the NMT frame, the CiA 402
-//! controlwords), and whether it needs confirming (broadcast NMT, resets, node 0).
+//! controlwords, the LSS requests), and whether it needs confirming (broadcast NMT, resets,
+//! node 0, LSS services that change state).
 
 use super::live::UNKNOWN_STATE;
+use crate::command::lss::LssAction;
 use crate::command::run::Action;
 use crate::command::{Command, CommandError, NmtAction, RunSpec, candump, drive, nmt, parse_command, sdo};
 use crate::decode::cia402::DriveState;
@@ -159,6 +161,20 @@ pub fn plan(
             };
             (text, None)
         }
+        Command::Lss { action, .. } => {
+            // Inquire and identify only ask; the others change the state of every slave they reach.
+            let asks = matches!(
+                action,
+                LssAction::Inquire(_) | LssAction::Identify { .. } | LssAction::IdentifyUnconfigured
+            );
+            let confirm = (!asks).then(|| {
+                format!(
+                    "LSS {} addresses every LSS slave (in configuration state, or not yet configured)",
+                    action.as_str()
+                )
+            });
+            (action.preview(), confirm)
+        }
         Command::Record { .. } => {
             return Err(CommandError::Usage(
                 "record runs from the command line (`cotui record IFACE -o FILE`)".into(),
@@ -261,6 +277,11 @@ mod tests {
             Some("broadcast NMT start to every node")
         );
         assert!(plan("nmt reset-node 4", &b(), |_| None).unwrap().confirm.is_some());
+        let p = plan("lss set-node 10", &b(), |_| None).unwrap();
+        assert_eq!(p.preview, "7E5#110A000000000000");
+        assert!(p.confirm.unwrap().contains("every LSS slave"));
+        let p = plan("lss inquire serial", &b(), |_| None).unwrap();
+        assert_eq!((p.preview.as_str(), p.confirm), ("7E5#5D00000000000000", None));
         assert!(plan("sdo read 2 nonsense_object", &b(), |_| None).is_err());
     }
 }

@@ -61,6 +61,13 @@ fn the_palette_and_the_command_line_give_the_same_command_or_the_same_error() {
         "stop",
         "stop 2 3 --ramp 300",
         "stop --node 2 --node 4 --listen 100",
+        "lss switch global config",
+        "lss select 0x3A 0x1234 2 0x99",
+        "lss set-bitrate 250 --timeout 50",
+        "lss inquire",
+        "lss fastscan --vendor 0x3A --product 0x1234",
+        "lss assign 10 --store",
+        "lss assign 12 --vendor 0 --product 0x04020001",
     ];
     for line in good {
         let (p, c) = (palette(line), cli(line));
@@ -132,6 +139,18 @@ fn the_palette_and_the_command_line_give_the_same_command_or_the_same_error() {
         (
             "stop 0",
             "invalid value '0' for '[NODES]...': node `0` must be a number 1..127 (decimal or 0x hex)",
+        ),
+        (
+            "lss set-node 200",
+            "node-ID `200` must be 1..127 (or 255 = unconfigured for set-node)",
+        ),
+        (
+            "lss store --vendor 1",
+            "--vendor and --product go with `lss fastscan` and `lss assign`",
+        ),
+        (
+            "lss select 1 2 3",
+            "`lss select` takes VENDOR PRODUCT REVISION SERIAL (got 3 words)",
         ),
     ];
     for (line, want) in bad {

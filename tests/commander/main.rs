@@ -7,6 +7,7 @@ mod cli_commander;
 mod cli_run;
 mod command_language;
 mod commander_demo;
+mod lss_sim;
 mod procedure_run;
 mod sdo_client_misbehave;
 mod sdo_client_server;

@@ -704,6 +704,54 @@ wait_for simdump.txt 100 "702#00" && ok "sim: 'reboot 2' -> boot-up 702#00" || b
 kill $simdump; exec 7>&-
 kill -TERM $sim; wait $sim && ok "sim: SIGTERM ends cotui sim with status 0" || bad "sim exit status"
 
+# ---- 11. lss: cotui's LSS master against cotui sim's drives without node-ID ----------------
+# Two simulated drives with node-ID 0xFF (LSS serials 0x99 and 0x1234). No slave in
+# configuration state: inquire gets no answer (exit 4). fastscan finds the lower address
+# (serial 0x99) and leaves it in configuration state: set-node 10, switch wait; assign 11
+# --store gives the other one its node-ID. candump sees the frames;
+# after NMT reset communication both answer SDO at their new node-IDs with their serials.
+# Under TCG on a loaded machine the simulator answers late: --timeout 150 per fastscan
+# request, and the vendor and product cotui sim prints are given so that only revision and
+# serial are scanned (about 70 requests).
+"$cotui" sim vcan0 --node ff=servo@0x99 --node ff=servo@0x1234 < /dev/null > lsim.out 2>&1 &
+lsim=$!
+pids+=($lsim)
+wait_for lsim.out 300 "commands on stdin" || bad "lss: cotui sim start: $(cat lsim.out)"
+known="--vendor $(grep -m1 -oE 'vendor 0x[0-9A-F]+' lsim.out | cut -d' ' -f2) --product $(grep -m1 -oE 'product 0x[0-9A-F]+' lsim.out | cut -d' ' -f2)"
+candump -L vcan0,7E4:7FE > lss.log 2> /dev/null &
+lss_dump=$!
+wait_socket $lss_dump || bad "lss: candump opened no socket"
+c lss vcan0 inquire node --json
+[ $rc = 4 ] && [ "$(j .error <<< "$out")" = timeout ] && grep -q "no answer from an LSS slave within 100 ms" cmd.err &&
+    ok "lss: inquire node with no slave in configuration -> exit 4, 'no answer from an LSS slave within 100 ms'" ||
+    bad "lss inquire without configuration: rc=$rc $out $err"
+c lss vcan0 fastscan $known --json --timeout 150
+[ $rc = 0 ] && [ "$(j .found <<< "$out")" = true ] && [ "$(j .address.serial <<< "$out")" = 153 ] &&
+    ok "lss: fastscan finds the drive with serial 0x99" || bad "lss fastscan: rc=$rc $out $err"
+c lss vcan0 set-node 10 && c2=$rc && c lss vcan0 switch wait
+[ "$c2$rc" = 00 ] && ok "lss: set-node 10 on the slave found, switch wait" || bad "lss set-node/switch: $c2 $rc $out $err"
+c lss vcan0 assign 11 --store $known --json --timeout 150
+[ $rc = 0 ] && [ "$(j .address.serial <<< "$out")" = 4660 ] && [ "$(j .stored <<< "$out")" = true ] &&
+    ok "lss: assign 11 --store finds the drive with serial 0x1234 and configures it" || bad "lss assign: rc=$rc $out $err"
+c lss vcan0 --listen-only switch config
+[ $rc = 2 ] && grep -q "listen-only" cmd.err && ok "lss --listen-only: refused with exit 2" || bad "lss listen-only: rc=$rc $err"
+sleep 0.3
+kill -INT $lss_dump
+wait $lss_dump
+grep -q " 7E5#110A000000000000" lss.log && grep -q " 7E4#1100000000000000" lss.log &&
+    grep -q " 7E5#110B000000000000" lss.log && grep -q " 7E4#1700000000000000" lss.log &&
+    [ "$(grep -c ' 7E5#0401' lss.log)" = 0 ] &&
+    ok "lss: candump saw configure node-ID 10 and 11, their successes, assign's store, nothing from --listen-only" ||
+    bad "lss frames: $(grep -v '#51' lss.log | tail -20)"
+c nmt vcan0 reset-comm 0
+c sdo read vcan0 10 0x1018:04 --json
+s10=$(j .value <<< "$out")
+c sdo read vcan0 11 0x1018:04 --json
+[ "$s10" = 153 ] && [ "$(j .value <<< "$out")" = 4660 ] &&
+    ok "lss: after NMT reset-comm, SDO 0x1018:04 of node 10 = 0x99, of node 11 = 0x1234" ||
+    bad "lss sdo after reset: node 10 '$s10', node 11 rc=$rc $out $err"
+kill -TERM $lsim; wait $lsim
+
 t_end=$(date +%s.%N)
 echo "$passed passed, $failed failed ($(awk -v a="$t_start" -v b="$t_end" 'BEGIN { printf "%.0f", b - a }') s in the guest)"
 [ "$failed" = 0 ]

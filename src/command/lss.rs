@@ -1,0 +1,891 @@
+//! LSS master commands (CiA 305) over a [`Bus`]: the IO around the pure
+//! [`crate::lss::master`] exchanges and [`crate::lss::fastscan`].
+//!
+//! Requests go out on 0x7E5, answers are read from 0x7E4. The clock is the bus's
+//! ([`Bus::now_ns`], the clock of the receive timestamps): before a deadline is judged at
+//! `now`, the loop gives the bus reader a turn and feeds every frame already queued, so a
+//! busy machine does not turn a prompt answer into a timeout. A listen-only bus refuses the
+//! first send ([`crate::bus::BusError::ListenOnly`]).
+
+use super::error::CommandError;
+use super::grammar::parse_int;
+use super::syntax::ParseError;
+use crate::bus::{Bus, BusError};
+use crate::frame::{Direction, Frame};
+use crate::lss::fastscan::{Fastscan, FastscanError, Found};
+use crate::lss::master::{Answer, LssError, Service, Step};
+use crate::lss::{Address, MASTER_ID, Part, SLAVE_ID, UNCONFIGURED, bit_rate_index, bit_rate_text};
+use serde::Serialize;
+use std::time::Duration;
+
+/// Default wait for each LSS answer, in ms.
+pub const LSS_TIMEOUT_MS: u64 = 100;
+/// Default wait for the answers to each fastscan request, in ms (a scan sends about 130).
+pub const FASTSCAN_TIMEOUT_MS: u64 = 30;
+
+/// What `lss inquire` asks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Inquiry {
+    /// One part of the LSS address.
+    Part(Part),
+    /// The node-ID.
+    NodeId,
+    /// The whole address and the node-ID.
+    All,
+}
+
+/// One LSS command.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LssAction {
+    /// `switch config|wait`: every slave to configuration or waiting state.
+    Switch { config: bool },
+    /// `select VENDOR PRODUCT REVISION SERIAL`: the slave with that address to configuration state.
+    Select(Address),
+    /// `set-node N`: configure node-ID (1..127, 255 = unconfigured).
+    SetNode(u8),
+    /// `set-bitrate KBIT`: configure bit timing, table 0.
+    SetBitrate { kbit: u32, index: u8 },
+    /// `activate-bitrate DELAY_MS`: activate bit timing (no answer).
+    ActivateBitrate { delay_ms: u16 },
+    /// `store`: store configuration.
+    Store,
+    /// `inquire [vendor|product|revision|serial|node|all]`.
+    Inquire(Inquiry),
+    /// `identify VENDOR PRODUCT REV_LO REV_HI SER_LO SER_HI`: identify remote slave.
+    Identify {
+        vendor: u32,
+        product: u32,
+        revision: (u32, u32),
+        serial: (u32, u32),
+    },
+    /// `identify-unconfigured`: identify non-configured remote slave.
+    IdentifyUnconfigured,
+    /// `fastscan [--vendor V] [--product P]`: find one non-configured slave, leave it in
+    /// configuration state.
+    Fastscan { vendor: Option<u32>, product: Option<u32> },
+    /// `assign N [--store] [--vendor V] [--product P]`: fastscan (narrowed like `fastscan`),
+    /// configure node-ID N, (store,) switch global waiting.
+    Assign {
+        node: u8,
+        store: bool,
+        vendor: Option<u32>,
+        product: Option<u32>,
+    },
+}
+
+/// The words of the LSS commands, for help and completion.
+pub const LSS_WORDS: &[&str] = &[
+    "switch",
+    "select",
+    "set-node",
+    "set-bitrate",
+    "activate-bitrate",
+    "store",
+    "inquire",
+    "identify",
+    "identify-unconfigured",
+    "fastscan",
+    "assign",
+];
+
+/// The flags of `lss` that only some commands take.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LssFlags {
+    /// `--vendor V` (fastscan, assign).
+    pub vendor: Option<u32>,
+    /// `--product P` (fastscan, assign).
+    pub product: Option<u32>,
+    /// `--store` (assign).
+    pub store: bool,
+}
+
+fn number(word: &str, what: &str) -> Result<u32, ParseError> {
+    parse_int(word)
+        .filter(|v| (0..=u32::MAX as i64).contains(v))
+        .map(|v| v as u32)
+        .ok_or_else(|| ParseError::Invalid(format!("{what} `{word}` must be a number 0..0xFFFFFFFF")))
+}
+
+impl LssAction {
+    /// Checks an action word (its arguments are checked by [`LssAction::parse`]).
+    pub fn verb(word: &str) -> Result<String, ParseError> {
+        if LSS_WORDS.contains(&word) {
+            Ok(word.to_string())
+        } else {
+            Err(ParseError::Invalid(format!(
+                "unknown LSS command `{word}`: use {}",
+                LSS_WORDS.join(", ")
+            )))
+        }
+    }
+
+    /// The command from its word, the words after it and the flags.
+    pub fn parse(word: &str, args: &[String], flags: LssFlags) -> Result<LssAction, ParseError> {
+        let want = |n: usize, usage: &str| {
+            if args.len() == n {
+                Ok(())
+            } else {
+                Err(ParseError::Invalid(format!(
+                    "`lss {word}` takes {usage} (got {} words)",
+                    args.len()
+                )))
+            }
+        };
+        let a = |i: usize, what: &str| number(&args[i], what);
+        let action = match word {
+            "switch" => {
+                let words: Vec<&str> = args.iter().map(String::as_str).collect();
+                let mode = match words.as_slice() {
+                    ["global", m] | [m] => *m,
+                    _ => "",
+                };
+                match mode {
+                    "config" | "configuration" => LssAction::Switch { config: true },
+                    "wait" | "waiting" => LssAction::Switch { config: false },
+                    _ => return Err(ParseError::Invalid("`lss switch` takes [global] config|wait".into())),
+                }
+            }
+            "select" => {
+                want(4, "VENDOR PRODUCT REVISION SERIAL")?;
+                LssAction::Select(Address {
+                    vendor: a(0, "VENDOR")?,
+                    product: a(1, "PRODUCT")?,
+                    revision: a(2, "REVISION")?,
+                    serial: a(3, "SERIAL")?,
+                })
+            }
+            "set-node" => {
+                want(1, "a node-ID N (1..127, 255 = unconfigured)")?;
+                LssAction::SetNode(node_id(&args[0])?)
+            }
+            "set-bitrate" => {
+                want(1, "a bit rate in kbit/s")?;
+                let kbit = a(0, "KBIT")?;
+                let index = bit_rate_index(kbit).ok_or_else(|| {
+                    ParseError::Invalid(format!(
+                        "bit rate `{kbit}` kbit/s is not in the CiA 305 table: use 1000, 800, 500, 250, 125, 50, 20 or 10"
+                    ))
+                })?;
+                LssAction::SetBitrate { kbit, index }
+            }
+            "activate-bitrate" => {
+                want(1, "the switch delay DELAY_MS")?;
+                let delay_ms = u16::try_from(a(0, "DELAY_MS")?)
+                    .map_err(|_| ParseError::Invalid("DELAY_MS must be 0..65535".into()))?;
+                LssAction::ActivateBitrate { delay_ms }
+            }
+            "store" => {
+                want(0, "no words")?;
+                LssAction::Store
+            }
+            "inquire" => {
+                let what = match args.iter().map(String::as_str).collect::<Vec<_>>().as_slice() {
+                    [] | ["all"] => Inquiry::All,
+                    ["vendor"] => Inquiry::Part(Part::Vendor),
+                    ["product"] => Inquiry::Part(Part::Product),
+                    ["revision"] => Inquiry::Part(Part::Revision),
+                    ["serial"] => Inquiry::Part(Part::Serial),
+                    ["node"] | ["node-id"] => Inquiry::NodeId,
+                    _ => {
+                        return Err(ParseError::Invalid(
+                            "`lss inquire` takes vendor, product, revision, serial, node or all".into(),
+                        ));
+                    }
+                };
+                LssAction::Inquire(what)
+            }
+            "identify" => {
+                want(6, "VENDOR PRODUCT REV_LO REV_HI SER_LO SER_HI")?;
+                LssAction::Identify {
+                    vendor: a(0, "VENDOR")?,
+                    product: a(1, "PRODUCT")?,
+                    revision: (a(2, "REV_LO")?, a(3, "REV_HI")?),
+                    serial: (a(4, "SER_LO")?, a(5, "SER_HI")?),
+                }
+            }
+            "identify-unconfigured" => {
+                want(0, "no words")?;
+                LssAction::IdentifyUnconfigured
+            }
+            "fastscan" => {
+                want(0, "no words (--vendor V, --product P narrow the scan)")?;
+                LssAction::Fastscan {
+                    vendor: flags.vendor,
+                    product: flags.product,
+                }
+            }
+            "assign" => {
+                want(1, "a node-ID N (1..127)")?;
+                let node = node_id(&args[0])?;
+                if node == UNCONFIGURED {
+                    return Err(ParseError::Invalid("`lss assign` takes a node-ID 1..127".into()));
+                }
+                LssAction::Assign {
+                    node,
+                    store: flags.store,
+                    vendor: flags.vendor,
+                    product: flags.product,
+                }
+            }
+            other => return Err(Self::verb(other).err().unwrap_or(ParseError::Invalid(other.into()))),
+        };
+        if flags.store && !matches!(action, LssAction::Assign { .. }) {
+            return Err(ParseError::Invalid("--store goes with `lss assign`".into()));
+        }
+        let scans = matches!(action, LssAction::Fastscan { .. } | LssAction::Assign { .. });
+        if (flags.vendor.is_some() || flags.product.is_some()) && !scans {
+            return Err(ParseError::Invalid(
+                "--vendor and --product go with `lss fastscan` and `lss assign`".into(),
+            ));
+        }
+        Ok(action)
+    }
+
+    /// The command's word.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            LssAction::Switch { .. } => "switch",
+            LssAction::Select(_) => "select",
+            LssAction::SetNode(_) => "set-node",
+            LssAction::SetBitrate { .. } => "set-bitrate",
+            LssAction::ActivateBitrate { .. } => "activate-bitrate",
+            LssAction::Store => "store",
+            LssAction::Inquire(_) => "inquire",
+            LssAction::Identify { .. } => "identify",
+            LssAction::IdentifyUnconfigured => "identify-unconfigured",
+            LssAction::Fastscan { .. } => "fastscan",
+            LssAction::Assign { .. } => "assign",
+        }
+    }
+
+    /// The master service the command runs, when it is one service.
+    pub fn service(&self) -> Option<Service> {
+        Some(match *self {
+            LssAction::Switch { config } => Service::SwitchGlobal(config),
+            LssAction::Select(a) => Service::SwitchSelective(a),
+            LssAction::SetNode(n) => Service::ConfigureNodeId(n),
+            LssAction::SetBitrate { index, .. } => Service::ConfigureBitTiming { table: 0, index },
+            LssAction::ActivateBitrate { delay_ms } => Service::ActivateBitTiming { delay_ms },
+            LssAction::Store => Service::StoreConfiguration,
+            LssAction::Inquire(Inquiry::Part(p)) => Service::Inquire(p),
+            LssAction::Inquire(Inquiry::NodeId) => Service::InquireNodeId,
+            LssAction::Inquire(Inquiry::All) => Service::InquireAddress,
+            LssAction::Identify {
+                vendor,
+                product,
+                revision,
+                serial,
+            } => Service::IdentifyRemote {
+                vendor,
+                product,
+                revision,
+                serial,
+            },
+            LssAction::IdentifyUnconfigured => Service::IdentifyNonConfigured,
+            LssAction::Fastscan { .. } | LssAction::Assign { .. } => return None,
+        })
+    }
+
+    /// What the command sends, for previews: the frames of its service, or a description
+    /// when they depend on the answers.
+    pub fn preview(&self) -> String {
+        match self {
+            LssAction::Fastscan { .. } => {
+                "fastscan: about 130 frames 7E5#51.. (one per bit of the unknown address parts), the found slave \
+                 left in configuration state"
+                    .into()
+            }
+            LssAction::Assign { node, store, .. } => format!(
+                "fastscan (about 130 frames 7E5#51..), then 7E5#11{node:02X}000000000000{}, then 7E5#0400000000000000",
+                if *store { ", 7E5#1700000000000000" } else { "" }
+            ),
+            LssAction::Inquire(Inquiry::All) => {
+                let mut frames = self.frames();
+                frames.push(Frame::classic(MASTER_ID, &crate::lss::Request::InquireNodeId.encode()));
+                frames.iter().map(super::candump).collect::<Vec<_>>().join(", ")
+            }
+            _ => self.frames().iter().map(super::candump).collect::<Vec<_>>().join(", "),
+        }
+    }
+
+    /// The frames of the command's service, as the protocol layer encodes them.
+    fn frames(&self) -> Vec<Frame> {
+        self.service()
+            .map(|s| s.requests())
+            .unwrap_or_default()
+            .iter()
+            .map(|r| Frame::classic(MASTER_ID, &r.encode()))
+            .collect()
+    }
+}
+
+fn node_id(word: &str) -> Result<u8, ParseError> {
+    parse_int(word)
+        .filter(|n| (1..=127).contains(n) || *n == i64::from(UNCONFIGURED))
+        .map(|n| n as u8)
+        .ok_or_else(|| {
+            ParseError::Invalid(format!(
+                "node-ID `{word}` must be 1..127 (or 255 = unconfigured for set-node)"
+            ))
+        })
+}
+
+/// The result of an LSS command (`--json`).
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct LssReport {
+    /// Always true (failures are [`CommandError`]s).
+    pub ok: bool,
+    /// The command word (`fastscan`, `set-node`...).
+    pub command: &'static str,
+    /// The master services run, in order (`configure_node_id`...).
+    pub services: Vec<&'static str>,
+    /// The LSS address answered (inquire all / fastscan / assign) or selected.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub address: Option<Address>,
+    /// A value inquired: `vendor`, `product`, `revision` or `serial` and its value.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub part: Option<&'static str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub value: Option<u32>,
+    /// The node-ID inquired or configured.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub node_id: Option<u8>,
+    /// The bit rate configured.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bit_rate: Option<&'static str>,
+    /// Identify: how many slaves answered.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub identified: Option<usize>,
+    /// Fastscan: whether a non-configured slave was found.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub found: Option<bool>,
+    /// Assign: whether the configuration was stored.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stored: Option<bool>,
+    /// What happened, in words.
+    pub text: String,
+}
+
+impl From<LssError> for CommandError {
+    fn from(e: LssError) -> Self {
+        match e {
+            LssError::NoAnswer { .. } => CommandError::Timeout(format!("LSS {e}")),
+            LssError::Refused {
+                service,
+                error,
+                spec,
+                text,
+            } => CommandError::LssRefused {
+                service,
+                error,
+                spec,
+                text,
+            },
+        }
+    }
+}
+
+impl From<FastscanError> for CommandError {
+    fn from(e: FastscanError) -> Self {
+        CommandError::Timeout(format!("LSS {e}"))
+    }
+}
+
+/// Runs `action`; `timeout_ms` is the wait for each answer (each fastscan request).
+pub async fn lss(bus: &Bus, action: LssAction, timeout_ms: u64) -> Result<LssReport, CommandError> {
+    let mut r = LssReport {
+        ok: true,
+        command: action.as_str(),
+        ..LssReport::default()
+    };
+    match action {
+        LssAction::Fastscan { vendor, product } => {
+            r.services.push("fastscan");
+            let found = fastscan(bus, [vendor, product, None, None], timeout_ms).await?;
+            r.found = Some(found.is_some());
+            r.address = found;
+            r.text = match found {
+                Some(a) => format!("found a non-configured slave, now in configuration state: {a}"),
+                None => "no non-configured LSS slave answered the fastscan".into(),
+            };
+        }
+        LssAction::Assign {
+            node,
+            store,
+            vendor,
+            product,
+        } => {
+            r.services.push("fastscan");
+            let a = fastscan(bus, [vendor, product, None, None], timeout_ms)
+                .await?
+                .ok_or_else(|| {
+                    CommandError::Timeout(
+                        "LSS assign: no non-configured LSS slave answered the fastscan (every slave has a node-ID?)"
+                            .into(),
+                    )
+                })?;
+            r.address = Some(a);
+            let mut services = vec![Service::ConfigureNodeId(node)];
+            if store {
+                services.push(Service::StoreConfiguration);
+            }
+            services.push(Service::SwitchGlobal(false));
+            for s in services {
+                r.services.push(s.name());
+                exchange(bus, s, timeout_ms).await?;
+            }
+            r.node_id = Some(node);
+            r.stored = Some(store);
+            r.text = format!(
+                "node-ID {node} configured{} on the slave with {a}; all slaves back to waiting state \
+                 (the node-ID is in use after an NMT reset communication or a power cycle)",
+                if store { " and stored" } else { "" }
+            );
+        }
+        LssAction::Inquire(Inquiry::All) => {
+            r.services.push(Service::InquireAddress.name());
+            if let Answer::Address(a) = exchange(bus, Service::InquireAddress, timeout_ms).await? {
+                r.address = Some(a);
+            }
+            r.services.push(Service::InquireNodeId.name());
+            if let Answer::NodeId(n) = exchange(bus, Service::InquireNodeId, timeout_ms).await? {
+                r.node_id = Some(n);
+            }
+            r.text = format!(
+                "{}, node-ID {}",
+                r.address.map(|a| a.to_string()).unwrap_or_default(),
+                node_text(r.node_id.unwrap_or(UNCONFIGURED))
+            );
+        }
+        _ => {
+            let Some(service) = action.service() else {
+                return Err(CommandError::Usage(format!(
+                    "lss {}: not a single service",
+                    action.as_str()
+                )));
+            };
+            r.services.push(service.name());
+            let answer = exchange(bus, service, timeout_ms).await?;
+            r.text = single_text(&mut r, action, answer);
+        }
+    }
+    Ok(r)
+}
+
+fn node_text(n: u8) -> String {
+    if n == UNCONFIGURED {
+        "255 (not configured)".into()
+    } else {
+        n.to_string()
+    }
+}
+
+/// Fills `r` from a single service's answer; gives its text.
+fn single_text(r: &mut LssReport, action: LssAction, answer: Answer) -> String {
+    match (action, answer) {
+        (_, Answer::Value(p, v)) => {
+            r.part = Some(p.name());
+            r.value = Some(v);
+            format!("{} 0x{v:08X} ({v})", p.name())
+        }
+        (_, Answer::NodeId(n)) => {
+            r.node_id = Some(n);
+            format!("node-ID {}", node_text(n))
+        }
+        (_, Answer::Identified(n)) => {
+            r.identified = Some(n);
+            match n {
+                0 => "no slave answered".to_string(),
+                1 => "1 slave answered".to_string(),
+                n => format!("{n} slaves answered"),
+            }
+        }
+        (LssAction::Switch { config }, _) => format!(
+            "switch state global sent: every slave to {} state",
+            if config { "configuration" } else { "waiting" }
+        ),
+        (LssAction::Select(a), _) => {
+            r.address = Some(a);
+            format!("the slave with {a} is in configuration state")
+        }
+        (LssAction::SetNode(n), _) => {
+            r.node_id = Some(n);
+            format!(
+                "node-ID {} configured (in use after an NMT reset communication; `lss store` keeps it)",
+                node_text(n)
+            )
+        }
+        (LssAction::SetBitrate { index, .. }, _) => {
+            r.bit_rate = bit_rate_text(0, index);
+            format!(
+                "bit rate {} configured (`lss activate-bitrate DELAY_MS` switches, `lss store` keeps it)",
+                r.bit_rate.unwrap_or("?")
+            )
+        }
+        (LssAction::ActivateBitrate { delay_ms }, _) => {
+            format!("activate bit timing sent: slaves switch after {delay_ms} ms, then wait {delay_ms} ms")
+        }
+        (LssAction::Store, _) => "configuration stored".into(),
+        _ => "done".into(),
+    }
+}
+
+/// Sends LSS master frames.
+async fn send_all(bus: &Bus, frames: &[[u8; 8]]) -> Result<(), CommandError> {
+    for p in frames {
+        bus.send(&Frame::classic(MASTER_ID, p)).await?;
+    }
+    Ok(())
+}
+
+/// The data and receive time of an LSS slave answer; `None` for other frames. A closed bus
+/// ends the command.
+fn answer(bus: &Bus, frame: Result<Frame, BusError>) -> Result<Option<([u8; 8], u64)>, CommandError> {
+    let f = match frame {
+        Ok(f) => f,
+        Err(BusError::Closed) => return Err(BusError::Closed.into()),
+        Err(_) => return Ok(None),
+    };
+    if f.direction() != Direction::Rx || f.is_ext() || f.is_rtr() || f.id != SLAVE_ID {
+        return Ok(None);
+    }
+    let Ok(data) = <[u8; 8]>::try_from(f.payload()) else {
+        return Ok(None);
+    };
+    Ok(Some((data, if f.ts_ns == 0 { bus.now_ns() } else { f.ts_ns })))
+}
+
+/// Runs one master service to its end.
+pub async fn exchange(bus: &Bus, service: Service, timeout_ms: u64) -> Result<Answer, CommandError> {
+    let mut rx = bus.subscribe();
+    let (mut x, first) = service.start(bus.now_ns(), timeout_ms.saturating_mul(1_000_000));
+    if let Some(done) = apply(bus, first).await? {
+        return Ok(done?);
+    }
+    loop {
+        let now = bus.now_ns();
+        tokio::task::yield_now().await;
+        while let Some(frame) = rx.try_recv() {
+            if let Some(done) = feed(bus, &mut x, frame).await? {
+                return Ok(done?);
+            }
+        }
+        if let Some(done) = apply(bus, x.on_time(now)).await? {
+            return Ok(done?);
+        }
+        let wait = x.deadline_ns().map_or(0, |d| d.saturating_sub(now));
+        if let Ok(frame) = tokio::time::timeout(Duration::from_nanos(wait), rx.recv()).await
+            && let Some(done) = feed(bus, &mut x, frame).await?
+        {
+            return Ok(done?);
+        }
+    }
+}
+
+type Done = Option<Result<Answer, LssError>>;
+
+/// Sends a step's frames; gives its result when it ends the exchange.
+async fn apply(bus: &Bus, step: Step) -> Result<Done, CommandError> {
+    send_all(bus, &step.send).await?;
+    Ok(step.done)
+}
+
+async fn feed(
+    bus: &Bus,
+    x: &mut crate::lss::master::Exchange,
+    frame: Result<Frame, BusError>,
+) -> Result<Done, CommandError> {
+    match answer(bus, frame)? {
+        Some((data, ts)) => apply(bus, x.on_frame(&data, ts)).await,
+        None => Ok(None),
+    }
+}
+
+/// Fastscan with the parts in `known` given; the slave found is left in configuration state.
+/// `None` when no non-configured slave answers (or none with the parts given).
+pub async fn fastscan(bus: &Bus, known: [Option<u32>; 4], timeout_ms: u64) -> Result<Option<Address>, CommandError> {
+    let mut rx = bus.subscribe();
+    let (mut f, first) = Fastscan::start(known, bus.now_ns(), timeout_ms.saturating_mul(1_000_000));
+    send_all(bus, &first).await?;
+    loop {
+        let now = bus.now_ns();
+        tokio::task::yield_now().await;
+        while let Some(frame) = rx.try_recv() {
+            if let Some((data, _)) = answer(bus, frame)? {
+                f.on_frame(&data);
+            }
+        }
+        let step = match f.on_time(now) {
+            Ok(step) => step,
+            // A part given that no slave confirms: no slave with that vendor/product.
+            Err(FastscanError::Lost(part))
+                if Part::ALL
+                    .iter()
+                    .zip(known)
+                    .any(|(p, k)| p.name() == part && k.is_some()) =>
+            {
+                return Ok(None);
+            }
+            Err(e) => return Err(e.into()),
+        };
+        send_all(bus, &step.send).await?;
+        match step.done {
+            Some(Found::Slave(a)) => return Ok(Some(a)),
+            Some(Found::Nobody) => return Ok(None),
+            None => {}
+        }
+        let wait = f.deadline_ns().saturating_sub(now);
+        if let Ok(frame) = tokio::time::timeout(Duration::from_nanos(wait), rx.recv()).await
+            && let Some((data, _)) = answer(bus, frame)?
+        {
+            f.on_frame(&data);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The runners on the virtual bus with paused time, against LSS slaves of the protocol
+    //! layer on their own endpoint.
+
+    use super::*;
+    use crate::bus::virt::VirtualBus;
+    use crate::command::ExitCode;
+    use crate::lss::slave::Slave;
+    use std::sync::{Arc, Mutex};
+
+    type Slaves = Arc<Mutex<Vec<Slave>>>;
+
+    fn addr(serial: u32) -> Address {
+        Address {
+            vendor: 0x3A,
+            product: 0x1234,
+            revision: 2,
+            serial,
+        }
+    }
+
+    /// Runs `slaves` on their own endpoint of `vbus`: each master frame goes to every slave,
+    /// their answers go out on 0x7E4.
+    fn serve(vbus: &VirtualBus, slaves: Vec<Slave>) -> Slaves {
+        let shared = Arc::new(Mutex::new(slaves));
+        let bus = vbus.endpoint(false);
+        let mut rx = bus.subscribe();
+        let s = shared.clone();
+        tokio::spawn(async move {
+            while let Ok(f) = rx.recv().await {
+                if f.id != MASTER_ID || f.direction() == Direction::Tx {
+                    continue;
+                }
+                let answers: Vec<[u8; 8]> = s
+                    .lock()
+                    .unwrap()
+                    .iter_mut()
+                    .filter_map(|sl| sl.on_request(f.payload()))
+                    .collect();
+                for a in answers {
+                    let _ = bus.send(&Frame::classic(SLAVE_ID, &a)).await;
+                }
+            }
+        });
+        shared
+    }
+
+    #[tokio::test(start_paused = true)]
+    async fn assign_gives_fresh_slaves_node_ids_one_by_one() {
+        let vbus = VirtualBus::new("vbus");
+        let slaves = serve(
+            &vbus,
+            vec![
+                Slave::new(addr(0x99), 0xFF),
+                Slave::new(addr(0x1234), 0xFF),
+                Slave::new(addr(7), 5),
+            ],
+        );
+        let bus = vbus.endpoint(false);
+        let first = lss(
+            &bus,
+            LssAction::Assign {
+                node: 10,
+                store: true,
+                vendor: None,
+                product: None,
+            },
+            30,
+        )
+        .await
+        .unwrap();
+        let second = lss(
+            &bus,
+            LssAction::Assign {
+                node: 11,
+                store: false,
+                vendor: Some(0x3A),
+                product: None,
+            },
+            30,
+        )
+        .await
+        .unwrap();
+        let none = lss(
+            &bus,
+            LssAction::Fastscan {
+                vendor: None,
+                product: None,
+            },
+            30,
+        )
+        .await
+        .unwrap();
+        let pending: Vec<u8> = slaves.lock().unwrap().iter().map(Slave::pending_node_id).collect();
+        let serial_of = |n: u8| addr(if pending[0] == n { 0x99 } else { 0x1234 });
+        assert_eq!(first.address, Some(serial_of(10)));
+        assert_eq!(second.address, Some(serial_of(11)));
+        let mut given = pending[..2].to_vec();
+        given.sort();
+        assert_eq!(given, [10, 11]);
+        assert_eq!(pending[2], 5);
+        assert_eq!(
+            first.services,
+            [
+                "fastscan",
+                "configure_node_id",
+                "store_configuration",
+                "switch_state_global"
+            ]
+        );
+        assert!(
+            first.text.starts_with("node-ID 10 configured and stored"),
+            "{}",
+            first.text
+        );
+        assert!(slaves.lock().unwrap().iter().all(|s| !s.in_configuration()));
+        assert_eq!(none.found, Some(false));
+        assert_eq!(none.text, "no non-configured LSS slave answered the fastscan");
+    }
+
+    #[tokio::test(start_paused = true)]
+    async fn fastscan_with_known_vendor_and_product_then_inquire_all() {
+        let vbus = VirtualBus::new("vbus");
+        serve(&vbus, vec![Slave::new(addr(0x99), 0xFF)]);
+        let bus = vbus.endpoint(false);
+        let found = lss(
+            &bus,
+            LssAction::Fastscan {
+                vendor: Some(0x3A),
+                product: Some(0x1234),
+            },
+            30,
+        )
+        .await
+        .unwrap();
+        assert_eq!(found.address, Some(addr(0x99)));
+        let all = lss(&bus, LssAction::Inquire(Inquiry::All), 100).await.unwrap();
+        assert_eq!(all.address, Some(addr(0x99)));
+        assert_eq!(all.node_id, Some(0xFF));
+        assert!(all.text.ends_with("node-ID 255 (not configured)"), "{}", all.text);
+        let serial = lss(&bus, LssAction::Inquire(Inquiry::Part(Part::Serial)), 100)
+            .await
+            .unwrap();
+        assert_eq!((serial.part, serial.value), (Some("serial"), Some(0x99)));
+        // A wrong vendor finds nobody.
+        lss(&bus, LssAction::Switch { config: false }, 100).await.unwrap();
+        let other = LssAction::Fastscan {
+            vendor: Some(0x3B),
+            product: None,
+        };
+        assert_eq!(lss(&bus, other, 30).await.unwrap().found, Some(false));
+    }
+
+    #[tokio::test(start_paused = true)]
+    async fn select_then_set_node_refused_and_bit_rate() {
+        let vbus = VirtualBus::new("vbus");
+        let slaves = serve(&vbus, vec![Slave::new(addr(1), 4), Slave::new(addr(2), 5)]);
+        let bus = vbus.endpoint(false);
+        lss(&bus, LssAction::Select(addr(2)), 100).await.unwrap();
+        let e = lss(&bus, LssAction::SetNode(200), 100).await.unwrap_err();
+        assert_eq!(e.exit_code(), ExitCode::Abort);
+        assert_eq!(
+            e.to_string(),
+            "LSS configure_node_id: the slave refused: node-ID out of range (1..127 or 255) (error code 1)"
+        );
+        let j = e.to_json();
+        assert_eq!(
+            (j["error"].as_str(), j["error_code"].as_u64()),
+            (Some("lss_refused"), Some(1))
+        );
+        let r = lss(&bus, LssAction::SetBitrate { kbit: 250, index: 3 }, 100)
+            .await
+            .unwrap();
+        assert_eq!(r.bit_rate, Some("250 kbit/s"));
+        assert_eq!(slaves.lock().unwrap()[1].bit_timing, Some(3));
+        assert_eq!(slaves.lock().unwrap()[0].bit_timing, None);
+        let id = lss(&bus, LssAction::Inquire(Inquiry::NodeId), 100).await.unwrap();
+        assert_eq!(id.node_id, Some(5));
+    }
+
+    #[tokio::test(start_paused = true)]
+    async fn no_slave_in_configuration_is_a_timeout_with_a_hint() {
+        let vbus = VirtualBus::new("vbus");
+        serve(&vbus, vec![Slave::new(addr(1), 4)]);
+        let bus = vbus.endpoint(false);
+        let e = lss(&bus, LssAction::Inquire(Inquiry::NodeId), 100).await.unwrap_err();
+        assert_eq!(e.exit_code(), ExitCode::Timeout);
+        assert!(
+            e.to_string().starts_with(
+                "LSS inquire_node_id: no answer from an LSS slave within 100 ms (is a slave in configuration state?"
+            ),
+            "{e}"
+        );
+        let e = lss(&bus, LssAction::Select(addr(9)), 100).await.unwrap_err();
+        assert!(e.to_string().contains("(no slave has that address)"), "{e}");
+    }
+
+    #[tokio::test(start_paused = true)]
+    async fn listen_only_sends_nothing() {
+        let vbus = VirtualBus::new("vbus");
+        let spy = vbus.endpoint(false);
+        let mut seen = spy.subscribe();
+        let bus = vbus.endpoint(true);
+        let e = lss(&bus, LssAction::Switch { config: true }, 100).await.unwrap_err();
+        assert_eq!(e.exit_code(), ExitCode::Unavailable);
+        assert!(matches!(e, CommandError::Bus(BusError::ListenOnly)), "{e:?}");
+        assert!(seen.try_recv().is_none());
+    }
+
+    #[test]
+    fn words_parse_and_previews_come_from_the_protocol_layer() {
+        let p = |w: &str, args: &[&str], flags| {
+            let args: Vec<String> = args.iter().map(|s| s.to_string()).collect();
+            LssAction::parse(w, &args, flags)
+        };
+        let none = LssFlags::default();
+        assert_eq!(
+            p("switch", &["global", "config"], none),
+            Ok(LssAction::Switch { config: true })
+        );
+        assert_eq!(p("switch", &["wait"], none), Ok(LssAction::Switch { config: false }));
+        assert_eq!(
+            p("set-bitrate", &["250"], none),
+            Ok(LssAction::SetBitrate { kbit: 250, index: 3 })
+        );
+        assert!(
+            p("set-bitrate", &["300"], none)
+                .unwrap_err()
+                .to_string()
+                .contains("not in the CiA 305 table")
+        );
+        assert!(
+            p("set-node", &["0"], none)
+                .unwrap_err()
+                .to_string()
+                .contains("must be 1..127")
+        );
+        assert!(p("store", &[], LssFlags { store: true, ..none }).is_err());
+        assert_eq!(p("set-node", &["10"], none).unwrap().preview(), "7E5#110A000000000000");
+        assert_eq!(
+            p("select", &["0x3A", "0x1234", "2", "0x99"], none).unwrap().preview(),
+            "7E5#403A000000000000, 7E5#4134120000000000, 7E5#4202000000000000, 7E5#4399000000000000"
+        );
+    }
+}
