@@ -49,12 +49,11 @@ impl Schedule {
 
     /// `every 10 ms, 5 times` / `once` / `every 10 ms until stopped`.
     pub fn text(self) -> String {
-        match (self.every_ms, self.total()) {
-            (None, Some(1)) => "once".into(),
+        match (self.every_ms, self.count) {
+            (None, None | Some(1)) => "once".into(),
             (None, Some(n)) => format!("{n} times back to back"),
             (Some(ms), Some(n)) => format!("every {ms} ms, {n} times"),
             (Some(ms), None) => format!("every {ms} ms until stopped"),
-            (None, None) => "until stopped".into(),
         }
     }
 }

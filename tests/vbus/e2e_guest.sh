@@ -707,11 +707,18 @@ kill -TERM $sim; wait $sim && ok "sim: SIGTERM ends cotui sim with status 0" || 
 
 # ---- 11. cyclic transmit: SYNC producer, cyclic RPDO, stop-all stops palette jobs --------
 # (syntron-ds RPDO1: controlword + mode of operation.)
-# candump's timestamps judge the period (generous for TCG under load: mean within 10 %, count
-# within 20 %); cotui's own report (from its TX echoes) is printed with the check.
-# period LOG ID: "count mean_ms" of the frames with ID in candump -L log LOG
-period() { awk -v id="$2" '{ split($3, f, "#") } f[1] == id { t = substr($1, 2, length($1) - 2); if (!n) a = t; b = t; n++ }
-    END { printf "%d %.3f", n, (n > 1 ? (b - a) * 1000 / (n - 1) : 0) }' "$1"; }
+# candump's timestamps judge the period (generous for TCG under load: median interval within
+# 10 %, mean within 25 %, count within 20 %); cotui's own report (from its TX echoes) is
+# printed with the check.
+# period LOG ID: sets n, mean and median (ms) of the frames with ID in candump -L log LOG.
+# The median judges the period; the mean (which a stall of the TCG guest stretches) gets more room.
+period() {
+    awk -v id="$2" '{ split($3, f, "#") } f[1] == id { print substr($1, 2, length($1) - 2) }' "$1" > period.ts
+    n=$(wc -l < period.ts)
+    mean=$(awk 'NR == 1 { a = $1 } { b = $1 } END { printf "%.3f", (NR > 1 ? (b - a) * 1000 / (NR - 1) : 0) }' period.ts)
+    median=$(awk 'NR > 1 { printf "%.3f\n", ($1 - p) * 1000 } { p = $1 }' period.ts | sort -n |
+        awk '{ v[NR] = $1 } END { print (NR ? v[int((NR + 1) / 2)] : 0) }')
+}
 # ms3 FIELD: a float field of the last command's JSON, to the µs
 ms3() { echo "$out" | j "$1 * 1000 | round / 1000"; }
 near() { awk -v x="$1" -v want="$2" -v tol="$3" 'BEGIN { exit !(x >= want * (1 - tol) && x <= want * (1 + tol)) }'; }
@@ -719,18 +726,18 @@ candump -L vcan0,080:7FF,202:7FF > cyc.log 2> /dev/null &
 cycdump=$!
 wait_socket $cycdump || bad "cyclic: candump opened no socket"
 c sync vcan0 --period 10 --count 200 --counter 16 --json
-read -r n mean <<< "$(period cyc.log 080)"
+period cyc.log 080
 counters=$(awk '$3 ~ /^080#/ { h = "0123456789ABCDEF"; printf "%d ", (index(h, substr($3, 5, 1)) - 1) * 16 + index(h, substr($3, 6, 1)) - 1 }' cyc.log |
     cut -d' ' -f1-18)
-[ "$rc" = 0 ] && near "$n" 200 0.2 && near "$mean" 10 0.1 && [ "$counters" = "1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 1 2" ] &&
-    ok "sync 10 ms x200: candump saw $n SYNCs, mean period $mean ms, counter 1..16 wraps; cotui measured mean $(ms3 .mean_period_ms) ms, jitter p99 $(ms3 .jitter_p99_ms) ms, max $(ms3 .jitter_max_ms) ms" ||
-    bad "sync: rc=$rc candump $n frames, mean $mean ms, counters '$counters'; $out $err"
+[ "$rc" = 0 ] && near "$n" 200 0.2 && near "$median" 10 0.1 && near "$mean" 10 0.25 && [ "$counters" = "1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 1 2" ] &&
+    ok "sync 10 ms x200: candump saw $n SYNCs, period median $median ms, mean $mean ms, counter 1..16 wraps; cotui measured mean $(ms3 .mean_period_ms) ms, jitter p99 $(ms3 .jitter_p99_ms) ms, max $(ms3 .jitter_max_ms) ms" ||
+    bad "sync: rc=$rc candump $n frames, median $median ms, mean $mean ms, counters '$counters'; $out $err"
 c pdo vcan0 2 send rpdo1 Controlword=0x0F 0x6060=9 --every 20 --count 50 --profile 2=syntron-ds --json
-read -r n mean <<< "$(period cyc.log 202)"
+period cyc.log 202
 data=$(awk '$3 ~ /^202#/ { print $3; exit }' cyc.log)
-[ "$rc" = 0 ] && near "$n" 50 0.2 && near "$mean" 20 0.1 && [ "$data" = 202#0F0009 ] &&
-    ok "pdo rpdo1 every 20 ms x50: candump saw $n x $data, mean period $mean ms" ||
-    bad "pdo: rc=$rc candump $n frames ($data), mean $mean ms; $out $err"
+[ "$rc" = 0 ] && near "$n" 50 0.2 && near "$median" 20 0.1 && near "$mean" 20 0.25 && [ "$data" = 202#0F0009 ] &&
+    ok "pdo rpdo1 every 20 ms x50: candump saw $n x $data, period median $median ms, mean $mean ms" ||
+    bad "pdo: rc=$rc candump $n frames ($data), median $median ms, mean $mean ms; $out $err"
 # The palette: `sync --period 10` runs as a job; `jobs` lists it, ctrl-s stops it first.
 export TERM=xterm-256color
 tmux new-session -d -s cyc -x 200 -y 45 "XDG_CONFIG_HOME=$work $cotui live vcan0; echo cotui-exit=\$?; sleep 60"
