@@ -1,4 +1,4 @@
-//! The commander subcommands (`cotui nmt|sdo|drive|run|scan|record|stop|lss IFACE ...`): the
+//! The commander subcommands (`cotui nmt|sdo|drive|run|scan|record|stop|lss|send|sync|pdo IFACE ...`): the
 //! declaration of [`crate::command::syntax`] with the bus options in front, the tokio
 //! runtime, opening the bus and printing one result or failure.
 
@@ -50,6 +50,19 @@ pub fn run_commander(c: &CliCommander) -> ExitCode {
             mode,
             format,
         } => super::record::run_record(bus, &output, limits, mode, format),
+        cmd @ (Command::Send { .. } | Command::Sync { .. } | Command::Pdo { .. }) => {
+            let bindings = super::bind::bindings_on(&bus.iface, &dict.profiles, &dict.eds);
+            run(bus, what(c), |bus| async move {
+                // Ctrl-C stops a cyclic send; the report follows.
+                let ctrl_c = async {
+                    if tokio::signal::ctrl_c().await.is_err() {
+                        std::future::pending::<()>().await;
+                    }
+                };
+                let progress = crate::command::cyclic::Progress::default();
+                crate::command::execute_until(&bus, &cmd, &bindings?, progress, ctrl_c).await
+            })
+        }
         cmd => {
             let bindings = super::bind::bindings_on(&bus.iface, &dict.profiles, &dict.eds);
             run(bus, what(c), |bus| async move {
@@ -72,6 +85,9 @@ fn what(c: &CliCommander) -> &'static str {
         Commander::Record(_) => "record",
         Commander::Stop(_) => "stop",
         Commander::Lss(_) => "lss",
+        Commander::Send(_) => "send",
+        Commander::Sync(_) => "sync",
+        Commander::Pdo(_) => "pdo send",
     }
 }
 

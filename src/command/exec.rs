@@ -25,6 +25,26 @@ pub struct Outcome {
 /// Runs `cmd` on `bus`; `bindings` give node dictionaries (object names, aliases, types).
 /// A `record` without limits runs until its future is dropped (the log is flushed then).
 pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Outcome, CommandError> {
+    let progress = super::cyclic::Progress::default();
+    execute_until(bus, cmd, bindings, progress, std::future::pending()).await
+}
+
+/// [`execute`], where a cyclic command (`send`, `sync`, `pdo`) notes its timing in
+/// `progress` and stops (and reports) when `stop` completes.
+pub async fn execute_until(
+    bus: &Bus,
+    cmd: &Command,
+    bindings: &Bindings,
+    progress: super::cyclic::Progress,
+    stop: impl std::future::Future<Output = ()>,
+) -> Result<Outcome, CommandError> {
+    if let Some(src) = super::cyclic::source(cmd, bindings) {
+        let report = super::cyclic::transmit(bus, src?, progress, stop).await?;
+        return Ok(Outcome {
+            json: to_json(&report),
+            text: report.text(),
+        });
+    }
     let json = match cmd {
         Command::Run(spec) => return run_procedure(bus, bindings, spec).await,
         Command::Stop {
@@ -129,6 +149,10 @@ pub async fn execute(bus: &Bus, cmd: &Command, bindings: &Bindings) -> Result<Ou
                 }));
             }
             n.to_json(output)
+        }
+        // Handled above by `cyclic::source`.
+        Command::Send { .. } | Command::Sync { .. } | Command::Pdo { .. } => {
+            return Err(CommandError::Usage("internal: cyclic command without a source".into()));
         }
     };
     let text = text(cmd, &json);
@@ -322,6 +346,8 @@ pub fn text(cmd: &Command, v: &Json) -> String {
         Command::Run(_) => run_summary(v),
         // A stop's text comes from its report (see `stop::StopReport::text`).
         Command::Stop { .. } => String::new(),
+        // A cyclic command's text comes from its report (see `cyclic::Report::text`).
+        Command::Send { .. } | Command::Sync { .. } | Command::Pdo { .. } => String::new(),
     }
 }
 

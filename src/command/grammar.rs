@@ -237,6 +237,27 @@ pub enum Command {
         action: super::lss::LssAction,
         timeout_ms: u64,
     },
+    /// `send FRAME [--every MS] [--count N]`: a raw frame in candump's compact form.
+    Send {
+        frame: crate::frame::Frame,
+        schedule: super::cyclic::Schedule,
+    },
+    /// `sync --period MS [--counter N] [--count N] [--cob-id ID]`: the SYNC producer.
+    Sync {
+        cob_id: u32,
+        /// The CiA 301 counter's overflow value (2..=240), if the counter is sent.
+        counter: Option<u8>,
+        schedule: super::cyclic::Schedule,
+    },
+    /// `pdo NODE send rpdoK NAME=VALUE ... [--every MS] [--count N]`: an RPDO encoded
+    /// through the node's mapping.
+    Pdo {
+        node: u8,
+        /// The RPDO number (1-based).
+        num: u16,
+        assignments: Vec<(String, String)>,
+        schedule: super::cyclic::Schedule,
+    },
 }
 
 /// What `run` runs: a procedure of a node with its parameters, or (no procedure) the list.

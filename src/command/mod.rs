@@ -1,6 +1,7 @@
 //! The commander: NMT, SDO, LSS, CiA 402 drive sequences, scan and record, as a library
 //! API shared by the command line and the TUI palette.
 
+pub mod cyclic;
 pub mod drive;
 pub mod error;
 pub mod exec;
@@ -16,7 +17,7 @@ pub mod syntax;
 pub mod value;
 
 pub use error::{CommandError, ExitCode};
-pub use exec::{Outcome, execute};
+pub use exec::{Outcome, execute, execute_until};
 pub use grammar::{Command, DriveAction, NmtAction, RunSpec, SdoOptions};
 pub use syntax::{ParseError, parse_command};
 

@@ -6,6 +6,8 @@
 //! shell line). So both accept the same lines and refuse the same ones with the same error:
 //! unknown flags, extra words, missing words, bad numbers.
 
+use super::cyclic::Schedule;
+use super::grammar::parse_assignments;
 use super::grammar::{
     Command, DEFAULT_TIMEOUT_MS, DriveAction, NMT_WAIT_MS, NmtAction, SCAN_LISTEN_MS, SCAN_TIMEOUT_MS, SdoOptions,
     parse_int, parse_node, parse_type, run_spec,
@@ -13,6 +15,7 @@ use super::grammar::{
 use super::lss::{FASTSCAN_TIMEOUT_MS, LSS_TIMEOUT_MS, LSS_WORDS, LssAction, LssFlags};
 use super::record::{Limits, LogFormat, WriteMode};
 use super::stop::{DEFAULT_LISTEN_MS, DEFAULT_RAMP_MS, StopOptions};
+use crate::frame::Frame;
 use crate::od::DataType;
 use clap::builder::{PossibleValue, TypedValueParser};
 use clap::error::ErrorKind;
@@ -110,6 +113,15 @@ pub enum Commander<B: Args, D: Args> {
     /// LSS master (CiA 305): switch, select, set-node, set-bitrate, activate-bitrate, store,
     /// inquire, identify, identify-unconfigured, fastscan, or assign N (fastscan + set-node).
     Lss(On<B, LssArgs>),
+    /// Send a raw frame in candump's compact form (`601#4041600000000000`, `123#R`,
+    /// `12345678#00`): once, --count N times, or --every MS (until stopped without --count).
+    Send(On<B, SendArgs>),
+    /// Produce SYNC every --period MS (COB-ID 0x080), with the CiA 301 counter 1..N when
+    /// --counter N is given; until stopped without --count.
+    Sync(On<B, SyncArgs>),
+    /// Send an RPDO encoded through the node's mapping: `pdo 2 send rpdo1 Controlword=0x0F
+    /// "Target velocity=500" --every 10` (mapped signals not given are sent as 0).
+    Pdo(On<B, PdoArgs<D>>),
 }
 
 /// `sdo read` and `sdo write`.
@@ -343,6 +355,74 @@ fn u32_arg(text: &str) -> Result<u32, ParseError> {
         .ok_or_else(|| ParseError::Invalid(format!("`{text}` must be a number 0..0xFFFFFFFF")))
 }
 
+/// How often `send`, `sync` and `pdo` send.
+#[derive(Args, Clone, Debug)]
+pub struct Repeat {
+    /// Send every MS ms (until stopped: Ctrl-C, or stop-all / `jobs stop ID` in the TUI).
+    #[arg(long, value_parser = ms_arg)]
+    pub every: Option<u64>,
+    /// Send this many frames (with --every: then stop).
+    #[arg(long, value_parser = count_arg)]
+    pub count: Option<u64>,
+}
+
+impl Repeat {
+    fn schedule(&self) -> Schedule {
+        Schedule {
+            every_ms: self.every,
+            count: self.count,
+        }
+    }
+}
+
+/// `send FRAME [--every MS] [--count N]`.
+#[derive(Args, Clone, Debug)]
+pub struct SendArgs {
+    /// The frame, as cansend takes it: `123#DEADBEEF`, `123#R`, 29-bit `12345678#00`.
+    #[arg(value_parser = frame_arg)]
+    pub frame: Frame,
+    #[command(flatten)]
+    pub repeat: Repeat,
+}
+
+/// `sync --period MS [--counter N] [--count N] [--cob-id ID]`.
+#[derive(Args, Clone, Debug)]
+pub struct SyncArgs {
+    /// The SYNC period in ms.
+    #[arg(long, value_parser = ms_arg)]
+    pub period: u64,
+    /// Send the CiA 301 SYNC counter, counting 1..N (N = 2..240).
+    #[arg(long, value_parser = counter_arg)]
+    pub counter: Option<u8>,
+    /// Stop after this many SYNCs.
+    #[arg(long, value_parser = count_arg)]
+    pub count: Option<u64>,
+    /// The SYNC COB-ID (11-bit).
+    #[arg(long, value_parser = cob_arg, default_value = "0x080")]
+    pub cob_id: u32,
+}
+
+/// `pdo NODE send rpdoK NAME=VALUE ... [--every MS] [--count N]`.
+#[derive(Args, Clone, Debug)]
+pub struct PdoArgs<D: Args> {
+    /// Node id 1..127 (decimal or 0x hex).
+    #[arg(value_parser = node_arg)]
+    pub node: u8,
+    /// send.
+    #[arg(value_parser = Words::new(&["send"], pdo_word))]
+    pub action: String,
+    /// The PDO: rpdo1, rpdo2, ...
+    #[arg(value_parser = rpdo_arg)]
+    pub pdo: u16,
+    /// The signals as NAME=VALUE (object name, alias or index:sub).
+    #[arg(allow_negative_numbers = true)]
+    pub signals: Vec<String>,
+    #[command(flatten)]
+    pub repeat: Repeat,
+    #[command(flatten)]
+    pub dict: D,
+}
+
 impl<B: Args, D: Args> Commander<B, D> {
     /// The options in front of the command (the command line's bus options).
     pub fn bus(&self) -> &B {
@@ -356,6 +436,9 @@ impl<B: Args, D: Args> Commander<B, D> {
             Commander::Record(o) => &o.bus,
             Commander::Stop(o) => &o.bus,
             Commander::Lss(o) => &o.bus,
+            Commander::Send(o) => &o.bus,
+            Commander::Sync(o) => &o.bus,
+            Commander::Pdo(o) => &o.bus,
         }
     }
 
@@ -365,6 +448,7 @@ impl<B: Args, D: Args> Commander<B, D> {
             Commander::Sdo(SdoCommand::Read(o)) => Some(&o.args.t.dict),
             Commander::Sdo(SdoCommand::Write(o)) => Some(&o.args.t.dict),
             Commander::Run(o) => Some(&o.args.dict),
+            Commander::Pdo(o) => Some(&o.args.dict),
             _ => None,
         }
     }
@@ -430,6 +514,27 @@ impl<B: Args, D: Args> Commander<B, D> {
                 }
             }
             Commander::Lss(On { args: a, .. }) => a.command()?,
+            Commander::Send(On { args: a, .. }) => Command::Send {
+                frame: a.frame,
+                schedule: a.repeat.schedule(),
+            },
+            Commander::Sync(On { args: a, .. }) => Command::Sync {
+                cob_id: a.cob_id,
+                counter: a.counter,
+                schedule: Schedule {
+                    every_ms: Some(a.period),
+                    count: a.count,
+                },
+            },
+            Commander::Pdo(On { args: a, .. }) => {
+                let words: Vec<&str> = a.signals.iter().map(String::as_str).collect();
+                Command::Pdo {
+                    node: a.node,
+                    num: a.pdo,
+                    assignments: parse_assignments(&words)?,
+                    schedule: a.repeat.schedule(),
+                }
+            }
         })
     }
 }
@@ -594,6 +699,50 @@ pub fn ms_arg(text: &str) -> Result<u64, ParseError> {
         .filter(|v| *v > 0)
         .map(|v| v as u64)
         .ok_or_else(|| ParseError::Invalid(format!("`{text}` must be a positive number of ms")))
+}
+
+/// Parses a frame in candump's compact form with the log reader's parser.
+fn frame_arg(text: &str) -> Result<Frame, ParseError> {
+    match crate::log::candump::parse_compact(text.as_bytes()) {
+        Ok(Some(f)) => Ok(f),
+        Ok(None) => Err(ParseError::Invalid(format!("`{text}`: CAN XL frames cannot be sent"))),
+        Err(e) => Err(ParseError::Invalid(format!(
+            "`{text}` is not a frame ({e}); write ID#DATA, e.g. 601#4041600000000000, 123#R, 12345678#00"
+        ))),
+    }
+}
+
+/// The `pdo` action word: `send` (an RPDO; TPDOs are the nodes' to send).
+fn pdo_word(word: &str) -> Result<String, ParseError> {
+    match word {
+        "send" => Ok(word.to_string()),
+        _ => Err(ParseError::Invalid(format!("unknown pdo command `{word}`: use send"))),
+    }
+}
+
+/// Parses the SYNC counter's overflow value 2..=240.
+fn counter_arg(text: &str) -> Result<u8, ParseError> {
+    parse_int(text)
+        .filter(|v| (2..=240).contains(v))
+        .map(|v| v as u8)
+        .ok_or_else(|| ParseError::Invalid(format!("`{text}`: the SYNC counter counts to 2..240")))
+}
+
+/// Parses an 11-bit COB-ID.
+fn cob_arg(text: &str) -> Result<u32, ParseError> {
+    parse_int(text)
+        .filter(|v| (1..=0x7FF).contains(v))
+        .map(|v| v as u32)
+        .ok_or_else(|| ParseError::Invalid(format!("`{text}` must be an 11-bit COB-ID 0x001..0x7FF")))
+}
+
+/// Parses `rpdo1`..`rpdo512`.
+fn rpdo_arg(text: &str) -> Result<u16, ParseError> {
+    text.to_ascii_lowercase()
+        .strip_prefix("rpdo")
+        .and_then(|n| n.parse::<u16>().ok())
+        .filter(|n| (1..=512).contains(n))
+        .ok_or_else(|| ParseError::Invalid(format!("`{text}` is not an RPDO: use rpdo1, rpdo2, ...")))
 }
 
 /// Parses a positive count.
@@ -790,10 +939,52 @@ mod tests {
     }
 
     #[test]
+    fn cyclic_lines() {
+        let every = |every_ms, count| Schedule { every_ms, count };
+        assert!(matches!(
+            parse_command("send 12345678#DEAD --every 5").unwrap(),
+            Command::Send { frame, schedule } if frame.id == 0x1234_5678 && frame.is_ext()
+                && schedule == every(Some(5), None)
+        ));
+        assert_eq!(
+            parse_command("sync --period 10 --counter 240 --count 3").unwrap(),
+            Command::Sync {
+                cob_id: 0x080,
+                counter: Some(240),
+                schedule: every(Some(10), Some(3))
+            }
+        );
+        assert_eq!(
+            parse_command("pdo 2 send rpdo1 Controlword=0x0F \"Target velocity=-5\" --count 2").unwrap(),
+            Command::Pdo {
+                node: 2,
+                num: 1,
+                assignments: vec![
+                    ("Controlword".into(), "0x0F".into()),
+                    ("Target velocity".into(), "-5".into())
+                ],
+                schedule: every(None, Some(2))
+            }
+        );
+        let err = |line: &str| parse_command(line).unwrap_err().to_string();
+        assert!(err("sync --period 10 --counter 1").contains("counts to 2..240"));
+        assert!(
+            err("send 601#4G").contains("is not a frame (column"),
+            "{}",
+            err("send 601#4G")
+        );
+        assert!(err("pdo 2 send tpdo1").contains("use rpdo1"));
+        assert!(err("pdo 2 read rpdo1").contains("use send"));
+        assert!(err("sync").contains("--period"));
+    }
+
+    #[test]
     fn completion_comes_from_the_declaration() {
         assert_eq!(
             commander_words(),
-            ["nmt", "sdo", "drive", "run", "scan", "record", "stop", "lss"]
+            [
+                "nmt", "sdo", "drive", "run", "scan", "record", "stop", "lss", "send", "sync", "pdo"
+            ]
         );
         assert_eq!(completions("sdo "), ["read", "write"]);
         assert_eq!(completions("nmt re"), NMT_WORDS);

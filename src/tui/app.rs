@@ -163,6 +163,7 @@ fn event_level(what: &crate::analysis::What) -> Level {
 /// Names the palette completes.
 pub const PALETTE_COMMANDS: &[&str] = &[
     "filter", "search", "goto", "time", "speed", "pause", "resume", "plot", "export", "help", "messages", "quit",
+    "jobs",
 ];
 
 /// Why a built-in palette command (`goto`, `time`, `speed`, `plot`, `export`, ...) failed;
@@ -590,6 +591,21 @@ impl App {
         self.say(Level::Info, &format!("{}: sending {}", p.line, p.preview));
     }
 
+    /// `jobs` (list the running palette commands) or `jobs stop ID`: asks the live task.
+    fn jobs_command(&mut self, rest: &str) {
+        let request = match rest.split_whitespace().collect::<Vec<_>>()[..] {
+            [] => Request::ListJobs,
+            ["stop", id] if id.parse::<u32>().is_ok() => Request::StopJob(id.parse().unwrap_or(0)),
+            _ => return self.say(Level::Error, "jobs: use `jobs` or `jobs stop ID`"),
+        };
+        match &self.source.requests {
+            Some(req) => {
+                let _ = req.send(request);
+            }
+            None => self.say(Level::Info, "jobs: this source has no bus, nothing runs"),
+        }
+    }
+
     /// True when the source cannot send (listen-only).
     fn listen_only(&self) -> bool {
         matches!(
@@ -780,6 +796,10 @@ impl App {
             }
             "quit" => {
                 self.request_quit();
+                return;
+            }
+            "jobs" => {
+                self.jobs_command(rest);
                 return;
             }
             "stop" => {

@@ -1,11 +1,13 @@
 //! The live capture task (`cotui live IFACE`, `cotui demo`): a thread with its own tokio
 //! runtime that opens the bus, forwards every frame in batches, reopens the interface when
-//! it fails, and runs the palette's commands on the same bus ([`Jobs`]: cancelled by
-//! stop-all before it stops the drives).
+//! it fails, and runs the palette's commands on the same bus ([`Jobs`]: listed by `jobs`,
+//! stopped one by one by `jobs stop ID`, cancelled by stop-all before it stops the drives,
+//! cyclic SYNC/RPDO/raw senders first).
 
 use super::messages::Level;
 use super::source::Feed;
 use crate::bus::{Bus, BusError, BusState, Event, StateChange};
+use crate::command::cyclic::{self, Progress};
 use crate::command::stop::{Commanded, StopOptions, stop_nodes};
 use crate::command::{self, Command};
 use crate::decode::cia402::DriveState;
@@ -25,6 +27,10 @@ pub enum Request {
     /// Stop-all: cancel every command still running, then quick stop and disable voltage on
     /// `nodes` and on every node this task saw cotui command.
     StopAll { nodes: BTreeSet<u8>, options: StopOptions },
+    /// `jobs`: list the palette commands still running (cyclic ones with their count so far).
+    ListJobs,
+    /// `jobs stop ID`: stop one of them, with its timing report.
+    StopJob(u32),
 }
 
 /// A handle to send requests to the live task.
@@ -186,11 +192,49 @@ fn state_feed(iface: &str, s: &StateChange, stopped_at: &mut Option<u64>) -> Fee
     }
 }
 
+/// A palette command the live task runs.
+struct Job {
+    /// Its number in `jobs` (from 1).
+    id: u32,
+    /// The palette line.
+    line: String,
+    task: AbortHandle,
+    /// A cyclic command's shared timing, what it sends and its period.
+    cyclic: Option<(Progress, String, Option<u64>)>,
+}
+
+impl Job {
+    /// `#2 sync --period 10: SYNC 080, every 10 ms, 123 sent` (the line for others).
+    fn listed(&self) -> String {
+        match &self.cyclic {
+            Some((p, what, period)) => format!(
+                "#{} {}: {what}, {}{} sent",
+                self.id,
+                self.line,
+                period.map(|ms| format!("every {ms} ms, ")).unwrap_or_default(),
+                cyclic::lock(p).sent
+            ),
+            None => format!("#{} {}", self.id, self.line),
+        }
+    }
+
+    /// Aborts the task; the line for the stop report (a cyclic job's with its timing so far).
+    fn cancel(self) -> String {
+        self.task.abort();
+        match &self.cyclic {
+            Some((p, what, period)) => format!("{} ({})", self.line, cyclic::lock(p).report(what, *period, &[]).text()),
+            None => self.line,
+        }
+    }
+}
+
 /// The commands the live task runs for the palette, and the nodes cotui commanded. Owned
 /// by the capture loop: it sees every frame first, so no lock is taken per frame.
 struct Jobs {
-    /// Running commands (the palette line and its task), cancelled by stop-all.
-    running: Vec<(String, AbortHandle)>,
+    /// Running commands, cancelled by stop-all (cyclic ones included) or `jobs stop ID`.
+    running: Vec<Job>,
+    /// The id of the next job.
+    next_id: u32,
     /// Nodes cotui commanded, from the frames it sent; a confirmed stop forgets a node.
     commanded: Commanded,
     /// Where a stop task sends the nodes it confirmed stopped (see [`Jobs::stopped`]).
@@ -201,6 +245,7 @@ impl Jobs {
     fn new(stopped_tx: UnboundedSender<Vec<u8>>) -> Jobs {
         Jobs {
             running: Vec::new(),
+            next_id: 1,
             commanded: Commanded::default(),
             stopped_tx,
         }
@@ -218,20 +263,53 @@ impl Jobs {
 
     /// Starts a request on `bus`; its result goes to `tx` when it ends.
     fn start(&mut self, bus: &Bus, r: Request, bindings: &Bindings, tx: &SyncSender<Feed>) {
-        self.running.retain(|(_, h)| !h.is_finished());
+        self.running.retain(|j| !j.task.is_finished());
         let (bus, tx) = (bus.clone(), tx.clone());
         match r {
             Request::Run { line, command } => {
+                let cyclic = cyclic::source(&command, bindings)
+                    .and_then(Result::ok)
+                    .map(|s| (Progress::default(), s.what, s.schedule.every_ms));
+                let progress = cyclic.as_ref().map(|c| c.0.clone()).unwrap_or_default();
                 let bindings = bindings.clone();
                 let label = line.clone();
                 let task = tokio::spawn(async move {
-                    let (level, text) = match command::execute(&bus, &command, &bindings).await {
+                    let stop = std::future::pending();
+                    let (level, text) = match command::execute_until(&bus, &command, &bindings, progress, stop).await {
                         Ok(o) => (Level::Info, format!("{line}: {}", o.text)),
                         Err(e) => (Level::Error, format!("{line}: error: {e}")),
                     };
                     let _ = tx.send(Feed::Result(level, text));
                 });
-                self.running.push((label, task.abort_handle()));
+                self.running.push(Job {
+                    id: self.next_id,
+                    line: label,
+                    task: task.abort_handle(),
+                    cyclic,
+                });
+                self.next_id += 1;
+            }
+            Request::ListJobs => {
+                let text = if self.running.is_empty() {
+                    "jobs: nothing running".to_string()
+                } else {
+                    let list: Vec<String> = self.running.iter().map(Job::listed).collect();
+                    format!("jobs: {}", list.join("; "))
+                };
+                let _ = tx.send(Feed::Result(Level::Info, text));
+            }
+            Request::StopJob(id) => {
+                let (level, text) = match self.running.iter().position(|j| j.id == id) {
+                    Some(k) => (
+                        Level::Info,
+                        format!("jobs stop {id}: stopped {}", self.running.remove(k).cancel()),
+                    ),
+                    None => (
+                        Level::Error,
+                        format!("jobs stop {id}: no such job running (see `jobs`)"),
+                    ),
+                };
+                let _ = tx.send(Feed::Result(level, text));
             }
             Request::StopAll { mut nodes, options } => {
                 // Cancel first: on this single-threaded runtime no cancelled task runs again,
@@ -256,15 +334,14 @@ impl Jobs {
         }
     }
 
-    /// Aborts every running command; returns their lines.
+    /// Aborts every running command, cyclic ones (SYNC, RPDOs, raw frames) first; returns
+    /// their lines (a cyclic one's with its timing report).
     fn cancel_all(&mut self) -> Vec<String> {
+        self.running.sort_by_key(|j| j.cyclic.is_none());
         self.running
             .drain(..)
-            .filter(|(_, h)| !h.is_finished())
-            .map(|(line, h)| {
-                h.abort();
-                line
-            })
+            .filter(|j| !j.task.is_finished())
+            .map(Job::cancel)
             .collect()
     }
 
@@ -273,6 +350,7 @@ impl Jobs {
     fn refuse(&mut self, r: Request, why: &BusError, tx: &SyncSender<Feed>) {
         let text = match r {
             Request::Run { line, .. } => format!("{line}: not sent: {why}"),
+            Request::ListJobs | Request::StopJob(_) => format!("jobs: the bus is unavailable ({why})"),
             Request::StopAll { .. } => {
                 let cancelled = self.cancel_all();
                 format!(
@@ -291,3 +369,97 @@ impl Jobs {
 
 /// The drive state assumed for a preview when the node's state is unknown.
 pub const UNKNOWN_STATE: DriveState = DriveState::SwitchOnDisabled;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::command::parse_command;
+
+    /// The next result the live task reports (waiting in tokio time, which is paused).
+    async fn result(rx: &Receiver<Feed>) -> String {
+        loop {
+            match rx.try_recv() {
+                Ok(Feed::Result(_, text)) => return text,
+                Ok(_) => {}
+                Err(_) => tokio::time::sleep(Duration::from_millis(5)).await,
+            }
+        }
+    }
+
+    /// One of our SYNCs (the demo bus has its own SYNC producer).
+    fn ours(f: &Frame) -> bool {
+        f.id == 0x080 && f.direction() == crate::frame::Direction::Tx
+    }
+
+    #[tokio::test(start_paused = true)]
+    async fn cyclic_jobs_are_listed_stopped_one_by_one_and_by_stop_all() {
+        let bus = crate::sim::demo::start(false);
+        let bindings = crate::cli::bind::bindings_on(crate::connect::DEMO, &[], &[]).unwrap();
+        let (tx, rx) = sync_channel(64);
+        let (stopped_tx, _stopped) = unbounded_channel();
+        let mut jobs = Jobs::new(stopped_tx);
+        let mut sub = bus.subscribe();
+        for line in ["sync --period 10", "send 123#01 --every 20"] {
+            let command = parse_command(line).unwrap();
+            jobs.start(
+                &bus,
+                Request::Run {
+                    line: line.into(),
+                    command,
+                },
+                &bindings,
+                &tx,
+            );
+        }
+        let mut syncs = 0;
+        while syncs < 5 {
+            let f = sub.recv().await.unwrap();
+            syncs += ours(&f) as u64;
+        }
+        jobs.start(&bus, Request::ListJobs, &bindings, &tx);
+        let list = result(&rx).await;
+        assert!(
+            list.starts_with("jobs: #1 sync --period 10: SYNC 080, every 10 ms, "),
+            "{list}"
+        );
+        assert!(
+            list.contains("; #2 send 123#01 --every 20: 123#01, every 20 ms, "),
+            "{list}"
+        );
+
+        jobs.start(&bus, Request::StopJob(1), &bindings, &tx);
+        let stopped = result(&rx).await;
+        assert!(
+            stopped.starts_with("jobs stop 1: stopped sync --period 10 (SYNC 080: "),
+            "{stopped}"
+        );
+        let sent: u64 = stopped
+            .split("SYNC 080: ")
+            .nth(1)
+            .and_then(|t| t.split(' ').next())
+            .and_then(|n| n.parse().ok())
+            .unwrap();
+        // No SYNC after the stop: every one on the bus was counted in the report.
+        tokio::time::sleep(Duration::from_millis(200)).await;
+        while let Some(f) = sub.try_recv() {
+            syncs += ours(&f.unwrap()) as u64;
+        }
+        assert_eq!(syncs, sent);
+        jobs.start(&bus, Request::StopJob(1), &bindings, &tx);
+        assert_eq!(result(&rx).await, "jobs stop 1: no such job running (see `jobs`)");
+
+        let options = StopOptions {
+            timeout_ms: 50,
+            ramp_ms: 10,
+        };
+        let nodes = BTreeSet::new();
+        jobs.start(&bus, Request::StopAll { nodes, options }, &bindings, &tx);
+        let report = result(&rx).await;
+        assert!(
+            report.contains("cancelled: send 123#01 --every 20 (123#01: "),
+            "{report}"
+        );
+        jobs.start(&bus, Request::ListJobs, &bindings, &tx);
+        assert_eq!(result(&rx).await, "jobs: nothing running");
+    }
+}

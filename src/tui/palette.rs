@@ -175,6 +175,21 @@ pub fn plan(
             });
             (action.preview(), confirm)
         }
+        Command::Send { .. } | Command::Sync { .. } | Command::Pdo { .. } => {
+            let mut src = crate::command::cyclic::source(&command, bindings)
+                .unwrap_or_else(|| Err(CommandError::Usage("not a cyclic command".into())))?;
+            let mut text = format!("{} {}", candump(&src.frame(0)), src.schedule.text());
+            if let Command::Sync { counter: Some(n), .. } = &command {
+                text.push_str(&format!(", counter 1..{n}"));
+            }
+            if src.schedule.total().is_none() {
+                text.push_str(" (a job: `jobs` lists, `jobs stop ID` or stop-all stops)");
+            }
+            if !src.defaulted.is_empty() {
+                text.push_str(&format!("; not given, sent as 0: {}", src.defaulted.join(", ")));
+            }
+            (text, None)
+        }
         Command::Record { .. } => {
             return Err(CommandError::Usage(
                 "record runs from the command line (`cotui record IFACE -o FILE`)".into(),
@@ -268,6 +283,17 @@ mod tests {
                 .to_string()
                 .contains("its procedures: ")
         );
+    }
+
+    #[test]
+    fn cyclic_previews() {
+        let preview = |line: &str| plan(line, &b(), |_| None).unwrap().preview;
+        assert_eq!(preview("send 601#4041600000000000"), "601#4041600000000000 once");
+        assert_eq!(
+            preview("sync --period 10 --counter 4"),
+            "080#01 every 10 ms until stopped, counter 1..4 (a job: `jobs` lists, `jobs stop ID` or stop-all stops)"
+        );
+        assert_eq!(preview("send 12345678#R --count 3"), "12345678#R 3 times back to back");
     }
 
     #[test]

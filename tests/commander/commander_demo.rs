@@ -215,8 +215,12 @@ async fn listen_only_sends_nothing_whatever_the_command() {
         assert_eq!(e.exit_code(), 2);
     }
     // Every palette command that sends fails the same way; record only listens.
-    let b = cotui::od::bind::Bindings::new().unwrap();
+    let b = cotui::cli::bind::bindings_on(cotui::connect::DEMO, &[], &[]).unwrap();
     for line in [
+        "send 601#4041600000000000",
+        "send 123#R --every 10 --count 3",
+        "sync --period 10 --counter 4",
+        "pdo 2 send rpdo1 Controlword=0x0F --every 10",
         "nmt reset-node 0",
         "sdo read 3 0x1008 --block",
         "sdo write 3 0x2000 \"01 02\" --type octets",

@@ -4,6 +4,7 @@
 
 mod cli_bitrate;
 mod cli_commander;
+mod cli_cyclic;
 mod cli_run;
 mod command_language;
 mod commander_demo;

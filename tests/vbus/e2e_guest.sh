@@ -317,7 +317,8 @@ wait_socket $dump || bad "listen-only: candump opened no socket"
 sleep 0.3
 declare -A lo_rc
 for cmd in "nmt vcan0 start 2" "nmt vcan0 reset-node 0" "sdo read vcan0 5 0x2000" "sdo write vcan0 5 0x2000 1 --type u8" \
-    "sdo read vcan0 5 0x2005 --block" "drive vcan0 2 enable" "drive vcan0 2 status" "scan vcan0 --listen 800"; do
+    "sdo read vcan0 5 0x2005 --block" "drive vcan0 2 enable" "drive vcan0 2 status" "scan vcan0 --listen 800" \
+    "send vcan0 601#4041600000000000" "sync vcan0 --period 10 --count 5" "pdo vcan0 2 send rpdo1 Controlword=6 --every 10 --profile 2=syntron-ds"; do
     # shellcheck disable=SC2086
     c $cmd --listen-only --json
     lo_rc[$cmd]=$rc
@@ -330,7 +331,7 @@ lo_log=$(ls -t candump-*.log | head -1)
 ours=$(frames "$lo_log" | grep -c .)
 heard=$(grep -c " vcan0 70[25]#" "$lo_log")
 summary=$(for k in "${!lo_rc[@]}"; do printf '%s=%s; ' "${k%% vcan0*} ${k#* vcan0 }" "${lo_rc[$k]}"; done)
-[ "$ours" = 0 ] && [ "$heard" -gt 0 ] && ok "listen-only: 8 sending commands, no frame from us on the bus ($heard peer heartbeats seen)" ||
+[ "$ours" = 0 ] && [ "$heard" -gt 0 ] && ok "listen-only: 11 sending commands, no frame from us on the bus ($heard peer heartbeats seen)" ||
     bad "listen-only: $ours frames not from the peers: $(frames "$lo_log" | head -3 | tr '\n' ' ')"
 sends=0
 for k in "${!lo_rc[@]}"; do
@@ -751,6 +752,66 @@ c sdo read vcan0 11 0x1018:04 --json
     ok "lss: after NMT reset-comm, SDO 0x1018:04 of node 10 = 0x99, of node 11 = 0x1234" ||
     bad "lss sdo after reset: node 10 '$s10', node 11 rc=$rc $out $err"
 kill -TERM $lsim; wait $lsim
+
+# ---- 12. cyclic transmit: SYNC producer, cyclic RPDO, stop-all stops palette jobs --------
+# (syntron-ds RPDO1: controlword + mode of operation.)
+# candump's timestamps judge the period (generous for TCG under load: median interval within
+# 10 %, mean within 25 %, count within 20 %); cotui's own report (from its TX echoes) is
+# printed with the check.
+# period LOG ID: sets n, mean and median (ms) of the frames with ID in candump -L log LOG.
+# The median judges the period; the mean (which a stall of the TCG guest stretches) gets more room.
+period() {
+    awk -v id="$2" '{ split($3, f, "#") } f[1] == id { print substr($1, 2, length($1) - 2) }' "$1" > period.ts
+    n=$(wc -l < period.ts)
+    mean=$(awk 'NR == 1 { a = $1 } { b = $1 } END { printf "%.3f", (NR > 1 ? (b - a) * 1000 / (NR - 1) : 0) }' period.ts)
+    median=$(awk 'NR > 1 { printf "%.3f\n", ($1 - p) * 1000 } { p = $1 }' period.ts | sort -n |
+        awk '{ v[NR] = $1 } END { print (NR ? v[int((NR + 1) / 2)] : 0) }')
+}
+# ms3 FIELD: a float field of the last command's JSON, to the µs
+ms3() { echo "$out" | j "$1 * 1000 | round / 1000"; }
+near() { awk -v x="$1" -v want="$2" -v tol="$3" 'BEGIN { exit !(x >= want * (1 - tol) && x <= want * (1 + tol)) }'; }
+candump -L vcan0,080:7FF,202:7FF > cyc.log 2> /dev/null &
+cycdump=$!
+wait_socket $cycdump || bad "cyclic: candump opened no socket"
+c sync vcan0 --period 10 --count 200 --counter 16 --json
+period cyc.log 080
+counters=$(awk '$3 ~ /^080#/ { h = "0123456789ABCDEF"; printf "%d ", (index(h, substr($3, 5, 1)) - 1) * 16 + index(h, substr($3, 6, 1)) - 1 }' cyc.log |
+    cut -d' ' -f1-18)
+[ "$rc" = 0 ] && near "$n" 200 0.2 && near "$median" 10 0.1 && near "$mean" 10 0.25 && [ "$counters" = "1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 1 2" ] &&
+    ok "sync 10 ms x200: candump saw $n SYNCs, period median $median ms, mean $mean ms, counter 1..16 wraps; cotui measured mean $(ms3 .mean_period_ms) ms, jitter p99 $(ms3 .jitter_p99_ms) ms, max $(ms3 .jitter_max_ms) ms" ||
+    bad "sync: rc=$rc candump $n frames, median $median ms, mean $mean ms, counters '$counters'; $out $err"
+c pdo vcan0 2 send rpdo1 Controlword=0x0F 0x6060=9 --every 20 --count 50 --profile 2=syntron-ds --json
+period cyc.log 202
+data=$(awk '$3 ~ /^202#/ { print $3; exit }' cyc.log)
+[ "$rc" = 0 ] && near "$n" 50 0.2 && near "$median" 20 0.1 && near "$mean" 20 0.25 && [ "$data" = 202#0F0009 ] &&
+    ok "pdo rpdo1 every 20 ms x50: candump saw $n x $data, period median $median ms, mean $mean ms" ||
+    bad "pdo: rc=$rc candump $n frames ($data), median $median ms, mean $mean ms; $out $err"
+# The palette: `sync --period 10` runs as a job; `jobs` lists it, ctrl-s stops it first.
+export TERM=xterm-256color
+tmux new-session -d -s cyc -x 200 -y 45 "XDG_CONFIG_HOME=$work $cotui live vcan0; echo cotui-exit=\$?; sleep 60"
+yscreen() { tmux capture-pane -p -t cyc > yscreen.txt; }
+ywait() { for _ in $(seq "$1"); do yscreen; grep -qE -- "$2" yscreen.txt && return 0; sleep 0.2; done; return 1; }
+ywait 150 "vcan0" || bad "cyclic tui start: $(cat yscreen.txt)"
+: > cyc.log
+tmux send-keys -t cyc ':sync --period 10' Enter
+wait_for cyc.log 150 "080#" || bad "cyclic tui: no SYNC from the palette job: $(cat yscreen.txt)"
+tmux send-keys -t cyc ':jobs' Enter
+ywait 50 "jobs: #1 sync --period 10: SYNC 080, every 10 ms, [0-9]+ sent" || bad "cyclic tui jobs: $(cat yscreen.txt)"
+tmux send-keys -t cyc C-s
+ywait 150 "stop all" || bad "cyclic tui stop: $(cat yscreen.txt)"
+sleep 0.5
+before=$(grep -c "080#" cyc.log)
+sleep 1
+after=$(grep -c "080#" cyc.log)
+tmux send-keys -t cyc m
+ywait 50 "cancelled: sync --period 10 \(SYNC 080: [0-9]+ frames sent" && [ "$before" = "$after" ] && [ "$before" -gt 0 ] &&
+    ok "tui: ctrl-s stops the palette's sync job first ($before SYNCs, none after; the stop report lists it)" ||
+    bad "tui cyclic stop: SYNCs $before then $after; $(cat yscreen.txt)"
+tmux send-keys -t cyc Escape
+sleep 0.3
+tmux send-keys -t cyc q
+tmux kill-session -t cyc 2> /dev/null
+kill $cycdump 2> /dev/null
 
 t_end=$(date +%s.%N)
 echo "$passed passed, $failed failed ($(awk -v a="$t_start" -v b="$t_end" 'BEGIN { printf "%.0f", b - a }') s in the guest)"
