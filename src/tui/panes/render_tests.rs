@@ -208,3 +208,42 @@ fn any_size_renders_without_panicking() {
         }
     }
 }
+
+#[test]
+fn a_replay_shows_its_position_and_progress_in_the_status_line() {
+    use crate::tui::app::SourceKind;
+    use crate::tui::source::{Extent, Position};
+    let mut a = app();
+    let frames = super::testutil::frames();
+    a.source.kind = SourceKind::Replay { speed: 2.0 };
+    a.source.done = false;
+    a.source.paused = true;
+    let first = frames[0].ts_ns;
+    a.source.replay = (
+        Some(Position {
+            frames: 22,
+            ts_ns: frames[21].ts_ns,
+        }),
+        Some(Extent {
+            frames: frames.len() as u64,
+            first_ns: first,
+            last_ns: frames.last().unwrap().ts_ns,
+        }),
+    );
+    let s = screen(&mut a, 80, 24);
+    let status: String = s.lines().rev().take(2).collect::<Vec<_>>().join("\n");
+    assert!(
+        status.contains("replay test.log 50% 0.0 s / 0.1 s ×2 (paused)"),
+        "{status}"
+    );
+    insta::assert_snapshot!(status);
+    // At the end it says so, and a log not measured yet shows only the time.
+    a.source.paused = false;
+    a.source.replay.0 = Some(Position {
+        frames: frames.len() as u64,
+        ts_ns: frames.last().unwrap().ts_ns,
+    });
+    assert!(screen(&mut a, 80, 24).contains("replay test.log 100% 0.1 s / 0.1 s ×2 (end)"));
+    a.source.replay.1 = None;
+    assert!(screen(&mut a, 80, 24).contains("replay test.log 0.1 s ×2 |"));
+}
