@@ -177,6 +177,43 @@ fn help_lists_the_keymap_in_force() {
 }
 
 #[test]
+fn help_at_80x24_scrolls_to_the_palette_commands_and_the_filter_language() {
+    let mut a = app();
+    a.act(Action::Help);
+    let s = screen(&mut a, 80, 24);
+    assert!(s.contains("down/up, pagedown/pageup scroll (1-19 of"), "{s}");
+    // Page down to the end: the last lines of the filter language show.
+    for _ in 0..20 {
+        a.act(Action::PageDown);
+    }
+    let end = screen(&mut a, 80, 24);
+    assert!(end.contains("( ... )"), "{end}");
+    insta::assert_snapshot!("help_80x24_end", end);
+    // Every line was on screen at some scroll position.
+    a.act(Action::Top);
+    let mut seen = String::new();
+    for _ in 0..20 {
+        seen.push_str(&screen(&mut a, 80, 24));
+        a.act(Action::PageDown);
+    }
+    for want in [
+        "ctrl-c, q",
+        "r                 Replay: start over",
+        "goto N",
+        "export FILE [--format candump|jsonl|pcapng] [--force]",
+        "sdo write [OPTIONS] <NODE> <OBJECT> <VALUE>",
+        "stop [OPTIONS] [NODES]...",
+        "id 180/780",
+        "abort, abort 0x0602",
+        "not a, !a",
+    ] {
+        assert!(seen.contains(want), "{want}");
+    }
+    a.act(Action::Back);
+    assert!(!screen(&mut a, 80, 24).contains("Help"));
+}
+
+#[test]
 fn filter_prompt_and_errors_show_in_the_bottom_line() {
     let mut a = app();
     a.set_filter("kind bogus");
