@@ -295,6 +295,10 @@ impl App {
                     }
                 }
                 Ok(Feed::Reset) => {
+                    // A replay going back is no longer at its end.
+                    if self.message.as_deref() == Some("replay finished") {
+                        self.message = None;
+                    }
                     self.trace.clear();
                     self.panes.trace.reset();
                     self.restart_search();

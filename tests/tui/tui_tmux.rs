@@ -232,7 +232,12 @@ fn replay_steps_seeks_and_rewinds_as_documented() {
     s.wait_for("the end", |t| {
         t.contains("100% 2.0 s / 2.0 s ×0.01 (end) | 11 frames |")
     });
-    // After the end a seek back works, and the rewind shows nothing.
+    // After the end a step back and a seek back work (the end note goes), the rewind
+    // shows nothing.
+    s.wait_for("the end note", |t| t.contains("replay finished"));
+    s.keys(&[","]);
+    let t = s.wait_for("a step back from the end", |t| t.contains("| 10 frames |"));
+    assert!(!t.contains("replay finished"), "{t}");
     s.keys(&[":", "time 0.25", "Enter"]);
     s.wait_for("0.25 s", |t| {
         t.contains("| 3 frames |") && t.contains("frame 3  t 0.200000 s")
