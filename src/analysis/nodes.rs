@@ -1,12 +1,16 @@
 //! Per-node state gathered while frames come in: liveness (NMT state, heartbeat timing,
 //! lost/back, boot-ups, from the [`EventTracker`]), the last EMCY, CiA 402 state and mode,
 //! frame rate and profile; and the bus events for the message log.
+//!
+//! A node is shown only once the bus gave CANopen evidence of it (see [`Evidence`]):
+//! frames of a node-ID without it (random or foreign traffic) are kept aside and counted as
+//! "other", their events held back until the node is confirmed.
 
 use crate::analysis::{Event, EventTracker, NodeLiveness};
 use crate::decode::Decoder;
 use crate::decode::cia402::DriveState;
 use crate::decode::emcy::Emcy;
-use crate::decode::heartbeat::Heartbeat;
+use crate::decode::heartbeat::{Heartbeat, NmtState};
 use crate::decode::pdo::Pdo;
 use crate::sdo::Transaction;
 use std::collections::{BTreeMap, VecDeque};
@@ -41,9 +45,45 @@ impl NodeInfo {
     }
 }
 
+/// Events held per unconfirmed node (oldest dropped).
+const HELD_EVENTS: usize = 16;
+
+/// What the bus said so far about a node-ID not shown yet.
+///
+/// The node is confirmed by one SDO transfer that completed without a problem (its
+/// initiate request and the matching response seen), or by two well-formed error-control
+/// frames (boot-up `00`, or one byte with a known NMT state `04`, `05`, `7F`, the toggle
+/// bit allowed) outnumbering the malformed ones at 0x700+node. EMCY, PDOs, aborted or
+/// unmatched SDO frames and guarding requests never create a node on their own: random
+/// traffic looks like them too often.
+#[derive(Clone, Debug, Default)]
+struct Evidence {
+    info: NodeInfo,
+    /// Well-formed and malformed error-control frames.
+    ec_ok: u32,
+    ec_bad: u32,
+    /// Clean SDO transfers.
+    sdo_ok: u32,
+    /// Events of the node, released when it is confirmed.
+    held: VecDeque<Event>,
+}
+
+impl Evidence {
+    fn confirmed(&self) -> bool {
+        self.sdo_ok > 0 || (self.ec_ok >= 2 && self.ec_ok > self.ec_bad)
+    }
+}
+
+/// True for an error-control frame a CANopen node sends: a boot-up or a known NMT state.
+fn well_formed(h: &Heartbeat) -> bool {
+    !h.request && matches!(h.state, Some(s) if !matches!(s, NmtState::Unknown(_)))
+}
+
 /// All nodes seen, by node-ID.
 pub struct Nodes {
     map: BTreeMap<u8, NodeInfo>,
+    /// Node-IDs with frames but no CANopen evidence yet.
+    candidates: BTreeMap<u8, Evidence>,
     tracker: EventTracker,
     events: VecDeque<Event>,
 }
@@ -53,6 +93,7 @@ impl Nodes {
     pub fn new(decoder: &Decoder) -> Nodes {
         Nodes {
             map: BTreeMap::new(),
+            candidates: BTreeMap::new(),
             tracker: EventTracker::new(|n| decoder.dictionary(n)),
             events: VecDeque::new(),
         }
@@ -69,9 +110,16 @@ impl Nodes {
     pub fn is_empty(&self) -> bool {
         self.map.is_empty()
     }
-    /// One node.
+    /// One node, also one without CANopen evidence yet (its drive state still counts for
+    /// the stop-all and quit checks).
     pub fn get(&self, node: u8) -> Option<&NodeInfo> {
-        self.map.get(&node)
+        self.map
+            .get(&node)
+            .or_else(|| self.candidates.get(&node).map(|c| &c.info))
+    }
+    /// Frames of node-IDs without CANopen evidence: "other" traffic, not nodes.
+    pub fn other_frames(&self) -> u64 {
+        self.candidates.values().map(|c| c.info.frames).sum()
     }
     /// The liveness of one node (None before its first error-control frame).
     pub fn liveness(&self, node: u8) -> Option<&NodeLiveness> {
@@ -88,17 +136,52 @@ impl Nodes {
     }
 
     fn entry(&mut self, node: u8) -> &mut NodeInfo {
-        self.map.entry(node).or_default()
+        match self.map.get_mut(&node) {
+            Some(n) => n,
+            None => &mut self.candidates.entry(node).or_default().info,
+        }
     }
 
-    /// Moves the tracker's new events to the backlog.
+    /// Adds evidence about an unconfirmed `node`; shows it once it is enough.
+    fn evidence(&mut self, node: u8, add: impl FnOnce(&mut Evidence)) {
+        if self.map.contains_key(&node) {
+            return;
+        }
+        let c = self.candidates.entry(node).or_default();
+        add(c);
+        if c.confirmed()
+            && let Some(c) = self.candidates.remove(&node)
+        {
+            self.map.insert(node, c.info);
+            // Held events go where their time puts them among those not taken yet.
+            self.backlog(c.held);
+            self.events.make_contiguous().sort_by_key(|e| e.t_ns);
+        }
+    }
+
+    fn backlog(&mut self, events: impl IntoIterator<Item = Event>) {
+        self.events.extend(events);
+        let excess = self.events.len().saturating_sub(EVENT_BACKLOG);
+        self.events.drain(..excess);
+    }
+
+    /// Moves the tracker's new events to the backlog, or holds them for their node when
+    /// it is not confirmed yet.
     fn collect(&mut self) {
         if self.tracker.pending() == 0 {
             return;
         }
-        self.events.extend(self.tracker.take_events());
-        let excess = self.events.len().saturating_sub(EVENT_BACKLOG);
-        self.events.drain(..excess);
+        for e in self.tracker.take_events() {
+            match e.node.and_then(|n| self.candidates.get_mut(&n)) {
+                Some(c) => {
+                    if c.held.len() == HELD_EVENTS {
+                        c.held.pop_front();
+                    }
+                    c.held.push_back(e);
+                }
+                None => self.backlog([e]),
+            }
+        }
     }
 
     /// Capture time has reached `now_ns` (a frame's time, or the capture clock of a live
@@ -127,7 +210,14 @@ impl Nodes {
             return;
         }
         self.entry(node);
-        self.tracker.heartbeat(node, ts_ns, h);
+        let ok = well_formed(h);
+        if !h.request {
+            self.evidence(node, |c| if ok { c.ec_ok += 1 } else { c.ec_bad += 1 });
+        }
+        // A malformed frame of a node not shown says nothing about its liveness.
+        if ok || h.request || self.map.contains_key(&node) {
+            self.tracker.heartbeat(node, ts_ns, h);
+        }
         self.collect();
     }
 
@@ -172,6 +262,9 @@ impl Nodes {
     /// A completed SDO transfer: picks up 0x1017 and aborts (events), the statusword and
     /// the mode.
     pub fn transaction(&mut self, t: &Transaction) {
+        if t.is_ok() && t.problems.is_empty() {
+            self.evidence(t.node, |c| c.sdo_ok += 1);
+        }
         self.tracker.transaction(t);
         self.collect();
         if !t.is_ok() || t.data.is_empty() {
@@ -193,7 +286,6 @@ impl Nodes {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::decode::heartbeat::NmtState;
     use crate::od::Dictionary;
 
     fn hb(b: u8) -> Heartbeat {
@@ -241,11 +333,117 @@ mod tests {
     fn the_event_backlog_is_bounded() {
         let mut n = Nodes::new(&Decoder::new(Dictionary::default(), Vec::new()));
         let e = crate::decode::emcy::decode(&[0x10, 0x23, 0x11, 0, 0, 0, 0, 0], &Dictionary::default()).0;
+        n.heartbeat(4, 0, &hb(0x00));
+        n.heartbeat(4, 0, &hb(0x7F));
+        n.take_events();
         for i in 0..(EVENT_BACKLOG as u64 + 5) {
             n.emcy(4, i, &e);
         }
         let kept = n.take_events();
         assert_eq!(kept.len(), EVENT_BACKLOG);
         assert_eq!(kept[0].t_ns, 5);
+    }
+
+    /// A deterministic xorshift: the crate has no rand dependency.
+    struct XorShift(u64);
+
+    impl XorShift {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            self.0
+        }
+    }
+
+    fn trace_of(frames: impl IntoIterator<Item = crate::frame::Frame>) -> crate::analysis::trace::Trace {
+        let mut t = crate::analysis::trace::Trace::new(Decoder::new(Dictionary::default(), Vec::new()), 500_000);
+        for f in frames {
+            t.push(&f);
+        }
+        t
+    }
+
+    /// `cangen`-like traffic: random 11-bit IDs, lengths 0..=8, random bytes, 1 ms apart.
+    fn random_frames(seed: u64, count: u64) -> Vec<crate::frame::Frame> {
+        let mut r = XorShift(seed);
+        (0..count)
+            .map(|i| {
+                let id = (r.next() % 0x800) as u32;
+                let len = (r.next() % 9) as usize;
+                let data: Vec<u8> = (0..len).map(|_| r.next() as u8).collect();
+                let mut f = crate::frame::Frame::classic(id, &data);
+                f.ts_ns = i * MS;
+                f
+            })
+            .collect()
+    }
+
+    #[test]
+    fn random_traffic_creates_no_node_and_is_counted_as_other() {
+        let frames = random_frames(0x9E37_79B9_7F4A_7C15, 200_000);
+        let t = trace_of(frames.clone());
+        let phantoms: Vec<u8> = t.nodes.iter().map(|(n, _)| *n).collect();
+        assert_eq!(phantoms, Vec::<u8>::new());
+        // Every frame of a node-ID range (all but NMT, SYNC/EMCY 0x080, TIME, LSS and the
+        // IDs outside the predefined set) is counted as other.
+        assert!(t.nodes.other_frames() > 140_000, "{}", t.nodes.other_frames());
+        let mut n = t.nodes;
+        assert!(n.take_events().iter().all(|e| e.node.is_none()));
+    }
+
+    #[test]
+    fn real_heartbeats_in_random_traffic_still_make_nodes() {
+        let mut frames = random_frames(42, 20_000);
+        for (i, f) in frames.iter_mut().enumerate().filter(|(i, _)| i % 100 == 0) {
+            // Node 5 boots, then beats every 100 ms; node 7 only beats.
+            *f = match i {
+                0 => crate::frame::Frame::classic(0x705, &[0x00]),
+                _ if i % 200 == 0 => crate::frame::Frame::classic(0x705, &[0x05]),
+                _ => crate::frame::Frame::classic(0x707, &[0x7F]),
+            };
+            f.ts_ns = i as u64 * MS;
+        }
+        let t = trace_of(frames);
+        let nodes: Vec<u8> = t.nodes.iter().map(|(n, _)| *n).collect();
+        assert_eq!(nodes, [5, 7]);
+        assert_eq!(t.nodes.liveness(5).unwrap().state, Some(NmtState::Operational));
+        assert_eq!(t.nodes.liveness(7).unwrap().state, Some(NmtState::PreOperational));
+        let mut n = t.nodes;
+        let texts: Vec<String> = n.take_events().iter().map(Event::text).collect();
+        assert_eq!(texts[0], "node 5 boot-up: boot-up, first message of the node");
+    }
+
+    #[test]
+    fn one_clean_sdo_transfer_shows_a_node_a_lone_response_does_not() {
+        let sdo = |ms: u64, id: u32, data: [u8; 8]| {
+            let mut f = crate::frame::Frame::classic(id, &data);
+            f.ts_ns = ms * MS;
+            f
+        };
+        let t = trace_of([
+            // node 3: read 0x1000 answered.
+            sdo(1, 0x603, [0x40, 0x00, 0x10, 0, 0, 0, 0, 0]),
+            sdo(2, 0x583, [0x43, 0x00, 0x10, 0, 0x92, 0x01, 0x02, 0]),
+            // node 4: an answer whose request was not seen; node 6: a response for another
+            // object than the request's.
+            sdo(3, 0x584, [0x43, 0x00, 0x10, 0, 0x92, 0x01, 0x02, 0]),
+            sdo(4, 0x606, [0x40, 0x00, 0x10, 0, 0, 0, 0, 0]),
+            sdo(5, 0x586, [0x43, 0x18, 0x10, 1, 0x92, 0x01, 0x02, 0]),
+        ]);
+        let nodes: Vec<u8> = t.nodes.iter().map(|(n, _)| *n).collect();
+        assert_eq!(nodes, [3]);
+        assert_eq!(t.nodes.other_frames(), 3);
+    }
+
+    #[test]
+    fn malformed_heartbeats_outnumbering_good_ones_make_no_node() {
+        let mut n = Nodes::new(&Decoder::new(Dictionary::default(), Vec::new()));
+        for b in [0x09, 0x33, 0x05, 0x05] {
+            n.heartbeat(9, 0, &hb(b));
+        }
+        assert!(n.is_empty());
+        n.heartbeat(9, 0, &hb(0x85));
+        assert_eq!(n.len(), 1);
     }
 }

@@ -211,8 +211,11 @@ pub fn run_replay(args: &ReplayArgs) -> ExitCode {
     if let Err(code) = check_file(&args.file) {
         return code;
     }
-    if !(args.speed >= 0.0 && args.speed.is_finite()) {
-        eprintln!("cotui replay: --speed must be 0 or more");
+    if !source::valid_speed(args.speed) {
+        eprintln!(
+            "cotui replay: --speed {} is out of range: 0 (as fast as possible) or 0.01 to 1000",
+            args.speed
+        );
         return ExitCode::Usage;
     }
     let name = args.file.display().to_string();

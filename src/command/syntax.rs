@@ -581,6 +581,28 @@ pub fn commander_words() -> Vec<&'static str> {
     palette().get_subcommands().map(clap::Command::get_name).collect()
 }
 
+/// The syntax of every commander command as the palette takes it, one line each, from the
+/// declaration: `(usage, about)`, e.g. `("sdo read [OPTIONS] <NODE> <OBJECT>", "Read ...")`.
+pub fn usages() -> Vec<(String, String)> {
+    fn walk(cmd: &clap::Command, path: &str, out: &mut Vec<(String, String)>) {
+        for sub in cmd.get_subcommands() {
+            let name = format!("{path}{}", sub.get_name()).trim_start().to_string();
+            if sub.has_subcommands() {
+                walk(sub, &format!("{name} "), out);
+                continue;
+            }
+            let usage = sub.clone().render_usage().to_string();
+            // clap says "Usage: : sdo read ..." (the palette's name is `:`).
+            let args = usage.split_once(sub.get_name()).map_or("", |(_, rest)| rest.trim());
+            let about = sub.get_about().map(ToString::to_string).unwrap_or_default();
+            out.push((format!("{name} {args}").trim_end().to_string(), about));
+        }
+    }
+    let mut out = Vec::new();
+    walk(palette(), "", &mut out);
+    out
+}
+
 /// The words that may complete the last (partial) word of `before`, a palette line up to
 /// the cursor: subcommands, flags (when the word starts with `-`), the values of the flag
 /// before it or of the positional argument it stands for (NMT and drive actions, types).

@@ -53,6 +53,8 @@ pub struct SourceInfo {
     pub drops: u64,
     /// The interface error in force (with the command that fixes it).
     pub bus_error: Option<String>,
+    /// Where a replay is, and the size of its log once measured.
+    pub replay: (Option<super::source::Position>, Option<super::source::Extent>),
     feed: Option<Receiver<Feed>>,
     control: Option<Sender<Control>>,
     requests: Option<Requests>,
@@ -68,10 +70,16 @@ impl SourceInfo {
             done: false,
             drops: 0,
             bus_error: None,
+            replay: (None, None),
             feed: Some(feed),
             control,
             requests: None,
         }
+    }
+
+    /// True when a replay has played its last frame (it waits for a seek back or a rewind).
+    pub fn replay_at_end(&self) -> bool {
+        matches!(self.replay, (Some(p), Some(e)) if e.frames > 0 && p.frames >= e.frames)
     }
 
     /// A live source that also runs palette commands.
@@ -162,8 +170,8 @@ fn event_level(what: &crate::analysis::What) -> Level {
 
 /// Names the palette completes.
 pub const PALETTE_COMMANDS: &[&str] = &[
-    "filter", "search", "goto", "time", "speed", "pause", "resume", "plot", "export", "help", "messages", "quit",
-    "jobs",
+    "filter", "search", "goto", "time", "speed", "pause", "resume", "rewind", "plot", "export", "help", "messages",
+    "quit", "jobs",
 ];
 
 /// Why a built-in palette command (`goto`, `time`, `speed`, `plot`, `export`, ...) failed;
@@ -177,8 +185,11 @@ pub enum CommandError {
     #[error("time: `{0}` is not seconds")]
     NotSeconds(String),
     /// `speed` without a factor.
-    #[error("speed: `{0}` is not a factor (0 = as fast as possible)")]
+    #[error("speed: `{0}` is not a factor from 0.01 to 1000 (0 = as fast as possible)")]
     NotAFactor(String),
+    /// A replay command on a source that is not a replay.
+    #[error("{0}: only a replay can do that")]
+    NoReplay(&'static str),
     /// `speed` on a source that is not a replay.
     #[error("speed: only a replay has a speed")]
     NoSpeed,
@@ -284,6 +295,10 @@ impl App {
                     }
                 }
                 Ok(Feed::Reset) => {
+                    // A replay going back is no longer at its end.
+                    if self.message.as_deref() == Some("replay finished") {
+                        self.message = None;
+                    }
                     self.trace.clear();
                     self.panes.trace.reset();
                     self.restart_search();
@@ -293,6 +308,11 @@ impl App {
                     self.dirty = true;
                 }
                 Ok(Feed::Status(s)) => self.say(Level::Info, &s),
+                Ok(Feed::Position(p)) => {
+                    self.source.replay.0 = Some(p);
+                    self.dirty = true;
+                }
+                Ok(Feed::Extent(e)) => self.source.replay.1 = Some(e),
                 Ok(Feed::Result(level, s)) => self.say(level, &s),
                 Ok(Feed::Lost(n)) => {
                     self.source.drops += n;
@@ -370,7 +390,7 @@ impl App {
             SourceKind::Replay { speed } if speed > 0.0 && !self.source.paused => speed,
             _ => return None,
         };
-        if self.source.done || self.source.bus_error.is_some() {
+        if self.source.done || self.source.replay_at_end() || self.source.bus_error.is_some() {
             return None;
         }
         let (ts, at) = self.capture_clock?;
@@ -760,20 +780,26 @@ impl App {
                 .parse::<usize>()
                 .map_err(|_| CommandError::NotAFrame(rest.to_string()))
                 .map(|n| {
-                    self.select_position(n.saturating_sub(1));
+                    if !self.replay_control(Control::GotoFrame(n as u64)) {
+                        self.select_position(n.saturating_sub(1));
+                    }
                     format!("frame {n}")
                 }),
             "time" => rest
                 .parse::<f64>()
                 .map_err(|_| CommandError::NotSeconds(rest.to_string()))
                 .map(|s| {
-                    let t0 = self.start_ns();
-                    let pos = self.trace.store.position_at(t0 + (s.max(0.0) * 1e9) as u64);
-                    self.select_position(pos);
+                    if !self.replay_control(Control::GotoTime((s.max(0.0) * 1e9) as u64)) {
+                        let t0 = self.start_ns();
+                        let pos = self.trace.store.position_at(t0 + (s.max(0.0) * 1e9) as u64);
+                        self.select_position(pos);
+                    }
                     format!("t = {s} s")
                 }),
+            "rewind" if self.replay_control(Control::Rewind) => Ok("rewind".into()),
+            "rewind" => Err(CommandError::NoReplay("rewind")),
             "speed" => match rest.parse::<f64>() {
-                Ok(x) if x >= 0.0 => self.set_speed(x),
+                Ok(x) if super::source::valid_speed(x) => self.set_speed(x),
                 _ => Err(CommandError::NotAFactor(rest.to_string())),
             },
             "pause" => {
@@ -880,6 +906,15 @@ impl App {
         } else {
             Err(CommandError::NoSeries { node, index, sub })
         }
+    }
+
+    /// Sends `c` to a replay, whose newest frame the trace then follows; false when the
+    /// source is not a replay.
+    fn replay_control(&mut self, c: Control) -> bool {
+        let Some(ctl) = &self.source.control else { return false };
+        let _ = ctl.send(c);
+        self.panes.trace.follow = true;
+        true
     }
 
     fn set_speed(&mut self, x: f64) -> Result<String, CommandError> {
@@ -1068,6 +1103,7 @@ impl App {
                 if let SourceKind::Replay { speed } = self.source.kind {
                     let base = if speed <= 0.0 { 1.0 } else { speed };
                     let x = if a == Action::SpeedUp { base * 2.0 } else { base / 2.0 };
+                    let x = x.clamp(*super::source::SPEEDS.start(), *super::source::SPEEDS.end());
                     self.message = Some(self.set_speed(x).unwrap_or_else(|e| e.to_string()));
                 }
             }
@@ -1078,6 +1114,16 @@ impl App {
                 }
                 _ => self.message = Some("step: pause a replay first".into()),
             },
+            Action::StepBack | Action::Rewind => {
+                let c = if a == Action::Rewind {
+                    Control::Rewind
+                } else {
+                    Control::StepBack
+                };
+                if !self.replay_control(c) {
+                    self.message = Some("only a replay can step back or rewind".into());
+                }
+            }
             Action::SeekForward | Action::SeekBack => match &self.source.control {
                 Some(c) => {
                     let d: i64 = if a == Action::SeekForward {

@@ -75,6 +75,8 @@ actions! {
     SpeedUp = "speed_up": "Replay faster",
     SpeedDown = "speed_down": "Replay slower",
     Step = "step": "Replay one frame (when paused)",
+    StepBack = "step_back": "Replay: one frame back (replays up to the frame before)",
+    Rewind = "rewind": "Replay: start over from the first frame",
     SeekForward = "seek_forward": "Replay: jump 10 s ahead",
     SeekBack = "seek_back": "Replay: jump 10 s back",
     NextSeries = "next_series": "Plot: next signal",

@@ -35,6 +35,10 @@ pub enum Feed {
     /// The interface is (again) capturing with an error-active controller; the text says so
     /// (and for how long capture had stopped).
     BusOk(String),
+    /// Where a replay is (after its batches and every command).
+    Position(Position),
+    /// The size of a replayed log, once measured.
+    Extent(Extent),
     /// The result of a palette command, and how much it matters.
     Result(super::messages::Level, String),
 }
@@ -48,8 +52,16 @@ pub enum Control {
     Speed(f64),
     /// Send the next frame (while paused).
     Step,
+    /// Go back one frame: replay from the start up to the frame before the last one sent.
+    StepBack,
     /// Jump by this many nanoseconds of log time (negative: back).
     Seek(i64),
+    /// Go to just after this many frames from the start (0: the start).
+    GotoFrame(u64),
+    /// Go to just after the frames up to this log time (ns after the first frame).
+    GotoTime(u64),
+    /// Start over from the first frame (paused or playing as before).
+    Rewind,
 }
 
 /// A feed and, for sources that take commands, its control line.
@@ -145,17 +157,50 @@ fn send_batch<R: std::io::BufRead>(
         .is_ok()
 }
 
-/// Replays `path` at `speed` (0 = as fast as possible); returns the feed and the control line.
+/// Replay speeds accepted besides 0 (as fast as possible).
+pub const SPEEDS: std::ops::RangeInclusive<f64> = 0.01..=1000.0;
+
+/// True for a replay speed the player takes: 0, or a finite factor in [`SPEEDS`].
+pub fn valid_speed(x: f64) -> bool {
+    x == 0.0 || SPEEDS.contains(&x)
+}
+
+/// Replays `path` at `speed` (0 = as fast as possible, else within [`SPEEDS`]); returns the
+/// feed and the control line. The replay sends [`Feed::Position`] with its batches and after
+/// every command, and [`Feed::Extent`] once a background pass has measured the log. At the
+/// end it says "replay finished" and waits for a seek back, a step back or a rewind.
 pub fn replay(path: PathBuf, speed: f64) -> (Receiver<Feed>, Sender<Control>) {
     let (tx, rx) = sync_channel(QUEUE);
     let (ctl_tx, ctl_rx) = channel();
+    let measure = (path.clone(), tx.clone());
+    thread::spawn(move || {
+        let (path, tx) = measure;
+        if let Ok(mut r) = reader(&path) {
+            let (mut frames, mut first, mut last) = (0u64, None, 0u64);
+            for item in r.by_ref() {
+                if let Ok((_, Outcome::Frame(f))) = item {
+                    frames += 1;
+                    first.get_or_insert(f.ts_ns);
+                    last = f.ts_ns;
+                }
+            }
+            let first = first.unwrap_or(0);
+            let _ = tx.send(Feed::Extent(Extent {
+                frames,
+                first_ns: first,
+                last_ns: last,
+            }));
+        }
+    });
     thread::spawn(move || {
         let mut player = Player {
             path,
             tx,
             ctl: ctl_rx,
-            speed,
+            speed: if valid_speed(speed) { speed } else { 1.0 },
             paused: false,
+            target: None,
+            first_ns: None,
         };
         if let Err(e) = player.run() {
             let _ = player.tx.send(Feed::Status(e.to_string()));
@@ -165,6 +210,14 @@ pub fn replay(path: PathBuf, speed: f64) -> (Receiver<Feed>, Sender<Control>) {
     (rx, ctl_tx)
 }
 
+/// Where a seek goes: after this many frames, or after the frames up to this log time (ns
+/// after the first frame).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Target {
+    Frame(u64),
+    Time(u64),
+}
+
 /// The replay task's state.
 struct Player {
     path: PathBuf,
@@ -172,133 +225,272 @@ struct Player {
     ctl: Receiver<Control>,
     speed: f64,
     paused: bool,
+    /// A seek in progress: frames go out at once until it is reached.
+    target: Option<Target>,
+    /// The log time of the first frame (time seeks count from it).
+    first_ns: Option<u64>,
 }
 
 /// Why the replay loop stopped reading.
 enum Stop {
     /// The UI went away.
     Gone,
-    /// Seek back to this log time: start over.
-    Restart(u64),
+    /// Start over (seek back, step back, rewind) towards the target.
+    Restart,
+    /// The end of the log.
+    End,
+}
+
+/// What a command asks of the reading loop.
+enum Next {
+    /// Go on (waiting or not as the state says; a new target is judged on the next frame).
+    Stay,
+    /// Send the next frame now (a step while paused).
+    Step,
+    /// Stop reading.
+    Stop(Stop),
+}
+
+/// What waiting for a frame's time ended with.
+enum Wait {
+    /// Send it.
+    Send,
+    /// A seek forward came: judge the frame against it again.
+    Retry,
+    /// Stop reading.
+    Stop(Stop),
+}
+
+/// Where a replay is, as [`Feed::Position`] says it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Position {
+    /// Frames played since the start of the log.
+    pub frames: u64,
+    /// Log time of the last frame played (ns, 0 before the first).
+    pub ts_ns: u64,
+}
+
+/// The size of a replayed log, measured in the background.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Extent {
+    /// Frames in the log.
+    pub frames: u64,
+    /// Log time of the first frame (ns).
+    pub first_ns: u64,
+    /// Log time of the last frame (ns).
+    pub last_ns: u64,
 }
 
 impl Player {
     fn run(&mut self) -> Result<(), ReadError> {
-        let mut skip_to = 0u64;
         loop {
-            match self.play(skip_to)? {
-                Some(Stop::Restart(t)) => {
+            let stop = match self.play()? {
+                (Stop::End, at) => self.finished(at),
+                (other, _) => other,
+            };
+            match stop {
+                Stop::Restart => {
                     if self.tx.send(Feed::Reset).is_err() {
                         return Ok(());
                     }
-                    skip_to = t;
                 }
-                Some(Stop::Gone) => return Ok(()),
-                None => {
-                    let _ = self.tx.send(Feed::Status("replay finished".into()));
-                    return Ok(());
-                }
+                Stop::Gone | Stop::End => return Ok(()),
             }
         }
     }
 
-    /// Plays the log from the start; frames before `skip_to` go out at once.
-    fn play(&mut self, mut skip_to: u64) -> Result<Option<Stop>, ReadError> {
+    /// At the end: waits for a command that goes back.
+    fn finished(&mut self, end: Position) -> Stop {
+        let _ = self.tx.send(Feed::Status("replay finished".into()));
+        self.target = None;
+        while let Ok(c) = self.ctl.recv() {
+            if let Next::Stop(s) = self.apply(c, end) {
+                return s;
+            }
+            self.target = None;
+            if self.tx.send(Feed::Position(end)).is_err() {
+                return Stop::Gone;
+            }
+        }
+        Stop::Gone
+    }
+
+    /// Plays the log from the start; frames up to the target go out at once. Returns why
+    /// it stopped and where it was.
+    fn play(&mut self) -> Result<(Stop, Position), ReadError> {
         let mut r = reader(&self.path)?;
         let mut names = 0;
         let mut batch = Vec::with_capacity(256);
         // Log time `anchor_ts` is played at wall time `anchor_wall`.
         let mut anchor: Option<(u64, Instant)> = None;
         let mut last_send = Instant::now();
-        let mut step = false;
-        while let Some(item) = r.next() {
-            let f = match item {
-                Ok((_, Outcome::Frame(f))) => f,
-                Ok(_) => continue,
-                Err(e) => return Err(ReadError::new(&self.path, e)),
+        let mut at = Position::default();
+        let mut held: Option<Frame> = None;
+        loop {
+            let f = match held.take() {
+                Some(f) => f,
+                None => match r.next() {
+                    Some(Ok((_, Outcome::Frame(f)))) => f,
+                    Some(Ok(_)) => continue,
+                    Some(Err(e)) => return Err(ReadError::new(&self.path, e)),
+                    None => break,
+                },
             };
-            let fast = f.ts_ns < skip_to || self.speed <= 0.0;
-            if !fast {
-                loop {
-                    let (ats, awall) = *anchor.get_or_insert((f.ts_ns, Instant::now()));
-                    let due = awall + Duration::from_secs_f64(f.ts_ns.saturating_sub(ats) as f64 / 1e9 / self.speed);
-                    let now = Instant::now();
-                    if !self.paused && (now >= due || step) {
-                        break;
-                    }
-                    if !batch.is_empty() && !send_batch(&self.tx, &mut batch, &r, &mut names) {
-                        return Ok(Some(Stop::Gone));
-                    }
-                    let wait = if self.paused {
-                        Duration::from_millis(100)
-                    } else {
-                        (due - now).min(Duration::from_millis(10))
-                    };
-                    match self.ctl.recv_timeout(wait) {
-                        Ok(c) => match self.apply(c, f.ts_ns, &mut anchor, &mut step, &mut skip_to) {
-                            Some(stop) => return Ok(Some(stop)),
-                            None => continue,
-                        },
-                        Err(RecvTimeoutError::Timeout) => {}
-                        Err(RecvTimeoutError::Disconnected) => return Ok(Some(Stop::Gone)),
+            let first = *self.first_ns.get_or_insert(f.ts_ns);
+            let seeking = match self.target {
+                Some(Target::Frame(n)) => at.frames < n,
+                Some(Target::Time(t)) => f.ts_ns <= first.saturating_add(t),
+                None => false,
+            };
+            if !seeking {
+                if self.target.take().is_some() {
+                    // Reached: show it, then play on (or stay paused) from here.
+                    anchor = None;
+                    if !self.flush(&mut batch, &r, &mut names, at) {
+                        return Ok((Stop::Gone, at));
                     }
                 }
+                match self.wait(f.ts_ns, &mut anchor, at, &mut batch, &r, &mut names) {
+                    Wait::Send => {}
+                    Wait::Retry => {
+                        held = Some(f);
+                        continue;
+                    }
+                    Wait::Stop(s) => return Ok((s, at)),
+                }
             }
-            if step {
-                step = false;
-                anchor = Some((f.ts_ns, Instant::now()));
-            }
+            let ts_ns = f.ts_ns;
             batch.push(f);
-            if batch.len() >= BATCH || last_send.elapsed() >= Duration::from_millis(10) {
-                if !send_batch(&self.tx, &mut batch, &r, &mut names) {
-                    return Ok(Some(Stop::Gone));
+            at = Position {
+                frames: at.frames + 1,
+                ts_ns,
+            };
+            let stepped = self.paused && !seeking;
+            if stepped || batch.len() >= BATCH || last_send.elapsed() >= Duration::from_millis(10) {
+                if !self.flush(&mut batch, &r, &mut names, at) {
+                    return Ok((Stop::Gone, at));
                 }
                 last_send = Instant::now();
             }
             loop {
                 match self.ctl.try_recv() {
                     Ok(c) => {
-                        if let Some(stop) = self.apply(c, f.ts_ns, &mut anchor, &mut step, &mut skip_to) {
-                            return Ok(Some(stop));
+                        if let Next::Stop(s) = self.apply(c, at) {
+                            self.flush(&mut batch, &r, &mut names, at);
+                            return Ok((s, at));
                         }
                     }
                     Err(TryRecvError::Empty) => break,
-                    Err(TryRecvError::Disconnected) => return Ok(Some(Stop::Gone)),
+                    Err(TryRecvError::Disconnected) => return Ok((Stop::Gone, at)),
                 }
             }
         }
-        send_batch(&self.tx, &mut batch, &r, &mut names);
-        Ok(None)
+        if !self.flush(&mut batch, &r, &mut names, at) {
+            return Ok((Stop::Gone, at));
+        }
+        Ok((Stop::End, at))
     }
 
-    /// Applies a command at log time `now_ts`.
-    fn apply(
+    /// Waits until the frame of log time `ts_ns` is due (or a step while paused), taking
+    /// commands meanwhile.
+    fn wait<R: std::io::BufRead>(
         &mut self,
-        c: Control,
-        now_ts: u64,
+        ts_ns: u64,
         anchor: &mut Option<(u64, Instant)>,
-        step: &mut bool,
-        skip_to: &mut u64,
-    ) -> Option<Stop> {
-        match c {
-            Control::Pause(p) => {
-                self.paused = p;
-                *anchor = None;
+        at: Position,
+        batch: &mut Vec<Frame>,
+        r: &LogReader<R>,
+        names: &mut usize,
+    ) -> Wait {
+        loop {
+            let timeout = if self.paused {
+                Duration::from_millis(100)
+            } else if self.speed <= 0.0 {
+                return Wait::Send;
+            } else {
+                let (ats, awall) = *anchor.get_or_insert((ts_ns, Instant::now()));
+                let secs = ts_ns.saturating_sub(ats) as f64 / 1e9 / self.speed;
+                let due = awall + Duration::try_from_secs_f64(secs).unwrap_or(Duration::from_secs(1 << 32));
+                let now = Instant::now();
+                if now >= due {
+                    return Wait::Send;
+                }
+                (due - now).min(Duration::from_millis(10))
+            };
+            if !batch.is_empty() && !self.flush(batch, r, names, at) {
+                return Wait::Stop(Stop::Gone);
             }
-            Control::Speed(s) => {
-                self.speed = s;
-                *anchor = None;
-            }
-            Control::Step => *step = true,
-            Control::Seek(d) if d < 0 => {
-                return Some(Stop::Restart(now_ts.saturating_sub(d.unsigned_abs())));
-            }
-            Control::Seek(d) => {
-                *skip_to = now_ts + d as u64;
-                *anchor = None;
+            match self.ctl.recv_timeout(timeout) {
+                Ok(c) => match self.apply(c, at) {
+                    Next::Stop(s) => return Wait::Stop(s),
+                    Next::Step => {
+                        *anchor = None;
+                        return Wait::Send;
+                    }
+                    Next::Stay if self.target.is_some() => return Wait::Retry,
+                    Next::Stay => {
+                        *anchor = None;
+                        if self.tx.send(Feed::Position(at)).is_err() {
+                            return Wait::Stop(Stop::Gone);
+                        }
+                    }
+                },
+                Err(RecvTimeoutError::Timeout) => {}
+                Err(RecvTimeoutError::Disconnected) => return Wait::Stop(Stop::Gone),
             }
         }
-        None
+    }
+
+    /// Sends the batch and the position; false when the UI is gone.
+    fn flush<R: std::io::BufRead>(
+        &self,
+        batch: &mut Vec<Frame>,
+        r: &LogReader<R>,
+        names: &mut usize,
+        at: Position,
+    ) -> bool {
+        send_batch(&self.tx, batch, r, names) && self.tx.send(Feed::Position(at)).is_ok()
+    }
+
+    /// Applies a command with the replay at `at`.
+    fn apply(&mut self, c: Control, at: Position) -> Next {
+        let first = self.first_ns.unwrap_or(0);
+        let seek_time = |player: &mut Player, t: u64| {
+            player.target = Some(Target::Time(t));
+            if at.frames > 0 && at.ts_ns > first.saturating_add(t) {
+                Next::Stop(Stop::Restart)
+            } else {
+                Next::Stay
+            }
+        };
+        match c {
+            Control::Pause(p) => self.paused = p,
+            Control::Speed(s) if valid_speed(s) => self.speed = s,
+            Control::Speed(_) => {}
+            Control::Step if self.paused => return Next::Step,
+            Control::Step => {}
+            Control::StepBack => {
+                self.target = Some(Target::Frame(at.frames.saturating_sub(1)));
+                return Next::Stop(Stop::Restart);
+            }
+            Control::Rewind => {
+                self.target = Some(Target::Frame(0));
+                return Next::Stop(Stop::Restart);
+            }
+            Control::GotoFrame(n) => {
+                self.target = Some(Target::Frame(n));
+                if n < at.frames {
+                    return Next::Stop(Stop::Restart);
+                }
+            }
+            Control::GotoTime(t) => return seek_time(self, t),
+            Control::Seek(d) => {
+                let now = at.ts_ns.max(first) as i128 - first as i128;
+                let t = (now + d as i128).clamp(0, u64::MAX as i128) as u64;
+                return seek_time(self, t);
+            }
+        }
+        Next::Stay
     }
 }
 
@@ -352,23 +544,131 @@ mod tests {
         assert!(notes[0].starts_with("/nonexistent/x.log: "), "{notes:?}");
     }
 
+    /// What the UI has from a replay: the frames since the last reset, the resets, the
+    /// notes and the position.
+    #[derive(Default)]
+    struct Ui {
+        frames: Vec<Frame>,
+        resets: usize,
+        notes: Vec<String>,
+        at: Option<Position>,
+        extent: Option<Extent>,
+    }
+
+    impl Ui {
+        /// Takes feed items until `done` holds (a minute at most: no timing is judged).
+        fn until(&mut self, rx: &Receiver<Feed>, done: impl Fn(&Ui) -> bool) {
+            while !done(self) {
+                match rx.recv_timeout(Duration::from_secs(60)).expect("the replay answers") {
+                    Feed::Frames(b) => self.frames.extend(b),
+                    Feed::Reset => {
+                        self.frames.clear();
+                        self.resets += 1;
+                    }
+                    Feed::Status(s) => self.notes.push(s),
+                    Feed::Position(p) => self.at = Some(p),
+                    Feed::Extent(e) => self.extent = Some(e),
+                    Feed::Interfaces(_) => {}
+                    other => panic!("{other:?}"),
+                }
+            }
+        }
+
+        /// Waits until the replay says it is at `frames` frames, and checks that the UI
+        /// then has exactly those frames.
+        fn at(&mut self, rx: &Receiver<Feed>, frames: u64, log: &[Frame]) {
+            self.until(rx, |u| u.at.is_some_and(|p| p.frames == frames));
+            assert_eq!(self.frames.len() as u64, frames);
+            assert_eq!(self.frames, log[..frames as usize]);
+        }
+    }
+
+    fn all_frames(path: &Path) -> Vec<Frame> {
+        open(path.to_path_buf())
+            .iter()
+            .take_while(|f| !matches!(f, Feed::Done))
+            .flat_map(|f| match f {
+                Feed::Frames(b) => b,
+                _ => Vec::new(),
+            })
+            .collect()
+    }
+
     #[test]
-    fn replay_paces_and_seeks_back_with_a_reset() {
+    fn replay_steps_seeks_and_rewinds_while_paused_and_after_the_end() {
+        let l = log(3000);
+        let frames = all_frames(&l.0);
+        // So slow that no frame is due by time during the test: only commands move it.
+        let (rx, ctl) = replay(l.0.clone(), 0.01);
+        let mut ui = Ui::default();
+        ctl.send(Control::Pause(true)).unwrap();
+        ctl.send(Control::GotoFrame(10)).unwrap();
+        ui.at(&rx, 10, &frames);
+        ctl.send(Control::Step).unwrap();
+        ui.at(&rx, 11, &frames);
+        ctl.send(Control::StepBack).unwrap();
+        ui.at(&rx, 10, &frames);
+        assert!(ui.resets >= 1);
+        // By time: the frames up to 0.5 ms after the first.
+        let t = 500_000;
+        let upto = frames.iter().filter(|f| f.ts_ns <= frames[0].ts_ns + t).count() as u64;
+        assert!((2..10).contains(&upto), "{upto}");
+        ctl.send(Control::GotoTime(t)).unwrap();
+        ui.at(&rx, upto, &frames);
+        // 10 s forward by a relative seek goes past the end of this 0.3 s log.
+        ctl.send(Control::Seek(10_000_000_000)).unwrap();
+        ui.until(&rx, |u| u.notes.iter().any(|n| n == "replay finished"));
+        ui.at(&rx, 3000, &frames);
+        ui.until(&rx, |u| u.extent.is_some());
+        let e = ui.extent.unwrap();
+        assert_eq!(
+            (e.frames, e.first_ns, e.last_ns),
+            (3000, frames[0].ts_ns, frames[2999].ts_ns)
+        );
+        // After the end: back by frame number, one step back, and a rewind to nothing.
+        ctl.send(Control::GotoFrame(1500)).unwrap();
+        ui.at(&rx, 1500, &frames);
+        ctl.send(Control::StepBack).unwrap();
+        ui.at(&rx, 1499, &frames);
+        ctl.send(Control::Rewind).unwrap();
+        ui.at(&rx, 0, &frames);
+        ctl.send(Control::Step).unwrap();
+        ui.at(&rx, 1, &frames);
+        // Resumed as fast as possible, it plays to the end again.
+        ctl.send(Control::Speed(0.0)).unwrap();
+        ctl.send(Control::Pause(false)).unwrap();
+        ui.notes.clear();
+        ui.until(&rx, |u| u.notes.iter().any(|n| n == "replay finished"));
+        ui.at(&rx, 3000, &frames);
+        drop(ctl);
+        // The UI gone, the replay ends.
+        assert!(rx.iter().any(|f| matches!(f, Feed::Done)));
+    }
+
+    #[test]
+    fn replay_speeds_are_bounded() {
+        for ok in [0.0, 0.01, 1.0, 1000.0] {
+            assert!(valid_speed(ok), "{ok}");
+        }
+        for bad in [1e-300, 0.001, -1.0, 1000.5, f64::NAN, f64::INFINITY] {
+            assert!(!valid_speed(bad), "{bad}");
+        }
+    }
+
+    #[test]
+    fn replay_plays_at_speed_and_seeks_back_with_a_reset() {
         // 2000 frames 100 µs apart = 0.2 s of log; at speed 1 it takes about that long.
         let l = log(2000);
         let start = Instant::now();
-        let (rx, _ctl) = replay(l.0.clone(), 1.0);
-        assert_eq!(drain(&rx).0, 2000);
+        let (rx, ctl) = replay(l.0.clone(), 1.0);
+        let mut ui = Ui::default();
+        ui.until(&rx, |u| u.notes.iter().any(|n| n == "replay finished"));
+        assert_eq!(ui.frames.len(), 2000);
         assert!(start.elapsed() >= Duration::from_millis(150));
-        let (rx, ctl) = replay(l.0.clone(), 0.5);
-        match rx.recv().unwrap() {
-            Feed::Interfaces(_) => {}
-            other => panic!("{other:?}"),
-        }
         ctl.send(Control::Seek(-1_000_000_000)).unwrap();
-        let (n, resets, notes) = drain(&rx);
-        assert_eq!(resets, 1);
-        assert!(n >= 2000);
-        assert_eq!(notes, ["replay finished"]);
+        ui.notes.clear();
+        ui.until(&rx, |u| u.notes.iter().any(|n| n == "replay finished"));
+        assert_eq!(ui.resets, 1);
+        assert_eq!(ui.frames.len(), 2000);
     }
 }

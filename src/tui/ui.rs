@@ -85,6 +85,6 @@ pub fn draw(f: &mut Frame, app: &mut App) {
         app.log_popup.render(&app.messages, f, body);
     }
     if app.help.shown {
-        panes::help::render(&app.keymap, f, body);
+        app.help.render(&app.keymap, f, body);
     }
 }

@@ -64,3 +64,20 @@ fn a_missing_log_is_reported_before_the_screen_changes() {
     assert!(String::from_utf8_lossy(&out.stderr).starts_with("cotui: /nonexistent/cotui.log: "));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_replay_speed_out_of_range_is_a_usage_error() {
+    let dir = tempdir("speed");
+    let log = dir.join("x.log");
+    std::fs::write(&log, "(1.000000) can0 701#05\n").unwrap();
+    for bad in ["1e-300", "-1", "inf", "NaN", "5000"] {
+        let out = cotui(&["replay", log.to_str().unwrap(), &format!("--speed={bad}")], &dir);
+        assert_eq!(out.status.code(), Some(1), "{bad}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("out of range: 0 (as fast as possible) or 0.01 to 1000"),
+            "{bad}: {err}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,7 +1,8 @@
 //! End-to-end: the real binary in a tmux pane. `cotui demo` shows the simulated drives
 //! reach their states, help opens, a filter narrows the trace, `q` quits and the terminal
 //! comes back (the shell after cotui prints and the alternate screen is gone). A replay
-//! marks a node LOST while its log is silent (the replay clock).
+//! marks a node LOST while its log is silent (the replay clock); replay step, step back,
+//! `:goto`, `:time` (also after the end) and rewind move it as docs/TUI.md says.
 //! Needs tmux (scripts/install-test-deps.sh installs it).
 
 use std::process::Command;
@@ -191,6 +192,60 @@ fn a_replay_marks_a_node_lost_while_the_log_is_silent() {
         "{t}"
     );
     assert!(t.contains("| 11 frames |"), "{t}");
+    s.keys(&["q"]);
+    s.wait_for("cotui to exit", |t| t.contains("cotui-exit=0"));
+    let _ = std::fs::remove_file(&log);
+}
+
+#[test]
+fn replay_steps_seeks_and_rewinds_as_documented() {
+    // Ten frames 0.1 s apart, then one at 2 s; played so slowly that only the keys move it.
+    let bin = env!("CARGO_BIN_EXE_cotui");
+    let name = format!("cotui-seek-{}", std::process::id());
+    let log = std::env::temp_dir().join(format!("{name}.log"));
+    let mut text: String = (0..10u64)
+        .map(|i| format!("(1700000000.{:06}) can0 181#{i:02X}\n", i * 100_000))
+        .collect();
+    text.push_str("(1700000002.000000) can0 181#FF\n");
+    std::fs::write(&log, text).unwrap();
+    let s = Session::start(
+        &name,
+        &format!(
+            "{bin} replay {} --speed 0.01; echo cotui-exit=$?; sleep 60",
+            log.display()
+        ),
+    );
+    s.wait_for("the first frame", |t| t.contains("| 1 frames |"));
+    s.keys(&["space", ":", "goto 5", "Enter"]);
+    s.wait_for("frame 5", |t| {
+        t.contains("replay") && t.contains("45% 0.4 s / 2.0 s ×0.01 (paused) | 5 frames |")
+    });
+    s.keys(&["."]);
+    s.wait_for("one step", |t| {
+        t.contains("| 6 frames |") && t.contains("frame 6  t 0.500000 s")
+    });
+    s.keys(&[","]);
+    s.wait_for("one step back", |t| {
+        t.contains("| 5 frames |") && t.contains("frame 5  t 0.400000 s")
+    });
+    s.keys(&[":", "time 10", "Enter"]);
+    s.wait_for("the end", |t| {
+        t.contains("100% 2.0 s / 2.0 s ×0.01 (end) | 11 frames |")
+    });
+    // After the end a step back and a seek back work (the end note goes), the rewind
+    // shows nothing.
+    s.wait_for("the end note", |t| t.contains("replay finished"));
+    s.keys(&[","]);
+    let t = s.wait_for("a step back from the end", |t| t.contains("| 10 frames |"));
+    assert!(!t.contains("replay finished"), "{t}");
+    s.keys(&[":", "time 0.25", "Enter"]);
+    s.wait_for("0.25 s", |t| {
+        t.contains("| 3 frames |") && t.contains("frame 3  t 0.200000 s")
+    });
+    s.keys(&["r"]);
+    s.wait_for("the rewind", |t| {
+        t.contains("0% 0.0 s / 2.0 s ×0.01 (paused) | 0 frames |")
+    });
     s.keys(&["q"]);
     s.wait_for("cotui to exit", |t| t.contains("cotui-exit=0"));
     let _ = std::fs::remove_file(&log);

@@ -118,7 +118,7 @@ impl Component for NodesPane {
     }
 
     fn render(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
-        f.render_widget(block(" Nodes ", focused), area);
+        f.render_widget(block(&title(ctx.trace), focused), area);
         let inner = block("", true).inner(area);
         if inner.height == 0 {
             return;
@@ -165,9 +165,17 @@ impl Component for NodesPane {
     }
 }
 
+/// The pane title, with the frames of node-IDs without CANopen evidence ("other").
+fn title(trace: &Trace) -> String {
+    match trace.nodes.other_frames() {
+        0 => " Nodes ".to_string(),
+        n => format!(" Nodes · {n} other frames "),
+    }
+}
+
 /// Draws the compact list beside the main pane: id, NMT state, drive state.
 pub fn render_compact(trace: &Trace, f: &mut Frame, area: Rect) {
-    f.render_widget(block(" Nodes ", false), area);
+    f.render_widget(block(&title(trace), false), area);
     let inner = block("", true).inner(area);
     let now = trace.nodes.now_ns();
     let lines: Vec<Line> = trace

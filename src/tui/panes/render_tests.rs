@@ -177,6 +177,43 @@ fn help_lists_the_keymap_in_force() {
 }
 
 #[test]
+fn help_at_80x24_scrolls_to_the_palette_commands_and_the_filter_language() {
+    let mut a = app();
+    a.act(Action::Help);
+    let s = screen(&mut a, 80, 24);
+    assert!(s.contains("down/up, pagedown/pageup scroll (1-19 of"), "{s}");
+    // Page down to the end: the last lines of the filter language show.
+    for _ in 0..20 {
+        a.act(Action::PageDown);
+    }
+    let end = screen(&mut a, 80, 24);
+    assert!(end.contains("( ... )"), "{end}");
+    insta::assert_snapshot!("help_80x24_end", end);
+    // Every line was on screen at some scroll position.
+    a.act(Action::Top);
+    let mut seen = String::new();
+    for _ in 0..20 {
+        seen.push_str(&screen(&mut a, 80, 24));
+        a.act(Action::PageDown);
+    }
+    for want in [
+        "ctrl-c, q",
+        "r                 Replay: start over",
+        "goto N",
+        "export FILE [--format candump|jsonl|pcapng] [--force]",
+        "sdo write [OPTIONS] <NODE> <OBJECT> <VALUE>",
+        "stop [OPTIONS] [NODES]...",
+        "id 180/780",
+        "abort, abort 0x0602",
+        "not a, !a",
+    ] {
+        assert!(seen.contains(want), "{want}");
+    }
+    a.act(Action::Back);
+    assert!(!screen(&mut a, 80, 24).contains("Help"));
+}
+
+#[test]
 fn filter_prompt_and_errors_show_in_the_bottom_line() {
     let mut a = app();
     a.set_filter("kind bogus");
@@ -207,4 +244,43 @@ fn any_size_renders_without_panicking() {
             let _ = screen(&mut a, w, h);
         }
     }
+}
+
+#[test]
+fn a_replay_shows_its_position_and_progress_in_the_status_line() {
+    use crate::tui::app::SourceKind;
+    use crate::tui::source::{Extent, Position};
+    let mut a = app();
+    let frames = super::testutil::frames();
+    a.source.kind = SourceKind::Replay { speed: 2.0 };
+    a.source.done = false;
+    a.source.paused = true;
+    let first = frames[0].ts_ns;
+    a.source.replay = (
+        Some(Position {
+            frames: 22,
+            ts_ns: frames[21].ts_ns,
+        }),
+        Some(Extent {
+            frames: frames.len() as u64,
+            first_ns: first,
+            last_ns: frames.last().unwrap().ts_ns,
+        }),
+    );
+    let s = screen(&mut a, 80, 24);
+    let status: String = s.lines().rev().take(2).collect::<Vec<_>>().join("\n");
+    assert!(
+        status.contains("replay test.log 50% 0.0 s / 0.1 s ×2 (paused)"),
+        "{status}"
+    );
+    insta::assert_snapshot!(status);
+    // At the end it says so, and a log not measured yet shows only the time.
+    a.source.paused = false;
+    a.source.replay.0 = Some(Position {
+        frames: frames.len() as u64,
+        ts_ns: frames.last().unwrap().ts_ns,
+    });
+    assert!(screen(&mut a, 80, 24).contains("replay test.log 100% 0.1 s / 0.1 s ×2 (end)"));
+    a.source.replay.1 = None;
+    assert!(screen(&mut a, 80, 24).contains("replay test.log 0.1 s ×2 |"));
 }

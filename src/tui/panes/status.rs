@@ -7,12 +7,35 @@ use ratatui::layout::Rect;
 use ratatui::style::{Color, Style};
 use ratatui::widgets::Paragraph;
 
+/// A replay's position: ` 45% 12.3 s / 27.0 s` (percent of the frames, log time from the
+/// first frame), only the time until the log is measured, nothing before the first frame.
+fn replay_position(app: &App) -> String {
+    match app.source.replay {
+        (Some(p), Some(e)) if e.frames > 0 => format!(
+            " {}% {:.1} s / {:.1} s",
+            p.frames * 100 / e.frames,
+            p.ts_ns.saturating_sub(e.first_ns) as f64 / 1e9,
+            e.last_ns.saturating_sub(e.first_ns) as f64 / 1e9
+        ),
+        (Some(p), _) if p.frames > 0 => {
+            format!(" {:.1} s", p.ts_ns.saturating_sub(app.start_ns()) as f64 / 1e9)
+        }
+        _ => String::new(),
+    }
+}
+
 /// The status bar text.
 pub fn text(app: &App) -> String {
     let src = match app.source.kind {
         SourceKind::Open => format!("open {}", app.source.name),
-        SourceKind::Replay { speed } if speed <= 0.0 => format!("replay {} ×max", app.source.name),
-        SourceKind::Replay { speed } => format!("replay {} ×{speed}", app.source.name),
+        SourceKind::Replay { speed } => {
+            let x = if speed <= 0.0 {
+                "max".to_string()
+            } else {
+                speed.to_string()
+            };
+            format!("replay {}{} ×{x}", app.source.name, replay_position(app))
+        }
         SourceKind::Live { listen_only } => {
             format!(
                 "live {}{}",
@@ -24,7 +47,7 @@ pub fn text(app: &App) -> String {
             format!("demo bus{}", if listen_only { " (listen-only)" } else { "" })
         }
     };
-    let state = if app.source.done {
+    let state = if app.source.done || app.source.replay_at_end() {
         " (end)"
     } else if app.source.paused {
         " (paused)"
