@@ -2,11 +2,15 @@
 //! TPDOs on SYNC and RPDOs from its mapping objects, the CiA 402 state machine
 //! (transitions 0..16), profile velocity motion and EMCY on faults, and an LSS slave
 //! (a drive made with node-ID 0xFF only answers LSS until it is given one and reset).
+//! Drives that are not CiA 402 (Dexmart, AQMD) act through [`super::vendor`] instead of
+//! the state machine. RPDOs with a synchronous transmission type (0..240) take effect at
+//! the next SYNC; TPDOs go out on SYNC (types 1..240) and on their event timer (254/255).
 //!
 //! Pure: frames and the current time in, frames out.
 
 use super::od::DeviceObjects;
-use super::profile;
+use super::profile::{self, Kind};
+use super::vendor::Vendor;
 use crate::decode::cia402::DriveState;
 use crate::frame::Frame;
 use crate::lss::{self, Address, UNCONFIGURED};
@@ -80,6 +84,12 @@ pub struct Drive {
     last_ns: Option<u64>,
     next_heartbeat_ns: Option<u64>,
     pending_fault: Option<u16>,
+    /// Vendor behaviour (drives that are not CiA 402).
+    vendor: Vendor,
+    /// Synchronous RPDOs received since the last SYNC, by PDO number (0-based).
+    sync_rpdo: [Option<Vec<u8>>; 4],
+    /// When each event-driven TPDO is due next.
+    next_event_ns: [Option<u64>; 4],
 }
 
 impl Drive {
@@ -93,6 +103,7 @@ impl Drive {
             revision: od.uint(0x1018, 3) as u32,
             serial: od.uint(0x1018, 4) as u32,
         };
+        let profile_kind = profile.kind;
         Drive {
             node,
             lss: lss::slave::Slave::new(address, node),
@@ -114,11 +125,18 @@ impl Drive {
             last_ns: None,
             next_heartbeat_ns: None,
             pending_fault: None,
+            vendor: Vendor::new(profile_kind),
+            sync_rpdo: Default::default(),
+            next_event_ns: [None; 4],
         }
     }
     /// The node id.
     pub fn node(&self) -> u8 {
         self.node
+    }
+    /// The built-in profile the drive's dictionary comes from.
+    pub fn dictionary(&self) -> &'static str {
+        self.profile.dictionary
     }
     /// The NMT state.
     pub fn nmt(&self) -> NmtState {
@@ -182,6 +200,12 @@ impl Drive {
     fn reset(&mut self, range: std::ops::RangeInclusive<u16>) {
         self.od.reset(range.clone());
         self.sdo = SdoServer::new(ServerConfig::default());
+        self.sync_rpdo = Default::default();
+        self.next_event_ns = [None; 4];
+        if range.contains(&0x2000) {
+            self.vendor = Vendor::new(self.profile.kind);
+            super::vendor::init_objects(self.profile.kind, &mut self.od);
+        }
         if range.contains(&0x6000) {
             // Reset of the application: the power stage starts over.
             self.state = DriveState::SwitchOnDisabled;
@@ -239,19 +263,19 @@ impl Drive {
         let node = self.node as u32;
         match f.id {
             0x000 => self.on_nmt(f.payload(), now_ns),
-            0x080 if self.nmt == NmtState::Operational => self.on_sync(),
+            0x080 if self.nmt == NmtState::Operational => {
+                let mut out = self.apply_sync_rpdos();
+                out.extend(self.on_sync());
+                out
+            }
             id if id == 0x600 + node && self.nmt != NmtState::Stopped && !f.is_rtr() => {
                 let replies = self.sdo.on_frame(f.payload(), now_ns, &mut self.od).frames;
                 let mut out: Vec<Frame> = replies.iter().map(|r| Frame::classic(0x580 + node, r)).collect();
+                self.vendor.on_sdo(&mut self.od, self.profile.dictionary);
                 out.extend(self.apply_objects());
                 out
             }
-            id if self.nmt == NmtState::Operational && !f.is_rtr() => {
-                let out = self.on_rpdo(id, f.payload());
-                let mut all = out;
-                all.extend(self.apply_objects());
-                all
-            }
+            id if self.nmt == NmtState::Operational && !f.is_rtr() => self.on_rpdo(id, f.payload()),
             _ => Vec::new(),
         }
     }
@@ -286,46 +310,93 @@ impl Drive {
         (self.od.entry(comm, 1).is_some() && cob & 0x8000_0000 == 0).then_some(cob & 0x7FF)
     }
 
+    /// An RPDO: stored at once (asynchronous types 254/255) or at the next SYNC.
     fn on_rpdo(&mut self, id: u32, p: &[u8]) -> Vec<Frame> {
+        let mut out = Vec::new();
         for n in 0..4u16 {
             if self.pdo_cob(0x1400 + n) != Some(id) {
                 continue;
             }
-            let map = 0x1600 + n;
-            let mut bit = 0usize;
-            for i in 1..=self.od.uint(map, 0) as u8 {
-                let e = self.od.uint(map, i) as u32;
-                let (index, sub, bits) = ((e >> 16) as u16, (e >> 8) as u8, (e & 0xFF) as usize);
-                let bytes = bits / 8;
-                if bit / 8 + bytes > p.len() {
-                    break;
-                }
-                self.od.set(index, sub, &p[bit / 8..bit / 8 + bytes]);
-                bit += bits;
+            if self.od.uint(0x1400 + n, 2) <= 240 {
+                self.sync_rpdo[n as usize] = Some(p.to_vec());
+            } else {
+                out.extend(self.take_rpdo(n, p));
             }
         }
-        Vec::new()
+        out
+    }
+
+    /// The synchronous RPDOs received since the last SYNC take effect.
+    fn apply_sync_rpdos(&mut self) -> Vec<Frame> {
+        let mut out = Vec::new();
+        for n in 0..4u16 {
+            if let Some(p) = self.sync_rpdo[n as usize].take() {
+                out.extend(self.take_rpdo(n, &p));
+            }
+        }
+        out
+    }
+
+    /// Writes RPDO `n`'s data into the mapped objects and acts on them.
+    fn take_rpdo(&mut self, n: u16, p: &[u8]) -> Vec<Frame> {
+        let map = 0x1600 + n;
+        let mut bit = 0usize;
+        for i in 1..=self.od.uint(map, 0) as u8 {
+            let e = self.od.uint(map, i) as u32;
+            let (index, sub, bits) = ((e >> 16) as u16, (e >> 8) as u8, (e & 0xFF) as usize);
+            let bytes = bits / 8;
+            if bit / 8 + bytes > p.len() {
+                break;
+            }
+            self.od.set(index, sub, &p[bit / 8..bit / 8 + bytes]);
+            bit += bits;
+        }
+        let replies = self.vendor.on_rpdo(n, &self.od);
+        let mut out = self.apply_objects();
+        out.extend(replies.into_iter().filter_map(|t| self.tpdo_frame(t)));
+        out
+    }
+
+    /// TPDO `n` (0-based) with the current values of its mapped objects, when valid.
+    fn tpdo_frame(&self, n: u16) -> Option<Frame> {
+        let cob = self.pdo_cob(0x1800 + n)?;
+        let map = 0x1A00 + n;
+        let mut data = Vec::new();
+        for i in 1..=self.od.uint(map, 0) as u8 {
+            let e = self.od.uint(map, i) as u32;
+            let (index, sub, bits) = ((e >> 16) as u16, (e >> 8) as u8, (e & 0xFF) as usize);
+            let mut v = self.od.entry(index, sub).map(|x| x.data.clone()).unwrap_or_default();
+            v.resize(bits / 8, 0);
+            data.extend_from_slice(&v);
+        }
+        (data.len() <= 8).then(|| Frame::classic(cob, &data))
     }
 
     fn on_sync(&mut self) -> Vec<Frame> {
+        (0..4u16)
+            .filter(|n| (1..=240).contains(&self.od.uint(0x1800 + n, 2)))
+            .filter_map(|n| self.tpdo_frame(n))
+            .collect()
+    }
+
+    /// The event-driven TPDOs (types 254/255) whose event timer ran out at `now_ns`.
+    fn event_tpdos(&mut self, now_ns: u64) -> Vec<Frame> {
         let mut out = Vec::new();
         for n in 0..4u16 {
-            let Some(cob) = self.pdo_cob(0x1800 + n) else { continue };
-            let kind = self.od.uint(0x1800 + n, 2);
-            if !(1..=240).contains(&kind) {
+            let period_ns = self.od.uint(0x1800 + n, 5) * 1_000_000;
+            let timed = self.od.uint(0x1800 + n, 2) >= 254 && period_ns > 0 && self.pdo_cob(0x1800 + n).is_some();
+            let slot = &mut self.next_event_ns[n as usize];
+            if !timed || self.nmt != NmtState::Operational {
+                *slot = None;
                 continue;
             }
-            let map = 0x1A00 + n;
-            let mut data = Vec::new();
-            for i in 1..=self.od.uint(map, 0) as u8 {
-                let e = self.od.uint(map, i) as u32;
-                let (index, sub, bits) = ((e >> 16) as u16, (e >> 8) as u8, (e & 0xFF) as usize);
-                let mut v = self.od.entry(index, sub).map(|x| x.data.clone()).unwrap_or_default();
-                v.resize(bits / 8, 0);
-                data.extend_from_slice(&v);
-            }
-            if data.len() <= 8 {
-                out.push(Frame::classic(cob, &data));
+            match *slot {
+                Some(due) if now_ns >= due => {
+                    *slot = Some(due.max(now_ns - period_ns) + period_ns);
+                    out.extend(self.tpdo_frame(n));
+                }
+                Some(_) => {}
+                None => *slot = Some(now_ns + period_ns),
             }
         }
         out
@@ -333,6 +404,9 @@ impl Drive {
 
     /// Acts on objects written by SDO or RPDO: controlword and mode of operation.
     fn apply_objects(&mut self) -> Vec<Frame> {
+        if self.profile.kind != Kind::Cia402 {
+            return Vec::new();
+        }
         let mode = self.od.int(0x6060, 0);
         self.od.set_int(0x6061, 0, mode);
         let cw = self.od.uint(0x6040, 0) as u16;
@@ -471,6 +545,12 @@ impl Drive {
             sw |= self.mode_bits();
         }
         self.od.set_int(0x6041, 0, sw as i64);
+        // Profile and cyclic torque: the torque follows its target while enabled.
+        let torque = match self.mode() {
+            MODE_PT | MODE_CST if self.state == OperationEnabled => self.od.int(0x6071, 0),
+            _ => 0,
+        };
+        self.od.set_int(0x6077, 0, torque);
         self.od.set_int(0x606C, 0, self.velocity.round() as i64);
         self.od.set_int(0x6064, 0, self.position.round() as i64);
     }
@@ -516,14 +596,19 @@ impl Drive {
             self.velocity = 0.0;
             self.state = DriveState::Fault;
         }
-        self.move_axis(dt);
-        self.update_statusword();
+        if self.profile.kind == Kind::Cia402 {
+            self.move_axis(dt);
+            self.update_statusword();
+        } else {
+            self.vendor.tick(dt, &mut self.od);
+        }
         if self.silent {
             return Vec::new();
         }
         if !self.configured() {
             return out;
         }
+        out.extend(self.event_tpdos(now_ns));
         if let Some(next) = self.next_heartbeat_ns {
             if now_ns >= next {
                 out.push(Frame::classic(0x700 + self.node as u32, &[self.nmt.byte()]));
