@@ -180,7 +180,9 @@ fn unknown_procedures_and_parameters_name_the_valid_ones() {
     let (rc, _, err) = cotui(&["run", "demo", "2", "fly", "--profile", "2=aimotor"]);
     assert_eq!(rc, 1);
     assert!(
-        err.contains("node 2 has no procedure `fly`; its procedures: csp, cst, csv, csv_pdo_remap, hm, pp, pp_example, pt, pv"),
+        err.contains(
+            "node 2 has no procedure `fly`; its procedures: csp, cst, csv, csv_pdo_remap, hm, pp, pp_example, pt, pv"
+        ),
         "{err}"
     );
     let (rc, out, err) = cotui(&["run", "demo", "2", "pv", "rpm=3", "--profile", "2=aimotor", "--json"]);
