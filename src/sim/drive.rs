@@ -271,7 +271,11 @@ impl Drive {
             id if id == 0x600 + node && self.nmt != NmtState::Stopped && !f.is_rtr() => {
                 let replies = self.sdo.on_frame(f.payload(), now_ns, &mut self.od).frames;
                 let mut out: Vec<Frame> = replies.iter().map(|r| Frame::classic(0x580 + node, r)).collect();
-                self.vendor.on_sdo(&mut self.od, self.profile.dictionary);
+                if self.profile.kind == Kind::Dexmart && alarm_reset(f.payload(), replies.first()) {
+                    out.extend(self.clear_fault());
+                }
+                let faulted = self.faulted();
+                self.vendor.on_sdo(&mut self.od, self.profile.dictionary, faulted);
                 out.extend(self.apply_objects());
                 out
             }
@@ -351,7 +355,7 @@ impl Drive {
             self.od.set(index, sub, &p[bit / 8..bit / 8 + bytes]);
             bit += bits;
         }
-        let replies = self.vendor.on_rpdo(n, &self.od);
+        let replies = self.vendor.on_rpdo(n, &self.od, self.faulted());
         let mut out = self.apply_objects();
         out.extend(replies.into_iter().filter_map(|t| self.tpdo_frame(t)));
         out
@@ -430,9 +434,7 @@ impl Drive {
         self.state = match self.state {
             Fault if rising_reset => {
                 // Transition 15; the reset EMCY tells the bus the error is gone.
-                self.od.set_int(0x603F, 0, 0);
-                self.od.set_int(0x1001, 0, 0);
-                out.push(self.emcy(0x0000));
+                out = self.clear_fault();
                 SwitchOnDisabled
             }
             SwitchOnDisabled if shutdown => ReadyToSwitchOn,
@@ -519,6 +521,23 @@ impl Drive {
         }
     }
 
+    /// In fault (or its reaction).
+    fn faulted(&self) -> bool {
+        matches!(self.state, DriveState::Fault | DriveState::FaultReactionActive)
+    }
+
+    /// Leaves the fault (CiA 402 transition 15; Dexmart: 300Ah Alarm Reset): error register
+    /// and error code cleared, the reset EMCY sent.
+    fn clear_fault(&mut self) -> Vec<Frame> {
+        if !self.faulted() {
+            return Vec::new();
+        }
+        self.od.set_int(0x603F, 0, 0);
+        self.od.set_int(0x1001, 0, 0);
+        self.state = DriveState::SwitchOnDisabled;
+        vec![self.emcy(0x0000)]
+    }
+
     fn emcy(&self, code: u16) -> Frame {
         let c = code.to_le_bytes();
         let reg = self.od.uint(0x1001, 0) as u8;
@@ -591,6 +610,11 @@ impl Drive {
             if self.nmt != NmtState::Stopped && self.configured() {
                 out.push(self.emcy(code));
             }
+            if self.profile.kind == Kind::Aqmd && self.nmt == NmtState::Operational {
+                // AQMD manual: after an EMCY in operational the driver drops to
+                // pre-operational and needs an NMT start.
+                self.nmt = NmtState::PreOperational;
+            }
         } else if self.state == DriveState::FaultReactionActive {
             // Transition 14: the fault reaction (motor stopped) is done.
             self.velocity = 0.0;
@@ -600,7 +624,8 @@ impl Drive {
             self.move_axis(dt);
             self.update_statusword();
         } else {
-            self.vendor.tick(dt, &mut self.od);
+            let faulted = self.faulted();
+            self.vendor.tick(dt, &mut self.od, faulted);
         }
         if self.silent {
             return Vec::new();
@@ -663,6 +688,15 @@ impl Drive {
             self.state = DriveState::SwitchOnDisabled;
         }
     }
+}
+
+/// Is this SDO request, answered by `reply`, a successful expedited download of 0x0000
+/// (Alarm Reset) to the Dexmart command object 300Ah?
+fn alarm_reset(request: &[u8], reply: Option<&[u8; 8]>) -> bool {
+    let [cs, 0x0A, 0x30, 0, data @ ..] = request else {
+        return false;
+    };
+    cs & 0xE2 == 0x22 && data.iter().take(2).all(|b| *b == 0) && reply.is_some_and(|r| r[0] == 0x60)
 }
 
 /// The error register (0x1001) bits for an EMCY error code: generic plus the class
@@ -832,5 +866,38 @@ mod tests {
         assert_eq!(d.nmt(), NmtState::PreOperational);
         assert!(d.on_frame(&Frame::classic(0x000, &[0x01, 0x03]), 0).is_empty());
         assert_eq!(d.nmt(), NmtState::PreOperational, "command for node 3 ignored");
+    }
+
+    #[test]
+    fn an_aqmd_fault_stops_the_motor_and_drops_to_pre_operational() {
+        let mut d = Drive::new(1, DriveProfile::aqmd_like());
+        d.power_on(0);
+        d.on_frame(&Frame::classic(0x000, &[0x01, 0x01]), 0);
+        // Manual 7.5.4: RPDO1 "201 03 88 13 00 F4 01 00 00" (command 3, speed 5000).
+        d.on_frame(&Frame::classic(0x201, &[0x03, 0x88, 0x13, 0x00, 0xF4, 0x01, 0, 0]), 0);
+        d.tick(0);
+        d.tick(1_000_000_000);
+        assert_eq!(d.objects().int(0x2101, 0), 1000, "duty capped at 100 %");
+        d.inject_fault(0x2310);
+        let emcy = d.tick(1_010_000_000);
+        assert_eq!(emcy[0].payload()[..3], [0x10, 0x23, 0x03]);
+        assert_eq!(d.nmt(), NmtState::PreOperational);
+        d.tick(3_000_000_000);
+        assert_eq!(d.objects().int(0x2101, 0), 0, "stopped by the fault");
+    }
+
+    #[test]
+    fn a_dexmart_fault_is_cleared_by_alarm_reset_300a() {
+        let mut d = Drive::new(1, DriveProfile::dexmart_like());
+        d.power_on(0);
+        d.inject_fault(0x3210);
+        d.tick(0);
+        d.tick(10_000_000);
+        assert_eq!(d.state(), DriveState::Fault);
+        let out = d.on_frame(&Frame::classic(0x601, &[0x2B, 0x0A, 0x30, 0, 0, 0, 0, 0]), 0);
+        assert_eq!(out[0].payload()[0], 0x60, "download answered");
+        assert_eq!((out[1].id, out[1].payload()), (0x81, &[0u8; 8][..]), "reset EMCY");
+        assert_eq!(d.objects().uint(0x1001, 0), 0);
+        assert_ne!(d.state(), DriveState::Fault);
     }
 }

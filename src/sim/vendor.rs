@@ -102,8 +102,9 @@ impl Vendor {
     }
 
     /// Acts on objects written by SDO: Dexmart 09-26 switches the PDO mapping set at once
-    /// (the simulator's choice; the manual does not say when it takes effect).
-    pub fn on_sdo(&mut self, od: &mut DeviceObjects, dictionary: &str) {
+    /// (the simulator's choice; the manual does not say when it takes effect). A faulted
+    /// drive (`faulted`) starts no motor.
+    pub fn on_sdo(&mut self, od: &mut DeviceObjects, dictionary: &str, faulted: bool) {
         if let Vendor::Dexmart { mapping_set, .. } = self {
             let set = od.int(DEX_MAPPING.0, DEX_MAPPING.1);
             if set != *mapping_set {
@@ -112,17 +113,17 @@ impl Vendor {
             }
         }
         if let Vendor::Aqmd { motor } = self {
-            aqmd_command(motor, od);
+            aqmd_command(motor, od, faulted);
         }
     }
 
-    /// RPDO `n` (0-based) was written into `od`: acts on it; returns the TPDOs (0-based)
-    /// sent in reply (Dexmart: TPDOn on RPDOn, 09-27 = 0).
-    pub fn on_rpdo(&mut self, n: u16, od: &DeviceObjects) -> Vec<u16> {
+    /// RPDO `n` (0-based) was written into `od`: acts on it (a faulted drive takes no
+    /// command); returns the TPDOs (0-based) sent in reply (Dexmart: TPDOn on RPDOn, 09-27 = 0).
+    pub fn on_rpdo(&mut self, n: u16, od: &DeviceObjects, faulted: bool) -> Vec<u16> {
         match self {
             Vendor::None => Vec::new(),
             Vendor::Aqmd { motor } => {
-                aqmd_command(motor, od);
+                aqmd_command(motor, od, faulted);
                 Vec::new()
             }
             Vendor::Dexmart { motors, mapping_set } => {
@@ -138,6 +139,7 @@ impl Vendor {
                 };
                 // A command the motor's drive mode does not take is ignored.
                 match cmd {
+                    _ if faulted => {}
                     CMD_ENCODER_SPEED if drive_mode == 2 => {
                         motor.target_position = None;
                         motor.target_speed = data2 as f64;
@@ -154,8 +156,15 @@ impl Vendor {
         }
     }
 
-    /// Advances the motors by `dt` seconds and shows them in the dictionary.
-    pub fn tick(&mut self, dt: f64, od: &mut DeviceObjects) {
+    /// Advances the motors by `dt` seconds and shows them in the dictionary; a fault
+    /// (`faulted`) stops them.
+    pub fn tick(&mut self, dt: f64, od: &mut DeviceObjects, faulted: bool) {
+        if faulted {
+            self.motors_mut().iter_mut().for_each(|m| {
+                m.target_speed = 0.0;
+                m.target_position = None;
+            });
+        }
         match self {
             Vendor::None => {}
             Vendor::Dexmart { motors, .. } => {
@@ -184,12 +193,24 @@ impl Vendor {
     }
 }
 
+impl Vendor {
+    /// The motors.
+    fn motors_mut(&mut self) -> &mut [Motor] {
+        match self {
+            Vendor::None => &mut [],
+            Vendor::Dexmart { motors, .. } => motors,
+            Vendor::Aqmd { motor } => std::slice::from_mut(motor),
+        }
+    }
+}
+
 /// AQMD: command 3 runs at the target speed (0x2001, reversed by direction 0x2002 = 1);
-/// the simulator stops the motor on every other command (their texts are lost in the seed).
-fn aqmd_command(motor: &mut Motor, od: &DeviceObjects) {
+/// the simulator stops the motor on every other command (their texts are lost in the seed)
+/// and while faulted.
+fn aqmd_command(motor: &mut Motor, od: &DeviceObjects, faulted: bool) {
     let sign = if od.int(0x2002, 0) == 1 { -1.0 } else { 1.0 };
     motor.target_speed = match od.int(0x2000, 0) {
-        3 => (od.int(0x2001, 0) as f64 * sign).clamp(-1000.0, 1000.0),
+        3 if !faulted => (od.int(0x2001, 0) as f64 * sign).clamp(-1000.0, 1000.0),
         _ => 0.0,
     };
 }
@@ -233,19 +254,19 @@ mod tests {
         // RPDO1 of mapping set 0: 201#0A0000B80B (manual: 3000 rpm on M1).
         od.set(0x3051, 1, &[0x0A]);
         od.set(0x3051, 3, &3000i16.to_le_bytes());
-        assert_eq!(v.on_rpdo(0, &od), vec![0]);
-        v.tick(1.0, &mut od);
+        assert_eq!(v.on_rpdo(0, &od, false), vec![0]);
+        v.tick(1.0, &mut od, false);
         assert_eq!((od.int(0x3046, 5), od.int(0x3046, 1)), (3000, 1));
         assert_eq!(od.uint(0x1002, 0), 1, "byte 0 = M1 running");
         od.set_int(0x3009, 26, 1);
-        v.on_sdo(&mut od, "dexmart-dev");
+        v.on_sdo(&mut od, "dexmart-dev", false);
         assert_eq!(od.uint(0x1600, 1), 0x305B_0108, "RPDO1 = Multi-Drive Lite M1");
         od.set_int(0x3001, 27, 0);
         od.set_int(0x3001, 28, 4);
         od.set(0x305C, 1, &[0x01]);
         od.set(0x305C, 2, &(-500i16).to_le_bytes());
-        v.on_rpdo(1, &od);
-        v.tick(1.0, &mut od);
+        v.on_rpdo(1, &od, false);
+        v.tick(1.0, &mut od, false);
         assert_eq!(od.int(0x304A, 5) as i16, -500);
     }
 
@@ -255,13 +276,13 @@ mod tests {
         let mut v = Vendor::new(Kind::Aqmd);
         od.set_int(0x2000, 0, 3);
         od.set_int(0x2001, 0, 500);
-        v.on_rpdo(0, &od);
-        v.tick(1.0, &mut od);
+        v.on_rpdo(0, &od, false);
+        v.tick(1.0, &mut od, false);
         assert_eq!((od.int(0x2101, 0), od.int(0x2111, 0)), (500, 1));
         assert!(od.int(0x2105, 0) > 0);
         od.set_int(0x2000, 0, 0);
-        v.on_sdo(&mut od, "aqmd2405");
-        v.tick(1.0, &mut od);
+        v.on_sdo(&mut od, "aqmd2405", false);
+        v.tick(1.0, &mut od, false);
         assert_eq!((od.int(0x2101, 0), od.int(0x2111, 0)), (0, 0));
     }
 }
