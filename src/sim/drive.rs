@@ -205,6 +205,9 @@ impl Drive {
         if range.contains(&0x2000) {
             self.vendor = Vendor::new(self.profile.kind);
             super::vendor::init_objects(self.profile.kind, &mut self.od);
+        } else {
+            self.vendor
+                .on_communication_reset(&mut self.od, self.profile.dictionary);
         }
         if range.contains(&0x6000) {
             // Reset of the application: the power stage starts over.

@@ -105,15 +105,29 @@ impl Vendor {
     /// (the simulator's choice; the manual does not say when it takes effect). A faulted
     /// drive (`faulted`) starts no motor.
     pub fn on_sdo(&mut self, od: &mut DeviceObjects, dictionary: &str, faulted: bool) {
+        self.follow_mapping_set(od, dictionary);
+        if let Vendor::Aqmd { motor } = self {
+            aqmd_command(motor, od, faulted);
+        }
+    }
+
+    /// After a reset of the communication objects (the PDO mappings are back to set 0):
+    /// Dexmart maps the set 09-26 selects again.
+    pub fn on_communication_reset(&mut self, od: &mut DeviceObjects, dictionary: &str) {
+        if let Vendor::Dexmart { mapping_set, .. } = self {
+            *mapping_set = 0;
+        }
+        self.follow_mapping_set(od, dictionary);
+    }
+
+    /// Dexmart: the PDO mappings of the set 09-26 selects, when it changed.
+    fn follow_mapping_set(&mut self, od: &mut DeviceObjects, dictionary: &str) {
         if let Vendor::Dexmart { mapping_set, .. } = self {
             let set = od.int(DEX_MAPPING.0, DEX_MAPPING.1);
             if set != *mapping_set {
                 *mapping_set = set;
                 select_mapping_set(od, dictionary, set);
             }
-        }
-        if let Vendor::Aqmd { motor } = self {
-            aqmd_command(motor, od, faulted);
         }
     }
 
@@ -268,6 +282,11 @@ mod tests {
         v.on_rpdo(1, &od, false);
         v.tick(1.0, &mut od, false);
         assert_eq!(od.int(0x304A, 5) as i16, -500);
+        // A reset of the communication objects keeps the set 09-26 selects.
+        od.reset(0x1000..=0x1FFF);
+        assert_eq!(od.uint(0x1600, 1), 0x3051_0108);
+        v.on_communication_reset(&mut od, "dexmart-dev");
+        assert_eq!(od.uint(0x1600, 1), 0x305B_0108);
     }
 
     #[test]
