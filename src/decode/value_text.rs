@@ -1,7 +1,7 @@
 //! How an object value is shown wherever it appears (SDO or PDO): CiA 402
 //! meaning, communication parameter meaning, else enum text / scaled value.
 
-use crate::od::{Dictionary, ObjectInfo, Value, format_value};
+use crate::od::{Dictionary, Meaning, ObjectInfo, Value, format_value};
 use serde::Serialize;
 
 /// The text of `value` of object (index, sub) on a node with dictionary `dict`
@@ -14,11 +14,32 @@ pub fn object_text(dict: &Dictionary, index: u16, sub: u8, value: &Value, mode: 
         if let Some(t) = super::comm_params::describe(index, sub, raw as u64, dict) {
             return t;
         }
-        if let Some(info) = dict.object(index, sub).filter(|i| !i.fields.is_empty()) {
-            return split(dict, info, raw);
+        if let Some(info) = dict.object(index, sub) {
+            if let Some(m) = info.meaning {
+                return meaning_text(dict, m, raw);
+            }
+            if !info.fields.is_empty() {
+                return split(dict, info, raw);
+            }
         }
     }
     format_value(dict.object(index, sub), value)
+}
+
+/// A vendor object's raw value read as the CiA 301 parameter it configures.
+fn meaning_text(dict: &Dictionary, meaning: Meaning, raw: i64) -> String {
+    use super::comm_params::{cob_id, transmission_type};
+    match meaning {
+        Meaning::CobId => cob_id(raw as u32, ""),
+        Meaning::TransmissionType => transmission_type(raw as u32),
+        Meaning::ObjectIndex => {
+            let index = raw as u16;
+            match dict.object_name(index) {
+                Some(name) => format!("{raw} (0x{index:04X} {name})"),
+                None => format!("{raw} (0x{index:04X})"),
+            }
+        }
+    }
 }
 
 /// One field of a structured value: 0x1016's node-ID and time, 0x1003's error code and
