@@ -10,7 +10,7 @@ use super::palette::{self, Planned, commander_words};
 use super::panes::detail::DetailPane;
 use super::panes::help::HelpPopup;
 use super::panes::messages::MessagesPopup;
-use super::panes::{Ctx, Outcome, Pane, Panes, Selected};
+use super::panes::{Component, Ctx, Outcome, Pane, Panes, Selected};
 use super::prompt::{Edit, PromptBar, PromptKind};
 use super::source::{Control, Feed};
 use crate::analysis::filter::{Filter, FilterError};
@@ -511,6 +511,18 @@ impl App {
                 self.send(p);
             } else {
                 self.message = Some("not sent".into());
+            }
+            return;
+        }
+        if let Some(picker) = self.panes.plot.picker.as_mut() {
+            use super::panes::picker::PickerEdit;
+            match picker.key(ev, &self.trace) {
+                PickerEdit::Editing => {}
+                PickerEdit::Closed => self.panes.plot.picker = None,
+                PickerEdit::Toggle(k) => {
+                    self.panes.plot.toggle(&self.trace, k);
+                    self.panes.plot.picker = None;
+                }
             }
             return;
         }
@@ -1139,6 +1151,12 @@ impl App {
             Action::NextSeries | Action::PrevSeries => {
                 self.panes.plot.step(&self.trace, a == Action::NextSeries);
                 self.focus = Pane::Plot;
+            }
+            // From another pane: the Plot pane comes to the front and takes them.
+            Action::PlotPick | Action::ZoomIn | Action::ZoomOut => {
+                self.focus = Pane::Plot;
+                let (panes, ctx) = self.panes_mut();
+                panes.plot.handle(a, &ctx);
             }
             // Taken by the help popup; row movement and `expand` in a pane without rows.
             Action::Help

@@ -162,7 +162,8 @@ fn plot_pane_draws_a_series() {
     a.act(Action::NextSeries);
     assert_eq!(a.focus, Pane::Plot);
     let s = screen(&mut a, 100, 20);
-    assert!(s.contains("Plot 2/2: node 1 0x6041:00 (6 points)"), "{s}");
+    assert!(s.contains("Plot: 1 of 2 signals"), "{s}");
+    assert!(s.contains("end 0.098 s  n1 0x6041:00 = 567"), "{s}");
     insta::assert_snapshot!(s);
 }
 
@@ -283,4 +284,72 @@ fn a_replay_shows_its_position_and_progress_in_the_status_line() {
     assert!(screen(&mut a, 80, 24).contains("replay test.log 100% 0.1 s / 0.1 s ×2 (end)"));
     a.source.replay.1 = None;
     assert!(screen(&mut a, 80, 24).contains("replay test.log 0.1 s ×2 |"));
+}
+
+/// The plot of [`plot_app`] with `keys` typed (through the keymap) first.
+fn plot_screen(keys: &str, w: u16, h: u16) -> (crate::tui::app::App, String) {
+    use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+    let mut a = super::testutil::plot_app();
+    a.focus = Pane::Plot;
+    let _ = screen(&mut a, w, h);
+    for c in keys.chars() {
+        let code = match c {
+            '\n' => KeyCode::Enter,
+            '>' => KeyCode::Right,
+            '<' => KeyCode::Left,
+            c => KeyCode::Char(c),
+        };
+        a.key(KeyEvent::new(code, KeyModifiers::NONE));
+    }
+    let s = screen(&mut a, w, h);
+    (a, s)
+}
+
+#[test]
+fn plot_picker_filters_signals_as_the_user_types() {
+    let (a, s) = plot_screen("pvel", 80, 24);
+    assert!(s.contains("Pick signals (1 of 3)"), "{s}");
+    assert!(s.contains("> vel_"), "{s}");
+    assert!(s.contains("node 1   6044:00  vl velocity actual value [rpm]"), "{s}");
+    assert!(a.panes.plot.picker.is_some());
+    insta::assert_snapshot!("plot_picker_80x24", s);
+    let (_, s) = plot_screen("p", 160, 48);
+    assert!(s.contains("Pick signals (3 of 3)"), "{s}");
+    insta::assert_snapshot!("plot_picker_160x48", s);
+}
+
+#[test]
+fn plot_shows_signals_on_one_axis_with_units_legend_and_bit_lanes() {
+    // The statusword is shown first; the picker adds the velocity and the mode.
+    let (a, s) = plot_screen("pvel\npmodes\n", 160, 48);
+    assert_eq!(a.panes.plot.signals, [(1, 0x6041, 0), (1, 0x6044, 0), (1, 0x6061, 0)]);
+    assert!(s.contains("Plot: 3 of 3 signals"), "{s}");
+    assert!(s.contains("n1 vl velocity actual value [rpm]"), "legend: {s}");
+    assert!(s.contains("rpm"), "unit on the axis: {s}");
+    assert!(s.contains(" 2 Operation enabled"), "bit lane: {s}");
+    assert!(s.contains(" 3 Fault"), "bit lane: {s}");
+    assert!(
+        s.contains("end 0.410 s  n1 Statusword = 0x0238  n1 vl velocity actual value = 0 rpm  n1 Modes of"),
+        "{s}"
+    );
+    insta::assert_snapshot!("plot_three_signals_160x48", s);
+}
+
+#[test]
+fn plot_cursor_reads_values_and_zoom_narrows_the_window() {
+    // Right places the cursor mid-window, then moves it one column at a time.
+    let (a, s) = plot_screen("pvel\n>>>>>", 80, 24);
+    let c = a.panes.plot.cursor.unwrap() - a.start_ns() as f64 / 1e9;
+    assert!((0.2..0.25).contains(&c), "{c}");
+    assert!(s.contains("cursor 0.2"), "{s}");
+    assert!(s.contains("n1 Statusword = 0x0237"), "{s}");
+    insta::assert_snapshot!("plot_cursor_80x24", s);
+    let (a, s) = plot_screen("pvel\n>zz", 80, 24);
+    let w = a.panes.plot.window.unwrap();
+    assert!((w.width() - 0.1).abs() < 0.01, "{w:?}");
+    assert!(s.contains("Plot: 2 of 3 signals 0.1"), "{s}");
+    // Home shows the whole span again.
+    let mut a = a;
+    a.act(crate::tui::keymap::Action::Top);
+    assert_eq!(a.panes.plot.window, None);
 }
