@@ -1152,6 +1152,12 @@ impl App {
                 self.panes.plot.step(&self.trace, a == Action::NextSeries);
                 self.focus = Pane::Plot;
             }
+            // From another pane: the Stats pane comes to the front and takes it.
+            Action::Sort => {
+                self.focus = Pane::Stats;
+                let (panes, ctx) = self.panes_mut();
+                panes.stats.handle(a, &ctx);
+            }
             // From another pane: the Plot pane comes to the front and takes them.
             Action::PlotPick | Action::ZoomIn | Action::ZoomOut => {
                 self.focus = Pane::Plot;

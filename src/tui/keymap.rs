@@ -84,6 +84,7 @@ actions! {
     PlotPick = "plot_pick": "Plot: pick signals (type to filter, enter adds or removes)",
     ZoomIn = "zoom_in": "Plot: zoom in around the cursor (page keys pan, home: all)",
     ZoomOut = "zoom_out": "Plot: zoom out",
+    Sort = "sort": "Stats: cycle the sort (COB-ID, count, period, last heard)",
 }
 
 /// One key press, normalised (no SHIFT on characters).

@@ -157,6 +157,51 @@ fn stats_pane_shows_rates_and_bus_load() {
 }
 
 #[test]
+fn receive_list_shows_latest_data_periods_and_labels_sorted_by_a_key() {
+    let mut a = app();
+    a.act(Action::Sort);
+    assert_eq!(a.focus, Pane::Stats, "the sort key brings the receive list up");
+    let s = screen(&mut a, 80, 24);
+    assert!(s.contains("Receive list by count"), "{s}");
+    // 0x701 (7 heartbeats) first; its latest data and label.
+    assert!(
+        s.contains("701        7   16.7 ms   14.0 ms  05                       Heartbeat node 1: …"),
+        "{s}"
+    );
+    insta::assert_snapshot!("receive_list_by_count_80x24", s);
+    a.act(Action::Sort);
+    a.act(Action::Sort);
+    let s = screen(&mut a, 160, 48);
+    assert!(s.contains("Receive list by last heard"), "{s}");
+    assert!(s.contains("jitter   rate/s"), "wide: {s}");
+    let first = s.lines().nth(3).unwrap_or("");
+    assert!(first.contains("082  "), "the EMCY came last: {s}");
+    // The Detail pane shows the selected COB-ID's latest frame.
+    assert!(s.contains("EMCY node 2: 0x2310"), "{s}");
+    insta::assert_snapshot!("receive_list_by_last_heard_160x48", s);
+}
+
+#[test]
+fn receive_list_highlights_the_bytes_that_changed() {
+    let mut a = app();
+    a.focus = Pane::Stats;
+    let mut term = ratatui::Terminal::new(ratatui::backend::TestBackend::new(100, 20)).unwrap();
+    term.draw(|fr| crate::tui::ui::draw(fr, &mut a)).unwrap();
+    let buf = term.backend().buffer().clone();
+    // RPDO1 0x201: 0F 00 05 00 00 00 after 0F 00 04 ...: only byte 2 changed.
+    let row = (0..buf.area.height)
+        .find(|&y| buf[(1, y)].symbol() == "2" && buf[(2, y)].symbol() == "0" && buf[(3, y)].symbol() == "1")
+        .expect("a row for 0x201");
+    let x0 = (0..buf.area.width)
+        .find(|&x| buf[(x, row)].symbol() == "0" && buf[(x + 1, row)].symbol() == "F")
+        .unwrap();
+    let hot: Vec<bool> = (0..6)
+        .map(|i| buf[(x0 + 3 * i, row)].fg == ratatui::style::Color::Yellow)
+        .collect();
+    assert_eq!(hot, [false, false, true, false, false, false]);
+}
+
+#[test]
 fn plot_pane_draws_a_series() {
     let mut a = app();
     a.act(Action::NextSeries);
