@@ -168,6 +168,19 @@ fn event_level(what: &crate::analysis::What) -> Level {
     }
 }
 
+/// What the palette completes from: the nodes heard (the node table) and the dictionaries
+/// the commander uses (the bindings).
+struct Heard<'a>(&'a App);
+
+impl crate::command::complete::Known for Heard<'_> {
+    fn nodes(&self) -> Vec<u8> {
+        self.0.trace.nodes.iter().map(|(id, _)| *id).collect()
+    }
+    fn dictionary(&self, node: u8) -> &crate::od::Dictionary {
+        self.0.bindings.dictionary(node)
+    }
+}
+
 /// Names the palette completes.
 pub const PALETTE_COMMANDS: &[&str] = &[
     "filter", "search", "goto", "time", "speed", "pause", "resume", "rewind", "plot", "export", "help", "messages",
@@ -527,8 +540,10 @@ impl App {
             return;
         }
         if self.prompt.editing.is_some() {
-            self.prompt_key(ev);
-            self.preview();
+            // The candidates a completion lists stay on the status line; else the preview.
+            if !self.prompt_key(ev) {
+                self.preview();
+            }
             return;
         }
         let Some(k) = Key::from_event(&ev) else { return };
@@ -548,7 +563,8 @@ impl App {
         }
     }
 
-    fn prompt_key(&mut self, ev: KeyEvent) {
+    /// Edits the prompt line; true when a completion listed its candidates.
+    fn prompt_key(&mut self, ev: KeyEvent) -> bool {
         match self.prompt.key(ev) {
             Edit::Submit(kind, text) => self.submit(kind, &text),
             Edit::Complete => {
@@ -558,8 +574,10 @@ impl App {
                     .as_ref()
                     .map(|p| p.text.chars().take(p.cursor).collect())
                     .unwrap_or_default();
-                let words: Vec<String> = if before.contains(' ') {
-                    crate::command::syntax::completions(&before)
+                let words: Vec<String> = if let Some(rest) = before.strip_prefix("plot ") {
+                    self.plot_completions(rest)
+                } else if before.contains(' ') {
+                    crate::command::syntax::completions(&before, &Heard(self))
                 } else {
                     PALETTE_COMMANDS
                         .iter()
@@ -572,9 +590,34 @@ impl App {
                     .complete(&words.iter().map(String::as_str).collect::<Vec<_>>());
                 if !shown.is_empty() {
                     self.message = Some(shown.join("  "));
+                    return true;
                 }
             }
             Edit::Editing | Edit::Cancelled => {}
+        }
+        false
+    }
+
+    /// `plot NODE INDEX:SUB`: the nodes with a series, then that node's series.
+    fn plot_completions(&self, rest: &str) -> Vec<String> {
+        let done: Vec<&str> = if rest.ends_with(' ') || rest.is_empty() {
+            rest.split_whitespace().collect()
+        } else {
+            let w: Vec<&str> = rest.split_whitespace().collect();
+            w[..w.len() - 1].to_vec()
+        };
+        let keys = self.trace.series.keys();
+        match done[..] {
+            [] => {
+                let nodes: BTreeSet<u8> = keys.iter().map(|k| k.0).collect();
+                nodes.iter().map(u8::to_string).collect()
+            }
+            [node] => keys
+                .iter()
+                .filter(|k| node.parse() == Ok(k.0))
+                .map(|k| format!("{:04X}:{:02X}", k.1, k.2))
+                .collect(),
+            _ => Vec::new(),
         }
     }
 
@@ -1355,6 +1398,33 @@ mod tests {
             assert_eq!(logged, format!("{line}: {want}"));
         }
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn palette_tab_completes_nodes_heard_objects_and_plot_series() {
+        let mut a = app();
+        let tab = KeyEvent::new(KeyCode::Tab, KeyModifiers::NONE);
+        a.key(key(':'));
+        for c in "sdo read ".chars() {
+            a.key(key(c));
+        }
+        a.key(tab);
+        assert_eq!(a.message.as_deref(), Some("1  2"), "the nodes heard");
+        for c in "2 statusw".chars() {
+            a.key(key(c));
+        }
+        a.key(tab);
+        assert_eq!(
+            a.prompt.editing.as_ref().map(|p| p.text.as_str()),
+            Some("sdo read 2 Statusword ")
+        );
+        a.key(KeyEvent::new(KeyCode::Esc, KeyModifiers::NONE));
+        a.key(key(':'));
+        for c in "plot 1 ".chars() {
+            a.key(key(c));
+        }
+        a.key(tab);
+        assert_eq!(a.message.as_deref(), Some("1017:00  6041:00"));
     }
 
     #[test]
