@@ -53,6 +53,8 @@ pub struct SourceInfo {
     pub drops: u64,
     /// The interface error in force (with the command that fixes it).
     pub bus_error: Option<String>,
+    /// A replay starts over at its end.
+    pub looping: bool,
     /// Where a replay is, and the size of its log once measured.
     pub replay: (Option<super::source::Position>, Option<super::source::Extent>),
     feed: Option<Receiver<Feed>>,
@@ -70,6 +72,7 @@ impl SourceInfo {
             done: false,
             drops: 0,
             bus_error: None,
+            looping: false,
             replay: (None, None),
             feed: Some(feed),
             control,
@@ -183,8 +186,8 @@ impl crate::command::complete::Known for Heard<'_> {
 
 /// Names the palette completes.
 pub const PALETTE_COMMANDS: &[&str] = &[
-    "filter", "search", "goto", "time", "speed", "pause", "resume", "rewind", "plot", "export", "help", "messages",
-    "quit", "jobs",
+    "filter", "search", "goto", "time", "speed", "pause", "resume", "rewind", "loop", "plot", "export", "help",
+    "messages", "quit", "jobs",
 ];
 
 /// Why a built-in palette command (`goto`, `time`, `speed`, `plot`, `export`, ...) failed;
@@ -527,6 +530,10 @@ impl App {
             }
             return;
         }
+        if self.help.shown && self.help.typing {
+            self.help.type_key(ev, &self.keymap);
+            return;
+        }
         if let Some(picker) = self.panes.plot.picker.as_mut() {
             use super::panes::picker::PickerEdit;
             match picker.key(ev, &self.trace) {
@@ -865,6 +872,10 @@ impl App {
                 self.set_paused(false);
                 Ok(String::new())
             }
+            "loop" => {
+                self.act(Action::Loop);
+                return;
+            }
             "plot" => self.plot_command(rest),
             "help" => {
                 self.help.shown = true;
@@ -1078,7 +1089,7 @@ impl App {
         if self.log_popup.shown && self.log_popup.handle(a, self.messages.lines().len()) {
             return;
         }
-        if self.help.handle(a) {
+        if self.help.handle(a, &self.keymap) {
             return;
         }
         if a == Action::Back && self.detail_below() {
@@ -1169,6 +1180,17 @@ impl App {
                 }
                 _ => self.message = Some("step: pause a replay first".into()),
             },
+            Action::Loop => {
+                let on = !self.source.looping;
+                match &self.source.control {
+                    Some(c) => {
+                        let _ = c.send(Control::Loop(on));
+                        self.source.looping = on;
+                        self.message = Some(format!("replay loop {}", if on { "on" } else { "off" }));
+                    }
+                    None => self.message = Some("loop: only a replay can loop".into()),
+                }
+            }
             Action::StepBack | Action::Rewind => {
                 let c = if a == Action::Rewind {
                     Control::Rewind

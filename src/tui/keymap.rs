@@ -77,6 +77,7 @@ actions! {
     Step = "step": "Replay one frame (when paused)",
     StepBack = "step_back": "Replay: one frame back (replays up to the frame before)",
     Rewind = "rewind": "Replay: start over from the first frame",
+    Loop = "loop": "Replay: loop at the end (on/off)",
     SeekForward = "seek_forward": "Replay: jump 10 s ahead (Plot focused: cursor right)",
     SeekBack = "seek_back": "Replay: jump 10 s back (Plot focused: cursor left)",
     NextSeries = "next_series": "Plot: next signal",

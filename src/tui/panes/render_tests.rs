@@ -401,3 +401,19 @@ fn plot_cursor_reads_values_and_zoom_narrows_the_window() {
     a.act(crate::tui::keymap::Action::Top);
     assert_eq!(a.panes.plot.window, None);
 }
+
+#[test]
+fn help_search_brings_the_first_line_found_to_the_top() {
+    use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+    let mut a = app();
+    a.act(Action::Help);
+    let _ = screen(&mut a, 80, 24);
+    for c in "/loop".chars() {
+        a.key(KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE));
+    }
+    let s = screen(&mut a, 80, 24);
+    assert!(s.contains("find: loop_ (2 lines)"), "{s}");
+    let first = s.lines().nth(2).unwrap_or("");
+    assert!(first.contains("Replay: loop at the end (on/off)"), "{s}");
+    insta::assert_snapshot!("help_search_80x24", s);
+}
