@@ -437,7 +437,22 @@ fn lanes(bits: &[&Shown], win: TimeWindow, cursor: Option<f64>, label_w: u16, f:
                 cell[1] |= v;
             }
         }
-        for (bit, name) in names {
+        // When the lanes do not all fit: the bits that change in the window first, then
+        // those set, shown in bit order.
+        let room = (area.height as usize).saturating_sub(out.len());
+        let mut chosen: Vec<(&u8, &String)> = names.iter().collect();
+        if chosen.len() > room {
+            let rank = |bit: u8| {
+                let mask = 1u16 << (bit & 15);
+                let low = seen.iter().any(|c| c[0] & mask != 0);
+                let high = seen.iter().any(|c| c[1] & mask != 0);
+                (!(low && high), !high)
+            };
+            chosen.sort_by_key(|(b, _)| (rank(**b), **b));
+            chosen.truncate(room);
+            chosen.sort_by_key(|(b, _)| **b);
+        }
+        for (bit, name) in chosen {
             let mask = 1u16 << (*bit & 15);
             let label = fit(&format!("{bit:>2} {name}"), label_w as usize);
             let mut spans = vec![Span::raw(format!("{label:<w$} ", w = label_w as usize))];
