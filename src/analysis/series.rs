@@ -40,6 +40,140 @@ impl Line {
         }
         self.points.push((t, v));
     }
+
+    /// The points from `t0` to `t1` (seconds), with the last point before `t0` first (the
+    /// value held at the window's start); found by binary search, so a draw touches only
+    /// what it shows.
+    pub fn window(&self, t0: f64, t1: f64) -> &[(f64, f64)] {
+        let start = self.points.partition_point(|p| p.0 < t0).saturating_sub(1);
+        let end = self.points.partition_point(|p| p.0 <= t1).max(start);
+        &self.points[start..end]
+    }
+
+    /// The value in force at `t`: the last point at or before it.
+    pub fn at(&self, t: f64) -> Option<f64> {
+        let n = self.points.partition_point(|p| p.0 <= t);
+        n.checked_sub(1).map(|i| self.points[i].1)
+    }
+
+    /// The first and last time, if any point was seen.
+    pub fn span(&self) -> Option<(f64, f64)> {
+        Some((self.points.first()?.0, self.points.last()?.0))
+    }
+}
+
+/// Points to draw for a state (step) signal: each value holds until the next, so each
+/// change becomes a vertical edge (`(t, old)` then `(t, new)`), never a slope; the last
+/// value holds to `until`.
+pub fn steps(points: &[(f64, f64)], until: f64) -> Vec<(f64, f64)> {
+    let mut out = Vec::with_capacity(points.len() * 2 + 1);
+    for (i, &(t, v)) in points.iter().enumerate() {
+        if i > 0 {
+            out.push((t, points[i - 1].1));
+        }
+        out.push((t, v));
+    }
+    if let Some(&(t, v)) = points.last()
+        && until > t
+    {
+        out.push((until, v));
+    }
+    out
+}
+
+/// At most four points per column (first, lowest, highest, last of the points falling in
+/// it, in time order) for `columns` columns between `t0` and `t1`: what a draw needs of a
+/// dense series, whatever its length.
+pub fn decimate(points: &[(f64, f64)], t0: f64, t1: f64, columns: usize) -> Vec<(f64, f64)> {
+    let columns = columns.max(1);
+    if points.len() <= columns * 4 || t1 <= t0 {
+        return points.to_vec();
+    }
+    let width = (t1 - t0) / columns as f64;
+    let mut out = Vec::with_capacity(columns * 4);
+    let mut i = 0;
+    while i < points.len() {
+        let col = ((points[i].0 - t0) / width).floor();
+        let mut j = i;
+        let (mut lo, mut hi) = (i, i);
+        while j < points.len() && ((points[j].0 - t0) / width).floor() == col {
+            if points[j].1 < points[lo].1 {
+                lo = j;
+            }
+            if points[j].1 > points[hi].1 {
+                hi = j;
+            }
+            j += 1;
+        }
+        let mut picks = [i, lo.min(hi), lo.max(hi), j - 1];
+        picks.sort_unstable();
+        let mut last = usize::MAX;
+        for k in picks {
+            if k != last {
+                out.push(points[k]);
+                last = k;
+            }
+        }
+        i = j;
+    }
+    out
+}
+
+/// The time window a plot shows (seconds): zoomed and panned within the whole span.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TimeWindow {
+    /// Start.
+    pub start: f64,
+    /// End (greater than `start`).
+    pub end: f64,
+}
+
+/// The narrowest window zooming in gives (seconds).
+pub const MIN_WINDOW: f64 = 1e-3;
+
+impl TimeWindow {
+    /// Width in seconds.
+    pub fn width(&self) -> f64 {
+        self.end - self.start
+    }
+
+    /// The window `factor` times as wide (below 1 zooms in), keeping the time `around` at
+    /// the same place on the screen, kept within `span` and no narrower than [`MIN_WINDOW`].
+    pub fn zoom(self, factor: f64, around: f64, span: TimeWindow) -> TimeWindow {
+        let around = around.clamp(self.start, self.end);
+        let width = (self.width() * factor).clamp(MIN_WINDOW, span.width().max(MIN_WINDOW));
+        let at = if self.width() > 0.0 {
+            (around - self.start) / self.width()
+        } else {
+            0.5
+        };
+        let start = around - at * width;
+        TimeWindow {
+            start,
+            end: start + width,
+        }
+        .within(span)
+    }
+
+    /// The window moved by `fraction` of its width (negative: back in time), within `span`.
+    pub fn pan(self, fraction: f64, span: TimeWindow) -> TimeWindow {
+        let d = self.width() * fraction;
+        TimeWindow {
+            start: self.start + d,
+            end: self.end + d,
+        }
+        .within(span)
+    }
+
+    /// The window shifted (not resized) to lie within `span` where it can.
+    fn within(self, span: TimeWindow) -> TimeWindow {
+        let w = self.width();
+        if w >= span.width() {
+            return span;
+        }
+        let start = self.start.clamp(span.start, span.end - w);
+        TimeWindow { start, end: start + w }
+    }
 }
 
 /// Every series.
@@ -52,6 +186,14 @@ impl Series {
     /// The series keys in order.
     pub fn keys(&self) -> Vec<SeriesKey> {
         self.lines.keys().copied().collect()
+    }
+    /// Number of series.
+    pub fn len(&self) -> usize {
+        self.lines.len()
+    }
+    /// True when no series was seen.
+    pub fn is_empty(&self) -> bool {
+        self.lines.is_empty()
     }
     /// One series.
     pub fn get(&self, key: &SeriesKey) -> Option<&Line> {
@@ -111,5 +253,76 @@ mod tests {
         assert!(l.points.len() <= MAX_POINTS);
         assert_eq!(l.points[0].0, 0.0);
         assert!(l.points.last().unwrap().0 > (MAX_POINTS * 3 - 10) as f64);
+    }
+
+    fn line(points: &[(f64, f64)]) -> Line {
+        Line {
+            points: points.to_vec(),
+            ..Line::default()
+        }
+    }
+
+    #[test]
+    fn a_state_signal_steps_and_holds_its_last_value() {
+        let p = [(1.0, 0x21 as f64), (2.0, 0x23 as f64), (3.0, 0x27 as f64)];
+        assert_eq!(
+            steps(&p, 5.0),
+            [
+                (1.0, 33.0),
+                (2.0, 33.0),
+                (2.0, 35.0),
+                (3.0, 35.0),
+                (3.0, 39.0),
+                (5.0, 39.0)
+            ]
+        );
+        assert_eq!(steps(&[], 5.0), []);
+        let l = line(&p);
+        assert_eq!(l.at(0.5), None);
+        assert_eq!(l.at(2.0), Some(35.0));
+        assert_eq!(l.at(2.9), Some(35.0));
+        assert_eq!(l.at(9.0), Some(39.0));
+    }
+
+    #[test]
+    fn a_window_holds_the_value_before_it_and_only_its_points() {
+        let l = line(&[(1.0, 1.0), (2.0, 2.0), (3.0, 3.0), (4.0, 4.0)]);
+        assert_eq!(l.window(2.5, 3.5), [(2.0, 2.0), (3.0, 3.0)]);
+        assert_eq!(l.window(0.0, 1.0), [(1.0, 1.0)]);
+        assert_eq!(l.window(5.0, 6.0), [(4.0, 4.0)]);
+        assert_eq!(l.span(), Some((1.0, 4.0)));
+    }
+
+    #[test]
+    fn decimation_keeps_the_extremes_of_each_column() {
+        let p: Vec<(f64, f64)> = (0..1000)
+            .map(|i| (i as f64 / 1000.0, if i == 503 { 99.0 } else { (i % 7) as f64 }))
+            .collect();
+        let d = decimate(&p, 0.0, 1.0, 10);
+        assert!(d.len() <= 40, "{}", d.len());
+        assert!(d.contains(&(0.503, 99.0)), "the spike survives");
+        assert!(d.windows(2).all(|w| w[0].0 <= w[1].0), "time order kept");
+        assert_eq!(decimate(&p[..20], 0.0, 1.0, 10).len(), 20, "few points: all kept");
+    }
+
+    #[test]
+    fn zoom_keeps_the_cursor_in_place_and_stays_within_the_span() {
+        let span = TimeWindow { start: 0.0, end: 100.0 };
+        let z = span.zoom(0.5, 25.0, span);
+        assert_eq!(z, TimeWindow { start: 12.5, end: 62.5 });
+        // Zooming out past the span gives the span; panning stops at its ends.
+        assert_eq!(z.zoom(4.0, 30.0, span), span);
+        assert_eq!(z.pan(-1.0, span), TimeWindow { start: 0.0, end: 50.0 });
+        assert_eq!(
+            z.pan(2.0, span),
+            TimeWindow {
+                start: 50.0,
+                end: 100.0
+            }
+        );
+        // Never narrower than a millisecond.
+        let tiny = span.zoom(1e-9, 50.0, span);
+        assert!((tiny.width() - MIN_WINDOW).abs() < 1e-12, "{tiny:?}");
+        assert!((tiny.start - 50.0 + MIN_WINDOW / 2.0).abs() < 1e-9, "{tiny:?}");
     }
 }

@@ -12,6 +12,11 @@ pub struct IdStats {
     pub first_ns: u64,
     /// Last frame time (ns).
     pub last_ns: u64,
+    /// Store position of the last frame.
+    pub last_pos: usize,
+    /// Store position of the frame before it.
+    pub prev_pos: Option<usize>,
+    last_gap: f64,
     sum_gap: f64,
     sum_gap2: f64,
 }
@@ -20,6 +25,10 @@ impl IdStats {
     /// Mean period in seconds (None with fewer than two frames).
     pub fn period(&self) -> Option<f64> {
         (self.count > 1).then(|| self.sum_gap / (self.count - 1) as f64)
+    }
+    /// The last period (between the last two frames) in seconds.
+    pub fn last_period(&self) -> Option<f64> {
+        (self.count > 1).then_some(self.last_gap)
     }
     /// Standard deviation of the period in seconds.
     pub fn jitter(&self) -> Option<f64> {
@@ -69,7 +78,10 @@ impl Stats {
             let gap = p.ts_ns.saturating_sub(s.last_ns) as f64 / 1e9;
             s.sum_gap += gap;
             s.sum_gap2 += gap * gap;
+            s.last_gap = gap;
+            s.prev_pos = Some(s.last_pos);
         }
+        s.last_pos = store.len() - 1;
         s.count += 1;
         s.last_ns = p.ts_ns;
         self.window_bits += p.wire_bits();
@@ -127,6 +139,8 @@ mod tests {
         assert!((s.period().unwrap() - 0.010).abs() < 1e-9);
         assert!(s.jitter().unwrap() > 0.001);
         assert!((s.rate() - 100.0).abs() < 1e-6);
+        assert!((s.last_period().unwrap() - 0.008).abs() < 1e-9);
+        assert_eq!((s.last_pos, s.prev_pos), (4, Some(3)));
         // 5 base frames of 8 bytes, 135 bits each at worst (see store::wire_bits), in the
         // last second: 675 bits of 125000 = 0.54 %.
         assert!((st.load_percent() - 0.54).abs() < 1e-9, "{}", st.load_percent());

@@ -1,6 +1,7 @@
 //! The commander: NMT, SDO, LSS, CiA 402 drive sequences, scan and record, as a library
 //! API shared by the command line and the TUI palette.
 
+pub mod complete;
 pub mod cyclic;
 pub mod drive;
 pub mod error;

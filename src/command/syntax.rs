@@ -605,9 +605,12 @@ pub fn usages() -> Vec<(String, String)> {
 
 /// The words that may complete the last (partial) word of `before`, a palette line up to
 /// the cursor: subcommands, flags (when the word starts with `-`), the values of the flag
-/// before it or of the positional argument it stands for (NMT and drive actions, types).
-pub fn completions(before: &str) -> Vec<String> {
-    let mut words: Vec<&str> = before.split_whitespace().collect();
+/// before it or of the positional argument it stands for (NMT and drive actions, types),
+/// and what `known` offers for nodes, objects, procedures and their parameters
+/// ([`super::complete::values`]).
+pub fn completions(before: &str, known: &dyn super::complete::Known) -> Vec<String> {
+    let split = shlex::split(before).unwrap_or_else(|| before.split_whitespace().map(String::from).collect());
+    let mut words: Vec<&str> = split.iter().map(String::as_str).collect();
     let partial = if before.ends_with(char::is_whitespace) || words.is_empty() {
         ""
     } else {
@@ -616,6 +619,15 @@ pub fn completions(before: &str) -> Vec<String> {
     let mut cmd = palette();
     let mut positional = 0;
     let mut expecting: Option<&clap::Arg> = None;
+    let mut node: Option<u8> = None;
+    let mut given: Vec<(String, String)> = Vec::new();
+    // The positional argument at `i`; past the last, the last when it takes many values.
+    let at = |cmd: &'static clap::Command, i: usize| -> Option<&'static clap::Arg> {
+        let all: Vec<&clap::Arg> = cmd.get_positionals().collect();
+        all.get(i)
+            .or(all.last().filter(|a| matches!(a.get_action(), clap::ArgAction::Append)))
+            .copied()
+    };
     for w in &words {
         if expecting.take().is_some() {
             continue;
@@ -635,6 +647,12 @@ pub fn completions(before: &str) -> Vec<String> {
                 .find(|a| a.get_short() == short)
                 .filter(|a| a.get_action().takes_values());
         } else {
+            if let Some(a) = at(cmd, positional) {
+                if a.get_id() == "node" {
+                    node = parse_int(w).and_then(|n| u8::try_from(n).ok());
+                }
+                given.push((a.get_id().to_string(), w.to_string()));
+            }
             positional += 1;
         }
     }
@@ -661,7 +679,16 @@ pub fn completions(before: &str) -> Vec<String> {
     if cmd.has_subcommands() {
         return cmd.get_subcommands().map(|s| s.get_name().to_string()).collect();
     }
-    cmd.get_positionals().nth(positional).map(values).unwrap_or_default()
+    let Some(arg) = at(cmd, positional) else {
+        return Vec::new();
+    };
+    let listed = values(arg);
+    if !listed.is_empty() {
+        return listed;
+    }
+    let id = arg.get_id().as_str();
+    let before_values: Vec<String> = given.into_iter().filter(|(a, _)| a == id).map(|(_, v)| v).collect();
+    super::complete::values(id, node, &before_values, known).unwrap_or_default()
 }
 
 /// A value parser that checks a word with `parse` and offers `words` for help and completion.
@@ -778,6 +805,11 @@ fn count_arg(text: &str) -> Result<u64, ParseError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Completions with nothing known of the bus.
+    fn completions_of(before: &str) -> Vec<String> {
+        completions(before, &crate::command::complete::Nothing::new())
+    }
 
     #[test]
     fn palette_lines() {
@@ -931,7 +963,7 @@ mod tests {
                 timeout_ms: 50
             }
         );
-        assert!(completions("lss ").contains(&"fastscan".to_string()));
+        assert!(completions_of("lss ").contains(&"fastscan".to_string()));
     }
 
     #[test]
@@ -1008,12 +1040,12 @@ mod tests {
                 "nmt", "sdo", "drive", "run", "scan", "record", "stop", "lss", "send", "sync", "pdo"
             ]
         );
-        assert_eq!(completions("sdo "), ["read", "write"]);
-        assert_eq!(completions("nmt re"), NMT_WORDS);
-        assert_eq!(completions("drive 2 "), DRIVE_WORDS);
-        assert!(completions("sdo write 2 0x6060 3 --t").contains(&"--type".to_string()));
-        assert!(completions("sdo write 2 0x6060 3 --type ").contains(&"i8".to_string()));
-        assert!(!completions("nmt start 2 --").contains(&"--block".to_string()));
-        assert!(completions("filter x").is_empty());
+        assert_eq!(completions_of("sdo "), ["read", "write"]);
+        assert_eq!(completions_of("nmt re"), NMT_WORDS);
+        assert_eq!(completions_of("drive 2 "), DRIVE_WORDS);
+        assert!(completions_of("sdo write 2 0x6060 3 --t").contains(&"--type".to_string()));
+        assert!(completions_of("sdo write 2 0x6060 3 --type ").contains(&"i8".to_string()));
+        assert!(!completions_of("nmt start 2 --").contains(&"--block".to_string()));
+        assert!(completions_of("filter x").is_empty());
     }
 }

@@ -10,7 +10,7 @@ use super::palette::{self, Planned, commander_words};
 use super::panes::detail::DetailPane;
 use super::panes::help::HelpPopup;
 use super::panes::messages::MessagesPopup;
-use super::panes::{Ctx, Outcome, Pane, Panes, Selected};
+use super::panes::{Component, Ctx, Outcome, Pane, Panes, Selected};
 use super::prompt::{Edit, PromptBar, PromptKind};
 use super::source::{Control, Feed};
 use crate::analysis::filter::{Filter, FilterError};
@@ -53,6 +53,8 @@ pub struct SourceInfo {
     pub drops: u64,
     /// The interface error in force (with the command that fixes it).
     pub bus_error: Option<String>,
+    /// A replay starts over at its end.
+    pub looping: bool,
     /// Where a replay is, and the size of its log once measured.
     pub replay: (Option<super::source::Position>, Option<super::source::Extent>),
     feed: Option<Receiver<Feed>>,
@@ -70,6 +72,7 @@ impl SourceInfo {
             done: false,
             drops: 0,
             bus_error: None,
+            looping: false,
             replay: (None, None),
             feed: Some(feed),
             control,
@@ -168,10 +171,23 @@ fn event_level(what: &crate::analysis::What) -> Level {
     }
 }
 
+/// What the palette completes from: the nodes heard (the node table) and the dictionaries
+/// the commander uses (the bindings).
+struct Heard<'a>(&'a App);
+
+impl crate::command::complete::Known for Heard<'_> {
+    fn nodes(&self) -> Vec<u8> {
+        self.0.trace.nodes.iter().map(|(id, _)| *id).collect()
+    }
+    fn dictionary(&self, node: u8) -> &crate::od::Dictionary {
+        self.0.bindings.dictionary(node)
+    }
+}
+
 /// Names the palette completes.
 pub const PALETTE_COMMANDS: &[&str] = &[
-    "filter", "search", "goto", "time", "speed", "pause", "resume", "rewind", "plot", "export", "help", "messages",
-    "quit", "jobs", "sim",
+    "filter", "search", "goto", "time", "speed", "pause", "resume", "rewind", "loop", "plot", "export", "help",
+    "messages", "quit", "jobs", "sim",
 ];
 
 /// Why a built-in palette command (`goto`, `time`, `speed`, `plot`, `export`, ...) failed;
@@ -514,9 +530,27 @@ impl App {
             }
             return;
         }
+        if self.help.shown && self.help.typing {
+            self.help.type_key(ev, &self.keymap);
+            return;
+        }
+        if let Some(picker) = self.panes.plot.picker.as_mut() {
+            use super::panes::picker::PickerEdit;
+            match picker.key(ev, &self.trace) {
+                PickerEdit::Editing => {}
+                PickerEdit::Closed => self.panes.plot.picker = None,
+                PickerEdit::Toggle(k) => {
+                    self.panes.plot.toggle(&self.trace, k);
+                    self.panes.plot.picker = None;
+                }
+            }
+            return;
+        }
         if self.prompt.editing.is_some() {
-            self.prompt_key(ev);
-            self.preview();
+            // The candidates a completion lists stay on the status line; else the preview.
+            if !self.prompt_key(ev) {
+                self.preview();
+            }
             return;
         }
         let Some(k) = Key::from_event(&ev) else { return };
@@ -536,7 +570,8 @@ impl App {
         }
     }
 
-    fn prompt_key(&mut self, ev: KeyEvent) {
+    /// Edits the prompt line; true when a completion listed its candidates.
+    fn prompt_key(&mut self, ev: KeyEvent) -> bool {
         match self.prompt.key(ev) {
             Edit::Submit(kind, text) => self.submit(kind, &text),
             Edit::Complete => {
@@ -546,8 +581,10 @@ impl App {
                     .as_ref()
                     .map(|p| p.text.chars().take(p.cursor).collect())
                     .unwrap_or_default();
-                let words: Vec<String> = if before.contains(' ') {
-                    crate::command::syntax::completions(&before)
+                let words: Vec<String> = if let Some(rest) = before.strip_prefix("plot ") {
+                    self.plot_completions(rest)
+                } else if before.contains(' ') {
+                    crate::command::syntax::completions(&before, &Heard(self))
                 } else {
                     PALETTE_COMMANDS
                         .iter()
@@ -560,9 +597,34 @@ impl App {
                     .complete(&words.iter().map(String::as_str).collect::<Vec<_>>());
                 if !shown.is_empty() {
                     self.message = Some(shown.join("  "));
+                    return true;
                 }
             }
             Edit::Editing | Edit::Cancelled => {}
+        }
+        false
+    }
+
+    /// `plot NODE INDEX:SUB`: the nodes with a series, then that node's series.
+    fn plot_completions(&self, rest: &str) -> Vec<String> {
+        let done: Vec<&str> = if rest.ends_with(' ') || rest.is_empty() {
+            rest.split_whitespace().collect()
+        } else {
+            let w: Vec<&str> = rest.split_whitespace().collect();
+            w[..w.len() - 1].to_vec()
+        };
+        let keys = self.trace.series.keys();
+        match done[..] {
+            [] => {
+                let nodes: BTreeSet<u8> = keys.iter().map(|k| k.0).collect();
+                nodes.iter().map(u8::to_string).collect()
+            }
+            [node] => keys
+                .iter()
+                .filter(|k| node.parse() == Ok(k.0))
+                .map(|k| format!("{:04X}:{:02X}", k.1, k.2))
+                .collect(),
+            _ => Vec::new(),
         }
     }
 
@@ -828,6 +890,10 @@ impl App {
                 self.set_paused(false);
                 Ok(String::new())
             }
+            "loop" => {
+                self.act(Action::Loop);
+                return;
+            }
             "plot" => self.plot_command(rest),
             "help" => {
                 self.help.shown = true;
@@ -1045,7 +1111,7 @@ impl App {
         if self.log_popup.shown && self.log_popup.handle(a, self.messages.lines().len()) {
             return;
         }
-        if self.help.handle(a) {
+        if self.help.handle(a, &self.keymap) {
             return;
         }
         if a == Action::Back && self.detail_below() {
@@ -1136,6 +1202,17 @@ impl App {
                 }
                 _ => self.message = Some("step: pause a replay first".into()),
             },
+            Action::Loop => {
+                let on = !self.source.looping;
+                match &self.source.control {
+                    Some(c) => {
+                        let _ = c.send(Control::Loop(on));
+                        self.source.looping = on;
+                        self.message = Some(format!("replay loop {}", if on { "on" } else { "off" }));
+                    }
+                    None => self.message = Some("loop: only a replay can loop".into()),
+                }
+            }
             Action::StepBack | Action::Rewind => {
                 let c = if a == Action::Rewind {
                     Control::Rewind
@@ -1161,6 +1238,18 @@ impl App {
             Action::NextSeries | Action::PrevSeries => {
                 self.panes.plot.step(&self.trace, a == Action::NextSeries);
                 self.focus = Pane::Plot;
+            }
+            // From another pane: the Stats pane comes to the front and takes it.
+            Action::Sort => {
+                self.focus = Pane::Stats;
+                let (panes, ctx) = self.panes_mut();
+                panes.stats.handle(a, &ctx);
+            }
+            // From another pane: the Plot pane comes to the front and takes them.
+            Action::PlotPick | Action::ZoomIn | Action::ZoomOut => {
+                self.focus = Pane::Plot;
+                let (panes, ctx) = self.panes_mut();
+                panes.plot.handle(a, &ctx);
             }
             // Taken by the help popup; row movement and `expand` in a pane without rows.
             Action::Help
@@ -1353,6 +1442,33 @@ mod tests {
             assert_eq!(logged, format!("{line}: {want}"));
         }
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn palette_tab_completes_nodes_heard_objects_and_plot_series() {
+        let mut a = app();
+        let tab = KeyEvent::new(KeyCode::Tab, KeyModifiers::NONE);
+        a.key(key(':'));
+        for c in "sdo read ".chars() {
+            a.key(key(c));
+        }
+        a.key(tab);
+        assert_eq!(a.message.as_deref(), Some("1  2"), "the nodes heard");
+        for c in "2 statusw".chars() {
+            a.key(key(c));
+        }
+        a.key(tab);
+        assert_eq!(
+            a.prompt.editing.as_ref().map(|p| p.text.as_str()),
+            Some("sdo read 2 Statusword ")
+        );
+        a.key(KeyEvent::new(KeyCode::Esc, KeyModifiers::NONE));
+        a.key(key(':'));
+        for c in "plot 1 ".chars() {
+            a.key(key(c));
+        }
+        a.key(tab);
+        assert_eq!(a.message.as_deref(), Some("1017:00  6041:00"));
     }
 
     #[test]

@@ -77,10 +77,15 @@ actions! {
     Step = "step": "Replay one frame (when paused)",
     StepBack = "step_back": "Replay: one frame back (replays up to the frame before)",
     Rewind = "rewind": "Replay: start over from the first frame",
-    SeekForward = "seek_forward": "Replay: jump 10 s ahead",
-    SeekBack = "seek_back": "Replay: jump 10 s back",
+    Loop = "loop": "Replay: loop at the end (on/off)",
+    SeekForward = "seek_forward": "Replay: jump 10 s ahead (Plot focused: cursor right)",
+    SeekBack = "seek_back": "Replay: jump 10 s back (Plot focused: cursor left)",
     NextSeries = "next_series": "Plot: next signal",
     PrevSeries = "prev_series": "Plot: previous signal",
+    PlotPick = "plot_pick": "Plot: pick signals (type to filter, enter adds or removes)",
+    ZoomIn = "zoom_in": "Plot: zoom in around the cursor (page keys pan, home: all)",
+    ZoomOut = "zoom_out": "Plot: zoom out",
+    Sort = "sort": "Stats: cycle the sort (COB-ID, count, period, last heard)",
 }
 
 /// One key press, normalised (no SHIFT on characters).

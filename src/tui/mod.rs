@@ -6,6 +6,7 @@
 
 pub mod app;
 pub mod export;
+pub mod fuzzy;
 pub mod keymap;
 pub mod live;
 pub mod messages;

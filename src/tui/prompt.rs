@@ -113,28 +113,38 @@ impl Prompt {
         self.jump(true);
     }
 
-    /// Completes the word under the cursor from `candidates`: a unique match is completed;
-    /// several matches are completed to their common prefix and returned for display.
+    /// Completes the word under the cursor from `candidates` (case ignored; the word is
+    /// replaced by the candidate's spelling): a unique match is completed; several matches
+    /// are completed to their common prefix and returned for display.
     pub fn complete(&mut self, candidates: &[&str]) -> Vec<String> {
         let b = self.byte(self.cursor);
         let start = self.text[..b].rfind(' ').map(|i| i + 1).unwrap_or(0);
-        let word = &self.text[start..b];
-        let hits: Vec<&str> = candidates.iter().copied().filter(|c| c.starts_with(word)).collect();
+        let word = self.text[start..b].to_lowercase();
+        let hits: Vec<&str> = candidates
+            .iter()
+            .copied()
+            .filter(|c| c.to_lowercase().starts_with(&word))
+            .collect();
         let Some(first) = hits.first() else {
             return Vec::new();
         };
-        let mut common = first.to_string();
+        let mut common: Vec<char> = first.chars().collect();
         for h in &hits[1..] {
-            while !h.starts_with(&common) {
-                common.pop();
-            }
+            let same = common
+                .iter()
+                .zip(h.chars())
+                .take_while(|(a, b)| a.to_lowercase().eq(b.to_lowercase()))
+                .count();
+            common.truncate(same);
         }
+        let mut replaced: String = common.iter().collect();
         if hits.len() == 1 {
-            common.push(' ');
+            replaced.push(' ');
         }
-        let added = common[word.len()..].to_string();
-        self.text.insert_str(b, &added);
-        self.cursor += added.chars().count();
+        if replaced.chars().count() >= word.chars().count() {
+            self.text.replace_range(start..b, &replaced);
+            self.cursor = self.text[..start].chars().count() + replaced.chars().count();
+        }
         if hits.len() > 1 {
             hits.iter().map(|s| s.to_string()).collect()
         } else {
@@ -253,6 +263,9 @@ mod tests {
         let mut q = Prompt::new(PromptKind::Palette, "s");
         assert_eq!(q.complete(&["seek", "search"]), vec!["seek", "search"]);
         assert_eq!(q.text, "se");
+        let mut c = Prompt::new(PromptKind::Palette, "sdo read 2 stat");
+        assert!(c.complete(&["Statusword", "Controlword"]).is_empty());
+        assert_eq!((c.text.as_str(), c.cursor), ("sdo read 2 Statusword ", 22));
         q.backspace();
         q.move_by(-5);
         q.insert('x');

@@ -62,6 +62,8 @@ pub enum Control {
     GotoTime(u64),
     /// Start over from the first frame (paused or playing as before).
     Rewind,
+    /// Loop (`true`): at the end, start over from the first frame and play on.
+    Loop(bool),
 }
 
 /// A feed and, for sources that take commands, its control line.
@@ -201,6 +203,7 @@ pub fn replay(path: PathBuf, speed: f64) -> (Receiver<Feed>, Sender<Control>) {
             paused: false,
             target: None,
             first_ns: None,
+            looping: false,
         };
         if let Err(e) = player.run() {
             let _ = player.tx.send(Feed::Status(e.to_string()));
@@ -229,6 +232,8 @@ struct Player {
     target: Option<Target>,
     /// The log time of the first frame (time seeks count from it).
     first_ns: Option<u64>,
+    /// At the end, start over.
+    looping: bool,
 }
 
 /// Why the replay loop stopped reading.
@@ -299,15 +304,25 @@ impl Player {
         }
     }
 
-    /// At the end: waits for a command that goes back.
+    /// At the end: starts over when looping (a log with frames), else waits for a command
+    /// that goes back (or turns looping on).
     fn finished(&mut self, end: Position) -> Stop {
-        let _ = self.tx.send(Feed::Status("replay finished".into()));
         self.target = None;
+        if self.looping && end.frames > 0 {
+            let _ = self
+                .tx
+                .send(Feed::Status("replay finished, looping: from the start".into()));
+            return Stop::Restart;
+        }
+        let _ = self.tx.send(Feed::Status("replay finished".into()));
         while let Ok(c) = self.ctl.recv() {
             if let Next::Stop(s) = self.apply(c, end) {
                 return s;
             }
             self.target = None;
+            if self.looping && end.frames > 0 {
+                return Stop::Restart;
+            }
             if self.tx.send(Feed::Position(end)).is_err() {
                 return Stop::Gone;
             }
@@ -477,6 +492,7 @@ impl Player {
                 self.target = Some(Target::Frame(0));
                 return Next::Stop(Stop::Restart);
             }
+            Control::Loop(on) => self.looping = on,
             Control::GotoFrame(n) => {
                 self.target = Some(Target::Frame(n));
                 if n < at.frames {
@@ -643,6 +659,27 @@ mod tests {
         drop(ctl);
         // The UI gone, the replay ends.
         assert!(rx.iter().any(|f| matches!(f, Feed::Done)));
+    }
+
+    #[test]
+    fn a_looping_replay_starts_over_at_the_end() {
+        let l = log(500);
+        let frames = all_frames(&l.0);
+        let (rx, ctl) = replay(l.0.clone(), 0.0);
+        let mut ui = Ui::default();
+        ui.until(&rx, |u| u.notes.iter().any(|n| n == "replay finished"));
+        ui.at(&rx, 500, &frames);
+        // Looping turned on at the end: from the start again, and again at the next end.
+        ctl.send(Control::Loop(true)).unwrap();
+        ui.until(&rx, |u| u.resets == 1);
+        ui.until(&rx, |u| {
+            u.notes.iter().any(|n| n == "replay finished, looping: from the start")
+        });
+        ui.until(&rx, |u| u.resets == 2);
+        ctl.send(Control::Loop(false)).unwrap();
+        ui.notes.clear();
+        ui.until(&rx, |u| u.notes.iter().any(|n| n == "replay finished"));
+        ui.at(&rx, 500, &frames);
     }
 
     #[test]

@@ -3,8 +3,10 @@
 
 use super::{block, header};
 use crate::tui::keymap::{Action, Keymap};
+use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::Frame;
 use ratatui::layout::Rect;
+use ratatui::style::{Color, Modifier, Style};
 use ratatui::text::Line;
 use ratatui::widgets::{Clear, Paragraph};
 use std::cell::Cell;
@@ -19,6 +21,7 @@ pub const PALETTE_SYNTAX: &[(&str, &str)] = &[
     ("pause", "Pause the capture / replay"),
     ("resume", "Resume it"),
     ("rewind", "Replay: start over from the first frame"),
+    ("loop", "Replay: loop at the end (on/off)"),
     ("plot NODE INDEX:SUB", "Plot a signal of a node"),
     (
         "export FILE [--format candump|jsonl|pcapng] [--force]",
@@ -68,7 +71,7 @@ const FILTER_SYNTAX: &[(&str, &str)] = &[
     ("( ... )", "grouping"),
 ];
 
-/// The help popup's state: shown, scrolled.
+/// The help popup's state: shown, scrolled, searched.
 #[derive(Default)]
 pub struct HelpPopup {
     /// The popup is shown.
@@ -77,12 +80,19 @@ pub struct HelpPopup {
     scroll: usize,
     /// Lines visible and the largest scroll at the last draw.
     fit: Cell<(usize, usize)>,
+    /// Text width at the last draw (the lines wrap by it).
+    width: Cell<usize>,
+    /// The text searched for (case ignored); empty: none.
+    pub query: String,
+    /// Keys go to the query (after the filter or search key).
+    pub typing: bool,
 }
 
 impl HelpPopup {
     /// `help` shows or hides the popup, `back` closes it, row and page moves scroll it
-    /// while it is shown; false when `action` is not for it.
-    pub fn handle(&mut self, action: Action) -> bool {
+    /// while it is shown, the filter and search keys start typing a text to find, the
+    /// match keys go to its next and previous line; false when `action` is not for it.
+    pub fn handle(&mut self, action: Action, keymap: &Keymap) -> bool {
         let (page, max) = self.fit.get();
         let page = page.max(1);
         match action {
@@ -98,15 +108,58 @@ impl HelpPopup {
             Action::PageUp => self.scroll = self.scroll.saturating_sub(page),
             Action::Top => self.scroll = 0,
             Action::Bottom => self.scroll = max,
+            Action::Filter | Action::Search => {
+                self.typing = true;
+                self.query.clear();
+            }
+            Action::NextMatch => self.find(keymap, self.scroll + 1, true),
+            Action::PrevMatch => self.find(keymap, self.scroll.saturating_sub(1), false),
             _ => return false,
         }
         true
     }
 
+    /// A key while typing the text to find: characters add to it (the first line holding
+    /// it comes to the top), backspace takes away, enter keeps it, esc drops it.
+    pub fn type_key(&mut self, ev: KeyEvent, keymap: &Keymap) {
+        match ev.code {
+            KeyCode::Esc => {
+                self.typing = false;
+                self.query.clear();
+            }
+            KeyCode::Enter => self.typing = false,
+            KeyCode::Backspace => {
+                self.query.pop();
+                self.find(keymap, 0, true);
+            }
+            KeyCode::Char(c) if !ev.modifiers.contains(KeyModifiers::CONTROL) => {
+                self.query.push(c);
+                self.find(keymap, 0, true);
+            }
+            _ => {}
+        }
+    }
+
+    /// Scrolls to the first line holding the query from line `from` on (or back from it),
+    /// going round; stays when no line holds it.
+    fn find(&mut self, keymap: &Keymap, from: usize, forward: bool) {
+        let hits = matches(&lines(keymap, self.width.get().max(20)), &self.query);
+        let next = if forward {
+            hits.iter().find(|&&i| i >= from).or(hits.first())
+        } else {
+            hits.iter().rev().find(|&&i| i <= from).or(hits.last())
+        };
+        if let Some(&i) = next {
+            self.scroll = i;
+        }
+    }
+
     /// Draws the popup for `keymap` over `area`.
     pub fn render(&self, keymap: &Keymap, f: &mut Frame, area: Rect) {
         let w = area.width.min(100);
+        self.width.set(w.saturating_sub(2) as usize);
         let body = lines(keymap, w.saturating_sub(2) as usize);
+        let hits = matches(&body, &self.query);
         let h = (body.len() as u16 + 2).min(area.height);
         let r = Rect {
             x: area.x + (area.width - w) / 2,
@@ -124,11 +177,49 @@ impl HelpPopup {
         } else {
             String::new()
         };
-        let title = format!(" Help — esc closes{scroll} ");
+        let title = match (self.typing, self.query.is_empty()) {
+            (true, _) => format!(
+                " Help — find: {}_ ({} lines), enter keeps, esc drops ",
+                self.query,
+                hits.len()
+            ),
+            (false, false) => format!(
+                " Help — `{}`: {} lines, n/N — esc closes{scroll} ",
+                self.query,
+                hits.len()
+            ),
+            (false, true) => format!(" Help — esc closes{scroll} "),
+        };
         f.render_widget(Clear, r);
-        let text: Vec<Line> = body.into_iter().skip(top).take(visible).collect();
+        let hot = Style::default().fg(Color::Yellow).add_modifier(Modifier::BOLD);
+        let text: Vec<Line> = body
+            .into_iter()
+            .enumerate()
+            .skip(top)
+            .take(visible)
+            .map(|(i, l)| {
+                if hits.binary_search(&i).is_ok() {
+                    l.style(hot)
+                } else {
+                    l
+                }
+            })
+            .collect();
         f.render_widget(Paragraph::new(text).block(block(&title, true)), r);
     }
+}
+
+/// The lines of `body` holding `query` (case ignored), rising; none for an empty query.
+fn matches(body: &[Line], query: &str) -> Vec<usize> {
+    if query.is_empty() {
+        return Vec::new();
+    }
+    let q = query.to_lowercase();
+    body.iter()
+        .enumerate()
+        .filter(|(_, l)| l.to_string().to_lowercase().contains(&q))
+        .map(|(i, _)| i)
+        .collect()
 }
 
 /// The keys that scroll, as the title names them (`down/up, pagedown/pageup`).
@@ -226,23 +317,50 @@ mod tests {
     }
 
     #[test]
+    fn typing_finds_lines_and_match_keys_go_round() {
+        let k = Keymap::default_map();
+        let mut h = HelpPopup::default();
+        h.handle(Action::Help, &k);
+        h.width.set(98);
+        assert!(h.handle(Action::Filter, &k));
+        assert!(h.typing);
+        for c in "ZOOM".chars() {
+            h.type_key(KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE), &k);
+        }
+        let body = lines(&k, 98);
+        let hits = matches(&body, "zoom");
+        assert_eq!(hits.len(), 2, "zoom in and zoom out");
+        assert_eq!(h.scroll, hits[0]);
+        h.type_key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE), &k);
+        assert!(!h.typing && h.query == "ZOOM");
+        h.handle(Action::NextMatch, &k);
+        assert_eq!(h.scroll, hits[1]);
+        h.handle(Action::NextMatch, &k);
+        assert_eq!(h.scroll, hits[0], "round to the first");
+        h.handle(Action::PrevMatch, &k);
+        assert_eq!(h.scroll, hits[1], "round back to the last");
+        assert!(body[hits[1]].to_string().contains("Plot: zoom out"));
+    }
+
+    #[test]
     fn scrolling_stops_at_both_ends() {
         let mut h = HelpPopup::default();
-        assert!(!h.handle(Action::Down));
-        h.handle(Action::Help);
+        let k = Keymap::default_map();
+        assert!(!h.handle(Action::Down, &k));
+        h.handle(Action::Help, &k);
         h.fit.set((20, 50));
-        h.handle(Action::Up);
+        h.handle(Action::Up, &k);
         assert_eq!(h.scroll, 0);
-        h.handle(Action::PageDown);
-        h.handle(Action::Down);
+        h.handle(Action::PageDown, &k);
+        h.handle(Action::Down, &k);
         assert_eq!(h.scroll, 21);
         for _ in 0..5 {
-            h.handle(Action::PageDown);
+            h.handle(Action::PageDown, &k);
         }
         assert_eq!(h.scroll, 50);
-        h.handle(Action::PageUp);
+        h.handle(Action::PageUp, &k);
         assert_eq!(h.scroll, 30);
-        h.handle(Action::Top);
+        h.handle(Action::Top, &k);
         assert_eq!(h.scroll, 0);
     }
 }

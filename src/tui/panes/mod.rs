@@ -5,6 +5,7 @@ pub mod detail;
 pub mod help;
 pub mod messages;
 pub mod nodes;
+pub mod picker;
 pub mod plot;
 pub mod sdo;
 pub mod stats;
@@ -55,7 +56,7 @@ pub struct Panes {
     pub sdo: sdo::SdoPane,
     /// One row per COB-ID.
     pub stats: stats::StatsPane,
-    /// One numeric series over time.
+    /// Numeric signals over one time axis.
     pub plot: plot::PlotPane,
 }
 
@@ -312,6 +313,49 @@ pub(crate) mod testutil {
         }
         let (_tx, rx) = std::sync::mpsc::channel();
         let mut src = SourceInfo::new("test.log", SourceKind::Open, rx, None);
+        src.done = true;
+        App::new(trace, Keymap::default_map(), src)
+    }
+
+    /// A drive (node 1, CiA 402 dictionary) whose TPDO1 carries the statusword, the vl
+    /// velocity actual value (rpm) and the mode display: 40 PDOs 10 ms apart, enabled at
+    /// the 10th, a speed ramp, profile velocity mode from the 20th, a fault at the 35th.
+    pub fn plot_app() -> App {
+        let bindings = crate::od::bind::Bindings::new().unwrap();
+        let mut trace = Trace::new(Decoder::from_bindings(&bindings), 500_000);
+        trace.ifaces.intern("can0");
+        let mut t = 1_700_000_000_000_000_000u64;
+        let mut add = |id: u32, data: &[u8], dt_ms: u64| {
+            t += dt_ms * 1_000_000;
+            let mut f = Frame::classic(id, data);
+            f.ts_ns = t;
+            trace.push(&f);
+        };
+        add(0x701, &[0x00], 0);
+        for (sub, value) in [
+            (0u8, 0u32),
+            (1, 0x6041_0010),
+            (2, 0x6044_0010),
+            (3, 0x6061_0008),
+            (0, 3),
+        ] {
+            let v = value.to_le_bytes();
+            add(0x601, &[0x23, 0x00, 0x1A, sub, v[0], v[1], v[2], v[3]], 1);
+            add(0x581, &[0x60, 0x00, 0x1A, sub, 0, 0, 0, 0], 1);
+        }
+        for i in 0..40u16 {
+            let sw: u16 = match i {
+                0..10 => 0x0231,
+                10..35 => 0x0237,
+                _ => 0x0238,
+            };
+            let speed: i16 = if (10..35).contains(&i) { (i as i16 - 10) * 40 } else { 0 };
+            let mode: u8 = if i >= 20 { 3 } else { 2 };
+            let (s, v) = (sw.to_le_bytes(), speed.to_le_bytes());
+            add(0x181, &[s[0], s[1], v[0], v[1], mode], 10);
+        }
+        let (_tx, rx) = std::sync::mpsc::channel();
+        let mut src = SourceInfo::new("drive.log", SourceKind::Open, rx, None);
         src.done = true;
         App::new(trace, Keymap::default_map(), src)
     }

@@ -46,8 +46,81 @@ fn state_text(live: Option<&NodeLiveness>, now_ns: u64) -> String {
     }
 }
 
-/// The row text of one node; `now_ns` is the capture time (for ages).
-pub fn row_text(id: u8, n: &NodeInfo, live: Option<&NodeLiveness>, now_ns: u64) -> String {
+/// The columns: header, width, right-aligned, and the order they give way in on a narrow
+/// pane (0: never; then 1 first). The last EMCY and the profile are cut to fit instead
+/// (to [`FLEX_MIN`]) once the others are placed.
+const COLUMNS: [(&str, usize, bool, u8); 11] = [
+    ("id", 3, true, 0),
+    ("nmt", 15, false, 0),
+    ("hb meas/cfg", 11, true, 4),
+    ("hb age", 9, true, 3),
+    ("miss", 4, true, 2),
+    ("boot", 4, true, 1),
+    ("cia402 state", 22, false, 0),
+    ("mode", 14, false, 5),
+    ("last emcy", 18, false, 0),
+    ("fr/s", 7, true, 0),
+    ("profile", 10, false, 0),
+];
+
+/// The narrowest the last EMCY and profile columns get.
+const FLEX_MIN: usize = 8;
+
+/// The columns shown in `width` characters and their widths (cut columns get less).
+pub fn layout(width: usize) -> Vec<(usize, usize)> {
+    let flex = |i: usize| COLUMNS[i].0 == "last emcy" || COLUMNS[i].0 == "profile";
+    let mut shown: Vec<usize> = (0..COLUMNS.len()).collect();
+    let need = |shown: &[usize]| -> usize {
+        shown
+            .iter()
+            .map(|&i| if flex(i) { FLEX_MIN } else { COLUMNS[i].1 } + 1)
+            .sum::<usize>()
+            - 1
+    };
+    let mut order: Vec<usize> = (0..COLUMNS.len()).filter(|&i| COLUMNS[i].3 > 0).collect();
+    order.sort_by_key(|&i| COLUMNS[i].3);
+    for drop in order {
+        if need(&shown) <= width {
+            break;
+        }
+        shown.retain(|&i| i != drop);
+    }
+    let mut spare = width.saturating_sub(need(&shown));
+    shown
+        .into_iter()
+        .map(|i| {
+            let w = if flex(i) {
+                let extra = spare.min(COLUMNS[i].1 - FLEX_MIN);
+                spare -= extra;
+                FLEX_MIN + extra
+            } else {
+                COLUMNS[i].1
+            };
+            (i, w)
+        })
+        .collect()
+}
+
+/// The cells of `cells` (one per column) laid out as `layout` says.
+fn join(cells: &[String], layout: &[(usize, usize)]) -> String {
+    layout
+        .iter()
+        .map(|&(i, w)| {
+            let c = fit(&cells[i], w);
+            if COLUMNS[i].2 {
+                format!("{c:>w$}")
+            } else {
+                format!("{c:<w$}")
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+        .trim_end()
+        .to_string()
+}
+
+/// The row text of one node in `width` characters; `now_ns` is the capture time (for ages).
+pub fn row_text(id: u8, n: &NodeInfo, live: Option<&NodeLiveness>, now_ns: u64, width: usize) -> String {
     let measured = live.and_then(NodeLiveness::measured_ns);
     let configured = live.and_then(|l| l.configured_ms.or(l.default_ms));
     let hb = match (measured, configured) {
@@ -65,21 +138,24 @@ pub fn row_text(id: u8, n: &NodeInfo, live: Option<&NodeLiveness>, now_ns: u64) 
         .as_ref()
         .map(|(_, c, t)| format!("{c:04X} {t}"))
         .unwrap_or_else(|| "-".into());
-    format!(
-        "{:>3} {:<15} {:>11} {:>9} {:>4} {:>4} {:<22} {:<14} {:<18} {:>7.1} {:<10} {}",
-        id,
+    let cells = [
+        id.to_string(),
         state_text(live, now_ns),
         hb,
         age,
-        live.map_or(0, |l| l.missed),
-        live.map_or(0, |l| l.boot_ups),
-        n.drive.map(|d| d.text()).unwrap_or("-"),
-        fit(n.mode.map(mode_name).unwrap_or("-"), 14),
-        fit(&emcy, 18),
-        n.rate(),
-        fit(if n.profile.is_empty() { "-" } else { &n.profile }, 10),
-        "",
-    )
+        live.map_or(0, |l| l.missed).to_string(),
+        live.map_or(0, |l| l.boot_ups).to_string(),
+        n.drive.map(|d| d.text()).unwrap_or("-").to_string(),
+        n.mode.map(mode_name).unwrap_or("-").to_string(),
+        emcy,
+        format!("{:.1}", n.rate()),
+        if n.profile.is_empty() {
+            "-".into()
+        } else {
+            n.profile.clone()
+        },
+    ];
+    join(&cells, &layout(width))
 }
 
 /// The Nodes pane's state: the selection.
@@ -125,23 +201,9 @@ impl Component for NodesPane {
         }
         let trace = ctx.trace;
         let now = trace.nodes.now_ns();
-        let mut lines = vec![Line::styled(
-            format!(
-                "{:>3} {:<15} {:>11} {:>9} {:>4} {:>4} {:<22} {:<14} {:<18} {:>7} {:<10}",
-                "id",
-                "nmt",
-                "hb meas/cfg",
-                "hb age",
-                "miss",
-                "boot",
-                "cia402 state",
-                "mode",
-                "last emcy",
-                "fr/s",
-                "profile"
-            ),
-            header(),
-        )];
+        let width = inner.width as usize;
+        let heads: Vec<String> = COLUMNS.iter().map(|c| c.0.to_string()).collect();
+        let mut lines = vec![Line::styled(join(&heads, &layout(width)), header())];
         let l = self.list;
         for (i, (id, n)) in trace
             .nodes
@@ -151,7 +213,7 @@ impl Component for NodesPane {
             .take(inner.height as usize - 1)
         {
             let live = trace.nodes.liveness(*id);
-            let line = Line::styled(row_text(*id, n, live, now), row_style(live));
+            let line = Line::styled(row_text(*id, n, live, now, width), row_style(live));
             lines.push(if i == l.selected && focused {
                 line.style(selected())
             } else {
@@ -201,4 +263,26 @@ pub fn render_compact(trace: &Trace, f: &mut Frame, area: Rect) {
         })
         .collect();
     f.render_widget(Paragraph::new(lines), inner);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn columns_give_way_in_order_and_rate_and_profile_stay() {
+        let names = |w: usize| -> Vec<&str> { layout(w).iter().map(|(i, _)| COLUMNS[*i].0).collect() };
+        let full = names(200);
+        assert_eq!(full.len(), COLUMNS.len());
+        let all: usize = COLUMNS.iter().map(|c| c.1 + 1).sum::<usize>() - 1;
+        assert_eq!(layout(all).iter().map(|(_, w)| w + 1).sum::<usize>() - 1, all);
+        // A 160-column terminal leaves the Nodes pane 113 columns: boot goes, the rest stays.
+        let at_160 = names(113);
+        assert!(!at_160.contains(&"boot"), "{at_160:?}");
+        assert!(at_160.contains(&"fr/s") && at_160.contains(&"profile") && at_160.contains(&"miss"));
+        assert!(layout(113).iter().map(|(_, w)| w + 1).sum::<usize>() - 1 <= 113);
+        // 80 columns: the mode still shown, the heartbeat columns gone.
+        let at_80 = names(78);
+        assert!(!at_80.contains(&"hb age") && at_80.contains(&"profile"), "{at_80:?}");
+    }
 }

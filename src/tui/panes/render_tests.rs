@@ -49,7 +49,10 @@ fn nodes_pane_marks_a_silent_node_lost_in_red_with_its_age() {
     a.trace.push(&f);
     let s = screen(&mut a, 160, 14);
     assert!(s.contains("  1 Operational       14/100 ms"), "{s}");
-    assert!(s.contains("  2 LOST 0.1 s          14/? ms  103.0 ms    1    1"), "{s}");
+    assert!(s.contains("  2 LOST 0.1 s          14/? ms  103.0 ms    1 -"), "{s}");
+    // At 160 columns the rate and profile columns show (boot-ups give way).
+    assert!(s.contains("fr/s profile"), "{s}");
+    assert!(s.contains("97.1 cia301"), "{s}");
     insta::assert_snapshot!(s);
     // The whole row is white on red, in the main pane and in the compact list.
     let mut term = ratatui::Terminal::new(ratatui::backend::TestBackend::new(160, 14)).unwrap();
@@ -157,12 +160,58 @@ fn stats_pane_shows_rates_and_bus_load() {
 }
 
 #[test]
+fn receive_list_shows_latest_data_periods_and_labels_sorted_by_a_key() {
+    let mut a = app();
+    a.act(Action::Sort);
+    assert_eq!(a.focus, Pane::Stats, "the sort key brings the receive list up");
+    let s = screen(&mut a, 80, 24);
+    assert!(s.contains("Receive list by count"), "{s}");
+    // 0x701 (7 heartbeats) first; its latest data and label.
+    assert!(
+        s.contains("701        7   16.7 ms   14.0 ms  05                       Heartbeat node 1: …"),
+        "{s}"
+    );
+    insta::assert_snapshot!("receive_list_by_count_80x24", s);
+    a.act(Action::Sort);
+    a.act(Action::Sort);
+    let s = screen(&mut a, 160, 48);
+    assert!(s.contains("Receive list by last heard"), "{s}");
+    assert!(s.contains("jitter   rate/s"), "wide: {s}");
+    let first = s.lines().nth(3).unwrap_or("");
+    assert!(first.contains("082  "), "the EMCY came last: {s}");
+    // The Detail pane shows the selected COB-ID's latest frame.
+    assert!(s.contains("EMCY node 2: 0x2310"), "{s}");
+    insta::assert_snapshot!("receive_list_by_last_heard_160x48", s);
+}
+
+#[test]
+fn receive_list_highlights_the_bytes_that_changed() {
+    let mut a = app();
+    a.focus = Pane::Stats;
+    let mut term = ratatui::Terminal::new(ratatui::backend::TestBackend::new(100, 20)).unwrap();
+    term.draw(|fr| crate::tui::ui::draw(fr, &mut a)).unwrap();
+    let buf = term.backend().buffer().clone();
+    // RPDO1 0x201: 0F 00 05 00 00 00 after 0F 00 04 ...: only byte 2 changed.
+    let row = (0..buf.area.height)
+        .find(|&y| buf[(1, y)].symbol() == "2" && buf[(2, y)].symbol() == "0" && buf[(3, y)].symbol() == "1")
+        .expect("a row for 0x201");
+    let x0 = (0..buf.area.width)
+        .find(|&x| buf[(x, row)].symbol() == "0" && buf[(x + 1, row)].symbol() == "F")
+        .unwrap();
+    let hot: Vec<bool> = (0..6)
+        .map(|i| buf[(x0 + 3 * i, row)].fg == ratatui::style::Color::Yellow)
+        .collect();
+    assert_eq!(hot, [false, false, true, false, false, false]);
+}
+
+#[test]
 fn plot_pane_draws_a_series() {
     let mut a = app();
     a.act(Action::NextSeries);
     assert_eq!(a.focus, Pane::Plot);
     let s = screen(&mut a, 100, 20);
-    assert!(s.contains("Plot 2/2: node 1 0x6041:00 (6 points)"), "{s}");
+    assert!(s.contains("Plot: 1 of 2 signals"), "{s}");
+    assert!(s.contains("end 0.098 s  n1 0x6041:00 = 567"), "{s}");
     insta::assert_snapshot!(s);
 }
 
@@ -283,4 +332,91 @@ fn a_replay_shows_its_position_and_progress_in_the_status_line() {
     assert!(screen(&mut a, 80, 24).contains("replay test.log 100% 0.1 s / 0.1 s ×2 (end)"));
     a.source.replay.1 = None;
     assert!(screen(&mut a, 80, 24).contains("replay test.log 0.1 s ×2 |"));
+}
+
+/// The plot of [`plot_app`] with `keys` typed (through the keymap) first.
+fn plot_screen(keys: &str, w: u16, h: u16) -> (crate::tui::app::App, String) {
+    use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+    let mut a = super::testutil::plot_app();
+    a.focus = Pane::Plot;
+    let _ = screen(&mut a, w, h);
+    for c in keys.chars() {
+        let code = match c {
+            '\n' => KeyCode::Enter,
+            '>' => KeyCode::Right,
+            '<' => KeyCode::Left,
+            c => KeyCode::Char(c),
+        };
+        a.key(KeyEvent::new(code, KeyModifiers::NONE));
+    }
+    let s = screen(&mut a, w, h);
+    (a, s)
+}
+
+#[test]
+fn plot_picker_filters_signals_as_the_user_types() {
+    let (a, s) = plot_screen("pvel", 80, 24);
+    assert!(s.contains("Pick signals (1 of 3)"), "{s}");
+    assert!(s.contains("> vel_"), "{s}");
+    assert!(s.contains("node 1   6044:00  vl velocity actual value [rpm]"), "{s}");
+    assert!(a.panes.plot.picker.is_some());
+    insta::assert_snapshot!("plot_picker_80x24", s);
+    let (_, s) = plot_screen("p", 160, 48);
+    assert!(s.contains("Pick signals (3 of 3)"), "{s}");
+    insta::assert_snapshot!("plot_picker_160x48", s);
+}
+
+#[test]
+fn plot_shows_signals_on_one_axis_with_units_legend_and_bit_lanes() {
+    // The statusword is shown first; the picker adds the velocity and the mode.
+    let (a, s) = plot_screen("pvel\npmodes\n", 160, 48);
+    assert_eq!(a.panes.plot.signals, [(1, 0x6041, 0), (1, 0x6044, 0), (1, 0x6061, 0)]);
+    assert!(s.contains("Plot: 3 of 3 signals"), "{s}");
+    assert!(s.contains("n1 vl velocity actual value [rpm]"), "legend: {s}");
+    assert!(s.contains("rpm"), "unit on the axis: {s}");
+    assert!(s.contains(" 2 Operation enabled"), "bit lane: {s}");
+    assert!(s.contains(" 3 Fault"), "bit lane: {s}");
+    assert!(
+        s.contains("end 0.410 s  n1 Statusword = 0x0238  n1 vl velocity actual value = 0 rpm  n1 Modes of"),
+        "{s}"
+    );
+    insta::assert_snapshot!("plot_three_signals_160x48", s);
+}
+
+#[test]
+fn plot_cursor_reads_values_and_zoom_narrows_the_window() {
+    // Right places the cursor mid-window, then moves it one column at a time.
+    let (a, s) = plot_screen("pvel\n>>>>>", 80, 24);
+    let c = a.panes.plot.cursor.unwrap() - a.start_ns() as f64 / 1e9;
+    assert!((0.2..0.25).contains(&c), "{c}");
+    assert!(s.contains("cursor 0.2"), "{s}");
+    assert!(s.contains("n1 Statusword = 0x0237"), "{s}");
+    // Not every lane fits at 80x24: the bits that change and those set come first.
+    assert!(s.contains(" 3 Fault") && s.contains(" 9 Remote"), "{s}");
+    assert!(!s.contains(" 7 Warning"), "{s}");
+    insta::assert_snapshot!("plot_cursor_80x24", s);
+    let (a, s) = plot_screen("pvel\n>zz", 80, 24);
+    let w = a.panes.plot.window.unwrap();
+    assert!((w.width() - 0.1).abs() < 0.01, "{w:?}");
+    assert!(s.contains("Plot: 2 of 3 signals 0.1"), "{s}");
+    // Home shows the whole span again.
+    let mut a = a;
+    a.act(crate::tui::keymap::Action::Top);
+    assert_eq!(a.panes.plot.window, None);
+}
+
+#[test]
+fn help_search_brings_the_first_line_found_to_the_top() {
+    use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+    let mut a = app();
+    a.act(Action::Help);
+    let _ = screen(&mut a, 80, 24);
+    for c in "/loop".chars() {
+        a.key(KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE));
+    }
+    let s = screen(&mut a, 80, 24);
+    assert!(s.contains("find: loop_ (2 lines)"), "{s}");
+    let first = s.lines().nth(2).unwrap_or("");
+    assert!(first.contains("Replay: loop at the end (on/off)"), "{s}");
+    insta::assert_snapshot!("help_search_80x24", s);
 }

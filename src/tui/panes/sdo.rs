@@ -11,6 +11,14 @@ use ratatui::style::{Color, Style};
 use ratatui::text::Line;
 use ratatui::widgets::Paragraph;
 
+/// Widths of the name and value columns in a pane `width` wide: the value takes what the
+/// fixed columns and 20 columns of outcome leave (at least 20), the name 24 (16 when narrow).
+pub fn widths(width: usize) -> (usize, usize) {
+    let avail = width.saturating_sub(30);
+    let name = if avail >= 80 { 24 } else { 16 };
+    (name, avail.saturating_sub(name + 20).max(20))
+}
+
 /// One transfer as a table row.
 pub fn row_text(trace: &Trace, t: &Transaction, width: usize) -> String {
     let dict = trace.decoder().dictionary(t.node);
@@ -36,17 +44,26 @@ pub fn row_text(trace: &Trace, t: &Transaction, width: usize) -> String {
     } else {
         (format!("{:04X}:{:02X}", t.index, t.sub), name)
     };
+    let (nw, vw) = widths(width);
     let text = format!(
-        "{:>3} {} {} {:<24} {:<20} {:>9} {}",
+        "{:>3} {} {} {:<nw$} {:<vw$} {:>9} {}",
         t.node,
         dir,
         object,
-        fit(name, 24),
-        fit(&value, 20),
+        fit(name, nw),
+        fit(&value, vw),
         duration(t.duration_ns() as f64 / 1e9),
         outcome
     );
     fit(&text, width)
+}
+
+#[cfg(test)]
+#[test]
+fn the_value_column_widens_with_the_pane() {
+    assert_eq!(widths(78), (16, 20));
+    assert_eq!(widths(113), (24, 39));
+    assert_eq!(widths(200), (24, 126));
 }
 
 fn color(t: &Transaction) -> Color {
@@ -200,10 +217,11 @@ impl SdoPane {
         if inner.height == 0 {
             return;
         }
+        let (nw, vw) = widths(inner.width as usize);
         let mut lines = vec![Line::styled(
             fit(
                 &format!(
-                    "{:>3} {} {:<7} {:<24} {:<20} {:>9} outcome",
+                    "{:>3} {} {:<7} {:<nw$} {:<vw$} {:>9} outcome",
                     "nd", "dir  ", "object", "name", "value", "duration"
                 ),
                 inner.width as usize,

@@ -1,28 +1,109 @@
-//! The Stats pane: per COB-ID count, rate, period and jitter; bus load from the bit rate.
+//! The Stats pane, a receive list in the manner of PCAN-View: one row per COB-ID with its
+//! count, period (mean and last), jitter and rate (on wide terminals), the latest data with
+//! the bytes that changed since the previous frame of that COB-ID highlighted, and the
+//! decoded label; the bus load from the bit rate in the title. A key cycles the sort.
 
-use super::{Component, Ctx, ListState, Outcome, block, duration, header, selected};
+use super::{Component, Ctx, ListState, Outcome, block, duration, fit, header, selected};
+use crate::analysis::stats::{IdStats, Stats};
+use crate::analysis::trace::Trace;
 use crate::tui::keymap::Action;
 use ratatui::Frame;
 use ratatui::layout::Rect;
-use ratatui::text::Line;
+use ratatui::style::{Color, Modifier, Style};
+use ratatui::text::{Line, Span};
 use ratatui::widgets::Paragraph;
+use std::cell::RefCell;
+use std::collections::HashMap;
 
-/// The Stats pane's state: the selection.
+/// The order of the rows.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Sort {
+    /// By COB-ID, rising.
+    #[default]
+    Id,
+    /// Most frames first.
+    Count,
+    /// Shortest mean period first (single frames last).
+    Period,
+    /// Most recently heard first.
+    Last,
+}
+
+impl Sort {
+    /// The next order in the cycle.
+    pub fn next(self) -> Sort {
+        match self {
+            Sort::Id => Sort::Count,
+            Sort::Count => Sort::Period,
+            Sort::Period => Sort::Last,
+            Sort::Last => Sort::Id,
+        }
+    }
+
+    /// The name the title shows.
+    pub fn name(self) -> &'static str {
+        match self {
+            Sort::Id => "cob-id",
+            Sort::Count => "count",
+            Sort::Period => "period",
+            Sort::Last => "last heard",
+        }
+    }
+}
+
+/// A COB-ID: extended flag and identifier.
+pub type CobKey = (bool, u32);
+
+/// The rows in `sort` order (ties by COB-ID).
+pub fn sorted(stats: &Stats, sort: Sort) -> Vec<(CobKey, IdStats)> {
+    let mut rows: Vec<(CobKey, IdStats)> = stats.iter().map(|(k, s)| (*k, *s)).collect();
+    match sort {
+        Sort::Id => {}
+        Sort::Count => rows.sort_by_key(|r| std::cmp::Reverse(r.1.count)),
+        Sort::Period => rows.sort_by(|a, b| {
+            let p = |s: &IdStats| s.period().unwrap_or(f64::INFINITY);
+            p(&a.1).total_cmp(&p(&b.1))
+        }),
+        Sort::Last => rows.sort_by_key(|r| std::cmp::Reverse(r.1.last_ns)),
+    }
+    rows
+}
+
+/// Which bytes of `cur` differ from `prev` (all of them without a previous frame; bytes
+/// beyond the previous length count as changed).
+pub fn changed(prev: Option<&[u8]>, cur: &[u8]) -> Vec<bool> {
+    cur.iter()
+        .enumerate()
+        .map(|(i, b)| prev.and_then(|p| p.get(i)) != Some(b))
+        .collect()
+}
+
+/// The Stats pane's state: the selection, the sort, the labels decoded.
 #[derive(Default)]
 pub struct StatsPane {
     /// Scroll state.
     pub list: ListState,
+    /// The order of the rows.
+    pub sort: Sort,
+    /// Decoded labels by store position (the rows last drawn), so a row is decoded once
+    /// per new frame of its COB-ID.
+    labels: RefCell<HashMap<usize, String>>,
 }
 
 impl Component for StatsPane {
-    /// Moves the selection; `expand` shows the selected COB-ID's frames in the trace.
+    /// Moves the selection; `sort` cycles the order; `expand` shows the selected COB-ID's
+    /// frames in the trace.
     fn handle(&mut self, action: Action, ctx: &Ctx) -> Outcome {
         if let Some(delta) = ListState::movement(action, ctx.page) {
             self.scroll(delta, ctx);
             return Outcome::Done;
         }
         match action {
-            Action::Expand => match ctx.trace.stats.iter().nth(self.list.selected) {
+            Action::Sort => {
+                self.sort = self.sort.next();
+                Outcome::Done
+            }
+            Action::Expand => match sorted(&ctx.trace.stats, self.sort).get(self.list.selected) {
                 Some(((_, id), _)) => Outcome::Filter(format!("id {id:X}")),
                 None => Outcome::Done,
             },
@@ -42,10 +123,18 @@ impl Component for StatsPane {
         self.list.clamp(ctx.trace.stats.len(), height);
     }
 
+    /// The Detail view shows the selected COB-ID's latest frame.
+    fn selected(&self, ctx: &Ctx) -> Option<super::Selected> {
+        let rows = sorted(&ctx.trace.stats, self.sort);
+        rows.get(self.list.selected)
+            .map(|(_, s)| super::Selected::Frame(s.last_pos))
+    }
+
     fn render(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
         let st = &ctx.trace.stats;
         let title = format!(
-            " Stats — bus load {:.1}% at {} kbit/s ({} frames in the last second) ",
+            " Receive list by {} — bus load {:.1}% at {} kbit/s ({} frames in the last second) ",
+            self.sort.name(),
             st.load_percent(),
             st.bitrate() / 1000,
             st.window_frames(&ctx.trace.store)
@@ -55,26 +144,127 @@ impl Component for StatsPane {
         if inner.height == 0 {
             return;
         }
-        let mut lines = vec![Line::styled(
-            format!(
-                "{:<9} {:>10} {:>9} {:>10} {:>10}",
-                "cob-id", "count", "rate/s", "period", "jitter"
-            ),
-            header(),
-        )];
+        // Jitter and rate on wide terminals; a wider COB-ID column once an extended one is seen.
+        let wide = inner.width >= 100;
+        let cw = if st.iter().any(|((ext, _), _)| *ext) { 9 } else { 4 };
+        let mut head = format!("{:<cw$}{:>8} {:>9} {:>9}", "cob", "count", "period", "last");
+        if wide {
+            head.push_str(&format!(" {:>9} {:>8}", "jitter", "rate/s"));
+        }
+        head.push_str(&format!("  {:<23}  label", "data"));
+        let mut lines = vec![Line::styled(fit(&head, inner.width as usize), header())];
         let l = self.list;
-        for (i, ((ext, id), s)) in st.iter().enumerate().skip(l.offset).take(inner.height as usize - 1) {
+        let rows: Vec<(CobKey, IdStats)> = sorted(st, self.sort)
+            .into_iter()
+            .skip(l.offset)
+            .take(inner.height as usize - 1)
+            .collect();
+        let labels = self.labels(ctx.trace, &rows);
+        for (i, ((ext, id), s)) in rows.iter().enumerate() {
             let cob = if *ext { format!("{id:08X}") } else { format!("{id:03X}") };
-            let line = Line::raw(format!(
-                "{:<9} {:>10} {:>9.1} {:>10} {:>10}",
-                cob,
+            let d = |x: Option<f64>| x.map(duration).unwrap_or_else(|| "-".into());
+            let mut left = format!(
+                "{cob:<cw$}{:>8} {:>9} {:>9}",
                 s.count,
-                s.rate(),
-                s.period().map(duration).unwrap_or_else(|| "-".into()),
-                s.jitter().map(duration).unwrap_or_else(|| "-".into()),
-            ));
-            lines.push(if i == l.selected { line.style(selected()) } else { line });
+                d(s.period()),
+                d(s.last_period())
+            );
+            if wide {
+                left.push_str(&format!(" {:>9} {:>8.1}", d(s.jitter()), s.rate()));
+            }
+            left.push_str("  ");
+            let cur = ctx.trace.store.frame(s.last_pos);
+            let prev = s.prev_pos.map(|p| ctx.trace.store.frame(p));
+            let mut spans = vec![Span::raw(left)];
+            spans.extend(data_spans(prev.as_ref().map(|p| p.payload()), cur.payload()));
+            let label = labels.get(&s.last_pos).map(String::as_str).unwrap_or("");
+            let used: usize = spans.iter().map(|s| s.content.chars().count()).sum();
+            spans.push(Span::raw(fit(label, (inner.width as usize).saturating_sub(used))));
+            let line = Line::from(spans);
+            lines.push(if i + l.offset == l.selected {
+                line.patch_style(selected())
+            } else {
+                line
+            });
         }
         f.render_widget(Paragraph::new(lines), inner);
+    }
+}
+
+impl StatsPane {
+    /// The labels of the rows' last frames: those decoded before, the others decoded now
+    /// in one forward walk; labels of rows no longer shown are dropped.
+    fn labels(&self, trace: &Trace, rows: &[(CobKey, IdStats)]) -> HashMap<usize, String> {
+        let mut cache = self.labels.borrow_mut();
+        let mut want: Vec<usize> = rows.iter().map(|(_, s)| s.last_pos).collect();
+        want.sort_unstable();
+        let missing: Vec<usize> = want.iter().copied().filter(|p| !cache.contains_key(p)).collect();
+        for (pos, d) in missing.iter().zip(trace.decode_positions(&missing)) {
+            cache.insert(*pos, d.label);
+        }
+        cache.retain(|p, _| want.binary_search(p).is_ok());
+        cache.clone()
+    }
+}
+
+/// The data bytes in hex, 23 columns wide; bytes that changed are yellow and bold.
+fn data_spans(prev: Option<&[u8]>, cur: &[u8]) -> Vec<Span<'static>> {
+    let hot = Style::default().fg(Color::Yellow).add_modifier(Modifier::BOLD);
+    let shown = &cur[..cur.len().min(8)];
+    let mut spans = Vec::new();
+    for (i, (b, c)) in shown.iter().zip(changed(prev, shown)).enumerate() {
+        if i > 0 {
+            spans.push(Span::raw(" "));
+        }
+        let text = format!("{b:02X}");
+        spans.push(if c { Span::styled(text, hot) } else { Span::raw(text) });
+    }
+    // 23 columns of data, then two spaces before the label.
+    let mut pad = 25 - (shown.len() * 3).saturating_sub(1);
+    if cur.len() > 8 {
+        spans.push(Span::raw("…"));
+        pad = pad.saturating_sub(1);
+    }
+    spans.push(Span::raw(" ".repeat(pad)));
+    spans
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::store::Store;
+    use crate::decode::Kind;
+    use crate::frame::Frame;
+
+    #[test]
+    fn changed_bytes_are_those_that_differ_from_the_previous_frame() {
+        assert_eq!(changed(Some(&[1, 2, 3]), &[1, 9, 3, 4]), [false, true, false, true]);
+        assert_eq!(changed(None, &[1, 2]), [true, true]);
+        assert_eq!(changed(Some(&[1, 2]), &[]), Vec::<bool>::new());
+    }
+
+    #[test]
+    fn each_sort_orders_the_rows_as_named() {
+        let mut store = Store::new();
+        let mut st = Stats::new(500_000);
+        // 0x181 every 10 ms (5 frames), 0x701 every 100 ms (2), 0x080 once, last.
+        let mut push = |id: u32, ms: u64| {
+            let mut f = Frame::classic(id, &[0]);
+            f.ts_ns = ms * 1_000_000;
+            let at = store.push(&f, Kind::Other, None);
+            st.add(&store.packed(at).clone(), &store);
+        };
+        for (id, ms) in [(0x701, 0), (0x181, 0), (0x181, 10), (0x181, 20), (0x181, 30)] {
+            push(id, ms);
+        }
+        push(0x181, 40);
+        push(0x701, 100);
+        push(0x080, 120);
+        let ids = |s: Sort| -> Vec<u32> { sorted(&st, s).iter().map(|((_, id), _)| *id).collect() };
+        assert_eq!(ids(Sort::Id), [0x080, 0x181, 0x701]);
+        assert_eq!(ids(Sort::Count), [0x181, 0x701, 0x080]);
+        assert_eq!(ids(Sort::Period), [0x181, 0x701, 0x080]);
+        assert_eq!(ids(Sort::Last), [0x080, 0x701, 0x181]);
+        assert_eq!(Sort::Last.next(), Sort::Id);
     }
 }

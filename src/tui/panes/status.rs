@@ -34,7 +34,8 @@ pub fn text(app: &App) -> String {
             } else {
                 speed.to_string()
             };
-            format!("replay {}{} ×{x}", app.source.name, replay_position(app))
+            let looping = if app.source.looping { " loop" } else { "" };
+            format!("replay {}{} ×{x}{looping}", app.source.name, replay_position(app))
         }
         SourceKind::Live { listen_only } => {
             format!(
