@@ -190,6 +190,24 @@ pub fn plan(
             }
             (text, None)
         }
+        Command::PdoRead { node, .. } => (
+            format!(
+                "{} then the other PDO records of node {node} (0x1400-0x1BFF, until one is missing)",
+                candump(&sdo::first_upload_frame(*node, 0x1400, 0, false))
+            ),
+            None,
+        ),
+        Command::PdoMap(spec) => {
+            let dict = bindings.dictionary(spec.node);
+            let writes = crate::command::pdo::plan(dict, spec, crate::command::pdo::assumed_cob(dict, spec))?;
+            let frames: Vec<Frame> = writes.iter().map(|w| w.frame(spec.node)).collect();
+            let read = candump(&sdo::first_upload_frame(spec.node, spec.pdo.comm_index(), 1, false));
+            if spec.dry_run {
+                (format!("nothing (dry run of {read}, {})", listed(&frames)), None)
+            } else {
+                (format!("{read} (COB-ID), {} then reads back", listed(&frames)), None)
+            }
+        }
         Command::Record { .. } => {
             return Err(CommandError::Usage(
                 "record runs from the command line (`cotui record IFACE -o FILE`)".into(),

@@ -9,6 +9,7 @@ mod cli_run;
 mod command_language;
 mod commander_demo;
 mod lss_sim;
+mod pdo_config;
 mod procedure_run;
 mod sdo_client_misbehave;
 mod sdo_client_server;
