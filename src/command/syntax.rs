@@ -1152,6 +1152,50 @@ mod tests {
     }
 
     #[test]
+    fn pdo_lines() {
+        assert_eq!(
+            parse_command("pdo 2 --timeout 300").unwrap(),
+            Command::PdoRead {
+                node: 2,
+                timeout_ms: 300
+            }
+        );
+        let Command::PdoMap(m) = parse_command(
+            "pdo 2 map TPDO3 Statusword 0x6064 --type sync:4 --event 100 --inhibit 2.5ms --cob-id 0x12345",
+        )
+        .unwrap() else {
+            panic!("not a map");
+        };
+        assert_eq!(m.pdo, PdoId { transmit: true, num: 3 });
+        assert_eq!(m.objects, ["Statusword", "0x6064"]);
+        assert_eq!(
+            (m.transmission, m.event_ms, m.inhibit_100us, m.cob_id),
+            (Some(4), Some(100), Some(25), Some(0x12345))
+        );
+        let kind = |t: &str| match parse_command(&format!("pdo 2 map rpdo1 0x6040 --type {t}")) {
+            Ok(Command::PdoMap(m)) => m.transmission,
+            _ => None,
+        };
+        assert_eq!(
+            ["acyclic", "sync", "rtr-sync", "rtr", "event-mfr", "event", "0xFE"].map(kind),
+            [0, 1, 252, 253, 254, 255, 254].map(Some)
+        );
+        let inhibit = |t: &str| match parse_command(&format!("pdo 2 map rpdo1 0x6040 --inhibit {t}")) {
+            Ok(Command::PdoMap(m)) => m.inhibit_100us,
+            _ => None,
+        };
+        assert_eq!(["25", "500us", "1ms", "0"].map(inhibit), [25, 5, 10, 0].map(Some));
+        let err = |line: &str| parse_command(line).unwrap_err().to_string();
+        assert!(err("pdo 2 map rpdo1 0x6040 --type sync:241").contains("not a transmission type"));
+        assert!(err("pdo 2 map rpdo1 0x6040 --inhibit 0.05ms").contains("multiples of 0.1 ms"));
+        assert!(err("pdo 2 map").contains("needs the PDO"));
+        assert!(err("pdo 2 map xpdo1 0x6040").contains("is not a PDO"));
+        assert!(err("pdo 2 send rpdo1 Controlword=1 --dry-run").contains("--dry-run does not go with `pdo send`"));
+        assert!(err("pdo 2 --event 5").contains("--event does not go with `pdo NODE`"));
+        assert!(completions("pdo 2 ").contains(&"map".to_string()));
+    }
+
+    #[test]
     fn completion_comes_from_the_declaration() {
         assert_eq!(
             commander_words(),

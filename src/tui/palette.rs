@@ -231,6 +231,30 @@ mod tests {
     }
 
     #[test]
+    fn pdo_previews_show_the_remapping_frames() {
+        let p = plan("pdo 5 map tpdo1 0x6041 --type sync:4", &b(), |_| None).unwrap();
+        assert_eq!(
+            p.preview,
+            "605#4000180100000000 (COB-ID), 605#2300180185010080, 605#2F001A0000000000, 605#23001A0110004160, \
+             605#2F001A0001000000, 605#2F00180204000000, 605#2300180185010000 then reads back"
+        );
+        let dry = plan("pdo 5 map tpdo1 0x6041 --dry-run", &b(), |_| None).unwrap();
+        assert!(
+            dry.preview.starts_with("nothing (dry run of 605#4000180100000000, "),
+            "{}",
+            dry.preview
+        );
+        let read = plan("pdo 5", &b(), |_| None).unwrap();
+        assert!(
+            read.preview.starts_with("605#4000140000000000 then"),
+            "{}",
+            read.preview
+        );
+        let err = plan("pdo 5 map tpdo1 0x6064 0x606C 0x6041", &b(), |_| None).unwrap_err();
+        assert!(err.to_string().contains("more than the 64 bits"), "{err}");
+    }
+
+    #[test]
     fn previews_show_exact_frames() {
         let p = plan("nmt start 3", &b(), |_| None).unwrap();
         assert_eq!((p.preview.as_str(), p.confirm), ("000#0103", None));
