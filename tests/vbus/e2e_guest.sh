@@ -818,7 +818,7 @@ kill $cycdump 2> /dev/null
 # tpdo1` is refused while the peer is operational (it changes mappings only outside
 # OPERATIONAL; the failure says why), done in pre-operational, read back; candump -L records
 # meanwhile and `cotui decode` of that log shows TPDO1 with the new signals. TPDO1 is
-# restored (statusword, type 255) at the end.
+# restored (statusword, type 255) at the end. The peer sends TPDO1 on entering OPERATIONAL.
 c nmt vcan0 start 2 --wait --timeout 3000
 c pdo vcan0 2 --json
 tp=$(echo "$out" | j '.pdos[] | select(.pdo == "tpdo1") | "\(.cob_id.id) \(.cob_id.valid) \(.transmission_type) \([.mapping[] | "\(.index):\(.bits)"] | join(","))"')
@@ -840,8 +840,7 @@ c pdo vcan0 2 map tpdo1 Statusword 0x6061 0x603F --type event-mfr --json
     ok "pdo map: TPDO1 remapped in pre-operational (statusword, mode display, error code; type 254), read back" ||
     bad "pdo map: rc=$rc $out $err"
 c nmt vcan0 start 2 --wait --timeout 3000
-c sdo write vcan0 2 0x6040 6
-sleep 0.5
+sleep 0.3
 kill $pdodump 2> /dev/null
 wait $pdodump 2> /dev/null
 c decode pdo13.log --format jsonl
