@@ -11,6 +11,7 @@ pub mod filter;
 pub mod incident;
 pub mod liveness;
 pub mod nodes;
+pub mod pdos;
 pub mod search;
 pub mod series;
 pub mod stats;

@@ -44,6 +44,14 @@ pub fn run_commander(c: &CliCommander) -> ExitCode {
     };
     match cmd {
         Command::Run(spec) => super::run::run_run(bus, &dict, &spec),
+        // A dry run needs no bus (not even an interface that exists).
+        Command::PdoMap(spec) if spec.dry_run => {
+            let result = super::bind::bindings_on(&bus.iface, &dict.profiles, &dict.eds)
+                .map_err(CommandError::from)
+                .and_then(|b| crate::command::pdo::dry_run(b.dictionary(spec.node), &spec))
+                .map(|(json, text)| Outcome { json, text });
+            report(bus, what(c), result)
+        }
         Command::Record {
             output,
             limits,
@@ -87,7 +95,7 @@ fn what(c: &CliCommander) -> &'static str {
         Commander::Lss(_) => "lss",
         Commander::Send(_) => "send",
         Commander::Sync(_) => "sync",
-        Commander::Pdo(_) => "pdo send",
+        Commander::Pdo(_) => "pdo",
     }
 }
 

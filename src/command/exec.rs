@@ -133,6 +133,20 @@ pub async fn execute_until(
             })
         }
         Command::Lss { action, timeout_ms } => to_json(&super::lss::lss(bus, *action, *timeout_ms).await?),
+        Command::PdoRead { node, timeout_ms } => {
+            let pdos = super::pdo::read_all(bus, *node, *timeout_ms).await?;
+            let (json, text) = super::pdo::read_report(*node, bindings.dictionary(*node), &pdos);
+            return Ok(Outcome { json, text });
+        }
+        Command::PdoMap(spec) => {
+            let dict = bindings.dictionary(spec.node);
+            let (json, text) = if spec.dry_run {
+                super::pdo::dry_run(dict, spec)?
+            } else {
+                super::pdo::map(bus, dict, spec).await?
+            };
+            return Ok(Outcome { json, text });
+        }
         Command::Record {
             output,
             limits,
@@ -348,6 +362,8 @@ pub fn text(cmd: &Command, v: &Json) -> String {
         Command::Stop { .. } => String::new(),
         // A cyclic command's text comes from its report (see `cyclic::Report::text`).
         Command::Send { .. } | Command::Sync { .. } | Command::Pdo { .. } => String::new(),
+        // `pdo` reads and maps return their own text (see `pdo::read_report`, `pdo::map`).
+        Command::PdoRead { .. } | Command::PdoMap(_) => String::new(),
     }
 }
 

@@ -258,6 +258,11 @@ pub enum Command {
         assignments: Vec<(String, String)>,
         schedule: super::cyclic::Schedule,
     },
+    /// `pdo NODE [--timeout MS]`: reads every PDO's communication and mapping parameters.
+    PdoRead { node: u8, timeout_ms: u64 },
+    /// `pdo NODE map PDO OBJECT... [--type T] [--event MS] [--inhibit T] [--cob-id ID]
+    /// [--dry-run] [--force] [--timeout MS]`: the CiA 301 remapping sequence.
+    PdoMap(super::pdo::MapSpec),
 }
 
 /// What `run` runs: a procedure of a node with its parameters, or (no procedure) the list.

@@ -9,6 +9,7 @@ pub mod exec;
 pub mod grammar;
 pub mod lss;
 pub mod nmt;
+pub mod pdo;
 pub mod record;
 pub mod run;
 pub mod scan;

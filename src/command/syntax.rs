@@ -13,8 +13,10 @@ use super::grammar::{
     parse_int, parse_node, parse_type, run_spec,
 };
 use super::lss::{FASTSCAN_TIMEOUT_MS, LSS_TIMEOUT_MS, LSS_WORDS, LssAction, LssFlags};
+use super::pdo::MapSpec;
 use super::record::{Limits, LogFormat, WriteMode};
 use super::stop::{DEFAULT_LISTEN_MS, DEFAULT_RAMP_MS, StopOptions};
+use crate::decode::pdo_config::PdoId;
 use crate::frame::Frame;
 use crate::od::DataType;
 use clap::builder::{PossibleValue, TypedValueParser};
@@ -119,8 +121,9 @@ pub enum Commander<B: Args, D: Args> {
     /// Produce SYNC every --period MS (COB-ID 0x080), with the CiA 301 counter 1..N when
     /// --counter N is given; until stopped without --count.
     Sync(On<B, SyncArgs>),
-    /// Send an RPDO encoded through the node's mapping: `pdo 2 send rpdo1 Controlword=0x0F
-    /// "Target velocity=500" --every 10` (mapped signals not given are sent as 0).
+    /// PDOs: `pdo 2` reads every PDO's configuration; `pdo 2 map tpdo1 0x6041 0x6064 --type
+    /// sync:2` remaps one (CiA 301 sequence, read back); `pdo 2 send rpdo1 Controlword=0x0F
+    /// "Target velocity=500" --every 10` sends an RPDO (mapped signals not given are sent as 0).
     Pdo(On<B, PdoArgs<D>>),
 }
 
@@ -402,25 +405,114 @@ pub struct SyncArgs {
     pub cob_id: u32,
 }
 
-/// `pdo NODE send rpdoK NAME=VALUE ... [--every MS] [--count N]`.
+/// `pdo NODE` (read every PDO), `pdo NODE send rpdoK NAME=VALUE ... [--every MS] [--count N]`,
+/// `pdo NODE map PDO OBJECT... [--type T] [--event MS] [--inhibit T] [--cob-id ID] [--dry-run]`.
 #[derive(Args, Clone, Debug)]
 pub struct PdoArgs<D: Args> {
     /// Node id 1..127 (decimal or 0x hex).
     #[arg(value_parser = node_arg)]
     pub node: u8,
-    /// send.
-    #[arg(value_parser = Words::new(&["send"], pdo_word))]
-    pub action: String,
-    /// The PDO: rpdo1, rpdo2, ...
-    #[arg(value_parser = rpdo_arg)]
-    pub pdo: u16,
-    /// The signals as NAME=VALUE (object name, alias or index:sub).
+    /// send (an RPDO) or map (remap a PDO); none: read every PDO's configuration.
+    #[arg(value_parser = Words::new(&["send", "map"], pdo_word))]
+    pub action: Option<String>,
+    /// The PDO: rpdo1, rpdo2, ... (send), tpdo1, rpdo1, ... (map).
+    #[arg(value_parser = pdo_arg)]
+    pub pdo: Option<PdoId>,
+    /// send: the signals as NAME=VALUE; map: the objects to map, in order (object name,
+    /// alias or index:sub; OBJECT/BITS for one the dictionary does not size).
     #[arg(allow_negative_numbers = true)]
     pub signals: Vec<String>,
     #[command(flatten)]
     pub repeat: Repeat,
+    /// map: the transmission type: acyclic (0), sync (1), sync:N (every N SYNCs), rtr-sync
+    /// (252), rtr (253), event-mfr (254), event (255), or a number.
+    #[arg(long = "type", value_parser = transmission_arg)]
+    pub transmission: Option<u8>,
+    /// map: the event timer in ms (0 = off).
+    #[arg(long, value_parser = u16_arg)]
+    pub event: Option<u16>,
+    /// map: the inhibit time, in 100 us units (`25` = 2.5 ms), or with a unit: `2.5ms`, `500us`.
+    #[arg(long, value_parser = inhibit_arg)]
+    pub inhibit: Option<u16>,
+    /// map: the COB-ID the PDO gets (29-bit above 0x7FF) [default: the PDO's own].
+    #[arg(long, value_parser = pdo_cob_arg)]
+    pub cob_id: Option<u32>,
+    /// map: print the frames without sending anything.
+    #[arg(long)]
+    pub dry_run: bool,
+    /// map: map objects the node's dictionary says are not mappable.
+    #[arg(long)]
+    pub force: bool,
+    /// read, map: how long to wait for each SDO answer, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
+    pub timeout: u64,
     #[command(flatten)]
     pub dict: D,
+}
+
+impl<D: Args> PdoArgs<D> {
+    fn command(&self) -> Result<Command, ParseError> {
+        let map_flags = [
+            ("--type", self.transmission.is_some()),
+            ("--event", self.event.is_some()),
+            ("--inhibit", self.inhibit.is_some()),
+            ("--cob-id", self.cob_id.is_some()),
+            ("--dry-run", self.dry_run),
+            ("--force", self.force),
+        ];
+        let send_flags = [
+            ("--every", self.repeat.every.is_some()),
+            ("--count", self.repeat.count.is_some()),
+        ];
+        let refuse = |flags: &[(&str, bool)], action: &str| match flags.iter().find(|(_, on)| *on) {
+            Some((flag, _)) => Err(ParseError::Invalid(format!("{flag} does not go with `pdo {action}`"))),
+            None => Ok(()),
+        };
+        match (self.action.as_deref(), self.pdo) {
+            (None, _) => {
+                refuse(&map_flags, "NODE")?;
+                refuse(&send_flags, "NODE")?;
+                Ok(Command::PdoRead {
+                    node: self.node,
+                    timeout_ms: self.timeout,
+                })
+            }
+            (Some(action), None) => Err(ParseError::Invalid(format!(
+                "`pdo NODE {action}` needs the PDO (rpdo1, tpdo1, ...)"
+            ))),
+            (Some("send"), Some(pdo)) => {
+                refuse(&map_flags, "send")?;
+                if pdo.transmit {
+                    return Err(ParseError::Invalid(format!(
+                        "`{}` is not an RPDO: use rpdo1, rpdo2, ... (TPDOs are the node's to send)",
+                        pdo.name()
+                    )));
+                }
+                let words: Vec<&str> = self.signals.iter().map(String::as_str).collect();
+                Ok(Command::Pdo {
+                    node: self.node,
+                    num: pdo.num,
+                    assignments: parse_assignments(&words)?,
+                    schedule: self.repeat.schedule(),
+                })
+            }
+            (Some(_), Some(pdo)) => {
+                refuse(&send_flags, "map")?;
+                Ok(Command::PdoMap(MapSpec {
+                    node: self.node,
+                    pdo,
+                    objects: self.signals.clone(),
+                    transmission: self.transmission,
+                    event_ms: self.event,
+                    inhibit_100us: self.inhibit,
+                    cob_id: self.cob_id,
+                    dry_run: self.dry_run,
+                    force: self.force,
+                    timeout_ms: self.timeout,
+                }))
+            }
+        }
+    }
 }
 
 impl<B: Args, D: Args> Commander<B, D> {
@@ -526,15 +618,7 @@ impl<B: Args, D: Args> Commander<B, D> {
                     count: a.count,
                 },
             },
-            Commander::Pdo(On { args: a, .. }) => {
-                let words: Vec<&str> = a.signals.iter().map(String::as_str).collect();
-                Command::Pdo {
-                    node: a.node,
-                    num: a.pdo,
-                    assignments: parse_assignments(&words)?,
-                    schedule: a.repeat.schedule(),
-                }
-            }
+            Commander::Pdo(On { args: a, .. }) => a.command()?,
         })
     }
 }
@@ -761,12 +845,88 @@ fn frame_arg(text: &str) -> Result<Frame, ParseError> {
     }
 }
 
-/// The `pdo` action word: `send` (an RPDO; TPDOs are the nodes' to send).
+/// The `pdo` action word: `send` (an RPDO; TPDOs are the nodes' to send) or `map`.
 fn pdo_word(word: &str) -> Result<String, ParseError> {
     match word {
-        "send" => Ok(word.to_string()),
-        _ => Err(ParseError::Invalid(format!("unknown pdo command `{word}`: use send"))),
+        "send" | "map" => Ok(word.to_string()),
+        _ => Err(ParseError::Invalid(format!(
+            "unknown pdo command `{word}`: use send or map (or nothing, to read the PDOs)"
+        ))),
     }
+}
+
+/// Parses `rpdo1`..`rpdo512`, `tpdo1`..`tpdo512`.
+fn pdo_arg(text: &str) -> Result<PdoId, ParseError> {
+    let lower = text.to_ascii_lowercase();
+    let (transmit, n) = match (lower.strip_prefix("rpdo"), lower.strip_prefix("tpdo")) {
+        (Some(n), _) => (false, n),
+        (_, Some(n)) => (true, n),
+        _ => (false, ""),
+    };
+    n.parse::<u16>()
+        .ok()
+        .filter(|n| (1..=512).contains(n))
+        .map(|num| PdoId { transmit, num })
+        .ok_or_else(|| ParseError::Invalid(format!("`{text}` is not a PDO: use rpdo1, tpdo1, ... (1..512)")))
+}
+
+/// Parses a transmission type: a number 0..255 or its word.
+fn transmission_arg(text: &str) -> Result<u8, ParseError> {
+    let t = text.to_ascii_lowercase();
+    let bad = || {
+        ParseError::Invalid(format!(
+            "`{text}` is not a transmission type: use acyclic, sync, sync:N (1..240), rtr-sync, rtr, event-mfr, \
+             event or a number 0..255"
+        ))
+    };
+    Ok(match t.as_str() {
+        "acyclic" => 0,
+        "sync" => 1,
+        "rtr-sync" => 252,
+        "rtr" => 253,
+        "event-mfr" => 254,
+        "event" => 255,
+        _ => match t.strip_prefix("sync:") {
+            Some(n) => parse_int(n).filter(|n| (1..=240).contains(n)).ok_or_else(bad)? as u8,
+            None => parse_int(&t).filter(|n| (0..=255).contains(n)).ok_or_else(bad)? as u8,
+        },
+    })
+}
+
+/// Parses a 16-bit number (ms of an event timer).
+fn u16_arg(text: &str) -> Result<u16, ParseError> {
+    parse_int(text)
+        .filter(|v| (0..=0xFFFF).contains(v))
+        .map(|v| v as u16)
+        .ok_or_else(|| ParseError::Invalid(format!("`{text}` must be a number 0..65535")))
+}
+
+/// Parses an inhibit time: 100 us units, or `2.5ms` / `500us`.
+fn inhibit_arg(text: &str) -> Result<u16, ParseError> {
+    let t = text.trim().to_ascii_lowercase();
+    let units = if let Some(ms) = t.strip_suffix("ms") {
+        ms.trim().parse::<f64>().ok().map(|v| v * 10.0)
+    } else if let Some(us) = t.strip_suffix("us") {
+        us.trim().parse::<f64>().ok().map(|v| v / 100.0)
+    } else {
+        parse_int(&t).map(|v| v as f64)
+    };
+    units
+        .filter(|u| (0.0..=65535.0).contains(u) && u.fract() == 0.0)
+        .map(|u| u as u16)
+        .ok_or_else(|| {
+            ParseError::Invalid(format!(
+                "`{text}`: the inhibit time is 0..65535 units of 100 us (`25`), or `2.5ms`, `500us` (multiples of 0.1 ms)"
+            ))
+        })
+}
+
+/// Parses a PDO COB-ID: 11-bit, or 29-bit above 0x7FF.
+fn pdo_cob_arg(text: &str) -> Result<u32, ParseError> {
+    parse_int(text)
+        .filter(|v| (1..=0x1FFF_FFFF).contains(v))
+        .map(|v| v as u32)
+        .ok_or_else(|| ParseError::Invalid(format!("`{text}` must be a COB-ID 0x001..0x1FFFFFFF")))
 }
 
 /// Parses the SYNC counter's overflow value 2..=240.
@@ -783,15 +943,6 @@ fn cob_arg(text: &str) -> Result<u32, ParseError> {
         .filter(|v| (1..=0x7FF).contains(v))
         .map(|v| v as u32)
         .ok_or_else(|| ParseError::Invalid(format!("`{text}` must be an 11-bit COB-ID 0x001..0x7FF")))
-}
-
-/// Parses `rpdo1`..`rpdo512`.
-fn rpdo_arg(text: &str) -> Result<u16, ParseError> {
-    text.to_ascii_lowercase()
-        .strip_prefix("rpdo")
-        .and_then(|n| n.parse::<u16>().ok())
-        .filter(|n| (1..=512).contains(n))
-        .ok_or_else(|| ParseError::Invalid(format!("`{text}` is not an RPDO: use rpdo1, rpdo2, ...")))
 }
 
 /// Parses a positive count.
@@ -1028,8 +1179,52 @@ mod tests {
             err("send 601#4G")
         );
         assert!(err("pdo 2 send tpdo1").contains("use rpdo1"));
-        assert!(err("pdo 2 read rpdo1").contains("use send"));
+        assert!(err("pdo 2 read rpdo1").contains("use send or map"));
         assert!(err("sync").contains("--period"));
+    }
+
+    #[test]
+    fn pdo_lines() {
+        assert_eq!(
+            parse_command("pdo 2 --timeout 300").unwrap(),
+            Command::PdoRead {
+                node: 2,
+                timeout_ms: 300
+            }
+        );
+        let Command::PdoMap(m) = parse_command(
+            "pdo 2 map TPDO3 Statusword 0x6064 --type sync:4 --event 100 --inhibit 2.5ms --cob-id 0x12345",
+        )
+        .unwrap() else {
+            panic!("not a map");
+        };
+        assert_eq!(m.pdo, PdoId { transmit: true, num: 3 });
+        assert_eq!(m.objects, ["Statusword", "0x6064"]);
+        assert_eq!(
+            (m.transmission, m.event_ms, m.inhibit_100us, m.cob_id),
+            (Some(4), Some(100), Some(25), Some(0x12345))
+        );
+        let kind = |t: &str| match parse_command(&format!("pdo 2 map rpdo1 0x6040 --type {t}")) {
+            Ok(Command::PdoMap(m)) => m.transmission,
+            _ => None,
+        };
+        assert_eq!(
+            ["acyclic", "sync", "rtr-sync", "rtr", "event-mfr", "event", "0xFE"].map(kind),
+            [0, 1, 252, 253, 254, 255, 254].map(Some)
+        );
+        let inhibit = |t: &str| match parse_command(&format!("pdo 2 map rpdo1 0x6040 --inhibit {t}")) {
+            Ok(Command::PdoMap(m)) => m.inhibit_100us,
+            _ => None,
+        };
+        assert_eq!(["25", "500us", "1ms", "0"].map(inhibit), [25, 5, 10, 0].map(Some));
+        let err = |line: &str| parse_command(line).unwrap_err().to_string();
+        assert!(err("pdo 2 map rpdo1 0x6040 --type sync:241").contains("not a transmission type"));
+        assert!(err("pdo 2 map rpdo1 0x6040 --inhibit 0.05ms").contains("multiples of 0.1 ms"));
+        assert!(err("pdo 2 map").contains("needs the PDO"));
+        assert!(err("pdo 2 map xpdo1 0x6040").contains("is not a PDO"));
+        assert!(err("pdo 2 send rpdo1 Controlword=1 --dry-run").contains("--dry-run does not go with `pdo send`"));
+        assert!(err("pdo 2 --event 5").contains("--event does not go with `pdo NODE`"));
+        assert!(completions_of("pdo 2 ").contains(&"map".to_string()));
     }
 
     #[test]

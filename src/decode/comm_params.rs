@@ -31,7 +31,12 @@ pub fn cob_id(raw: u32, bit30: &str) -> String {
 
 /// PDO transmission type text (sub 2 of 0x1400/0x1800 records).
 pub fn transmission_type(t: u32) -> String {
-    let what = match t {
+    format!("{t} ({})", transmission_words(t))
+}
+
+/// A PDO transmission type in words: `synchronous, every 5 SYNCs`, `event-driven (device profile)`.
+pub fn transmission_words(t: u32) -> String {
+    match t {
         0 => "synchronous, acyclic".to_string(),
         1 => "synchronous, every SYNC".to_string(),
         2..=240 => format!("synchronous, every {t} SYNCs"),
@@ -40,8 +45,7 @@ pub fn transmission_type(t: u32) -> String {
         253 => "RTR-only, event-driven".to_string(),
         254 => "event-driven (manufacturer-specific)".to_string(),
         _ => "event-driven (device profile)".to_string(),
-    };
-    format!("{t} ({what})")
+    }
 }
 
 /// A PDO mapping entry: `0x60410010 (0x6041:00 Statusword, 16 bits)`.

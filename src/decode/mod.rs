@@ -73,6 +73,7 @@ pub mod heartbeat;
 pub mod lss;
 pub mod nmt;
 pub mod pdo;
+pub mod pdo_config;
 pub mod registry;
 pub mod sdo;
 pub mod sync;

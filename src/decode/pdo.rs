@@ -93,12 +93,15 @@ pub struct SignalJson<'a> {
     pub value: &'a Value,
 }
 
-/// Short text of a mapping source: `profile syntron-ds`, `eds drive.eds`, `sniffed @ 12.345678 s`.
+/// Short text of a mapping source: `profile syntron-ds`, `eds drive.eds`, `sniffed @ 12.345678 s`
+/// (learned from another client's writes), `configured by cotui @ ...`, `read from node @ ...`.
 pub fn source_text(source: &MappingSource) -> String {
     match source {
         MappingSource::Profile(p) => format!("profile {p}"),
         MappingSource::Eds(f) => format!("eds {f}"),
         MappingSource::Sniffed { ts_ns } => format!("sniffed @ {:.6} s", *ts_ns as f64 / 1e9),
+        MappingSource::Configured { ts_ns } => format!("configured by cotui @ {:.6} s", *ts_ns as f64 / 1e9),
+        MappingSource::ReadFromNode { ts_ns } => format!("read from node @ {:.6} s", *ts_ns as f64 / 1e9),
     }
 }
 

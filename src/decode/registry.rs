@@ -5,11 +5,12 @@
 use super::cob_id::{CobId, CobTable, Route};
 use super::heartbeat::Heartbeat;
 use super::pdo::{self, Pdo};
+use super::pdo_config::{CommParams, PdoId};
 use super::sdo::{SdoFrame, SdoTracker};
 use super::{Kind, emcy, error_frame, heartbeat, lss, nmt, sync, time, value_text, vendor_sdo};
 use crate::frame::Frame;
 use crate::od::{Dictionary, MappingSource, PdoMapping, resolve_object};
-use crate::sdo::Transaction;
+use crate::sdo::{Transaction, TransferDirection};
 use std::collections::HashMap;
 
 /// The decoded meaning of one frame.
@@ -66,6 +67,11 @@ pub struct Decoder {
     cobs: CobTable,
     mappings: HashMap<PdoKey, PdoMapping>,
     learning: HashMap<PdoKey, LearnedMapping>,
+    /// PDO communication parameters seen in SDO transfers (reads and writes).
+    comm: HashMap<PdoKey, CommParams>,
+    /// Per node: the last SDO request to it was ours (marked TX), so a mapping it writes
+    /// is "configured", not "sniffed".
+    ours: [bool; 128],
     /// Mode of operation per node, from 0x6060/0x6061 traffic.
     modes: [Option<i8>; 128],
     sdo: SdoTracker,
@@ -86,6 +92,8 @@ impl Decoder {
             cobs: CobTable::default(),
             mappings: HashMap::new(),
             learning: HashMap::new(),
+            comm: HashMap::new(),
+            ours: [false; 128],
             modes: [None; 128],
             sdo: SdoTracker::new(),
             sdo_cobs: HashMap::new(),
@@ -295,6 +303,9 @@ impl Decoder {
     fn track_sdo(&mut self, frame: &Frame, route: Route) -> SdoFrame {
         let n = route.node.unwrap_or(0);
         let c2s = route.kind == Kind::SdoRx;
+        if c2s {
+            self.ours[n as usize & 0x7F] = frame.direction() == crate::frame::Direction::Tx;
+        }
         let s = self
             .sdo
             .on_frame(self.seq, frame.ts_ns, n, c2s, frame.payload(), &self.dicts[n as usize]);
@@ -380,12 +391,61 @@ impl Decoder {
                 let key = (v & 0x1FFF_FFFF) | if v & (1 << 29) != 0 { 1 << 29 } else { 0 };
                 self.sdo_cobs.insert(key, (node, t.sub == 1));
             }
-            (0x1400..=0x15FF, 1) => self.pdo_cob(node, false, t.index - 0x1400 + 1, v),
-            (0x1800..=0x19FF, 1) => self.pdo_cob(node, true, t.index - 0x1800 + 1, v),
-            (0x1600..=0x17FF, sub) => self.learn_mapping((node, false, t.index - 0x1600 + 1), sub, v, t.end_ns),
-            (0x1A00..=0x1BFF, sub) => self.learn_mapping((node, true, t.index - 0x1A00 + 1), sub, v, t.end_ns),
+            (0x1400..=0x15FF | 0x1800..=0x19FF, sub) => {
+                let transmit = t.index >= 0x1800;
+                let num = t.index - if transmit { 0x1800 } else { 0x1400 } + 1;
+                let key = (node, transmit, num);
+                let mut c = self.comm.get(&key).copied().unwrap_or_default();
+                if c.set(sub, v) {
+                    self.comm.insert(key, c);
+                }
+                if sub == 1 {
+                    self.pdo_cob(node, transmit, num, v);
+                }
+            }
+            (0x1600..=0x17FF | 0x1A00..=0x1BFF, sub) => {
+                let transmit = t.index >= 0x1A00;
+                let num = t.index - if transmit { 0x1A00 } else { 0x1600 } + 1;
+                let ts_ns = t.end_ns;
+                let source = match t.direction {
+                    TransferDirection::Upload => MappingSource::ReadFromNode { ts_ns },
+                    _ if self.ours[node as usize & 0x7F] => MappingSource::Configured { ts_ns },
+                    _ => MappingSource::Sniffed { ts_ns },
+                };
+                self.learn_mapping((node, transmit, num), sub, v, source);
+            }
             _ => {}
         }
+    }
+
+    /// The communication parameters of a PDO seen in SDO transfers (else the COB-ID of
+    /// its mapping in force, when that names one).
+    pub fn pdo_comm(&self, node: u8, transmit: bool, num: u16) -> Option<CommParams> {
+        let seen = self.comm.get(&(node, transmit, num)).copied();
+        let cob = self.mappings.get(&(node, transmit, num)).and_then(|m| m.cob_id);
+        match (seen, cob) {
+            (Some(mut c), Some(cob)) => {
+                c.cob_id = c.cob_id.or(Some(cob));
+                Some(c)
+            }
+            (Some(c), None) => Some(c),
+            (None, cob @ Some(_)) => Some(CommParams {
+                cob_id: cob,
+                ..CommParams::default()
+            }),
+            (None, None) => None,
+        }
+    }
+
+    /// Every PDO the decoder knows something about (a mapping or communication
+    /// parameters), in order of node, RPDO before TPDO, number.
+    pub fn known_pdos(&self) -> Vec<(u8, PdoId)> {
+        let mut keys: Vec<PdoKey> = self.mappings.keys().chain(self.comm.keys()).copied().collect();
+        keys.sort_unstable();
+        keys.dedup();
+        keys.into_iter()
+            .map(|(node, transmit, num)| (node, PdoId { transmit, num }))
+            .collect()
     }
 
     /// Switches `node` to the profile's PDO mapping set that (index, sub) = `value`
@@ -449,7 +509,7 @@ impl Decoder {
         }
     }
 
-    fn learn_mapping(&mut self, key: PdoKey, sub: u8, v: u32, ts_ns: u64) {
+    fn learn_mapping(&mut self, key: PdoKey, sub: u8, v: u32, source: MappingSource) {
         let l = self.learning.entry(key).or_default();
         if sub == 0 {
             l.count = Some(v as u8);
@@ -471,11 +531,16 @@ impl Decoder {
             .map(|i| l.entries.get(i).copied().flatten())
             .collect();
         if let Some(entries) = entries {
+            let entries: Vec<_> = entries.into_iter().map(pdo::entry_from_u32).collect();
+            // The same mapping seen again (read back after a write) keeps where it came from.
+            if self.mappings.get(&key).is_some_and(|m| m.entries == entries) {
+                return;
+            }
             let cob_id = self.mappings.get(&key).and_then(|m| m.cob_id);
             let mapping = PdoMapping {
                 cob_id,
-                entries: entries.into_iter().map(pdo::entry_from_u32).collect(),
-                source: MappingSource::Sniffed { ts_ns },
+                entries,
+                source,
             };
             self.mappings.insert(key, mapping);
         }

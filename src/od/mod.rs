@@ -142,8 +142,12 @@ pub enum MappingSource {
     Profile(String),
     /// An EDS/DCF file.
     Eds(String),
-    /// Learned from SDO traffic on the bus, at this timestamp (ns).
+    /// Learned from SDO writes on the bus by another client, at this timestamp (ns).
     Sniffed { ts_ns: u64 },
+    /// Written by cotui itself (its SDO requests came back marked TX), at this timestamp (ns).
+    Configured { ts_ns: u64 },
+    /// Read from the node (an SDO upload of the mapping seen on the bus), at this timestamp (ns).
+    ReadFromNode { ts_ns: u64 },
 }
 
 /// One mapped object inside a PDO.

@@ -1170,6 +1170,7 @@ impl App {
             Action::PaneSdo => self.focus = Pane::Sdo,
             Action::PaneStats => self.focus = Pane::Stats,
             Action::PanePlot => self.focus = Pane::Plot,
+            Action::PanePdo => self.focus = Pane::Pdo,
             Action::Filter => {
                 let text = self.panes.trace.view.filter.source.clone();
                 self.prompt.open(PromptKind::Filter, &text);
@@ -1286,7 +1287,7 @@ impl App {
     /// visible trace window (`rows` rows), the tail strip and what the Detail pane shows.
     pub fn prepare(&mut self, height: usize, rows: usize, tail: &[usize]) {
         let (panes, ctx) = self.panes_mut();
-        for p in [Pane::Nodes, Pane::Stats, Pane::Sdo] {
+        for p in [Pane::Nodes, Pane::Stats, Pane::Sdo, Pane::Pdo] {
             panes.get_mut(p).fit(height, &ctx);
         }
         self.panes.trace.prepare(&self.trace, rows, tail);

@@ -190,6 +190,24 @@ pub fn plan(
             }
             (text, None)
         }
+        Command::PdoRead { node, .. } => (
+            format!(
+                "{} then the other PDO records of node {node} (0x1400-0x1BFF, until one is missing)",
+                candump(&sdo::first_upload_frame(*node, 0x1400, 0, false))
+            ),
+            None,
+        ),
+        Command::PdoMap(spec) => {
+            let dict = bindings.dictionary(spec.node);
+            let writes = crate::command::pdo::plan(dict, spec, crate::command::pdo::assumed_cob(dict, spec))?;
+            let frames: Vec<Frame> = writes.iter().map(|w| w.frame(spec.node)).collect();
+            let read = candump(&sdo::first_upload_frame(spec.node, spec.pdo.comm_index(), 1, false));
+            if spec.dry_run {
+                (format!("nothing (dry run of {read}, {})", listed(&frames)), None)
+            } else {
+                (format!("{read} (COB-ID), {} then reads back", listed(&frames)), None)
+            }
+        }
         Command::Record { .. } => {
             return Err(CommandError::Usage(
                 "record runs from the command line (`cotui record IFACE -o FILE`)".into(),
@@ -210,6 +228,30 @@ mod tests {
 
     fn b() -> Bindings {
         Bindings::new().unwrap()
+    }
+
+    #[test]
+    fn pdo_previews_show_the_remapping_frames() {
+        let p = plan("pdo 5 map tpdo1 0x6041 --type sync:4", &b(), |_| None).unwrap();
+        assert_eq!(
+            p.preview,
+            "605#4000180100000000 (COB-ID), 605#2300180185010080, 605#2F001A0000000000, 605#23001A0110004160, \
+             605#2F001A0001000000, 605#2F00180204000000, 605#2300180185010000 then reads back"
+        );
+        let dry = plan("pdo 5 map tpdo1 0x6041 --dry-run", &b(), |_| None).unwrap();
+        assert!(
+            dry.preview.starts_with("nothing (dry run of 605#4000180100000000, "),
+            "{}",
+            dry.preview
+        );
+        let read = plan("pdo 5", &b(), |_| None).unwrap();
+        assert!(
+            read.preview.starts_with("605#4000140000000000 then"),
+            "{}",
+            read.preview
+        );
+        let err = plan("pdo 5 map tpdo1 0x6064 0x606C 0x6041", &b(), |_| None).unwrap_err();
+        assert!(err.to_string().contains("more than the 64 bits"), "{err}");
     }
 
     #[test]

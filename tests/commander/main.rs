@@ -10,6 +10,7 @@ mod command_language;
 mod commander_demo;
 mod every_procedure;
 mod lss_sim;
+mod pdo_config;
 mod procedure_run;
 mod sdo_client_misbehave;
 mod sdo_client_server;

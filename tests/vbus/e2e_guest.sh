@@ -847,6 +847,47 @@ done < vendor.out
 grep -qE "^(ok|FAIL) " vendor.out || bad "sim_master.py vendor printed no checks: $(cat vendor.out)"
 kill -TERM $dsim; wait $dsim
 
+# ---- 14 pdo: read, remap and decode the drive402 peer's TPDO1 -------------------------------
+# `cotui pdo vcan0 2` reads the peer's PDO parameters (python canopen LocalNode); `pdo ... map
+# tpdo1` is refused while the peer is operational (it changes mappings only outside
+# OPERATIONAL; the failure says why), done in pre-operational, read back; candump -L records
+# meanwhile and `cotui decode` of that log shows TPDO1 with the new signals. TPDO1 is
+# restored (statusword, type 255) at the end. The peer sends TPDO1 on entering OPERATIONAL.
+c nmt vcan0 start 2 --wait --timeout 3000
+c pdo vcan0 2 --json
+tp=$(echo "$out" | j '.pdos[] | select(.pdo == "tpdo1") | "\(.cob_id.id) \(.cob_id.valid) \(.transmission_type) \([.mapping[] | "\(.index):\(.bits)"] | join(","))"')
+rp=$(echo "$out" | j '[.pdos[] | select(.exists)] | length')
+[ "$rc" = 0 ] && [ "$tp" = "386 true 255 24641:16" ] && [ "$rp" = 1 ] &&
+    ok "pdo: reads the drive402 peer's PDOs (TPDO1 0x182 valid, type 255, statusword 16 bits; RPDO1-4 and TPDO2-4 absent)" ||
+    bad "pdo read: rc=$rc tpdo1='$tp' existing=$rp $out $err"
+candump -L vcan0 > pdo13.log 2> /dev/null &
+pdodump=$!
+wait_socket $pdodump || bad "pdo: candump opened no socket in 10 s"
+c pdo vcan0 2 map tpdo1 0x6041 0x6061 0x603F --json
+echo "$err" | grep -q "0x08000022" && echo "$err" | grep -q "node 2 is operational (its heartbeat says so)" &&
+    echo "$err" | grep -q "TPDO1 is left invalid" && [ "$rc" = 3 ] && [ "$(echo "$out" | j .failed_step)" = 2 ] &&
+    ok "pdo map: refused in OPERATIONAL (exit 3, step 2 0x1A00:00, abort 0x08000022, the heartbeat's state named)" ||
+    bad "pdo map in operational: rc=$rc $out $err"
+c nmt vcan0 preop 2 --wait --timeout 3000
+c pdo vcan0 2 map tpdo1 Statusword 0x6061 0x603F --type event-mfr --json
+[ "$rc" = 0 ] && [ "$(echo "$out" | j '"\(.verified) \(.comm.transmission_type) \(.comm.cob_id.id) \(.mapping | length)"')" = "true 254 386 3" ] &&
+    ok "pdo map: TPDO1 remapped in pre-operational (statusword, mode display, error code; type 254), read back" ||
+    bad "pdo map: rc=$rc $out $err"
+c nmt vcan0 start 2 --wait --timeout 3000
+sleep 0.3
+kill $pdodump 2> /dev/null
+wait $pdodump 2> /dev/null
+c decode pdo13.log --format jsonl
+last=$(echo "$out" | j 'select(.kind == "tpdo" and .node == 2) | "\(.len) \([.pdo.signals[].name] | join(",")) \(.pdo.mapping_source | split(" @")[0])"' | tail -1)
+[ "$last" = "5 Statusword,Modes of operation display,Error code sniffed" ] &&
+    ok "pdo: cotui decode of candump's log decodes TPDO1 through the new mapping ($last)" ||
+    bad "pdo decode: last TPDO1 '$last'; $(tail -5 pdo13.log)"
+c nmt vcan0 preop 2 --wait --timeout 3000
+c pdo vcan0 2 map tpdo1 0x6041 --type 255
+c2=$rc
+c nmt vcan0 start 2 --wait --timeout 3000
+[ "$c2" = 0 ] && ok "pdo: TPDO1 of the peer restored (statusword, type 255)" || bad "pdo restore: rc=$c2 $err"
+
 t_end=$(date +%s.%N)
 echo "$passed passed, $failed failed ($(awk -v a="$t_start" -v b="$t_end" 'BEGIN { printf "%.0f", b - a }') s in the guest)"
 [ "$failed" = 0 ]

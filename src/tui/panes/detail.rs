@@ -134,6 +134,12 @@ fn frame_lines(trace: &Trace, f: &Frame, d: &Decoded, pos: usize) -> Vec<Line<'s
                     "no mapping known (bind a profile or capture the SDO mapping writes)",
                 ));
             }
+            if let Some(source) = &p.source {
+                v.push(Line::raw(format!(
+                    "mapping: {}",
+                    crate::decode::pdo::source_text(source)
+                )));
+            }
             for s in &p.signals {
                 v.push(Line::raw(format!(
                     "0x{:04X}:{:02X} {} = {}",

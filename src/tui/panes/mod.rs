@@ -5,6 +5,7 @@ pub mod detail;
 pub mod help;
 pub mod messages;
 pub mod nodes;
+pub mod pdo;
 pub mod picker;
 pub mod plot;
 pub mod sdo;
@@ -28,11 +29,12 @@ pub enum Pane {
     Sdo,
     Stats,
     Plot,
+    Pdo,
 }
 
 impl Pane {
     /// Every pane in tab order.
-    pub const ALL: [Pane; 5] = [Pane::Trace, Pane::Nodes, Pane::Sdo, Pane::Stats, Pane::Plot];
+    pub const ALL: [Pane; 6] = [Pane::Trace, Pane::Nodes, Pane::Sdo, Pane::Stats, Pane::Plot, Pane::Pdo];
     /// Tab title.
     pub fn title(self) -> &'static str {
         match self {
@@ -41,6 +43,7 @@ impl Pane {
             Pane::Sdo => "SDO",
             Pane::Stats => "Stats",
             Pane::Plot => "Plot",
+            Pane::Pdo => "PDO",
         }
     }
 }
@@ -58,6 +61,8 @@ pub struct Panes {
     pub stats: stats::StatsPane,
     /// Numeric signals over one time axis.
     pub plot: plot::PlotPane,
+    /// One row per known PDO of each node.
+    pub pdo: pdo::PdoPane,
 }
 
 impl Panes {
@@ -69,6 +74,7 @@ impl Panes {
             Pane::Sdo => &self.sdo,
             Pane::Stats => &self.stats,
             Pane::Plot => &self.plot,
+            Pane::Pdo => &self.pdo,
         }
     }
 
@@ -80,6 +86,7 @@ impl Panes {
             Pane::Sdo => &mut self.sdo,
             Pane::Stats => &mut self.stats,
             Pane::Plot => &mut self.plot,
+            Pane::Pdo => &mut self.pdo,
         }
     }
 }

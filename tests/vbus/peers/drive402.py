@@ -15,9 +15,15 @@ Commands (controlword masks per CiA 402): shutdown 0x06, switch on 0x07, enable 
 0x0F, disable operation 0x07 (from Operation enabled), disable voltage (bit 1 clear), quick
 stop 0x02 (bit 2 clear), fault reset (bit 7 rising edge, in Fault). Writing a non-zero
 error code to 0x2100 (or --fault CODE at start) enters Fault with that code in 0x603F.
-0x6060 modes of operation (i8, rw) is mirrored in 0x6061. With --tpdo, TPDO1 (0x180+NODE,
-statusword, 2 bytes) is sent on every statusword change while NMT OPERATIONAL and on
-entering OPERATIONAL.
+0x6060 modes of operation (i8, rw) is mirrored in 0x6061. TPDO1 is sent on every statusword
+change while NMT OPERATIONAL and on entering OPERATIONAL, when its COB-ID (0x1800:01) is
+valid: with --tpdo it starts valid (0x180+NODE) and maps the statusword (2 bytes).
+
+TPDO1 can be remapped (CiA 301): 0x1800:01 COB-ID, :02 transmission type, :03 inhibit time,
+:05 event timer, 0x1A00:00 count and :01..:08 entries are writable; the frame follows the
+mapping. Like many devices, it changes its mapping and transmission parameters only outside
+NMT OPERATIONAL (abort 0x08000022 "present device state"), and refuses a count whose
+entries exceed 64 bits (abort 0x06040042).
 """
 
 import argparse
@@ -86,13 +92,16 @@ def build_od(heartbeat_ms):
     od.add_object(common.var(0x6061, 0, "Modes of operation display", odt.INTEGER8, 0, "ro"))
     od.add_object(common.var(0x2100, 0, "Simulate fault (error code)", odt.UNSIGNED16, 0))
     tp = odt.ODRecord("TPDO1 communication parameter", 0x1800)
-    tp.add_member(common.var(0x1800, 0, "Highest sub-index supported", odt.UNSIGNED8, 2, "const"))
-    tp.add_member(common.var(0x1800, 1, "COB-ID", odt.UNSIGNED32, 0, "ro"))
-    tp.add_member(common.var(0x1800, 2, "Transmission type", odt.UNSIGNED8, 0xFF, "ro"))
+    tp.add_member(common.var(0x1800, 0, "Highest sub-index supported", odt.UNSIGNED8, 5, "const"))
+    tp.add_member(common.var(0x1800, 1, "COB-ID", odt.UNSIGNED32, 0))
+    tp.add_member(common.var(0x1800, 2, "Transmission type", odt.UNSIGNED8, 0xFF))
+    tp.add_member(common.var(0x1800, 3, "Inhibit time", odt.UNSIGNED16, 0))
+    tp.add_member(common.var(0x1800, 5, "Event timer", odt.UNSIGNED16, 0))
     od.add_object(tp)
     tm = odt.ODRecord("TPDO1 mapping parameter", 0x1A00)
-    tm.add_member(common.var(0x1A00, 0, "Number of mapped objects", odt.UNSIGNED8, 1, "ro"))
-    tm.add_member(common.var(0x1A00, 1, "Mapping 1", odt.UNSIGNED32, 0x60410010, "ro"))
+    tm.add_member(common.var(0x1A00, 0, "Number of mapped objects", odt.UNSIGNED8, 1))
+    for sub in range(1, 9):
+        tm.add_member(common.var(0x1A00, sub, f"Mapping {sub}", odt.UNSIGNED32, 0x60410010 if sub == 1 else 0))
     od.add_object(tm)
     return od
 
@@ -102,7 +111,6 @@ class Drive:
 
     def __init__(self, node_id, heartbeat_ms=1000, tpdo=False):
         self.node = canopen.LocalNode(node_id, build_od(heartbeat_ms))
-        self.tpdo = tpdo
         self.statusword = SWITCH_ON_DISABLED
         self.error_code = 0
         self.controlword = 0
@@ -127,6 +135,8 @@ class Drive:
 
     def _on_write(self, index, subindex, od, data):
         with self._lock:
+            if index == 0x1A00 or (index == 0x1800 and subindex > 1):
+                self._check_remap(index, subindex, data)
             if index == 0x6040:
                 (cw,) = struct.unpack("<H", data)
                 self._control(cw)
@@ -158,10 +168,28 @@ class Drive:
         if changed:
             self.send_tpdo()
 
+    def _check_remap(self, index, subindex, data):
+        """Refuse TPDO1 parameter changes in OPERATIONAL, and mappings over 64 bits."""
+        if self.node.nmt.state == "OPERATIONAL":
+            raise canopen.SdoAbortedError(0x08000022)
+        if index == 0x1A00 and subindex == 0:
+            bits = sum(self._entry(k)[2] for k in range(1, data[0] + 1))
+            if data[0] > 8 or bits > 64:
+                raise canopen.SdoAbortedError(0x06040042)
+
+    def _entry(self, sub):
+        (e,) = struct.unpack("<I", self.node.get_data(0x1A00, sub))
+        return e >> 16, (e >> 8) & 0xFF, e & 0xFF
+
     def send_tpdo(self):
-        """Send TPDO1 (statusword) when enabled and the node is NMT OPERATIONAL."""
-        if self.tpdo and self.node.nmt.state == "OPERATIONAL":
-            self.node.network.send_message(0x180 + self.node.id, struct.pack("<H", self.statusword))
+        """Send TPDO1 through its mapping when its COB-ID is valid and the node is OPERATIONAL."""
+        (cob,) = struct.unpack("<I", self.node.get_data(0x1800, 1))
+        if cob & 0x80000000 or self.node.nmt.state != "OPERATIONAL":
+            return
+        data = b""
+        for index, sub, bits in (self._entry(k) for k in range(1, self.node.get_data(0x1A00, 0)[0] + 1)):
+            data += self.node.get_data(index, sub)[: bits // 8]
+        self.node.network.send_message(cob & 0x7FF, data)
 
     def attach(self, network):
         """Send TPDO1 on entering NMT OPERATIONAL (call after common.start)."""
