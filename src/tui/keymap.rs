@@ -55,7 +55,7 @@ actions! {
     Bottom = "bottom": "Last row (and follow)",
     Follow = "follow": "Toggle follow mode",
     Pause = "pause": "Pause or resume the capture / replay",
-    Expand = "expand": "Open the selected row (SDO transfer frames, signal to plot)",
+    Expand = "expand": "Open the selected row (SDO transfer frames, signal to plot; Objects: read)",
     Back = "back": "Close popup, clear search, leave expanded view",
     NextPane = "next_pane": "Next pane",
     PrevPane = "prev_pane": "Previous pane",
@@ -64,7 +64,8 @@ actions! {
     PaneSdo = "pane_sdo": "SDO transactions pane",
     PaneStats = "pane_stats": "Statistics pane",
     PanePlot = "pane_plot": "Plot pane",
-    Filter = "filter": "Edit the filter",
+    PaneObjects = "pane_objects": "Objects pane (dictionary of a node, last values)",
+    Filter = "filter": "Edit the filter (Objects: find by name, alias, index)",
     Search = "search": "Search (same language as the filter)",
     NextMatch = "next_match": "Jump to the next match",
     PrevMatch = "prev_match": "Jump to the previous match",
@@ -79,8 +80,10 @@ actions! {
     Rewind = "rewind": "Replay: start over from the first frame",
     SeekForward = "seek_forward": "Replay: jump 10 s ahead",
     SeekBack = "seek_back": "Replay: jump 10 s back",
-    NextSeries = "next_series": "Plot: next signal",
-    PrevSeries = "prev_series": "Plot: previous signal",
+    NextSeries = "next_series": "Plot: next signal (Objects: next node)",
+    PrevSeries = "prev_series": "Plot: previous signal (Objects: previous node)",
+    EditObject = "edit_object": "Objects: write the entry (palette prefilled)",
+    ReadAll = "read_all": "Objects: read every readable entry (again: stop)",
 }
 
 /// One key press, normalised (no SHIFT on characters).

@@ -24,6 +24,11 @@ pub const PALETTE_SYNTAX: &[(&str, &str)] = &[
         "export FILE [--format candump|jsonl|pcapng] [--force]",
         "Write the rows the view shows",
     ),
+    (
+        "record start FILE [--force|--append]",
+        "Live/demo: record the frames received to a candump -l log",
+    ),
+    ("record stop", "End the recording"),
     ("help", "This help"),
     ("messages", "The message log"),
     ("quit", "Quit"),

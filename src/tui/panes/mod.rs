@@ -5,6 +5,7 @@ pub mod detail;
 pub mod help;
 pub mod messages;
 pub mod nodes;
+pub mod objects;
 pub mod plot;
 pub mod sdo;
 pub mod stats;
@@ -27,11 +28,19 @@ pub enum Pane {
     Sdo,
     Stats,
     Plot,
+    Objects,
 }
 
 impl Pane {
     /// Every pane in tab order.
-    pub const ALL: [Pane; 5] = [Pane::Trace, Pane::Nodes, Pane::Sdo, Pane::Stats, Pane::Plot];
+    pub const ALL: [Pane; 6] = [
+        Pane::Trace,
+        Pane::Nodes,
+        Pane::Sdo,
+        Pane::Stats,
+        Pane::Plot,
+        Pane::Objects,
+    ];
     /// Tab title.
     pub fn title(self) -> &'static str {
         match self {
@@ -40,6 +49,7 @@ impl Pane {
             Pane::Sdo => "SDO",
             Pane::Stats => "Stats",
             Pane::Plot => "Plot",
+            Pane::Objects => "Objects",
         }
     }
 }
@@ -57,6 +67,8 @@ pub struct Panes {
     pub stats: stats::StatsPane,
     /// One numeric series over time.
     pub plot: plot::PlotPane,
+    /// The object dictionary of one node with the last values seen.
+    pub objects: objects::ObjectsPane,
 }
 
 impl Panes {
@@ -68,6 +80,7 @@ impl Panes {
             Pane::Sdo => &self.sdo,
             Pane::Stats => &self.stats,
             Pane::Plot => &self.plot,
+            Pane::Objects => &self.objects,
         }
     }
 
@@ -79,6 +92,7 @@ impl Panes {
             Pane::Sdo => &mut self.sdo,
             Pane::Stats => &mut self.stats,
             Pane::Plot => &mut self.plot,
+            Pane::Objects => &mut self.objects,
         }
     }
 }
@@ -107,6 +121,8 @@ pub enum Outcome {
     Filter(String),
     /// Show this trace position in the Trace pane, unfiltered.
     Show(usize),
+    /// What the Objects pane asks (read, write, read all, find).
+    Object(objects::ObjectRequest),
 }
 
 /// What the selected row of a pane is, for the Detail view.
