@@ -13,8 +13,8 @@
 use super::nodes::Nodes;
 use super::series::Series;
 use super::stats::Stats;
-use super::values::Values;
 use super::store::Store;
+use super::values::Values;
 use crate::decode::{Body, Decoded, Decoder, Kind};
 use crate::frame::{Frame, Interfaces};
 use crate::sdo::Transaction;

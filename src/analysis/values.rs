@@ -52,7 +52,7 @@ pub struct Seen {
 /// A transfer of the object that failed (aborted by a side or broken).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Failed {
-    /// What went wrong: `abort 0x06020000: Object does not exist in the object dictionary`.
+    /// What went wrong: `abort 06020000: Object does not exist in the object dictionary`.
     pub text: String,
     /// When (ns).
     pub ts_ns: u64,
@@ -118,7 +118,12 @@ impl Values {
         if !t.is_ok() {
             let text = match &t.outcome {
                 Outcome::Aborted { code, text, by } => {
-                    format!("abort 0x{code:08X} by {}: {text}", by.as_str())
+                    let by = if *by == crate::sdo::codec::Side::Client {
+                        " by the client"
+                    } else {
+                        ""
+                    };
+                    format!("abort {code:08X}{by}: {text}")
                 }
                 Outcome::ProtocolError(m) => format!("protocol error: {m}"),
                 _ => t
@@ -236,21 +241,41 @@ mod tests {
         let dict = dec.dictionary(2);
         let mode = v.get(2, 0x6061, 0).unwrap();
         let seen = mode.last.as_ref().unwrap();
-        assert_eq!((seen.value.clone(), seen.ts_ns, seen.via), (Value::Signed(3), 2_000_000, Via::Upload));
+        assert_eq!(
+            (seen.value.clone(), seen.ts_ns, seen.via),
+            (Value::Signed(3), 2_000_000, Via::Upload)
+        );
         assert_eq!(mode.text(dict, 0x6061, 0).as_deref(), Some("3 (Profile velocity)"));
         let hb = v.get(2, 0x1017, 0).unwrap().last.as_ref().unwrap();
         assert_eq!((hb.value.clone(), hb.via), (Value::Unsigned(100), Via::Download));
         let sw = v.get(2, 0x6041, 0).unwrap();
         let s = sw.last.as_ref().unwrap();
-        assert_eq!((s.value.clone(), s.ts_ns, s.via), (Value::Unsigned(0x0233), 9_000_000, Via::Pdo));
-        assert!(sw.text(dict, 0x6041, 0).unwrap().contains("Switched on"), "{:?}", sw.text(dict, 0x6041, 0));
+        assert_eq!(
+            (s.value.clone(), s.ts_ns, s.via),
+            (Value::Unsigned(0x0233), 9_000_000, Via::Pdo)
+        );
+        assert!(
+            sw.text(dict, 0x6041, 0).unwrap().contains("Switched on"),
+            "{:?}",
+            sw.text(dict, 0x6041, 0)
+        );
         let raw = v.get(2, 0x5000, 1).unwrap();
-        assert_eq!(raw.last.as_ref().unwrap().value, Value::Bytes(vec![0xEF, 0xBE, 0xAD, 0xDE]));
+        assert_eq!(
+            raw.last.as_ref().unwrap().value,
+            Value::Bytes(vec![0xEF, 0xBE, 0xAD, 0xDE])
+        );
         assert_eq!(raw.text(dict, 0x5000, 1).as_deref(), Some("EF BE AD DE (3735928559)"));
         let keys: Vec<(u16, u8)> = v.node(2).map(|(k, _)| k).collect();
         assert_eq!(
             keys,
-            [(0x1017, 0), (0x1A00, 0), (0x1A00, 1), (0x5000, 1), (0x6041, 0), (0x6061, 0)]
+            [
+                (0x1017, 0),
+                (0x1A00, 0),
+                (0x1A00, 1),
+                (0x5000, 1),
+                (0x6041, 0),
+                (0x6061, 0)
+            ]
         );
         assert_eq!(v.node(3).count(), 0);
     }
@@ -269,13 +294,13 @@ mod tests {
         assert_eq!(e.last.as_ref().map(|s| s.value.clone()), Some(Value::Signed(3)));
         assert_eq!(
             e.failed.as_ref().map(|f| (f.text.as_str(), f.ts_ns)),
-            Some(("abort 0x08000000 by server: General error", 4_000_000))
+            Some(("abort 08000000: General error", 4_000_000))
         );
         let missing = v.get(2, 0x5000, 0).unwrap();
         assert!(missing.last.is_none());
         assert_eq!(
             missing.failed.as_ref().map(|f| f.text.as_str()),
-            Some("abort 0x06020000 by server: Object does not exist in the object dictionary")
+            Some("abort 06020000: Object does not exist in the object dictionary")
         );
         // A value read afterwards clears the failure.
         let (v, _) = feed(&[

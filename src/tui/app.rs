@@ -877,7 +877,12 @@ impl App {
 
     /// Tells the Objects pane the Nodes pane's selection (its node unless one is picked there).
     fn sync_objects_node(&mut self) {
-        let n = self.trace.nodes.iter().nth(self.panes.nodes.list.selected).map(|(n, _)| *n);
+        let n = self
+            .trace
+            .nodes
+            .iter()
+            .nth(self.panes.nodes.list.selected)
+            .map(|(n, _)| *n);
         self.panes.objects.set_nodes_selection(n);
     }
 
@@ -1268,10 +1273,7 @@ impl App {
             Action::PanePlot => self.focus = Pane::Plot,
             Action::PaneObjects => self.focus = Pane::Objects,
             Action::EditObject | Action::ReadAll => {
-                self.message = Some(format!(
-                    "{}: only in the Objects pane",
-                    a.name().replace('_', " ")
-                ))
+                self.message = Some(format!("{}: only in the Objects pane", a.name().replace('_', " ")))
             }
             Action::Filter => {
                 let text = self.panes.trace.view.filter.source.clone();

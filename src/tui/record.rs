@@ -6,8 +6,8 @@
 use crate::command::CommandError;
 use crate::command::record::{WriteMode, open_output};
 use crate::frame::{Frame, Interfaces};
-use crate::log::writer::LogWriter;
 use crate::log::sink::{LineSink, Target};
+use crate::log::writer::LogWriter;
 
 /// A recording in progress.
 pub struct Recorder {
@@ -109,7 +109,10 @@ mod tests {
         );
         assert_eq!(parse("start"), Err(USAGE.to_string()));
         assert_eq!(parse("-o x.log"), Err(USAGE.to_string()));
-        assert_eq!(parse("start a b"), Err("record: one FILE only (`b` is extra)".to_string()));
+        assert_eq!(
+            parse("start a b"),
+            Err("record: one FILE only (`b` is extra)".to_string())
+        );
         assert!(parse("start a --force --append").unwrap_err().contains("exclude"));
     }
 }

@@ -64,12 +64,10 @@ fn catalog(dict: &Dictionary, seen: &BTreeSet<u16>) -> Vec<Obj> {
         }
         records.extend(layer.object_names.keys());
         for r in &layer.ranges {
-            let shown = if PDO_RANGES.contains(&r.first) {
-                r.first..=r.last.min(r.first.saturating_add(RANGE_SHOWN - 1))
-            } else {
-                // Nothing listed by default (e.g. 127 more SDO servers), only what was seen.
-                1..=0
-            };
+            // The first PDOs of a PDO range; of other ranges (e.g. 127 more SDO servers)
+            // only what was seen.
+            let shown = r.first..r.first.saturating_add(RANGE_SHOWN).min(r.last.saturating_add(1));
+            let shown = shown.filter(|_| PDO_RANGES.contains(&r.first));
             for i in shown.chain(seen.range(r.first..=r.last).copied()) {
                 subs.entry(i).or_default().extend(r.subs.keys());
                 records.insert(i);
@@ -126,6 +124,29 @@ pub fn type_word(t: DataType) -> &'static str {
     }
 }
 
+/// A record's name: the dictionary's, else for the CiA 301 parameter ranges what the
+/// record is (`TPDO3 communication parameter`), else its sub 0 entry's.
+fn record_name(dict: &Dictionary, index: u16) -> String {
+    if let Some(n) = dict.layers().iter().find_map(|p| p.object_names.get(&index)) {
+        return n.clone();
+    }
+    let ranged = [
+        (0x1200, "SDO server", "parameter"),
+        (0x1280, "SDO client", "parameter"),
+        (0x1400, "RPDO", "communication parameter"),
+        (0x1600, "RPDO", "mapping parameter"),
+        (0x1800, "TPDO", "communication parameter"),
+        (0x1A00, "TPDO", "mapping parameter"),
+    ];
+    for (first, what, kind) in ranged {
+        let span = if first < 0x1400 { 0x80 } else { 0x200 };
+        if (first..first + span).contains(&index) {
+            return format!("{what}{} {kind}", index - first + 1);
+        }
+    }
+    dict.object_name(index).unwrap_or("").to_string()
+}
+
 /// Access as EDS files write it.
 fn access_word(a: Access) -> &'static str {
     match a {
@@ -143,9 +164,12 @@ fn alias(dict: &Dictionary, index: u16, sub: u8) -> Option<String> {
     if let Some(a) = dict.object(index, sub).and_then(|o| o.alias.clone()) {
         return Some(a);
     }
-    dict.layers()
-        .iter()
-        .find_map(|p| p.aliases.iter().find(|(_, at)| **at == (index, sub)).map(|(a, _)| a.clone()))
+    dict.layers().iter().find_map(|p| {
+        p.aliases
+            .iter()
+            .find(|(_, at)| **at == (index, sub))
+            .map(|(a, _)| a.clone())
+    })
 }
 
 /// True when the entry matches a find text (lower case): a part of its name or alias, or
@@ -157,9 +181,7 @@ fn matches(query: &str, index: u16, sub: Option<u8>, name: &str, alias: Option<&
         Some(s) => format!("{index:04x}:{s:02x}"),
         None => format!("{index:04x}"),
     };
-    at.starts_with(q)
-        || name.to_lowercase().contains(query)
-        || alias.is_some_and(|a| a.to_lowercase().contains(query))
+    at.starts_with(q) || name.to_lowercase().contains(query) || alias.is_some_and(|a| a.to_lowercase().contains(query))
 }
 
 /// A read-all in progress.
@@ -175,8 +197,35 @@ pub struct ReadAll {
     pub done: usize,
     /// Entries in all.
     pub total: usize,
+    /// Entries left out: sub-indexes beyond what sub 0 says the node has, the rest of an
+    /// object the node does not have.
+    pub skipped: usize,
     /// Entries that failed, with what went wrong.
     pub failed: Vec<((u16, u8), String)>,
+}
+
+impl ReadAll {
+    /// Leaves out the queued entries of `index` whose sub-index is above `last`.
+    fn skip_above(&mut self, index: u16, last: Option<u8>) {
+        let before = self.queue.len();
+        self.queue.retain(|(i, s)| *i != index || last.is_some_and(|n| *s <= n));
+        self.skipped += before - self.queue.len();
+    }
+}
+
+/// The bytes of a read's result text (`... = 5 (data 05)`).
+fn result_data(text: &str) -> Option<Vec<u8>> {
+    let hex: String = text
+        .rsplit_once("(data ")?
+        .1
+        .split(')')
+        .next()?
+        .chars()
+        .filter(char::is_ascii_hexdigit)
+        .collect();
+    (0..hex.len() / 2)
+        .map(|k| u8::from_str_radix(&hex[2 * k..2 * k + 2], 16).ok())
+        .collect()
 }
 
 /// What a command result meant to the pane.
@@ -210,6 +259,8 @@ pub struct ObjectsPane {
     open: BTreeSet<u16>,
     /// The find text (filters the rows while typed).
     pub query: String,
+    /// The find text changed since the rows were last built.
+    fresh_query: bool,
     /// The catalog, and what it was built from (node, layers, indexes seen in ranges).
     catalog: Vec<Obj>,
     built: Option<(u8, Vec<usize>, BTreeSet<u16>)>,
@@ -240,8 +291,8 @@ impl ObjectsPane {
     /// Sets the find text (as typed: the rows follow each key).
     pub fn set_query(&mut self, text: &str) {
         self.query = text.trim().to_lowercase();
-        self.list.selected = 0;
-        self.list.offset = 0;
+        self.list = ListState::default();
+        self.fresh_query = true;
     }
 
     /// Rebuilds the catalog when the node or its dictionary changed, then the rows.
@@ -267,6 +318,12 @@ impl ObjectsPane {
             self.built = Some(key);
         }
         self.rows = self.build_rows(dict);
+        // A new find text selects the first row that matches it.
+        if std::mem::take(&mut self.fresh_query) {
+            self.list.selected = (0..self.rows.len())
+                .find(|k| self.row_matches(self.rows[*k], dict))
+                .unwrap_or(0);
+        }
     }
 
     /// The rows shown: every object (open records with their entries), or with a find
@@ -277,15 +334,15 @@ impl ObjectsPane {
         let named = (!q.is_empty())
             .then(|| crate::od::resolve_object(dict, q).ok())
             .flatten();
-        let hit = |index: u16, sub: Option<u8>, name: &str| {
+        let hit = |index: u16, sub: u8, name: &str| {
             q.is_empty()
-                || named.is_some_and(|(i, s)| i == index && sub.is_none_or(|x| x == s))
-                || matches(q, index, sub, name, sub.and_then(|s| alias(dict, index, s)).as_deref())
+                || named == Some((index, sub))
+                || matches(q, index, Some(sub), name, alias(dict, index, sub).as_deref())
         };
         for (k, o) in self.catalog.iter().enumerate() {
             if !o.record {
                 let sub = o.subs[0];
-                if hit(o.index, Some(sub), dict.name(o.index, sub).unwrap_or("")) {
+                if hit(o.index, sub, dict.name(o.index, sub).unwrap_or("")) {
                     rows.push(Row::Entry {
                         index: o.index,
                         sub,
@@ -294,12 +351,12 @@ impl ObjectsPane {
                 }
                 continue;
             }
-            let own = !q.is_empty() && hit(o.index, None, dict.object_name(o.index).unwrap_or(""));
+            let own = !q.is_empty() && matches(q, o.index, None, &record_name(dict, o.index), None);
             let subs: Vec<u8> = o
                 .subs
                 .iter()
                 .copied()
-                .filter(|s| own || hit(o.index, Some(*s), dict.name(o.index, *s).unwrap_or("")))
+                .filter(|s| own || hit(o.index, *s, dict.name(o.index, *s).unwrap_or("")))
                 .collect();
             if !q.is_empty() && subs.is_empty() {
                 continue;
@@ -315,6 +372,20 @@ impl ObjectsPane {
             }
         }
         rows
+    }
+
+    /// True when the row itself matches the find text (not only entries under it).
+    fn row_matches(&self, r: Row, dict: &Dictionary) -> bool {
+        match r {
+            Row::Entry { index, sub, .. } => {
+                let name = dict.name(index, sub).unwrap_or("");
+                matches(&self.query, index, Some(sub), name, alias(dict, index, sub).as_deref())
+            }
+            Row::Record { obj, .. } => {
+                let index = self.catalog[obj].index;
+                matches(&self.query, index, None, &record_name(dict, index), None)
+            }
+        }
     }
 
     /// The entry of the selected row, if it is one.
@@ -342,16 +413,7 @@ impl ObjectsPane {
         }
         let dict = ctx.trace.decoder().dictionary(node);
         let n = self.rows.len();
-        let own = |r: &Row| match *r {
-            Row::Entry { index, sub, .. } => {
-                let name = dict.name(index, sub).unwrap_or("");
-                matches(&self.query, index, Some(sub), name, alias(dict, index, sub).as_deref())
-            }
-            Row::Record { obj, .. } => {
-                let index = self.catalog[obj].index;
-                matches(&self.query, index, None, dict.object_name(index).unwrap_or(""), None)
-            }
-        };
+        let own = |r: &Row| self.row_matches(*r, dict);
         for step in 1..=n {
             let k = if forward {
                 (self.list.selected + step) % n
@@ -410,10 +472,20 @@ impl ObjectsPane {
             let key = (r.node, at.0, at.1);
             match failure(rest) {
                 Some(why) => {
+                    // An object the node does not have: none of its entries is read.
+                    if why.contains("06020000") {
+                        r.skip_above(at.0, None);
+                    }
                     r.failed.push((at, why.to_string()));
                     self.errors.insert(key, why.to_string());
                 }
                 None => {
+                    // Sub 0 of a record: its highest sub-index; the ones above are not read.
+                    if at.1 == 0
+                        && let Some(n) = result_data(rest).and_then(|d| d.first().copied())
+                    {
+                        r.skip_above(at.0, Some(n));
+                    }
                     self.errors.remove(&key);
                 }
             }
@@ -456,9 +528,9 @@ impl ObjectsPane {
     pub fn stop_read_all(&mut self) -> Option<String> {
         let r = self.read_all.take()?;
         Some(format!(
-            "read all node {}: stopped after {} of {} objects ({} failed)",
+            "read all node {}: stopped after {} of {} entries ({} failed)",
             r.node,
-            r.done,
+            r.done + r.skipped,
             r.total,
             r.failed.len()
         ))
@@ -466,7 +538,9 @@ impl ObjectsPane {
 
     /// The next read of the read-all, or its summary when all are done.
     fn next_read(&mut self) -> Step {
-        let Some(r) = self.read_all.as_mut() else { return Step::Noted };
+        let Some(r) = self.read_all.as_mut() else {
+            return Step::Noted;
+        };
         match r.queue.pop_front() {
             Some((i, s)) => {
                 let line = read_line(r.node, i, s);
@@ -476,12 +550,17 @@ impl ObjectsPane {
             None => {
                 let r = self.read_all.take().unwrap_or_default();
                 let mut text = format!(
-                    "read all node {}: {} objects, {} read, {} failed",
+                    "read all node {}: {} entries read, {} failed",
                     r.node,
-                    r.total,
-                    r.total - r.failed.len(),
+                    r.done - r.failed.len(),
                     r.failed.len()
                 );
+                if r.skipped > 0 {
+                    text.push_str(&format!(
+                        ", {} of the {} the dictionary knows not present on the node",
+                        r.skipped, r.total
+                    ));
+                }
                 for ((i, s), why) in &r.failed {
                     text.push_str(&format!("\n0x{i:04X}:{s:02X}: {why}"));
                 }
@@ -502,7 +581,7 @@ impl ObjectsPane {
             t.push_str(&format!(" · find `{}`", self.query));
         }
         if let Some(r) = &self.read_all {
-            t.push_str(&format!(" · read all {} of {}", r.done, r.total));
+            t.push_str(&format!(" · read all {} of {}", r.done + r.skipped, r.total));
             if !r.failed.is_empty() {
                 t.push_str(&format!(" ({} failed)", r.failed.len()));
             }
@@ -521,7 +600,7 @@ impl ObjectsPane {
                 let text = format!(
                     "{mark} {:04X}    {}",
                     o.index,
-                    fit(dict.object_name(o.index).unwrap_or(""), w.name + 1 + w.alias)
+                    fit(&record_name(dict, o.index), w.name + 1 + w.alias)
                 );
                 (text, Style::default().fg(Color::White))
             }
@@ -656,7 +735,7 @@ impl Widths {
         let fixed = 9 + 1 + 6 + 8 + if wide { 7 + 7 } else { 0 };
         let alias = if wide { 12 } else { 9 };
         let rest = width.saturating_sub(fixed + alias + 2);
-        let name = (rest * 11 / 20).max(8);
+        let name = (rest * 9 / 20).max(8);
         Widths {
             name,
             alias,
@@ -826,7 +905,11 @@ mod tests {
         assert_eq!((sw.record, sw.subs.as_slice()), (false, &[0u8][..]));
         assert!(c.iter().any(|o| (0x2000..0x6000).contains(&o.index)));
         // PDO parameter ranges: PDOs 1-4 listed; another one once a value of it was seen.
-        let tpdo_maps: Vec<u16> = c.iter().map(|o| o.index).filter(|i| (0x1A00..0x1C00).contains(i)).collect();
+        let tpdo_maps: Vec<u16> = c
+            .iter()
+            .map(|o| o.index)
+            .filter(|i| (0x1A00..0x1C00).contains(i))
+            .collect();
         assert_eq!(tpdo_maps, [0x1A00, 0x1A01, 0x1A02, 0x1A03]);
         let c = catalog(&d, &BTreeSet::from([0x1A07, 0x1280]));
         assert!(c.iter().any(|o| o.index == 0x1A07 && o.record));
@@ -863,9 +946,9 @@ mod tests {
         let r = p.read_all.as_ref().unwrap();
         assert_eq!((r.done, r.total, r.failed.len()), (2, 3, 1));
         assert_eq!(
-            p.result("sdo read 2 0x6041:00: node 2 0x6041:00 Statusword = 0x0250"),
+            p.result("sdo read 2 0x6041:00: node 2 0x6041:00 Statusword = 0x0250 (data 50 02)"),
             Step::Finished(
-                "read all node 2: 3 objects, 2 read, 1 failed\n0x1008:00: SDO abort 0x06020000: Object does not exist"
+                "read all node 2: 2 entries read, 1 failed\n0x1008:00: SDO abort 0x06020000: Object does not exist"
                     .into()
             )
         );
@@ -878,8 +961,189 @@ mod tests {
         p.start_read_all(3, vec![(0x1000, 0), (0x1001, 0)]);
         assert_eq!(
             p.stop_read_all().as_deref(),
-            Some("read all node 3: stopped after 0 of 2 objects (0 failed)")
+            Some("read all node 3: stopped after 0 of 2 entries (0 failed)")
         );
         assert_eq!(p.result("sdo read 3 0x1000:00: node 3 ..."), Step::NotOurs);
+        // Sub 0 of a record bounds the sub-indexes read; an absent object is left whole.
+        let all = vec![
+            (0x1003, 0),
+            (0x1003, 1),
+            (0x1003, 2),
+            (0x1003, 3),
+            (0x1010, 0),
+            (0x1010, 1),
+        ];
+        p.start_read_all(2, all);
+        assert_eq!(
+            p.result("sdo read 2 0x1003:00: node 2 0x1003:00 Number of errors = 1 (data 01)"),
+            Step::Next("sdo read 2 0x1003:01".into())
+        );
+        assert_eq!(
+            p.result("sdo read 2 0x1003:01: node 2 0x1003:01 Standard error field = 0 (data 00 00 00 00)"),
+            Step::Next("sdo read 2 0x1010:00".into())
+        );
+        assert_eq!(
+            p.result("sdo read 2 0x1010:00: error: SDO abort 0x06020000: Object does not exist"),
+            Step::Finished(
+                "read all node 2: 2 entries read, 1 failed, 3 of the 6 the dictionary knows not present on the node\n\
+                 0x1010:00: SDO abort 0x06020000: Object does not exist"
+                    .into()
+            )
+        );
+    }
+
+    /// The test capture with node 1 bound to the aimotor profile (CiA 402, CiA 301 below it)
+    /// and a few more transfers: the vendor-ID read, a write of an H parameter, an abort.
+    fn objects_app() -> crate::tui::app::App {
+        use crate::analysis::trace::Trace;
+        use crate::decode::Decoder;
+        use crate::frame::Frame;
+        use crate::tui::app::{App, SourceInfo, SourceKind};
+        let read = |p: &std::path::Path| std::fs::read(p);
+        let b = Bindings::from_args(&["1=aimotor".to_string()], &[], &read).unwrap();
+        let mut trace = Trace::new(Decoder::from_bindings(&b), 500_000);
+        trace.ifaces.intern("can0");
+        let mut frames = crate::tui::panes::testutil::frames();
+        let mut t = frames.last().unwrap().ts_ns;
+        for (id, data) in [
+            (0x601, [0x40, 0x18, 0x10, 0x01, 0, 0, 0, 0]),
+            (0x581, [0x43, 0x18, 0x10, 0x01, 0x78, 0x56, 0x34, 0x12]),
+            (0x601, [0x2B, 0x02, 0x20, 0x01, 0x2C, 0x01, 0, 0]),
+            (0x581, [0x60, 0x02, 0x20, 0x01, 0, 0, 0, 0]),
+            (0x601, [0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0]),
+            (0x581, [0x80, 0x08, 0x10, 0x00, 0x00, 0x00, 0x02, 0x06]),
+        ] {
+            t += 2_000_000;
+            let mut f = Frame::classic(id, &data);
+            f.ts_ns = t;
+            frames.push(f);
+        }
+        for f in &frames {
+            trace.push(f);
+        }
+        let (_tx, rx) = std::sync::mpsc::channel();
+        let mut src = SourceInfo::new("test.log", SourceKind::Open, rx, None);
+        src.done = true;
+        let mut a = App::new(trace, crate::tui::keymap::Keymap::default_map(), src);
+        a.bindings = b;
+        a.focus = crate::tui::panes::Pane::Objects;
+        a
+    }
+
+    #[test]
+    fn the_pane_shows_the_nodes_dictionary_with_last_values_at_160x48() {
+        use crate::tui::panes::testutil::screen;
+        let mut a = objects_app();
+        let s = screen(&mut a, 160, 48);
+        assert!(s.contains("Objects · node 1 aimotor"), "{s}");
+        assert!(s.contains("▸ 1018    Identity object"), "{s}");
+        // 0x1017 was read (100 ms, in the test capture); 0x1008 aborted.
+        assert!(s.contains("1017:00   Producer heartbeat time"), "{s}");
+        assert!(s.contains("✗ abort 06020000: Object does not"), "{s}");
+        insta::assert_snapshot!(s);
+        // Open the identity record: the vendor-ID read shows with its age.
+        for _ in 0..40 {
+            if a.panes.objects.selected_entry().is_none()
+                && matches!(a.panes.objects.rows.get(a.panes.objects.list.selected), Some(Row::Record { obj, .. }) if a.panes.objects.catalog[*obj].index == 0x1018)
+            {
+                break;
+            }
+            a.act(Action::Down);
+        }
+        a.act(Action::Expand);
+        let s = screen(&mut a, 160, 48);
+        assert!(s.contains("▾ 1018"), "{s}");
+        assert!(s.contains("  1018:01 Vendor-ID"), "{s}");
+        assert!(s.contains("305419896"), "{s}");
+    }
+
+    #[test]
+    fn find_while_typing_narrows_the_rows_at_80x24() {
+        use crate::tui::panes::testutil::screen;
+        use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+        let mut a = objects_app();
+        let _ = screen(&mut a, 80, 24);
+        a.key(KeyEvent::new(KeyCode::Char('/'), KeyModifiers::NONE));
+        for c in "h02".chars() {
+            a.key(KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE));
+        }
+        // The rows follow each key, before enter.
+        let s = screen(&mut a, 80, 24);
+        assert!(s.contains("find object: h02"), "{s}");
+        assert!(s.contains("2002:01 "), "{s}");
+        assert!(s.contains("H02-00"), "{s}");
+        assert!(!s.contains("1017:00"), "{s}");
+        insta::assert_snapshot!(s);
+        a.key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
+        assert_eq!(a.panes.objects.query, "h02");
+        // n goes to the next match; esc clears the find text.
+        a.act(Action::NextMatch);
+        assert!(a.panes.objects.selected_entry().is_some());
+        a.act(Action::Back);
+        assert_eq!(a.panes.objects.query, "");
+    }
+
+    #[test]
+    fn enter_and_read_all_on_a_log_say_there_is_no_bus_and_e_prefills_the_write() {
+        use crate::tui::panes::testutil::screen;
+        let mut a = objects_app();
+        a.run_command("filter node 1");
+        a.focus = crate::tui::panes::Pane::Objects;
+        a.panes.objects.set_query("1017");
+        let _ = screen(&mut a, 160, 48);
+        assert_eq!(a.panes.objects.selected_entry(), Some((0x1017, 0)));
+        a.act(Action::Expand);
+        assert_eq!(
+            a.message.as_deref(),
+            Some(
+                "sdo read 1 0x1017:00: this source is a log file, there is no bus to read from (use `cotui live IFACE` or `cotui demo`)"
+            )
+        );
+        a.act(Action::ReadAll);
+        assert!(
+            a.message
+                .as_deref()
+                .unwrap_or("")
+                .starts_with("read all node 1: this source is a log file")
+        );
+        assert!(a.panes.objects.read_all.is_none());
+        a.act(Action::EditObject);
+        let p = a.prompt.editing.as_ref().expect("the palette is open");
+        assert_eq!(p.text, "sdo write 1 0x1017:00 100 --type u16");
+        assert_eq!(p.cursor, "sdo write 1 0x1017:00 100".len());
+        let m = a.message.clone().unwrap_or_default();
+        assert!(
+            m.starts_with("u16 value in ms: edit it and press enter · will send: 601#2B17100064000000"),
+            "{m}"
+        );
+        // A read-only entry is not offered for writing.
+        a.prompt.editing = None;
+        a.panes.objects.set_query("1018:01");
+        let _ = screen(&mut a, 160, 48);
+        a.act(Action::EditObject);
+        assert!(a.prompt.editing.is_none());
+        assert_eq!(a.message.as_deref(), Some("0x1018:01 Vendor-ID is read-only (ro)"));
+    }
+
+    #[test]
+    fn listen_only_reads_nothing_and_says_so() {
+        let (_ftx, frx) = std::sync::mpsc::channel();
+        let (rtx, mut rrx) = tokio::sync::mpsc::unbounded_channel();
+        let mut a = objects_app();
+        a.source = crate::tui::app::SourceInfo::live(
+            "vcan0",
+            crate::tui::app::SourceKind::Live { listen_only: true },
+            frx,
+            rtx,
+        );
+        a.panes.objects.set_query("1017");
+        let _ = crate::tui::panes::testutil::screen(&mut a, 160, 48);
+        a.act(Action::Expand);
+        a.act(Action::ReadAll);
+        assert!(rrx.try_recv().is_err(), "nothing requested");
+        assert_eq!(
+            a.message.as_deref(),
+            Some("read all node 1: listen-only — nothing can be sent, so no object can be read")
+        );
     }
 }
