@@ -576,7 +576,9 @@ impl ObjectsPane {
         };
         let dict = ctx.trace.decoder().dictionary(node);
         let entries: usize = self.catalog.iter().map(|o| o.subs.len()).sum();
-        let mut t = format!(" Objects · node {node} {} · {entries} entries", dict.profile_name());
+        let mut layers: Vec<&str> = dict.layers().iter().map(|l| l.name.as_str()).collect();
+        layers.dedup();
+        let mut t = format!(" Objects · node {node} {} · {entries} entries", layers.join(" > "));
         if !self.query.is_empty() {
             t.push_str(&format!(" · find `{}`", self.query));
         }
@@ -1035,7 +1037,10 @@ mod tests {
         use crate::tui::panes::testutil::screen;
         let mut a = objects_app();
         let s = screen(&mut a, 160, 48);
-        assert!(s.contains("Objects · node 1 aimotor"), "{s}");
+        assert!(
+            s.contains("Objects · node 1 aimotor > cia402 > cia301 · 4607 entries"),
+            "{s}"
+        );
         assert!(s.contains("▸ 1018    Identity object"), "{s}");
         // 0x1017 was read (100 ms, in the test capture); 0x1008 aborted.
         assert!(s.contains("1017:00   Producer heartbeat time"), "{s}");
