@@ -2,5 +2,6 @@
 
 mod filter_search;
 mod objects_demo;
+mod objects_tmux;
 mod tui_cli;
 mod tui_tmux;
