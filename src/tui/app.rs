@@ -558,7 +558,9 @@ impl App {
                     .as_ref()
                     .map(|p| p.text.chars().take(p.cursor).collect())
                     .unwrap_or_default();
-                let words: Vec<String> = if before.contains(' ') {
+                let words: Vec<String> = if before.starts_with("record ") {
+                    super::record::WORDS.iter().map(|w| w.to_string()).collect()
+                } else if before.contains(' ') {
                     crate::command::syntax::completions(&before)
                 } else {
                     PALETTE_COMMANDS

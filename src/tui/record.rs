@@ -27,6 +27,9 @@ pub enum RecordCommand {
     Stop,
 }
 
+/// The words `record` takes in the palette (for completion).
+pub const WORDS: &[&str] = &["start", "stop", "--force", "--append"];
+
 /// How `record` is written in the palette.
 pub const USAGE: &str = "record: use `record start FILE [--force | --append]` or `record stop`";
 

@@ -120,7 +120,7 @@ fn objects_pane_reads_an_object_of_a_demo_drive_and_prefills_its_write() {
     // `e`: the palette holds the typed write command with the value read.
     key(&mut a, KeyCode::Char('e'));
     let p = a.prompt.editing.as_ref().expect("the palette is open");
-    assert_eq!(p.text, format!("sdo write 2 0x6060:00 {raw} --type i8"));
+    assert_eq!(p.text, format!("sdo write 2 0x6060:0x00 {raw} --type i8"));
     assert!(
         a.message.as_deref().unwrap_or("").contains("will send: 602#2F606000"),
         "{:?}",
@@ -177,4 +177,51 @@ fn record_start_and_stop_from_the_palette_write_the_frames_received() {
     a.run_command("record stop");
     assert_eq!(a.message.as_deref(), Some("record: not recording"));
     std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn read_all_reads_what_drive_2_has_with_progress_and_lists_the_failures() {
+    let mut a = demo_app();
+    until(&mut a, "node 2 to be listed", |a, _| {
+        a.trace.nodes.iter().any(|(n, _)| *n == 2)
+    });
+    key(&mut a, KeyCode::Char('6'));
+    for _ in 0..4 {
+        if screen(&mut a).contains("Objects · node 2 demo > aimotor") {
+            break;
+        }
+        key(&mut a, KeyCode::Char(']'));
+    }
+    key(&mut a, KeyCode::Char('R'));
+    let started = a.message.clone().unwrap_or_default();
+    assert!(
+        started.starts_with("read all node 2: reading ")
+            && started.ends_with(" objects one after the other (R again stops)"),
+        "{started}"
+    );
+    let total = started["read all node 2: reading ".len()..]
+        .split(' ')
+        .next()
+        .unwrap()
+        .to_string();
+    let s = until(&mut a, "progress in the title", |_, s| s.contains(" · read all "));
+    assert!(s.contains(&format!(" of {total}")), "{s}");
+    until(&mut a, "the read-all to end", |a, _| a.panes.objects.read_all.is_none());
+    let summary = a
+        .messages
+        .iter()
+        .map(|e| e.text.clone())
+        .find(|t| t.starts_with("read all node 2: ") && t.contains(" entries read, "))
+        .expect("a summary in the message log");
+    // Every line read was understood (the sub-index goes out in hex); the failures are the
+    // node's answers: objects or sub-indexes it does not have.
+    assert!(!summary.contains("unknown object"), "{summary}");
+    for l in summary.lines().skip(1) {
+        assert!(l.contains("does not exist"), "{l}");
+    }
+    // Every identity entry was read, and the drive's own objects.
+    for (i, s) in [(0x1000, 0), (0x1018, 1), (0x1018, 2), (0x6060, 0), (0x2002, 1)] {
+        let e = a.trace.values.get(2, i, s).and_then(|e| e.last.as_ref());
+        assert!(e.is_some(), "0x{i:04X}:{s:02X} read\n{summary}");
+    }
 }

@@ -92,21 +92,21 @@ fn demo_objects_pane_reads_and_writes_an_object() {
     s.wait_for("the find", |t| t.contains("find `6060`") && !row(t).is_empty());
     s.send("Enter", false);
     let t = s.wait_for("the read", |t| {
-        t.contains("sdo read 2 0x6060:00: node 2 0x6060:00 Modes of operation = ")
+        t.contains("sdo read 2 0x6060:0x00: node 2 0x6060:00 Modes of operation = ")
     });
     let r = row(&t);
     assert!(r.contains(" ms") || r.contains(" s"), "the value's age: {r}\n{t}");
 
     // `e` opens the palette with the typed write; replace the value with 1 (profile position).
     s.send("e", true);
-    let t = s.wait_for("the prefilled write", |t| t.contains(":sdo write 2 0x6060:00 "));
+    let t = s.wait_for("the prefilled write", |t| t.contains(":sdo write 2 0x6060:0x00 "));
     let line = t
         .lines()
-        .find(|l| l.starts_with(":sdo write 2 0x6060:00 "))
+        .find(|l| l.starts_with(":sdo write 2 0x6060:0x00 "))
         .unwrap()
         .to_string();
     assert!(line.trim_end().ends_with("--type i8"), "{line}");
-    let value = line[":sdo write 2 0x6060:00 ".len()..]
+    let value = line[":sdo write 2 0x6060:0x00 ".len()..]
         .split(' ')
         .next()
         .unwrap()

@@ -241,9 +241,9 @@ pub enum Step {
     Finished(String),
 }
 
-/// The palette line that reads an entry.
+/// The palette line that reads an entry (the sub-index in hex: bare digits would be decimal).
 pub fn read_line(node: u8, index: u16, sub: u8) -> String {
-    format!("sdo read {node} 0x{index:04X}:{sub:02X}")
+    format!("sdo read {node} 0x{index:04X}:0x{sub:02X}")
 }
 
 /// The Objects pane's state.
@@ -449,7 +449,7 @@ impl ObjectsPane {
             .or(info.default.as_ref())
             .map(raw_text)
             .unwrap_or_default();
-        let head = format!("sdo write {node} 0x{index:04X}:{sub:02X} {value}");
+        let head = format!("sdo write {node} 0x{index:04X}:0x{sub:02X} {value}");
         let cursor = head.chars().count();
         let text = match info.data_type {
             DataType::UnicodeString | DataType::TimeOfDay | DataType::TimeDifference => head,
@@ -934,21 +934,21 @@ mod tests {
     fn a_read_all_goes_on_result_by_result_and_sums_up_failures() {
         let mut p = ObjectsPane::default();
         let first = p.start_read_all(2, vec![(0x1000, 0), (0x1008, 0), (0x6041, 0)]);
-        assert_eq!(first, Step::Next("sdo read 2 0x1000:00".into()));
+        assert_eq!(first, Step::Next("sdo read 2 0x1000:0x00".into()));
         // Someone else's result changes nothing.
         assert_eq!(p.result("nmt start 2: NMT start sent to node 2"), Step::NotOurs);
         assert_eq!(
-            p.result("sdo read 2 0x1000:00: node 2 0x1000:00 Device type = 0x00020192"),
-            Step::Next("sdo read 2 0x1008:00".into())
+            p.result("sdo read 2 0x1000:0x00: node 2 0x1000:00 Device type = 0x00020192"),
+            Step::Next("sdo read 2 0x1008:0x00".into())
         );
         assert_eq!(
-            p.result("sdo read 2 0x1008:00: error: SDO abort 0x06020000: Object does not exist"),
-            Step::Next("sdo read 2 0x6041:00".into())
+            p.result("sdo read 2 0x1008:0x00: error: SDO abort 0x06020000: Object does not exist"),
+            Step::Next("sdo read 2 0x6041:0x00".into())
         );
         let r = p.read_all.as_ref().unwrap();
         assert_eq!((r.done, r.total, r.failed.len()), (2, 3, 1));
         assert_eq!(
-            p.result("sdo read 2 0x6041:00: node 2 0x6041:00 Statusword = 0x0250 (data 50 02)"),
+            p.result("sdo read 2 0x6041:0x00: node 2 0x6041:00 Statusword = 0x0250 (data 50 02)"),
             Step::Finished(
                 "read all node 2: 2 entries read, 1 failed\n0x1008:00: SDO abort 0x06020000: Object does not exist"
                     .into()
@@ -965,7 +965,7 @@ mod tests {
             p.stop_read_all().as_deref(),
             Some("read all node 3: stopped after 0 of 2 entries (0 failed)")
         );
-        assert_eq!(p.result("sdo read 3 0x1000:00: node 3 ..."), Step::NotOurs);
+        assert_eq!(p.result("sdo read 3 0x1000:0x00: node 3 ..."), Step::NotOurs);
         // Sub 0 of a record bounds the sub-indexes read; an absent object is left whole.
         let all = vec![
             (0x1003, 0),
@@ -977,15 +977,15 @@ mod tests {
         ];
         p.start_read_all(2, all);
         assert_eq!(
-            p.result("sdo read 2 0x1003:00: node 2 0x1003:00 Number of errors = 1 (data 01)"),
-            Step::Next("sdo read 2 0x1003:01".into())
+            p.result("sdo read 2 0x1003:0x00: node 2 0x1003:00 Number of errors = 1 (data 01)"),
+            Step::Next("sdo read 2 0x1003:0x01".into())
         );
         assert_eq!(
-            p.result("sdo read 2 0x1003:01: node 2 0x1003:01 Standard error field = 0 (data 00 00 00 00)"),
-            Step::Next("sdo read 2 0x1010:00".into())
+            p.result("sdo read 2 0x1003:0x01: node 2 0x1003:01 Standard error field = 0 (data 00 00 00 00)"),
+            Step::Next("sdo read 2 0x1010:0x00".into())
         );
         assert_eq!(
-            p.result("sdo read 2 0x1010:00: error: SDO abort 0x06020000: Object does not exist"),
+            p.result("sdo read 2 0x1010:0x00: error: SDO abort 0x06020000: Object does not exist"),
             Step::Finished(
                 "read all node 2: 2 entries read, 1 failed, 3 of the 6 the dictionary knows not present on the node\n\
                  0x1010:00: SDO abort 0x06020000: Object does not exist"
@@ -1101,7 +1101,7 @@ mod tests {
         assert_eq!(
             a.message.as_deref(),
             Some(
-                "sdo read 1 0x1017:00: this source is a log file, there is no bus to read from (use `cotui live IFACE` or `cotui demo`)"
+                "sdo read 1 0x1017:0x00: this source is a log file, there is no bus to read from (use `cotui live IFACE` or `cotui demo`)"
             )
         );
         a.act(Action::ReadAll);
@@ -1114,8 +1114,8 @@ mod tests {
         assert!(a.panes.objects.read_all.is_none());
         a.act(Action::EditObject);
         let p = a.prompt.editing.as_ref().expect("the palette is open");
-        assert_eq!(p.text, "sdo write 1 0x1017:00 100 --type u16");
-        assert_eq!(p.cursor, "sdo write 1 0x1017:00 100".len());
+        assert_eq!(p.text, "sdo write 1 0x1017:0x00 100 --type u16");
+        assert_eq!(p.cursor, "sdo write 1 0x1017:0x00 100".len());
         let m = a.message.clone().unwrap_or_default();
         assert!(
             m.starts_with("u16 value in ms: edit it and press enter · will send: 601#2B17100064000000"),
