@@ -319,7 +319,7 @@ impl App {
                 Ok(Feed::Extent(e)) => self.source.replay.1 = Some(e),
                 Ok(Feed::Result(level, s)) => {
                     self.say(level, &s);
-                    let step = self.panes.objects.result(&s);
+                    let step = self.panes.objects.result(&s, self.trace.nodes.now_ns());
                     self.read_all_step(step);
                 }
                 Ok(Feed::Lost(n)) => {
@@ -920,6 +920,10 @@ impl App {
                     self.run_command(&line);
                 }
             }
+            ObjectRequest::Edit { .. } if self.listen_only() => self.say(
+                Level::Error,
+                "write: listen-only — nothing can be sent, so no object can be written",
+            ),
             ObjectRequest::Edit { text, cursor, note } => {
                 self.prompt.open(PromptKind::Palette, &text);
                 if let Some(p) = self.prompt.editing.as_mut() {
@@ -972,7 +976,7 @@ impl App {
                     Err(e) => {
                         let text = format!("{line}: error: {e}");
                         self.log(Level::Error, &text);
-                        step = self.panes.objects.result(&text);
+                        step = self.panes.objects.result(&text, self.trace.nodes.now_ns());
                     }
                 },
                 Step::Finished(text) => {

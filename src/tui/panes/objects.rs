@@ -270,8 +270,9 @@ pub struct ObjectsPane {
     pub read_all: Option<ReadAll>,
     /// Single reads sent and not answered yet: line -> (node, index, sub).
     reading: BTreeMap<String, (u8, u16, u8)>,
-    /// The last failure of a read the pane sent, per (node, index, sub).
-    errors: BTreeMap<(u8, u16, u8), String>,
+    /// The last failure of a read the pane sent, per (node, index, sub), with the capture
+    /// time it was told (a value seen after it shows instead).
+    errors: BTreeMap<(u8, u16, u8), (String, u64)>,
 }
 
 impl ObjectsPane {
@@ -462,8 +463,9 @@ impl ObjectsPane {
         }
     }
 
-    /// Notes a command result; read-all goes on with the next entry.
-    pub fn result(&mut self, text: &str) -> Step {
+    /// Notes a command result told at capture time `now_ns`; read-all goes on with the
+    /// next entry.
+    pub fn result(&mut self, text: &str, now_ns: u64) -> Step {
         if let Some(r) = self.read_all.as_mut()
             && let Some((line, at)) = r.current.clone()
             && let Some(rest) = text.strip_prefix(&format!("{line}: "))
@@ -477,7 +479,7 @@ impl ObjectsPane {
                         r.skip_above(at.0, None);
                     }
                     r.failed.push((at, why.to_string()));
-                    self.errors.insert(key, why.to_string());
+                    self.errors.insert(key, (why.to_string(), now_ns));
                 }
                 None => {
                     // Sub 0 of a record: its highest sub-index; the ones above are not read.
@@ -501,7 +503,7 @@ impl ObjectsPane {
         };
         self.reading.remove(&line);
         match failure(&text[line.len() + 2..]) {
-            Some(why) => self.errors.insert(key, why.to_string()),
+            Some(why) => self.errors.insert(key, (why.to_string(), now_ns)),
             None => self.errors.remove(&key),
         };
         Step::Noted
@@ -646,7 +648,9 @@ impl ObjectsPane {
     /// value, or the last value's text.
     fn value_cell(&self, node: u8, index: u16, sub: u8, e: Option<&Entry>, dict: &Dictionary) -> (String, Style) {
         let red = Style::default().fg(Color::LightRed);
-        if let Some(why) = self.errors.get(&(node, index, sub)) {
+        if let Some((why, at)) = self.errors.get(&(node, index, sub))
+            && e.and_then(|e| e.last.as_ref()).is_none_or(|s| s.ts_ns <= *at)
+        {
             return (format!("✗ {why}"), red);
         }
         let Some(e) = e else {
@@ -936,19 +940,25 @@ mod tests {
         let first = p.start_read_all(2, vec![(0x1000, 0), (0x1008, 0), (0x6041, 0)]);
         assert_eq!(first, Step::Next("sdo read 2 0x1000:0x00".into()));
         // Someone else's result changes nothing.
-        assert_eq!(p.result("nmt start 2: NMT start sent to node 2"), Step::NotOurs);
+        assert_eq!(p.result("nmt start 2: NMT start sent to node 2", 0), Step::NotOurs);
         assert_eq!(
-            p.result("sdo read 2 0x1000:0x00: node 2 0x1000:00 Device type = 0x00020192"),
+            p.result("sdo read 2 0x1000:0x00: node 2 0x1000:00 Device type = 0x00020192", 0),
             Step::Next("sdo read 2 0x1008:0x00".into())
         );
         assert_eq!(
-            p.result("sdo read 2 0x1008:0x00: error: SDO abort 0x06020000: Object does not exist"),
+            p.result(
+                "sdo read 2 0x1008:0x00: error: SDO abort 0x06020000: Object does not exist",
+                0
+            ),
             Step::Next("sdo read 2 0x6041:0x00".into())
         );
         let r = p.read_all.as_ref().unwrap();
         assert_eq!((r.done, r.total, r.failed.len()), (2, 3, 1));
         assert_eq!(
-            p.result("sdo read 2 0x6041:0x00: node 2 0x6041:00 Statusword = 0x0250 (data 50 02)"),
+            p.result(
+                "sdo read 2 0x6041:0x00: node 2 0x6041:00 Statusword = 0x0250 (data 50 02)",
+                0
+            ),
             Step::Finished(
                 "read all node 2: 2 entries read, 1 failed\n0x1008:00: SDO abort 0x06020000: Object does not exist"
                     .into()
@@ -956,7 +966,7 @@ mod tests {
         );
         assert!(p.read_all.is_none());
         assert_eq!(
-            p.errors.get(&(2, 0x1008, 0)).map(String::as_str),
+            p.errors.get(&(2, 0x1008, 0)).map(|(e, _)| e.as_str()),
             Some("SDO abort 0x06020000: Object does not exist")
         );
         // Stopped half-way: a summary, and later results are no longer ours.
@@ -965,7 +975,7 @@ mod tests {
             p.stop_read_all().as_deref(),
             Some("read all node 3: stopped after 0 of 2 entries (0 failed)")
         );
-        assert_eq!(p.result("sdo read 3 0x1000:0x00: node 3 ..."), Step::NotOurs);
+        assert_eq!(p.result("sdo read 3 0x1000:0x00: node 3 ...", 0), Step::NotOurs);
         // Sub 0 of a record bounds the sub-indexes read; an absent object is left whole.
         let all = vec![
             (0x1003, 0),
@@ -977,15 +987,24 @@ mod tests {
         ];
         p.start_read_all(2, all);
         assert_eq!(
-            p.result("sdo read 2 0x1003:0x00: node 2 0x1003:00 Number of errors = 1 (data 01)"),
+            p.result(
+                "sdo read 2 0x1003:0x00: node 2 0x1003:00 Number of errors = 1 (data 01)",
+                0
+            ),
             Step::Next("sdo read 2 0x1003:0x01".into())
         );
         assert_eq!(
-            p.result("sdo read 2 0x1003:0x01: node 2 0x1003:01 Standard error field = 0 (data 00 00 00 00)"),
+            p.result(
+                "sdo read 2 0x1003:0x01: node 2 0x1003:01 Standard error field = 0 (data 00 00 00 00)",
+                0
+            ),
             Step::Next("sdo read 2 0x1010:0x00".into())
         );
         assert_eq!(
-            p.result("sdo read 2 0x1010:0x00: error: SDO abort 0x06020000: Object does not exist"),
+            p.result(
+                "sdo read 2 0x1010:0x00: error: SDO abort 0x06020000: Object does not exist",
+                0
+            ),
             Step::Finished(
                 "read all node 2: 2 entries read, 1 failed, 3 of the 6 the dictionary knows not present on the node\n\
                  0x1010:00: SDO abort 0x06020000: Object does not exist"
@@ -1149,6 +1168,12 @@ mod tests {
         assert_eq!(
             a.message.as_deref(),
             Some("read all node 1: listen-only — nothing can be sent, so no object can be read")
+        );
+        a.act(Action::EditObject);
+        assert!(a.prompt.editing.is_none(), "no write offered");
+        assert_eq!(
+            a.message.as_deref(),
+            Some("write: listen-only — nothing can be sent, so no object can be written")
         );
     }
 }
