@@ -877,7 +877,9 @@ impl App {
         };
     }
 
-    /// Tells the Objects pane the Nodes pane's selection (its node unless one is picked there).
+    /// Tells the Objects pane the Nodes pane's selection (its node unless one is picked
+    /// there): when the user selects in the Nodes pane, or while the Objects pane has none.
+    /// Not on every frame: a node appearing above the selection does not change it.
     fn sync_objects_node(&mut self) {
         let n = self
             .trace
@@ -1220,10 +1222,14 @@ impl App {
             self.detail.shown = false;
             return;
         }
-        self.sync_objects_node();
         let focus = self.focus;
         let (panes, ctx) = self.panes_mut();
-        match panes.get_mut(focus).handle(a, &ctx) {
+        let outcome = panes.get_mut(focus).handle(a, &ctx);
+        if focus == Pane::Nodes {
+            // A node selected in the Nodes pane is the one the Objects pane shows.
+            self.sync_objects_node();
+        }
+        match outcome {
             Outcome::Done => return,
             Outcome::Ignored => {}
             Outcome::Detail => {
@@ -1367,16 +1373,19 @@ impl App {
             }
             _ => {}
         }
+        if focus == Pane::Nodes {
+            self.sync_objects_node();
+        }
     }
 
     /// Before drawing: keeps the list panes' selections within their rows and visible in
     /// `height` rows, pins the trace selection to the newest row in follow mode, decodes the
     /// visible trace window (`rows` rows), the tail strip and what the Detail pane shows.
     pub fn prepare(&mut self, height: usize, rows: usize, tail: &[usize]) {
+        if self.panes.objects.node().is_none() {
+            self.sync_objects_node();
+        }
         let (panes, ctx) = self.panes_mut();
-        panes
-            .objects
-            .set_nodes_selection(ctx.trace.nodes.iter().nth(panes.nodes.list.selected).map(|(n, _)| *n));
         for p in [Pane::Nodes, Pane::Stats, Pane::Sdo, Pane::Objects] {
             panes.get_mut(p).fit(height, &ctx);
         }
