@@ -919,7 +919,15 @@ impl App {
                 let line = read_line(node, index, sub);
                 if self.can_read(&line) {
                     self.panes.objects.sent(&line, node, index, sub);
-                    self.run_command(&line);
+                    match palette::plan(&line, &self.bindings, |_| None) {
+                        Ok(_) => self.run_command(&line),
+                        // E.g. an object of the decoder's dictionary the session's bindings lack.
+                        Err(e) => {
+                            let text = format!("{line}: error: {e}");
+                            self.say(Level::Error, &text);
+                            self.panes.objects.result(&text, self.trace.nodes.now_ns());
+                        }
+                    }
                 }
             }
             ObjectRequest::Edit { .. } if self.listen_only() => self.say(
