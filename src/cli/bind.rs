@@ -93,15 +93,25 @@ fn kind_of(message: &str) -> String {
     out
 }
 
-/// The bindings for a bus: on the `demo` bus, the simulated drives are also named by the
-/// seed profiles they are built after (unless the user bound others to those nodes) and
-/// their start-up PDO mappings are known, so PDOs decode from the first frame.
+/// The bindings for a bus: on the `demo` bus those of [`bindings_for_demo`] with the
+/// standard demo drives.
 pub fn bindings_on(iface: &str, profiles: &[String], eds: &[String]) -> Result<Bindings, BindError> {
     if iface != crate::connect::DEMO {
         return bindings(profiles, eds);
     }
+    bindings_for_demo(&crate::sim::Simulation::demo(), profiles, eds)
+}
+
+/// The bindings for a demo bus running `sim`: the simulated drives are also named by the
+/// seed profiles they are built after (unless the user bound others to those nodes) and
+/// their start-up PDO mappings are known, so PDOs decode from the first frame.
+pub fn bindings_for_demo(
+    sim: &crate::sim::Simulation,
+    profiles: &[String],
+    eds: &[String],
+) -> Result<Bindings, BindError> {
     let mut profiles = profiles.to_vec();
-    for (node, profile) in crate::sim::DEMO_PROFILES {
+    for (node, profile) in sim.profiles() {
         let bound = profiles
             .iter()
             .chain(eds)
@@ -111,7 +121,7 @@ pub fn bindings_on(iface: &str, profiles: &[String], eds: &[String]) -> Result<B
         }
     }
     let mut b = bindings(&profiles, eds)?;
-    for (node, layer) in crate::sim::Simulation::demo().pdo_layers() {
+    for (node, layer) in sim.pdo_layers() {
         b.bind_layer(node, layer);
     }
     Ok(b)

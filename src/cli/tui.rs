@@ -91,6 +91,11 @@ pub struct DemoArgs {
     /// Never send: watch the simulated drives only.
     #[arg(long)]
     pub listen_only: bool,
+    /// A simulated drive: NODE=MODEL[@SERIAL], MODEL one of aimotor, syntron-ds,
+    /// dexmart-dev, aqmd2405, servo; NODE `ff` for a drive without node-ID (LSS only).
+    /// Repeatable. Default: 2=aimotor 3=syntron-ds.
+    #[arg(long = "node", value_name = "NODE=MODEL[@SERIAL]")]
+    pub nodes: Vec<String>,
     #[command(flatten)]
     pub ui: UiArgs,
 }
@@ -135,6 +140,8 @@ enum Feeding {
     Log(source::Feeds),
     /// A live bus (interface, listen-only) that also runs commands.
     Live(String, bool),
+    /// The demo bus with these simulated drives (listen-only).
+    Demo(crate::sim::Simulation, bool),
 }
 
 fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> ExitCode {
@@ -145,7 +152,11 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> ExitCode {
             return ExitCode::Usage;
         }
     };
-    let bindings = match super::bind::bindings_on(name, &ui.profiles, &ui.eds) {
+    let bindings = match &feed {
+        Feeding::Demo(sim, _) => super::bind::bindings_for_demo(sim, &ui.profiles, &ui.eds),
+        _ => super::bind::bindings_on(name, &ui.profiles, &ui.eds),
+    };
+    let bindings = match bindings {
         Ok(b) => b,
         Err(e) => {
             eprintln!("cotui: {e}");
@@ -156,7 +167,11 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> ExitCode {
     let src = match feed {
         Feeding::Log((rx, ctl)) => SourceInfo::new(name, kind, rx, ctl),
         Feeding::Live(iface, listen_only) => {
-            let (rx, req) = crate::tui::live::start(&iface, listen_only, bindings.clone());
+            let (rx, req) = crate::tui::live::start(&iface, listen_only, bindings.clone(), None);
+            SourceInfo::live(name, kind, rx, req)
+        }
+        Feeding::Demo(sim, listen_only) => {
+            let (rx, req) = crate::tui::live::start(crate::connect::DEMO, listen_only, bindings.clone(), Some(sim));
             SourceInfo::live(name, kind, rx, req)
         }
     };
@@ -242,7 +257,14 @@ pub fn run_demo(args: &DemoArgs) -> ExitCode {
     let kind = SourceKind::Demo {
         listen_only: args.listen_only,
     };
-    let feed = Feeding::Live(crate::connect::DEMO.to_string(), args.listen_only);
+    let drives = match crate::sim::spec::drives(&args.nodes, &crate::sim::DEMO_NODES) {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("cotui demo: {e}");
+            return ExitCode::Usage;
+        }
+    };
+    let feed = Feeding::Demo(crate::sim::Simulation::demo_with(drives), args.listen_only);
     start(&args.ui, crate::connect::DEMO, kind, feed)
 }
 

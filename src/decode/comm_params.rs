@@ -4,7 +4,7 @@
 use crate::od::Dictionary;
 
 /// A COB-ID value (0x1005, 0x1014, 0x12xx, 0x14xx, 0x18xx) with its flag bits.
-fn cob_id(raw: u32, bit30: &str) -> String {
+pub fn cob_id(raw: u32, bit30: &str) -> String {
     let ext = raw & (1 << 29) != 0;
     let id = if ext {
         format!("0x{:08X}", raw & 0x1FFF_FFFF)
@@ -30,7 +30,7 @@ fn cob_id(raw: u32, bit30: &str) -> String {
 }
 
 /// PDO transmission type text (sub 2 of 0x1400/0x1800 records).
-fn transmission_type(t: u32) -> String {
+pub fn transmission_type(t: u32) -> String {
     let what = match t {
         0 => "synchronous, acyclic".to_string(),
         1 => "synchronous, every SYNC".to_string(),

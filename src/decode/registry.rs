@@ -167,8 +167,8 @@ impl Decoder {
     pub fn classify(&mut self, frame: &Frame) -> (Kind, Option<u8>) {
         let route = self.route(frame);
         if matches!(route.kind, Kind::SdoRx | Kind::SdoTx) {
-            let d = self.decode_routed(frame, route);
-            return (d.kind, d.node);
+            self.seq += 1;
+            self.track_sdo(frame, route);
         }
         (route.kind, route.node)
     }
@@ -245,20 +245,13 @@ impl Decoder {
             Kind::Tpdo | Kind::Rpdo => self.decode_pdo(frame, route),
             Kind::SdoRx | Kind::SdoTx => {
                 let c2s = route.kind == Kind::SdoRx;
-                let mut s = self
-                    .sdo
-                    .on_frame(self.seq, frame.ts_ns, n, c2s, payload, &self.dicts[n as usize]);
+                let mut s = self.track_sdo(frame, route);
                 // Controlword and statusword bits are named per the node's mode in force.
                 if let (Some(mode), Some((index @ (0x6040 | 0x6041), 0)), Some(v)) =
                     (self.modes[n as usize], s.object, s.value.as_mut())
                     && let Some(typed) = &v.typed
                 {
                     v.text = value_text::object_text(&self.dicts[n as usize], index, 0, typed, Some(mode));
-                }
-                for mut t in self.sdo.take_completed() {
-                    t.mode = self.modes[(t.node & 0x7F) as usize];
-                    self.learn(&t);
-                    self.completed.push(t);
                 }
                 // The tracker sees vendor commands too (as unknown commands), so that
                 // their standard replies do not disturb a running transfer.
@@ -295,6 +288,22 @@ impl Decoder {
             body,
             malformed,
         }
+    }
+
+    /// Feeds an SDO frame to the transfer tracker and learns from the transfers it
+    /// completes (COB-IDs, PDO mappings, modes); returns the frame as the tracker read it.
+    fn track_sdo(&mut self, frame: &Frame, route: Route) -> SdoFrame {
+        let n = route.node.unwrap_or(0);
+        let c2s = route.kind == Kind::SdoRx;
+        let s = self
+            .sdo
+            .on_frame(self.seq, frame.ts_ns, n, c2s, frame.payload(), &self.dicts[n as usize]);
+        for mut t in self.sdo.take_completed() {
+            t.mode = self.modes[(t.node & 0x7F) as usize];
+            self.learn(&t);
+            self.completed.push(t);
+        }
+        s
     }
 
     fn decode_pdo(&mut self, frame: &Frame, route: Route) -> (String, Body, Option<String>) {

@@ -91,6 +91,96 @@ impl Serialize for Text<'_> {
     }
 }
 
+/// Appends `v` in decimal.
+pub fn push_u64(out: &mut Vec<u8>, mut v: u64) {
+    let mut buf = [0u8; 20];
+    let mut i = buf.len();
+    loop {
+        i -= 1;
+        buf[i] = b'0' + (v % 10) as u8;
+        v /= 10;
+        if v == 0 {
+            break;
+        }
+    }
+    out.extend_from_slice(&buf[i..]);
+}
+
+/// Appends a time in ns as seconds with all nine decimals (the JSON form of [`Seconds`]).
+pub fn push_seconds(out: &mut Vec<u8>, ns: u64) {
+    push_u64(out, ns / 1_000_000_000);
+    let mut frac = ns % 1_000_000_000;
+    let mut buf = [b'.'; 10];
+    for i in (1..10).rev() {
+        buf[i] = b'0' + (frac % 10) as u8;
+        frac /= 10;
+    }
+    out.extend_from_slice(&buf);
+}
+
+/// Appends bytes as a quoted upper-case hex string (the JSON form of [`Hex`]).
+pub fn push_hex(out: &mut Vec<u8>, bytes: &[u8]) {
+    const DIGITS: &[u8; 16] = b"0123456789ABCDEF";
+    out.reserve(2 * bytes.len() + 2);
+    out.push(b'"');
+    for b in bytes {
+        out.push(DIGITS[(b >> 4) as usize]);
+        out.push(DIGITS[(b & 15) as usize]);
+    }
+    out.push(b'"');
+}
+
+/// Whether any byte must be escaped in a JSON string (`"`, `\\`, control characters),
+/// eight bytes at a time.
+fn needs_escape(bytes: &[u8]) -> bool {
+    const ONES: u64 = 0x0101_0101_0101_0101;
+    const HIGH: u64 = 0x8080_8080_8080_8080;
+    // Bytes of `w` below `n` (n <= 0x80) set their high bit in the result.
+    let below = |w: u64, n: u8| w.wrapping_sub(ONES * u64::from(n)) & !w & HIGH;
+    let mut chunks = bytes.chunks_exact(8);
+    for c in &mut chunks {
+        let w = u64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]]);
+        if below(w, 0x20) | below(w ^ (ONES * u64::from(b'"')), 1) | below(w ^ (ONES * u64::from(b'\\')), 1) != 0 {
+            return true;
+        }
+    }
+    chunks.remainder().iter().any(|&b| b < 0x20 || b == b'"' || b == b'\\')
+}
+
+/// Appends a quoted string with the contract's escaping (the JSON form of [`Text`]).
+pub fn push_text(out: &mut Vec<u8>, text: &str) {
+    const HEX: &[u8; 16] = b"0123456789abcdef";
+    let bytes = text.as_bytes();
+    out.reserve(bytes.len() + 2);
+    out.push(b'"');
+    if !needs_escape(bytes) {
+        out.extend_from_slice(bytes);
+        out.push(b'"');
+        return;
+    }
+    let mut clean = 0;
+    for (i, &b) in bytes.iter().enumerate() {
+        let escape: &[u8] = match b {
+            b'"' => b"\\\"",
+            b'\\' => b"\\\\",
+            b'\n' => b"\\n",
+            b'\r' => b"\\r",
+            b'\t' => b"\\t",
+            0..=0x1F => b"",
+            _ => continue,
+        };
+        out.extend_from_slice(&bytes[clean..i]);
+        if escape.is_empty() {
+            out.extend_from_slice(&[b'\\', b'u', b'0', b'0', HEX[(b >> 4) as usize], HEX[(b & 15) as usize]]);
+        } else {
+            out.extend_from_slice(escape);
+        }
+        clean = i + 1;
+    }
+    out.extend_from_slice(&bytes[clean..]);
+    out.push(b'"');
+}
+
 /// Appends `record` as one JSON line; nothing when it cannot be written (the record
 /// types hold only what JSON can carry, so this does not happen).
 pub fn write_line(out: &mut Vec<u8>, record: &impl Serialize) {
@@ -122,6 +212,54 @@ mod tests {
         assert_eq!(json(Hex(&[])), r#""""#);
         let long = [0xABu8; 100];
         assert_eq!(json(Hex(&long)), format!("\"{}\"", "AB".repeat(100)));
+    }
+
+    /// The direct writers give what the `Serialize` forms give.
+    #[test]
+    fn direct_writers_match_the_serialize_forms() {
+        let pushed = |f: &dyn Fn(&mut Vec<u8>)| {
+            let mut v = Vec::new();
+            f(&mut v);
+            String::from_utf8(v).unwrap()
+        };
+        for ns in [0, 1, 999_999_999, 1_700_000_000_450_000_001, u64::MAX] {
+            assert_eq!(pushed(&|o| push_seconds(o, ns)), json(Seconds(ns)));
+        }
+        for v in [0, 7, 10, 4_294_967_295, u64::MAX] {
+            assert_eq!(pushed(&|o| push_u64(o, v)), v.to_string());
+        }
+        for b in [&[][..], &[0x1A, 0x2B], &[0xAB; 64]] {
+            assert_eq!(pushed(&|o| push_hex(o, b)), json(Hex(b)));
+        }
+        let long = "a label long enough for whole words, then a quote \" at byte 52";
+        for t in [
+            "",
+            "plain",
+            "a\"b\\c\u{1}",
+            "µ\tz\n°\r",
+            "\u{8}x\u{c}\u{1b}\u{7f}",
+            "end\\",
+            long,
+            "ÿÿÿÿÿÿÿÿ\u{1f}",
+        ] {
+            assert_eq!(pushed(&|o| push_text(o, t)), json(Text(t)), "{t:?}");
+        }
+    }
+
+    /// Every ASCII byte at every place of a 17-byte text (two words and a tail) is
+    /// escaped as serde_json would.
+    #[test]
+    fn direct_text_escaping_finds_every_byte_in_words_and_tail() {
+        for b in 0u8..0x80 {
+            for at in 0..17 {
+                let mut t = vec![b'x'; 17];
+                t[at] = b;
+                let t = String::from_utf8(t).unwrap();
+                let mut v = Vec::new();
+                push_text(&mut v, &t);
+                assert_eq!(String::from_utf8(v).unwrap(), json(Text(&t)), "byte {b:#x} at {at}");
+            }
+        }
     }
 
     #[test]

@@ -480,6 +480,15 @@ impl Cx<'_> {
         if let Some(s) = &e.scale {
             info.scale = self.ok(&format!("{at}.scale"), float(s));
         }
+        if let Some(m) = &e.meaning {
+            match super::Meaning::parse(m) {
+                Some(m) => info.meaning = Some(m),
+                None => self.warn(
+                    &format!("{at}.meaning"),
+                    format!("unknown meaning `{m}` (cob_id, transmission_type, object_index)"),
+                ),
+            }
+        }
         for (k, v) in e.values {
             match parse_int(&k) {
                 Some(raw) => {

@@ -43,6 +43,9 @@ fn complete(info: &mut ObjectInfo, base: &ObjectInfo) {
     if info.fields.is_empty() {
         info.fields.clone_from(&base.fields);
     }
+    if info.meaning.is_none() {
+        info.meaning = base.meaning;
+    }
 }
 
 #[cfg(test)]

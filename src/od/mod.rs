@@ -93,6 +93,33 @@ pub struct ObjectInfo {
     /// Parts of a structured value (bytes of its little-endian encoding), e.g. 0x1016's
     /// node-ID and heartbeat time, 0x1003's error code and manufacturer information.
     pub fields: Vec<fields::ByteField>,
+    /// What the raw value stands for when a vendor object holds a communication
+    /// parameter (profile `"meaning"`), e.g. Syn-tron F0.7.041 is a TPDO COB-ID.
+    pub meaning: Option<Meaning>,
+}
+
+/// A CiA 301 reading of a vendor object's raw value, so it is shown like the standard
+/// object it configures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Meaning {
+    /// A COB-ID with its flag bits (`0x00000181 (COB-ID 0x181)`).
+    CobId,
+    /// A PDO transmission type (`1 (synchronous, every SYNC)`).
+    TransmissionType,
+    /// A 16-bit object index (`24640 (0x6040 Controlword)`).
+    ObjectIndex,
+}
+
+impl Meaning {
+    /// The profile word for it.
+    pub fn parse(word: &str) -> Option<Meaning> {
+        match word {
+            "cob_id" => Some(Meaning::CobId),
+            "transmission_type" => Some(Meaning::TransmissionType),
+            "object_index" => Some(Meaning::ObjectIndex),
+            _ => None,
+        }
+    }
 }
 
 /// Whether an object may be mapped into PDOs.

@@ -1,7 +1,7 @@
 //! The JSONL contract: one JSON object per frame (field names are a public API).
 //!
-//! [`FrameRecord`] holds the common fields and [`BodyJson`] the kind-specific object,
-//! each decoder's `to_json`; serde writes the record straight into the output buffer
+//! [`write_frame`] writes the common fields straight into the output buffer and
+//! [`BodyJson`], the kind-specific object (each decoder's `to_json`), through serde
 //! (this is the hot path of `cotui decode --format jsonl`).
 
 use crate::decode::emcy::EmcyJson;
@@ -15,39 +15,9 @@ use crate::decode::sync::SyncJson;
 use crate::decode::time::TimeJson;
 use crate::decode::vendor_sdo::VendorSdoJson;
 use crate::decode::{Body, Decoded};
-use crate::frame::json::{Hex, Seconds, Text, write_line};
+use crate::frame::json::{push_hex, push_seconds, push_text, push_u64};
 use crate::frame::{Flags, Frame, Interfaces};
 use serde::Serialize;
-
-/// One frame as a JSONL record (fields in contract order).
-#[derive(Clone, Debug, Serialize)]
-pub struct FrameRecord<'a> {
-    /// Input line number (1-based).
-    pub line: u64,
-    /// Seconds, exact to the ns.
-    pub t: Seconds,
-    pub iface: Text<'a>,
-    pub id: u32,
-    pub ext: bool,
-    pub rtr: bool,
-    pub fd: bool,
-    pub err: bool,
-    pub len: u8,
-    /// The payload, upper-case hex.
-    pub data: Hex<'a>,
-    /// `rx` or `tx`.
-    pub dir: &'static str,
-    /// The [`crate::decode::Kind`] name.
-    pub kind: &'static str,
-    pub node: Option<u8>,
-    pub label: Text<'a>,
-    /// The kind-specific object under its key (absent for kinds without one).
-    #[serde(flatten)]
-    pub body: Option<BodyJson<'a>>,
-    /// Why the frame breaks a rule (absent when it does not).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub malformed: Option<Text<'a>>,
-}
 
 /// The kind-specific object of a frame record, under its key (`nmt`, `heartbeat`, ...).
 #[derive(Clone, Debug, Serialize)]
@@ -85,33 +55,103 @@ impl<'a> BodyJson<'a> {
     }
 }
 
-impl<'a> FrameRecord<'a> {
-    /// The record of one frame read from input line `line`.
-    pub fn new(line: u64, frame: &'a Frame, ifaces: &'a Interfaces, decoded: &'a Decoded) -> FrameRecord<'a> {
-        FrameRecord {
-            line,
-            t: Seconds(frame.ts_ns),
-            iface: Text(ifaces.name(frame.iface)),
-            id: frame.id,
-            ext: frame.is_ext(),
-            rtr: frame.is_rtr(),
-            fd: frame.is_fd(),
-            err: frame.is_err(),
-            len: frame.len,
-            data: Hex(frame.payload()),
-            dir: if frame.flags.has(Flags::TX) { "tx" } else { "rx" },
-            kind: decoded.kind.as_str(),
-            node: decoded.node,
-            label: Text(&decoded.label),
-            body: BodyJson::new(decoded, frame),
-            malformed: decoded.malformed.as_deref().map(Text),
+impl BodyJson<'_> {
+    /// The record key the object goes under.
+    fn key(&self) -> &'static str {
+        match self {
+            BodyJson::Nmt(_) => "nmt",
+            BodyJson::Heartbeat(_) => "heartbeat",
+            BodyJson::Sync(_) => "sync",
+            BodyJson::Time(_) => "time",
+            BodyJson::Emcy(_) => "emcy",
+            BodyJson::Pdo(_) => "pdo",
+            BodyJson::Sdo(_) => "sdo",
+            BodyJson::Lss(_) => "lss",
+            BodyJson::VendorSdo(_) => "vendor_sdo",
+            BodyJson::Error(_) => "error",
+        }
+    }
+
+    /// Appends the object itself (without its key).
+    fn write_object(&self, out: &mut Vec<u8>) -> serde_json::Result<()> {
+        match self {
+            BodyJson::Nmt(j) => serde_json::to_writer(out, j),
+            BodyJson::Heartbeat(j) => serde_json::to_writer(out, j),
+            BodyJson::Sync(j) => serde_json::to_writer(out, j),
+            BodyJson::Time(j) => serde_json::to_writer(out, j),
+            BodyJson::Emcy(j) => serde_json::to_writer(out, j),
+            BodyJson::Pdo(j) => serde_json::to_writer(out, j),
+            BodyJson::Sdo(j) => serde_json::to_writer(out, j),
+            BodyJson::Lss(j) => serde_json::to_writer(out, j),
+            BodyJson::VendorSdo(j) => serde_json::to_writer(out, j),
+            BodyJson::Error(j) => serde_json::to_writer(out, j),
         }
     }
 }
 
 /// Appends the JSON object (and a newline) for one frame read from input line `line`.
+///
+/// The record's fields, in contract order: `line` (input line, 1-based), `t` (seconds,
+/// exact to the ns), `iface`, `id`, `ext`, `rtr`, `fd`, `err`, `len`, `data` (upper-case
+/// hex), `dir` (`rx`/`tx`), `kind` (the [`crate::decode::Kind`] name), `node`, `label`,
+/// the kind-specific object under its key ([`BodyJson`], absent for kinds without one),
+/// and `malformed` (absent when the frame breaks no rule).
+///
+/// The record's own fields are written directly (this is the hot path of
+/// `cotui decode --format jsonl`); the kind-specific object goes through serde.
 pub fn write_frame(out: &mut Vec<u8>, line: u64, frame: &Frame, ifaces: &Interfaces, decoded: &Decoded) {
-    write_line(out, &FrameRecord::new(line, frame, ifaces, decoded));
+    let start = out.len();
+    out.extend_from_slice(b"{\"line\":");
+    push_u64(out, line);
+    out.extend_from_slice(b",\"t\":");
+    push_seconds(out, frame.ts_ns);
+    out.extend_from_slice(b",\"iface\":");
+    push_text(out, ifaces.name(frame.iface));
+    out.extend_from_slice(b",\"id\":");
+    push_u64(out, frame.id.into());
+    push_flag(out, b",\"ext\":", frame.is_ext());
+    push_flag(out, b",\"rtr\":", frame.is_rtr());
+    push_flag(out, b",\"fd\":", frame.is_fd());
+    push_flag(out, b",\"err\":", frame.is_err());
+    out.extend_from_slice(b",\"len\":");
+    push_u64(out, frame.len.into());
+    out.extend_from_slice(b",\"data\":");
+    push_hex(out, frame.payload());
+    out.extend_from_slice(if frame.flags.has(Flags::TX) {
+        b",\"dir\":\"tx\""
+    } else {
+        b",\"dir\":\"rx\""
+    });
+    out.extend_from_slice(b",\"kind\":\"");
+    out.extend_from_slice(decoded.kind.as_str().as_bytes());
+    out.extend_from_slice(b"\",\"node\":");
+    match decoded.node {
+        Some(n) => push_u64(out, n.into()),
+        None => out.extend_from_slice(b"null"),
+    }
+    out.extend_from_slice(b",\"label\":");
+    push_text(out, &decoded.label);
+    if let Some(body) = BodyJson::new(decoded, frame) {
+        out.extend_from_slice(b",\"");
+        out.extend_from_slice(body.key().as_bytes());
+        out.extend_from_slice(b"\":");
+        if body.write_object(out).is_err() {
+            // The body types hold only what JSON can carry: this does not happen.
+            out.truncate(start);
+            return;
+        }
+    }
+    if let Some(m) = &decoded.malformed {
+        out.extend_from_slice(b",\"malformed\":");
+        push_text(out, m);
+    }
+    out.extend_from_slice(b"}\n");
+}
+
+/// Appends `key` and `true`/`false`.
+fn push_flag(out: &mut Vec<u8>, key: &[u8], v: bool) {
+    out.extend_from_slice(key);
+    out.extend_from_slice(if v { b"true" } else { b"false" });
 }
 
 #[cfg(test)]
@@ -159,7 +199,7 @@ mod tests {
         assert_eq!(j["node"], 5);
         assert_eq!(j["heartbeat"]["state"], "operational");
         assert_eq!(j["malformed"], "heartbeat frame has 2 data bytes, expected 1");
-        let lit = |s| serde_json::to_string(&Text(s)).unwrap();
+        let lit = |s| serde_json::to_string(&crate::frame::json::Text(s)).unwrap();
         assert_eq!(lit("a\"b\\c\u{1}"), r#""a\"b\\c\u0001""#);
         assert_eq!(lit("µ\tz\n°"), r#""µ\tz\n°""#);
     }

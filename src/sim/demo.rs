@@ -15,6 +15,8 @@ pub struct Demo {
     pub bus: Bus,
     /// The bus itself, to add more endpoints.
     pub vbus: VirtualBus,
+    /// The simulation's own endpoint (what the nodes send goes out here).
+    pub nodes: Bus,
     /// The simulated nodes; lock briefly to inject faults or inspect state.
     pub sim: Arc<Mutex<Simulation>>,
 }
@@ -27,8 +29,9 @@ impl Demo {
         let sim = Arc::new(Mutex::new(sim));
         // Subscribe before the task starts so no frame sent from now on is missed.
         let rx = node_side.subscribe();
-        tokio::spawn(super::serve::serve(sim.clone(), node_side, rx));
+        tokio::spawn(super::serve::serve(sim.clone(), node_side.clone(), rx));
         Demo {
+            nodes: node_side,
             bus: vbus.endpoint(listen_only),
             vbus,
             sim,

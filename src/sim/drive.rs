@@ -2,11 +2,15 @@
 //! TPDOs on SYNC and RPDOs from its mapping objects, the CiA 402 state machine
 //! (transitions 0..16), profile velocity motion and EMCY on faults, and an LSS slave
 //! (a drive made with node-ID 0xFF only answers LSS until it is given one and reset).
+//! Drives that are not CiA 402 (Dexmart, AQMD) act through [`super::vendor`] instead of
+//! the state machine. RPDOs with a synchronous transmission type (0..240) take effect at
+//! the next SYNC; TPDOs go out on SYNC (types 1..240) and on their event timer (254/255).
 //!
 //! Pure: frames and the current time in, frames out.
 
 use super::od::DeviceObjects;
-use super::profile;
+use super::profile::{self, Kind};
+use super::vendor::Vendor;
 use crate::decode::cia402::DriveState;
 use crate::frame::Frame;
 use crate::lss::{self, Address, UNCONFIGURED};
@@ -80,6 +84,12 @@ pub struct Drive {
     last_ns: Option<u64>,
     next_heartbeat_ns: Option<u64>,
     pending_fault: Option<u16>,
+    /// Vendor behaviour (drives that are not CiA 402).
+    vendor: Vendor,
+    /// Synchronous RPDOs received since the last SYNC, by PDO number (0-based).
+    sync_rpdo: [Option<Vec<u8>>; 4],
+    /// When each event-driven TPDO is due next.
+    next_event_ns: [Option<u64>; 4],
 }
 
 impl Drive {
@@ -93,6 +103,7 @@ impl Drive {
             revision: od.uint(0x1018, 3) as u32,
             serial: od.uint(0x1018, 4) as u32,
         };
+        let profile_kind = profile.kind;
         Drive {
             node,
             lss: lss::slave::Slave::new(address, node),
@@ -114,11 +125,18 @@ impl Drive {
             last_ns: None,
             next_heartbeat_ns: None,
             pending_fault: None,
+            vendor: Vendor::new(profile_kind),
+            sync_rpdo: Default::default(),
+            next_event_ns: [None; 4],
         }
     }
     /// The node id.
     pub fn node(&self) -> u8 {
         self.node
+    }
+    /// The built-in profile the drive's dictionary comes from.
+    pub fn dictionary(&self) -> &'static str {
+        self.profile.dictionary
     }
     /// The NMT state.
     pub fn nmt(&self) -> NmtState {
@@ -182,6 +200,15 @@ impl Drive {
     fn reset(&mut self, range: std::ops::RangeInclusive<u16>) {
         self.od.reset(range.clone());
         self.sdo = SdoServer::new(ServerConfig::default());
+        self.sync_rpdo = Default::default();
+        self.next_event_ns = [None; 4];
+        if range.contains(&0x2000) {
+            self.vendor = Vendor::new(self.profile.kind);
+            super::vendor::init_objects(self.profile.kind, &mut self.od);
+        } else {
+            self.vendor
+                .on_communication_reset(&mut self.od, self.profile.dictionary);
+        }
         if range.contains(&0x6000) {
             // Reset of the application: the power stage starts over.
             self.state = DriveState::SwitchOnDisabled;
@@ -239,19 +266,23 @@ impl Drive {
         let node = self.node as u32;
         match f.id {
             0x000 => self.on_nmt(f.payload(), now_ns),
-            0x080 if self.nmt == NmtState::Operational => self.on_sync(),
+            0x080 if self.nmt == NmtState::Operational => {
+                let mut out = self.apply_sync_rpdos();
+                out.extend(self.on_sync());
+                out
+            }
             id if id == 0x600 + node && self.nmt != NmtState::Stopped && !f.is_rtr() => {
                 let replies = self.sdo.on_frame(f.payload(), now_ns, &mut self.od).frames;
                 let mut out: Vec<Frame> = replies.iter().map(|r| Frame::classic(0x580 + node, r)).collect();
+                if self.profile.kind == Kind::Dexmart && alarm_reset(f.payload(), replies.first()) {
+                    out.extend(self.clear_fault());
+                }
+                let faulted = self.faulted();
+                self.vendor.on_sdo(&mut self.od, self.profile.dictionary, faulted);
                 out.extend(self.apply_objects());
                 out
             }
-            id if self.nmt == NmtState::Operational && !f.is_rtr() => {
-                let out = self.on_rpdo(id, f.payload());
-                let mut all = out;
-                all.extend(self.apply_objects());
-                all
-            }
+            id if self.nmt == NmtState::Operational && !f.is_rtr() => self.on_rpdo(id, f.payload()),
             _ => Vec::new(),
         }
     }
@@ -286,46 +317,93 @@ impl Drive {
         (self.od.entry(comm, 1).is_some() && cob & 0x8000_0000 == 0).then_some(cob & 0x7FF)
     }
 
+    /// An RPDO: stored at once (asynchronous types 254/255) or at the next SYNC.
     fn on_rpdo(&mut self, id: u32, p: &[u8]) -> Vec<Frame> {
+        let mut out = Vec::new();
         for n in 0..4u16 {
             if self.pdo_cob(0x1400 + n) != Some(id) {
                 continue;
             }
-            let map = 0x1600 + n;
-            let mut bit = 0usize;
-            for i in 1..=self.od.uint(map, 0) as u8 {
-                let e = self.od.uint(map, i) as u32;
-                let (index, sub, bits) = ((e >> 16) as u16, (e >> 8) as u8, (e & 0xFF) as usize);
-                let bytes = bits / 8;
-                if bit / 8 + bytes > p.len() {
-                    break;
-                }
-                self.od.set(index, sub, &p[bit / 8..bit / 8 + bytes]);
-                bit += bits;
+            if self.od.uint(0x1400 + n, 2) <= 240 {
+                self.sync_rpdo[n as usize] = Some(p.to_vec());
+            } else {
+                out.extend(self.take_rpdo(n, p));
             }
         }
-        Vec::new()
+        out
+    }
+
+    /// The synchronous RPDOs received since the last SYNC take effect.
+    fn apply_sync_rpdos(&mut self) -> Vec<Frame> {
+        let mut out = Vec::new();
+        for n in 0..4u16 {
+            if let Some(p) = self.sync_rpdo[n as usize].take() {
+                out.extend(self.take_rpdo(n, &p));
+            }
+        }
+        out
+    }
+
+    /// Writes RPDO `n`'s data into the mapped objects and acts on them.
+    fn take_rpdo(&mut self, n: u16, p: &[u8]) -> Vec<Frame> {
+        let map = 0x1600 + n;
+        let mut bit = 0usize;
+        for i in 1..=self.od.uint(map, 0) as u8 {
+            let e = self.od.uint(map, i) as u32;
+            let (index, sub, bits) = ((e >> 16) as u16, (e >> 8) as u8, (e & 0xFF) as usize);
+            let bytes = bits / 8;
+            if bit / 8 + bytes > p.len() {
+                break;
+            }
+            self.od.set(index, sub, &p[bit / 8..bit / 8 + bytes]);
+            bit += bits;
+        }
+        let replies = self.vendor.on_rpdo(n, &self.od, self.faulted());
+        let mut out = self.apply_objects();
+        out.extend(replies.into_iter().filter_map(|t| self.tpdo_frame(t)));
+        out
+    }
+
+    /// TPDO `n` (0-based) with the current values of its mapped objects, when valid.
+    fn tpdo_frame(&self, n: u16) -> Option<Frame> {
+        let cob = self.pdo_cob(0x1800 + n)?;
+        let map = 0x1A00 + n;
+        let mut data = Vec::new();
+        for i in 1..=self.od.uint(map, 0) as u8 {
+            let e = self.od.uint(map, i) as u32;
+            let (index, sub, bits) = ((e >> 16) as u16, (e >> 8) as u8, (e & 0xFF) as usize);
+            let mut v = self.od.entry(index, sub).map(|x| x.data.clone()).unwrap_or_default();
+            v.resize(bits / 8, 0);
+            data.extend_from_slice(&v);
+        }
+        (data.len() <= 8).then(|| Frame::classic(cob, &data))
     }
 
     fn on_sync(&mut self) -> Vec<Frame> {
+        (0..4u16)
+            .filter(|n| (1..=240).contains(&self.od.uint(0x1800 + n, 2)))
+            .filter_map(|n| self.tpdo_frame(n))
+            .collect()
+    }
+
+    /// The event-driven TPDOs (types 254/255) whose event timer ran out at `now_ns`.
+    fn event_tpdos(&mut self, now_ns: u64) -> Vec<Frame> {
         let mut out = Vec::new();
         for n in 0..4u16 {
-            let Some(cob) = self.pdo_cob(0x1800 + n) else { continue };
-            let kind = self.od.uint(0x1800 + n, 2);
-            if !(1..=240).contains(&kind) {
+            let period_ns = self.od.uint(0x1800 + n, 5) * 1_000_000;
+            let timed = self.od.uint(0x1800 + n, 2) >= 254 && period_ns > 0 && self.pdo_cob(0x1800 + n).is_some();
+            let slot = &mut self.next_event_ns[n as usize];
+            if !timed || self.nmt != NmtState::Operational {
+                *slot = None;
                 continue;
             }
-            let map = 0x1A00 + n;
-            let mut data = Vec::new();
-            for i in 1..=self.od.uint(map, 0) as u8 {
-                let e = self.od.uint(map, i) as u32;
-                let (index, sub, bits) = ((e >> 16) as u16, (e >> 8) as u8, (e & 0xFF) as usize);
-                let mut v = self.od.entry(index, sub).map(|x| x.data.clone()).unwrap_or_default();
-                v.resize(bits / 8, 0);
-                data.extend_from_slice(&v);
-            }
-            if data.len() <= 8 {
-                out.push(Frame::classic(cob, &data));
+            match *slot {
+                Some(due) if now_ns >= due => {
+                    *slot = Some(due.max(now_ns - period_ns) + period_ns);
+                    out.extend(self.tpdo_frame(n));
+                }
+                Some(_) => {}
+                None => *slot = Some(now_ns + period_ns),
             }
         }
         out
@@ -333,6 +411,9 @@ impl Drive {
 
     /// Acts on objects written by SDO or RPDO: controlword and mode of operation.
     fn apply_objects(&mut self) -> Vec<Frame> {
+        if self.profile.kind != Kind::Cia402 {
+            return Vec::new();
+        }
         let mode = self.od.int(0x6060, 0);
         self.od.set_int(0x6061, 0, mode);
         let cw = self.od.uint(0x6040, 0) as u16;
@@ -356,9 +437,7 @@ impl Drive {
         self.state = match self.state {
             Fault if rising_reset => {
                 // Transition 15; the reset EMCY tells the bus the error is gone.
-                self.od.set_int(0x603F, 0, 0);
-                self.od.set_int(0x1001, 0, 0);
-                out.push(self.emcy(0x0000));
+                out = self.clear_fault();
                 SwitchOnDisabled
             }
             SwitchOnDisabled if shutdown => ReadyToSwitchOn,
@@ -445,6 +524,23 @@ impl Drive {
         }
     }
 
+    /// In fault (or its reaction).
+    fn faulted(&self) -> bool {
+        matches!(self.state, DriveState::Fault | DriveState::FaultReactionActive)
+    }
+
+    /// Leaves the fault (CiA 402 transition 15; Dexmart: 300Ah Alarm Reset): error register
+    /// and error code cleared, the reset EMCY sent.
+    fn clear_fault(&mut self) -> Vec<Frame> {
+        if !self.faulted() {
+            return Vec::new();
+        }
+        self.od.set_int(0x603F, 0, 0);
+        self.od.set_int(0x1001, 0, 0);
+        self.state = DriveState::SwitchOnDisabled;
+        vec![self.emcy(0x0000)]
+    }
+
     fn emcy(&self, code: u16) -> Frame {
         let c = code.to_le_bytes();
         let reg = self.od.uint(0x1001, 0) as u8;
@@ -471,6 +567,12 @@ impl Drive {
             sw |= self.mode_bits();
         }
         self.od.set_int(0x6041, 0, sw as i64);
+        // Profile and cyclic torque: the torque follows its target while enabled.
+        let torque = match self.mode() {
+            MODE_PT | MODE_CST if self.state == OperationEnabled => self.od.int(0x6071, 0),
+            _ => 0,
+        };
+        self.od.set_int(0x6077, 0, torque);
         self.od.set_int(0x606C, 0, self.velocity.round() as i64);
         self.od.set_int(0x6064, 0, self.position.round() as i64);
     }
@@ -511,19 +613,30 @@ impl Drive {
             if self.nmt != NmtState::Stopped && self.configured() {
                 out.push(self.emcy(code));
             }
+            if self.profile.kind == Kind::Aqmd && self.nmt == NmtState::Operational {
+                // AQMD manual: after an EMCY in operational the driver drops to
+                // pre-operational and needs an NMT start.
+                self.nmt = NmtState::PreOperational;
+            }
         } else if self.state == DriveState::FaultReactionActive {
             // Transition 14: the fault reaction (motor stopped) is done.
             self.velocity = 0.0;
             self.state = DriveState::Fault;
         }
-        self.move_axis(dt);
-        self.update_statusword();
+        if self.profile.kind == Kind::Cia402 {
+            self.move_axis(dt);
+            self.update_statusword();
+        } else {
+            let faulted = self.faulted();
+            self.vendor.tick(dt, &mut self.od, faulted);
+        }
         if self.silent {
             return Vec::new();
         }
         if !self.configured() {
             return out;
         }
+        out.extend(self.event_tpdos(now_ns));
         if let Some(next) = self.next_heartbeat_ns {
             if now_ns >= next {
                 out.push(Frame::classic(0x700 + self.node as u32, &[self.nmt.byte()]));
@@ -578,6 +691,15 @@ impl Drive {
             self.state = DriveState::SwitchOnDisabled;
         }
     }
+}
+
+/// Is this SDO request, answered by `reply`, a successful expedited download of 0x0000
+/// (Alarm Reset) to the Dexmart command object 300Ah?
+fn alarm_reset(request: &[u8], reply: Option<&[u8; 8]>) -> bool {
+    let [cs, 0x0A, 0x30, 0, data @ ..] = request else {
+        return false;
+    };
+    cs & 0xE2 == 0x22 && data.iter().take(2).all(|b| *b == 0) && reply.is_some_and(|r| r[0] == 0x60)
 }
 
 /// The error register (0x1001) bits for an EMCY error code: generic plus the class
@@ -747,5 +869,38 @@ mod tests {
         assert_eq!(d.nmt(), NmtState::PreOperational);
         assert!(d.on_frame(&Frame::classic(0x000, &[0x01, 0x03]), 0).is_empty());
         assert_eq!(d.nmt(), NmtState::PreOperational, "command for node 3 ignored");
+    }
+
+    #[test]
+    fn an_aqmd_fault_stops_the_motor_and_drops_to_pre_operational() {
+        let mut d = Drive::new(1, DriveProfile::aqmd_like());
+        d.power_on(0);
+        d.on_frame(&Frame::classic(0x000, &[0x01, 0x01]), 0);
+        // Manual 7.5.4: RPDO1 "201 03 88 13 00 F4 01 00 00" (command 3, speed 5000).
+        d.on_frame(&Frame::classic(0x201, &[0x03, 0x88, 0x13, 0x00, 0xF4, 0x01, 0, 0]), 0);
+        d.tick(0);
+        d.tick(1_000_000_000);
+        assert_eq!(d.objects().int(0x2101, 0), 1000, "duty capped at 100 %");
+        d.inject_fault(0x2310);
+        let emcy = d.tick(1_010_000_000);
+        assert_eq!(emcy[0].payload()[..3], [0x10, 0x23, 0x03]);
+        assert_eq!(d.nmt(), NmtState::PreOperational);
+        d.tick(3_000_000_000);
+        assert_eq!(d.objects().int(0x2101, 0), 0, "stopped by the fault");
+    }
+
+    #[test]
+    fn a_dexmart_fault_is_cleared_by_alarm_reset_300a() {
+        let mut d = Drive::new(1, DriveProfile::dexmart_like());
+        d.power_on(0);
+        d.inject_fault(0x3210);
+        d.tick(0);
+        d.tick(10_000_000);
+        assert_eq!(d.state(), DriveState::Fault);
+        let out = d.on_frame(&Frame::classic(0x601, &[0x2B, 0x0A, 0x30, 0, 0, 0, 0, 0]), 0);
+        assert_eq!(out[0].payload()[0], 0x60, "download answered");
+        assert_eq!((out[1].id, out[1].payload()), (0x81, &[0u8; 8][..]), "reset EMCY");
+        assert_eq!(d.objects().uint(0x1001, 0), 0);
+        assert_ne!(d.state(), DriveState::Fault);
     }
 }

@@ -3,18 +3,20 @@
 //! out). [`serve`] runs them on a bus on a tokio interval: [`demo`] on an in-process
 //! virtual bus, `cotui sim` on a SocketCAN interface.
 
+pub mod control;
 pub mod demo;
 pub mod drive;
 pub mod od;
 pub mod profile;
 pub mod serve;
+pub mod spec;
 pub mod synth;
+pub mod vendor;
 
 use crate::decode::pdo::entry_from_u32;
 use crate::frame::Frame;
 use crate::od::{MappingSource, PdoMapping, Profile};
 use drive::Drive;
-use profile::DriveProfile;
 use std::collections::BTreeMap;
 
 /// A set of simulated nodes plus a SYNC producer.
@@ -28,8 +30,8 @@ pub struct Simulation {
     start_all_at_ns: Option<u64>,
 }
 
-/// The seed profiles the demo's drives are built after: (node, profile name).
-pub const DEMO_PROFILES: [(u8, &str); 2] = [(2, "aimotor"), (3, "syntron-ds")];
+/// The drives of the demo when `--node` is not given (`NODE=MODEL`, see [`spec`]).
+pub const DEMO_NODES: [&str; 2] = ["2=aimotor", "3=syntron-ds"];
 
 impl Simulation {
     /// Drives at the given nodes, SYNC every `sync_ms` (0 = none), no NMT master.
@@ -41,24 +43,37 @@ impl Simulation {
             start_all_at_ns: None,
         }
     }
-    /// The demo bus: an AIMOTOR-like drive at node 2 and a Syn-tron-like one at node 3, SYNC every 100 ms, and an NMT master that
-    /// starts all nodes 0.8 s after power-on.
+    /// The standard demo bus: an AIMOTOR-like drive at node 2 and a Syn-tron-like one at
+    /// node 3 ([`DEMO_NODES`]), see [`Simulation::demo_with`].
     pub fn demo() -> Simulation {
-        let mut s = Simulation::new(
-            vec![
-                Drive::new(2, DriveProfile::aimotor_like()),
-                Drive::new(3, DriveProfile::syntron_like()),
-            ],
-            100,
-        );
+        let drives = DEMO_NODES
+            .iter()
+            .filter_map(|s| spec::parse_node(s).ok())
+            .map(|(node, p)| Drive::new(node, p))
+            .collect();
+        Simulation::demo_with(drives)
+    }
+    /// A demo bus with these drives, SYNC every 100 ms, and an NMT master that starts all
+    /// nodes 0.8 s after power-on.
+    pub fn demo_with(drives: Vec<Drive>) -> Simulation {
+        let mut s = Simulation::new(drives, 100);
         s.start_all_at_ns = Some(800_000_000);
         s
+    }
+    /// The built-in profile each configured drive is modelled after: (node, profile name).
+    pub fn profiles(&self) -> Vec<(u8, &'static str)> {
+        self.drives
+            .iter()
+            .filter(|d| d.node() != crate::lss::UNCONFIGURED)
+            .map(|d| (d.node(), d.dictionary()))
+            .collect()
     }
     /// The PDO mappings each drive starts with, as a dictionary layer per node, so that
     /// the demo decodes PDOs from the first frame. The source reads "demo simulator".
     pub fn pdo_layers(&self) -> Vec<(u8, Profile)> {
         self.drives
             .iter()
+            .filter(|d| d.node() != crate::lss::UNCONFIGURED)
             .map(|d| {
                 let od = d.objects();
                 let source = MappingSource::Profile("demo simulator".into());

@@ -173,7 +173,7 @@ fn event_level(what: &crate::analysis::What) -> Level {
 /// Names the palette completes.
 pub const PALETTE_COMMANDS: &[&str] = &[
     "filter", "search", "goto", "time", "speed", "pause", "resume", "rewind", "plot", "export", "help", "messages",
-    "quit", "jobs",
+    "quit", "jobs", "sim",
 ];
 
 /// Why a built-in palette command (`goto`, `time`, `speed`, `plot`, `export`, ...) failed;
@@ -640,6 +640,24 @@ impl App {
         }
     }
 
+    /// `sim fault NODE CODE`, `sim silence NODE`, `sim reboot NODE`, ... on the demo's
+    /// simulated drives (the words of `cotui sim`'s stdin): asks the live task.
+    fn sim_command(&mut self, line: &str, rest: &str) {
+        let control = match crate::sim::control::Control::parse(rest) {
+            Ok(c) => c,
+            Err(e) => return self.say(Level::Error, &format!("sim: {e}")),
+        };
+        match (&self.source.kind, &self.source.requests) {
+            (SourceKind::Demo { .. }, Some(req)) => {
+                let _ = req.send(Request::Sim {
+                    line: line.to_string(),
+                    control,
+                });
+            }
+            _ => self.say(Level::Error, "sim: only the demo's drives are simulated (`cotui demo`)"),
+        }
+    }
+
     /// True when the source cannot send (listen-only).
     fn listen_only(&self) -> bool {
         matches!(
@@ -851,6 +869,10 @@ impl App {
             }
             "record" => {
                 self.record_command(rest);
+                return;
+            }
+            "sim" => {
+                self.sim_command(line, rest);
                 return;
             }
             "stop" => {

@@ -13,6 +13,8 @@ use crate::command::{self, Command};
 use crate::decode::cia402::DriveState;
 use crate::frame::Frame;
 use crate::od::bind::Bindings;
+use crate::sim::control::Control;
+use crate::sim::demo::Demo;
 use std::collections::BTreeSet;
 use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::time::Duration;
@@ -31,6 +33,9 @@ pub enum Request {
     ListJobs,
     /// `jobs stop ID`: stop one of them, with its timing report.
     StopJob(u32),
+    /// `sim fault|silence|resume|reboot|mains|status ...` (`line` as typed): make a node of
+    /// the demo's simulation fail; refused on other sources.
+    Sim { line: String, control: Control },
 }
 
 /// A handle to send requests to the live task.
@@ -41,9 +46,14 @@ const BATCH: usize = 1024;
 /// Capacity of the feed channel in batches; when full, frames are dropped and counted.
 const QUEUE: usize = 256;
 
-/// Starts capturing `iface` (`demo` for the simulated bus); commands use `bindings` for
-/// object names and types.
-pub fn start(iface: &str, listen_only: bool, bindings: Bindings) -> (Receiver<Feed>, Requests) {
+/// Starts capturing `iface` (`demo` for the simulated bus: `demo` runs that simulation,
+/// the standard demo when `None`); commands use `bindings` for object names and types.
+pub fn start(
+    iface: &str,
+    listen_only: bool,
+    bindings: Bindings,
+    demo: Option<crate::sim::Simulation>,
+) -> (Receiver<Feed>, Requests) {
     let (tx, rx) = sync_channel(QUEUE);
     let (req_tx, req_rx) = unbounded_channel();
     let iface = iface.to_string();
@@ -56,7 +66,7 @@ pub fn start(iface: &str, listen_only: bool, bindings: Bindings) -> (Receiver<Fe
                 return;
             }
         };
-        rt.block_on(capture(iface, listen_only, bindings, tx, req_rx));
+        rt.block_on(capture(iface, listen_only, bindings, tx, req_rx, demo));
     });
     (rx, req_tx)
 }
@@ -84,6 +94,7 @@ async fn capture(
     bindings: Bindings,
     tx: SyncSender<Feed>,
     mut req: UnboundedReceiver<Request>,
+    mut demo: Option<crate::sim::Simulation>,
 ) {
     if tx.send(Feed::Interfaces(vec![iface.clone()])).is_err() {
         return;
@@ -91,7 +102,15 @@ async fn capture(
     // Nodes a stop confirmed stopped, from the stop task back to this loop.
     let (stopped_tx, mut stopped) = unbounded_channel();
     let mut jobs = Jobs::new(stopped_tx);
+    // The demo's simulation, for `sim` commands (none on a real interface).
+    let mut sim: Option<Demo> = None;
     let bus = loop {
+        if iface == crate::connect::DEMO {
+            let d = Demo::spawn(demo.take().unwrap_or_else(crate::sim::Simulation::demo), listen_only);
+            let bus = d.bus.clone();
+            sim = Some(d);
+            break bus;
+        }
         match crate::connect::open(&iface, listen_only).await {
             Ok(b) => break b,
             Err(e) => {
@@ -166,12 +185,40 @@ async fn capture(
                 }
             }
             r = req.recv() => match r {
+                Some(Request::Sim { line, control }) => {
+                    let feed = simulate(sim.as_ref(), &line, control).await;
+                    let _ = tx.send(feed);
+                }
                 Some(r) => jobs.start(&bus, r, &bindings, &tx),
                 None => return,
             },
             Some(nodes) = stopped.recv() => jobs.stopped(&nodes),
         }
     }
+}
+
+/// Why a `sim` command is refused on a real bus.
+fn not_simulated(line: &str) -> String {
+    format!("{line}: only the demo's drives are simulated (`cotui demo`)")
+}
+
+/// Carries out a `sim` command on the demo's simulation: the nodes' frames (boot-up after a
+/// reboot) go out from the simulation's side of the bus.
+async fn simulate(demo: Option<&Demo>, line: &str, control: Control) -> Feed {
+    let Some(demo) = demo else {
+        return Feed::Result(Level::Error, not_simulated(line));
+    };
+    let now = demo.nodes.now_ns();
+    let (text, frames) = match demo.sim.lock() {
+        Ok(mut s) => control.apply(&mut s, now),
+        Err(_) => return Feed::Result(Level::Error, format!("{line}: the simulation is unavailable")),
+    };
+    for f in &frames {
+        if let Err(e) = demo.nodes.send(f).await {
+            return Feed::Result(Level::Error, format!("{line}: {e}"));
+        }
+    }
+    Feed::Result(Level::Info, format!("{line}: {text}"))
 }
 
 /// The feed item for a change of state: trouble (with the fix) or all well again (saying
@@ -289,6 +336,9 @@ impl Jobs {
                 });
                 self.next_id += 1;
             }
+            Request::Sim { line, .. } => {
+                let _ = tx.send(Feed::Result(Level::Error, not_simulated(&line)));
+            }
             Request::ListJobs => {
                 let text = if self.running.is_empty() {
                     "jobs: nothing running".to_string()
@@ -351,6 +401,7 @@ impl Jobs {
         let text = match r {
             Request::Run { line, .. } => format!("{line}: not sent: {why}"),
             Request::ListJobs | Request::StopJob(_) => format!("jobs: the bus is unavailable ({why})"),
+            Request::Sim { line, .. } => not_simulated(&line),
             Request::StopAll { .. } => {
                 let cancelled = self.cancel_all();
                 format!(

@@ -180,7 +180,9 @@ fn unknown_procedures_and_parameters_name_the_valid_ones() {
     let (rc, _, err) = cotui(&["run", "demo", "2", "fly", "--profile", "2=aimotor"]);
     assert_eq!(rc, 1);
     assert!(
-        err.contains("node 2 has no procedure `fly`; its procedures: csv_pdo_remap, hm, pp, pp_example, pt, pv"),
+        err.contains(
+            "node 2 has no procedure `fly`; its procedures: csp, cst, csv, csv_pdo_remap, hm, pp, pp_example, pt, pv"
+        ),
         "{err}"
     );
     let (rc, out, err) = cotui(&["run", "demo", "2", "pv", "rpm=3", "--profile", "2=aimotor", "--json"]);
@@ -229,38 +231,20 @@ fn list_shows_procedures_with_descriptions_and_parameters() {
     assert_eq!(pv["steps"], 9);
 }
 
-/// Every procedure of the demo drives' profiles runs to completion on the demo bus: the
-/// simulated drives have the profiles' whole dictionaries and the modes the procedures use
-/// (PP set-point, PV, PT, HM homing attained, cyclic modes, PDO remapping).
+/// `cotui demo --node` takes the same NODE=MODEL as `cotui sim`; a wrong one is refused
+/// before the terminal is touched, naming the simulated drives.
 #[test]
-fn every_procedure_of_the_demo_drives_runs_to_completion() {
-    for (node, profile) in [("2", "aimotor"), ("3", "syntron-ds")] {
-        let (rc, out, err) = cotui(&["run", "demo", node, "--list", "--json"]);
-        assert_eq!(rc, 0, "{err}");
-        let list = json(&out);
-        let names: Vec<String> = list["procedures"]
-            .as_array()
-            .unwrap_or_else(|| panic!("no procedures in {list}"))
-            .iter()
-            .map(|p| p["name"].as_str().unwrap().to_string())
-            .collect();
-        assert!(names.len() >= 6, "{profile}: {names:?}");
-        let planned: Vec<u64> = list["procedures"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|p| p["steps"].as_u64().unwrap())
-            .collect();
-        for (name, steps) in names.iter().zip(planned) {
-            let (rc, out, err) = cotui(&["run", "demo", node, name, "--json"]);
-            assert_eq!(rc, 0, "{profile} {name}: exit {rc}\n{out}\n{err}");
-            let v = json(&out);
-            assert_eq!(v["ok"], true, "{profile} {name}: {v}");
-            assert_eq!(
-                v["steps"].as_array().map(Vec::len),
-                Some(steps as usize),
-                "{profile} {name}: every step done"
-            );
-        }
-    }
+fn demo_node_errors_name_the_simulated_drives() {
+    let (rc, out, err) = cotui(&["demo", "--node", "2=plc"]);
+    assert_eq!((rc, out.as_str()), (1, ""));
+    assert_eq!(
+        err.trim(),
+        "cotui demo: --node 2=plc: unknown drive `plc`; the simulated drives: aimotor, syntron-ds, dexmart-dev, aqmd2405, servo"
+    );
+    let (rc, _, err) = cotui(&["demo", "--node", "0=aimotor"]);
+    assert_eq!(rc, 1);
+    assert!(err.contains("node-ID `0` is not 1..127 or ff"), "{err}");
+    let (rc, _, err) = cotui(&["demo", "--node", "4=aqmd2405", "--node", "4=dexmart-dev"]);
+    assert_eq!(rc, 1);
+    assert!(err.contains("node 4 is given twice"), "{err}");
 }

@@ -2,13 +2,13 @@
 //! (`Drive::new(0xFF, ..)`, as `cotui sim --node ff=servo@SERIAL` runs them), tokio time
 //! paused: fresh drives get their node-IDs one by one, then answer SDO there.
 
-use cotui::cli::sim::parse_node;
 use cotui::command::sdo::upload;
 use cotui::command::{CommandError, ExitCode, execute, parse_command};
 use cotui::od::bind::Bindings;
 use cotui::sim::Simulation;
 use cotui::sim::demo::Demo;
 use cotui::sim::drive::Drive;
+use cotui::sim::spec::parse_node;
 
 fn fresh_drives(specs: &[&str]) -> Demo {
     let drives = specs

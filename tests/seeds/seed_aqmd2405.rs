@@ -257,6 +257,10 @@ fn communication_object_table() {
     let x = f.at(106, 0x601, "23161001F4010200");
     sdo(x, "sdo_rx", 1, 0x1016, 1, Some(0x0002_01F4));
     assert_eq!(x["sdo"]["value_text"], "0x000201F4 (node 2, time 500 ms)");
+    assert_eq!(
+        x["sdo"]["value_parts"],
+        json!([{"name": "node", "raw": 2, "text": "2"}, {"name": "time", "raw": 500, "text": "500 ms"}])
+    );
     // 0x1018 sub 0 "U8 0x04 RO"
     sdo(f.at(107, 0x581, "4F18100004000000"), "sdo_tx", 1, 0x1018, 0, Some(4));
     // 0x1400 sub 1 "0x200L" (+ node-ID), 0x1801 sub 1 with bit 31 "PDO not valid"

@@ -251,8 +251,18 @@ fn error_history_and_manufacturer_status_are_split() {
 (0.005) can0 581#4316100164000200
 ";
     let f = decode(&["1=dexmart-dev"], log);
+    let x = f.at(2, 0x581, "4303100110230507");
+    // The fields are in the JSON too, raw and as shown.
+    assert_eq!(
+        x["sdo"]["value_parts"],
+        json!([
+            {"name": "error code", "raw": 0x2310, "text": "0x2310 Continuous over-current"},
+            {"name": "M1 alarm code", "raw": 5, "text": "0x05"},
+            {"name": "M2 alarm code", "raw": 7, "text": "0x07"}
+        ])
+    );
     label_has(
-        f.at(2, 0x581, "4303100110230507"),
+        x,
         &[
             "Standard error field 1 = 0x07052310 (error code 0x2310 Continuous over-current, M1 alarm code 0x05, M2 alarm code 0x07)",
         ],
@@ -265,6 +275,21 @@ fn error_history_and_manufacturer_status_are_split() {
         f.at(6, 0x581, "4316100164000200"),
         &["Consumer heartbeat time 1 = 0x00020064 (node 2, time 100 ms)"],
     );
+    // The transfers' records carry the same fields.
+    let lines = run(
+        &["--transactions", "--format", "jsonl", "--profile", "1=dexmart-dev"],
+        log,
+    );
+    let records: Vec<Value> = lines.iter().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let heartbeat = records.iter().find(|r| r["index"] == 0x1016).expect("0x1016 transfer");
+    assert_eq!(
+        heartbeat["value_parts"][0],
+        json!({"name": "node", "raw": 2, "text": "2"})
+    );
+    assert_eq!(heartbeat["value_parts"][1]["text"], "100 ms");
+    let status = records.iter().find(|r| r["index"] == 0x1002).expect("0x1002 transfer");
+    assert_eq!(status["value_parts"][0]["name"], "M1 motor state");
+    assert_eq!(status["value_parts"][0]["raw"], 3);
 }
 
 #[test]

@@ -139,10 +139,19 @@ fn syntron_pv_and_hm_match_the_manual_lists() {
     );
     // 3.8.1: "601 E9 18 23 00 36 00 CA FF  // write 0x2318 and 0x3318 = 54 and -54"
     assert_eq!(expand("syntron-ds", 1, "dual_speed"), ["601#E91823003600CAFF"]);
-    // 3.8: "602 2B 18 23 00 64 00 00 00", "602 2B 00 21 00 01 ...", "602 40 00 50 00 ..."
+    // 3.8 STEP1 "F0.1.002 = 1, F0.3.018 = 0, F0.1.000 = 0, Pn5.00A = 0" (speed mode, speed 0, stopped,
+    // RAM only), STEP2 "602 2B 18 23 00 64 00 00 00", "602 2B 00 21 00 01 ...", "602 40 00 50 00 ..."
     assert_eq!(
         expand("syntron-ds", 2, "vendor_speed"),
-        ["602#2B18230064000000", "602#2B00210001000000", "602#4000500000000000"]
+        [
+            "602#2B02210001000000",
+            "602#2B18230000000000",
+            "602#2B00210000000000",
+            "602#2B0A450000000000",
+            "602#2B18230064000000",
+            "602#2B00210001000000",
+            "602#4000500000000000",
+        ]
     );
 }
 
@@ -543,4 +552,51 @@ async fn homing_waits_for_homing_attained_and_reports_homing_error() {
         "{msg}"
     );
     assert!(msg.contains("target reached, homing error]"), "{msg}");
+}
+
+#[test]
+fn aimotor_cyclic_synchronous_enables_follow_sections_2_7_and_5_4_5_5() {
+    // 5.4: RPDO1 mapped in pre-operational with the COB-ID invalid, entries written with
+    // "601 23 00 16 0n ..", transmission type 1 ("601 2F 00 14 02 01"); 5.5: the RPDO
+    // "201 0F 00 03 E8 03 00 00" (6040h, 6060h, target) followed by SYNC "080"; 2.7: the
+    // controlword 00h -> 06h -> 07h -> 0Fh in the cyclic modes goes by PDO.
+    let csv = expand("aimotor", 1, "csv");
+    assert_eq!(
+        csv[..11],
+        [
+            "000#8001",
+            "601#2300140101020080",
+            "601#2F00140201000000",
+            "601#2F00160000000000",
+            "601#2300160110004060",
+            "601#2300160208006060",
+            "601#230016032000FF60",
+            "601#2F00160003000000",
+            "601#2300140101020000",
+            "601#23061000D0070000",
+            "000#0101",
+        ]
+    );
+    assert_eq!(
+        csv[11..19],
+        [
+            "201#000009E8030000",
+            "080#",
+            "201#060009E8030000",
+            "080#",
+            "201#070009E8030000",
+            "080#",
+            "201#0F0009E8030000",
+            "080#",
+        ]
+    );
+    // Operation enabled is read back, then the velocity.
+    assert_eq!(csv[19..], ["601#4041600000000000", "601#406C600000000000"]);
+    let csp = expand("aimotor", 1, "csp");
+    assert_eq!(csp[6], "601#2300160320007A60");
+    assert_eq!(csp[17], "201#0F000800000000");
+    let cst = expand("aimotor", 1, "cst");
+    assert_eq!(cst[6], "601#2300160310007160");
+    assert_eq!(cst[17], "201#0F000A6400");
+    assert_eq!(cst.last().map(String::as_str), Some("601#4077600000000000"));
 }

@@ -218,3 +218,68 @@ fn procedures_write_only_objects_their_profile_lets_them_write() {
         assert!(writes > 0, "{name}: no procedure writes anything");
     }
 }
+
+#[test]
+fn syntron_cia402_object_list_of_section_3_4_3() {
+    use DataType::*;
+    use cotui::od::{Access, DataType};
+    let d = dict(load("syntron-ds"));
+    // "Mode Index Name Type Attr. unit": every row of the table; units as (unit, scale) of the
+    // physical value ("0.1rpm" = rpm x 0.1, "millisecond from 0rpm to 3000rpm" = ms).
+    let rw = Access::Rw;
+    let ro = Access::Ro;
+    type Row = (u16, u8, DataType, Access, Option<&'static str>, Option<f64>);
+    let rows: [Row; 35] = [
+        (0x603F, 0, U16, ro, None, None),
+        (0x6040, 0, U16, rw, None, None),
+        (0x6041, 0, U16, ro, None, None),
+        (0x6060, 0, I8, rw, None, None),
+        (0x6061, 0, I8, ro, None, None),
+        (0x6062, 0, I32, ro, Some("pulse"), None),
+        (0x6063, 0, I32, rw, Some("inc"), None),
+        (0x6064, 0, I32, ro, None, None),
+        (0x6065, 0, U32, rw, Some("pulse"), None),
+        (0x6066, 0, U16, rw, Some("ms"), None),
+        (0x6067, 0, U32, rw, Some("pulse"), None),
+        (0x6068, 0, U16, rw, Some("ms"), None),
+        (0x6069, 0, I32, ro, Some("rpm"), Some(0.1)),
+        (0x606B, 0, I32, ro, Some("rpm"), Some(0.1)),
+        // The table leaves 606Ch's unit empty; it is the same 0.1 rpm as 606Bh/6069h.
+        (0x606C, 0, I32, ro, Some("rpm"), Some(0.1)),
+        (0x606D, 0, U16, rw, Some("rpm"), Some(0.1)),
+        (0x606E, 0, U16, rw, Some("ms"), None),
+        (0x606F, 0, U16, rw, Some("rpm"), Some(0.1)),
+        (0x6070, 0, U16, rw, Some("ms"), None),
+        (0x6071, 0, I16, rw, Some("%"), Some(0.1)),
+        (0x607A, 0, I32, rw, Some("pulse"), None),
+        (0x607C, 0, I32, rw, None, None),
+        (0x6081, 0, U32, rw, Some("rpm"), Some(0.1)),
+        (0x6083, 0, U32, rw, Some("ms"), None),
+        (0x6084, 0, U32, rw, Some("ms"), None),
+        // "6087h Torque slope INTEGER32" (CiA 402 says UNSIGNED32; the manual's type is kept).
+        (0x6087, 0, I32, rw, None, None),
+        // "6093h Position factor UNSIGNED32 RW": CiA 402's numerator/divisor record, as 3.7.2 writes it.
+        (0x6093, 1, U32, rw, None, None),
+        (0x6098, 0, I8, rw, None, None),
+        (0x6099, 1, U32, rw, Some("rpm"), Some(0.1)),
+        (0x609A, 0, U32, rw, Some("ms"), None),
+        (0x60F4, 0, I32, ro, Some("pulse"), None),
+        (0x60FC, 0, I32, ro, Some("pulse"), None),
+        (0x60FD, 0, U32, ro, None, None),
+        (0x60FE, 0, U32, ro, None, None),
+        (0x60FF, 0, I32, rw, Some("rpm"), Some(0.1)),
+    ];
+    for (index, sub, ty, access, unit, scale) in rows {
+        let o = d
+            .object(index, sub)
+            .unwrap_or_else(|| panic!("0x{index:04X}:{sub} missing"));
+        assert_eq!(
+            (o.data_type, o.access, o.unit.as_deref(), o.scale),
+            (ty, access, unit, scale),
+            "0x{index:04X}:{sub} {}",
+            o.name
+        );
+    }
+    assert_eq!(d.object(0x6093, 2).map(|o| o.data_type), Some(U32));
+    assert_eq!(d.object(0x6099, 2).map(|o| o.unit.as_deref()), Some(Some("rpm")));
+}

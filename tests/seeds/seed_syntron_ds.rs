@@ -451,3 +451,97 @@ fn statusword_values_of_section_3_4_2() {
         assert!(text.starts_with(&format!("0x{value:04X} ({state} [")), "{text}");
     }
 }
+
+#[test]
+fn controlword_and_statusword_bits_of_sections_3_4_1_and_3_4_2() {
+    // 3.4.1: "Bit8 Halt, Bit7 Fault Reset, Bit6-4 Operation mode specific, Bit3 Enable Operation,
+    // Bit2 Quick Stop, Bit1 Enable Voltage, Bit0 Switch on"; "write 0x06, 0x07, 0x0F to enable,
+    // 0x07 disables the motor again".
+    // 3.4.2: "Bit11 Internal Limit Active, Bit10 Target Reached, Bit9 Remote, Bit7 Warning, Bit6
+    // Switch On Disabled, Bit5 Quick Stop, Bit4 Voltage Enabled, Bit3 Fault, Bit2 Operation Enabled,
+    // Bit1 Switched On, Bit0 Ready to Switch On".
+    let log = "\
+(0.000) can0 602#2B4060008F010000
+(0.001) can0 602#2B40600007000000
+(0.002) can0 582#4B416000370E0000
+(0.003) can0 582#4B416000B80E0000
+";
+    let f = decode(&["2=syntron-ds"], log);
+    let x = f.at(1, 0x602, "2B4060008F010000");
+    label_has(x, &["Controlword = 0x018F", "Fault reset", "halt"]);
+    label_has(f.at(2, 0x602, "2B40600007000000"), &["Controlword = 0x0007 (Switch on"]);
+    label_has(
+        f.at(3, 0x582, "4B416000370E0000"),
+        &[
+            "Operation enabled [ready to switch on, switched on, operation enabled, voltage enabled, quick stop, remote, target reached, internal limit active]",
+        ],
+    );
+    label_has(
+        f.at(4, 0x582, "4B416000B80E0000"),
+        &["Fault [fault, voltage enabled, quick stop, warning, remote, target reached, internal limit active]"],
+    );
+}
+
+#[test]
+fn pdo_configuration_parameters_of_section_3_6_4_read_like_the_objects_they_set() {
+    // 3.6.4's Fn example, written by SDO: RPDO1 "F0.7.000 2, F0.7.001 513, F0.7.005 24640,
+    // F0.7.007 24672" (6040h + 6060h on 0x201); TPDO1 "F0.7.041 385, F0.7.042 1, F0.7.045 24641,
+    // F0.7.049 24639" (6041h ... 603Fh on 0x181, every SYNC); B: "F1.7.011 769".
+    let log = "\
+(0.000) can0 602#2B00270002000000
+(0.001) can0 602#2B01270001020000
+(0.002) can0 602#2B05270040600000
+(0.003) can0 602#2B07270060600000
+(0.004) can0 602#2B41270081010000
+(0.005) can0 602#2B42270001000000
+(0.006) can0 602#2B45270041600000
+(0.007) can0 602#2B4927003F600000
+(0.008) can0 602#2B11370001030000
+(0.009) can0 602#2B52370002000000
+";
+    let f = decode(&["2=syntron-ds"], log);
+    label_has(
+        f.at(1, 0x602, "2B00270002000000"),
+        &["A RPDO1 number of mapped objects (F0.7.000) = 2"],
+    );
+    label_has(
+        f.at(2, 0x602, "2B01270001020000"),
+        &["A RPDO1 COB-ID (F0.7.001)", "(COB-ID 0x201)"],
+    );
+    label_has(
+        f.at(3, 0x602, "2B05270040600000"),
+        &["(F0.7.005) = 24640 (0x6040 Controlword)"],
+    );
+    label_has(
+        f.at(4, 0x602, "2B07270060600000"),
+        &["24672 (0x6060 Modes of operation)"],
+    );
+    label_has(
+        f.at(5, 0x602, "2B41270081010000"),
+        &["A TPDO1 COB-ID (F0.7.041)", "(COB-ID 0x181)"],
+    );
+    label_has(
+        f.at(6, 0x602, "2B42270001000000"),
+        &["(F0.7.042) = 1 (synchronous, every SYNC)"],
+    );
+    label_has(f.at(7, 0x602, "2B45270041600000"), &["24641 (0x6041 Statusword)"]);
+    label_has(f.at(8, 0x602, "2B4927003F600000"), &["24639 (0x603F Error code)"]);
+    label_has(
+        f.at(9, 0x602, "2B11370001030000"),
+        &["B RPDO2 COB-ID (F1.7.011)", "(COB-ID 0x301)"],
+    );
+    label_has(
+        f.at(10, 0x602, "2B52370002000000"),
+        &["(F1.7.052) = 2 (synchronous, every 2 SYNCs)"],
+    );
+}
+
+#[test]
+fn homing_switch_input_of_section_3_7_4() {
+    // "the home switch is one of the input terminals Pn1.000~Pn1.007, set to 18"
+    let f = decode(&["2=syntron-ds"], "(0.000) can0 602#2B03410012000000\n");
+    label_has(
+        f.at(1, 0x602, "2B03410012000000"),
+        &["Input terminal 4 function (Pn1.003) = 18 (Home switch)"],
+    );
+}

@@ -2,7 +2,8 @@
 //! reach their states, help opens, a filter narrows the trace, `q` quits and the terminal
 //! comes back (the shell after cotui prints and the alternate screen is gone). A replay
 //! marks a node LOST while its log is silent (the replay clock); replay step, step back,
-//! `:goto`, `:time` (also after the end) and rewind move it as docs/TUI.md says.
+//! `:goto`, `:time` (also after the end) and rewind move it as docs/TUI.md says. The
+//! demo with chosen drives takes `:sim` failures and `:lss` against its LSS slave.
 //! Needs tmux (scripts/install-test-deps.sh installs it).
 
 use std::process::Command;
@@ -249,4 +250,85 @@ fn replay_steps_seeks_and_rewinds_as_documented() {
     s.keys(&["q"]);
     s.wait_for("cotui to exit", |t| t.contains("cotui-exit=0"));
     let _ = std::fs::remove_file(&log);
+}
+
+/// `cotui demo --node` picks the simulated drives (one without node-ID); `:sim` makes them
+/// fail (EMCY and Fault, heartbeat lost, boot-up after a reboot) and `:lss` finds and
+/// configures the one without node-ID; the message log keeps every answer.
+#[test]
+fn demo_nodes_sim_words_and_lss_from_the_palette() {
+    let bin = env!("CARGO_BIN_EXE_cotui");
+    let home = std::env::temp_dir().join(format!("cotui-sim-{}", std::process::id()));
+    std::fs::create_dir_all(&home).unwrap();
+    let cmd = format!(
+        "env XDG_CONFIG_HOME={} {bin} demo --node 2=aimotor --node 5=aqmd2405 --node ff=servo@0x1234; \
+         echo cotui-exit=$?; sleep 60",
+        home.display()
+    );
+    let s = Session::start(&format!("cotui-sim-{}", std::process::id()), &cmd);
+    s.wait_for("the chosen nodes to be operational", |t| {
+        t.contains("  2 Operational") && t.contains("  5 Operational")
+    });
+
+    s.keys(&[":", "sim fault 2 0x2310", "Enter"]);
+    s.wait_for("the fault", |t| t.contains("node 2: fault 0x2310 (EMCY, then Fault)"));
+    s.wait_for("the nodes pane to show it", |t| t.contains("  2 Operational     Fault"));
+    s.keys(&[":", "sim silence 5", "Enter"]);
+    s.wait_for("node 5 lost", |t| t.contains("  5 LOST"));
+    s.keys(&[":", "sim reboot 5", "Enter"]);
+    s.wait_for("node 5 back", |t| t.contains("  5 Pre-operational"));
+    s.keys(&[":", "sim fault 2", "Enter"]);
+    s.wait_for("the usage", |t| {
+        t.contains("sim: usage: fault NODE CODE | silence NODE")
+    });
+
+    // LSS: fastscan finds the drive without node-ID (it asks first), inquire reads its
+    // serial, set-node gives it node 9, in use after a reset communication.
+    s.keys(&[":", "lss fastscan", "Enter"]);
+    s.wait_for("the confirmation", |t| {
+        t.contains("LSS fastscan addresses every LSS slave")
+    });
+    s.keys(&["y"]);
+    s.wait_for("the fastscan result", |t| {
+        t.contains(
+            "lss fastscan: found a non-configured slave, now in configuration state: vendor 0x00000000 \
+             product 0x04020001 revision 0x00010000 serial 0x00001234",
+        )
+    });
+    s.keys(&[":", "lss inquire serial", "Enter"]);
+    s.wait_for("the serial", |t| {
+        t.contains("lss inquire serial: serial 0x00001234 (4660)")
+    });
+    s.keys(&[":", "lss set-node 9", "Enter"]);
+    s.wait_for("the confirmation", |t| {
+        t.contains("LSS set-node addresses every LSS slave")
+    });
+    s.keys(&["y"]);
+    s.wait_for("node-ID 9", |t| t.contains("lss set-node 9: node-ID 9 configured"));
+    s.keys(&[":", "nmt reset-comm 0", "Enter"]);
+    s.wait_for("the confirmation", |t| t.contains("press y to send"));
+    s.keys(&["y"]);
+    s.wait_for("node 9 on the bus", |t| t.contains("  9 Pre-operational"));
+
+    s.keys(&[":", "messages", "Enter"]);
+    let t = s.wait_for("the message log", |t| t.contains("Messages ("));
+    for line in [
+        "sim fault 2 0x2310: node 2: fault 0x2310 (EMCY, then Fault)",
+        "node 2 EMCY: 0x2310 Continuous over-current",
+        "node 5 heartbeat lost",
+        "node 5 rebooted: boot-up #2, node seen before; it was lost",
+        "lss set-node 9: node-ID 9 configured",
+        "node 9 boot-up",
+    ] {
+        assert!(t.contains(line), "{line} not in the log:\n{t}");
+    }
+    s.keys(&["Escape", "q"]);
+    let t = s.wait_for("cotui to exit or ask", |t| {
+        t.contains("cotui-exit=") || t.contains("y quits")
+    });
+    if !t.contains("cotui-exit=") {
+        s.keys(&["y"]);
+    }
+    s.wait_for("cotui to exit", |t| t.contains("cotui-exit=0"));
+    let _ = std::fs::remove_dir_all(&home);
 }

@@ -3,6 +3,7 @@
 //! label and as JSON.
 
 use super::value::{ValueView, segment_text};
+use crate::decode::value_text::ValuePart;
 use crate::frame::hex;
 use crate::frame::json::Hex;
 use crate::sdo::abort::abort_text;
@@ -208,6 +209,11 @@ impl SdoFrame {
             toggle: None,
             unused: None,
             value: self.value.as_ref().map(|v| &v.json),
+            value_parts: self
+                .value
+                .as_ref()
+                .map(|v| v.parts.as_slice())
+                .filter(|p| !p.is_empty()),
             value_text: self.value.as_ref().map(|v| v.text.as_str()),
         };
         match &self.command {
@@ -312,6 +318,9 @@ pub struct SdoJson<'a> {
     pub unused: Option<u8>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub value: Option<&'a serde_json::Value>,
+    /// The fields of a structured value (`name`, `raw`, `text`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub value_parts: Option<&'a [ValuePart]>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub value_text: Option<&'a str>,
 }

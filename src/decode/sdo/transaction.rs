@@ -2,6 +2,7 @@
 //! through the dictionary. The transfer itself is [`crate::sdo::transaction`].
 
 use super::value::{ValueView, view_in_mode};
+use crate::decode::value_text::ValuePart;
 use crate::frame::json::Hex;
 use crate::od::Dictionary;
 use crate::sdo::transaction::{Outcome, Protocol, Transaction, TransferDirection};
@@ -108,6 +109,7 @@ impl Transaction {
             start_ns: self.start_ns,
             sub: (!partial).then_some(self.sub),
             value_text: value.as_ref().map(|v| v.text.clone()),
+            value_parts: value.as_ref().map_or_else(Vec::new, |v| v.parts.clone()),
             value,
         }
     }
@@ -146,6 +148,9 @@ pub struct TransactionJson<'a> {
     /// The typed value (`null` without data or for a partial transfer).
     #[serde(serialize_with = "view_json")]
     pub value: Option<ValueView>,
+    /// The fields of a structured value (`name`, `raw`, `text`), left out when none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub value_parts: Vec<ValuePart>,
     pub value_text: Option<String>,
 }
 

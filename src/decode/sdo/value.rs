@@ -1,5 +1,6 @@
 //! Object values as SDO labels and JSON show them, typed through the dictionary.
 
+use crate::decode::value_text::ValuePart;
 use crate::frame::hex;
 use crate::od::{Dictionary, Value};
 
@@ -16,6 +17,8 @@ pub struct ValueView {
     /// Byte count the object's type expects, when it has a fixed size that
     /// differs from the bytes seen.
     pub type_len_mismatch: Option<usize>,
+    /// The fields of a structured value (0x1016, 0x1003, ...), empty for others.
+    pub parts: Vec<ValuePart>,
 }
 
 /// Little-endian unsigned integer of 1-4 bytes.
@@ -40,6 +43,9 @@ pub fn view_in_mode(dict: &Dictionary, index: u16, sub: u8, bytes: &[u8], mode: 
         return ValueView {
             text: crate::decode::value_text::object_text(dict, index, sub, &typed, mode),
             json: typed.to_json(),
+            parts: typed
+                .as_i64()
+                .map_or_else(Vec::new, |raw| crate::decode::value_text::parts(dict, index, sub, raw)),
             typed: Some(typed),
             type_len_mismatch: size.filter(|n| *n != bytes.len()),
         };
@@ -52,12 +58,14 @@ pub fn view_in_mode(dict: &Dictionary, index: u16, sub: u8, bytes: &[u8], mode: 
             json: n.into(),
             typed: None,
             type_len_mismatch: None,
+            parts: Vec::new(),
         },
         None => ValueView {
             text: hex::spaced(bytes),
             json: hex::upper(bytes).into(),
             typed: None,
             type_len_mismatch: None,
+            parts: Vec::new(),
         },
     }
 }

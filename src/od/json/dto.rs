@@ -72,6 +72,8 @@ pub(super) struct EntryDto {
     pub(super) subs: Option<BTreeMap<String, EntryDto>>,
     #[serde(default)]
     pub(super) fields: Vec<FieldDto>,
+    #[serde(default)]
+    pub(super) meaning: Option<String>,
 }
 
 #[derive(Deserialize)]

@@ -187,6 +187,7 @@ fn unknown_fields_types_and_bad_values_are_warnings() {
         "0x6060": { "name": "Modes", "type": "i8", "access": "rx", "values": { "three": "PV", "3": "PV" } },
         "nonsense": { "name": "N" },
         "0x2000": { "type": "u8" },
+        "0x2001": { "name": "COB", "type": "u16", "meaning": "cobid" },
         "0x1016": { "name": "HB", "subs": { "9..1": { "name": "x" }, "1": { "name": "Consumer 1" } } },
         "0x0000..0xFFFF": { "name": "huge", "subs": { "0..255": { "name": "x{i}" } } },
         "0x3000..0x2000": { "name": "backwards" }
@@ -207,6 +208,7 @@ fn unknown_fields_types_and_bad_values_are_warnings() {
         "objects.0x6060.values.three",
         "objects.nonsense",
         "objects.0x2000",
+        "objects.0x2001.meaning",
         "objects.0x1016.subs.9..1",
         "objects.0x0000..0xFFFF",
         "objects.0x3000..0x2000",
@@ -221,7 +223,8 @@ fn unknown_fields_types_and_bad_values_are_warnings() {
     ] {
         assert!(at.contains(&expected), "no warning at {expected}: {w:#?}");
     }
-    assert_eq!(w.len(), 18, "{w:#?}");
+    assert_eq!(w.len(), 19, "{w:#?}");
+    assert_eq!(p.object(0x2001, 0).unwrap().meaning, None);
     // The rest loaded.
     assert_eq!(p.object(0x6041, 0).unwrap().data_type, DataType::Domain);
     assert_eq!(

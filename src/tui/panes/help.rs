@@ -36,6 +36,10 @@ pub const PALETTE_SYNTAX: &[(&str, &str)] = &[
         "jobs [stop ID]",
         "Cyclic jobs (send/sync/pdo --every): list, or stop one",
     ),
+    (
+        "sim fault NODE CODE | silence|resume|reboot NODE | mains NODE on|off | status",
+        "Demo: make a simulated drive fail (EMCY + Fault, no heartbeat, boot-up)",
+    ),
 ];
 
 /// The filter language, one line per form.

@@ -3,9 +3,10 @@ block, abort), the CiA 402 state machine through BaseNode402, and LSS (fastscan,
 node-ID, store, selective switch, inquire).
 
 usage: sim_master.py IFACE EDS_DIR CHECK...
-  CHECK: sdo | 402 | lss
+  CHECK: sdo | 402 | lss | vendor
 Expects `cotui sim IFACE --node 2=aimotor --node ff=servo@0x99 --node ff=servo@0x1234
---write-eds EDS_DIR` on the bus. Prints one line per check: "ok <what>" or "FAIL <what>";
+--write-eds EDS_DIR` on the bus (vendor: `--node 4=dexmart-dev --node 6=aqmd2405`, after
+`cotui run IFACE 4 encoder_speed_m1` and `cotui run IFACE 6 rpdo_speed`). Prints one line per check: "ok <what>" or "FAIL <what>";
 exits 1 on any failure.
 """
 
@@ -116,6 +117,36 @@ def lss_checks(network):
     lss.send_switch_state_global(lss.WAITING_STATE)
 
 
+def vendor_checks(network, eds_dir):
+    """The simulated Dexmart (node 4) and AQMD (node 6): their seed manuals' objects over SDO,
+    and a Dexmart Multi-Drive command sent as a raw RPDO, answered by TPDO2."""
+    dex = canopen.RemoteNode(4, f"{eds_dir}/node4.eds")
+    aqmd = canopen.RemoteNode(6, f"{eds_dir}/node6.eds")
+    for node in (dex, aqmd):
+        network.add_node(node)
+        node.sdo.RESPONSE_TIMEOUT = 3.0
+    name = dex.sdo.upload(0x1008, 0).decode()
+    check("dexmart: 0x1008 starts with DEV (the profile's identification)", name.startswith("DEV"), name)
+    dyn = int.from_bytes(dex.sdo.upload(0x3000, 0x0A), "little")
+    check("dexmart: Dynamic Data 10 = 2414 (manual: 581 4B 00 30 0A 6E 09)", dyn == 2414, dyn)
+    check("dexmart: M1 at 3000 rpm after encoder_speed_m1 (0x3046:05)",
+          wait_until(lambda: dex.sdo[0x3046][5].raw == 3000, 5), dex.sdo[0x3046][5].raw)
+    replies = []
+    network.subscribe(0x284, lambda can_id, data, ts: replies.append(bytes(data)))
+    dex.sdo[0x3001][27].raw = 2  # 01-27 = 2: M2 in an encoder mode
+    network.send_message(0x304, bytes([0x0F, 100, 0, 0, 0]))  # RPDO2: CMD 0Fh, position 100
+    check("dexmart: RPDO2 position command answered by TPDO2 (0x284)", wait_until(lambda: replies, 3), replies)
+    check("dexmart: M2 encoder position reaches 100 (0x304A:17)",
+          wait_until(lambda: dex.sdo[0x304A][23].raw == 100, 5), dex.sdo[0x304A][23].raw)
+    device_type = int.from_bytes(aqmd.sdo.upload(0x1000, 0), "little")
+    check("aqmd: device type 0 (no CiA profile)", device_type == 0, device_type)
+    check("aqmd: duty 100.0 % after rpdo_speed (0x2101)",
+          wait_until(lambda: aqmd.sdo[0x2101].raw == 1000, 5), aqmd.sdo[0x2101].raw)
+    aqmd.sdo[0x2000].raw = 0
+    check("aqmd: control command 0 by SDO stops it (0x2101 = 0)",
+          wait_until(lambda: aqmd.sdo[0x2101].raw == 0, 5), aqmd.sdo[0x2101].raw)
+
+
 def main():
     iface, eds_dir, checks = sys.argv[1], sys.argv[2], sys.argv[3:]
     network = canopen.Network()
@@ -125,7 +156,8 @@ def main():
             try:
                 {"sdo": lambda: sdo_checks(network, eds_dir),
                  "402": lambda: drive_checks(network, eds_dir),
-                 "lss": lambda: lss_checks(network)}[c]()
+                 "lss": lambda: lss_checks(network),
+                 "vendor": lambda: vendor_checks(network, eds_dir)}[c]()
             except Exception as e:  # a check that raises is a failure with its reason
                 fail(f"{c}: {type(e).__name__}: {e}")
     finally:
