@@ -18,6 +18,7 @@ pub mod stats;
 pub mod store;
 mod texts;
 pub mod trace;
+pub mod values;
 pub mod view;
 
 pub use diagnose::Diagnoser;

@@ -14,6 +14,7 @@ use super::nodes::Nodes;
 use super::series::Series;
 use super::stats::Stats;
 use super::store::Store;
+use super::values::Values;
 use crate::decode::{Body, Decoded, Decoder, Kind};
 use crate::frame::{Frame, Interfaces};
 use crate::sdo::Transaction;
@@ -39,6 +40,8 @@ pub struct Trace {
     pub stats: Stats,
     /// Numeric values over time (PDO signals, SDO reads).
     pub series: Series,
+    /// The last value seen per node and object (SDO transfers, PDO signals).
+    pub values: Values,
 }
 
 impl Trace {
@@ -55,6 +58,7 @@ impl Trace {
             nodes,
             stats: Stats::new(bitrate),
             series: Series::default(),
+            values: Values::default(),
         }
     }
 
@@ -105,6 +109,7 @@ impl Trace {
         for t in self.decoder.take_transactions() {
             self.nodes.transaction(&t);
             self.series.transaction(&t, self.decoder.dictionary(t.node));
+            self.values.transaction(&t, self.decoder.dictionary(t.node));
             self.transactions.push(t);
         }
     }
@@ -117,6 +122,7 @@ impl Trace {
             Body::Pdo(p) => {
                 self.nodes.pdo(n, p, self.decoder.mode(n));
                 self.series.pdo(n, frame.ts_ns, p);
+                self.values.pdo(n, frame.ts_ns, p, self.decoder.mode(n));
             }
             _ => {}
         }

@@ -148,6 +148,8 @@ pub struct App {
     rate_mark: (Instant, usize),
     /// Set when something changed since the last draw.
     pub dirty: bool,
+    /// `record start FILE`: the frames received go to this candump log.
+    pub recording: Option<super::record::Recorder>,
     // --- node liveness (branch `live`): bus events for the message log, and the clock
     // that lets a silent node be found lost when no frame arrives.
     /// Bus events (node lost/back, boot-ups, state changes, EMCY, SDO aborts, controller
@@ -283,6 +285,7 @@ impl App {
             pending: Vec::new(),
             rate_mark: (Instant::now(), 0),
             dirty: true,
+            recording: None,
             node_events: Vec::new(),
             capture_clock: None,
         }
@@ -302,6 +305,7 @@ impl App {
                         self.trace.push(f);
                     }
                     self.capture_clock = batch.last().map(|f| (f.ts_ns, Instant::now()));
+                    self.record(&batch);
                     self.collect_node_events();
                     self.dirty = true;
                 }
@@ -329,7 +333,11 @@ impl App {
                     self.dirty = true;
                 }
                 Ok(Feed::Extent(e)) => self.source.replay.1 = Some(e),
-                Ok(Feed::Result(level, s)) => self.say(level, &s),
+                Ok(Feed::Result(level, s)) => {
+                    self.say(level, &s);
+                    let step = self.panes.objects.result(&s, self.trace.nodes.now_ns());
+                    self.read_all_step(step);
+                }
                 Ok(Feed::Lost(n)) => {
                     self.source.drops += n;
                     self.dirty = true;
@@ -551,6 +559,10 @@ impl App {
             if !self.prompt_key(ev) {
                 self.preview();
             }
+            if let Some(p) = self.prompt.editing.as_ref().filter(|p| p.kind == PromptKind::Find) {
+                let text = p.text.clone();
+                self.panes.objects.set_query(&text);
+            }
             return;
         }
         let Some(k) = Key::from_event(&ev) else { return };
@@ -583,6 +595,8 @@ impl App {
                     .unwrap_or_default();
                 let words: Vec<String> = if let Some(rest) = before.strip_prefix("plot ") {
                     self.plot_completions(rest)
+                } else if before.starts_with("record ") {
+                    super::record::WORDS.iter().map(|w| w.to_string()).collect()
                 } else if before.contains(' ') {
                     crate::command::syntax::completions(&before, &Heard(self))
                 } else {
@@ -737,6 +751,9 @@ impl App {
             );
             return;
         }
+        if let Some(summary) = self.panes.objects.stop_read_all() {
+            self.log(Level::Warn, &summary);
+        }
         let Some(req) = &self.source.requests else {
             self.say(Level::Warn, "stop all: this source has no bus (a log), nothing to stop");
             return;
@@ -786,6 +803,10 @@ impl App {
             PromptKind::Search => self.apply_search(text),
             PromptKind::Palette => {
                 self.run_command(text);
+                Ok(())
+            }
+            PromptKind::Find => {
+                self.panes.objects.set_query(text);
                 Ok(())
             }
         };
@@ -912,6 +933,10 @@ impl App {
                 self.jobs_command(rest);
                 return;
             }
+            "record" => {
+                self.record_command(rest);
+                return;
+            }
             "sim" => {
                 self.sim_command(line, rest);
                 return;
@@ -938,6 +963,181 @@ impl App {
                 Some(e.to_string())
             }
         };
+    }
+
+    /// Tells the Objects pane the Nodes pane's selection (its node unless one is picked
+    /// there): when the user selects in the Nodes pane, or while the Objects pane has none.
+    /// Not on every frame: a node appearing above the selection does not change it.
+    fn sync_objects_node(&mut self) {
+        let n = self
+            .trace
+            .nodes
+            .iter()
+            .nth(self.panes.nodes.list.selected)
+            .map(|(n, _)| *n);
+        self.panes.objects.set_nodes_selection(n);
+    }
+
+    /// True when SDO reads can go out; else says why not (listen-only, or a log: no bus).
+    fn can_read(&mut self, what: &str) -> bool {
+        if self.listen_only() {
+            self.say(
+                Level::Error,
+                &format!("{what}: listen-only — nothing can be sent, so no object can be read"),
+            );
+            return false;
+        }
+        if self.source.requests.is_none() {
+            self.say(
+                Level::Error,
+                &format!(
+                    "{what}: this source is a log file, there is no bus to read from (use `cotui live IFACE` or `cotui demo`)"
+                ),
+            );
+            return false;
+        }
+        true
+    }
+
+    /// Does what the Objects pane asked.
+    fn object_request(&mut self, r: super::panes::objects::ObjectRequest) {
+        use super::panes::objects::{ObjectRequest, read_line};
+        match r {
+            ObjectRequest::Read { node, index, sub } => {
+                let line = read_line(node, index, sub);
+                if self.can_read(&line) {
+                    self.panes.objects.sent(&line, node, index, sub);
+                    match palette::plan(&line, &self.bindings, |_| None) {
+                        Ok(_) => self.run_command(&line),
+                        // E.g. an object of the decoder's dictionary the session's bindings lack.
+                        Err(e) => {
+                            let text = format!("{line}: error: {e}");
+                            self.say(Level::Error, &text);
+                            self.panes.objects.result(&text, self.trace.nodes.now_ns());
+                        }
+                    }
+                }
+            }
+            ObjectRequest::Edit { .. } if self.listen_only() => self.say(
+                Level::Error,
+                "write: listen-only — nothing can be sent, so no object can be written",
+            ),
+            ObjectRequest::Edit { text, cursor, note } => {
+                self.prompt.open(PromptKind::Palette, &text);
+                if let Some(p) = self.prompt.editing.as_mut() {
+                    p.cursor = cursor;
+                }
+                self.preview();
+                self.message = Some(match self.message.take() {
+                    Some(m) => format!("{note} · {m}"),
+                    None => note,
+                });
+            }
+            ObjectRequest::ReadAll { node, objects } => {
+                let what = format!("read all node {node}");
+                if objects.is_empty() {
+                    self.say(Level::Info, &format!("{what}: no readable object known"));
+                } else if self.can_read(&what) {
+                    let stop = self.keymap.key_for(Action::ReadAll).unwrap_or_default();
+                    self.say(
+                        Level::Info,
+                        &format!(
+                            "{what}: reading {} objects one after the other ({stop} again stops)",
+                            objects.len()
+                        ),
+                    );
+                    let step = self.panes.objects.start_read_all(node, objects);
+                    self.read_all_step(step);
+                }
+            }
+            ObjectRequest::Find(text) => self.prompt.open(PromptKind::Find, &text),
+            ObjectRequest::Note(text) => self.message = Some(text),
+        }
+    }
+
+    /// Goes on with a read-all: sends its next read (without the per-line "sending"
+    /// notice), or says how it ended.
+    fn read_all_step(&mut self, mut step: super::panes::objects::Step) {
+        use super::panes::objects::Step;
+        loop {
+            match step {
+                Step::Next(line) => match palette::plan(&line, &self.bindings, |_| None) {
+                    Ok(p) => {
+                        if let Some(req) = &self.source.requests {
+                            let _ = req.send(Request::Run {
+                                line: p.line,
+                                command: p.command,
+                            });
+                        }
+                        return;
+                    }
+                    Err(e) => {
+                        let text = format!("{line}: error: {e}");
+                        self.log(Level::Error, &text);
+                        step = self.panes.objects.result(&text, self.trace.nodes.now_ns());
+                    }
+                },
+                Step::Finished(text) => {
+                    let failed = text.lines().count() > 1;
+                    self.say(if failed { Level::Warn } else { Level::Info }, &text);
+                    return;
+                }
+                Step::NotOurs | Step::Noted => return,
+            }
+        }
+    }
+
+    /// `record start FILE [--force | --append]` / `record stop`: the frames the session
+    /// receives to a candump log.
+    fn record_command(&mut self, rest: &str) {
+        use super::record::{RecordCommand, Recorder, parse};
+        match parse(rest) {
+            Err(e) => self.say(Level::Error, &e),
+            Ok(RecordCommand::Stop) => match self.recording.take() {
+                None => self.say(Level::Info, "record: not recording"),
+                Some(r) => {
+                    let file = r.file.clone();
+                    match r.stop() {
+                        Ok(n) => self.say(Level::Info, &format!("record: stopped, {n} frames in {file}")),
+                        Err(e) => self.say(Level::Error, &format!("record: {file}: {e}")),
+                    }
+                }
+            },
+            Ok(RecordCommand::Start { .. }) if self.source.requests.is_none() => self.say(
+                Level::Error,
+                "record: only a live or demo session records what it receives; `export FILE` writes a log's view",
+            ),
+            Ok(RecordCommand::Start { .. }) if self.recording.is_some() => {
+                let file = self.recording.as_ref().map(|r| r.file.clone()).unwrap_or_default();
+                self.say(
+                    Level::Error,
+                    &format!("record: already recording to {file} (`record stop` first)"),
+                );
+            }
+            Ok(RecordCommand::Start { file, mode }) => match Recorder::start(&file, mode) {
+                Ok(r) => {
+                    self.recording = Some(r);
+                    self.say(
+                        Level::Info,
+                        &format!("record: recording the frames received to {file} (`record stop` ends it)"),
+                    );
+                }
+                Err(e) => self.say(Level::Error, &format!("record: {e}")),
+            },
+        }
+    }
+
+    /// Writes a batch of frames to the recording, if one runs; a failed write ends it.
+    fn record(&mut self, batch: &[crate::frame::Frame]) {
+        let Some(r) = self.recording.as_mut() else { return };
+        if let Err(e) = r.frames(batch, &self.trace.ifaces) {
+            let (file, n) = (r.file.clone(), r.count());
+            self.recording = None;
+            self.say(
+                Level::Error,
+                &format!("record: {file}: {e}; stopped, {n} whole frames kept"),
+            );
+        }
     }
 
     /// `export FILE [--format candump|jsonl|pcapng] [--force]`: the rows the view shows.
@@ -1120,7 +1320,12 @@ impl App {
         }
         let focus = self.focus;
         let (panes, ctx) = self.panes_mut();
-        match panes.get_mut(focus).handle(a, &ctx) {
+        let outcome = panes.get_mut(focus).handle(a, &ctx);
+        if focus == Pane::Nodes {
+            // A node selected in the Nodes pane is the one the Objects pane shows.
+            self.sync_objects_node();
+        }
+        match outcome {
             Outcome::Done => return,
             Outcome::Ignored => {}
             Outcome::Detail => {
@@ -1139,6 +1344,10 @@ impl App {
                 let page = self.page();
                 self.panes.trace.show(&self.trace, pos, page);
                 self.focus = Pane::Trace;
+                return;
+            }
+            Outcome::Object(r) => {
+                self.object_request(r);
                 return;
             }
         }
@@ -1171,6 +1380,10 @@ impl App {
             Action::PaneStats => self.focus = Pane::Stats,
             Action::PanePlot => self.focus = Pane::Plot,
             Action::PanePdo => self.focus = Pane::Pdo,
+            Action::PaneObjects => self.focus = Pane::Objects,
+            Action::EditObject | Action::ReadAll => {
+                self.message = Some(format!("{}: only in the Objects pane", a.name().replace('_', " ")))
+            }
             Action::Filter => {
                 let text = self.panes.trace.view.filter.source.clone();
                 self.prompt.open(PromptKind::Filter, &text);
@@ -1280,14 +1493,20 @@ impl App {
             }
             _ => {}
         }
+        if focus == Pane::Nodes {
+            self.sync_objects_node();
+        }
     }
 
     /// Before drawing: keeps the list panes' selections within their rows and visible in
     /// `height` rows, pins the trace selection to the newest row in follow mode, decodes the
     /// visible trace window (`rows` rows), the tail strip and what the Detail pane shows.
     pub fn prepare(&mut self, height: usize, rows: usize, tail: &[usize]) {
+        if self.panes.objects.node().is_none() {
+            self.sync_objects_node();
+        }
         let (panes, ctx) = self.panes_mut();
-        for p in [Pane::Nodes, Pane::Stats, Pane::Sdo, Pane::Pdo] {
+        for p in [Pane::Nodes, Pane::Stats, Pane::Sdo, Pane::Objects, Pane::Pdo] {
             panes.get_mut(p).fit(height, &ctx);
         }
         self.panes.trace.prepare(&self.trace, rows, tail);

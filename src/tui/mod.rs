@@ -13,6 +13,7 @@ pub mod messages;
 pub mod palette;
 pub mod panes;
 pub mod prompt;
+pub mod record;
 pub mod rows;
 pub mod source;
 pub mod term;

@@ -16,6 +16,8 @@ pub enum PromptKind {
     Search,
     /// The command palette.
     Palette,
+    /// Finding an object in the Objects pane (the rows follow each key).
+    Find,
 }
 
 impl PromptKind {
@@ -25,6 +27,7 @@ impl PromptKind {
             PromptKind::Filter => "filter: ",
             PromptKind::Search => "search: ",
             PromptKind::Palette => ":",
+            PromptKind::Find => "find object: ",
         }
     }
 }

@@ -1,6 +1,8 @@
 //! The interactive analyzer end to end: the real binary in tmux, and its command line.
 
 mod filter_search;
+mod objects_demo;
+mod objects_tmux;
 mod receive_list;
 mod tui_cli;
 mod tui_tmux;

@@ -27,6 +27,11 @@ pub const PALETTE_SYNTAX: &[(&str, &str)] = &[
         "export FILE [--format candump|jsonl|pcapng] [--force]",
         "Write the rows the view shows",
     ),
+    (
+        "record start FILE [--force|--append]",
+        "Live/demo: record the frames received to a candump -l log",
+    ),
+    ("record stop", "End the recording"),
     ("help", "This help"),
     ("messages", "The message log"),
     ("quit", "Quit"),
@@ -248,8 +253,11 @@ pub fn lines(keymap: &Keymap, width: usize) -> Vec<Line<'static>> {
     for (syntax, about) in PALETTE_SYNTAX {
         pair(&mut out, syntax, about, 30, width);
     }
+    // The palette records with `record start`/`record stop` (above), not the CLI's `record -o`.
     for (syntax, about) in crate::command::syntax::usages() {
-        pair(&mut out, &syntax, &about, 30, width);
+        if !syntax.starts_with("record ") {
+            pair(&mut out, &syntax, &about, 30, width);
+        }
     }
     out.push(Line::raw(""));
     out.push(Line::styled(

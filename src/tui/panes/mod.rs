@@ -5,6 +5,7 @@ pub mod detail;
 pub mod help;
 pub mod messages;
 pub mod nodes;
+pub mod objects;
 pub mod pdo;
 pub mod picker;
 pub mod plot;
@@ -29,12 +30,21 @@ pub enum Pane {
     Sdo,
     Stats,
     Plot,
+    Objects,
     Pdo,
 }
 
 impl Pane {
     /// Every pane in tab order.
-    pub const ALL: [Pane; 6] = [Pane::Trace, Pane::Nodes, Pane::Sdo, Pane::Stats, Pane::Plot, Pane::Pdo];
+    pub const ALL: [Pane; 7] = [
+        Pane::Trace,
+        Pane::Nodes,
+        Pane::Sdo,
+        Pane::Stats,
+        Pane::Plot,
+        Pane::Objects,
+        Pane::Pdo,
+    ];
     /// Tab title.
     pub fn title(self) -> &'static str {
         match self {
@@ -43,6 +53,7 @@ impl Pane {
             Pane::Sdo => "SDO",
             Pane::Stats => "Stats",
             Pane::Plot => "Plot",
+            Pane::Objects => "Objects",
             Pane::Pdo => "PDO",
         }
     }
@@ -61,6 +72,8 @@ pub struct Panes {
     pub stats: stats::StatsPane,
     /// Numeric signals over one time axis.
     pub plot: plot::PlotPane,
+    /// The object dictionary of one node with the last values seen.
+    pub objects: objects::ObjectsPane,
     /// One row per known PDO of each node.
     pub pdo: pdo::PdoPane,
 }
@@ -74,6 +87,7 @@ impl Panes {
             Pane::Sdo => &self.sdo,
             Pane::Stats => &self.stats,
             Pane::Plot => &self.plot,
+            Pane::Objects => &self.objects,
             Pane::Pdo => &self.pdo,
         }
     }
@@ -86,6 +100,7 @@ impl Panes {
             Pane::Sdo => &mut self.sdo,
             Pane::Stats => &mut self.stats,
             Pane::Plot => &mut self.plot,
+            Pane::Objects => &mut self.objects,
             Pane::Pdo => &mut self.pdo,
         }
     }
@@ -115,6 +130,8 @@ pub enum Outcome {
     Filter(String),
     /// Show this trace position in the Trace pane, unfiltered.
     Show(usize),
+    /// What the Objects pane asks (read, write, read all, find).
+    Object(objects::ObjectRequest),
 }
 
 /// What the selected row of a pane is, for the Detail view.

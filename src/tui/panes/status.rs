@@ -55,6 +55,11 @@ pub fn text(app: &App) -> String {
     } else {
         ""
     };
+    let rec = app
+        .recording
+        .as_ref()
+        .map(|r| format!(" | REC {} ({} frames)", r.file, r.count()))
+        .unwrap_or_default();
     let view = &app.panes.trace.view;
     let filter = if view.filter.is_empty() {
         String::new()
@@ -83,7 +88,7 @@ pub fn text(app: &App) -> String {
         .map(|k| format!(" | help: {k}"))
         .unwrap_or_default();
     format!(
-        "{src}{state} | {} frames | {:.0} fr/s | drops {}{filter}{search}{stop}{help}",
+        "{src}{state}{rec} | {} frames | {:.0} fr/s | drops {}{filter}{search}{stop}{help}",
         app.trace.len(),
         app.rate,
         app.source.drops
