@@ -116,10 +116,16 @@ struct FaultMeta {
     emcy: Option<u16>,
 }
 
-/// Builds incidents from the frames of one capture, in order.
+/// Builds incidents from the frames of one capture, in order. Incremental: frames go in
+/// one at a time ([`Diagnoser::frame`], [`Diagnoser::skip`]), the capture clock advances
+/// on a quiet bus with [`Diagnoser::tick`], and [`Diagnoser::incidents`] tells what is
+/// wrong so far without ending the capture.
+#[derive(Clone)]
 pub struct Diagnoser {
     tracker: EventTracker,
     at: At,
+    /// The capture time reached by [`Diagnoser::tick`] (ns), 0 before any tick.
+    now: u64,
     first_ns: Option<u64>,
     nodes: BTreeMap<u8, Node>,
     incidents: Vec<Incident>,
@@ -146,6 +152,7 @@ impl Diagnoser {
         Diagnoser {
             tracker,
             at: At::default(),
+            now: 0,
             first_ns: None,
             nodes: BTreeMap::new(),
             incidents: Vec::new(),
@@ -817,10 +824,36 @@ impl Diagnoser {
         }
     }
 
+    /// The capture clock reached `now_ns` with no frame since the last one (a quiet bus in
+    /// a live capture or a running replay): heartbeats and SDO answers overdue by then are
+    /// missed.
+    pub fn tick(&mut self, now_ns: u64) {
+        if now_ns <= self.now.max(self.at.t) {
+            return;
+        }
+        self.now = now_ns;
+        self.tracker.tick(now_ns);
+        for e in self.tracker.take_events() {
+            self.event(&e);
+        }
+        if self.sdo_deadline.is_some_and(|dl| now_ns > dl) {
+            self.sdo_timeouts(now_ns);
+        }
+    }
+
+    /// The incidents so far, ranked as [`Diagnoser::finish`] ranks them, as if the capture
+    /// ended now (the builder goes on).
+    pub fn incidents(&self) -> Vec<Incident> {
+        self.clone().finish()
+    }
+
     /// The end of the capture: what is still wrong is open. Returns the incidents ranked,
     /// open first, then recovered, then warnings; each by time.
     pub fn finish(mut self) -> Vec<Incident> {
-        let end = self.at;
+        let end = At {
+            t: self.at.t.max(self.now),
+            ..self.at
+        };
         self.tracker.tick(end.t);
         for e in self.tracker.take_events() {
             self.event(&e);

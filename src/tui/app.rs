@@ -10,7 +10,7 @@ use super::palette::{self, Planned, commander_words};
 use super::panes::detail::DetailPane;
 use super::panes::help::HelpPopup;
 use super::panes::messages::MessagesPopup;
-use super::panes::{Ctx, Outcome, Pane, Panes, Selected};
+use super::panes::{Component, Ctx, Outcome, Pane, Panes, Selected};
 use super::prompt::{Edit, PromptBar, PromptKind};
 use super::source::{Control, Feed};
 use crate::analysis::filter::{Filter, FilterError};
@@ -400,7 +400,7 @@ impl App {
     /// Advances the node table to the capture time at wall time `now` (live and replay).
     fn liveness_tick(&mut self, now: Instant) {
         if let Some(t) = self.capture_now_ns(now) {
-            self.trace.nodes.tick(t);
+            self.trace.tick(t);
             if self.collect_node_events() {
                 self.dirty = true;
             }
@@ -1082,6 +1082,7 @@ impl App {
             Action::PaneSdo => self.focus = Pane::Sdo,
             Action::PaneStats => self.focus = Pane::Stats,
             Action::PanePlot => self.focus = Pane::Plot,
+            Action::PaneProblems => self.focus = Pane::Problems,
             Action::Filter => {
                 let text = self.panes.trace.view.filter.source.clone();
                 self.prompt.open(PromptKind::Filter, &text);
@@ -1140,6 +1141,17 @@ impl App {
                 self.panes.plot.step(&self.trace, a == Action::NextSeries);
                 self.focus = Pane::Plot;
             }
+            // From any pane: the next frame of the incident selected in the Problems pane, so
+            // that pressing it again in the trace walks through the incident's frames.
+            Action::ShowFrames => {
+                let (panes, ctx) = self.panes_mut();
+                panes.problems.refresh(&ctx);
+                if let Outcome::Show(pos) = panes.problems.handle(a, &ctx) {
+                    let page = self.page();
+                    self.panes.trace.show(&self.trace, pos, page);
+                    self.focus = Pane::Trace;
+                }
+            }
             // Taken by the help popup; row movement and `expand` in a pane without rows.
             Action::Help
             | Action::Down
@@ -1175,7 +1187,7 @@ impl App {
     /// visible trace window (`rows` rows), the tail strip and what the Detail pane shows.
     pub fn prepare(&mut self, height: usize, rows: usize, tail: &[usize]) {
         let (panes, ctx) = self.panes_mut();
-        for p in [Pane::Nodes, Pane::Stats, Pane::Sdo] {
+        for p in [Pane::Nodes, Pane::Stats, Pane::Sdo, Pane::Problems] {
             panes.get_mut(p).fit(height, &ctx);
         }
         self.panes.trace.prepare(&self.trace, rows, tail);

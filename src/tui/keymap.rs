@@ -64,6 +64,7 @@ actions! {
     PaneSdo = "pane_sdo": "SDO transactions pane",
     PaneStats = "pane_stats": "Statistics pane",
     PanePlot = "pane_plot": "Plot pane",
+    PaneProblems = "pane_problems": "Problems pane (the diagnosis: what went wrong, open first)",
     Filter = "filter": "Edit the filter",
     Search = "search": "Search (same language as the filter)",
     NextMatch = "next_match": "Jump to the next match",
@@ -81,6 +82,7 @@ actions! {
     SeekBack = "seek_back": "Replay: jump 10 s back",
     NextSeries = "next_series": "Plot: next signal",
     PrevSeries = "prev_series": "Plot: previous signal",
+    ShowFrames = "show_frames": "Problems: show the selected incident's frames in the trace (first, then the next at each press)",
 }
 
 /// One key press, normalised (no SHIFT on characters).

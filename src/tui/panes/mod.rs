@@ -6,6 +6,7 @@ pub mod help;
 pub mod messages;
 pub mod nodes;
 pub mod plot;
+pub mod problems;
 pub mod sdo;
 pub mod stats;
 pub mod status;
@@ -27,11 +28,19 @@ pub enum Pane {
     Sdo,
     Stats,
     Plot,
+    Problems,
 }
 
 impl Pane {
     /// Every pane in tab order.
-    pub const ALL: [Pane; 5] = [Pane::Trace, Pane::Nodes, Pane::Sdo, Pane::Stats, Pane::Plot];
+    pub const ALL: [Pane; 6] = [
+        Pane::Trace,
+        Pane::Nodes,
+        Pane::Sdo,
+        Pane::Stats,
+        Pane::Plot,
+        Pane::Problems,
+    ];
     /// Tab title.
     pub fn title(self) -> &'static str {
         match self {
@@ -40,6 +49,7 @@ impl Pane {
             Pane::Sdo => "SDO",
             Pane::Stats => "Stats",
             Pane::Plot => "Plot",
+            Pane::Problems => "Problems",
         }
     }
 }
@@ -57,6 +67,8 @@ pub struct Panes {
     pub stats: stats::StatsPane,
     /// One numeric series over time.
     pub plot: plot::PlotPane,
+    /// One row per incident of the diagnosis.
+    pub problems: problems::ProblemsPane,
 }
 
 impl Panes {
@@ -68,6 +80,7 @@ impl Panes {
             Pane::Sdo => &self.sdo,
             Pane::Stats => &self.stats,
             Pane::Plot => &self.plot,
+            Pane::Problems => &self.problems,
         }
     }
 
@@ -79,6 +92,7 @@ impl Panes {
             Pane::Sdo => &mut self.sdo,
             Pane::Stats => &mut self.stats,
             Pane::Plot => &mut self.plot,
+            Pane::Problems => &mut self.problems,
         }
     }
 }
