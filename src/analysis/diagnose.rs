@@ -1022,6 +1022,49 @@ mod tests {
         assert_eq!(run(&f), ["2 drive_fault recovered 1"]);
     }
 
+    /// Like [`run`], with capture-clock ticks: `(ms, 0xFFFF_FFFF, "")` is a tick at `ms`.
+    fn run_ticked(frames: &[(u64, u32, &str)]) -> Vec<String> {
+        let mut dec = Decoder::new(Dictionary::default(), Vec::new());
+        let mut diag = Diagnoser::new(EventTracker::new(|n| dec.dictionary(n)));
+        for (ms, id, data) in frames {
+            if *id == u32::MAX {
+                diag.tick(ms * MS);
+                continue;
+            }
+            let bytes: Vec<u8> = (0..data.len() / 2)
+                .map(|i| u8::from_str_radix(&data[2 * i..2 * i + 2], 16).unwrap())
+                .collect();
+            let mut f = Frame::classic(*id, &bytes);
+            f.ts_ns = ms * MS;
+            let d = dec.decode(&f);
+            diag.frame(&f, "can0", &d);
+        }
+        diag.incidents()
+            .iter()
+            .map(|i| {
+                let node = i.node.map_or("-".into(), |n| n.to_string());
+                format!("{node} {} {} {}", i.problem.as_str(), i.status.as_str(), i.count)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn ticks_on_a_quiet_bus_find_a_silent_node_and_later_frames_undo_it() {
+        let mut f = heartbeats(5, 0, 1000, "05");
+        // The clock passes the deadline with no frame: silent so far.
+        f.push((1500, u32::MAX, ""));
+        assert_eq!(run_ticked(&f), ["5 silent open 1"]);
+        // It beats again: it was a silence that ended.
+        f.extend(heartbeats(5, 1600, 2000, "05"));
+        assert_eq!(run_ticked(&f), ["5 silent_back warning 1"]);
+        // A tick that runs ahead of the frames (a late delivery) is undone by them.
+        let mut f = heartbeats(5, 0, 500, "05");
+        f.push((560, u32::MAX, ""));
+        f.extend(heartbeats(5, 500, 1000, "05"));
+        let got = run_ticked(&f);
+        assert!(got.iter().all(|g| !g.contains("silent open")), "{got:?}");
+    }
+
     #[test]
     fn boot_ups_with_equal_times_are_not_a_duplicate_id() {
         // Logs without timestamps give every frame time 0: two boot-ups say nothing there.
