@@ -14,6 +14,7 @@ use super::liveness::EventTracker;
 use crate::decode::cia402::DriveState;
 use crate::decode::emcy::Emcy;
 use crate::decode::heartbeat::NmtState;
+use crate::decode::stall::{self, Observation, Step};
 use crate::decode::{Body, Decoded, Kind};
 use crate::frame::Frame;
 use crate::od::PdoMapping;
@@ -37,6 +38,8 @@ const RESET_BOOT_NS: u64 = 5_000 * MS;
 const NMT_GRACE_NS: u64 = 100 * MS;
 /// A fault reset this soon after the fault cleared belongs to it (one SYNC cycle).
 const SAME_CYCLE_NS: u64 = 20 * MS;
+/// A drive has this long to show the state its controlword asked for.
+const STALL_NS: u64 = 1_000 * MS;
 /// Axes of a multi-axis drive (objects 0x6000 + 0x800 * (axis - 1)).
 const AXES: u16 = 8;
 
@@ -74,6 +77,13 @@ struct Axis {
     fault: Option<usize>,
     /// A cleared fault waiting for "operation enabled".
     cleared: Option<usize>,
+    /// The last statusword.
+    sw: Option<u16>,
+    /// A state change the controlword asked for and the statusword has not shown yet:
+    /// when, what, and the statusword then.
+    asked: Option<(At, Step, Option<u16>)>,
+    /// The open "stuck" incident, until the drive reaches the state asked for.
+    stuck: Option<usize>,
 }
 
 /// What one node has shown so far.
@@ -106,6 +116,8 @@ struct Node {
     axes: BTreeMap<u8, Axis>,
     /// EMCY not yet given to an incident (a fault may follow at once).
     emcy: Vec<(At, Emcy)>,
+    /// The last EMCY error code.
+    last_emcy: Option<u16>,
     silence: Option<(At, u64, f64)>,
 }
 
@@ -353,6 +365,80 @@ impl Diagnoser {
         }
     }
 
+    /// A statusword `sw` of an axis asked to change state: reached (a stuck incident
+    /// recovers), a fault (the fault incident tells it), or still not there after
+    /// [`STALL_NS`]: the drive is stuck, with the reason the bus shows.
+    fn stall(&mut self, n: u8, axis: u8, sw: u16, state: DriveState) {
+        let at = self.at;
+        let nmt = self.nodes.get(&n).and_then(|d| d.last_state.map(|(_, s)| s));
+        let emcy = self.nodes.get(&n).and_then(|d| d.last_emcy);
+        let a = self.node(n).axes.entry(axis).or_default();
+        a.sw = Some(sw);
+        let stuck = a.stuck;
+        let cw = a.cw;
+        let Some((asked, step, before)) = a.asked else {
+            return;
+        };
+        let faulted = matches!(state, DriveState::Fault | DriveState::FaultReactionActive);
+        if stall::reached(&step, state) || faulted {
+            a.asked = None;
+            a.stuck = None;
+            if let Some(i) = stuck.filter(|_| !faulted) {
+                self.incidents[i].status = Status::Recovered;
+                self.incidents[i].last_ns = at.t;
+                let waited = (at.t - asked.t) as f64 / 1e9;
+                let inc = &mut self.incidents[i];
+                inc.title = format!("{}; reached {} after {waited:.2} s", inc.title, state.text());
+                self.step(i, at, format!("Reached {} after {waited:.2} s", state.text()));
+            }
+            return;
+        }
+        if stuck.is_some() || at.t.saturating_sub(asked.t) < STALL_NS {
+            return;
+        }
+        let obs = Observation {
+            nmt,
+            before,
+            statusword: Some(sw),
+            controlword: cw,
+            emcy,
+            ..Observation::default()
+        };
+        let reason = stall::diagnose(n, &step, &obs);
+        let detail = (u32::from(axis) << 8) | u32::from(step.controlword as u8);
+        let i = self.grouped(Some(n), Problem::DriveStuck, detail, asked.t);
+        let inc = &mut self.incidents[i];
+        if !inc.axes.contains(&axis) {
+            inc.axes.push(axis);
+        }
+        inc.status = Status::Open;
+        inc.last_ns = at.t;
+        inc.title = format!(
+            "Stuck in {}: {} (controlword 0x{:04X}) not followed",
+            state.text(),
+            step.name,
+            step.controlword
+        );
+        inc.cause = Some(reason);
+        self.step(
+            i,
+            asked,
+            format!(
+                "Controlword 0x{:04X} ({}) asks for {}",
+                step.controlword,
+                step.name,
+                step.target.text()
+            ),
+        );
+        let waited = (at.t - asked.t) as f64 / 1e9;
+        self.step(
+            i,
+            at,
+            format!("Still {} (statusword 0x{sw:04X}) after {waited:.2} s", state.text()),
+        );
+        self.node(n).axes.entry(axis).or_default().stuck = Some(i);
+    }
+
     /// A CiA 402 object value of `node` (from a PDO or an SDO transfer).
     fn drive_word(&mut self, n: u8, index: u16, w: u16) {
         if let Some(axis) = axis_of(index, 0x6041) {
@@ -381,6 +467,7 @@ impl Diagnoser {
     fn statusword(&mut self, n: u8, axis: u8, sw: u16) {
         let at = self.at;
         let state = DriveState::from_statusword(sw);
+        self.stall(n, axis, sw, state);
         let faulted = matches!(state, DriveState::Fault | DriveState::FaultReactionActive);
         let a = self.node(n).axes.entry(axis).or_default().clone();
         match (a.fault, faulted) {
@@ -445,6 +532,14 @@ impl Diagnoser {
     fn controlword(&mut self, n: u8, axis: u8, cw: u16) {
         let at = self.at;
         let ax = self.node(n).axes.entry(axis).or_default().clone();
+        if ax.cw != Some(cw)
+            && let Some(step) = stall::requested(cw)
+        {
+            let a = self.node(n).axes.entry(axis).or_default();
+            let done =
+                a.sw.is_some_and(|sw| stall::reached(&step, DriveState::from_statusword(sw)));
+            a.asked = (!done).then_some((at, step, a.sw));
+        }
         let rising = cw & 0x80 != 0 && ax.cw.is_none_or(|p| p & 0x80 == 0);
         self.node(n).axes.entry(axis).or_default().cw = Some(cw);
         // A reset in the same cycle as the clear (the statusword went out first) counts too.
@@ -472,6 +567,7 @@ impl Diagnoser {
 
     fn emcy(&mut self, n: u8, e: &Emcy) {
         let at = self.at;
+        self.node(n).last_emcy = Some(e.code);
         self.flush_emcy(n, at.t.saturating_sub(EMCY_CAUSE_NS));
         if e.code == 0 {
             // "Error reset or no error": the node's EMCY incidents are over.
@@ -873,6 +969,13 @@ impl Diagnoser {
                 self.incidents[i].last_ns = end.t;
             }
             let node = self.nodes[&n].clone();
+            for a in node.axes.values() {
+                if let (Some(i), Some(sw)) = (a.stuck, a.sw) {
+                    let state = DriveState::from_statusword(sw).text();
+                    self.step(i, end, format!("Still {state} at the end of the capture"));
+                    self.incidents[i].last_ns = end.t;
+                }
+            }
             if let Some(at) = node.heartbeat_off.filter(|_| !node.guarded) {
                 let i = self.grouped(Some(n), Problem::Unmonitored, 0, at.t);
                 self.incidents[i].status = Status::Warning;

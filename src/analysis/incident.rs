@@ -59,6 +59,8 @@ pub enum Problem {
     DuplicateId,
     /// An NMT command the node did not follow.
     NmtIgnored,
+    /// A CiA 402 drive that did not reach the state its controlword asked for.
+    DriveStuck,
 }
 
 impl Problem {
@@ -78,6 +80,7 @@ impl Problem {
             Problem::BusErrors => "bus_errors",
             Problem::DuplicateId => "duplicate_id",
             Problem::NmtIgnored => "nmt_ignored",
+            Problem::DriveStuck => "drive_stuck",
         }
     }
 }

@@ -230,5 +230,15 @@ pub fn fill(inc: &mut Incident, resets: u32, emcy: Option<u16>, error_frames: u6
                 "The master thinks the node is in one state while it is in another: PDOs may not be sent or used."
                     .into();
         }
+        Problem::DriveStuck => {
+            // The title (the state it stayed in and what was asked) is set by the builder.
+            inc.check = strings(&[
+                "Do what the cause says first: a fault needs a fault reset; \"voltage not enabled\" needs the drive's main power (DC link); a quick stop needs disable voltage (0x00) before 0x06 → 0x07 → 0x0F.",
+                "Check the enable sequence the master sends: 0x06 → 0x07 → 0x0F, each only after the statusword shows the state before.",
+                "Check the drive's enable inputs (STO, hardware enable) and its display or error log.",
+            ]);
+            inc.why = "The master waits for a state the drive does not reach: the axis does not move and motion commands are ignored."
+                .into();
+        }
     }
 }

@@ -75,6 +75,7 @@ pub mod nmt;
 pub mod pdo;
 pub mod registry;
 pub mod sdo;
+pub mod stall;
 pub mod sync;
 pub mod time;
 pub mod value_text;

@@ -293,3 +293,39 @@ fn realworld_logs() {
     // A J1939 log is not CANopen: nothing to report, and no crash.
     assert!(get("python-can_logfile.asc").is_empty());
 }
+
+#[test]
+fn drive_stuck_with_the_reason_the_bus_shows() {
+    // Node 3 is asked to switch on with its DC link off (statusword bit 4 clear) and gets
+    // there 2 s later; node 4 never follows "enable operation".
+    let inc = golden("drive_stuck");
+    assert_eq!(
+        summary(&inc),
+        [
+            s(Some(4), "drive_stuck", "open"),
+            s(Some(3), "drive_stuck", "recovered")
+        ]
+    );
+    assert_eq!(
+        inc[0]["title"],
+        "Stuck in Switched on: enable operation (controlword 0x000F) not followed"
+    );
+    assert_eq!(
+        inc[0]["cause"],
+        "statusword stale: still 0x0233 (Switched on) after controlword 0x000F"
+    );
+    assert_eq!(inc[0]["axes"], serde_json::json!([1]));
+    assert_eq!(frames(&inc[0]), [38, 100, 238]);
+    assert_eq!(
+        inc[1]["cause"],
+        "voltage not enabled: statusword 0x0221 bit 4 is clear; switch on the drive's DC link / main power"
+    );
+    assert!(
+        inc[1]["title"]
+            .as_str()
+            .unwrap()
+            .ends_with("reached Switched on after 2.01 s"),
+        "{}",
+        inc[1]["title"]
+    );
+}
