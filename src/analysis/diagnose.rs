@@ -11,6 +11,7 @@
 use super::events::{Event, What};
 use super::incident::{Incident, Problem, Status};
 use super::liveness::EventTracker;
+use super::timing::{PdoGap, PdoKey, PdoTiming, PeriodFrom, SyncTiming};
 use crate::decode::cia402::DriveState;
 use crate::decode::emcy::Emcy;
 use crate::decode::heartbeat::NmtState;
@@ -150,6 +151,10 @@ pub struct Diagnoser {
     reset_all: Option<u64>,
     /// Longest silence per node that came back (ms).
     silent_max: BTreeMap<u8, f64>,
+    sync: SyncTiming,
+    pdos: PdoTiming,
+    /// The incident of each PDO that stopped, while it is missing.
+    pdo_gaps: HashMap<PdoKey, usize>,
 }
 
 /// Index offset of `axis` (1-based) in the CiA 402 range.
@@ -175,6 +180,9 @@ impl Diagnoser {
             sdo_deadline: None,
             silent_max: BTreeMap::new(),
             reset_all: None,
+            sync: SyncTiming::default(),
+            pdos: PdoTiming::default(),
+            pdo_gaps: HashMap::new(),
         }
     }
 
@@ -240,6 +248,80 @@ impl Diagnoser {
         if self.sdo_deadline.is_some_and(|dl| frame.ts_ns > dl) {
             self.sdo_timeouts(frame.ts_ns);
         }
+        self.pdos_due(frame.ts_ns);
+    }
+
+    /// PDOs overdue at `now` become (or add to) incidents.
+    fn pdos_due(&mut self, now: u64) {
+        for gap in self.pdos.due(now) {
+            self.pdo_gap(gap);
+        }
+    }
+
+    fn pdo_name((_, transmit, num): PdoKey) -> String {
+        format!("{}PDO{num}", if transmit { "T" } else { "R" })
+    }
+
+    fn pdo_gap(&mut self, gap: PdoGap) {
+        match gap {
+            PdoGap::Missing {
+                key,
+                last_frame,
+                last_ns,
+                period_ns,
+                from,
+            } => {
+                let n = key.0;
+                let node = self.node(n);
+                // PDOs flow in "operational" only; a silent node is its own incident.
+                if node.last_state.is_some_and(|(_, s)| s != NmtState::Operational) || node.silence.is_some() {
+                    return;
+                }
+                let name = Self::pdo_name(key);
+                let detail = (u32::from(key.1) << 16) | u32::from(key.2);
+                let i = self.grouped(Some(n), Problem::PdoMissing, detail, last_ns);
+                let every = match from {
+                    PeriodFrom::EventTimer => format!("at least every {:.1} ms (event time)", period_ns as f64 / 1e6),
+                    PeriodFrom::Measured => format!("every {:.1} ms (measured)", period_ns as f64 / 1e6),
+                };
+                let inc = &mut self.incidents[i];
+                inc.status = Status::Open;
+                inc.title = format!("{name} stopped arriving");
+                if inc.cause.is_none() {
+                    inc.cause = Some(format!("{name} expected {every}"));
+                }
+                let at = At {
+                    frame: last_frame,
+                    t: last_ns,
+                };
+                self.step(i, at, format!("Last {name} before the gap"));
+                self.pdo_gaps.insert(key, i);
+            }
+            PdoGap::Back { key, gap_ns } => {
+                let Some(i) = self.pdo_gaps.remove(&key) else { return };
+                let name = Self::pdo_name(key);
+                let at = self.at;
+                let inc = &mut self.incidents[i];
+                inc.status = Status::Warning;
+                inc.last_ns = at.t;
+                inc.title = if inc.count == 1 {
+                    format!("{name} stopped for a while, then came again")
+                } else {
+                    format!("{name} stopped {} times, came again each time", inc.count)
+                };
+                self.step(i, at, format!("{name} again after {:.3} s", gap_ns as f64 / 1e9));
+            }
+        }
+    }
+
+    /// A PDO of `node` arrived (number `num`, TPDO when `transmit`).
+    fn pdo_arrived(&mut self, node: u8, transmit: bool, num: u16) {
+        let at = self.at;
+        if num > 0
+            && let Some(gap) = self.pdos.pdo((node, transmit, num), at.frame, at.t)
+        {
+            self.pdo_gap(gap);
+        }
     }
 
     /// True when a PDO of `node` can tell the diagnosis something: its `mapping` holds a
@@ -258,11 +340,17 @@ impl Diagnoser {
     /// A frame left undecoded (SYNC, TIME, LSS, unknown COB-IDs, PDOs that
     /// [`Diagnoser::wants_pdo`] declines): time and frame number advance, and a TPDO
     /// still shows that its node is there.
-    pub fn skip(&mut self, frame: &Frame, kind: Kind, node: Option<u8>) {
+    /// `pdo` is the PDO number (from [`crate::decode::Decoder::peek`]), 0 for other frames.
+    pub fn skip(&mut self, frame: &Frame, kind: Kind, node: Option<u8>, pdo: u16) {
         self.advance(frame);
         self.tracker.tick(frame.ts_ns);
         for e in self.tracker.take_events() {
             self.event(&e);
+        }
+        match (kind, node) {
+            (Kind::Sync, _) => self.sync.sync(self.at.frame, frame.ts_ns),
+            (Kind::Tpdo | Kind::Rpdo, Some(n)) => self.pdo_arrived(n, kind == Kind::Tpdo, pdo),
+            _ => {}
         }
         if let (Kind::Tpdo, Some(n)) = (kind, node) {
             let at = self.at;
@@ -280,6 +368,9 @@ impl Diagnoser {
             self.event(&e);
         }
         let Some(n) = d.node else {
+            if d.kind == Kind::Sync {
+                self.sync.sync(self.at.frame, frame.ts_ns);
+            }
             if let Body::Nmt(nmt) = &d.body {
                 self.nmt(nmt.cs, nmt.target);
             }
@@ -342,6 +433,7 @@ impl Diagnoser {
                 if p.transmit {
                     self.node(n).heard = true;
                 }
+                self.pdo_arrived(n, p.transmit, p.num);
                 let mut words = Vec::new();
                 for s in &p.signals {
                     let Some(v) = s.value.as_i64() else { continue };
@@ -709,6 +801,9 @@ impl Diagnoser {
             0x82 => ("reset communication", NmtState::BootUp),
             _ => return,
         };
+        if cs != 0x01 {
+            self.pdos.pause((target != 0).then_some(target));
+        }
         let at = self.at;
         let known: Vec<u8> = self
             .nodes
@@ -764,6 +859,7 @@ impl Diagnoser {
             }
             What::HeartbeatBack { silent_ms } => self.back(n, at, *silent_ms),
             What::BootUp { rebooted, .. } => {
+                self.pdos.pause(Some(n));
                 let reset_all = self.reset_all;
                 let node = self.node(n);
                 // (Equal times say nothing: logs without timestamps.)
@@ -902,6 +998,15 @@ impl Diagnoser {
         if t.sub == 0 {
             self.drive_word(t.node, t.index, v as u16);
         }
+        match (t.index, t.sub) {
+            (0x1800..=0x19FF, 5) => self
+                .pdos
+                .event_timer((t.node, true, t.index - 0x1800 + 1), u64::from(v & 0xFFFF)),
+            (0x1400..=0x15FF, 5) => self
+                .pdos
+                .event_timer((t.node, false, t.index - 0x1400 + 1), u64::from(v & 0xFFFF)),
+            _ => {}
+        }
         if (t.index, t.sub) == (0x1017, 0) {
             let at = self.at;
             self.node(t.node).heartbeat_off = (v & 0xFFFF == 0).then_some(at);
@@ -935,12 +1040,49 @@ impl Diagnoser {
         if self.sdo_deadline.is_some_and(|dl| now_ns > dl) {
             self.sdo_timeouts(now_ns);
         }
+        self.pdos_due(now_ns);
     }
 
     /// The incidents so far, ranked as [`Diagnoser::finish`] ranks them, as if the capture
     /// ended now (the builder goes on).
     pub fn incidents(&self) -> Vec<Incident> {
         self.clone().finish()
+    }
+
+    /// SYNC intervals off the period become one warning with the jitter figures.
+    fn sync_jitter(&mut self) {
+        let Some(sum) = self.sync.summary().filter(|s| s.off > 0) else {
+            return;
+        };
+        let ms = |ns: u64| ns as f64 / 1e6;
+        let first = self.sync.kept.first().map_or(0, |o| o.t_ns);
+        let i = self.grouped(None, Problem::SyncJitter, 0, first);
+        let inc = &mut self.incidents[i];
+        inc.count = sum.off;
+        inc.status = Status::Warning;
+        inc.title = format!(
+            "SYNC timing uneven: {} of {} cycles more than 10 % off the {:.3} ms period",
+            sum.off,
+            sum.intervals,
+            ms(sum.period_ns)
+        );
+        inc.cause = Some(format!(
+            "period {:.3} ms; intervals {:.3} to {:.3} ms; standard deviation {:.3} ms",
+            ms(sum.period_ns),
+            ms(sum.min_ns),
+            ms(sum.max_ns),
+            sum.std_ns / 1e6
+        ));
+        if let Some(last) = self.sync.kept.last() {
+            inc.last_ns = last.t_ns;
+        }
+        for o in self.sync.kept.clone() {
+            let at = At {
+                frame: o.frame,
+                t: o.t_ns,
+            };
+            self.step(i, at, format!("SYNC {:.3} ms after the one before", ms(o.interval_ns)));
+        }
     }
 
     /// The end of the capture: what is still wrong is open. Returns the incidents ranked,
@@ -955,6 +1097,13 @@ impl Diagnoser {
             self.event(&e);
         }
         self.sdo_timeouts(end.t);
+        self.pdos_due(end.t);
+        for (key, i) in std::mem::take(&mut self.pdo_gaps) {
+            let name = Self::pdo_name(key);
+            self.step(i, end, format!("No {name} after that, until the end of the capture"));
+            self.incidents[i].last_ns = end.t;
+        }
+        self.sync_jitter();
         let nodes: Vec<u8> = self.nodes.keys().copied().collect();
         for n in nodes {
             self.flush_emcy(n, u64::MAX);
@@ -1022,6 +1171,15 @@ impl Diagnoser {
             let meta = self.faults.get(&i).cloned().unwrap_or_default();
             super::texts::fill(inc, meta.resets, meta.emcy, self.error_frames);
         }
+        // A PDO that stops because its node went silent for good is part of that silence.
+        let gone: Vec<Option<u8>> = self
+            .incidents
+            .iter()
+            .filter(|i| i.problem == Problem::Silent)
+            .map(|i| i.node)
+            .collect();
+        self.incidents
+            .retain(|i| !(i.problem == Problem::PdoMissing && gone.contains(&i.node)));
         let mut out = merge_faults(self.incidents);
         for inc in &mut out {
             inc.events.sort_by_key(|e| e.frame);

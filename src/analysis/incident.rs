@@ -61,6 +61,10 @@ pub enum Problem {
     NmtIgnored,
     /// A CiA 402 drive that did not reach the state its controlword asked for.
     DriveStuck,
+    /// A PDO that stopped arriving within its event time or measured period.
+    PdoMissing,
+    /// SYNC intervals off the SYNC period.
+    SyncJitter,
 }
 
 impl Problem {
@@ -81,6 +85,8 @@ impl Problem {
             Problem::DuplicateId => "duplicate_id",
             Problem::NmtIgnored => "nmt_ignored",
             Problem::DriveStuck => "drive_stuck",
+            Problem::PdoMissing => "pdo_missing",
+            Problem::SyncJitter => "sync_jitter",
         }
     }
 }

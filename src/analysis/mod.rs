@@ -16,6 +16,7 @@ pub mod series;
 pub mod stats;
 pub mod store;
 mod texts;
+pub mod timing;
 pub mod trace;
 pub mod view;
 

@@ -240,5 +240,25 @@ pub fn fill(inc: &mut Incident, resets: u32, emcy: Option<u16>, error_frames: u6
             inc.why = "The master waits for a state the drive does not reach: the axis does not move and motion commands are ignored."
                 .into();
         }
+        Problem::PdoMissing => {
+            // The title (which PDO) is set by the builder.
+            inc.check = strings(&[
+                "Check the node's NMT state: PDOs are sent in operational only.",
+                "Check the PDO's transmission type and event time (0x1800/0x1400 sub 2 and 5) and, for synchronous PDOs, that SYNC kept coming.",
+                "Look for bus errors or a busy bus at the same time: a PDO with a low priority waits behind others.",
+            ]);
+            inc.why = "The master or the drive works on stale values while the PDO is missing; a drive may stop on its RPDO timeout."
+                .into();
+        }
+        Problem::SyncJitter => {
+            // The title (the figures) is set by the builder.
+            inc.check = strings(&[
+                "Check the SYNC producer: a PC master without real-time scheduling sends SYNC late under load.",
+                "Check the bus load: frames in the way delay even the high-priority SYNC.",
+                "Check the drives' SYNC-loss and following-error settings if they run cyclic synchronous modes.",
+            ]);
+            inc.why = "Drives in cyclic synchronous modes (CSP, CSV) move in steps of one SYNC: an uneven SYNC makes the motion rough or trips a following error."
+                .into();
+        }
     }
 }

@@ -91,7 +91,7 @@ impl Trace {
         }
         self.nodes.tick(frame.ts_ns);
         self.diagnosis_version += 1;
-        let (kind, node, _) = self.decoder.peek(frame);
+        let (kind, node, pdo) = self.decoder.peek(frame);
         // Frames that change what the panes or the diagnosis show are decoded in full (SDO
         // frames always were: the decoder tracks their transfers); the rest only routed.
         let (kind, node) = if matches!(
@@ -117,7 +117,7 @@ impl Trace {
             self.diagnosis.frame(frame, iface, &d);
             (d.kind, d.node)
         } else {
-            self.diagnosis.skip(frame, kind, node);
+            self.diagnosis.skip(frame, kind, node, pdo);
             (kind, node)
         };
         self.store.push(frame, kind, node);

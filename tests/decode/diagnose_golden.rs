@@ -329,3 +329,35 @@ fn drive_stuck_with_the_reason_the_bus_shows() {
         inc[1]["title"]
     );
 }
+
+#[test]
+fn pdo_missing_and_sync_jitter() {
+    // SYNC every 10 ms with two late ones; node 2's synchronous TPDO1 (measured period)
+    // stops for 0.5 s; node 3's event-driven TPDO1 (event time 50 ms written to 0x1800:05)
+    // stops at 2 s while its heartbeat goes on.
+    let inc = golden("timing");
+    assert_eq!(
+        summary(&inc),
+        [
+            s(Some(3), "pdo_missing", "open"),
+            s(Some(2), "pdo_missing", "warning"),
+            s(None, "sync_jitter", "warning"),
+        ]
+    );
+    assert_eq!(inc[0]["title"], "TPDO1 stopped arriving");
+    assert_eq!(inc[0]["cause"], "TPDO1 expected at least every 50.0 ms (event time)");
+    assert_eq!(frames(&inc[0]), [443, 673]);
+    assert_eq!(inc[1]["title"], "TPDO1 stopped for a while, then came again");
+    assert_eq!(inc[1]["cause"], "TPDO1 expected every 10.0 ms (measured)");
+    assert_eq!(inc[1]["events"][1]["text"], "TPDO1 again after 0.514 s");
+    assert_eq!(
+        inc[2]["title"],
+        "SYNC timing uneven: 2 of 298 cycles more than 10 % off the 10.000 ms period"
+    );
+    assert_eq!(
+        inc[2]["cause"],
+        "period 10.000 ms; intervals 10.000 to 17.000 ms; standard deviation 0.466 ms"
+    );
+    assert_eq!(frames(&inc[2]), [284, 454]);
+    assert_eq!(inc[2]["count"], 2);
+}
