@@ -155,6 +155,8 @@ pub struct Diagnoser {
     pdos: PdoTiming,
     /// The incident of each PDO that stopped, while it is missing.
     pdo_gaps: HashMap<PdoKey, usize>,
+    /// The profile's "check first" steps for the EMCY code of an incident.
+    device_check: HashMap<usize, Vec<String>>,
 }
 
 /// Index offset of `axis` (1-based) in the CiA 402 range.
@@ -183,6 +185,7 @@ impl Diagnoser {
             sync: SyncTiming::default(),
             pdos: PdoTiming::default(),
             pdo_gaps: HashMap::new(),
+            device_check: HashMap::new(),
         }
     }
 
@@ -696,6 +699,9 @@ impl Diagnoser {
     }
 
     fn give_cause(&mut self, i: usize, at: At, e: &Emcy) {
+        if !e.check.is_empty() {
+            self.device_check.insert(i, e.check.clone());
+        }
         self.incidents[i].cause = Some(Self::emcy_text(e));
         self.faults.entry(i).or_default().emcy = Some(e.code);
         self.step(i, at, format!("Cause reported: {}", Self::emcy_text(e)));
@@ -722,6 +728,9 @@ impl Diagnoser {
         let old: Vec<(At, Emcy)> = node.emcy.drain(..keep).collect();
         for (at, e) in old {
             let i = self.grouped(Some(n), Problem::Emcy, u32::from(e.code), at.t);
+            if !e.check.is_empty() {
+                self.device_check.insert(i, e.check.clone());
+            }
             let inc = &mut self.incidents[i];
             inc.status = Status::Open;
             inc.cause = Some(Self::emcy_text(&e));
@@ -1170,6 +1179,10 @@ impl Diagnoser {
         for (i, inc) in self.incidents.iter_mut().enumerate() {
             let meta = self.faults.get(&i).cloned().unwrap_or_default();
             super::texts::fill(inc, meta.resets, meta.emcy, self.error_frames);
+            // The device's own steps for its EMCY code come first.
+            if let Some(steps) = self.device_check.get(&i) {
+                inc.check.splice(0..0, steps.iter().cloned());
+            }
         }
         // A PDO that stops because its node went silent for good is part of that silence.
         let gone: Vec<Option<u8>> = self

@@ -209,6 +209,19 @@ fn causes_through_the_profiles() {
         inc[1]["title"],
         "Stopped: continuous over-current no. 2 (AIMOTOR fault 0201h; read H0B-34); still in fault at the end"
     );
+    // The profile's own steps for EMCY 0x2312 (emcy.check) come before the generic ones.
+    let check: Vec<&str> = inc[1]["check"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_str().unwrap())
+        .collect();
+    assert!(
+        check[0].starts_with("Read the fault code H0B-34 (SDO upload 0x200B:23"),
+        "{check:?}"
+    );
+    assert!(check[1].starts_with("Check the motor for a blocked shaft"), "{check:?}");
+    assert_eq!(check[2], "Look up EMCY 0x2312 in the drive manual's error table.");
 }
 
 #[test]
