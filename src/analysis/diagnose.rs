@@ -39,6 +39,9 @@ const RESET_BOOT_NS: u64 = 5_000 * MS;
 const NMT_GRACE_NS: u64 = 100 * MS;
 /// A fault reset this soon after the fault cleared belongs to it (one SYNC cycle).
 const SAME_CYCLE_NS: u64 = 20 * MS;
+/// An SDO request this soon after another one to the same node that is still going on,
+/// or NMT commands this close that undo each other, come from a second master.
+const TWO_MASTERS_NS: u64 = 25 * MS;
 /// A drive has this long to show the state its controlword asked for.
 const STALL_NS: u64 = 1_000 * MS;
 /// Axes of a multi-axis drive (objects 0x6000 + 0x800 * (axis - 1)).
@@ -119,6 +122,8 @@ struct Node {
     emcy: Vec<(At, Emcy)>,
     /// The last EMCY error code.
     last_emcy: Option<u16>,
+    /// The last segment of a segmented SDO transfer still going on.
+    segmenting: Option<At>,
     silence: Option<(At, u64, f64)>,
 }
 
@@ -157,6 +162,8 @@ pub struct Diagnoser {
     pdo_gaps: HashMap<PdoKey, usize>,
     /// The profile's "check first" steps for the EMCY code of an incident.
     device_check: HashMap<usize, Vec<String>>,
+    /// The last NMT command: when, command specifier, target.
+    last_nmt: Option<(At, u8, u8)>,
 }
 
 /// Index offset of `axis` (1-based) in the CiA 402 range.
@@ -186,6 +193,7 @@ impl Diagnoser {
             pdos: PdoTiming::default(),
             pdo_gaps: HashMap::new(),
             device_check: HashMap::new(),
+            last_nmt: None,
         }
     }
 
@@ -408,18 +416,26 @@ impl Diagnoser {
                 node.pending = None;
                 node.answered_after = true;
                 if let SdoCommand::Abort { index, sub, code } = s.command {
+                    self.node(n).segmenting = None;
                     self.refused(n, index, sub, code);
                 } else if s.problems.iter().any(|p| p == "outside any transfer seen") {
                     self.garbled(n, format!("{} frame outside any transfer", s.command.cs_name()));
                 }
             }
             Body::Sdo(s) => {
+                if matches!(s.command.cs_name(), "download_segment" | "upload_segment") {
+                    self.node(n).segmenting = Some(at);
+                }
                 // Only initiate frames start a request (segments carry no object themselves).
                 if let Some((index, sub)) = s.command.object()
                     && s.command.cs_name() != "abort"
                 {
+                    // The other client's request may well be answered: not counted as unanswered.
+                    let overlap = self.overlapping_request(n, index, sub);
                     self.node(n).download = matches!(s.command.cs_name(), "initiate_download" | "block_download");
-                    if let Some(old) = self.node(n).pending.take() {
+                    if let Some(old) = self.node(n).pending.take()
+                        && !overlap
+                    {
                         self.unanswered(n, Request { replaced: true, ..old });
                     }
                     self.node(n).pending = Some(Request {
@@ -532,6 +548,43 @@ impl Diagnoser {
             format!("Still {} (statusword 0x{sw:04X}) after {waited:.2} s", state.text()),
         );
         self.node(n).axes.entry(axis).or_default().stuck = Some(i);
+    }
+
+    /// An SDO request for `index:sub` to node `n` while another one is going on (sent
+    /// just before and not answered, or a segmented transfer in mid-flow): two clients.
+    /// True when it is one.
+    fn overlapping_request(&mut self, n: u8, index: u16, sub: u8) -> bool {
+        let at = self.at;
+        let node = self.node(n);
+        let young = |a: At| at.t.saturating_sub(a.t) < TWO_MASTERS_NS;
+        let what = match (node.pending, node.segmenting) {
+            (Some(r), _) if young(r.at) && (r.index, r.sub) != (index, sub) => format!(
+                "Request for 0x{index:04X}:{sub:02X} while the request for 0x{:04X}:{:02X} (#{}) still waits for its answer",
+                r.index, r.sub, r.at.frame
+            ),
+            (_, Some(s)) if young(s) => {
+                format!(
+                    "Request for 0x{index:04X}:{sub:02X} in the middle of a segmented transfer (#{})",
+                    s.frame
+                )
+            }
+            _ => return false,
+        };
+        node.segmenting = None;
+        self.second_master(Some(n), "SDO requests to the node overlap", at, what);
+        true
+    }
+
+    fn second_master(&mut self, node: Option<u8>, cause: &str, at: At, what: String) {
+        let i = self.grouped(node, Problem::SecondMaster, 0, at.t);
+        let inc = &mut self.incidents[i];
+        inc.status = Status::Warning;
+        inc.cause = match inc.cause.take() {
+            Some(c) if c.contains(cause) => Some(c),
+            Some(c) => Some(format!("{c}; {cause}")),
+            None => Some(cause.to_string()),
+        };
+        self.step(i, at, what);
     }
 
     /// A CiA 402 object value of `node` (from a PDO or an SDO transfer).
@@ -814,6 +867,27 @@ impl Diagnoser {
             self.pdos.pause((target != 0).then_some(target));
         }
         let at = self.at;
+        // A start undone at once by a stop or pre-operational for the same node: two
+        // masters disagree (one master leaving pre-operational right after entering it is
+        // a normal re-configuration, the other order is not).
+        if let Some((last, last_cs, last_target)) = self.last_nmt.replace((at, cs, target))
+            && at.t.saturating_sub(last.t) < TWO_MASTERS_NS
+            && (last_target == target || last_target == 0 || target == 0)
+            && matches!((last_cs, cs), (0x01, 0x02 | 0x80))
+        {
+            let node = [target, last_target].into_iter().find(|t| *t != 0);
+            let text = format!(
+                "NMT {command} {} right after NMT {} (#{})",
+                if target == 0 {
+                    "all nodes".to_string()
+                } else {
+                    format!("node {target}")
+                },
+                "start",
+                last.frame
+            );
+            self.second_master(node, "NMT commands that undo each other", at, text);
+        }
         let known: Vec<u8> = self
             .nodes
             .iter()
@@ -992,6 +1066,7 @@ impl Diagnoser {
 
     /// A completed SDO transfer (in order, right after the frame that ended it).
     pub fn transaction(&mut self, t: &Transaction) {
+        self.node(t.node).segmenting = None;
         self.tracker.transaction(t);
         for e in self.tracker.take_events() {
             self.event(&e);

@@ -65,6 +65,8 @@ pub enum Problem {
     PdoMissing,
     /// SYNC intervals off the SYNC period.
     SyncJitter,
+    /// Requests or commands from two masters at once.
+    SecondMaster,
 }
 
 impl Problem {
@@ -87,6 +89,7 @@ impl Problem {
             Problem::DriveStuck => "drive_stuck",
             Problem::PdoMissing => "pdo_missing",
             Problem::SyncJitter => "sync_jitter",
+            Problem::SecondMaster => "second_master",
         }
     }
 }

@@ -260,5 +260,20 @@ pub fn fill(inc: &mut Incident, resets: u32, emcy: Option<u16>, error_frames: u6
             inc.why = "Drives in cyclic synchronous modes (CSP, CSV) move in steps of one SYNC: an uneven SYNC makes the motion rough or trips a following error."
                 .into();
         }
+        Problem::SecondMaster => {
+            inc.title = if inc.count == 1 {
+                "Commands from two masters at once".into()
+            } else {
+                format!("Commands from two masters at once ({} times)", inc.count)
+            };
+            inc.check = strings(&[
+                "Look for a second device or tool acting as master: a PLC and a PC tool, a configuration tool left connected, a second controller.",
+                "Only one SDO client may use a node's default SDO channel (0x600 + node) at a time: stop the other one or give it its own SDO channel (0x1280).",
+                "Only one master should start and stop nodes (NMT): check the NMT start-up settings of each.",
+            ]);
+            inc.why =
+                "Two masters undo each other's settings and states: commands seem to be ignored or reversed at random."
+                    .into();
+        }
     }
 }

@@ -374,3 +374,23 @@ fn pdo_missing_and_sync_jitter() {
     assert_eq!(frames(&inc[2]), [284, 454]);
     assert_eq!(inc[2]["count"], 2);
 }
+
+#[test]
+fn second_master_from_overlapping_sdo_requests_and_nmt() {
+    // A write to 0x6040 in the middle of another client's segmented read of 0x1008, a read
+    // sent 3 ms after another one still unanswered, and NMT stop 10 ms after NMT start.
+    let inc = golden("second_master");
+    assert_eq!(summary(&inc), [s(Some(2), "second_master", "warning")]);
+    assert_eq!(inc[0]["title"], "Commands from two masters at once (3 times)");
+    assert_eq!(
+        inc[0]["cause"],
+        "SDO requests to the node overlap; NMT commands that undo each other"
+    );
+    assert_eq!(frames(&inc[0]), [7, 12, 17]);
+    assert_eq!(
+        inc[0]["events"][1]["text"],
+        "Request for 0x6060:00 while the request for 0x1017:00 (#11) still waits for its answer"
+    );
+    // The overlapped request was not counted as unanswered: the other client got its answer.
+    assert!(inc.iter().all(|i| i["kind"] != "sdo_timeout"));
+}
