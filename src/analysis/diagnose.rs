@@ -164,6 +164,9 @@ pub struct Diagnoser {
     device_check: HashMap<usize, Vec<String>>,
     /// The last NMT command: when, command specifier, target.
     last_nmt: Option<(At, u8, u8)>,
+    /// The synchronous window length 0x1007 written to each node (ns), and the last SYNC.
+    sync_window: BTreeMap<u8, u64>,
+    last_sync: Option<At>,
 }
 
 /// Index offset of `axis` (1-based) in the CiA 402 range.
@@ -194,6 +197,8 @@ impl Diagnoser {
             pdo_gaps: HashMap::new(),
             device_check: HashMap::new(),
             last_nmt: None,
+            sync_window: BTreeMap::new(),
+            last_sync: None,
         }
     }
 
@@ -328,6 +333,23 @@ impl Diagnoser {
     /// A PDO of `node` arrived (number `num`, TPDO when `transmit`).
     fn pdo_arrived(&mut self, node: u8, transmit: bool, num: u16) {
         let at = self.at;
+        if transmit
+            && let (Some(&window), Some(sync)) = (self.sync_window.get(&node), self.last_sync)
+            && at.t.saturating_sub(sync.t) > window
+            && self.pdos.synchronous((node, transmit, num))
+        {
+            let name = Self::pdo_name((node, transmit, num));
+            let i = self.grouped(Some(node), Problem::PdoLate, u32::from(num), at.t);
+            let inc = &mut self.incidents[i];
+            inc.status = Status::Warning;
+            inc.title = match inc.count {
+                1 => format!("{name} sent after the SYNC window closed"),
+                n => format!("{name} sent after the SYNC window closed ({n} times)"),
+            };
+            inc.cause = Some(format!("synchronous window 0x1007 = {} µs", window / 1000));
+            let late = at.t.saturating_sub(sync.t) as f64 / 1e6;
+            self.step(i, at, format!("{name} {late:.3} ms after the SYNC (#{})", sync.frame));
+        }
         if num > 0
             && let Some(gap) = self.pdos.pdo((node, transmit, num), at.frame, at.t)
         {
@@ -359,7 +381,10 @@ impl Diagnoser {
             self.event(&e);
         }
         match (kind, node) {
-            (Kind::Sync, _) => self.sync.sync(self.at.frame, frame.ts_ns),
+            (Kind::Sync, _) => {
+                self.sync.sync(self.at.frame, frame.ts_ns);
+                self.last_sync = Some(self.at);
+            }
             (Kind::Tpdo | Kind::Rpdo, Some(n)) => self.pdo_arrived(n, kind == Kind::Tpdo, pdo),
             _ => {}
         }
@@ -381,6 +406,7 @@ impl Diagnoser {
         let Some(n) = d.node else {
             if d.kind == Kind::Sync {
                 self.sync.sync(self.at.frame, frame.ts_ns);
+                self.last_sync = Some(self.at);
             }
             if let Body::Nmt(nmt) = &d.body {
                 self.nmt(nmt.cs, nmt.target);
@@ -1086,6 +1112,15 @@ impl Diagnoser {
             (0x1800..=0x19FF, 5) => self
                 .pdos
                 .event_timer((t.node, true, t.index - 0x1800 + 1), u64::from(v & 0xFFFF)),
+            (0x1800..=0x19FF, 2) => self
+                .pdos
+                .transmission_type((t.node, true, t.index - 0x1800 + 1), v as u8),
+            (0x1007, 0) if v > 0 => {
+                self.sync_window.insert(t.node, u64::from(v) * 1000);
+            }
+            (0x1007, 0) => {
+                self.sync_window.remove(&t.node);
+            }
             (0x1400..=0x15FF, 5) => self
                 .pdos
                 .event_timer((t.node, false, t.index - 0x1400 + 1), u64::from(v & 0xFFFF)),

@@ -67,6 +67,8 @@ pub enum Problem {
     SyncJitter,
     /// Requests or commands from two masters at once.
     SecondMaster,
+    /// A synchronous TPDO sent after the SYNC window (0x1007) closed.
+    PdoLate,
 }
 
 impl Problem {
@@ -90,6 +92,7 @@ impl Problem {
             Problem::PdoMissing => "pdo_missing",
             Problem::SyncJitter => "sync_jitter",
             Problem::SecondMaster => "second_master",
+            Problem::PdoLate => "pdo_late",
         }
     }
 }

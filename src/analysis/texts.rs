@@ -275,5 +275,15 @@ pub fn fill(inc: &mut Incident, resets: u32, emcy: Option<u16>, error_frames: u6
                 "Two masters undo each other's settings and states: commands seem to be ignored or reversed at random."
                     .into();
         }
+        Problem::PdoLate => {
+            // The title (which PDO, how often) is set by the builder.
+            inc.check = strings(&[
+                "Check the node's load and its synchronous window setting 0x1007 against its PDO processing time.",
+                "Check the bus load right after SYNC: many synchronous PDOs queue behind each other; spread them or raise the bit rate.",
+                "Check that the window (0x1007) fits inside the SYNC period (0x1006).",
+            ]);
+            inc.why = "A PDO sent after the window is not taken in this cycle: the master or the drive works on values one cycle old."
+                .into();
+        }
     }
 }

@@ -163,6 +163,8 @@ struct Stream {
     measured: Option<u64>,
     irregular: bool,
     event_timer: Option<u64>,
+    /// Transmission type 1..=240 (sent after SYNC) written on the bus.
+    synchronous: bool,
     /// A gap was reported and the PDO has not come back yet.
     missing: bool,
 }
@@ -245,6 +247,16 @@ impl PdoTiming {
     /// The event timer of `key` was written: `ms` (0 switches it off).
     pub fn event_timer(&mut self, key: PdoKey, ms: u64) {
         self.streams.entry(key).or_default().event_timer = (ms > 0).then_some(ms * MS);
+    }
+
+    /// The transmission type of `key` was written (sub 2): 1..=240 is synchronous.
+    pub fn transmission_type(&mut self, key: PdoKey, t: u8) {
+        self.streams.entry(key).or_default().synchronous = (1..=240).contains(&t);
+    }
+
+    /// True when `key` was configured synchronous (transmission type 1..=240).
+    pub fn synchronous(&self, key: PdoKey) -> bool {
+        self.streams.get(&key).is_some_and(|s| s.synchronous)
     }
 
     /// `node` stops sending PDOs for a reason (NMT stop, pre-operational, reset, boot-up):

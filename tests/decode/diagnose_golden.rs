@@ -394,3 +394,15 @@ fn second_master_from_overlapping_sdo_requests_and_nmt() {
     // The overlapped request was not counted as unanswered: the other client got its answer.
     assert!(inc.iter().all(|i| i["kind"] != "sdo_timeout"));
 }
+
+#[test]
+fn pdo_late_after_the_sync_window() {
+    // Node 2's TPDO1 is synchronous (0x1800:02 = 1) with a 2 ms window (0x1007 = 2000 µs)
+    // and comes 1 ms after SYNC, three times 4 ms after it.
+    let inc = golden("sync_window");
+    assert_eq!(summary(&inc), [s(Some(2), "pdo_late", "warning")]);
+    assert_eq!(inc[0]["title"], "TPDO1 sent after the SYNC window closed (3 times)");
+    assert_eq!(inc[0]["cause"], "synchronous window 0x1007 = 2000 µs");
+    assert_eq!(frames(&inc[0]), [66, 69, 150]);
+    assert_eq!(inc[0]["events"][0]["text"], "TPDO1 4.000 ms after the SYNC (#65)");
+}
