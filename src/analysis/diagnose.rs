@@ -11,9 +11,11 @@
 use super::events::{Event, What};
 use super::incident::{Incident, Problem, Status};
 use super::liveness::EventTracker;
+use super::timing::{PdoGap, PdoKey, PdoTiming, PeriodFrom, SyncTiming};
 use crate::decode::cia402::DriveState;
 use crate::decode::emcy::Emcy;
 use crate::decode::heartbeat::NmtState;
+use crate::decode::stall::{self, Observation, Step};
 use crate::decode::{Body, Decoded, Kind};
 use crate::frame::Frame;
 use crate::od::PdoMapping;
@@ -37,6 +39,11 @@ const RESET_BOOT_NS: u64 = 5_000 * MS;
 const NMT_GRACE_NS: u64 = 100 * MS;
 /// A fault reset this soon after the fault cleared belongs to it (one SYNC cycle).
 const SAME_CYCLE_NS: u64 = 20 * MS;
+/// An SDO request this soon after another one to the same node that is still going on,
+/// or NMT commands this close that undo each other, come from a second master.
+const TWO_MASTERS_NS: u64 = 25 * MS;
+/// A drive has this long to show the state its controlword asked for.
+const STALL_NS: u64 = 1_000 * MS;
 /// Axes of a multi-axis drive (objects 0x6000 + 0x800 * (axis - 1)).
 const AXES: u16 = 8;
 
@@ -74,6 +81,13 @@ struct Axis {
     fault: Option<usize>,
     /// A cleared fault waiting for "operation enabled".
     cleared: Option<usize>,
+    /// The last statusword.
+    sw: Option<u16>,
+    /// A state change the controlword asked for and the statusword has not shown yet:
+    /// when, what, and the statusword then.
+    asked: Option<(At, Step, Option<u16>)>,
+    /// The open "stuck" incident, until the drive reaches the state asked for.
+    stuck: Option<usize>,
 }
 
 /// What one node has shown so far.
@@ -106,6 +120,10 @@ struct Node {
     axes: BTreeMap<u8, Axis>,
     /// EMCY not yet given to an incident (a fault may follow at once).
     emcy: Vec<(At, Emcy)>,
+    /// The last EMCY error code.
+    last_emcy: Option<u16>,
+    /// The last segment of a segmented SDO transfer still going on.
+    segmenting: Option<At>,
     silence: Option<(At, u64, f64)>,
 }
 
@@ -116,10 +134,16 @@ struct FaultMeta {
     emcy: Option<u16>,
 }
 
-/// Builds incidents from the frames of one capture, in order.
+/// Builds incidents from the frames of one capture, in order. Incremental: frames go in
+/// one at a time ([`Diagnoser::frame`], [`Diagnoser::skip`]), the capture clock advances
+/// on a quiet bus with [`Diagnoser::tick`], and [`Diagnoser::incidents`] tells what is
+/// wrong so far without ending the capture.
+#[derive(Clone)]
 pub struct Diagnoser {
     tracker: EventTracker,
     at: At,
+    /// The capture time reached by [`Diagnoser::tick`] (ns), 0 before any tick.
+    now: u64,
     first_ns: Option<u64>,
     nodes: BTreeMap<u8, Node>,
     incidents: Vec<Incident>,
@@ -132,6 +156,17 @@ pub struct Diagnoser {
     reset_all: Option<u64>,
     /// Longest silence per node that came back (ms).
     silent_max: BTreeMap<u8, f64>,
+    sync: SyncTiming,
+    pdos: PdoTiming,
+    /// The incident of each PDO that stopped, while it is missing.
+    pdo_gaps: HashMap<PdoKey, usize>,
+    /// The profile's "check first" steps for the EMCY code of an incident.
+    device_check: HashMap<usize, Vec<String>>,
+    /// The last NMT command: when, command specifier, target.
+    last_nmt: Option<(At, u8, u8)>,
+    /// The synchronous window length 0x1007 written to each node (ns), and the last SYNC.
+    sync_window: BTreeMap<u8, u64>,
+    last_sync: Option<At>,
 }
 
 /// Index offset of `axis` (1-based) in the CiA 402 range.
@@ -146,6 +181,7 @@ impl Diagnoser {
         Diagnoser {
             tracker,
             at: At::default(),
+            now: 0,
             first_ns: None,
             nodes: BTreeMap::new(),
             incidents: Vec::new(),
@@ -156,6 +192,13 @@ impl Diagnoser {
             sdo_deadline: None,
             silent_max: BTreeMap::new(),
             reset_all: None,
+            sync: SyncTiming::default(),
+            pdos: PdoTiming::default(),
+            pdo_gaps: HashMap::new(),
+            device_check: HashMap::new(),
+            last_nmt: None,
+            sync_window: BTreeMap::new(),
+            last_sync: None,
         }
     }
 
@@ -221,6 +264,97 @@ impl Diagnoser {
         if self.sdo_deadline.is_some_and(|dl| frame.ts_ns > dl) {
             self.sdo_timeouts(frame.ts_ns);
         }
+        self.pdos_due(frame.ts_ns);
+    }
+
+    /// PDOs overdue at `now` become (or add to) incidents.
+    fn pdos_due(&mut self, now: u64) {
+        for gap in self.pdos.due(now) {
+            self.pdo_gap(gap);
+        }
+    }
+
+    fn pdo_name((_, transmit, num): PdoKey) -> String {
+        format!("{}PDO{num}", if transmit { "T" } else { "R" })
+    }
+
+    fn pdo_gap(&mut self, gap: PdoGap) {
+        match gap {
+            PdoGap::Missing {
+                key,
+                last_frame,
+                last_ns,
+                period_ns,
+                from,
+            } => {
+                let n = key.0;
+                let node = self.node(n);
+                // PDOs flow in "operational" only; a silent node is its own incident.
+                if node.last_state.is_some_and(|(_, s)| s != NmtState::Operational) || node.silence.is_some() {
+                    return;
+                }
+                let name = Self::pdo_name(key);
+                let detail = (u32::from(key.1) << 16) | u32::from(key.2);
+                let i = self.grouped(Some(n), Problem::PdoMissing, detail, last_ns);
+                let every = match from {
+                    PeriodFrom::EventTimer => format!("at least every {:.1} ms (event time)", period_ns as f64 / 1e6),
+                    PeriodFrom::Measured => format!("every {:.1} ms (measured)", period_ns as f64 / 1e6),
+                };
+                let inc = &mut self.incidents[i];
+                inc.status = Status::Open;
+                inc.title = format!("{name} stopped arriving");
+                if inc.cause.is_none() {
+                    inc.cause = Some(format!("{name} expected {every}"));
+                }
+                let at = At {
+                    frame: last_frame,
+                    t: last_ns,
+                };
+                self.step(i, at, format!("Last {name} before the gap"));
+                self.pdo_gaps.insert(key, i);
+            }
+            PdoGap::Back { key, gap_ns } => {
+                let Some(i) = self.pdo_gaps.remove(&key) else { return };
+                let name = Self::pdo_name(key);
+                let at = self.at;
+                let inc = &mut self.incidents[i];
+                inc.status = Status::Warning;
+                inc.last_ns = at.t;
+                inc.title = if inc.count == 1 {
+                    format!("{name} stopped for a while, then came again")
+                } else {
+                    format!("{name} stopped {} times, came again each time", inc.count)
+                };
+                self.step(i, at, format!("{name} again after {:.3} s", gap_ns as f64 / 1e9));
+            }
+        }
+    }
+
+    /// A PDO of `node` arrived (number `num`, TPDO when `transmit`).
+    fn pdo_arrived(&mut self, node: u8, transmit: bool, num: u16) {
+        let at = self.at;
+        if transmit
+            && let (Some(&window), Some(sync)) = (self.sync_window.get(&node), self.last_sync)
+            && at.t.saturating_sub(sync.t) > window
+            && self.pdos.synchronous((node, transmit, num))
+        {
+            let name = Self::pdo_name((node, transmit, num));
+            let i = self.grouped(Some(node), Problem::PdoLate, u32::from(num), at.t);
+            let inc = &mut self.incidents[i];
+            inc.status = Status::Warning;
+            inc.title = match inc.count {
+                1 => format!("{name} sent after the SYNC window closed"),
+                n => format!("{name} sent after the SYNC window closed ({n} times)"),
+            };
+            inc.cause = Some(format!("synchronous window 0x1007 = {} µs", window / 1000));
+            let late = at.t.saturating_sub(sync.t) as f64 / 1e6;
+            self.step(i, at, format!("{name} {late:.3} ms after the SYNC (#{})", sync.frame));
+        }
+        if num > 0
+            && let Some(gap) = self.pdos.pdo((node, transmit, num), at.frame, at.t)
+        {
+            self.pdo_gap(gap);
+        }
     }
 
     /// True when a PDO of `node` can tell the diagnosis something: its `mapping` holds a
@@ -239,11 +373,20 @@ impl Diagnoser {
     /// A frame left undecoded (SYNC, TIME, LSS, unknown COB-IDs, PDOs that
     /// [`Diagnoser::wants_pdo`] declines): time and frame number advance, and a TPDO
     /// still shows that its node is there.
-    pub fn skip(&mut self, frame: &Frame, kind: Kind, node: Option<u8>) {
+    /// `pdo` is the PDO number (from [`crate::decode::Decoder::peek`]), 0 for other frames.
+    pub fn skip(&mut self, frame: &Frame, kind: Kind, node: Option<u8>, pdo: u16) {
         self.advance(frame);
         self.tracker.tick(frame.ts_ns);
         for e in self.tracker.take_events() {
             self.event(&e);
+        }
+        match (kind, node) {
+            (Kind::Sync, _) => {
+                self.sync.sync(self.at.frame, frame.ts_ns);
+                self.last_sync = Some(self.at);
+            }
+            (Kind::Tpdo | Kind::Rpdo, Some(n)) => self.pdo_arrived(n, kind == Kind::Tpdo, pdo),
+            _ => {}
         }
         if let (Kind::Tpdo, Some(n)) = (kind, node) {
             let at = self.at;
@@ -261,6 +404,10 @@ impl Diagnoser {
             self.event(&e);
         }
         let Some(n) = d.node else {
+            if d.kind == Kind::Sync {
+                self.sync.sync(self.at.frame, frame.ts_ns);
+                self.last_sync = Some(self.at);
+            }
             if let Body::Nmt(nmt) = &d.body {
                 self.nmt(nmt.cs, nmt.target);
             }
@@ -295,18 +442,26 @@ impl Diagnoser {
                 node.pending = None;
                 node.answered_after = true;
                 if let SdoCommand::Abort { index, sub, code } = s.command {
+                    self.node(n).segmenting = None;
                     self.refused(n, index, sub, code);
                 } else if s.problems.iter().any(|p| p == "outside any transfer seen") {
                     self.garbled(n, format!("{} frame outside any transfer", s.command.cs_name()));
                 }
             }
             Body::Sdo(s) => {
+                if matches!(s.command.cs_name(), "download_segment" | "upload_segment") {
+                    self.node(n).segmenting = Some(at);
+                }
                 // Only initiate frames start a request (segments carry no object themselves).
                 if let Some((index, sub)) = s.command.object()
                     && s.command.cs_name() != "abort"
                 {
+                    // The other client's request may well be answered: not counted as unanswered.
+                    let overlap = self.overlapping_request(n, index, sub);
                     self.node(n).download = matches!(s.command.cs_name(), "initiate_download" | "block_download");
-                    if let Some(old) = self.node(n).pending.take() {
+                    if let Some(old) = self.node(n).pending.take()
+                        && !overlap
+                    {
                         self.unanswered(n, Request { replaced: true, ..old });
                     }
                     self.node(n).pending = Some(Request {
@@ -323,6 +478,7 @@ impl Diagnoser {
                 if p.transmit {
                     self.node(n).heard = true;
                 }
+                self.pdo_arrived(n, p.transmit, p.num);
                 let mut words = Vec::new();
                 for s in &p.signals {
                     let Some(v) = s.value.as_i64() else { continue };
@@ -344,6 +500,117 @@ impl Diagnoser {
                 }
             }
         }
+    }
+
+    /// A statusword `sw` of an axis asked to change state: reached (a stuck incident
+    /// recovers), a fault (the fault incident tells it), or still not there after
+    /// [`STALL_NS`]: the drive is stuck, with the reason the bus shows.
+    fn stall(&mut self, n: u8, axis: u8, sw: u16, state: DriveState) {
+        let at = self.at;
+        let nmt = self.nodes.get(&n).and_then(|d| d.last_state.map(|(_, s)| s));
+        let emcy = self.nodes.get(&n).and_then(|d| d.last_emcy);
+        let a = self.node(n).axes.entry(axis).or_default();
+        a.sw = Some(sw);
+        let stuck = a.stuck;
+        let cw = a.cw;
+        let Some((asked, step, before)) = a.asked else {
+            return;
+        };
+        let faulted = matches!(state, DriveState::Fault | DriveState::FaultReactionActive);
+        if stall::reached(&step, state) || faulted {
+            a.asked = None;
+            a.stuck = None;
+            if let Some(i) = stuck.filter(|_| !faulted) {
+                self.incidents[i].status = Status::Recovered;
+                self.incidents[i].last_ns = at.t;
+                let waited = (at.t - asked.t) as f64 / 1e9;
+                let inc = &mut self.incidents[i];
+                inc.title = format!("{}; reached {} after {waited:.2} s", inc.title, state.text());
+                self.step(i, at, format!("Reached {} after {waited:.2} s", state.text()));
+            }
+            return;
+        }
+        if stuck.is_some() || at.t.saturating_sub(asked.t) < STALL_NS {
+            return;
+        }
+        let obs = Observation {
+            nmt,
+            before,
+            statusword: Some(sw),
+            controlword: cw,
+            emcy,
+            ..Observation::default()
+        };
+        let reason = stall::diagnose(n, &step, &obs);
+        let detail = (u32::from(axis) << 8) | u32::from(step.controlword as u8);
+        let i = self.grouped(Some(n), Problem::DriveStuck, detail, asked.t);
+        let inc = &mut self.incidents[i];
+        if !inc.axes.contains(&axis) {
+            inc.axes.push(axis);
+        }
+        inc.status = Status::Open;
+        inc.last_ns = at.t;
+        inc.title = format!(
+            "Stuck in {}: {} (controlword 0x{:04X}) not followed",
+            state.text(),
+            step.name,
+            step.controlword
+        );
+        inc.cause = Some(reason);
+        self.step(
+            i,
+            asked,
+            format!(
+                "Controlword 0x{:04X} ({}) asks for {}",
+                step.controlword,
+                step.name,
+                step.target.text()
+            ),
+        );
+        let waited = (at.t - asked.t) as f64 / 1e9;
+        self.step(
+            i,
+            at,
+            format!("Still {} (statusword 0x{sw:04X}) after {waited:.2} s", state.text()),
+        );
+        self.node(n).axes.entry(axis).or_default().stuck = Some(i);
+    }
+
+    /// An SDO request for `index:sub` to node `n` while another one is going on (sent
+    /// just before and not answered, or a segmented transfer in mid-flow): two clients.
+    /// True when it is one.
+    fn overlapping_request(&mut self, n: u8, index: u16, sub: u8) -> bool {
+        let at = self.at;
+        let node = self.node(n);
+        let young = |a: At| at.t.saturating_sub(a.t) < TWO_MASTERS_NS;
+        let what = match (node.pending, node.segmenting) {
+            (Some(r), _) if young(r.at) && (r.index, r.sub) != (index, sub) => format!(
+                "Request for 0x{index:04X}:{sub:02X} while the request for 0x{:04X}:{:02X} (#{}) still waits for its answer",
+                r.index, r.sub, r.at.frame
+            ),
+            (_, Some(s)) if young(s) => {
+                format!(
+                    "Request for 0x{index:04X}:{sub:02X} in the middle of a segmented transfer (#{})",
+                    s.frame
+                )
+            }
+            _ => return false,
+        };
+        node.segmenting = None;
+        self.second_master(Some(n), "SDO requests to the node overlap", at, what);
+        true
+    }
+
+    fn second_master(&mut self, node: Option<u8>, cause: &str, at: At, what: String) {
+        let i = self.grouped(node, Problem::SecondMaster, 0, at.t);
+        let inc = &mut self.incidents[i];
+        inc.status = Status::Warning;
+        inc.cause = match inc.cause.take() {
+            Some(c) if c.contains(cause) => Some(c),
+            Some(c) => Some(format!("{c}; {cause}")),
+            None => Some(cause.to_string()),
+        };
+        self.step(i, at, what);
     }
 
     /// A CiA 402 object value of `node` (from a PDO or an SDO transfer).
@@ -374,6 +641,7 @@ impl Diagnoser {
     fn statusword(&mut self, n: u8, axis: u8, sw: u16) {
         let at = self.at;
         let state = DriveState::from_statusword(sw);
+        self.stall(n, axis, sw, state);
         let faulted = matches!(state, DriveState::Fault | DriveState::FaultReactionActive);
         let a = self.node(n).axes.entry(axis).or_default().clone();
         match (a.fault, faulted) {
@@ -438,6 +706,14 @@ impl Diagnoser {
     fn controlword(&mut self, n: u8, axis: u8, cw: u16) {
         let at = self.at;
         let ax = self.node(n).axes.entry(axis).or_default().clone();
+        if ax.cw != Some(cw)
+            && let Some(step) = stall::requested(cw)
+        {
+            let a = self.node(n).axes.entry(axis).or_default();
+            let done =
+                a.sw.is_some_and(|sw| stall::reached(&step, DriveState::from_statusword(sw)));
+            a.asked = (!done).then_some((at, step, a.sw));
+        }
         let rising = cw & 0x80 != 0 && ax.cw.is_none_or(|p| p & 0x80 == 0);
         self.node(n).axes.entry(axis).or_default().cw = Some(cw);
         // A reset in the same cycle as the clear (the statusword went out first) counts too.
@@ -465,6 +741,7 @@ impl Diagnoser {
 
     fn emcy(&mut self, n: u8, e: &Emcy) {
         let at = self.at;
+        self.node(n).last_emcy = Some(e.code);
         self.flush_emcy(n, at.t.saturating_sub(EMCY_CAUSE_NS));
         if e.code == 0 {
             // "Error reset or no error": the node's EMCY incidents are over.
@@ -501,6 +778,9 @@ impl Diagnoser {
     }
 
     fn give_cause(&mut self, i: usize, at: At, e: &Emcy) {
+        if !e.check.is_empty() {
+            self.device_check.insert(i, e.check.clone());
+        }
         self.incidents[i].cause = Some(Self::emcy_text(e));
         self.faults.entry(i).or_default().emcy = Some(e.code);
         self.step(i, at, format!("Cause reported: {}", Self::emcy_text(e)));
@@ -527,6 +807,9 @@ impl Diagnoser {
         let old: Vec<(At, Emcy)> = node.emcy.drain(..keep).collect();
         for (at, e) in old {
             let i = self.grouped(Some(n), Problem::Emcy, u32::from(e.code), at.t);
+            if !e.check.is_empty() {
+                self.device_check.insert(i, e.check.clone());
+            }
             let inc = &mut self.incidents[i];
             inc.status = Status::Open;
             inc.cause = Some(Self::emcy_text(&e));
@@ -606,7 +889,31 @@ impl Diagnoser {
             0x82 => ("reset communication", NmtState::BootUp),
             _ => return,
         };
+        if cs != 0x01 {
+            self.pdos.pause((target != 0).then_some(target));
+        }
         let at = self.at;
+        // A start undone at once by a stop or pre-operational for the same node: two
+        // masters disagree (one master leaving pre-operational right after entering it is
+        // a normal re-configuration, the other order is not).
+        if let Some((last, last_cs, last_target)) = self.last_nmt.replace((at, cs, target))
+            && at.t.saturating_sub(last.t) < TWO_MASTERS_NS
+            && (last_target == target || last_target == 0 || target == 0)
+            && matches!((last_cs, cs), (0x01, 0x02 | 0x80))
+        {
+            let node = [target, last_target].into_iter().find(|t| *t != 0);
+            let text = format!(
+                "NMT {command} {} right after NMT {} (#{})",
+                if target == 0 {
+                    "all nodes".to_string()
+                } else {
+                    format!("node {target}")
+                },
+                "start",
+                last.frame
+            );
+            self.second_master(node, "NMT commands that undo each other", at, text);
+        }
         let known: Vec<u8> = self
             .nodes
             .iter()
@@ -661,6 +968,7 @@ impl Diagnoser {
             }
             What::HeartbeatBack { silent_ms } => self.back(n, at, *silent_ms),
             What::BootUp { rebooted, .. } => {
+                self.pdos.pause(Some(n));
                 let reset_all = self.reset_all;
                 let node = self.node(n);
                 // (Equal times say nothing: logs without timestamps.)
@@ -784,6 +1092,7 @@ impl Diagnoser {
 
     /// A completed SDO transfer (in order, right after the frame that ended it).
     pub fn transaction(&mut self, t: &Transaction) {
+        self.node(t.node).segmenting = None;
         self.tracker.transaction(t);
         for e in self.tracker.take_events() {
             self.event(&e);
@@ -798,6 +1107,24 @@ impl Diagnoser {
         }
         if t.sub == 0 {
             self.drive_word(t.node, t.index, v as u16);
+        }
+        match (t.index, t.sub) {
+            (0x1800..=0x19FF, 5) => self
+                .pdos
+                .event_timer((t.node, true, t.index - 0x1800 + 1), u64::from(v & 0xFFFF)),
+            (0x1800..=0x19FF, 2) => self
+                .pdos
+                .transmission_type((t.node, true, t.index - 0x1800 + 1), v as u8),
+            (0x1007, 0) if v > 0 => {
+                self.sync_window.insert(t.node, u64::from(v) * 1000);
+            }
+            (0x1007, 0) => {
+                self.sync_window.remove(&t.node);
+            }
+            (0x1400..=0x15FF, 5) => self
+                .pdos
+                .event_timer((t.node, false, t.index - 0x1400 + 1), u64::from(v & 0xFFFF)),
+            _ => {}
         }
         if (t.index, t.sub) == (0x1017, 0) {
             let at = self.at;
@@ -817,15 +1144,85 @@ impl Diagnoser {
         }
     }
 
+    /// The capture clock reached `now_ns` with no frame since the last one (a quiet bus in
+    /// a live capture or a running replay): heartbeats and SDO answers overdue by then are
+    /// missed.
+    pub fn tick(&mut self, now_ns: u64) {
+        if now_ns <= self.now.max(self.at.t) {
+            return;
+        }
+        self.now = now_ns;
+        self.tracker.tick(now_ns);
+        for e in self.tracker.take_events() {
+            self.event(&e);
+        }
+        if self.sdo_deadline.is_some_and(|dl| now_ns > dl) {
+            self.sdo_timeouts(now_ns);
+        }
+        self.pdos_due(now_ns);
+    }
+
+    /// The incidents so far, ranked as [`Diagnoser::finish`] ranks them, as if the capture
+    /// ended now (the builder goes on).
+    pub fn incidents(&self) -> Vec<Incident> {
+        self.clone().finish()
+    }
+
+    /// SYNC intervals off the period become one warning with the jitter figures.
+    fn sync_jitter(&mut self) {
+        let Some(sum) = self.sync.summary().filter(|s| s.off > 0) else {
+            return;
+        };
+        let ms = |ns: u64| ns as f64 / 1e6;
+        let first = self.sync.kept.first().map_or(0, |o| o.t_ns);
+        let i = self.grouped(None, Problem::SyncJitter, 0, first);
+        let inc = &mut self.incidents[i];
+        inc.count = sum.off;
+        inc.status = Status::Warning;
+        inc.title = format!(
+            "SYNC timing uneven: {} of {} cycles more than 10 % off the {:.3} ms period",
+            sum.off,
+            sum.intervals,
+            ms(sum.period_ns)
+        );
+        inc.cause = Some(format!(
+            "period {:.3} ms; intervals {:.3} to {:.3} ms; standard deviation {:.3} ms",
+            ms(sum.period_ns),
+            ms(sum.min_ns),
+            ms(sum.max_ns),
+            sum.std_ns / 1e6
+        ));
+        if let Some(last) = self.sync.kept.last() {
+            inc.last_ns = last.t_ns;
+        }
+        for o in self.sync.kept.clone() {
+            let at = At {
+                frame: o.frame,
+                t: o.t_ns,
+            };
+            self.step(i, at, format!("SYNC {:.3} ms after the one before", ms(o.interval_ns)));
+        }
+    }
+
     /// The end of the capture: what is still wrong is open. Returns the incidents ranked,
     /// open first, then recovered, then warnings; each by time.
     pub fn finish(mut self) -> Vec<Incident> {
-        let end = self.at;
+        let end = At {
+            t: self.at.t.max(self.now),
+            ..self.at
+        };
         self.tracker.tick(end.t);
         for e in self.tracker.take_events() {
             self.event(&e);
         }
         self.sdo_timeouts(end.t);
+        self.pdos_due(end.t);
+        for (key, i) in std::mem::take(&mut self.pdo_gaps) {
+            let name = Self::pdo_name(key);
+            self.step(i, end, format!("No {name} after that, until the end of the capture"));
+            self.incidents[i].last_ns = end.t;
+        }
+        self.sync_jitter();
         let nodes: Vec<u8> = self.nodes.keys().copied().collect();
         for n in nodes {
             self.flush_emcy(n, u64::MAX);
@@ -840,6 +1237,13 @@ impl Diagnoser {
                 self.incidents[i].last_ns = end.t;
             }
             let node = self.nodes[&n].clone();
+            for a in node.axes.values() {
+                if let (Some(i), Some(sw)) = (a.stuck, a.sw) {
+                    let state = DriveState::from_statusword(sw).text();
+                    self.step(i, end, format!("Still {state} at the end of the capture"));
+                    self.incidents[i].last_ns = end.t;
+                }
+            }
             if let Some(at) = node.heartbeat_off.filter(|_| !node.guarded) {
                 let i = self.grouped(Some(n), Problem::Unmonitored, 0, at.t);
                 self.incidents[i].status = Status::Warning;
@@ -885,7 +1289,20 @@ impl Diagnoser {
         for (i, inc) in self.incidents.iter_mut().enumerate() {
             let meta = self.faults.get(&i).cloned().unwrap_or_default();
             super::texts::fill(inc, meta.resets, meta.emcy, self.error_frames);
+            // The device's own steps for its EMCY code come first.
+            if let Some(steps) = self.device_check.get(&i) {
+                inc.check.splice(0..0, steps.iter().cloned());
+            }
         }
+        // A PDO that stops because its node went silent for good is part of that silence.
+        let gone: Vec<Option<u8>> = self
+            .incidents
+            .iter()
+            .filter(|i| i.problem == Problem::Silent)
+            .map(|i| i.node)
+            .collect();
+        self.incidents
+            .retain(|i| !(i.problem == Problem::PdoMissing && gone.contains(&i.node)));
         let mut out = merge_faults(self.incidents);
         for inc in &mut out {
             inc.events.sort_by_key(|e| e.frame);
@@ -987,6 +1404,49 @@ mod tests {
             (400, 0x182, "3702"),
         ];
         assert_eq!(run(&f), ["2 drive_fault recovered 1"]);
+    }
+
+    /// Like [`run`], with capture-clock ticks: `(ms, 0xFFFF_FFFF, "")` is a tick at `ms`.
+    fn run_ticked(frames: &[(u64, u32, &str)]) -> Vec<String> {
+        let mut dec = Decoder::new(Dictionary::default(), Vec::new());
+        let mut diag = Diagnoser::new(EventTracker::new(|n| dec.dictionary(n)));
+        for (ms, id, data) in frames {
+            if *id == u32::MAX {
+                diag.tick(ms * MS);
+                continue;
+            }
+            let bytes: Vec<u8> = (0..data.len() / 2)
+                .map(|i| u8::from_str_radix(&data[2 * i..2 * i + 2], 16).unwrap())
+                .collect();
+            let mut f = Frame::classic(*id, &bytes);
+            f.ts_ns = ms * MS;
+            let d = dec.decode(&f);
+            diag.frame(&f, "can0", &d);
+        }
+        diag.incidents()
+            .iter()
+            .map(|i| {
+                let node = i.node.map_or("-".into(), |n| n.to_string());
+                format!("{node} {} {} {}", i.problem.as_str(), i.status.as_str(), i.count)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn ticks_on_a_quiet_bus_find_a_silent_node_and_later_frames_undo_it() {
+        let mut f = heartbeats(5, 0, 1000, "05");
+        // The clock passes the deadline with no frame: silent so far.
+        f.push((1500, u32::MAX, ""));
+        assert_eq!(run_ticked(&f), ["5 silent open 1"]);
+        // It beats again: it was a silence that ended.
+        f.extend(heartbeats(5, 1600, 2000, "05"));
+        assert_eq!(run_ticked(&f), ["5 silent_back warning 1"]);
+        // A tick that runs ahead of the frames (a late delivery) is undone by them.
+        let mut f = heartbeats(5, 0, 500, "05");
+        f.push((560, u32::MAX, ""));
+        f.extend(heartbeats(5, 500, 1000, "05"));
+        let got = run_ticked(&f);
+        assert!(got.iter().all(|g| !g.contains("silent open")), "{got:?}");
     }
 
     #[test]

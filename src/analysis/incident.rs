@@ -59,6 +59,16 @@ pub enum Problem {
     DuplicateId,
     /// An NMT command the node did not follow.
     NmtIgnored,
+    /// A CiA 402 drive that did not reach the state its controlword asked for.
+    DriveStuck,
+    /// A PDO that stopped arriving within its event time or measured period.
+    PdoMissing,
+    /// SYNC intervals off the SYNC period.
+    SyncJitter,
+    /// Requests or commands from two masters at once.
+    SecondMaster,
+    /// A synchronous TPDO sent after the SYNC window (0x1007) closed.
+    PdoLate,
 }
 
 impl Problem {
@@ -78,6 +88,11 @@ impl Problem {
             Problem::BusErrors => "bus_errors",
             Problem::DuplicateId => "duplicate_id",
             Problem::NmtIgnored => "nmt_ignored",
+            Problem::DriveStuck => "drive_stuck",
+            Problem::PdoMissing => "pdo_missing",
+            Problem::SyncJitter => "sync_jitter",
+            Problem::SecondMaster => "second_master",
+            Problem::PdoLate => "pdo_late",
         }
     }
 }

@@ -17,6 +17,7 @@ pub mod series;
 pub mod stats;
 pub mod store;
 mod texts;
+pub mod timing;
 pub mod trace;
 pub mod values;
 pub mod view;

@@ -230,5 +230,60 @@ pub fn fill(inc: &mut Incident, resets: u32, emcy: Option<u16>, error_frames: u6
                 "The master thinks the node is in one state while it is in another: PDOs may not be sent or used."
                     .into();
         }
+        Problem::DriveStuck => {
+            // The title (the state it stayed in and what was asked) is set by the builder.
+            inc.check = strings(&[
+                "Do what the cause says first: a fault needs a fault reset; \"voltage not enabled\" needs the drive's main power (DC link); a quick stop needs disable voltage (0x00) before 0x06 → 0x07 → 0x0F.",
+                "Check the enable sequence the master sends: 0x06 → 0x07 → 0x0F, each only after the statusword shows the state before.",
+                "Check the drive's enable inputs (STO, hardware enable) and its display or error log.",
+            ]);
+            inc.why = "The master waits for a state the drive does not reach: the axis does not move and motion commands are ignored."
+                .into();
+        }
+        Problem::PdoMissing => {
+            // The title (which PDO) is set by the builder.
+            inc.check = strings(&[
+                "Check the node's NMT state: PDOs are sent in operational only.",
+                "Check the PDO's transmission type and event time (0x1800/0x1400 sub 2 and 5) and, for synchronous PDOs, that SYNC kept coming.",
+                "Look for bus errors or a busy bus at the same time: a PDO with a low priority waits behind others.",
+            ]);
+            inc.why = "The master or the drive works on stale values while the PDO is missing; a drive may stop on its RPDO timeout."
+                .into();
+        }
+        Problem::SyncJitter => {
+            // The title (the figures) is set by the builder.
+            inc.check = strings(&[
+                "Check the SYNC producer: a PC master without real-time scheduling sends SYNC late under load.",
+                "Check the bus load: frames in the way delay even the high-priority SYNC.",
+                "Check the drives' SYNC-loss and following-error settings if they run cyclic synchronous modes.",
+            ]);
+            inc.why = "Drives in cyclic synchronous modes (CSP, CSV) move in steps of one SYNC: an uneven SYNC makes the motion rough or trips a following error."
+                .into();
+        }
+        Problem::SecondMaster => {
+            inc.title = if inc.count == 1 {
+                "Commands from two masters at once".into()
+            } else {
+                format!("Commands from two masters at once ({} times)", inc.count)
+            };
+            inc.check = strings(&[
+                "Look for a second device or tool acting as master: a PLC and a PC tool, a configuration tool left connected, a second controller.",
+                "Only one SDO client may use a node's default SDO channel (0x600 + node) at a time: stop the other one or give it its own SDO channel (0x1280).",
+                "Only one master should start and stop nodes (NMT): check the NMT start-up settings of each.",
+            ]);
+            inc.why =
+                "Two masters undo each other's settings and states: commands seem to be ignored or reversed at random."
+                    .into();
+        }
+        Problem::PdoLate => {
+            // The title (which PDO, how often) is set by the builder.
+            inc.check = strings(&[
+                "Check the node's load and its synchronous window setting 0x1007 against its PDO processing time.",
+                "Check the bus load right after SYNC: many synchronous PDOs queue behind each other; spread them or raise the bit rate.",
+                "Check that the window (0x1007) fits inside the SYNC period (0x1006).",
+            ]);
+            inc.why = "A PDO sent after the window is not taken in this cycle: the master or the drive works on values one cycle old."
+                .into();
+        }
     }
 }

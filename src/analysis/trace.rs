@@ -10,6 +10,8 @@
 //! `a..b`. So labels are exact, at most `CHECKPOINT` frames are replayed per window, and
 //! the checkpoints cost well under a byte per frame.
 
+use super::diagnose::Diagnoser;
+use super::liveness::EventTracker;
 use super::nodes::Nodes;
 use super::series::Series;
 use super::stats::Stats;
@@ -42,13 +44,20 @@ pub struct Trace {
     pub series: Series,
     /// The last value seen per node and object (SDO transfers, PDO signals).
     pub values: Values,
+    /// What went wrong so far (the same diagnosis as `cotui diagnose`).
+    pub diagnosis: Diagnoser,
+    /// Changes of [`Trace::diagnosis`] (frames and clock ticks taken), for caches.
+    pub diagnosis_version: u64,
 }
 
 impl Trace {
     /// An empty trace decoded with `decoder`.
     pub fn new(decoder: Decoder, bitrate: u64) -> Trace {
         let nodes = Nodes::new(&decoder);
+        let diagnosis = Diagnoser::new(EventTracker::new(|n| decoder.dictionary(n)));
         Trace {
+            diagnosis,
+            diagnosis_version: 0,
             store: Store::new(),
             ifaces: Interfaces::default(),
             initial: decoder.clone(),
@@ -84,21 +93,36 @@ impl Trace {
         if pos.is_multiple_of(CHECKPOINT) {
             self.checkpoints.push(self.decoder.clone());
         }
-        self.decoder.set_seq(pos as u64);
         self.nodes.tick(frame.ts_ns);
-        let (kind, node) = match self.decoder.classify(frame) {
-            (k @ (Kind::Tpdo | Kind::Rpdo | Kind::Emcy | Kind::Heartbeat), _) => {
-                self.decoder.set_seq(pos as u64);
-                let d = self.decoder.decode(frame);
-                self.observe(frame, &d);
-                (k, d.node)
+        self.diagnosis_version += 1;
+        let (kind, node, pdo) = self.decoder.peek(frame);
+        // Frames that change what the panes or the diagnosis show are decoded in full (SDO
+        // frames always were: the decoder tracks their transfers); the rest only routed.
+        let (kind, node) = if matches!(
+            kind,
+            Kind::Tpdo
+                | Kind::Rpdo
+                | Kind::Emcy
+                | Kind::Heartbeat
+                | Kind::SdoRx
+                | Kind::SdoTx
+                | Kind::Nmt
+                | Kind::ErrorFrame
+        ) {
+            self.decoder.set_seq(pos as u64);
+            let d = self.decoder.decode(frame);
+            let iface = self.ifaces.name(frame.iface);
+            match kind {
+                Kind::ErrorFrame => self.nodes.error_frame(frame.ts_ns, iface, frame.id, frame.payload()),
+                Kind::Tpdo | Kind::Rpdo | Kind::Emcy | Kind::Heartbeat => self.observe(frame, &d),
+                _ => {}
             }
-            (Kind::ErrorFrame, node) => {
-                let iface = self.ifaces.name(frame.iface);
-                self.nodes.error_frame(frame.ts_ns, iface, frame.id, frame.payload());
-                (Kind::ErrorFrame, node)
-            }
-            other => other,
+            let iface = self.ifaces.name(frame.iface);
+            self.diagnosis.frame(frame, iface, &d);
+            (d.kind, d.node)
+        } else {
+            self.diagnosis.skip(frame, kind, node, pdo);
+            (kind, node)
         };
         self.store.push(frame, kind, node);
         let p = *self.store.packed(pos);
@@ -107,6 +131,7 @@ impl Trace {
             self.nodes.frame(n, frame.ts_ns);
         }
         for t in self.decoder.take_transactions() {
+            self.diagnosis.transaction(&t);
             self.nodes.transaction(&t);
             self.series.transaction(&t, self.decoder.dictionary(t.node));
             self.values.transaction(&t, self.decoder.dictionary(t.node));
@@ -128,6 +153,14 @@ impl Trace {
         }
         self.nodes
             .profile(n, self.decoder.dictionary(n).profile_name(), self.decoder.mode(n));
+    }
+
+    /// The capture clock reached `now_ns` with no new frame (live or a running replay):
+    /// node liveness and the diagnosis catch up.
+    pub fn tick(&mut self, now_ns: u64) {
+        self.nodes.tick(now_ns);
+        self.diagnosis.tick(now_ns);
+        self.diagnosis_version += 1;
     }
 
     /// Decodes the frames `start..end` exactly as the indexing pass did.

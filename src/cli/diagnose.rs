@@ -68,7 +68,7 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
                     _ => false,
                 };
                 if skip {
-                    diag.skip(frame, kind, node);
+                    diag.skip(frame, kind, node, pdo);
                     continue;
                 }
                 let d = decoder.decode(frame);

@@ -18,6 +18,8 @@ pub struct Emcy {
     pub text: String,
     /// Manufacturer bytes decoded through the profile's layout, e.g. `M1 alarm=0x12`.
     pub mfr_fields: Vec<(String, String)>,
+    /// The profile's "check first" steps for this code (empty when it has none).
+    pub check: Vec<String>,
 }
 
 /// Names of the error register bits 0..7 (CiA 301 7.5.2.2).
@@ -104,6 +106,7 @@ pub fn decode(payload: &[u8], dict: &Dictionary) -> (Emcy, Option<String>) {
         mfr,
         text,
         mfr_fields,
+        check: dict.emcy_check(code).to_vec(),
     };
     let problem = if payload.len() != 8 {
         Some(format!("EMCY frame has {} data bytes, expected 8", payload.len()))

@@ -76,6 +76,7 @@ pub mod pdo;
 pub mod pdo_config;
 pub mod registry;
 pub mod sdo;
+pub mod stall;
 pub mod sync;
 pub mod time;
 pub mod value_text;

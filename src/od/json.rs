@@ -327,6 +327,15 @@ impl Cx<'_> {
                     None => self.warn(&at, format!("`{code}` is not an EMCY code (0x0000..0xFFFF)")),
                 }
             }
+            for (code, steps) in emcy.check {
+                let at = format!("emcy.check.{code}");
+                match parse_int(&code).and_then(|c| u16::try_from(c).ok()) {
+                    Some(c) => {
+                        p.emcy_check.insert(c, steps);
+                    }
+                    None => self.warn(&at, format!("`{code}` is not an EMCY code (0x0000..0xFFFF)")),
+                }
+            }
             for (i, f) in emcy.manufacturer_fields.into_iter().enumerate() {
                 let at = format!("emcy.manufacturer_fields.{i}");
                 if f.object.is_some() || f.object_sub.is_some() {

@@ -206,6 +206,8 @@ pub struct Profile {
     pub ranges: Vec<IndexRange>,
     /// Vendor EMCY code texts by exact code.
     pub emcy_codes: BTreeMap<u16, String>,
+    /// Device-specific "check first" steps by exact EMCY code, most likely cause first.
+    pub emcy_check: BTreeMap<u16, Vec<String>>,
     /// Default RPDO mappings by PDO number (1-based).
     pub rpdo: BTreeMap<u8, PdoMapping>,
     /// Default TPDO mappings by PDO number (1-based).
@@ -357,6 +359,13 @@ impl Dictionary {
             .iter()
             .map(|p| if transmit { &p.tpdo } else { &p.rpdo })
             .find(|m| !m.is_empty())
+    }
+    /// The profile's "check first" steps for an exact EMCY code (empty when none).
+    pub fn emcy_check(&self, code: u16) -> &[String] {
+        self.layers
+            .iter()
+            .find_map(|p| p.emcy_check.get(&code))
+            .map_or(&[], Vec::as_slice)
     }
     /// A vendor EMCY text for an exact code.
     pub fn emcy_text(&self, code: u16) -> Option<&str> {

@@ -424,7 +424,7 @@ impl App {
     /// Advances the node table to the capture time at wall time `now` (live and replay).
     fn liveness_tick(&mut self, now: Instant) {
         if let Some(t) = self.capture_now_ns(now) {
-            self.trace.nodes.tick(t);
+            self.trace.tick(t);
             if self.collect_node_events() {
                 self.dirty = true;
             }
@@ -1384,6 +1384,7 @@ impl App {
             Action::EditObject | Action::ReadAll => {
                 self.message = Some(format!("{}: only in the Objects pane", a.name().replace('_', " ")))
             }
+            Action::PaneProblems => self.focus = Pane::Problems,
             Action::Filter => {
                 let text = self.panes.trace.view.filter.source.clone();
                 self.prompt.open(PromptKind::Filter, &text);
@@ -1465,6 +1466,17 @@ impl App {
                 let (panes, ctx) = self.panes_mut();
                 panes.plot.handle(a, &ctx);
             }
+            // From any pane: the next frame of the incident selected in the Problems pane, so
+            // that pressing it again in the trace walks through the incident's frames.
+            Action::ShowFrames => {
+                let (panes, ctx) = self.panes_mut();
+                panes.problems.refresh(&ctx);
+                if let Outcome::Show(pos) = panes.problems.handle(a, &ctx) {
+                    let page = self.page();
+                    self.panes.trace.show(&self.trace, pos, page);
+                    self.focus = Pane::Trace;
+                }
+            }
             // Taken by the help popup; row movement and `expand` in a pane without rows.
             Action::Help
             | Action::Down
@@ -1506,7 +1518,14 @@ impl App {
             self.sync_objects_node();
         }
         let (panes, ctx) = self.panes_mut();
-        for p in [Pane::Nodes, Pane::Stats, Pane::Sdo, Pane::Objects, Pane::Pdo] {
+        for p in [
+            Pane::Nodes,
+            Pane::Stats,
+            Pane::Sdo,
+            Pane::Objects,
+            Pane::Pdo,
+            Pane::Problems,
+        ] {
             panes.get_mut(p).fit(height, &ctx);
         }
         self.panes.trace.prepare(&self.trace, rows, tail);

@@ -66,6 +66,7 @@ actions! {
     PanePlot = "pane_plot": "Plot pane",
     PaneObjects = "pane_objects": "Objects pane (dictionary of a node, last values)",
     PanePdo = "pane_pdo": "PDO pane (each node's RPDOs/TPDOs, their parameters and mapping source)",
+    PaneProblems = "pane_problems": "Problems pane (the diagnosis: what went wrong, open first)",
     Filter = "filter": "Edit the filter (Objects: find by name, alias, index)",
     Search = "search": "Search (same language as the filter)",
     NextMatch = "next_match": "Jump to the next match",
@@ -90,6 +91,7 @@ actions! {
     Sort = "sort": "Stats: cycle the sort (COB-ID, count, period, last heard)",
     EditObject = "edit_object": "Objects: write the entry (palette prefilled)",
     ReadAll = "read_all": "Objects: read every readable entry (again: stop)",
+    ShowFrames = "show_frames": "Problems: show the selected incident's frames in the trace (first, then the next at each press)",
 }
 
 /// One key press, normalised (no SHIFT on characters).

@@ -209,6 +209,19 @@ fn causes_through_the_profiles() {
         inc[1]["title"],
         "Stopped: continuous over-current no. 2 (AIMOTOR fault 0201h; read H0B-34); still in fault at the end"
     );
+    // The profile's own steps for EMCY 0x2312 (emcy.check) come before the generic ones.
+    let check: Vec<&str> = inc[1]["check"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_str().unwrap())
+        .collect();
+    assert!(
+        check[0].starts_with("Read the fault code H0B-34 (SDO upload 0x200B:23"),
+        "{check:?}"
+    );
+    assert!(check[1].starts_with("Check the motor for a blocked shaft"), "{check:?}");
+    assert_eq!(check[2], "Look up EMCY 0x2312 in the drive manual's error table.");
 }
 
 #[test]
@@ -292,4 +305,104 @@ fn realworld_logs() {
     assert_eq!(summary(&inc), [s(Some(2), "sdo_timeout", "warning")]);
     // A J1939 log is not CANopen: nothing to report, and no crash.
     assert!(get("python-can_logfile.asc").is_empty());
+}
+
+#[test]
+fn drive_stuck_with_the_reason_the_bus_shows() {
+    // Node 3 is asked to switch on with its DC link off (statusword bit 4 clear) and gets
+    // there 2 s later; node 4 never follows "enable operation".
+    let inc = golden("drive_stuck");
+    assert_eq!(
+        summary(&inc),
+        [
+            s(Some(4), "drive_stuck", "open"),
+            s(Some(3), "drive_stuck", "recovered")
+        ]
+    );
+    assert_eq!(
+        inc[0]["title"],
+        "Stuck in Switched on: enable operation (controlword 0x000F) not followed"
+    );
+    assert_eq!(
+        inc[0]["cause"],
+        "statusword stale: still 0x0233 (Switched on) after controlword 0x000F"
+    );
+    assert_eq!(inc[0]["axes"], serde_json::json!([1]));
+    assert_eq!(frames(&inc[0]), [38, 100, 238]);
+    assert_eq!(
+        inc[1]["cause"],
+        "voltage not enabled: statusword 0x0221 bit 4 is clear; switch on the drive's DC link / main power"
+    );
+    assert!(
+        inc[1]["title"]
+            .as_str()
+            .unwrap()
+            .ends_with("reached Switched on after 2.01 s"),
+        "{}",
+        inc[1]["title"]
+    );
+}
+
+#[test]
+fn pdo_missing_and_sync_jitter() {
+    // SYNC every 10 ms with two late ones; node 2's synchronous TPDO1 (measured period)
+    // stops for 0.5 s; node 3's event-driven TPDO1 (event time 50 ms written to 0x1800:05)
+    // stops at 2 s while its heartbeat goes on.
+    let inc = golden("timing");
+    assert_eq!(
+        summary(&inc),
+        [
+            s(Some(3), "pdo_missing", "open"),
+            s(Some(2), "pdo_missing", "warning"),
+            s(None, "sync_jitter", "warning"),
+        ]
+    );
+    assert_eq!(inc[0]["title"], "TPDO1 stopped arriving");
+    assert_eq!(inc[0]["cause"], "TPDO1 expected at least every 50.0 ms (event time)");
+    assert_eq!(frames(&inc[0]), [443, 673]);
+    assert_eq!(inc[1]["title"], "TPDO1 stopped for a while, then came again");
+    assert_eq!(inc[1]["cause"], "TPDO1 expected every 10.0 ms (measured)");
+    assert_eq!(inc[1]["events"][1]["text"], "TPDO1 again after 0.514 s");
+    assert_eq!(
+        inc[2]["title"],
+        "SYNC timing uneven: 2 of 298 cycles more than 10 % off the 10.000 ms period"
+    );
+    assert_eq!(
+        inc[2]["cause"],
+        "period 10.000 ms; intervals 10.000 to 17.000 ms; standard deviation 0.466 ms"
+    );
+    assert_eq!(frames(&inc[2]), [284, 454]);
+    assert_eq!(inc[2]["count"], 2);
+}
+
+#[test]
+fn second_master_from_overlapping_sdo_requests_and_nmt() {
+    // A write to 0x6040 in the middle of another client's segmented read of 0x1008, a read
+    // sent 3 ms after another one still unanswered, and NMT stop 10 ms after NMT start.
+    let inc = golden("second_master");
+    assert_eq!(summary(&inc), [s(Some(2), "second_master", "warning")]);
+    assert_eq!(inc[0]["title"], "Commands from two masters at once (3 times)");
+    assert_eq!(
+        inc[0]["cause"],
+        "SDO requests to the node overlap; NMT commands that undo each other"
+    );
+    assert_eq!(frames(&inc[0]), [7, 12, 17]);
+    assert_eq!(
+        inc[0]["events"][1]["text"],
+        "Request for 0x6060:00 while the request for 0x1017:00 (#11) still waits for its answer"
+    );
+    // The overlapped request was not counted as unanswered: the other client got its answer.
+    assert!(inc.iter().all(|i| i["kind"] != "sdo_timeout"));
+}
+
+#[test]
+fn pdo_late_after_the_sync_window() {
+    // Node 2's TPDO1 is synchronous (0x1800:02 = 1) with a 2 ms window (0x1007 = 2000 µs)
+    // and comes 1 ms after SYNC, three times 4 ms after it.
+    let inc = golden("sync_window");
+    assert_eq!(summary(&inc), [s(Some(2), "pdo_late", "warning")]);
+    assert_eq!(inc[0]["title"], "TPDO1 sent after the SYNC window closed (3 times)");
+    assert_eq!(inc[0]["cause"], "synchronous window 0x1007 = 2000 µs");
+    assert_eq!(frames(&inc[0]), [66, 69, 150]);
+    assert_eq!(inc[0]["events"][0]["text"], "TPDO1 4.000 ms after the SYNC (#65)");
 }

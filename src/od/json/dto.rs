@@ -105,6 +105,9 @@ pub(super) struct EmcyDto {
     pub(super) codes: BTreeMap<String, String>,
     #[serde(default)]
     pub(super) manufacturer_fields: Vec<FieldDto>,
+    /// "Check first" steps per EMCY code (the manual's causes and remedies).
+    #[serde(default)]
+    pub(super) check: BTreeMap<String, Vec<String>>,
 }
 
 #[derive(Deserialize)]

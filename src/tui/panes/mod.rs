@@ -9,6 +9,7 @@ pub mod objects;
 pub mod pdo;
 pub mod picker;
 pub mod plot;
+pub mod problems;
 pub mod sdo;
 pub mod stats;
 pub mod status;
@@ -32,11 +33,12 @@ pub enum Pane {
     Plot,
     Objects,
     Pdo,
+    Problems,
 }
 
 impl Pane {
     /// Every pane in tab order.
-    pub const ALL: [Pane; 7] = [
+    pub const ALL: [Pane; 8] = [
         Pane::Trace,
         Pane::Nodes,
         Pane::Sdo,
@@ -44,6 +46,7 @@ impl Pane {
         Pane::Plot,
         Pane::Objects,
         Pane::Pdo,
+        Pane::Problems,
     ];
     /// Tab title.
     pub fn title(self) -> &'static str {
@@ -55,6 +58,7 @@ impl Pane {
             Pane::Plot => "Plot",
             Pane::Objects => "Objects",
             Pane::Pdo => "PDO",
+            Pane::Problems => "Problems",
         }
     }
 }
@@ -76,6 +80,8 @@ pub struct Panes {
     pub objects: objects::ObjectsPane,
     /// One row per known PDO of each node.
     pub pdo: pdo::PdoPane,
+    /// One row per incident of the diagnosis.
+    pub problems: problems::ProblemsPane,
 }
 
 impl Panes {
@@ -89,6 +95,7 @@ impl Panes {
             Pane::Plot => &self.plot,
             Pane::Objects => &self.objects,
             Pane::Pdo => &self.pdo,
+            Pane::Problems => &self.problems,
         }
     }
 
@@ -102,6 +109,7 @@ impl Panes {
             Pane::Plot => &mut self.plot,
             Pane::Objects => &mut self.objects,
             Pane::Pdo => &mut self.pdo,
+            Pane::Problems => &mut self.problems,
         }
     }
 }

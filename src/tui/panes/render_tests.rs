@@ -420,3 +420,51 @@ fn help_search_brings_the_first_line_found_to_the_top() {
     assert!(first.contains("Replay: loop at the end (on/off)"), "{s}");
     insta::assert_snapshot!("help_search_80x24", s);
 }
+
+#[test]
+fn problems_pane_lists_the_incidents_and_opens_one_at_80x24() {
+    let mut a = app();
+    a.act(Action::PaneProblems);
+    assert_eq!(a.focus, Pane::Problems);
+    let s = screen(&mut a, 80, 24);
+    // Node 2 refused the read of 0x6041:00 and sent an EMCY; nothing recovered.
+    assert!(s.contains("8 Problems"), "{s}");
+    assert!(s.contains("Problems (2 open, 0 recovered, 0 warnings)"), "{s}");
+    assert!(s.contains("OPEN      Node 2"), "{s}");
+    insta::assert_snapshot!("problems_80x24_list", s);
+    a.act(Action::Down);
+    a.act(Action::Expand);
+    let s = screen(&mut a, 80, 24);
+    assert!(s.contains("What happened"), "{s}");
+    assert!(s.contains("Check first"), "{s}");
+    assert!(s.contains("Why it matters"), "{s}");
+    insta::assert_snapshot!("problems_80x24_opened", s);
+}
+
+#[test]
+fn problems_pane_at_160x48_and_its_frames_in_the_trace() {
+    let mut a = app();
+    a.act(Action::PaneProblems);
+    let s = screen(&mut a, 160, 48);
+    assert!(
+        s.contains("A value could not be read — 0x6041:00: Object does not exist"),
+        "{s}"
+    );
+    insta::assert_snapshot!("problems_160x48_list", s);
+    // The first incident is the refused read (frame 13, the abort): `show_frames` shows it
+    // in the trace; pressing it again in the trace goes on to the incident's next frame.
+    let first = a.panes.problems.incidents()[0].clone();
+    a.act(Action::ShowFrames);
+    assert_eq!(a.focus, Pane::Trace);
+    assert_eq!(a.selected_position(), Some(first.events[0].frame as usize - 1));
+    a.act(Action::ShowFrames);
+    let next = first.events.get(1).unwrap_or(&first.events[0]).frame as usize - 1;
+    assert_eq!(a.selected_position(), Some(next));
+    // Enter on a timeline step of the opened incident shows that frame.
+    a.act(Action::PaneProblems);
+    let _ = screen(&mut a, 160, 48);
+    a.act(Action::Expand);
+    a.act(Action::Expand);
+    assert_eq!(a.focus, Pane::Trace);
+    assert_eq!(a.selected_position(), Some(first.events[0].frame as usize - 1));
+}
