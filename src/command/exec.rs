@@ -47,6 +47,7 @@ pub async fn execute_until(
     }
     let json = match cmd {
         Command::Run(spec) => return run_procedure(bus, bindings, spec).await,
+        Command::Dcf(c) => return super::dcf::execute(bus, bindings.dictionary(c.node), c).await,
         Command::Stop {
             nodes,
             listen_ms,
@@ -348,6 +349,8 @@ pub fn text(cmd: &Command, v: &Json) -> String {
         Command::Stop { .. } => String::new(),
         // A cyclic command's text comes from its report (see `cyclic::Report::text`).
         Command::Send { .. } | Command::Sync { .. } | Command::Pdo { .. } => String::new(),
+        // A dcf command's text comes from its report (see `dcf`).
+        Command::Dcf(_) => String::new(),
     }
 }
 

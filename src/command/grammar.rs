@@ -258,6 +258,8 @@ pub enum Command {
         assignments: Vec<(String, String)>,
         schedule: super::cyclic::Schedule,
     },
+    /// `dcf save|load|diff NODE ...`: a node's configuration as a CiA 306 DCF.
+    Dcf(super::dcf::DcfCommand),
 }
 
 /// What `run` runs: a procedure of a node with its parameters, or (no procedure) the list.

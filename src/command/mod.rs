@@ -2,6 +2,7 @@
 //! API shared by the command line and the TUI palette.
 
 pub mod cyclic;
+pub mod dcf;
 pub mod drive;
 pub mod error;
 pub mod exec;

@@ -190,6 +190,30 @@ pub fn plan(
             }
             (text, None)
         }
+        Command::Dcf(d) => {
+            use crate::command::dcf::DcfAction;
+            let n = d.node;
+            match &d.action {
+                DcfAction::Save { output, .. } => (
+                    format!("reads every object node {n}'s dictionary knows by SDO, writes {output}"),
+                    None,
+                ),
+                DcfAction::Diff { file } => (format!("reads node {n} by SDO, compares with {file}"), None),
+                DcfAction::Load {
+                    file, dry_run: true, ..
+                } => (
+                    format!("reads node {n} by SDO, lists what {file} would write (writes nothing)"),
+                    None,
+                ),
+                DcfAction::Load { file, store, .. } => (
+                    format!(
+                        "reads node {n}, writes the values of {file} that differ (PDOs remapped), reads them back{}",
+                        if *store { ", stores (0x1010:01)" } else { "" }
+                    ),
+                    Some(format!("dcf load writes node {n}'s configuration from {file}")),
+                ),
+            }
+        }
         Command::Record { .. } => {
             return Err(CommandError::Usage(
                 "record runs from the command line (`cotui record IFACE -o FILE`)".into(),

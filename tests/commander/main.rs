@@ -8,6 +8,7 @@ mod cli_cyclic;
 mod cli_run;
 mod command_language;
 mod commander_demo;
+mod dcf_demo;
 mod lss_sim;
 mod procedure_run;
 mod sdo_client_misbehave;
