@@ -146,15 +146,16 @@ async fn save(sdo: &mut Sdo<'_>, dict: &Dictionary, output: &str, force: bool) -
             continue;
         }
         let first = t.subs[0];
-        let rest = match sdo.read(t.index, first).await? {
+        let (rest, highest) = match sdo.read(t.index, first).await? {
             Ok(bytes) => {
+                let highest = bytes.first().copied().unwrap_or(0);
                 let rest = if first == 0 && t.subs.len() > 1 {
-                    plan::subs_after(t, bytes.first().copied().unwrap_or(0))
+                    plan::subs_after(t, highest)
                 } else {
                     t.subs[1..].to_vec()
                 };
                 values.insert((t.index, first), bytes);
-                rest
+                (rest, highest)
             }
             Err(plan::NO_OBJECT | plan::NO_SUB) => {
                 absent += 1;
@@ -173,6 +174,8 @@ async fn save(sdo: &mut Sdo<'_>, dict: &Dictionary, output: &str, force: bool) -
                 Ok(bytes) => {
                     values.insert((t.index, sub), bytes);
                 }
+                // The unused entries of a PDO mapping end where the node's do.
+                Err(plan::NO_SUB) if sub > highest => break,
                 Err(plan::NO_OBJECT | plan::NO_SUB) => absent += 1,
                 Err(code) => refused.push(item(t.index, sub).abort(code)),
             }

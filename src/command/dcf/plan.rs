@@ -83,13 +83,20 @@ pub fn save_plan(dict: &Dictionary) -> SavePlan {
     SavePlan { targets, ranges }
 }
 
-/// The subs to read after sub 0 answered `highest`: those known up to it.
+/// Whether an index is a PDO mapping parameter, whose sub 0 is the number of mapped
+/// objects rather than the highest sub-index supported.
+pub fn is_mapping(index: u16) -> bool {
+    matches!(index, 0x1600..=0x17FF | 0x1A00..=0x1BFF)
+}
+
+/// The subs to read after sub 0 answered `highest`: those known up to it, and for a PDO
+/// mapping also the (unused) entries after its count, read until one the node does not have.
 pub fn subs_after(target: &ReadTarget, highest: u8) -> Vec<u8> {
     target
         .subs
         .iter()
         .copied()
-        .filter(|s| *s != 0 && *s <= highest)
+        .filter(|s| *s != 0 && (*s <= highest || is_mapping(target.index)))
         .collect()
 }
 
@@ -246,16 +253,16 @@ fn trim_nul(b: &[u8]) -> &[u8] {
 }
 
 /// Why a load never writes an object, whatever the file says: commands rather than
-/// configuration (store/restore, program control, the controlword) and set-points written
-/// by RPDOs (access `rww`).
-pub fn never_written(index: u16, access: Access) -> Option<&'static str> {
+/// configuration (store/restore, program control, the controlword) and the CiA 402
+/// set-points that move a motor (target position, velocity, torque).
+pub fn never_written(index: u16) -> Option<&'static str> {
     match index {
         0x1010 => Some("store command (use --store)"),
         0x1011 => Some("restore-defaults command"),
         0x1003 => Some("error history (writing clears it)"),
         0x1F50..=0x1F57 => Some("program download/control"),
         0x6040 => Some("controlword (a command, not configuration)"),
-        _ if access == Access::Rww => Some("set-point written by RPDOs, not configuration"),
+        0x6042 | 0x6071 | 0x607A | 0x60C1 | 0x60FF => Some("set-point (moves the motor), not configuration"),
         _ => None,
     }
 }
@@ -292,7 +299,7 @@ pub type ReadResult = Result<Vec<u8>, u32>;
 /// Whether a file value is read from the node at all (not for the objects never written,
 /// nor write-only ones).
 pub fn needs_read(v: &FileValue) -> bool {
-    v.access != Access::Wo && never_written(v.index, v.access).is_none()
+    v.access != Access::Wo && never_written(v.index).is_none()
 }
 
 /// Compares the file's values with what the node answered (`reads`, by (index, sub)).
@@ -301,7 +308,7 @@ pub fn compare(values: &[FileValue], reads: &BTreeMap<(u16, u8), ReadResult>) ->
         .iter()
         .map(|v| {
             let read = reads.get(&(v.index, v.sub));
-            let state = if let Some(why) = never_written(v.index, v.access) {
+            let state = if let Some(why) = never_written(v.index) {
                 State::Skipped(why)
             } else if v.access == Access::Wo {
                 State::Skipped("write-only (nothing to compare)")
@@ -367,8 +374,26 @@ pub struct PdoChange {
     /// Other communication subs to write (transmission type, inhibit time, event timer,
     /// SYNC start value), with their bytes.
     pub comm_subs: Vec<(u8, Vec<u8>)>,
-    /// The file's mapping entries (sub 1..n), when the mapping changes.
-    pub entries: Option<Vec<u32>>,
+    /// The new mapping, when it changes.
+    pub mapping_entries: Option<Mapping>,
+}
+
+/// A PDO mapping to write: the entries by sub (the unused ones after the count included),
+/// then the count.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Mapping {
+    pub entries: Vec<(u8, u32)>,
+    pub count: u8,
+}
+
+impl Mapping {
+    /// The mapping of these objects, in order (`0xIIIISSLL` each).
+    pub fn of(objects: &[u32]) -> Mapping {
+        Mapping {
+            entries: (1..).zip(objects.iter().copied()).collect(),
+            count: objects.len() as u8,
+        }
+    }
 }
 
 /// The PDO invalid bit of a COB-ID.
@@ -399,12 +424,12 @@ pub fn pdo_remap_sequence(c: &PdoChange) -> Vec<Write> {
     for (sub, bytes) in &c.comm_subs {
         out.push(w(c.comm, *sub, bytes.clone(), Step::Value));
     }
-    if let Some(entries) = &c.entries {
+    if let Some(m) = &c.mapping_entries {
         out.push(w(c.mapping, 0, vec![0], Step::ClearMapping));
-        for (i, e) in entries.iter().enumerate() {
-            out.push(w(c.mapping, i as u8 + 1, e.to_le_bytes().to_vec(), Step::Value));
+        for (sub, e) in &m.entries {
+            out.push(w(c.mapping, *sub, e.to_le_bytes().to_vec(), Step::Value));
         }
-        out.push(w(c.mapping, 0, vec![entries.len() as u8], Step::Value));
+        out.push(w(c.mapping, 0, vec![m.count], Step::Value));
     }
     if let Some(target) = c.cob_id.or(c.node_cob_id)
         && Some(target) != last_cob
@@ -460,11 +485,16 @@ pub fn load_plan(compared: &[Compared]) -> Vec<Vec<Write>> {
         let mapping_changes = compared
             .iter()
             .any(|c| c.file.index == mapping && c.state == State::Differs);
-        let entries = mapping_changes.then(|| {
-            let n = at(mapping, 0).and_then(|c| c.file.bytes.first().copied()).unwrap_or(0);
-            (1..=n)
-                .filter_map(|s| at(mapping, s).map(|c| u32_of(&c.file.bytes)))
-                .collect()
+        // The active entries (1..count) all, the unused ones after them where they differ.
+        let count = at(mapping, 0).and_then(|c| c.file.bytes.first().copied()).unwrap_or(0);
+        let mapping_entries = mapping_changes.then(|| Mapping {
+            entries: compared
+                .iter()
+                .filter(|c| c.file.index == mapping && c.file.sub > 0)
+                .filter(|c| c.file.sub <= count || c.state == State::Differs)
+                .map(|c| (c.file.sub, u32_of(&c.file.bytes)))
+                .collect(),
+            count,
         });
         let change = PdoChange {
             comm,
@@ -476,7 +506,7 @@ pub fn load_plan(compared: &[Compared]) -> Vec<Vec<Write>> {
                 .filter(|c| c.file.index == comm && c.file.sub > 1 && c.state == State::Differs)
                 .map(|c| (c.file.sub, c.file.bytes.clone()))
                 .collect(),
-            entries,
+            mapping_entries,
         };
         groups.push(pdo_remap_sequence(&change));
     }
@@ -594,7 +624,7 @@ mod tests {
             node_cob_id: Some(0x185),
             cob_id: Some(0x185),
             comm_subs: vec![(2, vec![1])],
-            entries: Some(vec![0x6041_0010, 0x6064_0020]),
+            mapping_entries: Some(Mapping::of(&[0x6041_0010, 0x6064_0020])),
         };
         let steps: Vec<(u16, u8, Vec<u8>, Step)> = pdo_remap_sequence(&change)
             .into_iter()
@@ -616,7 +646,7 @@ mod tests {
         let invalid = PdoChange {
             node_cob_id: Some(0x8000_0185),
             cob_id: Some(0x8000_0185),
-            entries: Some(vec![]),
+            mapping_entries: Some(Mapping::of(&[])),
             ..change
         };
         let steps: Vec<(u16, u8)> = pdo_remap_sequence(&invalid).iter().map(|w| (w.index, w.sub)).collect();
@@ -629,6 +659,9 @@ mod tests {
             fv(0x1017, 0, DataType::U16, Access::Rw, &[0xE8, 3]),
             fv(0x1A00, 0, DataType::U8, Access::Rw, &[1]),
             fv(0x1A00, 1, DataType::U32, Access::Rw, &[0x10, 0, 0x41, 0x60]),
+            // Unused entries after the count: written where they differ only.
+            fv(0x1A00, 2, DataType::U32, Access::Rw, &[0, 0, 0, 0]),
+            fv(0x1A00, 3, DataType::U32, Access::Rw, &[0, 0, 0, 0]),
             fv(0x1800, 1, DataType::U32, Access::Rw, &[0x85, 1, 0, 0]),
             fv(0x1800, 2, DataType::U8, Access::Rw, &[0xFF]),
             fv(0x6083, 0, DataType::U32, Access::Rw, &[1, 0, 0, 0]),
@@ -638,6 +671,8 @@ mod tests {
             ((0x1017, 0), Ok(vec![0, 0])),
             ((0x1A00, 0), Ok(vec![1])),
             ((0x1A00, 1), Ok(vec![0x10, 0, 0x40, 0x60])),
+            ((0x1A00, 2), Ok(vec![0x20, 0, 0x64, 0x60])),
+            ((0x1A00, 3), Ok(vec![0, 0, 0, 0])),
             ((0x1800, 1), Ok(vec![0x85, 1, 0, 0])),
             ((0x1800, 2), Ok(vec![0xFF])),
             ((0x6083, 0), Ok(vec![2, 0, 0, 0])),
@@ -658,6 +693,7 @@ mod tests {
                     (0x1800, 1, Step::Invalidate),
                     (0x1A00, 0, Step::ClearMapping),
                     (0x1A00, 1, Step::Value),
+                    (0x1A00, 2, Step::Value),
                     (0x1A00, 0, Step::Value),
                     (0x1800, 1, Step::Value),
                 ],
@@ -675,6 +711,8 @@ mod tests {
         let tpdo1 = t(0x1800).unwrap();
         assert!(tpdo1.range.is_some() && tpdo1.subs.starts_with(&[0, 1, 2]));
         assert!(t(0x6041).is_some() && t(0x6040).is_some());
-        assert_eq!(subs_after(&t(0x1A00).unwrap(), 2), [1, 2]);
+        assert_eq!(subs_after(&t(0x1018).unwrap(), 2), [1, 2]);
+        // A mapping's unused entries too (read until the node has no more).
+        assert_eq!(subs_after(&t(0x1A00).unwrap(), 2).len(), 64);
     }
 }
