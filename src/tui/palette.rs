@@ -256,6 +256,27 @@ mod tests {
     }
 
     #[test]
+    fn dcf_load_asks_first_unless_dry_run() {
+        let load = plan("dcf load 5 node5.dcf --store", &b(), |_| None).unwrap();
+        assert!(load.preview.contains("stores (0x1010:01)"), "{}", load.preview);
+        assert_eq!(
+            load.confirm.as_deref(),
+            Some("dcf load writes node 5's configuration from node5.dcf")
+        );
+        assert_eq!(
+            plan("dcf load 5 node5.dcf --dry-run", &b(), |_| None).unwrap().confirm,
+            None
+        );
+        assert_eq!(plan("dcf diff 5 node5.dcf", &b(), |_| None).unwrap().confirm, None);
+        assert!(
+            plan("dcf save 5 -o n.dcf", &b(), |_| None)
+                .unwrap()
+                .preview
+                .contains("writes n.dcf")
+        );
+    }
+
+    #[test]
     fn block_and_segmented_previews_say_what_follows() {
         let preview = |line: &str| plan(line, &b(), |_| None).unwrap().preview;
         // Block download initiate (client command 6, CRC and size indicated), not the expedited write.

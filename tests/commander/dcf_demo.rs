@@ -221,3 +221,40 @@ async fn a_refused_write_is_reported_with_its_abort_text() {
     assert_eq!(r["object"], "0x6083:00");
     assert!(r["abort_text"].as_str().unwrap().contains("length"), "{r}");
 }
+
+/// The real binary: `--eds FILE` binds to the command's node, diff exits 0 then 6 after the
+/// file is edited, and `--listen-only` makes a load impossible (exit 2, nothing sent).
+#[test]
+fn through_the_binary_exit_statuses_follow_the_differences() {
+    let cotui = |args: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_cotui"))
+            .args(args)
+            .output()
+            .unwrap();
+        let json = serde_json::from_slice(&out.stdout).unwrap_or(Json::Null);
+        (
+            out.status.code().unwrap_or(-1),
+            json,
+            String::from_utf8_lossy(&out.stderr).to_string(),
+        )
+    };
+    let path = dir("cli").join("node3.dcf");
+    let file = path.to_str().unwrap();
+    let eds = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/eds/servo-ds.eds");
+    let (rc, v, err) = cotui(&["dcf", "save", "demo", "3", "-o", file, "--eds", eds, "--json"]);
+    assert_eq!(rc, 0, "{err}");
+    assert!(v["objects"].as_u64().unwrap() > 50, "{v}");
+    let (rc, v, err) = cotui(&["dcf", "diff", "demo", "3", file, "--json"]);
+    assert_eq!((rc, v["equal"].as_bool()), (0, Some(true)), "{err}");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let at = text.find("[6083]").unwrap();
+    let value = at + text[at..].find("ParameterValue=").unwrap();
+    let end = value + text[value..].find('\n').unwrap();
+    std::fs::write(&path, format!("{}ParameterValue=0x7{}", &text[..value], &text[end..])).unwrap();
+    let (rc, v, err) = cotui(&["dcf", "diff", "demo", "3", file, "--json"]);
+    assert_eq!((rc, v["error"].as_str()), (6, Some("differs")), "{err}");
+    assert_eq!(v["differences"][0]["object"], "0x6083:00");
+    assert!(err.contains("0x6083:00 Profile acceleration: file 0x7, node "), "{err}");
+    let (rc, _, err) = cotui(&["dcf", "load", "demo", "3", file, "--listen-only"]);
+    assert_eq!(rc, 2, "{err}");
+}
