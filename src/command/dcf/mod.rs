@@ -38,17 +38,6 @@ pub enum DcfAction {
     Diff { file: String },
 }
 
-impl DcfAction {
-    /// The subcommand word.
-    pub fn verb(&self) -> &'static str {
-        match self {
-            DcfAction::Save { .. } => "save",
-            DcfAction::Load { .. } => "load",
-            DcfAction::Diff { .. } => "diff",
-        }
-    }
-}
-
 /// How many SDO timeouts in a row end a command: the node has stopped answering.
 const SILENT_LIMIT: u32 = 3;
 

@@ -116,7 +116,7 @@ pub struct FileValue {
 }
 
 /// A problem at a line of a file.
-#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Located {
     pub file: String,
     pub line: usize,
@@ -387,7 +387,7 @@ pub struct Mapping {
 }
 
 impl Mapping {
-    /// The mapping of these objects, in order (`0xIIIISSLL` each).
+    /// The mapping of these objects, in order (`0xIIIISSLL` each): what `pdo map` writes.
     pub fn of(objects: &[u32]) -> Mapping {
         Mapping {
             entries: (1..).zip(objects.iter().copied()).collect(),
