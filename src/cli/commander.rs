@@ -37,11 +37,19 @@ pub struct DictArgs {
 
 /// Runs a commander subcommand; returns the exit status.
 pub fn run_commander(c: &CliCommander) -> ExitCode {
-    let (bus, dict) = (c.bus(), c.dict().cloned().unwrap_or_default());
+    let (bus, mut dict) = (c.bus(), c.dict().cloned().unwrap_or_default());
     let cmd = match c.command() {
         Ok(cmd) => cmd,
         Err(e) => return report(bus, what(c), Err(e.into())),
     };
+    if let Command::Dcf(d) = &cmd {
+        // `dcf ... --eds FILE`: the EDS of the one node the command is about.
+        for e in &mut dict.eds {
+            if !e.contains('=') {
+                *e = format!("{}={e}", d.node);
+            }
+        }
+    }
     match cmd {
         Command::Run(spec) => super::run::run_run(bus, &dict, &spec),
         // A dry run needs no bus (not even an interface that exists).
@@ -82,7 +90,7 @@ pub fn run_commander(c: &CliCommander) -> ExitCode {
 
 /// The subcommand's name, as failures are prefixed (`cotui sdo read: ...`).
 fn what(c: &CliCommander) -> &'static str {
-    use crate::command::syntax::SdoCommand;
+    use crate::command::syntax::{DcfCommand, SdoCommand};
     match c {
         Commander::Nmt(_) => "nmt",
         Commander::Sdo(SdoCommand::Read(_)) => "sdo read",
@@ -96,6 +104,9 @@ fn what(c: &CliCommander) -> &'static str {
         Commander::Send(_) => "send",
         Commander::Sync(_) => "sync",
         Commander::Pdo(_) => "pdo",
+        Commander::Dcf(DcfCommand::Save(_)) => "dcf save",
+        Commander::Dcf(DcfCommand::Load(_)) => "dcf load",
+        Commander::Dcf(DcfCommand::Diff(_)) => "dcf diff",
     }
 }
 

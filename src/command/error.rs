@@ -23,6 +23,9 @@ pub enum ExitCode {
     Timeout = 4,
     /// 5: a drive sequence or a procedure's wait failed, or a stop was not confirmed.
     Drive = 5,
+    /// 6: the node's configuration differs from a DCF (`dcf diff`, or a `dcf load` whose
+    /// values did not read back).
+    Differs = 6,
 }
 
 impl ExitCode {
@@ -98,6 +101,16 @@ pub enum CommandError {
         report: Box<serde_json::Value>,
         text: String,
     },
+    /// A command that finished with a report that is a failure (`dcf diff` found
+    /// differences, `dcf load` was refused): `report` is its JSON, `text` its text, `error`
+    /// the JSON `error` word.
+    #[error("{text}")]
+    Report {
+        exit: ExitCode,
+        error: &'static str,
+        report: Box<serde_json::Value>,
+        text: String,
+    },
 }
 
 impl CommandError {
@@ -111,6 +124,7 @@ impl CommandError {
             CommandError::Drive { .. } => ExitCode::Drive,
             CommandError::Step { cause, .. } => cause.exit_code(),
             CommandError::NotStopped { .. } => ExitCode::Drive,
+            CommandError::Report { exit, .. } => *exit,
         }
     }
     /// The `--json` object of the failure.
@@ -171,6 +185,14 @@ impl CommandError {
                     o.insert("ok".into(), false.into());
                     o.insert("error".into(), "not_stopped".into());
                     o.insert("message".into(), message.into());
+                }
+                v
+            }
+            CommandError::Report { error, report, .. } => {
+                let mut v = (**report).clone();
+                if let Some(o) = v.as_object_mut() {
+                    o.insert("ok".into(), false.into());
+                    o.insert("error".into(), (*error).into());
                 }
                 v
             }

@@ -47,6 +47,7 @@ pub async fn execute_until(
     }
     let json = match cmd {
         Command::Run(spec) => return run_procedure(bus, bindings, spec).await,
+        Command::Dcf(c) => return super::dcf::execute(bus, bindings.dictionary(c.node), c).await,
         Command::Stop {
             nodes,
             listen_ms,
@@ -364,6 +365,8 @@ pub fn text(cmd: &Command, v: &Json) -> String {
         Command::Send { .. } | Command::Sync { .. } | Command::Pdo { .. } => String::new(),
         // `pdo` reads and maps return their own text (see `pdo::read_report`, `pdo::map`).
         Command::PdoRead { .. } | Command::PdoMap(_) => String::new(),
+        // A dcf command's text comes from its report (see `dcf`).
+        Command::Dcf(_) => String::new(),
     }
 }
 

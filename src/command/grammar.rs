@@ -263,6 +263,8 @@ pub enum Command {
     /// `pdo NODE map PDO OBJECT... [--type T] [--event MS] [--inhibit T] [--cob-id ID]
     /// [--dry-run] [--force] [--timeout MS]`: the CiA 301 remapping sequence.
     PdoMap(super::pdo::MapSpec),
+    /// `dcf save|load|diff NODE ...`: a node's configuration as a CiA 306 DCF.
+    Dcf(super::dcf::DcfCommand),
 }
 
 /// What `run` runs: a procedure of a node with its parameters, or (no procedure) the list.

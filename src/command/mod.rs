@@ -3,6 +3,7 @@
 
 pub mod complete;
 pub mod cyclic;
+pub mod dcf;
 pub mod drive;
 pub mod error;
 pub mod exec;

@@ -1,5 +1,5 @@
 //! The commander's command language, declared once. Each command (nmt, sdo read/write, lss,
-//! drive, run, scan, record, stop) is a clap declaration here: its words, flags, help text,
+//! drive, run, scan, record, stop, send, sync, pdo, dcf) is a clap declaration here: its words, flags, help text,
 //! checks and completion. The command line parses [`Commander`] with its bus options in
 //! front (`cotui sdo read IFACE 2 0x6041`, see `crate::cli`); the TUI palette parses the same
 //! declaration with nothing in front ([`parse_command`]: `sdo read 2 0x6041`, split like a
@@ -7,6 +7,7 @@
 //! unknown flags, extra words, missing words, bad numbers.
 
 use super::cyclic::Schedule;
+use super::dcf::DcfAction;
 use super::grammar::parse_assignments;
 use super::grammar::{
     Command, DEFAULT_TIMEOUT_MS, DriveAction, NMT_WAIT_MS, NmtAction, SCAN_LISTEN_MS, SCAN_TIMEOUT_MS, SdoOptions,
@@ -125,6 +126,78 @@ pub enum Commander<B: Args, D: Args> {
     /// sync:2` remaps one (CiA 301 sequence, read back); `pdo 2 send rpdo1 Controlword=0x0F
     /// "Target velocity=500" --every 10` sends an RPDO (mapped signals not given are sent as 0).
     Pdo(On<B, PdoArgs<D>>),
+    /// A node's configuration as a CiA 306 DCF: save it, load it back (the values that
+    /// differ, PDOs remapped), or show what differs.
+    #[command(subcommand)]
+    Dcf(DcfCommand<B, D>),
+}
+
+/// `dcf save`, `dcf load` and `dcf diff`.
+#[derive(Subcommand, Clone, Debug)]
+pub enum DcfCommand<B: Args, D: Args> {
+    /// Read every readable object the node's dictionary knows and write a DCF: `dcf save 5 -o node5.dcf`.
+    Save(On<B, DcfSaveArgs<D>>),
+    /// Write the file's writable values that differ from the node's, PDO mappings by the CiA
+    /// 301 sequence, communication objects last; read them back: `dcf load 5 node5.dcf --store`.
+    Load(On<B, DcfLoadArgs<D>>),
+    /// Show the objects whose values differ between the file and the node (exit status 6
+    /// when any writable one does): `dcf diff 5 node5.dcf`.
+    Diff(On<B, DcfDiffArgs<D>>),
+}
+
+/// `dcf save NODE -o FILE [--force] [--timeout MS]`.
+#[derive(Args, Clone, Debug)]
+pub struct DcfSaveArgs<D: Args> {
+    /// Node id 1..127 (decimal or 0x hex).
+    #[arg(value_parser = node_arg)]
+    pub node: u8,
+    /// The DCF to write. An existing file is refused unless --force.
+    #[arg(short = 'o', long)]
+    pub output: String,
+    /// Overwrite an existing output file.
+    #[arg(long)]
+    pub force: bool,
+    /// How long to wait for each SDO answer, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
+    pub timeout: u64,
+    #[command(flatten)]
+    pub dict: D,
+}
+
+/// `dcf load NODE FILE [--store] [--dry-run] [--timeout MS]`.
+#[derive(Args, Clone, Debug)]
+pub struct DcfLoadArgs<D: Args> {
+    /// Node id 1..127 (decimal or 0x hex).
+    #[arg(value_parser = node_arg)]
+    pub node: u8,
+    /// The DCF to load.
+    pub file: String,
+    /// Then write "save" (0x65766173) to 0x1010:01 to store the configuration.
+    #[arg(long)]
+    pub store: bool,
+    /// Read the node and print what would be written; write nothing.
+    #[arg(long)]
+    pub dry_run: bool,
+    /// How long to wait for each SDO answer, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
+    pub timeout: u64,
+    #[command(flatten)]
+    pub dict: D,
+}
+
+/// `dcf diff NODE FILE [--timeout MS]`.
+#[derive(Args, Clone, Debug)]
+pub struct DcfDiffArgs<D: Args> {
+    /// Node id 1..127 (decimal or 0x hex).
+    #[arg(value_parser = node_arg)]
+    pub node: u8,
+    /// The DCF to compare with.
+    pub file: String,
+    /// How long to wait for each SDO answer, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
+    pub timeout: u64,
+    #[command(flatten)]
+    pub dict: D,
 }
 
 /// `sdo read` and `sdo write`.
@@ -531,6 +604,9 @@ impl<B: Args, D: Args> Commander<B, D> {
             Commander::Send(o) => &o.bus,
             Commander::Sync(o) => &o.bus,
             Commander::Pdo(o) => &o.bus,
+            Commander::Dcf(DcfCommand::Save(o)) => &o.bus,
+            Commander::Dcf(DcfCommand::Load(o)) => &o.bus,
+            Commander::Dcf(DcfCommand::Diff(o)) => &o.bus,
         }
     }
 
@@ -541,6 +617,9 @@ impl<B: Args, D: Args> Commander<B, D> {
             Commander::Sdo(SdoCommand::Write(o)) => Some(&o.args.t.dict),
             Commander::Run(o) => Some(&o.args.dict),
             Commander::Pdo(o) => Some(&o.args.dict),
+            Commander::Dcf(DcfCommand::Save(o)) => Some(&o.args.dict),
+            Commander::Dcf(DcfCommand::Load(o)) => Some(&o.args.dict),
+            Commander::Dcf(DcfCommand::Diff(o)) => Some(&o.args.dict),
             _ => None,
         }
     }
@@ -619,8 +698,37 @@ impl<B: Args, D: Args> Commander<B, D> {
                 },
             },
             Commander::Pdo(On { args: a, .. }) => a.command()?,
+            Commander::Dcf(DcfCommand::Save(On { args: a, .. })) => dcf(
+                a.node,
+                DcfAction::Save {
+                    output: a.output.clone(),
+                    force: a.force,
+                },
+                a.timeout,
+            ),
+            Commander::Dcf(DcfCommand::Load(On { args: a, .. })) => dcf(
+                a.node,
+                DcfAction::Load {
+                    file: a.file.clone(),
+                    store: a.store,
+                    dry_run: a.dry_run,
+                },
+                a.timeout,
+            ),
+            Commander::Dcf(DcfCommand::Diff(On { args: a, .. })) => {
+                dcf(a.node, DcfAction::Diff { file: a.file.clone() }, a.timeout)
+            }
         })
     }
+}
+
+/// A `dcf` command.
+fn dcf(node: u8, action: DcfAction, timeout_ms: u64) -> Command {
+    Command::Dcf(super::dcf::DcfCommand {
+        node,
+        action,
+        timeout_ms,
+    })
 }
 
 /// The palette's parser: the commander declaration with nothing in front.
@@ -1232,7 +1340,7 @@ mod tests {
         assert_eq!(
             commander_words(),
             [
-                "nmt", "sdo", "drive", "run", "scan", "record", "stop", "lss", "send", "sync", "pdo"
+                "nmt", "sdo", "drive", "run", "scan", "record", "stop", "lss", "send", "sync", "pdo", "dcf"
             ]
         );
         assert_eq!(completions_of("sdo "), ["read", "write"]);

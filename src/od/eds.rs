@@ -580,3 +580,31 @@ fn pdos(im: &mut Importer, p: &Profile, comm: u16, map: u16, source: &MappingSou
     }
     out
 }
+
+/// One `ParameterValue` of a DCF: the entry it configures, its text as written, its line.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ParameterValue {
+    pub index: u16,
+    pub sub: u8,
+    pub text: String,
+    pub line: usize,
+}
+
+/// Every non-empty `ParameterValue` of a DCF (`[IIII]` is sub 0, `[IIIIsubS]` sub S), by
+/// (index, sub). Problems of the text itself are [`import`]'s warnings.
+pub fn parameter_values(text: &str) -> Vec<ParameterValue> {
+    let ini = parse_ini(text, &mut Vec::new());
+    ini.sections
+        .iter()
+        .filter_map(|(name, sec)| {
+            let (index, sub) = section_index(name)?;
+            let (v, line) = sec.get("parametervalue").filter(|(v, _)| !v.is_empty())?;
+            Some(ParameterValue {
+                index,
+                sub: sub.unwrap_or(0),
+                text: v.to_string(),
+                line,
+            })
+        })
+        .collect()
+}

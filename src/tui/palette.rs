@@ -208,6 +208,30 @@ pub fn plan(
                 (format!("{read} (COB-ID), {} then reads back", listed(&frames)), None)
             }
         }
+        Command::Dcf(d) => {
+            use crate::command::dcf::DcfAction;
+            let n = d.node;
+            match &d.action {
+                DcfAction::Save { output, .. } => (
+                    format!("reads every object node {n}'s dictionary knows by SDO, writes {output}"),
+                    None,
+                ),
+                DcfAction::Diff { file } => (format!("reads node {n} by SDO, compares with {file}"), None),
+                DcfAction::Load {
+                    file, dry_run: true, ..
+                } => (
+                    format!("reads node {n} by SDO, lists what {file} would write (writes nothing)"),
+                    None,
+                ),
+                DcfAction::Load { file, store, .. } => (
+                    format!(
+                        "reads node {n}, writes the values of {file} that differ (PDOs remapped), reads them back{}",
+                        if *store { ", stores (0x1010:01)" } else { "" }
+                    ),
+                    Some(format!("dcf load writes node {n}'s configuration from {file}")),
+                ),
+            }
+        }
         Command::Record { .. } => {
             return Err(CommandError::Usage(
                 "record runs from the command line (`cotui record IFACE -o FILE`)".into(),
@@ -270,6 +294,27 @@ mod tests {
         assert_eq!(
             d.preview,
             "602#2B40600006000000, 602#2B40600007000000, 602#2B4060000F000000 (from Switch on disabled)"
+        );
+    }
+
+    #[test]
+    fn dcf_load_asks_first_unless_dry_run() {
+        let load = plan("dcf load 5 node5.dcf --store", &b(), |_| None).unwrap();
+        assert!(load.preview.contains("stores (0x1010:01)"), "{}", load.preview);
+        assert_eq!(
+            load.confirm.as_deref(),
+            Some("dcf load writes node 5's configuration from node5.dcf")
+        );
+        assert_eq!(
+            plan("dcf load 5 node5.dcf --dry-run", &b(), |_| None).unwrap().confirm,
+            None
+        );
+        assert_eq!(plan("dcf diff 5 node5.dcf", &b(), |_| None).unwrap().confirm, None);
+        assert!(
+            plan("dcf save 5 -o n.dcf", &b(), |_| None)
+                .unwrap()
+                .preview
+                .contains("writes n.dcf")
         );
     }
 

@@ -8,6 +8,7 @@ mod cli_cyclic;
 mod cli_run;
 mod command_language;
 mod commander_demo;
+mod dcf_demo;
 mod every_procedure;
 mod lss_sim;
 mod pdo_config;

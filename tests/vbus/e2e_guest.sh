@@ -4,8 +4,9 @@
 #   VBUS_IFACES="vcan0 vcan1:fd" tests/vbus/run.sh tests/vbus/e2e_guest.sh COTUI SOCKETCAN_LIVE_TEST
 # Every check runs host-built cotui against peers cotui did not write: can-utils
 # (cangen, cansend, candump), the python canopen peers (peers/sdo_server.py node 5,
-# peers/drive402.py node 2) and tmux. Prints one line per check ("ok   ..." or
-# "FAIL ...") and "N passed, N failed"; exits 1 on any failure.
+# peers/drive402.py node 2; peers/dcf_node.py nodes 10 and 11 in section 13) and tmux.
+# Prints one line per check ("ok   ..." or "FAIL ...") and "N passed, N failed"; exits 1
+# on any failure.
 set -uo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 [ "${VBUS_GUEST:-}" = 1 ] || { echo "e2e_guest.sh runs inside the guest: tests/vbus/e2e.sh" >&2; exit 2; }
@@ -887,6 +888,78 @@ c pdo vcan0 2 map tpdo1 0x6041 --type 255
 c2=$rc
 c nmt vcan0 start 2 --wait --timeout 3000
 [ "$c2" = 0 ] && ok "pdo: TPDO1 of the peer restored (statusword, type 255)" || bad "pdo restore: rc=$c2 $err"
+
+# ---- 15 dcf: configuration backup and restore against canopen LocalNodes ------------------
+# Two canopen LocalNodes built from the repo's SERVO-DS EDS (peers/dcf_node.py): node 10
+# with values changed from the EDS defaults (the DCF must hold the node's values), node 11
+# with others (another TPDO1 mapping and transmission type, a gain, an acceleration). `dcf save`
+# of node 10 must load in canopen.import_od with the node's values; `dcf load` of that file
+# onto node 11 must make its writable values equal to node 10's, TPDO1 remapped by the
+# CiA 301 sequence (seen on the bus), then stored; `dcf diff` shows the difference before
+# and none after.
+dcf_eds="$here/../fixtures/eds/servo-ds.eds"
+python3 "$here/peers/dcf_node.py" serve vcan0 10 "$dcf_eds" --set 0x2318:0=321 --set 0x1800:5=250 \
+    --set 0x1A01:2=0x60640020 --dump dcf_a.json > dcf_a.out 2>&1 &
+dcf_a=$!
+pids+=($dcf_a)
+python3 "$here/peers/dcf_node.py" serve vcan0 11 "$dcf_eds" --set 0x2318:0=100 --set 0x1800:2=1 \
+    --set 0x1A00:0=1 --set 0x1A00:1=0x606C0020 --set 0x6083:0=5000 --dump dcf_b.json > dcf_b.out 2>&1 &
+dcf_b=$!
+pids+=($dcf_b)
+# dcf_dump PID OUT: the peer writes its values (SIGUSR1) and says so in OUT.
+dcf_dump() {
+    : > "$2.mark"
+    grep -c "dcf_node dumped" "$2" > "$2.mark"
+    kill -USR1 "$1"
+    for _ in $(seq 100); do
+        [ "$(grep -c "dcf_node dumped" "$2")" -gt "$(cat "$2.mark")" ] && return 0
+        sleep 0.1
+    done
+    return 1
+}
+wait_for dcf_a.out 900 "dcf_node ready vcan0 10" && wait_for dcf_b.out 900 "dcf_node ready vcan0 11" ||
+    bad "dcf peers not ready: $(cat dcf_a.out dcf_b.out)"
+c dcf save vcan0 10 -o node10.dcf --eds "$dcf_eds" --json
+[ "$rc" = 0 ] && grep -q "^NodeID=10$" node10.dcf &&
+    ok "dcf save: $(echo "$out" | j .objects) objects of LocalNode 10 in node10.dcf ($(echo "$out" | j .absent) of cotui's dictionary not in the node)" ||
+    bad "dcf save: rc=$rc $out $err"
+dcf_dump $dcf_a dcf_a.out || bad "dcf: node 10 wrote no dump: $(cat dcf_a.out)"
+c dcf diff vcan0 11 node10.dcf --eds "$dcf_eds" --json
+diffs=$(echo "$out" | j '[.differences[].object] | join(" ")')
+[ "$rc" = 6 ] && [ "$(echo "$out" | j .error)" = differs ] && [[ " $diffs " == *" 0x2318:00 "* ]] &&
+    [[ " $diffs " == *" 0x1A00:01 "* ]] && [[ " $diffs " == *" 0x6083:00 "* ]] &&
+    ok "dcf diff before: exit 6, differs in $diffs" ||
+    bad "dcf diff before: rc=$rc $out $err"
+candump -L vcan0,60B:7FF > dcf_sdo.log 2> /dev/null &
+dcf_dumper=$!
+wait_socket $dcf_dumper || bad "dcf: candump opened no socket"
+c dcf load vcan0 11 node10.dcf --eds "$dcf_eds" --store --json
+wait_for dcf_sdo.log 30 "60B#2310100173617665" # the store request, the last frame we send
+kill $dcf_dumper 2> /dev/null
+# TPDO1 by the CiA 301 sequence: COB-ID 0x18B invalid, count 0, entries, count 3, COB-ID 0x18A.
+at() { grep -n -m1 "$1" dcf_sdo.log | cut -d: -f1; }
+inv=$(at "60B#230018018B010080")
+clear=$(at "60B#2F001A0000000000")
+count=$(at "60B#2F001A0003000000")
+valid=$(at "60B#230018018A010000")
+dcf_dump $dcf_b dcf_b.out || bad "dcf: node 11 wrote no dump: $(cat dcf_b.out)"
+[ "$rc" = 0 ] && [ "$(echo "$out" | j .stored)" = true ] && [ "$(jq -r '."1010:01"' dcf_b.json)" = 73617665 ] &&
+    [ -n "$inv" ] && [ -n "$valid" ] && [ "$inv" -lt "$clear" ] && [ "$clear" -lt "$count" ] && [ "$count" -lt "$valid" ] &&
+    ok "dcf load onto LocalNode 11: $(echo "$out" | j '.writes | length') writes, $(echo "$out" | j .verified) verified, TPDO1 remapped in the CiA 301 order (candump lines $inv < $clear < $count < $valid), stored (0x1010:01 = save)" ||
+    bad "dcf load: rc=$rc $out $err; frames inv=$inv clear=$clear count=$count valid=$valid; 1010:01=$(jq -r '."1010:01"' dcf_b.json)"
+# One python start-up for both checks against canopen's own reading of the files.
+checks=$(python3 "$here/peers/dcf_node.py" check node10.dcf 10 dcf_a.json "$dcf_eds" dcf_b.json 2>&1)
+[ "$(echo "$checks" | head -1 | cut -d' ' -f1)" = same ] &&
+    ok "dcf: canopen.import_od of node10.dcf has LocalNode 10's values ($(echo "$checks" | head -1))" ||
+    bad "dcf: import_od of the DCF differs from LocalNode 10: $checks"
+[ "$(echo "$checks" | tail -1 | cut -d' ' -f1)" = equal ] &&
+    ok "dcf: after the load, LocalNode 11's writable values are LocalNode 10's ($(echo "$checks" | tail -1))" ||
+    bad "dcf: LocalNode 11 after the load: $checks"
+c dcf diff vcan0 11 node10.dcf --eds "$dcf_eds" --json
+[ "$rc" = 0 ] && [ "$(echo "$out" | j .equal)" = true ] &&
+    ok "dcf diff after: exit 0, $(echo "$out" | j .unchanged) values equal" ||
+    bad "dcf diff after: rc=$rc $out $err"
+kill $dcf_a $dcf_b 2> /dev/null
 
 t_end=$(date +%s.%N)
 echo "$passed passed, $failed failed ($(awk -v a="$t_start" -v b="$t_end" 'BEGIN { printf "%.0f", b - a }') s in the guest)"
