@@ -4,7 +4,7 @@
 #   VBUS_IFACES="vcan0 vcan1:fd" tests/vbus/run.sh tests/vbus/e2e_guest.sh COTUI SOCKETCAN_LIVE_TEST
 # Every check runs host-built cotui against peers cotui did not write: can-utils
 # (cangen, cansend, candump), the python canopen peers (peers/sdo_server.py node 5,
-# peers/drive402.py node 2; peers/dcf_node.py nodes 10 and 11 in section 13) and tmux.
+# peers/drive402.py node 2 (and node 12 in section 14); peers/dcf_node.py nodes 10 and 11 in section 15) and tmux.
 # Prints one line per check ("ok   ..." or "FAIL ...") and "N passed, N failed"; exits 1
 # on any failure.
 set -uo pipefail
@@ -814,6 +814,12 @@ tmux send-keys -t cyc q
 tmux kill-session -t cyc 2> /dev/null
 kill $cycdump 2> /dev/null
 
+# Section 14's own CiA 402 peer (node 12), started here so that its python start-up overlaps
+# section 13; the shared node-2 peer has been commanded by every section before.
+python3 "$here/peers/drive402.py" vcan0 12 --heartbeat-ms 300 --tpdo > pdodrive.out 2>&1 &
+pdodrive=$!
+pids+=($pdodrive)
+
 # ---- 13 demo: the simulated Dexmart and AQMD drives against cotui run and python canopen ----
 # cotui sim with the two non-CiA 402 seed drives; cotui runs a procedure of each (candump sees
 # the manuals' RPDOs and the Dexmart's TPDO1 answer); then peers/sim_master.py (python
@@ -848,46 +854,48 @@ done < vendor.out
 grep -qE "^(ok|FAIL) " vendor.out || bad "sim_master.py vendor printed no checks: $(cat vendor.out)"
 kill -TERM $dsim; wait $dsim
 
-# ---- 14 pdo: read, remap and decode the drive402 peer's TPDO1 -------------------------------
-# `cotui pdo vcan0 2` reads the peer's PDO parameters (python canopen LocalNode); `pdo ... map
+# ---- 14 pdo: read, remap and decode a drive402 peer's TPDO1 (node 12) -----------------------
+# `cotui pdo vcan0 12` reads the peer's PDO parameters (python canopen LocalNode); `pdo ... map
 # tpdo1` is refused while the peer is operational (it changes mappings only outside
 # OPERATIONAL; the failure says why), done in pre-operational, read back; candump -L records
 # meanwhile and `cotui decode` of that log shows TPDO1 with the new signals. TPDO1 is
 # restored (statusword, type 255) at the end. The peer sends TPDO1 on entering OPERATIONAL.
-c nmt vcan0 start 2 --wait --timeout 3000
-c pdo vcan0 2 --json
+wait_for pdodrive.out 900 "drive402 ready vcan0 12" || bad "pdo: drive402.py node 12 not ready: $(cat pdodrive.out)"
+c nmt vcan0 start 12 --wait --timeout 3000
+c pdo vcan0 12 --json
 tp=$(echo "$out" | j '.pdos[] | select(.pdo == "tpdo1") | "\(.cob_id.id) \(.cob_id.valid) \(.transmission_type) \([.mapping[] | "\(.index):\(.bits)"] | join(","))"')
 rp=$(echo "$out" | j '[.pdos[] | select(.exists)] | length')
-[ "$rc" = 0 ] && [ "$tp" = "386 true 255 24641:16" ] && [ "$rp" = 1 ] &&
-    ok "pdo: reads the drive402 peer's PDOs (TPDO1 0x182 valid, type 255, statusword 16 bits; RPDO1-4 and TPDO2-4 absent)" ||
-    bad "pdo read: rc=$rc tpdo1='$tp' existing=$rp $out $err"
+[ "$rc" = 0 ] && [ "$tp" = "396 true 255 24641:16" ] && [ "$rp" = 1 ] &&
+    ok "pdo: reads the drive402 peer's PDOs (TPDO1 0x18C valid, type 255, statusword 16 bits; RPDO1-4 and TPDO2-4 absent)" ||
+    bad "pdo read: rc=$rc tpdo1='$tp' existing=$rp $out $err; peer: $(tail -3 pdodrive.out)"
 candump -L vcan0 > pdo13.log 2> /dev/null &
 pdodump=$!
 wait_socket $pdodump || bad "pdo: candump opened no socket in 10 s"
-c pdo vcan0 2 map tpdo1 0x6041 0x6061 0x603F --json
-echo "$err" | grep -q "0x08000022" && echo "$err" | grep -q "node 2 is operational (its heartbeat says so)" &&
+c pdo vcan0 12 map tpdo1 0x6041 0x6061 0x603F --json
+echo "$err" | grep -q "0x08000022" && echo "$err" | grep -q "node 12 is operational (its heartbeat says so)" &&
     echo "$err" | grep -q "TPDO1 is left invalid" && [ "$rc" = 3 ] && [ "$(echo "$out" | j .failed_step)" = 2 ] &&
     ok "pdo map: refused in OPERATIONAL (exit 3, step 2 0x1A00:00, abort 0x08000022, the heartbeat's state named)" ||
     bad "pdo map in operational: rc=$rc $out $err"
-c nmt vcan0 preop 2 --wait --timeout 3000
-c pdo vcan0 2 map tpdo1 Statusword 0x6061 0x603F --type event-mfr --json
-[ "$rc" = 0 ] && [ "$(echo "$out" | j '"\(.verified) \(.comm.transmission_type) \(.comm.cob_id.id) \(.mapping | length)"')" = "true 254 386 3" ] &&
+c nmt vcan0 preop 12 --wait --timeout 3000
+c pdo vcan0 12 map tpdo1 Statusword 0x6061 0x603F --type event-mfr --json
+[ "$rc" = 0 ] && [ "$(echo "$out" | j '"\(.verified) \(.comm.transmission_type) \(.comm.cob_id.id) \(.mapping | length)"')" = "true 254 396 3" ] &&
     ok "pdo map: TPDO1 remapped in pre-operational (statusword, mode display, error code; type 254), read back" ||
     bad "pdo map: rc=$rc $out $err"
-c nmt vcan0 start 2 --wait --timeout 3000
+c nmt vcan0 start 12 --wait --timeout 3000
 sleep 0.3
 kill $pdodump 2> /dev/null
 wait $pdodump 2> /dev/null
 c decode pdo13.log --format jsonl
-last=$(echo "$out" | j 'select(.kind == "tpdo" and .node == 2) | "\(.len) \([.pdo.signals[].name] | join(",")) \(.pdo.mapping_source | split(" @")[0])"' | tail -1)
+last=$(echo "$out" | j 'select(.kind == "tpdo" and .node == 12) | "\(.len) \([.pdo.signals[].name] | join(",")) \(.pdo.mapping_source | split(" @")[0])"' | tail -1)
 [ "$last" = "5 Statusword,Modes of operation display,Error code sniffed" ] &&
     ok "pdo: cotui decode of candump's log decodes TPDO1 through the new mapping ($last)" ||
     bad "pdo decode: last TPDO1 '$last'; $(tail -5 pdo13.log)"
-c nmt vcan0 preop 2 --wait --timeout 3000
-c pdo vcan0 2 map tpdo1 0x6041 --type 255
+c nmt vcan0 preop 12 --wait --timeout 3000
+c pdo vcan0 12 map tpdo1 0x6041 --type 255
 c2=$rc
-c nmt vcan0 start 2 --wait --timeout 3000
+c nmt vcan0 start 12 --wait --timeout 3000
 [ "$c2" = 0 ] && ok "pdo: TPDO1 of the peer restored (statusword, type 255)" || bad "pdo restore: rc=$c2 $err"
+kill $pdodrive 2> /dev/null
 
 # ---- 15 dcf: configuration backup and restore against canopen LocalNodes ------------------
 # Two canopen LocalNodes built from the repo's SERVO-DS EDS (peers/dcf_node.py): node 10

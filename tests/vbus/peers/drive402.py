@@ -169,13 +169,28 @@ class Drive:
             self.send_tpdo()
 
     def _check_remap(self, index, subindex, data):
-        """Refuse TPDO1 parameter changes in OPERATIONAL, and mappings over 64 bits."""
+        """Refuse TPDO1 parameter changes in OPERATIONAL, entries of objects this drive does
+        not have, and mappings over 64 bits."""
         if self.node.nmt.state == "OPERATIONAL":
             raise canopen.SdoAbortedError(0x08000022)
+        if index == 0x1A00 and subindex > 0:
+            (e,) = struct.unpack("<I", bytes(data[:4]).ljust(4, b"\0"))
+            if e and not self._has(e >> 16, (e >> 8) & 0xFF):
+                raise canopen.SdoAbortedError(0x06040041)
         if index == 0x1A00 and subindex == 0:
             bits = sum(self._entry(k)[2] for k in range(1, data[0] + 1))
             if data[0] > 8 or bits > 64:
                 raise canopen.SdoAbortedError(0x06040042)
+
+    def _has(self, index, sub):
+        """Whether the dictionary has (index, sub)."""
+        try:
+            obj = self.node.object_dictionary[index]
+            if isinstance(obj, (odt.ODRecord, odt.ODArray)):
+                obj[sub]
+            return True
+        except (KeyError, IndexError):
+            return False
 
     def _entry(self, sub):
         (e,) = struct.unpack("<I", self.node.get_data(0x1A00, sub))
@@ -187,8 +202,12 @@ class Drive:
         if cob & 0x80000000 or self.node.nmt.state != "OPERATIONAL":
             return
         data = b""
-        for index, sub, bits in (self._entry(k) for k in range(1, self.node.get_data(0x1A00, 0)[0] + 1)):
-            data += self.node.get_data(index, sub)[: bits // 8]
+        try:
+            for index, sub, bits in (self._entry(k) for k in range(1, self.node.get_data(0x1A00, 0)[0] + 1)):
+                data += self.node.get_data(index, sub)[: bits // 8]
+        except Exception as e:  # noqa: BLE001 - never let the bus's notifier thread die
+            print(f"drive402: TPDO1 not sent: {e!r}", flush=True)
+            return
         self.node.network.send_message(cob & 0x7FF, data)
 
     def attach(self, network):
