@@ -2,6 +2,7 @@
 //! (what the drive sends after a remap, decoded), the real binary for dry runs, refusals and
 //! listen-only.
 
+use crate::run::cotui_json;
 use cotui::command::{execute, parse_command};
 use cotui::decode::{Body, Decoder};
 use cotui::frame::Direction;
@@ -9,19 +10,7 @@ use cotui::od::MappingSource;
 use cotui::sim::Simulation;
 use cotui::sim::demo::Demo;
 use serde_json::json;
-use std::process::Command;
 use std::time::Duration;
-
-fn cotui(args: &[&str]) -> (i32, serde_json::Value, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_cotui")).args(args).output().unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
-    let json = serde_json::from_str(stdout.trim()).unwrap_or(serde_json::Value::Null);
-    (
-        out.status.code().unwrap_or(-1),
-        json,
-        String::from_utf8_lossy(&out.stderr).to_string(),
-    )
-}
 
 fn bindings() -> cotui::od::Bindings {
     cotui::cli::bind::bindings_on(cotui::connect::DEMO, &[], &[]).unwrap()
@@ -193,7 +182,7 @@ fn dry_run_prints_the_frames_and_needs_no_bus() {
         "--dry-run",
         "--json",
     ];
-    let (rc, v, err) = cotui(&[&args[..], &["--listen-only"]].concat());
+    let (rc, v, err) = cotui_json(&[&args[..], &["--listen-only"]].concat());
     assert_eq!(rc, 0, "{err}");
     let frames: Vec<&str> = v["steps"]
         .as_array()
@@ -214,23 +203,23 @@ fn dry_run_prints_the_frames_and_needs_no_bus() {
     );
     assert_eq!(v["dry_run"], true);
     // No interface needed at all.
-    let (rc, _, err) = cotui(&["pdo", "nosuchcan9", "2", "map", "tpdo1", "0x6041", "--dry-run"]);
+    let (rc, _, err) = cotui_json(&["pdo", "nosuchcan9", "2", "map", "tpdo1", "0x6041", "--dry-run"]);
     assert_eq!(rc, 0, "{err}");
 }
 
 #[test]
 fn listen_only_cannot_read_or_map_and_bad_lines_are_refused() {
-    let (rc, v, _) = cotui(&["pdo", "demo", "2", "map", "tpdo1", "0x6041", "--listen-only", "--json"]);
+    let (rc, v, _) = cotui_json(&["pdo", "demo", "2", "map", "tpdo1", "0x6041", "--listen-only", "--json"]);
     assert_eq!((rc, &v["error"]), (2, &json!("bus")));
-    let (rc, v, _) = cotui(&["pdo", "demo", "2", "--listen-only", "--json"]);
+    let (rc, v, _) = cotui_json(&["pdo", "demo", "2", "--listen-only", "--json"]);
     assert_eq!((rc, &v["error"]), (2, &json!("bus")));
-    let (rc, _, err) = cotui(&["pdo", "demo", "2", "map", "tpdo1", "0x6064", "0x606C", "0x6041"]);
+    let (rc, _, err) = cotui_json(&["pdo", "demo", "2", "map", "tpdo1", "0x6064", "0x606C", "0x6041"]);
     assert_eq!(rc, 1);
     assert!(
         err.contains("more than the 64 bits a PDO carries; nothing sent"),
         "{err}"
     );
-    let (rc, _, err) = cotui(&["pdo", "demo", "2", "map", "tpdo1", "0x6041", "--count", "2"]);
+    let (rc, _, err) = cotui_json(&["pdo", "demo", "2", "map", "tpdo1", "0x6041", "--count", "2"]);
     assert_eq!(rc, 1);
     assert!(err.contains("--count does not go with `pdo map`"), "{err}");
 }
