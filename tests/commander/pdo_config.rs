@@ -69,7 +69,28 @@ async fn after_map_tpdo1_the_drive_sends_and_the_decoder_decodes_the_new_signals
     assert_eq!(o.json["comm"]["transmission_type"], 2);
     assert_eq!(o.json["comm"]["inhibit_100us"], 15);
     assert_eq!(o.json["comm"]["event_ms"], 50);
-    assert_eq!(o.json["steps"].as_array().unwrap().len(), 9);
+    // CiA 301: COB-ID invalid, the communication parameters while invalid, count 0,
+    // entries, count, COB-ID valid again (the order `dcf load` writes too).
+    let order: Vec<&str> = o.json["steps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["object"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        order,
+        [
+            "0x1800:01",
+            "0x1800:02",
+            "0x1800:03",
+            "0x1800:05",
+            "0x1A00:00",
+            "0x1A00:01",
+            "0x1A00:02",
+            "0x1A00:00",
+            "0x1800:01"
+        ]
+    );
     assert!(
         o.text
             .starts_with("TPDO1 of node 2 mapped (9 writes, read back): COB-ID 0x182, synchronous, every 2 SYNCs (2)"),
