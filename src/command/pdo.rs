@@ -5,7 +5,7 @@
 
 pub mod remap;
 
-use super::error::CommandError;
+use super::error::{CommandError, ExitCode};
 use super::sdo::{download, first_download_frame, first_upload_frame, upload};
 use super::{candump, to_json};
 use crate::bus::{Bus, Subscription};
@@ -368,12 +368,27 @@ pub async fn map(bus: &Bus, dict: &Dictionary, spec: &MapSpec) -> Result<(Json, 
         }
     }
     let back = read_back(bus, spec, t).await?;
-    let differs = verify(&back, &entries, spec, &writes);
-    if let Some(reason) = differs {
-        return Err(CommandError::Drive {
+    if let Some(reason) = verify(&back, &entries, spec, &writes) {
+        let mut report = to_json(&MapJson {
+            ok: false,
             node,
-            step: format!("read back of {}", spec.pdo.title()),
-            reason,
+            pdo: spec.pdo.name(),
+            dry_run: false,
+            cob_id_before: Some(current),
+            steps: steps_json(node, &writes, "written"),
+            mapping: entries.iter().map(|e| EntryJson::new(e, dict)).collect(),
+            comm: Some(back.comm.to_json()),
+            verified: false,
+        });
+        report["reason"] = reason.clone().into();
+        return Err(CommandError::Report {
+            exit: ExitCode::Differs,
+            error: "differs",
+            report: Box::new(report),
+            text: format!(
+                "{} of node {node} differs from what was written: {reason}",
+                spec.pdo.title()
+            ),
         });
     }
     let json = to_json(&MapJson {

@@ -172,6 +172,59 @@ async fn a_refusal_says_why_with_the_nmt_state() {
     assert_eq!(e.to_json()["error"], "sdo_abort");
 }
 
+/// Node 20 on its own endpoint of the demo bus: an expedited SDO server that keeps every
+/// write, but reads TPDO1's transmission type (0x1800:02) back as 1 whatever was written.
+fn lying_node(d: &Demo) {
+    let peer = d.vbus.endpoint(false);
+    let mut rx = peer.subscribe();
+    tokio::spawn(async move {
+        let mut store = std::collections::HashMap::from([((0x1800u16, 1u8), 0x194u32)]);
+        while let Ok(f) = rx.recv().await {
+            if f.id != 0x614 || f.direction() == Direction::Tx {
+                continue;
+            }
+            let (c, index, sub) = (f.data[0], u16::from_le_bytes([f.data[1], f.data[2]]), f.data[3]);
+            let mut answer = [0u8; 8];
+            answer[1..4].copy_from_slice(&f.data[1..4]);
+            if c == 0x40 {
+                let v = if (index, sub) == (0x1800, 2) {
+                    1
+                } else {
+                    store.get(&(index, sub)).copied().unwrap_or(0)
+                };
+                answer[0] = 0x43;
+                answer[4..].copy_from_slice(&v.to_le_bytes());
+            } else {
+                let v = u32::from_le_bytes([f.data[4], f.data[5], f.data[6], f.data[7]]);
+                store.insert((index, sub), v);
+                answer[0] = 0x60;
+            }
+            let _ = peer.send(&cotui::frame::Frame::classic(0x594, &answer)).await;
+        }
+    });
+}
+
+#[tokio::test(start_paused = true)]
+async fn a_read_back_that_differs_exits_6() {
+    let d = Demo::spawn(Simulation::demo(), false);
+    lying_node(&d);
+    let cmd = parse_command("pdo 20 map tpdo1 0x6041 --type 255").unwrap();
+    let e = execute(&d.bus, &cmd, &bindings()).await.unwrap_err();
+    assert_eq!(e.exit_code(), 6, "{e}");
+    assert_eq!(
+        e.to_string(),
+        "TPDO1 of node 20 differs from what was written: transmission type reads 0x1 after writing 0xFF"
+    );
+    let j = e.to_json();
+    assert_eq!(
+        (&j["ok"], &j["error"], &j["verified"]),
+        (&json!(false), &json!("differs"), &json!(false))
+    );
+    assert_eq!(j["reason"], "transmission type reads 0x1 after writing 0xFF");
+    assert_eq!(j["comm"]["transmission_type"], 1);
+    assert_eq!(j["steps"].as_array().unwrap().len(), 6);
+}
+
 #[tokio::test(start_paused = true)]
 async fn over_64_bits_nothing_is_sent() {
     let d = Demo::spawn(Simulation::demo(), false);
