@@ -4,7 +4,8 @@
 #   VBUS_IFACES="vcan0 vcan1:fd" tests/vbus/run.sh tests/vbus/e2e_guest.sh COTUI SOCKETCAN_LIVE_TEST
 # Every check runs host-built cotui against peers cotui did not write: can-utils
 # (cangen, cansend, candump), the python canopen peers (peers/sdo_server.py node 5,
-# peers/drive402.py node 2 (and node 12 in section 14); peers/dcf_node.py nodes 10 and 11 in section 15) and tmux.
+# peers/drive402.py node 2 (sections 2-5, stopped with sdo_server.py after section 5) and node 12
+# (section 14); peers/dcf_node.py nodes 10 and 11 in section 15) and tmux.
 # Prints one line per check ("ok   ..." or "FAIL ...") and "N passed, N failed"; exits 1
 # on any failure.
 set -uo pipefail
@@ -815,7 +816,8 @@ tmux kill-session -t cyc 2> /dev/null
 kill $cycdump 2> /dev/null
 
 # Section 14's own CiA 402 peer (node 12), started here so that its python start-up overlaps
-# section 13; the shared node-2 peer has been commanded by every section before.
+# section 13. The node-2 peer started at the top is gone by now: "stop the peers" ends it
+# after section 5 (and section 8 deletes vcan0, which ends any python-can peer's reader).
 python3 "$here/peers/drive402.py" vcan0 12 --heartbeat-ms 300 --tpdo > pdodrive.out 2>&1 &
 pdodrive=$!
 pids+=($pdodrive)
