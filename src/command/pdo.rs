@@ -368,31 +368,9 @@ pub async fn map(bus: &Bus, dict: &Dictionary, spec: &MapSpec) -> Result<(Json, 
         }
     }
     let back = read_back(bus, spec, t).await?;
-    if let Some(reason) = verify(&back, &entries, spec, &writes) {
-        let mut report = to_json(&MapJson {
-            ok: false,
-            node,
-            pdo: spec.pdo.name(),
-            dry_run: false,
-            cob_id_before: Some(current),
-            steps: steps_json(node, &writes, "written"),
-            mapping: entries.iter().map(|e| EntryJson::new(e, dict)).collect(),
-            comm: Some(back.comm.to_json()),
-            verified: false,
-        });
-        report["reason"] = reason.clone().into();
-        return Err(CommandError::Report {
-            exit: ExitCode::Differs,
-            error: "differs",
-            report: Box::new(report),
-            text: format!(
-                "{} of node {node} differs from what was written: {reason}",
-                spec.pdo.title()
-            ),
-        });
-    }
-    let json = to_json(&MapJson {
-        ok: true,
+    let differs = verify(&back, &entries, spec, &writes);
+    let mut json = to_json(&MapJson {
+        ok: differs.is_none(),
         node,
         pdo: spec.pdo.name(),
         dry_run: false,
@@ -400,8 +378,20 @@ pub async fn map(bus: &Bus, dict: &Dictionary, spec: &MapSpec) -> Result<(Json, 
         steps: steps_json(node, &writes, "written"),
         mapping: entries.iter().map(|e| EntryJson::new(e, dict)).collect(),
         comm: Some(back.comm.to_json()),
-        verified: true,
+        verified: differs.is_none(),
     });
+    if let Some(reason) = differs {
+        json["reason"] = reason.clone().into();
+        return Err(CommandError::Report {
+            exit: ExitCode::Differs,
+            error: "differs",
+            report: Box::new(json),
+            text: format!(
+                "{} of node {node} differs from what was written: {reason}",
+                spec.pdo.title()
+            ),
+        });
+    }
     let mut lines = vec![format!(
         "{} of node {} mapped ({} writes, read back): {}",
         spec.pdo.title(),
