@@ -23,8 +23,8 @@ pub enum ExitCode {
     Timeout = 4,
     /// 5: a drive sequence or a procedure's wait failed, or a stop was not confirmed.
     Drive = 5,
-    /// 6: the node's configuration differs from a DCF (`dcf diff`, or a `dcf load` whose
-    /// values did not read back).
+    /// 6: the node differs from what was asked: its configuration from a DCF (`dcf diff`,
+    /// or a `dcf load` whose values did not read back), or a `pdo map` read back.
     Differs = 6,
 }
 
@@ -102,8 +102,8 @@ pub enum CommandError {
         text: String,
     },
     /// A command that finished with a report that is a failure (`dcf diff` found
-    /// differences, `dcf load` was refused): `report` is its JSON, `text` its text, `error`
-    /// the JSON `error` word.
+    /// differences, `dcf load` was refused, a `pdo map` did not read back as written):
+    /// `report` is its JSON, `text` its text, `error` the JSON `error` word.
     #[error("{text}")]
     Report {
         exit: ExitCode,

@@ -1,17 +1,22 @@
 //! `pdo NODE`: reads every PDO's communication and mapping parameters by SDO and prints
-//! them in words; `pdo NODE map PDO OBJECT...`: the CiA 301 remapping sequence (invalidate
-//! the COB-ID, count 0, entries, count, communication parameters, COB-ID valid again), each
-//! answer checked, the result read back, a refusal explained.
+//! them in words; `pdo NODE map PDO OBJECT...`: the CiA 301 remapping sequence of
+//! [`remap`] (invalidate the COB-ID, communication parameters, count 0, entries, count,
+//! COB-ID valid again), each answer checked, the result read back, a refusal explained.
 
-use super::error::CommandError;
+pub mod remap;
+
+use super::error::{CommandError, ExitCode};
 use super::sdo::{download, first_download_frame, first_upload_frame, upload};
 use super::{candump, to_json};
 use crate::bus::{Bus, Subscription};
 use crate::decode::pdo::entry_from_u32;
-use crate::decode::pdo_config::{COMM_SUBS, CommJson, CommParams, EntryJson, PdoId, entry_text};
+use crate::decode::pdo_config::{
+    COMM_SUBS, Cob, CommJson, CommParams, EntryJson, PdoId, entry_text, event_text, inhibit_text, transmission_text,
+};
 use crate::od::alias::resolve_object;
 use crate::od::{Dictionary, MappedEntry, PdoMappable};
 use crate::sdo::abort_text;
+use remap::{Action, Mapping, Remap, remap_sequence};
 use serde::Serialize;
 use serde_json::Value as Json;
 use std::time::Duration;
@@ -167,55 +172,54 @@ fn new_cob(spec: &MapSpec, current: u32) -> Result<u32, CommandError> {
     })
 }
 
-/// The writes of the remapping, in order, for a PDO whose COB-ID is `current` now.
+/// The writes of the remapping, in order ([`remap::remap_sequence`]), for a PDO whose
+/// COB-ID is `current` now.
 pub fn plan(dict: &Dictionary, spec: &MapSpec, current: u32) -> Result<Vec<Write>, CommandError> {
     let entries = entries(dict, spec)?;
-    let (comm, map) = (spec.pdo.comm_index(), spec.pdo.map_index());
+    let raw: Vec<u32> = entries
+        .iter()
+        .map(|e| u32::from(e.index) << 16 | u32::from(e.sub) << 8 | u32::from(e.bits))
+        .collect();
+    // The communication parameters asked for: sub, bytes, what it sets in words.
+    let comm: Vec<(u8, Vec<u8>, String)> = [
+        spec.transmission
+            .map(|t| (2, vec![t], format!("transmission type {}", transmission_text(t)))),
+        spec.inhibit_100us
+            .map(|t| (3, t.to_le_bytes().to_vec(), format!("inhibit time {}", inhibit_text(t)))),
+        spec.event_ms
+            .map(|ms| (5, ms.to_le_bytes().to_vec(), format!("event timer {}", event_text(ms)))),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
     let cob = new_cob(spec, current)?;
-    let mut w = vec![
-        Write::new(
-            comm,
-            1,
-            &(current | 1 << 31).to_le_bytes(),
-            "invalidate the COB-ID (bit 31)",
-        ),
-        Write::new(map, 0, &[0], "mapping count 0"),
-    ];
-    for (k, e) in entries.iter().enumerate() {
-        let raw = u32::from(e.index) << 16 | u32::from(e.sub) << 8 | u32::from(e.bits);
-        w.push(Write::new(
-            map,
-            k as u8 + 1,
-            &raw.to_le_bytes(),
-            format!("mapping entry {}: {}", k + 1, entry_text(e, dict)),
-        ));
-    }
-    w.push(Write::new(
-        map,
-        0,
-        &[entries.len() as u8],
-        format!("mapping count {}", entries.len()),
-    ));
-    if let Some(t) = spec.transmission {
-        let words = crate::decode::pdo_config::transmission_text(t);
-        w.push(Write::new(comm, 2, &[t], format!("transmission type {words}")));
-    }
-    if let Some(t) = spec.inhibit_100us {
-        let ms = crate::decode::pdo_config::inhibit_text(t);
-        w.push(Write::new(comm, 3, &t.to_le_bytes(), format!("inhibit time {ms}")));
-    }
-    if let Some(ms) = spec.event_ms {
-        let text = crate::decode::pdo_config::event_text(ms);
-        w.push(Write::new(comm, 5, &ms.to_le_bytes(), format!("event timer {text}")));
-    }
-    let text = crate::decode::pdo_config::Cob::new(cob).text();
-    w.push(Write::new(
-        comm,
-        1,
-        &cob.to_le_bytes(),
-        format!("COB-ID {text}, valid again"),
-    ));
-    Ok(w)
+    let remap = Remap {
+        comm: spec.pdo.comm_index(),
+        mapping: spec.pdo.map_index(),
+        current_cob: Some(current),
+        final_cob: Some(cob),
+        comm_subs: comm.iter().map(|(sub, data, _)| (*sub, data.clone())).collect(),
+        mapping_entries: Some(Mapping::of(&raw)),
+    };
+    let writes = remap_sequence(&remap).into_iter().map(|w| {
+        let what = match w.action {
+            Action::Invalidate => "invalidate the COB-ID (bit 31)".to_string(),
+            Action::Comm => comm
+                .iter()
+                .find(|(sub, ..)| *sub == w.sub)
+                .map(|(.., what)| what.clone())
+                .unwrap_or_default(),
+            Action::ClearMapping => "mapping count 0".to_string(),
+            Action::Entry => {
+                let k = usize::from(w.sub);
+                format!("mapping entry {k}: {}", entry_text(&entries[k - 1], dict))
+            }
+            Action::Count => format!("mapping count {}", entries.len()),
+            Action::Cob => format!("COB-ID {}, valid again", Cob::new(cob).text()),
+        };
+        Write::new(w.index, w.sub, &w.data, what)
+    });
+    Ok(writes.collect())
 }
 
 /// The COB-ID a dry run or preview assumes the PDO has (it is read first for real).
@@ -365,15 +369,8 @@ pub async fn map(bus: &Bus, dict: &Dictionary, spec: &MapSpec) -> Result<(Json, 
     }
     let back = read_back(bus, spec, t).await?;
     let differs = verify(&back, &entries, spec, &writes);
-    if let Some(reason) = differs {
-        return Err(CommandError::Drive {
-            node,
-            step: format!("read back of {}", spec.pdo.title()),
-            reason,
-        });
-    }
-    let json = to_json(&MapJson {
-        ok: true,
+    let mut json = to_json(&MapJson {
+        ok: differs.is_none(),
         node,
         pdo: spec.pdo.name(),
         dry_run: false,
@@ -381,8 +378,20 @@ pub async fn map(bus: &Bus, dict: &Dictionary, spec: &MapSpec) -> Result<(Json, 
         steps: steps_json(node, &writes, "written"),
         mapping: entries.iter().map(|e| EntryJson::new(e, dict)).collect(),
         comm: Some(back.comm.to_json()),
-        verified: true,
+        verified: differs.is_none(),
     });
+    if let Some(reason) = differs {
+        json["reason"] = reason.clone().into();
+        return Err(CommandError::Report {
+            exit: ExitCode::Differs,
+            error: "differs",
+            report: Box::new(json),
+            text: format!(
+                "{} of node {node} differs from what was written: {reason}",
+                spec.pdo.title()
+            ),
+        });
+    }
     let mut lines = vec![format!(
         "{} of node {} mapped ({} writes, read back): {}",
         spec.pdo.title(),
@@ -730,18 +739,20 @@ mod tests {
             frames,
             [
                 "602#23001801820100C0", // COB-ID | bit 31 (bit 30 kept)
+                "602#2F00180205000000", // transmission type 5, while invalid
+                "602#2B00180319000000", // inhibit 2.5 ms
+                "602#2B00180564000000", // event timer 100 ms
                 "602#2F001A0000000000", // count 0
                 "602#23001A0110004160", // 0x6041:00, 16 bits
                 "602#23001A0220006460", // 0x6064:00, 32 bits
                 "602#2F001A0002000000", // count 2
-                "602#2F00180205000000", // transmission type 5
-                "602#2B00180319000000", // inhibit 2.5 ms
-                "602#2B00180564000000", // event timer 100 ms
                 "602#2300180182010040", // valid again
             ]
         );
-        assert_eq!(w[2].what, "mapping entry 1: 0x6041:00 Statusword, 16 bits");
-        assert_eq!(w[5].what, "transmission type synchronous, every 5 SYNCs (5)");
+        assert_eq!(w[1].what, "transmission type synchronous, every 5 SYNCs (5)");
+        assert_eq!(w[3].what, "event timer 100 ms");
+        assert_eq!(w[5].what, "mapping entry 1: 0x6041:00 Statusword, 16 bits");
+        assert_eq!(w[7].what, "mapping count 2");
         assert_eq!(w[8].what, "COB-ID 0x182 (no RTR), valid again");
     }
 

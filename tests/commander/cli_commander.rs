@@ -1,31 +1,21 @@
 //! The commander subcommands through the real binary, on the demo bus.
 
+use crate::run::cotui_json;
 use std::process::Command;
-
-fn cotui(args: &[&str]) -> (i32, serde_json::Value, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_cotui")).args(args).output().unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
-    let json = serde_json::from_str(stdout.trim()).unwrap_or(serde_json::Value::Null);
-    (
-        out.status.code().unwrap_or(-1),
-        json,
-        String::from_utf8_lossy(&out.stderr).to_string(),
-    )
-}
 
 #[test]
 fn sdo_read_json_has_value_and_data() {
-    let (rc, v, _) = cotui(&["sdo", "read", "demo", "2", "0x6041", "--json"]);
+    let (rc, v, _) = cotui_json(&["sdo", "read", "demo", "2", "0x6041", "--json"]);
     assert_eq!(rc, 0);
     assert_eq!(v["node"], 2);
     assert_eq!(v["index"], 0x6041);
     assert_eq!(v["sub"], 0);
     assert_eq!(v["value"], 0x0250);
     assert_eq!(v["data"], "5002");
-    let (rc, v, _) = cotui(&["sdo", "read", "demo", "0x3", "0x1018:2", "--json", "--block"]);
+    let (rc, v, _) = cotui_json(&["sdo", "read", "demo", "0x3", "0x1018:2", "--json", "--block"]);
     assert_eq!(rc, 0);
     assert_eq!(v["value"], 0x0402_0003);
-    let (rc, v, _) = cotui(&["sdo", "read", "demo", "3", "Manufacturer device name", "--json"]);
+    let (rc, v, _) = cotui_json(&["sdo", "read", "demo", "3", "Manufacturer device name", "--json"]);
     assert_eq!(rc, 0);
     assert_eq!(v["name"], "Manufacturer device name");
     assert_eq!(v["value"], "cotui simulated Syn-tron-like DS servo");
@@ -33,12 +23,12 @@ fn sdo_read_json_has_value_and_data() {
 
 #[test]
 fn sdo_abort_exits_3_with_code_and_text() {
-    let (rc, v, err) = cotui(&["sdo", "read", "demo", "2", "0x2345:1", "--json"]);
+    let (rc, v, err) = cotui_json(&["sdo", "read", "demo", "2", "0x2345:1", "--json"]);
     assert_eq!(rc, 3);
     assert_eq!(v["abort_code"], 0x0602_0000);
     assert_eq!(v["abort_text"], "Object does not exist in the object dictionary");
     assert!(err.contains("aborted by the server"), "{err}");
-    let (rc, v, _) = cotui(&["sdo", "write", "demo", "2", "0x6041", "6", "--type", "u16", "--json"]);
+    let (rc, v, _) = cotui_json(&["sdo", "write", "demo", "2", "0x6041", "6", "--type", "u16", "--json"]);
     assert_eq!(rc, 3);
     assert_eq!(v["abort_code"], 0x0601_0002);
 }
@@ -50,7 +40,7 @@ fn sdo_write_then_domain_round_trip_through_files() {
     let input = dir.join("in.bin");
     let blob: Vec<u8> = (0..100u8).collect();
     std::fs::write(&input, &blob).unwrap();
-    let (rc, v, _) = cotui(&[
+    let (rc, v, _) = cotui_json(&[
         "sdo",
         "write",
         "demo",
@@ -63,10 +53,10 @@ fn sdo_write_then_domain_round_trip_through_files() {
         "--json",
     ]);
     assert_eq!((rc, v["len"].as_u64()), (0, Some(100)));
-    let (rc, v, _) = cotui(&["sdo", "write", "demo", "2", "0x6060", "9", "--type", "i8", "--json"]);
+    let (rc, v, _) = cotui_json(&["sdo", "write", "demo", "2", "0x6060", "9", "--type", "i8", "--json"]);
     assert_eq!((rc, v["data"].as_str()), (0, Some("09")));
     let out = dir.join("out.bin");
-    let (rc, v, _) = cotui(&[
+    let (rc, v, _) = cotui_json(&[
         "sdo",
         "read",
         "demo",
@@ -79,7 +69,7 @@ fn sdo_write_then_domain_round_trip_through_files() {
     assert_eq!(rc, 0);
     assert_eq!(v["len"], 200);
     assert_eq!(std::fs::read(&out).unwrap().len(), 200);
-    let (rc, _, err) = cotui(&["sdo", "write", "demo", "2", "0x6060", "300", "--type", "i8"]);
+    let (rc, _, err) = cotui_json(&["sdo", "write", "demo", "2", "0x6060", "300", "--type", "i8"]);
     assert_eq!(rc, 1);
     assert!(err.contains("does not fit"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
@@ -87,13 +77,13 @@ fn sdo_write_then_domain_round_trip_through_files() {
 
 #[test]
 fn drive_enable_and_failure_reason() {
-    let (rc, v, _) = cotui(&["drive", "demo", "2", "enable", "--json"]);
+    let (rc, v, _) = cotui_json(&["drive", "demo", "2", "enable", "--json"]);
     assert_eq!(rc, 0);
     assert_eq!(v["state"], "operation_enabled");
     assert_eq!(v["controlwords"], serde_json::json!(["0x0006", "0x0007", "0x000F"]));
-    let (rc, v, _) = cotui(&["drive", "demo", "2", "status", "--json"]);
+    let (rc, v, _) = cotui_json(&["drive", "demo", "2", "status", "--json"]);
     assert_eq!((rc, v["state"].as_str()), (0, Some("switch_on_disabled")));
-    let (rc, v, _) = cotui(&["drive", "demo", "9", "enable", "--json", "--timeout", "200"]);
+    let (rc, v, _) = cotui_json(&["drive", "demo", "9", "enable", "--json", "--timeout", "200"]);
     assert_eq!(rc, 5);
     assert!(
         v["reason"]
@@ -106,30 +96,30 @@ fn drive_enable_and_failure_reason() {
 
 #[test]
 fn nmt_wait_and_listen_only_and_missing_interface() {
-    let (rc, v, _) = cotui(&["nmt", "demo", "reset-node", "0", "--wait", "--json"]);
+    let (rc, v, _) = cotui_json(&["nmt", "demo", "reset-node", "0", "--wait", "--json"]);
     assert_eq!(rc, 0);
     assert_eq!(v["confirmed"], serde_json::json!({"2": "boot_up", "3": "boot_up"}));
-    let (rc, v, _) = cotui(&["nmt", "demo", "start", "2", "--listen-only", "--json"]);
+    let (rc, v, _) = cotui_json(&["nmt", "demo", "start", "2", "--listen-only", "--json"]);
     assert_eq!(rc, 2);
     assert_eq!(v["error"], "bus");
-    let (rc, _, err) = cotui(&["scan", "cotuinosuch0"]);
+    let (rc, _, err) = cotui_json(&["scan", "cotuinosuch0"]);
     assert_eq!(rc, 2);
     assert!(err.contains("sudo modprobe vcan"), "{err}");
-    let (rc, _, err) = cotui(&["sdo", "read", "demo", "200", "0x1000"]);
+    let (rc, _, err) = cotui_json(&["sdo", "read", "demo", "200", "0x1000"]);
     assert_eq!(rc, 1);
     assert!(err.contains("node `200` must be a number 1..127"), "{err}");
 }
 
 #[test]
 fn sdo_write_takes_a_negative_value_without_double_dash() {
-    let (rc, v, err) = cotui(&["sdo", "write", "demo", "2", "0x6060", "-3", "--type", "i8", "--json"]);
+    let (rc, v, err) = cotui_json(&["sdo", "write", "demo", "2", "0x6060", "-3", "--type", "i8", "--json"]);
     assert_eq!(rc, 0, "{err}");
     assert_eq!(v["data"], "FD");
 }
 
 #[test]
 fn scan_and_record() {
-    let (rc, v, _) = cotui(&["scan", "demo", "--json"]);
+    let (rc, v, _) = cotui_json(&["scan", "demo", "--json"]);
     assert_eq!(rc, 0);
     let nodes = v["nodes"].as_array().unwrap();
     assert_eq!(nodes.len(), 2);
@@ -142,7 +132,7 @@ fn scan_and_record() {
     assert_eq!(nodes[1]["profile"], "cia402");
     assert_eq!(nodes[1]["device_name"], "cotui simulated Syn-tron-like DS servo");
     let path = std::env::temp_dir().join(format!("cotui-rec-{}.log", std::process::id()));
-    let (rc, v, _) = cotui(&["record", "demo", "-o", path.to_str().unwrap(), "--count", "5", "--json"]);
+    let (rc, v, _) = cotui_json(&["record", "demo", "-o", path.to_str().unwrap(), "--count", "5", "--json"]);
     assert_eq!((rc, v["frames"].as_u64(), v["dropped"].as_u64()), (0, Some(5), Some(0)));
     let log = std::fs::read_to_string(&path).unwrap();
     let lines: Vec<&str> = log.lines().collect();
@@ -199,24 +189,24 @@ fn record_refuses_an_existing_log_unless_force_or_append() {
     let path = std::env::temp_dir().join(format!("cotui-rec-exists-{}.log", std::process::id()));
     std::fs::write(&path, "(1.000000) can0 123#01\n").unwrap();
     let p = path.to_str().unwrap();
-    let (rc, v, err) = cotui(&["record", "demo", "-o", p, "--count", "2", "--json"]);
+    let (rc, v, err) = cotui_json(&["record", "demo", "-o", p, "--count", "2", "--json"]);
     assert_eq!((rc, v["error"].as_str()), (1, Some("usage")), "{err}");
     assert!(
         err.contains("exists; --force overwrites it, --append adds to it"),
         "{err}"
     );
     assert_eq!(std::fs::read_to_string(&path).unwrap(), "(1.000000) can0 123#01\n");
-    let (rc, v, _) = cotui(&["record", "demo", "-o", p, "--count", "2", "--append", "--json"]);
+    let (rc, v, _) = cotui_json(&["record", "demo", "-o", p, "--count", "2", "--append", "--json"]);
     assert_eq!((rc, v["frames"].as_u64()), (0, Some(2)));
     let log = std::fs::read_to_string(&path).unwrap();
     assert!(
         log.starts_with("(1.000000) can0 123#01\n") && log.lines().count() == 3,
         "{log}"
     );
-    let (rc, _, _) = cotui(&["record", "demo", "-o", p, "--count", "1", "--force"]);
+    let (rc, _, _) = cotui_json(&["record", "demo", "-o", p, "--count", "1", "--force"]);
     assert_eq!(rc, 0);
     assert_eq!(std::fs::read_to_string(&path).unwrap().lines().count(), 1);
-    let (rc, _, err) = cotui(&["record", "demo", "-o", p, "--force", "--append"]);
+    let (rc, _, err) = cotui_json(&["record", "demo", "-o", p, "--force", "--append"]);
     assert_eq!(rc, 1, "usage error: {err}");
     assert!(err.contains("cannot be used with"), "{err}");
     std::fs::remove_file(&path).unwrap();

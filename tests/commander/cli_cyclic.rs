@@ -1,6 +1,7 @@
 //! `send`, `sync` and `pdo send`: through the real binary on the demo bus, and through the
 //! library on one demo bus (tokio time paused) to see what the nodes make of the frames.
 
+use crate::run::cotui_json;
 use cotui::command::{execute, parse_command};
 use cotui::frame::Direction;
 use cotui::sim::Simulation;
@@ -8,20 +9,9 @@ use cotui::sim::demo::Demo;
 use std::process::Command;
 use std::time::Duration;
 
-fn cotui(args: &[&str]) -> (i32, serde_json::Value, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_cotui")).args(args).output().unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
-    let json = serde_json::from_str(stdout.trim()).unwrap_or(serde_json::Value::Null);
-    (
-        out.status.code().unwrap_or(-1),
-        json,
-        String::from_utf8_lossy(&out.stderr).to_string(),
-    )
-}
-
 #[test]
 fn send_counts_frames_and_measures_the_period() {
-    let (rc, v, err) = cotui(&[
+    let (rc, v, err) = cotui_json(&[
         "send",
         "demo",
         "601#4041600000000000",
@@ -39,16 +29,16 @@ fn send_counts_frames_and_measures_the_period() {
         v["mean_period_ms"].as_f64().is_some() && v["jitter_max_ms"].as_f64().is_some(),
         "{v}"
     );
-    let (rc, v, _) = cotui(&["send", "demo", "601#40", "--listen-only", "--json"]);
+    let (rc, v, _) = cotui_json(&["send", "demo", "601#40", "--listen-only", "--json"]);
     assert_eq!((rc, &v["error"]), (2, &serde_json::json!("bus")));
-    let (rc, _, err) = cotui(&["send", "demo", "601#4G"]);
+    let (rc, _, err) = cotui_json(&["send", "demo", "601#4G"]);
     assert_eq!(rc, 1);
     assert!(err.contains("is not a frame (column 6"), "{err}");
 }
 
 #[test]
 fn pdo_send_encodes_through_the_mapping_and_names_the_signals() {
-    let (rc, v, err) = cotui(&[
+    let (rc, v, err) = cotui_json(&[
         "pdo",
         "demo",
         "2",
@@ -73,7 +63,7 @@ fn pdo_send_encodes_through_the_mapping_and_names_the_signals() {
         out.contains("202#0000FFFFFFFF: 1 frame sent; not given, sent as 0: Controlword"),
         "{out}"
     );
-    let (rc, _, err) = cotui(&["pdo", "demo", "2", "send", "rpdo1", "Speed=3"]);
+    let (rc, _, err) = cotui_json(&["pdo", "demo", "2", "send", "rpdo1", "Speed=3"]);
     assert_eq!(rc, 1);
     assert!(
         err.contains("RPDO1 of node 2 maps: Controlword (0x6040:00), Target velocity (0x60FF:00)"),

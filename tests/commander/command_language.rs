@@ -2,6 +2,7 @@
 //! the same line gives the same command or the same error in both; `--json` failures are
 //! one JSON object; the palette's preview is the frame the SDO client really sends.
 
+use crate::run::cotui;
 use clap::Parser;
 use cotui::bus::Event;
 use cotui::cli::{Cli, Command as CliCommand};
@@ -158,19 +159,6 @@ fn the_palette_and_the_command_line_give_the_same_command_or_the_same_error() {
         assert_eq!(p, Err(want.to_string()), "{line}");
         assert_eq!(c, p, "{line}");
     }
-}
-
-/// Runs the binary; gives (exit status, stdout, stderr).
-fn cotui(args: &[&str]) -> (i32, String, String) {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_cotui"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).to_string(),
-        String::from_utf8_lossy(&out.stderr).to_string(),
-    )
 }
 
 #[test]

@@ -13,6 +13,7 @@ mod every_procedure;
 mod lss_sim;
 mod pdo_config;
 mod procedure_run;
+mod run;
 mod sdo_client_misbehave;
 mod sdo_client_server;
 mod sdo_proptest;

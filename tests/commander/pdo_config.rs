@@ -2,6 +2,7 @@
 //! (what the drive sends after a remap, decoded), the real binary for dry runs, refusals and
 //! listen-only.
 
+use crate::run::cotui_json;
 use cotui::command::{execute, parse_command};
 use cotui::decode::{Body, Decoder};
 use cotui::frame::Direction;
@@ -9,19 +10,7 @@ use cotui::od::MappingSource;
 use cotui::sim::Simulation;
 use cotui::sim::demo::Demo;
 use serde_json::json;
-use std::process::Command;
 use std::time::Duration;
-
-fn cotui(args: &[&str]) -> (i32, serde_json::Value, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_cotui")).args(args).output().unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
-    let json = serde_json::from_str(stdout.trim()).unwrap_or(serde_json::Value::Null);
-    (
-        out.status.code().unwrap_or(-1),
-        json,
-        String::from_utf8_lossy(&out.stderr).to_string(),
-    )
-}
 
 fn bindings() -> cotui::od::Bindings {
     cotui::cli::bind::bindings_on(cotui::connect::DEMO, &[], &[]).unwrap()
@@ -80,7 +69,28 @@ async fn after_map_tpdo1_the_drive_sends_and_the_decoder_decodes_the_new_signals
     assert_eq!(o.json["comm"]["transmission_type"], 2);
     assert_eq!(o.json["comm"]["inhibit_100us"], 15);
     assert_eq!(o.json["comm"]["event_ms"], 50);
-    assert_eq!(o.json["steps"].as_array().unwrap().len(), 9);
+    // CiA 301: COB-ID invalid, the communication parameters while invalid, count 0,
+    // entries, count, COB-ID valid again (the order `dcf load` writes too).
+    let order: Vec<&str> = o.json["steps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["object"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        order,
+        [
+            "0x1800:01",
+            "0x1800:02",
+            "0x1800:03",
+            "0x1800:05",
+            "0x1A00:00",
+            "0x1A00:01",
+            "0x1A00:02",
+            "0x1A00:00",
+            "0x1800:01"
+        ]
+    );
     assert!(
         o.text
             .starts_with("TPDO1 of node 2 mapped (9 writes, read back): COB-ID 0x182, synchronous, every 2 SYNCs (2)"),
@@ -162,6 +172,59 @@ async fn a_refusal_says_why_with_the_nmt_state() {
     assert_eq!(e.to_json()["error"], "sdo_abort");
 }
 
+/// Node 20 on its own endpoint of the demo bus: an expedited SDO server that keeps every
+/// write, but reads TPDO1's transmission type (0x1800:02) back as 1 whatever was written.
+fn lying_node(d: &Demo) {
+    let peer = d.vbus.endpoint(false);
+    let mut rx = peer.subscribe();
+    tokio::spawn(async move {
+        let mut store = std::collections::HashMap::from([((0x1800u16, 1u8), 0x194u32)]);
+        while let Ok(f) = rx.recv().await {
+            if f.id != 0x614 || f.direction() == Direction::Tx {
+                continue;
+            }
+            let (c, index, sub) = (f.data[0], u16::from_le_bytes([f.data[1], f.data[2]]), f.data[3]);
+            let mut answer = [0u8; 8];
+            answer[1..4].copy_from_slice(&f.data[1..4]);
+            if c == 0x40 {
+                let v = if (index, sub) == (0x1800, 2) {
+                    1
+                } else {
+                    store.get(&(index, sub)).copied().unwrap_or(0)
+                };
+                answer[0] = 0x43;
+                answer[4..].copy_from_slice(&v.to_le_bytes());
+            } else {
+                let v = u32::from_le_bytes([f.data[4], f.data[5], f.data[6], f.data[7]]);
+                store.insert((index, sub), v);
+                answer[0] = 0x60;
+            }
+            let _ = peer.send(&cotui::frame::Frame::classic(0x594, &answer)).await;
+        }
+    });
+}
+
+#[tokio::test(start_paused = true)]
+async fn a_read_back_that_differs_exits_6() {
+    let d = Demo::spawn(Simulation::demo(), false);
+    lying_node(&d);
+    let cmd = parse_command("pdo 20 map tpdo1 0x6041 --type 255").unwrap();
+    let e = execute(&d.bus, &cmd, &bindings()).await.unwrap_err();
+    assert_eq!(e.exit_code(), 6, "{e}");
+    assert_eq!(
+        e.to_string(),
+        "TPDO1 of node 20 differs from what was written: transmission type reads 0x1 after writing 0xFF"
+    );
+    let j = e.to_json();
+    assert_eq!(
+        (&j["ok"], &j["error"], &j["verified"]),
+        (&json!(false), &json!("differs"), &json!(false))
+    );
+    assert_eq!(j["reason"], "transmission type reads 0x1 after writing 0xFF");
+    assert_eq!(j["comm"]["transmission_type"], 1);
+    assert_eq!(j["steps"].as_array().unwrap().len(), 6);
+}
+
 #[tokio::test(start_paused = true)]
 async fn over_64_bits_nothing_is_sent() {
     let d = Demo::spawn(Simulation::demo(), false);
@@ -193,7 +256,7 @@ fn dry_run_prints_the_frames_and_needs_no_bus() {
         "--dry-run",
         "--json",
     ];
-    let (rc, v, err) = cotui(&[&args[..], &["--listen-only"]].concat());
+    let (rc, v, err) = cotui_json(&[&args[..], &["--listen-only"]].concat());
     assert_eq!(rc, 0, "{err}");
     let frames: Vec<&str> = v["steps"]
         .as_array()
@@ -214,23 +277,23 @@ fn dry_run_prints_the_frames_and_needs_no_bus() {
     );
     assert_eq!(v["dry_run"], true);
     // No interface needed at all.
-    let (rc, _, err) = cotui(&["pdo", "nosuchcan9", "2", "map", "tpdo1", "0x6041", "--dry-run"]);
+    let (rc, _, err) = cotui_json(&["pdo", "nosuchcan9", "2", "map", "tpdo1", "0x6041", "--dry-run"]);
     assert_eq!(rc, 0, "{err}");
 }
 
 #[test]
 fn listen_only_cannot_read_or_map_and_bad_lines_are_refused() {
-    let (rc, v, _) = cotui(&["pdo", "demo", "2", "map", "tpdo1", "0x6041", "--listen-only", "--json"]);
+    let (rc, v, _) = cotui_json(&["pdo", "demo", "2", "map", "tpdo1", "0x6041", "--listen-only", "--json"]);
     assert_eq!((rc, &v["error"]), (2, &json!("bus")));
-    let (rc, v, _) = cotui(&["pdo", "demo", "2", "--listen-only", "--json"]);
+    let (rc, v, _) = cotui_json(&["pdo", "demo", "2", "--listen-only", "--json"]);
     assert_eq!((rc, &v["error"]), (2, &json!("bus")));
-    let (rc, _, err) = cotui(&["pdo", "demo", "2", "map", "tpdo1", "0x6064", "0x606C", "0x6041"]);
+    let (rc, _, err) = cotui_json(&["pdo", "demo", "2", "map", "tpdo1", "0x6064", "0x606C", "0x6041"]);
     assert_eq!(rc, 1);
     assert!(
         err.contains("more than the 64 bits a PDO carries; nothing sent"),
         "{err}"
     );
-    let (rc, _, err) = cotui(&["pdo", "demo", "2", "map", "tpdo1", "0x6041", "--count", "2"]);
+    let (rc, _, err) = cotui_json(&["pdo", "demo", "2", "map", "tpdo1", "0x6041", "--count", "2"]);
     assert_eq!(rc, 1);
     assert!(err.contains("--count does not go with `pdo map`"), "{err}");
 }

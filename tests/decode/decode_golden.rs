@@ -3,26 +3,8 @@
 //! change: `cargo insta test --test decode --review` (or `INSTA_UPDATE=always cargo test
 //! --test decode` and review the diff).
 
-use std::process::{Command, Output};
-
-fn cotui(args: &[&str], stdin: Option<&str>) -> Output {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_cotui"));
-    cmd.args(args).current_dir(env!("CARGO_MANIFEST_DIR"));
-    match stdin {
-        None => cmd.output().expect("run cotui"),
-        Some(text) => {
-            use std::io::Write;
-            let mut child = cmd
-                .stdin(std::process::Stdio::piped())
-                .stdout(std::process::Stdio::piped())
-                .stderr(std::process::Stdio::piped())
-                .spawn()
-                .expect("spawn cotui");
-            child.stdin.take().unwrap().write_all(text.as_bytes()).unwrap();
-            child.wait_with_output().expect("wait cotui")
-        }
-    }
-}
+use crate::run::cotui;
+use std::process::Command;
 
 fn check(fixture: &str, mode: &str, args: &[&str]) {
     let log = format!("tests/fixtures/{fixture}.log");

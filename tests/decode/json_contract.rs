@@ -4,26 +4,10 @@
 //! The snapshots hold the exact text `cotui` prints: key names, key order, number forms
 //! and escaping are all pinned (the README documents the names).
 
-use std::io::Write;
-use std::process::{Command, Stdio};
-
 /// Runs `cotui ARGS -` with `log` on stdin; its stdout.
 fn cotui(args: &[&str], log: &str) -> String {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_cotui"))
-        .args(args)
-        .arg("-")
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("cotui runs");
-    child
-        .stdin
-        .take()
-        .expect("stdin")
-        .write_all(log.as_bytes())
-        .expect("log written");
-    let out = child.wait_with_output().expect("cotui ends");
+    let args: Vec<&str> = args.iter().copied().chain(["-"]).collect();
+    let out = crate::run::cotui(&args, Some(log));
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     String::from_utf8(out.stdout).expect("UTF-8 output")
 }

@@ -5,73 +5,12 @@
 //! background while the UI answers keys, and only then moves the selection.
 //! The TUI parts run the real binary in tmux (scripts/install-test-deps.sh installs it).
 
+use crate::tmux::Options;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::thread::sleep;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 const BIN: &str = env!("CARGO_BIN_EXE_cotui");
-
-struct Session(String);
-
-impl Session {
-    fn start(name: &str, cmd: &str) -> Session {
-        let _ = Command::new("tmux").args(["kill-session", "-t", name]).status();
-        let ok = Command::new("tmux")
-            .args(["new-session", "-d", "-s", name, "-x", "220", "-y", "40", cmd])
-            .status()
-            .expect("tmux is installed (scripts/install-test-deps.sh)");
-        assert!(ok.success());
-        Session(name.to_string())
-    }
-    fn keys(&self, keys: &[&str]) {
-        for k in keys {
-            let ok = Command::new("tmux")
-                .args(["send-keys", "-t", &self.0, "-l", k])
-                .status()
-                .unwrap();
-            assert!(ok.success());
-        }
-    }
-    fn key(&self, k: &str) {
-        assert!(
-            Command::new("tmux")
-                .args(["send-keys", "-t", &self.0, k])
-                .status()
-                .unwrap()
-                .success()
-        );
-    }
-    fn screen(&self) -> String {
-        let out = Command::new("tmux")
-            .args(["capture-pane", "-p", "-t", &self.0])
-            .output()
-            .unwrap();
-        String::from_utf8_lossy(&out.stdout).into_owned()
-    }
-    /// Waits until the screen satisfies `f` (a generous bound: the machine may be busy
-    /// and the binary a debug build); returns the screen.
-    fn wait_for(&self, what: &str, secs: u64, f: impl Fn(&str) -> bool) -> String {
-        let start = Instant::now();
-        loop {
-            let s = self.screen();
-            if f(&s) {
-                return s;
-            }
-            assert!(
-                start.elapsed() < Duration::from_secs(secs),
-                "timed out waiting for {what}:\n{s}"
-            );
-            sleep(Duration::from_millis(50));
-        }
-    }
-}
-
-impl Drop for Session {
-    fn drop(&mut self) {
-        let _ = Command::new("tmux").args(["kill-session", "-t", &self.0]).status();
-    }
-}
 
 /// A generated log of `frames` frames (`cotui bench --write-log`) in a fresh directory.
 fn generated(name: &str, frames: u64) -> (PathBuf, PathBuf) {
@@ -135,32 +74,34 @@ fn decode_and_the_tui_filtered_view_count_the_same_frames() {
     let counts: Vec<usize> = exprs.iter().map(|e| decode_count(&log, e)).collect();
     assert!(counts.iter().all(|&n| n > 0 && n < 40_000), "{counts:?}");
     let name = format!("cotui-fcount-{}", std::process::id());
-    let s = Session::start(
+    let s = Options::default().size(220, 40).key_delay(Duration::ZERO).start(
         &name,
         &format!("cd {} && {BIN} open g.log; echo cotui-exit=$?; sleep 60", dir.display()),
     );
-    s.wait_for("the log to load", 120, |t| t.contains("(end) | 40000 frames"));
+    s.wait_within("the log to load", Duration::from_secs(120), |t| {
+        t.contains("(end) | 40000 frames")
+    });
     for (e, n) in exprs.iter().zip(&counts) {
-        s.key("/");
-        s.key("C-u");
-        s.keys(&[e]);
-        s.key("Enter");
+        s.keys(&["/"]);
+        s.keys(&["C-u"]);
+        s.type_text(e);
+        s.keys(&["Enter"]);
         let want = format!("filter: {e} ({n} rows)");
-        s.wait_for(&want, 120, |t| t.contains(&want));
+        s.wait_within(&want, Duration::from_secs(120), |t| t.contains(&want));
     }
     // A bad filter keeps the prompt open with the text, and says where it is wrong.
-    s.key("/");
-    s.key("C-u");
-    s.keys(&["node 2 or 6041:zz"]);
-    s.key("Enter");
-    let t = s.wait_for("the error", 30, |t| {
+    s.keys(&["/"]);
+    s.keys(&["C-u"]);
+    s.type_text("node 2 or 6041:zz");
+    s.keys(&["Enter"]);
+    let t = s.wait_for("the error", |t| {
         t.contains("filter: column 16: `zz` is not a sub-index")
     });
     assert!(t.contains("filter: node 2 or 6041:zz"), "{t}");
-    s.key("Escape");
-    s.wait_for("the prompt to close", 30, |t| !t.contains("filter: node 2 or 6041:zz"));
-    s.key("q");
-    s.wait_for("cotui to exit", 30, |t| t.contains("cotui-exit=0"));
+    s.keys(&["Escape"]);
+    s.wait_for("the prompt to close", |t| !t.contains("filter: node 2 or 6041:zz"));
+    s.keys(&["q"]);
+    s.wait_for("cotui to exit", |t| t.contains("cotui-exit=0"));
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -172,41 +113,45 @@ fn a_search_through_a_million_frames_runs_in_the_background() {
     std::io::Write::write_all(&mut f, b"(1700000200.000000) can0 77D#05\n").unwrap();
     drop(f);
     let name = format!("cotui-search-{}", std::process::id());
-    let s = Session::start(
+    let s = Options::default().size(220, 40).key_delay(Duration::ZERO).start(
         &name,
         &format!("cd {} && {BIN} open g.log; echo cotui-exit=$?; sleep 60", dir.display()),
     );
-    s.wait_for("the log to load", 600, |t| t.contains("(end) | 1000001 frames"));
-    s.key("Home");
-    s.wait_for("the first frame selected", 60, |t| t.contains("frame 1  t 0.000000 s"));
+    s.wait_within("the log to load", Duration::from_secs(600), |t| {
+        t.contains("(end) | 1000001 frames")
+    });
+    s.keys(&["Home"]);
+    s.wait_for("the first frame selected", |t| t.contains("frame 1  t 0.000000 s"));
     // The label text needs every frame decoded: the slowest kind of search.
-    s.key("C-f");
-    s.keys(&["\"node 125\""]);
+    s.keys(&["C-f"]);
+    s.type_text("\"node 125\"");
     // `?` right behind `enter`: it is answered while the search has just started.
-    s.key("Enter");
-    s.key("?");
-    let t = s.wait_for("help", 60, |t| t.contains("Show or hide this help"));
+    s.keys(&["Enter"]);
+    s.keys(&["?"]);
+    let t = s.wait_for("help", |t| t.contains("Show or hide this help"));
     assert!(
         t.contains("0 matches so far"),
         "the search ended before help opened:\n{t}"
     );
     assert!(t.contains("the selection stays until a match is found"), "{t}");
-    s.key("?");
-    let t = s.wait_for("help to close", 60, |t| !t.contains("Show or hide this help"));
+    s.keys(&["?"]);
+    let t = s.wait_for("help to close", |t| !t.contains("Show or hide this help"));
     // Until the match is found, the selection stays on the first frame.
     if t.contains("0 matches so far") {
         assert!(t.contains("frame 1  t 0.000000 s"), "the selection moved:\n{t}");
     }
     // The match is found at the end, the selection goes there.
-    let t = s.wait_for("the match", 600, |t| t.contains("match 1 of 1 at frame 1000001"));
+    let t = s.wait_within("the match", Duration::from_secs(600), |t| {
+        t.contains("match 1 of 1 at frame 1000001")
+    });
     assert!(t.contains("search: \"node 125\" (1 match)"), "{t}");
     assert!(t.contains("Heartbeat node 125: Operational"), "{t}");
     // `n` wraps around to the only match.
-    s.key("n");
-    s.wait_for("the wrap", 60, |t| {
+    s.keys(&["n"]);
+    s.wait_for("the wrap", |t| {
         t.contains("match 1 of 1 at frame 1000001 (wrapped around)")
     });
-    s.key("q");
-    s.wait_for("cotui to exit", 30, |t| t.contains("cotui-exit=0"));
+    s.keys(&["q"]);
+    s.wait_for("cotui to exit", |t| t.contains("cotui-exit=0"));
     let _ = std::fs::remove_dir_all(&dir);
 }

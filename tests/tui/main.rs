@@ -5,5 +5,6 @@ mod objects_demo;
 mod objects_tmux;
 mod problems;
 mod receive_list;
+mod tmux;
 mod tui_cli;
 mod tui_tmux;

@@ -2,61 +2,8 @@
 //! finds 0x6060 of drive 2 by typing, reads it with `enter`, writes a new value through the
 //! palette that `e` prefills, and reads it back. Needs tmux (scripts/install-test-deps.sh).
 
-use std::process::Command;
-use std::thread::sleep;
-use std::time::{Duration, Instant};
-
-struct Session(String);
-
-impl Session {
-    fn start(name: &str, cmd: &str) -> Session {
-        let _ = Command::new("tmux").args(["kill-session", "-t", name]).status();
-        let ok = Command::new("tmux")
-            .args(["new-session", "-d", "-s", name, "-x", "160", "-y", "45", cmd])
-            .status()
-            .expect("tmux is installed (scripts/install-test-deps.sh)");
-        assert!(ok.success());
-        Session(name.to_string())
-    }
-    /// Sends tmux key names (`Enter`, `BSpace`) or, with `literal`, text as typed.
-    fn send(&self, keys: &str, literal: bool) {
-        let mut args = vec!["send-keys", "-t", &self.0];
-        if literal {
-            args.push("-l");
-        }
-        args.push(keys);
-        assert!(Command::new("tmux").args(&args).status().unwrap().success());
-        sleep(Duration::from_millis(60));
-    }
-    fn screen(&self) -> String {
-        let out = Command::new("tmux")
-            .args(["capture-pane", "-p", "-t", &self.0])
-            .output()
-            .unwrap();
-        String::from_utf8_lossy(&out.stdout).into_owned()
-    }
-    /// Waits until the screen satisfies `f` (30 s at most: a busy machine, a debug build).
-    fn wait_for(&self, what: &str, f: impl Fn(&str) -> bool) -> String {
-        let start = Instant::now();
-        loop {
-            let s = self.screen();
-            if f(&s) {
-                return s;
-            }
-            assert!(
-                start.elapsed() < Duration::from_secs(30),
-                "timed out waiting for {what}:\n{s}"
-            );
-            sleep(Duration::from_millis(100));
-        }
-    }
-}
-
-impl Drop for Session {
-    fn drop(&mut self) {
-        let _ = Command::new("tmux").args(["kill-session", "-t", &self.0]).status();
-    }
-}
+use crate::tmux::Options;
+use std::time::Duration;
 
 /// The row of 0x6060 in the pane (without the side column).
 fn row(screen: &str) -> String {
@@ -81,9 +28,12 @@ fn demo_objects_pane_reads_and_writes_an_object() {
     let home = std::env::temp_dir().join(format!("cotui-objects-{}", std::process::id()));
     std::fs::create_dir_all(&home).unwrap();
     let cmd = format!("env XDG_CONFIG_HOME={} {bin} demo; sleep 60", home.display());
-    let s = Session::start(&format!("cotui-objects-{}", std::process::id()), &cmd);
+    let s = Options::default()
+        .size(160, 45)
+        .key_delay(Duration::from_millis(60))
+        .start(&format!("cotui-objects-{}", std::process::id()), &cmd);
     s.wait_for("drive 2 in the nodes list", |t| t.contains("│  2 "));
-    s.send("6", true);
+    s.type_text("6");
     // The Nodes selection may be another node: `]` picks the next one (each key once the
     // screen shows what the one before did).
     let title = |t: &str| t.lines().nth(1).unwrap_or_default().to_string();
@@ -93,23 +43,23 @@ fn demo_objects_pane_reads_and_writes_an_object() {
             break;
         }
         let before = title(&t);
-        s.send("]", true);
+        s.type_text("]");
         t = s.wait_for("the next node", |t| title(t) != before);
     }
     s.wait_for("node 2's dictionary", |t| t.contains("Objects · node 2 demo > aimotor"));
 
     // Find by typing, read with enter: the value and its age show in the row.
-    s.send("/", true);
-    s.send("6060", true);
-    s.send("Enter", false);
+    s.type_text("/");
+    s.type_text("6060");
+    s.keys(&["Enter"]);
     s.wait_for("the find", |t| t.contains("find `6060`") && !row(t).is_empty());
     // The demo reads nothing by itself: the value and its age in the row come from our read.
     assert!(!has_age(&s.screen()), "{}", s.screen());
-    s.send("Enter", false);
+    s.keys(&["Enter"]);
     s.wait_for("the value read", has_age);
 
     // `e` opens the palette with the typed write; replace the value with 1 (profile position).
-    s.send("e", true);
+    s.type_text("e");
     let t = s.wait_for("the prefilled write", |t| t.contains(":sdo write 2 0x6060:0x00 "));
     let line = t
         .lines()
@@ -123,17 +73,17 @@ fn demo_objects_pane_reads_and_writes_an_object() {
         .unwrap()
         .to_string();
     for _ in 0..value.chars().count() {
-        s.send("BSpace", false);
+        s.keys(&["BSpace"]);
     }
-    s.send("1", true);
+    s.type_text("1");
     s.wait_for("the preview", |t| t.contains("will send: 602#2F60600001000000"));
-    s.send("Enter", false);
+    s.keys(&["Enter"]);
     // The row shows the value written (the download seen on the bus).
     s.wait_for("the write", |t| row(t).contains("1 (Profile position (PP))"));
     // Read it back: the message log has both results (the status line may show news of the
     // bus meanwhile).
-    s.send("Enter", false);
-    s.send("m", true);
+    s.keys(&["Enter"]);
+    s.type_text("m");
     s.wait_for("the value read back", |t| {
         t.contains("node 2 0x6060:00 Modes of operation written (1 bytes: 01)")
             && t.contains(

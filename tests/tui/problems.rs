@@ -2,14 +2,13 @@
 //! golden fixture, frame by frame through the trace), and in the real binary a replayed
 //! log with a fault shows its incident in tab 8, opens it, and jumps to its frames.
 
+use crate::tmux::Session;
 use cotui::analysis::trace::Trace;
 use cotui::cli::bind::decoder;
 use cotui::frame::json::write_line;
 use cotui::log::{LogReader, Outcome};
 use std::io::BufReader;
 use std::process::Command;
-use std::thread::sleep;
-use std::time::{Duration, Instant};
 
 /// The incidents of the trace's live diagnosis after every frame of `path`, as JSON lines.
 fn live_diagnosis(path: &str) -> String {
@@ -55,60 +54,6 @@ fn the_live_diagnosis_equals_cotui_diagnose_on_every_fixture() {
         seen += 1;
     }
     assert!(seen >= 8, "only {seen} fixtures");
-}
-
-struct Session(String);
-
-impl Session {
-    fn start(name: &str, cmd: &str) -> Session {
-        let _ = Command::new("tmux").args(["kill-session", "-t", name]).status();
-        let ok = Command::new("tmux")
-            .args(["new-session", "-d", "-s", name, "-x", "150", "-y", "40", cmd])
-            .status()
-            .expect("tmux is installed (scripts/install-test-deps.sh)");
-        assert!(ok.success());
-        Session(name.to_string())
-    }
-    fn keys(&self, keys: &[&str]) {
-        for k in keys {
-            assert!(
-                Command::new("tmux")
-                    .args(["send-keys", "-t", &self.0, k])
-                    .status()
-                    .unwrap()
-                    .success()
-            );
-            sleep(Duration::from_millis(80));
-        }
-    }
-    fn screen(&self) -> String {
-        let out = Command::new("tmux")
-            .args(["capture-pane", "-p", "-t", &self.0])
-            .output()
-            .unwrap();
-        String::from_utf8_lossy(&out.stdout).into_owned()
-    }
-    /// Waits until the screen satisfies `f` (10 s at most); returns the screen.
-    fn wait_for(&self, what: &str, f: impl Fn(&str) -> bool) -> String {
-        let start = Instant::now();
-        loop {
-            let s = self.screen();
-            if f(&s) {
-                return s;
-            }
-            assert!(
-                start.elapsed() < Duration::from_secs(10),
-                "timed out waiting for {what}:\n{s}"
-            );
-            sleep(Duration::from_millis(100));
-        }
-    }
-}
-
-impl Drop for Session {
-    fn drop(&mut self) {
-        let _ = Command::new("tmux").args(["kill-session", "-t", &self.0]).status();
-    }
 }
 
 #[test]

@@ -2,61 +2,10 @@
 //! the previous frame of a COB-ID are highlighted (yellow, bold), and the sort key orders
 //! the rows by count.
 
-use std::process::Command;
-use std::thread::sleep;
-use std::time::{Duration, Instant};
+use crate::tmux::Options;
+use std::time::Duration;
 
 const BIN: &str = env!("CARGO_BIN_EXE_cotui");
-
-struct Session(String);
-
-impl Session {
-    fn start(name: &str, cmd: &str) -> Session {
-        let _ = Command::new("tmux").args(["kill-session", "-t", name]).status();
-        let ok = Command::new("tmux")
-            .args(["new-session", "-d", "-s", name, "-x", "160", "-y", "30", cmd])
-            .status()
-            .expect("tmux is installed (scripts/install-test-deps.sh)");
-        assert!(ok.success());
-        Session(name.to_string())
-    }
-    fn key(&self, k: &str) {
-        let ok = Command::new("tmux")
-            .args(["send-keys", "-t", &self.0, "-l", k])
-            .status()
-            .unwrap();
-        assert!(ok.success());
-    }
-    /// The screen with its colours as escape sequences.
-    fn screen(&self) -> String {
-        let out = Command::new("tmux")
-            .args(["capture-pane", "-e", "-p", "-t", &self.0])
-            .output()
-            .unwrap();
-        String::from_utf8_lossy(&out.stdout).into_owned()
-    }
-    /// Waits until the screen satisfies `f` (a generous bound for a busy machine).
-    fn wait_for(&self, what: &str, f: impl Fn(&str) -> bool) -> String {
-        let start = Instant::now();
-        loop {
-            let s = self.screen();
-            if f(&s) {
-                return s;
-            }
-            assert!(
-                start.elapsed() < Duration::from_secs(60),
-                "timed out waiting for {what}:\n{s}"
-            );
-            sleep(Duration::from_millis(50));
-        }
-    }
-}
-
-impl Drop for Session {
-    fn drop(&mut self) {
-        let _ = Command::new("tmux").args(["kill-session", "-t", &self.0]).status();
-    }
-}
 
 /// The screen text without escape sequences.
 fn plain(s: &str) -> String {
@@ -125,9 +74,13 @@ fn receive_list_highlights_changed_bytes_and_sorts_by_count() {
                (1.050000) can0 701#05\n";
     std::fs::write(dir.join("rx.log"), log).unwrap();
     let name = format!("cotui-rxlist-{}", std::process::id());
-    let s = Session::start(&name, &format!("cd {} && {BIN} open rx.log; sleep 60", dir.display()));
+    let s = Options::default()
+        .size(160, 30)
+        .key_delay(Duration::ZERO)
+        .colours()
+        .start(&name, &format!("cd {} && {BIN} open rx.log; sleep 60", dir.display()));
     s.wait_for("the trace", |t| plain(t).contains("6 frames"));
-    s.key("4");
+    s.type_text("4");
     let screen = s.wait_for("the receive list", |t| plain(t).contains("Receive list by cob-id"));
     let row = screen
         .lines()
@@ -146,7 +99,7 @@ fn receive_list_highlights_changed_bytes_and_sorts_by_count() {
         .collect();
     assert_eq!(hot, "...yy.........", "{row:?}");
     // The sort key: most frames first.
-    s.key("s");
+    s.type_text("s");
     let screen = plain(&s.wait_for("the sort by count", |t| plain(t).contains("Receive list by count")));
     let order: Vec<&str> = screen
         .lines()
@@ -155,6 +108,6 @@ fn receive_list_highlights_changed_bytes_and_sorts_by_count() {
         .filter(|w| ["181", "701", "3A0"].contains(w))
         .collect();
     assert_eq!(order, ["181", "701", "3A0"], "{screen}");
-    s.key("q");
+    s.type_text("q");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -6,63 +6,8 @@
 //! demo with chosen drives takes `:sim` failures and `:lss` against its LSS slave.
 //! Needs tmux (scripts/install-test-deps.sh installs it).
 
+use crate::tmux::Session;
 use std::process::Command;
-use std::thread::sleep;
-use std::time::{Duration, Instant};
-
-struct Session(String);
-
-impl Session {
-    fn start(name: &str, cmd: &str) -> Session {
-        let _ = Command::new("tmux").args(["kill-session", "-t", name]).status();
-        let ok = Command::new("tmux")
-            .args(["new-session", "-d", "-s", name, "-x", "150", "-y", "40", cmd])
-            .status()
-            .expect("tmux is installed (scripts/install-test-deps.sh)");
-        assert!(ok.success());
-        Session(name.to_string())
-    }
-    fn keys(&self, keys: &[&str]) {
-        for k in keys {
-            assert!(
-                Command::new("tmux")
-                    .args(["send-keys", "-t", &self.0, k])
-                    .status()
-                    .unwrap()
-                    .success()
-            );
-            sleep(Duration::from_millis(80));
-        }
-    }
-    fn screen(&self) -> String {
-        let out = Command::new("tmux")
-            .args(["capture-pane", "-p", "-t", &self.0])
-            .output()
-            .unwrap();
-        String::from_utf8_lossy(&out.stdout).into_owned()
-    }
-    /// Waits until the screen satisfies `f` (10 s at most); returns the screen.
-    fn wait_for(&self, what: &str, f: impl Fn(&str) -> bool) -> String {
-        let start = Instant::now();
-        loop {
-            let s = self.screen();
-            if f(&s) {
-                return s;
-            }
-            assert!(
-                start.elapsed() < Duration::from_secs(10),
-                "timed out waiting for {what}:\n{s}"
-            );
-            sleep(Duration::from_millis(100));
-        }
-    }
-}
-
-impl Drop for Session {
-    fn drop(&mut self) {
-        let _ = Command::new("tmux").args(["kill-session", "-t", &self.0]).status();
-    }
-}
 
 #[test]
 fn demo_runs_filters_helps_and_quits_cleanly() {

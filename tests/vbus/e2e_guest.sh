@@ -4,7 +4,8 @@
 #   VBUS_IFACES="vcan0 vcan1:fd" tests/vbus/run.sh tests/vbus/e2e_guest.sh COTUI SOCKETCAN_LIVE_TEST
 # Every check runs host-built cotui against peers cotui did not write: can-utils
 # (cangen, cansend, candump), the python canopen peers (peers/sdo_server.py node 5,
-# peers/drive402.py node 2 (and node 12 in section 14); peers/dcf_node.py nodes 10 and 11 in section 15) and tmux.
+# peers/drive402.py node 2 (sections 2-5, stopped with sdo_server.py after section 5) and node 12
+# (section 14); peers/dcf_node.py nodes 10 and 11 in section 15) and tmux.
 # Prints one line per check ("ok   ..." or "FAIL ...") and "N passed, N failed"; exits 1
 # on any failure.
 set -uo pipefail
@@ -815,7 +816,8 @@ tmux kill-session -t cyc 2> /dev/null
 kill $cycdump 2> /dev/null
 
 # Section 14's own CiA 402 peer (node 12), started here so that its python start-up overlaps
-# section 13; the shared node-2 peer has been commanded by every section before.
+# section 13. The node-2 peer started at the top is gone by now: "stop the peers" ends it
+# after section 5 (and section 8 deletes vcan0, which ends any python-can peer's reader).
 python3 "$here/peers/drive402.py" vcan0 12 --heartbeat-ms 300 --tpdo > pdodrive.out 2>&1 &
 pdodrive=$!
 pids+=($pdodrive)
@@ -885,6 +887,15 @@ c nmt vcan0 start 12 --wait --timeout 3000
 sleep 0.3
 kill $pdodump 2> /dev/null
 wait $pdodump 2> /dev/null
+# Both remappings' writes to TPDO1 in candump's order: I COB-ID invalid, T type 254, Z count 0,
+# C count 3, V COB-ID valid. The refused one: I, Z (refused). The second finds TPDO1 left
+# invalid (not invalidated again): the type while invalid, then the mapping, then valid.
+seq=$(awk 'BEGIN { t["230018018C010080"] = "I"; t["2F001802FE000000"] = "T"; t["2F001A0000000000"] = "Z"
+    t["2F001A0003000000"] = "C"; t["230018018C010000"] = "V" }
+    { split($3, f, "#"); if (f[1] == "60C" && f[2] in t) printf "%s", t[f[2]] }' pdo13.log)
+[ "$seq" = IZTZCV ] &&
+    ok "pdo map: candump saw the CiA 301 order (COB-ID invalid, type while invalid, count 0, entries, count 3, valid: $seq)" ||
+    bad "pdo map order: '$seq' (want IZTZCV); $(grep -c " 60C#" pdo13.log) requests"
 c decode pdo13.log --format jsonl
 last=$(echo "$out" | j 'select(.kind == "tpdo" and .node == 12) | "\(.len) \([.pdo.signals[].name] | join(",")) \(.pdo.mapping_source | split(" @")[0])"' | tail -1)
 [ "$last" = "5 Statusword,Modes of operation display,Error code sniffed" ] &&
@@ -944,17 +955,21 @@ wait_socket $dcf_dumper || bad "dcf: candump opened no socket"
 c dcf load vcan0 11 node10.dcf --eds "$dcf_eds" --store --json
 wait_for dcf_sdo.log 30 "60B#2310100173617665" # the store request, the last frame we send
 kill $dcf_dumper 2> /dev/null
-# TPDO1 by the CiA 301 sequence: COB-ID 0x18B invalid, count 0, entries, count 3, COB-ID 0x18A.
+# TPDO1 by the CiA 301 sequence (the one `pdo map` writes): COB-ID 0x18B invalid, type 254
+# and event timer 250 ms while invalid, count 0, entries, count 3, COB-ID 0x18A.
 at() { grep -n -m1 "$1" dcf_sdo.log | cut -d: -f1; }
 inv=$(at "60B#230018018B010080")
+ttype=$(at "60B#2F001802FE000000")
+event=$(at "60B#2B001805FA000000")
 clear=$(at "60B#2F001A0000000000")
 count=$(at "60B#2F001A0003000000")
 valid=$(at "60B#230018018A010000")
 dcf_dump $dcf_b dcf_b.out || bad "dcf: node 11 wrote no dump: $(cat dcf_b.out)"
 [ "$rc" = 0 ] && [ "$(echo "$out" | j .stored)" = true ] && [ "$(jq -r '."1010:01"' dcf_b.json)" = 73617665 ] &&
-    [ -n "$inv" ] && [ -n "$valid" ] && [ "$inv" -lt "$clear" ] && [ "$clear" -lt "$count" ] && [ "$count" -lt "$valid" ] &&
-    ok "dcf load onto LocalNode 11: $(echo "$out" | j '.writes | length') writes, $(echo "$out" | j .verified) verified, TPDO1 remapped in the CiA 301 order (candump lines $inv < $clear < $count < $valid), stored (0x1010:01 = save)" ||
-    bad "dcf load: rc=$rc $out $err; frames inv=$inv clear=$clear count=$count valid=$valid; 1010:01=$(jq -r '."1010:01"' dcf_b.json)"
+    [ -n "$inv" ] && [ -n "$ttype" ] && [ -n "$event" ] && [ -n "$valid" ] && [ "$inv" -lt "$ttype" ] &&
+    [ "$ttype" -lt "$event" ] && [ "$event" -lt "$clear" ] && [ "$clear" -lt "$count" ] && [ "$count" -lt "$valid" ] &&
+    ok "dcf load onto LocalNode 11: $(echo "$out" | j '.writes | length') writes, $(echo "$out" | j .verified) verified, TPDO1 remapped in the CiA 301 order (candump lines $inv < $ttype < $event < $clear < $count < $valid), stored (0x1010:01 = save)" ||
+    bad "dcf load: rc=$rc $out $err; frames inv=$inv type=$ttype event=$event clear=$clear count=$count valid=$valid; 1010:01=$(jq -r '."1010:01"' dcf_b.json)"
 # One python start-up for both checks against canopen's own reading of the files.
 checks=$(python3 "$here/peers/dcf_node.py" check node10.dcf 10 dcf_a.json "$dcf_eds" dcf_b.json 2>&1)
 [ "$(echo "$checks" | head -1 | cut -d' ' -f1)" = same ] &&

@@ -1,6 +1,7 @@
 //! What `dcf save` reads and what `dcf load` writes, in which order: pure functions of
 //! dictionaries, DCF text and values read, so they are tested without a bus.
 
+use crate::command::pdo::remap::{Action, Mapping, Remap, RemapWrite, remap_sequence};
 use crate::od::eds::{ParameterValue, parse_number};
 use crate::od::{Access, DataType, Dictionary, Profile};
 use std::collections::{BTreeMap, BTreeSet};
@@ -360,83 +361,20 @@ pub enum Step {
     ClearMapping,
 }
 
-/// One PDO's communication and mapping parameters, as a load changes them together.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct PdoChange {
-    /// The communication parameter index (0x1400+n or 0x1800+n).
-    pub comm: u16,
-    /// The mapping parameter index (0x1600+n or 0x1A00+n).
-    pub mapping: u16,
-    /// The node's COB-ID (comm sub 1), when read.
-    pub node_cob_id: Option<u32>,
-    /// The file's COB-ID, when the file has it.
-    pub cob_id: Option<u32>,
-    /// Other communication subs to write (transmission type, inhibit time, event timer,
-    /// SYNC start value), with their bytes.
-    pub comm_subs: Vec<(u8, Vec<u8>)>,
-    /// The new mapping, when it changes.
-    pub mapping_entries: Option<Mapping>,
-}
-
-/// A PDO mapping to write: the entries by sub (the unused ones after the count included),
-/// then the count.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct Mapping {
-    pub entries: Vec<(u8, u32)>,
-    pub count: u8,
-}
-
-impl Mapping {
-    /// The mapping of these objects, in order (`0xIIIISSLL` each): what `pdo map` writes.
-    pub fn of(objects: &[u32]) -> Mapping {
-        Mapping {
-            entries: (1..).zip(objects.iter().copied()).collect(),
-            count: objects.len() as u8,
+impl From<RemapWrite> for Write {
+    fn from(w: RemapWrite) -> Write {
+        let step = match w.action {
+            Action::Invalidate => Step::Invalidate,
+            Action::ClearMapping => Step::ClearMapping,
+            Action::Comm | Action::Entry | Action::Count | Action::Cob => Step::Value,
+        };
+        Write {
+            index: w.index,
+            sub: w.sub,
+            bytes: w.data,
+            step,
         }
     }
-}
-
-/// The PDO invalid bit of a COB-ID.
-pub const COB_INVALID: u32 = 0x8000_0000;
-
-/// The CiA 301 sequence that changes a PDO: invalidate the COB-ID (bit 31), write the
-/// communication parameters, set the mapping count to 0, write the entries, set the count,
-/// then write the final COB-ID (valid again unless the file has it invalid).
-pub fn pdo_remap_sequence(c: &PdoChange) -> Vec<Write> {
-    let w = |index, sub, bytes: Vec<u8>, step| Write {
-        index,
-        sub,
-        bytes,
-        step,
-    };
-    let mut out = Vec::new();
-    let current = c.node_cob_id.or(c.cob_id);
-    let mut last_cob = current;
-    if let Some(cob) = current.filter(|v| v & COB_INVALID == 0) {
-        out.push(w(
-            c.comm,
-            1,
-            (cob | COB_INVALID).to_le_bytes().to_vec(),
-            Step::Invalidate,
-        ));
-        last_cob = Some(cob | COB_INVALID);
-    }
-    for (sub, bytes) in &c.comm_subs {
-        out.push(w(c.comm, *sub, bytes.clone(), Step::Value));
-    }
-    if let Some(m) = &c.mapping_entries {
-        out.push(w(c.mapping, 0, vec![0], Step::ClearMapping));
-        for (sub, e) in &m.entries {
-            out.push(w(c.mapping, *sub, e.to_le_bytes().to_vec(), Step::Value));
-        }
-        out.push(w(c.mapping, 0, vec![m.count], Step::Value));
-    }
-    if let Some(target) = c.cob_id.or(c.node_cob_id)
-        && Some(target) != last_cob
-    {
-        out.push(w(c.comm, 1, target.to_le_bytes().to_vec(), Step::Value));
-    }
-    out
 }
 
 /// Whether an index is a PDO parameter: `(comm index, mapping index)` of its PDO.
@@ -459,7 +397,8 @@ fn u32_of(b: &[u8]) -> u32 {
 
 /// The writes of a load, in an order that works: application objects first (index order),
 /// then the communication objects 0x1000-0x1FFF, each PDO's communication and mapping
-/// parameters together by [`pdo_remap_sequence`] (RPDOs, then TPDOs) last.
+/// parameters together by the sequence `pdo map` writes too ([`remap_sequence`]; RPDOs,
+/// then TPDOs) last.
 pub fn load_plan(compared: &[Compared]) -> Vec<Vec<Write>> {
     let value = |c: &Compared| Write {
         index: c.file.index,
@@ -496,11 +435,15 @@ pub fn load_plan(compared: &[Compared]) -> Vec<Vec<Write>> {
                 .collect(),
             count,
         });
-        let change = PdoChange {
+        let (node_cob, file_cob) = (
+            at(comm, 1).and_then(|c| c.node.as_deref()).map(u32_of),
+            at(comm, 1).map(|c| u32_of(&c.file.bytes)),
+        );
+        let remap = Remap {
             comm,
             mapping,
-            node_cob_id: at(comm, 1).and_then(|c| c.node.as_deref()).map(u32_of),
-            cob_id: at(comm, 1).map(|c| u32_of(&c.file.bytes)),
+            current_cob: node_cob.or(file_cob),
+            final_cob: file_cob.or(node_cob),
             comm_subs: compared
                 .iter()
                 .filter(|c| c.file.index == comm && c.file.sub > 1 && c.state == State::Differs)
@@ -508,7 +451,7 @@ pub fn load_plan(compared: &[Compared]) -> Vec<Vec<Write>> {
                 .collect(),
             mapping_entries,
         };
-        groups.push(pdo_remap_sequence(&change));
+        groups.push(remap_sequence(&remap).into_iter().map(Write::from).collect());
     }
     groups
 }
@@ -614,43 +557,6 @@ mod tests {
             ]
         );
         assert!(!needs_read(&values[2]));
-    }
-
-    #[test]
-    fn remap_follows_the_cia301_sequence() {
-        let change = PdoChange {
-            comm: 0x1800,
-            mapping: 0x1A00,
-            node_cob_id: Some(0x185),
-            cob_id: Some(0x185),
-            comm_subs: vec![(2, vec![1])],
-            mapping_entries: Some(Mapping::of(&[0x6041_0010, 0x6064_0020])),
-        };
-        let steps: Vec<(u16, u8, Vec<u8>, Step)> = pdo_remap_sequence(&change)
-            .into_iter()
-            .map(|w| (w.index, w.sub, w.bytes, w.step))
-            .collect();
-        assert_eq!(
-            steps,
-            [
-                (0x1800, 1, vec![0x85, 1, 0, 0x80], Step::Invalidate),
-                (0x1800, 2, vec![1], Step::Value),
-                (0x1A00, 0, vec![0], Step::ClearMapping),
-                (0x1A00, 1, vec![0x10, 0, 0x41, 0x60], Step::Value),
-                (0x1A00, 2, vec![0x20, 0, 0x64, 0x60], Step::Value),
-                (0x1A00, 0, vec![2], Step::Value),
-                (0x1800, 1, vec![0x85, 1, 0, 0], Step::Value),
-            ]
-        );
-        // A PDO the node has invalid, that the file keeps invalid: no COB-ID writes.
-        let invalid = PdoChange {
-            node_cob_id: Some(0x8000_0185),
-            cob_id: Some(0x8000_0185),
-            mapping_entries: Some(Mapping::of(&[])),
-            ..change
-        };
-        let steps: Vec<(u16, u8)> = pdo_remap_sequence(&invalid).iter().map(|w| (w.index, w.sub)).collect();
-        assert_eq!(steps, [(0x1800, 2), (0x1A00, 0), (0x1A00, 0)]);
     }
 
     #[test]

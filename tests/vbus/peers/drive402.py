@@ -205,7 +205,7 @@ class Drive:
         try:
             for index, sub, bits in (self._entry(k) for k in range(1, self.node.get_data(0x1A00, 0)[0] + 1)):
                 data += self.node.get_data(index, sub)[: bits // 8]
-        except Exception as e:  # noqa: BLE001 - never let the bus's notifier thread die
+        except Exception as e:  # noqa: BLE001 - say why in the peer's output (canopen only logs str(e))
             print(f"drive402: TPDO1 not sent: {e!r}", flush=True)
             return
         self.node.network.send_message(cob & 0x7FF, data)
