@@ -47,7 +47,11 @@ impl IdStats {
 
 /// Statistics of every identifier plus the bus load.
 pub struct Stats {
-    ids: BTreeMap<(bool, u32), IdStats>,
+    /// Each identifier's index in `entries`, in id order.
+    ids: BTreeMap<(bool, u32), u32>,
+    entries: Vec<IdStats>,
+    /// Index in `entries` (+1, 0 for none) of each 11-bit id: no map search per frame.
+    base: Vec<u32>,
     bitrate: u64,
     window_bits: u64,
     window_start: usize,
@@ -58,6 +62,8 @@ impl Stats {
     pub fn new(bitrate: u64) -> Stats {
         Stats {
             ids: BTreeMap::new(),
+            entries: Vec::new(),
+            base: vec![0; 0x800],
             bitrate: bitrate.max(1),
             window_bits: 0,
             window_start: 0,
@@ -71,7 +77,8 @@ impl Stats {
 
     /// Adds the frame just stored (the last one in `store`).
     pub fn add(&mut self, p: &Packed, store: &Store) {
-        let s = self.ids.entry((p.is_ext(), p.id)).or_default();
+        let i = self.index(p.is_ext(), p.id);
+        let s = &mut self.entries[i];
         if s.count == 0 {
             s.first_ns = p.ts_ns;
         } else {
@@ -92,6 +99,25 @@ impl Stats {
         }
     }
 
+    /// The index in `entries` of an identifier, added on first sight.
+    fn index(&mut self, ext: bool, id: u32) -> usize {
+        let slot = if ext { None } else { self.base.get_mut(id as usize) };
+        if let Some(&i) = slot.as_deref()
+            && i > 0
+        {
+            return i as usize - 1;
+        }
+        let next = self.entries.len() as u32;
+        let i = *self.ids.entry((ext, id)).or_insert(next);
+        if i == next {
+            self.entries.push(IdStats::default());
+        }
+        if let Some(s) = slot {
+            *s = i + 1;
+        }
+        i as usize
+    }
+
     /// Bus load in percent over the last second of the trace.
     pub fn load_percent(&self) -> f64 {
         self.window_bits as f64 * 100.0 / self.bitrate as f64
@@ -104,7 +130,7 @@ impl Stats {
 
     /// Every identifier: (extended, id) and its statistics, in id order.
     pub fn iter(&self) -> impl Iterator<Item = (&(bool, u32), &IdStats)> {
-        self.ids.iter()
+        self.ids.iter().map(|(k, &i)| (k, &self.entries[i as usize]))
     }
 
     /// Number of identifiers seen.
@@ -144,5 +170,39 @@ mod tests {
         // 5 base frames of 8 bytes, 135 bits each at worst (see store::wire_bits), in the
         // last second: 675 bits of 125000 = 0.54 %.
         assert!((st.load_percent() - 0.54).abs() < 1e-9, "{}", st.load_percent());
+    }
+
+    #[test]
+    fn identifiers_are_counted_apart_and_listed_in_id_order() {
+        let mut store = Store::new();
+        let mut st = Stats::new(125_000);
+        let mut err = Frame::classic(0x4, &[0; 8]);
+        err.flags = crate::frame::Flags(crate::frame::Flags::ERR);
+        let frames = [
+            Frame::classic(0x701, &[5]),
+            Frame::classic(0x181, &[1]),
+            Frame::classic(0x181_0000, &[2]),
+            Frame::classic(0x181, &[1]),
+            err,
+            Frame::classic(0x7FF, &[]),
+            Frame::classic(0x181_0000, &[2]),
+            Frame::classic(0x181, &[1]),
+        ];
+        for f in &frames {
+            let at = store.push(f, Kind::Other, None);
+            st.add(&store.packed(at).clone(), &store);
+        }
+        let got: Vec<((bool, u32), u64, usize)> = st.iter().map(|(k, s)| (*k, s.count, s.last_pos)).collect();
+        assert_eq!(
+            got,
+            [
+                ((false, 0x4), 1, 4),
+                ((false, 0x181), 3, 7),
+                ((false, 0x701), 1, 0),
+                ((false, 0x7FF), 1, 5),
+                ((true, 0x181_0000), 2, 6)
+            ]
+        );
+        assert_eq!(st.len(), 5);
     }
 }

@@ -46,6 +46,16 @@ impl Parser {
         self.tail
     }
 
+    /// Reads the common `-l` line at the start of `buf` (see [`super::fast`]) into `frame`;
+    /// returns the bytes it took, its line end included, or `None` when the general
+    /// [`Parser::parse_into`] must read it.
+    #[inline]
+    pub fn parse_fast(&mut self, buf: &[u8], ifaces: &mut Interfaces, frame: &mut Frame) -> Option<usize> {
+        let n = super::fast::line(buf, &mut self.iface, ifaces, frame)?;
+        self.tail = false;
+        Some(n)
+    }
+
     /// Parses one line (with or without its line end).
     pub fn parse_line(&mut self, line: &[u8], ifaces: &mut Interfaces) -> Result<Line, ParseError> {
         let mut frame = Frame::default();

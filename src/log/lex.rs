@@ -4,7 +4,7 @@ use super::ParseError;
 use crate::frame::Interfaces;
 
 /// Value of each byte as a hex digit, `0xFF` when it is not one.
-const HEX: [u8; 256] = {
+pub(crate) const HEX: [u8; 256] = {
     let mut t = [0xFFu8; 256];
     let mut i = 0;
     while i < 10 {
@@ -185,6 +185,9 @@ pub(crate) struct IfaceCache {
     last: Option<u16>,
     name: [u8; 16],
     len: usize,
+    /// The name as a little-endian word, and the mask of its bytes in a 16-byte load.
+    word: u128,
+    mask: u128,
 }
 
 impl IfaceCache {
@@ -200,6 +203,16 @@ impl IfaceCache {
         self.intern(ifaces, name, at)
     }
 
+    /// The cached interface when `buf[at..]` starts with its name and a space: its index
+    /// and the index of that space (one 16-byte compare, no search for the name's end).
+    #[inline]
+    pub(crate) fn at_space(&self, buf: &[u8], at: usize) -> Option<(u16, usize)> {
+        let idx = self.last?;
+        let end = at + self.len;
+        let chunk: &[u8; 16] = buf.get(at..at + 16)?.try_into().ok()?;
+        (u128::from_le_bytes(*chunk) & self.mask == self.word && buf.get(end) == Some(&b' ')).then_some((idx, end))
+    }
+
     /// The slow path of [`IfaceCache::get`].
     fn intern(&mut self, ifaces: &mut Interfaces, name: &[u8], at: usize) -> Result<u16, ParseError> {
         let text = std::str::from_utf8(name).map_err(|_| err(at, "interface name is not valid UTF-8"))?;
@@ -213,9 +226,12 @@ impl IfaceCache {
         // Only names that fit are cached; longer ones take the slow path every time.
         self.last = None;
         if name.len() <= self.name.len() {
+            self.name = [0; 16];
             self.name[..name.len()].copy_from_slice(name);
             self.len = name.len();
             self.last = Some(idx);
+            self.word = u128::from_le_bytes(self.name);
+            self.mask = u128::MAX.checked_shr(8 * (16 - name.len() as u32)).unwrap_or(0);
         }
         Ok(idx)
     }

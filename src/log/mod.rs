@@ -8,6 +8,7 @@
 
 pub mod asc;
 pub mod candump;
+mod fast;
 mod lex;
 pub mod read_ahead;
 pub mod screen;
@@ -264,6 +265,49 @@ impl<R: BufRead> LogReader<R> {
     /// A line that lies whole in the source's buffer is parsed in place; one that straddles
     /// the buffer's end is gathered in the reader's own line buffer (reused, never shrunk).
     pub fn next_line(&mut self) -> io::Result<Option<(u64, Outcome)>> {
+        if let Parser::Candump(p) = &mut self.parser {
+            let available = self.src.fill_buf()?;
+            if let Some(n) = p.parse_fast(available, &mut self.ifaces, &mut self.frame) {
+                self.src.consume(n);
+                self.line_no += 1;
+                self.counts.frames += 1;
+                return Ok(Some((self.line_no, Outcome::Frame(self.frame))));
+            }
+        }
+        self.general_line()
+    }
+
+    /// Appends the next lines to `out`, as [`LogReader::next_line`] gives them, until `out`
+    /// holds `max` or the input ends. Runs of common candump lines are read in one go from
+    /// the source's buffer.
+    pub fn fill(&mut self, out: &mut Vec<(u64, Outcome)>, max: usize) -> io::Result<()> {
+        while out.len() < max {
+            if let Parser::Candump(p) = &mut self.parser {
+                let buf = self.src.fill_buf()?;
+                let (mut at, before) = (0, out.len());
+                while out.len() < max
+                    && let Some(n) = p.parse_fast(&buf[at..], &mut self.ifaces, &mut self.frame)
+                {
+                    at += n;
+                    self.line_no += 1;
+                    out.push((self.line_no, Outcome::Frame(self.frame)));
+                }
+                self.counts.frames += (out.len() - before) as u64;
+                self.src.consume(at);
+                if out.len() == max {
+                    break;
+                }
+            }
+            match self.general_line()? {
+                Some(item) => out.push(item),
+                None => break,
+            }
+        }
+        Ok(())
+    }
+
+    /// [`LogReader::next_line`] by the format's general parser.
+    fn general_line(&mut self) -> io::Result<Option<(u64, Outcome)>> {
         let available = self.src.fill_buf()?;
         if available.is_empty() {
             return Ok(None);
@@ -451,6 +495,45 @@ mod tests {
         }
         assert_eq!(whole.len(), 4);
         assert!(matches!(whole[3], (4, Outcome::Frame(f)) if f.raw_dlc == 9));
+    }
+
+    #[test]
+    fn batches_read_as_line_by_line_whatever_the_buffer() {
+        let mut text = Vec::new();
+        for k in 0..40u32 {
+            text.extend_from_slice(
+                format!(
+                    "(1700000000.{k:06}) can{} {:03X}#{}\n",
+                    k % 3,
+                    k * 37,
+                    "A5".repeat((k % 9) as usize)
+                )
+                .as_bytes(),
+            );
+            if k % 7 == 0 {
+                text.extend_from_slice(b"# note\n(1700000000.000001) can0 12G#11\n(1.5) can0 123#R\n");
+            }
+        }
+        text.extend_from_slice(b"(1700000000.000002) can0 123#11");
+        let one_by_one: Vec<(u64, Outcome)> = LogReader::with_format(&text[..], Format::Candump)
+            .map(Result::unwrap)
+            .collect();
+        assert_eq!(one_by_one.len(), 40 + 6 * 3 + 1);
+        for (cap, max) in [(1, 3), (30, 7), (64, 1000), (1 << 16, 5), (1 << 16, 1000)] {
+            let mut r = LogReader::with_format(std::io::BufReader::with_capacity(cap, &text[..]), Format::Candump);
+            let mut all = Vec::new();
+            loop {
+                let mut batch = Vec::new();
+                r.fill(&mut batch, max).unwrap();
+                let last = batch.len() < max;
+                all.extend(batch);
+                if last {
+                    break;
+                }
+            }
+            assert_eq!(all, one_by_one, "capacity {cap}, batches of {max}");
+            assert_eq!((r.counts().frames, r.counts().warnings), (40 + 6 + 1, 6));
+        }
     }
 
     #[test]

@@ -41,17 +41,7 @@ where
             loop {
                 let mut lines = recycle_rx.try_recv().unwrap_or_else(|_| Vec::with_capacity(BATCH));
                 lines.clear();
-                let mut error = None;
-                while lines.len() < BATCH {
-                    match reader.next_line() {
-                        Ok(Some(item)) => lines.push(item),
-                        Ok(None) => break,
-                        Err(e) => {
-                            error = Some(e);
-                            break;
-                        }
-                    }
-                }
+                let error = reader.fill(&mut lines, BATCH).err();
                 let done = lines.len() < BATCH;
                 let names = reader.interfaces().names().len();
                 let interfaces = (names != sent_ifaces).then(|| reader.interfaces().clone());

@@ -14,6 +14,9 @@ use std::time::{Duration, Instant};
 /// Frames per batch sent to the UI.
 const BATCH: usize = 4096;
 
+/// Lines the log reader parses in one go before their frames are batched.
+const LINES: usize = 1024;
+
 /// What a capture task sends.
 #[derive(Debug)]
 pub enum Feed {
@@ -109,22 +112,31 @@ pub fn open(path: PathBuf) -> Receiver<Feed> {
             }
         };
         let mut batch = Vec::with_capacity(BATCH);
+        let mut lines = Vec::with_capacity(LINES);
         let mut names = 0;
         let mut first_warning = None;
-        while let Some(item) = r.next() {
-            match item {
-                Ok((_, Outcome::Frame(f))) => batch.push(f),
-                Ok((line, Outcome::Warning(w))) => {
-                    first_warning.get_or_insert(format!("line {line}: {w}"));
+        loop {
+            lines.clear();
+            let read = r.fill(&mut lines, LINES);
+            let more = lines.len() == LINES;
+            for (line, outcome) in lines.drain(..) {
+                match outcome {
+                    Outcome::Frame(f) => batch.push(f),
+                    Outcome::Warning(w) => {
+                        first_warning.get_or_insert(format!("line {line}: {w}"));
+                    }
+                    Outcome::Skip(_) => {}
                 }
-                Ok(_) => {}
-                Err(e) => {
-                    let _ = tx.send(Feed::Status(ReadError::new(&path, e).to_string()));
-                    break;
+                if batch.len() == BATCH && !send_batch(&tx, &mut batch, &r, &mut names) {
+                    return;
                 }
             }
-            if batch.len() == BATCH && !send_batch(&tx, &mut batch, &r, &mut names) {
-                return;
+            if let Err(e) = read {
+                let _ = tx.send(Feed::Status(ReadError::new(&path, e).to_string()));
+                break;
+            }
+            if !more {
+                break;
             }
         }
         send_batch(&tx, &mut batch, &r, &mut names);
