@@ -55,8 +55,8 @@ pub fn for_each_frame(
 ) -> io::Result<Counts> {
     let mut ifaces = Interfaces::default();
     let finished = read_ahead::for_each_batch(input, |batch| {
-        if let Some(i) = &batch.interfaces {
-            ifaces = i.clone();
+        for name in &batch.new_interfaces {
+            ifaces.intern(name);
         }
         consume(Frames {
             path,

@@ -4,6 +4,8 @@
 //! instant. It is a plain `Copy` value with no heap data so that parsers and
 //! decoders never allocate per frame; the trace store packs it further.
 
+use std::collections::HashMap;
+
 pub mod hex;
 pub mod json;
 
@@ -134,19 +136,27 @@ impl Frame {
 }
 
 /// Interned interface names: frames carry a `u16` index instead of a string.
+/// Lookups go through a hash index, so a log with tens of thousands of names stays linear.
 #[derive(Clone, Debug, Default)]
 pub struct Interfaces {
     names: Vec<String>,
+    index: HashMap<String, u16>,
 }
 
 impl Interfaces {
     /// The index of `name`, adding it on first sight.
     pub fn intern(&mut self, name: &str) -> u16 {
-        if let Some(i) = self.names.iter().position(|n| n == name) {
-            return i as u16;
+        if let Some(i) = self.find(name) {
+            return i;
         }
+        let i = self.names.len() as u16;
         self.names.push(name.to_string());
-        (self.names.len() - 1) as u16
+        self.index.insert(name.to_string(), i);
+        i
+    }
+    /// The index of `name` if it was interned.
+    pub fn find(&self, name: &str) -> Option<u16> {
+        self.index.get(name).copied()
     }
     /// The name behind an index (`"?"` when unknown).
     pub fn name(&self, idx: u16) -> &str {

@@ -216,8 +216,8 @@ impl IfaceCache {
     /// The slow path of [`IfaceCache::get`].
     fn intern(&mut self, ifaces: &mut Interfaces, name: &[u8], at: usize) -> Result<u16, ParseError> {
         let text = std::str::from_utf8(name).map_err(|_| err(at, "interface name is not valid UTF-8"))?;
-        let idx = match ifaces.names().iter().position(|n| n == text) {
-            Some(i) => i as u16,
+        let idx = match ifaces.find(text) {
+            Some(i) => i,
             None if ifaces.names().len() >= u16::MAX as usize => {
                 return Err(err(at, "too many distinct interface names"));
             }

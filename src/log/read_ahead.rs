@@ -1,7 +1,6 @@
 //! Reads and parses a log on a second thread, handing the caller batches of
 //! parsed lines: parsing and decoding then run on two cores at once.
 
-use crate::frame::Interfaces;
 use crate::log::{Counts, LogReader, Outcome};
 use std::io::{self, BufRead};
 use std::sync::mpsc;
@@ -12,8 +11,9 @@ const BATCH: usize = 2048;
 /// A batch of parsed lines: (1-based line number, outcome).
 pub struct Batch {
     pub lines: Vec<(u64, Outcome)>,
-    /// The interface table, sent only when it grew since the previous batch.
-    pub interfaces: Option<Interfaces>,
+    /// Interface names first seen in this batch, in the order they were interned
+    /// (interning them in that order gives the reader's indices).
+    pub new_interfaces: Vec<String>,
 }
 
 /// What the reader thread reports at the end.
@@ -43,10 +43,10 @@ where
                 lines.clear();
                 let error = reader.fill(&mut lines, BATCH).err();
                 let done = lines.len() < BATCH;
-                let names = reader.interfaces().names().len();
-                let interfaces = (names != sent_ifaces).then(|| reader.interfaces().clone());
-                sent_ifaces = names;
-                if tx.send(Batch { lines, interfaces }).is_err() || done || error.is_some() {
+                let names = reader.interfaces().names();
+                let new_interfaces = names[sent_ifaces..].to_vec();
+                sent_ifaces = names.len();
+                if tx.send(Batch { lines, new_interfaces }).is_err() || done || error.is_some() {
                     return Ok(Finished {
                         counts: reader.counts().clone(),
                         error,
@@ -70,4 +70,37 @@ where
             .unwrap_or_else(|_| Err(io::Error::other("log reader thread panicked")));
         result.map(|_| finished)
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::Interfaces;
+
+    /// A log naming a new interface on every line, over several batches: each frame's
+    /// index names its own interface once the batch's new names are interned in order.
+    #[test]
+    fn new_interface_names_arrive_with_their_batch() {
+        let n = BATCH * 2 + 100;
+        let log: String = (0..n).map(|i| format!("(1.{i:06}) if{i} 181#01\n")).collect();
+        let mut ifaces = Interfaces::default();
+        let mut seen = Vec::new();
+        for_each_batch(log.as_bytes(), |batch| -> Result<(), ()> {
+            for name in &batch.new_interfaces {
+                ifaces.intern(name);
+            }
+            for (_, outcome) in &batch.lines {
+                if let Outcome::Frame(f) = outcome {
+                    seen.push(ifaces.name(f.iface).to_string());
+                }
+            }
+            Ok(())
+        })
+        .unwrap()
+        .unwrap();
+        assert_eq!(seen.len(), n);
+        assert!(seen.iter().enumerate().all(|(i, name)| *name == format!("if{i}")));
+        assert_eq!(ifaces.find("if7"), Some(7));
+        assert_eq!(ifaces.find("can0"), None);
+    }
 }

@@ -22,7 +22,8 @@ const LINES: usize = 1024;
 pub enum Feed {
     /// Frames in order.
     Frames(Vec<Frame>),
-    /// Interface names, whenever a new one appears (frames index into it).
+    /// Interface names first seen since the previous such message, in index order
+    /// (frames index into the table they extend).
     Interfaces(Vec<String>),
     /// Forget all frames: what follows starts over (a replay seeking back).
     Reset,
@@ -159,8 +160,9 @@ fn send_batch<R: std::io::BufRead>(
 ) -> bool {
     let ifaces = r.interfaces().names();
     if ifaces.len() > *names {
+        let new = ifaces[*names..].to_vec();
         *names = ifaces.len();
-        if tx.send(Feed::Interfaces(ifaces.to_vec())).is_err() {
+        if tx.send(Feed::Interfaces(new)).is_err() {
             return false;
         }
     }
