@@ -19,6 +19,24 @@ pub fn write_bench_log(path: &Path, frames: u64) -> std::io::Result<()> {
     write_frames(path, frames, Some(GARBAGE_EVERY))
 }
 
+/// Writes `frames` synthetic frames spread round-robin over `ifaces` distinct interface
+/// names (`can0`, `can1`, ...): the interning of names must stay linear.
+pub fn write_many_iface_log(path: &Path, frames: u64, ifaces: u32) -> std::io::Result<()> {
+    let file = std::fs::File::create(path)?;
+    let mut out = std::io::BufWriter::with_capacity(1 << 20, file);
+    let mut writer = LogWriter::new();
+    let mut line = String::with_capacity(1 << 16);
+    for (i, frame) in Traffic::new(frames, 1_700_000_000_000_000_000).enumerate() {
+        writer.write_line(&mut line, &frame, &format!("can{}", i as u32 % ifaces.max(1)));
+        if line.len() > 1 << 15 {
+            out.write_all(line.as_bytes())?;
+            line.clear();
+        }
+    }
+    out.write_all(line.as_bytes())?;
+    out.flush()
+}
+
 fn write_frames(path: &Path, frames: u64, garbage_every: Option<u64>) -> std::io::Result<()> {
     let file = std::fs::File::create(path)?;
     let mut out = std::io::BufWriter::with_capacity(1 << 20, file);

@@ -39,6 +39,15 @@ const ROUNDS: usize = 5;
 const STARTUP_RUNS: usize = 21;
 /// Target start-up time (ms).
 const STARTUP_TARGET_MS: f64 = 3.0;
+/// Distinct interface names in the many- and few-interfaces logs (same frames, names
+/// round-robin). With 40,000 names each is seen only about six times in the 1/4 log, so
+/// the first sight of a name (interned on both threads) weighs; a table searched name by
+/// name made this log 100x slower, a hash index keeps it above a quarter of the rate.
+const MANY_IFACES: u32 = 40_000;
+const FEW_IFACES: u32 = 40;
+/// `scan --probe` on the demo bus: how long it listens and waits for each answer (ms).
+const SCAN_LISTEN_MS: u64 = 100;
+const SCAN_TIMEOUT_MS: u64 = 300;
 
 /// One way of running the decoder, and its measurements.
 struct Run {
@@ -150,15 +159,25 @@ fn bench(args: &BenchArgs) -> std::io::Result<()> {
 /// Runs every figure `ROUNDS` times, interleaved (so a load change hits all alike).
 fn measure_all(args: &BenchArgs, exe: &Path, dir: &Path) -> std::io::Result<Figures> {
     let load_before = load_average();
-    let (big, small, tiny) = (
+    let (big, small, tiny, many, few) = (
         dir.join("bench.log"),
         dir.join("bench-quarter.log"),
         dir.join("tiny.log"),
+        dir.join("many-ifaces.log"),
+        dir.join("few-ifaces.log"),
     );
     log::write_bench_log(&big, args.frames)?;
     log::write_bench_log(&small, args.frames / 4)?;
     log::write_bench_log(&tiny, 10)?;
-    let (b, s, t) = (big.to_string_lossy(), small.to_string_lossy(), tiny.to_string_lossy());
+    log::write_many_iface_log(&many, args.frames / 4, MANY_IFACES)?;
+    log::write_many_iface_log(&few, args.frames / 4, FEW_IFACES)?;
+    let (b, s, t, m, f) = (
+        big.to_string_lossy(),
+        small.to_string_lossy(),
+        tiny.to_string_lossy(),
+        many.to_string_lossy(),
+        few.to_string_lossy(),
+    );
     let n = args.frames;
     let mut runs = vec![
         Run::new(
@@ -197,6 +216,20 @@ fn measure_all(args: &BenchArgs, exe: &Path, dir: &Path) -> std::io::Result<Figu
             None,
         ),
         Run::new(
+            "summary-many-ifaces",
+            "decode --summary, 40,000 ifaces (1/4 log)",
+            &["decode", "--summary", &m],
+            n / 4,
+            None,
+        ),
+        Run::new(
+            "summary-few-ifaces",
+            "decode --summary, 40 ifaces (1/4 log)",
+            &["decode", "--summary", &f],
+            n / 4,
+            None,
+        ),
+        Run::new(
             "text-quarter",
             "decode --format text (1/4 log)",
             &["decode", "--format", "text", &s],
@@ -223,10 +256,14 @@ fn measure_all(args: &BenchArgs, exe: &Path, dir: &Path) -> std::io::Result<Figu
     let startup: Vec<f64> = (0..STARTUP_RUNS)
         .map(|_| measure(exe, &["decode", &t]).map(|(secs, _)| secs))
         .collect::<std::io::Result<_>>()?;
+    let (listen, timeout) = (SCAN_LISTEN_MS.to_string(), SCAN_TIMEOUT_MS.to_string());
+    let scan_args = ["scan", "demo", "--probe", "--listen", &listen, "--timeout", &timeout];
+    let (scan_s, _) = measure(exe, &scan_args)?;
     Ok(Figures {
         runs,
         log2asc,
         startup_s: median(&startup),
+        scan_s,
         load: [load_before, load_average()],
         lens_rate,
     })
@@ -238,6 +275,8 @@ struct Figures {
     log2asc: Option<Run>,
     /// Median start-up time (decode of a 10-line log).
     startup_s: f64,
+    /// Wall time of `scan demo --probe` (all 127 node-IDs probed at once).
+    scan_s: f64,
     /// The 1-minute load average before and after.
     load: [Option<String>; 2],
     /// canopen-lens's rate on the quarter log (frames/s), when it is installed.
@@ -251,6 +290,17 @@ fn measure_into(exe: &Path, run: &mut Run) -> std::io::Result<()> {
     run.seconds.push(secs);
     run.peak_rss_kib = run.peak_rss_kib.max(rss);
     Ok(())
+}
+
+/// The `scan --probe` target: listening, one round of probes and one of identity reads.
+fn scan_target_s() -> f64 {
+    (SCAN_LISTEN_MS + 3 * SCAN_TIMEOUT_MS) as f64 / 1e3
+}
+
+/// The 40,000-names log's `--summary` rate as a fraction of the 40-names log's.
+fn many_ifaces_ratio(runs: &[Run]) -> Option<f64> {
+    let rate = |name| runs.iter().find(|r| r.name == name).map(Run::rate);
+    Some(rate("summary-many-ifaces")? / rate("summary-few-ifaces")?)
 }
 
 /// The 1-minute load average (from /proc/loadavg), when known.
@@ -281,6 +331,8 @@ fn report(args: &BenchArgs, f: &Figures) {
                 "log2asc_frames_per_s": base, "load_average": [before, after],
                 "startup_ms": startup_ms, "startup_target_ms": STARTUP_TARGET_MS,
                 "canopen_lens_frames_per_s": f.lens_rate,
+                "scan_probe_s": f.scan_s, "scan_probe_target_s": scan_target_s(),
+                "many_ifaces_vs_few": many_ifaces_ratio(runs),
             })
         );
         return;
@@ -315,6 +367,20 @@ fn report(args: &BenchArgs, f: &Figures) {
         "  {:<32} {startup_ms:>12.2} ms (target < {STARTUP_TARGET_MS} ms)",
         "start-up (decode of a 10-line log)"
     );
+    println!(
+        "  {:<32} {:>12.3} s  (target < {:.1} s: {SCAN_LISTEN_MS} ms listening + one {SCAN_TIMEOUT_MS} ms \
+         probe round; one node-ID at a time would take {:.1} s)",
+        "scan demo --probe (127 node-IDs)",
+        f.scan_s,
+        scan_target_s(),
+        (SCAN_LISTEN_MS + 127 * SCAN_TIMEOUT_MS) as f64 / 1e3,
+    );
+    if let Some(r) = many_ifaces_ratio(runs) {
+        println!(
+            "  {:<32} {r:>12.2}x the rate with 40 names (target >= 0.25x: interning stays linear)",
+            "40,000 interface names"
+        );
+    }
     match f.lens_rate {
         Some(r) => println!(
             "  {:<32} {r:>12.0} frames/s (the diagnose peer, 1/4 log)",
