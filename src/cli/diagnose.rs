@@ -1,7 +1,7 @@
 //! `cotui diagnose FILE...`: what went wrong on the bus, as a short ranked list of incidents.
 
 use super::input;
-use crate::analysis::{Diagnoser, EventTracker, Incident, Status};
+use crate::analysis::{Diagnoser, Incident, Status};
 use crate::command::ExitCode;
 use crate::decode::Kind;
 use crate::frame::json::write_line;
@@ -47,7 +47,7 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
             return ExitCode::Usage;
         }
     };
-    let mut diag = Diagnoser::new(EventTracker::new(|n| decoder.dictionary(n)));
+    let mut diag = Diagnoser::new(|n| decoder.dictionary(n));
     let mut status = ExitCode::Ok;
     for path in &args.files {
         let Some(input) = input::open_input(path, "diagnose") else {
@@ -61,6 +61,15 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
                 let (kind, node, pdo) = decoder.peek(frame);
                 let skip = match kind {
                     Kind::Sync | Kind::Time | Kind::Lss | Kind::Other => true,
+                    // SDO frames: tracked without building the label nobody reads.
+                    Kind::SdoRx | Kind::SdoTx => {
+                        let s = decoder.sdo_frame(frame);
+                        diag.sdo(frame, node.unwrap_or(0), kind == Kind::SdoRx, s.as_ref());
+                        for t in decoder.take_transactions() {
+                            diag.transaction(&t);
+                        }
+                        continue;
+                    }
                     Kind::Tpdo | Kind::Rpdo => {
                         let n = node.unwrap_or(0);
                         !diag.wants_pdo(n, pdo, decoder.mapping(n, kind == Kind::Tpdo, pdo))
