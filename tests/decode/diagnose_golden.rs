@@ -446,3 +446,24 @@ fn pdo_late_after_the_sync_window() {
     assert_eq!(frames(&inc[0]), [66, 69, 150]);
     assert_eq!(inc[0]["events"][0]["text"], "TPDO1 4.000 ms after the SYNC (#65)");
 }
+
+#[test]
+fn live_reads_a_bus_and_duration_needs_live() {
+    // The simulated bus (`demo`) stands in for SocketCAN here (tests/vbus/e2e_guest.sh
+    // section 16 runs it on vcan0): frames are diagnosed and the report comes at the end.
+    let out = cotui(&["diagnose", "--live", "demo", "--duration", "1"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).unwrap();
+    let frames: u64 = text
+        .split(" frames")
+        .next()
+        .and_then(|h| h.rsplit(['(', ' ']).next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no frame count in the headline: {text}"));
+    assert!(frames > 0, "{text}");
+    let out = cotui(&["diagnose", "--duration", "1", "tests/fixtures/diagnose/emcy.log"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--duration needs --live IFACE"));
+    let out = cotui(&["diagnose", "--live", "demo", "tests/fixtures/diagnose/emcy.log"]);
+    assert_eq!(out.status.code(), Some(1), "a log and --live at once are refused");
+}
