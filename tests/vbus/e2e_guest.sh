@@ -995,7 +995,7 @@ if wait_socket "$diag_dump" && dwait 150 "vcan0 \|"; then
     diag_peer=$!
     pids+=($diag_peer)
     dwait 150 "OPEN +Node 7 .*Reported an error" &&
-        ok "diag: the Problems pane shows node 7's EMCY live ($(grep -oE 'Node 7 .*Reported an error[^|]*' dscreen.txt | tr -s ' ' | head -1))" ||
+        ok "diag: the Problems pane shows node 7's EMCY live ($(grep -oE 'Node 7 .*Reported an error: [^(]*\(EMCY 0x[0-9A-F]{4}\)' dscreen.txt | tr -s ' ' | head -1))" ||
         bad "diag: no EMCY incident of node 7 in the Problems pane: $(cat diag_node.out) $(cat dscreen.txt)"
     if wait_for diag_node.out 150 "diag_node silent" && dwait 50 "OPEN +Node 7 .*Went silent"; then
         ok "diag: the Problems pane shows node 7 silent with no frame of it after the last heartbeat"
@@ -1007,10 +1007,10 @@ else
     bad "diag: candump or cotui live did not start: $(cat dscreen.txt)"
     live_screen=""
 fi
+kill -INT "$diag_live" 2> /dev/null
 tmux send-keys -t diag q
 dwait 100 "cotui-exit=0" || bad "diag: cotui live did not quit: $(cat dscreen.txt)"
 tmux kill-session -t diag 2> /dev/null
-kill -INT "$diag_live" 2> /dev/null
 wait "$diag_live"
 live_rc=$?
 # One frame after node 7's deadline, so that the recording itself shows the silence.
