@@ -15,10 +15,11 @@ use super::timing::{PdoGap, PdoKey, PdoTiming, PeriodFrom, SyncTiming};
 use crate::decode::cia402::DriveState;
 use crate::decode::emcy::Emcy;
 use crate::decode::heartbeat::NmtState;
+use crate::decode::sdo::frame::{Chunk8, SdoFrame};
 use crate::decode::stall::{self, Observation, Step};
 use crate::decode::{Body, Decoded, Kind};
 use crate::frame::Frame;
-use crate::od::PdoMapping;
+use crate::od::{Dictionary, PdoMapping};
 use crate::sdo::abort::abort_text;
 use crate::sdo::codec::{SdoCommand, Side};
 use crate::sdo::transaction::{Outcome, Transaction, TransferDirection};
@@ -62,6 +63,17 @@ struct Request {
     replaced: bool,
     index: u16,
     sub: u8,
+}
+
+/// The last segment request of a segmented SDO transfer to a node.
+#[derive(Clone, Copy, Debug)]
+struct Segment {
+    at: At,
+    toggle: bool,
+    /// The frame's bytes when it is a download segment (which carries data).
+    data: Option<Chunk8>,
+    /// When the node answered it.
+    answered: Option<At>,
 }
 
 /// An NMT command a node should follow.
@@ -124,6 +136,8 @@ struct Node {
     last_emcy: Option<u16>,
     /// The last segment of a segmented SDO transfer still going on.
     segmenting: Option<At>,
+    /// The last segment request, for its toggle bit.
+    segment: Option<Segment>,
     silence: Option<(At, u64, f64)>,
 }
 
@@ -175,9 +189,73 @@ fn axis_of(index: u16, base: u16) -> Option<u8> {
     (off % 0x800 == 0 && off / 0x800 < AXES).then(|| (off / 0x800 + 1) as u8)
 }
 
+/// A dictionary's default sync window (µs) and TPDO transmission types (PDO number, type).
+type SyncDefaults = (Option<u64>, Vec<(u16, u8)>);
+
+/// The sync window (0x1007, µs) and the transmission types of the TPDOs (0x1800.. sub 2)
+/// that `dict` gives as default values (EDS `DefaultValue`, profile `default`).
+fn sync_defaults(dict: &Dictionary) -> SyncDefaults {
+    let default = |index: u16, sub: u8| dict.object(index, sub)?.default.as_ref()?.as_i64();
+    let window = default(0x1007, 0)
+        .and_then(|v| u64::try_from(v).ok())
+        .filter(|v| *v > 0);
+    // Only indexes some layer names (objects or index ranges) can have a default.
+    let mut indexes: Vec<u16> = Vec::new();
+    for layer in dict.layers() {
+        indexes.extend(
+            layer
+                .objects
+                .range((0x1800, 2)..=(0x19FF, 2))
+                .filter(|(k, _)| k.1 == 2)
+                .map(|(k, _)| k.0),
+        );
+        for r in layer
+            .ranges
+            .iter()
+            .filter(|r| r.subs.get(&2).is_some_and(|o| o.default.is_some()))
+        {
+            indexes.extend(r.first.max(0x1800)..=r.last.min(0x19FF));
+        }
+    }
+    indexes.sort_unstable();
+    indexes.dedup();
+    let types = indexes
+        .into_iter()
+        .filter_map(|i| Some((i - 0x1800 + 1, u8::try_from(default(i, 2)?).ok()?)))
+        .collect();
+    (window, types)
+}
+
 impl Diagnoser {
-    /// A builder over `tracker` (made with the nodes' dictionaries for their heartbeat periods).
-    pub fn new(tracker: EventTracker) -> Diagnoser {
+    /// A builder for nodes that use `dict(node)`: their default heartbeat periods (0x1017),
+    /// sync windows (0x1007) and TPDO transmission types (0x1800.. sub 2) hold until the
+    /// bus shows other values.
+    pub fn new<'a>(dict: impl Fn(u8) -> &'a Dictionary) -> Diagnoser {
+        let mut d = Diagnoser::with_tracker(EventTracker::new(&dict));
+        // Unbound nodes share one dictionary: each distinct one is read once.
+        let mut seen: Vec<(Vec<*const crate::od::Profile>, SyncDefaults)> = Vec::new();
+        for n in 1..128u8 {
+            let dict = dict(n);
+            let layers: Vec<_> = dict.layers().iter().map(std::sync::Arc::as_ptr).collect();
+            let known = match seen.iter().position(|(l, _)| *l == layers) {
+                Some(i) => i,
+                None => {
+                    seen.push((layers, sync_defaults(dict)));
+                    seen.len() - 1
+                }
+            };
+            let (window, types) = &seen[known].1;
+            if let Some(us) = window {
+                d.sync_window.insert(n, us * 1000);
+            }
+            for (num, t) in types {
+                d.pdos.transmission_type((n, true, *num), *t);
+            }
+        }
+        d
+    }
+
+    fn with_tracker(tracker: EventTracker) -> Diagnoser {
         Diagnoser {
             tracker,
             at: At::default(),
@@ -254,7 +332,18 @@ impl Diagnoser {
         self.incidents[i].step(at.frame, at.t, text);
     }
 
+    /// The tracker's events, if any (checked per frame: most frames make none).
+    #[inline]
+    fn take_events(&mut self) {
+        if self.tracker.pending() > 0 {
+            for e in self.tracker.take_events() {
+                self.event(&e);
+            }
+        }
+    }
+
     /// Frame number and time advance to `frame`'s.
+    #[inline]
     fn advance(&mut self, frame: &Frame) {
         self.at = At {
             frame: self.at.frame + 1,
@@ -268,6 +357,7 @@ impl Diagnoser {
     }
 
     /// PDOs overdue at `now` become (or add to) incidents.
+    #[inline]
     fn pdos_due(&mut self, now: u64) {
         for gap in self.pdos.due(now) {
             self.pdo_gap(gap);
@@ -377,9 +467,7 @@ impl Diagnoser {
     pub fn skip(&mut self, frame: &Frame, kind: Kind, node: Option<u8>, pdo: u16) {
         self.advance(frame);
         self.tracker.tick(frame.ts_ns);
-        for e in self.tracker.take_events() {
-            self.event(&e);
-        }
+        self.take_events();
         match (kind, node) {
             (Kind::Sync, _) => {
                 self.sync.sync(self.at.frame, frame.ts_ns);
@@ -400,9 +488,7 @@ impl Diagnoser {
     pub fn frame(&mut self, frame: &Frame, iface: &str, d: &Decoded) {
         self.advance(frame);
         self.tracker.frame(frame, iface, d);
-        for e in self.tracker.take_events() {
-            self.event(&e);
-        }
+        self.take_events();
         let Some(n) = d.node else {
             if d.kind == Kind::Sync {
                 self.sync.sync(self.at.frame, frame.ts_ns);
@@ -436,44 +522,7 @@ impl Diagnoser {
                 self.node(n).heard = true;
                 self.emcy(n, e);
             }
-            Body::Sdo(s) if s.side == Side::Server => {
-                let node = self.node(n);
-                node.heard = true;
-                node.pending = None;
-                node.answered_after = true;
-                if let SdoCommand::Abort { index, sub, code } = s.command {
-                    self.node(n).segmenting = None;
-                    self.refused(n, index, sub, code);
-                } else if s.problems.iter().any(|p| p == "outside any transfer seen") {
-                    self.garbled(n, format!("{} frame outside any transfer", s.command.cs_name()));
-                }
-            }
-            Body::Sdo(s) => {
-                if matches!(s.command.cs_name(), "download_segment" | "upload_segment") {
-                    self.node(n).segmenting = Some(at);
-                }
-                // Only initiate frames start a request (segments carry no object themselves).
-                if let Some((index, sub)) = s.command.object()
-                    && s.command.cs_name() != "abort"
-                {
-                    // The other client's request may well be answered: not counted as unanswered.
-                    let overlap = self.overlapping_request(n, index, sub);
-                    self.node(n).download = matches!(s.command.cs_name(), "initiate_download" | "block_download");
-                    if let Some(old) = self.node(n).pending.take()
-                        && !overlap
-                    {
-                        self.unanswered(n, Request { replaced: true, ..old });
-                    }
-                    self.node(n).pending = Some(Request {
-                        at,
-                        replaced: false,
-                        index,
-                        sub,
-                    });
-                    let dl = at.t + SDO_TIMEOUT_NS;
-                    self.sdo_deadline = Some(self.sdo_deadline.map_or(dl, |d| d.min(dl)));
-                }
-            }
+            Body::Sdo(s) => self.sdo_body(n, s),
             Body::Pdo(p) => {
                 if p.transmit {
                     self.node(n).heard = true;
@@ -498,6 +547,84 @@ impl Diagnoser {
                 if matches!(d.kind, Kind::Tpdo | Kind::SdoTx) {
                     self.node(n).heard = true;
                 }
+            }
+        }
+    }
+
+    /// An SDO frame of node `n` read by [`crate::decode::Decoder::sdo_frame`] (None: a
+    /// vendor command of the node's profile): the cheap twin of [`Diagnoser::frame`] for
+    /// SDO frames, which needs no label. `to_node` tells a client request.
+    pub fn sdo(&mut self, frame: &Frame, n: u8, to_node: bool, s: Option<&SdoFrame>) {
+        self.advance(frame);
+        self.tracker.tick(frame.ts_ns);
+        self.take_events();
+        if !to_node {
+            let at = self.at;
+            let node = self.node(n);
+            node.last_any = Some(at);
+            node.heard = true;
+        }
+        if let Some(s) = s {
+            self.sdo_body(n, s);
+        }
+    }
+
+    fn sdo_body(&mut self, n: u8, s: &SdoFrame) {
+        let at = self.at;
+        if s.side == Side::Server {
+            let node = self.node(n);
+            node.heard = true;
+            node.pending = None;
+            node.answered_after = true;
+            if matches!(
+                s.command,
+                SdoCommand::DownloadSegmentResponse { .. } | SdoCommand::UploadSegmentResponse { .. }
+            ) && let Some(seg) = &mut self.node(n).segment
+            {
+                seg.answered.get_or_insert(at);
+            }
+            if let SdoCommand::Abort { index, sub, code } = s.command {
+                let node = self.node(n);
+                node.segmenting = None;
+                node.segment = None;
+                self.refused(n, index, sub, code);
+            } else if s.problems.iter().any(|p| p == "outside any transfer seen") {
+                self.garbled(n, format!("{} frame outside any transfer", s.command.cs_name()));
+            }
+        } else {
+            match s.command {
+                SdoCommand::DownloadSegment { toggle, .. } => {
+                    self.node(n).segmenting = Some(at);
+                    self.segment_request(n, toggle, Some(s.raw));
+                }
+                SdoCommand::UploadSegment { toggle } => {
+                    self.node(n).segmenting = Some(at);
+                    self.segment_request(n, toggle, None);
+                }
+                // A new transfer (or its end) starts the toggle bit over.
+                _ if s.command.object().is_some() => self.node(n).segment = None,
+                _ => {}
+            }
+            // Only initiate frames start a request (segments carry no object themselves).
+            if let Some((index, sub)) = s.command.object()
+                && s.command.cs_name() != "abort"
+            {
+                // The other client's request may well be answered: not counted as unanswered.
+                let overlap = self.overlapping_request(n, index, sub);
+                self.node(n).download = matches!(s.command.cs_name(), "initiate_download" | "block_download");
+                if let Some(old) = self.node(n).pending.take()
+                    && !overlap
+                {
+                    self.unanswered(n, Request { replaced: true, ..old });
+                }
+                self.node(n).pending = Some(Request {
+                    at,
+                    replaced: false,
+                    index,
+                    sub,
+                });
+                let dl = at.t + SDO_TIMEOUT_NS;
+                self.sdo_deadline = Some(self.sdo_deadline.map_or(dl, |d| d.min(dl)));
             }
         }
     }
@@ -599,6 +726,41 @@ impl Diagnoser {
         node.segmenting = None;
         self.second_master(Some(n), "SDO requests to the node overlap", at, what);
         true
+    }
+
+    /// A segment request with toggle bit `toggle` to node `n`. One client alternates the
+    /// bit and waits for each answer; the same bit again within [`TWO_MASTERS_NS`] of the
+    /// request before (still unanswered) or of its answer is a second client's transfer
+    /// interleaving. A retry after a timeout repeats the bit too, but much later; the same
+    /// download segment again (same bytes) is a retransmission or a frame captured twice;
+    /// and equal times (a log without timestamps) say nothing.
+    fn segment_request(&mut self, n: u8, toggle: bool, data: Option<Chunk8>) {
+        let at = self.at;
+        let young = |a: At| at.t > a.t && at.t - a.t < TWO_MASTERS_NS;
+        let Some(prev) = self.node(n).segment.replace(Segment {
+            at,
+            toggle,
+            data,
+            answered: None,
+        }) else {
+            return;
+        };
+        if prev.toggle != toggle || (data.is_some() && prev.data == data) {
+            return;
+        }
+        let bit = u8::from(toggle);
+        let what = match prev.answered {
+            Some(a) if young(a) => format!(
+                "Segment request with toggle bit {bit} again, right after the node answered the one with toggle bit {bit} (#{}): segments of another client's transfer",
+                prev.at.frame
+            ),
+            None if young(prev.at) => format!(
+                "Segment request with toggle bit {bit} while the one with the same toggle bit (#{}) still waits for its answer",
+                prev.at.frame
+            ),
+            _ => return,
+        };
+        self.second_master(Some(n), "SDO segments of two clients interleave", at, what);
     }
 
     fn second_master(&mut self, node: Option<u8>, cause: &str, at: At, what: String) {
@@ -893,23 +1055,28 @@ impl Diagnoser {
             self.pdos.pause((target != 0).then_some(target));
         }
         let at = self.at;
-        // A start undone at once by a stop or pre-operational for the same node: two
-        // masters disagree (one master leaving pre-operational right after entering it is
-        // a normal re-configuration, the other order is not).
+        // A start undone at once (stop, pre-operational or a reset) for the same node, or
+        // for all nodes: two masters disagree. One master leaving pre-operational right
+        // after entering it is a normal re-configuration, and "start all" then "stop node
+        // 3" a choice of which nodes run: the other orders are not. (Equal times, a log
+        // without timestamps, say nothing.)
         if let Some((last, last_cs, last_target)) = self.last_nmt.replace((at, cs, target))
-            && at.t.saturating_sub(last.t) < TWO_MASTERS_NS
-            && (last_target == target || last_target == 0 || target == 0)
-            && matches!((last_cs, cs), (0x01, 0x02 | 0x80))
+            && at.t > last.t
+            && at.t - last.t < TWO_MASTERS_NS
+            && (last_target == target || target == 0)
+            && last_cs == 0x01
+            && cs != 0x01
         {
             let node = [target, last_target].into_iter().find(|t| *t != 0);
+            // "reset node" names its target itself: "NMT reset node 2".
+            let verb = command.strip_suffix(" node").unwrap_or(command);
             let text = format!(
-                "NMT {command} {} right after NMT {} (#{})",
+                "NMT {verb} {} right after NMT start (#{})",
                 if target == 0 {
                     "all nodes".to_string()
                 } else {
                     format!("node {target}")
                 },
-                "start",
                 last.frame
             );
             self.second_master(node, "NMT commands that undo each other", at, text);
@@ -1094,9 +1261,7 @@ impl Diagnoser {
     pub fn transaction(&mut self, t: &Transaction) {
         self.node(t.node).segmenting = None;
         self.tracker.transaction(t);
-        for e in self.tracker.take_events() {
-            self.event(&e);
-        }
+        self.take_events();
         if t.outcome != Outcome::Ok || t.data.is_empty() {
             return;
         }
@@ -1153,9 +1318,7 @@ impl Diagnoser {
         }
         self.now = now_ns;
         self.tracker.tick(now_ns);
-        for e in self.tracker.take_events() {
-            self.event(&e);
-        }
+        self.take_events();
         if self.sdo_deadline.is_some_and(|dl| now_ns > dl) {
             self.sdo_timeouts(now_ns);
         }
@@ -1212,9 +1375,7 @@ impl Diagnoser {
             ..self.at
         };
         self.tracker.tick(end.t);
-        for e in self.tracker.take_events() {
-            self.event(&e);
-        }
+        self.take_events();
         self.sdo_timeouts(end.t);
         self.pdos_due(end.t);
         for (key, i) in std::mem::take(&mut self.pdo_gaps) {
@@ -1340,13 +1501,12 @@ fn merge_faults(all: Vec<Incident>) -> Vec<Incident> {
 mod tests {
     use super::*;
     use crate::decode::Decoder;
-    use crate::od::Dictionary;
 
     /// Runs `frames` (ms, COB-ID, hex data) through a decoder and a diagnoser; returns
     /// `node kind status count` per incident.
     fn run(frames: &[(u64, u32, &str)]) -> Vec<String> {
         let mut dec = Decoder::new(Dictionary::default(), Vec::new());
-        let mut diag = Diagnoser::new(EventTracker::new(|n| dec.dictionary(n)));
+        let mut diag = Diagnoser::new(|n| dec.dictionary(n));
         for (ms, id, data) in frames {
             let bytes: Vec<u8> = (0..data.len() / 2)
                 .map(|i| u8::from_str_radix(&data[2 * i..2 * i + 2], 16).unwrap())
@@ -1409,7 +1569,7 @@ mod tests {
     /// Like [`run`], with capture-clock ticks: `(ms, 0xFFFF_FFFF, "")` is a tick at `ms`.
     fn run_ticked(frames: &[(u64, u32, &str)]) -> Vec<String> {
         let mut dec = Decoder::new(Dictionary::default(), Vec::new());
-        let mut diag = Diagnoser::new(EventTracker::new(|n| dec.dictionary(n)));
+        let mut diag = Diagnoser::new(|n| dec.dictionary(n));
         for (ms, id, data) in frames {
             if *id == u32::MAX {
                 diag.tick(ms * MS);
@@ -1456,6 +1616,73 @@ mod tests {
         assert!(run(&f).is_empty(), "{:?}", run(&f));
         let f = [(0, 0x000, "8100"), (10, 0x705, "00"), (30, 0x705, "00")];
         assert_eq!(run(&f), ["5 duplicate_id open 1"]);
+    }
+
+    /// `run` of `frames`, only the second-master incidents.
+    fn masters(frames: &[(u64, u32, &str)]) -> Vec<String> {
+        run(frames)
+            .into_iter()
+            .filter(|i| i.contains("second_master"))
+            .collect()
+    }
+
+    /// A segmented upload of 0x1008 from node 2: initiate, answer, segment t0, answer t0.
+    const UPLOAD: [(u64, u32, &str); 4] = [
+        (0, 0x602, "4008100000000000"),
+        (1, 0x582, "4108100010000000"),
+        (2, 0x602, "6000000000000000"),
+        (3, 0x582, "00434F5455492044"),
+    ];
+
+    #[test]
+    fn a_segment_toggle_bit_repeated_at_once_is_a_second_client() {
+        // Right after the node answered the segment with toggle bit 0, another one with
+        // toggle bit 0: only a second client's transfer explains it.
+        let mut f = UPLOAD.to_vec();
+        f.extend([(5, 0x602, "6000000000000000"), (6, 0x582, "8008100000000305")]);
+        assert_eq!(masters(&f), ["2 second_master warning 1"]);
+        // Two segment requests with one toggle bit before any answer, 4 ms apart.
+        let mut f = UPLOAD[..3].to_vec();
+        f.extend([(6, 0x602, "6000000000000000"), (7, 0x582, "00434F5455492044")]);
+        assert_eq!(masters(&f), ["2 second_master warning 1"]);
+    }
+
+    #[test]
+    fn a_segment_retried_after_a_timeout_or_alternating_bits_are_one_client() {
+        // The toggle bit alternates: t0, answer, t1, answer (last).
+        let mut f = UPLOAD.to_vec();
+        f.extend([(4, 0x602, "7000000000000000"), (5, 0x582, "1D55492D31000000")]);
+        assert!(masters(&f).is_empty(), "{:?}", run(&f));
+        // The segment request is repeated 300 ms later, unanswered: a retry, not a second client.
+        let mut f = UPLOAD[..3].to_vec();
+        f.extend([
+            (300, 0x602, "6000000000000000"),
+            (301, 0x582, "00434F5455492044"),
+            (302, 0x602, "7000000000000000"),
+            (303, 0x582, "1D55492D31000000"),
+        ]);
+        assert!(masters(&f).is_empty(), "{:?}", run(&f));
+        // A new transfer starts the toggle bit over.
+        let mut f = UPLOAD.to_vec();
+        f.extend([(4, 0x602, "8008100000000000"), (5, 0x602, "4008100000000000")]);
+        f.extend([(6, 0x582, "4108100010000000"), (7, 0x602, "6000000000000000")]);
+        assert!(masters(&f).is_empty(), "{:?}", run(&f));
+    }
+
+    #[test]
+    fn nmt_start_undone_at_once_is_a_second_master_a_selection_is_not() {
+        // Start node 3, reset node 3 10 ms later: two masters disagree.
+        let f = [(0, 0x000, "0103"), (10, 0x000, "8103")];
+        assert_eq!(masters(&f), ["3 second_master warning 1"]);
+        // Start node 3, then pre-operational for all nodes 5 ms later.
+        let f = [(0, 0x000, "0103"), (5, 0x000, "8000")];
+        assert_eq!(masters(&f), ["3 second_master warning 1"]);
+        // Start all, then keep node 3 stopped: one master choosing which nodes run.
+        let f = [(0, 0x000, "0100"), (5, 0x000, "0203")];
+        assert!(masters(&f).is_empty());
+        // Pre-operational then start (re-configuration), and a stop 30 ms after the start.
+        let f = [(0, 0x000, "8003"), (2, 0x000, "0103"), (32, 0x000, "0203")];
+        assert!(masters(&f).is_empty());
     }
 
     #[test]

@@ -194,11 +194,17 @@ impl EventTracker {
 
     /// Time has reached `now_ns` (a frame's timestamp, or the capture clock when no frame
     /// comes): every node whose deadline is before it is lost, dated at its deadline.
+    #[inline]
     pub fn tick(&mut self, now_ns: u64) {
         self.now_ns = self.now_ns.max(now_ns);
         if self.next_deadline.is_none_or(|d| now_ns <= d) {
             return;
         }
+        self.lose_overdue(now_ns);
+    }
+
+    /// Every node whose deadline is before `now_ns` is lost (see [`EventTracker::tick`]).
+    fn lose_overdue(&mut self, now_ns: u64) {
         let mut due: Vec<(u64, u8)> = self
             .nodes
             .iter()

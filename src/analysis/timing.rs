@@ -2,7 +2,7 @@
 //! stop arriving within their event time (0x1800/0x1400 sub 5 seen on the bus) or their
 //! measured period. Pure: times are frame timestamps (ns) passed in.
 
-use std::collections::BTreeMap;
+use std::collections::HashMap;
 
 const MS: u64 = 1_000_000;
 /// Intervals used to learn a period.
@@ -208,17 +208,69 @@ pub enum PdoGap {
     Back { key: PdoKey, gap_ns: u64 },
 }
 
-/// Arrival times of every PDO, and the event timers seen written.
+/// PDOs 1..=[`FAST_PDOS`] of each node are found by direct index (the common ones).
+const FAST_PDOS: usize = 8;
+/// No stream yet in a [`PdoTiming::slot`] entry.
+const NONE: u32 = u32::MAX;
+
+/// Where `key` is in [`PdoTiming::slot`], for PDOs 1..=[`FAST_PDOS`].
+fn fast_slot((node, transmit, num): PdoKey) -> Option<usize> {
+    let num = usize::from(num);
+    ((1..=FAST_PDOS).contains(&num))
+        .then(|| (usize::from(node & 0x7F) * 2 + usize::from(transmit)) * FAST_PDOS + num - 1)
+}
+
+/// Arrival times of every PDO, and the event timers seen written. Looked up per PDO
+/// frame, so the common PDOs take an array index, not a map search.
 #[derive(Clone, Debug, Default)]
 pub struct PdoTiming {
-    streams: BTreeMap<PdoKey, Stream>,
+    /// Every PDO seen, in the order first seen.
+    streams: Vec<(PdoKey, Stream)>,
+    /// Index in `streams` of PDOs 1..=[`FAST_PDOS`] per node and direction ([`NONE`]:
+    /// not seen); empty until the first PDO.
+    slot: Vec<u32>,
+    /// Index in `streams` of the other PDOs.
+    more: HashMap<PdoKey, usize>,
     next: Option<u64>,
 }
 
 impl PdoTiming {
+    #[inline]
+    fn find(&self, key: PdoKey) -> Option<usize> {
+        match fast_slot(key) {
+            Some(i) => self.slot.get(i).filter(|s| **s != NONE).map(|s| *s as usize),
+            None => self.more.get(&key).copied(),
+        }
+    }
+
+    /// The stream of `key`, made on first use.
+    #[inline]
+    fn stream(&mut self, key: PdoKey) -> &mut Stream {
+        let i = match self.find(key) {
+            Some(i) => i,
+            None => {
+                let i = self.streams.len();
+                self.streams.push((key, Stream::default()));
+                match fast_slot(key) {
+                    Some(f) => {
+                        if self.slot.is_empty() {
+                            self.slot = vec![NONE; 128 * 2 * FAST_PDOS];
+                        }
+                        self.slot[f] = i as u32;
+                    }
+                    None => {
+                        self.more.insert(key, i);
+                    }
+                }
+                i
+            }
+        };
+        &mut self.streams[i].1
+    }
+
     /// A PDO `key` arrived (frame `frame` at `t_ns`); returns a gap that it ends.
     pub fn pdo(&mut self, key: PdoKey, frame: u64, t_ns: u64) -> Option<PdoGap> {
-        let s = self.streams.entry(key).or_default();
+        let s = self.stream(key);
         let prev = s.last.replace((frame, t_ns));
         let back = std::mem::take(&mut s.missing);
         if let Some((_, last)) = prev
@@ -246,23 +298,23 @@ impl PdoTiming {
 
     /// The event timer of `key` was written: `ms` (0 switches it off).
     pub fn event_timer(&mut self, key: PdoKey, ms: u64) {
-        self.streams.entry(key).or_default().event_timer = (ms > 0).then_some(ms * MS);
+        self.stream(key).event_timer = (ms > 0).then_some(ms * MS);
     }
 
     /// The transmission type of `key` was written (sub 2): 1..=240 is synchronous.
     pub fn transmission_type(&mut self, key: PdoKey, t: u8) {
-        self.streams.entry(key).or_default().synchronous = (1..=240).contains(&t);
+        self.stream(key).synchronous = (1..=240).contains(&t);
     }
 
     /// True when `key` was configured synchronous (transmission type 1..=240).
     pub fn synchronous(&self, key: PdoKey) -> bool {
-        self.streams.get(&key).is_some_and(|s| s.synchronous)
+        self.find(key).is_some_and(|i| self.streams[i].1.synchronous)
     }
 
     /// `node` stops sending PDOs for a reason (NMT stop, pre-operational, reset, boot-up):
     /// its PDOs are not expected until they come again.
     pub fn pause(&mut self, node: Option<u8>) {
-        for (k, s) in self.streams.iter_mut() {
+        for (k, s) in &mut self.streams {
             if node.is_none_or(|n| n == k.0) {
                 s.last = None;
                 s.missing = false;
@@ -270,13 +322,19 @@ impl PdoTiming {
         }
     }
 
-    /// PDOs overdue at `now_ns` (each reported once until it comes back).
+    /// PDOs overdue at `now_ns` (each reported once until it comes back), in PDO order
+    /// (node, RPDO before TPDO, number). Called per frame: the common "none" is inline.
+    #[inline]
     pub fn due(&mut self, now_ns: u64) -> Vec<PdoGap> {
         if self.next.is_none_or(|n| now_ns <= n) {
             return Vec::new();
         }
+        self.overdue(now_ns)
+    }
+
+    fn overdue(&mut self, now_ns: u64) -> Vec<PdoGap> {
         let mut out = Vec::new();
-        for (k, s) in self.streams.iter_mut() {
+        for (k, s) in &mut self.streams {
             if s.deadline().is_some_and(|d| d < now_ns)
                 && let (Some((frame, t)), Some((p, from))) = (s.last, s.expected())
             {
@@ -290,7 +348,10 @@ impl PdoTiming {
                 });
             }
         }
-        self.next = self.streams.values().filter_map(Stream::deadline).min();
+        self.next = self.streams.iter().filter_map(|(_, s)| s.deadline()).min();
+        out.sort_by_key(|g| match g {
+            PdoGap::Missing { key, .. } | PdoGap::Back { key, .. } => *key,
+        });
         out
     }
 }

@@ -11,7 +11,6 @@
 //! the checkpoints cost well under a byte per frame.
 
 use super::diagnose::Diagnoser;
-use super::liveness::EventTracker;
 use super::nodes::Nodes;
 use super::series::Series;
 use super::stats::Stats;
@@ -54,7 +53,7 @@ impl Trace {
     /// An empty trace decoded with `decoder`.
     pub fn new(decoder: Decoder, bitrate: u64) -> Trace {
         let nodes = Nodes::new(&decoder);
-        let diagnosis = Diagnoser::new(EventTracker::new(|n| decoder.dictionary(n)));
+        let diagnosis = Diagnoser::new(|n| decoder.dictionary(n));
         Trace {
             diagnosis,
             diagnosis_version: 0,

@@ -1,9 +1,11 @@
-//! `cotui diagnose FILE...`: what went wrong on the bus, as a short ranked list of incidents.
+//! `cotui diagnose FILE...` (or `--live IFACE`): what went wrong on the bus, as a short
+//! ranked list of incidents.
 
 use super::input;
-use crate::analysis::{Diagnoser, EventTracker, Incident, Status};
+use crate::analysis::{Diagnoser, Incident, Status};
 use crate::command::ExitCode;
-use crate::decode::Kind;
+use crate::decode::{Decoder, Kind};
+use crate::frame::Frame;
 use crate::frame::json::write_line;
 use clap::{Args, ValueEnum};
 use std::io::{self, Write};
@@ -22,8 +24,15 @@ pub enum DiagnoseFormat {
 pub struct DiagnoseArgs {
     /// Log files (candump -l/-L, candump screen output, Vector ASC), read as one capture;
     /// `-` reads stdin.
-    #[arg(required = true)]
+    #[arg(required_unless_present = "live")]
     pub files: Vec<String>,
+    /// Diagnose a live SocketCAN interface instead (listen-only: nothing is sent) until
+    /// Ctrl-C (SIGINT or SIGTERM) or `--duration`, then report as for a log.
+    #[arg(long, value_name = "IFACE", conflicts_with = "files")]
+    pub live: Option<String>,
+    /// With `--live`: stop after this many seconds.
+    #[arg(long, value_name = "SECONDS")]
+    pub duration: Option<f64>,
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     pub format: DiagnoseFormat,
@@ -47,8 +56,18 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
             return ExitCode::Usage;
         }
     };
-    let mut diag = Diagnoser::new(EventTracker::new(|n| decoder.dictionary(n)));
+    let mut diag = Diagnoser::new(|n| decoder.dictionary(n));
+    if args.duration.is_some() && args.live.is_none() {
+        eprintln!("cotui diagnose: --duration needs --live IFACE (a log ends by itself)");
+        return ExitCode::Usage;
+    }
     let mut status = ExitCode::Ok;
+    if let Some(iface) = &args.live
+        && let Err(e) = live::capture(iface, args.duration, &mut decoder, &mut diag)
+    {
+        eprintln!("cotui diagnose: {e}");
+        return ExitCode::Unavailable;
+    }
     for path in &args.files {
         let Some(input) = input::open_input(path, "diagnose") else {
             status = ExitCode::Unavailable;
@@ -57,25 +76,7 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
         let result = input::for_each_frame(path, input, |frames| {
             let ifaces = frames.ifaces;
             for (_, frame) in frames {
-                // Frames that cannot tell the diagnosis anything are not decoded.
-                let (kind, node, pdo) = decoder.peek(frame);
-                let skip = match kind {
-                    Kind::Sync | Kind::Time | Kind::Lss | Kind::Other => true,
-                    Kind::Tpdo | Kind::Rpdo => {
-                        let n = node.unwrap_or(0);
-                        !diag.wants_pdo(n, pdo, decoder.mapping(n, kind == Kind::Tpdo, pdo))
-                    }
-                    _ => false,
-                };
-                if skip {
-                    diag.skip(frame, kind, node, pdo);
-                    continue;
-                }
-                let d = decoder.decode(frame);
-                diag.frame(frame, ifaces.name(frame.iface), &d);
-                for t in decoder.take_transactions() {
-                    diag.transaction(&t);
-                }
+                feed(&mut decoder, &mut diag, frame, ifaces.name(frame.iface));
             }
             Ok(())
         });
@@ -111,6 +112,102 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
         return ExitCode::Usage;
     }
     status
+}
+
+/// One frame of interface `iface` into the diagnosis: decoded only as far as it can tell
+/// the diagnosis something.
+fn feed(decoder: &mut Decoder, diag: &mut Diagnoser, frame: &Frame, iface: &str) {
+    let (kind, node, pdo) = decoder.peek(frame);
+    let skip = match kind {
+        Kind::Sync | Kind::Time | Kind::Lss | Kind::Other => true,
+        // SDO frames: tracked without building the label nobody reads.
+        Kind::SdoRx | Kind::SdoTx => {
+            let s = decoder.sdo_frame(frame);
+            diag.sdo(frame, node.unwrap_or(0), kind == Kind::SdoRx, s.as_ref());
+            for t in decoder.take_transactions() {
+                diag.transaction(&t);
+            }
+            return;
+        }
+        Kind::Tpdo | Kind::Rpdo => {
+            let n = node.unwrap_or(0);
+            !diag.wants_pdo(n, pdo, decoder.mapping(n, kind == Kind::Tpdo, pdo))
+        }
+        _ => false,
+    };
+    if skip {
+        diag.skip(frame, kind, node, pdo);
+        return;
+    }
+    let d = decoder.decode(frame);
+    diag.frame(frame, iface, &d);
+    for t in decoder.take_transactions() {
+        diag.transaction(&t);
+    }
+}
+
+/// `--live`: the frames of a SocketCAN interface, as they come.
+mod live {
+    use super::{Decoder, Diagnoser, feed};
+    use std::time::Duration;
+    use tokio::signal::unix::{SignalKind, signal};
+
+    /// How often the capture clock advances on a quiet bus (heartbeats missed by then count).
+    const TICK: Duration = Duration::from_millis(100);
+
+    /// Feeds the frames of `iface` (opened listen-only) to the diagnosis until SIGINT or
+    /// SIGTERM, or for `seconds`; the capture clock ends at the bus time then.
+    pub fn capture(
+        iface: &str,
+        seconds: Option<f64>,
+        decoder: &mut Decoder,
+        diag: &mut Diagnoser,
+    ) -> Result<(), String> {
+        let limit = match seconds {
+            Some(s) => {
+                Some(Duration::try_from_secs_f64(s).map_err(|_| format!("--duration {s}: not a number of seconds"))?)
+            }
+            None => None,
+        };
+        let rt = tokio::runtime::Builder::new_current_thread()
+            .enable_all()
+            .build()
+            .map_err(|e| format!("cannot start the runtime: {e}"))?;
+        rt.block_on(async {
+            let handler = |kind| signal(kind).map_err(|e| format!("cannot install a signal handler: {e}"));
+            let (mut int, mut term) = (handler(SignalKind::interrupt())?, handler(SignalKind::terminate())?);
+            let bus = crate::connect::open(iface, true).await.map_err(|e| e.to_string())?;
+            let mut frames = bus.subscribe();
+            let end = limit.map(|d| tokio::time::Instant::now() + d);
+            let mut tick = tokio::time::interval(TICK);
+            loop {
+                let deadline = async {
+                    match end {
+                        Some(e) => tokio::time::sleep_until(e).await,
+                        None => std::future::pending().await,
+                    }
+                };
+                tokio::select! {
+                    got = frames.recv() => match got {
+                        Ok(f) => feed(decoder, diag, &f, iface),
+                        Err(crate::bus::BusError::Closed) => return Err(format!("{iface}: the bus was closed")),
+                        // The interface went down or away: said, and the capture goes on.
+                        Err(e) => eprintln!("cotui diagnose: {e}"),
+                    },
+                    _ = tick.tick() => diag.tick(bus.now_ns()),
+                    _ = int.recv() => break,
+                    _ = term.recv() => break,
+                    _ = deadline => break,
+                }
+            }
+            // Frames the kernel still holds are part of the capture.
+            while let Some(Ok(f)) = frames.try_recv() {
+                feed(decoder, diag, &f, iface);
+            }
+            diag.tick(bus.now_ns());
+            Ok(())
+        })
+    }
 }
 
 /// The text report: a headline with the counts, then one block per incident.

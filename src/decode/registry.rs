@@ -181,6 +181,22 @@ impl Decoder {
         (route.kind, route.node)
     }
 
+    /// An SDO frame (per [`Decoder::peek`]) tracked as [`Decoder::decode`] tracks it, without
+    /// building its label: the frame as the tracker read it, or None for a vendor SDO
+    /// command of the node's profile (which `decode` shows as [`Body::VendorSdo`]).
+    /// For callers that only need the command and the tracker's notes (the diagnosis).
+    pub fn sdo_frame(&mut self, frame: &Frame) -> Option<SdoFrame> {
+        let route = self.route(frame);
+        debug_assert!(matches!(route.kind, Kind::SdoRx | Kind::SdoTx));
+        self.seq += 1;
+        let s = self.track_sdo(frame, route);
+        let n = route.node.unwrap_or(0) as usize & 0x7F;
+        let c2s = route.kind == Kind::SdoRx;
+        vendor_sdo::decode(&self.dicts[n], c2s, frame.payload())
+            .is_none()
+            .then_some(s)
+    }
+
     fn route(&self, frame: &Frame) -> Route {
         if frame.is_err() {
             return Route {

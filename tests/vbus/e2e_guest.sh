@@ -5,7 +5,8 @@
 # Every check runs host-built cotui against peers cotui did not write: can-utils
 # (cangen, cansend, candump), the python canopen peers (peers/sdo_server.py node 5,
 # peers/drive402.py node 2 (sections 2-5, stopped with sdo_server.py after section 5) and node 12
-# (section 14); peers/dcf_node.py nodes 10 and 11 in section 15) and tmux.
+# (section 14); peers/dcf_node.py nodes 10 and 11 in section 15; peers/diag_node.py node 7 in
+# section 16) and tmux.
 # Prints one line per check ("ok   ..." or "FAIL ...") and "N passed, N failed"; exits 1
 # on any failure.
 set -uo pipefail
@@ -983,6 +984,68 @@ c dcf diff vcan0 11 node10.dcf --eds "$dcf_eds" --json
     ok "dcf diff after: exit 0, $(echo "$out" | j .unchanged) values equal" ||
     bad "dcf diff after: rc=$rc $out $err"
 kill $dcf_a $dcf_b 2> /dev/null
+
+# ---- 16 diag: the live diagnosis (Problems pane) and cotui diagnose of the same capture ----
+# peers/diag_node.py (node 7; a raw socket of python's standard library, so it starts in about
+# a second under TCG) sends a boot-up, heartbeats every 250 ms, an EMCY 0x3210 after 8 of
+# them, 8 more heartbeats, then goes silent as a crashed device does. cotui live vcan0 in
+# tmux shows tab 8 Problems: node 7's EMCY and its silence must appear there while the run
+# goes on (no frame of node 7 follows the silence: the live capture clock must find it).
+# The headless twin `cotui diagnose --live vcan0 --check` runs beside it until SIGINT. candump -L
+# records the same run; `cotui diagnose --check` of that file must report the same open
+# incidents of node 7 as both (status and title as the pane shows them) and exit 1. (A
+# heartbeat that python sends late under TCG may add a warning: not compared.)
+candump -L vcan0 > diag.log 2> /dev/null &
+diag_dump=$!
+pids+=($diag_dump)
+"$cotui" diagnose --live vcan0 --check --format jsonl --duration 120 > diag_live.jsonl 2> diag_live.err &
+diag_live=$!
+pids+=($diag_live)
+tmux new-session -d -s diag -x 200 -y 45 "XDG_CONFIG_HOME=$work $cotui live vcan0; echo cotui-exit=\$?; sleep 60"
+dscreen() { tmux capture-pane -p -t diag; }
+dwait() { for _ in $(seq "$1"); do dscreen > dscreen.txt; grep -qE -- "$2" dscreen.txt && return 0; sleep 0.2; done; return 1; }
+if wait_socket "$diag_dump" && dwait 150 "vcan0 \|"; then
+    tmux send-keys -t diag 8
+    python3 "$here/peers/diag_node.py" vcan0 7 --heartbeat-ms 250 --beats 8 --after-s 2 > diag_node.out 2>&1 &
+    diag_peer=$!
+    pids+=($diag_peer)
+    dwait 150 "OPEN +Node 7 .*Reported an error" &&
+        ok "diag: the Problems pane shows node 7's EMCY live ($(grep -oE 'Node 7 .*Reported an error: [^(]*\(EMCY 0x[0-9A-F]{4}\)' dscreen.txt | tr -s ' ' | head -1))" ||
+        bad "diag: no EMCY incident of node 7 in the Problems pane: $(cat diag_node.out) $(cat dscreen.txt)"
+    if wait_for diag_node.out 150 "diag_node silent" && dwait 50 "OPEN +Node 7 .*Went silent"; then
+        ok "diag: the Problems pane shows node 7 silent with no frame of it after the last heartbeat"
+    else
+        bad "diag: node 7's silence not in the Problems pane within 10 s: $(cat diag_node.out) $(cat dscreen.txt)"
+    fi
+    live_screen=$(cat dscreen.txt)
+else
+    bad "diag: candump or cotui live did not start: $(cat dscreen.txt)"
+    live_screen=""
+fi
+kill -INT "$diag_live" 2> /dev/null
+tmux send-keys -t diag q
+dwait 100 "cotui-exit=0" || bad "diag: cotui live did not quit: $(cat dscreen.txt)"
+tmux kill-session -t diag 2> /dev/null
+wait "$diag_live"
+live_rc=$?
+# One frame after node 7's deadline, so that the recording itself shows the silence.
+cansend vcan0 080#
+sleep 0.3
+kill "$diag_dump" 2> /dev/null
+c diagnose --check --format jsonl diag.log
+node7=$(echo "$out" | jq -c 'select(.node == 7 and .status == "open") | [.status, .kind]' | sort | tr -d '\n')
+missing=""
+while IFS=$'\t' read -r status title; do
+    [ -n "$title" ] || continue
+    echo "$live_screen" | grep -F "Node 7" | grep -F -- "$title" | grep -qiE "$status +Node 7 " || missing="$missing [$status $title]"
+done < <(echo "$out" | jq -r 'select(.node == 7 and .status == "open") | [.status, .title] | @tsv')
+[ "$rc" = 1 ] && [ "$node7" = '["open","emcy"]["open","silent"]' ] && [ -z "$missing" ] &&
+    ok "diag: cotui diagnose --check of candump's recording: exit 1, node 7 $node7, each as the live pane showed it ($(echo "$out" | jq -s 'map(select(.node == 7 and .status != "open")) | length') warnings of node 7 besides)" ||
+    bad "diag: diagnose of the recording: rc=$rc node 7: $node7; not in the live pane:$missing; $err"
+live7=$(jq -c 'select(.node == 7 and .status == "open") | [.status, .kind, .title]' diag_live.jsonl | sort | tr -d '\n')
+[ "$live_rc" = 1 ] && [ -n "$live7" ] && [ "$live7" = "$(echo "$out" | jq -c 'select(.node == 7 and .status == "open") | [.status, .kind, .title]' | sort | tr -d '\n')" ] &&
+    ok "diag: cotui diagnose --live vcan0 --check (stopped by SIGINT): exit 1, the same open incidents of node 7 as the recording" ||
+    bad "diag: diagnose --live: rc=$live_rc node 7: $live7; $(cat diag_live.err)"
 
 t_end=$(date +%s.%N)
 echo "$passed passed, $failed failed ($(awk -v a="$t_start" -v b="$t_end" 'BEGIN { printf "%.0f", b - a }') s in the guest)"
