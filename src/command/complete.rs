@@ -55,7 +55,7 @@ pub fn objects(dict: &Dictionary, suffix: &str) -> Vec<String> {
     for layer in dict.layers() {
         names.extend(layer.aliases.keys().cloned());
         names.extend(layer.object_names.values().cloned());
-        for o in layer.objects.values() {
+        for (_, o) in layer.entries() {
             names.insert(o.name.clone());
             names.extend(o.alias.clone());
         }

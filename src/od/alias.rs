@@ -221,11 +221,10 @@ pub fn resolve_object(dict: &Dictionary, text: &str) -> Result<(u16, u8), Object
     }
     for layer in dict.layers() {
         if let Some((k, _)) = layer
-            .objects
-            .iter()
+            .entries()
             .find(|(_, o)| o.alias.as_deref().is_some_and(|a| a.eq_ignore_ascii_case(t)))
         {
-            return Ok(*k);
+            return Ok(k);
         }
         if let Some((_, r)) = layer.aliases.iter().find(|(a, _)| a.eq_ignore_ascii_case(t)) {
             return Ok(*r);
@@ -247,8 +246,8 @@ pub fn resolve_object(dict: &Dictionary, text: &str) -> Result<(u16, u8), Object
         if let Some((i, _)) = layer.object_names.iter().find(|(_, n)| n.eq_ignore_ascii_case(name)) {
             return Ok((*i, sub.unwrap_or(0)));
         }
-        if let Some(((i, s), _)) = layer.objects.iter().find(|(_, o)| o.name.eq_ignore_ascii_case(name)) {
-            return Ok((*i, sub.unwrap_or(*s)));
+        if let Some(((i, s), _)) = layer.entries().find(|(_, o)| o.name.eq_ignore_ascii_case(name)) {
+            return Ok((i, sub.unwrap_or(s)));
         }
     }
     Err(ObjectError::Unknown {

@@ -12,6 +12,7 @@ pub mod dcf;
 mod device;
 pub mod eds;
 pub mod expr;
+pub mod family;
 pub mod fields;
 pub mod json;
 pub mod merge;
@@ -23,6 +24,7 @@ pub use alias::{AliasRule, resolve_object};
 pub use bind::Bindings;
 pub use device::{Axis, IdCondition, IdTest, IndexRange, ObjectRange, PdoSet, PdoTemplate, TextMatch};
 pub use expr::Expr;
+pub use family::SubFamily;
 pub use fields::{ByteField, SdoCommand, SdoDirection};
 pub use procedure::{Procedure, Step};
 pub use value::{DataType, Value};
@@ -199,8 +201,12 @@ pub struct Profile {
     pub node_id: Option<u8>,
     /// Node name from an EDS/DCF `[DeviceCommissioning]` section.
     pub node_name: Option<String>,
-    /// Objects by (index, sub). Single-valued objects use sub 0.
+    /// Objects given one by one, by (index, sub). Single-valued objects use sub 0.
+    /// Entries of sub ranges are in `families`: [`Profile::entries`] lists both.
     pub objects: BTreeMap<(u16, u8), ObjectInfo>,
+    /// Sub ranges of records (`"1..254"`) by (index, first sub), each one template; an
+    /// entry in `objects` at the same (index, sub) wins.
+    pub families: BTreeMap<(u16, u8), SubFamily>,
     /// Families of identical records over index ranges (PDO/SDO parameters),
     /// used for an index that has no entry in `objects`.
     pub ranges: Vec<IndexRange>,
@@ -215,16 +221,79 @@ pub struct Profile {
 }
 
 impl Profile {
-    /// The entry at (index, sub): from `objects`, or from an index range when
-    /// `objects` has nothing at that index.
+    /// The entry at (index, sub): from `objects`, else from a sub family, or from an
+    /// index range when the profile has nothing else at that index.
     pub fn object(&self, index: u16, sub: u8) -> Option<&ObjectInfo> {
         if let Some(o) = self.objects.get(&(index, sub)) {
             return Some(o);
         }
-        if self.objects.range((index, 0)..=(index, 255)).next().is_some() {
+        if let Some(o) = self.family_entry(index, sub) {
+            return Some(o);
+        }
+        if self.has_index(index) {
             return None;
         }
         self.range_of(index).and_then(|r| r.subs.get(&sub))
+    }
+
+    /// The entry at (index, sub) of a sub family.
+    fn family_entry(&self, index: u16, sub: u8) -> Option<&ObjectInfo> {
+        let (_, family) = self.families.range((index, 0)..=(index, sub)).next_back()?;
+        family.get(sub)
+    }
+
+    /// Whether `objects` or `families` have anything at `index`.
+    fn has_index(&self, index: u16) -> bool {
+        self.objects.range((index, 0)..=(index, 255)).next().is_some()
+            || self.families.range((index, 0)..=(index, 255)).next().is_some()
+    }
+
+    /// Every entry of `objects` and `families` (not index ranges), by (index, sub),
+    /// each once: the one `object` gives.
+    pub fn entries(&self) -> impl Iterator<Item = ((u16, u8), &ObjectInfo)> {
+        let families = self.families.iter().flat_map(|(&(index, _), f)| {
+            f.iter()
+                .map(move |(sub, info)| ((index, sub), info))
+                .filter(|(key, _)| !self.objects.contains_key(key))
+        });
+        let mut all: Vec<((u16, u8), &ObjectInfo)> = self.objects.iter().map(|(k, o)| (*k, o)).collect();
+        if !self.families.is_empty() {
+            all.extend(families);
+            all.sort_unstable_by_key(|(key, _)| *key);
+        }
+        all.into_iter()
+    }
+
+    /// The entries of `objects` and `families` at `index`, by sub, each once.
+    pub fn entries_at(&self, index: u16) -> Vec<(u8, &ObjectInfo)> {
+        let mut subs: BTreeMap<u8, &ObjectInfo> = self
+            .families
+            .range((index, 0)..=(index, 255))
+            .flat_map(|(_, f)| f.iter())
+            .collect();
+        subs.extend(self.objects.range((index, 0)..=(index, 255)).map(|(k, o)| (k.1, o)));
+        subs.into_iter().collect()
+    }
+
+    /// Adds a sub family at `index`.
+    pub fn add_family(&mut self, index: u16, family: SubFamily) {
+        self.families.insert((index, *family.subs().start()), family);
+    }
+
+    /// Removes every entry and family at `index`.
+    pub fn remove_index(&mut self, index: u16) {
+        let stale: Vec<(u16, u8)> = self.objects.range((index, 0)..=(index, 255)).map(|(k, _)| *k).collect();
+        for k in stale {
+            self.objects.remove(&k);
+        }
+        let stale: Vec<(u16, u8)> = self
+            .families
+            .range((index, 0)..=(index, 255))
+            .map(|(k, _)| *k)
+            .collect();
+        for k in stale {
+            self.families.remove(&k);
+        }
     }
 
     /// The last-defined index range containing `index`.
@@ -235,7 +304,7 @@ impl Profile {
     /// Copies an index range's entries for `index` into `objects`, so that single
     /// entries can then be changed there.
     pub fn materialize(&mut self, index: u16) {
-        if self.objects.range((index, 0)..=(index, 255)).next().is_some() {
+        if self.has_index(index) {
             return;
         }
         let Some(subs) = self.range_of(index).map(|r| r.subs.clone()) else {

@@ -59,7 +59,7 @@ fn catalog(dict: &Dictionary, seen: &BTreeSet<u16>) -> Vec<Obj> {
     let mut subs: BTreeMap<u16, BTreeSet<u8>> = BTreeMap::new();
     let mut records: BTreeSet<u16> = BTreeSet::new();
     for layer in dict.layers() {
-        for &(i, s) in layer.objects.keys() {
+        for ((i, s), _) in layer.entries() {
             subs.entry(i).or_default().insert(s);
         }
         records.extend(layer.object_names.keys());
