@@ -243,8 +243,8 @@ pub fn resolve_object(dict: &Dictionary, text: &str) -> Result<(u16, u8), Object
         None => (t, None),
     };
     for layer in dict.layers() {
-        if let Some((i, _)) = layer.object_names.iter().find(|(_, n)| n.eq_ignore_ascii_case(name)) {
-            return Ok((*i, sub.unwrap_or(0)));
+        if let Some((i, _)) = layer.names().into_iter().find(|(_, n)| n.eq_ignore_ascii_case(name)) {
+            return Ok((i, sub.unwrap_or(0)));
         }
         if let Some(((i, s), _)) = layer.entries().find(|(_, o)| o.name.eq_ignore_ascii_case(name)) {
             return Ok((i, sub.unwrap_or(s)));

@@ -14,7 +14,7 @@ use serde_json::Value as Json;
 
 use super::alias::{AliasRule, parse_object_ref};
 use super::expr::{Expr, parse_int};
-use super::family::{SubFamily, fill};
+use super::family::{Numbered, SubFamily, fill};
 use super::fields::{ByteField, SdoCommand, SdoDirection};
 use super::procedure::{
     FailIf, NmtCommand, ProcParam, Procedure, ProcedureError, Step, object_variables, parse_frame_data,
@@ -190,6 +190,17 @@ fn place_names(p: &mut Profile, index: u16, nth: Option<u32>, b: &Built) {
     }
 }
 
+/// Puts the record alias of `b` at every index of `first..=last`, `{i}` in it standing for
+/// the 1-based place in the range. (The record names stay in the [`IndexRange`].)
+fn place_range_aliases(p: &mut Profile, first: u16, last: u16, b: &Built) {
+    if let Some(a) = &b.alias {
+        let alias = Numbered::new(a, "{i}");
+        for index in first..=last {
+            p.aliases.insert(alias.with(u32::from(index - first) + 1), (index, 0));
+        }
+    }
+}
+
 /// `name` with `{i}` replaced by `i`.
 fn nth_name(name: &str, i: u32) -> String {
     fill(name, "{i}", i)
@@ -241,11 +252,8 @@ impl Cx<'_> {
             // template (PDO parameters would otherwise be 70000 entries).
             if built.record && !built.names_index() {
                 // Only the names go to each index; the subs stay in the template.
-                for index in first..=last {
-                    place_names(&mut p, index, Some(u32::from(index - first) + 1), &built);
-                }
-                let subs = built.subs();
-                p.ranges.push(IndexRange { first, last, subs });
+                place_range_aliases(&mut p, first, last, &built);
+                p.ranges.push(IndexRange::new(first, last, built.subs(), built.name));
                 continue;
             }
             let size = (usize::from(last - first) + 1) * built.len().max(1);

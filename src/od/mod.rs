@@ -179,7 +179,9 @@ pub struct Profile {
     pub description: String,
     /// Profiles this one builds on, most specific first (e.g. ["cia402"]).
     pub extends: Vec<String>,
-    /// Names of records and arrays at index level, e.g. 0x1018 -> "Identity object".
+    /// Names of records and arrays at index level, e.g. 0x1018 -> "Identity object";
+    /// an index range's are in the range: [`Profile::object_name`] and
+    /// [`Profile::names`] give both.
     pub object_names: BTreeMap<u16, String>,
     /// Extra vendor aliases besides each object's own `alias`.
     pub aliases: BTreeMap<String, (u16, u8)>,
@@ -296,9 +298,28 @@ impl Profile {
         }
     }
 
+    /// The name of the record at `index`: its own, else the last-defined index range's
+    /// that names it (`TPDO3 mapping parameter`).
+    pub fn object_name(&self, index: u16) -> Option<&str> {
+        match self.object_names.get(&index) {
+            Some(name) => Some(name),
+            None => self.ranges.iter().rev().find_map(|r| r.name(index)),
+        }
+    }
+
+    /// Every record name by index, as `object_name` gives it.
+    pub fn names(&self) -> BTreeMap<u16, &str> {
+        let mut names = BTreeMap::new();
+        for r in &self.ranges {
+            names.extend((r.first..=r.last).filter_map(|i| Some((i, r.name(i)?))));
+        }
+        names.extend(self.object_names.iter().map(|(i, n)| (*i, n.as_str())));
+        names
+    }
+
     /// The last-defined index range containing `index`.
     fn range_of(&self, index: u16) -> Option<&IndexRange> {
-        self.ranges.iter().rev().find(|r| (r.first..=r.last).contains(&index))
+        self.ranges.iter().rev().find(|r| r.contains(index))
     }
 
     /// Copies an index range's entries for `index` into `objects`, so that single
@@ -388,10 +409,8 @@ impl Dictionary {
     /// The name of an object at index level: a record's name, or its sub 0 entry's.
     pub fn object_name(&self, index: u16) -> Option<&str> {
         self.layers.iter().find_map(|p| {
-            p.object_names
-                .get(&index)
-                .map(String::as_str)
-                .or(p.object(index, 0).map(|o| o.name.as_str()))
+            p.object_name(index)
+                .or_else(|| p.object(index, 0).map(|o| o.name.as_str()))
         })
     }
     /// The first layer with an EMCY manufacturer-byte layout, and that layout.

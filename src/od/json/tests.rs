@@ -77,15 +77,15 @@ fn good_profile_loads_everything() {
     assert_eq!(p.object(0x1018, 0).unwrap().default, Some(Value::Unsigned(4)));
     assert_eq!(p.object(0x1016, 3).unwrap().name, "Consumer heartbeat time 3");
     assert_eq!(p.object(0x1008, 0).unwrap().default, Some(Value::Text("DEV".into())));
-    assert_eq!(p.object_names[&0x19FF], "TPDO512 communication parameter");
+    assert_eq!(p.object_name(0x19FF), Some("TPDO512 communication parameter"));
     assert_eq!(p.object(0x1800, 1).unwrap().name, "COB-ID used by TPDO1");
-    assert_eq!(p.object_names[&0x1801], "Special TPDO");
+    assert_eq!(p.object_name(0x1801), Some("Special TPDO"));
     assert_eq!(p.object(0x1801, 1), None);
     assert_eq!(p.object(0x1801, 2).unwrap().name, "Transmission type");
     assert_eq!(p.object(0x1A00, 0).unwrap().name, "Number of mapped objects");
     // A record range without {i} in its subs is kept once, not per index.
     assert_eq!(p.ranges.len(), 1);
-    assert_eq!(p.object_names[&0x17FF], "RPDO512 mapping parameter");
+    assert_eq!(p.object_name(0x17FF), Some("RPDO512 mapping parameter"));
     assert_eq!(p.object(0x17FF, 64).unwrap().name, "Mapped object 64");
     assert_eq!(p.object(0x17FF, 65), None);
     // A flat key inside the range changes one sub and keeps the others.
@@ -426,4 +426,21 @@ fn the_first_layer_with_an_entry_wins_over_a_lower_layers_sub_range() {
     assert_eq!(name(0x1016, 2), Some("Vendor heartbeat 2"));
     assert_eq!(name(0x1016, 3), Some("Consumer heartbeat time 3"));
     assert_eq!(name(0x1016, 128), None);
+}
+
+#[test]
+fn index_range_names_are_listed_and_resolved_like_record_names() {
+    let (p, _) = load_profile("g.json", GOOD).unwrap();
+    let names = p.names();
+    assert_eq!(names[&0x1600], "RPDO1 mapping parameter");
+    assert_eq!(names[&0x17FF], "RPDO512 mapping parameter");
+    assert_eq!(names[&0x1801], "Special TPDO", "a record's own name wins");
+    assert_eq!(names[&0x1018], "Identity object");
+    assert!(p.object_name(0x15FF).is_none() && !names.contains_key(&0x1A01));
+    let dict = crate::od::Dictionary::new(vec![std::sync::Arc::new(p)]);
+    assert_eq!(dict.object_name(0x1602), Some("RPDO3 mapping parameter"));
+    assert_eq!(
+        crate::od::resolve_object(&dict, "rpdo3 mapping parameter:2"),
+        Ok((0x1602, 2))
+    );
 }
