@@ -220,10 +220,7 @@ pub fn resolve_object(dict: &Dictionary, text: &str) -> Result<(u16, u8), Object
         return Ok(r);
     }
     for layer in dict.layers() {
-        if let Some((k, _)) = layer
-            .entries()
-            .find(|(_, o)| o.alias.as_deref().is_some_and(|a| a.eq_ignore_ascii_case(t)))
-        {
+        if let Some((k, _)) = layer.find_entry(|o| o.alias.as_deref().is_some_and(|a| a.eq_ignore_ascii_case(t))) {
             return Ok(k);
         }
         if let Some((_, r)) = layer.aliases.iter().find(|(a, _)| a.eq_ignore_ascii_case(t)) {
@@ -243,10 +240,10 @@ pub fn resolve_object(dict: &Dictionary, text: &str) -> Result<(u16, u8), Object
         None => (t, None),
     };
     for layer in dict.layers() {
-        if let Some((i, _)) = layer.names().into_iter().find(|(_, n)| n.eq_ignore_ascii_case(name)) {
+        if let Some(i) = layer.find_name(|n| n.eq_ignore_ascii_case(name)) {
             return Ok((i, sub.unwrap_or(0)));
         }
-        if let Some(((i, s), _)) = layer.entries().find(|(_, o)| o.name.eq_ignore_ascii_case(name)) {
+        if let Some(((i, s), _)) = layer.find_entry(|o| o.name.eq_ignore_ascii_case(name)) {
             return Ok((i, sub.unwrap_or(s)));
         }
     }

@@ -14,6 +14,7 @@ pub mod eds;
 pub mod expr;
 pub mod family;
 pub mod fields;
+mod index_set;
 pub mod json;
 pub mod merge;
 pub mod procedure;
@@ -266,6 +267,35 @@ impl Profile {
         all.into_iter()
     }
 
+    /// The first entry by (index, sub) for which `pred` holds: what `entries().find` gives,
+    /// without listing every entry.
+    pub fn find_entry(&self, pred: impl Fn(&ObjectInfo) -> bool) -> Option<((u16, u8), &ObjectInfo)> {
+        let own = self.objects.iter().find(|(_, o)| pred(o)).map(|(k, o)| (*k, o));
+        let in_family = self
+            .families
+            .iter()
+            .flat_map(|(&(index, _), f)| f.iter().map(move |(sub, o)| ((index, sub), o)))
+            .find(|(key, o)| pred(o) && !self.objects.contains_key(key));
+        match (own, in_family) {
+            (Some(a), Some(b)) => Some(if a.0 <= b.0 { a } else { b }),
+            (a, b) => a.or(b),
+        }
+    }
+
+    /// The lowest index whose record name (as `object_name` gives it) `pred` accepts: what
+    /// `names().find` gives, without listing every name.
+    pub fn find_name(&self, pred: impl Fn(&str) -> bool) -> Option<u16> {
+        let own = self.object_names.iter().find(|(_, n)| pred(n)).map(|(i, _)| *i);
+        let ranged = self
+            .ranges
+            .iter()
+            .filter_map(|r| {
+                (r.first..=r.last).find(|&i| r.name(i).is_some_and(&pred) && self.object_name(i) == r.name(i))
+            })
+            .min();
+        own.into_iter().chain(ranged).min()
+    }
+
     /// The entries of `objects` and `families` at `index`, by sub, each once.
     pub fn entries_at(&self, index: u16) -> Vec<(u8, &ObjectInfo)> {
         let mut subs: BTreeMap<u8, &ObjectInfo> = self
@@ -371,12 +401,23 @@ impl Profile {
 #[derive(Clone, Debug, Default)]
 pub struct Dictionary {
     layers: Vec<std::sync::Arc<Profile>>,
+    /// Per layer, the indexes it knows: lookups pass over the others.
+    indexes: std::sync::Arc<[index_set::IndexSet]>,
 }
 
 impl Dictionary {
     /// A dictionary made of these layers, most specific first.
     pub fn new(layers: Vec<std::sync::Arc<Profile>>) -> Self {
-        Dictionary { layers }
+        let indexes = layers.iter().map(|p| index_set::IndexSet::of(p)).collect();
+        Dictionary { layers, indexes }
+    }
+    /// The layers that know anything at `index`, most specific first.
+    fn layers_at(&self, index: u16) -> impl Iterator<Item = &Profile> {
+        self.layers
+            .iter()
+            .zip(self.indexes.iter())
+            .filter(move |(_, known)| known.contains(index))
+            .map(|(p, _)| p.as_ref())
     }
     /// The layers, most specific first.
     pub fn layers(&self) -> &[std::sync::Arc<Profile>] {
@@ -384,7 +425,7 @@ impl Dictionary {
     }
     /// The entry at (index, sub) from the first layer that has it.
     pub fn object(&self, index: u16, sub: u8) -> Option<&ObjectInfo> {
-        self.layers.iter().find_map(|p| p.object(index, sub))
+        self.layers_at(index).find_map(|p| p.object(index, sub))
     }
     /// The name of the entry, else of the object (index level: a record's name or
     /// its sub 0 entry's), for labels.
@@ -396,8 +437,9 @@ impl Dictionary {
     /// The name for labels: the entry's name followed by the vendor alias when the
     /// entry has one, e.g. `A speed command (F0.3.018)`.
     pub fn label_name(&self, index: u16, sub: u8) -> Option<String> {
-        let name = self.name(index, sub)?;
-        match self.object(index, sub).and_then(|o| o.alias.as_deref()) {
+        let object = self.object(index, sub);
+        let name = object.map(|o| o.name.as_str()).or_else(|| self.object_name(index))?;
+        match object.and_then(|o| o.alias.as_deref()) {
             Some(alias) => Some(format!("{name} ({alias})")),
             None => Some(name.to_string()),
         }
@@ -408,7 +450,7 @@ impl Dictionary {
     }
     /// The name of an object at index level: a record's name, or its sub 0 entry's.
     pub fn object_name(&self, index: u16) -> Option<&str> {
-        self.layers.iter().find_map(|p| {
+        self.layers_at(index).find_map(|p| {
             p.object_name(index)
                 .or_else(|| p.object(index, 0).map(|o| o.name.as_str()))
         })

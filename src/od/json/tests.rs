@@ -444,3 +444,45 @@ fn index_range_names_are_listed_and_resolved_like_record_names() {
         Ok((0x1602, 2))
     );
 }
+
+#[test]
+fn finding_an_entry_or_a_name_gives_the_first_in_index_order() {
+    let text = r#"{ "name": "x", "objects": {
+        "0x1003": { "name": "Errors", "subs": { "1..254": { "name": "Error {n}", "type": "u32" } } },
+        "0x1003:7": { "name": "Error 9", "type": "u16", "alias": "E7" },
+        "0x1002": { "name": "Error 200", "type": "u8" },
+        "0x1A00": { "name": "Special", "subs": { "0": { "name": "Error 8", "type": "u8" } } },
+        "0x1A00..0x1A03": { "name": "Map {i}", "subs": { "0": { "name": "Count", "type": "u8" } } },
+        "0x1A02": { "name": "Map 1", "subs": { "0": { "name": "Count", "type": "u8" } } }
+    } }"#;
+    let (p, w) = load_profile("f.json", text).unwrap();
+    assert!(w.is_empty(), "{w:?}");
+    for name in [
+        "Error 9",
+        "Error 8",
+        "Error 200",
+        "Error 7",
+        "Error 254",
+        "Count",
+        "Nothing",
+    ] {
+        let found = p.find_entry(|o| o.name == name).map(|(k, _)| k);
+        assert_eq!(
+            found,
+            p.entries().find(|(_, o)| o.name == name).map(|(k, _)| k),
+            "{name}"
+        );
+    }
+    assert_eq!(p.find_entry(|o| o.name == "Error 9").unwrap().0, (0x1003, 7));
+    assert_eq!(
+        p.find_entry(|o| o.name == "Error 7"),
+        None,
+        "overridden by the single key"
+    );
+    let names = p.names();
+    for name in ["Map 1", "Map 2", "Map 4", "Special", "Errors", "Map 5"] {
+        let first = names.iter().find(|(_, n)| **n == name).map(|(i, _)| *i);
+        assert_eq!(p.find_name(|n| n == name), first, "{name}");
+    }
+    assert_eq!(p.find_name(|n| n == "Map 1"), Some(0x1A02), "0x1A00 has its own name");
+}
