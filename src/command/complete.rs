@@ -54,8 +54,8 @@ pub fn objects(dict: &Dictionary, suffix: &str) -> Vec<String> {
     let mut names = BTreeSet::new();
     for layer in dict.layers() {
         names.extend(layer.aliases.keys().cloned());
-        names.extend(layer.object_names.values().cloned());
-        for o in layer.objects.values() {
+        names.extend(layer.names().into_values().map(String::from));
+        for (_, o) in layer.entries() {
             names.insert(o.name.clone());
             names.extend(o.alias.clone());
         }

@@ -220,12 +220,8 @@ pub fn resolve_object(dict: &Dictionary, text: &str) -> Result<(u16, u8), Object
         return Ok(r);
     }
     for layer in dict.layers() {
-        if let Some((k, _)) = layer
-            .objects
-            .iter()
-            .find(|(_, o)| o.alias.as_deref().is_some_and(|a| a.eq_ignore_ascii_case(t)))
-        {
-            return Ok(*k);
+        if let Some((k, _)) = layer.find_entry(|o| o.alias.as_deref().is_some_and(|a| a.eq_ignore_ascii_case(t))) {
+            return Ok(k);
         }
         if let Some((_, r)) = layer.aliases.iter().find(|(a, _)| a.eq_ignore_ascii_case(t)) {
             return Ok(*r);
@@ -244,11 +240,11 @@ pub fn resolve_object(dict: &Dictionary, text: &str) -> Result<(u16, u8), Object
         None => (t, None),
     };
     for layer in dict.layers() {
-        if let Some((i, _)) = layer.object_names.iter().find(|(_, n)| n.eq_ignore_ascii_case(name)) {
-            return Ok((*i, sub.unwrap_or(0)));
+        if let Some(i) = layer.find_name(|n| n.eq_ignore_ascii_case(name)) {
+            return Ok((i, sub.unwrap_or(0)));
         }
-        if let Some(((i, s), _)) = layer.objects.iter().find(|(_, o)| o.name.eq_ignore_ascii_case(name)) {
-            return Ok((*i, sub.unwrap_or(*s)));
+        if let Some(((i, s), _)) = layer.find_entry(|o| o.name.eq_ignore_ascii_case(name)) {
+            return Ok((i, sub.unwrap_or(s)));
         }
     }
     Err(ObjectError::Unknown {

@@ -2,7 +2,9 @@
 //! identification, logical axes and index-range templates.
 
 use std::collections::BTreeMap;
+use std::sync::OnceLock;
 
+use super::family::Numbered;
 use super::{Expr, MappedEntry, MappingSource, ObjectInfo, PdoMapping, Value};
 
 /// A PDO of a mapping set before it is placed on a node.
@@ -146,4 +148,40 @@ pub struct IndexRange {
     pub last: u16,
     /// The sub-entries every index in the range has.
     pub subs: BTreeMap<u8, ObjectInfo>,
+    /// The record name, `{i}` standing for the 1-based place in the range
+    /// (`TPDO{i} mapping parameter`).
+    pub name: Option<String>,
+    /// The names made from `name`, on first use (thousands in CiA 301).
+    names: OnceLock<Vec<String>>,
+}
+
+impl IndexRange {
+    /// Records at `first..=last` with these subs and record name.
+    pub fn new(first: u16, last: u16, subs: BTreeMap<u8, ObjectInfo>, name: Option<String>) -> IndexRange {
+        IndexRange {
+            first,
+            last: last.max(first),
+            subs,
+            name,
+            names: OnceLock::new(),
+        }
+    }
+
+    /// Whether `index` is in the range.
+    pub fn contains(&self, index: u16) -> bool {
+        (self.first..=self.last).contains(&index)
+    }
+
+    /// The record name at `index` (`TPDO3 mapping parameter`), `None` outside the range
+    /// or when the range has no name.
+    pub fn name(&self, index: u16) -> Option<&str> {
+        let template = self.name.as_deref().filter(|_| self.contains(index))?;
+        let names = self.names.get_or_init(|| {
+            let name = Numbered::new(template, "{i}");
+            (1..=u32::from(self.last - self.first) + 1)
+                .map(|i| name.with(i))
+                .collect()
+        });
+        names.get(usize::from(index - self.first)).map(String::as_str)
+    }
 }

@@ -8,11 +8,13 @@
 
 use std::collections::BTreeMap;
 use std::fmt;
+use std::ops::RangeInclusive;
 
 use serde_json::Value as Json;
 
 use super::alias::{AliasRule, parse_object_ref};
 use super::expr::{Expr, parse_int};
+use super::family::{Numbered, SubFamily, fill};
 use super::fields::{ByteField, SdoCommand, SdoDirection};
 use super::procedure::{
     FailIf, NmtCommand, ProcParam, Procedure, ProcedureError, Step, object_variables, parse_frame_data,
@@ -116,14 +118,45 @@ struct Built {
     name: Option<String>,
     /// The record's alias.
     alias: Option<String>,
-    /// Entries by sub.
+    /// Entries by sub, given one by one; they win over a family covering the same sub.
     entries: Vec<(u8, ObjectInfo)>,
+    /// Sub ranges (`"1..254"`), each kept as one template.
+    families: Vec<SubFamily>,
+}
+
+impl Built {
+    /// Every entry by sub, the families' made one by one.
+    fn subs(&self) -> BTreeMap<u8, ObjectInfo> {
+        let mut subs: BTreeMap<u8, ObjectInfo> = self
+            .families
+            .iter()
+            .flat_map(|f| f.iter().map(|(n, info)| (n, info.clone())))
+            .collect();
+        subs.extend(self.entries.iter().cloned());
+        subs
+    }
+
+    /// How many entries it stands for.
+    fn len(&self) -> usize {
+        let families: usize = self.families.iter().map(|f| f.subs().count()).sum();
+        self.entries.len() + families
+    }
+
+    /// Whether any name depends on the index (`{i}`).
+    fn names_index(&self) -> bool {
+        let templates = self.families.iter().map(SubFamily::template);
+        self.entries
+            .iter()
+            .map(|(_, e)| e)
+            .chain(templates)
+            .any(|e| e.name.contains("{i}"))
+    }
 }
 
 /// Puts built entries at `index`; `nth` (1-based place in an index range) replaces `{i}` in names.
-fn place(p: &mut Profile, index: u16, nth: Option<u32>, b: &Built) {
+fn place(p: &mut Profile, index: u16, nth: Option<u32>, b: &Built, subs: &BTreeMap<u8, ObjectInfo>) {
     place_names(p, index, nth, b);
-    for (sub, info) in &b.entries {
+    for (sub, info) in subs {
         let mut info = info.clone();
         if let Some(i) = nth {
             info.name = nth_name(&info.name, i);
@@ -132,11 +165,14 @@ fn place(p: &mut Profile, index: u16, nth: Option<u32>, b: &Built) {
     }
 }
 
-/// Puts a single object's built entries at `index`, moving them (no `{i}` to replace).
+/// Puts a single object's built entries and families at `index`, moving them (no `{i}` to replace).
 fn place_single(p: &mut Profile, index: u16, b: Built) {
     place_names(p, index, None, &b);
     for (sub, info) in b.entries {
         p.objects.insert((index, sub), info);
+    }
+    for family in b.families {
+        p.add_family(index, family);
     }
 }
 
@@ -154,48 +190,20 @@ fn place_names(p: &mut Profile, index: u16, nth: Option<u32>, b: &Built) {
     }
 }
 
+/// Puts the record alias of `b` at every index of `first..=last`, `{i}` in it standing for
+/// the 1-based place in the range. (The record names stay in the [`IndexRange`].)
+fn place_range_aliases(p: &mut Profile, first: u16, last: u16, b: &Built) {
+    if let Some(a) = &b.alias {
+        let alias = Numbered::new(a, "{i}");
+        for index in first..=last {
+            p.aliases.insert(alias.with(u32::from(index - first) + 1), (index, 0));
+        }
+    }
+}
+
 /// `name` with `{i}` replaced by `i`.
 fn nth_name(name: &str, i: u32) -> String {
     fill(name, "{i}", i)
-}
-
-/// `template` with every `slot` (e.g. `{i}`) replaced by `value`: a byte search for `{`
-/// and hand-made digits, because `str::replace` plus `to_string` made up a third of the
-/// start-up time for the thousands of range names of CiA 301.
-fn fill(template: &str, slot: &str, value: u32) -> String {
-    let mut out = String::with_capacity(template.len() + 8);
-    let mut rest = template;
-    while let Some(at) = rest.find('{') {
-        let (before, tail) = rest.split_at(at);
-        out.push_str(before);
-        match tail.strip_prefix(slot) {
-            Some(after) => {
-                push_decimal(&mut out, value);
-                rest = after;
-            }
-            None => {
-                out.push('{');
-                rest = &tail[1..];
-            }
-        }
-    }
-    out.push_str(rest);
-    out
-}
-
-/// Appends `v` in decimal.
-fn push_decimal(out: &mut String, mut v: u32) {
-    let mut digits = [0u8; 10];
-    let mut n = digits.len();
-    loop {
-        n -= 1;
-        digits[n] = b'0' + (v % 10) as u8;
-        v /= 10;
-        if v == 0 {
-            break;
-        }
-    }
-    out.extend(digits[n..].iter().map(|&d| char::from(d)));
 }
 
 /// Conversion context: collects warnings.
@@ -242,22 +250,13 @@ impl Cx<'_> {
             let built = self.build(&at, 0, entry);
             // Records whose sub names do not depend on the index are kept once as a
             // template (PDO parameters would otherwise be 70000 entries).
-            if built.record && !built.entries.iter().any(|(_, e)| e.name.contains("{i}")) {
+            if built.record && !built.names_index() {
                 // Only the names go to each index; the subs stay in the template.
-                let names = Built {
-                    record: true,
-                    name: built.name,
-                    alias: built.alias,
-                    entries: vec![],
-                };
-                for index in first..=last {
-                    place(&mut p, index, Some(u32::from(index - first) + 1), &names);
-                }
-                let subs = built.entries.into_iter().collect();
-                p.ranges.push(IndexRange { first, last, subs });
+                place_range_aliases(&mut p, first, last, &built);
+                p.ranges.push(IndexRange::new(first, last, built.subs(), built.name));
                 continue;
             }
-            let size = (usize::from(last - first) + 1) * built.entries.len().max(1);
+            let size = (usize::from(last - first) + 1) * built.len().max(1);
             if size > MAX_RANGE_ENTRIES {
                 self.warn(
                     &at,
@@ -265,8 +264,9 @@ impl Cx<'_> {
                 );
                 continue;
             }
+            let subs = built.subs();
             for index in first..=last {
-                place(&mut p, index, Some(u32::from(index - first) + 1), &built);
+                place(&mut p, index, Some(u32::from(index - first) + 1), &built, &subs);
             }
         }
         for (key, entry) in singles {
@@ -283,10 +283,7 @@ impl Cx<'_> {
                 p.materialize(index);
             }
             if built.record {
-                let stale: Vec<(u16, u8)> = p.objects.range((index, 0)..=(index, 255)).map(|(k, _)| *k).collect();
-                for k in stale {
-                    p.objects.remove(&k);
-                }
+                p.remove_index(index);
             }
             place_single(&mut p, index, built);
         }
@@ -395,6 +392,7 @@ impl Cx<'_> {
                 name: None,
                 alias: None,
                 entries,
+                families: vec![],
             };
         };
         if sub != 0 {
@@ -404,6 +402,7 @@ impl Cx<'_> {
                 name: None,
                 alias: None,
                 entries: vec![],
+                families: vec![],
             };
         }
         if e.name.is_none() {
@@ -415,17 +414,24 @@ impl Cx<'_> {
         // Ranges first, then single subs: a single sub wins over a range that covers it.
         // Two ranges, or two single keys, giving the same sub cannot be resolved.
         let (ranges, singles): (Vec<_>, Vec<_>) = subs.into_iter().partition(|(k, _)| k.contains(".."));
-        let mut entries: BTreeMap<u8, (ObjectInfo, bool, String)> = BTreeMap::new();
+        // The subs taken so far: range, whether by a single key, and the key.
+        let mut taken: Vec<(RangeInclusive<u8>, bool, String)> = Vec::new();
+        let mut entries: BTreeMap<u8, ObjectInfo> = BTreeMap::new();
+        let mut families = Vec::new();
         for (key, s) in ranges.into_iter().chain(singles) {
             let at = format!("{at}.subs.{key}");
             let Some(range) = self.ok(&at, sub_range(&key)) else {
                 continue;
             };
             let single = !key.contains("..");
-            if let Some((_, _, other)) = range
-                .clone()
-                .find_map(|n| entries.get(&n).filter(|(_, was_single, _)| *was_single == single))
-            {
+            // The key holding the lowest sub of `range` already taken by the same kind of key.
+            let overlapped = taken
+                .iter()
+                .filter(|(r, was_single, _)| {
+                    *was_single == single && r.start() <= range.end() && range.start() <= r.end()
+                })
+                .min_by_key(|(r, _, _)| *r.start().max(range.start()));
+            if let Some((_, _, other)) = overlapped {
                 let what = if single { "sub" } else { "range" };
                 self.warn(&at, format!("{what} `{key}` overlaps `{other}`, skipped"));
                 continue;
@@ -434,19 +440,19 @@ impl Cx<'_> {
                 self.warn(&format!("{at}.subs"), "subs cannot nest, ignored");
             }
             let Some(info) = self.entry(&at, s) else { continue };
-            for n in range {
-                let mut info = info.clone();
-                if !single {
-                    info.name = fill(&info.name, "{n}", n.into());
-                }
-                entries.insert(n, (info, single, key.clone()));
+            taken.push((range.clone(), single, key));
+            if single {
+                entries.insert(*range.start(), info);
+            } else {
+                families.push(SubFamily::new(*range.start(), *range.end(), info));
             }
         }
         Built {
             record: true,
             name: e.name,
             alias: e.alias,
-            entries: entries.into_iter().map(|(n, (info, _, _))| (n, info)).collect(),
+            entries: entries.into_iter().collect(),
+            families,
         }
     }
 

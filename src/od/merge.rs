@@ -11,7 +11,7 @@ use std::sync::Arc;
 /// entry gains anything, so the caller keeps sharing the original.
 pub fn enriched(top: &Profile, lower: &[Arc<Profile>]) -> Option<Profile> {
     let mut out: Option<Profile> = None;
-    for (&(index, sub), info) in &top.objects {
+    for ((index, sub), info) in top.entries() {
         let mut merged = info.clone();
         for layer in lower {
             if let Some(base) = layer.object(index, sub).filter(|b| b.data_type == info.data_type) {

@@ -12,7 +12,9 @@ pub mod dcf;
 mod device;
 pub mod eds;
 pub mod expr;
+pub mod family;
 pub mod fields;
+mod index_set;
 pub mod json;
 pub mod merge;
 pub mod procedure;
@@ -23,6 +25,7 @@ pub use alias::{AliasRule, resolve_object};
 pub use bind::Bindings;
 pub use device::{Axis, IdCondition, IdTest, IndexRange, ObjectRange, PdoSet, PdoTemplate, TextMatch};
 pub use expr::Expr;
+pub use family::SubFamily;
 pub use fields::{ByteField, SdoCommand, SdoDirection};
 pub use procedure::{Procedure, Step};
 pub use value::{DataType, Value};
@@ -177,7 +180,9 @@ pub struct Profile {
     pub description: String,
     /// Profiles this one builds on, most specific first (e.g. ["cia402"]).
     pub extends: Vec<String>,
-    /// Names of records and arrays at index level, e.g. 0x1018 -> "Identity object".
+    /// Names of records and arrays at index level, e.g. 0x1018 -> "Identity object";
+    /// an index range's are in the range: [`Profile::object_name`] and
+    /// [`Profile::names`] give both.
     pub object_names: BTreeMap<u16, String>,
     /// Extra vendor aliases besides each object's own `alias`.
     pub aliases: BTreeMap<String, (u16, u8)>,
@@ -199,8 +204,12 @@ pub struct Profile {
     pub node_id: Option<u8>,
     /// Node name from an EDS/DCF `[DeviceCommissioning]` section.
     pub node_name: Option<String>,
-    /// Objects by (index, sub). Single-valued objects use sub 0.
+    /// Objects given one by one, by (index, sub). Single-valued objects use sub 0.
+    /// Entries of sub ranges are in `families`: [`Profile::entries`] lists both.
     pub objects: BTreeMap<(u16, u8), ObjectInfo>,
+    /// Sub ranges of records (`"1..254"`) by (index, first sub), each one template; an
+    /// entry in `objects` at the same (index, sub) wins.
+    pub families: BTreeMap<(u16, u8), SubFamily>,
     /// Families of identical records over index ranges (PDO/SDO parameters),
     /// used for an index that has no entry in `objects`.
     pub ranges: Vec<IndexRange>,
@@ -215,27 +224,138 @@ pub struct Profile {
 }
 
 impl Profile {
-    /// The entry at (index, sub): from `objects`, or from an index range when
-    /// `objects` has nothing at that index.
+    /// The entry at (index, sub): from `objects`, else from a sub family, or from an
+    /// index range when the profile has nothing else at that index.
     pub fn object(&self, index: u16, sub: u8) -> Option<&ObjectInfo> {
         if let Some(o) = self.objects.get(&(index, sub)) {
             return Some(o);
         }
-        if self.objects.range((index, 0)..=(index, 255)).next().is_some() {
+        if let Some(o) = self.family_entry(index, sub) {
+            return Some(o);
+        }
+        if self.has_index(index) {
             return None;
         }
         self.range_of(index).and_then(|r| r.subs.get(&sub))
     }
 
+    /// The entry at (index, sub) of a sub family.
+    fn family_entry(&self, index: u16, sub: u8) -> Option<&ObjectInfo> {
+        let (_, family) = self.families.range((index, 0)..=(index, sub)).next_back()?;
+        family.get(sub)
+    }
+
+    /// Whether `objects` or `families` have anything at `index`.
+    fn has_index(&self, index: u16) -> bool {
+        self.objects.range((index, 0)..=(index, 255)).next().is_some()
+            || self.families.range((index, 0)..=(index, 255)).next().is_some()
+    }
+
+    /// Every entry of `objects` and `families` (not index ranges), by (index, sub),
+    /// each once: the one `object` gives.
+    pub fn entries(&self) -> impl Iterator<Item = ((u16, u8), &ObjectInfo)> {
+        let families = self.families.iter().flat_map(|(&(index, _), f)| {
+            f.iter()
+                .map(move |(sub, info)| ((index, sub), info))
+                .filter(|(key, _)| !self.objects.contains_key(key))
+        });
+        let mut all: Vec<((u16, u8), &ObjectInfo)> = self.objects.iter().map(|(k, o)| (*k, o)).collect();
+        if !self.families.is_empty() {
+            all.extend(families);
+            all.sort_unstable_by_key(|(key, _)| *key);
+        }
+        all.into_iter()
+    }
+
+    /// The first entry by (index, sub) for which `pred` holds: what `entries().find` gives,
+    /// without listing every entry.
+    pub fn find_entry(&self, pred: impl Fn(&ObjectInfo) -> bool) -> Option<((u16, u8), &ObjectInfo)> {
+        let own = self.objects.iter().find(|(_, o)| pred(o)).map(|(k, o)| (*k, o));
+        let in_family = self
+            .families
+            .iter()
+            .flat_map(|(&(index, _), f)| f.iter().map(move |(sub, o)| ((index, sub), o)))
+            .find(|(key, o)| pred(o) && !self.objects.contains_key(key));
+        match (own, in_family) {
+            (Some(a), Some(b)) => Some(if a.0 <= b.0 { a } else { b }),
+            (a, b) => a.or(b),
+        }
+    }
+
+    /// The lowest index whose record name (as `object_name` gives it) `pred` accepts: what
+    /// `names().find` gives, without listing every name.
+    pub fn find_name(&self, pred: impl Fn(&str) -> bool) -> Option<u16> {
+        let own = self.object_names.iter().find(|(_, n)| pred(n)).map(|(i, _)| *i);
+        let ranged = self
+            .ranges
+            .iter()
+            .filter_map(|r| {
+                (r.first..=r.last).find(|&i| r.name(i).is_some_and(&pred) && self.object_name(i) == r.name(i))
+            })
+            .min();
+        own.into_iter().chain(ranged).min()
+    }
+
+    /// The entries of `objects` and `families` at `index`, by sub, each once.
+    pub fn entries_at(&self, index: u16) -> Vec<(u8, &ObjectInfo)> {
+        let mut subs: BTreeMap<u8, &ObjectInfo> = self
+            .families
+            .range((index, 0)..=(index, 255))
+            .flat_map(|(_, f)| f.iter())
+            .collect();
+        subs.extend(self.objects.range((index, 0)..=(index, 255)).map(|(k, o)| (k.1, o)));
+        subs.into_iter().collect()
+    }
+
+    /// Adds a sub family at `index`.
+    pub fn add_family(&mut self, index: u16, family: SubFamily) {
+        self.families.insert((index, *family.subs().start()), family);
+    }
+
+    /// Removes every entry and family at `index`.
+    pub fn remove_index(&mut self, index: u16) {
+        let stale: Vec<(u16, u8)> = self.objects.range((index, 0)..=(index, 255)).map(|(k, _)| *k).collect();
+        for k in stale {
+            self.objects.remove(&k);
+        }
+        let stale: Vec<(u16, u8)> = self
+            .families
+            .range((index, 0)..=(index, 255))
+            .map(|(k, _)| *k)
+            .collect();
+        for k in stale {
+            self.families.remove(&k);
+        }
+    }
+
+    /// The name of the record at `index`: its own, else the last-defined index range's
+    /// that names it (`TPDO3 mapping parameter`).
+    pub fn object_name(&self, index: u16) -> Option<&str> {
+        match self.object_names.get(&index) {
+            Some(name) => Some(name),
+            None => self.ranges.iter().rev().find_map(|r| r.name(index)),
+        }
+    }
+
+    /// Every record name by index, as `object_name` gives it.
+    pub fn names(&self) -> BTreeMap<u16, &str> {
+        let mut names = BTreeMap::new();
+        for r in &self.ranges {
+            names.extend((r.first..=r.last).filter_map(|i| Some((i, r.name(i)?))));
+        }
+        names.extend(self.object_names.iter().map(|(i, n)| (*i, n.as_str())));
+        names
+    }
+
     /// The last-defined index range containing `index`.
     fn range_of(&self, index: u16) -> Option<&IndexRange> {
-        self.ranges.iter().rev().find(|r| (r.first..=r.last).contains(&index))
+        self.ranges.iter().rev().find(|r| r.contains(index))
     }
 
     /// Copies an index range's entries for `index` into `objects`, so that single
     /// entries can then be changed there.
     pub fn materialize(&mut self, index: u16) {
-        if self.objects.range((index, 0)..=(index, 255)).next().is_some() {
+        if self.has_index(index) {
             return;
         }
         let Some(subs) = self.range_of(index).map(|r| r.subs.clone()) else {
@@ -281,12 +401,23 @@ impl Profile {
 #[derive(Clone, Debug, Default)]
 pub struct Dictionary {
     layers: Vec<std::sync::Arc<Profile>>,
+    /// Per layer, the indexes it knows: lookups pass over the others.
+    indexes: std::sync::Arc<[index_set::IndexSet]>,
 }
 
 impl Dictionary {
     /// A dictionary made of these layers, most specific first.
     pub fn new(layers: Vec<std::sync::Arc<Profile>>) -> Self {
-        Dictionary { layers }
+        let indexes = layers.iter().map(|p| index_set::IndexSet::of(p)).collect();
+        Dictionary { layers, indexes }
+    }
+    /// The layers that know anything at `index`, most specific first.
+    fn layers_at(&self, index: u16) -> impl Iterator<Item = &Profile> {
+        self.layers
+            .iter()
+            .zip(self.indexes.iter())
+            .filter(move |(_, known)| known.contains(index))
+            .map(|(p, _)| p.as_ref())
     }
     /// The layers, most specific first.
     pub fn layers(&self) -> &[std::sync::Arc<Profile>] {
@@ -294,7 +425,7 @@ impl Dictionary {
     }
     /// The entry at (index, sub) from the first layer that has it.
     pub fn object(&self, index: u16, sub: u8) -> Option<&ObjectInfo> {
-        self.layers.iter().find_map(|p| p.object(index, sub))
+        self.layers_at(index).find_map(|p| p.object(index, sub))
     }
     /// The name of the entry, else of the object (index level: a record's name or
     /// its sub 0 entry's), for labels.
@@ -306,8 +437,9 @@ impl Dictionary {
     /// The name for labels: the entry's name followed by the vendor alias when the
     /// entry has one, e.g. `A speed command (F0.3.018)`.
     pub fn label_name(&self, index: u16, sub: u8) -> Option<String> {
-        let name = self.name(index, sub)?;
-        match self.object(index, sub).and_then(|o| o.alias.as_deref()) {
+        let object = self.object(index, sub);
+        let name = object.map(|o| o.name.as_str()).or_else(|| self.object_name(index))?;
+        match object.and_then(|o| o.alias.as_deref()) {
             Some(alias) => Some(format!("{name} ({alias})")),
             None => Some(name.to_string()),
         }
@@ -318,11 +450,9 @@ impl Dictionary {
     }
     /// The name of an object at index level: a record's name, or its sub 0 entry's.
     pub fn object_name(&self, index: u16) -> Option<&str> {
-        self.layers.iter().find_map(|p| {
-            p.object_names
-                .get(&index)
-                .map(String::as_str)
-                .or(p.object(index, 0).map(|o| o.name.as_str()))
+        self.layers_at(index).find_map(|p| {
+            p.object_name(index)
+                .or_else(|| p.object(index, 0).map(|o| o.name.as_str()))
         })
     }
     /// The first layer with an EMCY manufacturer-byte layout, and that layout.

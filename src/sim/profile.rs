@@ -296,7 +296,7 @@ fn add_profile_objects(s: &mut DeviceObjects, name: &str) {
                 names.push(e.clone());
             }
         }
-        for (&(index, sub), info) in &profile.objects {
+        for ((index, sub), info) in profile.entries() {
             // PDO parameters are the simulator's own (above), as are the objects it has.
             if (0x1400..=0x1BFF).contains(&index) || s.entry(index, sub).is_some() {
                 continue;

@@ -37,7 +37,7 @@ pub struct SavePlan {
 
 /// The subs a layer knows at `index`: its own entries, else its index range's.
 fn layer_subs(p: &Profile, index: u16) -> Vec<u8> {
-    let own: Vec<u8> = p.objects.range((index, 0)..=(index, 255)).map(|(k, _)| k.1).collect();
+    let own: Vec<u8> = p.entries_at(index).into_iter().map(|(sub, _)| sub).collect();
     if !own.is_empty() {
         return own;
     }
@@ -55,7 +55,7 @@ pub fn save_plan(dict: &Dictionary) -> SavePlan {
     let mut ranges: Vec<(u16, u16)> = Vec::new();
     let mut explicit = BTreeSet::new();
     for p in dict.layers() {
-        explicit.extend(p.objects.keys().map(|k| k.0));
+        explicit.extend(p.objects.keys().chain(p.families.keys()).map(|k| k.0));
         for r in &p.ranges {
             if !ranges.contains(&(r.first, r.last)) {
                 ranges.push((r.first, r.last));

@@ -77,15 +77,15 @@ fn good_profile_loads_everything() {
     assert_eq!(p.object(0x1018, 0).unwrap().default, Some(Value::Unsigned(4)));
     assert_eq!(p.object(0x1016, 3).unwrap().name, "Consumer heartbeat time 3");
     assert_eq!(p.object(0x1008, 0).unwrap().default, Some(Value::Text("DEV".into())));
-    assert_eq!(p.object_names[&0x19FF], "TPDO512 communication parameter");
+    assert_eq!(p.object_name(0x19FF), Some("TPDO512 communication parameter"));
     assert_eq!(p.object(0x1800, 1).unwrap().name, "COB-ID used by TPDO1");
-    assert_eq!(p.object_names[&0x1801], "Special TPDO");
+    assert_eq!(p.object_name(0x1801), Some("Special TPDO"));
     assert_eq!(p.object(0x1801, 1), None);
     assert_eq!(p.object(0x1801, 2).unwrap().name, "Transmission type");
     assert_eq!(p.object(0x1A00, 0).unwrap().name, "Number of mapped objects");
     // A record range without {i} in its subs is kept once, not per index.
     assert_eq!(p.ranges.len(), 1);
-    assert_eq!(p.object_names[&0x17FF], "RPDO512 mapping parameter");
+    assert_eq!(p.object_name(0x17FF), Some("RPDO512 mapping parameter"));
     assert_eq!(p.object(0x17FF, 64).unwrap().name, "Mapped object 64");
     assert_eq!(p.object(0x17FF, 65), None);
     // A flat key inside the range changes one sub and keeps the others.
@@ -339,4 +339,150 @@ fn range_names_fill_every_slot_and_keep_other_braces() {
     assert_eq!(super::fill("A {n} {x} {", "{n}", 0), "A 0 {x} {");
     assert_eq!(super::fill("none", "{n}", 7), "none");
     assert_eq!(super::fill("{n}", "{n}", u32::MAX), "4294967295");
+}
+
+/// Every entry of `p` by (index, sub), as `object` gives it, with its name.
+fn all_entries(p: &Profile) -> Vec<((u16, u8), String)> {
+    let indexes = [0x1003, 0x1016, 0x3046, 0x3047];
+    let looked_up = indexes
+        .iter()
+        .flat_map(|&i| (0..=255).map(move |s| (i, s)))
+        .filter_map(|(i, s)| p.object(i, s).map(|o| ((i, s), o.name.clone())));
+    let listed: Vec<((u16, u8), String)> = p.entries().map(|(k, o)| (k, o.name.clone())).collect();
+    assert_eq!(
+        listed,
+        looked_up.collect::<Vec<_>>(),
+        "entries() lists what object() finds"
+    );
+    listed
+}
+
+#[test]
+fn sub_ranges_give_the_same_entries_as_the_subs_written_out() {
+    let ranges = r#"{ "name": "x", "objects": {
+        "0x1003": { "name": "Errors", "subs": {
+            "0": { "name": "Count", "type": "u8" },
+            "1..254": { "name": "Error {n}", "type": "u32", "values": { "1": "one" } } } },
+        "0x1003:7": { "name": "Seventh", "type": "u16" },
+        "0x3046": { "name": "Monitor", "subs": {
+            "1..3": { "name": "Low {n}", "type": "u8" },
+            "2": { "name": "Two", "type": "u8" },
+            "10..11": { "name": "High {n}", "type": "u8" } } },
+        "0x3047": { "name": "Old", "subs": { "1..9": { "name": "Old {n}", "type": "u8" } } },
+        "0x3047:0": { "name": "Replaced", "subs": { "1": { "name": "New", "type": "u8" } } }
+    } }"#;
+    let mut subs: Vec<String> = vec![r#""0": { "name": "Count", "type": "u8" }"#.into()];
+    subs.extend(
+        (1..=254).map(|n| format!(r#""{n}": {{ "name": "Error {n}", "type": "u32", "values": {{ "1": "one" }} }}"#)),
+    );
+    let written_out = format!(
+        r#"{{ "name": "x", "objects": {{
+        "0x1003": {{ "name": "Errors", "subs": {{ {} }} }},
+        "0x1003:7": {{ "name": "Seventh", "type": "u16" }},
+        "0x3046": {{ "name": "Monitor", "subs": {{
+            "1": {{ "name": "Low 1", "type": "u8" }}, "2": {{ "name": "Two", "type": "u8" }},
+            "3": {{ "name": "Low 3", "type": "u8" }},
+            "10": {{ "name": "High 10", "type": "u8" }}, "11": {{ "name": "High 11", "type": "u8" }} }} }},
+        "0x3047": {{ "name": "Replaced", "subs": {{ "1": {{ "name": "New", "type": "u8" }} }} }}
+    }} }}"#,
+        subs.join(",")
+    );
+    let (p, w) = load_profile("r.json", ranges).unwrap();
+    assert!(w.is_empty(), "{w:?}");
+    let (q, w) = load_profile("o.json", &written_out).unwrap();
+    assert!(w.is_empty(), "{w:?}");
+    let got = all_entries(&p);
+    assert_eq!(got, all_entries(&q));
+    assert_eq!(got.len(), 255 + 5 + 1, "each entry once");
+    assert_eq!(
+        p.object(0x1003, 7).unwrap().data_type,
+        DataType::U16,
+        "a later single key wins"
+    );
+    assert_eq!(p.object(0x1003, 254).unwrap().values[&1], "one");
+    assert!(p.object(0x1003, 255).is_none() && p.object(0x3046, 4).is_none() && p.object(0x3047, 2).is_none());
+    let at: Vec<(u8, &str)> = p
+        .entries_at(0x3046)
+        .into_iter()
+        .map(|(s, o)| (s, o.name.as_str()))
+        .collect();
+    assert_eq!(
+        at,
+        [(1, "Low 1"), (2, "Two"), (3, "Low 3"), (10, "High 10"), (11, "High 11")]
+    );
+}
+
+#[test]
+fn the_first_layer_with_an_entry_wins_over_a_lower_layers_sub_range() {
+    let vendor = r#"{ "name": "v", "objects": {
+        "0x1003:5": { "name": "Vendor fifth", "type": "u32" },
+        "0x1016": { "name": "Heartbeats", "subs": { "1..2": { "name": "Vendor heartbeat {n}", "type": "u32" } } } } }"#;
+    let (vendor, _) = load_profile("v.json", vendor).unwrap();
+    let (cia301, _) = crate::od::bind::load_builtin("cia301").unwrap().unwrap();
+    let dict = crate::od::Dictionary::new(vec![std::sync::Arc::new(vendor), std::sync::Arc::new(cia301)]);
+    let name = |i, s| dict.object(i, s).map(|o| o.name.as_str());
+    assert_eq!(name(0x1003, 5), Some("Vendor fifth"));
+    assert_eq!(name(0x1003, 6), Some("Standard error field 6"));
+    assert_eq!(name(0x1016, 2), Some("Vendor heartbeat 2"));
+    assert_eq!(name(0x1016, 3), Some("Consumer heartbeat time 3"));
+    assert_eq!(name(0x1016, 128), None);
+}
+
+#[test]
+fn index_range_names_are_listed_and_resolved_like_record_names() {
+    let (p, _) = load_profile("g.json", GOOD).unwrap();
+    let names = p.names();
+    assert_eq!(names[&0x1600], "RPDO1 mapping parameter");
+    assert_eq!(names[&0x17FF], "RPDO512 mapping parameter");
+    assert_eq!(names[&0x1801], "Special TPDO", "a record's own name wins");
+    assert_eq!(names[&0x1018], "Identity object");
+    assert!(p.object_name(0x15FF).is_none() && !names.contains_key(&0x1A01));
+    let dict = crate::od::Dictionary::new(vec![std::sync::Arc::new(p)]);
+    assert_eq!(dict.object_name(0x1602), Some("RPDO3 mapping parameter"));
+    assert_eq!(
+        crate::od::resolve_object(&dict, "rpdo3 mapping parameter:2"),
+        Ok((0x1602, 2))
+    );
+}
+
+#[test]
+fn finding_an_entry_or_a_name_gives_the_first_in_index_order() {
+    let text = r#"{ "name": "x", "objects": {
+        "0x1003": { "name": "Errors", "subs": { "1..254": { "name": "Error {n}", "type": "u32" } } },
+        "0x1003:7": { "name": "Error 9", "type": "u16", "alias": "E7" },
+        "0x1002": { "name": "Error 200", "type": "u8" },
+        "0x1A00": { "name": "Special", "subs": { "0": { "name": "Error 8", "type": "u8" } } },
+        "0x1A00..0x1A03": { "name": "Map {i}", "subs": { "0": { "name": "Count", "type": "u8" } } },
+        "0x1A02": { "name": "Map 1", "subs": { "0": { "name": "Count", "type": "u8" } } }
+    } }"#;
+    let (p, w) = load_profile("f.json", text).unwrap();
+    assert!(w.is_empty(), "{w:?}");
+    for name in [
+        "Error 9",
+        "Error 8",
+        "Error 200",
+        "Error 7",
+        "Error 254",
+        "Count",
+        "Nothing",
+    ] {
+        let found = p.find_entry(|o| o.name == name).map(|(k, _)| k);
+        assert_eq!(
+            found,
+            p.entries().find(|(_, o)| o.name == name).map(|(k, _)| k),
+            "{name}"
+        );
+    }
+    assert_eq!(p.find_entry(|o| o.name == "Error 9").unwrap().0, (0x1003, 7));
+    assert_eq!(
+        p.find_entry(|o| o.name == "Error 7"),
+        None,
+        "overridden by the single key"
+    );
+    let names = p.names();
+    for name in ["Map 1", "Map 2", "Map 4", "Special", "Errors", "Map 5"] {
+        let first = names.iter().find(|(_, n)| **n == name).map(|(i, _)| *i);
+        assert_eq!(p.find_name(|n| n == name), first, "{name}");
+    }
+    assert_eq!(p.find_name(|n| n == "Map 1"), Some(0x1A02), "0x1A00 has its own name");
 }

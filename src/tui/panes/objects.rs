@@ -59,10 +59,10 @@ fn catalog(dict: &Dictionary, seen: &BTreeSet<u16>) -> Vec<Obj> {
     let mut subs: BTreeMap<u16, BTreeSet<u8>> = BTreeMap::new();
     let mut records: BTreeSet<u16> = BTreeSet::new();
     for layer in dict.layers() {
-        for &(i, s) in layer.objects.keys() {
+        for ((i, s), _) in layer.entries() {
             subs.entry(i).or_default().insert(s);
         }
-        records.extend(layer.object_names.keys());
+        records.extend(layer.names().into_keys());
         for r in &layer.ranges {
             // The first PDOs of a PDO range; of other ranges (e.g. 127 more SDO servers)
             // only what was seen.
@@ -127,8 +127,8 @@ pub fn type_word(t: DataType) -> &'static str {
 /// A record's name: the dictionary's, else for the CiA 301 parameter ranges what the
 /// record is (`TPDO3 communication parameter`), else its sub 0 entry's.
 fn record_name(dict: &Dictionary, index: u16) -> String {
-    if let Some(n) = dict.layers().iter().find_map(|p| p.object_names.get(&index)) {
-        return n.clone();
+    if let Some(n) = dict.layers().iter().find_map(|p| p.object_name(index)) {
+        return n.to_string();
     }
     let ranged = [
         (0x1200, "SDO server", "parameter"),
