@@ -11,7 +11,7 @@ pub mod text;
 /// input field (an interface name in a log, a name in an EDS) can drive the terminal.
 pub fn push_escaped(out: &mut String, s: &str) {
     // Fast path: no C0 control, DEL, or UTF-8 lead byte of a C1 control (0xC2 0x80..0x9F).
-    if !s.bytes().any(|b| b < 0x20 || b == 0x7F || b == 0xC2) {
+    if !has_control(s.as_bytes()) {
         out.push_str(s);
         return;
     }
@@ -27,6 +27,23 @@ pub fn push_escaped(out: &mut String, s: &str) {
     }
 }
 
+/// Whether `bytes` hold a byte below 0x20, 0x7F or 0xC2 (the lead byte of the C1
+/// controls, U+0080..U+009F), eight bytes at a time.
+fn has_control(bytes: &[u8]) -> bool {
+    const ONES: u64 = 0x0101_0101_0101_0101;
+    const HIGH: u64 = 0x8080_8080_8080_8080;
+    // Bytes of `w` below `n` (n <= 0x80) set their high bit in the result.
+    let below = |w: u64, n: u8| w.wrapping_sub(ONES * u64::from(n)) & !w & HIGH;
+    let mut chunks = bytes.chunks_exact(8);
+    for c in &mut chunks {
+        let w = u64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]]);
+        if below(w, 0x20) | below(w ^ (ONES * 0x7F), 1) | below(w ^ (ONES * 0xC2), 1) != 0 {
+            return true;
+        }
+    }
+    chunks.remainder().iter().any(|&b| b < 0x20 || b == 0x7F || b == 0xC2)
+}
+
 #[cfg(test)]
 mod tests {
     #[test]
@@ -34,5 +51,19 @@ mod tests {
         let mut s = String::new();
         super::push_escaped(&mut s, "can0\x1b]0;pwned\x07\u{85}€ ok");
         assert_eq!(s, "can0\\x1B]0;pwned\\x07\\u{0085}€ ok");
+    }
+
+    /// The word-at-a-time check finds every byte the per-byte rule finds, at every place
+    /// of a text of two words and a tail.
+    #[test]
+    fn control_check_matches_the_byte_rule() {
+        for b in 0u8..=0xFF {
+            for at in 0..19 {
+                let mut t = vec![b'x'; 19];
+                t[at] = b;
+                let expected = b < 0x20 || b == 0x7F || b == 0xC2;
+                assert_eq!(super::has_control(&t), expected, "byte {b:#x} at {at}");
+            }
+        }
     }
 }

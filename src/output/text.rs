@@ -38,6 +38,40 @@ pub fn write_line(out: &mut String, frame: &Frame, ifaces: &Interfaces, decoded:
         push_decimal(out, frame.len as u64, 1);
     }
     out.push_str("]  ");
+    let payload = frame.payload();
+    if !frame.is_fd() && !frame.is_rtr() && payload.len() <= 8 {
+        push_classic_data(out, payload);
+    } else {
+        push_data_column(out, frame);
+    }
+    if frame.flags.has(crate::frame::Flags::TX) {
+        out.push_str("T ");
+    }
+    out.push(' ');
+    super::push_escaped(out, &decoded.label);
+    if let Some(m) = &decoded.malformed {
+        out.push_str("  !! ");
+        super::push_escaped(out, m);
+    }
+    out.push('\n');
+}
+
+/// Appends the data column of a classic frame with up to eight bytes: spaced upper-case
+/// hex and a trailing space, padded to 24 characters (the common case, from the stack).
+fn push_classic_data(out: &mut String, payload: &[u8]) {
+    const DIGITS: &[u8; 16] = b"0123456789ABCDEF";
+    let mut buf = [b' '; 24];
+    for (i, b) in payload.iter().enumerate() {
+        buf[3 * i] = DIGITS[(b >> 4) as usize];
+        buf[3 * i + 1] = DIGITS[(b & 15) as usize];
+    }
+    // Hex digits and spaces only: always valid UTF-8.
+    out.push_str(std::str::from_utf8(&buf).unwrap_or_default());
+}
+
+/// Appends the data column of any other frame (remote request, CAN FD, longer payloads):
+/// spaced hex or `remote request`, padded to 24 characters (3 per byte for CAN FD).
+fn push_data_column(out: &mut String, frame: &Frame) {
     let width = if frame.is_fd() { 3 * frame.len as usize } else { 24 };
     let start = out.len();
     if frame.is_rtr() {
@@ -50,16 +84,6 @@ pub fn write_line(out: &mut String, frame: &Frame, ifaces: &Interfaces, decoded:
     }
     let used = out.len() - start;
     out.push_str(&PADDING[..width.saturating_sub(used).min(PADDING.len())]);
-    if frame.flags.has(crate::frame::Flags::TX) {
-        out.push_str("T ");
-    }
-    out.push(' ');
-    super::push_escaped(out, &decoded.label);
-    if let Some(m) = &decoded.malformed {
-        out.push_str("  !! ");
-        super::push_escaped(out, m);
-    }
-    out.push('\n');
 }
 
 #[cfg(test)]
