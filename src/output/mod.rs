@@ -9,20 +9,19 @@ pub mod text;
 
 /// Appends `s` with control characters escaped (`\xNN`, `\u{NNNN}` for C1), so that no
 /// input field (an interface name in a log, a name in an EDS) can drive the terminal.
-pub fn push_escaped(out: &mut String, s: &str) {
-    // Fast path: no C0 control, DEL, or UTF-8 lead byte of a C1 control (0xC2 0x80..0x9F).
+pub fn push_escaped(out: &mut Vec<u8>, s: &str) {
     if !has_control(s.as_bytes()) {
-        out.push_str(s);
+        out.extend_from_slice(s.as_bytes());
         return;
     }
     for c in s.chars() {
         let u = c as u32;
         if u < 0x20 || u == 0x7F {
-            out.push_str(&format!("\\x{u:02X}"));
+            out.extend_from_slice(format!("\\x{u:02X}").as_bytes());
         } else if c.is_control() {
-            out.push_str(&format!("\\u{{{u:04X}}}"));
+            out.extend_from_slice(format!("\\u{{{u:04X}}}").as_bytes());
         } else {
-            out.push(c);
+            out.extend_from_slice(c.encode_utf8(&mut [0; 4]).as_bytes());
         }
     }
 }
@@ -41,16 +40,20 @@ fn has_control(bytes: &[u8]) -> bool {
             return true;
         }
     }
-    chunks.remainder().iter().any(|&b| b < 0x20 || b == 0x7F || b == 0xC2)
+    // The tail as one more word, padded with a harmless byte.
+    let mut tail = [b'x'; 8];
+    tail[..chunks.remainder().len()].copy_from_slice(chunks.remainder());
+    let w = u64::from_le_bytes(tail);
+    below(w, 0x20) | below(w ^ (ONES * 0x7F), 1) | below(w ^ (ONES * 0xC2), 1) != 0
 }
 
 #[cfg(test)]
 mod tests {
     #[test]
     fn control_characters_are_escaped_and_text_is_kept() {
-        let mut s = String::new();
+        let mut s = Vec::new();
         super::push_escaped(&mut s, "can0\x1b]0;pwned\x07\u{85}€ ok");
-        assert_eq!(s, "can0\\x1B]0;pwned\\x07\\u{0085}€ ok");
+        assert_eq!(String::from_utf8(s).unwrap(), "can0\\x1B]0;pwned\\x07\\u{0085}€ ok");
     }
 
     /// The word-at-a-time check finds every byte the per-byte rule finds, at every place
