@@ -17,4 +17,5 @@ mod parquet_duckdb;
 mod pcapng;
 mod profile_example;
 mod realworld_block;
+mod track_path;
 mod wireshark;
