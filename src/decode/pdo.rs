@@ -180,7 +180,7 @@ fn signal(payload: &[u8], pos: usize, e: &MappedEntry, dict: &Dictionary, mode: 
         .name(e.index, e.sub)
         .map(str::to_string)
         .unwrap_or_else(|| format!("0x{:04X}:{:02X}", e.index, e.sub));
-    let text = super::value_text::object_text(dict, e.index, e.sub, &value, mode);
+    let text = super::value_text::object_text_of(dict, info, e.index, e.sub, &value, mode);
     Signal {
         index: e.index,
         sub: e.sub,
