@@ -5,6 +5,7 @@ use crate::analysis::EventTracker;
 use crate::command::ExitCode;
 use crate::decode::{Decoder, Kind};
 use crate::frame::json::write_line;
+use crate::od::Dictionary;
 use crate::output::{jsonl, summary::Summary, text};
 use crate::sdo::Transaction;
 use clap::{Args, ValueEnum};
@@ -149,9 +150,11 @@ fn decode_stream(
     sinks: &mut Sinks,
     out: &mut impl Write,
 ) -> io::Result<()> {
-    // Text lines go to `buf`, JSON lines to `json`; a run writes only one of them.
+    // Event text lines go to `buf`, all other lines to `json`; a run writes only one of
+    // them. `label` is scratch space for transaction labels.
     let mut buf = String::with_capacity(1 << 16);
     let mut json = Vec::with_capacity(1 << 16);
+    let mut label = String::new();
     let counts = input::for_each_frame(path, input, |frames| {
         let ifaces = frames.ifaces;
         for (line, frame) in frames {
@@ -185,16 +188,18 @@ fn decode_stream(
                 }
                 Mode::Frames(OutputFormat::Text) => {
                     let d = decoder.decode(frame);
-                    text::write_line(&mut buf, frame, ifaces, &d);
+                    text::write_line(&mut json, frame, ifaces, &d);
+                    decoder.recycle(d);
                 }
                 Mode::Frames(OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet) => {
                     let d = decoder.decode(frame);
                     jsonl::write_frame(&mut json, line, frame, ifaces, &d);
+                    decoder.recycle(d);
                 }
                 Mode::Transactions(fmt) => {
-                    decoder.decode(frame);
+                    decoder.track(frame);
                     for t in decoder.take_transactions() {
-                        write_transaction(&mut buf, &mut json, &t, decoder, fmt);
+                        write_transaction(&mut json, &mut label, &t, decoder.dictionary(t.node), fmt);
                     }
                 }
             }
@@ -213,39 +218,47 @@ fn decode_stream(
     Ok(())
 }
 
-/// Appends one transaction: a text line to `text`, a JSON line to `json`.
-fn write_transaction(text: &mut String, json: &mut Vec<u8>, t: &Transaction, decoder: &Decoder, fmt: OutputFormat) {
-    let dict = decoder.dictionary(t.node);
+/// Appends one transaction to `out`: its label line (built in the scratch `label`) or its
+/// JSON line.
+pub(super) fn write_transaction(
+    out: &mut Vec<u8>,
+    label: &mut String,
+    t: &Transaction,
+    dict: &Dictionary,
+    fmt: OutputFormat,
+) {
     match fmt {
         OutputFormat::Text => {
-            text.push_str(&t.label(dict));
-            text.push('\n');
+            label.clear();
+            t.write_label(label, dict);
+            out.extend_from_slice(label.as_bytes());
+            out.push(b'\n');
         }
-        OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => write_line(json, &t.to_json(dict)),
+        OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => write_line(out, &t.to_json(dict)),
+    }
+}
+
+/// Appends the totals of a `--summary` run in `fmt`.
+pub(super) fn write_summary(out: &mut Vec<u8>, summary: &mut Summary, fmt: OutputFormat) {
+    summary.finish();
+    match fmt {
+        OutputFormat::Text => out.extend_from_slice(summary.to_text().as_bytes()),
+        OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => write_line(out, &summary.to_json()),
     }
 }
 
 /// Writes what is due at the end of all inputs.
 fn finish(decoder: &mut Decoder, mode: Mode, summary: &mut Summary, out: &mut impl Write) -> io::Result<()> {
-    let mut buf = String::new();
-    let mut json = Vec::new();
+    let mut buf = Vec::new();
     match mode {
         Mode::Transactions(fmt) => {
+            let mut label = String::new();
             for t in decoder.finish() {
-                write_transaction(&mut buf, &mut json, &t, decoder, fmt);
+                write_transaction(&mut buf, &mut label, &t, decoder.dictionary(t.node), fmt);
             }
         }
-        Mode::Summary(fmt) => {
-            summary.finish();
-            match fmt {
-                OutputFormat::Text => buf.push_str(&summary.to_text()),
-                OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => {
-                    write_line(&mut json, &summary.to_json())
-                }
-            }
-        }
+        Mode::Summary(fmt) => write_summary(&mut buf, summary, fmt),
         Mode::Frames(_) | Mode::Events(_) => {}
     }
-    out.write_all(buf.as_bytes())?;
-    out.write_all(&json)
+    out.write_all(&buf)
 }

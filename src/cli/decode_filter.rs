@@ -2,13 +2,12 @@
 //! or with `--summary` the totals of the frames) that match an expression of the TUI's
 //! filter language, judged as the TUI's filtered view judges them.
 
-use super::decode::{DecodeArgs, OutputFormat};
+use super::decode::{DecodeArgs, OutputFormat, write_summary, write_transaction};
 use super::input::{for_each_frame, open_input, report_counts};
 use crate::analysis::filter::stream::Stream;
 use crate::analysis::filter::{Facts, Filter};
 use crate::command::ExitCode;
 use crate::decode::{Decoder, Kind};
-use crate::frame::json::write_line;
 use crate::output::{jsonl, summary::Summary, text};
 use std::io::{self, Write};
 
@@ -115,15 +114,17 @@ impl Run {
             for (line, frame) in frames {
                 let t0 = *self.t0_ns.get_or_insert(frame.ts_ns);
                 self.decoder.set_seq(self.pos);
-                let d = self.decoder.decode(frame);
-                let done = self.decoder.take_transactions();
                 if self.mode == Mode::Transactions {
-                    for t in &done {
-                        self.transaction(&mut buf, t, t0);
+                    // Only the transfers are printed: no frame labels.
+                    self.decoder.track(frame);
+                    for t in self.decoder.take_transactions() {
+                        self.transaction(&mut buf, &t, t0);
                     }
                     self.pos += 1;
                     continue;
                 }
+                let d = self.decoder.decode(frame);
+                let done = self.decoder.take_transactions();
                 let facts = Facts {
                     ts_ns: frame.ts_ns,
                     id: frame.id,
@@ -136,11 +137,7 @@ impl Run {
                     let mut s = Vec::new();
                     match (mode, format) {
                         (Mode::Summary, _) => return Out::Count(d.kind, d.node),
-                        (_, OutputFormat::Text) => {
-                            let mut t = String::new();
-                            text::write_line(&mut t, frame, ifaces, d);
-                            s = t.into_bytes();
-                        }
+                        (_, OutputFormat::Text) => text::write_line(&mut s, frame, ifaces, d),
                         _ => jsonl::write_frame(&mut s, line, frame, ifaces, d),
                     }
                     Out::Line(s)
@@ -172,13 +169,7 @@ impl Run {
         if !self.filter.matches_transaction(t, dict, t0) {
             return;
         }
-        match self.format {
-            OutputFormat::Text => {
-                buf.extend_from_slice(t.label(dict).as_bytes());
-                buf.push(b'\n');
-            }
-            _ => write_line(buf, &t.to_json(dict)),
-        }
+        write_transaction(buf, &mut String::new(), t, dict, self.format);
     }
 
     /// Writes what waited for the end of the input.
@@ -197,11 +188,7 @@ impl Run {
             }
         }
         if self.mode == Mode::Summary {
-            self.summary.finish();
-            match self.format {
-                OutputFormat::Text => buf.extend_from_slice(self.summary.to_text().as_bytes()),
-                _ => write_line(&mut buf, &self.summary.to_json()),
-            }
+            write_summary(&mut buf, &mut self.summary, self.format);
         }
         out.write_all(&buf)
     }

@@ -33,13 +33,19 @@ impl Pdo {
     /// One-line label for `node`.
     pub fn label(&self, node: u8, payload: &[u8]) -> String {
         let mut s = String::with_capacity(64);
+        self.write_label(&mut s, node, payload);
+        s
+    }
+
+    /// Appends [`Pdo::label`] to `s`.
+    pub fn write_label(&self, s: &mut String, node: u8, payload: &[u8]) {
         s.push_str(if self.transmit { "TPDO" } else { "RPDO" });
-        crate::frame::hex::push_decimal(&mut s, self.num as u64, 1);
+        crate::frame::hex::push_decimal(s, self.num as u64, 1);
         s.push_str(" node ");
-        crate::frame::hex::push_decimal(&mut s, node as u64, 1);
+        crate::frame::hex::push_decimal(s, node as u64, 1);
         s.push_str(": ");
         if self.signals.is_empty() {
-            crate::frame::hex::push_spaced(&mut s, payload);
+            crate::frame::hex::push_spaced(s, payload);
         }
         for (i, sig) in self.signals.iter().enumerate() {
             if i > 0 {
@@ -49,7 +55,6 @@ impl Pdo {
             s.push('=');
             s.push_str(&sig.text);
         }
-        s
     }
 
     /// The kind-specific JSON object.
@@ -175,7 +180,7 @@ fn signal(payload: &[u8], pos: usize, e: &MappedEntry, dict: &Dictionary, mode: 
         .name(e.index, e.sub)
         .map(str::to_string)
         .unwrap_or_else(|| format!("0x{:04X}:{:02X}", e.index, e.sub));
-    let text = super::value_text::object_text(dict, e.index, e.sub, &value, mode);
+    let text = super::value_text::object_text_of(dict, info, e.index, e.sub, &value, mode);
     Signal {
         index: e.index,
         sub: e.sub,

@@ -6,10 +6,12 @@ use super::cob_id::{CobId, CobTable, Route};
 use super::heartbeat::Heartbeat;
 use super::pdo::{self, Pdo};
 use super::pdo_config::{CommParams, PdoId};
+use super::sdo::tracker::labelled;
 use super::sdo::{SdoFrame, SdoTracker};
 use super::{Kind, emcy, error_frame, heartbeat, lss, nmt, sync, time, value_text, vendor_sdo};
 use crate::frame::Frame;
 use crate::od::{Dictionary, MappingSource, PdoMapping, resolve_object};
+use crate::sdo::tracker::Tracked;
 use crate::sdo::{Transaction, TransferDirection};
 use std::collections::HashMap;
 
@@ -79,6 +81,8 @@ pub struct Decoder {
     sdo_cobs: HashMap<u32, (u8, bool)>,
     completed: Vec<Transaction>,
     seq: u64,
+    /// A label buffer handed back by [`Decoder::recycle`], reused for the next PDO or SDO label.
+    spare: String,
 }
 
 impl Decoder {
@@ -99,6 +103,7 @@ impl Decoder {
             sdo_cobs: HashMap::new(),
             completed: Vec::new(),
             seq: 0,
+            spare: String::new(),
         };
         for (node, dict) in bound {
             if (1..128).contains(&node) {
@@ -221,6 +226,14 @@ impl Decoder {
         self.cobs.route(frame.id, frame.is_ext())
     }
 
+    /// Hands a decoded frame back once it is written, so that its label buffer serves the
+    /// next label (saves an allocation per frame on the hot paths).
+    pub fn recycle(&mut self, decoded: Decoded) {
+        let mut label = decoded.label;
+        label.clear();
+        self.spare = label;
+    }
+
     /// Decodes one frame, updating the bus state.
     pub fn decode(&mut self, frame: &Frame) -> Decoded {
         let route = self.route(frame);
@@ -269,7 +282,8 @@ impl Decoder {
             Kind::Tpdo | Kind::Rpdo => self.decode_pdo(frame, route),
             Kind::SdoRx | Kind::SdoTx => {
                 let c2s = route.kind == Kind::SdoRx;
-                let mut s = self.track_sdo(frame, route);
+                let tracked = self.track_sdo(frame, route);
+                let mut s = labelled(tracked, payload, &self.dicts[n as usize]);
                 // Controlword and statusword bits are named per the node's mode in force.
                 if let (Some(mode), Some((index @ (0x6040 | 0x6041), 0)), Some(v)) =
                     (self.modes[n as usize], s.object, s.value.as_mut())
@@ -283,7 +297,9 @@ impl Decoder {
                     Some(v) => (v.label(), Body::VendorSdo(v), None),
                     None => {
                         let p = s.malformed();
-                        (s.label(), Body::Sdo(s), p)
+                        let mut label = std::mem::take(&mut self.spare);
+                        s.write_label(&mut label);
+                        (label, Body::Sdo(s), p)
                     }
                 }
             }
@@ -314,9 +330,38 @@ impl Decoder {
         }
     }
 
+    /// Feeds a frame into the bus state without building its label or body: SDO transfers
+    /// (and what their completion teaches) and modes of operation mapped into PDOs. The
+    /// cheap path for `--transactions`: the transactions and the state afterwards are those
+    /// [`Decoder::decode`] gives.
+    pub fn track(&mut self, frame: &Frame) {
+        let route = self.route(frame);
+        match route.kind {
+            Kind::SdoRx | Kind::SdoTx => {
+                self.seq += 1;
+                self.track_sdo(frame, route);
+            }
+            Kind::Tpdo | Kind::Rpdo if self.maps_mode(route) => {
+                self.decode_routed(frame, route);
+            }
+            _ => self.seq += 1,
+        }
+    }
+
+    /// Whether the mapping in force for the PDO of `route` carries the mode of operation
+    /// (0x6060/0x6061), which decoding the PDO records.
+    fn maps_mode(&self, route: Route) -> bool {
+        let key = (route.node.unwrap_or(0), route.kind == Kind::Tpdo, route.pdo);
+        self.mappings.get(&key).is_some_and(|m| {
+            m.entries
+                .iter()
+                .any(|e| matches!((e.index, e.sub), (0x6060 | 0x6061, 0)))
+        })
+    }
+
     /// Feeds an SDO frame to the transfer tracker and learns from the transfers it
     /// completes (COB-IDs, PDO mappings, modes); returns the frame as the tracker read it.
-    fn track_sdo(&mut self, frame: &Frame, route: Route) -> SdoFrame {
+    fn track_sdo(&mut self, frame: &Frame, route: Route) -> Tracked {
         let n = route.node.unwrap_or(0);
         let c2s = route.kind == Kind::SdoRx;
         if c2s {
@@ -324,7 +369,7 @@ impl Decoder {
         }
         let s = self
             .sdo
-            .on_frame(self.seq, frame.ts_ns, n, c2s, frame.payload(), &self.dicts[n as usize]);
+            .track(self.seq, frame.ts_ns, n, c2s, frame.payload(), &self.dicts[n as usize]);
         for mut t in self.sdo.take_completed() {
             t.mode = self.modes[(t.node & 0x7F) as usize];
             self.learn(&t);
@@ -369,7 +414,9 @@ impl Decoder {
             signals,
             source,
         };
-        (pdo.label(n, payload), Body::Pdo(pdo), problem)
+        let mut label = std::mem::take(&mut self.spare);
+        pdo.write_label(&mut label, n, payload);
+        (label, Body::Pdo(pdo), problem)
     }
 
     /// Learns COB-IDs, PDO mappings and modes from a completed SDO transfer.

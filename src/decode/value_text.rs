@@ -7,14 +7,27 @@ use serde::Serialize;
 /// The text of `value` of object (index, sub) on a node with dictionary `dict`
 /// and mode of operation `mode`.
 pub fn object_text(dict: &Dictionary, index: u16, sub: u8, value: &Value, mode: Option<i8>) -> String {
+    object_text_of(dict, dict.object(index, sub), index, sub, value, mode)
+}
+
+/// [`object_text`] for a caller that has looked up the object's entry, `info`
+/// (`dict.object(index, sub)`), already: one dictionary lookup instead of three.
+pub fn object_text_of(
+    dict: &Dictionary,
+    info: Option<&ObjectInfo>,
+    index: u16,
+    sub: u8,
+    value: &Value,
+    mode: Option<i8>,
+) -> String {
     if let Some(raw) = value.as_i64() {
-        if let Some(t) = super::cia402::value_text(index, sub, raw, mode, dict.object(index, sub)) {
+        if let Some(t) = super::cia402::value_text(index, sub, raw, mode, info) {
             return t;
         }
         if let Some(t) = super::comm_params::describe(index, sub, raw as u64, dict) {
             return t;
         }
-        if let Some(info) = dict.object(index, sub) {
+        if let Some(info) = info {
             if let Some(m) = info.meaning {
                 return meaning_text(dict, m, raw);
             }
@@ -23,7 +36,7 @@ pub fn object_text(dict: &Dictionary, index: u16, sub: u8, value: &Value, mode: 
             }
         }
     }
-    format_value(dict.object(index, sub), value)
+    format_value(info, value)
 }
 
 /// A vendor object's raw value read as the CiA 301 parameter it configures.

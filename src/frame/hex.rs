@@ -38,8 +38,9 @@ pub fn spaced(bytes: &[u8]) -> String {
 
 /// Appends upper-case hex bytes separated by spaces.
 pub fn push_spaced(out: &mut String, bytes: &[u8]) {
-    for (n, chunk) in bytes.chunks(64).enumerate() {
-        let mut buf = [b' '; 192];
+    // Eight bytes at a time: a classic frame's payload from one small stack buffer.
+    for (n, chunk) in bytes.chunks(8).enumerate() {
+        let mut buf = [b' '; 24];
         for (i, b) in chunk.iter().enumerate() {
             buf[3 * i + 1] = DIGITS[(b >> 4) as usize];
             buf[3 * i + 2] = DIGITS[(b & 15) as usize];

@@ -91,29 +91,67 @@ impl Serialize for Text<'_> {
     }
 }
 
+/// The decimal digits of 0..100, two by two.
+const PAIRS: &[u8; 200] = b"0001020304050607080910111213141516171819\
+2021222324252627282930313233343536373839\
+4041424344454647484950515253545556575859\
+6061626364656667686970717273747576777879\
+8081828384858687888990919293949596979899";
+
 /// Appends `v` in decimal.
-pub fn push_u64(out: &mut Vec<u8>, mut v: u64) {
+#[inline]
+pub fn push_u64(out: &mut Vec<u8>, v: u64) {
+    // Node-IDs, lengths, flags, PDO numbers: one or two digits.
+    if v < 10 {
+        out.push(b'0' + v as u8);
+    } else if v < 100 {
+        let d = v as usize * 2;
+        out.extend_from_slice(&PAIRS[d..d + 2]);
+    } else {
+        push_u64_long(out, v);
+    }
+}
+
+/// [`push_u64`] for any value.
+fn push_u64_long(out: &mut Vec<u8>, mut v: u64) {
     let mut buf = [0u8; 20];
     let mut i = buf.len();
-    loop {
+    while v >= 100 {
+        let d = (v % 100) as usize * 2;
+        v /= 100;
+        i -= 2;
+        buf[i..i + 2].copy_from_slice(&PAIRS[d..d + 2]);
+    }
+    if v >= 10 {
+        let d = v as usize * 2;
+        i -= 2;
+        buf[i..i + 2].copy_from_slice(&PAIRS[d..d + 2]);
+    } else {
         i -= 1;
-        buf[i] = b'0' + (v % 10) as u8;
-        v /= 10;
-        if v == 0 {
-            break;
-        }
+        buf[i] = b'0' + v as u8;
     }
     out.extend_from_slice(&buf[i..]);
+}
+
+/// Appends `v` in decimal, with a minus sign when negative.
+pub fn push_i64(out: &mut Vec<u8>, v: i64) {
+    if v < 0 {
+        out.push(b'-');
+    }
+    push_u64(out, v.unsigned_abs());
 }
 
 /// Appends a time in ns as seconds with all nine decimals (the JSON form of [`Seconds`]).
 pub fn push_seconds(out: &mut Vec<u8>, ns: u64) {
     push_u64(out, ns / 1_000_000_000);
-    let mut frac = ns % 1_000_000_000;
+    let mut frac = (ns % 1_000_000_000) as u32;
     let mut buf = [b'.'; 10];
-    for i in (1..10).rev() {
-        buf[i] = b'0' + (frac % 10) as u8;
-        frac /= 10;
+    buf[1] = b'0' + (frac / 100_000_000) as u8;
+    frac %= 100_000_000;
+    for i in [8, 6, 4, 2] {
+        let d = (frac % 100) as usize * 2;
+        frac /= 100;
+        buf[i..i + 2].copy_from_slice(&PAIRS[d..d + 2]);
     }
     out.extend_from_slice(&buf);
 }
@@ -123,9 +161,14 @@ pub fn push_hex(out: &mut Vec<u8>, bytes: &[u8]) {
     const DIGITS: &[u8; 16] = b"0123456789ABCDEF";
     out.reserve(2 * bytes.len() + 2);
     out.push(b'"');
-    for b in bytes {
-        out.push(DIGITS[(b >> 4) as usize]);
-        out.push(DIGITS[(b & 15) as usize]);
+    // Eight bytes (a classic payload) at a time from the stack.
+    for chunk in bytes.chunks(8) {
+        let mut buf = [0u8; 16];
+        for (i, b) in chunk.iter().enumerate() {
+            buf[2 * i] = DIGITS[(b >> 4) as usize];
+            buf[2 * i + 1] = DIGITS[(b & 15) as usize];
+        }
+        out.extend_from_slice(&buf[..2 * chunk.len()]);
     }
     out.push(b'"');
 }
@@ -181,6 +224,49 @@ pub fn push_text(out: &mut Vec<u8>, text: &str) {
     out.push(b'"');
 }
 
+/// Appends a quoted string escaped as serde_json escapes it (the form of the kind-specific
+/// objects' strings; the record's own fields use [`push_text`]).
+pub fn push_str(out: &mut Vec<u8>, text: &str) {
+    if needs_escape(text.as_bytes()) {
+        // Writing into a Vec cannot fail.
+        let _ = serde_json::to_writer(&mut *out, text);
+        return;
+    }
+    out.reserve(text.len() + 2);
+    out.push(b'"');
+    out.extend_from_slice(text.as_bytes());
+    out.push(b'"');
+}
+
+/// Appends `prefix` and `text` as one quoted string escaped as [`push_str`] does (`prefix`
+/// is plain ASCII that needs no escaping).
+pub fn push_prefixed_str(out: &mut Vec<u8>, prefix: &str, text: &str) {
+    if needs_escape(text.as_bytes()) {
+        push_str(out, &format!("{prefix}{text}"));
+        return;
+    }
+    out.push(b'"');
+    out.extend_from_slice(prefix.as_bytes());
+    out.extend_from_slice(text.as_bytes());
+    out.push(b'"');
+}
+
+/// Appends `v` as JSON, as serde_json writes it.
+pub fn push_value(out: &mut Vec<u8>, v: &crate::od::Value) {
+    use crate::od::Value;
+    match v {
+        Value::Bool(b) => out.extend_from_slice(if *b { b"true" } else { b"false" }),
+        Value::Unsigned(u) => push_u64(out, *u),
+        Value::Signed(i) => push_i64(out, *i),
+        Value::Text(t) => push_str(out, t),
+        Value::Bytes(b) => push_hex(out, b),
+        // Floats (ryu through serde_json) and non-finite ones (null) are rare.
+        Value::Float(_) => {
+            let _ = serde_json::to_writer(&mut *out, v);
+        }
+    }
+}
+
 /// Appends `record` as one JSON line; nothing when it cannot be written (the record
 /// types hold only what JSON can carry, so this does not happen).
 pub fn write_line(out: &mut Vec<u8>, record: &impl Serialize) {
@@ -225,10 +311,32 @@ mod tests {
         for ns in [0, 1, 999_999_999, 1_700_000_000_450_000_001, u64::MAX] {
             assert_eq!(pushed(&|o| push_seconds(o, ns)), json(Seconds(ns)));
         }
-        for v in [0, 7, 10, 4_294_967_295, u64::MAX] {
+        for v in [0, 7, 9, 10, 99, 100, 101, 999, 1000, 12345, 4_294_967_295, u64::MAX] {
             assert_eq!(pushed(&|o| push_u64(o, v)), v.to_string());
         }
-        for b in [&[][..], &[0x1A, 0x2B], &[0xAB; 64]] {
+        for v in [0, -1, 9, -10, 100, i64::MIN, i64::MAX] {
+            assert_eq!(pushed(&|o| push_i64(o, v)), v.to_string());
+        }
+        for ns in [5, 10_000_001, 123_456_789, 1_000_000_000] {
+            assert_eq!(pushed(&|o| push_seconds(o, ns)), json(Seconds(ns)));
+        }
+        use crate::od::Value;
+        for v in [
+            Value::Bool(true),
+            Value::Bool(false),
+            Value::Unsigned(u64::MAX),
+            Value::Signed(-15000),
+            Value::Signed(i64::MIN),
+            Value::Float(1.5),
+            Value::Float(-0.1),
+            Value::Float(f64::NAN),
+            Value::Text("DEXMART \"x\"\u{8}\u{c}\u{1f}µ".into()),
+            Value::Bytes(vec![0xAB; 70]),
+            Value::Bytes(vec![1, 2]),
+        ] {
+            assert_eq!(pushed(&|o| push_value(o, &v)), json(&v), "{v:?}");
+        }
+        for b in [&[][..], &[0x1A, 0x2B], &[0xAB; 64], &[0x12; 9]] {
             assert_eq!(pushed(&|o| push_hex(o, b)), json(Hex(b)));
         }
         let long = "a label long enough for whole words, then a quote \" at byte 52";
@@ -243,6 +351,12 @@ mod tests {
             "ÿÿÿÿÿÿÿÿ\u{1f}",
         ] {
             assert_eq!(pushed(&|o| push_text(o, t)), json(Text(t)), "{t:?}");
+            assert_eq!(pushed(&|o| push_str(o, t)), json(t), "{t:?}");
+            assert_eq!(
+                pushed(&|o| push_prefixed_str(o, "eds ", t)),
+                json(format!("eds {t}")),
+                "{t:?}"
+            );
         }
     }
 

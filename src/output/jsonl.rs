@@ -1,7 +1,8 @@
 //! The JSONL contract: one JSON object per frame (field names are a public API).
 //!
-//! [`write_frame`] writes the common fields straight into the output buffer and
-//! [`BodyJson`], the kind-specific object (each decoder's `to_json`), through serde
+//! [`write_frame`] writes the common fields and the most frequent kind-specific objects
+//! (`pdo`, `sdo`) straight into the output buffer, byte for byte as serde writes them;
+//! [`BodyJson`], the other kinds' objects (each decoder's `to_json`), go through serde
 //! (this is the hot path of `cotui decode --format jsonl`).
 
 use crate::decode::emcy::EmcyJson;
@@ -9,14 +10,15 @@ use crate::decode::error_frame::{self, ErrorFrameJson};
 use crate::decode::heartbeat::HeartbeatJson;
 use crate::decode::lss::LssJson;
 use crate::decode::nmt::NmtJson;
-use crate::decode::pdo::PdoJson;
+use crate::decode::pdo::{Pdo, PdoJson, source_text};
 use crate::decode::sdo::frame::SdoJson;
 use crate::decode::sync::SyncJson;
 use crate::decode::time::TimeJson;
 use crate::decode::vendor_sdo::VendorSdoJson;
 use crate::decode::{Body, Decoded};
-use crate::frame::json::{push_hex, push_seconds, push_text, push_u64};
+use crate::frame::json::{push_hex, push_prefixed_str, push_seconds, push_str, push_text, push_u64, push_value};
 use crate::frame::{Flags, Frame, Interfaces};
+use crate::od::MappingSource;
 use serde::Serialize;
 
 /// The kind-specific object of a frame record, under its key (`nmt`, `heartbeat`, ...).
@@ -97,10 +99,11 @@ impl BodyJson<'_> {
 /// the kind-specific object under its key ([`BodyJson`], absent for kinds without one),
 /// and `malformed` (absent when the frame breaks no rule).
 ///
-/// The record's own fields are written directly (this is the hot path of
-/// `cotui decode --format jsonl`); the kind-specific object goes through serde.
+/// The record's own fields and the `pdo` and `sdo` objects are written directly (this is
+/// the hot path of `cotui decode --format jsonl`); the other kinds' objects go through serde.
 pub fn write_frame(out: &mut Vec<u8>, line: u64, frame: &Frame, ifaces: &Interfaces, decoded: &Decoded) {
     let start = out.len();
+    out.reserve(384);
     out.extend_from_slice(b"{\"line\":");
     push_u64(out, line);
     out.extend_from_slice(b",\"t\":");
@@ -131,7 +134,14 @@ pub fn write_frame(out: &mut Vec<u8>, line: u64, frame: &Frame, ifaces: &Interfa
     }
     out.extend_from_slice(b",\"label\":");
     push_text(out, &decoded.label);
-    if let Some(body) = BodyJson::new(decoded, frame) {
+    if let Body::Pdo(p) = &decoded.body {
+        // The most frequent kinds are written directly (as serde would write them).
+        out.extend_from_slice(b",\"pdo\":");
+        write_pdo(out, p);
+    } else if let Body::Sdo(s) = &decoded.body {
+        out.extend_from_slice(b",\"sdo\":");
+        write_sdo(out, &s.to_json());
+    } else if let Some(body) = BodyJson::new(decoded, frame) {
         out.extend_from_slice(b",\"");
         out.extend_from_slice(body.key().as_bytes());
         out.extend_from_slice(b"\":");
@@ -146,6 +156,139 @@ pub fn write_frame(out: &mut Vec<u8>, line: u64, frame: &Frame, ifaces: &Interfa
         push_text(out, m);
     }
     out.extend_from_slice(b"}\n");
+}
+
+/// Appends the `pdo` object, byte for byte as serde writes [`PdoJson`].
+fn write_pdo(out: &mut Vec<u8>, p: &Pdo) {
+    out.extend_from_slice(b"{\"mapping_source\":");
+    match &p.source {
+        None => out.extend_from_slice(b"null"),
+        Some(MappingSource::Profile(name)) => push_prefixed_str(out, "profile ", name),
+        Some(MappingSource::Eds(file)) => push_prefixed_str(out, "eds ", file),
+        Some(source) => push_str(out, &source_text(source)),
+    }
+    out.extend_from_slice(b",\"num\":");
+    push_u64(out, p.num.into());
+    out.extend_from_slice(b",\"signals\":[");
+    for (i, s) in p.signals.iter().enumerate() {
+        if i > 0 {
+            out.push(b',');
+        }
+        out.extend_from_slice(b"{\"index\":");
+        push_u64(out, s.index.into());
+        out.extend_from_slice(b",\"name\":");
+        push_str(out, &s.name);
+        out.extend_from_slice(b",\"sub\":");
+        push_u64(out, s.sub.into());
+        out.extend_from_slice(b",\"text\":");
+        push_str(out, &s.text);
+        out.extend_from_slice(b",\"value\":");
+        push_value(out, &s.value);
+        out.push(b'}');
+    }
+    out.extend_from_slice(b"]}");
+}
+
+/// Appends the `sdo` object, byte for byte as serde writes [`SdoJson`] (fields in its order,
+/// the optional ones only when set).
+fn write_sdo(out: &mut Vec<u8>, j: &SdoJson) {
+    out.extend_from_slice(b"{\"abort_code\":");
+    match j.abort_code {
+        Some(c) => push_u64(out, c.into()),
+        None => out.extend_from_slice(b"null"),
+    }
+    out.extend_from_slice(b",\"abort_text\":");
+    match j.abort_text {
+        Some(t) => push_str(out, t),
+        None => out.extend_from_slice(b"null"),
+    }
+    push_opt_u64(out, b",\"ackseq\":", j.ackseq.map(u64::from));
+    push_opt_u64(out, b",\"blksize\":", j.blksize.map(u64::from));
+    if let Some(step) = j.block_step {
+        out.extend_from_slice(b",\"block_step\":");
+        push_str(out, step);
+    }
+    push_opt_u64(out, b",\"command\":", j.command.map(u64::from));
+    push_opt_u64(out, b",\"crc\":", j.crc.map(u64::from));
+    if let Some(v) = j.crc_supported {
+        push_flag(out, b",\"crc_supported\":", v);
+    }
+    out.extend_from_slice(b",\"cs\":");
+    push_str(out, j.cs);
+    if let Some(data) = j.data {
+        out.extend_from_slice(b",\"data\":");
+        push_hex(out, data.0);
+    }
+    if let Some(v) = j.expedited {
+        push_flag(out, b",\"expedited\":", v);
+    }
+    out.extend_from_slice(b",\"index\":");
+    match j.index {
+        Some(i) => push_u64(out, i.into()),
+        None => out.extend_from_slice(b"null"),
+    }
+    if let Some(v) = j.last {
+        push_flag(out, b",\"last\":", v);
+    }
+    push_flag(out, b",\"malformed\":", j.malformed);
+    if let Some(r) = j.malformed_reason {
+        out.extend_from_slice(b",\"malformed_reason\":");
+        push_str(out, r);
+    }
+    if let Some(n) = j.name {
+        out.extend_from_slice(b",\"name\":");
+        push_str(out, n);
+    }
+    if let Some(problems) = j.problems {
+        out.extend_from_slice(b",\"problems\":[");
+        for (i, p) in problems.iter().enumerate() {
+            if i > 0 {
+                out.push(b',');
+            }
+            push_str(out, p);
+        }
+        out.push(b']');
+    }
+    push_opt_u64(out, b",\"pst\":", j.pst.map(u64::from));
+    push_opt_u64(out, b",\"seqno\":", j.seqno.map(u64::from));
+    out.extend_from_slice(b",\"side\":");
+    push_str(out, j.side);
+    if let Some(size) = j.size {
+        out.extend_from_slice(b",\"size\":");
+        match size {
+            Some(n) => push_u64(out, n.into()),
+            None => out.extend_from_slice(b"null"),
+        }
+    }
+    out.extend_from_slice(b",\"sub\":");
+    match j.sub {
+        Some(s) => push_u64(out, s.into()),
+        None => out.extend_from_slice(b"null"),
+    }
+    push_opt_u64(out, b",\"toggle\":", j.toggle.map(u64::from));
+    push_opt_u64(out, b",\"unused\":", j.unused.map(u64::from));
+    // Typed values and structured parts are rarer: serde writes them.
+    if let Some(v) = j.value {
+        out.extend_from_slice(b",\"value\":");
+        let _ = serde_json::to_writer(&mut *out, v);
+    }
+    if let Some(parts) = j.value_parts {
+        out.extend_from_slice(b",\"value_parts\":");
+        let _ = serde_json::to_writer(&mut *out, parts);
+    }
+    if let Some(t) = j.value_text {
+        out.extend_from_slice(b",\"value_text\":");
+        push_str(out, t);
+    }
+    out.push(b'}');
+}
+
+/// Appends `key` and `v` when `v` is set.
+fn push_opt_u64(out: &mut Vec<u8>, key: &[u8], v: Option<u64>) {
+    if let Some(v) = v {
+        out.extend_from_slice(key);
+        push_u64(out, v);
+    }
 }
 
 /// Appends `key` and `true`/`false`.
@@ -191,6 +334,98 @@ mod tests {
         assert_eq!(j["nmt"], json!({"command": "reset_node", "target": 0}));
         assert_eq!(j["label"], "NMT Reset node -> all nodes");
         assert!(j.get("malformed").is_none());
+    }
+
+    /// The directly written `pdo` object is what serde writes for [`PdoJson`].
+    #[test]
+    fn pdo_object_as_serde_writes_it() {
+        use crate::decode::pdo::Signal;
+        use crate::od::Value;
+        let sig = |name: &str, text: &str, value: Value| Signal {
+            index: 0x6041,
+            sub: 0,
+            name: name.into(),
+            value,
+            text: text.into(),
+        };
+        let sources = [
+            None,
+            Some(MappingSource::Profile("syntron-ds".into())),
+            Some(MappingSource::Eds("a\"b.eds".into())),
+            Some(MappingSource::Sniffed { ts_ns: 12_345_678_901 }),
+        ];
+        for source in sources {
+            let p = Pdo {
+                num: 3,
+                transmit: true,
+                signals: vec![
+                    sig("Statusword", "0x0237 (Operation enabled)", Value::Unsigned(567)),
+                    sig("Velo\tcity", "-1.5 rpm", Value::Float(-1.5)),
+                    sig("Name", "\"x\"", Value::Text("x\u{8}".into())),
+                ],
+                source,
+            };
+            let mut direct = Vec::new();
+            write_pdo(&mut direct, &p);
+            assert_eq!(
+                String::from_utf8(direct).unwrap(),
+                serde_json::to_string(&p.to_json()).unwrap()
+            );
+        }
+    }
+
+    /// The directly written `sdo` object is what serde writes for [`SdoJson`], for frames
+    /// of every command with and without tracker and dictionary additions.
+    #[test]
+    fn sdo_object_as_serde_writes_it() {
+        use crate::decode::sdo::SdoFrame;
+        use crate::decode::sdo::value::view;
+        use crate::sdo::codec::Side;
+        let dict = crate::od::Dictionary::default();
+        let frames: [(Side, &[u8]); 14] = [
+            (Side::Client, &[0x2B, 0x40, 0x60, 0x00, 0x06, 0x00, 0, 0]),
+            (Side::Client, &[0x21, 0x08, 0x10, 0x00, 0x07, 0, 0, 0]),
+            (Side::Server, &[0x60, 0x40, 0x60, 0x00, 0, 0, 0, 0]),
+            (Side::Client, &[0x00, b'D', b'E', b'X', b'"', 0, 0, 0]),
+            (Side::Server, &[0x43, 0x41, 0x60, 0x00, 0x37, 0x02, 0, 0]),
+            (Side::Server, &[0x80, 0x00, 0x20, 0x01, 0x11, 0x00, 0x09, 0x06]),
+            (Side::Client, &[0xC6, 0x00, 0x20, 0x00, 0x10, 0, 0, 0]),
+            (Side::Server, &[0xA4, 0x00, 0x20, 0x00, 0x7F, 0, 0, 0]),
+            (Side::Server, &[0xA2, 0x05, 0x7F, 0, 0, 0, 0, 0]),
+            (Side::Client, &[0xC9, 0x34, 0x12, 0, 0, 0, 0, 0]),
+            (Side::Client, &[0xA4, 0x00, 0x20, 0x00, 0x20, 0x00, 0, 0]),
+            (Side::Client, &[0xE0, 0, 0, 0, 0, 0, 0, 0]),
+            (Side::Client, &[0x2B, 0x40, 0x60]),
+            (Side::Server, &[0x10, 0x08, 0x10, 0x00, 0, 0, 0, 0]),
+        ];
+        for (side, payload) in frames {
+            let mut f = SdoFrame::new(side, payload, false);
+            let mut variants = vec![f.clone()];
+            f.name = Some("Controlword \"x\"".into());
+            f.problems = vec!["toggle error".into(), "b\\c".into()];
+            if let (Some((index, sub)), Some(data)) = (f.object, f.command.data()) {
+                f.value = Some(view(&dict, index, sub, data));
+            }
+            variants.push(f);
+            for f in variants {
+                let mut direct = Vec::new();
+                write_sdo(&mut direct, &f.to_json());
+                assert_eq!(
+                    String::from_utf8(direct).unwrap(),
+                    serde_json::to_string(&f.to_json()).unwrap(),
+                    "{f:?}"
+                );
+            }
+        }
+        let structured = view(&dict, 0x1018, 1, &[0x11, 0x22, 0, 0]);
+        let mut f = SdoFrame::new(Side::Server, &[0x43, 0x18, 0x10, 0x01, 0x11, 0x22, 0, 0], false);
+        f.value = Some(structured);
+        let mut direct = Vec::new();
+        write_sdo(&mut direct, &f.to_json());
+        assert_eq!(
+            String::from_utf8(direct).unwrap(),
+            serde_json::to_string(&f.to_json()).unwrap()
+        );
     }
 
     #[test]

@@ -9,30 +9,64 @@ pub mod text;
 
 /// Appends `s` with control characters escaped (`\xNN`, `\u{NNNN}` for C1), so that no
 /// input field (an interface name in a log, a name in an EDS) can drive the terminal.
-pub fn push_escaped(out: &mut String, s: &str) {
-    // Fast path: no C0 control, DEL, or UTF-8 lead byte of a C1 control (0xC2 0x80..0x9F).
-    if !s.bytes().any(|b| b < 0x20 || b == 0x7F || b == 0xC2) {
-        out.push_str(s);
+pub fn push_escaped(out: &mut Vec<u8>, s: &str) {
+    if !has_control(s.as_bytes()) {
+        out.extend_from_slice(s.as_bytes());
         return;
     }
     for c in s.chars() {
         let u = c as u32;
         if u < 0x20 || u == 0x7F {
-            out.push_str(&format!("\\x{u:02X}"));
+            out.extend_from_slice(format!("\\x{u:02X}").as_bytes());
         } else if c.is_control() {
-            out.push_str(&format!("\\u{{{u:04X}}}"));
+            out.extend_from_slice(format!("\\u{{{u:04X}}}").as_bytes());
         } else {
-            out.push(c);
+            out.extend_from_slice(c.encode_utf8(&mut [0; 4]).as_bytes());
         }
     }
+}
+
+/// Whether `bytes` hold a byte below 0x20, 0x7F or 0xC2 (the lead byte of the C1
+/// controls, U+0080..U+009F), eight bytes at a time.
+fn has_control(bytes: &[u8]) -> bool {
+    const ONES: u64 = 0x0101_0101_0101_0101;
+    const HIGH: u64 = 0x8080_8080_8080_8080;
+    // Bytes of `w` below `n` (n <= 0x80) set their high bit in the result.
+    let below = |w: u64, n: u8| w.wrapping_sub(ONES * u64::from(n)) & !w & HIGH;
+    let mut chunks = bytes.chunks_exact(8);
+    for c in &mut chunks {
+        let w = u64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]]);
+        if below(w, 0x20) | below(w ^ (ONES * 0x7F), 1) | below(w ^ (ONES * 0xC2), 1) != 0 {
+            return true;
+        }
+    }
+    // The tail as one more word, padded with a harmless byte.
+    let mut tail = [b'x'; 8];
+    tail[..chunks.remainder().len()].copy_from_slice(chunks.remainder());
+    let w = u64::from_le_bytes(tail);
+    below(w, 0x20) | below(w ^ (ONES * 0x7F), 1) | below(w ^ (ONES * 0xC2), 1) != 0
 }
 
 #[cfg(test)]
 mod tests {
     #[test]
     fn control_characters_are_escaped_and_text_is_kept() {
-        let mut s = String::new();
+        let mut s = Vec::new();
         super::push_escaped(&mut s, "can0\x1b]0;pwned\x07\u{85}€ ok");
-        assert_eq!(s, "can0\\x1B]0;pwned\\x07\\u{0085}€ ok");
+        assert_eq!(String::from_utf8(s).unwrap(), "can0\\x1B]0;pwned\\x07\\u{0085}€ ok");
+    }
+
+    /// The word-at-a-time check finds every byte the per-byte rule finds, at every place
+    /// of a text of two words and a tail.
+    #[test]
+    fn control_check_matches_the_byte_rule() {
+        for b in 0u8..=0xFF {
+            for at in 0..19 {
+                let mut t = vec![b'x'; 19];
+                t[at] = b;
+                let expected = b < 0x20 || b == 0x7F || b == 0xC2;
+                assert_eq!(super::has_control(&t), expected, "byte {b:#x} at {at}");
+            }
+        }
     }
 }

@@ -49,8 +49,9 @@ proptest! {
         let mut decoder = Decoder::new(Dictionary::default(), vec![]);
         for (i, f) in frames.iter().enumerate() {
             let d = decoder.decode(f);
-            let mut line = String::new();
+            let mut line = Vec::new();
             text::write_line(&mut line, f, &ifaces, &d);
+            let line = String::from_utf8(line).expect("UTF-8 line");
             prop_assert_eq!(line.matches('\n').count(), 1);
             let mut j = Vec::new();
             jsonl::write_frame(&mut j, i as u64 + 1, f, &ifaces, &d);

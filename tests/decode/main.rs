@@ -18,4 +18,5 @@ mod pcapng;
 mod profile_example;
 mod realworld_block;
 mod run;
+mod track_path;
 mod wireshark;

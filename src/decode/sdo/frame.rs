@@ -84,95 +84,155 @@ impl SdoFrame {
         self.malformed_reason.clone()
     }
 
-    /// The object as `0x6040:00` plus its name when known.
-    fn object_text(&self) -> String {
+    /// Appends the object as ` 0x6040:00` plus its name when known.
+    fn push_object(&self, s: &mut String) {
         let Some((index, sub)) = self.object else {
-            return String::new();
+            return;
         };
-        match &self.name {
-            Some(name) => format!(" 0x{index:04X}:{sub:02X} {name}"),
-            None => format!(" 0x{index:04X}:{sub:02X}"),
+        s.push_str(" 0x");
+        hex::push_hex(s, index.into(), 4);
+        s.push(':');
+        hex::push_hex(s, sub.into(), 2);
+        if let Some(name) = &self.name {
+            s.push(' ');
+            s.push_str(name);
         }
     }
 
-    /// The value part of an expedited label: ` = 6 (Shutdown)`.
-    fn value_text(&self) -> String {
-        self.value
-            .as_ref()
-            .map(|v| format!(" = {}", v.text))
-            .unwrap_or_default()
+    /// Appends the value part of an expedited label: ` = 6 (Shutdown)`.
+    fn push_value(&self, s: &mut String) {
+        if let Some(v) = &self.value {
+            s.push_str(" = ");
+            s.push_str(&v.text);
+        }
     }
 
     /// One-line label, e.g. `Download 0x6040:00 Controlword = 6 (Shutdown)`, with tracker
     /// problems in brackets. Malformation is reported by [`SdoFrame::malformed`], not here.
     pub fn label(&self) -> String {
+        let mut s = String::with_capacity(64);
+        self.write_label(&mut s);
+        s
+    }
+
+    /// Appends [`SdoFrame::label`] to `s`.
+    pub fn write_label(&self, s: &mut String) {
+        // Writing into a String cannot fail.
+        let _ = self.write_label_fmt(s);
+    }
+
+    fn write_label_fmt(&self, s: &mut String) -> std::fmt::Result {
         use SdoCommand::*;
-        let obj = self.object_text();
-        let mut s = match self.command {
-            InitiateDownload { expedited: true, .. } => format!("Download{obj}{}", self.value_text()),
-            InitiateDownload { size, .. } => format!("Download{obj} ({})", segmented_size(size)),
-            InitiateDownloadResponse { .. } => format!("Download response{obj}"),
-            DownloadSegment { toggle, last, data } => {
-                format!(
-                    "Download segment t={} {} c={}",
-                    toggle as u8,
-                    segment_text(data.bytes()),
-                    last as u8
-                )
+        use std::fmt::Write;
+        match self.command {
+            InitiateDownload { expedited: true, .. } => {
+                s.push_str("Download");
+                self.push_object(s);
+                self.push_value(s);
             }
-            DownloadSegmentResponse { toggle } => format!("Download segment response t={}", toggle as u8),
-            InitiateUpload { .. } => format!("Upload{obj}"),
-            InitiateUploadResponse { expedited: true, .. } => format!("Upload response{obj}{}", self.value_text()),
-            InitiateUploadResponse { size, .. } => format!("Upload response{obj} ({})", segmented_size(size)),
-            UploadSegment { toggle } => format!("Upload segment request t={}", toggle as u8),
-            UploadSegmentResponse { toggle, last, data } => {
-                format!(
-                    "Upload segment t={} {} c={}",
-                    toggle as u8,
-                    segment_text(data.bytes()),
-                    last as u8
-                )
+            InitiateDownload { size, .. } => {
+                s.push_str("Download");
+                self.push_object(s);
+                push_segmented_size(s, size)?;
             }
-            Abort { code, .. } => format!("Abort{obj}: 0x{code:08X} {}", abort_text(code)),
-            BlockDownloadInitiate { crc, size, .. } => format!("Block download{obj} ({})", block_opts(crc, size)),
+            InitiateDownloadResponse { .. } => {
+                s.push_str("Download response");
+                self.push_object(s);
+            }
+            DownloadSegment { toggle, last, data } => write!(
+                s,
+                "Download segment t={} {} c={}",
+                toggle as u8,
+                segment_text(data.bytes()),
+                last as u8
+            )?,
+            DownloadSegmentResponse { toggle } => s.push_str(if toggle {
+                "Download segment response t=1"
+            } else {
+                "Download segment response t=0"
+            }),
+            InitiateUpload { .. } => {
+                s.push_str("Upload");
+                self.push_object(s);
+            }
+            InitiateUploadResponse { expedited: true, .. } => {
+                s.push_str("Upload response");
+                self.push_object(s);
+                self.push_value(s);
+            }
+            InitiateUploadResponse { size, .. } => {
+                s.push_str("Upload response");
+                self.push_object(s);
+                push_segmented_size(s, size)?;
+            }
+            UploadSegment { toggle } => s.push_str(if toggle {
+                "Upload segment request t=1"
+            } else {
+                "Upload segment request t=0"
+            }),
+            UploadSegmentResponse { toggle, last, data } => write!(
+                s,
+                "Upload segment t={} {} c={}",
+                toggle as u8,
+                segment_text(data.bytes()),
+                last as u8
+            )?,
+            Abort { code, .. } => {
+                s.push_str("Abort");
+                self.push_object(s);
+                write!(s, ": 0x{code:08X} {}", abort_text(code))?;
+            }
+            BlockDownloadInitiate { crc, size, .. } => {
+                s.push_str("Block download");
+                self.push_object(s);
+                write!(s, " ({})", block_opts(crc, size))?;
+            }
             BlockDownloadInitiateResponse { crc, blksize, .. } => {
-                format!(
-                    "Block download response{obj} blksize={blksize}{}",
-                    if crc { " (crc)" } else { "" }
-                )
+                s.push_str("Block download response");
+                self.push_object(s);
+                write!(s, " blksize={blksize}{}", if crc { " (crc)" } else { "" })?;
             }
-            BlockDownloadAck { ackseq, blksize } => format!("Block download ack ackseq={ackseq} blksize={blksize}"),
-            BlockDownloadEnd { unused, crc } => format!("Block download end n={unused} crc=0x{crc:04X}"),
-            BlockDownloadEndResponse => "Block download end response".to_string(),
+            BlockDownloadAck { ackseq, blksize } => write!(s, "Block download ack ackseq={ackseq} blksize={blksize}")?,
+            BlockDownloadEnd { unused, crc } => write!(s, "Block download end n={unused} crc=0x{crc:04X}")?,
+            BlockDownloadEndResponse => s.push_str("Block download end response"),
             BlockUploadInitiate { crc, blksize, pst, .. } => {
-                format!(
-                    "Block upload{obj} blksize={blksize} pst={pst}{}",
-                    if crc { " (crc)" } else { "" }
-                )
+                s.push_str("Block upload");
+                self.push_object(s);
+                write!(s, " blksize={blksize} pst={pst}{}", if crc { " (crc)" } else { "" })?;
             }
             BlockUploadInitiateResponse { crc, size, .. } => {
-                format!("Block upload response{obj} ({})", block_opts(crc, size))
+                s.push_str("Block upload response");
+                self.push_object(s);
+                write!(s, " ({})", block_opts(crc, size))?;
             }
-            BlockUploadStart => "Block upload start".to_string(),
-            BlockUploadAck { ackseq, blksize } => format!("Block upload ack ackseq={ackseq} blksize={blksize}"),
-            BlockUploadEnd { unused, crc } => format!("Block upload end n={unused} crc=0x{crc:04X}"),
-            BlockUploadEndResponse => "Block upload end response".to_string(),
+            BlockUploadStart => s.push_str("Block upload start"),
+            BlockUploadAck { ackseq, blksize } => write!(s, "Block upload ack ackseq={ackseq} blksize={blksize}")?,
+            BlockUploadEnd { unused, crc } => write!(s, "Block upload end n={unused} crc=0x{crc:04X}")?,
+            BlockUploadEndResponse => s.push_str("Block upload end response"),
             BlockSegment { seqno, last, .. } => {
                 let dir = if self.side == Side::Client {
                     "download"
                 } else {
                     "upload"
                 };
-                format!("Block {dir} segment seqno={seqno}{}", if last { " last" } else { "" })
+                write!(
+                    s,
+                    "Block {dir} segment seqno={seqno}{}",
+                    if last { " last" } else { "" }
+                )?;
             }
-            Unknown { command } => format!("Unknown SDO command 0x{command:02X}: {}", hex::spaced(self.raw.bytes())),
-        };
+            Unknown { command } => write!(
+                s,
+                "Unknown SDO command 0x{command:02X}: {}",
+                hex::spaced(self.raw.bytes())
+            )?,
+        }
         for p in &self.problems {
             s.push_str(" [");
             s.push_str(p);
             s.push(']');
         }
-        s
+        Ok(())
     }
 
     /// The `sdo` object of the frame's JSONL record: `cs`, `side`, `index`, `sub`,
@@ -325,11 +385,15 @@ pub struct SdoJson<'a> {
     pub value_text: Option<&'a str>,
 }
 
-/// `segmented, 16 bytes` or `segmented, size not indicated`.
-fn segmented_size(size: Option<u32>) -> String {
+/// Appends ` (segmented, 16 bytes)` or ` (segmented, size not indicated)`.
+fn push_segmented_size(s: &mut String, size: Option<u32>) -> std::fmt::Result {
+    use std::fmt::Write;
     match size {
-        Some(n) => format!("segmented, {n} bytes"),
-        None => "segmented, size not indicated".to_string(),
+        Some(n) => write!(s, " (segmented, {n} bytes)"),
+        None => {
+            s.push_str(" (segmented, size not indicated)");
+            Ok(())
+        }
     }
 }
 

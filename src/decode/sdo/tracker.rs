@@ -31,8 +31,23 @@ impl SdoTracker {
         payload: &[u8],
         dict: &Dictionary,
     ) -> SdoFrame {
-        let side = if client_to_server { Side::Client } else { Side::Server };
-        self.on_channel_frame(seq, ts_ns, Channel::default_for(node), side, payload, dict)
+        let tracked = self.track(seq, ts_ns, node, client_to_server, payload, dict);
+        labelled(tracked, payload, dict)
+    }
+
+    /// [`SdoTracker::on_frame`] without the dictionary name and typed value of the frame
+    /// (for callers that print no frame labels); the transfers go on the same way.
+    pub fn track(
+        &mut self,
+        seq: u64,
+        ts_ns: u64,
+        node: u8,
+        client_to_server: bool,
+        payload: &[u8],
+        dict: &Dictionary,
+    ) -> Tracked {
+        self.transfers
+            .on_frame(seq, ts_ns, node, client_to_server, payload, dict)
     }
 
     /// Feeds one frame of `channel` sent by `side`; returns its decoded meaning.
@@ -63,8 +78,9 @@ impl SdoTracker {
     }
 }
 
-/// The frame with the object's name and, for expedited data, its typed value.
-fn labelled(tracked: Tracked, payload: &[u8], dict: &Dictionary) -> SdoFrame {
+/// The frame as [`SdoTracker::track`] saw it, with the object's name and, for expedited
+/// data, its typed value.
+pub fn labelled(tracked: Tracked, payload: &[u8], dict: &Dictionary) -> SdoFrame {
     let mut frame = SdoFrame::of(tracked.side, payload, tracked.command);
     frame.object = tracked.object;
     frame.problems = tracked.problems;

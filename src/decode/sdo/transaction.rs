@@ -12,29 +12,44 @@ impl Transaction {
     /// One-line label, e.g.
     /// `Upload 0x1008:00 Manufacturer device name = "DEXMART" (segmented, 7 bytes, 1.200 ms): ok`.
     pub fn label(&self, dict: &Dictionary) -> String {
-        let dir = match self.direction {
+        let mut s = String::new();
+        self.write_label(&mut s, dict);
+        s
+    }
+
+    /// Appends [`Transaction::label`] to `s`.
+    pub fn write_label(&self, s: &mut String, dict: &Dictionary) {
+        // Writing into a String cannot fail.
+        let _ = self.write_label_fmt(s, dict);
+    }
+
+    fn write_label_fmt(&self, s: &mut String, dict: &Dictionary) -> std::fmt::Result {
+        use std::fmt::Write;
+        s.push_str(match self.direction {
             TransferDirection::Upload => "Upload",
             TransferDirection::Download => "Download",
-        };
+        });
         let partial = self.is_partial();
-        let mut s = if partial {
-            format!("{dir} (object not captured)")
+        if partial {
+            s.push_str(" (object not captured)");
         } else {
-            format!("{dir} 0x{:04X}:{:02X}", self.index, self.sub)
-        };
-        if let Some(name) = dict.label_name(self.index, self.sub).filter(|_| !partial) {
-            s.push(' ');
-            s.push_str(&name);
+            write!(s, " 0x{:04X}:{:02X}", self.index, self.sub)?;
+            if let Some(name) = dict.label_name(self.index, self.sub) {
+                s.push(' ');
+                s.push_str(&name);
+            }
         }
         if self.outcome == Outcome::Ok && !self.data.is_empty() && !partial {
             let v = view_in_mode(dict, self.index, self.sub, &self.data, self.mode);
-            let text: String = if v.text.chars().count() > 80 {
-                v.text.chars().take(77).chain("...".chars()).collect()
-            } else {
-                v.text
-            };
             s.push_str(" = ");
-            s.push_str(&text);
+            match v.text.char_indices().nth(80) {
+                Some(_) => {
+                    let cut = v.text.char_indices().nth(77).map_or(v.text.len(), |(i, _)| i);
+                    s.push_str(&v.text[..cut]);
+                    s.push_str("...");
+                }
+                None => s.push_str(&v.text),
+            }
         }
         let n = self.len();
         s.push_str(" (");
@@ -42,29 +57,27 @@ impl Transaction {
             s.push_str(self.protocol.as_str());
             s.push_str(", ");
         }
-        let plural = if n == 1 { "" } else { "s" };
-        let seen = if partial { " seen" } else { "" };
-        let kept = if self.dropped > 0 {
-            format!(", first {} kept", self.data.len())
-        } else {
-            String::new()
-        };
-        s.push_str(&format!(
-            "{n} byte{plural}{seen}{kept}, {:.3} ms): ",
-            self.duration_ns() as f64 / 1e6
-        ));
+        write!(s, "{n} byte")?;
+        if n != 1 {
+            s.push('s');
+        }
+        if partial {
+            s.push_str(" seen");
+        }
+        if self.dropped > 0 {
+            write!(s, ", first {} kept", self.data.len())?;
+        }
+        write!(s, ", {:.3} ms): ", self.duration_ns() as f64 / 1e6)?;
         match &self.outcome {
             Outcome::Ok => s.push_str("ok"),
-            Outcome::Aborted { code, text, by } => {
-                s.push_str(&format!("aborted by {}: 0x{code:08X} {text}", by.as_str()))
-            }
+            Outcome::Aborted { code, text, by } => write!(s, "aborted by {}: 0x{code:08X} {text}", by.as_str())?,
             Outcome::Incomplete => s.push_str("incomplete"),
-            Outcome::ProtocolError(e) => s.push_str(&format!("protocol error: {e}")),
+            Outcome::ProtocolError(e) => write!(s, "protocol error: {e}")?,
         }
         for p in &self.problems {
-            s.push_str(&format!(" [{p}]"));
+            write!(s, " [{p}]")?;
         }
-        s
+        Ok(())
     }
 
     /// The JSONL record of `--transactions --format jsonl`: the object, name, typed value,

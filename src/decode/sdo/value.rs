@@ -41,7 +41,7 @@ pub fn view_in_mode(dict: &Dictionary, index: u16, sub: u8, bytes: &[u8], mode: 
         let take = size.map_or(bytes.len(), |n| n.min(bytes.len()));
         let typed = info.data_type.decode(&bytes[..take]);
         return ValueView {
-            text: crate::decode::value_text::object_text(dict, index, sub, &typed, mode),
+            text: crate::decode::value_text::object_text_of(dict, Some(info), index, sub, &typed, mode),
             json: typed.to_json(),
             parts: typed
                 .as_i64()
