@@ -6,7 +6,7 @@ use super::cob_id::{CobId, CobTable, Route};
 use super::heartbeat::Heartbeat;
 use super::pdo::{self, Pdo};
 use super::pdo_config::{CommParams, PdoId};
-use super::sdo::tracker::labelled;
+use super::sdo::tracker::{labelled, unlabelled};
 use super::sdo::{SdoFrame, SdoTracker};
 use super::{Kind, emcy, error_frame, heartbeat, lss, nmt, sync, time, value_text, vendor_sdo};
 use crate::frame::Frame;
@@ -199,7 +199,7 @@ impl Decoder {
         let c2s = route.kind == Kind::SdoRx;
         vendor_sdo::decode(&self.dicts[n], c2s, frame.payload())
             .is_none()
-            .then_some(s)
+            .then(|| unlabelled(s, frame.payload()))
     }
 
     fn route(&self, frame: &Frame) -> Route {
