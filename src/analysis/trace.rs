@@ -10,7 +10,7 @@
 //! `a..b`. So labels are exact, at most `CHECKPOINT` frames are replayed per window, and
 //! the checkpoints cost well under a byte per frame.
 
-use super::diagnose::Diagnoser;
+use super::diagnose::{Diagnoser, feed};
 use super::nodes::Nodes;
 use super::series::Series;
 use super::stats::Stats;
@@ -94,35 +94,23 @@ impl Trace {
         }
         self.nodes.tick(frame.ts_ns);
         self.diagnosis_version += 1;
-        let (kind, node, pdo) = self.decoder.peek(frame);
-        // Frames that change what the panes or the diagnosis show are decoded in full (SDO
-        // frames always were: the decoder tracks their transfers); the rest only routed.
-        let (kind, node) = if matches!(
-            kind,
-            Kind::Tpdo
-                | Kind::Rpdo
-                | Kind::Emcy
-                | Kind::Heartbeat
-                | Kind::SdoRx
-                | Kind::SdoTx
-                | Kind::Nmt
-                | Kind::ErrorFrame
-        ) {
-            self.decoder.set_seq(pos as u64);
-            let d = self.decoder.decode(frame);
-            let iface = self.ifaces.name(frame.iface);
-            match kind {
+        self.decoder.set_seq(pos as u64);
+        let (kind, node, _) = self.decoder.peek(frame);
+        let iface = self.ifaces.name(frame.iface);
+        // PDOs: their values, without the names, texts and labels that rows decode anew
+        // from checkpoints. Other frames: as far as the diagnosis decodes them (SDO frames
+        // tracked without labels), the rest only routed.
+        if matches!(kind, Kind::Tpdo | Kind::Rpdo) {
+            let d = self.decoder.pdo_values(frame);
+            self.diagnosis.frame(frame, iface, &d);
+            self.observe(frame, &d);
+        } else if let Some(d) = feed(&mut self.decoder, &mut self.diagnosis, frame, iface) {
+            match d.kind {
                 Kind::ErrorFrame => self.nodes.error_frame(frame.ts_ns, iface, frame.id, frame.payload()),
-                Kind::Tpdo | Kind::Rpdo | Kind::Emcy | Kind::Heartbeat => self.observe(frame, &d),
+                Kind::Emcy | Kind::Heartbeat => self.observe(frame, &d),
                 _ => {}
             }
-            let iface = self.ifaces.name(frame.iface);
-            self.diagnosis.frame(frame, iface, &d);
-            (d.kind, d.node)
-        } else {
-            self.diagnosis.skip(frame, kind, node, pdo);
-            (kind, node)
-        };
+        }
         self.store.push(frame, kind, node);
         let p = *self.store.packed(pos);
         self.stats.add(&p, &self.store);
@@ -145,7 +133,7 @@ impl Trace {
             Body::Emcy(e) => self.nodes.emcy(n, frame.ts_ns, e),
             Body::Pdo(p) => {
                 self.nodes.pdo(n, p, self.decoder.mode(n));
-                self.series.pdo(n, frame.ts_ns, p);
+                self.series.pdo(n, frame.ts_ns, p, self.decoder.dictionary(n));
                 self.values.pdo(n, frame.ts_ns, p, self.decoder.mode(n));
             }
             _ => {}
