@@ -231,9 +231,15 @@ fn sync_defaults(dict: &Dictionary) -> SyncDefaults {
 /// COB-IDs and PDOs that [`Diagnoser::wants_pdo`] declines only routed). Returns the
 /// frame's full decoding when it made one. The SDO transactions the frame completed stay
 /// in the decoder: the caller takes them ([`Decoder::take_transactions`]) and hands them
-/// to [`Diagnoser::transaction`].
-pub fn feed(decoder: &mut Decoder, diag: &mut Diagnoser, frame: &Frame, iface: &str) -> Option<Decoded> {
-    let (kind, node, pdo) = decoder.peek(frame);
+/// to [`Diagnoser::transaction`]. `peeked` is what [`Decoder::peek`] says of the frame.
+pub fn feed(
+    decoder: &mut Decoder,
+    diag: &mut Diagnoser,
+    frame: &Frame,
+    peeked: (Kind, Option<u8>, u16),
+    iface: &str,
+) -> Option<Decoded> {
+    let (kind, node, pdo) = peeked;
     let skip = match kind {
         Kind::Sync | Kind::Time | Kind::Lss | Kind::Other => true,
         Kind::SdoRx | Kind::SdoTx => {

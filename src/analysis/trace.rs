@@ -95,7 +95,7 @@ impl Trace {
         self.nodes.tick(frame.ts_ns);
         self.diagnosis_version += 1;
         self.decoder.set_seq(pos as u64);
-        let (kind, node, _) = self.decoder.peek(frame);
+        let peeked @ (kind, node, _) = self.decoder.peek(frame);
         let iface = self.ifaces.name(frame.iface);
         // PDOs: their values, without the names, texts and labels that rows decode anew
         // from checkpoints. Other frames: as far as the diagnosis decodes them (SDO frames
@@ -104,7 +104,7 @@ impl Trace {
             let d = self.decoder.pdo_values(frame);
             self.diagnosis.frame(frame, iface, &d);
             self.observe(frame, &d);
-        } else if let Some(d) = feed(&mut self.decoder, &mut self.diagnosis, frame, iface) {
+        } else if let Some(d) = feed(&mut self.decoder, &mut self.diagnosis, frame, peeked, iface) {
             match d.kind {
                 Kind::ErrorFrame => self.nodes.error_frame(frame.ts_ns, iface, frame.id, frame.payload()),
                 Kind::Emcy | Kind::Heartbeat => self.observe(frame, &d),
@@ -128,18 +128,19 @@ impl Trace {
 
     fn observe(&mut self, frame: &Frame, d: &Decoded) {
         let n = d.node.unwrap_or(0);
+        let (profile, mode) = (self.decoder.dictionary(n).profile_name(), self.decoder.mode(n));
         match &d.body {
             Body::Heartbeat(h) => self.nodes.heartbeat(n, frame.ts_ns, h),
             Body::Emcy(e) => self.nodes.emcy(n, frame.ts_ns, e),
             Body::Pdo(p) => {
-                self.nodes.pdo(n, p, self.decoder.mode(n));
+                self.nodes.pdo(n, p, profile, mode);
                 self.series.pdo(n, frame.ts_ns, p, self.decoder.dictionary(n));
-                self.values.pdo(n, frame.ts_ns, p, self.decoder.mode(n));
+                self.values.pdo(n, frame.ts_ns, p, mode);
+                return;
             }
             _ => {}
         }
-        self.nodes
-            .profile(n, self.decoder.dictionary(n).profile_name(), self.decoder.mode(n));
+        self.nodes.profile(n, profile, mode);
     }
 
     /// The capture clock reached `now_ns` with no new frame (live or a running replay):

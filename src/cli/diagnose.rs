@@ -117,7 +117,8 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
 /// One frame of interface `iface` into the diagnosis (see [`diagnose::feed`]), with the
 /// SDO transactions it completed.
 fn feed(decoder: &mut Decoder, diag: &mut Diagnoser, frame: &Frame, iface: &str) {
-    if let Some(d) = diagnose::feed(decoder, diag, frame, iface) {
+    let peeked = decoder.peek(frame);
+    if let Some(d) = diagnose::feed(decoder, diag, frame, peeked, iface) {
         decoder.recycle(d);
     }
     for t in decoder.take_transactions() {
