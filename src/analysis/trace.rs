@@ -221,6 +221,46 @@ mod tests {
     }
 
     #[test]
+    fn indexed_pdo_values_and_series_names_equal_a_full_decode() {
+        let read = |p: &std::path::Path| std::fs::read(p);
+        let b = crate::od::bind::Bindings::from_args(&["1=aimotor".to_string(), "2=aimotor".to_string()], &[], &read)
+            .unwrap();
+        let mut t = Trace::new(Decoder::from_bindings(&b), 500_000);
+        let mut full = Decoder::from_bindings(&b);
+        let mut values = std::collections::BTreeMap::new();
+        let mut names = std::collections::BTreeMap::new();
+        for (i, f) in crate::sim::synth::Traffic::new(20_000, 0).enumerate() {
+            t.push(&f);
+            full.set_seq(i as u64);
+            let d = full.decode(&f);
+            if let (Body::Pdo(p), Some(n)) = (&d.body, d.node) {
+                for s in &p.signals {
+                    values.insert((n, s.index, s.sub), s.value.clone());
+                    names.entry((n, s.index, s.sub)).or_insert_with(|| s.name.clone());
+                }
+            }
+            full.take_transactions();
+        }
+        assert!(values.len() > 1, "the traffic maps PDO signals");
+        let mut compared = 0;
+        for (&(n, index, sub), v) in &values {
+            let seen = t.values.get(n, index, sub).and_then(|e| e.last.as_ref()).unwrap();
+            // An SDO transfer after the last PDO carries the last value then.
+            if seen.via == crate::analysis::values::Via::Pdo {
+                assert_eq!(&seen.value, v, "{n} {index:04X}:{sub}");
+                compared += 1;
+            }
+        }
+        assert!(compared > 0);
+        for (key, name) in &names {
+            if let Some(line) = t.series.get(key) {
+                assert_eq!(&line.name, name);
+            }
+        }
+        assert!(names.keys().any(|k| t.series.get(k).is_some()));
+    }
+
+    #[test]
     fn window_labels_equal_a_full_sequential_decode() {
         let mut t = Trace::new(decoder(), 500_000);
         let frames: Vec<Frame> = crate::sim::synth::Traffic::new(3 * CHECKPOINT as u64 + 77, 0).collect();
