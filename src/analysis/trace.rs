@@ -101,7 +101,7 @@ impl Trace {
         // from checkpoints. Other frames: as far as the diagnosis decodes them (SDO frames
         // tracked without labels), the rest only routed.
         if matches!(kind, Kind::Tpdo | Kind::Rpdo) {
-            let d = self.decoder.pdo_values(frame);
+            let d = self.decoder.pdo_values(frame, peeked);
             self.diagnosis.frame(frame, iface, &d);
             self.observe(frame, &d);
         } else if let Some(d) = feed(&mut self.decoder, &mut self.diagnosis, frame, peeked, iface) {

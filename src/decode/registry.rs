@@ -381,23 +381,24 @@ impl Decoder {
     /// A PDO frame (per [`Decoder::peek`]) decoded as [`Decoder::decode`] decodes it, bus
     /// state included (modes of operation), but with no label, `malformed` or mapping source
     /// and its signals without names or texts: for callers that keep values (the TUI's index).
-    pub fn pdo_values(&mut self, frame: &Frame) -> Decoded {
-        let route = self.route(frame);
-        debug_assert!(matches!(route.kind, Kind::Tpdo | Kind::Rpdo));
+    /// `peeked` is what [`Decoder::peek`] says of the frame (not routed again).
+    pub fn pdo_values(&mut self, frame: &Frame, peeked: (Kind, Option<u8>, u16)) -> Decoded {
+        let (kind, node, num) = peeked;
+        debug_assert!(matches!(kind, Kind::Tpdo | Kind::Rpdo));
         self.seq += 1;
-        let n = route.node.unwrap_or(0);
-        let transmit = route.kind == Kind::Tpdo;
-        let signals = match self.mappings.get(&(n, transmit, route.pdo)) {
+        let n = node.unwrap_or(0);
+        let transmit = kind == Kind::Tpdo;
+        let signals = match self.mappings.get(&(n, transmit, num)) {
             Some(m) if !frame.is_rtr() => pdo::decode_values(frame.payload(), m, &self.dicts[n as usize]),
             _ => Vec::new(),
         };
         self.note_mode(n, &signals);
         Decoded {
-            kind: route.kind,
-            node: route.node,
+            kind,
+            node,
             label: String::new(),
             body: Body::Pdo(Pdo {
-                num: route.pdo,
+                num,
                 transmit,
                 signals,
                 source: None,
