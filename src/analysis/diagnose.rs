@@ -17,7 +17,7 @@ use crate::decode::emcy::Emcy;
 use crate::decode::heartbeat::NmtState;
 use crate::decode::sdo::frame::{Chunk8, SdoFrame};
 use crate::decode::stall::{self, Observation, Step};
-use crate::decode::{Body, Decoded, Kind};
+use crate::decode::{Body, Decoded, Decoder, Kind};
 use crate::frame::Frame;
 use crate::od::{Dictionary, PdoMapping};
 use crate::sdo::abort::abort_text;
@@ -224,6 +224,42 @@ fn sync_defaults(dict: &Dictionary) -> SyncDefaults {
         .filter_map(|i| Some((i - 0x1800 + 1, u8::try_from(default(i, 2)?).ok()?)))
         .collect();
     (window, types)
+}
+
+/// One frame of interface `iface` into the diagnosis, decoded only as far as it can tell
+/// the diagnosis something (SDO frames tracked without labels, SYNC, TIME, LSS, unknown
+/// COB-IDs and PDOs that [`Diagnoser::wants_pdo`] declines only routed). Returns the
+/// frame's full decoding when it made one. The SDO transactions the frame completed stay
+/// in the decoder: the caller takes them ([`Decoder::take_transactions`]) and hands them
+/// to [`Diagnoser::transaction`]. `peeked` is what [`Decoder::peek`] says of the frame.
+pub fn feed(
+    decoder: &mut Decoder,
+    diag: &mut Diagnoser,
+    frame: &Frame,
+    peeked: (Kind, Option<u8>, u16),
+    iface: &str,
+) -> Option<Decoded> {
+    let (kind, node, pdo) = peeked;
+    let skip = match kind {
+        Kind::Sync | Kind::Time | Kind::Lss | Kind::Other => true,
+        Kind::SdoRx | Kind::SdoTx => {
+            let s = decoder.sdo_frame(frame);
+            diag.sdo(frame, node.unwrap_or(0), kind == Kind::SdoRx, s.as_ref());
+            return None;
+        }
+        Kind::Tpdo | Kind::Rpdo => {
+            let n = node.unwrap_or(0);
+            !diag.wants_pdo(n, pdo, decoder.mapping(n, kind == Kind::Tpdo, pdo))
+        }
+        _ => false,
+    };
+    if skip {
+        diag.skip(frame, kind, node, pdo);
+        return None;
+    }
+    let d = decoder.decode(frame);
+    diag.frame(frame, iface, &d);
+    Some(d)
 }
 
 impl Diagnoser {

@@ -234,8 +234,9 @@ impl Nodes {
         self.collect();
     }
 
-    /// A PDO of `node`: picks up the statusword.
-    pub fn pdo(&mut self, node: u8, p: &Pdo, mode: Option<i8>) {
+    /// A PDO of `node`: picks up the statusword, and records the profile and mode in force
+    /// as [`Nodes::profile`] does (one node lookup for both).
+    pub fn pdo(&mut self, node: u8, p: &Pdo, profile: &str, mode: Option<i8>) {
         let n = self.entry(node);
         for s in &p.signals {
             if (s.index, s.sub) == (0x6041, 0)
@@ -243,6 +244,9 @@ impl Nodes {
             {
                 n.drive = Some(DriveState::from_statusword(sw as u16));
             }
+        }
+        if node != 0 && n.profile != profile {
+            n.profile = profile.to_string();
         }
         n.mode = mode.or(n.mode);
     }

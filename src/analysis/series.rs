@@ -200,19 +200,27 @@ impl Series {
         self.lines.get(key)
     }
 
-    fn add(&mut self, key: SeriesKey, name: &str, t: f64, v: f64) {
-        let line = self.lines.entry(key).or_insert_with(|| Line {
-            name: name.to_string(),
-            ..Line::default()
+    /// Adds a point to the series `key`, named by `dict` when it is new.
+    fn add(&mut self, key: SeriesKey, dict: &Dictionary, t: f64, v: f64) {
+        let line = self.lines.entry(key).or_insert_with(|| {
+            let (_, index, sub) = key;
+            Line {
+                name: dict
+                    .name(index, sub)
+                    .map(str::to_string)
+                    .unwrap_or_else(|| format!("0x{index:04X}:{sub:02X}")),
+                ..Line::default()
+            }
         });
         line.add(t, v);
     }
 
-    /// Adds the numeric signals of a PDO of `node` at `ts_ns`.
-    pub fn pdo(&mut self, node: u8, ts_ns: u64, p: &Pdo) {
+    /// Adds the numeric signals of a PDO of `node` at `ts_ns` (`dict`: the node's dictionary,
+    /// which names new series).
+    pub fn pdo(&mut self, node: u8, ts_ns: u64, p: &Pdo, dict: &Dictionary) {
         for s in &p.signals {
             if let Some(v) = s.value.as_f64() {
-                self.add((node, s.index, s.sub), &s.name, ts_ns as f64 / 1e9, v);
+                self.add((node, s.index, s.sub), dict, ts_ns as f64 / 1e9, v);
             }
         }
     }
@@ -232,11 +240,7 @@ impl Series {
             }
         };
         let Some(v) = value else { return };
-        let name = dict
-            .name(t.index, t.sub)
-            .map(str::to_string)
-            .unwrap_or_else(|| format!("0x{:04X}:{:02X}", t.index, t.sub));
-        self.add((t.node, t.index, t.sub), &name, t.end_ns as f64 / 1e9, v);
+        self.add((t.node, t.index, t.sub), dict, t.end_ns as f64 / 1e9, v);
     }
 }
 

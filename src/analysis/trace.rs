@@ -10,7 +10,7 @@
 //! `a..b`. So labels are exact, at most `CHECKPOINT` frames are replayed per window, and
 //! the checkpoints cost well under a byte per frame.
 
-use super::diagnose::Diagnoser;
+use super::diagnose::{Diagnoser, feed};
 use super::nodes::Nodes;
 use super::series::Series;
 use super::stats::Stats;
@@ -94,35 +94,23 @@ impl Trace {
         }
         self.nodes.tick(frame.ts_ns);
         self.diagnosis_version += 1;
-        let (kind, node, pdo) = self.decoder.peek(frame);
-        // Frames that change what the panes or the diagnosis show are decoded in full (SDO
-        // frames always were: the decoder tracks their transfers); the rest only routed.
-        let (kind, node) = if matches!(
-            kind,
-            Kind::Tpdo
-                | Kind::Rpdo
-                | Kind::Emcy
-                | Kind::Heartbeat
-                | Kind::SdoRx
-                | Kind::SdoTx
-                | Kind::Nmt
-                | Kind::ErrorFrame
-        ) {
-            self.decoder.set_seq(pos as u64);
-            let d = self.decoder.decode(frame);
-            let iface = self.ifaces.name(frame.iface);
-            match kind {
+        self.decoder.set_seq(pos as u64);
+        let peeked @ (kind, node, _) = self.decoder.peek(frame);
+        let iface = self.ifaces.name(frame.iface);
+        // PDOs: their values, without the names, texts and labels that rows decode anew
+        // from checkpoints. Other frames: as far as the diagnosis decodes them (SDO frames
+        // tracked without labels), the rest only routed.
+        if matches!(kind, Kind::Tpdo | Kind::Rpdo) {
+            let d = self.decoder.pdo_values(frame, peeked);
+            self.diagnosis.frame(frame, iface, &d);
+            self.observe(frame, &d);
+        } else if let Some(d) = feed(&mut self.decoder, &mut self.diagnosis, frame, peeked, iface) {
+            match d.kind {
                 Kind::ErrorFrame => self.nodes.error_frame(frame.ts_ns, iface, frame.id, frame.payload()),
-                Kind::Tpdo | Kind::Rpdo | Kind::Emcy | Kind::Heartbeat => self.observe(frame, &d),
+                Kind::Emcy | Kind::Heartbeat => self.observe(frame, &d),
                 _ => {}
             }
-            let iface = self.ifaces.name(frame.iface);
-            self.diagnosis.frame(frame, iface, &d);
-            (d.kind, d.node)
-        } else {
-            self.diagnosis.skip(frame, kind, node, pdo);
-            (kind, node)
-        };
+        }
         self.store.push(frame, kind, node);
         let p = *self.store.packed(pos);
         self.stats.add(&p, &self.store);
@@ -140,18 +128,19 @@ impl Trace {
 
     fn observe(&mut self, frame: &Frame, d: &Decoded) {
         let n = d.node.unwrap_or(0);
+        let (profile, mode) = (self.decoder.dictionary(n).profile_name(), self.decoder.mode(n));
         match &d.body {
             Body::Heartbeat(h) => self.nodes.heartbeat(n, frame.ts_ns, h),
             Body::Emcy(e) => self.nodes.emcy(n, frame.ts_ns, e),
             Body::Pdo(p) => {
-                self.nodes.pdo(n, p, self.decoder.mode(n));
-                self.series.pdo(n, frame.ts_ns, p);
-                self.values.pdo(n, frame.ts_ns, p, self.decoder.mode(n));
+                self.nodes.pdo(n, p, profile, mode);
+                self.series.pdo(n, frame.ts_ns, p, self.decoder.dictionary(n));
+                self.values.pdo(n, frame.ts_ns, p, mode);
+                return;
             }
             _ => {}
         }
-        self.nodes
-            .profile(n, self.decoder.dictionary(n).profile_name(), self.decoder.mode(n));
+        self.nodes.profile(n, profile, mode);
     }
 
     /// The capture clock reached `now_ns` with no new frame (live or a running replay):
@@ -229,6 +218,46 @@ mod tests {
 
     fn decoder() -> Decoder {
         Decoder::new(Dictionary::default(), Vec::new())
+    }
+
+    #[test]
+    fn indexed_pdo_values_and_series_names_equal_a_full_decode() {
+        let read = |p: &std::path::Path| std::fs::read(p);
+        let b = crate::od::bind::Bindings::from_args(&["1=aimotor".to_string(), "2=aimotor".to_string()], &[], &read)
+            .unwrap();
+        let mut t = Trace::new(Decoder::from_bindings(&b), 500_000);
+        let mut full = Decoder::from_bindings(&b);
+        let mut values = std::collections::BTreeMap::new();
+        let mut names = std::collections::BTreeMap::new();
+        for (i, f) in crate::sim::synth::Traffic::new(20_000, 0).enumerate() {
+            t.push(&f);
+            full.set_seq(i as u64);
+            let d = full.decode(&f);
+            if let (Body::Pdo(p), Some(n)) = (&d.body, d.node) {
+                for s in &p.signals {
+                    values.insert((n, s.index, s.sub), s.value.clone());
+                    names.entry((n, s.index, s.sub)).or_insert_with(|| s.name.clone());
+                }
+            }
+            full.take_transactions();
+        }
+        assert!(values.len() > 1, "the traffic maps PDO signals");
+        let mut compared = 0;
+        for (&(n, index, sub), v) in &values {
+            let seen = t.values.get(n, index, sub).and_then(|e| e.last.as_ref()).unwrap();
+            // An SDO transfer after the last PDO carries the last value then.
+            if seen.via == crate::analysis::values::Via::Pdo {
+                assert_eq!(&seen.value, v, "{n} {index:04X}:{sub}");
+                compared += 1;
+            }
+        }
+        assert!(compared > 0);
+        for (key, name) in &names {
+            if let Some(line) = t.series.get(key) {
+                assert_eq!(&line.name, name);
+            }
+        }
+        assert!(names.keys().any(|k| t.series.get(k).is_some()));
     }
 
     #[test]

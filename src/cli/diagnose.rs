@@ -2,9 +2,9 @@
 //! ranked list of incidents.
 
 use super::input;
-use crate::analysis::{Diagnoser, Incident, Status};
+use crate::analysis::{Diagnoser, Incident, Status, diagnose};
 use crate::command::ExitCode;
-use crate::decode::{Decoder, Kind};
+use crate::decode::Decoder;
 use crate::frame::Frame;
 use crate::frame::json::write_line;
 use clap::{Args, ValueEnum};
@@ -114,33 +114,13 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
     status
 }
 
-/// One frame of interface `iface` into the diagnosis: decoded only as far as it can tell
-/// the diagnosis something.
+/// One frame of interface `iface` into the diagnosis (see [`diagnose::feed`]), with the
+/// SDO transactions it completed.
 fn feed(decoder: &mut Decoder, diag: &mut Diagnoser, frame: &Frame, iface: &str) {
-    let (kind, node, pdo) = decoder.peek(frame);
-    let skip = match kind {
-        Kind::Sync | Kind::Time | Kind::Lss | Kind::Other => true,
-        // SDO frames: tracked without building the label nobody reads.
-        Kind::SdoRx | Kind::SdoTx => {
-            let s = decoder.sdo_frame(frame);
-            diag.sdo(frame, node.unwrap_or(0), kind == Kind::SdoRx, s.as_ref());
-            for t in decoder.take_transactions() {
-                diag.transaction(&t);
-            }
-            return;
-        }
-        Kind::Tpdo | Kind::Rpdo => {
-            let n = node.unwrap_or(0);
-            !diag.wants_pdo(n, pdo, decoder.mapping(n, kind == Kind::Tpdo, pdo))
-        }
-        _ => false,
-    };
-    if skip {
-        diag.skip(frame, kind, node, pdo);
-        return;
+    let peeked = decoder.peek(frame);
+    if let Some(d) = diagnose::feed(decoder, diag, frame, peeked, iface) {
+        decoder.recycle(d);
     }
-    let d = decoder.decode(frame);
-    diag.frame(frame, iface, &d);
     for t in decoder.take_transactions() {
         diag.transaction(&t);
     }

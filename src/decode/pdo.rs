@@ -1,6 +1,6 @@
 //! PDO payloads decoded into named, typed, scaled signals through the mapping in force.
 
-use crate::od::{DataType, Dictionary, MappedEntry, MappingSource, PdoMapping, Value};
+use crate::od::{DataType, Dictionary, MappedEntry, MappingSource, ObjectInfo, PdoMapping, Value};
 use serde::Serialize;
 
 /// One mapped signal taken out of a PDO payload.
@@ -160,22 +160,34 @@ pub fn decode_signals(
     (signals, problem)
 }
 
+/// The values of the signals of `payload` through `mapping`, as [`decode_signals`] takes
+/// them, without names or texts (both left empty): for callers that keep numbers.
+pub fn decode_values(payload: &[u8], mapping: &PdoMapping, dict: &Dictionary) -> Vec<Signal> {
+    let available = payload.len() * 8;
+    let mut signals = Vec::with_capacity(mapping.entries.len());
+    let mut pos = 0usize;
+    for e in &mapping.entries {
+        let bits = e.bits as usize;
+        if pos + bits > available {
+            break;
+        }
+        if !(0x0001..=0x0007).contains(&e.index) {
+            signals.push(Signal {
+                index: e.index,
+                sub: e.sub,
+                name: String::new(),
+                value: value(payload, pos, e, dict.object(e.index, e.sub)),
+                text: String::new(),
+            });
+        }
+        pos += bits;
+    }
+    signals
+}
+
 fn signal(payload: &[u8], pos: usize, e: &MappedEntry, dict: &Dictionary, mode: Option<i8>) -> Signal {
-    let bits = e.bits as usize;
     let info = dict.object(e.index, e.sub);
-    let value = if pos.is_multiple_of(8) && bits.is_multiple_of(8) {
-        let bytes = &payload[pos / 8..(pos + bits) / 8];
-        match info.map(|i| i.data_type) {
-            Some(dt) if dt.size().is_none_or(|s| s * 8 == bits) => dt.decode(bytes),
-            _ => DataType::U64.decode(bytes),
-        }
-    } else {
-        let raw = extract_bits(payload, pos, bits);
-        match info.map(|i| i.data_type) {
-            Some(DataType::Boolean) => Value::Bool(raw != 0),
-            _ => Value::Unsigned(raw),
-        }
-    };
+    let value = value(payload, pos, e, info);
     let name = dict
         .name(e.index, e.sub)
         .map(str::to_string)
@@ -187,6 +199,24 @@ fn signal(payload: &[u8], pos: usize, e: &MappedEntry, dict: &Dictionary, mode: 
         name,
         value,
         text,
+    }
+}
+
+/// The value of the entry `e` at bit `pos` of `payload`, typed by the object `info`.
+fn value(payload: &[u8], pos: usize, e: &MappedEntry, info: Option<&ObjectInfo>) -> Value {
+    let bits = e.bits as usize;
+    if pos.is_multiple_of(8) && bits.is_multiple_of(8) {
+        let bytes = &payload[pos / 8..(pos + bits) / 8];
+        match info.map(|i| i.data_type) {
+            Some(dt) if dt.size().is_none_or(|s| s * 8 == bits) => dt.decode(bytes),
+            _ => DataType::U64.decode(bytes),
+        }
+    } else {
+        let raw = extract_bits(payload, pos, bits);
+        match info.map(|i| i.data_type) {
+            Some(DataType::Boolean) => Value::Bool(raw != 0),
+            _ => Value::Unsigned(raw),
+        }
     }
 }
 

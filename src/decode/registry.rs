@@ -378,6 +378,44 @@ impl Decoder {
         s
     }
 
+    /// A PDO frame (per [`Decoder::peek`]) decoded as [`Decoder::decode`] decodes it, bus
+    /// state included (modes of operation), but with no label, `malformed` or mapping source
+    /// and its signals without names or texts: for callers that keep values (the TUI's index).
+    /// `peeked` is what [`Decoder::peek`] says of the frame (not routed again).
+    pub fn pdo_values(&mut self, frame: &Frame, peeked: (Kind, Option<u8>, u16)) -> Decoded {
+        let (kind, node, num) = peeked;
+        debug_assert!(matches!(kind, Kind::Tpdo | Kind::Rpdo));
+        self.seq += 1;
+        let n = node.unwrap_or(0);
+        let transmit = kind == Kind::Tpdo;
+        let signals = match self.mappings.get(&(n, transmit, num)) {
+            Some(m) if !frame.is_rtr() => pdo::decode_values(frame.payload(), m, &self.dicts[n as usize]),
+            _ => Vec::new(),
+        };
+        self.note_mode(n, &signals);
+        Decoded {
+            kind,
+            node,
+            label: String::new(),
+            body: Body::Pdo(Pdo {
+                num,
+                transmit,
+                signals,
+                source: None,
+            }),
+            malformed: None,
+        }
+    }
+
+    /// Records a mode of operation carried by PDO `signals` of node `n`.
+    fn note_mode(&mut self, n: u8, signals: &[pdo::Signal]) {
+        for s in signals {
+            if matches!((s.index, s.sub), (0x6060 | 0x6061, 0)) {
+                self.modes[n as usize] = s.value.as_i64().map(|m| m as i8);
+            }
+        }
+    }
+
     fn decode_pdo(&mut self, frame: &Frame, route: Route) -> (String, Body, Option<String>) {
         let n = route.node.unwrap_or(0);
         let transmit = route.kind == Kind::Tpdo;
@@ -403,11 +441,7 @@ impl Decoder {
             }
             None => (Vec::new(), None, None),
         };
-        for s in &signals {
-            if matches!((s.index, s.sub), (0x6060 | 0x6061, 0)) {
-                self.modes[n as usize] = s.value.as_i64().map(|m| m as i8);
-            }
-        }
+        self.note_mode(n, &signals);
         let pdo = Pdo {
             num: route.pdo,
             transmit,
