@@ -179,22 +179,40 @@ impl Stacked {
     }
 
     /// Appends `v` in decimal (as [`push_u64`]).
-    pub fn u64(&mut self, mut v: u64) {
-        let end = self.len + v.checked_ilog10().unwrap_or(0) as usize + 1;
-        let mut i = end;
+    pub fn u64(&mut self, v: u64) {
+        if v < 10 {
+            self.buf[self.len] = b'0' + v as u8;
+            self.len += 1;
+        } else if v < 100 {
+            let d = v as usize * 2;
+            self.buf[self.len..self.len + 2].copy_from_slice(&PAIRS[d..d + 2]);
+            self.len += 2;
+        } else {
+            self.long(v);
+        }
+    }
+
+    /// [`Stacked::u64`] for three digits and more: written backwards into a scratch
+    /// buffer, then moved with a copy of fixed size.
+    fn long(&mut self, mut v: u64) {
+        let mut tmp = [0u8; 40];
+        let mut i = 20;
         while v >= 100 {
             let d = (v % 100) as usize * 2;
             v /= 100;
             i -= 2;
-            self.buf[i..i + 2].copy_from_slice(&PAIRS[d..d + 2]);
+            tmp[i..i + 2].copy_from_slice(&PAIRS[d..d + 2]);
         }
         if v >= 10 {
             let d = v as usize * 2;
-            self.buf[i - 2..i].copy_from_slice(&PAIRS[d..d + 2]);
+            i -= 2;
+            tmp[i..i + 2].copy_from_slice(&PAIRS[d..d + 2]);
         } else {
-            self.buf[i - 1] = b'0' + v as u8;
+            i -= 1;
+            tmp[i] = b'0' + v as u8;
         }
-        self.len = end;
+        self.buf[self.len..self.len + 20].copy_from_slice(&tmp[i..i + 20]);
+        self.len += 20 - i;
     }
 
     /// Appends a time in ns as seconds with all nine decimals (as [`push_seconds`]).

@@ -137,11 +137,8 @@ pub fn write_frame(out: &mut Vec<u8>, line: u64, frame: &Frame, ifaces: &Interfa
         None => st.lit(b"null"),
     }
     st.lit(b",\"label\":");
-    let label_fits = st.plain_text(&decoded.label);
     st.flush(out);
-    if !label_fits {
-        push_text(out, &decoded.label);
-    }
+    push_text(out, &decoded.label);
     if let Body::Pdo(p) = &decoded.body {
         // The most frequent kinds are written directly (as serde would write them).
         out.extend_from_slice(b",\"pdo\":");
