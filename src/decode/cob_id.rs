@@ -58,8 +58,10 @@ impl CobTable {
 
     /// How a frame with this id is to be read.
     pub fn route(&self, id: u32, ext: bool) -> Route {
-        let cob = CobId { id, ext };
-        if let Some(r) = self.moved.get(&cob) {
+        // Most buses move no COB-ID: skip hashing the id then.
+        if !self.moved.is_empty()
+            && let Some(r) = self.moved.get(&CobId { id, ext })
+        {
             return *r;
         }
         if ext {

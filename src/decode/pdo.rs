@@ -39,12 +39,26 @@ impl Pdo {
 
     /// Appends [`Pdo::label`] to `s`.
     pub fn write_label(&self, s: &mut String, node: u8, payload: &[u8]) {
-        s.push_str(if self.transmit { "TPDO" } else { "RPDO" });
-        crate::frame::hex::push_decimal(s, self.num as u64, 1);
-        s.push_str(" node ");
-        crate::frame::hex::push_decimal(s, node as u64, 1);
-        s.push_str(": ");
-        if self.signals.is_empty() {
+        // `TPDO1 node 1: ` and, without signals, a classic payload: composed on the stack
+        // and appended at once (the hot path of text and JSONL output).
+        let mut buf = [b' '; 48];
+        buf[..4].copy_from_slice(if self.transmit { b"TPDO" } else { b"RPDO" });
+        let mut n = 4 + decimal_into(&mut buf[4..], self.num);
+        buf[n..n + 6].copy_from_slice(b" node ");
+        n += 6;
+        n += decimal_into(&mut buf[n..], node.into());
+        buf[n] = b':';
+        n += 2;
+        if self.signals.is_empty() && payload.len() <= 8 {
+            for (i, b) in payload.iter().enumerate() {
+                buf[n + 3 * i] = HEX[(b >> 4) as usize];
+                buf[n + 3 * i + 1] = HEX[(b & 15) as usize];
+            }
+            n += (3 * payload.len()).saturating_sub(1);
+        }
+        // Only ASCII digits, letters and punctuation were written.
+        crate::frame::hex::push_ascii(s, &buf[..n]);
+        if self.signals.is_empty() && payload.len() > 8 {
             crate::frame::hex::push_spaced(s, payload);
         }
         for (i, sig) in self.signals.iter().enumerate() {
@@ -75,6 +89,20 @@ impl Pdo {
                 .collect(),
         }
     }
+}
+
+/// Upper-case hex digits.
+const HEX: &[u8; 16] = b"0123456789ABCDEF";
+
+/// Writes `v` in decimal at the start of `out` (at least five bytes); returns the digits written.
+fn decimal_into(out: &mut [u8], v: u16) -> usize {
+    let digits = v.checked_ilog10().unwrap_or(0) as usize + 1;
+    let mut v = v;
+    for d in out[..digits].iter_mut().rev() {
+        *d = b'0' + (v % 10) as u8;
+        v /= 10;
+    }
+    digits
 }
 
 /// The `pdo` object of a JSONL frame record (fields in key order).

@@ -211,9 +211,11 @@ impl Decoder {
                 reserved: false,
             };
         }
-        if let Some(&(node, c2s)) = self
-            .sdo_cobs
-            .get(&(frame.id | if frame.is_ext() { 1 << 29 } else { 0 }))
+        // Most buses move no SDO channel: skip hashing the id then.
+        if !self.sdo_cobs.is_empty()
+            && let Some(&(node, c2s)) = self
+                .sdo_cobs
+                .get(&(frame.id | if frame.is_ext() { 1 << 29 } else { 0 }))
         {
             let kind = if c2s { Kind::SdoRx } else { Kind::SdoTx };
             return Route {
@@ -228,6 +230,7 @@ impl Decoder {
 
     /// Hands a decoded frame back once it is written, so that its label buffer serves the
     /// next label (saves an allocation per frame on the hot paths).
+    #[inline]
     pub fn recycle(&mut self, decoded: Decoded) {
         let mut label = decoded.label;
         label.clear();

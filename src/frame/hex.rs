@@ -2,11 +2,13 @@
 
 const DIGITS: &[u8; 16] = b"0123456789ABCDEF";
 
-/// Appends ASCII bytes produced by the helpers below.
-fn push_ascii(out: &mut String, ascii: &[u8]) {
+/// Appends ASCII bytes produced by the helpers below (and by other formatters that write
+/// only digits, letters, spaces and punctuation from literals).
+pub(crate) fn push_ascii(out: &mut String, ascii: &[u8]) {
     debug_assert!(ascii.is_ascii());
-    // SAFETY: every caller fills `ascii` only from DIGITS, b'0'..=b'9' and b' ', so it
-    // is ASCII and therefore valid UTF-8 (checked in debug builds and by the tests).
+    // SAFETY: every caller fills `ascii` only from DIGITS, b'0'..=b'9', b' ' and ASCII
+    // literals, so it is ASCII and therefore valid UTF-8 (checked in debug builds and by
+    // the tests).
     out.push_str(unsafe { std::str::from_utf8_unchecked(ascii) });
 }
 

@@ -16,7 +16,7 @@ use crate::decode::sync::SyncJson;
 use crate::decode::time::TimeJson;
 use crate::decode::vendor_sdo::VendorSdoJson;
 use crate::decode::{Body, Decoded};
-use crate::frame::json::{push_hex, push_prefixed_str, push_seconds, push_str, push_text, push_u64, push_value};
+use crate::frame::json::{Stacked, push_hex, push_prefixed_str, push_str, push_text, push_u64, push_value};
 use crate::frame::{Flags, Frame, Interfaces};
 use crate::od::MappingSource;
 use serde::Serialize;
@@ -103,36 +103,41 @@ impl BodyJson<'_> {
 /// the hot path of `cotui decode --format jsonl`); the other kinds' objects go through serde.
 pub fn write_frame(out: &mut Vec<u8>, line: u64, frame: &Frame, ifaces: &Interfaces, decoded: &Decoded) {
     let start = out.len();
-    out.reserve(384);
-    out.extend_from_slice(b"{\"line\":");
-    push_u64(out, line);
-    out.extend_from_slice(b",\"t\":");
-    push_seconds(out, frame.ts_ns);
-    out.extend_from_slice(b",\"iface\":");
-    push_text(out, ifaces.name(frame.iface));
-    out.extend_from_slice(b",\"id\":");
-    push_u64(out, frame.id.into());
-    push_flag(out, b",\"ext\":", frame.is_ext());
-    push_flag(out, b",\"rtr\":", frame.is_rtr());
-    push_flag(out, b",\"fd\":", frame.is_fd());
-    push_flag(out, b",\"err\":", frame.is_err());
-    out.extend_from_slice(b",\"len\":");
-    push_u64(out, frame.len.into());
-    out.extend_from_slice(b",\"data\":");
-    push_hex(out, frame.payload());
-    out.extend_from_slice(if frame.flags.has(Flags::TX) {
+    let mut st = Stacked::default();
+    st.lit(b"{\"line\":");
+    st.u64(line);
+    st.lit(b",\"t\":");
+    st.seconds(frame.ts_ns);
+    st.lit(b",\"iface\":");
+    let name = ifaces.name(frame.iface);
+    if !(name.len() <= 32 && st.plain_text(name)) {
+        st.flush(out);
+        push_text(out, name);
+    }
+    st.lit(b",\"id\":");
+    st.u64(frame.id.into());
+    st.flag(b",\"ext\":", frame.is_ext());
+    st.flag(b",\"rtr\":", frame.is_rtr());
+    st.flag(b",\"fd\":", frame.is_fd());
+    st.flag(b",\"err\":", frame.is_err());
+    st.lit(b",\"len\":");
+    st.u64(frame.len.into());
+    st.lit(b",\"data\":");
+    st.hex(frame.payload());
+    st.lit(if frame.flags.has(Flags::TX) {
         b",\"dir\":\"tx\""
     } else {
         b",\"dir\":\"rx\""
     });
-    out.extend_from_slice(b",\"kind\":\"");
-    out.extend_from_slice(decoded.kind.as_str().as_bytes());
-    out.extend_from_slice(b"\",\"node\":");
+    st.lit(b",\"kind\":\"");
+    st.bytes(decoded.kind.as_str().as_bytes());
+    st.lit(b"\",\"node\":");
     match decoded.node {
-        Some(n) => push_u64(out, n.into()),
-        None => out.extend_from_slice(b"null"),
+        Some(n) => st.u64(n.into()),
+        None => st.lit(b"null"),
     }
-    out.extend_from_slice(b",\"label\":");
+    st.lit(b",\"label\":");
+    st.flush(out);
     push_text(out, &decoded.label);
     if let Body::Pdo(p) = &decoded.body {
         // The most frequent kinds are written directly (as serde would write them).

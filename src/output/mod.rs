@@ -40,11 +40,8 @@ fn has_control(bytes: &[u8]) -> bool {
             return true;
         }
     }
-    // The tail as one more word, padded with a harmless byte.
-    let mut tail = [b'x'; 8];
-    tail[..chunks.remainder().len()].copy_from_slice(chunks.remainder());
-    let w = u64::from_le_bytes(tail);
-    below(w, 0x20) | below(w ^ (ONES * 0x7F), 1) | below(w ^ (ONES * 0xC2), 1) != 0
+    // The tail byte by byte (a copy into a word would cost a call to memcpy).
+    chunks.remainder().iter().any(|&b| b < 0x20 || b == 0x7F || b == 0xC2)
 }
 
 #[cfg(test)]

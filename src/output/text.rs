@@ -13,36 +13,71 @@ const DIGITS: &[u8; 16] = b"0123456789ABCDEF";
 /// `(1700000000.123456)  can0  181   [8]  37 02 00 00 00 00 00 00  TPDO1 node 1: ...`.
 /// A frame that breaks its kind's rules ends with `  !! <reason>`. The line is UTF-8.
 pub fn write_line(out: &mut Vec<u8>, frame: &Frame, ifaces: &Interfaces, decoded: &Decoded) {
-    out.reserve(160);
-    push_time(out, frame.ts_ns);
     let name = ifaces.name(frame.iface);
-    out.extend_from_slice(&PADDING[..4usize.saturating_sub(name.len())]);
-    super::push_escaped(out, name);
-    out.extend_from_slice(b"  ");
-    if frame.is_ext() || frame.is_err() {
-        push_hex(out, frame.id, 8);
+    // The columns before the label are composed on the stack and appended at once (one
+    // copy instead of one per column): the hot path of `cotui decode --format text`.
+    let mut line = [b' '; 128];
+    let start = time_into(&mut line, frame.ts_ns);
+    let mut n = TIME_END;
+    let short_name = name.len() <= 16 && !super::has_control(name.as_bytes());
+    if short_name {
+        // The padding is already spaces.
+        n += 4usize.saturating_sub(name.len());
+        for &b in name.as_bytes() {
+            line[n] = b;
+            n += 1;
+        }
     } else {
-        out.extend_from_slice(b"     ");
-        push_hex(out, frame.id, 3);
+        out.extend_from_slice(&line[start..n]);
+        out.extend_from_slice(&PADDING[..4usize.saturating_sub(name.len())]);
+        super::push_escaped(out, name);
+        line[..TIME_END].fill(b' ');
+        n = 0;
+    }
+    let from = if short_name { start } else { 0 };
+    n += 2;
+    if frame.is_ext() || frame.is_err() {
+        hex_into(&mut line[n..n + 8], frame.id);
+        n += 8;
+    } else {
+        hex_into(&mut line[n + 5..n + 8], frame.id);
+        n += 8;
     }
     if frame.is_fd() {
         // Two digits at least: `[08]`, `[64]`.
-        out.extend_from_slice(if frame.len < 10 { b"  [0" } else { b"  [" });
+        if frame.len < 10 {
+            line[n..n + 4].copy_from_slice(b"  [0");
+        } else {
+            line[n..n + 3].copy_from_slice(b"  [");
+        }
+        n += if frame.len < 10 { 4 } else { 3 };
     } else {
-        out.extend_from_slice(b"   [");
+        line[n..n + 4].copy_from_slice(b"   [");
+        n += 4;
     }
-    push_len(out, frame.len);
-    out.extend_from_slice(b"]  ");
+    n += len_into(&mut line[n..n + 3], frame.len);
+    line[n..n + 3].copy_from_slice(b"]  ");
+    n += 3;
     let payload = frame.payload();
-    if !frame.is_fd() && !frame.is_rtr() && payload.len() <= 8 {
-        push_classic_data(out, payload);
+    let classic = !frame.is_fd() && !frame.is_rtr() && payload.len() <= 8;
+    if classic {
+        classic_data_into(&mut line[n..n + 24], payload);
+        n += 24;
+        if frame.flags.has(crate::frame::Flags::TX) {
+            line[n] = b'T';
+            n += 2;
+        }
+        n += 1;
+        out.reserve(n - from + decoded.label.len() + 1);
+        out.extend_from_slice(&line[from..n]);
     } else {
+        out.extend_from_slice(&line[from..n]);
         push_data_column(out, frame);
+        if frame.flags.has(crate::frame::Flags::TX) {
+            out.extend_from_slice(b"T ");
+        }
+        out.push(b' ');
     }
-    if frame.flags.has(crate::frame::Flags::TX) {
-        out.extend_from_slice(b"T ");
-    }
-    out.push(b' ');
     super::push_escaped(out, &decoded.label);
     if let Some(m) = &decoded.malformed {
         out.extend_from_slice(b"  !! ");
@@ -51,37 +86,38 @@ pub fn write_line(out: &mut Vec<u8>, frame: &Frame, ifaces: &Interfaces, decoded
     out.push(b'\n');
 }
 
-/// Appends the low `digits` hex digits of `v`, upper case.
-fn push_hex(out: &mut Vec<u8>, v: u32, digits: usize) {
-    let mut buf = [b'0'; 8];
-    for (i, d) in buf[..digits].iter_mut().rev().enumerate() {
+/// Writes the low `out.len()` hex digits of `v`, upper case, into `out`.
+fn hex_into(out: &mut [u8], v: u32) {
+    for (i, d) in out.iter_mut().rev().enumerate() {
         *d = DIGITS[(v >> (4 * i) & 0xF) as usize];
     }
-    out.extend_from_slice(&buf[..digits]);
 }
 
-/// Appends a frame length (0..=64) in decimal.
-fn push_len(out: &mut Vec<u8>, len: u8) {
-    if len >= 10 {
+/// Writes a frame length (0..=255) in decimal at the start of `out` (three bytes);
+/// returns the digits written.
+fn len_into(out: &mut [u8], len: u8) -> usize {
+    if len >= 100 {
         let d = len as usize % 100 * 2;
-        if len >= 100 {
-            out.push(b'0' + len / 100);
-        }
-        out.extend_from_slice(&PAIRS[d..d + 2]);
+        out[0] = b'0' + len / 100;
+        out[1..3].copy_from_slice(&PAIRS[d..d + 2]);
+        3
+    } else if len >= 10 {
+        let d = len as usize * 2;
+        out[..2].copy_from_slice(&PAIRS[d..d + 2]);
+        2
     } else {
-        out.push(b'0' + len);
+        out[0] = b'0' + len;
+        1
     }
 }
 
-/// Appends the data column of a classic frame with up to eight bytes: spaced upper-case
-/// hex and a trailing space, padded to 24 characters (the common case, from the stack).
-fn push_classic_data(out: &mut Vec<u8>, payload: &[u8]) {
-    let mut buf = [b' '; 24];
+/// Writes the data column of a classic frame with up to eight bytes into `out` (24
+/// bytes, spaces): spaced upper-case hex and a trailing space, padded to 24 characters.
+fn classic_data_into(out: &mut [u8], payload: &[u8]) {
     for (i, b) in payload.iter().enumerate() {
-        buf[3 * i] = DIGITS[(b >> 4) as usize];
-        buf[3 * i + 1] = DIGITS[(b & 15) as usize];
+        out[3 * i] = DIGITS[(b >> 4) as usize];
+        out[3 * i + 1] = DIGITS[(b & 15) as usize];
     }
-    out.extend_from_slice(&buf);
 }
 
 /// The decimal digits of 0..100, two by two.
@@ -91,12 +127,15 @@ const PAIRS: &[u8; 200] = b"0001020304050607080910111213141516171819\
 6061626364656667686970717273747576777879\
 8081828384858687888990919293949596979899";
 
-/// Appends `(SSSSSSSSSS.UUUUUU)  `: the seconds with at least ten digits and the
-/// microseconds, two digits at a time.
-fn push_time(out: &mut Vec<u8>, ts_ns: u64) {
-    // Seconds end at 13 (u64::MAX ns is 18446744073 s: eleven digits at most), then
-    // `.UUUUUU)  `. Zeros pad the seconds to ten digits.
-    let mut buf = [b'0'; 23];
+/// Where the time column ends in the line buffer of [`write_line`].
+const TIME_END: usize = 23;
+
+/// Writes `(SSSSSSSSSS.UUUUUU)  ` into `buf[..TIME_END]`: the seconds with at least ten
+/// digits and the microseconds, two digits at a time. Returns where the column starts
+/// (1 or 2: the seconds end at 13, u64::MAX ns is 18446744073 s, eleven digits at most).
+fn time_into(buf: &mut [u8; 128], ts_ns: u64) -> usize {
+    // Zeros pad the seconds to ten digits.
+    buf[..13].fill(b'0');
     let mut i = 13;
     let mut secs = ts_ns / 1_000_000_000;
     while secs >= 100 {
@@ -123,7 +162,7 @@ fn push_time(out: &mut Vec<u8>, ts_ns: u64) {
         buf[at..at + 2].copy_from_slice(&PAIRS[d..d + 2]);
     }
     buf[20..23].copy_from_slice(b")  ");
-    out.extend_from_slice(&buf[start..]);
+    start
 }
 
 /// Appends the data column of any other frame (remote request, CAN FD, longer payloads):
@@ -163,13 +202,22 @@ mod tests {
 
     #[test]
     fn number_formatting() {
-        let mut s = Vec::new();
-        push_hex(&mut s, 0x1ABCDEF, 8);
-        push_hex(&mut s, 0x7E5, 3);
-        for len in [0, 8, 9, 12, 64] {
-            push_len(&mut s, len);
+        let mut s = [0u8; 11];
+        hex_into(&mut s[..8], 0x1ABCDEF);
+        hex_into(&mut s[8..], 0x7E5);
+        let mut t = Vec::from(s);
+        for len in [0, 8, 9, 12, 64, 200] {
+            let mut b = [0u8; 3];
+            let n = len_into(&mut b, len);
+            t.extend_from_slice(&b[..n]);
         }
-        assert_eq!(String::from_utf8(s).unwrap(), "01ABCDEF7E5089126".to_string() + "4");
+        assert_eq!(String::from_utf8(t).unwrap(), "01ABCDEF7E5089126".to_string() + "4200");
+    }
+
+    fn time(ns: u64) -> String {
+        let mut buf = [b' '; 128];
+        let start = time_into(&mut buf, ns);
+        String::from_utf8(buf[start..TIME_END].to_vec()).unwrap()
     }
 
     /// Timestamps: ten digits of seconds at least, six of microseconds, at every length.
@@ -184,15 +232,11 @@ mod tests {
             9_999_999_999_999_999_999,
             u64::MAX,
         ] {
-            let mut s = Vec::new();
-            push_time(&mut s, ns);
             let expected = format!("({:010}.{:06})  ", ns / 1_000_000_000, ns % 1_000_000_000 / 1000);
-            assert_eq!(String::from_utf8(s).unwrap(), expected);
+            assert_eq!(time(ns), expected);
         }
         for secs in [1u64, 9, 10, 99, 100, 12_345_678_901] {
-            let mut s = Vec::new();
-            push_time(&mut s, secs * 1_000_000_000 + 7_000);
-            assert_eq!(String::from_utf8(s).unwrap(), format!("({secs:010}.000007)  "));
+            assert_eq!(time(secs * 1_000_000_000 + 7_000), format!("({secs:010}.000007)  "));
         }
     }
 
