@@ -159,22 +159,10 @@ pub fn decode_signals(
     mode: Option<i8>,
 ) -> (Vec<Signal>, Option<String>) {
     let total: usize = mapping.entries.iter().map(|e| e.bits as usize).sum();
-    let available = payload.len() * 8;
     let mut signals = Vec::with_capacity(mapping.entries.len());
-    let mut pos = 0usize;
-    for e in &mapping.entries {
-        let bits = e.bits as usize;
-        if pos + bits > available {
-            break;
-        }
-        // Dummy entries (index 0x0001..0x0007 are data type "dummies") only pad.
-        if e.index >= 0x0001 && e.index <= 0x0007 {
-            pos += bits;
-            continue;
-        }
-        signals.push(signal(payload, pos, e, dict, mode));
-        pos += bits;
-    }
+    for_each_mapped(payload, mapping, |pos, e| {
+        signals.push(signal(payload, pos, e, dict, mode))
+    });
     let problem = if total.div_ceil(8) != payload.len() {
         Some(format!(
             "PDO has {} data bytes, mapping needs {} bits ({} bytes)",
@@ -191,8 +179,24 @@ pub fn decode_signals(
 /// The values of the signals of `payload` through `mapping`, as [`decode_signals`] takes
 /// them, without names or texts (both left empty): for callers that keep numbers.
 pub fn decode_values(payload: &[u8], mapping: &PdoMapping, dict: &Dictionary) -> Vec<Signal> {
-    let available = payload.len() * 8;
     let mut signals = Vec::with_capacity(mapping.entries.len());
+    for_each_mapped(payload, mapping, |pos, e| {
+        signals.push(Signal {
+            index: e.index,
+            sub: e.sub,
+            name: String::new(),
+            value: value(payload, pos, e, dict.object(e.index, e.sub)),
+            text: String::new(),
+        })
+    });
+    signals
+}
+
+/// Calls `f` with the bit position and entry of every mapped object whose bits `payload`
+/// holds, in mapping order; dummy entries (index 0x0001..0x0007, data type "dummies")
+/// only pad and are skipped.
+fn for_each_mapped(payload: &[u8], mapping: &PdoMapping, mut f: impl FnMut(usize, &MappedEntry)) {
+    let available = payload.len() * 8;
     let mut pos = 0usize;
     for e in &mapping.entries {
         let bits = e.bits as usize;
@@ -200,17 +204,10 @@ pub fn decode_values(payload: &[u8], mapping: &PdoMapping, dict: &Dictionary) ->
             break;
         }
         if !(0x0001..=0x0007).contains(&e.index) {
-            signals.push(Signal {
-                index: e.index,
-                sub: e.sub,
-                name: String::new(),
-                value: value(payload, pos, e, dict.object(e.index, e.sub)),
-                text: String::new(),
-            });
+            f(pos, e);
         }
         pos += bits;
     }
-    signals
 }
 
 fn signal(payload: &[u8], pos: usize, e: &MappedEntry, dict: &Dictionary, mode: Option<i8>) -> Signal {

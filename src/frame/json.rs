@@ -300,21 +300,28 @@ pub fn push_hex(out: &mut Vec<u8>, bytes: &[u8]) {
     out.push(b'"');
 }
 
-/// Whether any byte must be escaped in a JSON string (`"`, `\\`, control characters),
-/// eight bytes at a time.
+/// Whether any byte must be escaped in a JSON string (`"`, `\\`, control characters).
 fn needs_escape(bytes: &[u8]) -> bool {
+    any_below_or_equal(bytes, 0x20, [b'"', b'\\'])
+}
+
+/// Whether any byte of `bytes` is below `limit` (at most 0x80) or equal to one of `equal`,
+/// eight bytes at a time (the text and JSON writers' check before escaping).
+pub(crate) fn any_below_or_equal(bytes: &[u8], limit: u8, equal: [u8; 2]) -> bool {
     const ONES: u64 = 0x0101_0101_0101_0101;
     const HIGH: u64 = 0x8080_8080_8080_8080;
     // Bytes of `w` below `n` (n <= 0x80) set their high bit in the result.
     let below = |w: u64, n: u8| w.wrapping_sub(ONES * u64::from(n)) & !w & HIGH;
+    let [a, b] = equal.map(|e| ONES * u64::from(e));
     let mut chunks = bytes.chunks_exact(8);
     for c in &mut chunks {
         let w = u64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]]);
-        if below(w, 0x20) | below(w ^ (ONES * u64::from(b'"')), 1) | below(w ^ (ONES * u64::from(b'\\')), 1) != 0 {
+        if below(w, limit) | below(w ^ a, 1) | below(w ^ b, 1) != 0 {
             return true;
         }
     }
-    chunks.remainder().iter().any(|&b| b < 0x20 || b == b'"' || b == b'\\')
+    // The tail byte by byte (a copy into a word would cost a call to memcpy).
+    chunks.remainder().iter().any(|&c| c < limit || equal.contains(&c))
 }
 
 /// Appends a quoted string with the contract's escaping (the JSON form of [`Text`]).

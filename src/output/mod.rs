@@ -27,21 +27,9 @@ pub fn push_escaped(out: &mut Vec<u8>, s: &str) {
 }
 
 /// Whether `bytes` hold a byte below 0x20, 0x7F or 0xC2 (the lead byte of the C1
-/// controls, U+0080..U+009F), eight bytes at a time.
+/// controls, U+0080..U+009F).
 fn has_control(bytes: &[u8]) -> bool {
-    const ONES: u64 = 0x0101_0101_0101_0101;
-    const HIGH: u64 = 0x8080_8080_8080_8080;
-    // Bytes of `w` below `n` (n <= 0x80) set their high bit in the result.
-    let below = |w: u64, n: u8| w.wrapping_sub(ONES * u64::from(n)) & !w & HIGH;
-    let mut chunks = bytes.chunks_exact(8);
-    for c in &mut chunks {
-        let w = u64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]]);
-        if below(w, 0x20) | below(w ^ (ONES * 0x7F), 1) | below(w ^ (ONES * 0xC2), 1) != 0 {
-            return true;
-        }
-    }
-    // The tail byte by byte (a copy into a word would cost a call to memcpy).
-    chunks.remainder().iter().any(|&b| b < 0x20 || b == 0x7F || b == 0xC2)
+    crate::frame::json::any_below_or_equal(bytes, 0x20, [0x7F, 0xC2])
 }
 
 #[cfg(test)]
