@@ -106,11 +106,13 @@ fn decode_and_the_tui_filtered_view_count_the_same_frames() {
 }
 
 #[test]
-fn a_search_through_a_million_frames_runs_in_the_background() {
-    let (dir, log) = generated("search-1m", 1_000_000);
+fn a_search_through_millions_of_frames_runs_in_the_background() {
+    // Four million frames: long enough a search (every label decoded, ~1.5 s on the build
+    // machine) that the help key is answered while it runs, even on a quiet machine.
+    let (dir, log) = generated("search-4m", 4_000_000);
     // One heartbeat of node 125, only at the very end.
     let mut f = std::fs::OpenOptions::new().append(true).open(&log).unwrap();
-    std::io::Write::write_all(&mut f, b"(1700000200.000000) can0 77D#05\n").unwrap();
+    std::io::Write::write_all(&mut f, b"(1700001000.000000) can0 77D#05\n").unwrap();
     drop(f);
     let name = format!("cotui-search-{}", std::process::id());
     let s = Options::default().size(220, 40).key_delay(Duration::ZERO).start(
@@ -118,7 +120,7 @@ fn a_search_through_a_million_frames_runs_in_the_background() {
         &format!("cd {} && {BIN} open g.log; echo cotui-exit=$?; sleep 60", dir.display()),
     );
     s.wait_within("the log to load", Duration::from_secs(600), |t| {
-        t.contains("(end) | 1000001 frames")
+        t.contains("(end) | 4000001 frames")
     });
     s.keys(&["Home"]);
     s.wait_for("the first frame selected", |t| t.contains("frame 1  t 0.000000 s"));
@@ -142,14 +144,14 @@ fn a_search_through_a_million_frames_runs_in_the_background() {
     }
     // The match is found at the end, the selection goes there.
     let t = s.wait_within("the match", Duration::from_secs(600), |t| {
-        t.contains("match 1 of 1 at frame 1000001")
+        t.contains("match 1 of 1 at frame 4000001")
     });
     assert!(t.contains("search: \"node 125\" (1 match)"), "{t}");
     assert!(t.contains("Heartbeat node 125: Operational"), "{t}");
     // `n` wraps around to the only match.
     s.keys(&["n"]);
     s.wait_for("the wrap", |t| {
-        t.contains("match 1 of 1 at frame 1000001 (wrapped around)")
+        t.contains("match 1 of 1 at frame 4000001 (wrapped around)")
     });
     s.keys(&["q"]);
     s.wait_for("cotui to exit", |t| t.contains("cotui-exit=0"));
