@@ -1,8 +1,12 @@
 //! cotui: a terminal CANopen bus analyzer and commander.
 //!
-//! The protocol core (`frame`, `log`, `od`, `decode`) is pure: it takes bytes
-//! and returns values, with no IO, clock or terminal. Sources, panes and the
-//! command line live at the edges and call into it.
+//! The protocol core is its own crate, [`canopen`] (`crates/canopen`): frames, log parsers,
+//! object dictionaries, SDO/LSS state machines and the decoder registry, pure. This crate
+//! holds what is built on it: the analysis, the writers, the buses, the simulation, the
+//! commands and the two front ends (TUI and CLI). The core's modules are re-exported here
+//! under their own names, so `cotui::decode` is `canopen::decode`.
+
+pub use canopen::{decode, frame, log, lss, od, sdo};
 
 pub mod analysis;
 pub mod bench;
@@ -10,12 +14,8 @@ pub mod bus;
 pub mod cli;
 pub mod command;
 pub mod connect;
-pub mod decode;
-pub mod frame;
-pub mod log;
-pub mod lss;
-pub mod od;
+pub mod files;
+pub mod logio;
 pub mod output;
-pub mod sdo;
 pub mod sim;
 pub mod tui;

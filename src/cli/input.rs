@@ -3,7 +3,8 @@
 //! and the closing counts of what was skipped.
 
 use crate::frame::{Frame, Interfaces};
-use crate::log::{Counts, Outcome, read_ahead};
+use crate::log::{Counts, Outcome};
+use crate::logio::read_ahead;
 use std::io::{self, BufRead, BufReader};
 
 /// A log to read: stdin for `-`, else the file; `None` (with the message on stderr, `what`

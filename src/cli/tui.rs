@@ -111,7 +111,7 @@ pub fn user_keymap_path() -> Option<PathBuf> {
 
 /// A keymap file's text, read with the dictionary files' size cap.
 fn read_text(path: &std::path::Path) -> std::io::Result<String> {
-    String::from_utf8(super::bind::read_capped(path)?).map_err(|_| std::io::Error::other("not UTF-8"))
+    String::from_utf8(crate::files::read_capped(path)?).map_err(|_| std::io::Error::other("not UTF-8"))
 }
 
 /// Loads the keymap named by `--keymap` plus the user's overrides.

@@ -6,8 +6,8 @@
 use super::error::CommandError;
 use crate::bus::{Bus, BusError, Event, StateChange};
 use crate::frame::Frame;
-use crate::log::sink::{LineSink, Target};
 use crate::log::writer::LogWriter;
+use crate::logio::sink::{LineSink, Target};
 use std::fs::{File, OpenOptions};
 use std::future::Future;
 use std::time::{Duration, Instant};

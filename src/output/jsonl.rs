@@ -16,7 +16,7 @@ use crate::decode::sync::SyncJson;
 use crate::decode::time::TimeJson;
 use crate::decode::vendor_sdo::VendorSdoJson;
 use crate::decode::{Body, Decoded};
-use crate::frame::json::{Stacked, push_hex, push_prefixed_str, push_str, push_text, push_u64, push_value};
+use crate::frame::json::{Stacked, push_hex, push_prefixed_str, push_str, push_text, push_u64};
 use crate::frame::{Flags, Frame, Interfaces};
 use crate::od::MappingSource;
 use serde::Serialize;
@@ -188,7 +188,7 @@ fn write_pdo(out: &mut Vec<u8>, p: &Pdo) {
         out.extend_from_slice(b",\"text\":");
         push_str(out, &s.text);
         out.extend_from_slice(b",\"value\":");
-        push_value(out, &s.value);
+        s.value.push_json(out);
         out.push(b'}');
     }
     out.extend_from_slice(b"]}");

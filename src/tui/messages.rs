@@ -79,8 +79,9 @@ impl Messages {
 pub fn clock(t: SystemTime) -> String {
     let d = t.duration_since(SystemTime::UNIX_EPOCH).unwrap_or_default();
     let secs = d.as_secs() as libc::time_t;
-    // SAFETY: `tm` is plain data filled by localtime_r from a valid time_t.
+    // SAFETY: `libc::tm` is plain data (integers and a pointer), for which all zeroes is valid.
     let mut tm: libc::tm = unsafe { std::mem::zeroed() };
+    // SAFETY: both pointers are to live locals; localtime_r is the thread-safe variant.
     let ok = unsafe { !libc::localtime_r(&secs, &mut tm).is_null() };
     let (h, m, s) = if ok {
         (tm.tm_hour as u64, tm.tm_min as u64, tm.tm_sec as u64)

@@ -1,13 +1,13 @@
 //! `record start FILE` / `record stop` in the palette: the frames the session receives
 //! (cotui's own included, as they come back marked TX) go to a candump `-l` log, whole
 //! lines only (a failed write cuts the file back to its last whole line, see
-//! [`crate::log::sink`]).
+//! [`crate::logio::sink`]).
 
 use crate::command::CommandError;
 use crate::command::record::{WriteMode, open_output};
 use crate::frame::{Frame, Interfaces};
-use crate::log::sink::{LineSink, Target};
 use crate::log::writer::LogWriter;
+use crate::logio::sink::{LineSink, Target};
 
 /// A recording in progress.
 pub struct Recorder {

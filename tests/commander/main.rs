@@ -2,6 +2,9 @@
 //! against the SDO server and misbehaving peers, and (ignored here, run in the vbus guest:
 //! `socketcan_live::`) the SocketCAN layer on a real vcan.
 
+// Test code may unwrap: a failed unwrap is a failed test with its location.
+#![allow(clippy::unwrap_used)]
+
 mod cli_bitrate;
 mod cli_commander;
 mod cli_cyclic;

@@ -2,6 +2,9 @@
 //! `cotui decode`/`diagnose`, log formats against can-utils, Wireshark's dissector, EDS import
 //! against python canopen, pcapng/Parquet read back by their own tools, fuzzing.
 
+// Test code may unwrap: a failed unwrap is a failed test with its location.
+#![allow(clippy::unwrap_used)]
+
 mod architecture;
 mod decode_golden;
 mod decode_proptest;

@@ -1,6 +1,9 @@
 //! The four seed drives: every worked example frame of their manuals decodes to what the
 //! manual says, profiles load, procedures expand to the manuals' frame lists and run.
 
+// Test code may unwrap: a failed unwrap is a failed test with its location.
+#![allow(clippy::unwrap_used)]
+
 mod seed_aimotor;
 mod seed_aqmd2405;
 mod seed_common;

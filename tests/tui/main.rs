@@ -1,5 +1,8 @@
 //! The interactive analyzer end to end: the real binary in tmux, and its command line.
 
+// Test code may unwrap: a failed unwrap is a failed test with its location.
+#![allow(clippy::unwrap_used)]
+
 mod filter_search;
 mod objects_demo;
 mod objects_tmux;

@@ -234,7 +234,7 @@ async fn save(sdo: &mut Sdo<'_>, dict: &Dictionary, output: &str, force: bool) -
 
 /// Reads a DCF (at most 64 MiB).
 fn read_file(path: &str) -> Result<String, CommandError> {
-    let cap = crate::cli::bind::MAX_FILE;
+    let cap = crate::files::MAX_FILE;
     let mut bytes = Vec::new();
     std::fs::File::open(path)
         .and_then(|f| f.take(cap + 1).read_to_end(&mut bytes))

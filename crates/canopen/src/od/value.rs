@@ -202,6 +202,24 @@ impl Value {
 
 /// Numbers stay numbers (a float that is not finite is `null`), text stays text, bytes
 /// become upper-case hex.
+impl Value {
+    /// Appends the value as JSON, as serde_json writes it (the JSONL writer's hot path).
+    pub fn push_json(&self, out: &mut Vec<u8>) {
+        use crate::frame::json::{push_hex, push_i64, push_str, push_u64};
+        match self {
+            Value::Bool(b) => out.extend_from_slice(if *b { b"true" } else { b"false" }),
+            Value::Unsigned(u) => push_u64(out, *u),
+            Value::Signed(i) => push_i64(out, *i),
+            Value::Text(t) => push_str(out, t),
+            Value::Bytes(b) => push_hex(out, b),
+            // Floats (ryu through serde_json) and non-finite ones (null) are rare.
+            Value::Float(_) => {
+                let _ = serde_json::to_writer(&mut *out, self);
+            }
+        }
+    }
+}
+
 impl Serialize for Value {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         match self {
@@ -232,6 +250,31 @@ impl fmt::Display for Value {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn push_json_writes_what_serde_json_writes() {
+        for v in [
+            Value::Bool(true),
+            Value::Bool(false),
+            Value::Unsigned(u64::MAX),
+            Value::Signed(-15000),
+            Value::Signed(i64::MIN),
+            Value::Float(1.5),
+            Value::Float(-0.1),
+            Value::Float(f64::NAN),
+            Value::Text("DEXMART \"x\"\u{8}\u{c}\u{1f}µ".into()),
+            Value::Bytes(vec![0xAB; 70]),
+            Value::Bytes(vec![1, 2]),
+        ] {
+            let mut out = Vec::new();
+            v.push_json(&mut out);
+            assert_eq!(
+                String::from_utf8(out).unwrap(),
+                serde_json::to_string(&v).unwrap(),
+                "{v:?}"
+            );
+        }
+    }
 
     #[test]
     fn strings_are_utf8_and_shown_as_written_with_controls_escaped() {

@@ -1,13 +1,13 @@
-//! Measures how fast [`cotui::log::LogReader`] reads a typical classic candump log held in
+//! Measures how fast [`canopen::log::LogReader`] reads a typical classic candump log held in
 //! memory: `cargo run --release --example log_throughput [lines]`.
 //! With a second argument `generate-only` it stops before parsing (to subtract the setup
 //! from `perf stat` counts).
 
 use std::time::Instant;
 
-use cotui::frame::{Frame, Interfaces};
-use cotui::log::writer::LogWriter;
-use cotui::log::{Format, LogReader, Outcome, candump};
+use canopen::frame::{Frame, Interfaces};
+use canopen::log::writer::LogWriter;
+use canopen::log::{Format, LogReader, Outcome, candump};
 
 fn main() {
     let lines: usize = std::env::args()

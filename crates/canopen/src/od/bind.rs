@@ -15,12 +15,12 @@ use super::{Dictionary, MappingSource, Profile, Value, Warning};
 /// The profiles built into the binary: name and JSON text. To add one, put
 /// `decoders/<name>.json` in the repository and add a line here.
 pub const BUILTIN: &[(&str, &str)] = &[
-    ("cia301", include_str!("../../decoders/cia301.json")),
-    ("cia402", include_str!("../../decoders/cia402.json")),
-    ("aimotor", include_str!("../../decoders/aimotor.json")),
-    ("aqmd2405", include_str!("../../decoders/aqmd2405.json")),
-    ("dexmart-dev", include_str!("../../decoders/dexmart-dev.json")),
-    ("syntron-ds", include_str!("../../decoders/syntron-ds.json")),
+    ("cia301", include_str!("../../../../decoders/cia301.json")),
+    ("cia402", include_str!("../../../../decoders/cia402.json")),
+    ("aimotor", include_str!("../../../../decoders/aimotor.json")),
+    ("aqmd2405", include_str!("../../../../decoders/aqmd2405.json")),
+    ("dexmart-dev", include_str!("../../../../decoders/dexmart-dev.json")),
+    ("syntron-ds", include_str!("../../../../decoders/syntron-ds.json")),
 ];
 
 /// Reads a file's bytes for the bindings (the CLI reads with a size cap).

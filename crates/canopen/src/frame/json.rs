@@ -307,7 +307,7 @@ fn needs_escape(bytes: &[u8]) -> bool {
 
 /// Whether any byte of `bytes` is below `limit` (at most 0x80) or equal to one of `equal`,
 /// eight bytes at a time (the text and JSON writers' check before escaping).
-pub(crate) fn any_below_or_equal(bytes: &[u8], limit: u8, equal: [u8; 2]) -> bool {
+pub fn any_below_or_equal(bytes: &[u8], limit: u8, equal: [u8; 2]) -> bool {
     const ONES: u64 = 0x0101_0101_0101_0101;
     const HIGH: u64 = 0x8080_8080_8080_8080;
     // Bytes of `w` below `n` (n <= 0x80) set their high bit in the result.
@@ -385,22 +385,6 @@ pub fn push_prefixed_str(out: &mut Vec<u8>, prefix: &str, text: &str) {
     out.push(b'"');
 }
 
-/// Appends `v` as JSON, as serde_json writes it.
-pub fn push_value(out: &mut Vec<u8>, v: &crate::od::Value) {
-    use crate::od::Value;
-    match v {
-        Value::Bool(b) => out.extend_from_slice(if *b { b"true" } else { b"false" }),
-        Value::Unsigned(u) => push_u64(out, *u),
-        Value::Signed(i) => push_i64(out, *i),
-        Value::Text(t) => push_str(out, t),
-        Value::Bytes(b) => push_hex(out, b),
-        // Floats (ryu through serde_json) and non-finite ones (null) are rare.
-        Value::Float(_) => {
-            let _ = serde_json::to_writer(&mut *out, v);
-        }
-    }
-}
-
 /// Appends `record` as one JSON line; nothing when it cannot be written (the record
 /// types hold only what JSON can carry, so this does not happen).
 pub fn write_line(out: &mut Vec<u8>, record: &impl Serialize) {
@@ -461,22 +445,6 @@ mod tests {
         }
         for ns in [5, 10_000_001, 123_456_789, 1_000_000_000] {
             assert_eq!(pushed(&|o| push_seconds(o, ns)), json(Seconds(ns)));
-        }
-        use crate::od::Value;
-        for v in [
-            Value::Bool(true),
-            Value::Bool(false),
-            Value::Unsigned(u64::MAX),
-            Value::Signed(-15000),
-            Value::Signed(i64::MIN),
-            Value::Float(1.5),
-            Value::Float(-0.1),
-            Value::Float(f64::NAN),
-            Value::Text("DEXMART \"x\"\u{8}\u{c}\u{1f}µ".into()),
-            Value::Bytes(vec![0xAB; 70]),
-            Value::Bytes(vec![1, 2]),
-        ] {
-            assert_eq!(pushed(&|o| push_value(o, &v)), json(&v), "{v:?}");
         }
         for b in [&[][..], &[0x1A, 0x2B], &[0xAB; 64], &[0x12; 9]] {
             assert_eq!(pushed(&|o| push_hex(o, b)), json(Hex(b)));

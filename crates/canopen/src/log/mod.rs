@@ -10,9 +10,7 @@ pub mod asc;
 pub mod candump;
 mod fast;
 mod lex;
-pub mod read_ahead;
 pub mod screen;
-pub mod sink;
 pub mod writer;
 
 use std::fmt;

@@ -4,6 +4,7 @@ const DIGITS: &[u8; 16] = b"0123456789ABCDEF";
 
 /// Appends ASCII bytes produced by the helpers below (and by other formatters that write
 /// only digits, letters, spaces and punctuation from literals).
+#[allow(unsafe_code)] // the one unsafe block of the core: see SAFETY below
 pub(crate) fn push_ascii(out: &mut String, ascii: &[u8]) {
     debug_assert!(ascii.is_ascii());
     // SAFETY: every caller fills `ascii` only from DIGITS, b'0'..=b'9', b' ' and ASCII
