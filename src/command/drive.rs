@@ -6,6 +6,7 @@ use super::error::CommandError;
 use super::grammar::DriveAction;
 use super::sdo::{download, upload};
 use crate::bus::{Bus, Subscription};
+use crate::cob;
 use crate::decode::cia402::{DriveState, mode_name};
 use crate::decode::heartbeat::NmtState;
 use crate::frame::Direction;
@@ -149,10 +150,10 @@ impl Watch {
                 continue;
             }
             let p = f.payload();
-            let n = self.node as u32;
-            if f.id == 0x700 + n && !p.is_empty() {
+            let n = self.node;
+            if f.id == cob::heartbeat(n) && !p.is_empty() {
                 self.obs.nmt = Some(NmtState::from_byte(p[0]));
-            } else if f.id == 0x80 + n && p.len() >= 2 {
+            } else if f.id == cob::emcy(n) && p.len() >= 2 {
                 let code = u16::from_le_bytes([p[0], p[1]]);
                 self.obs.emcy = (code != 0).then_some(code);
             } else if let Some((cob, off)) = self.tpdo

@@ -8,6 +8,7 @@
 
 use super::error::CommandError;
 use crate::bus::{Bus, BusError, Subscription};
+use crate::cob;
 use crate::frame::{Direction, Frame};
 use crate::sdo::client::{ClientConfig, Completion, Mode, SdoClient, SdoError};
 use std::time::Duration;
@@ -131,7 +132,7 @@ pub fn first_download_frame(node: u8, index: u16, sub: u8, data: &[u8], block: b
 
 /// A request of the client to `node`'s server (COB-ID 0x600 + node).
 fn request_frame(node: u8, payload: &[u8; 8]) -> Frame {
-    Frame::classic(0x600 + u32::from(node), payload)
+    Frame::classic(cob::sdo_request(node), payload)
 }
 
 fn config(timing: Timing) -> ClientConfig {
@@ -177,7 +178,7 @@ fn unexpected(node: u8, index: u16, sub: u8, c: Completion, timing: Timing) -> C
 
 async fn send_all(bus: &Bus, node: u8, frames: &[[u8; 8]]) -> Result<(), CommandError> {
     for p in frames {
-        bus.send(&Frame::classic(0x600 + node as u32, p)).await?;
+        bus.send(&Frame::classic(cob::sdo_request(node), p)).await?;
     }
     Ok(())
 }
@@ -233,12 +234,12 @@ async fn feed(
     };
     let ts = if f.ts_ns == 0 { bus.now_ns() } else { f.ts_ns };
     match f.direction() {
-        Direction::Rx if f.id == 0x580 + node as u32 => {
+        Direction::Rx if f.id == cob::sdo_response(node) => {
             let out = client.on_frame(f.payload(), ts);
             send_all(bus, node, &out.frames).await?;
             Ok(out.done)
         }
-        Direction::Tx if f.id == 0x600 + node as u32 => {
+        Direction::Tx if f.id == cob::sdo_request(node) => {
             client.on_sent(ts);
             Ok(None)
         }
@@ -270,13 +271,13 @@ mod tests {
         let seen = log.clone();
         tokio::spawn(async move {
             while let Ok(f) = rx.recv().await {
-                if f.id != 0x600 + NODE as u32 || f.direction() == Direction::Tx {
+                if f.id != cob::sdo_request(NODE) || f.direction() == Direction::Tx {
                     continue;
                 }
                 seen.lock().unwrap().push(f.payload().to_vec());
                 for (delay_ms, p) in script(f.payload()) {
                     tokio::time::sleep(Duration::from_millis(delay_ms)).await;
-                    let _ = server.send(&Frame::classic(0x580 + NODE as u32, &p)).await;
+                    let _ = server.send(&Frame::classic(cob::sdo_response(NODE), &p)).await;
                 }
             }
         });
@@ -426,13 +427,13 @@ mod tests {
         tokio::spawn(async move {
             let request = loop {
                 match rx.recv().await {
-                    Ok(f) if f.id == 0x600 + NODE as u32 => break f,
+                    Ok(f) if f.id == cob::sdo_request(NODE) => break f,
                     Ok(_) => {}
                     Err(_) => return,
                 }
             };
             tokio::time::sleep(Duration::from_millis(1000)).await;
-            let mut answer = Frame::classic(0x580 + NODE as u32, &[0x4B, 0x41, 0x60, 0x00, 0x37, 0x02, 0, 0]);
+            let mut answer = Frame::classic(cob::sdo_response(NODE), &[0x4B, 0x41, 0x60, 0x00, 0x37, 0x02, 0, 0]);
             answer.ts_ns = request.ts_ns + 4 * MS;
             reader.inject(answer);
         });
@@ -463,7 +464,7 @@ mod tests {
         let reader = bus.clone();
         let before = vbus.now_ns();
         reader.inject({
-            let mut f = Frame::classic(0x580 + NODE as u32, &[0x4B, 0x41, 0x60, 0x00, 0x37, 0x02, 0, 0]);
+            let mut f = Frame::classic(cob::sdo_response(NODE), &[0x4B, 0x41, 0x60, 0x00, 0x37, 0x02, 0, 0]);
             f.ts_ns = before + 1500 * MS;
             f
         });

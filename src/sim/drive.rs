@@ -11,6 +11,7 @@
 use super::od::DeviceObjects;
 use super::profile::{self, Kind};
 use super::vendor::Vendor;
+use crate::cob;
 use crate::decode::cia402::DriveState;
 use crate::frame::Frame;
 use crate::lss::{self, Address, UNCONFIGURED};
@@ -231,7 +232,7 @@ impl Drive {
             return Vec::new();
         }
         self.next_heartbeat_ns = self.heartbeat_period_ns().map(|p| now_ns + p);
-        vec![Frame::classic(0x700 + self.node as u32, &[0])]
+        vec![Frame::classic(cob::heartbeat(self.node), &[0])]
     }
 
     /// NMT reset: a node-ID configured by LSS comes into use, with the communication
@@ -263,7 +264,7 @@ impl Drive {
         if !self.configured() && f.id != 0x000 {
             return Vec::new();
         }
-        let node = self.node as u32;
+        let node = self.node;
         match f.id {
             0x000 => self.on_nmt(f.payload(), now_ns),
             0x080 if self.nmt == NmtState::Operational => {
@@ -271,9 +272,12 @@ impl Drive {
                 out.extend(self.on_sync());
                 out
             }
-            id if id == 0x600 + node && self.nmt != NmtState::Stopped && !f.is_rtr() => {
+            id if id == cob::sdo_request(node) && self.nmt != NmtState::Stopped && !f.is_rtr() => {
                 let replies = self.sdo.on_frame(f.payload(), now_ns, &mut self.od).frames;
-                let mut out: Vec<Frame> = replies.iter().map(|r| Frame::classic(0x580 + node, r)).collect();
+                let mut out: Vec<Frame> = replies
+                    .iter()
+                    .map(|r| Frame::classic(cob::sdo_response(node), r))
+                    .collect();
                 if self.profile.kind == Kind::Dexmart && alarm_reset(f.payload(), replies.first()) {
                     out.extend(self.clear_fault());
                 }
@@ -544,7 +548,7 @@ impl Drive {
     fn emcy(&self, code: u16) -> Frame {
         let c = code.to_le_bytes();
         let reg = self.od.uint(0x1001, 0) as u8;
-        Frame::classic(0x80 + self.node as u32, &[c[0], c[1], reg, 0, 0, 0, 0, 0])
+        Frame::classic(cob::emcy(self.node), &[c[0], c[1], reg, 0, 0, 0, 0, 0])
     }
 
     fn update_statusword(&mut self) {
@@ -639,7 +643,7 @@ impl Drive {
         out.extend(self.event_tpdos(now_ns));
         if let Some(next) = self.next_heartbeat_ns {
             if now_ns >= next {
-                out.push(Frame::classic(0x700 + self.node as u32, &[self.nmt.byte()]));
+                out.push(Frame::classic(cob::heartbeat(self.node), &[self.nmt.byte()]));
                 self.next_heartbeat_ns = self.heartbeat_period_ns().map(|p| next.max(now_ns - p) + p);
             }
         } else if let Some(p) = self.heartbeat_period_ns() {

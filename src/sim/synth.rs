@@ -3,6 +3,7 @@
 //! about 12 % SDO frames with segmented and block transfers and aborts, EMCY, NMT).
 //! Pure: the same frame count always gives the same frames.
 
+use crate::cob;
 use crate::frame::Frame;
 use crate::sdo::codec::{Chunk, SdoCommand, encode, sub_block};
 
@@ -37,17 +38,17 @@ impl Traffic {
         self.cycle += 1;
         let s = &mut self.script;
         s.push(Frame::classic(0x080, &[(c % 240 + 1) as u8]));
-        for node in 1u32..=NODES {
+        for node in 1u8..=NODES {
             pdos(s, c, node);
         }
         if c.is_multiple_of(10) {
             for node in 1..=NODES {
-                s.push(Frame::classic(0x700 + node, &[0x05]));
+                s.push(Frame::classic(cob::heartbeat(node), &[0x05]));
             }
         }
         // Every cycle one expedited upload, every other cycle one expedited download,
         // each on the next node in turn.
-        let node = (c % u64::from(NODES)) as u32 + 1;
+        let node = (c % u64::from(NODES)) as u8 + 1;
         let (index, sub, value) = POLLED[(c / u64::from(NODES)) as usize % POLLED.len()];
         expedited_upload(s, node, index, sub, value);
         if c.is_multiple_of(2) {
@@ -72,8 +73,8 @@ impl Traffic {
         }
         if c % 997 == 11 {
             // EMCY: overcurrent, then its reset.
-            s.push(Frame::classic(0x080 + node, &[0x10, 0x23, 0x03, 0, 0, 0, 0, 0]));
-            s.push(Frame::classic(0x080 + node, &[0, 0, 0, 0, 0, 0, 0, 0]));
+            s.push(Frame::classic(cob::emcy(node), &[0x10, 0x23, 0x03, 0, 0, 0, 0, 0]));
+            s.push(Frame::classic(cob::emcy(node), &[0, 0, 0, 0, 0, 0, 0, 0]));
         }
         if c % 1000 == 13 {
             // NMT: enter pre-operational, then start, all nodes.
@@ -84,7 +85,7 @@ impl Traffic {
 }
 
 /// Drives on the generated bus (node-IDs 1..=NODES).
-const NODES: u32 = 4;
+const NODES: u8 = 4;
 
 /// The objects the expedited uploads poll, with the answer's value.
 const POLLED: [(u16, u8, u32); 5] = [
@@ -96,41 +97,41 @@ const POLLED: [(u16, u8, u32); 5] = [
 ];
 
 /// The node's four TPDOs and the master's four RPDOs to it.
-fn pdos(s: &mut Vec<Frame>, c: u64, node: u32) {
+fn pdos(s: &mut Vec<Frame>, c: u64, node: u8) {
     let pos = (c as i32 * 100 + node as i32).to_le_bytes();
     let vel = ((c % 3000) as i32 - 1500).to_le_bytes();
     let torque = ((c % 200) as i16 - 100).to_le_bytes();
     // TPDO1 statusword + mode display; TPDO2 position + velocity; TPDO3 torque +
     // current; TPDO4 error code + digital inputs.
-    s.push(Frame::classic(0x180 + node, &[0x37, 0x02, 0x03]));
+    s.push(Frame::classic(cob::tpdo(1, node), &[0x37, 0x02, 0x03]));
     s.push(Frame::classic(
-        0x280 + node,
+        cob::tpdo(2, node),
         &[pos[0], pos[1], pos[2], pos[3], vel[0], vel[1], vel[2], vel[3]],
     ));
-    s.push(Frame::classic(0x380 + node, &[torque[0], torque[1], 0x20, 0x01]));
-    s.push(Frame::classic(0x480 + node, &[0, 0, 0x01, 0, 0, 0]));
+    s.push(Frame::classic(cob::tpdo(3, node), &[torque[0], torque[1], 0x20, 0x01]));
+    s.push(Frame::classic(cob::tpdo(4, node), &[0, 0, 0x01, 0, 0, 0]));
     // RPDO1 controlword + target velocity; RPDO2 controlword + target position;
     // RPDO3 target torque; RPDO4 profile velocity.
     s.push(Frame::classic(
-        0x200 + node,
+        cob::rpdo(1, node),
         &[0x0F, 0x00, vel[0], vel[1], vel[2], vel[3]],
     ));
     s.push(Frame::classic(
-        0x300 + node,
+        cob::rpdo(2, node),
         &[0x1F, 0x00, pos[0], pos[1], pos[2], pos[3]],
     ));
-    s.push(Frame::classic(0x400 + node, &[torque[0], torque[1]]));
-    s.push(Frame::classic(0x500 + node, &[0xE8, 0x03, 0, 0]));
+    s.push(Frame::classic(cob::rpdo(3, node), &[torque[0], torque[1]]));
+    s.push(Frame::classic(cob::rpdo(4, node), &[0xE8, 0x03, 0, 0]));
 }
 
 /// One SDO request from the master and the node's answer.
-fn sdo_pair(s: &mut Vec<Frame>, node: u32, request: SdoCommand, answer: SdoCommand) {
-    s.push(Frame::classic(0x600 + node, &encode(&request)));
-    s.push(Frame::classic(0x580 + node, &encode(&answer)));
+fn sdo_pair(s: &mut Vec<Frame>, node: u8, request: SdoCommand, answer: SdoCommand) {
+    s.push(Frame::classic(cob::sdo_request(node), &encode(&request)));
+    s.push(Frame::classic(cob::sdo_response(node), &encode(&answer)));
 }
 
 /// An expedited download of `value` (1-4 bytes) to (index, sub), confirmed.
-fn expedited_download(s: &mut Vec<Frame>, node: u32, index: u16, sub: u8, value: &[u8]) {
+fn expedited_download(s: &mut Vec<Frame>, node: u8, index: u16, sub: u8, value: &[u8]) {
     let request = SdoCommand::InitiateDownload {
         index,
         sub,
@@ -142,7 +143,7 @@ fn expedited_download(s: &mut Vec<Frame>, node: u32, index: u16, sub: u8, value:
 }
 
 /// An expedited 4-byte upload of (index, sub) answering `value`.
-fn expedited_upload(s: &mut Vec<Frame>, node: u32, index: u16, sub: u8, value: u32) {
+fn expedited_upload(s: &mut Vec<Frame>, node: u8, index: u16, sub: u8, value: u32) {
     let answer = SdoCommand::InitiateUploadResponse {
         index,
         sub,
@@ -154,7 +155,7 @@ fn expedited_upload(s: &mut Vec<Frame>, node: u32, index: u16, sub: u8, value: u
 }
 
 /// A segmented upload of the 16-byte device name (0x1008).
-fn segmented_upload(s: &mut Vec<Frame>, node: u32) {
+fn segmented_upload(s: &mut Vec<Frame>, node: u8) {
     let name = b"COTUI DRIVE 01!!";
     let (index, sub) = (0x1008, 0);
     let answer = SdoCommand::InitiateUploadResponse {
@@ -178,7 +179,7 @@ fn segmented_upload(s: &mut Vec<Frame>, node: u32) {
 }
 
 /// A block upload (no CRC) of 20 bytes of 0x1008: three segments, one block.
-fn block_upload(s: &mut Vec<Frame>, node: u32) {
+fn block_upload(s: &mut Vec<Frame>, node: u8) {
     let data = b"cotui bench drive 01";
     let (index, sub) = (0x1008, 0);
     let request = SdoCommand::BlockUploadInitiate {
@@ -196,10 +197,14 @@ fn block_upload(s: &mut Vec<Frame>, node: u32) {
         size,
     };
     sdo_pair(s, node, request, answer);
-    let client = |cmd: SdoCommand| Frame::classic(0x600 + node, &encode(&cmd));
+    let client = |cmd: SdoCommand| Frame::classic(cob::sdo_request(node), &encode(&cmd));
     s.push(client(SdoCommand::BlockUploadStart));
     let (segments, _) = sub_block(data, 0, 127);
-    s.extend(segments.iter().map(|seg| Frame::classic(0x580 + node, &encode(seg))));
+    s.extend(
+        segments
+            .iter()
+            .map(|seg| Frame::classic(cob::sdo_response(node), &encode(seg))),
+    );
     s.push(client(SdoCommand::BlockUploadAck {
         ackseq: segments.len() as u8,
         blksize: 127,
@@ -207,7 +212,7 @@ fn block_upload(s: &mut Vec<Frame>, node: u32) {
     // The last segment carries 6 data bytes, the 7th unused (n = 1 in the end frame).
     let unused = (segments.len() * 7 - data.len()) as u8;
     let end = SdoCommand::BlockUploadEnd { unused, crc: 0 };
-    s.push(Frame::classic(0x580 + node, &encode(&end)));
+    s.push(Frame::classic(cob::sdo_response(node), &encode(&end)));
     s.push(client(SdoCommand::BlockUploadEndResponse));
 }
 

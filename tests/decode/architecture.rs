@@ -9,42 +9,45 @@ fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-#[test]
-fn every_path_architecture_md_names_exists() {
-    let doc = std::fs::read_to_string(root().join("docs/ARCHITECTURE.md")).unwrap();
-    let mut checked = 0;
+/// The repository paths a document names in backticks (and, bare, in its diagram).
+fn paths_named(doc: &str) -> Vec<String> {
+    let prefixes = [
+        "src/",
+        "crates/",
+        "tests/",
+        "docs/",
+        "decoders/",
+        "keymaps/",
+        "scripts/",
+    ];
+    let mut paths = Vec::new();
     for (i, piece) in doc.split('`').enumerate() {
         let word = piece.split_whitespace().next().unwrap_or("");
         let word = word.trim_end_matches([',', ')', ':']);
-        let in_code = i % 2 == 1;
-        let prefixes = [
-            "src/",
-            "crates/",
-            "tests/",
-            "docs/",
-            "decoders/",
-            "keymaps/",
-            "scripts/",
-        ];
-        if !in_code || !prefixes.iter().any(|p| word.starts_with(p)) || word.contains(['<', '*']) {
-            continue;
+        if i % 2 == 1 && prefixes.iter().any(|p| word.starts_with(p)) && !word.contains(['<', '*']) {
+            paths.push(word.to_string());
+        }
+    }
+    for word in doc.split_whitespace().filter(|w| w.starts_with("src/")) {
+        paths.push(word.trim_end_matches([',', ')', ':', '`']).to_string());
+    }
+    paths
+}
+
+#[test]
+fn every_path_architecture_md_and_contributing_md_name_exists() {
+    for (doc, at_least) in [("docs/ARCHITECTURE.md", 40), ("CONTRIBUTING.md", 20)] {
+        let text = std::fs::read_to_string(root().join(doc)).unwrap();
+        let paths = paths_named(&text);
+        for path in &paths {
+            assert!(root().join(path).exists(), "{doc} names `{path}`, which does not exist");
         }
         assert!(
-            root().join(word).exists(),
-            "docs/ARCHITECTURE.md names `{word}`, which does not exist"
+            paths.len() > at_least,
+            "{doc}: only {} paths found: did the format change?",
+            paths.len()
         );
-        checked += 1;
     }
-    // The diagram names paths without backticks too.
-    for word in doc.split_whitespace().filter(|w| w.starts_with("src/")) {
-        let word = word.trim_end_matches([',', ')', ':', '`']);
-        assert!(
-            root().join(word).exists(),
-            "the diagram names `{word}`, which does not exist"
-        );
-        checked += 1;
-    }
-    assert!(checked > 40, "only {checked} paths found: did the format change?");
 }
 
 /// The Rust files under `dir`, recursively.

@@ -3,6 +3,7 @@
 //! Everything here takes bytes and returns values: no IO, no clock, no terminal, no async
 //! runtime. The modules, from the bottom up:
 //!
+//! - [`cob`]: the COB-IDs of the predefined connection set (`cob::sdo_request(node)`).
 //! - [`frame`]: the [`frame::Frame`] value (classic and FD, 11/29-bit, flags, timestamp).
 //! - [`log`]: streaming parsers of candump `-l`/`-L` logs, candump screen output and Vector
 //!   ASC over any `BufRead`, and a candump log writer.
@@ -35,6 +36,7 @@
 
 #![deny(unsafe_code)]
 
+pub mod cob;
 pub mod decode;
 pub mod frame;
 pub mod log;

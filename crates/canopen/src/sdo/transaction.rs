@@ -1,6 +1,7 @@
 //! A reassembled SDO transfer: what was read or written, how, and how it ended.
 
 use super::codec::Side;
+use crate::cob;
 use std::fmt;
 
 /// An SDO channel: a node and the COB-ID pair its client and server use.
@@ -19,8 +20,8 @@ impl Channel {
     pub fn default_for(node: u8) -> Channel {
         Channel {
             node,
-            request_cob: 0x600 + node as u32,
-            response_cob: 0x580 + node as u32,
+            request_cob: cob::sdo_request(node),
+            response_cob: cob::sdo_response(node),
         }
     }
 }
