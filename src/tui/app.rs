@@ -358,6 +358,8 @@ impl App {
                     self.dirty = true;
                 }
                 Ok(Feed::Done) | Err(TryRecvError::Disconnected) => {
+                    // Transfers the input cut off are listed, as `decode --transactions` lists them.
+                    self.trace.end_of_input();
                     self.trace.store.shrink();
                     self.source.done = true;
                     self.source.feed = None;

@@ -82,6 +82,8 @@ fn sdo_pane_lists_transfers_and_expands_to_frames() {
     assert!(s.contains("1017:00"), "{s}");
     assert!(s.contains("abort 06020000"), "{s}");
     insta::assert_snapshot!("sdo_list", s);
+    // The list follows the newest transfer; the first is opened from the top.
+    a.act(Action::Top);
     a.act(Action::Expand);
     let s = screen(&mut a, 140, 14);
     assert!(s.contains("SDO transfer 1017:00 node 1"), "{s}");
@@ -120,6 +122,10 @@ fn at_80x24_the_detail_pane_follows_the_sdo_pane_selection() {
     let _ = screen(&mut a, 80, 24);
     a.act(Action::Expand);
     a.act(Action::PaneSdo);
+    let s = screen(&mut a, 80, 24);
+    // The newest transfer is selected (the pane follows), then the first.
+    assert!(s.contains("Upload 0x6041:00"), "{s}");
+    a.act(Action::Top);
     let s = screen(&mut a, 80, 24);
     assert!(s.contains("Upload 0x1017:00"), "{s}");
     a.act(Action::Expand);
