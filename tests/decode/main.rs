@@ -3,6 +3,7 @@
 //! against python canopen, pcapng/Parquet read back by their own tools, fuzzing.
 
 mod architecture;
+mod cut_short;
 mod decode_golden;
 mod decode_proptest;
 mod diagnose_golden;

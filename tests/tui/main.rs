@@ -1,5 +1,6 @@
 //! The interactive analyzer end to end: the real binary in tmux, and its command line.
 
+mod agreement;
 mod filter_search;
 mod objects_demo;
 mod objects_tmux;
