@@ -19,6 +19,7 @@ pub mod store;
 mod texts;
 pub mod timing;
 pub mod trace;
+pub mod transfers;
 pub mod values;
 pub mod view;
 

@@ -3,7 +3,7 @@
 //! Decoding is stateful (learned COB-IDs and PDO mappings, modes of operation, SDO transfer
 //! context), so a frame's label depends on everything before it. The indexing pass runs one
 //! [`Decoder`] over every frame as it arrives, but keeps only the frame's kind and node (in
-//! the store), the completed SDO transactions, node and COB-ID statistics and the numeric
+//! the store), the SDO transactions (see [`Transfers`]), node and COB-ID statistics and the numeric
 //! signal series. Every [`CHECKPOINT`] frames it keeps a clone of the decoder state. To show
 //! rows `a..b`, [`Trace::decode_range`] clones the checkpoint at or before `a`, replays the
 //! frames up to `a` through it (cheaply: only SDO and PDO frames change state) and decodes
@@ -15,6 +15,7 @@ use super::nodes::Nodes;
 use super::series::Series;
 use super::stats::Stats;
 use super::store::Store;
+use super::transfers::Transfers;
 use super::values::Values;
 use crate::decode::{Body, Decoded, Decoder, Kind};
 use crate::frame::{Frame, Interfaces};
@@ -33,8 +34,10 @@ pub struct Trace {
     /// The decoder as it was for a fresh start (used when nothing is checkpointed yet).
     initial: Decoder,
     checkpoints: Vec<Decoder>,
-    /// Completed SDO transactions, in order of completion.
+    /// SDO transactions in order of completion, then (once the input ended) those left
+    /// running, as incomplete: the transfers `cotui decode --transactions` lists.
     pub transactions: Vec<Transaction>,
+    transfers: Transfers,
     /// Per-node state.
     pub nodes: Nodes,
     /// Per-COB-ID statistics and bus load.
@@ -63,6 +66,7 @@ impl Trace {
             decoder,
             checkpoints: Vec::new(),
             transactions: Vec::new(),
+            transfers: Transfers::new(),
             nodes,
             stats: Stats::new(bitrate),
             series: Series::default(),
@@ -117,13 +121,22 @@ impl Trace {
         if let Some(n) = node {
             self.nodes.frame(n, frame.ts_ns);
         }
-        for t in self.decoder.take_transactions() {
+        for t in self.transfers.completed(&mut self.decoder) {
             self.diagnosis.transaction(&t);
             self.nodes.transaction(&t);
             self.series.transaction(&t, self.decoder.dictionary(t.node));
             self.values.transaction(&t, self.decoder.dictionary(t.node));
             self.transactions.push(t);
         }
+    }
+
+    /// The input ended (a loaded log read to its end): the SDO transfers still running
+    /// are listed as incomplete, as `cotui decode --transactions` lists them. They were
+    /// not completed, so the diagnosis, nodes and values do not take them (nor does
+    /// `cotui diagnose`).
+    pub fn end_of_input(&mut self) {
+        let rest = self.transfers.end(&mut self.decoder);
+        self.transactions.extend(rest);
     }
 
     fn observe(&mut self, frame: &Frame, d: &Decoded) {

@@ -2,6 +2,7 @@
 
 use super::input;
 use crate::analysis::EventTracker;
+use crate::analysis::transfers::Transfers;
 use crate::command::ExitCode;
 use crate::decode::{Decoder, Kind};
 use crate::frame::json::write_line;
@@ -106,6 +107,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
         }
     };
     let mut summary = Summary::default();
+    let mut transfers = Transfers::new();
     let mut status = ExitCode::Ok;
     for path in &args.files {
         let Some(input) = input::open_input(path, "decode") else {
@@ -115,6 +117,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
         let mut sinks = Sinks {
             summary: &mut summary,
             events: &mut events,
+            transfers: &mut transfers,
         };
         match decode_stream(path, input, &mut decoder, mode, &mut sinks, &mut out) {
             Ok(()) => {}
@@ -125,7 +128,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
             }
         }
     }
-    let result = finish(&mut decoder, mode, &mut summary, &mut out).and_then(|_| out.flush());
+    let result = finish(&mut decoder, mode, &mut summary, &mut transfers, &mut out).and_then(|_| out.flush());
     match result {
         Err(e) if e.kind() != io::ErrorKind::BrokenPipe => {
             eprintln!("cotui decode: {e}");
@@ -139,6 +142,8 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
 struct Sinks<'a> {
     summary: &'a mut Summary,
     events: &'a mut EventTracker,
+    /// The SDO transfers of `--transactions`, as the TUI's SDO pane takes them.
+    transfers: &'a mut Transfers,
 }
 
 /// Decodes one input into `out` (parsing runs on a second thread).
@@ -198,7 +203,7 @@ fn decode_stream(
                 }
                 Mode::Transactions(fmt) => {
                     decoder.track(frame);
-                    for t in decoder.take_transactions() {
+                    for t in sinks.transfers.completed(decoder) {
                         write_transaction(&mut json, &mut label, &t, decoder.dictionary(t.node), fmt);
                     }
                 }
@@ -248,12 +253,18 @@ pub(super) fn write_summary(out: &mut Vec<u8>, summary: &mut Summary, fmt: Outpu
 }
 
 /// Writes what is due at the end of all inputs.
-fn finish(decoder: &mut Decoder, mode: Mode, summary: &mut Summary, out: &mut impl Write) -> io::Result<()> {
+fn finish(
+    decoder: &mut Decoder,
+    mode: Mode,
+    summary: &mut Summary,
+    transfers: &mut Transfers,
+    out: &mut impl Write,
+) -> io::Result<()> {
     let mut buf = Vec::new();
     match mode {
         Mode::Transactions(fmt) => {
             let mut label = String::new();
-            for t in decoder.finish() {
+            for t in transfers.end(decoder) {
                 write_transaction(&mut buf, &mut label, &t, decoder.dictionary(t.node), fmt);
             }
         }

@@ -6,6 +6,7 @@ use super::decode::{DecodeArgs, OutputFormat, write_summary, write_transaction};
 use super::input::{for_each_frame, open_input, report_counts};
 use crate::analysis::filter::stream::Stream;
 use crate::analysis::filter::{Facts, Filter};
+use crate::analysis::transfers::Transfers;
 use crate::command::ExitCode;
 use crate::decode::{Decoder, Kind};
 use crate::output::{jsonl, summary::Summary, text};
@@ -33,6 +34,8 @@ struct Run {
     format: OutputFormat,
     stream: Stream<Out>,
     summary: Summary,
+    /// The SDO transfers of `--transactions`, as the TUI's SDO pane takes them.
+    transfers: Transfers,
     /// Frames taken so far (the decoder's sequence numbers).
     pos: u64,
     t0_ns: Option<u64>,
@@ -79,6 +82,7 @@ pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
         mode,
         format: args.format,
         summary: Summary::default(),
+        transfers: Transfers::new(),
         pos: 0,
         t0_ns: None,
     };
@@ -117,7 +121,7 @@ impl Run {
                 if self.mode == Mode::Transactions {
                     // Only the transfers are printed: no frame labels.
                     self.decoder.track(frame);
-                    for t in self.decoder.take_transactions() {
+                    for t in self.transfers.completed(&mut self.decoder) {
                         self.transaction(&mut buf, &t, t0);
                     }
                     self.pos += 1;
@@ -178,7 +182,7 @@ impl Run {
         match self.mode {
             Mode::Transactions => {
                 let t0 = self.t0_ns.unwrap_or(0);
-                for t in self.decoder.finish() {
+                for t in self.transfers.end(&mut self.decoder) {
                     self.transaction(&mut buf, &t, t0);
                 }
             }

@@ -330,9 +330,13 @@ impl App {
                 Ok(Feed::Status(s)) => self.say(Level::Info, &s),
                 Ok(Feed::Position(p)) => {
                     self.source.replay.0 = Some(p);
+                    self.replay_end();
                     self.dirty = true;
                 }
-                Ok(Feed::Extent(e)) => self.source.replay.1 = Some(e),
+                Ok(Feed::Extent(e)) => {
+                    self.source.replay.1 = Some(e);
+                    self.replay_end();
+                }
                 Ok(Feed::Result(level, s)) => {
                     self.say(level, &s);
                     let step = self.panes.objects.result(&s, self.trace.nodes.now_ns());
@@ -358,6 +362,8 @@ impl App {
                     self.dirty = true;
                 }
                 Ok(Feed::Done) | Err(TryRecvError::Disconnected) => {
+                    // Transfers the input cut off are listed, as `decode --transactions` lists them.
+                    self.trace.end_of_input();
                     self.trace.store.shrink();
                     self.source.done = true;
                     self.source.feed = None;
@@ -369,6 +375,14 @@ impl App {
             if start.elapsed() >= budget {
                 return true;
             }
+        }
+    }
+
+    /// A replay that played its last frame ended its input (until it goes back, which
+    /// starts the trace over): the transfers it cut off are listed.
+    fn replay_end(&mut self) {
+        if self.source.replay_at_end() {
+            self.trace.end_of_input();
         }
     }
 
@@ -1542,6 +1556,55 @@ mod tests {
 
     fn key(c: char) -> KeyEvent {
         KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE)
+    }
+
+    #[test]
+    fn transfers_cut_off_by_the_end_of_a_log_are_listed_when_it_is_read_or_replayed_to_the_end() {
+        use crate::tui::source::{Extent, Position};
+        // A download announcing 64 bytes, answered, then nothing more.
+        let frames = || {
+            [
+                (0x603, [0x21, 0x01, 0x70, 0x01, 0x40, 0, 0, 0]),
+                (0x583, [0x60, 0x01, 0x70, 0x01, 0, 0, 0, 0]),
+            ]
+            .iter()
+            .map(|(id, d)| crate::frame::Frame::classic(*id, d))
+            .collect::<Vec<_>>()
+        };
+        let fresh = |kind| {
+            let (ftx, frx) = std::sync::mpsc::channel();
+            let mut a = app();
+            a.trace.clear();
+            a.source = SourceInfo::new("x.log", kind, frx, None);
+            ftx.send(Feed::Frames(frames())).unwrap();
+            (a, ftx)
+        };
+        let (mut a, ftx) = fresh(SourceKind::Open);
+        a.ingest(Duration::from_millis(100));
+        assert!(a.trace.transactions.is_empty(), "still running while the log is read");
+        ftx.send(Feed::Done).unwrap();
+        a.ingest(Duration::from_millis(100));
+        let t = &a.trace.transactions;
+        assert_eq!(
+            (t.len(), t[0].outcome.as_str(), t[0].cut_short_of()),
+            (1, "incomplete", Some(64))
+        );
+        // A replay: at its last frame.
+        let (mut a, ftx) = fresh(SourceKind::Replay { speed: 1.0 });
+        let at = Position { frames: 2, ts_ns: 0 };
+        ftx.send(Feed::Position(Position { frames: 1, ts_ns: 0 })).unwrap();
+        ftx.send(Feed::Extent(Extent {
+            frames: 2,
+            first_ns: 0,
+            last_ns: 0,
+        }))
+        .unwrap();
+        a.ingest(Duration::from_millis(100));
+        assert!(a.trace.transactions.is_empty(), "not at the end yet");
+        ftx.send(Feed::Position(at)).unwrap();
+        ftx.send(Feed::Position(at)).unwrap();
+        a.ingest(Duration::from_millis(100));
+        assert_eq!(a.trace.transactions.len(), 1, "listed once");
     }
 
     #[test]

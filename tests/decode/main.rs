@@ -6,6 +6,7 @@
 #![allow(clippy::unwrap_used)]
 
 mod architecture;
+mod cut_short;
 mod decode_golden;
 mod decode_proptest;
 mod diagnose_golden;

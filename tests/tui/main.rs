@@ -3,6 +3,7 @@
 // Test code may unwrap: a failed unwrap is a failed test with its location.
 #![allow(clippy::unwrap_used)]
 
+mod agreement;
 mod filter_search;
 mod objects_demo;
 mod objects_tmux;

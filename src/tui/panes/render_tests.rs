@@ -82,6 +82,8 @@ fn sdo_pane_lists_transfers_and_expands_to_frames() {
     assert!(s.contains("1017:00"), "{s}");
     assert!(s.contains("abort 06020000"), "{s}");
     insta::assert_snapshot!("sdo_list", s);
+    // The list follows the newest transfer; the first is opened from the top.
+    a.act(Action::Top);
     a.act(Action::Expand);
     let s = screen(&mut a, 140, 14);
     assert!(s.contains("SDO transfer 1017:00 node 1"), "{s}");
@@ -91,6 +93,59 @@ fn sdo_pane_lists_transfers_and_expands_to_frames() {
     a.act(Action::Down);
     let s = screen(&mut a, 140, 14);
     assert!(s.contains("frame 5  t 0.008000 s"), "{s}");
+}
+
+/// One expedited read of 0x1018:sub from node 1, `dt_ms` after the newest frame.
+fn read_identity(a: &mut crate::tui::app::App, sub: u8, dt_ms: u64) {
+    let t = a.trace.store.packed(a.trace.len() - 1).ts_ns + dt_ms * 1_000_000;
+    for (i, (id, data)) in [
+        (0x601, [0x40, 0x18, 0x10, sub, 0, 0, 0, 0]),
+        (0x581, [0x43, 0x18, 0x10, sub, 0x78, 0x56, 0x34, 0x12]),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut f = crate::frame::Frame::classic(id, &data);
+        f.ts_ns = t + i as u64 * 1_000_000;
+        a.trace.push(&f);
+    }
+}
+
+/// The selected row of the SDO pane (drawn reversed).
+fn selected_sdo_row(a: &mut crate::tui::app::App) -> String {
+    let mut term = ratatui::Terminal::new(ratatui::backend::TestBackend::new(140, 16)).unwrap();
+    term.draw(|f| crate::tui::ui::draw(f, a)).unwrap();
+    let buf = term.backend().buffer().clone();
+    let rows: Vec<String> = (0..buf.area.height)
+        .filter(|&y| buf[(5, y)].modifier.contains(ratatui::style::Modifier::REVERSED))
+        .map(|y| (0..100).map(|x| buf[(x, y)].symbol().to_string()).collect())
+        .collect();
+    assert_eq!(rows.len(), 1, "{rows:?}");
+    rows[0].clone()
+}
+
+#[test]
+fn the_sdo_pane_has_a_time_column_and_follows_the_newest_transfer_until_scrolled() {
+    let mut a = app();
+    a.focus = Pane::Sdo;
+    let s = screen(&mut a, 140, 16);
+    // Trace time, as the trace pane counts it: the 0x1017 read is frame 4, at 0.007 s.
+    assert!(s.contains("      time  nd dir   object"), "{s}");
+    assert!(s.contains("     0.007   1 read  1017:00"), "{s}");
+    assert!(selected_sdo_row(&mut a).contains("6041:00"));
+    // A new transfer comes: the selection goes with it.
+    read_identity(&mut a, 1, 100);
+    let row = selected_sdo_row(&mut a);
+    assert!(row.contains("     0.204   1 read  1018:01"), "{row}");
+    // Scrolled up, the selection stays where the user put it while transfers come.
+    a.act(Action::Up);
+    read_identity(&mut a, 2, 10);
+    assert!(selected_sdo_row(&mut a).contains("6041:00"));
+    assert!(screen(&mut a, 140, 16).contains("1018:02"));
+    // `end` follows again.
+    a.act(Action::Bottom);
+    read_identity(&mut a, 3, 10);
+    assert!(selected_sdo_row(&mut a).contains("1018:03"));
 }
 
 #[test]
@@ -120,6 +175,10 @@ fn at_80x24_the_detail_pane_follows_the_sdo_pane_selection() {
     let _ = screen(&mut a, 80, 24);
     a.act(Action::Expand);
     a.act(Action::PaneSdo);
+    let s = screen(&mut a, 80, 24);
+    // The newest transfer is selected (the pane follows), then the first.
+    assert!(s.contains("Upload 0x6041:00"), "{s}");
+    a.act(Action::Top);
     let s = screen(&mut a, 80, 24);
     assert!(s.contains("Upload 0x1017:00"), "{s}");
     a.act(Action::Expand);

@@ -1,5 +1,6 @@
-//! The SDO pane: one row per transfer (object, value, duration, outcome, abort text);
-//! `expand` opens a transfer's frames.
+//! The SDO pane: one row per transfer (start time, object, value, duration, outcome,
+//! abort text), the newest selected until the user moves the selection (as the trace
+//! follows); `expand` opens a transfer's frames.
 
 use super::{Component, Ctx, ListState, Selected, block, duration, fit, header, selected};
 use crate::analysis::trace::Trace;
@@ -11,10 +12,14 @@ use ratatui::style::{Color, Style};
 use ratatui::text::Line;
 use ratatui::widgets::Paragraph;
 
+/// Width of the time column: seconds since the first frame of the trace, as the trace
+/// pane counts them, to the millisecond.
+const TIME: usize = 10;
+
 /// Widths of the name and value columns in a pane `width` wide: the value takes what the
 /// fixed columns and 20 columns of outcome leave (at least 20), the name 24 (16 when narrow).
 pub fn widths(width: usize) -> (usize, usize) {
-    let avail = width.saturating_sub(30);
+    let avail = width.saturating_sub(30 + TIME + 1);
     let name = if avail >= 80 { 24 } else { 16 };
     (name, avail.saturating_sub(name + 20).max(20))
 }
@@ -25,6 +30,9 @@ pub fn row_text(trace: &Trace, t: &Transaction, width: usize) -> String {
     let name = dict.name(t.index, t.sub).unwrap_or("");
     let value = if t.outcome == Outcome::Ok && !t.data.is_empty() && !t.is_partial() {
         crate::decode::sdo::value::view(dict, t.index, t.sub, &t.data).text
+    } else if let Some(size) = t.cut_short_of() {
+        // Ended before the announced size came: how much did.
+        format!("{} of {size} bytes", t.len())
     } else {
         String::new()
     };
@@ -45,8 +53,9 @@ pub fn row_text(trace: &Trace, t: &Transaction, width: usize) -> String {
         (format!("{:04X}:{:02X}", t.index, t.sub), name)
     };
     let (nw, vw) = widths(width);
+    let time = t.start_ns.saturating_sub(super::start_ns(trace)) as f64 / 1e9;
     let text = format!(
-        "{:>3} {} {} {:<nw$} {:<vw$} {:>9} {}",
+        "{time:>TIME$.3} {:>3} {} {} {:<nw$} {:<vw$} {:>9} {}",
         t.node,
         dir,
         object,
@@ -62,8 +71,8 @@ pub fn row_text(trace: &Trace, t: &Transaction, width: usize) -> String {
 #[test]
 fn the_value_column_widens_with_the_pane() {
     assert_eq!(widths(78), (16, 20));
-    assert_eq!(widths(113), (24, 39));
-    assert_eq!(widths(200), (24, 126));
+    assert_eq!(widths(124), (24, 39));
+    assert_eq!(widths(211), (24, 126));
 }
 
 fn color(t: &Transaction) -> Color {
@@ -75,13 +84,26 @@ fn color(t: &Transaction) -> Color {
     }
 }
 
-/// The SDO pane's state: the selection, and the transfer opened to its frames.
-#[derive(Default)]
+/// The SDO pane's state: the selection, whether it follows the newest transfer, and the
+/// transfer opened to its frames.
 pub struct SdoPane {
     /// Scroll state (transfers, or the frames of the opened transfer).
     pub list: ListState,
+    /// Select the newest transfer as transfers come (until the selection is moved; `end`
+    /// follows again).
+    pub follow: bool,
     /// The transfer opened to its frames (index into the transactions).
     pub expanded: Option<usize>,
+}
+
+impl Default for SdoPane {
+    fn default() -> SdoPane {
+        SdoPane {
+            list: ListState::default(),
+            follow: true,
+            expanded: None,
+        }
+    }
 }
 
 impl SdoPane {
@@ -111,11 +133,15 @@ impl Component for SdoPane {
     fn handle(&mut self, action: Action, ctx: &Ctx) -> super::Outcome {
         if let Some(delta) = ListState::movement(action, ctx.page) {
             self.scroll(delta, ctx);
+            if action == Action::Bottom && self.expanded.is_none() {
+                self.follow = true;
+            }
             return super::Outcome::Done;
         }
         match action {
             Action::Expand if self.expanded.is_none() => {
                 if !ctx.trace.transactions.is_empty() {
+                    self.follow = false;
                     self.expanded = Some(self.list.selected);
                     self.list = ListState::default();
                 }
@@ -140,15 +166,22 @@ impl Component for SdoPane {
     }
 
     fn scroll(&mut self, delta: isize, ctx: &Ctx) {
+        self.follow = false;
         self.list.scroll(delta, self.len(ctx.trace), ctx.page);
     }
 
     fn click(&mut self, row: usize, ctx: &Ctx) {
+        self.follow = false;
         self.list.click(row, self.len(ctx.trace), ctx.page);
     }
 
+    /// Keeps the selection visible; when following, on the newest transfer.
     fn fit(&mut self, height: usize, ctx: &Ctx) {
-        self.list.clamp(self.len(ctx.trace), height);
+        let n = self.len(ctx.trace);
+        if self.follow && self.expanded.is_none() {
+            self.list.selected = n.saturating_sub(1);
+        }
+        self.list.clamp(n, height);
     }
 
     /// The selected transfer, or the selected frame of the opened one.
@@ -221,8 +254,8 @@ impl SdoPane {
         let mut lines = vec![Line::styled(
             fit(
                 &format!(
-                    "{:>3} {} {:<7} {:<nw$} {:<vw$} {:>9} outcome",
-                    "nd", "dir  ", "object", "name", "value", "duration"
+                    "{:>TIME$} {:>3} {} {:<7} {:<nw$} {:<vw$} {:>9} outcome",
+                    "time", "nd", "dir  ", "object", "name", "value", "duration"
                 ),
                 inner.width as usize,
             ),

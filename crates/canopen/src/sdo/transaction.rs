@@ -227,6 +227,14 @@ impl Transaction {
         self.problems.contains(&Problem::StartedBeforeCapture)
     }
 
+    /// The size the initiate announced, when the transfer ended (aborted, broke, or was
+    /// still running when the input ended) before that many bytes came: a download that
+    /// announced 64 bytes and sent 7 gives `Some(64)`.
+    pub fn cut_short_of(&self) -> Option<u32> {
+        let size = self.size?;
+        (self.outcome != Outcome::Ok && (self.len() as u64) < u64::from(size)).then_some(size)
+    }
+
     /// Bytes transferred, kept or not.
     pub fn len(&self) -> usize {
         self.data.len() + self.dropped

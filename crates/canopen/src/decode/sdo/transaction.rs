@@ -57,10 +57,18 @@ impl Transaction {
             s.push_str(self.protocol.as_str());
             s.push_str(", ");
         }
-        write!(s, "{n} byte")?;
-        if n != 1 {
-            s.push('s');
-        }
+        // Cut short: `7 of 64 bytes`, the count then the size the initiate announced.
+        let last = match self.cut_short_of() {
+            Some(size) => {
+                write!(s, "{n} of {size}")?;
+                size as usize
+            }
+            None => {
+                write!(s, "{n}")?;
+                n
+            }
+        };
+        s.push_str(if last == 1 { " byte" } else { " bytes" });
         if partial {
             s.push_str(" seen");
         }
@@ -119,6 +127,7 @@ impl Transaction {
             request_cob: self.channel.request_cob,
             response_cob: self.channel.response_cob,
             size: self.size,
+            size_announced: self.cut_short_of(),
             start_ns: self.start_ns,
             sub: (!partial).then_some(self.sub),
             value_text: value.as_ref().map(|v| v.text.clone()),
@@ -156,6 +165,10 @@ pub struct TransactionJson<'a> {
     pub request_cob: u32,
     pub response_cob: u32,
     pub size: Option<u32>,
+    /// The size the initiate announced, on a transfer that ended before that many bytes
+    /// came (`len` of them did); left out otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub size_announced: Option<u32>,
     pub start_ns: u64,
     pub sub: Option<u8>,
     /// The typed value (`null` without data or for a partial transfer).
