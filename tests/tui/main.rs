@@ -3,6 +3,7 @@
 mod filter_search;
 mod objects_demo;
 mod objects_tmux;
+mod own_reads;
 mod problems;
 mod receive_list;
 mod tmux;
