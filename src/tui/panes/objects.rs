@@ -1157,7 +1157,9 @@ mod tests {
         assert_eq!(p.cursor, "sdo write 1 0x1017:0x00 100".len());
         let m = a.message.clone().unwrap_or_default();
         assert!(
-            m.starts_with("u16 value in ms: edit it and press enter · will send: 601#2B17100064000000"),
+            m.starts_with(
+                "u16 value in ms: edit it and press enter · blocked: this source has no bus — would send 601#2B17100064000000"
+            ),
             "{m}"
         );
         // A read-only entry is not offered for writing.
