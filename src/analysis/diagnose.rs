@@ -46,6 +46,8 @@ const SAME_CYCLE_NS: u64 = 20 * MS;
 const TWO_MASTERS_NS: u64 = 25 * MS;
 /// A drive has this long to show the state its controlword asked for.
 const STALL_NS: u64 = 1_000 * MS;
+/// Distinct abort codes an SDO incident's cause names (the others are counted).
+const CODES_TOLD: usize = 6;
 /// Axes of a multi-axis drive (objects 0x6000 + 0x800 * (axis - 1)).
 const AXES: u16 = 8;
 
@@ -1264,11 +1266,16 @@ impl Diagnoser {
         let cause = match absent {
             true => format!("the node does not have them (abort {})", codes.join(", ")),
             false => {
-                let said: Vec<String> = meta
+                // Every distinct code, up to a readable few.
+                let mut said: Vec<String> = meta
                     .codes
                     .iter()
+                    .take(CODES_TOLD)
                     .map(|c| format!("{} (abort 0x{c:08X})", abort_text(*c)))
                     .collect();
+                if meta.codes.len() > CODES_TOLD {
+                    said.push(format!("{} more abort codes", meta.codes.len() - CODES_TOLD));
+                }
                 format!("0x{index:04X}:{sub:02X}: {}", said.join("; "))
             }
         };
