@@ -249,21 +249,15 @@ fn text_report_and_check_status() {
         "--check: an open incident"
     );
     // Only warnings (a node that stopped answering once, then answered): --check passes.
-    let (inc, code) = diagnose(realworld("ros2_canopen_issue46_boot.txt").to_str().unwrap());
+    let (inc, code) = diagnose("../shared/realworld/logs/ros2_canopen_issue46_boot.txt");
     assert!(inc.iter().all(|i| i["status"] != "open"), "{inc:?}");
     assert_eq!(code, 0);
 }
 
-/// `name` in `shared/realworld/logs/` beside the checkout (or beside the folder of a git
-/// worktree the checkout is in).
 fn realworld(name: &str) -> PathBuf {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let dir = ["../shared", "../../shared"]
-        .iter()
-        .map(|s| root.join(s).join("realworld/logs"))
-        .find(|d| d.is_dir())
-        .unwrap_or_else(|| root.join("../shared/realworld/logs"));
-    dir.join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/realworld/logs")
+        .join(name)
 }
 
 #[test]

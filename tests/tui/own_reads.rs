@@ -101,7 +101,7 @@ fn own_reads_of_missing_objects_do_not_hide_a_drive_fault_and_a_lost_node() {
     let rows: Vec<&str> = s.lines().filter(|l| l.contains("Node ")).collect();
     let info: Vec<&&str> = rows.iter().filter(|l| l.contains("not present")).collect();
     assert_eq!(info.len(), 1, "{s}");
-    assert!(info[0].contains(&format!("INFO      Node 2 ")), "{s}");
+    assert!(info[0].contains("INFO      Node 2 "), "{s}");
     assert!(info[0].contains(&format!("{absent} objects not present")), "{s}");
     assert!(!s.contains("could not be read"), "{s}");
     let pos = |what: &str| rows.iter().position(|l| l.contains(what)).unwrap();
