@@ -11,6 +11,7 @@
 use super::events::{Event, What};
 use super::incident::{Incident, Problem, Status};
 use super::liveness::EventTracker;
+use super::texts::SdoAborts;
 use super::timing::{PdoGap, PdoKey, PdoTiming, PeriodFrom, SyncTiming};
 use crate::decode::cia402::DriveState;
 use crate::decode::emcy::Emcy;
@@ -18,9 +19,9 @@ use crate::decode::heartbeat::NmtState;
 use crate::decode::sdo::frame::{Chunk8, SdoFrame};
 use crate::decode::stall::{self, Observation, Step};
 use crate::decode::{Body, Decoded, Decoder, Kind};
-use crate::frame::Frame;
+use crate::frame::{Flags, Frame};
 use crate::od::{Dictionary, PdoMapping};
-use crate::sdo::abort::abort_text;
+use crate::sdo::abort::{AbortClass, abort_class, abort_text};
 use crate::sdo::codec::{SdoCommand, Side};
 use crate::sdo::transaction::{Outcome, Transaction, TransferDirection};
 use std::collections::{BTreeMap, HashMap};
@@ -45,6 +46,8 @@ const SAME_CYCLE_NS: u64 = 20 * MS;
 const TWO_MASTERS_NS: u64 = 25 * MS;
 /// A drive has this long to show the state its controlword asked for.
 const STALL_NS: u64 = 1_000 * MS;
+/// Distinct abort codes an SDO incident's cause names (the others are counted).
+const CODES_TOLD: usize = 6;
 /// Axes of a multi-axis drive (objects 0x6000 + 0x800 * (axis - 1)).
 const AXES: u16 = 8;
 
@@ -118,6 +121,9 @@ struct Node {
     pending: Option<Request>,
     /// The last SDO request was a write.
     download: bool,
+    /// The last SDO request was sent by the capturing host (TX-marked: cotui itself, or
+    /// the host that recorded the log).
+    ours: bool,
     /// Last frame of any kind sent by the node.
     last_any: Option<At>,
     /// 0x1017 = 0 seen on the bus, and when.
@@ -163,6 +169,8 @@ pub struct Diagnoser {
     incidents: Vec<Incident>,
     keyed: HashMap<(Option<u8>, Problem, u32), usize>,
     faults: HashMap<usize, FaultMeta>,
+    /// The abort codes and directions of each SDO incident.
+    aborts: HashMap<usize, SdoAborts>,
     error_frames: u64,
     bus_state: BTreeMap<String, &'static str>,
     sdo_deadline: Option<u64>,
@@ -301,6 +309,7 @@ impl Diagnoser {
             incidents: Vec::new(),
             keyed: HashMap::new(),
             faults: HashMap::new(),
+            aborts: HashMap::new(),
             error_frames: 0,
             bus_state: BTreeMap::new(),
             sdo_deadline: None,
@@ -558,7 +567,7 @@ impl Diagnoser {
                 self.node(n).heard = true;
                 self.emcy(n, e);
             }
-            Body::Sdo(s) => self.sdo_body(n, s),
+            Body::Sdo(s) => self.sdo_body(n, s, frame.flags.has(Flags::TX)),
             Body::Pdo(p) => {
                 if p.transmit {
                     self.node(n).heard = true;
@@ -601,11 +610,12 @@ impl Diagnoser {
             node.heard = true;
         }
         if let Some(s) = s {
-            self.sdo_body(n, s);
+            self.sdo_body(n, s, frame.flags.has(Flags::TX));
         }
     }
 
-    fn sdo_body(&mut self, n: u8, s: &SdoFrame) {
+    /// `ours`: the frame is TX-marked (sent by the capturing host).
+    fn sdo_body(&mut self, n: u8, s: &SdoFrame, ours: bool) {
         let at = self.at;
         if s.side == Side::Server {
             let node = self.node(n);
@@ -648,6 +658,7 @@ impl Diagnoser {
                 // The other client's request may well be answered: not counted as unanswered.
                 let overlap = self.overlapping_request(n, index, sub);
                 self.node(n).download = matches!(s.command.cs_name(), "initiate_download" | "block_download");
+                self.node(n).ours = ours;
                 if let Some(old) = self.node(n).pending.take()
                     && !overlap
                 {
@@ -1232,17 +1243,51 @@ impl Diagnoser {
     fn refused(&mut self, n: u8, index: u16, sub: u8, code: u32) {
         let at = self.at;
         let text = abort_text(code);
-        let detail = (u32::from(index) << 8) | u32::from(sub);
-        let write = self.node(n).download;
-        let i = self.grouped(Some(n), Problem::SdoRefused, detail, at.t);
+        let (write, ours) = (self.node(n).download, self.node(n).ours);
+        // A read the capturing host sent (cotui's own, or a TX-marked line of a log) of an
+        // entry the node does not have: worth knowing, not a problem of the node.
+        let absent = ours && !write && abort_class(code) == AbortClass::NotPresent;
+        let (problem, detail) = match absent {
+            true => (Problem::NotPresent, 0),
+            false => (Problem::SdoRefused, (u32::from(index) << 8) | u32::from(sub)),
+        };
+        let i = self.grouped(Some(n), problem, detail, at.t);
+        let meta = self.aborts.entry(i).or_default();
+        if !meta.codes.contains(&code) {
+            meta.codes.push(code);
+        }
+        meta.entries.insert((index, sub));
+        if write {
+            meta.writes = true;
+        } else {
+            meta.reads = true;
+        }
+        let codes: Vec<String> = meta.codes.iter().map(|c| format!("0x{c:08X}")).collect();
+        let cause = match absent {
+            true => format!("the node does not have them (abort {})", codes.join(", ")),
+            false => {
+                // Every distinct code, up to a readable few.
+                let mut said: Vec<String> = meta
+                    .codes
+                    .iter()
+                    .take(CODES_TOLD)
+                    .map(|c| format!("{} (abort 0x{c:08X})", abort_text(*c)))
+                    .collect();
+                if meta.codes.len() > CODES_TOLD {
+                    said.push(format!("{} more abort codes", meta.codes.len() - CODES_TOLD));
+                }
+                format!("0x{index:04X}:{sub:02X}: {}", said.join("; "))
+            }
+        };
         let inc = &mut self.incidents[i];
-        inc.status = Status::Open;
-        inc.cause = Some(format!("0x{index:04X}:{sub:02X}: {text} (abort 0x{code:08X})"));
+        inc.status = if absent { Status::Info } else { Status::Open };
+        inc.cause = Some(cause);
         let what = if write { "Write" } else { "Read" };
+        let how = if absent { "not present" } else { "refused" };
         self.step(
             i,
             at,
-            format!("{what} of 0x{index:04X}:{sub:02X} refused: {text} (0x{code:08X})"),
+            format!("{what} of 0x{index:04X}:{sub:02X} {how}: {text} (0x{code:08X})"),
         );
     }
 
@@ -1485,7 +1530,7 @@ impl Diagnoser {
         }
         for (i, inc) in self.incidents.iter_mut().enumerate() {
             let meta = self.faults.get(&i).cloned().unwrap_or_default();
-            super::texts::fill(inc, meta.resets, meta.emcy, self.error_frames);
+            super::texts::fill(inc, meta.resets, meta.emcy, self.error_frames, self.aborts.get(&i));
             // The device's own steps for its EMCY code come first.
             if let Some(steps) = self.device_check.get(&i) {
                 inc.check.splice(0..0, steps.iter().cloned());

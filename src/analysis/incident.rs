@@ -17,6 +17,9 @@ pub enum Status {
     Recovered,
     /// Worth knowing, did not stop anything that the bus shows.
     Warning,
+    /// Only for information: nothing went wrong (e.g. entries the node does not have, read
+    /// by the capturing host itself).
+    Info,
 }
 
 impl Status {
@@ -26,6 +29,7 @@ impl Status {
             Status::Open => "open",
             Status::Recovered => "recovered",
             Status::Warning => "warning",
+            Status::Info => "info",
         }
     }
 }
@@ -69,6 +73,9 @@ pub enum Problem {
     SecondMaster,
     /// A synchronous TPDO sent after the SYNC window (0x1007) closed.
     PdoLate,
+    /// Entries a node does not have, asked for by reads the capturing host sent (cotui's
+    /// own, or TX-marked in a log): one info row per node, not an incident per entry.
+    NotPresent,
 }
 
 impl Problem {
@@ -93,6 +100,7 @@ impl Problem {
             Problem::SyncJitter => "sync_jitter",
             Problem::SecondMaster => "second_master",
             Problem::PdoLate => "pdo_late",
+            Problem::NotPresent => "not_present",
         }
     }
 }
@@ -206,6 +214,7 @@ impl Incident {
             Status::Open => "OPEN",
             Status::Recovered => "RECOVERED",
             Status::Warning => "WARNING",
+            Status::Info => "INFO",
         };
         let _ = writeln!(out, "{n:>2}. {status:<9}  {}: {}", self.place(), self.title);
         if let Some(c) = &self.cause {

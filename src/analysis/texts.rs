@@ -2,6 +2,91 @@
 //! technician at the machine rather than a protocol expert.
 
 use super::incident::{Incident, Problem, Status};
+use crate::sdo::abort::{AbortClass, abort_class};
+use std::collections::BTreeSet;
+
+/// What the bus showed of an SDO incident's aborts (kept by the diagnosis per incident).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct SdoAborts {
+    /// The distinct abort codes, first seen first.
+    pub codes: Vec<u32>,
+    /// The entries aborted (index, sub-index).
+    pub entries: BTreeSet<(u16, u8)>,
+    /// Some were reads (uploads).
+    pub reads: bool,
+    /// Some were writes (downloads).
+    pub writes: bool,
+}
+
+/// The words of a refused SDO transfer by the class of its abort codes: the title and why
+/// for a read, a write, and an object both read and written (in that order), and the steps
+/// to check first.
+struct AbortWords {
+    class: AbortClass,
+    title: [&'static str; 3],
+    why: [&'static str; 3],
+    check: &'static [&'static str],
+}
+
+/// One row per class; a class not listed takes the last row's words.
+const ABORT_WORDS: &[AbortWords] = &[
+    AbortWords {
+        class: AbortClass::Protocol,
+        title: [
+            "The transfer broke: a value was not read",
+            "The transfer broke: a setting was not written",
+            "The transfer broke: reads and writes of this object failed",
+        ],
+        why: [
+            "The transfer did not finish: the master does not have the value, and a retry may break the same way.",
+            "The transfer did not finish: the setting was not written, and a retry may break the same way.",
+            "The transfers did not finish: values were neither read nor written, and retries may break the same way.",
+        ],
+        check: &[
+            "Look for a second SDO client on this node's channel (0x600 + node): another tool or master talking to the node at the same time breaks the transfer.",
+            "Check the timing: the client's SDO timeout against the time the device takes to answer, and segments or blocks sent no faster than the device takes them.",
+            "Check the bus at that moment for error frames and lost frames (wiring, termination, bus load): a lost segment breaks the transfer.",
+        ],
+    },
+    AbortWords {
+        class: AbortClass::Refused,
+        title: [
+            "A value could not be read",
+            "A setting was not applied",
+            "Reads and writes of this object were refused",
+        ],
+        why: [
+            "The master does not know this value.",
+            "The device keeps running with its old or default value.",
+            "The master does not know this value, and the device keeps its old or default one.",
+        ],
+        check: &[
+            "Compare index, sub-index, data size and access rights with the device manual or EDS.",
+            "Check that the node is in the right state for this object (some are writable only when disabled).",
+            "Fix the master's configuration that sends it, then record a new capture.",
+        ],
+    },
+];
+
+/// The words for `aborts`: a transfer that broke when any code is a protocol abort, else
+/// a refusal (read, write or both).
+fn abort_words(aborts: &SdoAborts) -> (&'static AbortWords, usize) {
+    let class = if aborts.codes.iter().any(|c| abort_class(*c) == AbortClass::Protocol) {
+        AbortClass::Protocol
+    } else {
+        AbortClass::Refused
+    };
+    let words = ABORT_WORDS
+        .iter()
+        .find(|w| w.class == class)
+        .unwrap_or(&ABORT_WORDS[ABORT_WORDS.len() - 1]);
+    let which = match (aborts.reads, aborts.writes) {
+        (true, true) => 2,
+        (false, true) => 1,
+        _ => 0,
+    };
+    (words, which)
+}
 
 fn plural(n: u64, one: &str) -> String {
     if n == 1 {
@@ -24,8 +109,9 @@ fn strings(v: &[&str]) -> Vec<String> {
 }
 
 /// Sets `inc`'s title, check steps and why; `resets` and `emcy` are a drive fault's fault
-/// resets and EMCY code, `error_frames` the capture's CAN error frames.
-pub fn fill(inc: &mut Incident, resets: u32, emcy: Option<u16>, error_frames: u64) {
+/// resets and EMCY code, `error_frames` the capture's CAN error frames, `sdo` the aborts of
+/// an SDO incident.
+pub fn fill(inc: &mut Incident, resets: u32, emcy: Option<u16>, error_frames: u64, sdo: Option<&SdoAborts>) {
     let node = inc.node.map_or(String::new(), |n| n.to_string());
     match inc.problem {
         Problem::Missing => {
@@ -84,25 +170,30 @@ pub fn fill(inc: &mut Incident, resets: u32, emcy: Option<u16>, error_frames: u6
             inc.why = "A restarted node forgets what the master configured and starts again in pre-operational.".into();
         }
         Problem::SdoRefused => {
-            let write = inc.events.first().is_some_and(|e| e.text.starts_with("Write"));
-            inc.title = if write {
-                "A setting was not applied".into()
-            } else {
-                "A value could not be read".into()
+            let fallback = SdoAborts {
+                writes: inc.events.first().is_some_and(|e| e.text.starts_with("Write")),
+                ..SdoAborts::default()
             };
+            let (words, which) = abort_words(sdo.unwrap_or(&fallback));
+            inc.title = words.title[which].into();
             if inc.status == Status::Recovered {
                 inc.title.push_str(" (a later try worked)");
             }
-            inc.check = strings(&[
-                "Compare index, sub-index, data size and access rights with the device manual or EDS.",
-                "Check that the node is in the right state for this object (some are writable only when disabled).",
-                "Fix the master's configuration that sends it, then record a new capture.",
-            ]);
-            inc.why = if write {
-                "The device keeps running with its old or default value.".into()
+            inc.check = strings(words.check);
+            inc.why = words.why[which].into();
+        }
+        Problem::NotPresent => {
+            let n = sdo.map_or(inc.count, |a| a.entries.len() as u64);
+            inc.title = if n == 1 {
+                "1 object not present (read from here)".into()
             } else {
-                "The master does not know this value.".into()
+                format!("{n} objects not present (read from here)")
             };
+            inc.check = strings(&[
+                "Nothing to fix on the bus: the device does not have these entries, although the dictionary used (EDS or profile) lists them.",
+                "If the device should have one of them, compare its firmware version and EDS with the device manual.",
+            ]);
+            inc.why = "Only worth knowing: reading an entry the device lacks changes nothing on the device.".into();
         }
         Problem::SdoTimeout => {
             inc.title = format!("{} not answered", plural(inc.count, "SDO request"));

@@ -194,14 +194,22 @@ mod live {
 pub fn report(incidents: &[Incident], origin: u64, frames: u64) -> String {
     let count = |s: Status| incidents.iter().filter(|i| i.status == s).count();
     let (open, recovered, warning) = (count(Status::Open), count(Status::Recovered), count(Status::Warning));
-    let mut out = if incidents.is_empty() {
-        format!("No problems found in {frames} frames.\n")
+    // Notes for information only (entries a node lacks, read by the capturing host).
+    let info = match count(Status::Info) {
+        0 => String::new(),
+        1 => ", 1 note".to_string(),
+        n => format!(", {n} notes"),
+    };
+    let mut out = if incidents.len() == count(Status::Info) {
+        format!("No problems found in {frames} frames{}.\n", info.replacen(',', ";", 1))
     } else if open > 0 {
         format!(
-            "Needs attention: {open} open, {recovered} recovered, {warning} warnings ({frames} frames). Start from the top.\n"
+            "Needs attention: {open} open, {recovered} recovered, {warning} warnings{info} ({frames} frames). Start from the top.\n"
         )
     } else {
-        format!("Problems occurred, none left open: {recovered} recovered, {warning} warnings ({frames} frames).\n")
+        format!(
+            "Problems occurred, none left open: {recovered} recovered, {warning} warnings{info} ({frames} frames).\n"
+        )
     };
     for (n, inc) in incidents.iter().enumerate() {
         out.push('\n');

@@ -661,8 +661,19 @@ impl App {
         let Some(p) = &self.prompt.editing else { return };
         let first = p.text.split_whitespace().next().unwrap_or("");
         if p.kind == PromptKind::Palette && commander_words().contains(&first) {
+            // The preview says before enter when nothing can go out.
+            let blocked = if self.listen_only() {
+                Some("listen-only")
+            } else if self.source.requests.is_none() {
+                Some("this source has no bus")
+            } else {
+                None
+            };
             self.message = Some(match palette::plan(&p.text, &self.bindings, |n| self.drive_state(n)) {
-                Ok(pl) => format!("will send: {}", pl.preview),
+                Ok(pl) => match blocked {
+                    Some(why) => format!("blocked: {why} — would send {}", pl.preview),
+                    None => format!("will send: {}", pl.preview),
+                },
                 Err(e) => e.to_string(),
             });
         }
@@ -1780,7 +1791,11 @@ mod tests {
         for c in "nmt reset-node 0".chars() {
             a.key(key(c));
         }
-        assert_eq!(a.message.as_deref(), Some("will send: 000#8100"));
+        // A log has no bus: the preview says so before enter.
+        assert_eq!(
+            a.message.as_deref(),
+            Some("blocked: this source has no bus — would send 000#8100")
+        );
         a.key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
         assert!(a.confirm.is_some());
         a.key(key('y'));
@@ -1833,6 +1848,23 @@ mod tests {
             }
             other => panic!("expected a stop request, got {other:?}"),
         }
+    }
+
+    #[test]
+    fn the_palette_preview_says_a_listen_only_session_blocks_the_frame() {
+        let (mut a, _req) = live_app(true);
+        a.key(key(':'));
+        for c in "nmt stop 2".chars() {
+            a.key(key(c));
+        }
+        assert_eq!(a.message.as_deref(), Some("blocked: listen-only — would send 000#0202"));
+        // A session that can send previews what goes out.
+        let (mut a, _req) = live_app(false);
+        a.key(key(':'));
+        for c in "nmt stop 2".chars() {
+            a.key(key(c));
+        }
+        assert_eq!(a.message.as_deref(), Some("will send: 000#0202"));
     }
 
     #[test]

@@ -211,3 +211,38 @@ fn record_refuses_an_existing_log_unless_force_or_append() {
     assert!(err.contains("cannot be used with"), "{err}");
     std::fs::remove_file(&path).unwrap();
 }
+
+#[test]
+fn sdo_read_shows_identity_objects_and_cob_ids_in_hex_and_json_keeps_numbers() {
+    let text = |object: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_cotui"))
+            .args(["sdo", "read", "demo", "2", object])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8(out.stdout).unwrap()
+    };
+    assert_eq!(
+        text("0x1000"),
+        "node 2 0x1000:00 Device type = 0x00020192 (CiA 402, servo drive) (data 92010200)\n"
+    );
+    assert_eq!(
+        text("0x1018:2"),
+        "node 2 0x1018:02 Product code = 0x04020002 (data 02000204)\n"
+    );
+    assert_eq!(
+        text("0x1018:4"),
+        "node 2 0x1018:04 Serial number = 0x000003EA (data EA030000)\n"
+    );
+    assert!(text("0x1800:1").contains("COB-ID used by TPDO = 0x00000182 (COB-ID 0x182)"));
+    // Sub 0 counts the entries: a number, not an identifier.
+    assert_eq!(
+        text("0x1018:0"),
+        "node 2 0x1018:00 Highest sub-index supported = 4 (data 04)\n"
+    );
+    // JSON: the value stays a number; the text field holds the hex.
+    let (rc, v, _) = cotui_json(&["sdo", "read", "demo", "2", "0x1000", "--json"]);
+    assert_eq!(rc, 0);
+    assert_eq!(v["value"], 0x0002_0192);
+    assert_eq!(v["text"], "0x00020192 (CiA 402, servo drive)");
+}

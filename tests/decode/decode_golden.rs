@@ -196,3 +196,60 @@ fn a_lost_event_is_dated_one_and_a_half_periods_after_the_last_heartbeat() {
             .all(|e| e["node"].is_null())
     );
 }
+
+#[test]
+fn identity_objects_and_cob_ids_decode_in_hex_with_the_device_profile() {
+    // Reads of 0x1000, 0x1018:01, 0x1018:02 from node 2 and 0x1000 from node 1, a TPDO
+    // COB-ID written, and a CiA 402 device type without a drive type.
+    let log = "(1.000000) can0 602#4000100000000000\n\
+               (1.000500) can0 582#4300100092010200\n\
+               (1.001000) can0 602#4018100100000000\n\
+               (1.001500) can0 582#4318100100030000\n\
+               (1.002000) can0 602#4018100200000000\n\
+               (1.002500) can0 582#4318100244460000\n\
+               (1.003000) can0 601#4000100000000000\n\
+               (1.003500) can0 581#43001000FE030000\n\
+               (1.004000) can0 602#2301180182010080\n\
+               (1.004500) can0 582#6001180100000000\n\
+               (1.005000) can0 603#4000100000000000\n\
+               (1.005500) can0 583#4300100092010000\n";
+    let out = cotui(&["decode", "-"], Some(log));
+    let text = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(
+        lines[1].ends_with("Device type = 0x00020192 (CiA 402, servo drive)"),
+        "{text}"
+    );
+    assert!(lines[3].ends_with("Vendor-ID = 0x00000300"), "{text}");
+    assert!(lines[5].ends_with("Product code = 0x00004644"), "{text}");
+    assert!(
+        lines[7].ends_with("Device type = 0x000003FE (device profile 1022)"),
+        "{text}"
+    );
+    assert!(
+        lines[8].ends_with("COB-ID used by TPDO = 0x80000182 (COB-ID 0x182, invalid/disabled)"),
+        "{text}"
+    );
+    assert!(lines[11].ends_with("Device type = 0x00000192 (CiA 402)"), "{text}");
+    // JSON lines: `value` stays the number, `value_text` and the label carry the hex.
+    let out = cotui(&["decode", "--format", "jsonl", "-"], Some(log));
+    let lines: Vec<serde_json::Value> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines[1]["sdo"]["value"], 131474);
+    assert_eq!(lines[1]["sdo"]["value_text"], "0x00020192 (CiA 402, servo drive)");
+    assert_eq!(lines[3]["sdo"]["value"], 768);
+    assert_eq!(lines[3]["sdo"]["value_text"], "0x00000300");
+    // Transactions say the same.
+    let out = cotui(&["decode", "--transactions", "-"], Some(log));
+    let tx = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        tx.contains(
+            "Upload 0x1000:00 Device type = 0x00020192 (CiA 402, servo drive) (expedited, 4 bytes, 0.500 ms): ok"
+        ),
+        "{tx}"
+    );
+    assert!(tx.contains("Vendor-ID = 0x00000300 (expedited"), "{tx}");
+}

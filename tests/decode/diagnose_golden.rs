@@ -467,3 +467,112 @@ fn live_reads_a_bus_and_duration_needs_live() {
     let out = cotui(&["diagnose", "--live", "demo", "tests/fixtures/diagnose/emcy.log"]);
     assert_eq!(out.status.code(), Some(1), "a log and --live at once are refused");
 }
+
+#[test]
+fn reads_the_capturing_host_sent_of_missing_objects_are_one_info_row() {
+    // own_reads.log: five TX-marked reads (`T`) of entries node 2 lacks (0x06020000,
+    // 0x06090011), one read by another client (`R`) and one TX-marked write refused.
+    let inc = golden("own_reads");
+    assert_eq!(
+        summary(&inc),
+        [
+            s(Some(2), "sdo_refused", "open"),
+            s(Some(2), "sdo_refused", "open"),
+            s(Some(2), "not_present", "info"),
+        ]
+    );
+    // Another client's read and this host's write are real refusals.
+    assert_eq!(inc[0]["title"], "A value could not be read");
+    assert!(inc[0]["cause"].as_str().unwrap().starts_with("0x1013:00"), "{}", inc[0]);
+    assert_eq!(inc[1]["title"], "A setting was not applied");
+    assert_eq!(inc[2]["title"], "5 objects not present (read from here)");
+    assert_eq!(inc[2]["count"], 5);
+    assert_eq!(frames(&inc[2]), [3, 5, 7, 9, 11]);
+    // The text report: the note is counted apart and --check does not fail on it.
+    let out = cotui(&["diagnose", "tests/fixtures/diagnose/own_reads.log"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.starts_with("Needs attention: 2 open, 0 recovered, 0 warnings, 1 note (21 frames)."),
+        "{text}"
+    );
+    assert!(
+        text.contains(" 3. INFO       Node 2: 5 objects not present (read from here)\n"),
+        "{text}"
+    );
+    assert_eq!(text.matches("not present").count(), 6, "{text}");
+    // Without the TX marks (the same frames received from another client): five incidents.
+    let log = std::fs::read_to_string("tests/fixtures/diagnose/own_reads.log").unwrap();
+    let path = std::env::temp_dir().join(format!("cotui-own-reads-rx-{}.log", std::process::id()));
+    std::fs::write(&path, log.replace(" T\n", " R\n")).unwrap();
+    let (rx, _) = diagnose(path.to_str().unwrap());
+    let _ = std::fs::remove_file(&path);
+    assert_eq!(rx.iter().filter(|i| i["kind"] == "sdo_refused").count(), 6, "{rx:?}");
+    assert!(rx.iter().all(|i| i["kind"] != "not_present"), "{rx:?}");
+}
+
+#[test]
+fn a_protocol_abort_is_a_broken_transfer_with_its_codes_listed() {
+    // CANopenNode issue 486: the download of 0x7000:01 ends in 0x05040001 (command
+    // specifier unknown): the transfer broke, it is not a matter of access rights.
+    let path = realworld("canopennode_issue486_flood.txt");
+    let path = path.to_str().unwrap();
+    let (inc, _) = diagnose(path);
+    let refused = inc.iter().find(|i| i["kind"] == "sdo_refused").expect("the abort");
+    assert_eq!(refused["title"], "The transfer broke: a setting was not written");
+    assert_eq!(
+        refused["cause"],
+        "0x7000:01: Client/server command specifier not valid or unknown (abort 0x05040001)"
+    );
+    let check = refused["check"].as_array().unwrap();
+    let all: String = check.iter().map(|c| c.as_str().unwrap()).collect();
+    assert!(all.contains("second SDO client"), "{all}");
+    assert!(all.contains("timing") && all.contains("SDO timeout"), "{all}");
+    assert!(all.contains("error frames"), "{all}");
+    assert!(!all.contains("access rights"), "{all}");
+    let out = cotui(&["diagnose", path]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains(" 2. OPEN       Node 3: The transfer broke: a setting was not written\n"),
+        "{text}"
+    );
+    assert!(!text.contains("A setting was not applied"), "{text}");
+    // One object read and written, refused with two codes: both in the cause, and the
+    // title says reads and writes.
+    let log = "(1.000000) can0 602#4001200000000000\n\
+               (1.001000) can0 582#8001200000000305\n\
+               (1.100000) can0 602#2B01200001000000\n\
+               (1.101000) can0 582#8001200001000405\n";
+    let tmp = std::env::temp_dir().join(format!("cotui-abort-classes-{}.log", std::process::id()));
+    std::fs::write(&tmp, log).unwrap();
+    let (inc, _) = diagnose(tmp.to_str().unwrap());
+    let _ = std::fs::remove_file(&tmp);
+    assert_eq!(summary(&inc), [s(Some(2), "sdo_refused", "open")]);
+    assert_eq!(
+        inc[0]["title"],
+        "The transfer broke: reads and writes of this object failed"
+    );
+    assert_eq!(
+        inc[0]["cause"],
+        "0x2001:00: Toggle bit not alternated (abort 0x05030000); \
+         Client/server command specifier not valid or unknown (abort 0x05040001)"
+    );
+    // A refusal read and written: the access advice, and the title says both.
+    let log = "(1.000000) can0 602#4001200000000000\n\
+               (1.001000) can0 582#8001200001000106\n\
+               (1.100000) can0 602#2B01200001000000\n\
+               (1.101000) can0 582#8001200002000106\n";
+    std::fs::write(&tmp, log).unwrap();
+    let (inc, _) = diagnose(tmp.to_str().unwrap());
+    let _ = std::fs::remove_file(&tmp);
+    assert_eq!(inc[0]["title"], "Reads and writes of this object were refused");
+    assert!(
+        inc[0]["check"][0].as_str().unwrap().contains("access rights"),
+        "{}",
+        inc[0]
+    );
+    assert_eq!(
+        inc[0]["cause"],
+        "0x2001:00: Attempt to read a write only object (abort 0x06010001); \
+         Attempt to write a read only object (abort 0x06010002)"
+    );
+}

@@ -13,6 +13,7 @@
 use super::{Component, Ctx, ListState, Outcome, block, fit, header, selected};
 use crate::analysis::values::Entry;
 use crate::od::{Access, DataType, Dictionary, ObjectInfo, Profile};
+use crate::sdo::abort::{AbortClass, abort_class};
 use crate::tui::keymap::Action;
 use ratatui::Frame;
 use ratatui::layout::Rect;
@@ -202,6 +203,9 @@ pub struct ReadAll {
     pub skipped: usize,
     /// Entries that failed, with what went wrong.
     pub failed: Vec<((u16, u8), String)>,
+    /// Entries the node answered it does not have (an abort of
+    /// [`crate::sdo::abort::NOT_PRESENT`]): not failures.
+    pub not_present: usize,
 }
 
 impl ReadAll {
@@ -474,11 +478,16 @@ impl ObjectsPane {
             let key = (r.node, at.0, at.1);
             match failure(rest) {
                 Some(why) => {
+                    let code = abort_code(why);
                     // An object the node does not have: none of its entries is read.
-                    if why.contains("06020000") {
+                    if code == Some(crate::sdo::abort::codes::NO_OBJECT) {
                         r.skip_above(at.0, None);
                     }
-                    r.failed.push((at, why.to_string()));
+                    if code.is_some_and(|c| abort_class(c) == AbortClass::NotPresent) {
+                        r.not_present += 1;
+                    } else {
+                        r.failed.push((at, why.to_string()));
+                    }
                     self.errors.insert(key, (why.to_string(), now_ns));
                 }
                 None => {
@@ -530,10 +539,11 @@ impl ObjectsPane {
     pub fn stop_read_all(&mut self) -> Option<String> {
         let r = self.read_all.take()?;
         Some(format!(
-            "read all node {}: stopped after {} of {} entries ({} failed)",
+            "read all node {}: stopped after {} of {} entries ({} not present, {} failed)",
             r.node,
             r.done + r.skipped,
             r.total,
+            r.not_present,
             r.failed.len()
         ))
     }
@@ -552,14 +562,15 @@ impl ObjectsPane {
             None => {
                 let r = self.read_all.take().unwrap_or_default();
                 let mut text = format!(
-                    "read all node {}: {} entries read, {} failed",
+                    "read all node {}: {} entries read, {} not present, {} failed",
                     r.node,
-                    r.done - r.failed.len(),
+                    r.done - r.failed.len() - r.not_present,
+                    r.not_present,
                     r.failed.len()
                 );
                 if r.skipped > 0 {
                     text.push_str(&format!(
-                        ", {} of the {} the dictionary knows not present on the node",
+                        "; {} more of the {} the dictionary knows left out (not on the node)",
                         r.skipped, r.total
                     ));
                 }
@@ -674,6 +685,15 @@ fn in_range(layers: &[Arc<Profile>], index: u16) -> bool {
 }
 
 /// What went wrong, when a command result says so (`error: ...`, `not sent: ...`).
+/// The abort code of a failure text (`... aborted by the server: 0x06020000 ...`): its
+/// first `0x` with eight hex digits.
+fn abort_code(why: &str) -> Option<u32> {
+    why.split(|c: char| !c.is_ascii_alphanumeric())
+        .filter_map(|w| w.strip_prefix("0x"))
+        .find(|h| h.len() == 8 && h.chars().all(|c| c.is_ascii_hexdigit()))
+        .and_then(|h| u32::from_str_radix(h, 16).ok())
+}
+
 fn failure(rest: &str) -> Option<&str> {
     rest.strip_prefix("error: ")
         .or_else(|| rest.starts_with("not sent").then_some(rest))
@@ -945,35 +965,39 @@ mod tests {
             p.result("sdo read 2 0x1000:0x00: node 2 0x1000:00 Device type = 0x00020192", 0),
             Step::Next("sdo read 2 0x1008:0x00".into())
         );
+        // An object the node does not have is not present, not a failure.
         assert_eq!(
             p.result(
-                "sdo read 2 0x1008:0x00: error: SDO abort 0x06020000: Object does not exist",
+                "sdo read 2 0x1008:0x00: error: SDO 1008:00 on node 2 aborted by the server: 0x06020000 Object does not exist in the object dictionary",
                 0
             ),
             Step::Next("sdo read 2 0x6041:0x00".into())
         );
         let r = p.read_all.as_ref().unwrap();
-        assert_eq!((r.done, r.total, r.failed.len()), (2, 3, 1));
+        assert_eq!((r.done, r.total, r.failed.len(), r.not_present), (2, 3, 0, 1));
         assert_eq!(
             p.result(
-                "sdo read 2 0x6041:0x00: node 2 0x6041:00 Statusword = 0x0250 (data 50 02)",
+                "sdo read 2 0x6041:0x00: error: SDO 6041:00 on node 2 aborted by the server: 0x08000022 Data cannot be transferred",
                 0
             ),
             Step::Finished(
-                "read all node 2: 2 entries read, 1 failed\n0x1008:00: SDO abort 0x06020000: Object does not exist"
+                "read all node 2: 1 entries read, 1 not present, 1 failed\n\
+                 0x6041:00: SDO 6041:00 on node 2 aborted by the server: 0x08000022 Data cannot be transferred"
                     .into()
             )
         );
         assert!(p.read_all.is_none());
         assert_eq!(
             p.errors.get(&(2, 0x1008, 0)).map(|(e, _)| e.as_str()),
-            Some("SDO abort 0x06020000: Object does not exist")
+            Some(
+                "SDO 1008:00 on node 2 aborted by the server: 0x06020000 Object does not exist in the object dictionary"
+            )
         );
         // Stopped half-way: a summary, and later results are no longer ours.
         p.start_read_all(3, vec![(0x1000, 0), (0x1001, 0)]);
         assert_eq!(
             p.stop_read_all().as_deref(),
-            Some("read all node 3: stopped after 0 of 2 entries (0 failed)")
+            Some("read all node 3: stopped after 0 of 2 entries (0 not present, 0 failed)")
         );
         assert_eq!(p.result("sdo read 3 0x1000:0x00: node 3 ...", 0), Step::NotOurs);
         // Sub 0 of a record bounds the sub-indexes read; an absent object is left whole.
@@ -1001,13 +1025,9 @@ mod tests {
             Step::Next("sdo read 2 0x1010:0x00".into())
         );
         assert_eq!(
-            p.result(
-                "sdo read 2 0x1010:0x00: error: SDO abort 0x06020000: Object does not exist",
-                0
-            ),
+            p.result("sdo read 2 0x1010:0x00: error: SDO abort 0x06020000: Object does not exist", 0),
             Step::Finished(
-                "read all node 2: 2 entries read, 1 failed, 3 of the 6 the dictionary knows not present on the node\n\
-                 0x1010:00: SDO abort 0x06020000: Object does not exist"
+                "read all node 2: 2 entries read, 1 not present, 0 failed; 3 more of the 6 the dictionary knows left out (not on the node)"
                     .into()
             )
         );
@@ -1078,7 +1098,9 @@ mod tests {
         let s = screen(&mut a, 160, 48);
         assert!(s.contains("▾ 1018"), "{s}");
         assert!(s.contains("  1018:01 Vendor-ID"), "{s}");
-        assert!(s.contains("305419896"), "{s}");
+        // An identifier, in hex (not 305419896).
+        assert!(s.contains("0x12345678"), "{s}");
+        assert!(!s.contains("305419896"), "{s}");
     }
 
     #[test]
@@ -1137,7 +1159,9 @@ mod tests {
         assert_eq!(p.cursor, "sdo write 1 0x1017:0x00 100".len());
         let m = a.message.clone().unwrap_or_default();
         assert!(
-            m.starts_with("u16 value in ms: edit it and press enter · will send: 601#2B17100064000000"),
+            m.starts_with(
+                "u16 value in ms: edit it and press enter · blocked: this source has no bus — would send 601#2B17100064000000"
+            ),
             "{m}"
         );
         // A read-only entry is not offered for writing.

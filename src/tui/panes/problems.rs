@@ -45,6 +45,7 @@ fn color(s: Status) -> Color {
         Status::Open => Color::Red,
         Status::Recovered => Color::Green,
         Status::Warning => Color::Yellow,
+        Status::Info => Color::Cyan,
     }
 }
 
@@ -62,6 +63,7 @@ fn status_text(s: Status) -> &'static str {
         Status::Open => "OPEN",
         Status::Recovered => "RECOVERED",
         Status::Warning => "WARNING",
+        Status::Info => "INFO",
     }
 }
 
@@ -203,12 +205,18 @@ impl ProblemsPane {
     /// Draws the ranked list (only the visible rows).
     fn render_list(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
         let count = |s: Status| self.incidents.iter().filter(|i| i.status == s).count();
-        let title = format!(
-            " Problems ({} open, {} recovered, {} warnings) ",
+        let mut title = format!(
+            " Problems ({} open, {} recovered, {} warnings",
             count(Status::Open),
             count(Status::Recovered),
             count(Status::Warning)
         );
+        match count(Status::Info) {
+            0 => {}
+            1 => title.push_str(", 1 note"),
+            n => title.push_str(&format!(", {n} notes")),
+        }
+        title.push_str(") ");
         f.render_widget(block(&title, focused), area);
         let inner = block("", true).inner(area);
         if inner.height == 0 {

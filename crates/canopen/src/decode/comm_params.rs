@@ -1,5 +1,9 @@
 //! Meaning of CiA 301 communication parameter values: COB-IDs with their flag
-//! bits, PDO transmission types and mapping entries, store/restore signatures.
+//! bits, PDO transmission types and mapping entries, store/restore signatures, and the
+//! identity objects (device type 0x1000 with its profile, 0x1018 and the expected
+//! identities 0x1F84..0x1F88), which are identifiers: shown in hex, as manuals write them.
+//! [`describe`] is the one place that says how these objects read; every value text
+//! (SDO labels, PDO signals, `sdo read`, the Objects pane) goes through it.
 
 use crate::od::Dictionary;
 
@@ -27,6 +31,46 @@ pub fn cob_id(raw: u32, bit30: &str) -> String {
         format!(", {}", flags.join(", "))
     };
     format!("0x{raw:08X} (COB-ID {id}{flags})")
+}
+
+/// A device type (0x1000, 0x1F84 subs, 0x67FF): `0x00020192 (CiA 402, servo drive)`.
+/// CiA 301: bits 0-15 the device profile number, bits 16-31 additional information that
+/// the profile defines (0xFFFF: a multiple device module). CiA 402: bits 16-23 the type
+/// (1 frequency converter, 2 servo drive, 3 stepper motor; +0x40 with the type's PDO
+/// mapping; 0xFF multiple device module), bits 24-31 manufacturer-specific mode bits.
+pub fn device_type(raw: u32) -> String {
+    let (profile, info) = (raw & 0xFFFF, raw >> 16);
+    let mut words = vec![match profile {
+        0 => "no standard device profile".to_string(),
+        400..=499 => format!("CiA {profile}"),
+        n => format!("device profile {n}"),
+    }];
+    if info == 0xFFFF {
+        words.push("multiple device module".into());
+    } else if profile == 402 {
+        let (kind, mode) = (info & 0xFF, info >> 8);
+        let name = match kind & 0x3F {
+            _ if kind == 0xFF => Some("multiple device module"),
+            1 => Some("frequency converter"),
+            2 => Some("servo drive"),
+            3 => Some("stepper motor"),
+            _ => None,
+        };
+        match name {
+            Some(n) => words.push(n.into()),
+            None if kind != 0 => words.push(format!("type 0x{kind:02X}")),
+            None => {}
+        }
+        if kind != 0xFF && kind & 0x40 != 0 && name.is_some() {
+            words.push("type-specific PDO mapping".into());
+        }
+        if mode != 0 {
+            words.push(format!("mode bits 0x{mode:02X}"));
+        }
+    } else if info != 0 {
+        words.push(format!("additional information 0x{info:04X}"));
+    }
+    format!("0x{raw:08X} ({})", words.join(", "))
 }
 
 /// PDO transmission type text (sub 2 of 0x1400/0x1800 records).
@@ -61,6 +105,10 @@ fn mapping_entry(raw: u32, dict: &Dictionary) -> String {
 pub fn describe(index: u16, sub: u8, raw: u64, dict: &Dictionary) -> Option<String> {
     let v = raw as u32;
     Some(match (index, sub) {
+        (0x1000 | 0x67FF, 0) | (0x1F84, 1..) => device_type(v),
+        // Vendor-ID, product code, revision and serial number, as the node has them and as
+        // a master expects them: identifiers, in hex.
+        (0x1018, 1..) | (0x1F85..=0x1F88, 1..) => format!("0x{v:08X}"),
         (0x1005, 0) => cob_id(v, "generates SYNC"),
         (0x1012, 0) => cob_id(v, "produces TIME"),
         (0x1014, 0) => cob_id(v, ""),
@@ -100,6 +148,39 @@ mod tests {
             describe(0x1005, 0, 0x4000_0080, &d).unwrap(),
             "0x40000080 (COB-ID 0x080, generates SYNC)"
         );
+    }
+
+    #[test]
+    fn identity_objects_in_hex_and_the_device_type_with_its_profile() {
+        let d = Dictionary::default();
+        let t = |i, s, v| describe(i, s, v, &d).unwrap();
+        assert_eq!(t(0x1000, 0, 0x0002_0192), "0x00020192 (CiA 402, servo drive)");
+        assert_eq!(
+            t(0x1000, 0, 0x0042_0192),
+            "0x00420192 (CiA 402, servo drive, type-specific PDO mapping)"
+        );
+        assert_eq!(
+            t(0x1000, 0, 0x00FF_0192),
+            "0x00FF0192 (CiA 402, multiple device module)"
+        );
+        assert_eq!(
+            t(0x1000, 0, 0x3003_0192),
+            "0x30030192 (CiA 402, stepper motor, mode bits 0x30)"
+        );
+        assert_eq!(t(0x1000, 0, 0x0000_0192), "0x00000192 (CiA 402)");
+        assert_eq!(
+            t(0x1000, 0, 0x000F_0191),
+            "0x000F0191 (CiA 401, additional information 0x000F)"
+        );
+        assert_eq!(t(0x1000, 0, 0), "0x00000000 (no standard device profile)");
+        assert_eq!(t(0x1000, 0, 1022), "0x000003FE (device profile 1022)");
+        assert_eq!(t(0x1F84, 2, 0x0002_0192), "0x00020192 (CiA 402, servo drive)");
+        assert_eq!(t(0x1018, 1, 768), "0x00000300");
+        assert_eq!(t(0x1018, 4, 0x1234_5678), "0x12345678");
+        assert_eq!(t(0x1F85, 3, 864), "0x00000360");
+        // Sub 0 is a count, not an identifier.
+        assert_eq!(describe(0x1018, 0, 4, &d), None);
+        assert_eq!(describe(0x1F84, 0, 4, &d), None);
     }
 
     #[test]

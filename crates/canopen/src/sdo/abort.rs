@@ -72,6 +72,35 @@ pub fn abort_text(code: u32) -> &'static str {
     known_abort_text(code).unwrap_or(UNKNOWN_ABORT_TEXT)
 }
 
+/// What an abort code tells about the failure, for the words a diagnosis gives it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum AbortClass {
+    /// The transfer itself broke (CiA 301 0x0503xxxx toggle bit, 0x0504xxxx timeout,
+    /// command specifier, block size, sequence number, CRC, memory): the protocol between
+    /// client and server failed, whatever the object.
+    Protocol,
+    /// The object or sub-index is not on the device: [`NOT_PRESENT`].
+    NotPresent,
+    /// The server refused the access (rights, data type or length, value range, device
+    /// state, hardware, ...): every other code.
+    Refused,
+}
+
+/// Codes that say the device does not have the entry asked for: object does not exist
+/// (0x06020000), sub-index does not exist (0x06090011), no data available (0x08000024,
+/// e.g. an empty error-history entry). A read of such an entry answers "not present", it
+/// is not a failure of the device.
+pub const NOT_PRESENT: &[u32] = &[codes::NO_OBJECT, codes::NO_SUB, 0x0800_0024];
+
+/// The class of an abort code.
+pub fn abort_class(code: u32) -> AbortClass {
+    match code >> 16 {
+        0x0503 | 0x0504 => AbortClass::Protocol,
+        _ if NOT_PRESENT.contains(&code) => AbortClass::NotPresent,
+        _ => AbortClass::Refused,
+    }
+}
+
 /// Named abort codes the client and server send.
 pub mod codes {
     /// Toggle bit not alternated.
@@ -130,6 +159,19 @@ mod tests {
         assert_eq!(ABORT_CODES.len(), 31);
         for (i, (c, _)) in ABORT_CODES.iter().enumerate() {
             assert!(ABORT_CODES[i + 1..].iter().all(|(d, _)| d != c), "{c:#010X} twice");
+        }
+    }
+
+    #[test]
+    fn classes_of_abort_codes() {
+        for c in [0x0503_0000, 0x0504_0000, 0x0504_0001, 0x0504_0004, 0x0504_0005] {
+            assert_eq!(abort_class(c), AbortClass::Protocol, "{c:#010X}");
+        }
+        for c in [0x0602_0000, 0x0609_0011, 0x0800_0024] {
+            assert_eq!(abort_class(c), AbortClass::NotPresent, "{c:#010X}");
+        }
+        for c in [0x0601_0002, 0x0607_0010, 0x0609_0030, 0x0800_0022, 0x1234_5678] {
+            assert_eq!(abort_class(c), AbortClass::Refused, "{c:#010X}");
         }
     }
 
