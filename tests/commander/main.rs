@@ -6,6 +6,7 @@ mod cli_bitrate;
 mod cli_commander;
 mod cli_cyclic;
 mod cli_run;
+mod cli_streams;
 mod command_language;
 mod commander_demo;
 mod dcf_demo;

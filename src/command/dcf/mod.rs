@@ -119,7 +119,7 @@ impl Sdo<'_> {
 
 /// `dcf save`: reads the node and writes the DCF.
 async fn save(sdo: &mut Sdo<'_>, dict: &Dictionary, output: &str, force: bool) -> Result<Outcome, CommandError> {
-    if !force && std::path::Path::new(output).exists() {
+    if !force && output != "-" && std::path::Path::new(output).exists() {
         return Err(CommandError::Usage(format!(
             "{output} exists; give --force to overwrite it"
         )));
@@ -216,7 +216,7 @@ async fn save(sdo: &mut Sdo<'_>, dict: &Dictionary, output: &str, force: bool) -
         description: format!("configuration of node {} read by cotui", sdo.node),
     };
     let text = crate::od::dcf::write(&info, &entries);
-    std::fs::write(output, text).map_err(|e| CommandError::Usage(format!("cannot write {output}: {e}")))?;
+    crate::command::exec::write_output(output, text.as_bytes())?;
     let saved = Saved {
         ok: true,
         node: sdo.node,
