@@ -120,17 +120,16 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
             Ok(()) => {}
             Err(e) if e.kind() == io::ErrorKind::BrokenPipe => return status,
             Err(e) => {
-                eprintln!("cotui decode: {path}: {e}");
-                status = ExitCode::Unavailable;
+                status = out.blame().report(Some(path), &e);
+                if out.blame().output_failed() {
+                    return status;
+                }
             }
         }
     }
     let result = finish(&mut decoder, mode, &mut summary, &mut out).and_then(|_| out.flush());
     match result {
-        Err(e) if e.kind() != io::ErrorKind::BrokenPipe => {
-            eprintln!("cotui decode: {e}");
-            ExitCode::Unavailable
-        }
+        Err(e) if e.kind() != io::ErrorKind::BrokenPipe => out.blame().report(None, &e),
         _ => status,
     }
 }

@@ -83,7 +83,7 @@ async fn capture(
         handler(SignalKind::quit())?,
     ];
     let bus = crate::connect::open(&args.iface, args.listen_only).await?;
-    let mut out = open_output(path, mode)?;
+    let mut out = open_output(path, mode, format)?;
     let [int, term, hup, quit] = &mut signals;
     let stop = async {
         tokio::select! {

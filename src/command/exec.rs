@@ -154,7 +154,7 @@ pub async fn execute_until(
             mode,
             format,
         } => {
-            let mut out = super::record::open_output(output, *mode)?;
+            let mut out = super::record::open_output(output, *mode, *format)?;
             let forever = std::future::pending::<()>();
             let n = super::record::record(bus, &mut out, *limits, *format, forever, |_| {}).await?;
             if let Some(m) = n.gap_message(output) {

@@ -84,3 +84,89 @@ fn sdo_read_and_dcf_save_to_stdout_give_the_data_alone() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("objects saved to -"), "report on stderr");
     assert!(!std::path::Path::new("-").exists(), "no file named -");
 }
+
+/// A candump log of `n` frames in a fresh temp file.
+fn log_of(n: usize, name: &str) -> std::path::PathBuf {
+    let path = std::env::temp_dir().join(format!("cotui-streams-{}-{name}.log", std::process::id()));
+    let text: String = (0..n)
+        .map(|i| format!("({}.{:06}) can0 182#{:04X}\n", 1000 + i / 1000, i % 1000, i % 0xFFFF))
+        .collect();
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn an_output_that_cannot_be_written_is_blamed_not_the_input() {
+    if !std::path::Path::new("/dev/full").exists() {
+        return;
+    }
+    // Small (the error comes at the final flush) and large (in the middle of the input).
+    for n in [3, 50_000] {
+        let log = log_of(n, &format!("full{n}"));
+        let log = log.to_str().unwrap();
+        for fmt in ["text", "jsonl", "pcapng"] {
+            let out = run(&["decode", log, "--format", fmt, "-o", "/dev/full"]);
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(1), "{fmt} {n}: {err}");
+            assert!(err.contains("cannot write /dev/full: No space left on device"), "{fmt} {n}: {err}");
+            assert!(!err.contains(log), "the input is not to blame: {err}");
+        }
+        let out = run(&["decode", log, "--transactions", "-o", "/dev/full"]);
+        assert_eq!(out.status.code(), Some(0), "nothing to write is no error");
+        std::fs::remove_file(log).unwrap();
+    }
+    let log = log_of(3, "proc");
+    let log = log.to_str().unwrap();
+    if std::path::Path::new("/proc/version").exists() {
+        let out = run(&["decode", log, "-o", "/proc/version"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(err.contains("/proc/version"), "the path is named: {err}");
+    }
+    let out = run(&["decode", log, "--format", "parquet", "-o", "/dev/full"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("cannot write /dev/full: not a directory"), "{err}");
+    std::fs::remove_file(log).unwrap();
+}
+
+#[test]
+fn record_append_refuses_a_file_of_the_other_format() {
+    let dir = std::env::temp_dir().join(format!("cotui-streams-append-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (pcap, text) = (dir.join("a.pcapng"), dir.join("a.log"));
+    let (pcap, text) = (pcap.to_str().unwrap(), text.to_str().unwrap());
+    let rec = |path: &str, fmt: &str| run(&["record", "demo", "-o", path, "--count", "2", "--format", fmt, "--append"]);
+    assert_eq!(rec(pcap, "pcapng").status.code(), Some(0));
+    assert_eq!(rec(text, "candump").status.code(), Some(0));
+    let (pcap_before, text_before) = (std::fs::read(pcap).unwrap(), std::fs::read(text).unwrap());
+    let out = rec(pcap, "candump");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("is pcapng: --append would add candump lines to it"), "{err}");
+    let out = rec(text, "pcapng");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("is not pcapng (a text log?)"), "{err}");
+    assert_eq!(std::fs::read(pcap).unwrap(), pcap_before, "untouched");
+    assert_eq!(std::fs::read(text).unwrap(), text_before, "untouched");
+    // The same format appends: pcapng as a second section.
+    assert_eq!(rec(pcap, "pcapng").status.code(), Some(0));
+    let blocks = pcapng_blocks(&std::fs::read(pcap).unwrap()).unwrap();
+    assert_eq!(blocks.iter().filter(|&&b| b == 0x0A0D_0D0A).count(), 2, "{blocks:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn diagnose_of_nothing_says_only_the_error_and_a_bad_duration_is_usage() {
+    let out = run(&["diagnose", "/nonexistent/cotui.log"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(out.stdout, b"", "no report of 0 frames");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/cotui.log"));
+    for bad in ["nan", "1e300", "inf", "0"] {
+        let out = run(&["diagnose", "--live", "demo", "--duration", bad]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "--duration {bad}: {err}");
+        assert!(err.contains("--duration"), "{err}");
+    }
+}
