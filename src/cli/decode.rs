@@ -19,11 +19,12 @@ pub enum OutputFormat {
     /// One JSON object per frame (see README, "JSONL contract").
     Jsonl,
     /// A pcapng capture for Wireshark (binary: with -o FILE or a redirected stdout).
-    /// `run` hands it to `decode_out` before decoding, so the matches below that pair it
-    /// with `Jsonl` never see it.
+    // `run` hands it to `decode_out` before decoding, so the matches below that pair it
+    // with `Jsonl` never see it.
     Pcapng,
     /// Two Parquet tables, frames and decoded values (with -o DIR or -o NAME.parquet;
-    /// see README, "Parquet tables"). `run` hands it to `decode_parquet` before decoding.
+    /// see README, "Parquet tables").
+    // `run` hands it to `decode_parquet` before decoding.
     Parquet,
 }
 
