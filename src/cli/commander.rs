@@ -132,7 +132,11 @@ pub enum Stream {
 impl Stream {
     /// Stderr for a command that writes its data to stdout, else stdout.
     pub fn report_of(cmd: &Command) -> Stream {
-        if cmd.data_to_stdout() { Stream::Stderr } else { Stream::Stdout }
+        if cmd.data_to_stdout() {
+            Stream::Stderr
+        } else {
+            Stream::Stdout
+        }
     }
 
     /// Writes one line; a closed stream (a gone terminal, a closed pipe) is not an error.

@@ -140,7 +140,13 @@ pub fn entries(dict: &Dictionary, spec: &MapSpec) -> Result<Vec<MappedEntry>, Co
 /// or 8 bits; strings and domains any length up to 64 bits), or a direction the dictionary
 /// does not map it in. `force` skips both checks. An object the dictionary does not know
 /// (or a dummy entry) is the node's to judge: `None`.
-pub fn entry_refusal(dict: &Dictionary, transmit: bool, (index, sub): (u16, u8), bits: u8, force: bool) -> Option<String> {
+pub fn entry_refusal(
+    dict: &Dictionary,
+    transmit: bool,
+    (index, sub): (u16, u8),
+    bits: u8,
+    force: bool,
+) -> Option<String> {
     let o = dict.object(index, sub).filter(|_| !force)?;
     let size_ok = match o.data_type.size() {
         _ if o.data_type == crate::od::DataType::Boolean => matches!(bits, 1 | 8),
@@ -163,7 +169,10 @@ pub fn entry_refusal(dict: &Dictionary, transmit: bool, (index, sub): (u16, u8),
         PdoMappable::Tpdo => "only into TPDOs",
         PdoMappable::Rpdo => "only into RPDOs",
     };
-    Some(format!("the node's dictionary ({}) maps it {into}", dict.profile_name()))
+    Some(format!(
+        "the node's dictionary ({}) maps it {into}",
+        dict.profile_name()
+    ))
 }
 
 /// Why a PDO COB-ID value (sub 1) cannot be given to a PDO: an 11-bit id (bit 29 clear)

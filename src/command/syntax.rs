@@ -122,8 +122,8 @@ pub enum Commander<B: Args, D: Args> {
     /// Produce SYNC every --period MS (COB-ID 0x080), with the CiA 301 counter 1..N when
     /// --counter N is given; until stopped without --count.
     Sync(On<B, SyncArgs>),
-    /// PDOs: `pdo can0 2` reads every PDO's configuration; `pdo can0 2 map tpdo1 0x6041 0x6064 --type
-    /// sync:2` remaps one (CiA 301 sequence, read back); `pdo can0 2 send rpdo1 Controlword=0x0F
+    /// PDOs: `pdo 2` reads every PDO's configuration; `pdo 2 map tpdo1 0x6041 0x6064 --type
+    /// sync:2` remaps one (CiA 301 sequence, read back); `pdo 2 send rpdo1 Controlword=0x0F
     /// "Target velocity=500" --every 10` sends an RPDO (mapped signals not given are sent as 0).
     Pdo(On<B, PdoArgs<D>>),
     /// A node's configuration as a CiA 306 DCF: save it, load it back (the values that
@@ -135,13 +135,13 @@ pub enum Commander<B: Args, D: Args> {
 /// `dcf save`, `dcf load` and `dcf diff`.
 #[derive(Subcommand, Clone, Debug)]
 pub enum DcfCommand<B: Args, D: Args> {
-    /// Read every readable object the node's dictionary knows and write a DCF: `dcf save can0 5 -o node5.dcf`.
+    /// Read every readable object the node's dictionary knows and write a DCF: `dcf save 5 -o node5.dcf`.
     Save(On<B, DcfSaveArgs<D>>),
     /// Write the file's writable values that differ from the node's, PDO mappings by the CiA
-    /// 301 sequence, communication objects last; read them back: `dcf load can0 5 node5.dcf --store`.
+    /// 301 sequence, communication objects last; read them back: `dcf load 5 node5.dcf --store`.
     Load(On<B, DcfLoadArgs<D>>),
     /// Show the objects whose values differ between the file and the node (exit status 6
-    /// when any writable one does): `dcf diff can0 5 node5.dcf`.
+    /// when any writable one does): `dcf diff 5 node5.dcf`.
     Diff(On<B, DcfDiffArgs<D>>),
 }
 
@@ -203,10 +203,9 @@ pub struct DcfDiffArgs<D: Args> {
 /// `sdo read` and `sdo write`.
 #[derive(Subcommand, Clone, Debug)]
 pub enum SdoCommand<B: Args, D: Args> {
-    /// Read an object: `sdo read can0 2 0x6041` (the TUI palette takes it without the interface).
+    /// Read an object: `sdo read 2 0x6041`.
     Read(On<B, SdoReadArgs<D>>),
-    /// Write an object: `sdo write can0 2 0x6060 3 --type i8` (a name with blanks in quotes:
-    /// `"Modes of operation"`).
+    /// Write an object: `sdo write 2 0x6060 3 --type i8`.
     Write(On<B, SdoWriteArgs<D>>),
 }
 

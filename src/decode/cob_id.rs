@@ -162,7 +162,10 @@ mod tests {
         assert_eq!(reserved_for(0x085).as_deref(), Some("node 5's EMCY"));
         assert_eq!(reserved_for(0x000).as_deref(), Some("NMT (node control)"));
         assert_eq!(reserved_for(0x100).as_deref(), Some("TIME"));
-        assert_eq!(reserved_for(0x77F).as_deref(), Some("node 127's heartbeat (NMT error control)"));
+        assert_eq!(
+            reserved_for(0x77F).as_deref(),
+            Some("node 127's heartbeat (NMT error control)")
+        );
         assert!(reserved_for(0x7E4).unwrap().starts_with("LSS"));
         assert!(reserved_for(0x7E5).unwrap().starts_with("LSS"));
         assert_eq!(reserved_for(0x050).as_deref(), Some("restricted by CiA 301"));

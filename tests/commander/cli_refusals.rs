@@ -21,7 +21,13 @@ fn refused(args: &[&str], why: &str) {
         .iter()
         .enumerate()
         .filter(|(i, _)| *i != 1)
-        .map(|(_, a)| if a.contains(' ') { format!("\"{a}\"") } else { a.to_string() })
+        .map(|(_, a)| {
+            if a.contains(' ') {
+                format!("\"{a}\"")
+            } else {
+                a.to_string()
+            }
+        })
         .collect();
     let e = parse_command(&line.join(" ")).unwrap_err();
     assert!(e.to_string().contains(why), "{line:?}: {e}");
@@ -41,7 +47,11 @@ fn reserved_cob_ids_are_refused_with_their_owner() {
     refused(&sync("0x602"), "--cob-id 0x602 is node 2's SDO request");
     refused(&sync("0x000"), "must be an 11-bit COB-ID");
     // SYNC's own COB-ID, a free one, and --force go out.
-    for args in [sync("0x080").to_vec(), sync("0x1A0").to_vec(), [&sync("0x602")[..], &["--force"]].concat()] {
+    for args in [
+        sync("0x080").to_vec(),
+        sync("0x1A0").to_vec(),
+        [&sync("0x602")[..], &["--force"]].concat(),
+    ] {
         let (rc, out, err) = cotui(&args);
         assert_eq!(rc, 0, "{args:?}: {err}");
         assert!(out.contains("1 frame sent"), "{out}");
@@ -66,7 +76,10 @@ fn a_mapping_length_other_than_the_objects_type_is_refused() {
 fn send_refuses_fd_flags_no_flag_uses_and_says_what_0x_and_blanks_are() {
     refused(&["send", "demo", "123##F00"], "CAN FD flags digit `F` is not 0..7");
     refused(&["send", "demo", "123##800"], "CAN FD flags digit `8` is not 0..7");
-    refused(&["send", "demo", "0x123#00"], "the CAN id is hex without 0x, as cansend takes it: `123#00`");
+    refused(
+        &["send", "demo", "0x123#00"],
+        "the CAN id is hex without 0x, as cansend takes it: `123#00`",
+    );
     let (rc, out, err) = cotui(&["send", "demo", "123##700"]);
     assert_eq!((rc, out.trim()), (0, "123##700: 1 frame sent"), "{err}");
     // Blanks around a quoted frame are a quoting artifact, not CAN XL.
@@ -80,6 +93,12 @@ fn lss_identify_refuses_a_range_upside_down_and_counts_words_in_english() {
         &["lss", "demo", "identify", "1", "2", "5", "3", "0", "9"],
         "REV_LO 0x00000005 is above REV_HI 0x00000003",
     );
-    refused(&["lss", "demo", "identify", "1", "2", "0", "3", "9", "8"], "SER_LO 0x00000009 is above SER_HI");
-    refused(&["lss", "demo", "store", "x"], "`lss store` takes no words (got 1 word)");
+    refused(
+        &["lss", "demo", "identify", "1", "2", "0", "3", "9", "8"],
+        "SER_LO 0x00000009 is above SER_HI",
+    );
+    refused(
+        &["lss", "demo", "store", "x"],
+        "`lss store` takes no words (got 1 word)",
+    );
 }

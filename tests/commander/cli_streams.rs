@@ -35,9 +35,15 @@ fn record_to_stdout_as_pcapng_is_pcapng_alone_with_the_report_on_stderr() {
     let out = run(&["record", "demo", "-o", "-", "--count", "3", "--format", "pcapng"]);
     assert_eq!(out.status.code(), Some(0));
     let blocks = pcapng_blocks(&out.stdout).unwrap();
-    assert_eq!(blocks.iter().filter(|&&b| b == 6).count(), 3, "three enhanced packet blocks: {blocks:?}");
+    assert_eq!(
+        blocks.iter().filter(|&&b| b == 6).count(),
+        3,
+        "three enhanced packet blocks: {blocks:?}"
+    );
     assert!(String::from_utf8_lossy(&out.stderr).contains("3 frames written to -"));
-    let out = run(&["record", "demo", "-o", "-", "--count", "3", "--format", "pcapng", "--json"]);
+    let out = run(&[
+        "record", "demo", "-o", "-", "--count", "3", "--format", "pcapng", "--json",
+    ]);
     pcapng_blocks(&out.stdout).unwrap();
     let report: serde_json::Value = serde_json::from_slice(&out.stderr).unwrap();
     assert_eq!(report["frames"], 3);
@@ -55,9 +61,14 @@ fn record_to_stdout_as_candump_is_log_lines_alone() {
         let stdout = String::from_utf8(out.stdout).unwrap();
         assert_eq!(stdout.lines().count(), 4, "{stdout}");
         for line in stdout.lines() {
-            let (time, rest) = line.split_once(") ").unwrap_or_else(|| panic!("not candump -l: {line}"));
+            let (time, rest) = line
+                .split_once(") ")
+                .unwrap_or_else(|| panic!("not candump -l: {line}"));
             let (iface, frame) = rest.split_once(' ').unwrap();
-            assert!(time.starts_with('(') && iface == "demo" && frame.contains('#'), "{line}");
+            assert!(
+                time.starts_with('(') && iface == "demo" && frame.contains('#'),
+                "{line}"
+            );
         }
         let stderr = String::from_utf8(out.stderr).unwrap();
         if json {
@@ -81,7 +92,10 @@ fn sdo_read_and_dcf_save_to_stdout_give_the_data_alone() {
     let dcf = String::from_utf8(out.stdout).unwrap();
     assert!(dcf.starts_with("[FileInfo]"), "{}", &dcf[..dcf.len().min(200)]);
     assert!(!dcf.contains("saved to"), "no report in the DCF");
-    assert!(String::from_utf8_lossy(&out.stderr).contains("objects saved to -"), "report on stderr");
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("objects saved to -"),
+        "report on stderr"
+    );
     assert!(!std::path::Path::new("-").exists(), "no file named -");
 }
 
@@ -108,7 +122,10 @@ fn an_output_that_cannot_be_written_is_blamed_not_the_input() {
             let out = run(&["decode", log, "--format", fmt, "-o", "/dev/full"]);
             let err = String::from_utf8_lossy(&out.stderr);
             assert_eq!(out.status.code(), Some(1), "{fmt} {n}: {err}");
-            assert!(err.contains("cannot write /dev/full: No space left on device"), "{fmt} {n}: {err}");
+            assert!(
+                err.contains("cannot write /dev/full: No space left on device"),
+                "{fmt} {n}: {err}"
+            );
             assert!(!err.contains(log), "the input is not to blame: {err}");
         }
         let out = run(&["decode", log, "--transactions", "-o", "/dev/full"]);
@@ -136,14 +153,21 @@ fn record_append_refuses_a_file_of_the_other_format() {
     std::fs::create_dir_all(&dir).unwrap();
     let (pcap, text) = (dir.join("a.pcapng"), dir.join("a.log"));
     let (pcap, text) = (pcap.to_str().unwrap(), text.to_str().unwrap());
-    let rec = |path: &str, fmt: &str| run(&["record", "demo", "-o", path, "--count", "2", "--format", fmt, "--append"]);
+    let rec = |path: &str, fmt: &str| {
+        run(&[
+            "record", "demo", "-o", path, "--count", "2", "--format", fmt, "--append",
+        ])
+    };
     assert_eq!(rec(pcap, "pcapng").status.code(), Some(0));
     assert_eq!(rec(text, "candump").status.code(), Some(0));
     let (pcap_before, text_before) = (std::fs::read(pcap).unwrap(), std::fs::read(text).unwrap());
     let out = rec(pcap, "candump");
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(err.contains("is pcapng: --append would add candump lines to it"), "{err}");
+    assert!(
+        err.contains("is pcapng: --append would add candump lines to it"),
+        "{err}"
+    );
     let out = rec(text, "pcapng");
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");

@@ -290,10 +290,22 @@ async fn load_refuses_a_pdo_that_pdo_map_would_refuse_and_sends_nothing_of_it() 
     };
     let eight: String = (1..=8).map(|s| entry(s, "0x60FF0020")).collect();
     let cases = [
-        (format!("{}{}{eight}", comm("0x3FFFFFFF"), count(8)), "256 bits, more than the 64"),
-        (format!("{}{}{}", comm("0x602"), count(1), entry(1, "0x60400010")), "node 2's SDO request"),
-        (format!("{}{}{}", comm("0x202"), count(1), entry(1, "0x60400008")), "8 bits given"),
-        (format!("{}{}{}", comm("0x202"), count(1), entry(1, "0x60410010")), "only into TPDOs"),
+        (
+            format!("{}{}{eight}", comm("0x3FFFFFFF"), count(8)),
+            "256 bits, more than the 64",
+        ),
+        (
+            format!("{}{}{}", comm("0x602"), count(1), entry(1, "0x60400010")),
+            "node 2's SDO request",
+        ),
+        (
+            format!("{}{}{}", comm("0x202"), count(1), entry(1, "0x60400008")),
+            "8 bits given",
+        ),
+        (
+            format!("{}{}{}", comm("0x202"), count(1), entry(1, "0x60410010")),
+            "only into TPDOs",
+        ),
         (format!("{}{}", comm("0x00000A02"), count(0)), "bits above 0x7FF"),
     ];
     for (i, (rpdo1, why)) in cases.iter().enumerate() {

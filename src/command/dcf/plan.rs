@@ -418,7 +418,10 @@ fn pdo_refusal(compared: &[Compared], dict: &Dictionary, (comm, mapping): (u16, 
     {
         return Some(why);
     }
-    if !compared.iter().any(|c| c.file.index == mapping && c.state == State::Differs) {
+    if !compared
+        .iter()
+        .any(|c| c.file.index == mapping && c.state == State::Differs)
+    {
         return None;
     }
     let count = at(mapping, 0).and_then(|c| c.file.bytes.first().copied()).unwrap_or(0);
