@@ -81,7 +81,8 @@ pub fn run_commander(c: &CliCommander) -> ExitCode {
         }
         cmd => {
             let bindings = super::bind::bindings_on(&bus.iface, &dict.profiles, &dict.eds);
-            run(bus, what(c), |bus| async move {
+            let report_to = Stream::report_of(&cmd);
+            run_to(bus, what(c), report_to, |bus| async move {
                 crate::command::execute(&bus, &cmd, &bindings?).await
             })
         }
@@ -117,6 +118,43 @@ where
     F: FnOnce(Bus) -> Fut,
     Fut: Future<Output = Result<Outcome, CommandError>>,
 {
+    run_to(args, what, Stream::Stdout, body)
+}
+
+/// Where a command's report goes: stdout, or stderr when stdout carries the command's data
+/// (`-o -`), so that a pipe gets the data alone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stream {
+    Stdout,
+    Stderr,
+}
+
+impl Stream {
+    /// Stderr for a command that writes its data to stdout, else stdout.
+    pub fn report_of(cmd: &Command) -> Stream {
+        if cmd.data_to_stdout() {
+            Stream::Stderr
+        } else {
+            Stream::Stdout
+        }
+    }
+
+    /// Writes one line; a closed stream (a gone terminal, a closed pipe) is not an error.
+    pub fn line(self, text: &str) {
+        use std::io::Write;
+        let _ = match self {
+            Stream::Stdout => writeln!(std::io::stdout(), "{text}"),
+            Stream::Stderr => writeln!(std::io::stderr(), "{text}"),
+        };
+    }
+}
+
+/// [`run`], with the report on `to`.
+pub fn run_to<F, Fut>(args: &BusArgs, what: &str, to: Stream, body: F) -> ExitCode
+where
+    F: FnOnce(Bus) -> Fut,
+    Fut: Future<Output = Result<Outcome, CommandError>>,
+{
     let rt = match tokio::runtime::Builder::new_current_thread().enable_all().build() {
         Ok(rt) => rt,
         Err(e) => {
@@ -131,23 +169,28 @@ where
         let bus = crate::connect::open(&args.iface, args.listen_only).await?;
         body(bus).await
     });
-    report(args, what, result)
+    report_to(args, what, to, result)
 }
 
 /// Prints `result` (text, or JSON with `--json`; failures also to stderr) and gives the exit status.
 pub fn report(args: &BusArgs, what: &str, result: Result<Outcome, CommandError>) -> ExitCode {
+    report_to(args, what, Stream::Stdout, result)
+}
+
+/// [`report`], with the outcome (text or JSON) on `to`.
+pub fn report_to(args: &BusArgs, what: &str, to: Stream, result: Result<Outcome, CommandError>) -> ExitCode {
     match result {
         Ok(o) => {
             if args.json {
-                println!("{}", o.json);
+                to.line(&o.json.to_string());
             } else if !o.text.is_empty() {
-                println!("{}", o.text);
+                to.line(&o.text);
             }
             ExitCode::Ok
         }
         Err(e) => {
             if args.json {
-                println!("{}", e.to_json());
+                to.line(&e.to_json().to_string());
             }
             eprintln!("cotui {what}: {e}");
             e.exit_code()

@@ -20,11 +20,12 @@ pub enum OutputFormat {
     /// One JSON object per frame (see README, "JSONL contract").
     Jsonl,
     /// A pcapng capture for Wireshark (binary: with -o FILE or a redirected stdout).
-    /// `run` hands it to `decode_out` before decoding, so the matches below that pair it
-    /// with `Jsonl` never see it.
+    // `run` hands it to `decode_out` before decoding, so the matches below that pair it
+    // with `Jsonl` never see it.
     Pcapng,
     /// Two Parquet tables, frames and decoded values (with -o DIR or -o NAME.parquet;
-    /// see README, "Parquet tables"). `run` hands it to `decode_parquet` before decoding.
+    /// see README, "Parquet tables").
+    // `run` hands it to `decode_parquet` before decoding.
     Parquet,
 }
 
@@ -123,17 +124,16 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
             Ok(()) => {}
             Err(e) if e.kind() == io::ErrorKind::BrokenPipe => return status,
             Err(e) => {
-                eprintln!("cotui decode: {path}: {e}");
-                status = ExitCode::Unavailable;
+                status = out.blame().report(Some(path), &e);
+                if out.blame().output_failed() {
+                    return status;
+                }
             }
         }
     }
     let result = finish(&mut decoder, mode, &mut summary, &mut transfers, &mut out).and_then(|_| out.flush());
     match result {
-        Err(e) if e.kind() != io::ErrorKind::BrokenPipe => {
-            eprintln!("cotui decode: {e}");
-            ExitCode::Unavailable
-        }
+        Err(e) if e.kind() != io::ErrorKind::BrokenPipe => out.blame().report(None, &e),
         _ => status,
     }
 }

@@ -96,16 +96,15 @@ pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
             Ok(()) => {}
             Err(e) if e.kind() == io::ErrorKind::BrokenPipe => return status,
             Err(e) => {
-                eprintln!("cotui decode: {path}: {e}");
-                status = ExitCode::Unavailable;
+                status = out.blame().report(Some(path), &e);
+                if out.blame().output_failed() {
+                    return status;
+                }
             }
         }
     }
     match run.finish(&mut out).and_then(|_| out.flush()) {
-        Err(e) if e.kind() != io::ErrorKind::BrokenPipe => {
-            eprintln!("cotui decode: {e}");
-            ExitCode::Unavailable
-        }
+        Err(e) if e.kind() != io::ErrorKind::BrokenPipe => out.blame().report(None, &e),
         _ => status,
     }
 }

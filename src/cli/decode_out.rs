@@ -4,7 +4,9 @@ use super::decode::DecodeArgs;
 use super::input;
 use crate::command::ExitCode;
 use crate::output::pcapng::PcapngWriter;
+use std::cell::Cell;
 use std::io::{self, BufRead, IsTerminal, Write};
+use std::rc::Rc;
 
 /// Why the output of `cotui decode` cannot be opened.
 #[derive(Debug, thiserror::Error)]
@@ -17,9 +19,87 @@ pub enum OutputError {
     Create { path: String, source: io::Error },
 }
 
+/// The output of `cotui decode`: it remembers a failed write, so that an error is blamed
+/// on the output (exit 1, "cannot write OUT") and not on the input being read.
+pub struct Output {
+    inner: Box<dyn Write>,
+    failed: Blame,
+}
+
+/// Who an I/O error of a decode run is blamed on (see [`Output`]).
+#[derive(Clone)]
+pub struct Blame {
+    name: Rc<str>,
+    failed: Rc<Cell<bool>>,
+}
+
+impl Blame {
+    /// Prints `e` for the user, blaming the output when a write failed, else `input` (the
+    /// file being read, if any); gives the exit status: 1 for the output (a file that cannot
+    /// be written), 2 for an input.
+    pub fn report(&self, input: Option<&str>, e: &io::Error) -> ExitCode {
+        if self.failed.get() {
+            eprintln!("cotui decode: cannot write {}: {e}", self.name);
+            ExitCode::Usage
+        } else {
+            match input {
+                Some(path) => eprintln!("cotui decode: {path}: {e}"),
+                None => eprintln!("cotui decode: {e}"),
+            }
+            ExitCode::Unavailable
+        }
+    }
+    /// Whether a write to the output failed (the run cannot go on).
+    pub fn output_failed(&self) -> bool {
+        self.failed.get()
+    }
+}
+
+impl Output {
+    /// A handle that tells, after an error, whether the output failed.
+    pub fn blame(&self) -> Blame {
+        self.failed.clone()
+    }
+    fn new(inner: Box<dyn Write>, name: &str) -> Output {
+        Output {
+            inner,
+            failed: Blame {
+                name: name.into(),
+                failed: Rc::new(Cell::new(false)),
+            },
+        }
+    }
+    fn noted<T>(&self, r: io::Result<T>) -> io::Result<T> {
+        if r.as_ref().is_err_and(|e| e.kind() != io::ErrorKind::Interrupted) {
+            self.failed.failed.set(true);
+        }
+        r
+    }
+}
+
+impl Write for Output {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        let r = self.inner.write(buf);
+        self.noted(r)
+    }
+    fn write_all(&mut self, buf: &[u8]) -> io::Result<()> {
+        let r = self.inner.write_all(buf);
+        self.noted(r)
+    }
+    fn flush(&mut self) -> io::Result<()> {
+        let r = self.inner.flush();
+        self.noted(r)
+    }
+}
+
 /// The output stream: `path` (`None` or `-` is stdout). Binary output is refused when
 /// it would go to a terminal.
-pub fn open(path: Option<&str>, binary: bool) -> Result<Box<dyn Write>, OutputError> {
+pub fn open(path: Option<&str>, binary: bool) -> Result<Output, OutputError> {
+    let name = path.filter(|p| *p != "-").unwrap_or("stdout");
+    open_stream(path, binary).map(|w| Output::new(w, name))
+}
+
+fn open_stream(path: Option<&str>, binary: bool) -> Result<Box<dyn Write>, OutputError> {
     match path {
         None | Some("-") => {
             let stdout = io::stdout();
@@ -55,12 +135,10 @@ pub fn pcapng(args: &DecodeArgs) -> ExitCode {
             return ExitCode::Usage;
         }
     };
+    let blame = out.blame();
     let mut w = match PcapngWriter::new(out) {
         Ok(w) => w,
-        Err(e) => {
-            eprintln!("cotui decode: {e}");
-            return ExitCode::Unavailable;
-        }
+        Err(e) => return blame.report(None, &e),
     };
     let mut status = ExitCode::Ok;
     for path in &args.files {
@@ -72,15 +150,14 @@ pub fn pcapng(args: &DecodeArgs) -> ExitCode {
             if e.kind() == io::ErrorKind::BrokenPipe {
                 return status;
             }
-            eprintln!("cotui decode: {path}: {e}");
-            status = ExitCode::Unavailable;
+            status = blame.report(Some(path), &e);
+            if blame.output_failed() {
+                return status;
+            }
         }
     }
     match w.flush() {
-        Err(e) if e.kind() != io::ErrorKind::BrokenPipe => {
-            eprintln!("cotui decode: {e}");
-            ExitCode::Unavailable
-        }
+        Err(e) if e.kind() != io::ErrorKind::BrokenPipe => blame.report(None, &e),
         _ => status,
     }
 }

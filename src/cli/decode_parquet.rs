@@ -130,6 +130,12 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
         }
     };
     let (frames_path, values_path) = paths(output);
+    if !output.ends_with(".parquet") && Path::new(output).exists() && !Path::new(output).is_dir() {
+        eprintln!(
+            "cotui decode: cannot write {output}: not a directory (-o DIR writes DIR/frames.parquet and DIR/values.parquet; -o NAME.parquet writes NAME.parquet and NAME.values.parquet)"
+        );
+        return ExitCode::Usage;
+    }
     let tables =
         create(&frames_path, "frames", &FRAME_COLS).and_then(|f| Ok((f, create(&values_path, "values", &VALUE_COLS)?)));
     let (mut frames, mut values) = match tables {
@@ -161,8 +167,9 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
     let result = end().and_then(|_| frames.finish()).and_then(|_| values.finish());
     match result {
         Err(e) => {
-            eprintln!("cotui decode: {output}: {e}");
-            ExitCode::Unavailable
+            // Writing the tables failed: the output is to blame (1), not an input.
+            eprintln!("cotui decode: cannot write {output}: {e}");
+            ExitCode::Usage
         }
         Ok(()) => status,
     }

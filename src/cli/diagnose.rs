@@ -61,6 +61,12 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
         eprintln!("cotui diagnose: --duration needs --live IFACE (a log ends by itself)");
         return ExitCode::Usage;
     }
+    if let Some(s) = args.duration
+        && !(s.is_finite() && s > 0.0 && s < 1e9)
+    {
+        eprintln!("cotui diagnose: --duration {s}: give a number of seconds above 0 (e.g. 30 or 0.5)");
+        return ExitCode::Usage;
+    }
     let mut status = ExitCode::Ok;
     if let Some(iface) = &args.live
         && let Err(e) = live::capture(iface, args.duration, &mut decoder, &mut diag)
@@ -68,11 +74,13 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
         eprintln!("cotui diagnose: {e}");
         return ExitCode::Unavailable;
     }
+    let mut opened = args.live.is_some();
     for path in &args.files {
         let Some(input) = input::open_input(path, "diagnose") else {
             status = ExitCode::Unavailable;
             continue;
         };
+        opened = true;
         let result = input::for_each_frame(path, input, |frames| {
             let ifaces = frames.ifaces;
             for (_, frame) in frames {
@@ -84,6 +92,10 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
             eprintln!("cotui diagnose: {path}: {e}");
             status = ExitCode::Unavailable;
         }
+    }
+    if !opened {
+        // Nothing was read: a report of "no problems" would be false; the errors are said.
+        return status;
     }
     for t in decoder.finish() {
         diag.transaction(&t);

@@ -74,7 +74,8 @@ All commands:              cotui --help
 
 /// Runs the command line and returns the process exit status.
 pub fn run() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    use clap::FromArgMatches;
+    let cli = match cli_command().try_get_matches().and_then(|m| Cli::from_arg_matches(&m)) {
         Ok(c) => c,
         Err(e) => return refused(e, std::env::args_os().skip(1)),
     };
@@ -104,10 +105,96 @@ pub fn refused(e: clap::Error, args: impl IntoIterator<Item = std::ffi::OsString
     if !e.use_stderr() {
         return ExitCode::Ok;
     }
-    if args.into_iter().take_while(|a| a != "--").any(|a| a == "--json") {
+    let args: Vec<String> = args.into_iter().map(|a| a.to_string_lossy().into_owned()).collect();
+    if let Some(h) = hint(&args, e.kind()) {
+        eprintln!("hint: {h}");
+    }
+    if args.iter().take_while(|a| *a != "--").any(|a| a == "--json") {
         println!("{}", CommandError::Syntax(ParseError::from(e)).to_json());
     }
     ExitCode::Usage
+}
+
+/// The command line's declaration, with the commander examples in its help as the command
+/// line takes them: the declaration is the palette's too, whose lines have no IFACE
+/// (`sdo read 2 0x6041`); here IFACE goes in (`sdo read can0 2 0x6041`).
+pub fn cli_command() -> clap::Command {
+    fn with_iface(cmd: clap::Command, path: &str) -> clap::Command {
+        let example = format!("`{path} ");
+        let fix = |t: &clap::builder::StyledStr| t.to_string().replace(&example, &format!("`{path} can0 "));
+        let (about, long) = (cmd.get_about().map(fix), cmd.get_long_about().map(fix));
+        let mut cmd = cmd;
+        if let Some(a) = about {
+            cmd = cmd.about(a);
+        }
+        if let Some(a) = long {
+            cmd = cmd.long_about(a);
+        }
+        let subs: Vec<String> = cmd.get_subcommands().map(|s| s.get_name().to_string()).collect();
+        for sub in subs {
+            let path = format!("{path} {sub}");
+            cmd = cmd.mut_subcommand(&sub, |c| with_iface(c, &path));
+        }
+        cmd
+    }
+    let mut cmd = <Cli as clap::CommandFactory>::command();
+    for sub in ON_A_BUS {
+        if cmd.find_subcommand(sub).is_some() {
+            cmd = cmd.mut_subcommand(sub, |c| with_iface(c, sub));
+        }
+    }
+    cmd
+}
+
+/// The subcommands whose first word is IFACE (after the action word of `sdo` and `dcf`).
+const ON_A_BUS: [&str; 12] = [
+    "nmt", "sdo", "drive", "run", "scan", "record", "stop", "lss", "send", "sync", "pdo", "dcf",
+];
+
+/// A hint for a refused command line (`args` without the program name), for the mistakes
+/// clap cannot name: a commander line without IFACE (`sdo read 2 0x6041`: the node where
+/// IFACE goes), an object name with blanks not in quotes (`sdo write can0 2 Target velocity
+/// 3000`).
+fn hint(args: &[String], kind: clap::error::ErrorKind) -> Option<String> {
+    let words: Vec<&str> = args
+        .iter()
+        .map(String::as_str)
+        .filter(|a| !a.starts_with('-'))
+        .collect();
+    let sub = *words.first()?;
+    if !ON_A_BUS.contains(&sub) {
+        return None;
+    }
+    let action = matches!(sub, "sdo" | "dcf");
+    let at = if action { 2 } else { 1 };
+    let iface = words.get(at)?;
+    if crate::command::grammar::parse_int(iface).is_some() {
+        // The user's line with `can0` where IFACE goes (before the at-th word).
+        let pos = args.iter().position(|a| std::ptr::eq(a.as_str(), *iface))?;
+        let mut line: Vec<String> = args
+            .iter()
+            .map(|a| if a.contains(' ') { format!("\"{a}\"") } else { a.clone() })
+            .collect();
+        line.insert(pos, "can0".into());
+        return Some(format!(
+            "did you forget IFACE? It comes first: `cotui {}` (or `demo` for the simulated bus)",
+            line.join(" ")
+        ));
+    }
+    if sub == "sdo" && kind == clap::error::ErrorKind::UnknownArgument && words.len() > 5 {
+        let (object, value) = match words[1] {
+            "write" => (
+                words[4..words.len() - 1].join(" "),
+                format!(" {}", words[words.len() - 1]),
+            ),
+            _ => (words[4..].join(" "), String::new()),
+        };
+        return Some(format!(
+            "an object name with blanks goes in quotes: `cotui sdo {} {iface} {} \"{object}\"{value}`",
+            words[1], words[3]
+        ));
+    }
+    None
 }
 
 #[cfg(test)]
@@ -120,6 +207,78 @@ mod tests {
         // Duplicate names, flags or argument groups (e.g. from flattening the commander's
         // declaration) would only panic when that subcommand is parsed.
         Cli::command().debug_assert();
+    }
+
+    /// Every (sub)command's `--help`, with its path (`cotui sdo read`).
+    fn every_help(cmd: &mut clap::Command, path: &str, out: &mut Vec<(String, String)>) {
+        out.push((path.to_string(), cmd.render_long_help().to_string()));
+        for sub in cmd.get_subcommands_mut() {
+            let name = format!("{path} {}", sub.get_name());
+            every_help(sub, &name, out);
+        }
+    }
+
+    #[test]
+    fn no_help_text_shows_developer_notes() {
+        let mut helps = Vec::new();
+        every_help(&mut cli_command(), "cotui", &mut helps);
+        assert!(helps.len() > 20, "the walk reaches the subcommands");
+        let decode = &helps.iter().find(|(p, _)| p == "cotui decode").unwrap().1;
+        assert!(
+            decode.contains("A pcapng capture for Wireshark"),
+            "value docs are checked too: {decode}"
+        );
+        let internal = [
+            "decode_out",
+            "decode_parquet",
+            "fn ",
+            "crate::",
+            "::",
+            "the matches below",
+            "TODO",
+            "FIXME",
+        ];
+        for (path, help) in &helps {
+            for word in internal {
+                assert!(!help.contains(word), "`{path} --help` shows `{word}`:\n{help}");
+            }
+            // A backticked identifier with an underscore (`decode_out`, `run_record`) is
+            // code, not something a user types.
+            for quoted in help.split('`').skip(1).step_by(2) {
+                let code = quoted.contains('_')
+                    && quoted
+                        .chars()
+                        .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
+                assert!(!code, "`{path} --help` quotes the identifier `{quoted}`:\n{help}");
+            }
+        }
+    }
+
+    #[test]
+    fn hints_for_a_forgotten_iface_and_an_unquoted_name() {
+        let words = |line: &str| line.split(' ').map(String::from).collect::<Vec<_>>();
+        let kind = clap::error::ErrorKind::ValueValidation;
+        assert_eq!(
+            hint(&words("sdo read 2 0x6041"), kind).as_deref(),
+            Some(
+                "did you forget IFACE? It comes first: `cotui sdo read can0 2 0x6041` (or `demo` for the simulated bus)"
+            )
+        );
+        assert!(
+            hint(&words("nmt 2 start"), kind)
+                .unwrap()
+                .contains("`cotui nmt can0 2 start`")
+        );
+        assert_eq!(hint(&words("sdo read demo 2 0x6041"), kind), None);
+        assert_eq!(hint(&words("decode 2"), kind), None);
+        assert_eq!(
+            hint(
+                &words("sdo write demo 2 Target velocity 3000"),
+                clap::error::ErrorKind::UnknownArgument
+            )
+            .as_deref(),
+            Some("an object name with blanks goes in quotes: `cotui sdo write demo 2 \"Target velocity\" 3000`")
+        );
     }
 
     #[test]

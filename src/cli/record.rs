@@ -4,7 +4,7 @@
 //! loses at most that much. Gaps (interface down or gone, bus-off) are reported on stderr as
 //! they happen and make the exit status 2.
 
-use super::commander::{BusArgs, report};
+use super::commander::{BusArgs, Stream, report_to};
 use crate::command::exec::text;
 use crate::command::record::{Limits, LogFormat, Recorded, WriteMode, open_output, record};
 use crate::command::{Command, CommandError, ExitCode};
@@ -16,9 +16,10 @@ use tokio::signal::unix::{SignalKind, signal};
 /// for a usage or write error.
 pub fn run_record(bus: &BusArgs, path: &str, limits: Limits, mode: WriteMode, format: LogFormat) -> ExitCode {
     if format == LogFormat::Pcapng && path == "-" && std::io::IsTerminal::is_terminal(&std::io::stdout()) {
-        return report(
+        return report_to(
             bus,
             "record",
+            Stream::Stderr,
             Err(CommandError::Usage(
                 "pcapng is binary: write it to a file (-o FILE) or a pipe, not to a terminal".into(),
             )),
@@ -29,9 +30,11 @@ pub fn run_record(bus: &BusArgs, path: &str, limits: Limits, mode: WriteMode, fo
         .build()
         .map_err(|e| CommandError::Usage(format!("cannot start the runtime: {e}")))
         .and_then(|rt| rt.block_on(capture(bus, path, (limits, format), mode)));
+    // `-o -`: stdout is the log; every report goes to stderr.
+    let to = if path == "-" { Stream::Stderr } else { Stream::Stdout };
     let n = match result {
         Ok(n) => n,
-        Err(e) => return report(bus, "record", Err(e)),
+        Err(e) => return report_to(bus, "record", to, Err(e)),
     };
     let cmd = Command::Record {
         output: path.to_string(),
@@ -42,9 +45,9 @@ pub fn run_record(bus: &BusArgs, path: &str, limits: Limits, mode: WriteMode, fo
     let json = n.to_json(path);
     // After SIGHUP the terminal may be gone: printing must not fail the recording.
     if bus.json {
-        let _ = writeln!(std::io::stdout(), "{json}");
+        to.line(&json.to_string());
     } else {
-        let _ = writeln!(std::io::stdout(), "{}", text(&cmd, &json));
+        to.line(&text(&cmd, &json));
     }
     if n.dropped > 0 {
         say(&format!(
@@ -80,7 +83,7 @@ async fn capture(
         handler(SignalKind::quit())?,
     ];
     let bus = crate::connect::open(&args.iface, args.listen_only).await?;
-    let mut out = open_output(path, mode)?;
+    let mut out = open_output(path, mode, format)?;
     let [int, term, hup, quit] = &mut signals;
     let stop = async {
         tokio::select! {

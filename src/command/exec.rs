@@ -77,7 +77,7 @@ pub async fn execute_until(
             let (index, sub) = resolve_object(dict, object).map_err(|e| CommandError::Usage(e.to_string()))?;
             let data = super::sdo::upload_within(bus, *node, index, sub, options.block, timing(options)).await?;
             if let Some(path) = output {
-                std::fs::write(path, &data).map_err(|e| CommandError::Usage(format!("cannot write {path}: {e}")))?;
+                write_output(path, &data)?;
             }
             let ty = options
                 .data_type
@@ -154,7 +154,7 @@ pub async fn execute_until(
             mode,
             format,
         } => {
-            let mut out = super::record::open_output(output, *mode)?;
+            let mut out = super::record::open_output(output, *mode, *format)?;
             let forever = std::future::pending::<()>();
             let n = super::record::record(bus, &mut out, *limits, *format, forever, |_| {}).await?;
             if let Some(m) = n.gap_message(output) {
@@ -403,4 +403,20 @@ fn scan_text(v: &Json) -> String {
         })
         .collect::<Vec<_>>()
         .join("\n")
+}
+
+/// Writes a command's data to `path`; `-` is stdout (the command's report then goes to
+/// stderr, see [`Command::data_to_stdout`]).
+pub(crate) fn write_output(path: &str, data: &[u8]) -> Result<(), CommandError> {
+    use std::io::Write;
+    let written = if path == "-" {
+        let mut out = std::io::stdout().lock();
+        out.write_all(data).and_then(|()| out.flush())
+    } else {
+        std::fs::write(path, data)
+    };
+    written.map_err(|e| {
+        let path = if path == "-" { "stdout" } else { path };
+        CommandError::Usage(format!("cannot write {path}: {e}"))
+    })
 }

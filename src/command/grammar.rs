@@ -267,6 +267,19 @@ pub enum Command {
     Dcf(super::dcf::DcfCommand),
 }
 
+impl Command {
+    /// True when the command writes its data to stdout (`-o -`): its report (text or JSON)
+    /// then goes to stderr, so that stdout is the data alone.
+    pub fn data_to_stdout(&self) -> bool {
+        match self {
+            Command::Record { output, .. } => output == "-",
+            Command::SdoRead { output, .. } => output.as_deref() == Some("-"),
+            Command::Dcf(d) => matches!(&d.action, super::dcf::DcfAction::Save { output, .. } if output == "-"),
+            _ => false,
+        }
+    }
+}
+
 /// What `run` runs: a procedure of a node with its parameters, or (no procedure) the list.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RunSpec {

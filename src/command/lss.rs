@@ -126,8 +126,9 @@ impl LssAction {
                 Ok(())
             } else {
                 Err(ParseError::Invalid(format!(
-                    "`lss {word}` takes {usage} (got {} words)",
-                    args.len()
+                    "`lss {word}` takes {usage} (got {} word{})",
+                    args.len(),
+                    if args.len() == 1 { "" } else { "s" }
                 )))
             }
         };
@@ -196,11 +197,20 @@ impl LssAction {
             }
             "identify" => {
                 want(6, "VENDOR PRODUCT REV_LO REV_HI SER_LO SER_HI")?;
+                let range = |lo: usize, hi: usize, what: &str| {
+                    let (l, h) = (a(lo, &format!("{what}_LO"))?, a(hi, &format!("{what}_HI"))?);
+                    if l > h {
+                        return Err(ParseError::Invalid(format!(
+                            "`lss identify`: {what}_LO 0x{l:08X} is above {what}_HI 0x{h:08X}: the range is LO..HI (no slave would answer; nothing sent)"
+                        )));
+                    }
+                    Ok((l, h))
+                };
                 LssAction::Identify {
                     vendor: a(0, "VENDOR")?,
                     product: a(1, "PRODUCT")?,
-                    revision: (a(2, "REV_LO")?, a(3, "REV_HI")?),
-                    serial: (a(4, "SER_LO")?, a(5, "SER_HI")?),
+                    revision: range(2, 3, "REV")?,
+                    serial: range(4, 5, "SER")?,
                 }
             }
             "identify-unconfigured" => {

@@ -109,28 +109,11 @@ pub fn entries(dict: &Dictionary, spec: &MapSpec) -> Result<Vec<MappedEntry>, Co
                 )));
             }
         };
-        if let Some(o) = info
-            && !spec.force
-        {
-            let ok = match o.pdo {
-                PdoMappable::Both => true,
-                PdoMappable::Tpdo => spec.pdo.transmit,
-                PdoMappable::Rpdo => !spec.pdo.transmit,
-                PdoMappable::No => false,
-            };
-            if !ok {
-                let into = match o.pdo {
-                    PdoMappable::No => "into no PDO".to_string(),
-                    PdoMappable::Tpdo => "only into TPDOs".to_string(),
-                    _ => "only into RPDOs".to_string(),
-                };
-                return Err(CommandError::Usage(format!(
-                    "{} cannot be mapped into {pdo}: the node's dictionary ({}) maps it {into}; nothing sent \
-                     (--force maps it anyway)",
-                    name(),
-                    dict.profile_name()
-                )));
-            }
+        if let Some(why) = entry_refusal(dict, spec.pdo.transmit, (index, sub), bits, spec.force) {
+            return Err(CommandError::Usage(format!(
+                "{} cannot be mapped into {pdo}: {why}; nothing sent (--force maps it anyway)",
+                name()
+            )));
         }
         out.push(MappedEntry { index, sub, bits });
     }
@@ -150,6 +133,70 @@ pub fn entries(dict: &Dictionary, spec: &MapSpec) -> Result<Vec<MappedEntry>, Co
         )));
     }
     Ok(out)
+}
+
+/// Why `bits` bits of the object at `(index, sub)` cannot go into a PDO (a TPDO when
+/// `transmit`) by the node's dictionary: a length other than its type's (a BOOLEAN takes 1
+/// or 8 bits; strings and domains any length up to 64 bits), or a direction the dictionary
+/// does not map it in. `force` skips both checks. An object the dictionary does not know
+/// (or a dummy entry) is the node's to judge: `None`.
+pub fn entry_refusal(
+    dict: &Dictionary,
+    transmit: bool,
+    (index, sub): (u16, u8),
+    bits: u8,
+    force: bool,
+) -> Option<String> {
+    let o = dict.object(index, sub).filter(|_| !force)?;
+    let size_ok = match o.data_type.size() {
+        _ if o.data_type == crate::od::DataType::Boolean => matches!(bits, 1 | 8),
+        Some(size) => usize::from(bits) == size * 8,
+        None => true,
+    };
+    if !size_ok {
+        return Some(format!(
+            "{bits} bits given, but the node's dictionary ({}) types it {:?}, {} bits",
+            dict.profile_name(),
+            o.data_type,
+            o.data_type.size().unwrap_or(0) * 8
+        ));
+    }
+    let into = match o.pdo {
+        PdoMappable::Both => return None,
+        PdoMappable::Tpdo if transmit => return None,
+        PdoMappable::Rpdo if !transmit => return None,
+        PdoMappable::No => "into no PDO",
+        PdoMappable::Tpdo => "only into TPDOs",
+        PdoMappable::Rpdo => "only into RPDOs",
+    };
+    Some(format!(
+        "the node's dictionary ({}) maps it {into}",
+        dict.profile_name()
+    ))
+}
+
+/// Why a PDO COB-ID value (sub 1) cannot be given to a PDO: an 11-bit id (bit 29 clear)
+/// above 0x7FF or with bits 11..28 set, id 0, or an id another service owns
+/// ([`crate::decode::cob_id::reserved_for`]). A value with bit 31 set (PDO not valid)
+/// carries no id in use and passes.
+pub fn cob_refusal(raw: u32) -> Option<String> {
+    let cob = Cob::new(raw);
+    if !cob.valid {
+        return None;
+    }
+    if !cob.extended && raw & 0x1FFF_F800 != 0 {
+        return Some(format!(
+            "COB-ID 0x{raw:08X} has bit 29 clear (11-bit) but bits above 0x7FF set"
+        ));
+    }
+    if cob.id == 0 {
+        return Some(format!("COB-ID 0x{raw:08X} has CAN-ID 0 (NMT)"));
+    }
+    if cob.extended {
+        return None;
+    }
+    crate::decode::cob_id::reserved_for(cob.id)
+        .map(|owner| format!("COB-ID 0x{raw:08X}: CAN-ID 0x{:03X} is {owner}", cob.id))
 }
 
 /// The COB-ID value the PDO gets back at the end: `--cob-id` (bit 29 for a 29-bit one),

@@ -125,10 +125,19 @@ struct GapJson<'a> {
     reason: &'a str,
 }
 
-/// Opens the log: `-` is stdout; an existing file is refused unless `mode` says overwrite or append.
-pub fn open_output(path: &str, mode: WriteMode) -> Result<LineSink<Box<dyn Target + Send>>, CommandError> {
+/// Opens the log: `-` is stdout; an existing file is refused unless `mode` says overwrite or
+/// append. Appending is refused when the file is of the other format (candump lines onto a
+/// pcapng file, or pcapng onto a text log), which would leave neither readable.
+pub fn open_output(
+    path: &str,
+    mode: WriteMode,
+    format: LogFormat,
+) -> Result<LineSink<Box<dyn Target + Send>>, CommandError> {
     if path == "-" {
         return Ok(LineSink::new(Box::new(std::io::stdout()), 0));
+    }
+    if mode == WriteMode::Append {
+        refuse_other_format(path, format)?;
     }
     let mut o = OpenOptions::new();
     match mode {
@@ -145,6 +154,29 @@ pub fn open_output(path: &str, mode: WriteMode) -> Result<LineSink<Box<dyn Targe
     })?;
     let len = file.metadata().map(|m| m.len()).unwrap_or(0);
     Ok(LineSink::new(Box::new(file), len))
+}
+
+/// Refuses to append `format` to the existing, non-empty file at `path` of the other format
+/// (told by the pcapng section header's first four bytes).
+fn refuse_other_format(path: &str, format: LogFormat) -> Result<(), CommandError> {
+    use std::io::Read;
+    let mut head = [0u8; 4];
+    let Ok(n) = File::open(path).and_then(|f| f.take(4).read(&mut head)) else {
+        return Ok(());
+    };
+    if n == 0 {
+        return Ok(());
+    }
+    let pcapng = n == 4 && head == [0x0A, 0x0D, 0x0D, 0x0A];
+    let (is, given) = match (pcapng, format) {
+        (true, LogFormat::Candump) => ("pcapng", "candump lines"),
+        (false, LogFormat::Pcapng) => ("not pcapng (a text log?)", "pcapng"),
+        _ => return Ok(()),
+    };
+    Err(CommandError::Usage(format!(
+        "{path} is {is}: --append would add {given} to it and leave it unreadable; \
+         append with its own --format, or write another file"
+    )))
 }
 
 /// Records frames from `bus` into `out` until `stop` resolves or a limit is reached; then
@@ -506,13 +538,13 @@ mod tests {
         let path = std::env::temp_dir().join(format!("cotui-rec-mode-{}.log", std::process::id()));
         std::fs::write(&path, "(1.000000) can0 123#01\n").unwrap();
         let p = path.to_str().unwrap();
-        let e = open_output(p, WriteMode::New).err().unwrap();
+        let e = open_output(p, WriteMode::New, LogFormat::Candump).err().unwrap();
         assert_eq!(
             e.to_string(),
             format!("{p} exists; --force overwrites it, --append adds to it")
         );
         assert_eq!(e.exit_code(), 1);
-        let mut out = open_output(p, WriteMode::Append).unwrap();
+        let mut out = open_output(p, WriteMode::Append, LogFormat::Candump).unwrap();
         out.buffer().extend_from_slice(b"(2.000000) can0 123#02\n");
         out.flush().unwrap();
         drop(out);
@@ -520,7 +552,7 @@ mod tests {
             std::fs::read_to_string(&path).unwrap(),
             "(1.000000) can0 123#01\n(2.000000) can0 123#02\n"
         );
-        drop(open_output(p, WriteMode::Overwrite).unwrap());
+        drop(open_output(p, WriteMode::Overwrite, LogFormat::Candump).unwrap());
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "");
         std::fs::remove_file(&path).unwrap();
     }

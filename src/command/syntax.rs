@@ -476,6 +476,9 @@ pub struct SyncArgs {
     /// The SYNC COB-ID (11-bit).
     #[arg(long, value_parser = cob_arg, default_value = "0x080")]
     pub cob_id: u32,
+    /// Use a --cob-id that another service owns (an SDO, EMCY or heartbeat id...).
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// `pdo NODE` (read every PDO), `pdo NODE send rpdoK NAME=VALUE ... [--every MS] [--count N]`,
@@ -513,7 +516,8 @@ pub struct PdoArgs<D: Args> {
     /// map: print the frames without sending anything.
     #[arg(long)]
     pub dry_run: bool,
-    /// map: map objects the node's dictionary says are not mappable.
+    /// map: map objects the node's dictionary says are not mappable, or use a --cob-id
+    /// another service owns.
     #[arg(long)]
     pub force: bool,
     /// read, map: how long to wait for each SDO answer, in ms.
@@ -571,6 +575,11 @@ impl<D: Args> PdoArgs<D> {
             }
             (Some(_), Some(pdo)) => {
                 refuse(&send_flags, "map")?;
+                if let Some(id) = self.cob_id
+                    && !self.force
+                {
+                    not_reserved(id, &format!("{} of node {}", pdo.title(), self.node))?;
+                }
                 Ok(Command::PdoMap(MapSpec {
                     node: self.node,
                     pdo,
@@ -690,7 +699,12 @@ impl<B: Args, D: Args> Commander<B, D> {
                 schedule: a.repeat.schedule(),
             },
             Commander::Sync(On { args: a, .. }) => Command::Sync {
-                cob_id: a.cob_id,
+                cob_id: match a.cob_id {
+                    // SYNC's own COB-ID; any other service's needs --force.
+                    0x080 => 0x080,
+                    id if a.force => id,
+                    id => not_reserved(id, "the SYNC producer").map(|()| id)?,
+                },
                 counter: a.counter,
                 schedule: Schedule {
                     every_ms: Some(a.period),
@@ -943,7 +957,26 @@ pub fn ms_arg(text: &str) -> Result<u64, ParseError> {
 }
 
 /// Parses a frame in candump's compact form with the log reader's parser.
+///
+/// Blanks around the frame (a quoting artifact) are ignored; a `0x` before the id is
+/// refused with the cansend form to write instead (cansend's grammar is hex already); an FD
+/// flags digit must be 0..7 (1 BRS, 2 ESI, 4 FDF: bit 3 is no flag, and would be dropped).
 fn frame_arg(text: &str) -> Result<Frame, ParseError> {
+    let text = text.trim();
+    if let Some(rest) = text.strip_prefix("0x").or_else(|| text.strip_prefix("0X")) {
+        return Err(ParseError::Invalid(format!(
+            "`{text}`: the CAN id is hex without 0x, as cansend takes it: `{rest}`"
+        )));
+    }
+    if let Some((_, after)) = text.split_once("##")
+        && let Some(digit) = after.chars().next()
+        && digit.to_digit(16).is_some_and(|d| d > 7)
+    {
+        return Err(ParseError::Invalid(format!(
+            "`{text}`: CAN FD flags digit `{digit}` is not 0..7 (1 = bit rate switch, 2 = error state \
+             indicator, 4 = FD format; add them): e.g. `##1` for BRS"
+        )));
+    }
     match crate::log::candump::parse_compact(text.as_bytes()) {
         Ok(Some(f)) => Ok(f),
         Ok(None) => Err(ParseError::Invalid(format!("`{text}`: CAN XL frames cannot be sent"))),
@@ -1035,6 +1068,16 @@ fn pdo_cob_arg(text: &str) -> Result<u32, ParseError> {
         .filter(|v| (1..=0x1FFF_FFFF).contains(v))
         .map(|v| v as u32)
         .ok_or_else(|| ParseError::Invalid(format!("`{text}` must be a COB-ID 0x001..0x1FFFFFFF")))
+}
+
+/// Refuses a COB-ID another service owns ([`crate::decode::cob_id::reserved_for`]) for `user`.
+fn not_reserved(id: u32, user: &str) -> Result<(), ParseError> {
+    match crate::decode::cob_id::reserved_for(id) {
+        Some(owner) => Err(ParseError::Invalid(format!(
+            "--cob-id 0x{id:03X} is {owner}: {user} would collide with it; nothing sent (--force uses it anyway)"
+        ))),
+        None => Ok(()),
+    }
 }
 
 /// Parses the SYNC counter's overflow value 2..=240.

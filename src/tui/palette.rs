@@ -44,6 +44,12 @@ pub fn plan(
     state: impl Fn(u8) -> Option<DriveState>,
 ) -> Result<Planned, CommandError> {
     let command = parse_command(line)?;
+    if command.data_to_stdout() && !matches!(command, Command::Record { .. }) {
+        // The TUI owns the terminal: data on stdout would land in the middle of the screen.
+        return Err(CommandError::Usage(
+            "-o - (stdout) is for the command line; in the TUI give a file".into(),
+        ));
+    }
     let object = |node: u8, object: &str| {
         resolve_object(bindings.dictionary(node), object).map_err(|e| CommandError::Usage(e.to_string()))
     };

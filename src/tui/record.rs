@@ -67,7 +67,7 @@ impl Recorder {
         }
         Ok(Recorder {
             file: file.to_string(),
-            sink: open_output(file, mode)?,
+            sink: open_output(file, mode, crate::command::record::LogFormat::Candump)?,
             writer: LogWriter::new(),
             line: String::new(),
         })

@@ -258,3 +258,83 @@ fn through_the_binary_exit_statuses_follow_the_differences() {
     let (rc, _, err) = cotui(&["dcf", "load", "demo", "3", file, "--listen-only"]);
     assert_eq!(rc, 2, "{err}");
 }
+
+/// The SDO download requests (index, sub) we sent to `node` among `frames`.
+fn downloads_sent(frames: &[cotui::frame::Frame], node: u8) -> Vec<(u16, u8)> {
+    frames
+        .iter()
+        .filter(|f| f.direction() == cotui::frame::Direction::Tx && f.id == 0x600 + u32::from(node))
+        .filter(|f| f.payload()[0] & 0xE0 == 0x20)
+        .map(|f| (u16::from_le_bytes([f.payload()[1], f.payload()[2]]), f.payload()[3]))
+        .collect()
+}
+
+/// A DCF for node 2 with RPDO1 (`rpdo1`: its [1400]/[1600] sections) and 0x1017 = 0x3E8.
+fn dcf_with(rpdo1: &str) -> String {
+    format!(
+        "[DeviceInfo]\nProductName=x\n\n[DeviceComissioning]\nNodeID=2\n\n\
+         [1017]\nParameterName=Producer heartbeat time\nDataType=0x0006\nAccessType=rw\nParameterValue=0x3E8\n\n{rpdo1}"
+    )
+}
+
+#[tokio::test(start_paused = true)]
+async fn load_refuses_a_pdo_that_pdo_map_would_refuse_and_sends_nothing_of_it() {
+    let entry = |sub: u8, value: &str| {
+        format!("[1600sub{sub}]\nParameterName=Entry {sub}\nDataType=0x0007\nAccessType=rw\nParameterValue={value}\n\n")
+    };
+    let comm = |cob: &str| {
+        format!("[1400sub1]\nParameterName=COB-ID\nDataType=0x0007\nAccessType=rw\nParameterValue={cob}\n\n")
+    };
+    let count = |n: u8| {
+        format!("[1600sub0]\nParameterName=Number of entries\nDataType=0x0005\nAccessType=rw\nParameterValue={n}\n\n")
+    };
+    let eight: String = (1..=8).map(|s| entry(s, "0x60FF0020")).collect();
+    let cases = [
+        (
+            format!("{}{}{eight}", comm("0x3FFFFFFF"), count(8)),
+            "256 bits, more than the 64",
+        ),
+        (
+            format!("{}{}{}", comm("0x602"), count(1), entry(1, "0x60400010")),
+            "node 2's SDO request",
+        ),
+        (
+            format!("{}{}{}", comm("0x202"), count(1), entry(1, "0x60400008")),
+            "8 bits given",
+        ),
+        (
+            format!("{}{}{}", comm("0x202"), count(1), entry(1, "0x60410010")),
+            "only into TPDOs",
+        ),
+        (format!("{}{}", comm("0x00000A02"), count(0)), "bits above 0x7FF"),
+    ];
+    for (i, (rpdo1, why)) in cases.iter().enumerate() {
+        let d = Demo::spawn(Simulation::demo(), false);
+        let path = dir(&format!("refused{i}")).join("rpdo1.dcf");
+        std::fs::write(&path, dcf_with(rpdo1)).unwrap();
+        let mut rx = d.bus.subscribe();
+        let (rc, v) = failed(run(&d, &format!("dcf load 2 {}", path.display())).await);
+        let sent = downloads_sent(&drain(&mut rx), 2);
+        assert_eq!((rc, v["error"].as_str()), (1, Some("invalid")), "{why}: {v}");
+        let refused = &v["refused"][0];
+        assert_eq!(refused["object"], "0x1400:00", "{v}");
+        assert!(refused["reason"].as_str().unwrap().contains(why), "{why}: {refused}");
+        // The rest of the file is loaded; nothing of RPDO1 is sent.
+        assert_eq!(sent, [(0x1017, 0)], "{why}");
+        assert_eq!(objects(&v, "writes"), ["0x1017:00"]);
+        let text = e_text(run(&d, &format!("dcf load 2 {} --dry-run", path.display())).await);
+        assert!(text.contains("refused 0x1400:00 RPDO1") && text.contains(why), "{text}");
+    }
+}
+
+fn drain(rx: &mut cotui::bus::Subscription) -> Vec<cotui::frame::Frame> {
+    std::iter::from_fn(|| rx.try_recv()).filter_map(Result::ok).collect()
+}
+
+/// The text of a command's outcome or failure.
+fn e_text(r: Result<Outcome, CommandError>) -> String {
+    match r {
+        Ok(o) => o.text,
+        Err(e) => e.to_string(),
+    }
+}

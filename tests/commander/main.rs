@@ -8,7 +8,9 @@
 mod cli_bitrate;
 mod cli_commander;
 mod cli_cyclic;
+mod cli_refusals;
 mod cli_run;
+mod cli_streams;
 mod command_language;
 mod commander_demo;
 mod dcf_demo;

@@ -374,3 +374,20 @@ fn an_eds_without_units_takes_them_from_cia402() {
     assert_eq!(b.dictionary(3).name(0x6072, 0), Some("Max torque (vendor)"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_huge_value_in_a_warning_is_cut_with_its_length() {
+    let v = "1".repeat(10_000);
+    let text = format!(
+        "[DeviceInfo]\nVendorName=x\n\n[MandatoryObjects]\nSupportedObjects=1\n1=0x1000\n\n[1000]\n\
+         ParameterName=Device type\nObjectType=0x7\nDataType=0x0007\nAccessType=ro\nDefaultValue={v}\n\nzz{v}\n"
+    );
+    let (_, warnings) = import("long.eds", &text, 1);
+    let all: Vec<&str> = warnings.iter().map(|w| w.message.as_str()).collect();
+    assert!(all.len() >= 2, "{all:?}");
+    for m in &all {
+        assert!(m.len() < 300, "{m}");
+    }
+    assert!(all.iter().any(|m| m.contains("…` (10002 characters)")), "{all:?}");
+    assert!(all.iter().any(|m| m.contains("…` (10000 characters)")), "{all:?}");
+}

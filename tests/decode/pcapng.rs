@@ -284,8 +284,8 @@ async fn a_pcapng_recording_holds_what_a_candump_recording_of_the_same_bus_holds
         count: Some(80),
         duration_ms: None,
     };
-    let mut a = open_output(log.to_str().unwrap(), WriteMode::New).unwrap();
-    let mut b = open_output(cap.to_str().unwrap(), WriteMode::New).unwrap();
+    let mut a = open_output(log.to_str().unwrap(), WriteMode::New, LogFormat::Candump).unwrap();
+    let mut b = open_output(cap.to_str().unwrap(), WriteMode::New, LogFormat::Pcapng).unwrap();
     let never = || std::future::pending::<()>();
     let (ra, rb) = tokio::join!(
         record(&demo.bus, &mut a, limits, LogFormat::Candump, never(), |_| {}),

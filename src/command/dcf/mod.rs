@@ -119,7 +119,7 @@ impl Sdo<'_> {
 
 /// `dcf save`: reads the node and writes the DCF.
 async fn save(sdo: &mut Sdo<'_>, dict: &Dictionary, output: &str, force: bool) -> Result<Outcome, CommandError> {
-    if !force && std::path::Path::new(output).exists() {
+    if !force && output != "-" && std::path::Path::new(output).exists() {
         return Err(CommandError::Usage(format!(
             "{output} exists; give --force to overwrite it"
         )));
@@ -216,7 +216,7 @@ async fn save(sdo: &mut Sdo<'_>, dict: &Dictionary, output: &str, force: bool) -
         description: format!("configuration of node {} read by cotui", sdo.node),
     };
     let text = crate::od::dcf::write(&info, &entries);
-    std::fs::write(output, text).map_err(|e| CommandError::Usage(format!("cannot write {output}: {e}")))?;
+    crate::command::exec::write_output(output, text.as_bytes())?;
     let saved = Saved {
         ok: true,
         node: sdo.node,
@@ -300,8 +300,23 @@ async fn load(
     dry_run: bool,
 ) -> Result<Outcome, CommandError> {
     let (compared, problems) = compare_node(sdo, dict, file).await?;
-    let groups = plan::load_plan(&compared);
+    // The checks `pdo map` makes, before anything is sent: a refused PDO is left out whole.
+    let invalid = plan::pdo_refusals(&compared, dict);
+    let groups = plan::load_plan(&compared, &invalid);
     let mut l = Loaded::new(sdo.node, file, &compared, problems, dry_run);
+    for r in &invalid {
+        let pdo = crate::decode::pdo_config::PdoId {
+            transmit: r.comm >= 0x1800,
+            num: (r.comm & 0x1FF) + 1,
+        };
+        let mut item = Item::new(r.comm, 0, &pdo.title());
+        item.reason = Some(r.reason.clone());
+        item.note = Some(format!(
+            "nothing of this PDO (0x{:04X}, 0x{:04X}) was sent",
+            r.comm, r.mapping
+        ));
+        l.refused.push(item);
+    }
     let name = |index: u16, sub: u8| {
         compared
             .iter()
@@ -370,10 +385,13 @@ async fn load(
     if l.ok {
         return Ok(Outcome { json, text });
     }
-    let (exit, error) = if l.refused.is_empty() {
-        (ExitCode::Differs, "differs")
-    } else {
+    // An SDO abort first; then a PDO of the file refused before sending (a bad file: usage).
+    let (exit, error) = if l.refused.iter().any(|r| r.abort_code.is_some()) {
         (ExitCode::Abort, "refused")
+    } else if !l.refused.is_empty() {
+        (ExitCode::Usage, "invalid")
+    } else {
+        (ExitCode::Differs, "differs")
     };
     Err(CommandError::Report {
         exit,

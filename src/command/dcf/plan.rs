@@ -395,11 +395,79 @@ fn u32_of(b: &[u8]) -> u32 {
     u32::from_le_bytes(le)
 }
 
+/// A PDO of the file that a load does not touch (nothing of it is sent), and why.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PdoRefused {
+    /// Its communication parameter index (0x1400.., 0x1800..).
+    pub comm: u16,
+    /// Its mapping parameter index (0x1600.., 0x1A00..).
+    pub mapping: u16,
+    pub reason: String,
+}
+
+/// Why the file's configuration of the PDO `(comm, mapping)` must not be loaded: the checks
+/// `pdo map` makes ([`crate::command::pdo::entry_refusal`], [`crate::command::pdo::cob_refusal`]):
+/// at most 64 mapped bits and 64 entries, each entry's length its object's type and the
+/// object mappable in the PDO's direction per `dict`, a COB-ID that is valid and not another
+/// service's. Entries and COB-ID as they would be after the load (the file's, else the node's).
+fn pdo_refusal(compared: &[Compared], dict: &Dictionary, (comm, mapping): (u16, u16)) -> Option<String> {
+    let at = |index: u16, sub: u8| compared.iter().find(|c| c.file.index == index && c.file.sub == sub);
+    let differs = |index: u16, sub: u8| at(index, sub).is_some_and(|c| c.state == State::Differs);
+    if differs(comm, 1)
+        && let Some(why) = at(comm, 1).and_then(|c| crate::command::pdo::cob_refusal(u32_of(&c.file.bytes)))
+    {
+        return Some(why);
+    }
+    if !compared
+        .iter()
+        .any(|c| c.file.index == mapping && c.state == State::Differs)
+    {
+        return None;
+    }
+    let count = at(mapping, 0).and_then(|c| c.file.bytes.first().copied()).unwrap_or(0);
+    if count > 64 {
+        return Some(format!("0x{mapping:04X}:00 maps {count} entries, more than 64"));
+    }
+    let transmit = comm >= 0x1800;
+    let mut total = 0u32;
+    for sub in 1..=count {
+        // An entry the file does not give keeps the node's value, which the node accepted.
+        let Some(c) = at(mapping, sub) else { continue };
+        let e = crate::decode::pdo::entry_from_u32(u32_of(&c.file.bytes));
+        total += u32::from(e.bits);
+        if let Some(why) = crate::command::pdo::entry_refusal(dict, transmit, (e.index, e.sub), e.bits, false) {
+            return Some(format!(
+                "entry {sub} (0x{:04X}:{:02X}, {} bits): {why}",
+                e.index, e.sub, e.bits
+            ));
+        }
+    }
+    (total > 64).then(|| format!("{count} entries map {total} bits, more than the 64 bits a PDO carries"))
+}
+
+/// The PDOs of the file a load refuses ([`pdo_refusal`]), before anything is sent.
+pub fn pdo_refusals(compared: &[Compared], dict: &Dictionary) -> Vec<PdoRefused> {
+    let pdos: BTreeSet<(u16, u16)> = compared
+        .iter()
+        .filter(|c| c.state == State::Differs)
+        .filter_map(|c| pdo_of(c.file.index))
+        .collect();
+    pdos.into_iter()
+        .filter_map(|pdo| {
+            pdo_refusal(compared, dict, pdo).map(|reason| PdoRefused {
+                comm: pdo.0,
+                mapping: pdo.1,
+                reason,
+            })
+        })
+        .collect()
+}
+
 /// The writes of a load, in an order that works: application objects first (index order),
 /// then the communication objects 0x1000-0x1FFF, each PDO's communication and mapping
 /// parameters together by the sequence `pdo map` writes too ([`remap_sequence`]; RPDOs,
-/// then TPDOs) last.
-pub fn load_plan(compared: &[Compared]) -> Vec<Vec<Write>> {
+/// then TPDOs) last. The PDOs in `refused` are left out whole.
+pub fn load_plan(compared: &[Compared], refused: &[PdoRefused]) -> Vec<Vec<Write>> {
     let value = |c: &Compared| Write {
         index: c.file.index,
         sub: c.file.sub,
@@ -420,6 +488,9 @@ pub fn load_plan(compared: &[Compared]) -> Vec<Vec<Write>> {
     let mut pdos: BTreeSet<(u16, u16)> = BTreeSet::new();
     pdos.extend(compared.iter().filter(differs).filter_map(|c| pdo_of(c.file.index)));
     for (comm, mapping) in pdos {
+        if refused.iter().any(|r| r.comm == comm) {
+            continue;
+        }
         let at = |index: u16, sub: u8| compared.iter().find(|c| c.file.index == index && c.file.sub == sub);
         let mapping_changes = compared
             .iter()
@@ -585,7 +656,7 @@ mod tests {
         ]
         .into_iter()
         .collect();
-        let plan = load_plan(&compare(&values, &reads));
+        let plan = load_plan(&compare(&values, &reads), &[]);
         let order: Vec<Vec<(u16, u8, Step)>> = plan
             .iter()
             .map(|g| g.iter().map(|w| (w.index, w.sub, w.step)).collect())

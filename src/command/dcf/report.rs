@@ -334,7 +334,8 @@ impl Loaded {
         }
         for r in &self.refused {
             let note = r.note.as_deref().map(|n| format!("; {n}")).unwrap_or_default();
-            lines.push(format!("  refused {}{}{note}", r.label(), r.abort_suffix()));
+            let why = r.reason.as_deref().map(|w| format!(": {w}")).unwrap_or_default();
+            lines.push(format!("  refused {}{}{why}{note}", r.label(), r.abort_suffix()));
         }
         for n in &self.not_verified {
             lines.push(format!(

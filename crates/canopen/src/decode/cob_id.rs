@@ -128,9 +128,52 @@ pub fn is_reserved(id: u32) -> bool {
         && !matches!(id, 0x7E4 | 0x7E5)
 }
 
+/// What an 11-bit COB-ID is reserved for, when a PDO or a SYNC producer is to be given it:
+/// a service of the predefined connection set whose id is fixed, or that every node uses
+/// (NMT, SYNC, EMCY, TIME, SDO, heartbeat, LSS), or an id CiA 301 restricts (7.3.5,
+/// "restricted CAN-IDs"). `None` for a free id (a PDO's own range, or 29-bit ids, which
+/// the predefined set does not use). The text names the owner: `node 2's SDO request`.
+pub fn reserved_for(id: u32) -> Option<String> {
+    let node = id & 0x7F;
+    Some(match id {
+        0x000 => "NMT (node control)".into(),
+        0x080 => "SYNC".into(),
+        0x081..=0x0FF => format!("node {node}'s EMCY"),
+        0x100 => "TIME".into(),
+        0x581..=0x5FF => format!("node {node}'s SDO response"),
+        0x601..=0x67F => format!("node {node}'s SDO request"),
+        0x701..=0x77F => format!("node {node}'s heartbeat (NMT error control)"),
+        0x7E4 => "LSS (slave to master)".into(),
+        0x7E5 => "LSS (master to slave)".into(),
+        _ if id <= 0x7FF && is_reserved(id) => "restricted by CiA 301".into(),
+        _ => return None,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn reserved_ids_name_their_owner() {
+        assert_eq!(reserved_for(0x602).as_deref(), Some("node 2's SDO request"));
+        assert_eq!(reserved_for(0x5FF).as_deref(), Some("node 127's SDO response"));
+        assert_eq!(reserved_for(0x080).as_deref(), Some("SYNC"));
+        assert_eq!(reserved_for(0x085).as_deref(), Some("node 5's EMCY"));
+        assert_eq!(reserved_for(0x000).as_deref(), Some("NMT (node control)"));
+        assert_eq!(reserved_for(0x100).as_deref(), Some("TIME"));
+        assert_eq!(
+            reserved_for(0x77F).as_deref(),
+            Some("node 127's heartbeat (NMT error control)")
+        );
+        assert!(reserved_for(0x7E4).unwrap().starts_with("LSS"));
+        assert!(reserved_for(0x7E5).unwrap().starts_with("LSS"));
+        assert_eq!(reserved_for(0x050).as_deref(), Some("restricted by CiA 301"));
+        assert_eq!(reserved_for(0x6E0).as_deref(), Some("restricted by CiA 301"));
+        for free in [0x181, 0x1FF, 0x202, 0x57F, 0x680, 0x6DF, 0x12345, 0x602 | 0x1000] {
+            assert_eq!(reserved_for(free), None, "{free:#x}");
+        }
+    }
 
     #[test]
     fn predefined_set() {

@@ -183,12 +183,44 @@ struct Importer<'a> {
     lines: BTreeMap<(u16, u8), usize>,
 }
 
+/// The longest text quoted in a warning (between backticks) before it is cut.
+const QUOTE_MAX: usize = 60;
+
+/// `message` with every text between backticks longer than [`QUOTE_MAX`] characters cut to
+/// its start, an ellipsis and its length (`` `1111…` (10000 characters) ``): a warning names
+/// the value, it does not repeat a huge one.
+fn clip_quoted(message: String) -> String {
+    if message.len() <= QUOTE_MAX {
+        return message;
+    }
+    let parts: Vec<&str> = message.split('`').collect();
+    let mut out = String::with_capacity(message.len().min(512));
+    for (i, part) in parts.iter().enumerate() {
+        if i % 2 == 0 {
+            out.push_str(part);
+            continue;
+        }
+        let n = part.chars().count();
+        if n > QUOTE_MAX {
+            let head: String = part.chars().take(QUOTE_MAX - 20).collect();
+            out.push_str(&format!("`{head}…` ({n} characters)"));
+        } else {
+            out.push('`');
+            out.push_str(part);
+            if i + 1 < parts.len() {
+                out.push('`');
+            }
+        }
+    }
+    out
+}
+
 impl Importer<'_> {
     fn warn(&mut self, line: usize, message: impl Into<String>) {
         self.warnings.push(Warning {
             file: self.file.to_string(),
             at: format!("line {line}"),
-            message: message.into(),
+            message: clip_quoted(message.into()),
         });
     }
 
