@@ -14,6 +14,7 @@ mod cli_streams;
 mod command_language;
 mod commander_demo;
 mod dcf_demo;
+mod json_snapshots;
 mod every_procedure;
 mod lss_sim;
 mod pdo_config;
