@@ -106,6 +106,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
         }
     };
     let mut summary = Summary::default();
+    let mut names = Vec::new();
     let mut status = ExitCode::Ok;
     for path in &args.files {
         let Some(input) = input::open_input(path, "decode") else {
@@ -115,6 +116,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
         let mut sinks = Sinks {
             summary: &mut summary,
             events: &mut events,
+            names: &mut names,
         };
         match decode_stream(path, input, &mut decoder, mode, &mut sinks, &mut out) {
             Ok(()) => {}
@@ -125,7 +127,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
             }
         }
     }
-    let result = finish(&mut decoder, mode, &mut summary, &mut out).and_then(|_| out.flush());
+    let result = finish(&mut decoder, mode, &mut summary, &names, &mut out).and_then(|_| out.flush());
     match result {
         Err(e) if e.kind() != io::ErrorKind::BrokenPipe => {
             eprintln!("cotui decode: {e}");
@@ -139,6 +141,23 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
 struct Sinks<'a> {
     summary: &'a mut Summary,
     events: &'a mut EventTracker,
+    /// Interface names of the input so far (see [`note_interfaces`]).
+    names: &'a mut Vec<String>,
+}
+
+/// Keeps `names` up with a source's interface table (which grows as names appear).
+pub(super) fn note_interfaces(names: &mut Vec<String>, ifaces: &crate::frame::Interfaces) {
+    let all = ifaces.names();
+    if all.len() > names.len() {
+        names.extend(all[names.len()..].iter().cloned());
+    }
+}
+
+/// The interface name shown with a node-level record (event, transaction, summary row):
+/// only when the input has several interfaces, so that node 5 of can0 and node 5 of can1
+/// tell apart; a capture of one interface prints as it always did.
+pub(super) fn shown_iface(names: &[String], iface: u16) -> Option<&str> {
+    (names.len() > 1).then(|| names.get(usize::from(iface)).map_or("?", String::as_str))
 }
 
 /// Decodes one input into `out` (parsing runs on a second thread).
@@ -157,11 +176,13 @@ fn decode_stream(
     let mut label = String::new();
     let counts = input::for_each_frame(path, input, |frames| {
         let ifaces = frames.ifaces;
+        note_interfaces(sinks.names, ifaces);
+        sinks.summary.name_interfaces(ifaces);
         for (line, frame) in frames {
             match mode {
                 Mode::Summary(_) => {
                     let (kind, node) = decoder.classify(frame);
-                    sinks.summary.add(kind, node);
+                    sinks.summary.add_on(frame.iface, kind, node);
                 }
                 Mode::Events(fmt) => {
                     let events = &mut *sinks.events;
@@ -177,11 +198,12 @@ fn decode_stream(
                         events.transaction(&t);
                     }
                     for e in events.take_events() {
+                        let iface = shown_iface(sinks.names, e.iface);
                         match fmt {
-                            OutputFormat::Text => e.write_line(&mut buf),
+                            OutputFormat::Text => e.write_line_on(&mut buf, iface),
                             // (pcapng and parquet never reach here: they are refused with --events)
                             OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => {
-                                e.write_json(&mut json)
+                                e.write_json_on(&mut json, iface)
                             }
                         }
                     }
@@ -199,7 +221,8 @@ fn decode_stream(
                 Mode::Transactions(fmt) => {
                     decoder.track(frame);
                     for t in decoder.take_transactions() {
-                        write_transaction(&mut json, &mut label, &t, decoder.dictionary(t.node), fmt);
+                        let iface = shown_iface(sinks.names, t.iface);
+                        write_transaction(&mut json, &mut label, &t, decoder.dictionary(t.node), iface, fmt);
                     }
                 }
             }
@@ -225,16 +248,28 @@ pub(super) fn write_transaction(
     label: &mut String,
     t: &Transaction,
     dict: &Dictionary,
+    iface: Option<&str>,
     fmt: OutputFormat,
 ) {
     match fmt {
         OutputFormat::Text => {
             label.clear();
+            // Several interfaces: `can1 node 2: Upload 0x6041:00 ...`.
+            if let Some(i) = iface {
+                label.push_str(i);
+                label.push_str(" node ");
+                label.push_str(&t.node.to_string());
+                label.push_str(": ");
+            }
             t.write_label(label, dict);
             out.extend_from_slice(label.as_bytes());
             out.push(b'\n');
         }
-        OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => write_line(out, &t.to_json(dict)),
+        OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => {
+            let mut j = t.to_json(dict);
+            j.iface = iface;
+            write_line(out, &j)
+        }
     }
 }
 
@@ -248,13 +283,20 @@ pub(super) fn write_summary(out: &mut Vec<u8>, summary: &mut Summary, fmt: Outpu
 }
 
 /// Writes what is due at the end of all inputs.
-fn finish(decoder: &mut Decoder, mode: Mode, summary: &mut Summary, out: &mut impl Write) -> io::Result<()> {
+fn finish(
+    decoder: &mut Decoder,
+    mode: Mode,
+    summary: &mut Summary,
+    names: &[String],
+    out: &mut impl Write,
+) -> io::Result<()> {
     let mut buf = Vec::new();
     match mode {
         Mode::Transactions(fmt) => {
             let mut label = String::new();
             for t in decoder.finish() {
-                write_transaction(&mut buf, &mut label, &t, decoder.dictionary(t.node), fmt);
+                let iface = shown_iface(names, t.iface);
+                write_transaction(&mut buf, &mut label, &t, decoder.dictionary(t.node), iface, fmt);
             }
         }
         Mode::Summary(fmt) => write_summary(&mut buf, summary, fmt),
