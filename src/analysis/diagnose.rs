@@ -189,7 +189,7 @@ pub struct Diagnoser {
     ifaces_seen: u16,
     /// The dictionaries' sync windows (ns) and TPDO transmission types per node-ID: each
     /// interface's nodes start from them.
-    defaults: Vec<(u8, Option<u64>, Vec<(u16, u8)>)>,
+    defaults: Vec<NodeDefaults>,
 }
 
 /// Index offset of `axis` (1-based) in the CiA 402 range.
@@ -200,6 +200,9 @@ fn axis_of(index: u16, base: u16) -> Option<u8> {
 
 /// A dictionary's default sync window (µs) and TPDO transmission types (PDO number, type).
 type SyncDefaults = (Option<u64>, Vec<(u16, u8)>);
+
+/// A node-ID's default sync window (ns) and TPDO transmission types, for each interface.
+type NodeDefaults = (u8, Option<u64>, Vec<(u16, u8)>);
 
 /// The sync window (0x1007, µs) and the transmission types of the TPDOs (0x1800.. sub 2)
 /// that `dict` gives as default values (EDS `DefaultValue`, profile `default`).
@@ -1572,7 +1575,11 @@ impl Diagnoser {
         let first = self.nodes.keys().next().map(|k| k.iface);
         if self.nodes.keys().any(|k| Some(k.iface) != first) {
             for inc in out.iter_mut().filter(|i| i.node.is_some()) {
-                inc.iface_name = self.iface_names.get(inc.iface as usize).filter(|n| !n.is_empty()).cloned();
+                inc.iface_name = self
+                    .iface_names
+                    .get(inc.iface as usize)
+                    .filter(|n| !n.is_empty())
+                    .cloned();
             }
         }
         out

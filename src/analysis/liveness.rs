@@ -186,7 +186,12 @@ impl EventTracker {
             Some(k) => (Some(k.node), k.iface),
             None => (None, 0),
         };
-        self.events.push(Event { t_ns, node, iface, what });
+        self.events.push(Event {
+            t_ns,
+            node,
+            iface,
+            what,
+        });
     }
 
     /// Takes note of `node`'s deadline after a change.

@@ -121,7 +121,12 @@ impl Nodes {
     /// A node by node-ID alone, on the first interface that has it: for what addresses the
     /// bus of a live session (one interface), e.g. the drive state stop-all and quit check.
     pub fn by_id(&self, node: u8) -> Option<&NodeInfo> {
-        let first = self.map.keys().chain(self.candidates.keys()).filter(|k| k.node == node).min()?;
+        let first = self
+            .map
+            .keys()
+            .chain(self.candidates.keys())
+            .filter(|k| k.node == node)
+            .min()?;
         self.get(*first)
     }
     /// Frames of node-IDs without CANopen evidence: "other" traffic, not nodes.

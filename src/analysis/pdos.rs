@@ -3,9 +3,9 @@
 //! parameters in words and its mapping. Built for the rows asked for only.
 
 use crate::decode::Decoder;
-use crate::frame::NodeKey;
 use crate::decode::pdo::source_text;
 use crate::decode::pdo_config::{CommParams, PdoId, event_text, inhibit_text, sync_start_text, transmission_text};
+use crate::frame::NodeKey;
 use crate::od::{MappingSource, PdoMapping};
 
 /// One PDO of one node as the decoder knows it.

@@ -411,9 +411,7 @@ impl Decoder {
         let bus = self.bus(frame.iface);
         // Most buses move no SDO channel: skip hashing the id then.
         if !bus.sdo_cobs.is_empty()
-            && let Some(&(node, c2s)) = bus
-                .sdo_cobs
-                .get(&(frame.id | if frame.is_ext() { 1 << 29 } else { 0 }))
+            && let Some(&(node, c2s)) = bus.sdo_cobs.get(&(frame.id | if frame.is_ext() { 1 << 29 } else { 0 }))
         {
             let kind = if c2s { Kind::SdoRx } else { Kind::SdoTx };
             return Route {
@@ -486,9 +484,11 @@ impl Decoder {
                 let tracked = self.track_sdo(frame, route);
                 let mut s = labelled(tracked, payload, &self.dicts[n as usize]);
                 // Controlword and statusword bits are named per the node's mode in force.
-                if let (Some(mode), Some((index @ (0x6040 | 0x6041), 0)), Some(v)) =
-                    (self.bus(frame.iface).modes[n as usize & 0x7F], s.object, s.value.as_mut())
-                    && let Some(typed) = &v.typed
+                if let (Some(mode), Some((index @ (0x6040 | 0x6041), 0)), Some(v)) = (
+                    self.bus(frame.iface).modes[n as usize & 0x7F],
+                    s.object,
+                    s.value.as_mut(),
+                ) && let Some(typed) = &v.typed
                 {
                     v.text = value_text::object_text(&self.dicts[n as usize], index, 0, typed, Some(mode));
                 }

@@ -153,7 +153,10 @@ impl NodeKey {
     }
     /// Node `node` on the interface `frame` came from.
     pub const fn of(frame: &Frame, node: u8) -> NodeKey {
-        NodeKey { iface: frame.iface, node }
+        NodeKey {
+            iface: frame.iface,
+            node,
+        }
     }
 }
 

@@ -38,7 +38,8 @@ impl Summary {
         if let Some(n) = node {
             let i = usize::from(iface) * 128 + usize::from(n & 0x7F);
             if i >= self.node_counts.len() {
-                self.node_counts.resize((usize::from(iface) + 1) * 128, [0; Kind::ALL.len()]);
+                self.node_counts
+                    .resize((usize::from(iface) + 1) * 128, [0; Kind::ALL.len()]);
             }
             self.node_counts[i][k] += 1;
         }
@@ -92,7 +93,11 @@ impl Summary {
             let total: u64 = kinds.values().sum();
             let parts: Vec<String> = kinds.iter().map(|(k, n)| format!("{}={n}", k.as_str())).collect();
             match self.iface_of(*node) {
-                Some(iface) => s.push_str(&format!("  {iface} node {:<3} {total:>10}  {}\n", node.node, parts.join(" "))),
+                Some(iface) => s.push_str(&format!(
+                    "  {iface} node {:<3} {total:>10}  {}\n",
+                    node.node,
+                    parts.join(" ")
+                )),
                 None => s.push_str(&format!("  node {:<3} {total:>10}  {}\n", node.node, parts.join(" "))),
             }
         }

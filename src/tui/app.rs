@@ -1566,8 +1566,20 @@ mod tests {
         a.ingest(Duration::from_millis(100));
         let taken = Instant::now();
         // Node 2 (heartbeats every 14 ms in the capture) was found lost by these frames.
-        assert!(a.trace.nodes.liveness(crate::frame::NodeKey::new(0, 2)).unwrap().is_lost());
-        assert!(!a.trace.nodes.liveness(crate::frame::NodeKey::new(0, 5)).unwrap().is_lost());
+        assert!(
+            a.trace
+                .nodes
+                .liveness(crate::frame::NodeKey::new(0, 2))
+                .unwrap()
+                .is_lost()
+        );
+        assert!(
+            !a.trace
+                .nodes
+                .liveness(crate::frame::NodeKey::new(0, 5))
+                .unwrap()
+                .is_lost()
+        );
         // No frame comes for a second of wall time: node 5 (every 100 ms) is lost too,
         // dated 150 ms after its last heartbeat.
         a.liveness_tick(taken + Duration::from_secs(1));

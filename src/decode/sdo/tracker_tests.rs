@@ -52,8 +52,14 @@ impl Bus {
     }
     fn send(&mut self, node: u8, c2s: bool, bytes: &[u8]) -> SdoFrame {
         self.seq += 1;
-        self.t
-            .on_frame(self.seq, self.seq * 1_000_000, NodeKey::new(0, node), c2s, bytes, &self.dict)
+        self.t.on_frame(
+            self.seq,
+            self.seq * 1_000_000,
+            NodeKey::new(0, node),
+            c2s,
+            bytes,
+            &self.dict,
+        )
     }
     fn c(&mut self, node: u8, bytes: &[u8]) -> SdoFrame {
         self.send(node, true, bytes)
