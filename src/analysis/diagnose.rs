@@ -19,7 +19,7 @@ use crate::decode::heartbeat::NmtState;
 use crate::decode::sdo::frame::{Chunk8, SdoFrame};
 use crate::decode::stall::{self, Observation, Step};
 use crate::decode::{Body, Decoded, Decoder, Kind};
-use crate::frame::{Flags, Frame};
+use crate::frame::{Flags, Frame, NodeKey};
 use crate::od::{Dictionary, PdoMapping};
 use crate::sdo::abort::{AbortClass, abort_class, abort_text};
 use crate::sdo::codec::{SdoCommand, Side};
@@ -165,30 +165,39 @@ pub struct Diagnoser {
     /// The capture time reached by [`Diagnoser::tick`] (ns), 0 before any tick.
     now: u64,
     first_ns: Option<u64>,
-    nodes: BTreeMap<u8, Node>,
+    nodes: BTreeMap<NodeKey, Node>,
     incidents: Vec<Incident>,
-    keyed: HashMap<(Option<u8>, Problem, u32), usize>,
+    keyed: HashMap<(Option<NodeKey>, Problem, u32), usize>,
     faults: HashMap<usize, FaultMeta>,
     /// The abort codes and directions of each SDO incident.
     aborts: HashMap<usize, SdoAborts>,
     error_frames: u64,
     bus_state: BTreeMap<String, &'static str>,
     sdo_deadline: Option<u64>,
-    /// The last NMT reset addressed to all nodes.
-    reset_all: Option<u64>,
+    /// The last NMT reset addressed to all nodes, per interface.
+    reset_all: BTreeMap<u16, u64>,
     /// Longest silence per node that came back (ms).
-    silent_max: BTreeMap<u8, f64>,
+    silent_max: BTreeMap<NodeKey, f64>,
     sync: SyncTiming,
     pdos: PdoTiming,
     /// The incident of each PDO that stopped, while it is missing.
     pdo_gaps: HashMap<PdoKey, usize>,
     /// The profile's "check first" steps for the EMCY code of an incident.
     device_check: HashMap<usize, Vec<String>>,
-    /// The last NMT command: when, command specifier, target.
-    last_nmt: Option<(At, u8, u8)>,
+    /// The last NMT command: when, command specifier, target, interface.
+    last_nmt: Option<(At, u8, u8, u16)>,
     /// The synchronous window length 0x1007 written to each node (ns), and the last SYNC.
-    sync_window: BTreeMap<u8, u64>,
+    sync_window: BTreeMap<NodeKey, u64>,
     last_sync: Option<At>,
+    /// The interface of the frame being read (index into the source's table).
+    iface: u16,
+    /// Interface names by index, as far as known (to name nodes when there are several).
+    iface_names: Vec<String>,
+    /// Interfaces seen so far: their nodes got the dictionaries' defaults.
+    ifaces_seen: u16,
+    /// The dictionaries' sync windows (ns) and TPDO transmission types per node-ID: each
+    /// interface's nodes start from them.
+    defaults: Vec<NodeDefaults>,
 }
 
 /// Index offset of `axis` (1-based) in the CiA 402 range.
@@ -199,6 +208,9 @@ fn axis_of(index: u16, base: u16) -> Option<u8> {
 
 /// A dictionary's default sync window (µs) and TPDO transmission types (PDO number, type).
 type SyncDefaults = (Option<u64>, Vec<(u16, u8)>);
+
+/// A node-ID's default sync window (ns) and TPDO transmission types, for each interface.
+type NodeDefaults = (u8, Option<u64>, Vec<(u16, u8)>);
 
 /// The sync window (0x1007, µs) and the transmission types of the TPDOs (0x1800.. sub 2)
 /// that `dict` gives as default values (EDS `DefaultValue`, profile `default`).
@@ -248,6 +260,7 @@ pub fn feed(
     iface: &str,
 ) -> Option<Decoded> {
     let (kind, node, pdo) = peeked;
+    diag.name_interface(frame.iface, iface);
     let skip = match kind {
         Kind::Sync | Kind::Time | Kind::Lss | Kind::Other => true,
         Kind::SdoRx | Kind::SdoTx => {
@@ -256,7 +269,7 @@ pub fn feed(
             return None;
         }
         Kind::Tpdo | Kind::Rpdo => {
-            let n = node.unwrap_or(0);
+            let n = NodeKey::of(frame, node.unwrap_or(0));
             !diag.wants_pdo(n, pdo, decoder.mapping(n, kind == Kind::Tpdo, pdo))
         }
         _ => false,
@@ -289,14 +302,38 @@ impl Diagnoser {
                 }
             };
             let (window, types) = &seen[known].1;
-            if let Some(us) = window {
-                d.sync_window.insert(n, us * 1000);
-            }
-            for (num, t) in types {
-                d.pdos.transmission_type((n, true, *num), *t);
+            if window.is_some() || !types.is_empty() {
+                d.defaults.push((n, window.map(|us| us * 1000), types.clone()));
             }
         }
+        d.apply_defaults(0);
+        d.ifaces_seen = 1;
         d
+    }
+
+    /// The nodes of interface `iface` start from the dictionaries' defaults.
+    fn apply_defaults(&mut self, iface: u16) {
+        for (n, window, types) in &self.defaults {
+            let key = NodeKey::new(iface, *n);
+            if let Some(ns) = window {
+                self.sync_window.insert(key, *ns);
+            }
+            for (num, t) in types {
+                self.pdos.transmission_type((key, true, *num), *t);
+            }
+        }
+    }
+
+    /// Names interface `iface` (as the frames of the source call it); a node of a capture
+    /// with several interfaces is then shown with its interface's name.
+    pub fn name_interface(&mut self, iface: u16, name: &str) {
+        let i = iface as usize;
+        if i >= self.iface_names.len() {
+            self.iface_names.resize(i + 1, String::new());
+        }
+        if self.iface_names[i].is_empty() {
+            self.iface_names[i] = name.to_string();
+        }
     }
 
     fn with_tracker(tracker: EventTracker) -> Diagnoser {
@@ -314,7 +351,7 @@ impl Diagnoser {
             bus_state: BTreeMap::new(),
             sdo_deadline: None,
             silent_max: BTreeMap::new(),
-            reset_all: None,
+            reset_all: BTreeMap::new(),
             sync: SyncTiming::default(),
             pdos: PdoTiming::default(),
             pdo_gaps: HashMap::new(),
@@ -322,6 +359,10 @@ impl Diagnoser {
             last_nmt: None,
             sync_window: BTreeMap::new(),
             last_sync: None,
+            iface: 0,
+            iface_names: Vec::new(),
+            ifaces_seen: 0,
+            defaults: Vec::new(),
         }
     }
 
@@ -335,13 +376,15 @@ impl Diagnoser {
         self.at.frame
     }
 
-    fn node(&mut self, n: u8) -> &mut Node {
+    fn node(&mut self, n: NodeKey) -> &mut Node {
         self.nodes.entry(n).or_default()
     }
 
-    fn open(&mut self, node: Option<u8>, problem: Problem, t: u64) -> usize {
+    fn open(&mut self, node: Option<NodeKey>, problem: Problem, t: u64) -> usize {
         self.incidents.push(Incident {
-            node,
+            node: node.map(|k| k.node),
+            iface: node.map_or(0, |k| k.iface),
+            iface_name: None,
             axes: Vec::new(),
             problem,
             status: Status::Open,
@@ -358,7 +401,7 @@ impl Diagnoser {
     }
 
     /// The incident for `key`, made on first use; counts one more occurrence at `t`.
-    fn grouped(&mut self, node: Option<u8>, problem: Problem, detail: u32, t: u64) -> usize {
+    fn grouped(&mut self, node: Option<NodeKey>, problem: Problem, detail: u32, t: u64) -> usize {
         let i = match self.keyed.get(&(node, problem, detail)) {
             Some(i) => *i,
             None => {
@@ -390,6 +433,10 @@ impl Diagnoser {
     /// Frame number and time advance to `frame`'s.
     #[inline]
     fn advance(&mut self, frame: &Frame) {
+        self.iface = frame.iface;
+        if frame.iface >= self.ifaces_seen {
+            self.new_interfaces(frame.iface);
+        }
         self.at = At {
             frame: self.at.frame + 1,
             t: frame.ts_ns,
@@ -399,6 +446,15 @@ impl Diagnoser {
             self.sdo_timeouts(frame.ts_ns);
         }
         self.pdos_due(frame.ts_ns);
+    }
+
+    /// Interfaces up to `iface` are seen: their nodes get the dictionaries' defaults.
+    #[cold]
+    fn new_interfaces(&mut self, iface: u16) {
+        for i in self.ifaces_seen..=iface {
+            self.apply_defaults(i);
+        }
+        self.ifaces_seen = iface.saturating_add(1);
     }
 
     /// PDOs overdue at `now` become (or add to) incidents.
@@ -466,7 +522,7 @@ impl Diagnoser {
     }
 
     /// A PDO of `node` arrived (number `num`, TPDO when `transmit`).
-    fn pdo_arrived(&mut self, node: u8, transmit: bool, num: u16) {
+    fn pdo_arrived(&mut self, node: NodeKey, transmit: bool, num: u16) {
         let at = self.at;
         if transmit
             && let (Some(&window), Some(sync)) = (self.sync_window.get(&node), self.last_sync)
@@ -495,7 +551,7 @@ impl Diagnoser {
     /// True when a PDO of `node` can tell the diagnosis something: its `mapping` holds a
     /// CiA 402 controlword, statusword or error code, or (mapping unknown) it is the
     /// predefined TPDO1/RPDO1 of a CiA 402 device. Other PDOs need no decoding.
-    pub fn wants_pdo(&self, node: u8, num: u16, mapping: Option<&PdoMapping>) -> bool {
+    pub fn wants_pdo(&self, node: NodeKey, num: u16, mapping: Option<&PdoMapping>) -> bool {
         match mapping {
             Some(m) => m
                 .entries
@@ -513,6 +569,7 @@ impl Diagnoser {
         self.advance(frame);
         self.tracker.tick(frame.ts_ns);
         self.take_events();
+        let node = node.map(|n| NodeKey::of(frame, n));
         match (kind, node) {
             (Kind::Sync, _) => {
                 self.sync.sync(self.at.frame, frame.ts_ns);
@@ -531,6 +588,7 @@ impl Diagnoser {
 
     /// One frame, in capture order, with its decoding; `iface` names its interface.
     pub fn frame(&mut self, frame: &Frame, iface: &str, d: &Decoded) {
+        self.name_interface(frame.iface, iface);
         self.advance(frame);
         self.tracker.frame(frame, iface, d);
         self.take_events();
@@ -547,6 +605,7 @@ impl Diagnoser {
             }
             return;
         };
+        let n = NodeKey::of(frame, n);
         let at = self.at;
         if matches!(d.kind, Kind::Tpdo | Kind::SdoTx | Kind::Emcy)
             || matches!(&d.body, Body::Heartbeat(h) if !h.request)
@@ -600,6 +659,7 @@ impl Diagnoser {
     /// vendor command of the node's profile): the cheap twin of [`Diagnoser::frame`] for
     /// SDO frames, which needs no label. `to_node` tells a client request.
     pub fn sdo(&mut self, frame: &Frame, n: u8, to_node: bool, s: Option<&SdoFrame>) {
+        let n = NodeKey::of(frame, n);
         self.advance(frame);
         self.tracker.tick(frame.ts_ns);
         self.take_events();
@@ -615,7 +675,7 @@ impl Diagnoser {
     }
 
     /// `ours`: the frame is TX-marked (sent by the capturing host).
-    fn sdo_body(&mut self, n: u8, s: &SdoFrame, ours: bool) {
+    fn sdo_body(&mut self, n: NodeKey, s: &SdoFrame, ours: bool) {
         let at = self.at;
         if s.side == Side::Server {
             let node = self.node(n);
@@ -679,7 +739,7 @@ impl Diagnoser {
     /// A statusword `sw` of an axis asked to change state: reached (a stuck incident
     /// recovers), a fault (the fault incident tells it), or still not there after
     /// [`STALL_NS`]: the drive is stuck, with the reason the bus shows.
-    fn stall(&mut self, n: u8, axis: u8, sw: u16, state: DriveState) {
+    fn stall(&mut self, n: NodeKey, axis: u8, sw: u16, state: DriveState) {
         let at = self.at;
         let nmt = self.nodes.get(&n).and_then(|d| d.last_state.map(|(_, s)| s));
         let emcy = self.nodes.get(&n).and_then(|d| d.last_emcy);
@@ -715,7 +775,7 @@ impl Diagnoser {
             emcy,
             ..Observation::default()
         };
-        let reason = stall::diagnose(n, &step, &obs);
+        let reason = stall::diagnose(n.node, &step, &obs);
         let detail = (u32::from(axis) << 8) | u32::from(step.controlword as u8);
         let i = self.grouped(Some(n), Problem::DriveStuck, detail, asked.t);
         let inc = &mut self.incidents[i];
@@ -753,7 +813,7 @@ impl Diagnoser {
     /// An SDO request for `index:sub` to node `n` while another one is going on (sent
     /// just before and not answered, or a segmented transfer in mid-flow): two clients.
     /// True when it is one.
-    fn overlapping_request(&mut self, n: u8, index: u16, sub: u8) -> bool {
+    fn overlapping_request(&mut self, n: NodeKey, index: u16, sub: u8) -> bool {
         let at = self.at;
         let node = self.node(n);
         let young = |a: At| at.t.saturating_sub(a.t) < TWO_MASTERS_NS;
@@ -781,7 +841,7 @@ impl Diagnoser {
     /// interleaving. A retry after a timeout repeats the bit too, but much later; the same
     /// download segment again (same bytes) is a retransmission or a frame captured twice;
     /// and equal times (a log without timestamps) say nothing.
-    fn segment_request(&mut self, n: u8, toggle: bool, data: Option<Chunk8>) {
+    fn segment_request(&mut self, n: NodeKey, toggle: bool, data: Option<Chunk8>) {
         let at = self.at;
         let young = |a: At| at.t > a.t && at.t - a.t < TWO_MASTERS_NS;
         let Some(prev) = self.node(n).segment.replace(Segment {
@@ -810,7 +870,7 @@ impl Diagnoser {
         self.second_master(Some(n), "SDO segments of two clients interleave", at, what);
     }
 
-    fn second_master(&mut self, node: Option<u8>, cause: &str, at: At, what: String) {
+    fn second_master(&mut self, node: Option<NodeKey>, cause: &str, at: At, what: String) {
         let i = self.grouped(node, Problem::SecondMaster, 0, at.t);
         let inc = &mut self.incidents[i];
         inc.status = Status::Warning;
@@ -823,7 +883,7 @@ impl Diagnoser {
     }
 
     /// A CiA 402 object value of `node` (from a PDO or an SDO transfer).
-    fn drive_word(&mut self, n: u8, index: u16, w: u16) {
+    fn drive_word(&mut self, n: NodeKey, index: u16, w: u16) {
         if let Some(axis) = axis_of(index, 0x6041) {
             self.statusword(n, axis, w);
         } else if let Some(axis) = axis_of(index, 0x6040) {
@@ -847,7 +907,7 @@ impl Diagnoser {
         }
     }
 
-    fn statusword(&mut self, n: u8, axis: u8, sw: u16) {
+    fn statusword(&mut self, n: NodeKey, axis: u8, sw: u16) {
         let at = self.at;
         let state = DriveState::from_statusword(sw);
         self.stall(n, axis, sw, state);
@@ -912,7 +972,7 @@ impl Diagnoser {
         }
     }
 
-    fn controlword(&mut self, n: u8, axis: u8, cw: u16) {
+    fn controlword(&mut self, n: NodeKey, axis: u8, cw: u16) {
         let at = self.at;
         let ax = self.node(n).axes.entry(axis).or_default().clone();
         if ax.cw != Some(cw)
@@ -948,7 +1008,7 @@ impl Diagnoser {
         self.step(i, at, text);
     }
 
-    fn emcy(&mut self, n: u8, e: &Emcy) {
+    fn emcy(&mut self, n: NodeKey, e: &Emcy) {
         let at = self.at;
         self.node(n).last_emcy = Some(e.code);
         self.flush_emcy(n, at.t.saturating_sub(EMCY_CAUSE_NS));
@@ -958,7 +1018,7 @@ impl Diagnoser {
             let mine: Vec<usize> = (0..self.incidents.len())
                 .filter(|i| {
                     let inc = &self.incidents[*i];
-                    inc.node == Some(n) && inc.problem == Problem::Emcy && inc.status == Status::Open
+                    inc.key() == Some(n) && inc.problem == Problem::Emcy && inc.status == Status::Open
                 })
                 .collect();
             for i in mine {
@@ -996,7 +1056,7 @@ impl Diagnoser {
     }
 
     /// A fault just started: a recent EMCY of the node is its cause.
-    fn absorb_emcy(&mut self, n: u8, i: usize) {
+    fn absorb_emcy(&mut self, n: NodeKey, i: usize) {
         let t = self.at.t;
         self.flush_emcy(n, t.saturating_sub(EMCY_CAUSE_NS));
         if let Some((at, e)) = self.node(n).emcy.pop() {
@@ -1006,7 +1066,7 @@ impl Diagnoser {
     }
 
     /// EMCY of `n` older than `before` become EMCY incidents (grouped per code).
-    fn flush_emcy(&mut self, n: u8, before: u64) {
+    fn flush_emcy(&mut self, n: NodeKey, before: u64) {
         let node = self.node(n);
         let keep = node
             .emcy
@@ -1026,7 +1086,7 @@ impl Diagnoser {
         }
     }
 
-    fn heartbeat(&mut self, n: u8, s: NmtState) {
+    fn heartbeat(&mut self, n: NodeKey, s: NmtState) {
         let at = self.at;
         let node = self.node(n);
         node.last_hb = Some(at);
@@ -1098,8 +1158,9 @@ impl Diagnoser {
             0x82 => ("reset communication", NmtState::BootUp),
             _ => return,
         };
+        let iface = self.iface;
         if cs != 0x01 {
-            self.pdos.pause((target != 0).then_some(target));
+            self.pdos.pause(iface, (target != 0).then_some(target));
         }
         let at = self.at;
         // A start undone at once (stop, pre-operational or a reset) for the same node, or
@@ -1107,14 +1168,18 @@ impl Diagnoser {
         // after entering it is a normal re-configuration, and "start all" then "stop node
         // 3" a choice of which nodes run: the other orders are not. (Equal times, a log
         // without timestamps, say nothing.)
-        if let Some((last, last_cs, last_target)) = self.last_nmt.replace((at, cs, target))
+        if let Some((last, last_cs, last_target, last_iface)) = self.last_nmt.replace((at, cs, target, iface))
+            && last_iface == iface
             && at.t > last.t
             && at.t - last.t < TWO_MASTERS_NS
             && (last_target == target || target == 0)
             && last_cs == 0x01
             && cs != 0x01
         {
-            let node = [target, last_target].into_iter().find(|t| *t != 0);
+            let node = [target, last_target]
+                .into_iter()
+                .find(|t| *t != 0)
+                .map(|t| NodeKey::new(iface, t));
             // "reset node" names its target itself: "NMT reset node 2".
             let verb = command.strip_suffix(" node").unwrap_or(command);
             let text = format!(
@@ -1128,17 +1193,17 @@ impl Diagnoser {
             );
             self.second_master(node, "NMT commands that undo each other", at, text);
         }
-        let known: Vec<u8> = self
+        let known: Vec<NodeKey> = self
             .nodes
             .iter()
-            .filter(|(n, d)| (target == 0 || **n == target) && d.last_state.is_some())
+            .filter(|(n, d)| n.iface == iface && (target == 0 || n.node == target) && d.last_state.is_some())
             .map(|(n, _)| *n)
             .collect();
         if state == NmtState::BootUp {
             if target == 0 {
-                self.reset_all = Some(at.t);
+                self.reset_all.insert(iface, at.t);
             } else {
-                self.node(target).reset_asked = Some(at.t);
+                self.node(NodeKey::new(iface, target)).reset_asked = Some(at.t);
             }
         }
         for n in known {
@@ -1152,7 +1217,7 @@ impl Diagnoser {
     }
 
     fn event(&mut self, e: &Event) {
-        let Some(n) = e.node else {
+        let Some(n) = e.key() else {
             if let What::BusState { iface, to, detail, .. } = &e.what {
                 self.bus_state.insert(iface.clone(), to);
                 let i = self.grouped(None, Problem::BusErrors, 0, e.t_ns);
@@ -1182,8 +1247,8 @@ impl Diagnoser {
             }
             What::HeartbeatBack { silent_ms } => self.back(n, at, *silent_ms),
             What::BootUp { rebooted, .. } => {
-                self.pdos.pause(Some(n));
-                let reset_all = self.reset_all;
+                self.pdos.pause(n.iface, Some(n.node));
+                let reset_all = self.reset_all.get(&n.iface).copied();
                 let node = self.node(n);
                 // (Equal times say nothing: logs without timestamps.)
                 let close = node
@@ -1219,7 +1284,7 @@ impl Diagnoser {
         }
     }
 
-    fn back(&mut self, n: u8, at: At, silent_ms: f64) {
+    fn back(&mut self, n: NodeKey, at: At, silent_ms: f64) {
         let Some((last, lost, _)) = self.node(n).silence.take() else {
             return;
         };
@@ -1240,7 +1305,7 @@ impl Diagnoser {
         );
     }
 
-    fn refused(&mut self, n: u8, index: u16, sub: u8, code: u32) {
+    fn refused(&mut self, n: NodeKey, index: u16, sub: u8, code: u32) {
         let at = self.at;
         let text = abort_text(code);
         let (write, ours) = (self.node(n).download, self.node(n).ours);
@@ -1291,7 +1356,7 @@ impl Diagnoser {
         );
     }
 
-    fn garbled(&mut self, n: u8, what: String) {
+    fn garbled(&mut self, n: NodeKey, what: String) {
         let at = self.at;
         let i = self.grouped(Some(n), Problem::SdoGarbled, 0, at.t);
         self.incidents[i].status = Status::Open;
@@ -1313,7 +1378,7 @@ impl Diagnoser {
 
     /// Requests unanswered for longer than the SDO timeout at `now`.
     fn sdo_timeouts(&mut self, now: u64) {
-        let late: Vec<(u8, Request)> = self
+        let late: Vec<(NodeKey, Request)> = self
             .nodes
             .iter()
             .filter_map(|(n, d)| d.pending.filter(|r| r.at.t + SDO_TIMEOUT_NS < now).map(|r| (*n, r)))
@@ -1329,7 +1394,7 @@ impl Diagnoser {
             .min();
     }
 
-    fn unanswered(&mut self, n: u8, r: Request) {
+    fn unanswered(&mut self, n: NodeKey, r: Request) {
         let node = self.node(n);
         node.n_unanswered += 1;
         node.answered_after = false;
@@ -1340,7 +1405,7 @@ impl Diagnoser {
 
     /// A completed SDO transfer (in order, right after the frame that ended it).
     pub fn transaction(&mut self, t: &Transaction) {
-        self.node(t.node).segmenting = None;
+        self.node(t.key()).segmenting = None;
         self.tracker.transaction(t);
         self.take_events();
         if t.outcome != Outcome::Ok || t.data.is_empty() {
@@ -1349,35 +1414,35 @@ impl Diagnoser {
         let le = |d: &[u8]| d.iter().take(4).rev().fold(0u32, |a, b| a << 8 | u32::from(*b));
         let v = le(&t.data);
         if (t.index, t.sub, t.direction) == (0x1000, 0, TransferDirection::Upload) {
-            self.node(t.node).cia402 = v & 0xFFFF == 402;
+            self.node(t.key()).cia402 = v & 0xFFFF == 402;
         }
         if t.sub == 0 {
-            self.drive_word(t.node, t.index, v as u16);
+            self.drive_word(t.key(), t.index, v as u16);
         }
         match (t.index, t.sub) {
             (0x1800..=0x19FF, 5) => self
                 .pdos
-                .event_timer((t.node, true, t.index - 0x1800 + 1), u64::from(v & 0xFFFF)),
+                .event_timer((t.key(), true, t.index - 0x1800 + 1), u64::from(v & 0xFFFF)),
             (0x1800..=0x19FF, 2) => self
                 .pdos
-                .transmission_type((t.node, true, t.index - 0x1800 + 1), v as u8),
+                .transmission_type((t.key(), true, t.index - 0x1800 + 1), v as u8),
             (0x1007, 0) if v > 0 => {
-                self.sync_window.insert(t.node, u64::from(v) * 1000);
+                self.sync_window.insert(t.key(), u64::from(v) * 1000);
             }
             (0x1007, 0) => {
-                self.sync_window.remove(&t.node);
+                self.sync_window.remove(&t.key());
             }
             (0x1400..=0x15FF, 5) => self
                 .pdos
-                .event_timer((t.node, false, t.index - 0x1400 + 1), u64::from(v & 0xFFFF)),
+                .event_timer((t.key(), false, t.index - 0x1400 + 1), u64::from(v & 0xFFFF)),
             _ => {}
         }
         if (t.index, t.sub) == (0x1017, 0) {
             let at = self.at;
-            self.node(t.node).heartbeat_off = (v & 0xFFFF == 0).then_some(at);
+            self.node(t.key()).heartbeat_off = (v & 0xFFFF == 0).then_some(at);
         }
         let key = (
-            Some(t.node),
+            Some(t.key()),
             Problem::SdoRefused,
             (u32::from(t.index) << 8) | u32::from(t.sub),
         );
@@ -1465,7 +1530,7 @@ impl Diagnoser {
             self.incidents[i].last_ns = end.t;
         }
         self.sync_jitter();
-        let nodes: Vec<u8> = self.nodes.keys().copied().collect();
+        let nodes: Vec<NodeKey> = self.nodes.keys().copied().collect();
         for n in nodes {
             self.flush_emcy(n, u64::MAX);
             if let Some((last, lost, _)) = self.node(n).silence.take() {
@@ -1537,20 +1602,31 @@ impl Diagnoser {
             }
         }
         // A PDO that stops because its node went silent for good is part of that silence.
-        let gone: Vec<Option<u8>> = self
+        let gone: Vec<Option<NodeKey>> = self
             .incidents
             .iter()
             .filter(|i| i.problem == Problem::Silent)
-            .map(|i| i.node)
+            .map(Incident::key)
             .collect();
         self.incidents
-            .retain(|i| !(i.problem == Problem::PdoMissing && gone.contains(&i.node)));
+            .retain(|i| !(i.problem == Problem::PdoMissing && gone.contains(&i.key())));
         let mut out = merge_faults(self.incidents);
         for inc in &mut out {
             inc.events.sort_by_key(|e| e.frame);
         }
         out.retain(|i| i.count > 0 || !i.events.is_empty());
         out.sort_by_key(|i| (i.status, i.first_ns));
+        // Nodes on several interfaces: each node is shown with its interface's name.
+        let first = self.nodes.keys().next().map(|k| k.iface);
+        if self.nodes.keys().any(|k| Some(k.iface) != first) {
+            for inc in out.iter_mut().filter(|i| i.node.is_some()) {
+                inc.iface_name = self
+                    .iface_names
+                    .get(inc.iface as usize)
+                    .filter(|n| !n.is_empty())
+                    .cloned();
+            }
+        }
         out
     }
 }
@@ -1561,7 +1637,7 @@ fn merge_faults(all: Vec<Incident>) -> Vec<Incident> {
     for inc in all {
         if inc.problem == Problem::DriveFault
             && let Some(prev) = out.iter_mut().find(|p| {
-                p.problem == Problem::DriveFault && p.node == inc.node && p.axes == inc.axes && p.cause == inc.cause
+                p.problem == Problem::DriveFault && p.key() == inc.key() && p.axes == inc.axes && p.cause == inc.cause
             })
         {
             prev.count += inc.count;

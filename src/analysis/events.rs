@@ -38,6 +38,9 @@ pub struct Event {
     pub t_ns: u64,
     /// The node, None for interface events.
     pub node: Option<u8>,
+    /// The interface of the node (index into the source's interface table; 0 for
+    /// interface events, whose [`What::BusState`] names theirs).
+    pub iface: u16,
     /// What happened.
     pub what: What,
 }
@@ -253,11 +256,23 @@ impl What {
 }
 
 impl Event {
+    /// The node as a node of its interface (None for interface events).
+    pub fn key(&self) -> Option<crate::frame::NodeKey> {
+        self.node.map(|n| crate::frame::NodeKey::new(self.iface, n))
+    }
+
     /// One line for a message log, e.g. `node 5 heartbeat lost: no heartbeat for 450.0 ms, ...`.
     pub fn text(&self) -> String {
-        let who = match self.node {
-            Some(n) => format!("node {n}"),
-            None => "bus".to_string(),
+        self.text_on(None)
+    }
+
+    /// [`Event::text`] with the node's interface named after it (`node 5 (can1) ...`) when
+    /// `iface` is given (several interfaces in the capture).
+    pub fn text_on(&self, iface: Option<&str>) -> String {
+        let who = match (self.node, iface) {
+            (Some(n), Some(i)) => format!("node {n} ({i})"),
+            (Some(n), None) => format!("node {n}"),
+            (None, _) => "bus".to_string(),
         };
         format!("{who} {}: {}", self.what.title(), self.what.detail())
     }
@@ -265,32 +280,50 @@ impl Event {
     /// Appends the `cotui decode --events` text line (with `\n`):
     /// `(1700000000.450000)  node   5  heartbeat_lost    no heartbeat for ...`.
     pub fn write_line(&self, out: &mut String) {
+        self.write_line_on(out, None);
+    }
+
+    /// [`Event::write_line`] with the node's interface after the node-ID
+    /// (`node   5 (can1)  heartbeat_lost ...`) when `iface` is given.
+    pub fn write_line_on(&self, out: &mut String, iface: Option<&str>) {
         let _ = write!(
             out,
             "({}.{:06})  ",
             self.t_ns / 1_000_000_000,
             self.t_ns % 1_000_000_000 / 1000
         );
-        match self.node {
-            Some(n) => {
+        match (self.node, iface) {
+            (Some(n), Some(i)) => {
+                let _ = write!(out, "node {n:>3} ({i})");
+            }
+            (Some(n), None) => {
                 let _ = write!(out, "node {n:>3}");
             }
-            None => out.push_str("bus     "),
+            (None, _) => out.push_str("bus     "),
         }
         let _ = writeln!(out, "  {:<16}  {}", self.what.name(), self.what.detail());
     }
 
     /// Appends the JSON line (with `\n`) of [`Event::to_json`].
     pub fn write_json(&self, out: &mut Vec<u8>) {
-        crate::frame::json::write_line(out, &self.to_json());
+        self.write_json_on(out, None);
+    }
+
+    /// [`Event::write_json`] with an `iface` field after `node` when `iface` is given.
+    pub fn write_json_on(&self, out: &mut Vec<u8>, iface: Option<&str>) {
+        let mut j = self.to_json();
+        j.iface = iface.filter(|_| self.node.is_some());
+        crate::frame::json::write_line(out, &j);
     }
 
     /// The JSONL record: `t` (seconds, exact to the ns like the frame JSONL), `node` (null
-    /// for the bus), `event`, then the details of [`What`].
+    /// for the bus), `iface` (only when the capture has several interfaces), `event`, then
+    /// the details of [`What`].
     pub fn to_json(&self) -> EventJson<'_> {
         EventJson {
             t: Seconds(self.t_ns),
             node: self.node,
+            iface: None,
             what: &self.what,
         }
     }
@@ -301,6 +334,9 @@ impl Event {
 pub struct EventJson<'a> {
     pub t: Seconds,
     pub node: Option<u8>,
+    /// The node's interface, present only when the capture has several interfaces.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub iface: Option<&'a str>,
     /// `event` (the variant name) and its details, flat.
     #[serde(flatten)]
     pub what: &'a What,
@@ -315,6 +351,7 @@ mod tests {
         Event {
             t_ns: 1_700_000_000_450_000_000,
             node: Some(5),
+            iface: 0,
             what: What::HeartbeatLost {
                 period_ms: 300.0,
                 period_source: PeriodSource::Sdo,
@@ -342,6 +379,7 @@ mod tests {
         let state = Event {
             t_ns: 1,
             node: Some(2),
+            iface: 0,
             what: What::State {
                 from: None,
                 to: NmtState::PreOperational,
@@ -370,6 +408,7 @@ mod tests {
         let bus = Event {
             t_ns: 0,
             node: None,
+            iface: 0,
             what: What::BusState {
                 iface: "can0".into(),
                 from: "error_active",

@@ -121,6 +121,11 @@ pub struct Step {
 pub struct Incident {
     /// The node, None for the bus itself.
     pub node: Option<u8>,
+    /// The node's interface (index into the source's interface table).
+    pub iface: u16,
+    /// The node's interface by name, given only when the capture has nodes on several
+    /// interfaces (then the node is shown as `Node 5 (can1)` and JSON has an `iface` field).
+    pub iface_name: Option<String>,
     /// Axes of a multi-axis drive (1-based), empty when not axis-specific.
     pub axes: Vec<u8>,
     /// The kind of problem.
@@ -162,11 +167,17 @@ impl Incident {
         }
     }
 
-    /// `Node 5 · axis 2`, `Node 4` or `CAN bus`.
+    /// The node as a node of its interface (None for the bus).
+    pub fn key(&self) -> Option<crate::frame::NodeKey> {
+        self.node.map(|n| crate::frame::NodeKey::new(self.iface, n))
+    }
+
+    /// `Node 5 · axis 2`, `Node 4`, `Node 5 (can1)` (several interfaces) or `CAN bus`.
     pub fn place(&self) -> String {
-        let mut s = match self.node {
-            Some(n) => format!("Node {n}"),
-            None => "CAN bus".to_string(),
+        let mut s = match (self.node, &self.iface_name) {
+            (Some(n), Some(i)) => format!("Node {n} ({i})"),
+            (Some(n), None) => format!("Node {n}"),
+            (None, _) => "CAN bus".to_string(),
         };
         match self.axes.as_slice() {
             [] | [1] => {}
@@ -199,6 +210,7 @@ impl Incident {
                 })
                 .collect(),
             first: secs(self.first_ns, origin),
+            iface: self.iface_name.as_deref().filter(|_| self.node.is_some()),
             kind: self.problem.as_str(),
             last: secs(self.last_ns, origin),
             node: self.node,
@@ -255,6 +267,9 @@ pub struct IncidentJson<'a> {
     pub events: Vec<StepJson<'a>>,
     /// Seconds since the capture's first frame.
     pub first: f64,
+    /// The node's interface, only when the capture has several interfaces.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub iface: Option<&'a str>,
     /// The [`Problem`] name.
     pub kind: &'static str,
     pub last: f64,

@@ -16,7 +16,7 @@ use crate::decode::emcy::Emcy;
 use crate::decode::error_frame;
 use crate::decode::heartbeat::{Heartbeat, NmtState};
 use crate::decode::{Body, Decoded};
-use crate::frame::Frame;
+use crate::frame::{Frame, NodeKey};
 use crate::od::Dictionary;
 use crate::sdo::{Outcome, Transaction};
 use std::collections::BTreeMap;
@@ -123,7 +123,7 @@ fn controller_state(class: u32, data: &[u8]) -> Option<&'static str> {
 /// Turns decoded frames and SDO transactions into [`Event`]s and per-node liveness.
 #[derive(Clone, Debug)]
 pub struct EventTracker {
-    nodes: BTreeMap<u8, NodeLiveness>,
+    nodes: BTreeMap<NodeKey, NodeLiveness>,
     defaults: Vec<Option<u16>>,
     /// Controller state per interface name.
     buses: Vec<(String, &'static str)>,
@@ -159,7 +159,7 @@ impl EventTracker {
     }
 
     /// What is known about `node`.
-    pub fn node(&self, node: u8) -> Option<&NodeLiveness> {
+    pub fn node(&self, node: NodeKey) -> Option<&NodeLiveness> {
         self.nodes.get(&node)
     }
 
@@ -173,20 +173,29 @@ impl EventTracker {
         self.events.len()
     }
 
-    fn entry(&mut self, node: u8) -> &mut NodeLiveness {
-        let default_ms = self.defaults.get(node as usize).copied().flatten();
+    fn entry(&mut self, node: NodeKey) -> &mut NodeLiveness {
+        let default_ms = self.defaults.get(node.node as usize).copied().flatten();
         self.nodes.entry(node).or_insert_with(|| NodeLiveness {
             default_ms,
             ..NodeLiveness::default()
         })
     }
 
-    fn push(&mut self, t_ns: u64, node: Option<u8>, what: What) {
-        self.events.push(Event { t_ns, node, what });
+    fn push(&mut self, t_ns: u64, node: Option<NodeKey>, what: What) {
+        let (node, iface) = match node {
+            Some(k) => (Some(k.node), k.iface),
+            None => (None, 0),
+        };
+        self.events.push(Event {
+            t_ns,
+            node,
+            iface,
+            what,
+        });
     }
 
     /// Takes note of `node`'s deadline after a change.
-    fn rearm(&mut self, node: u8) {
+    fn rearm(&mut self, node: NodeKey) {
         if let Some(d) = self.nodes.get(&node).and_then(NodeLiveness::deadline) {
             self.next_deadline = Some(self.next_deadline.map_or(d, |n| n.min(d)));
         }
@@ -205,7 +214,7 @@ impl EventTracker {
 
     /// Every node whose deadline is before `now_ns` is lost (see [`EventTracker::tick`]).
     fn lose_overdue(&mut self, now_ns: u64) {
-        let mut due: Vec<(u64, u8)> = self
+        let mut due: Vec<(u64, NodeKey)> = self
             .nodes
             .iter()
             .filter_map(|(n, l)| l.deadline().filter(|d| *d < now_ns).map(|d| (d, *n)))
@@ -238,7 +247,7 @@ impl EventTracker {
     /// frame's interface.
     pub fn frame(&mut self, frame: &Frame, iface: &str, decoded: &Decoded) {
         self.tick(frame.ts_ns);
-        let node = decoded.node.unwrap_or(0);
+        let node = NodeKey::of(frame, decoded.node.unwrap_or(0));
         match &decoded.body {
             Body::Heartbeat(h) => self.heartbeat(node, frame.ts_ns, h),
             Body::Emcy(e) => self.emcy(node, frame.ts_ns, e),
@@ -248,8 +257,8 @@ impl EventTracker {
     }
 
     /// A heartbeat, boot-up, guarding request or guarding response of `node` at `ts_ns`.
-    pub fn heartbeat(&mut self, node: u8, ts_ns: u64, h: &Heartbeat) {
-        if node == 0 {
+    pub fn heartbeat(&mut self, node: NodeKey, ts_ns: u64, h: &Heartbeat) {
+        if node.node == 0 {
             return;
         }
         self.tick(ts_ns);
@@ -291,7 +300,7 @@ impl EventTracker {
         self.rearm(node);
     }
 
-    fn boot_up(&mut self, node: u8, ts_ns: u64) {
+    fn boot_up(&mut self, node: NodeKey, ts_ns: u64) {
         let l = self.entry(node);
         let rebooted = l.boot_ups > 0 || l.state.is_some();
         let was_lost = l.lost_at_ns.take().is_some();
@@ -316,7 +325,7 @@ impl EventTracker {
         self.rearm(node);
     }
 
-    fn guard_request(&mut self, node: u8, ts_ns: u64) {
+    fn guard_request(&mut self, node: NodeKey, ts_ns: u64) {
         let l = self.entry(node);
         l.guarded = true;
         let unanswered = l.guard_request_ns.replace(ts_ns);
@@ -343,7 +352,7 @@ impl EventTracker {
     }
 
     /// An EMCY of `node`.
-    pub fn emcy(&mut self, node: u8, ts_ns: u64, e: &Emcy) {
+    pub fn emcy(&mut self, node: NodeKey, ts_ns: u64, e: &Emcy) {
         self.tick(ts_ns);
         self.push(
             ts_ns,
@@ -390,7 +399,7 @@ impl EventTracker {
         if let Outcome::Aborted { code, text, by } = &t.outcome {
             self.push(
                 t.end_ns,
-                Some(t.node),
+                Some(t.key()),
                 What::SdoAbort {
                     direction: t.direction.as_str(),
                     index: t.index,
@@ -406,11 +415,11 @@ impl EventTracker {
             return;
         }
         let ms = u16::from_le_bytes([t.data[0], t.data.get(1).copied().unwrap_or(0)]);
-        let l = self.entry(t.node);
+        let l = self.entry(t.key());
         if l.configured_ms.replace(ms) != Some(ms) {
-            self.push(t.end_ns, Some(t.node), What::HeartbeatPeriod { period_ms: ms });
+            self.push(t.end_ns, Some(t.key()), What::HeartbeatPeriod { period_ms: ms });
         }
-        self.rearm(t.node);
+        self.rearm(t.key());
     }
 }
 
@@ -573,10 +582,10 @@ mod tests {
         let mut tr = EventTracker::new(|_| &dict);
         let hb = crate::decode::heartbeat::decode(&[0x05], false).0;
         for t in [0, u64::MAX / 2, u64::MAX - 1, 5, 5, u64::MAX] {
-            tr.heartbeat(9, t, &hb);
+            tr.heartbeat(NodeKey::new(0, 9), t, &hb);
         }
         tr.tick(u64::MAX);
-        let l = tr.node(9).unwrap();
+        let l = tr.node(NodeKey::new(0, 9)).unwrap();
         assert_eq!(l.deadline(), Some(u64::MAX));
         assert!(!l.is_lost());
     }

@@ -12,6 +12,7 @@ use crate::decode::cia402::DriveState;
 use crate::decode::emcy::Emcy;
 use crate::decode::heartbeat::{Heartbeat, NmtState};
 use crate::decode::pdo::Pdo;
+use crate::frame::NodeKey;
 use crate::sdo::Transaction;
 use std::collections::{BTreeMap, VecDeque};
 
@@ -79,11 +80,11 @@ fn well_formed(h: &Heartbeat) -> bool {
     !h.request && matches!(h.state, Some(s) if !matches!(s, NmtState::Unknown(_)))
 }
 
-/// All nodes seen, by node-ID.
+/// All nodes seen, by interface and node-ID ([`NodeKey`]).
 pub struct Nodes {
-    map: BTreeMap<u8, NodeInfo>,
+    map: BTreeMap<NodeKey, NodeInfo>,
     /// Node-IDs with frames but no CANopen evidence yet.
-    candidates: BTreeMap<u8, Evidence>,
+    candidates: BTreeMap<NodeKey, Evidence>,
     tracker: EventTracker,
     events: VecDeque<Event>,
 }
@@ -98,8 +99,8 @@ impl Nodes {
             events: VecDeque::new(),
         }
     }
-    /// The nodes in node-ID order.
-    pub fn iter(&self) -> impl Iterator<Item = (&u8, &NodeInfo)> {
+    /// The nodes in interface, then node-ID order.
+    pub fn iter(&self) -> impl Iterator<Item = (&NodeKey, &NodeInfo)> {
         self.map.iter()
     }
     /// Number of nodes.
@@ -112,17 +113,28 @@ impl Nodes {
     }
     /// One node, also one without CANopen evidence yet (its drive state still counts for
     /// the stop-all and quit checks).
-    pub fn get(&self, node: u8) -> Option<&NodeInfo> {
+    pub fn get(&self, node: NodeKey) -> Option<&NodeInfo> {
         self.map
             .get(&node)
             .or_else(|| self.candidates.get(&node).map(|c| &c.info))
+    }
+    /// A node by node-ID alone, on the first interface that has it: for what addresses the
+    /// bus of a live session (one interface), e.g. the drive state stop-all and quit check.
+    pub fn by_id(&self, node: u8) -> Option<&NodeInfo> {
+        let first = self
+            .map
+            .keys()
+            .chain(self.candidates.keys())
+            .filter(|k| k.node == node)
+            .min()?;
+        self.get(*first)
     }
     /// Frames of node-IDs without CANopen evidence: "other" traffic, not nodes.
     pub fn other_frames(&self) -> u64 {
         self.candidates.values().map(|c| c.info.frames).sum()
     }
     /// The liveness of one node (None before its first error-control frame).
-    pub fn liveness(&self, node: u8) -> Option<&NodeLiveness> {
+    pub fn liveness(&self, node: NodeKey) -> Option<&NodeLiveness> {
         self.tracker.node(node)
     }
     /// The capture time the node table is at: the newest frame or tick (ns).
@@ -135,7 +147,7 @@ impl Nodes {
         self.events.drain(..).collect()
     }
 
-    fn entry(&mut self, node: u8) -> &mut NodeInfo {
+    fn entry(&mut self, node: NodeKey) -> &mut NodeInfo {
         match self.map.get_mut(&node) {
             Some(n) => n,
             None => &mut self.candidates.entry(node).or_default().info,
@@ -143,7 +155,7 @@ impl Nodes {
     }
 
     /// Adds evidence about an unconfirmed `node`; shows it once it is enough.
-    fn evidence(&mut self, node: u8, add: impl FnOnce(&mut Evidence)) {
+    fn evidence(&mut self, node: NodeKey, add: impl FnOnce(&mut Evidence)) {
         if self.map.contains_key(&node) {
             return;
         }
@@ -172,7 +184,7 @@ impl Nodes {
             return;
         }
         for e in self.tracker.take_events() {
-            match e.node.and_then(|n| self.candidates.get_mut(&n)) {
+            match e.key().and_then(|n| self.candidates.get_mut(&n)) {
                 Some(c) => {
                     if c.held.len() == HELD_EVENTS {
                         c.held.pop_front();
@@ -192,8 +204,8 @@ impl Nodes {
     }
 
     /// Counts a frame of `node`.
-    pub fn frame(&mut self, node: u8, ts_ns: u64) {
-        if node == 0 {
+    pub fn frame(&mut self, node: NodeKey, ts_ns: u64) {
+        if node.node == 0 {
             return;
         }
         let n = self.entry(node);
@@ -205,8 +217,8 @@ impl Nodes {
     }
 
     /// A heartbeat, boot-up or guarding frame of `node`.
-    pub fn heartbeat(&mut self, node: u8, ts_ns: u64, h: &Heartbeat) {
-        if node == 0 {
+    pub fn heartbeat(&mut self, node: NodeKey, ts_ns: u64, h: &Heartbeat) {
+        if node.node == 0 {
             return;
         }
         self.entry(node);
@@ -222,7 +234,7 @@ impl Nodes {
     }
 
     /// An EMCY of `node`.
-    pub fn emcy(&mut self, node: u8, ts_ns: u64, e: &Emcy) {
+    pub fn emcy(&mut self, node: NodeKey, ts_ns: u64, e: &Emcy) {
         self.entry(node).last_emcy = Some((ts_ns, e.code, e.text.clone()));
         self.tracker.emcy(node, ts_ns, e);
         self.collect();
@@ -236,7 +248,7 @@ impl Nodes {
 
     /// A PDO of `node`: picks up the statusword, and records the profile and mode in force
     /// as [`Nodes::profile`] does (one node lookup for both).
-    pub fn pdo(&mut self, node: u8, p: &Pdo, profile: &str, mode: Option<i8>) {
+    pub fn pdo(&mut self, node: NodeKey, p: &Pdo, profile: &str, mode: Option<i8>) {
         let n = self.entry(node);
         for s in &p.signals {
             if (s.index, s.sub) == (0x6041, 0)
@@ -245,15 +257,15 @@ impl Nodes {
                 n.drive = Some(DriveState::from_statusword(sw as u16));
             }
         }
-        if node != 0 && n.profile != profile {
+        if node.node != 0 && n.profile != profile {
             n.profile = profile.to_string();
         }
         n.mode = mode.or(n.mode);
     }
 
     /// Records the profile and mode in force for `node`.
-    pub fn profile(&mut self, node: u8, name: &str, mode: Option<i8>) {
-        if node == 0 {
+    pub fn profile(&mut self, node: NodeKey, name: &str, mode: Option<i8>) {
+        if node.node == 0 {
             return;
         }
         let n = self.entry(node);
@@ -267,7 +279,7 @@ impl Nodes {
     /// the mode.
     pub fn transaction(&mut self, t: &Transaction) {
         if t.is_ok() && t.problems.is_empty() {
-            self.evidence(t.node, |c| c.sdo_ok += 1);
+            self.evidence(t.key(), |c| c.sdo_ok += 1);
         }
         self.tracker.transaction(t);
         self.collect();
@@ -278,7 +290,7 @@ impl Nodes {
         let k = t.data.len().min(4);
         b[..k].copy_from_slice(&t.data[..k]);
         let v = u32::from_le_bytes(b);
-        let n = self.entry(t.node);
+        let n = self.entry(t.key());
         match (t.index, t.sub) {
             (0x6041, 0) => n.drive = Some(DriveState::from_statusword(v as u16)),
             (0x6060 | 0x6061, 0) => n.mode = Some(v as u8 as i8),
@@ -298,14 +310,18 @@ mod tests {
 
     const MS: u64 = 1_000_000;
 
+    fn k(node: u8) -> NodeKey {
+        NodeKey::new(0, node)
+    }
+
     #[test]
     fn heartbeats_give_state_period_boot_ups_then_a_loss_found_by_a_tick() {
         let mut n = Nodes::new(&Decoder::new(Dictionary::default(), Vec::new()));
-        n.heartbeat(3, 0, &hb(0x00));
+        n.heartbeat(k(3), 0, &hb(0x00));
         for (i, t) in [100u64, 200, 300, 400, 500].iter().enumerate() {
-            n.heartbeat(3, t * MS, &hb(if i < 4 { 0x7F } else { 0x05 }));
+            n.heartbeat(k(3), t * MS, &hb(if i < 4 { 0x7F } else { 0x05 }));
         }
-        let l = n.liveness(3).unwrap();
+        let l = n.liveness(k(3)).unwrap();
         assert_eq!(l.boot_ups, 1);
         assert_eq!(l.state, Some(NmtState::Operational));
         assert_eq!(l.measured_ns(), Some(100 * MS));
@@ -322,7 +338,7 @@ mod tests {
         n.tick(650 * MS);
         assert!(n.take_events().is_empty());
         n.tick(651 * MS);
-        let l = n.liveness(3).unwrap();
+        let l = n.liveness(k(3)).unwrap();
         assert_eq!((l.lost_at_ns, l.missed), (Some(650 * MS), 1));
         assert_eq!(n.now_ns(), 651 * MS);
         let e = n.take_events();
@@ -337,11 +353,11 @@ mod tests {
     fn the_event_backlog_is_bounded() {
         let mut n = Nodes::new(&Decoder::new(Dictionary::default(), Vec::new()));
         let e = crate::decode::emcy::decode(&[0x10, 0x23, 0x11, 0, 0, 0, 0, 0], &Dictionary::default()).0;
-        n.heartbeat(4, 0, &hb(0x00));
-        n.heartbeat(4, 0, &hb(0x7F));
+        n.heartbeat(k(4), 0, &hb(0x00));
+        n.heartbeat(k(4), 0, &hb(0x7F));
         n.take_events();
         for i in 0..(EVENT_BACKLOG as u64 + 5) {
-            n.emcy(4, i, &e);
+            n.emcy(k(4), i, &e);
         }
         let kept = n.take_events();
         assert_eq!(kept.len(), EVENT_BACKLOG);
@@ -387,7 +403,7 @@ mod tests {
     fn random_traffic_creates_no_node_and_is_counted_as_other() {
         let frames = random_frames(0x9E37_79B9_7F4A_7C15, 200_000);
         let t = trace_of(frames.clone());
-        let phantoms: Vec<u8> = t.nodes.iter().map(|(n, _)| *n).collect();
+        let phantoms: Vec<u8> = t.nodes.iter().map(|(n, _)| n.node).collect();
         assert_eq!(phantoms, Vec::<u8>::new());
         // Every frame of a node-ID range (all but NMT, SYNC/EMCY 0x080, TIME, LSS and the
         // IDs outside the predefined set) is counted as other.
@@ -409,10 +425,10 @@ mod tests {
             f.ts_ns = i as u64 * MS;
         }
         let t = trace_of(frames);
-        let nodes: Vec<u8> = t.nodes.iter().map(|(n, _)| *n).collect();
+        let nodes: Vec<u8> = t.nodes.iter().map(|(n, _)| n.node).collect();
         assert_eq!(nodes, [5, 7]);
-        assert_eq!(t.nodes.liveness(5).unwrap().state, Some(NmtState::Operational));
-        assert_eq!(t.nodes.liveness(7).unwrap().state, Some(NmtState::PreOperational));
+        assert_eq!(t.nodes.liveness(k(5)).unwrap().state, Some(NmtState::Operational));
+        assert_eq!(t.nodes.liveness(k(7)).unwrap().state, Some(NmtState::PreOperational));
         let mut n = t.nodes;
         let texts: Vec<String> = n.take_events().iter().map(Event::text).collect();
         assert_eq!(texts[0], "node 5 boot-up: boot-up, first message of the node");
@@ -435,7 +451,7 @@ mod tests {
             sdo(4, 0x606, [0x40, 0x00, 0x10, 0, 0, 0, 0, 0]),
             sdo(5, 0x586, [0x43, 0x18, 0x10, 1, 0x92, 0x01, 0x02, 0]),
         ]);
-        let nodes: Vec<u8> = t.nodes.iter().map(|(n, _)| *n).collect();
+        let nodes: Vec<u8> = t.nodes.iter().map(|(n, _)| n.node).collect();
         assert_eq!(nodes, [3]);
         assert_eq!(t.nodes.other_frames(), 3);
     }
@@ -444,10 +460,10 @@ mod tests {
     fn malformed_heartbeats_outnumbering_good_ones_make_no_node() {
         let mut n = Nodes::new(&Decoder::new(Dictionary::default(), Vec::new()));
         for b in [0x09, 0x33, 0x05, 0x05] {
-            n.heartbeat(9, 0, &hb(b));
+            n.heartbeat(k(9), 0, &hb(b));
         }
         assert!(n.is_empty());
-        n.heartbeat(9, 0, &hb(0x85));
+        n.heartbeat(k(9), 0, &hb(0x85));
         assert_eq!(n.len(), 1);
     }
 }

@@ -5,12 +5,15 @@
 use crate::decode::Decoder;
 use crate::decode::pdo::source_text;
 use crate::decode::pdo_config::{CommParams, PdoId, event_text, inhibit_text, sync_start_text, transmission_text};
+use crate::frame::NodeKey;
 use crate::od::{MappingSource, PdoMapping};
 
 /// One PDO of one node as the decoder knows it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PdoRow {
     pub node: u8,
+    /// The node's interface (index into the source's interface table).
+    pub iface: u16,
     pub id: PdoId,
     /// The communication parameters seen (null when only a mapping is known).
     pub comm: Option<CommParams>,
@@ -20,15 +23,16 @@ pub struct PdoRow {
 
 /// The PDOs the decoder knows, in order (node, RPDO before TPDO, number): cheap keys, so a
 /// pane can count and scroll without building rows.
-pub fn keys(decoder: &Decoder) -> Vec<(u8, PdoId)> {
+pub fn keys(decoder: &Decoder) -> Vec<(NodeKey, PdoId)> {
     decoder.known_pdos()
 }
 
 /// The rows of `keys` (a visible window of [`keys`]).
-pub fn rows(decoder: &Decoder, keys: &[(u8, PdoId)]) -> Vec<PdoRow> {
+pub fn rows(decoder: &Decoder, keys: &[(NodeKey, PdoId)]) -> Vec<PdoRow> {
     keys.iter()
         .map(|&(node, id)| PdoRow {
-            node,
+            node: node.node,
+            iface: node.iface,
             id,
             comm: decoder.pdo_comm(node, id.transmit, id.num),
             mapping: decoder.mapping(node, id.transmit, id.num).cloned(),
@@ -129,13 +133,13 @@ mod tests {
             keys,
             [
                 (
-                    5,
+                    NodeKey::new(0, 5),
                     PdoId {
                         transmit: false,
                         num: 2
                     }
                 ),
-                (5, PdoId { transmit: true, num: 1 })
+                (NodeKey::new(0, 5), PdoId { transmit: true, num: 1 })
             ]
         );
         let rows = rows(&d, &keys);

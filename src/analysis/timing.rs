@@ -2,6 +2,7 @@
 //! stop arriving within their event time (0x1800/0x1400 sub 5 seen on the bus) or their
 //! measured period. Pure: times are frame timestamps (ns) passed in.
 
+use crate::frame::NodeKey;
 use std::collections::HashMap;
 
 const MS: u64 = 1_000_000;
@@ -142,8 +143,8 @@ impl SyncTiming {
     }
 }
 
-/// Which PDO: node, transmit (TPDO) or receive, number 1..512.
-pub type PdoKey = (u8, bool, u16);
+/// Which PDO: node (of its interface), transmit (TPDO) or receive, number 1..512.
+pub type PdoKey = (NodeKey, bool, u16);
 
 /// Where a PDO's expected interval comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -216,8 +217,9 @@ const NONE: u32 = u32::MAX;
 /// Where `key` is in [`PdoTiming::slot`], for PDOs 1..=[`FAST_PDOS`].
 fn fast_slot((node, transmit, num): PdoKey) -> Option<usize> {
     let num = usize::from(num);
-    ((1..=FAST_PDOS).contains(&num))
-        .then(|| (usize::from(node & 0x7F) * 2 + usize::from(transmit)) * FAST_PDOS + num - 1)
+    // The first interface's (a capture of one bus has only that one).
+    (node.iface == 0 && (1..=FAST_PDOS).contains(&num))
+        .then(|| (usize::from(node.node & 0x7F) * 2 + usize::from(transmit)) * FAST_PDOS + num - 1)
 }
 
 /// Arrival times of every PDO, and the event timers seen written. Looked up per PDO
@@ -311,11 +313,12 @@ impl PdoTiming {
         self.find(key).is_some_and(|i| self.streams[i].1.synchronous)
     }
 
-    /// `node` stops sending PDOs for a reason (NMT stop, pre-operational, reset, boot-up):
-    /// its PDOs are not expected until they come again.
-    pub fn pause(&mut self, node: Option<u8>) {
+    /// `node` of interface `iface` (None: every node of it) stops sending PDOs for a
+    /// reason (NMT stop, pre-operational, reset, boot-up): its PDOs are not expected until
+    /// they come again.
+    pub fn pause(&mut self, iface: u16, node: Option<u8>) {
         for (k, s) in &mut self.streams {
-            if node.is_none_or(|n| n == k.0) {
+            if k.0.iface == iface && node.is_none_or(|n| n == k.0.node) {
                 s.last = None;
                 s.missing = false;
             }
@@ -378,7 +381,7 @@ mod tests {
     #[test]
     fn a_regular_pdo_that_stops_is_missing_once_and_back_when_it_comes() {
         let mut p = PdoTiming::default();
-        let key = (2, true, 1);
+        let key = (NodeKey::new(0, 2), true, 1);
         for i in 0..10u64 {
             assert_eq!(p.pdo(key, i + 1, i * 10 * MS), None);
         }
@@ -399,7 +402,7 @@ mod tests {
     #[test]
     fn irregular_pdos_are_not_judged_without_an_event_timer() {
         let mut p = PdoTiming::default();
-        let key = (2, true, 2);
+        let key = (NodeKey::new(0, 2), true, 2);
         for (i, t) in [0u64, 5, 50, 55, 200, 210, 400, 401, 700].iter().enumerate() {
             p.pdo(key, i as u64 + 1, t * MS);
         }

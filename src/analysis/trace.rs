@@ -18,7 +18,7 @@ use super::store::Store;
 use super::transfers::Transfers;
 use super::values::Values;
 use crate::decode::{Body, Decoded, Decoder, Kind};
-use crate::frame::{Frame, Interfaces};
+use crate::frame::{Frame, Interfaces, NodeKey};
 use crate::sdo::Transaction;
 
 /// Frames between two decoder checkpoints.
@@ -119,7 +119,7 @@ impl Trace {
         let p = *self.store.packed(pos);
         self.stats.add(&p, &self.store);
         if let Some(n) = node {
-            self.nodes.frame(n, frame.ts_ns);
+            self.nodes.frame(NodeKey::of(frame, n), frame.ts_ns);
         }
         for t in self.transfers.completed(&mut self.decoder) {
             self.diagnosis.transaction(&t);
@@ -141,19 +141,20 @@ impl Trace {
 
     fn observe(&mut self, frame: &Frame, d: &Decoded) {
         let n = d.node.unwrap_or(0);
-        let (profile, mode) = (self.decoder.dictionary(n).profile_name(), self.decoder.mode(n));
+        let key = NodeKey::of(frame, n);
+        let (profile, mode) = (self.decoder.dictionary(n).profile_name(), self.decoder.mode(key));
         match &d.body {
-            Body::Heartbeat(h) => self.nodes.heartbeat(n, frame.ts_ns, h),
-            Body::Emcy(e) => self.nodes.emcy(n, frame.ts_ns, e),
+            Body::Heartbeat(h) => self.nodes.heartbeat(key, frame.ts_ns, h),
+            Body::Emcy(e) => self.nodes.emcy(key, frame.ts_ns, e),
             Body::Pdo(p) => {
-                self.nodes.pdo(n, p, profile, mode);
+                self.nodes.pdo(key, p, profile, mode);
                 self.series.pdo(n, frame.ts_ns, p, self.decoder.dictionary(n));
                 self.values.pdo(n, frame.ts_ns, p, mode);
                 return;
             }
             _ => {}
         }
-        self.nodes.profile(n, profile, mode);
+        self.nodes.profile(key, profile, mode);
     }
 
     /// The capture clock reached `now_ns` with no new frame (live or a running replay):

@@ -207,7 +207,7 @@ mod tests {
             dec.set_seq(i as u64);
             let d = dec.decode(&f);
             if let (Body::Pdo(p), Some(n)) = (&d.body, d.node) {
-                v.pdo(n, f.ts_ns, p, dec.mode(n));
+                v.pdo(n, f.ts_ns, p, dec.mode(crate::frame::NodeKey::of(&f, n)));
             }
             for t in dec.take_transactions() {
                 v.transaction(&t, dec.dictionary(t.node));

@@ -109,6 +109,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
     };
     let mut summary = Summary::default();
     let mut transfers = Transfers::new();
+    let mut names = Vec::new();
     let mut status = ExitCode::Ok;
     for path in &args.files {
         let Some(input) = input::open_input(path, "decode") else {
@@ -119,6 +120,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
             summary: &mut summary,
             events: &mut events,
             transfers: &mut transfers,
+            names: &mut names,
         };
         match decode_stream(path, input, &mut decoder, mode, &mut sinks, &mut out) {
             Ok(()) => {}
@@ -131,7 +133,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
             }
         }
     }
-    let result = finish(&mut decoder, mode, &mut summary, &mut transfers, &mut out).and_then(|_| out.flush());
+    let result = finish(&mut decoder, mode, &mut summary, &mut transfers, &names, &mut out).and_then(|_| out.flush());
     match result {
         Err(e) if e.kind() != io::ErrorKind::BrokenPipe => out.blame().report(None, &e),
         _ => status,
@@ -144,6 +146,23 @@ struct Sinks<'a> {
     events: &'a mut EventTracker,
     /// The SDO transfers of `--transactions`, as the TUI's SDO pane takes them.
     transfers: &'a mut Transfers,
+    /// Interface names of the input so far (see [`note_interfaces`]).
+    names: &'a mut Vec<String>,
+}
+
+/// Keeps `names` up with a source's interface table (which grows as names appear).
+pub(super) fn note_interfaces(names: &mut Vec<String>, ifaces: &crate::frame::Interfaces) {
+    let all = ifaces.names();
+    if all.len() > names.len() {
+        names.extend(all[names.len()..].iter().cloned());
+    }
+}
+
+/// The interface name shown with a node-level record (event, transaction, summary row):
+/// only when the input has several interfaces, so that node 5 of can0 and node 5 of can1
+/// tell apart; a capture of one interface prints as it always did.
+pub(super) fn shown_iface(names: &[String], iface: u16) -> Option<&str> {
+    (names.len() > 1).then(|| names.get(usize::from(iface)).map_or("?", String::as_str))
 }
 
 /// Decodes one input into `out` (parsing runs on a second thread).
@@ -162,11 +181,13 @@ fn decode_stream(
     let mut label = String::new();
     let counts = input::for_each_frame(path, input, |frames| {
         let ifaces = frames.ifaces;
+        note_interfaces(sinks.names, ifaces);
+        sinks.summary.name_interfaces(ifaces);
         for (line, frame) in frames {
             match mode {
                 Mode::Summary(_) => {
                     let (kind, node) = decoder.classify(frame);
-                    sinks.summary.add(kind, node);
+                    sinks.summary.add_on(frame.iface, kind, node);
                 }
                 Mode::Events(fmt) => {
                     let events = &mut *sinks.events;
@@ -182,11 +203,12 @@ fn decode_stream(
                         events.transaction(&t);
                     }
                     for e in events.take_events() {
+                        let iface = shown_iface(sinks.names, e.iface);
                         match fmt {
-                            OutputFormat::Text => e.write_line(&mut buf),
+                            OutputFormat::Text => e.write_line_on(&mut buf, iface),
                             // (pcapng and parquet never reach here: they are refused with --events)
                             OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => {
-                                e.write_json(&mut json)
+                                e.write_json_on(&mut json, iface)
                             }
                         }
                     }
@@ -204,7 +226,8 @@ fn decode_stream(
                 Mode::Transactions(fmt) => {
                     decoder.track(frame);
                     for t in sinks.transfers.completed(decoder) {
-                        write_transaction(&mut json, &mut label, &t, decoder.dictionary(t.node), fmt);
+                        let iface = shown_iface(sinks.names, t.iface);
+                        write_transaction(&mut json, &mut label, &t, decoder.dictionary(t.node), iface, fmt);
                     }
                 }
             }
@@ -230,16 +253,28 @@ pub(super) fn write_transaction(
     label: &mut String,
     t: &Transaction,
     dict: &Dictionary,
+    iface: Option<&str>,
     fmt: OutputFormat,
 ) {
     match fmt {
         OutputFormat::Text => {
             label.clear();
+            // Several interfaces: `can1 node 2: Upload 0x6041:00 ...`.
+            if let Some(i) = iface {
+                label.push_str(i);
+                label.push_str(" node ");
+                label.push_str(&t.node.to_string());
+                label.push_str(": ");
+            }
             t.write_label(label, dict);
             out.extend_from_slice(label.as_bytes());
             out.push(b'\n');
         }
-        OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => write_line(out, &t.to_json(dict)),
+        OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => {
+            let mut j = t.to_json(dict);
+            j.iface = iface;
+            write_line(out, &j)
+        }
     }
 }
 
@@ -258,6 +293,7 @@ fn finish(
     mode: Mode,
     summary: &mut Summary,
     transfers: &mut Transfers,
+    names: &[String],
     out: &mut impl Write,
 ) -> io::Result<()> {
     let mut buf = Vec::new();
@@ -265,7 +301,8 @@ fn finish(
         Mode::Transactions(fmt) => {
             let mut label = String::new();
             for t in transfers.end(decoder) {
-                write_transaction(&mut buf, &mut label, &t, decoder.dictionary(t.node), fmt);
+                let iface = shown_iface(names, t.iface);
+                write_transaction(&mut buf, &mut label, &t, decoder.dictionary(t.node), iface, fmt);
             }
         }
         Mode::Summary(fmt) => write_summary(&mut buf, summary, fmt),

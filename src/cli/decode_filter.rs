@@ -15,7 +15,8 @@ use std::io::{self, Write};
 /// What a matching frame gives: its output line, or its kind and node for the totals.
 enum Out {
     Line(Vec<u8>),
-    Count(Kind, Option<u8>),
+    /// A frame of (interface, kind, node) to count.
+    Count(u16, Kind, Option<u8>),
 }
 
 /// What a filtered run writes.
@@ -36,6 +37,8 @@ struct Run {
     summary: Summary,
     /// The SDO transfers of `--transactions`, as the TUI's SDO pane takes them.
     transfers: Transfers,
+    /// Interface names of the input so far.
+    names: Vec<String>,
     /// Frames taken so far (the decoder's sequence numbers).
     pos: u64,
     t0_ns: Option<u64>,
@@ -83,6 +86,7 @@ pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
         format: args.format,
         summary: Summary::default(),
         transfers: Transfers::new(),
+        names: Vec::new(),
         pos: 0,
         t0_ns: None,
     };
@@ -114,6 +118,8 @@ impl Run {
         let mut buf = Vec::with_capacity(1 << 16);
         let counts = for_each_frame(path, input, |frames| {
             let ifaces = frames.ifaces;
+            super::decode::note_interfaces(&mut self.names, ifaces);
+            self.summary.name_interfaces(ifaces);
             for (line, frame) in frames {
                 let t0 = *self.t0_ns.get_or_insert(frame.ts_ns);
                 self.decoder.set_seq(self.pos);
@@ -139,7 +145,7 @@ impl Run {
                 self.stream.frame(self.pos, facts, d, &done, |d| {
                     let mut s = Vec::new();
                     match (mode, format) {
-                        (Mode::Summary, _) => return Out::Count(d.kind, d.node),
+                        (Mode::Summary, _) => return Out::Count(frame.iface, d.kind, d.node),
                         (_, OutputFormat::Text) => text::write_line(&mut s, frame, ifaces, d),
                         _ => jsonl::write_frame(&mut s, line, frame, ifaces, d),
                     }
@@ -161,7 +167,7 @@ impl Run {
     fn take(&mut self, buf: &mut Vec<u8>, ready: Vec<Out>) {
         for o in ready {
             match o {
-                Out::Count(kind, node) => self.summary.add(kind, node),
+                Out::Count(iface, kind, node) => self.summary.add_on(iface, kind, node),
                 Out::Line(s) => buf.extend_from_slice(&s),
             }
         }
@@ -172,7 +178,8 @@ impl Run {
         if !self.filter.matches_transaction(t, dict, t0) {
             return;
         }
-        write_transaction(buf, &mut String::new(), t, dict, self.format);
+        let iface = super::decode::shown_iface(&self.names, t.iface);
+        write_transaction(buf, &mut String::new(), t, dict, iface, self.format);
     }
 
     /// Writes what waited for the end of the input.

@@ -1,6 +1,7 @@
 //! `--summary`: per-node and per-kind totals.
 
 use crate::decode::Kind;
+use crate::frame::{Interfaces, NodeKey};
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -9,26 +10,56 @@ use std::collections::BTreeMap;
 pub struct Summary {
     /// Frames per kind.
     pub by_kind: BTreeMap<Kind, u64>,
-    /// Frames per node, split by kind.
-    pub by_node: BTreeMap<u8, BTreeMap<Kind, u64>>,
+    /// Frames per node (of its interface), split by kind.
+    pub by_node: BTreeMap<NodeKey, BTreeMap<Kind, u64>>,
     /// Frames in all.
     pub frames: u64,
     kind_counts: [u64; Kind::ALL.len()],
+    /// Per interface, 128 nodes' counters.
     node_counts: Vec<[u64; Kind::ALL.len()]>,
+    /// Interface names by index, as far as known: with nodes on several, a node is shown
+    /// with its interface (`can1 node 5`, JSON key `"can1/5"`).
+    ifaces: Vec<String>,
 }
 
 impl Summary {
-    /// Counts one frame (a fixed-size array increment: this is the hot path).
+    /// Counts one frame of the first interface.
     pub fn add(&mut self, kind: Kind, node: Option<u8>) {
+        self.add_on(0, kind, node);
+    }
+
+    /// Counts one frame of interface `iface` (a fixed-size array increment: this is the hot
+    /// path).
+    #[inline]
+    pub fn add_on(&mut self, iface: u16, kind: Kind, node: Option<u8>) {
         self.frames += 1;
         let k = kind.index();
         self.kind_counts[k] += 1;
         if let Some(n) = node {
-            if self.node_counts.is_empty() {
-                self.node_counts = vec![[0; Kind::ALL.len()]; 128];
+            let i = usize::from(iface) * 128 + usize::from(n & 0x7F);
+            if i >= self.node_counts.len() {
+                self.node_counts
+                    .resize((usize::from(iface) + 1) * 128, [0; Kind::ALL.len()]);
             }
-            self.node_counts[(n & 0x7F) as usize][k] += 1;
+            self.node_counts[i][k] += 1;
         }
+    }
+
+    /// Takes note of the interface names of the frames counted (a source's table grows as
+    /// names appear; call it with the newest).
+    pub fn name_interfaces(&mut self, ifaces: &Interfaces) {
+        let names = ifaces.names();
+        if names.len() > self.ifaces.len() {
+            self.ifaces.extend(names[self.ifaces.len()..].iter().cloned());
+        }
+    }
+
+    /// The interface name to show with `node`: only when nodes were counted on several
+    /// interfaces (then node 5 of can0 and node 5 of can1 are told apart).
+    fn iface_of(&self, node: NodeKey) -> Option<&str> {
+        let first = self.by_node.keys().next().map(|k| k.iface);
+        let several = self.by_node.keys().any(|k| Some(k.iface) != first);
+        several.then(|| self.ifaces.get(usize::from(node.iface)).map_or("?", String::as_str))
     }
 
     /// Folds the counters into the `by_kind`/`by_node` maps.
@@ -41,9 +72,10 @@ impl Summary {
             }
         }
         for (n, counts) in self.node_counts.iter().enumerate() {
+            let key = NodeKey::new(u16::try_from(n / 128).unwrap_or(u16::MAX), (n % 128) as u8);
             for (i, k) in Kind::ALL.iter().enumerate() {
                 if counts[i] > 0 {
-                    self.by_node.entry(n as u8).or_default().insert(*k, counts[i]);
+                    self.by_node.entry(key).or_default().insert(*k, counts[i]);
                 }
             }
         }
@@ -60,7 +92,14 @@ impl Summary {
         for (node, kinds) in &self.by_node {
             let total: u64 = kinds.values().sum();
             let parts: Vec<String> = kinds.iter().map(|(k, n)| format!("{}={n}", k.as_str())).collect();
-            s.push_str(&format!("  node {node:<3} {total:>10}  {}\n", parts.join(" ")));
+            match self.iface_of(*node) {
+                Some(iface) => s.push_str(&format!(
+                    "  {iface} node {:<3} {total:>10}  {}\n",
+                    node.node,
+                    parts.join(" ")
+                )),
+                None => s.push_str(&format!("  node {:<3} {total:>10}  {}\n", node.node, parts.join(" "))),
+            }
         }
         s
     }
@@ -73,7 +112,13 @@ impl Summary {
             by_node: self
                 .by_node
                 .iter()
-                .map(|(node, kinds)| (node.to_string(), named(kinds)))
+                .map(|(node, kinds)| {
+                    let key = match self.iface_of(*node) {
+                        Some(iface) => format!("{iface}/{}", node.node),
+                        None => node.node.to_string(),
+                    };
+                    (key, named(kinds))
+                })
                 .collect(),
             frames: self.frames,
         }
@@ -86,7 +131,8 @@ impl Summary {
 pub struct SummaryJson {
     /// Frames per kind name.
     pub by_kind: BTreeMap<&'static str, u64>,
-    /// Frames per node (its number as text), per kind name.
+    /// Frames per node (its number as text; `"can1/5"` when the input has several
+    /// interfaces), per kind name.
     pub by_node: BTreeMap<String, BTreeMap<&'static str, u64>>,
     /// Frames in all.
     pub frames: u64,
@@ -106,7 +152,7 @@ mod tests {
         s.finish();
         assert_eq!(s.frames, 4);
         assert_eq!(s.by_kind[&Kind::Heartbeat], 2);
-        assert_eq!(s.by_node[&5][&Kind::Heartbeat], 2);
+        assert_eq!(s.by_node[&NodeKey::new(0, 5)][&Kind::Heartbeat], 2);
         let t = s.to_text();
         assert!(t.contains("  heartbeat    2"), "{t}");
         assert!(t.contains("node 5            2  heartbeat=2"), "{t}");

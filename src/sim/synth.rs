@@ -281,7 +281,14 @@ mod tests {
         for (seq, f) in Traffic::new(20_000, 0).enumerate() {
             let (base, node) = (f.id & 0x780, (f.id & 0x7F) as u8);
             if base == 0x580 || base == 0x600 {
-                let t = tracker.on_frame(seq as u64, f.ts_ns, node, base == 0x600, f.payload(), &dict);
+                let t = tracker.on_frame(
+                    seq as u64,
+                    f.ts_ns,
+                    crate::frame::NodeKey::of(&f, node),
+                    base == 0x600,
+                    f.payload(),
+                    &dict,
+                );
                 assert!(t.problems.is_empty(), "frame {seq}: {t:?}");
             }
         }

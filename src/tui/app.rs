@@ -179,7 +179,10 @@ struct Heard<'a>(&'a App);
 
 impl crate::command::complete::Known for Heard<'_> {
     fn nodes(&self) -> Vec<u8> {
-        self.0.trace.nodes.iter().map(|(id, _)| *id).collect()
+        let mut ids: Vec<u8> = self.0.trace.nodes.iter().map(|(id, _)| id.node).collect();
+        ids.sort_unstable();
+        ids.dedup();
+        ids
     }
     fn dictionary(&self, node: u8) -> &crate::od::Dictionary {
         self.0.bindings.dictionary(node)
@@ -680,7 +683,7 @@ impl App {
     }
 
     fn drive_state(&self, node: u8) -> Option<crate::decode::cia402::DriveState> {
-        self.trace.nodes.get(node).and_then(|n| n.drive)
+        self.trace.nodes.by_id(node).and_then(|n| n.drive)
     }
 
     /// Runs a commander line: asks for confirmation first when it needs one.
@@ -761,7 +764,7 @@ impl App {
                 .nodes
                 .iter()
                 .filter(|(_, n)| n.drive.is_some_and(is_powered))
-                .map(|(id, _)| *id),
+                .map(|(id, _)| id.node),
         );
         t
     }
@@ -807,7 +810,7 @@ impl App {
         let powered: Vec<u8> = self
             .commanded
             .nodes()
-            .filter(|n| self.trace.nodes.get(*n).and_then(|i| i.drive).is_some_and(is_powered))
+            .filter(|n| self.trace.nodes.by_id(*n).and_then(|i| i.drive).is_some_and(is_powered))
             .collect();
         if powered.is_empty() || self.source.requests.is_none() {
             self.quit = true;
@@ -999,7 +1002,7 @@ impl App {
             .nodes
             .iter()
             .nth(self.panes.nodes.list.selected)
-            .map(|(n, _)| *n);
+            .map(|(n, _)| n.node);
         self.panes.objects.set_nodes_selection(n);
     }
 
@@ -1637,12 +1640,24 @@ mod tests {
         a.ingest(Duration::from_millis(100));
         let taken = Instant::now();
         // Node 2 (heartbeats every 14 ms in the capture) was found lost by these frames.
-        assert!(a.trace.nodes.liveness(2).unwrap().is_lost());
-        assert!(!a.trace.nodes.liveness(5).unwrap().is_lost());
+        assert!(
+            a.trace
+                .nodes
+                .liveness(crate::frame::NodeKey::new(0, 2))
+                .unwrap()
+                .is_lost()
+        );
+        assert!(
+            !a.trace
+                .nodes
+                .liveness(crate::frame::NodeKey::new(0, 5))
+                .unwrap()
+                .is_lost()
+        );
         // No frame comes for a second of wall time: node 5 (every 100 ms) is lost too,
         // dated 150 ms after its last heartbeat.
         a.liveness_tick(taken + Duration::from_secs(1));
-        let l = a.trace.nodes.liveness(5).unwrap();
+        let l = a.trace.nodes.liveness(crate::frame::NodeKey::new(0, 5)).unwrap();
         assert_eq!(l.lost_at_ns, Some(t0 + 650_000_000));
         let msg = a.message.clone().unwrap_or_default();
         assert!(

@@ -33,7 +33,11 @@ fn pinned(name: &str, args: &[&str], status: i32, tmp: &str) {
     line.push("--json");
     let (rc, mut json, stderr) = cotui_json(&line);
     assert_eq!(rc, status, "cotui {}: {json} {stderr}", line.join(" "));
-    assert!(json.is_object(), "cotui {}: not one JSON object: {stderr}", line.join(" "));
+    assert!(
+        json.is_object(),
+        "cotui {}: not one JSON object: {stderr}",
+        line.join(" ")
+    );
     stable(&mut json, tmp);
     let pretty = serde_json::to_string_pretty(&json).unwrap();
     insta::assert_snapshot!(name, pretty, &format!("cotui {}", line.join(" ")));
@@ -52,11 +56,23 @@ fn every_command_answers_json_as_documented() {
         ("sdo_read", vec!["sdo", "read", "demo", "2", "0x6041"], 0),
         ("sdo_read_abort", vec!["sdo", "read", "demo", "2", "0x2345:1"], 3),
         ("sdo_read_usage", vec!["sdo", "read", "demo", "2"], 1),
-        ("sdo_write", vec!["sdo", "write", "demo", "2", "0x6060", "1", "--type", "i8"], 0),
-        ("sdo_write_abort", vec!["sdo", "write", "demo", "2", "0x6041", "6", "--type", "u16"], 3),
+        (
+            "sdo_write",
+            vec!["sdo", "write", "demo", "2", "0x6060", "1", "--type", "i8"],
+            0,
+        ),
+        (
+            "sdo_write_abort",
+            vec!["sdo", "write", "demo", "2", "0x6041", "6", "--type", "u16"],
+            3,
+        ),
         ("drive_status", vec!["drive", "demo", "2", "status"], 0),
         ("drive_enable", vec!["drive", "demo", "2", "enable"], 0),
-        ("drive_no_such_node", vec!["drive", "demo", "9", "enable", "--timeout", "100"], 5),
+        (
+            "drive_no_such_node",
+            vec!["drive", "demo", "9", "enable", "--timeout", "100"],
+            5,
+        ),
         ("scan", vec!["scan", "demo"], 0),
         ("lss_switch", vec!["lss", "demo", "switch", "config"], 0),
         ("lss_inquire_timeout", vec!["lss", "demo", "inquire", "all"], 4),
@@ -64,8 +80,16 @@ fn every_command_answers_json_as_documented() {
         ("send_bad_frame", vec!["send", "demo", "123#1"], 1),
         ("sync", vec!["sync", "demo", "--period", "10", "--count", "2"], 0),
         ("pdo_read", vec!["pdo", "demo", "2"], 0),
-        ("pdo_map_dry_run", vec!["pdo", "demo", "2", "map", "tpdo1", "0x6041", "--dry-run"], 0),
-        ("pdo_map_reserved", vec!["pdo", "demo", "2", "map", "tpdo1", "0x6041", "--cob-id", "0x602"], 1),
+        (
+            "pdo_map_dry_run",
+            vec!["pdo", "demo", "2", "map", "tpdo1", "0x6041", "--dry-run"],
+            0,
+        ),
+        (
+            "pdo_map_reserved",
+            vec!["pdo", "demo", "2", "map", "tpdo1", "0x6041", "--cob-id", "0x602"],
+            1,
+        ),
         ("stop", vec!["stop", "demo", "2"], 0),
         ("run_list", vec!["run", "demo", "2"], 0),
         ("run_unknown", vec!["run", "demo", "2", "no-such-procedure"], 1),
@@ -73,7 +97,11 @@ fn every_command_answers_json_as_documented() {
         ("record_exists", vec!["record", "demo", "-o", &log, "--count", "3"], 1),
         ("dcf_save", vec!["dcf", "save", "demo", "2", "-o", &dcf], 0),
         ("dcf_diff", vec!["dcf", "diff", "demo", "2", &dcf], 0),
-        ("dcf_diff_missing", vec!["dcf", "diff", "demo", "2", "/nonexistent.dcf"], 1),
+        (
+            "dcf_diff_missing",
+            vec!["dcf", "diff", "demo", "2", "/nonexistent.dcf"],
+            1,
+        ),
     ];
     for (name, args, status) in cases {
         pinned(name, &args, status, tmp);

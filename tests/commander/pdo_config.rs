@@ -143,9 +143,9 @@ async fn after_map_tpdo1_the_drive_sends_and_the_decoder_decodes_the_new_signals
         decoder.decode(&f);
         fresh.decode(&f);
     }
-    let m = decoder.mapping(2, true, 1).unwrap();
+    let m = decoder.mapping(cotui::frame::NodeKey::new(0, 2), true, 1).unwrap();
     assert!(matches!(m.source, MappingSource::Configured { .. }), "{:?}", m.source);
-    let m = fresh.mapping(2, true, 1).unwrap();
+    let m = fresh.mapping(cotui::frame::NodeKey::new(0, 2), true, 1).unwrap();
     assert!(matches!(m.source, MappingSource::ReadFromNode { .. }), "{:?}", m.source);
     assert_eq!(m.entries.len(), 2);
 }

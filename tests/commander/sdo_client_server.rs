@@ -62,7 +62,14 @@ impl Link {
         }
         self.seq += 1;
         self.now += 100_000;
-        self.tracker.on_frame(self.seq, self.now, NODE, c2s, &frame, &self.dict);
+        self.tracker.on_frame(
+            self.seq,
+            self.now,
+            cotui::frame::NodeKey::new(0, NODE),
+            c2s,
+            &frame,
+            &self.dict,
+        );
         Some(frame)
     }
 

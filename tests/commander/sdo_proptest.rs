@@ -53,7 +53,7 @@ proptest! {
         let mut t = SdoTracker::new();
         let mut txns = Vec::new();
         for (i, (node, c2s, bytes)) in frames.iter().enumerate() {
-            let f = t.on_frame(i as u64, i as u64 * 1000, *node, *c2s, bytes, &dict);
+            let f = t.on_frame(i as u64, i as u64 * 1000, cotui::frame::NodeKey::new(0, *node), *c2s, bytes, &dict);
             prop_assert!(!f.label().is_empty());
             prop_assert!(serde_json::to_value(f.to_json()).unwrap()["cs"].is_string());
             txns.extend(t.take_completed());
@@ -91,13 +91,13 @@ fn exchange(
         for f in std::mem::take(&mut to_server) {
             seq += 1;
             now += 1000;
-            tracker.on_frame(seq, now, 9, true, &f, &dict);
+            tracker.on_frame(seq, now, cotui::frame::NodeKey::new(0, 9), true, &f, &dict);
             to_client.extend(server.on_frame(&f, now, store).frames);
         }
         for f in to_client {
             seq += 1;
             now += 1000;
-            tracker.on_frame(seq, now, 9, false, &f, &dict);
+            tracker.on_frame(seq, now, cotui::frame::NodeKey::new(0, 9), false, &f, &dict);
             let out = client.on_frame(&f, now);
             done = out.done.or(done);
             to_server.extend(out.frames);
@@ -222,7 +222,7 @@ proptest! {
         let mut t = SdoTracker::new();
         let mut labels = Vec::new();
         for (i, (c2s, f)) in frames[cut..].iter().enumerate() {
-            labels.push(t.on_frame(i as u64 + 1, i as u64 * 1000, 9, *c2s, f, &dict).label());
+            labels.push(t.on_frame(i as u64 + 1, i as u64 * 1000, cotui::frame::NodeKey::new(0, 9), *c2s, f, &dict).label());
         }
         let txns = t.finish();
         // A server's first byte 0x42/0x43/0x47/0x4B/0x4F reads as a complete expedited upload

@@ -23,4 +23,5 @@ mod profile_example;
 mod realworld_block;
 mod run;
 mod track_path;
+mod two_buses;
 mod wireshark;

@@ -67,9 +67,14 @@ impl Trace {
             _ => panic!("not an SDO COB-ID: {line}"),
         };
         self.seq += 1;
-        let f = self
-            .tracker
-            .on_frame(self.seq, self.seq * 1_000_000, node, c2s, &bytes, &self.dict);
+        let f = self.tracker.on_frame(
+            self.seq,
+            self.seq * 1_000_000,
+            cotui::frame::NodeKey::new(0, node),
+            c2s,
+            &bytes,
+            &self.dict,
+        );
         f.label()
     }
     fn done(&mut self) -> Vec<Transaction> {
@@ -410,7 +415,14 @@ fn syntron_pdo_mapping_frames() {
             .skip(1)
             .map(|w| u8::from_str_radix(w, 16).unwrap())
             .collect();
-        let f = t.on_frame(i as u64, i as u64, 2, true, &bytes, &dict);
+        let f = t.on_frame(
+            i as u64,
+            i as u64,
+            cotui::frame::NodeKey::new(0, 2),
+            true,
+            &bytes,
+            &dict,
+        );
         let j = serde_json::to_value(f.to_json()).unwrap();
         assert_eq!(j["cs"], "initiate_download", "{line}");
         assert_eq!(j["expedited"], true, "{line}");

@@ -68,7 +68,7 @@ fn demo_app() -> App {
 fn objects_pane_reads_an_object_of_a_demo_drive_and_prefills_its_write() {
     let mut a = demo_app();
     until(&mut a, "node 2 to be listed", |a, _| {
-        a.trace.nodes.iter().any(|(n, _)| *n == 2)
+        a.trace.nodes.iter().any(|(n, _)| n.node == 2)
     });
     key(&mut a, KeyCode::Char('6'));
     // Node 2 (the Nodes selection may be another node: `]` picks the next one).
@@ -183,7 +183,7 @@ fn record_start_and_stop_from_the_palette_write_the_frames_received() {
 fn read_all_reads_what_drive_2_has_with_progress_and_lists_the_failures() {
     let mut a = demo_app();
     until(&mut a, "node 2 to be listed", |a, _| {
-        a.trace.nodes.iter().any(|(n, _)| *n == 2)
+        a.trace.nodes.iter().any(|(n, _)| n.node == 2)
     });
     key(&mut a, KeyCode::Char('6'));
     for _ in 0..4 {

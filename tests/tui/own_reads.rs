@@ -63,7 +63,7 @@ fn demo_app() -> App {
 fn own_reads_of_missing_objects_do_not_hide_a_drive_fault_and_a_lost_node() {
     let mut a = demo_app();
     until(&mut a, "nodes 2 and 3 to be listed", |a, _| {
-        a.trace.nodes.iter().any(|(n, _)| *n == 2) && a.trace.nodes.iter().any(|(n, _)| *n == 3)
+        a.trace.nodes.iter().any(|(n, _)| n.node == 2) && a.trace.nodes.iter().any(|(n, _)| n.node == 3)
     });
     key(&mut a, KeyCode::Char('6'));
     for _ in 0..4 {

@@ -86,7 +86,7 @@ fn frame_lines(trace: &Trace, f: &Frame, d: &Decoded, pos: usize) -> Vec<Line<'s
         ));
     }
     let node = d.node.unwrap_or(0);
-    let mode = trace.decoder().mode(node);
+    let mode = trace.decoder().mode(crate::frame::NodeKey::of(f, node));
     let dict = trace.decoder().dictionary(node);
     match &d.body {
         Body::Sdo(s) => {

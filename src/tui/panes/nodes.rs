@@ -174,7 +174,7 @@ impl Component for NodesPane {
         }
         match action {
             Action::Expand => match ctx.trace.nodes.iter().nth(self.list.selected) {
-                Some((n, _)) => Outcome::Filter(format!("node {n}")),
+                Some((n, _)) => Outcome::Filter(format!("node {}", n.node)),
                 None => Outcome::Done,
             },
             _ => Outcome::Ignored,
@@ -201,9 +201,15 @@ impl Component for NodesPane {
         }
         let trace = ctx.trace;
         let now = trace.nodes.now_ns();
-        let width = inner.width as usize;
+        // Several interfaces: each row starts with its node's interface (rows come grouped
+        // per interface, in node-ID order within each).
+        let bus = BusColumn::of(trace);
+        let width = (inner.width as usize).saturating_sub(bus.width());
         let heads: Vec<String> = COLUMNS.iter().map(|c| c.0.to_string()).collect();
-        let mut lines = vec![Line::styled(join(&heads, &layout(width)), header())];
+        let mut lines = vec![Line::styled(
+            format!("{}{}", bus.cell("iface"), join(&heads, &layout(width))),
+            header(),
+        )];
         let l = self.list;
         for (i, (id, n)) in trace
             .nodes
@@ -213,7 +219,12 @@ impl Component for NodesPane {
             .take(inner.height as usize - 1)
         {
             let live = trace.nodes.liveness(*id);
-            let line = Line::styled(row_text(*id, n, live, now, width), row_style(live));
+            let text = format!(
+                "{}{}",
+                bus.cell(trace.ifaces.name(id.iface)),
+                row_text(id.node, n, live, now, width)
+            );
+            let line = Line::styled(text, row_style(live));
             lines.push(if i == l.selected && focused {
                 line.style(selected())
             } else {
@@ -224,6 +235,35 @@ impl Component for NodesPane {
             lines.push(Line::raw("no node seen yet"));
         }
         f.render_widget(Paragraph::new(lines), inner);
+    }
+}
+
+/// The interface column shown before the others when the trace has several interfaces.
+struct BusColumn(usize);
+
+impl BusColumn {
+    /// As wide as the longest interface name (5 to 12), or absent while every node is on
+    /// one interface.
+    fn of(trace: &Trace) -> BusColumn {
+        let mut ifaces = trace.nodes.iter().map(|(k, _)| k.iface);
+        let first = ifaces.next();
+        if !ifaces.any(|i| Some(i) != first) {
+            return BusColumn(0);
+        }
+        let names = trace.ifaces.names();
+        BusColumn(names.iter().map(|n| n.chars().count()).max().unwrap_or(0).clamp(5, 12))
+    }
+    /// Characters taken, with the space after it.
+    fn width(&self) -> usize {
+        if self.0 == 0 { 0 } else { self.0 + 1 }
+    }
+    /// `text` fitted to the column, with the space after it ("" without the column).
+    fn cell(&self, text: &str) -> String {
+        if self.0 == 0 {
+            return String::new();
+        }
+        let w = self.0;
+        format!("{:<w$} ", fit(text, w))
     }
 }
 
@@ -240,6 +280,7 @@ pub fn render_compact(trace: &Trace, f: &mut Frame, area: Rect) {
     f.render_widget(block(&title(trace), false), area);
     let inner = block("", true).inner(area);
     let now = trace.nodes.now_ns();
+    let bus = BusColumn::of(trace);
     let lines: Vec<Line> = trace
         .nodes
         .iter()
@@ -250,8 +291,9 @@ pub fn render_compact(trace: &Trace, f: &mut Frame, area: Rect) {
             Line::styled(
                 fit(
                     &format!(
-                        "{:>3} {:<15} {}{}",
-                        id,
+                        "{}{:>3} {:<15} {}{}",
+                        bus.cell(trace.ifaces.name(id.iface)),
+                        id.node,
                         state_text(live, now),
                         n.drive.map(|d| d.text()).unwrap_or(""),
                         emcy

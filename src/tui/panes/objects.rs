@@ -778,7 +778,7 @@ impl Component for ObjectsPane {
             self.scroll(delta, ctx);
             return Outcome::Done;
         }
-        let nodes: Vec<u8> = ctx.trace.nodes.iter().map(|(n, _)| *n).collect();
+        let nodes: Vec<u8> = ctx.trace.nodes.iter().map(|(n, _)| n.node).collect();
         let Some(node) = self.node() else {
             return match action {
                 Action::NextSeries | Action::PrevSeries | Action::Expand | Action::EditObject | Action::ReadAll => {

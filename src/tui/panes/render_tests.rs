@@ -74,6 +74,49 @@ fn nodes_pane_marks_a_silent_node_lost_in_red_with_its_age() {
     }
 }
 
+/// A capture of two buses, each with a node 5 (tests/fixtures/two_buses.log): node 5 on
+/// can1 goes silent for good while node 5 on can0 goes on.
+fn two_bus_app() -> crate::tui::app::App {
+    use crate::analysis::trace::Trace;
+    use crate::decode::Decoder;
+    use crate::od::Dictionary;
+    use crate::tui::app::{SourceInfo, SourceKind};
+    let mut trace = Trace::new(Decoder::new(Dictionary::default(), Vec::new()), 500_000);
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/two_buses.log")).unwrap();
+    for line in text.lines() {
+        let mut ifaces = std::mem::take(&mut trace.ifaces);
+        if let Ok(crate::log::Line::Frame(f)) = crate::log::candump::parse_line(line.as_bytes(), &mut ifaces) {
+            trace.ifaces = ifaces;
+            trace.push(&f);
+        } else {
+            trace.ifaces = ifaces;
+        }
+    }
+    let (_tx, rx) = std::sync::mpsc::channel();
+    let mut src = SourceInfo::new("two_buses.log", SourceKind::Open, rx, None);
+    src.done = true;
+    crate::tui::app::App::new(trace, crate::tui::keymap::Keymap::default_map(), src)
+}
+
+#[test]
+fn nodes_pane_shows_node_5_of_each_interface_with_its_interface() {
+    let mut a = two_bus_app();
+    a.focus = Pane::Nodes;
+    let s = screen(&mut a, 160, 14);
+    assert!(s.contains("iface  id nmt"), "{s}");
+    let row = |iface: &str| {
+        s.lines()
+            .find(|l| l.contains(&format!("{iface}    5 ")))
+            .unwrap_or_else(|| panic!("no row of node 5 on {iface}: {s}"))
+            .to_string()
+    };
+    assert!(row("can0").contains("Operational"), "{s}");
+    assert!(row("can1").contains("LOST"), "{s}");
+    // can0 rows come first, then can1's.
+    let at = |needle: &str| s.find(needle).unwrap();
+    assert!(at("can0    5 ") < at("can1    5 "), "{s}");
+}
+
 #[test]
 fn sdo_pane_lists_transfers_and_expands_to_frames() {
     let mut a = app();

@@ -9,7 +9,7 @@ use super::pdo_config::{CommParams, PdoId};
 use super::sdo::tracker::{labelled, unlabelled};
 use super::sdo::{SdoFrame, SdoTracker};
 use super::{Kind, emcy, error_frame, heartbeat, lss, nmt, sync, time, value_text, vendor_sdo};
-use crate::frame::Frame;
+use crate::frame::{Frame, NodeKey};
 use crate::od::{Dictionary, MappingSource, PdoMapping, resolve_object};
 use crate::sdo::tracker::Tracked;
 use crate::sdo::{Transaction, TransferDirection};
@@ -58,14 +58,11 @@ struct LearnedMapping {
     entries: Vec<Option<u32>>,
 }
 
-/// Decodes frames one after another, keeping the state of the bus.
-///
-/// `Clone` lets a viewer keep checkpoints of the state and decode any stretch of a
-/// long trace again from the nearest one.
+/// What decoding learns about one bus (interface): its moved COB-IDs, PDO mappings and
+/// communication parameters, modes of operation. Each interface has its own: node 5 on
+/// can0 and node 5 on can1 are two nodes.
 #[derive(Clone)]
-pub struct Decoder {
-    /// Per-node dictionaries, index = node id (0 unused).
-    dicts: Vec<Dictionary>,
+struct Bus {
     cobs: CobTable,
     mappings: HashMap<PdoKey, PdoMapping>,
     learning: HashMap<PdoKey, LearnedMapping>,
@@ -76,54 +73,25 @@ pub struct Decoder {
     ours: [bool; 128],
     /// Mode of operation per node, from 0x6060/0x6061 traffic.
     modes: [Option<i8>; 128],
-    sdo: SdoTracker,
     /// SDO channels moved by 0x1200 writes: COB-ID -> (node, client_to_server).
     sdo_cobs: HashMap<u32, (u8, bool)>,
-    completed: Vec<Transaction>,
-    seq: u64,
-    /// A label buffer handed back by [`Decoder::recycle`], reused for the next PDO or SDO label.
-    spare: String,
 }
 
-impl Decoder {
-    /// A decoder where node `n` uses `dict_for(n)`. Nodes listed in `bound`
-    /// (explicit `--profile`/`--eds` bindings) also get their default PDO
-    /// mappings and COB-IDs from their dictionary.
-    pub fn new(default: Dictionary, bound: Vec<(u8, Dictionary)>) -> Decoder {
-        let mut dicts = vec![default; 128];
-        let mut d = Decoder {
-            dicts: Vec::new(),
+impl Default for Bus {
+    fn default() -> Self {
+        Bus {
             cobs: CobTable::default(),
             mappings: HashMap::new(),
             learning: HashMap::new(),
             comm: HashMap::new(),
             ours: [false; 128],
             modes: [None; 128],
-            sdo: SdoTracker::new(),
             sdo_cobs: HashMap::new(),
-            completed: Vec::new(),
-            seq: 0,
-            spare: String::new(),
-        };
-        for (node, dict) in bound {
-            if (1..128).contains(&node) {
-                d.install_default_mappings(node, &dict);
-                dicts[node as usize] = dict;
-            }
         }
-        d.dicts = dicts;
-        d
     }
+}
 
-    /// A decoder for the nodes bound in `bindings` (others use CiA 402 + 301).
-    pub fn from_bindings(bindings: &crate::od::bind::Bindings) -> Decoder {
-        let bound = bindings
-            .bound_nodes()
-            .map(|n| (n, bindings.dictionary(n).clone()))
-            .collect();
-        Decoder::new(bindings.default_dictionary().clone(), bound)
-    }
-
+impl Bus {
     fn install_default_mappings(&mut self, node: u8, dict: &Dictionary) {
         for layer in dict.layers().iter().rev() {
             for (transmit, maps) in [(false, &layer.rpdo), (true, &layer.tpdo)] {
@@ -146,318 +114,8 @@ impl Decoder {
         }
     }
 
-    /// Numbers the frames that follow from `seq + 1` on (the numbers SDO transactions list in
-    /// `frames`). A caller that skips frames (e.g. classifies only some) keeps them equal to
-    /// frame positions this way.
-    pub fn set_seq(&mut self, seq: u64) {
-        self.seq = seq;
-    }
-
-    /// The dictionary used for `node`.
-    pub fn dictionary(&self, node: u8) -> &Dictionary {
-        &self.dicts[(node & 0x7F) as usize]
-    }
-
-    /// The mapping in force for a PDO, if known.
-    pub fn mapping(&self, node: u8, transmit: bool, num: u16) -> Option<&PdoMapping> {
-        self.mappings.get(&(node, transmit, num))
-    }
-
-    /// Where a frame goes: kind, node and PDO number (0 when not a PDO), without decoding
-    /// it or changing any state (for callers that decode only some frames).
-    pub fn peek(&self, frame: &Frame) -> (Kind, Option<u8>, u16) {
-        let r = self.route(frame);
-        (r.kind, r.node, r.pdo)
-    }
-
-    /// The last mode of operation seen for `node`.
-    pub fn mode(&self, node: u8) -> Option<i8> {
-        self.modes[(node & 0x7F) as usize]
-    }
-
-    /// Where a frame goes, without building its label (the cheap path for `--summary`).
-    /// SDO frames are still tracked so that COB-ID and mapping changes are learned.
-    pub fn classify(&mut self, frame: &Frame) -> (Kind, Option<u8>) {
-        let route = self.route(frame);
-        if matches!(route.kind, Kind::SdoRx | Kind::SdoTx) {
-            self.seq += 1;
-            self.track_sdo(frame, route);
-        }
-        (route.kind, route.node)
-    }
-
-    /// An SDO frame (per [`Decoder::peek`]) tracked as [`Decoder::decode`] tracks it, without
-    /// building its label: the frame as the tracker read it, or None for a vendor SDO
-    /// command of the node's profile (which `decode` shows as [`Body::VendorSdo`]).
-    /// For callers that only need the command and the tracker's notes (the diagnosis).
-    pub fn sdo_frame(&mut self, frame: &Frame) -> Option<SdoFrame> {
-        let route = self.route(frame);
-        debug_assert!(matches!(route.kind, Kind::SdoRx | Kind::SdoTx));
-        self.seq += 1;
-        let s = self.track_sdo(frame, route);
-        let n = route.node.unwrap_or(0) as usize & 0x7F;
-        let c2s = route.kind == Kind::SdoRx;
-        vendor_sdo::decode(&self.dicts[n], c2s, frame.payload())
-            .is_none()
-            .then(|| unlabelled(s, frame.payload()))
-    }
-
-    fn route(&self, frame: &Frame) -> Route {
-        if frame.is_err() {
-            return Route {
-                kind: Kind::ErrorFrame,
-                node: None,
-                pdo: 0,
-                reserved: false,
-            };
-        }
-        // Most buses move no SDO channel: skip hashing the id then.
-        if !self.sdo_cobs.is_empty()
-            && let Some(&(node, c2s)) = self
-                .sdo_cobs
-                .get(&(frame.id | if frame.is_ext() { 1 << 29 } else { 0 }))
-        {
-            let kind = if c2s { Kind::SdoRx } else { Kind::SdoTx };
-            return Route {
-                kind,
-                node: Some(node),
-                pdo: 0,
-                reserved: false,
-            };
-        }
-        self.cobs.route(frame.id, frame.is_ext())
-    }
-
-    /// Hands a decoded frame back once it is written, so that its label buffer serves the
-    /// next label (saves an allocation per frame on the hot paths).
-    #[inline]
-    pub fn recycle(&mut self, decoded: Decoded) {
-        let mut label = decoded.label;
-        label.clear();
-        self.spare = label;
-    }
-
-    /// Decodes one frame, updating the bus state.
-    pub fn decode(&mut self, frame: &Frame) -> Decoded {
-        let route = self.route(frame);
-        self.decode_routed(frame, route)
-    }
-
-    fn decode_routed(&mut self, frame: &Frame, route: Route) -> Decoded {
-        self.seq += 1;
-        let payload = frame.payload();
-        let node = route.node;
-        let n = node.unwrap_or(0);
-        let mut rtr_problem = None;
-        if frame.is_rtr() && !matches!(route.kind, Kind::Heartbeat | Kind::Tpdo | Kind::Other) {
-            rtr_problem = Some(format!("remote frame on a {} COB-ID", route.kind.as_str()));
-        }
-        let (label, body, problem) = match route.kind {
-            Kind::ErrorFrame => (
-                error_frame::label(frame.id, payload),
-                Body::ErrorFrame { class: frame.id },
-                None,
-            ),
-            Kind::Nmt => {
-                let (m, p) = nmt::decode(payload);
-                (m.label(), Body::Nmt(m), p)
-            }
-            Kind::Sync => {
-                let (s, p) = sync::decode(payload);
-                (s.label(), Body::Sync(s), p)
-            }
-            Kind::Time => {
-                let (t, p) = time::decode(payload);
-                (t.label(), Body::Time(t), p)
-            }
-            Kind::Emcy => {
-                let (e, p) = emcy::decode(payload, &self.dicts[n as usize]);
-                (e.label(n), Body::Emcy(e), p)
-            }
-            Kind::Heartbeat => {
-                let (h, p) = heartbeat::decode(payload, frame.is_rtr());
-                (h.label(n), Body::Heartbeat(h), p)
-            }
-            Kind::Lss => {
-                let (l, p) = lss::decode(payload, frame.id == 0x7E5);
-                (l.label(), Body::Lss(l), p)
-            }
-            Kind::Tpdo | Kind::Rpdo => self.decode_pdo(frame, route),
-            Kind::SdoRx | Kind::SdoTx => {
-                let c2s = route.kind == Kind::SdoRx;
-                let tracked = self.track_sdo(frame, route);
-                let mut s = labelled(tracked, payload, &self.dicts[n as usize]);
-                // Controlword and statusword bits are named per the node's mode in force.
-                if let (Some(mode), Some((index @ (0x6040 | 0x6041), 0)), Some(v)) =
-                    (self.modes[n as usize], s.object, s.value.as_mut())
-                    && let Some(typed) = &v.typed
-                {
-                    v.text = value_text::object_text(&self.dicts[n as usize], index, 0, typed, Some(mode));
-                }
-                // The tracker sees vendor commands too (as unknown commands), so that
-                // their standard replies do not disturb a running transfer.
-                match vendor_sdo::decode(&self.dicts[n as usize], c2s, payload) {
-                    Some(v) => (v.label(), Body::VendorSdo(v), None),
-                    None => {
-                        let p = s.malformed();
-                        let mut label = std::mem::take(&mut self.spare);
-                        s.write_label(&mut label);
-                        (label, Body::Sdo(s), p)
-                    }
-                }
-            }
-            Kind::Other => {
-                let label = if route.reserved {
-                    format!("Reserved COB-ID 0x{:03X}", frame.id)
-                } else if frame.is_ext() {
-                    format!("29-bit frame 0x{:08X}", frame.id)
-                } else {
-                    format!("Not a predefined CANopen COB-ID (0x{:03X})", frame.id)
-                };
-                let p = route
-                    .reserved
-                    .then(|| format!("COB-ID 0x{:03X} is reserved by CiA 301", frame.id));
-                (label, Body::None, p)
-            }
-        };
-        let malformed = match (rtr_problem, problem) {
-            (Some(a), Some(b)) => Some(format!("{a}; {b}")),
-            (a, b) => a.or(b),
-        };
-        Decoded {
-            kind: route.kind,
-            node,
-            label,
-            body,
-            malformed,
-        }
-    }
-
-    /// Feeds a frame into the bus state without building its label or body: SDO transfers
-    /// (and what their completion teaches) and modes of operation mapped into PDOs. The
-    /// cheap path for `--transactions`: the transactions and the state afterwards are those
-    /// [`Decoder::decode`] gives.
-    pub fn track(&mut self, frame: &Frame) {
-        let route = self.route(frame);
-        match route.kind {
-            Kind::SdoRx | Kind::SdoTx => {
-                self.seq += 1;
-                self.track_sdo(frame, route);
-            }
-            Kind::Tpdo | Kind::Rpdo if self.maps_mode(route) => {
-                self.decode_routed(frame, route);
-            }
-            _ => self.seq += 1,
-        }
-    }
-
-    /// Whether the mapping in force for the PDO of `route` carries the mode of operation
-    /// (0x6060/0x6061), which decoding the PDO records.
-    fn maps_mode(&self, route: Route) -> bool {
-        let key = (route.node.unwrap_or(0), route.kind == Kind::Tpdo, route.pdo);
-        self.mappings.get(&key).is_some_and(|m| {
-            m.entries
-                .iter()
-                .any(|e| matches!((e.index, e.sub), (0x6060 | 0x6061, 0)))
-        })
-    }
-
-    /// Feeds an SDO frame to the transfer tracker and learns from the transfers it
-    /// completes (COB-IDs, PDO mappings, modes); returns the frame as the tracker read it.
-    fn track_sdo(&mut self, frame: &Frame, route: Route) -> Tracked {
-        let n = route.node.unwrap_or(0);
-        let c2s = route.kind == Kind::SdoRx;
-        if c2s {
-            self.ours[n as usize & 0x7F] = frame.direction() == crate::frame::Direction::Tx;
-        }
-        let s = self
-            .sdo
-            .track(self.seq, frame.ts_ns, n, c2s, frame.payload(), &self.dicts[n as usize]);
-        for mut t in self.sdo.take_completed() {
-            t.mode = self.modes[(t.node & 0x7F) as usize];
-            self.learn(&t);
-            self.completed.push(t);
-        }
-        s
-    }
-
-    /// A PDO frame (per [`Decoder::peek`]) decoded as [`Decoder::decode`] decodes it, bus
-    /// state included (modes of operation), but with no label, `malformed` or mapping source
-    /// and its signals without names or texts: for callers that keep values (the TUI's index).
-    /// `peeked` is what [`Decoder::peek`] says of the frame (not routed again).
-    pub fn pdo_values(&mut self, frame: &Frame, peeked: (Kind, Option<u8>, u16)) -> Decoded {
-        let (kind, node, num) = peeked;
-        debug_assert!(matches!(kind, Kind::Tpdo | Kind::Rpdo));
-        self.seq += 1;
-        let n = node.unwrap_or(0);
-        let transmit = kind == Kind::Tpdo;
-        let signals = match self.mappings.get(&(n, transmit, num)) {
-            Some(m) if !frame.is_rtr() => pdo::decode_values(frame.payload(), m, &self.dicts[n as usize]),
-            _ => Vec::new(),
-        };
-        self.note_mode(n, &signals);
-        Decoded {
-            kind,
-            node,
-            label: String::new(),
-            body: Body::Pdo(Pdo {
-                num,
-                transmit,
-                signals,
-                source: None,
-            }),
-            malformed: None,
-        }
-    }
-
-    /// Records a mode of operation carried by PDO `signals` of node `n`.
-    fn note_mode(&mut self, n: u8, signals: &[pdo::Signal]) {
-        for s in signals {
-            if matches!((s.index, s.sub), (0x6060 | 0x6061, 0)) {
-                self.modes[n as usize] = s.value.as_i64().map(|m| m as i8);
-            }
-        }
-    }
-
-    fn decode_pdo(&mut self, frame: &Frame, route: Route) -> (String, Body, Option<String>) {
-        let n = route.node.unwrap_or(0);
-        let transmit = route.kind == Kind::Tpdo;
-        let payload = frame.payload();
-        if frame.is_rtr() {
-            let name = if transmit { "TPDO" } else { "RPDO" };
-            let pdo = Pdo {
-                num: route.pdo,
-                transmit,
-                signals: Vec::new(),
-                source: None,
-            };
-            return (
-                format!("{name}{} node {n}: remote request", route.pdo),
-                Body::Pdo(pdo),
-                None,
-            );
-        }
-        let (signals, source, problem) = match self.mappings.get(&(n, transmit, route.pdo)) {
-            Some(m) => {
-                let (s, p) = pdo::decode_signals(payload, m, &self.dicts[n as usize], self.modes[n as usize]);
-                (s, Some(m.source.clone()), p)
-            }
-            None => (Vec::new(), None, None),
-        };
-        self.note_mode(n, &signals);
-        let pdo = Pdo {
-            num: route.pdo,
-            transmit,
-            signals,
-            source,
-        };
-        let mut label = std::mem::take(&mut self.spare);
-        pdo.write_label(&mut label, n, payload);
-        (label, Body::Pdo(pdo), problem)
-    }
-
     /// Learns COB-IDs, PDO mappings and modes from a completed SDO transfer.
-    fn learn(&mut self, t: &Transaction) {
+    fn learn(&mut self, t: &Transaction, dict: &Dictionary) {
         if !t.is_ok() || t.data.is_empty() {
             return;
         }
@@ -466,7 +124,7 @@ impl Decoder {
         let len = t.data.len().min(4);
         b[..len].copy_from_slice(&t.data[..len]);
         let v = u32::from_le_bytes(b);
-        self.select_pdo_set(node, t.index, t.sub, i64::from(v));
+        self.select_pdo_set(node, t.index, t.sub, i64::from(v), dict);
         match (t.index, t.sub) {
             (0x6060 | 0x6061, 0) => self.modes[(node & 0x7F) as usize] = Some(t.data[0] as i8),
             (0x1005, 0) => self.assign_cob(
@@ -518,45 +176,14 @@ impl Decoder {
         }
     }
 
-    /// The communication parameters of a PDO seen in SDO transfers (else the COB-ID of
-    /// its mapping in force, when that names one).
-    pub fn pdo_comm(&self, node: u8, transmit: bool, num: u16) -> Option<CommParams> {
-        let seen = self.comm.get(&(node, transmit, num)).copied();
-        let cob = self.mappings.get(&(node, transmit, num)).and_then(|m| m.cob_id);
-        match (seen, cob) {
-            (Some(mut c), Some(cob)) => {
-                c.cob_id = c.cob_id.or(Some(cob));
-                Some(c)
-            }
-            (Some(c), None) => Some(c),
-            (None, cob @ Some(_)) => Some(CommParams {
-                cob_id: cob,
-                ..CommParams::default()
-            }),
-            (None, None) => None,
-        }
-    }
-
-    /// Every PDO the decoder knows something about (a mapping or communication
-    /// parameters), in order of node, RPDO before TPDO, number.
-    pub fn known_pdos(&self) -> Vec<(u8, PdoId)> {
-        let mut keys: Vec<PdoKey> = self.mappings.keys().chain(self.comm.keys()).copied().collect();
-        keys.sort_unstable();
-        keys.dedup();
-        keys.into_iter()
-            .map(|(node, transmit, num)| (node, PdoId { transmit, num }))
-            .collect()
-    }
-
     /// Switches `node` to the profile's PDO mapping set that (index, sub) = `value`
     /// selects (e.g. Dexmart parameter 09-26), when one does.
-    fn select_pdo_set(&mut self, node: u8, index: u16, sub: u8, value: i64) {
-        let dict = self.dicts[(node & 0x7F) as usize].clone();
+    fn select_pdo_set(&mut self, node: u8, index: u16, sub: u8, value: i64, dict: &Dictionary) {
         let chosen = dict.layers().iter().find_map(|layer| {
             layer.pdo_sets.iter().find(|set| {
                 set.selected_by
                     .as_ref()
-                    .is_some_and(|(object, v)| *v == value && resolve_object(&dict, object) == Ok((index, sub)))
+                    .is_some_and(|(object, v)| *v == value && resolve_object(dict, object) == Ok((index, sub)))
             })
         });
         let Some(set) = chosen else { return };
@@ -645,6 +272,433 @@ impl Decoder {
             self.mappings.insert(key, mapping);
         }
     }
+}
+
+/// Decodes frames one after another, keeping the state of the bus.
+///
+/// `Clone` lets a viewer keep checkpoints of the state and decode any stretch of a
+/// long trace again from the nearest one.
+#[derive(Clone)]
+pub struct Decoder {
+    /// Per-node dictionaries, index = node id (0 unused).
+    dicts: Vec<Dictionary>,
+    /// The state of each interface, index = `Frame::iface` (made on its first frame).
+    buses: Vec<Bus>,
+    /// The state of an interface before its first frame (the bound nodes' defaults).
+    fresh: Bus,
+    /// SDO transfers of every interface (channels are per interface).
+    sdo: SdoTracker,
+    completed: Vec<Transaction>,
+    seq: u64,
+    /// A label buffer handed back by [`Decoder::recycle`], reused for the next PDO or SDO label.
+    spare: String,
+}
+
+impl Decoder {
+    /// A decoder where node `n` uses `dict_for(n)`. Nodes listed in `bound`
+    /// (explicit `--profile`/`--eds` bindings) also get their default PDO
+    /// mappings and COB-IDs from their dictionary.
+    pub fn new(default: Dictionary, bound: Vec<(u8, Dictionary)>) -> Decoder {
+        let mut dicts = vec![default; 128];
+        let mut fresh = Bus::default();
+        for (node, dict) in bound {
+            if (1..128).contains(&node) {
+                fresh.install_default_mappings(node, &dict);
+                dicts[node as usize] = dict;
+            }
+        }
+        Decoder {
+            dicts,
+            buses: vec![fresh.clone()],
+            fresh,
+            sdo: SdoTracker::new(),
+            completed: Vec::new(),
+            seq: 0,
+            spare: String::new(),
+        }
+    }
+
+    /// A decoder for the nodes bound in `bindings` (others use CiA 402 + 301).
+    pub fn from_bindings(bindings: &crate::od::bind::Bindings) -> Decoder {
+        let bound = bindings
+            .bound_nodes()
+            .map(|n| (n, bindings.dictionary(n).clone()))
+            .collect();
+        Decoder::new(bindings.default_dictionary().clone(), bound)
+    }
+
+    /// The state of interface `iface` (a fresh one before its first frame).
+    #[inline]
+    fn bus(&self, iface: u16) -> &Bus {
+        self.buses.get(iface as usize).unwrap_or(&self.fresh)
+    }
+
+    /// The state of interface `iface`, made on first use.
+    #[inline]
+    fn bus_mut(&mut self, iface: u16) -> &mut Bus {
+        let i = iface as usize;
+        if i >= self.buses.len() {
+            self.buses.resize(i + 1, self.fresh.clone());
+        }
+        &mut self.buses[i]
+    }
+
+    /// Numbers the frames that follow from `seq + 1` on (the numbers SDO transactions list in
+    /// `frames`). A caller that skips frames (e.g. classifies only some) keeps them equal to
+    /// frame positions this way.
+    pub fn set_seq(&mut self, seq: u64) {
+        self.seq = seq;
+    }
+
+    /// The dictionary used for `node`.
+    pub fn dictionary(&self, node: u8) -> &Dictionary {
+        &self.dicts[(node & 0x7F) as usize]
+    }
+
+    /// The mapping in force for a PDO of a node, if known.
+    pub fn mapping(&self, node: NodeKey, transmit: bool, num: u16) -> Option<&PdoMapping> {
+        self.bus(node.iface).mappings.get(&(node.node, transmit, num))
+    }
+
+    /// Where a frame goes: kind, node and PDO number (0 when not a PDO), without decoding
+    /// it or changing any state (for callers that decode only some frames).
+    pub fn peek(&self, frame: &Frame) -> (Kind, Option<u8>, u16) {
+        let r = self.route(frame);
+        (r.kind, r.node, r.pdo)
+    }
+
+    /// The last mode of operation seen for `node`.
+    pub fn mode(&self, node: NodeKey) -> Option<i8> {
+        self.bus(node.iface).modes[(node.node & 0x7F) as usize]
+    }
+
+    /// Where a frame goes, without building its label (the cheap path for `--summary`).
+    /// SDO frames are still tracked so that COB-ID and mapping changes are learned.
+    pub fn classify(&mut self, frame: &Frame) -> (Kind, Option<u8>) {
+        let route = self.route(frame);
+        if matches!(route.kind, Kind::SdoRx | Kind::SdoTx) {
+            self.seq += 1;
+            self.track_sdo(frame, route);
+        }
+        (route.kind, route.node)
+    }
+
+    /// An SDO frame (per [`Decoder::peek`]) tracked as [`Decoder::decode`] tracks it, without
+    /// building its label: the frame as the tracker read it, or None for a vendor SDO
+    /// command of the node's profile (which `decode` shows as [`Body::VendorSdo`]).
+    /// For callers that only need the command and the tracker's notes (the diagnosis).
+    pub fn sdo_frame(&mut self, frame: &Frame) -> Option<SdoFrame> {
+        let route = self.route(frame);
+        debug_assert!(matches!(route.kind, Kind::SdoRx | Kind::SdoTx));
+        self.seq += 1;
+        let s = self.track_sdo(frame, route);
+        let n = route.node.unwrap_or(0) as usize & 0x7F;
+        let c2s = route.kind == Kind::SdoRx;
+        vendor_sdo::decode(&self.dicts[n], c2s, frame.payload())
+            .is_none()
+            .then(|| unlabelled(s, frame.payload()))
+    }
+
+    fn route(&self, frame: &Frame) -> Route {
+        if frame.is_err() {
+            return Route {
+                kind: Kind::ErrorFrame,
+                node: None,
+                pdo: 0,
+                reserved: false,
+            };
+        }
+        let bus = self.bus(frame.iface);
+        // Most buses move no SDO channel: skip hashing the id then.
+        if !bus.sdo_cobs.is_empty()
+            && let Some(&(node, c2s)) = bus.sdo_cobs.get(&(frame.id | if frame.is_ext() { 1 << 29 } else { 0 }))
+        {
+            let kind = if c2s { Kind::SdoRx } else { Kind::SdoTx };
+            return Route {
+                kind,
+                node: Some(node),
+                pdo: 0,
+                reserved: false,
+            };
+        }
+        bus.cobs.route(frame.id, frame.is_ext())
+    }
+
+    /// Hands a decoded frame back once it is written, so that its label buffer serves the
+    /// next label (saves an allocation per frame on the hot paths).
+    #[inline]
+    pub fn recycle(&mut self, decoded: Decoded) {
+        let mut label = decoded.label;
+        label.clear();
+        self.spare = label;
+    }
+
+    /// Decodes one frame, updating the bus state.
+    pub fn decode(&mut self, frame: &Frame) -> Decoded {
+        let route = self.route(frame);
+        self.decode_routed(frame, route)
+    }
+
+    fn decode_routed(&mut self, frame: &Frame, route: Route) -> Decoded {
+        self.seq += 1;
+        let payload = frame.payload();
+        let node = route.node;
+        let n = node.unwrap_or(0);
+        let mut rtr_problem = None;
+        if frame.is_rtr() && !matches!(route.kind, Kind::Heartbeat | Kind::Tpdo | Kind::Other) {
+            rtr_problem = Some(format!("remote frame on a {} COB-ID", route.kind.as_str()));
+        }
+        let (label, body, problem) = match route.kind {
+            Kind::ErrorFrame => (
+                error_frame::label(frame.id, payload),
+                Body::ErrorFrame { class: frame.id },
+                None,
+            ),
+            Kind::Nmt => {
+                let (m, p) = nmt::decode(payload);
+                (m.label(), Body::Nmt(m), p)
+            }
+            Kind::Sync => {
+                let (s, p) = sync::decode(payload);
+                (s.label(), Body::Sync(s), p)
+            }
+            Kind::Time => {
+                let (t, p) = time::decode(payload);
+                (t.label(), Body::Time(t), p)
+            }
+            Kind::Emcy => {
+                let (e, p) = emcy::decode(payload, &self.dicts[n as usize]);
+                (e.label(n), Body::Emcy(e), p)
+            }
+            Kind::Heartbeat => {
+                let (h, p) = heartbeat::decode(payload, frame.is_rtr());
+                (h.label(n), Body::Heartbeat(h), p)
+            }
+            Kind::Lss => {
+                let (l, p) = lss::decode(payload, frame.id == 0x7E5);
+                (l.label(), Body::Lss(l), p)
+            }
+            Kind::Tpdo | Kind::Rpdo => self.decode_pdo(frame, route),
+            Kind::SdoRx | Kind::SdoTx => {
+                let c2s = route.kind == Kind::SdoRx;
+                let tracked = self.track_sdo(frame, route);
+                let mut s = labelled(tracked, payload, &self.dicts[n as usize]);
+                // Controlword and statusword bits are named per the node's mode in force.
+                if let (Some(mode), Some((index @ (0x6040 | 0x6041), 0)), Some(v)) = (
+                    self.bus(frame.iface).modes[n as usize & 0x7F],
+                    s.object,
+                    s.value.as_mut(),
+                ) && let Some(typed) = &v.typed
+                {
+                    v.text = value_text::object_text(&self.dicts[n as usize], index, 0, typed, Some(mode));
+                }
+                // The tracker sees vendor commands too (as unknown commands), so that
+                // their standard replies do not disturb a running transfer.
+                match vendor_sdo::decode(&self.dicts[n as usize], c2s, payload) {
+                    Some(v) => (v.label(), Body::VendorSdo(v), None),
+                    None => {
+                        let p = s.malformed();
+                        let mut label = std::mem::take(&mut self.spare);
+                        s.write_label(&mut label);
+                        (label, Body::Sdo(s), p)
+                    }
+                }
+            }
+            Kind::Other => {
+                let label = if route.reserved {
+                    format!("Reserved COB-ID 0x{:03X}", frame.id)
+                } else if frame.is_ext() {
+                    format!("29-bit frame 0x{:08X}", frame.id)
+                } else {
+                    format!("Not a predefined CANopen COB-ID (0x{:03X})", frame.id)
+                };
+                let p = route
+                    .reserved
+                    .then(|| format!("COB-ID 0x{:03X} is reserved by CiA 301", frame.id));
+                (label, Body::None, p)
+            }
+        };
+        let malformed = match (rtr_problem, problem) {
+            (Some(a), Some(b)) => Some(format!("{a}; {b}")),
+            (a, b) => a.or(b),
+        };
+        Decoded {
+            kind: route.kind,
+            node,
+            label,
+            body,
+            malformed,
+        }
+    }
+
+    /// Feeds a frame into the bus state without building its label or body: SDO transfers
+    /// (and what their completion teaches) and modes of operation mapped into PDOs. The
+    /// cheap path for `--transactions`: the transactions and the state afterwards are those
+    /// [`Decoder::decode`] gives.
+    pub fn track(&mut self, frame: &Frame) {
+        let route = self.route(frame);
+        match route.kind {
+            Kind::SdoRx | Kind::SdoTx => {
+                self.seq += 1;
+                self.track_sdo(frame, route);
+            }
+            Kind::Tpdo | Kind::Rpdo if self.maps_mode(frame.iface, route) => {
+                self.decode_routed(frame, route);
+            }
+            _ => self.seq += 1,
+        }
+    }
+
+    /// Whether the mapping in force for the PDO of `route` carries the mode of operation
+    /// (0x6060/0x6061), which decoding the PDO records.
+    fn maps_mode(&self, iface: u16, route: Route) -> bool {
+        let key = (route.node.unwrap_or(0), route.kind == Kind::Tpdo, route.pdo);
+        self.bus(iface).mappings.get(&key).is_some_and(|m| {
+            m.entries
+                .iter()
+                .any(|e| matches!((e.index, e.sub), (0x6060 | 0x6061, 0)))
+        })
+    }
+
+    /// Feeds an SDO frame to the transfer tracker and learns from the transfers it
+    /// completes (COB-IDs, PDO mappings, modes); returns the frame as the tracker read it.
+    fn track_sdo(&mut self, frame: &Frame, route: Route) -> Tracked {
+        let n = route.node.unwrap_or(0);
+        let c2s = route.kind == Kind::SdoRx;
+        let key = NodeKey::of(frame, n);
+        if c2s {
+            self.bus_mut(frame.iface).ours[n as usize & 0x7F] = frame.direction() == crate::frame::Direction::Tx;
+        }
+        let dict = &self.dicts[n as usize & 0x7F];
+        let s = self.sdo.track(self.seq, frame.ts_ns, key, c2s, frame.payload(), dict);
+        for mut t in self.sdo.take_completed() {
+            let dict = &self.dicts[t.node as usize & 0x7F];
+            let i = t.iface as usize;
+            if i >= self.buses.len() {
+                self.buses.resize(i + 1, self.fresh.clone());
+            }
+            let bus = &mut self.buses[i];
+            t.mode = bus.modes[(t.node & 0x7F) as usize];
+            bus.learn(&t, dict);
+            self.completed.push(t);
+        }
+        s
+    }
+
+    /// A PDO frame (per [`Decoder::peek`]) decoded as [`Decoder::decode`] decodes it, bus
+    /// state included (modes of operation), but with no label, `malformed` or mapping source
+    /// and its signals without names or texts: for callers that keep values (the TUI's index).
+    /// `peeked` is what [`Decoder::peek`] says of the frame (not routed again).
+    pub fn pdo_values(&mut self, frame: &Frame, peeked: (Kind, Option<u8>, u16)) -> Decoded {
+        let (kind, node, num) = peeked;
+        debug_assert!(matches!(kind, Kind::Tpdo | Kind::Rpdo));
+        self.seq += 1;
+        let n = node.unwrap_or(0);
+        let transmit = kind == Kind::Tpdo;
+        let signals = match self.bus(frame.iface).mappings.get(&(n, transmit, num)) {
+            Some(m) if !frame.is_rtr() => pdo::decode_values(frame.payload(), m, &self.dicts[n as usize & 0x7F]),
+            _ => Vec::new(),
+        };
+        self.note_mode(NodeKey::of(frame, n), &signals);
+        Decoded {
+            kind,
+            node,
+            label: String::new(),
+            body: Body::Pdo(Pdo {
+                num,
+                transmit,
+                signals,
+                source: None,
+            }),
+            malformed: None,
+        }
+    }
+
+    /// Records a mode of operation carried by PDO `signals` of node `n`.
+    fn note_mode(&mut self, n: NodeKey, signals: &[pdo::Signal]) {
+        for s in signals {
+            if matches!((s.index, s.sub), (0x6060 | 0x6061, 0)) {
+                self.bus_mut(n.iface).modes[n.node as usize & 0x7F] = s.value.as_i64().map(|m| m as i8);
+            }
+        }
+    }
+
+    fn decode_pdo(&mut self, frame: &Frame, route: Route) -> (String, Body, Option<String>) {
+        let n = route.node.unwrap_or(0);
+        let transmit = route.kind == Kind::Tpdo;
+        let payload = frame.payload();
+        if frame.is_rtr() {
+            let name = if transmit { "TPDO" } else { "RPDO" };
+            let pdo = Pdo {
+                num: route.pdo,
+                transmit,
+                signals: Vec::new(),
+                source: None,
+            };
+            return (
+                format!("{name}{} node {n}: remote request", route.pdo),
+                Body::Pdo(pdo),
+                None,
+            );
+        }
+        let bus = self.bus(frame.iface);
+        let (signals, source, problem) = match bus.mappings.get(&(n, transmit, route.pdo)) {
+            Some(m) => {
+                let mode = bus.modes[n as usize & 0x7F];
+                let (s, p) = pdo::decode_signals(payload, m, &self.dicts[n as usize & 0x7F], mode);
+                (s, Some(m.source.clone()), p)
+            }
+            None => (Vec::new(), None, None),
+        };
+        self.note_mode(NodeKey::of(frame, n), &signals);
+        let pdo = Pdo {
+            num: route.pdo,
+            transmit,
+            signals,
+            source,
+        };
+        let mut label = std::mem::take(&mut self.spare);
+        pdo.write_label(&mut label, n, payload);
+        (label, Body::Pdo(pdo), problem)
+    }
+
+    /// The communication parameters of a PDO seen in SDO transfers (else the COB-ID of
+    /// its mapping in force, when that names one).
+    pub fn pdo_comm(&self, node: NodeKey, transmit: bool, num: u16) -> Option<CommParams> {
+        let bus = self.bus(node.iface);
+        let key = (node.node, transmit, num);
+        let seen = bus.comm.get(&key).copied();
+        let cob = bus.mappings.get(&key).and_then(|m| m.cob_id);
+        match (seen, cob) {
+            (Some(mut c), Some(cob)) => {
+                c.cob_id = c.cob_id.or(Some(cob));
+                Some(c)
+            }
+            (Some(c), None) => Some(c),
+            (None, cob @ Some(_)) => Some(CommParams {
+                cob_id: cob,
+                ..CommParams::default()
+            }),
+            (None, None) => None,
+        }
+    }
+
+    /// Every PDO the decoder knows something about (a mapping or communication
+    /// parameters), in order of interface, node, RPDO before TPDO, number.
+    pub fn known_pdos(&self) -> Vec<(NodeKey, PdoId)> {
+        let mut out = Vec::new();
+        for (iface, bus) in self.buses.iter().enumerate() {
+            let mut keys: Vec<PdoKey> = bus.mappings.keys().chain(bus.comm.keys()).copied().collect();
+            keys.sort_unstable();
+            keys.dedup();
+            let iface = u16::try_from(iface).unwrap_or(u16::MAX);
+            out.extend(
+                keys.into_iter()
+                    .map(|(node, transmit, num)| (NodeKey::new(iface, node), PdoId { transmit, num })),
+            );
+        }
+        out
+    }
 
     /// SDO transactions completed since the last call.
     pub fn take_transactions(&mut self) -> Vec<Transaction> {
@@ -655,7 +709,7 @@ impl Decoder {
     pub fn finish(&mut self) -> Vec<Transaction> {
         let mut all = std::mem::take(&mut self.completed);
         all.extend(self.sdo.finish().into_iter().map(|mut t| {
-            t.mode = self.modes[(t.node & 0x7F) as usize];
+            t.mode = self.bus(t.iface).modes[(t.node & 0x7F) as usize];
             t
         }));
         all

@@ -135,6 +135,31 @@ impl Frame {
     }
 }
 
+/// A node as every derived view knows it: a node-ID on one interface. Two buses may each
+/// have a node 5; they are two nodes. Ordered by interface, then node-ID, so a capture of
+/// one interface keeps node-ID order.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct NodeKey {
+    /// Index into the source's [`Interfaces`] table (as [`Frame::iface`]).
+    pub iface: u16,
+    /// The CANopen node-ID (0 for frames of no node).
+    pub node: u8,
+}
+
+impl NodeKey {
+    /// Node `node` on interface `iface`.
+    pub const fn new(iface: u16, node: u8) -> NodeKey {
+        NodeKey { iface, node }
+    }
+    /// Node `node` on the interface `frame` came from.
+    pub const fn of(frame: &Frame, node: u8) -> NodeKey {
+        NodeKey {
+            iface: frame.iface,
+            node,
+        }
+    }
+}
+
 /// Interned interface names: frames carry a `u16` index instead of a string.
 /// Lookups go through a hash index, so a log with tens of thousands of names stays linear.
 #[derive(Clone, Debug, Default)]

@@ -21,6 +21,7 @@ use super::codec::{Chunk, SdoCommand, Side, decode, end_command, parse};
 use super::crc::crc16_update;
 use super::resync::{Orphan, impossible_command};
 use super::transaction::{Channel, Outcome, Problem, Protocol, Transaction, TransferDirection};
+use crate::frame::NodeKey;
 use crate::od::Dictionary;
 use std::collections::BTreeMap;
 
@@ -171,18 +172,19 @@ impl TransferTracker {
         TransferTracker::default()
     }
 
-    /// Feeds one frame on the node's default channel (0x600 + node / 0x580 + node).
+    /// Feeds one frame on the node's default channel (0x600 + node / 0x580 + node) of its
+    /// interface.
     pub fn on_frame(
         &mut self,
         seq: u64,
         ts_ns: u64,
-        node: u8,
+        node: NodeKey,
         client_to_server: bool,
         payload: &[u8],
         dict: &Dictionary,
     ) -> Tracked {
         let side = if client_to_server { Side::Client } else { Side::Server };
-        self.on_channel_frame(seq, ts_ns, Channel::default_for(node), side, payload, dict)
+        self.on_channel_frame(seq, ts_ns, Channel::default_on(node), side, payload, dict)
     }
 
     /// Feeds one frame of `channel` sent by `side`; returns what it means in its transfer.
@@ -394,6 +396,7 @@ fn finalize(p: Pending, outcome: Outcome, dict: &Dictionary) -> Transaction {
 /// A new transaction from its first frame.
 fn new_txn(ctx: &FrameCtx, index: u16, sub: u8, dir: TransferDirection, proto: Protocol) -> Transaction {
     Transaction {
+        iface: ctx.channel.iface,
         node: ctx.channel.node,
         channel: ctx.channel,
         index,

@@ -4,9 +4,12 @@ use super::codec::Side;
 use crate::cob;
 use std::fmt;
 
-/// An SDO channel: a node and the COB-ID pair its client and server use.
+/// An SDO channel: a node on one interface and the COB-ID pair its client and server
+/// use. Frames of different interfaces never share a channel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Channel {
+    /// The interface (index into the source's interface table, as `Frame::iface`).
+    pub iface: u16,
     /// The server's node-ID.
     pub node: u8,
     /// Client to server COB-ID (0x600 + node by default).
@@ -16,9 +19,16 @@ pub struct Channel {
 }
 
 impl Channel {
-    /// The default SDO channel of a node (0x600 + node / 0x580 + node).
+    /// The default SDO channel of a node on the first interface (0x600 + node / 0x580 + node).
     pub fn default_for(node: u8) -> Channel {
+        Channel::default_on(crate::frame::NodeKey::new(0, node))
+    }
+
+    /// The default SDO channel of a node on its interface (0x600 + node / 0x580 + node).
+    pub fn default_on(key: crate::frame::NodeKey) -> Channel {
+        let node = key.node;
         Channel {
+            iface: key.iface,
             node,
             request_cob: cob::sdo_request(node),
             response_cob: cob::sdo_response(node),
@@ -158,6 +168,8 @@ impl fmt::Display for Problem {
 /// One reassembled SDO transfer.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Transaction {
+    /// The interface it ran on (index into the source's interface table).
+    pub iface: u16,
     /// The server's node-ID.
     pub node: u8,
     /// The channel it ran on.
@@ -202,6 +214,11 @@ pub const DATA_KEPT: usize = 1 << 20;
 pub const FRAMES_KEPT: usize = 1 << 14;
 
 impl Transaction {
+    /// The server as a node of its interface.
+    pub fn key(&self) -> crate::frame::NodeKey {
+        crate::frame::NodeKey::new(self.iface, self.node)
+    }
+
     /// Duration from first to last frame, in ns.
     pub fn duration_ns(&self) -> u64 {
         self.end_ns.saturating_sub(self.start_ns)

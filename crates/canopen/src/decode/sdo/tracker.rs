@@ -3,6 +3,7 @@
 
 use super::frame::SdoFrame;
 use super::value::view;
+use crate::frame::NodeKey;
 use crate::od::Dictionary;
 use crate::sdo::codec::{SdoCommand, Side};
 use crate::sdo::tracker::{Tracked, TransferTracker};
@@ -26,7 +27,7 @@ impl SdoTracker {
         &mut self,
         seq: u64,
         ts_ns: u64,
-        node: u8,
+        node: NodeKey,
         client_to_server: bool,
         payload: &[u8],
         dict: &Dictionary,
@@ -41,7 +42,7 @@ impl SdoTracker {
         &mut self,
         seq: u64,
         ts_ns: u64,
-        node: u8,
+        node: NodeKey,
         client_to_server: bool,
         payload: &[u8],
         dict: &Dictionary,

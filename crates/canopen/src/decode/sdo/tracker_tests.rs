@@ -1,6 +1,7 @@
 //! Tracker tests: every transfer path, as a user reading the trace would see it.
 
 use super::*;
+use crate::frame::NodeKey;
 use crate::od::{DataType, Dictionary, ObjectInfo, Profile};
 use crate::sdo::crc::crc16;
 use crate::sdo::{Channel, Outcome, Problem, Protocol, Side, Transaction, TransferDirection};
@@ -51,8 +52,14 @@ impl Bus {
     }
     fn send(&mut self, node: u8, c2s: bool, bytes: &[u8]) -> SdoFrame {
         self.seq += 1;
-        self.t
-            .on_frame(self.seq, self.seq * 1_000_000, node, c2s, bytes, &self.dict)
+        self.t.on_frame(
+            self.seq,
+            self.seq * 1_000_000,
+            NodeKey::new(0, node),
+            c2s,
+            bytes,
+            &self.dict,
+        )
     }
     fn c(&mut self, node: u8, bytes: &[u8]) -> SdoFrame {
         self.send(node, true, bytes)
@@ -635,12 +642,13 @@ fn non_default_channel() {
     let mut t = SdoTracker::new();
     let d = dict();
     let ch = Channel {
+        iface: 0,
         node: 7,
         request_cob: 0x640,
         response_cob: 0x5C0,
     };
     t.on_channel_frame(1, 10, ch, Side::Client, &[0x40, 0x41, 0x60, 0, 0, 0, 0, 0], &d);
-    t.on_frame(2, 11, 7, false, &[0x4B, 0x41, 0x60, 0, 1, 0, 0, 0], &d);
+    t.on_frame(2, 11, NodeKey::new(0, 7), false, &[0x4B, 0x41, 0x60, 0, 1, 0, 0, 0], &d);
     t.on_channel_frame(3, 12, ch, Side::Server, &[0x4B, 0x41, 0x60, 0, 2, 0, 0, 0], &d);
     let v = t.take_completed();
     assert_eq!(v.len(), 2);

@@ -109,6 +109,7 @@ impl Transaction {
             end_ns: self.end_ns,
             error,
             frames: &self.frames,
+            iface: None,
             index: (!partial).then_some(self.index),
             len: self.len(),
             name: if partial { None } else { dict.name(self.index, self.sub) },
@@ -154,6 +155,9 @@ pub struct TransactionJson<'a> {
     pub error: Option<&'a str>,
     /// Sequence numbers of the frames (the first ones).
     pub frames: &'a [u64],
+    /// The interface it ran on, only when the input has several interfaces.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub iface: Option<&'a str>,
     pub index: Option<u16>,
     pub len: usize,
     pub name: Option<&'a str>,

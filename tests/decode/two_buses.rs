@@ -1,0 +1,119 @@
+//! A capture of two buses (`can0`, `can1`), each with a node 5 heartbeating, is two
+//! buses: node 5 on can1 goes silent for good while node 5 on can0 goes on, and an SDO
+//! request to node 2 on can0 is answered only on can1. A node is (interface, node-ID) in
+//! every view (issue 25, item 1).
+
+use crate::run::cotui;
+
+const LOG: &str = "tests/fixtures/two_buses.log";
+
+fn stdout(args: &[&str]) -> String {
+    let out = cotui(args, None);
+    assert!(
+        out.status.success(),
+        "cotui {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("UTF-8 output")
+}
+
+#[test]
+fn an_sdo_request_on_can0_never_pairs_with_an_answer_on_can1() {
+    let text = stdout(&["decode", "--transactions", LOG]);
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 2, "{text}");
+    // The request on can0 stays unanswered; the answer on can1 has no request there.
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.starts_with("can0 node 2: Upload 0x6041:00") && l.ends_with(": incomplete")),
+        "{text}"
+    );
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.starts_with("can1 node 2: Upload 0x6041:00") && l.contains("[unmatched response]")),
+        "{text}"
+    );
+    assert!(!text.contains("1.000 ms): ok"), "paired across interfaces: {text}");
+
+    let json = stdout(&["decode", "--transactions", "--format", "jsonl", LOG]);
+    let rows: Vec<serde_json::Value> = json.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let on = |iface: &str| {
+        rows.iter()
+            .find(|r| r["iface"] == iface)
+            .unwrap_or_else(|| panic!("{iface}: {json}"))
+    };
+    assert_eq!(on("can0")["outcome"], "incomplete");
+    assert_eq!(on("can0")["frames"], serde_json::json!([12]));
+    assert_eq!(on("can1")["frames"], serde_json::json!([13]));
+    assert_eq!(on("can1")["problems"][0]["kind"], "unmatched_response", "{json}");
+}
+
+#[test]
+fn diagnose_reports_node_5_on_can1_silent_and_nothing_about_can0() {
+    let report = stdout(&["diagnose", LOG]);
+    assert!(report.starts_with("Needs attention: 2 open"), "{report}");
+    assert!(
+        report.contains("OPEN       Node 5 (can1): Went silent and never came back"),
+        "{report}"
+    );
+    assert!(!report.contains("came back each time"), "{report}");
+    assert!(!report.contains("Node 5 (can0)"), "{report}");
+    // The request on can0 is unanswered there.
+    assert!(report.contains("OPEN       Node 2 (can0): No answer"), "{report}");
+
+    let json = stdout(&["diagnose", "--format", "jsonl", LOG]);
+    let incidents: Vec<serde_json::Value> = json.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let silent: Vec<_> = incidents.iter().filter(|i| i["kind"] == "silent").collect();
+    assert_eq!(silent.len(), 1, "{json}");
+    assert_eq!(silent[0]["node"], 5);
+    assert_eq!(silent[0]["iface"], "can1");
+    assert_eq!(silent[0]["status"], "open");
+    assert!(incidents.iter().all(|i| i["kind"] != "silent_back"), "{json}");
+}
+
+#[test]
+fn the_summary_has_a_row_per_node_of_each_interface() {
+    let text = stdout(&["decode", "--summary", LOG]);
+    assert!(text.contains("\n  can0 node 5          101  heartbeat=101\n"), "{text}");
+    assert!(text.contains("\n  can1 node 5           11  heartbeat=11\n"), "{text}");
+    assert!(text.contains("\n  can0 node 2            1  sdo_rx=1\n"), "{text}");
+    assert!(text.contains("\n  can1 node 2            1  sdo_tx=1\n"), "{text}");
+    let json: serde_json::Value =
+        serde_json::from_str(&stdout(&["decode", "--summary", "--format", "jsonl", LOG])).unwrap();
+    assert_eq!(json["by_node"]["can0/5"]["heartbeat"], 101);
+    assert_eq!(json["by_node"]["can1/5"]["heartbeat"], 11);
+    assert!(json["by_node"].get("5").is_none(), "{json}");
+}
+
+#[test]
+fn events_name_the_interface_of_each_node() {
+    let text = stdout(&["decode", "--events", LOG]);
+    let lost: Vec<&str> = text.lines().filter(|l| l.contains("heartbeat_lost")).collect();
+    assert_eq!(lost.len(), 1, "{text}");
+    assert!(lost[0].contains("node   5 (can1)  heartbeat_lost"), "{text}");
+    assert!(!text.contains("heartbeat_back"), "{text}");
+    let json = stdout(&["decode", "--events", "--format", "jsonl", LOG]);
+    let events: Vec<serde_json::Value> = json.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    let lost: Vec<_> = events.iter().filter(|e| e["event"] == "heartbeat_lost").collect();
+    assert_eq!(lost.len(), 1, "{json}");
+    assert_eq!(
+        (lost[0]["node"].clone(), lost[0]["iface"].clone()),
+        (5.into(), "can1".into())
+    );
+}
+
+#[test]
+fn a_capture_of_one_interface_prints_no_interface() {
+    let text = stdout(&["decode", "--summary", "tests/fixtures/heartbeat_stops.log"]);
+    assert!(text.contains("\n  node 5 ") && !text.contains("can0 node"), "{text}");
+    let json = stdout(&[
+        "decode",
+        "--events",
+        "--format",
+        "jsonl",
+        "tests/fixtures/heartbeat_stops.log",
+    ]);
+    assert!(!json.contains("\"iface\""), "{json}");
+}
