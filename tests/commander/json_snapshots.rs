@@ -40,7 +40,8 @@ fn pinned(name: &str, args: &[&str], status: i32, tmp: &str) {
     );
     stable(&mut json, tmp);
     let pretty = serde_json::to_string_pretty(&json).unwrap();
-    insta::assert_snapshot!(name, pretty, &format!("cotui {}", line.join(" ")));
+    let command = format!("cotui {}", line.join(" ")).replace(tmp, "[tmp]");
+    insta::assert_snapshot!(name, pretty, &command);
 }
 
 #[test]
