@@ -118,12 +118,16 @@ fn draw(app: &mut App, w: u16, h: u16) -> String {
 /// The SDO pane's transfers as `--transactions --format jsonl` records.
 fn sdo_rows(app: &App) -> Vec<String> {
     let dec = app.trace.decoder();
+    // Several interfaces: each transfer names its own, as decode --transactions does.
+    let several = app.trace.ifaces.names().len() > 1;
     app.trace
         .transactions
         .iter()
         .map(|t| {
             let mut line = Vec::new();
-            write_line(&mut line, &t.to_json(dec.dictionary(t.node)));
+            let mut json = t.to_json(dec.dictionary(t.node));
+            json.iface = several.then(|| app.trace.ifaces.name(t.iface));
+            write_line(&mut line, &json);
             String::from_utf8(line).unwrap().trim_end().to_string()
         })
         .collect()
