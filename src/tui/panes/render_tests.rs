@@ -560,3 +560,63 @@ fn problems_pane_at_160x48_and_its_frames_in_the_trace() {
     assert_eq!(a.focus, Pane::Trace);
     assert_eq!(a.selected_position(), Some(first.events[0].frame as usize - 1));
 }
+
+#[test]
+fn lss_fastscan_confirmation_at_80x24_shows_the_key_first_and_wraps_the_rest() {
+    use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+    let mut a = app();
+    for c in ":lss fastscan".chars() {
+        a.key(KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE));
+    }
+    a.key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
+    let s = screen(&mut a, 80, 24);
+    let lines: Vec<&str> = s.lines().collect();
+    assert_eq!(lines.len(), 24, "{s}");
+    // The key hint starts the question; the reason wraps below, whole.
+    let at = lines
+        .iter()
+        .position(|l| l.starts_with("y send · any other key cancels  "))
+        .unwrap_or_else(|| panic!("{s}"));
+    let question = lines[at..].join(" ");
+    assert!(
+        question.contains("LSS fastscan addresses every LSS slave (in configuration state, or not yet configured):"),
+        "{s}"
+    );
+    assert!(at >= 20, "the question takes the bottom lines: {s}");
+    assert!(
+        lines[at - 1].starts_with("open test.log"),
+        "the status bar stays above it: {s}"
+    );
+    insta::assert_snapshot!("lss_fastscan_confirmation_80x24", s);
+    // The hint is drawn as a key: black on yellow.
+    let mut term = ratatui::Terminal::new(ratatui::backend::TestBackend::new(80, 24)).unwrap();
+    term.draw(|fr| crate::tui::ui::draw(fr, &mut a)).unwrap();
+    let buf = term.backend().buffer().clone();
+    assert_eq!(buf[(0, at as u16)].bg, ratatui::style::Color::Yellow);
+    // Answered, the bottom is one line again.
+    a.key(KeyEvent::new(KeyCode::Char('n'), KeyModifiers::NONE));
+    let s = screen(&mut a, 80, 24);
+    assert!(s.lines().nth(22).unwrap_or("").starts_with("open test.log"), "{s}");
+    assert_eq!(s.lines().nth(23), Some("not sent"), "{s}");
+}
+
+#[test]
+fn dcf_load_confirmation_at_160_columns_shows_the_key_and_all_of_the_reason() {
+    use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+    let mut a = app();
+    for c in ":dcf load 5 node5.dcf --store".chars() {
+        a.key(KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE));
+    }
+    a.key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
+    let s = screen(&mut a, 160, 24);
+    let lines: Vec<&str> = s.lines().collect();
+    let at = lines
+        .iter()
+        .position(|l| {
+            l.starts_with("y send · any other key cancels  dcf load writes node 5's configuration from node5.dcf:")
+        })
+        .unwrap_or_else(|| panic!("{s}"));
+    let question = lines[at..].join(" ");
+    assert!(question.contains("stores (0x1010:01)"), "{s}");
+    assert!(!question.contains('…'), "nothing cut: {s}");
+}
