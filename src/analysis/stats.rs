@@ -1,4 +1,11 @@
-//! Per-COB-ID statistics (count, rate, period, jitter) and the bus load over the last second.
+//! Per-COB-ID statistics (count, period and its min/max/jitter, the rate and the age at
+//! capture time "now") and the bus load over the last second.
+//!
+//! "Now" is capture time: the newest frame timestamp or clock tick seen ([`Stats::tick`]),
+//! never the wall clock. The rate of a COB-ID is its frames in the last second of capture
+//! time (the same window as the bus load), so a COB-ID that stops falls to 0 within a
+//! second; its age (time since its last frame) grows with later frames and ticks, and
+//! [`IdStats::stale`] tells when it passed [`STALE_PERIODS`] of its mean periods.
 
 use super::store::{Packed, Store};
 use std::collections::BTreeMap;
@@ -16,10 +23,21 @@ pub struct IdStats {
     pub last_pos: usize,
     /// Store position of the frame before it.
     pub prev_pos: Option<usize>,
+    /// Frames in the last second of capture time (see [`Stats::now_ns`]).
+    pub in_window: u32,
     last_gap: f64,
+    min_gap: f64,
+    max_gap: f64,
     sum_gap: f64,
     sum_gap2: f64,
 }
+
+/// A COB-ID is stale (dimmed in the receive list) once its age passes this many of its
+/// mean periods, as PCAN-View does.
+pub const STALE_PERIODS: f64 = 3.0;
+
+/// The window of the rate and the bus load: one second of capture time.
+pub const WINDOW_NS: u64 = 1_000_000_000;
 
 impl IdStats {
     /// Mean period in seconds (None with fewer than two frames).
@@ -36,11 +54,31 @@ impl IdStats {
         let var = self.sum_gap2 / (self.count - 1) as f64 - p * p;
         Some(var.max(0.0).sqrt())
     }
-    /// Frames per second over the identifier's span.
-    pub fn rate(&self) -> f64 {
+    /// The shortest period in seconds (None with fewer than two frames).
+    pub fn min_period(&self) -> Option<f64> {
+        (self.count > 1).then_some(self.min_gap)
+    }
+    /// The longest period in seconds (None with fewer than two frames).
+    pub fn max_period(&self) -> Option<f64> {
+        (self.count > 1).then_some(self.max_gap)
+    }
+    /// Frames per second over the identifier's whole span (1 / mean period).
+    pub fn mean_rate(&self) -> f64 {
         match self.period() {
             Some(p) if p > 0.0 => 1.0 / p,
             _ => 0.0,
+        }
+    }
+    /// Seconds of capture time since the last frame, at capture time `now_ns`.
+    pub fn age(&self, now_ns: u64) -> f64 {
+        now_ns.saturating_sub(self.last_ns) as f64 / 1e9
+    }
+    /// True when, at `now_ns`, the age passed [`STALE_PERIODS`] mean periods (never for an
+    /// identifier seen once: it has no period).
+    pub fn stale(&self, now_ns: u64) -> bool {
+        match self.period() {
+            Some(p) => self.age(now_ns) > STALE_PERIODS * p,
+            None => false,
         }
     }
 }
@@ -55,6 +93,9 @@ pub struct Stats {
     bitrate: u64,
     window_bits: u64,
     window_start: usize,
+    now_ns: u64,
+    /// The first frame's time.
+    start_ns: Option<u64>,
 }
 
 impl Stats {
@@ -67,7 +108,29 @@ impl Stats {
             bitrate: bitrate.max(1),
             window_bits: 0,
             window_start: 0,
+            now_ns: 0,
+            start_ns: None,
         }
+    }
+
+    /// Frames per second of `s` now: its frames in the last second of capture time, or,
+    /// while the capture spans less than that, its frames per second since the capture
+    /// began (0 at the first instant).
+    pub fn rate(&self, s: &IdStats) -> f64 {
+        let span = self
+            .start_ns
+            .map_or(0, |t0| self.now_ns.saturating_sub(t0))
+            .min(WINDOW_NS);
+        if span == 0 {
+            0.0
+        } else {
+            s.in_window as f64 * 1e9 / span as f64
+        }
+    }
+
+    /// Capture time now (ns): the newest frame time or tick seen.
+    pub fn now_ns(&self) -> u64 {
+        self.now_ns
     }
 
     /// The bus bit rate used for the load.
@@ -86,15 +149,37 @@ impl Stats {
             s.sum_gap += gap;
             s.sum_gap2 += gap * gap;
             s.last_gap = gap;
+            if s.count == 1 {
+                (s.min_gap, s.max_gap) = (gap, gap);
+            } else {
+                s.min_gap = s.min_gap.min(gap);
+                s.max_gap = s.max_gap.max(gap);
+            }
             s.prev_pos = Some(s.last_pos);
         }
         s.last_pos = store.len() - 1;
         s.count += 1;
         s.last_ns = p.ts_ns;
+        s.in_window += 1;
+        self.start_ns.get_or_insert(p.ts_ns);
         self.window_bits += p.wire_bits();
-        let since = p.ts_ns.saturating_sub(1_000_000_000);
-        while self.window_start < store.len() && store.packed(self.window_start).ts_ns < since {
-            self.window_bits -= store.packed(self.window_start).wire_bits();
+        self.tick(p.ts_ns, store);
+    }
+
+    /// Capture time has reached `now_ns` (a frame's time, or the capture clock when no
+    /// frame comes): frames older than the window leave the rates and the bus load.
+    pub fn tick(&mut self, now_ns: u64, store: &Store) {
+        self.now_ns = self.now_ns.max(now_ns);
+        // The window is (now - 1 s, now]; nothing leaves it in the first second.
+        let Some(since) = self.now_ns.checked_sub(WINDOW_NS) else {
+            return;
+        };
+        while self.window_start < store.len() && store.packed(self.window_start).ts_ns <= since {
+            let old = *store.packed(self.window_start);
+            self.window_bits = self.window_bits.saturating_sub(old.wire_bits());
+            let i = self.index(old.is_ext(), old.id);
+            let e = &mut self.entries[i];
+            e.in_window = e.in_window.saturating_sub(1);
             self.window_start += 1;
         }
     }
@@ -160,11 +245,14 @@ mod tests {
             let at = store.push(&f, Kind::Tpdo, Some(1));
             st.add(&store.packed(at).clone(), &store);
         }
-        let s = st.iter().next().unwrap().1;
+        let s = *st.iter().next().unwrap().1;
         assert_eq!(s.count, 5);
         assert!((s.period().unwrap() - 0.010).abs() < 1e-9);
         assert!(s.jitter().unwrap() > 0.001);
-        assert!((s.rate() - 100.0).abs() < 1e-6);
+        assert!((s.mean_rate() - 100.0).abs() < 1e-6);
+        assert_eq!(s.in_window, 5, "5 frames in the last second");
+        // A capture shorter than the window: frames per second since it began.
+        assert!((st.rate(&s) - 125.0).abs() < 1e-6, "5 frames in 40 ms: {}", st.rate(&s));
         assert!((s.last_period().unwrap() - 0.008).abs() < 1e-9);
         assert_eq!((s.last_pos, s.prev_pos), (4, Some(3)));
         // 5 base frames of 8 bytes, 135 bits each at worst (see store::wire_bits), in the
@@ -204,5 +292,81 @@ mod tests {
             ]
         );
         assert_eq!(st.len(), 5);
+    }
+
+    fn push(store: &mut Store, st: &mut Stats, id: u32, ms: u64) {
+        let mut f = Frame::classic(id, &[0; 8]);
+        f.ts_ns = ms * 1_000_000;
+        let at = store.push(&f, Kind::Other, None);
+        st.add(&store.packed(at).clone(), store);
+    }
+
+    #[test]
+    fn a_cob_id_that_stops_falls_to_rate_0_and_ages_with_later_frames_and_ticks() {
+        let mut store = Store::new();
+        let mut st = Stats::new(500_000);
+        // 0x183 and 0x080 every 100 ms for 2 s, then only 0x080 for 2 s more.
+        for k in 0..=20 {
+            push(&mut store, &mut st, 0x183, k * 100);
+            push(&mut store, &mut st, 0x080, k * 100);
+        }
+        let get = |st: &Stats, id: u32| *st.iter().find(|(k, _)| k.1 == id).unwrap().1;
+        let s = get(&st, 0x183);
+        assert_eq!(st.rate(&s), 10.0, "(1 s, 2 s] holds 10 frames");
+        assert_eq!(s.age(st.now_ns()), 0.0);
+        assert!(!s.stale(st.now_ns()));
+        // 0x183 stops; 0x080 goes on: after 250 ms (2.5 periods) not stale yet.
+        push(&mut store, &mut st, 0x080, 2100);
+        push(&mut store, &mut st, 0x080, 2200);
+        let s = get(&st, 0x183);
+        assert_eq!(st.rate(&s), 8.0, "2 of its frames left the window");
+        assert!((s.age(st.now_ns()) - 0.2).abs() < 1e-9);
+        assert!(!s.stale(st.now_ns()));
+        push(&mut store, &mut st, 0x080, 2400);
+        assert!(get(&st, 0x183).stale(st.now_ns()), "age 0.4 s > 3 x 100 ms");
+        assert!(!get(&st, 0x080).stale(st.now_ns()));
+        for k in 25..=40 {
+            push(&mut store, &mut st, 0x080, k * 100);
+        }
+        let s = get(&st, 0x183);
+        assert_eq!(st.rate(&s), 0.0, "no frame in the last second");
+        assert!((s.age(st.now_ns()) - 2.0).abs() < 1e-9);
+        assert_eq!(s.count, 21, "the count stays");
+        assert_eq!(st.rate(&get(&st, 0x080)), 10.0);
+        // No frame at all, only the capture clock: everything ages, the rates fall to 0.
+        st.tick(60_000_000_000, &store);
+        assert_eq!(st.rate(&get(&st, 0x080)), 0.0);
+        assert!((get(&st, 0x183).age(st.now_ns()) - 58.0).abs() < 1e-9);
+        assert!(get(&st, 0x080).stale(st.now_ns()));
+        assert_eq!(st.load_percent(), 0.0);
+        assert_eq!(st.window_frames(&store), 0);
+        // A tick back in time (a late one) does not turn the clock back.
+        st.tick(1_000, &store);
+        assert_eq!(st.now_ns(), 60_000_000_000);
+    }
+
+    #[test]
+    fn cycle_time_min_max_and_jitter_of_a_known_sequence() {
+        let mut store = Store::new();
+        let mut st = Stats::new(500_000);
+        // Gaps 10, 12, 8, 10, 20 ms: mean 12 ms, min 8, max 20; variance of the gaps
+        // (4 + 0 + 16 + 4 + 64) / 5 = 17.6 ms², so the jitter is 4.195 ms.
+        for ms in [0, 10, 22, 30, 40, 60] {
+            push(&mut store, &mut st, 0x202, ms);
+        }
+        let s = *st.iter().next().unwrap().1;
+        assert!((s.period().unwrap() - 0.012).abs() < 1e-12);
+        assert!((s.min_period().unwrap() - 0.008).abs() < 1e-12);
+        assert!((s.max_period().unwrap() - 0.020).abs() < 1e-12);
+        assert!(
+            (s.jitter().unwrap() - 17.6e-6f64.sqrt()).abs() < 1e-9,
+            "{:?}",
+            s.jitter()
+        );
+        // One frame: no period, so no min/max/jitter, and never stale.
+        push(&mut store, &mut st, 0x701, 70);
+        let one = *st.iter().find(|(k, _)| k.1 == 0x701).unwrap().1;
+        assert_eq!((one.min_period(), one.max_period(), one.jitter()), (None, None, None));
+        assert!(!one.stale(100_000_000_000));
     }
 }

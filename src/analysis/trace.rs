@@ -161,6 +161,7 @@ impl Trace {
     /// node liveness and the diagnosis catch up.
     pub fn tick(&mut self, now_ns: u64) {
         self.nodes.tick(now_ns);
+        self.stats.tick(now_ns, &self.store);
         self.diagnosis.tick(now_ns);
         self.diagnosis_version += 1;
     }

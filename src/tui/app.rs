@@ -539,11 +539,17 @@ impl App {
     /// Handles a key press.
     pub fn key(&mut self, ev: KeyEvent) {
         self.dirty = true;
+        // A question waiting for a key takes that key, whatever it is: it answers and does
+        // nothing else, except that a key opening a prompt (`:`, `/`, the search key) also
+        // opens it afresh, so the line typed next goes there, never to the keymap.
         if let Some(nodes) = self.quit_confirm.take() {
             match ev.code {
                 KeyCode::Char('y') => self.quit = true,
                 KeyCode::Char('s') => self.stop_all(&nodes, StopOptions::default()),
-                _ => self.message = Some("not quitting".into()),
+                _ => {
+                    self.message = Some("not quitting".into());
+                    self.reopen_prompt(&ev);
+                }
             }
             return;
         }
@@ -552,6 +558,7 @@ impl App {
                 self.send(p);
             } else {
                 self.message = Some("not sent".into());
+                self.reopen_prompt(&ev);
             }
             return;
         }
@@ -597,6 +604,32 @@ impl App {
                 }
             }
         }
+    }
+
+    /// After a question was answered with `ev`: when `ev` alone is the key of the palette,
+    /// the filter or the search, that prompt opens (a fresh line); any other key does nothing.
+    fn reopen_prompt(&mut self, ev: &KeyEvent) {
+        let Some(k) = Key::from_event(ev) else { return };
+        if let Lookup::Action(a @ (Action::Palette | Action::Filter | Action::Search)) = self.keymap.lookup(&[k]) {
+            self.pending.clear();
+            self.act(a);
+        }
+    }
+
+    /// The question waiting for a key, if any: the key hint first (`y send · any other key
+    /// cancels`), then what it is about.
+    pub fn question(&self) -> Option<(String, String)> {
+        if let Some(nodes) = &self.quit_confirm {
+            let stop = self.keymap.key_for(Action::StopAll).unwrap_or_default();
+            let list = nodes.iter().map(u8::to_string).collect::<Vec<_>>().join(", ");
+            return Some((
+                "y quit · s stop them first · any other key stays".into(),
+                format!("drive(s) {list} that cotui commanded are still powered (stop all any time: {stop})"),
+            ));
+        }
+        let p = self.confirm.as_ref()?;
+        let why = p.confirm.as_deref().unwrap_or("confirm");
+        Some(("y send · any other key cancels".into(), format!("{why}: {}", p.preview)))
     }
 
     /// Edits the prompt line; true when a completion listed its candidates.
@@ -691,7 +724,7 @@ impl App {
         match palette::plan(line, &self.bindings, |n| self.drive_state(n)) {
             Ok(p) => match &p.confirm {
                 Some(why) => {
-                    self.message = Some(format!("{why}: {} — press y to send, any other key cancels", p.preview));
+                    self.message = Some(format!("y send · any other key cancels — {why}: {}", p.preview));
                     self.confirm = Some(p);
                 }
                 None => self.send(p),
@@ -816,12 +849,8 @@ impl App {
             self.quit = true;
             return;
         }
-        let stop = self.keymap.key_for(super::keymap::Action::StopAll).unwrap_or_default();
-        self.message = Some(format!(
-            "drive(s) {} that cotui commanded are still powered: y quits anyway, s stops them first ({stop}              any time), any other key stays",
-            powered.iter().map(u8::to_string).collect::<Vec<_>>().join(", ")
-        ));
         self.quit_confirm = Some(powered);
+        self.message = self.question().map(|(hint, text)| format!("{hint} — {text}"));
     }
 
     /// Runs a line entered at a prompt (the filter, search or palette prompt).
@@ -1821,6 +1850,53 @@ mod tests {
         assert_eq!(a.prompt.history, ["nmt reset-node 0"]);
     }
 
+    #[test]
+    fn the_key_that_cancels_a_confirmation_does_nothing_else_and_colon_opens_a_fresh_palette() {
+        let typed = |a: &mut App, text: &str| {
+            for c in text.chars() {
+                a.key(key(c));
+            }
+        };
+        let enter = KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE);
+        let mut a = app();
+        typed(&mut a, ":lss fastscan");
+        a.key(enter);
+        assert!(a.confirm.is_some());
+        assert_eq!(
+            a.question().map(|q| q.0).as_deref(),
+            Some("y send · any other key cancels")
+        );
+        // `:` cancels and opens a new palette: the review's `lss inquire all` goes there,
+        // its `q` does not quit, its `s` does not sort.
+        a.key(key(':'));
+        assert!(a.confirm.is_none() && a.question().is_none());
+        typed(&mut a, "lss inquire all");
+        assert!(!a.quit, "the q went to the palette");
+        assert_eq!(
+            a.focus,
+            Pane::Trace,
+            "the s did not sort (that brings the receive list up)"
+        );
+        assert_eq!(
+            a.prompt.editing.as_ref().map(|p| p.text.as_str()),
+            Some("lss inquire all")
+        );
+        a.key(KeyEvent::new(KeyCode::Esc, KeyModifiers::NONE));
+        // Any other key only cancels: `4` does not switch to the Stats pane, `q` not quit.
+        typed(&mut a, ":lss fastscan");
+        a.key(enter);
+        a.key(key('4'));
+        assert_eq!((a.confirm.is_none(), a.focus), (true, Pane::Trace));
+        assert_eq!(a.message.as_deref(), Some("not sent"));
+        typed(&mut a, ":nmt stop 0");
+        a.key(enter);
+        a.key(key('q'));
+        assert!(!a.quit && a.confirm.is_none(), "q cancelled, and only cancelled");
+        // The next key is the user's again.
+        a.key(key('4'));
+        assert_eq!(a.focus, Pane::Stats);
+    }
+
     /// `app()` fed by a live source whose requests the test reads.
     fn live_app(listen_only: bool) -> (App, tokio::sync::mpsc::UnboundedReceiver<Request>) {
         let (_ftx, frx) = std::sync::mpsc::channel();
@@ -1907,11 +1983,12 @@ mod tests {
         a.commanded.observe(&cw);
         a.act(Action::Quit);
         assert!(!a.quit);
-        assert!(
-            a.message
-                .as_deref()
-                .unwrap_or("")
-                .starts_with("drive(s) 1 that cotui commanded are still powered")
+        assert_eq!(
+            a.question(),
+            Some((
+                "y quit · s stop them first · any other key stays".into(),
+                "drive(s) 1 that cotui commanded are still powered (stop all any time: ctrl-s)".into()
+            ))
         );
         a.key(key('n'));
         assert!(!a.quit && a.quit_confirm.is_none());

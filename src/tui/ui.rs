@@ -16,11 +16,14 @@ const SIDE_MIN_WIDTH: u16 = 110;
 /// Draws the whole screen.
 pub fn draw(f: &mut Frame, app: &mut App) {
     let area = f.area();
+    // A question waiting for a key wraps onto the lines it needs (within reason).
+    let max = panes::status::QUESTION_LINES.min(area.height as usize / 4).max(1);
+    let asked = panes::status::question_lines(app, area.width, max).map_or(1, |l| l.len().clamp(1, max));
     let [tabs, body, bar, line] = Layout::vertical([
         Constraint::Length(1),
         Constraint::Min(0),
         Constraint::Length(1),
-        Constraint::Length(1),
+        Constraint::Length(asked as u16),
     ])
     .areas(area);
     let (main, side) = if area.width >= SIDE_MIN_WIDTH {

@@ -63,7 +63,8 @@ fn demo_runs_filters_helps_and_quits_cleanly() {
     // shell gets its screen back.
     s.keys(&["q"]);
     s.wait_for("the quit confirmation", |t| {
-        t.contains("drive(s) 2 that cotui commanded are still powered: y quits anyway")
+        t.contains("y quit · s stop them first · any other key stays")
+            && t.contains("drive(s) 2 that cotui commanded are still powered")
     });
     s.keys(&["y"]);
     let t = s.wait_for("cotui to exit", |t| t.contains("cotui-exit=0"));
@@ -251,7 +252,7 @@ fn demo_nodes_sim_words_and_lss_from_the_palette() {
     s.keys(&["y"]);
     s.wait_for("node-ID 9", |t| t.contains("lss set-node 9: node-ID 9 configured"));
     s.keys(&[":", "nmt reset-comm 0", "Enter"]);
-    s.wait_for("the confirmation", |t| t.contains("press y to send"));
+    s.wait_for("the confirmation", |t| t.contains("y send · any other key cancels"));
     s.keys(&["y"]);
     s.wait_for("node 9 on the bus", |t| t.contains("  9 Pre-operational"));
 
@@ -269,7 +270,7 @@ fn demo_nodes_sim_words_and_lss_from_the_palette() {
     }
     s.keys(&["Escape", "q"]);
     let t = s.wait_for("cotui to exit or ask", |t| {
-        t.contains("cotui-exit=") || t.contains("y quits")
+        t.contains("cotui-exit=") || t.contains("y quit ·")
     });
     if !t.contains("cotui-exit=") {
         s.keys(&["y"]);

@@ -270,7 +270,7 @@ fn receive_list_shows_latest_data_periods_and_labels_sorted_by_a_key() {
     assert!(s.contains("Receive list by count"), "{s}");
     // 0x701 (7 heartbeats) first; its latest data and label.
     assert!(
-        s.contains("701        7   16.7 ms   14.0 ms  05                       Heartbeat node 1: …"),
+        s.contains("701    67.3    4 ms   16.7 ms  05                       Heartbeat node 1: Ope…"),
         "{s}"
     );
     insta::assert_snapshot!("receive_list_by_count_80x24", s);
@@ -278,12 +278,45 @@ fn receive_list_shows_latest_data_periods_and_labels_sorted_by_a_key() {
     a.act(Action::Sort);
     let s = screen(&mut a, 160, 48);
     assert!(s.contains("Receive list by last heard"), "{s}");
-    assert!(s.contains("jitter   rate/s"), "wide: {s}");
+    assert!(s.contains("count rate/s     age    period    jitter"), "wide: {s}");
     let first = s.lines().nth(3).unwrap_or("");
     assert!(first.contains("082  "), "the EMCY came last: {s}");
     // The Detail pane shows the selected COB-ID's latest frame.
     assert!(s.contains("EMCY node 2: 0x2310"), "{s}");
     insta::assert_snapshot!("receive_list_by_last_heard_160x48", s);
+}
+
+#[test]
+fn receive_list_at_80x24_shows_the_age_and_dims_a_stale_row() {
+    use ratatui::style::{Color, Modifier};
+    let mut a = app();
+    a.focus = Pane::Stats;
+    // 100 ms after the capture's last frame only node 1's heartbeat comes again: 0x181
+    // (every 14 ms) is 7 periods late, stale; 0x701 was heard just now.
+    let end = a.trace.nodes.now_ns();
+    let mut f = crate::frame::Frame::classic(0x701, &[0x05]);
+    f.ts_ns = end + 100_000_000;
+    a.trace.push(&f);
+    let s = screen(&mut a, 80, 24);
+    assert!(s.contains("cob  rate/s     age    period  data"), "{s}");
+    assert!(s.contains("181    29.4  106 ms   14.0 ms  37 02"), "{s}");
+    assert!(s.contains("701    39.2    0 ms   29.1 ms  05"), "{s}");
+    insta::assert_snapshot!("receive_list_stale_80x24", s);
+    let mut term = ratatui::Terminal::new(ratatui::backend::TestBackend::new(80, 24)).unwrap();
+    term.draw(|fr| crate::tui::ui::draw(fr, &mut a)).unwrap();
+    let buf = term.backend().buffer().clone();
+    let row = |id: &str| {
+        (0..buf.area.height)
+            .find(|&y| (0..3).all(|i| buf[(1 + i as u16, y)].symbol() == &id[i..i + 1]))
+            .unwrap_or_else(|| panic!("a row for {id}: {s}"))
+    };
+    let dim = |y: u16, x: u16| buf[(x, y)].fg == Color::DarkGray && buf[(x, y)].modifier.contains(Modifier::DIM);
+    // Every cell of the stale row is dim, the COB-ID, the age and the changed data bytes.
+    let (stale, alive) = (row("181"), row("701"));
+    assert!((1..79).all(|x| dim(stale, x)), "{s}");
+    assert!(!(1..79).any(|x| dim(alive, x)), "{s}");
+    // A COB-ID seen once has no period: not dimmed.
+    assert!(!dim(row("082"), 1), "{s}");
 }
 
 #[test]
@@ -569,4 +602,64 @@ fn problems_pane_at_160x48_and_its_frames_in_the_trace() {
     a.act(Action::Expand);
     assert_eq!(a.focus, Pane::Trace);
     assert_eq!(a.selected_position(), Some(first.events[0].frame as usize - 1));
+}
+
+#[test]
+fn lss_fastscan_confirmation_at_80x24_shows_the_key_first_and_wraps_the_rest() {
+    use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+    let mut a = app();
+    for c in ":lss fastscan".chars() {
+        a.key(KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE));
+    }
+    a.key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
+    let s = screen(&mut a, 80, 24);
+    let lines: Vec<&str> = s.lines().collect();
+    assert_eq!(lines.len(), 24, "{s}");
+    // The key hint starts the question; the reason wraps below, whole.
+    let at = lines
+        .iter()
+        .position(|l| l.starts_with("y send · any other key cancels  "))
+        .unwrap_or_else(|| panic!("{s}"));
+    let question = lines[at..].join(" ");
+    assert!(
+        question.contains("LSS fastscan addresses every LSS slave (in configuration state, or not yet configured):"),
+        "{s}"
+    );
+    assert!(at >= 20, "the question takes the bottom lines: {s}");
+    assert!(
+        lines[at - 1].starts_with("open test.log"),
+        "the status bar stays above it: {s}"
+    );
+    insta::assert_snapshot!("lss_fastscan_confirmation_80x24", s);
+    // The hint is drawn as a key: black on yellow.
+    let mut term = ratatui::Terminal::new(ratatui::backend::TestBackend::new(80, 24)).unwrap();
+    term.draw(|fr| crate::tui::ui::draw(fr, &mut a)).unwrap();
+    let buf = term.backend().buffer().clone();
+    assert_eq!(buf[(0, at as u16)].bg, ratatui::style::Color::Yellow);
+    // Answered, the bottom is one line again.
+    a.key(KeyEvent::new(KeyCode::Char('n'), KeyModifiers::NONE));
+    let s = screen(&mut a, 80, 24);
+    assert!(s.lines().nth(22).unwrap_or("").starts_with("open test.log"), "{s}");
+    assert_eq!(s.lines().nth(23), Some("not sent"), "{s}");
+}
+
+#[test]
+fn dcf_load_confirmation_at_160_columns_shows_the_key_and_all_of_the_reason() {
+    use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+    let mut a = app();
+    for c in ":dcf load 5 node5.dcf --store".chars() {
+        a.key(KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE));
+    }
+    a.key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
+    let s = screen(&mut a, 160, 24);
+    let lines: Vec<&str> = s.lines().collect();
+    let at = lines
+        .iter()
+        .position(|l| {
+            l.starts_with("y send · any other key cancels  dcf load writes node 5's configuration from node5.dcf:")
+        })
+        .unwrap_or_else(|| panic!("{s}"));
+    let question = lines[at..].join(" ");
+    assert!(question.contains("stores (0x1010:01)"), "{s}");
+    assert!(!question.contains('…'), "nothing cut: {s}");
 }

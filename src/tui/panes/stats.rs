@@ -1,7 +1,9 @@
 //! The Stats pane, a receive list in the manner of PCAN-View: one row per COB-ID with its
-//! count, period (mean and last), jitter and rate (on wide terminals), the latest data with
+//! rate over the last second, its age (capture time since its last frame), its period
+//! (mean, then on wider terminals count, jitter, min, max and last), the latest data with
 //! the bytes that changed since the previous frame of that COB-ID highlighted, and the
-//! decoded label; the bus load from the bit rate in the title. A key cycles the sort.
+//! decoded label; the bus load from the bit rate in the title. A row whose age passed 3 of
+//! its periods is dimmed (stale). A key cycles the sort.
 
 use super::{Component, Ctx, ListState, Outcome, block, duration, fit, header, selected};
 use crate::analysis::stats::{IdStats, Stats};
@@ -133,7 +135,7 @@ impl Component for StatsPane {
     fn render(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
         let st = &ctx.trace.stats;
         let title = format!(
-            " Receive list by {} — bus load {:.1}% at {} kbit/s ({} frames in the last second) ",
+            " Receive list by {} — bus load {:.1}% at {} kbit/s, {} fr in the last 1 s ",
             self.sort.name(),
             st.load_percent(),
             st.bitrate() / 1000,
@@ -144,16 +146,17 @@ impl Component for StatsPane {
         if inner.height == 0 {
             return;
         }
-        // Jitter and rate on wide terminals; a wider COB-ID column once an extended one is seen.
-        let wide = inner.width >= 100;
+        // A wider COB-ID column once an extended one is seen; the columns that fit.
         let cw = if st.iter().any(|((ext, _), _)| *ext) { 9 } else { 4 };
-        let mut head = format!("{:<cw$}{:>8} {:>9} {:>9}", "cob", "count", "period", "last");
-        if wide {
-            head.push_str(&format!(" {:>9} {:>8}", "jitter", "rate/s"));
+        let cols = columns(inner.width as usize, cw);
+        let mut head = format!("{:<cw$}", "cob");
+        for c in &cols {
+            head.push_str(&format!(" {:>w$}", c.name(), w = c.width()));
         }
         head.push_str(&format!("  {:<23}  label", "data"));
         let mut lines = vec![Line::styled(fit(&head, inner.width as usize), header())];
         let l = self.list;
+        let now = st.now_ns();
         let rows: Vec<(CobKey, IdStats)> = sorted(st, self.sort)
             .into_iter()
             .skip(l.offset)
@@ -162,15 +165,9 @@ impl Component for StatsPane {
         let labels = self.labels(ctx.trace, &rows);
         for (i, ((ext, id), s)) in rows.iter().enumerate() {
             let cob = if *ext { format!("{id:08X}") } else { format!("{id:03X}") };
-            let d = |x: Option<f64>| x.map(duration).unwrap_or_else(|| "-".into());
-            let mut left = format!(
-                "{cob:<cw$}{:>8} {:>9} {:>9}",
-                s.count,
-                d(s.period()),
-                d(s.last_period())
-            );
-            if wide {
-                left.push_str(&format!(" {:>9} {:>8.1}", d(s.jitter()), s.rate()));
+            let mut left = format!("{cob:<cw$}");
+            for c in &cols {
+                left.push_str(&format!(" {:>w$}", c.cell(s, st), w = c.width()));
             }
             left.push_str("  ");
             let cur = ctx.trace.store.frame(s.last_pos);
@@ -180,6 +177,12 @@ impl Component for StatsPane {
             let label = labels.get(&s.last_pos).map(String::as_str).unwrap_or("");
             let used: usize = spans.iter().map(|s| s.content.chars().count()).sum();
             spans.push(Span::raw(fit(label, (inner.width as usize).saturating_sub(used))));
+            if s.stale(now) {
+                // Stale: the whole row dim grey, changed bytes included.
+                for sp in &mut spans {
+                    sp.style = sp.style.patch(stale());
+                }
+            }
             let line = Line::from(spans);
             lines.push(if i + l.offset == l.selected {
                 line.patch_style(selected())
@@ -204,6 +207,128 @@ impl StatsPane {
         }
         cache.retain(|p, _| want.binary_search(p).is_ok());
         cache.clone()
+    }
+}
+
+/// The style of a stale row (its age passed 3 of its periods).
+pub fn stale() -> Style {
+    Style::default().fg(Color::DarkGray).add_modifier(Modifier::DIM)
+}
+
+/// A column of the receive list between the COB-ID and the data.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Column {
+    /// Frames seen.
+    Count,
+    /// Frames in the last second of capture time.
+    Rate,
+    /// Capture time since the last frame.
+    Age,
+    /// Mean period.
+    Period,
+    /// The last period.
+    Last,
+    /// Shortest period.
+    Min,
+    /// Longest period.
+    Max,
+    /// Standard deviation of the period.
+    Jitter,
+}
+
+impl Column {
+    /// Left to right as drawn.
+    const ORDER: [Column; 8] = [
+        Column::Count,
+        Column::Rate,
+        Column::Age,
+        Column::Period,
+        Column::Jitter,
+        Column::Min,
+        Column::Max,
+        Column::Last,
+    ];
+    /// Which columns a narrow terminal keeps first: whether a COB-ID is alive (age), its
+    /// cycle time and rate, then the count and the cycle time's spread.
+    const PRIORITY: [Column; 8] = [
+        Column::Age,
+        Column::Period,
+        Column::Rate,
+        Column::Count,
+        Column::Jitter,
+        Column::Min,
+        Column::Max,
+        Column::Last,
+    ];
+
+    fn name(self) -> &'static str {
+        match self {
+            Column::Count => "count",
+            Column::Rate => "rate/s",
+            Column::Age => "age",
+            Column::Period => "period",
+            Column::Last => "last",
+            Column::Min => "min",
+            Column::Max => "max",
+            Column::Jitter => "jitter",
+        }
+    }
+
+    fn width(self) -> usize {
+        match self {
+            Column::Count => 7,
+            Column::Rate => 6,
+            Column::Age => 7,
+            _ => 9,
+        }
+    }
+
+    fn cell(self, s: &IdStats, st: &Stats) -> String {
+        let now_ns = st.now_ns();
+        let d = |x: Option<f64>| x.map(duration).unwrap_or_else(|| "-".into());
+        match self {
+            Column::Count => s.count.to_string(),
+            Column::Rate => format!("{:.1}", st.rate(s)),
+            Column::Age => age(s.age(now_ns)),
+            Column::Period => d(s.period()),
+            Column::Last => d(s.last_period()),
+            Column::Min => d(s.min_period()),
+            Column::Max => d(s.max_period()),
+            Column::Jitter => d(s.jitter()),
+        }
+    }
+}
+
+/// The label keeps at least this many columns before another column is shown.
+const LABEL_MIN: usize = 20;
+
+/// The columns shown in a pane `width` wide with a COB-ID column `cob_width` wide: in
+/// [`Column::PRIORITY`] order while the label keeps [`LABEL_MIN`] columns, drawn in
+/// [`Column::ORDER`].
+pub fn columns(width: usize, cob_width: usize) -> Vec<Column> {
+    // The COB-ID, two spaces, 23 columns of data, two spaces.
+    let mut free = width.saturating_sub(cob_width + 27 + LABEL_MIN);
+    let mut keep = Vec::new();
+    for c in Column::PRIORITY {
+        if c.width() + 1 > free {
+            break;
+        }
+        free -= c.width() + 1;
+        keep.push(c);
+    }
+    Column::ORDER.into_iter().filter(|c| keep.contains(c)).collect()
+}
+
+/// An age in at most 7 columns: `40 ms`, `2.5 s`, `125 s`, `2.1 h`.
+pub fn age(secs: f64) -> String {
+    if secs < 1.0 {
+        format!("{:.0} ms", secs * 1e3)
+    } else if secs < 100.0 {
+        format!("{secs:.1} s")
+    } else if secs < 3600.0 {
+        format!("{secs:.0} s")
+    } else {
+        format!("{:.1} h", secs / 3600.0)
     }
 }
 
@@ -266,5 +391,21 @@ mod tests {
         assert_eq!(ids(Sort::Period), [0x181, 0x701, 0x080]);
         assert_eq!(ids(Sort::Last), [0x080, 0x701, 0x181]);
         assert_eq!(Sort::Last.next(), Sort::Id);
+    }
+
+    #[test]
+    fn narrow_panes_keep_age_period_and_rate_and_wide_ones_show_the_spread() {
+        use Column::*;
+        // An 80-column terminal: 78 inside the frame.
+        assert_eq!(columns(78, 4), [Rate, Age, Period]);
+        assert_eq!(columns(98, 4), [Count, Rate, Age, Period, Jitter]);
+        assert_eq!(columns(160, 4), [Count, Rate, Age, Period, Jitter, Min, Max, Last]);
+        // Extended COB-IDs take 5 more columns.
+        assert_eq!(columns(78, 9), [Age, Period]);
+        assert_eq!(columns(10, 4), []);
+        assert_eq!(
+            [age(0.04), age(2.54), age(125.0), age(7560.0)],
+            ["40 ms", "2.5 s", "125 s", "2.1 h"]
+        );
     }
 }

@@ -4,8 +4,82 @@ use crate::tui::app::{App, SourceKind};
 use crate::tui::keymap::Action;
 use ratatui::Frame;
 use ratatui::layout::Rect;
-use ratatui::style::{Color, Style};
+use ratatui::style::{Color, Modifier, Style};
+use ratatui::text::{Line, Span};
 use ratatui::widgets::Paragraph;
+
+/// The most lines a question (a confirmation waiting for a key) takes at the bottom.
+pub const QUESTION_LINES: usize = 6;
+
+/// A question waiting for a key, wrapped to `width` columns: the key hint first (black on
+/// yellow), then what it is about, word by word; at most `max` lines, the last cut with `…`.
+pub fn question_lines(app: &App, width: u16, max: usize) -> Option<Vec<Line<'static>>> {
+    let (hint, text) = app.question()?;
+    Some(wrap_question(&hint, &text, width as usize, max.max(1)))
+}
+
+fn wrap_question(hint: &str, text: &str, width: usize, max: usize) -> Vec<Line<'static>> {
+    let width = width.max(1);
+    let key = Style::default()
+        .fg(Color::Black)
+        .bg(Color::Yellow)
+        .add_modifier(Modifier::BOLD);
+    let hint: String = hint.chars().take(width).collect();
+    let mut rows: Vec<String> = Vec::new();
+    let mut cur = String::new();
+    let mut used = hint.chars().count();
+    // Words longer than a line are split into pieces of a line.
+    let words = text.split_whitespace().flat_map(|w| {
+        let chars: Vec<char> = w.chars().collect();
+        chars
+            .chunks(width)
+            .map(|c| c.iter().collect::<String>())
+            .collect::<Vec<_>>()
+    });
+    for w in words {
+        let n = w.chars().count();
+        let gap = if used == 0 {
+            0
+        } else if rows.is_empty() && cur.is_empty() {
+            2
+        } else {
+            1
+        };
+        if used > 0 && used + gap + n > width {
+            rows.push(std::mem::take(&mut cur));
+            used = 0;
+        } else if gap > 0 {
+            cur.push_str(&" ".repeat(gap));
+            used += gap;
+        }
+        cur.push_str(&w);
+        used += n;
+    }
+    rows.push(cur);
+    let mut lines: Vec<Line<'static>> = rows
+        .into_iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let text = Span::styled(r, Style::default().fg(Color::Yellow));
+            if i == 0 {
+                Line::from(vec![Span::styled(hint.clone(), key), text])
+            } else {
+                Line::from(text)
+            }
+        })
+        .collect();
+    if lines.len() > max {
+        lines.truncate(max);
+        if let Some(last) = lines.last_mut().and_then(|l| l.spans.last_mut()) {
+            let mut t: String = last.content.to_string();
+            let keep = t.chars().count().min(width.saturating_sub(1));
+            t = t.chars().take(keep).collect();
+            t.push('…');
+            last.content = t.into();
+        }
+    }
+    lines
+}
 
 /// A replay's position: ` 45% 12.3 s / 27.0 s` (percent of the frames, log time from the
 /// first frame), only the time until the log is measured, nothing before the first frame.
@@ -105,6 +179,10 @@ pub fn render(app: &App, f: &mut Frame, bar: Rect, line: Rect) {
         _ => (text(app), Color::Blue),
     };
     f.render_widget(Paragraph::new(txt).style(Style::default().bg(bg).fg(Color::White)), bar);
+    if let Some(lines) = question_lines(app, line.width, line.height as usize) {
+        f.render_widget(Paragraph::new(lines), line);
+        return;
+    }
     if app.prompt.render(f, line) {
         return;
     }
@@ -113,5 +191,27 @@ pub fn render(app: &App, f: &mut Frame, bar: Rect, line: Rect) {
             Paragraph::new(m.as_str()).style(Style::default().fg(Color::Yellow)),
             line,
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::wrap_question;
+
+    fn text(lines: &[ratatui::text::Line]) -> Vec<String> {
+        lines
+            .iter()
+            .map(|l| l.spans.iter().map(|s| s.content.as_ref()).collect())
+            .collect()
+    }
+
+    #[test]
+    fn a_question_wraps_by_words_after_its_key_hint_and_cuts_at_the_last_line_allowed() {
+        let l = wrap_question("y send", "one two three four", 16, 6);
+        assert_eq!(text(&l), ["y send  one two", "three four"]);
+        // A word longer than a line is split; past `max` lines the last is marked cut.
+        let l = wrap_question("y", "aaaaaaaaaaaa bb cc dd", 5, 3);
+        assert_eq!(text(&l), ["y", "aaaaa", "aaaa…"]);
+        assert_eq!(text(&wrap_question("y send", "", 3, 2)), ["y s"]);
     }
 }
