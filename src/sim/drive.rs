@@ -1070,7 +1070,10 @@ mod pdo_tests {
         let cs = 0x23 | ((4 - len) << 2);
         let [i0, i1] = index.to_le_bytes();
         let [v0, v1, v2, v3] = value.to_le_bytes();
-        let out = d.on_frame(&Frame::classic(cob::sdo_request(2), &[cs, i0, i1, sub, v0, v1, v2, v3]), now_ns);
+        let out = d.on_frame(
+            &Frame::classic(cob::sdo_request(2), &[cs, i0, i1, sub, v0, v1, v2, v3]),
+            now_ns,
+        );
         assert_eq!(out[0].payload()[0], 0x60, "download of {index:04X}:{sub:02X} answered");
         out
     }
@@ -1134,7 +1137,12 @@ mod pdo_tests {
         assert!(sync(&mut d, 0).is_empty(), "pre-operational");
         let mut sent = Vec::new();
         let mut record = |frames: Vec<Frame>, t: u64| {
-            sent.extend(frames.iter().filter(|f| f.id == TPDO1).map(|f| (t / MS, f.payload()[0])));
+            sent.extend(
+                frames
+                    .iter()
+                    .filter(|f| f.id == TPDO1)
+                    .map(|f| (t / MS, f.payload()[0])),
+            );
         };
         record(start(&mut d, 0), 0);
         for k in 1..=100u64 {
@@ -1207,7 +1215,11 @@ mod pdo_tests {
             assert_eq!(answer.len(), 1, "type {kind}");
             assert_eq!(answer[0].id, TPDO1);
             assert!(!answer[0].is_rtr());
-            let expect: &[u8] = if kind == 252 { &[0x50, 0x02, 0x03] } else { &[0x31, 0x02, 0x03] };
+            let expect: &[u8] = if kind == 252 {
+                &[0x50, 0x02, 0x03]
+            } else {
+                &[0x31, 0x02, 0x03]
+            };
             assert_eq!(answer[0].payload(), expect, "type {kind}");
         }
         // A synchronous TPDO does not answer remote requests.
