@@ -46,7 +46,9 @@ fn demo_objects_pane_reads_and_writes_an_object() {
         s.type_text("]");
         t = s.wait_for("the next node", |t| title(t) != before);
     }
-    s.wait_for("node 2's dictionary", |t| t.contains("Objects · node 2 aimotor > cia402"));
+    s.wait_for("node 2's dictionary", |t| {
+        t.contains("Objects · node 2 aimotor > cia402")
+    });
 
     // Find by typing, read with enter: the value and its age show in the row.
     s.type_text("/");
