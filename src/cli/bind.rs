@@ -105,7 +105,9 @@ pub fn bindings_for_demo(
         }
     }
     let mut b = bindings(&profiles, eds)?;
-    for (node, layer) in sim.pdo_layers() {
+    for (node, mut layer) in sim.pdo_layers() {
+        // The layer is the device's configuration; it goes by the profile bound to the node.
+        layer.name = b.dictionary(node).profile_name().to_string();
         b.bind_layer(node, layer);
     }
     Ok(b)

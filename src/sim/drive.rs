@@ -3,8 +3,11 @@
 //! (transitions 0..16), profile velocity motion and EMCY on faults, and an LSS slave
 //! (a drive made with node-ID 0xFF only answers LSS until it is given one and reset).
 //! Drives that are not CiA 402 (Dexmart, AQMD) act through [`super::vendor`] instead of
-//! the state machine. RPDOs with a synchronous transmission type (0..240) take effect at
-//! the next SYNC; TPDOs go out on SYNC (types 1..240) and on their event timer (254/255).
+//! the state machine. PDOs follow their communication parameters (CiA 301, see
+//! [`Tpdo`]): RPDOs with a synchronous transmission type (0..240) take effect at the next
+//! SYNC, 254/255 at once; TPDOs go out every N-th SYNC (1..240), after a SYNC when their
+//! data changed (0), on a remote request (252/253), or on change and on their event timer
+//! (254/255), never closer together than their inhibit time.
 //!
 //! Pure: frames and the current time in, frames out.
 
@@ -89,9 +92,36 @@ pub struct Drive {
     vendor: Vendor,
     /// Synchronous RPDOs received since the last SYNC, by PDO number (0-based).
     sync_rpdo: [Option<Vec<u8>>; 4],
-    /// When each event-driven TPDO is due next.
-    next_event_ns: [Option<u64>; 4],
+    /// The transmission state of each TPDO (0-based).
+    tpdo: [Tpdo; 4],
 }
+
+/// The transmission state of one TPDO, driven by its communication parameters 0x1800+n
+/// (CiA 301 7.2.2): sub 2 transmission type, sub 3 inhibit time (100 µs), sub 5 event
+/// timer (ms). Reset when the node leaves operational, so that the first chance after an
+/// NMT start sends the current values (nothing has been sent yet).
+#[derive(Clone, Debug, Default)]
+struct Tpdo {
+    /// SYNCs counted toward the next synchronous send (types 1..240).
+    syncs: u64,
+    /// The data last sent (types 0, 254, 255 send when it changes).
+    last_data: Option<Vec<u8>>,
+    /// When it was last sent (inhibit time).
+    last_sent_ns: Option<u64>,
+    /// An event that waits for the inhibit time to pass.
+    pending: bool,
+    /// When the event timer runs out.
+    timer_due_ns: Option<u64>,
+    /// Type 252: the data sampled at the last SYNC, sent on the next remote request.
+    sampled: Option<Vec<u8>>,
+}
+
+/// Transmission types of 0x1800+n sub 2 (CiA 301 table 71).
+const ACYCLIC_SYNC: u64 = 0;
+const RTR_SYNC: u64 = 252;
+const RTR_EVENT: u64 = 253;
+const EVENT_MANUFACTURER: u64 = 254;
+const EVENT_PROFILE: u64 = 255;
 
 impl Drive {
     /// A drive at `node` with the object dictionary of `profile` (see [`profile::drive_objects`]).
@@ -128,7 +158,7 @@ impl Drive {
             pending_fault: None,
             vendor: Vendor::new(profile_kind),
             sync_rpdo: Default::default(),
-            next_event_ns: [None; 4],
+            tpdo: Default::default(),
         }
     }
     /// The node id.
@@ -202,7 +232,7 @@ impl Drive {
         self.od.reset(range.clone());
         self.sdo = SdoServer::new(ServerConfig::default());
         self.sync_rpdo = Default::default();
-        self.next_event_ns = [None; 4];
+        self.tpdo = Default::default();
         if range.contains(&0x2000) {
             self.vendor = Vendor::new(self.profile.kind);
             super::vendor::init_objects(self.profile.kind, &mut self.od);
@@ -265,13 +295,14 @@ impl Drive {
             return Vec::new();
         }
         let node = self.node;
-        match f.id {
+        let mut out = match f.id {
             0x000 => self.on_nmt(f.payload(), now_ns),
             0x080 if self.nmt == NmtState::Operational => {
                 let mut out = self.apply_sync_rpdos();
                 out.extend(self.on_sync());
                 out
             }
+            id if self.nmt == NmtState::Operational && f.is_rtr() => self.on_remote_request(id, now_ns),
             id if id == cob::sdo_request(node) && self.nmt != NmtState::Stopped && !f.is_rtr() => {
                 let replies = self.sdo.on_frame(f.payload(), now_ns, &mut self.od).frames;
                 let mut out: Vec<Frame> = replies
@@ -288,13 +319,21 @@ impl Drive {
             }
             id if self.nmt == NmtState::Operational && !f.is_rtr() => self.on_rpdo(id, f.payload()),
             _ => Vec::new(),
-        }
+        };
+        // What the frame changed (an SDO or RPDO write, a state transition) is an event
+        // for the event-driven TPDOs.
+        out.extend(self.event_tpdos(now_ns));
+        out
     }
 
     fn on_nmt(&mut self, p: &[u8], now_ns: u64) -> Vec<Frame> {
         let [cs, target, ..] = p else { return Vec::new() };
         if *target != 0 && (*target != self.node || !self.configured()) {
             return Vec::new();
+        }
+        if *cs != 0x01 {
+            // Out of operational no PDO goes out; the next start sends afresh.
+            self.tpdo = Default::default();
         }
         match cs {
             0x01 => self.nmt = NmtState::Operational,
@@ -383,32 +422,127 @@ impl Drive {
         (data.len() <= 8).then(|| Frame::classic(cob, &data))
     }
 
-    fn on_sync(&mut self) -> Vec<Frame> {
-        (0..4u16)
-            .filter(|n| (1..=240).contains(&self.od.uint(0x1800 + n, 2)))
-            .filter_map(|n| self.tpdo_frame(n))
-            .collect()
+    /// The transmission type of TPDO `n` (0x1800+n sub 2).
+    fn tpdo_type(&self, n: u16) -> u64 {
+        self.od.uint(0x1800 + n, 2)
     }
 
-    /// The event-driven TPDOs (types 254/255) whose event timer ran out at `now_ns`.
-    fn event_tpdos(&mut self, now_ns: u64) -> Vec<Frame> {
+    /// A SYNC: the synchronous TPDOs that are due (every N-th SYNC for types 1..240; type 0
+    /// when its data changed since it was last sent); type 252 samples its data.
+    fn on_sync(&mut self) -> Vec<Frame> {
         let mut out = Vec::new();
         for n in 0..4u16 {
-            let period_ns = self.od.uint(0x1800 + n, 5) * 1_000_000;
-            let timed = self.od.uint(0x1800 + n, 2) >= 254 && period_ns > 0 && self.pdo_cob(0x1800 + n).is_some();
-            let slot = &mut self.next_event_ns[n as usize];
-            if !timed || self.nmt != NmtState::Operational {
-                *slot = None;
+            let kind = self.tpdo_type(n);
+            let Some(frame) = self.tpdo_frame(n) else {
+                continue;
+            };
+            let data = frame.payload().to_vec();
+            let t = &mut self.tpdo[n as usize];
+            let send = match kind {
+                ACYCLIC_SYNC => t.last_data.as_ref() != Some(&data),
+                1..=240 => {
+                    t.syncs += 1;
+                    let due = t.syncs >= kind;
+                    if due {
+                        t.syncs = 0;
+                    }
+                    due
+                }
+                RTR_SYNC => {
+                    t.sampled = Some(data);
+                    continue;
+                }
+                _ => continue,
+            };
+            if send {
+                t.last_data = Some(data);
+                out.push(frame);
+            }
+        }
+        out
+    }
+
+    /// A remote request for one of the drive's TPDOs: answered when its type is RTR-only
+    /// (252 with the data sampled at the last SYNC, 253 with the current data) and its
+    /// COB-ID allows remote requests (bit 30 clear).
+    fn on_remote_request(&mut self, id: u32, now_ns: u64) -> Vec<Frame> {
+        let mut out = Vec::new();
+        for n in 0..4u16 {
+            let kind = self.tpdo_type(n);
+            let rtr_allowed = self.od.uint(0x1800 + n, 1) & 0x4000_0000 == 0;
+            if self.pdo_cob(0x1800 + n) != Some(id) || !rtr_allowed || !(RTR_SYNC..=RTR_EVENT).contains(&kind) {
                 continue;
             }
-            match *slot {
+            let Some(mut frame) = self.tpdo_frame(n) else {
+                continue;
+            };
+            let t = &mut self.tpdo[n as usize];
+            if kind == RTR_SYNC
+                && let Some(sampled) = &t.sampled
+            {
+                frame = Frame::classic(frame.id, sampled);
+            }
+            t.last_sent_ns = Some(now_ns);
+            out.push(frame);
+        }
+        out
+    }
+
+    /// Does a change of TPDO `n`'s data make it go out? Types 255 (device profile
+    /// events) and, for CiA 402 drives, 254; the manufacturer events of 254 on the vendor
+    /// drives are their own (Dexmart: a TPDO in reply to each RPDO, see [`Vendor::on_rpdo`]).
+    fn sends_on_change(&self, kind: u64) -> bool {
+        kind == EVENT_PROFILE || (kind == EVENT_MANUFACTURER && self.profile.kind == Kind::Cia402)
+    }
+
+    /// The event-driven TPDOs (types 254/255) that go out at `now_ns`: when their data
+    /// changed or their event timer ran out, once their inhibit time since the last send
+    /// has passed (an event during the inhibit time waits for its end).
+    fn event_tpdos(&mut self, now_ns: u64) -> Vec<Frame> {
+        let mut out = Vec::new();
+        let running = self.nmt == NmtState::Operational && self.configured() && !self.silent;
+        for n in 0..4u16 {
+            let kind = self.tpdo_type(n);
+            let frame = self.tpdo_frame(n);
+            let on_change = self.sends_on_change(kind);
+            let period_ns = self.od.uint(0x1800 + n, 5) * 1_000_000;
+            let inhibit_ns = self.od.uint(0x1800 + n, 3) * 100_000;
+            let t = &mut self.tpdo[n as usize];
+            let (true, Some(frame)) = (running && kind >= EVENT_MANUFACTURER, frame) else {
+                t.pending = false;
+                t.timer_due_ns = None;
+                continue;
+            };
+            let data = frame.payload();
+            if on_change && t.last_data.as_deref() != Some(data) {
+                t.pending = true;
+            }
+            let mut timed_out = false;
+            match t.timer_due_ns {
+                _ if period_ns == 0 => t.timer_due_ns = None,
                 Some(due) if now_ns >= due => {
-                    *slot = Some(due.max(now_ns - period_ns) + period_ns);
-                    out.extend(self.tpdo_frame(n));
+                    t.pending = true;
+                    timed_out = true;
                 }
                 Some(_) => {}
-                None => *slot = Some(now_ns + period_ns),
+                None => t.timer_due_ns = Some(now_ns + period_ns),
             }
+            let inhibited = t.last_sent_ns.is_some_and(|last| now_ns < last + inhibit_ns);
+            if !t.pending || inhibited {
+                continue;
+            }
+            t.pending = false;
+            t.last_data = Some(data.to_vec());
+            t.last_sent_ns = Some(now_ns);
+            if period_ns > 0 {
+                // The event timer restarts with every send; when it ran out, the next one
+                // keeps its cycle (late ticks do not add up).
+                t.timer_due_ns = Some(match t.timer_due_ns {
+                    Some(due) if timed_out => due.max(now_ns.saturating_sub(period_ns)) + period_ns,
+                    _ => now_ns + period_ns,
+                });
+            }
+            out.push(frame);
         }
         out
     }
@@ -906,5 +1040,212 @@ mod tests {
         assert_eq!((out[1].id, out[1].payload()), (0x81, &[0u8; 8][..]), "reset EMCY");
         assert_eq!(d.objects().uint(0x1001, 0), 0);
         assert_ne!(d.state(), DriveState::Fault);
+    }
+}
+
+/// The PDO communication parameters against the CiA 301 rules: frames and bus times in,
+/// the TPDOs that come out.
+#[cfg(test)]
+mod pdo_tests {
+    use super::*;
+    use crate::frame::Flags;
+    use crate::sim::profile::DriveProfile;
+
+    const MS: u64 = 1_000_000;
+    const TPDO1: u32 = cob::tpdo(1, 2);
+
+    /// A servo at node 2 (TPDO1 = statusword + mode display), operational at 0 ms.
+    fn running() -> Drive {
+        let mut d = Drive::new(2, DriveProfile::servo("test", 1));
+        d.power_on(0);
+        d
+    }
+
+    fn start(d: &mut Drive, now_ns: u64) -> Vec<Frame> {
+        d.on_frame(&Frame::classic(0x000, &[0x01, 0x00]), now_ns)
+    }
+
+    /// An expedited SDO download of `len` bytes of `value`, as a client would send it.
+    fn write(d: &mut Drive, index: u16, sub: u8, value: u32, len: u8, now_ns: u64) -> Vec<Frame> {
+        let cs = 0x23 | ((4 - len) << 2);
+        let [i0, i1] = index.to_le_bytes();
+        let [v0, v1, v2, v3] = value.to_le_bytes();
+        let out = d.on_frame(
+            &Frame::classic(cob::sdo_request(2), &[cs, i0, i1, sub, v0, v1, v2, v3]),
+            now_ns,
+        );
+        assert_eq!(out[0].payload()[0], 0x60, "download of {index:04X}:{sub:02X} answered");
+        out
+    }
+
+    fn sync(d: &mut Drive, now_ns: u64) -> Vec<Frame> {
+        d.on_frame(&Frame::classic(cob::SYNC, &[]), now_ns)
+    }
+
+    fn tpdo1s(frames: &[Frame]) -> usize {
+        frames.iter().filter(|f| f.id == TPDO1).count()
+    }
+
+    /// Which of the next `count` SYNCs (1-based, 100 ms apart from the drive's last tick,
+    /// the drive ticking in between) TPDO1 followed.
+    fn syncs_answered(d: &mut Drive, count: u64) -> Vec<u64> {
+        let base = d.last_ns.unwrap_or(0) + 50 * MS;
+        (1..=count)
+            .filter(|k| {
+                let t = base + k * 100 * MS;
+                let mut out = d.tick(t - 50 * MS);
+                out.extend(sync(d, t));
+                tpdo1s(&out) > 0
+            })
+            .collect()
+    }
+
+    #[test]
+    fn type_1_sends_on_every_sync_and_type_2_on_every_second() {
+        let mut d = running();
+        start(&mut d, 0);
+        assert_eq!(syncs_answered(&mut d, 4), [1, 2, 3, 4]);
+        write(&mut d, 0x1800, 2, 2, 1, 450 * MS);
+        assert_eq!(syncs_answered(&mut d, 6), [2, 4, 6]);
+        write(&mut d, 0x1800, 2, 5, 1, 1_060 * MS);
+        assert_eq!(syncs_answered(&mut d, 10), [5, 10]);
+    }
+
+    #[test]
+    fn type_0_sends_after_a_sync_only_when_the_data_changed() {
+        let mut d = running();
+        write(&mut d, 0x1800, 2, 0, 1, 0);
+        start(&mut d, 0);
+        // The first SYNC after the start sends the values (none sent yet), then silence.
+        assert_eq!(syncs_answered(&mut d, 5), [1]);
+        // Shutdown: the statusword changes; nothing until the next SYNC, then once.
+        let out = write(&mut d, 0x6040, 0, 0x06, 2, 510 * MS);
+        assert_eq!(tpdo1s(&out), 0, "acyclic synchronous waits for the SYNC");
+        assert_eq!(tpdo1s(&d.tick(550 * MS)), 0);
+        let sent: Vec<Frame> = sync(&mut d, 600 * MS).into_iter().filter(|f| f.id == TPDO1).collect();
+        assert_eq!(sent.len(), 1);
+        assert_eq!(sent[0].payload(), &[0x31, 0x02, 0x03], "ready to switch on");
+        assert_eq!(syncs_answered(&mut d, 5), Vec::<u64>::new());
+    }
+
+    #[test]
+    fn type_254_follows_its_event_timer_and_changes_never_closer_than_the_inhibit_time() {
+        let mut d = running();
+        write(&mut d, 0x1800, 2, 254, 1, 0);
+        write(&mut d, 0x1800, 5, 100, 2, 0); // event timer 100 ms
+        write(&mut d, 0x1800, 3, 300, 2, 0); // inhibit time 30 ms
+        assert!(sync(&mut d, 0).is_empty(), "pre-operational");
+        let mut sent = Vec::new();
+        let mut record = |frames: Vec<Frame>, t: u64| {
+            sent.extend(
+                frames
+                    .iter()
+                    .filter(|f| f.id == TPDO1)
+                    .map(|f| (t / MS, f.payload()[0])),
+            );
+        };
+        record(start(&mut d, 0), 0);
+        for k in 1..=100u64 {
+            let t = k * 10 * MS;
+            record(d.tick(t), t);
+            record(sync(&mut d, t), t); // SYNCs do not trigger an event-driven TPDO
+            if k == 34 {
+                // Two changes 10 ms apart: the first goes out at once, the second when
+                // the 30 ms inhibit time since the first has passed (the tick at 380 ms).
+                record(write(&mut d, 0x6040, 0, 0x06, 2, 345 * MS), 345 * MS);
+            }
+            if k == 35 {
+                record(write(&mut d, 0x6040, 0, 0x07, 2, 355 * MS), 355 * MS);
+            }
+        }
+        let times: Vec<u64> = sent.iter().map(|(t, _)| *t).collect();
+        assert_eq!(times, [0, 100, 200, 300, 345, 380, 480, 580, 680, 780, 880, 980]);
+        assert_eq!(sent[4].1, 0x31, "ready to switch on");
+        assert_eq!(sent[5].1, 0x33, "switched on");
+        assert!(times.windows(2).all(|w| w[1] - w[0] >= 30), "{times:?}");
+    }
+
+    #[test]
+    fn type_255_without_event_timer_sends_only_on_change() {
+        let mut d = running();
+        write(&mut d, 0x1800, 2, 255, 1, 0);
+        assert_eq!(tpdo1s(&start(&mut d, 0)), 1, "the values once at the start");
+        let quiet: usize = (1..=50u64).map(|k| tpdo1s(&d.tick(k * 10 * MS))).sum();
+        assert_eq!(quiet, 0);
+        assert_eq!(tpdo1s(&write(&mut d, 0x6040, 0, 0x06, 2, 505 * MS)), 1);
+        assert_eq!(tpdo1s(&d.tick(510 * MS)), 0);
+    }
+
+    #[test]
+    fn an_invalid_cob_id_sends_nothing_whatever_the_type() {
+        for kind in [1u32, 0, 253, 254, 255] {
+            let mut d = running();
+            write(&mut d, 0x1800, 1, 0x8000_0000 | TPDO1, 4, 0);
+            write(&mut d, 0x1800, 2, kind, 1, 0);
+            write(&mut d, 0x1800, 5, 100, 2, 0);
+            let mut out = start(&mut d, 0);
+            for k in 1..=20u64 {
+                out.extend(d.tick(k * 50 * MS));
+                out.extend(sync(&mut d, k * 50 * MS));
+            }
+            out.extend(write(&mut d, 0x6040, 0, 0x06, 2, 1_010 * MS));
+            let mut rtr = Frame::classic(TPDO1, &[]);
+            rtr.flags.set(Flags::RTR, true);
+            out.extend(d.on_frame(&rtr, 1_020 * MS));
+            assert_eq!(tpdo1s(&out), 0, "type {kind}");
+            assert!(out.iter().any(|f| f.id == cob::tpdo(2, 2)), "TPDO2 still goes out");
+        }
+    }
+
+    #[test]
+    fn rtr_only_types_answer_a_remote_request_and_nothing_else() {
+        let mut rtr = Frame::classic(TPDO1, &[]);
+        rtr.flags.set(Flags::RTR, true);
+        rtr.len = 3;
+        for kind in [252u32, 253] {
+            let mut d = running();
+            write(&mut d, 0x1800, 2, kind, 1, 0);
+            write(&mut d, 0x1800, 5, 100, 2, 0);
+            start(&mut d, 0);
+            assert_eq!(syncs_answered(&mut d, 5), Vec::<u64>::new(), "type {kind}");
+            // Shutdown after the last SYNC: 252 answers with what it sampled at the SYNC,
+            // 253 with the value now.
+            write(&mut d, 0x6040, 0, 0x06, 2, 510 * MS);
+            let answer = d.on_frame(&rtr, 520 * MS);
+            assert_eq!(answer.len(), 1, "type {kind}");
+            assert_eq!(answer[0].id, TPDO1);
+            assert!(!answer[0].is_rtr());
+            let expect: &[u8] = if kind == 252 {
+                &[0x50, 0x02, 0x03]
+            } else {
+                &[0x31, 0x02, 0x03]
+            };
+            assert_eq!(answer[0].payload(), expect, "type {kind}");
+        }
+        // A synchronous TPDO does not answer remote requests.
+        let mut d = running();
+        start(&mut d, 0);
+        assert!(d.on_frame(&rtr, 10 * MS).is_empty());
+    }
+
+    #[test]
+    fn a_synchronous_rpdo_takes_effect_at_the_next_sync_an_asynchronous_one_at_once() {
+        let rpdo1 = |cw: u8| Frame::classic(cob::rpdo(1, 2), &[cw, 0, 0, 0, 0, 0]);
+        let mut d = running();
+        start(&mut d, 0);
+        write(&mut d, 0x1400, 2, 1, 1, 0);
+        d.on_frame(&rpdo1(0x06), 10 * MS);
+        assert_eq!(d.state(), DriveState::SwitchOnDisabled, "waits for the SYNC");
+        let out = sync(&mut d, 100 * MS);
+        assert_eq!(d.state(), DriveState::ReadyToSwitchOn);
+        let tpdo = out.iter().find(|f| f.id == TPDO1).unwrap();
+        assert_eq!(tpdo.payload()[0], 0x31, "the TPDO of that SYNC shows the new state");
+        write(&mut d, 0x1400, 2, 255, 1, 110 * MS);
+        d.on_frame(&rpdo1(0x07), 120 * MS);
+        assert_eq!(d.state(), DriveState::SwitchedOn, "event-driven: at once");
+        write(&mut d, 0x1400, 1, 0x8000_0000 | cob::rpdo(1, 2), 4, 130 * MS);
+        d.on_frame(&rpdo1(0x06), 140 * MS);
+        sync(&mut d, 200 * MS);
+        assert_eq!(d.state(), DriveState::SwitchedOn, "an invalid RPDO is ignored");
     }
 }

@@ -97,10 +97,23 @@ impl Simulation {
                         })
                         .collect()
                 };
+                // The device's own heartbeat default (as its EDS would give it), so the
+                // Nodes pane knows the period before anyone reads 0x1017.
+                let heartbeat = crate::od::ObjectInfo {
+                    name: "Producer heartbeat time".into(),
+                    data_type: crate::od::DataType::U16,
+                    access: crate::od::Access::Rw,
+                    unit: Some("ms".into()),
+                    default: Some(crate::od::Value::Unsigned(od.uint(0x1017, 0))),
+                    ..Default::default()
+                };
                 let layer = Profile {
-                    name: "demo".into(),
+                    // Named after the profile the drive is modelled on (the Nodes pane
+                    // shows it); `cli::bind::bindings_on` renames it to the bound one.
+                    name: d.dictionary().into(),
                     rpdo: read(0x1400, 0x1600),
                     tpdo: read(0x1800, 0x1A00),
+                    objects: BTreeMap::from([((0x1017, 0), heartbeat)]),
                     ..Profile::default()
                 };
                 (d.node(), layer)

@@ -297,3 +297,37 @@ fn listen_only_cannot_read_or_map_and_bad_lines_are_refused() {
     assert_eq!(rc, 1);
     assert!(err.contains("--count does not go with `pdo map`"), "{err}");
 }
+
+/// Issue 24 item 6: after `pdo 2 map tpdo1 0x6041 --type sync:2` the demo drive sends
+/// TPDO1 on every second SYNC only, as the transmission type says.
+#[tokio::test(start_paused = true)]
+async fn a_tpdo_mapped_sync_2_comes_on_every_second_sync() {
+    let d = Demo::spawn(Simulation::demo(), false);
+    let b = bindings();
+    execute(&d.bus, &parse_command("nmt start 2 --wait").unwrap(), &b)
+        .await
+        .unwrap();
+    let map = parse_command("pdo 2 map tpdo1 0x6041 --type sync:2").unwrap();
+    let o = execute(&d.bus, &map, &b).await.unwrap();
+    assert_eq!(o.json["verified"], true, "{}", o.json);
+    let mut watch = d.bus.subscribe();
+    tokio::time::sleep(Duration::from_millis(1_050)).await;
+    let mut seen = String::new();
+    while let Some(Ok(f)) = watch.try_recv() {
+        match f.id {
+            0x080 => seen.push('S'),
+            0x182 => {
+                assert_eq!(f.len, 2, "only the statusword is mapped now");
+                seen.push('T');
+            }
+            _ => {}
+        }
+    }
+    // SYNC every 100 ms: ten in the second, TPDO1 after every other one.
+    let gaps: Vec<usize> = seen.split('T').skip(1).map(str::len).collect();
+    assert!(seen.matches('T').count() >= 4, "{seen}");
+    assert!(
+        gaps[..gaps.len() - 1].iter().all(|g| *g == 2),
+        "TPDO1 (T) after every second SYNC (S): {seen}"
+    );
+}

@@ -73,13 +73,13 @@ fn objects_pane_reads_an_object_of_a_demo_drive_and_prefills_its_write() {
     key(&mut a, KeyCode::Char('6'));
     // Node 2 (the Nodes selection may be another node: `]` picks the next one).
     for _ in 0..4 {
-        if screen(&mut a).contains("Objects · node 2 demo > aimotor") {
+        if screen(&mut a).contains("Objects · node 2 aimotor > cia402") {
             break;
         }
         key(&mut a, KeyCode::Char(']'));
     }
     let s = screen(&mut a);
-    assert!(s.contains("Objects · node 2 demo > aimotor"), "{s}");
+    assert!(s.contains("Objects · node 2 aimotor > cia402"), "{s}");
     key(&mut a, KeyCode::Char('/'));
     typed(&mut a, "6060");
     key(&mut a, KeyCode::Enter);
@@ -187,7 +187,7 @@ fn read_all_reads_what_drive_2_has_with_progress_and_lists_the_failures() {
     });
     key(&mut a, KeyCode::Char('6'));
     for _ in 0..4 {
-        if screen(&mut a).contains("Objects · node 2 demo > aimotor") {
+        if screen(&mut a).contains("Objects · node 2 aimotor > cia402") {
             break;
         }
         key(&mut a, KeyCode::Char(']'));

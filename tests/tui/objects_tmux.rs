@@ -39,14 +39,16 @@ fn demo_objects_pane_reads_and_writes_an_object() {
     let title = |t: &str| t.lines().nth(1).unwrap_or_default().to_string();
     let mut t = s.wait_for("the Objects pane", |t| t.contains("Objects · node "));
     for _ in 0..4 {
-        if t.contains("Objects · node 2 demo > aimotor") {
+        if t.contains("Objects · node 2 aimotor > cia402") {
             break;
         }
         let before = title(&t);
         s.type_text("]");
         t = s.wait_for("the next node", |t| title(t) != before);
     }
-    s.wait_for("node 2's dictionary", |t| t.contains("Objects · node 2 demo > aimotor"));
+    s.wait_for("node 2's dictionary", |t| {
+        t.contains("Objects · node 2 aimotor > cia402")
+    });
 
     // Find by typing, read with enter: the value and its age show in the row.
     s.type_text("/");

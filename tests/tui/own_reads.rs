@@ -67,7 +67,7 @@ fn own_reads_of_missing_objects_do_not_hide_a_drive_fault_and_a_lost_node() {
     });
     key(&mut a, KeyCode::Char('6'));
     for _ in 0..4 {
-        if screen_at(&mut a, 160, 40).contains("Objects · node 2 demo > aimotor") {
+        if screen_at(&mut a, 160, 40).contains("Objects · node 2 aimotor > cia402") {
             break;
         }
         key(&mut a, KeyCode::Char(']'));

@@ -663,3 +663,53 @@ fn dcf_load_confirmation_at_160_columns_shows_the_key_and_all_of_the_reason() {
     assert!(question.contains("stores (0x1010:01)"), "{s}");
     assert!(!question.contains('…'), "nothing cut: {s}");
 }
+
+/// The demo's own bindings come from `cli::bind` (test code only: `tui` does not use `cli`).
+#[cfg(test)]
+mod demo {
+    use super::{Pane, screen};
+
+    /// Issue 24 item 13: on the demo bus the Nodes pane names the profile each drive is bound
+    /// to (not the simulator's layer, `demo`) and shows the heartbeat period the device's
+    /// dictionary gives as default before anyone has read 0x1017.
+    #[test]
+    fn nodes_pane_on_the_demo_shows_the_bound_profiles_and_the_default_heartbeat() {
+        use crate::analysis::trace::Trace;
+        use crate::decode::Decoder;
+        use crate::tui::app::{App, SourceInfo, SourceKind};
+        let bindings = crate::cli::bind::bindings_on(crate::connect::DEMO, &[], &[]).unwrap();
+        let mut trace = Trace::new(Decoder::from_bindings(&bindings), 500_000);
+        trace.ifaces.intern("can0");
+        let base = 1_700_000_000_000_000_000u64;
+        let mut sim = crate::sim::Simulation::demo();
+        let mut push = |frames: Vec<crate::frame::Frame>, now: u64| {
+            for mut f in frames {
+                f.ts_ns = base + now;
+                trace.push(&f);
+            }
+        };
+        let boot = sim.power_on(0);
+        push(sim.settle(boot, 0), 0);
+        for k in 1..=120u64 {
+            let now = k * 10_000_000;
+            let out = sim.tick(now);
+            push(sim.settle(out, now), now);
+        }
+        let (_tx, rx) = std::sync::mpsc::channel();
+        let mut src = SourceInfo::new("sim.log", SourceKind::Open, rx, None);
+        src.done = true;
+        let mut a = App::new(trace, crate::tui::keymap::Keymap::default_map(), src);
+        a.focus = Pane::Nodes;
+        let s = screen(&mut a, 200, 14);
+        let row = |node: &str| {
+            s.lines()
+                .find(|l| l.contains(&format!("┃  {node} Operational")))
+                .unwrap_or_else(|| panic!("no row for node {node}: {s}"))
+                .to_string()
+        };
+        let (two, three) = (row("2"), row("3"));
+        assert!(two.contains(" 500/500 ms ") && two.contains(" aimotor "), "{s}");
+        assert!(three.contains(" 500/500 ms ") && three.contains(" syntron-ds "), "{s}");
+        assert!(!s.contains(" demo "), "{s}");
+    }
+}
