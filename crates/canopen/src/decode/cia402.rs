@@ -60,7 +60,7 @@ impl DriveState {
 }
 
 /// Does a statusword bit pattern match one of the defined states exactly?
-pub fn statusword_is_valid(sw: u16) -> bool {
+pub(crate) fn statusword_is_valid(sw: u16) -> bool {
     matches!(sw & 0x4F, 0x00 | 0x40 | 0x0F | 0x08) || matches!(sw & 0x6F, 0x21 | 0x23 | 0x27 | 0x07)
 }
 
@@ -86,7 +86,7 @@ const STATUS_BITS: [&str; 16] = [
 
 /// The profile's texts for a controlword or statusword (`values` for whole words,
 /// `bits` for single bits); `None` when the dictionary has no entry.
-pub type WordTexts<'a> = Option<&'a ObjectInfo>;
+pub(crate) type WordTexts<'a> = Option<&'a ObjectInfo>;
 
 /// Names of statusword bits 10, 12 and 13 in a mode of operation (CiA 402-2), `None`
 /// when the mode is unknown.
@@ -131,7 +131,7 @@ fn profile_bit(texts: WordTexts<'_>, bit: u8, fallback: &str) -> String {
 /// Names of the statusword bits that are set, in bit order: bits 10/12/13 per the mode in
 /// force, else the profile's bit names, else `mode bit N`. In the cyclic synchronous modes an
 /// enabled drive with bit 12 clear also shows `target ignored`.
-pub fn statusword_bits(sw: u16, mode: Option<i8>, texts: WordTexts<'_>) -> Vec<String> {
+pub(crate) fn statusword_bits(sw: u16, mode: Option<i8>, texts: WordTexts<'_>) -> Vec<String> {
     let m = status_mode_bits(mode);
     let mut out: Vec<String> = (0..16u8)
         .filter(|b| sw & (1 << b) != 0)
@@ -168,7 +168,7 @@ pub fn describe_statusword(sw: u16, mode: Option<i8>, texts: WordTexts<'_>) -> S
 }
 
 /// The device control command a controlword encodes (CiA 402 table 29).
-pub fn controlword_command(cw: u16) -> &'static str {
+pub(crate) fn controlword_command(cw: u16) -> &'static str {
     if cw & 0x80 != 0 {
         "Fault reset"
     } else if cw & 0x02 == 0 {

@@ -29,14 +29,14 @@ impl Route {
 
 /// COB-ID key: 11- or 29-bit id plus the extended flag.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct CobId {
+pub(crate) struct CobId {
     pub id: u32,
     pub ext: bool,
 }
 
 /// The classification table: predefined set plus overrides.
 #[derive(Clone, Debug, Default)]
-pub struct CobTable {
+pub(crate) struct CobTable {
     moved: HashMap<CobId, Route>,
 }
 
@@ -68,11 +68,6 @@ impl CobTable {
             return Route::new(Kind::Other, None, 0);
         }
         predefined(id)
-    }
-
-    /// Every moved COB-ID, for the detail pane and `--summary`.
-    pub fn moved(&self) -> impl Iterator<Item = (&CobId, &Route)> {
-        self.moved.iter()
     }
 }
 
@@ -123,7 +118,7 @@ pub fn predefined(id: u32) -> Route {
 }
 
 /// CiA 301 reserved COB-IDs (CiA 301 7.3.5, table 65 and CiA 305 for LSS).
-pub fn is_reserved(id: u32) -> bool {
+pub(crate) fn is_reserved(id: u32) -> bool {
     matches!(id, 0x001..=0x07F | 0x101..=0x180 | 0x580 | 0x600 | 0x6E0..=0x6FF | 0x700 | 0x780..=0x7FF)
         && !matches!(id, 0x7E4 | 0x7E5)
 }

@@ -79,7 +79,7 @@ pub fn transmission_type(t: u32) -> String {
 }
 
 /// A PDO transmission type in words: `synchronous, every 5 SYNCs`, `event-driven (device profile)`.
-pub fn transmission_words(t: u32) -> String {
+pub(crate) fn transmission_words(t: u32) -> String {
     match t {
         0 => "synchronous, acyclic".to_string(),
         1 => "synchronous, every SYNC".to_string(),

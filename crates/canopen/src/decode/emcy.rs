@@ -23,7 +23,7 @@ pub struct Emcy {
 }
 
 /// Names of the error register bits 0..7 (CiA 301 7.5.2.2).
-pub const REGISTER_BITS: [&str; 8] = [
+pub(crate) const REGISTER_BITS: [&str; 8] = [
     "generic",
     "current",
     "voltage",
@@ -117,7 +117,7 @@ pub fn decode(payload: &[u8], dict: &Dictionary) -> (Emcy, Option<String>) {
 }
 
 /// Text of a standard emergency code: exact CiA 301/402 code first, then its class.
-pub fn code_text(code: u16) -> &'static str {
+pub(crate) fn code_text(code: u16) -> &'static str {
     if let Ok(i) = EXACT.binary_search_by_key(&code, |(c, _)| *c) {
         return EXACT[i].1;
     }

@@ -152,7 +152,7 @@ fn extract_bits(data: &[u8], start: usize, bits: usize) -> u64 {
 
 /// Signals of `payload` through `mapping`; the second value explains a length mismatch.
 /// `mode` is the node's mode of operation, for CiA 402 bit names.
-pub fn decode_signals(
+pub(crate) fn decode_signals(
     payload: &[u8],
     mapping: &PdoMapping,
     dict: &Dictionary,
@@ -178,7 +178,7 @@ pub fn decode_signals(
 
 /// The values of the signals of `payload` through `mapping`, as [`decode_signals`] takes
 /// them, without names or texts (both left empty): for callers that keep numbers.
-pub fn decode_values(payload: &[u8], mapping: &PdoMapping, dict: &Dictionary) -> Vec<Signal> {
+pub(crate) fn decode_values(payload: &[u8], mapping: &PdoMapping, dict: &Dictionary) -> Vec<Signal> {
     let mut signals = Vec::with_capacity(mapping.entries.len());
     for_each_mapped(payload, mapping, |pos, e| {
         signals.push(Signal {

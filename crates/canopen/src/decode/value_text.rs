@@ -12,7 +12,7 @@ pub fn object_text(dict: &Dictionary, index: u16, sub: u8, value: &Value, mode: 
 
 /// [`object_text`] for a caller that has looked up the object's entry, `info`
 /// (`dict.object(index, sub)`), already: one dictionary lookup instead of three.
-pub fn object_text_of(
+pub(crate) fn object_text_of(
     dict: &Dictionary,
     info: Option<&ObjectInfo>,
     index: u16,

@@ -21,7 +21,7 @@ pub fn upper(bytes: &[u8]) -> String {
 }
 
 /// Appends upper-case hex without separators.
-pub fn push_upper(out: &mut String, bytes: &[u8]) {
+pub(crate) fn push_upper(out: &mut String, bytes: &[u8]) {
     for chunk in bytes.chunks(64) {
         let mut buf = [0u8; 128];
         for (i, b) in chunk.iter().enumerate() {

@@ -269,7 +269,7 @@ impl Stacked {
 }
 
 /// Appends `v` in decimal, with a minus sign when negative.
-pub fn push_i64(out: &mut Vec<u8>, v: i64) {
+pub(crate) fn push_i64(out: &mut Vec<u8>, v: i64) {
     if v < 0 {
         out.push(b'-');
     }

@@ -143,7 +143,7 @@ impl Counts {
 /// Guesses the format from the first non-empty lines of `sample` (e.g. the reader's first
 /// buffer). Comments, `DROPCOUNT` lines and blank lines are passed over; `None` when no
 /// line decides.
-pub fn detect(sample: &[u8]) -> Option<Format> {
+pub(crate) fn detect(sample: &[u8]) -> Option<Format> {
     sample.split(|&b| b == b'\n').take(64).find_map(detect_line)
 }
 
@@ -189,7 +189,7 @@ enum Parser {
 
 /// The longest line a reader takes: a longer one (e.g. a file with no line ends) is
 /// skipped with a warning, so no input can exhaust memory.
-pub const MAX_LINE: usize = 1 << 20;
+pub(crate) const MAX_LINE: usize = 1 << 20;
 
 /// Streams a log line by line, yielding `(line_number, Outcome)` for every line.
 ///

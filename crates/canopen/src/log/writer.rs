@@ -25,7 +25,7 @@ use crate::frame::{Flags, Frame};
 const DIGITS: &[u8; 16] = b"0123456789ABCDEF";
 
 /// Longest compact frame: 8-digit id, `##`, flags, 64 bytes.
-pub const COMPACT_MAX: usize = 8 + 2 + 1 + 128 + 2;
+pub(crate) const COMPACT_MAX: usize = 8 + 2 + 1 + 128 + 2;
 
 /// Timestamp style of the log, as chosen on candump's command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -192,7 +192,7 @@ impl RangeBound {
 }
 
 /// Bit-check value of a fastscan request that resets every slave's scan position.
-pub const FASTSCAN_RESET: u8 = 0x80;
+pub(crate) const FASTSCAN_RESET: u8 = 0x80;
 
 fn frame(cs: u8, args: &[u8]) -> [u8; 8] {
     let mut b = [0u8; 8];
@@ -316,7 +316,7 @@ impl Response {
 }
 
 /// What a configure service's error code means (CiA 305 for each service).
-pub fn configure_error_text(cs: u8, error: u8, spec: u8) -> String {
+pub(crate) fn configure_error_text(cs: u8, error: u8, spec: u8) -> String {
     match (cs, error) {
         (_, 0) => "success".into(),
         (0x11, 1) => "node-ID out of range (1..127 or 255)".into(),

@@ -167,7 +167,7 @@ fn match_pieces(pieces: &[Piece], text: &[char]) -> Option<Vec<(String, i64)>> {
 }
 
 /// Parses an index form: `0x6041`, `0x1018:1`, `0x1018:0x01`, `0x1018sub1`, `6041h`, `1018h:01h`.
-pub fn parse_object_ref(text: &str) -> Option<(u16, u8)> {
+pub(crate) fn parse_object_ref(text: &str) -> Option<(u16, u8)> {
     let t = text.trim();
     let lower = t.to_ascii_lowercase();
     let (idx, sub) = if let Some((a, b)) = lower.split_once(':') {

@@ -5,7 +5,7 @@ use super::Profile;
 
 /// A set of object indexes (0x0000..=0xFFFF).
 #[derive(Clone, Debug)]
-pub struct IndexSet {
+pub(crate) struct IndexSet {
     bits: Box<[u64]>,
 }
 

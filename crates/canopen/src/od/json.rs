@@ -25,7 +25,7 @@ use super::{
 };
 
 /// The newest profile format this loader knows.
-pub const FORMAT_VERSION: u64 = 1;
+pub(crate) const FORMAT_VERSION: u64 = 1;
 
 /// A profile that could not be loaded at all.
 #[derive(Clone, Debug, PartialEq, Eq)]

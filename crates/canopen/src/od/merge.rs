@@ -9,7 +9,7 @@ use std::sync::Arc;
 
 /// `top` with each entry completed from `lower` (first layer first); `None` when no
 /// entry gains anything, so the caller keeps sharing the original.
-pub fn enriched(top: &Profile, lower: &[Arc<Profile>]) -> Option<Profile> {
+pub(crate) fn enriched(top: &Profile, lower: &[Arc<Profile>]) -> Option<Profile> {
     let mut out: Option<Profile> = None;
     for ((index, sub), info) in top.entries() {
         let mut merged = info.clone();

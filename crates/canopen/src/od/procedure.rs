@@ -103,7 +103,7 @@ fn object_pieces(text: &str) -> Result<Vec<Result<&str, Expr>>, ProcedureError> 
 }
 
 /// Checks the `{EXPR}` placeholders of a step's object text; gives the variables they use.
-pub fn object_variables(text: &str) -> Result<Vec<String>, ProcedureError> {
+pub(crate) fn object_variables(text: &str) -> Result<Vec<String>, ProcedureError> {
     Ok(object_pieces(text)?
         .into_iter()
         .filter_map(Result::err)

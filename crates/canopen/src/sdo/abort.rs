@@ -1,12 +1,12 @@
 //! SDO abort codes (CiA 301, table "SDO abort codes") and their texts.
 
 /// Text used for codes CiA 301 does not define.
-pub const UNKNOWN_ABORT_TEXT: &str = "unknown abort code";
+pub(crate) const UNKNOWN_ABORT_TEXT: &str = "unknown abort code";
 
 /// Every abort code CiA 301 defines, with its text as the standard words it, grammar
 /// included ("an hardware error"). The standard's trailing full stops are left out so
 /// texts end cleanly in labels.
-pub const ABORT_CODES: &[(u32, &str)] = &[
+pub(crate) const ABORT_CODES: &[(u32, &str)] = &[
     (0x0503_0000, "Toggle bit not alternated"),
     (0x0504_0000, "SDO protocol timed out"),
     (0x0504_0001, "Client/server command specifier not valid or unknown"),

@@ -61,7 +61,7 @@ impl Default for ClientConfig {
 }
 
 /// The default [`ClientConfig::max_size`]: 16 MiB.
-pub const DEFAULT_MAX_SIZE: usize = 16 << 20;
+pub(crate) const DEFAULT_MAX_SIZE: usize = 16 << 20;
 /// The default overall deadline is at least this long (10 s)...
 const MIN_DEADLINE_NS: u64 = 10_000_000_000;
 /// ...and at least this many per-answer timeouts...

@@ -508,7 +508,7 @@ pub fn parse(side: Side, frame: &[u8; 8], block_segments: bool) -> Result<SdoCom
 /// Whether `byte` is a command byte CiA 301 allows `side` to send, with every reserved
 /// bit zero (in an initiate, `n` is zero unless both `e` and `s` are set);
 /// `0xE0..=0xFF` (no command specifier 7) is left to the unknown-command handling.
-pub fn command_allowed(side: Side, byte: u8) -> bool {
+pub(crate) fn command_allowed(side: Side, byte: u8) -> bool {
     let initiate = |b: u8| b & 0x03 == 0x03 || b & 0x0C == 0;
     match (side, byte) {
         (_, 0x00..=0x1F) | (_, 0x80) | (_, 0xE0..=0xFF) => true,
@@ -525,7 +525,7 @@ pub fn command_allowed(side: Side, byte: u8) -> bool {
 }
 
 /// An end-of-block command byte (`110 n n n x 1`, either side).
-pub fn end_command(byte: u8) -> bool {
+pub(crate) fn end_command(byte: u8) -> bool {
     byte & 0xE3 == BLOCK_END
 }
 

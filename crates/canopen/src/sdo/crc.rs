@@ -2,7 +2,7 @@
 //! initial value 0, no reflection, no final XOR (a.k.a. CRC-16/XMODEM).
 
 /// Continues a CRC over more bytes (start with 0).
-pub fn crc16_update(mut crc: u16, bytes: &[u8]) -> u16 {
+pub(crate) fn crc16_update(mut crc: u16, bytes: &[u8]) -> u16 {
     for &b in bytes {
         crc ^= (b as u16) << 8;
         for _ in 0..8 {
@@ -17,7 +17,7 @@ pub fn crc16_update(mut crc: u16, bytes: &[u8]) -> u16 {
 }
 
 /// The CRC of a whole transfer.
-pub fn crc16(bytes: &[u8]) -> u16 {
+pub(crate) fn crc16(bytes: &[u8]) -> u16 {
     crc16_update(0, bytes)
 }
 

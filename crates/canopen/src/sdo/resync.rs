@@ -12,7 +12,7 @@
 use super::codec::{Chunk, Side, command_allowed};
 
 /// A frame that no command explains: the first byte is `c | seqno` with seqno 1..=127.
-pub fn impossible_command(side: Side, payload: &[u8]) -> bool {
+pub(crate) fn impossible_command(side: Side, payload: &[u8]) -> bool {
     match payload {
         [first, ..] if payload.len() == 8 => first & 0x7F != 0 && !command_allowed(side, *first),
         _ => false,
@@ -21,7 +21,7 @@ pub fn impossible_command(side: Side, payload: &[u8]) -> bool {
 
 /// The last frame of a channel that fitted no transfer, kept to spot a run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Orphan {
+pub(crate) struct Orphan {
     /// Who sent it.
     pub side: Side,
     /// Its first byte.

@@ -208,10 +208,10 @@ pub struct Transaction {
 
 /// Bytes of one transfer kept in [`Transaction::data`]; a longer transfer (a firmware
 /// download, or a transfer that never ends) is counted, not kept, so memory stays flat.
-pub const DATA_KEPT: usize = 1 << 20;
+pub(crate) const DATA_KEPT: usize = 1 << 20;
 
 /// Frame numbers of one transfer kept in [`Transaction::frames`].
-pub const FRAMES_KEPT: usize = 1 << 14;
+pub(crate) const FRAMES_KEPT: usize = 1 << 14;
 
 impl Transaction {
     /// The server as a node of its interface.

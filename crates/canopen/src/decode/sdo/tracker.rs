@@ -81,7 +81,7 @@ impl SdoTracker {
 
 /// The frame as [`SdoTracker::track`] saw it: command, object and problems, without the
 /// object's name or value (for callers that read only those, like the diagnosis).
-pub fn unlabelled(tracked: Tracked, payload: &[u8]) -> SdoFrame {
+pub(crate) fn unlabelled(tracked: Tracked, payload: &[u8]) -> SdoFrame {
     let mut frame = SdoFrame::of(tracked.side, payload, tracked.command);
     frame.object = tracked.object;
     frame.problems = tracked.problems;
@@ -90,7 +90,7 @@ pub fn unlabelled(tracked: Tracked, payload: &[u8]) -> SdoFrame {
 
 /// The frame as [`SdoTracker::track`] saw it, with the object's name and, for expedited
 /// data, its typed value.
-pub fn labelled(tracked: Tracked, payload: &[u8], dict: &Dictionary) -> SdoFrame {
+pub(crate) fn labelled(tracked: Tracked, payload: &[u8], dict: &Dictionary) -> SdoFrame {
     let mut frame = unlabelled(tracked, payload);
     if let Some((index, sub)) = frame.object {
         frame.name = dict.label_name(index, sub);

@@ -22,7 +22,7 @@ pub struct ValueView {
 }
 
 /// Little-endian unsigned integer of 1-4 bytes.
-pub fn le_uint(bytes: &[u8]) -> Option<u32> {
+pub(crate) fn le_uint(bytes: &[u8]) -> Option<u32> {
     if bytes.is_empty() || bytes.len() > 4 {
         return None;
     }
@@ -35,7 +35,7 @@ pub fn view(dict: &Dictionary, index: u16, sub: u8, bytes: &[u8]) -> ValueView {
 }
 
 /// [`view`] with the node's mode of operation, which names controlword/statusword bits.
-pub fn view_in_mode(dict: &Dictionary, index: u16, sub: u8, bytes: &[u8], mode: Option<i8>) -> ValueView {
+pub(crate) fn view_in_mode(dict: &Dictionary, index: u16, sub: u8, bytes: &[u8], mode: Option<i8>) -> ValueView {
     if let Some(info) = dict.object(index, sub) {
         let size = info.data_type.size();
         let take = size.map_or(bytes.len(), |n| n.min(bytes.len()));
@@ -71,7 +71,7 @@ pub fn view_in_mode(dict: &Dictionary, index: u16, sub: u8, bytes: &[u8], mode: 
 }
 
 /// Segment bytes for a label: quoted text when all printable ASCII, else spaced hex.
-pub fn segment_text(bytes: &[u8]) -> String {
+pub(crate) fn segment_text(bytes: &[u8]) -> String {
     if !bytes.is_empty() && bytes.iter().all(|b| (0x20..0x7F).contains(b)) {
         format!("\"{}\"", bytes.iter().map(|b| *b as char).collect::<String>())
     } else {
