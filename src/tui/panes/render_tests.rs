@@ -118,6 +118,24 @@ fn nodes_pane_shows_node_5_of_each_interface_with_its_interface() {
 }
 
 #[test]
+fn sdo_pane_names_the_interface_of_each_transfer_when_there_are_several() {
+    let mut a = two_bus_app();
+    a.trace.end_of_input();
+    a.focus = Pane::Sdo;
+    let s = screen(&mut a, 160, 14);
+    assert!(s.contains("iface       time  nd"), "{s}");
+    // The request on can0 is never answered there: its "answer" came on can1.
+    let row = |iface: &str| {
+        s.lines()
+            .find(|l| l.contains(&format!("┃{iface} ")) && l.contains("6041:00"))
+            .unwrap_or_else(|| panic!("no 6041 row on {iface}: {s}"))
+            .to_string()
+    };
+    assert!(row("can0").contains("incomplete"), "{s}");
+    assert!(row("can1").contains(" ok"), "{s}");
+}
+
+#[test]
 fn sdo_pane_lists_transfers_and_expands_to_frames() {
     let mut a = app();
     a.focus = Pane::Sdo;

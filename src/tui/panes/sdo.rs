@@ -24,8 +24,30 @@ pub fn widths(width: usize) -> (usize, usize) {
     (name, avail.saturating_sub(name + 20).max(20))
 }
 
+/// Width of the interface column: shown only when the capture has several interfaces,
+/// so that node 5 of can0 and node 5 of can1 tell apart (0 otherwise).
+fn iface_width(trace: &Trace) -> usize {
+    let names = trace.ifaces.names();
+    if names.len() > 1 {
+        names.iter().map(|n| n.chars().count()).max().unwrap_or(0).min(12) + 1
+    } else {
+        0
+    }
+}
+
 /// One transfer as a table row.
 pub fn row_text(trace: &Trace, t: &Transaction, width: usize) -> String {
+    let iw = iface_width(trace);
+    if iw > 0 {
+        let iface = fit(trace.ifaces.name(t.iface), iw - 1);
+        let rest = row_columns(trace, t, width.saturating_sub(iw));
+        return fit(&format!("{iface:<w$} {rest}", w = iw - 1), width);
+    }
+    row_columns(trace, t, width)
+}
+
+/// The columns of a row after the interface.
+fn row_columns(trace: &Trace, t: &Transaction, width: usize) -> String {
     let dict = trace.decoder().dictionary(t.node);
     let name = dict.name(t.index, t.sub).unwrap_or("");
     let value = if t.outcome == Outcome::Ok && !t.data.is_empty() && !t.is_partial() {
@@ -250,11 +272,17 @@ impl SdoPane {
         if inner.height == 0 {
             return;
         }
-        let (nw, vw) = widths(inner.width as usize);
+        let iw = iface_width(trace);
+        let (nw, vw) = widths((inner.width as usize).saturating_sub(iw));
+        let iface = if iw > 0 {
+            format!("{:<w$} ", "iface", w = iw - 1)
+        } else {
+            String::new()
+        };
         let mut lines = vec![Line::styled(
             fit(
                 &format!(
-                    "{:>TIME$} {:>3} {} {:<7} {:<nw$} {:<vw$} {:>9} outcome",
+                    "{iface}{:>TIME$} {:>3} {} {:<7} {:<nw$} {:<vw$} {:>9} outcome",
                     "time", "nd", "dir  ", "object", "name", "value", "duration"
                 ),
                 inner.width as usize,
