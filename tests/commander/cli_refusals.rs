@@ -65,7 +65,7 @@ fn reserved_cob_ids_are_refused_with_their_owner() {
 fn a_mapping_length_other_than_the_objects_type_is_refused() {
     refused_cli(
         &["pdo", "demo", "2", "map", "tpdo1", "0x6041/8"],
-        "0x6041:00 Statusword cannot be mapped into TPDO1: 8 bits given, but the node's dictionary (demo) types it U16, 16 bits",
+        "0x6041:00 Statusword cannot be mapped into TPDO1: 8 bits given, but the node's dictionary (aimotor) types it U16, 16 bits",
     );
     refused_cli(&["pdo", "demo", "2", "map", "tpdo1", "0x6041/32"], "32 bits given");
     let (rc, out, err) = cotui(&["pdo", "demo", "2", "map", "tpdo1", "0x6041/16", "--dry-run"]);

@@ -85,6 +85,12 @@ impl Session {
         }
     }
 
+    /// Sends `keys` in one `send-keys`, so they reach the program in one read (as a fast
+    /// typist's keys do): what it does with the first cannot delay the second.
+    pub fn keys_together(&self, keys: &[&str]) {
+        self.send(keys);
+    }
+
     /// Sends `text` as typed, key names not interpreted (`send-keys -l`).
     pub fn type_text(&self, text: &str) {
         self.send(&["-l", text]);
