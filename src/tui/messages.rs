@@ -182,11 +182,18 @@ mod tests {
 
     #[test]
     fn long_lines_wrap_between_words_and_long_words_are_cut() {
-        assert_eq!(wrap("will send: 602#2F00 1A 00 00", 12), ["will send:", "602#2F00 1A", "00 00"]);
+        assert_eq!(
+            wrap("will send: 602#2F00 1A 00 00", 12),
+            ["will send:", "602#2F00 1A", "00 00"]
+        );
         assert_eq!(wrap("  node 2", 20), ["  node 2"]);
         assert_eq!(wrap("0123456789abc", 5), ["01234", "56789", "abc"]);
         assert_eq!(wrap("", 5), [""]);
-        let e = Entry { at: SystemTime::UNIX_EPOCH, level: Level::Info, text: "a b c d".into() };
+        let e = Entry {
+            at: SystemTime::UNIX_EPOCH,
+            level: Level::Info,
+            text: "a b c d".into(),
+        };
         let w = e.wrapped(LEAD + 8);
         assert_eq!(w.len(), 1);
         assert!(w[0].ends_with("  a b c d"));

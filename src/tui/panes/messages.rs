@@ -164,15 +164,18 @@ impl MessagesPopup {
             }
         );
         let Some(sel) = self.index(log) else {
-            let body = Paragraph::new(
-                "no messages yet: command results, node and bus events appear here",
-            );
+            let body = Paragraph::new("no messages yet: command results, node and bus events appear here");
             f.render_widget(body.block(block(" Messages (0) — esc closes ", true)), r);
             return;
         };
         if let (Some(down), Some(e)) = (self.whole, log.get(sel)) {
             let mut lines = vec![Line::styled(
-                format!("{} (entry {} of {})", crate::tui::messages::clock(e.at), sel + 1, log.len()),
+                format!(
+                    "{} (entry {} of {})",
+                    crate::tui::messages::clock(e.at),
+                    sel + 1,
+                    log.len()
+                ),
                 Style::default().add_modifier(Modifier::BOLD),
             )];
             let style = Style::default().fg(color(e.level));

@@ -49,7 +49,10 @@ fn nodes_pane_marks_a_silent_node_lost_in_red_with_its_age() {
     a.trace.push(&f);
     let s = screen(&mut a, 160, 14);
     assert!(s.contains("  1 Operational       14/100 ms"), "{s}");
-    assert!(s.contains("  2 LOST 0.1 s          14/? ms  103.0 ms    1    1 -"), "{s}");
+    assert!(
+        s.contains("  2 LOST 0.1 s          14/? ms  103.0 ms    1    1 -"),
+        "{s}"
+    );
     // At 160 columns the profile shows; the frame rate gives way first.
     assert!(s.contains("last emcy      profile"), "{s}");
     assert!(!s.lines().nth(2).unwrap_or("").contains("fr/s"), "{s}");
@@ -750,7 +753,14 @@ fn message_log_at_80x24_wraps_long_entries_scrolls_to_the_oldest_and_shows_one_w
     // (The popup's text starts at column 5, after the time stamp column, 14 wide.)
     let joined: String = s
         .lines()
-        .map(|l| l.chars().skip(5 + 14).take(70 - 14).collect::<String>().trim().to_string())
+        .map(|l| {
+            l.chars()
+                .skip(5 + 14)
+                .take(70 - 14)
+                .collect::<String>()
+                .trim()
+                .to_string()
+        })
         .collect::<Vec<_>>()
         .join(" ");
     assert!(joined.contains("(node 2 must be pre-operational)"), "{s}");
@@ -772,7 +782,8 @@ fn message_log_at_80x24_wraps_long_entries_scrolls_to_the_oldest_and_shows_one_w
     // Enter shows the selected entry whole, even one taller than the popup.
     a.act(Action::Bottom);
     let scan: String = (1..=40).map(|n| format!("node {n}: 0x{n:08X}\n")).collect();
-    a.messages.push(t, Level::Info, &format!("lss fastscan: 40 found\n{scan}"));
+    a.messages
+        .push(t, Level::Info, &format!("lss fastscan: 40 found\n{scan}"));
     a.act(Action::Expand);
     let s = screen(&mut a, 80, 24);
     assert!(s.contains("lss fastscan: 40 found"), "{s}");
@@ -782,4 +793,32 @@ fn message_log_at_80x24_wraps_long_entries_scrolls_to_the_oldest_and_shows_one_w
     assert!(s.contains("node 40: 0x00000028"), "{s}");
     a.act(Action::Back);
     assert!(a.log_popup.shown && a.log_popup.whole.is_none());
+}
+
+#[test]
+fn every_pane_at_80x24() {
+    // What a bench reads first must be on each 80x24 screen.
+    let wants: [(Pane, &[&str]); 8] = [
+        (Pane::Trace, &["Heartbeat node 2: Pre-operational", "| help: ?"]),
+        (
+            Pane::Nodes,
+            &["hb meas/cfg", "hb age", "miss", "14/100 ms", "Pre-operational"],
+        ),
+        (Pane::Sdo, &["1017:00", "64 00 (100)", "ok", "abort 06020000"]),
+        (Pane::Stats, &["701"]),
+        (Pane::Plot, &[]),
+        (Pane::Objects, &[]),
+        (Pane::Pdo, &[]),
+        (Pane::Problems, &[]),
+    ];
+    for (pane, want) in wants {
+        let mut a = app();
+        a.focus = pane;
+        let s = screen(&mut a, 80, 24);
+        for w in want {
+            assert!(s.contains(w), "{pane:?}: {w}\n{s}");
+        }
+        assert!(s.lines().nth(22).unwrap_or("").ends_with("help: ?"), "{pane:?}\n{s}");
+        insta::assert_snapshot!(format!("pane_{pane:?}_80x24").to_lowercase(), s);
+    }
 }

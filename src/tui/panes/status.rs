@@ -207,7 +207,11 @@ pub fn fit_bar(bar: &str, path: &str, width: usize) -> String {
         body = super::fit(&body, room);
     }
     let out = format!("{body}{hints}");
-    if len(&out) > width { super::fit(&out, width) } else { out }
+    if len(&out) > width {
+        super::fit(&out, width)
+    } else {
+        out
+    }
 }
 
 /// Draws the status bar and, below it, the prompt or the last message.

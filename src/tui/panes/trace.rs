@@ -175,9 +175,15 @@ impl Component for TracePane {
         }
         let head = Rect { height: 1, ..inner };
         let heading = if compact(inner.width) {
-            format!("{:>9} {:<4} {:<6} {:>3} {:<16} label", "time", "cob", "kind", "nd", "data")
+            format!(
+                "{:>9} {:<4} {:<6} {:>3} {:<16} label",
+                "time", "cob", "kind", "nd", "data"
+            )
         } else {
-            format!("{:>12} {:<9} {:<9} {:>3} {:<23} label", "time", "cob-id", "kind", "nd", "data")
+            format!(
+                "{:>12} {:<9} {:<9} {:>3} {:<23} label",
+                "time", "cob-id", "kind", "nd", "data"
+            )
         };
         f.render_widget(Paragraph::new(Line::styled(heading, header())), head);
         let (rows, strip) = self.split(ctx.trace, area);
