@@ -186,14 +186,15 @@ pub fn fit_bar(bar: &str, path: &str, width: usize) -> String {
     let room = width.saturating_sub(len(hints));
     let mut body = body.to_string();
     let over = len(&body).saturating_sub(room);
-    if over > 0 && !path.is_empty() {
-        if let Some(i) = body.find(path) {
-            // Keep at least the last 16 characters of the path (the file name).
-            let keep = len(path).saturating_sub(over + 1).max(16.min(len(path)));
-            if keep < len(path) {
-                let tail: String = path.chars().skip(len(path) - keep).collect();
-                body.replace_range(i..i + path.len(), &format!("…{tail}"));
-            }
+    if over > 0
+        && !path.is_empty()
+        && let Some(i) = body.find(path)
+    {
+        // Keep at least the last 16 characters of the path (the file name).
+        let keep = len(path).saturating_sub(over + 1).max(16.min(len(path)));
+        if keep < len(path) {
+            let tail: String = path.chars().skip(len(path) - keep).collect();
+            body.replace_range(i..i + path.len(), &format!("…{tail}"));
         }
     }
     // Then whole ` | ` fields from the end (never the source), then a cut.
