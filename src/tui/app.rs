@@ -1365,7 +1365,7 @@ impl App {
     /// takes is for the application.
     pub fn act(&mut self, a: Action) {
         self.dirty = true;
-        if self.log_popup.shown && self.log_popup.handle(a, self.messages.lines().len()) {
+        if self.log_popup.shown && self.log_popup.handle(a, &self.messages) {
             return;
         }
         if self.help.handle(a, &self.keymap) {
@@ -2035,7 +2035,7 @@ mod tests {
         assert!(s.contains("Messages (3)"), "{s}");
         assert!(s.contains("node 3 syntron-ds"), "{s}");
         a.act(Action::Up);
-        assert_eq!(a.log_popup.back, 0, "all lines fit: nothing to scroll");
+        assert_eq!(a.log_popup.selected, Some(1), "up selects the entry before the newest");
         a.act(Action::Back);
         assert!(!a.log_popup.shown);
     }

@@ -61,6 +61,10 @@ impl Messages {
     pub fn is_empty(&self) -> bool {
         self.entries.is_empty()
     }
+    /// The entry at position `i` (0 = oldest kept).
+    pub fn get(&self, i: usize) -> Option<&Entry> {
+        self.entries.get(i)
+    }
     /// The log as display lines: `HH:MM:SS.mmm  text`, continuation lines indented.
     pub fn lines(&self) -> Vec<(Level, String)> {
         let mut out = Vec::new();
@@ -73,6 +77,67 @@ impl Messages {
         }
         out
     }
+}
+
+/// Width of the time stamp and the gap after it that starts every log line.
+pub const LEAD: usize = 14;
+
+impl Entry {
+    /// The entry as display lines `width` characters wide: the time stamp on the first,
+    /// continuation lines indented under the text, long lines wrapped by words.
+    pub fn wrapped(&self, width: usize) -> Vec<String> {
+        let stamp = clock(self.at);
+        let mut out = Vec::new();
+        for l in self.text.lines() {
+            for piece in wrap(l, width.saturating_sub(LEAD).max(8)) {
+                let lead = if out.is_empty() { stamp.as_str() } else { "            " };
+                out.push(format!("{lead}  {piece}"));
+            }
+        }
+        if out.is_empty() {
+            out.push(stamp);
+        }
+        out
+    }
+}
+
+/// `line` broken into pieces of at most `width` characters, between words where it can
+/// (a word longer than `width` is cut); leading spaces are kept on the first piece.
+pub fn wrap(line: &str, width: usize) -> Vec<String> {
+    let width = width.max(1);
+    let mut out = Vec::new();
+    let mut cur = String::new();
+    let mut len = 0;
+    let mut started = false;
+    for word in line.split(' ') {
+        let wl = word.chars().count();
+        if !started {
+            started = true;
+        } else if len + 1 + wl <= width {
+            cur.push(' ');
+            len += 1;
+        } else {
+            out.push(std::mem::take(&mut cur));
+            len = 0;
+            if word.is_empty() {
+                continue;
+            }
+        }
+        let mut rest = word;
+        while len + rest.chars().count() > width {
+            let cut = rest.char_indices().nth(width - len).map_or(rest.len(), |(i, _)| i);
+            cur.push_str(&rest[..cut]);
+            out.push(std::mem::take(&mut cur));
+            len = 0;
+            rest = &rest[cut..];
+        }
+        len += rest.chars().count();
+        cur.push_str(rest);
+    }
+    if !cur.is_empty() || out.is_empty() {
+        out.push(cur);
+    }
+    out
 }
 
 /// The local time of day of `t` as `HH:MM:SS.mmm`.
@@ -113,5 +178,24 @@ mod tests {
         }
         assert_eq!((m.len(), m.dropped), (Messages::CAPACITY, 2));
         assert_eq!(m.iter().next().map(|e| e.text.as_str()), Some("0"));
+    }
+
+    #[test]
+    fn long_lines_wrap_between_words_and_long_words_are_cut() {
+        assert_eq!(
+            wrap("will send: 602#2F00 1A 00 00", 12),
+            ["will send:", "602#2F00 1A", "00 00"]
+        );
+        assert_eq!(wrap("  node 2", 20), ["  node 2"]);
+        assert_eq!(wrap("0123456789abc", 5), ["01234", "56789", "abc"]);
+        assert_eq!(wrap("", 5), [""]);
+        let e = Entry {
+            at: SystemTime::UNIX_EPOCH,
+            level: Level::Info,
+            text: "a b c d".into(),
+        };
+        let w = e.wrapped(LEAD + 8);
+        assert_eq!(w.len(), 1);
+        assert!(w[0].ends_with("  a b c d"));
     }
 }

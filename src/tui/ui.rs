@@ -69,6 +69,7 @@ pub fn draw(f: &mut Frame, app: &mut App) {
     let tail = app.panes.trace.tail_positions(&app.trace, strip);
     app.prepare(app.layout.table.height as usize, rows.height as usize, &tail);
     app.log_popup.page = panes::messages::height(body);
+    app.log_popup.width = panes::messages::width(body);
 
     let app = &*app;
     let ctx = app.ctx();

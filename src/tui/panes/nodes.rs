@@ -47,20 +47,21 @@ fn state_text(live: Option<&NodeLiveness>, now_ns: u64) -> String {
 }
 
 /// The columns: header, width, right-aligned, and the order they give way in on a narrow
-/// pane (0: never; then 1 first). The last EMCY and the profile are cut to fit instead
-/// (to [`FLEX_MIN`]) once the others are placed.
+/// pane (0: never; then 1 first). What a bench reads first stays: the id, the NMT state and
+/// the heartbeat (period, age, misses); the frame rate and the profile go first. The last
+/// EMCY and the profile are cut to fit instead (to [`FLEX_MIN`]) once the others are placed.
 const COLUMNS: [(&str, usize, bool, u8); 11] = [
     ("id", 3, true, 0),
     ("nmt", 15, false, 0),
-    ("hb meas/cfg", 11, true, 4),
-    ("hb age", 9, true, 3),
-    ("miss", 4, true, 2),
-    ("boot", 4, true, 1),
-    ("cia402 state", 22, false, 0),
-    ("mode", 14, false, 5),
-    ("last emcy", 18, false, 0),
-    ("fr/s", 7, true, 0),
-    ("profile", 10, false, 0),
+    ("hb meas/cfg", 11, true, 0),
+    ("hb age", 9, true, 0),
+    ("miss", 4, true, 0),
+    ("boot", 4, true, 3),
+    ("cia402 state", 22, false, 5),
+    ("mode", 14, false, 4),
+    ("last emcy", 18, false, 6),
+    ("fr/s", 7, true, 1),
+    ("profile", 10, false, 2),
 ];
 
 /// The narrowest the last EMCY and profile columns get.
@@ -312,19 +313,25 @@ mod tests {
     use super::*;
 
     #[test]
-    fn columns_give_way_in_order_and_rate_and_profile_stay() {
+    fn columns_give_way_rate_and_profile_first_and_the_heartbeat_stays() {
         let names = |w: usize| -> Vec<&str> { layout(w).iter().map(|(i, _)| COLUMNS[*i].0).collect() };
         let full = names(200);
         assert_eq!(full.len(), COLUMNS.len());
         let all: usize = COLUMNS.iter().map(|c| c.1 + 1).sum::<usize>() - 1;
         assert_eq!(layout(all).iter().map(|(_, w)| w + 1).sum::<usize>() - 1, all);
-        // A 160-column terminal leaves the Nodes pane 113 columns: boot goes, the rest stays.
+        // A 160-column terminal leaves the Nodes pane 113 columns: the rate goes first.
         let at_160 = names(113);
-        assert!(!at_160.contains(&"boot"), "{at_160:?}");
-        assert!(at_160.contains(&"fr/s") && at_160.contains(&"profile") && at_160.contains(&"miss"));
+        assert!(!at_160.contains(&"fr/s"), "{at_160:?}");
+        assert!(at_160.contains(&"boot") && at_160.contains(&"profile") && at_160.contains(&"miss"));
         assert!(layout(113).iter().map(|(_, w)| w + 1).sum::<usize>() - 1 <= 113);
-        // 80 columns: the mode still shown, the heartbeat columns gone.
+        // 80 columns: id, state and the whole heartbeat stay; rate and profile are gone.
         let at_80 = names(78);
-        assert!(!at_80.contains(&"hb age") && at_80.contains(&"profile"), "{at_80:?}");
+        for keep in ["id", "nmt", "hb meas/cfg", "hb age", "miss"] {
+            assert!(at_80.contains(&keep), "{keep}: {at_80:?}");
+        }
+        assert!(!at_80.contains(&"fr/s") && !at_80.contains(&"profile"), "{at_80:?}");
+        assert!(layout(78).iter().map(|(_, w)| w + 1).sum::<usize>() - 1 <= 78);
+        // Even at 50 the heartbeat columns are the last to go.
+        assert_eq!(names(50), ["id", "nmt", "hb meas/cfg", "hb age", "miss"]);
     }
 }

@@ -17,10 +17,17 @@ use ratatui::widgets::Paragraph;
 const TIME: usize = 10;
 
 /// Widths of the name and value columns in a pane `width` wide: the value takes what the
-/// fixed columns and 20 columns of outcome leave (at least 20), the name 24 (16 when narrow).
+/// fixed columns and 20 columns of outcome leave (at least 20), the name 24 (16 when narrow,
+/// none below 100 columns: the outcome, ok or the abort, matters more at a bench).
 pub fn widths(width: usize) -> (usize, usize) {
     let avail = width.saturating_sub(30 + TIME + 1);
-    let name = if avail >= 80 { 24 } else { 16 };
+    let name = if avail >= 80 {
+        24
+    } else if width >= 100 {
+        16
+    } else {
+        0
+    };
     (name, avail.saturating_sub(name + 20).max(20))
 }
 
@@ -77,11 +84,11 @@ fn row_columns(trace: &Trace, t: &Transaction, width: usize) -> String {
     let (nw, vw) = widths(width);
     let time = t.start_ns.saturating_sub(super::start_ns(trace)) as f64 / 1e9;
     let text = format!(
-        "{time:>TIME$.3} {:>3} {} {} {:<nw$} {:<vw$} {:>9} {}",
+        "{time:>TIME$.3} {:>3} {} {} {}{:<vw$} {:>9} {}",
         t.node,
         dir,
         object,
-        fit(name, nw),
+        name_cell(name, nw),
         fit(&value, vw),
         duration(t.duration_ns() as f64 / 1e9),
         outcome
@@ -89,10 +96,20 @@ fn row_columns(trace: &Trace, t: &Transaction, width: usize) -> String {
     fit(&text, width)
 }
 
+/// The name cell and its gap, or nothing when the column is not shown (`nw` 0).
+fn name_cell(name: &str, nw: usize) -> String {
+    if nw == 0 {
+        String::new()
+    } else {
+        format!("{:<nw$} ", fit(name, nw))
+    }
+}
+
 #[cfg(test)]
 #[test]
 fn the_value_column_widens_with_the_pane() {
-    assert_eq!(widths(78), (16, 20));
+    assert_eq!(widths(78), (0, 20));
+    assert_eq!(widths(100), (16, 23));
     assert_eq!(widths(124), (24, 39));
     assert_eq!(widths(211), (24, 126));
 }
@@ -282,8 +299,14 @@ impl SdoPane {
         let mut lines = vec![Line::styled(
             fit(
                 &format!(
-                    "{iface}{:>TIME$} {:>3} {} {:<7} {:<nw$} {:<vw$} {:>9} outcome",
-                    "time", "nd", "dir  ", "object", "name", "value", "duration"
+                    "{iface}{:>TIME$} {:>3} {} {:<7} {}{:<vw$} {:>9} outcome",
+                    "time",
+                    "nd",
+                    "dir  ",
+                    "object",
+                    name_cell("name", nw),
+                    "value",
+                    "duration"
                 ),
                 inner.width as usize,
             ),

@@ -169,6 +169,52 @@ pub fn text(app: &App) -> String {
     )
 }
 
+/// `bar` (a status bar text) made to fit `width` columns without losing its key hints (the
+/// ` | stop all: …` and ` | help: …` at its end): first the file name `path` is shortened
+/// from the left with `…` (its end, the file's own name, stays), then whole fields before the
+/// hints go from the end, then the rest is cut with `…`.
+pub fn fit_bar(bar: &str, path: &str, width: usize) -> String {
+    let len = |s: &str| s.chars().count();
+    if len(bar) <= width {
+        return bar.to_string();
+    }
+    let at = bar
+        .rfind(" | stop all: ")
+        .or_else(|| bar.rfind(" | help: "))
+        .unwrap_or(bar.len());
+    let (body, hints) = bar.split_at(at);
+    let room = width.saturating_sub(len(hints));
+    let mut body = body.to_string();
+    let over = len(&body).saturating_sub(room);
+    if over > 0
+        && !path.is_empty()
+        && let Some(i) = body.find(path)
+    {
+        // Keep at least the last 16 characters of the path (the file name).
+        let keep = len(path).saturating_sub(over + 1).max(16.min(len(path)));
+        if keep < len(path) {
+            let tail: String = path.chars().skip(len(path) - keep).collect();
+            body.replace_range(i..i + path.len(), &format!("…{tail}"));
+        }
+    }
+    // Then whole ` | ` fields from the end (never the source), then a cut.
+    while len(&body) > room {
+        match body.rfind(" | ") {
+            Some(i) if i > 0 => body.truncate(i),
+            _ => break,
+        }
+    }
+    if len(&body) > room {
+        body = super::fit(&body, room);
+    }
+    let out = format!("{body}{hints}");
+    if len(&out) > width {
+        super::fit(&out, width)
+    } else {
+        out
+    }
+}
+
 /// Draws the status bar and, below it, the prompt or the last message.
 pub fn render(app: &App, f: &mut Frame, bar: Rect, line: Rect) {
     let (txt, bg) = match (&app.source.bus_error, &app.prompt.editing, &app.message) {
@@ -178,6 +224,11 @@ pub fn render(app: &App, f: &mut Frame, bar: Rect, line: Rect) {
         (Some(e), _, _) => (format!("{e} | {}", text(app)), Color::Red),
         _ => (text(app), Color::Blue),
     };
+    let path = match app.source.kind {
+        SourceKind::Open | SourceKind::Replay { .. } => app.source.name.as_str(),
+        _ => "",
+    };
+    let txt = fit_bar(&txt, path, bar.width as usize);
     f.render_widget(Paragraph::new(txt).style(Style::default().bg(bg).fg(Color::White)), bar);
     if let Some(lines) = question_lines(app, line.width, line.height as usize) {
         f.render_widget(Paragraph::new(lines), line);
@@ -196,7 +247,25 @@ pub fn render(app: &App, f: &mut Frame, bar: Rect, line: Rect) {
 
 #[cfg(test)]
 mod tests {
-    use super::wrap_question;
+    use super::{fit_bar, wrap_question};
+
+    #[test]
+    fn the_status_bar_shortens_the_path_from_the_left_and_keeps_the_key_hints() {
+        let bar = "open /home/bench/captures/2026-11-30/line3/drive_commissioning.log (end) | 44 frames | 0 fr/s | drops 0 | stop all: ctrl-s | help: ?";
+        let path = "/home/bench/captures/2026-11-30/line3/drive_commissioning.log";
+        let s = fit_bar(bar, path, 80);
+        assert_eq!(
+            s,
+            "open …ommissioning.log (end) | 44 frames | 0 fr/s | stop all: ctrl-s | help: ?"
+        );
+        assert!(s.ends_with(" | stop all: ctrl-s | help: ?"), "{s}");
+        // Narrower: the path keeps its file name, fields go, the hints stay whole.
+        let s = fit_bar(bar, path, 60);
+        assert_eq!(s, "open …ommissioning.log (end) | stop all: ctrl-s | help: ?");
+        assert!(s.chars().count() <= 60, "{s}");
+        // What fits is left alone.
+        assert_eq!(fit_bar("demo bus | help: ?", "", 80), "demo bus | help: ?");
+    }
 
     fn text(lines: &[ratatui::text::Line]) -> Vec<String> {
         lines

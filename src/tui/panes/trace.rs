@@ -174,16 +174,18 @@ impl Component for TracePane {
             return;
         }
         let head = Rect { height: 1, ..inner };
-        f.render_widget(
-            Paragraph::new(Line::styled(
-                format!(
-                    "{:>12} {:<9} {:<9} {:>3} {:<23} label",
-                    "time", "cob-id", "kind", "nd", "data"
-                ),
-                header(),
-            )),
-            head,
-        );
+        let heading = if compact(inner.width) {
+            format!(
+                "{:>9} {:<4} {:<6} {:>3} {:<16} label",
+                "time", "cob", "kind", "nd", "data"
+            )
+        } else {
+            format!(
+                "{:>12} {:<9} {:<9} {:>3} {:<23} label",
+                "time", "cob-id", "kind", "nd", "data"
+            )
+        };
+        f.render_widget(Paragraph::new(Line::styled(heading, header())), head);
         let (rows, strip) = self.split(ctx.trace, area);
         let l = self.list;
         let lines: Vec<Line> = (l.offset..(l.offset + rows.height as usize).min(self.len(ctx.trace)))
@@ -208,12 +210,53 @@ impl Component for TracePane {
     }
 }
 
+/// Below this width the columns before the label narrow (time in ms, 3-digit COB-IDs,
+/// short kinds, data bytes unspaced) so the label, what a bench reads, keeps most of the row.
+const COMPACT_BELOW: u16 = 90;
+
+fn compact(width: u16) -> bool {
+    width < COMPACT_BELOW
+}
+
 /// The cells of one row: the decoded `row` of trace position `pos`, or just its number.
 fn cells(row: Option<&Row>, pos: usize, width: u16) -> Vec<Span<'static>> {
     let Some(r) = row else {
         return vec![Span::raw(format!("{:>12}", pos + 1))];
     };
     let color = kind_color(r.kind);
+    if compact(width) {
+        let kind = match r.kind {
+            crate::decode::Kind::Heartbeat => "hb",
+            crate::decode::Kind::ErrorFrame => "error",
+            k => k.as_str(),
+        };
+        let cols = [
+            format!("{:>9.3} ", r.time),
+            format!("{:<4} ", r.cob),
+            format!("{:<6} ", kind),
+            format!("{:>3} ", r.node),
+            format!("{:<16} ", r.data.replace(' ', "")),
+        ];
+        let used: usize = cols.iter().map(|c| c.chars().count()).sum();
+        let label_w = (width as usize).saturating_sub(used);
+        let label = if r.malformed.is_some() && label_w > 2 {
+            format!("! {}", fit(&r.label, label_w - 2))
+        } else {
+            fit(&r.label, label_w)
+        };
+        let [time, cob, kind, node, data] = cols;
+        return vec![
+            Span::raw(time),
+            Span::styled(cob, Style::default().fg(color)),
+            Span::styled(kind, Style::default().fg(color)),
+            Span::raw(node),
+            Span::raw(data),
+            Span::styled(
+                label,
+                Style::default().fg(if r.malformed.is_some() { Color::LightRed } else { color }),
+            ),
+        ];
+    }
     let used = 12 + 1 + 9 + 1 + 9 + 1 + 3 + 1 + 23 + 1;
     let label_w = (width as usize).saturating_sub(used);
     let mut label = fit(&r.label, label_w);
