@@ -433,9 +433,17 @@ fn pdo_refusal(compared: &[Compared], dict: &Dictionary, (comm, mapping): (u16, 
     for sub in 1..=count {
         // An entry the file does not give keeps the node's value, which the node accepted.
         let Some(c) = at(mapping, sub) else { continue };
-        let e = crate::decode::pdo::entry_from_u32(u32_of(&c.file.bytes));
+        let raw = u32_of(&c.file.bytes);
+        let e = crate::decode::pdo::entry_from_u32(raw);
         total += u32::from(e.bits);
-        if let Some(why) = crate::command::pdo::entry_refusal(dict, transmit, (e.index, e.sub), e.bits, false) {
+        // The dictionary's own default mapping is not refused: EDS files often map an object
+        // by default into a direction its access type does not name (SERVO-DS maps 0x6060,
+        // `rww`, into TPDO1), and the node, which took that default, judges it on the bus.
+        let default = dict.object(mapping, sub).and_then(|o| o.default.as_ref());
+        let dictionary_default = matches!(default, Some(crate::od::Value::Unsigned(d)) if *d == u64::from(raw));
+        if !dictionary_default
+            && let Some(why) = crate::command::pdo::entry_refusal(dict, transmit, (e.index, e.sub), e.bits, false)
+        {
             return Some(format!(
                 "entry {sub} (0x{:04X}:{:02X}, {} bits): {why}",
                 e.index, e.sub, e.bits
