@@ -54,7 +54,8 @@ fn until(a: &mut App, what: &str, f: impl Fn(&App, &str) -> bool) -> String {
     }
 }
 
-fn demo_app() -> App {
+/// The TUI on the demo bus, as `cotui demo` starts it (shared with `own_reads`).
+pub(crate) fn demo_app() -> App {
     let bindings = cotui::cli::bind::bindings_on("demo", &[], &[]).unwrap();
     let trace = Trace::new(Decoder::from_bindings(&bindings), 500_000);
     let (rx, req) = cotui::tui::live::start("demo", false, bindings.clone(), None);

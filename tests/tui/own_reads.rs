@@ -4,10 +4,8 @@
 //! lost node; the objects the drive lacks are one info row, and the read-all summary counts
 //! them as not present, not as failed.
 
-use cotui::analysis::trace::Trace;
-use cotui::decode::Decoder;
-use cotui::tui::app::{App, SourceInfo, SourceKind};
-use cotui::tui::keymap::Keymap;
+use crate::objects_demo::demo_app;
+use cotui::tui::app::App;
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::Terminal;
 use ratatui::backend::TestBackend;
@@ -47,16 +45,6 @@ fn until(a: &mut App, what: &str, f: impl Fn(&App, &str) -> bool) -> String {
         );
         std::thread::sleep(Duration::from_millis(10));
     }
-}
-
-fn demo_app() -> App {
-    let bindings = cotui::cli::bind::bindings_on("demo", &[], &[]).unwrap();
-    let trace = Trace::new(Decoder::from_bindings(&bindings), 500_000);
-    let (rx, req) = cotui::tui::live::start("demo", false, bindings.clone(), None);
-    let src = SourceInfo::live("demo", SourceKind::Demo { listen_only: false }, rx, req);
-    let mut a = App::new(trace, Keymap::default_map(), src);
-    a.bindings = bindings;
-    a
 }
 
 #[test]
