@@ -1,11 +1,12 @@
 //! Numeric values over time for the Plot pane: every numeric PDO signal and every SDO
-//! upload of a number, per (node, index, sub).
+//! upload of a number, per (node of its interface, index, sub).
 //!
 //! Each series keeps at most [`MAX_POINTS`] points; when full, every other point is dropped
 //! and the series keeps one point in two from then on, so a long trace is covered whole at
 //! a coarser step and memory stays bounded.
 
 use crate::decode::pdo::Pdo;
+use crate::frame::NodeKey;
 use crate::od::Dictionary;
 use crate::sdo::{Transaction, TransferDirection};
 use std::collections::BTreeMap;
@@ -13,8 +14,8 @@ use std::collections::BTreeMap;
 /// Points kept per series.
 pub const MAX_POINTS: usize = 4096;
 
-/// A series key: node, index, sub.
-pub type SeriesKey = (u8, u16, u8);
+/// A series key: node (of its interface), index, sub.
+pub type SeriesKey = (NodeKey, u16, u8);
 
 /// One series.
 #[derive(Clone, Debug, Default)]
@@ -217,7 +218,7 @@ impl Series {
 
     /// Adds the numeric signals of a PDO of `node` at `ts_ns` (`dict`: the node's dictionary,
     /// which names new series).
-    pub fn pdo(&mut self, node: u8, ts_ns: u64, p: &Pdo, dict: &Dictionary) {
+    pub fn pdo(&mut self, node: NodeKey, ts_ns: u64, p: &Pdo, dict: &Dictionary) {
         for s in &p.signals {
             if let Some(v) = s.value.as_f64() {
                 self.add((node, s.index, s.sub), dict, ts_ns as f64 / 1e9, v);
@@ -240,7 +241,7 @@ impl Series {
             }
         };
         let Some(v) = value else { return };
-        self.add((t.node, t.index, t.sub), dict, t.end_ns as f64 / 1e9, v);
+        self.add((t.key(), t.index, t.sub), dict, t.end_ns as f64 / 1e9, v);
     }
 }
 

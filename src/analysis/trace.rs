@@ -1,16 +1,21 @@
-//! The trace: the store plus everything derived from it while frames come in.
+//! The trace: the one analysis pipeline. Frames go in through [`Trace::push`]; the views
+//! chosen at construction ([`Views`]) are derived from them as they come. The TUI keeps
+//! them all ([`Views::All`]); each headless command keeps only the view it prints
+//! ([`Views::Summary`], [`Views::Transactions`], [`Views::Events`], [`Views::Diagnosis`]),
+//! a fast path of the same `push`, not a copy of its loop.
 //!
 //! Decoding is stateful (learned COB-IDs and PDO mappings, modes of operation, SDO transfer
-//! context), so a frame's label depends on everything before it. The indexing pass runs one
-//! [`Decoder`] over every frame as it arrives, but keeps only the frame's kind and node (in
-//! the store), the SDO transactions (see [`Transfers`]), node and COB-ID statistics and the numeric
-//! signal series. Every [`CHECKPOINT`] frames it keeps a clone of the decoder state. To show
-//! rows `a..b`, [`Trace::decode_range`] clones the checkpoint at or before `a`, replays the
-//! frames up to `a` through it (cheaply: only SDO and PDO frames change state) and decodes
-//! `a..b`. So labels are exact, at most `CHECKPOINT` frames are replayed per window, and
-//! the checkpoints cost well under a byte per frame.
+//! context), so a frame's label depends on everything before it. With every view, the indexing
+//! pass runs one [`Decoder`] over every frame as it arrives, but keeps only the frame's kind
+//! and node (in the store), the SDO transactions (see [`Transfers`]), node and COB-ID
+//! statistics and the numeric signal series. Every [`CHECKPOINT`] frames it keeps a clone of
+//! the decoder state. To show rows `a..b`, [`Trace::decode_range`] clones the checkpoint at
+//! or before `a`, replays the frames up to `a` through it (cheaply: only SDO and PDO frames
+//! change state) and decodes `a..b`. So labels are exact, at most `CHECKPOINT` frames are
+//! replayed per window, and the checkpoints cost well under a byte per frame.
 
 use super::diagnose::{Diagnoser, feed};
+use super::liveness::EventTracker;
 use super::nodes::Nodes;
 use super::series::Series;
 use super::stats::Stats;
@@ -19,16 +24,41 @@ use super::transfers::Transfers;
 use super::values::Values;
 use crate::decode::{Body, Decoded, Decoder, Kind};
 use crate::frame::{Frame, Interfaces, NodeKey};
+use crate::output::summary::Summary;
 use crate::sdo::Transaction;
+
+/// Which views a [`Trace`] derives from its frames, chosen once at construction. Each
+/// mode other than [`Views::All`] is the fast path of one headless command: it decodes
+/// only as far as its view needs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Views {
+    /// Everything the TUI panes show: the store with decoder checkpoints, the SDO
+    /// transactions, nodes, statistics, series, values and the diagnosis.
+    All,
+    /// Only the totals per kind and node, [`Trace::summary`] (`cotui decode --summary`):
+    /// frames are classified, not decoded.
+    Summary,
+    /// Only the SDO transfers, [`Trace::transactions`] (`cotui decode --transactions`):
+    /// frames are tracked, not labelled.
+    Transactions,
+    /// Only the bus events, [`Trace::events`] (`cotui decode --events`): heartbeats,
+    /// EMCYs and error frames are decoded, SDO frames tracked.
+    Events,
+    /// Only the diagnosis, [`Trace::diagnosis`] (`cotui diagnose`): frames are decoded as
+    /// far as the diagnosis reads them.
+    Diagnosis,
+}
 
 /// Frames between two decoder checkpoints.
 pub const CHECKPOINT: usize = 8192;
 
-/// Everything the panes show, built incrementally.
+/// Everything the panes show (or, in a headless mode, the one view a command prints),
+/// built incrementally.
 pub struct Trace {
-    /// The frames.
+    views: Views,
+    /// The frames (kept with [`Views::All`] only).
     pub store: Store,
-    /// Interface names.
+    /// Interface names: those of the frames' source (see [`Trace::name_interfaces`]).
     pub ifaces: Interfaces,
     decoder: Decoder,
     /// The decoder as it was for a fresh start (used when nothing is checkpointed yet).
@@ -48,17 +78,36 @@ pub struct Trace {
     pub values: Values,
     /// What went wrong so far (the same diagnosis as `cotui diagnose`).
     pub diagnosis: Diagnoser,
+    /// Frames per kind and node (kept with [`Views::Summary`] only).
+    pub summary: Summary,
+    /// Bus events not yet taken (kept with [`Views::Events`] only).
+    pub events: EventTracker,
     /// Changes of [`Trace::diagnosis`] (frames and clock ticks taken), for caches.
     pub diagnosis_version: u64,
 }
 
 impl Trace {
-    /// An empty trace decoded with `decoder`.
+    /// An empty trace decoded with `decoder`, keeping every view (the TUI's).
     pub fn new(decoder: Decoder, bitrate: u64) -> Trace {
+        Trace::with_views(decoder, bitrate, Views::All)
+    }
+
+    /// An empty trace for a headless command: one that keeps `views`, without statistics
+    /// (so no bitrate to count bus load against).
+    pub fn headless(decoder: Decoder, views: Views) -> Trace {
+        Trace::with_views(decoder, 500_000, views)
+    }
+
+    /// An empty trace decoded with `decoder` that keeps `views`.
+    pub fn with_views(decoder: Decoder, bitrate: u64, views: Views) -> Trace {
         let nodes = Nodes::new(&decoder);
         let diagnosis = Diagnoser::new(|n| decoder.dictionary(n));
+        let events = EventTracker::new(|n| decoder.dictionary(n));
         Trace {
+            views,
             diagnosis,
+            summary: Summary::default(),
+            events,
             diagnosis_version: 0,
             store: Store::new(),
             ifaces: Interfaces::default(),
@@ -77,7 +126,30 @@ impl Trace {
     /// Forgets every frame (a replay seeking backwards starts over).
     pub fn clear(&mut self) {
         let bitrate = self.stats.bitrate();
-        *self = Trace::new(self.initial.clone(), bitrate);
+        *self = Trace::with_views(self.initial.clone(), bitrate, self.views);
+    }
+
+    /// The views this trace keeps.
+    pub fn views(&self) -> Views {
+        self.views
+    }
+
+    /// A new input begins whose frames number their interfaces from 0 again (a headless
+    /// command reads each log file with its own interface table).
+    pub fn new_input(&mut self) {
+        self.ifaces = Interfaces::default();
+    }
+
+    /// Takes note of the interface table of the frames' source, which grows as names
+    /// appear: call it with the newest before pushing its frames.
+    pub fn name_interfaces(&mut self, source: &Interfaces) {
+        let known = self.ifaces.names().len();
+        for name in source.names().iter().skip(known) {
+            self.ifaces.intern(name);
+        }
+        if self.views == Views::Summary {
+            self.summary.name_interfaces(source);
+        }
     }
 
     /// Number of frames.
@@ -90,8 +162,52 @@ impl Trace {
         self.store.is_empty()
     }
 
-    /// Adds one frame: classifies it, updates nodes, statistics and series.
+    /// Adds one frame: derives the views kept from it (with [`Views::All`]: classifies it,
+    /// updates nodes, statistics, series, values and the diagnosis).
     pub fn push(&mut self, frame: &Frame) {
+        match self.views {
+            Views::All => self.index(frame),
+            Views::Summary => {
+                let (kind, node) = self.decoder.classify(frame);
+                self.summary.add_on(frame.iface, kind, node);
+                if matches!(kind, Kind::SdoRx | Kind::SdoTx) {
+                    // Only SDO frames complete transfers; none is kept (memory stays flat).
+                    self.decoder.take_transactions();
+                }
+            }
+            Views::Transactions => {
+                self.decoder.track(frame);
+                let done = self.transfers.completed(&mut self.decoder);
+                self.transactions.extend(done);
+            }
+            Views::Events => {
+                // Only these kinds carry events; SDO frames are tracked by classify.
+                match self.decoder.classify(frame) {
+                    (Kind::Heartbeat | Kind::Emcy | Kind::ErrorFrame, _) => {
+                        let d = self.decoder.decode(frame);
+                        self.events.frame(frame, self.ifaces.name(frame.iface), &d);
+                    }
+                    _ => self.events.tick(frame.ts_ns),
+                }
+                for t in self.decoder.take_transactions() {
+                    self.events.transaction(&t);
+                }
+            }
+            Views::Diagnosis => {
+                let peeked = self.decoder.peek(frame);
+                let iface = self.ifaces.name(frame.iface);
+                if let Some(d) = feed(&mut self.decoder, &mut self.diagnosis, frame, peeked, iface) {
+                    self.decoder.recycle(d);
+                }
+                for t in self.decoder.take_transactions() {
+                    self.diagnosis.transaction(&t);
+                }
+            }
+        }
+    }
+
+    /// [`Trace::push`] with every view: the store, checkpoints and all that the panes show.
+    fn index(&mut self, frame: &Frame) {
         let pos = self.store.len();
         if pos.is_multiple_of(CHECKPOINT) {
             self.checkpoints.push(self.decoder.clone());
@@ -132,11 +248,25 @@ impl Trace {
 
     /// The input ended (a loaded log read to its end): the SDO transfers still running
     /// are listed as incomplete, as `cotui decode --transactions` lists them. They were
-    /// not completed, so the diagnosis, nodes and values do not take them (nor does
-    /// `cotui diagnose`).
+    /// not completed, so nodes and values do not take them; the diagnosis of `cotui
+    /// diagnose` ([`Views::Diagnosis`]) sees them end (it opens no incident for them).
     pub fn end_of_input(&mut self) {
         let rest = self.transfers.end(&mut self.decoder);
-        self.transactions.extend(rest);
+        match self.views {
+            Views::All | Views::Transactions => self.transactions.extend(rest),
+            Views::Diagnosis => {
+                for t in &rest {
+                    self.diagnosis.transaction(t);
+                }
+            }
+            Views::Summary | Views::Events => {}
+        }
+    }
+
+    /// Takes the SDO transactions listed so far (a headless command prints them as they
+    /// come, keeping memory flat).
+    pub fn take_transactions(&mut self) -> Vec<Transaction> {
+        std::mem::take(&mut self.transactions)
     }
 
     fn observe(&mut self, frame: &Frame, d: &Decoded) {
@@ -148,8 +278,8 @@ impl Trace {
             Body::Emcy(e) => self.nodes.emcy(key, frame.ts_ns, e),
             Body::Pdo(p) => {
                 self.nodes.pdo(key, p, profile, mode);
-                self.series.pdo(n, frame.ts_ns, p, self.decoder.dictionary(n));
-                self.values.pdo(n, frame.ts_ns, p, mode);
+                self.series.pdo(key, frame.ts_ns, p, self.decoder.dictionary(n));
+                self.values.pdo(key, frame.ts_ns, p, mode);
                 return;
             }
             _ => {}
@@ -160,10 +290,17 @@ impl Trace {
     /// The capture clock reached `now_ns` with no new frame (live or a running replay):
     /// node liveness and the diagnosis catch up.
     pub fn tick(&mut self, now_ns: u64) {
-        self.nodes.tick(now_ns);
-        self.stats.tick(now_ns, &self.store);
-        self.diagnosis.tick(now_ns);
-        self.diagnosis_version += 1;
+        match self.views {
+            Views::All => {
+                self.nodes.tick(now_ns);
+                self.stats.tick(now_ns, &self.store);
+                self.diagnosis.tick(now_ns);
+                self.diagnosis_version += 1;
+            }
+            Views::Diagnosis => self.diagnosis.tick(now_ns),
+            Views::Events => self.events.tick(now_ns),
+            Views::Summary | Views::Transactions => {}
+        }
     }
 
     /// Decodes the frames `start..end` exactly as the indexing pass did.
@@ -249,6 +386,7 @@ mod tests {
             full.set_seq(i as u64);
             let d = full.decode(&f);
             if let (Body::Pdo(p), Some(n)) = (&d.body, d.node) {
+                let n = NodeKey::of(&f, n);
                 for s in &p.signals {
                     values.insert((n, s.index, s.sub), s.value.clone());
                     names.entry((n, s.index, s.sub)).or_insert_with(|| s.name.clone());
@@ -262,7 +400,7 @@ mod tests {
             let seen = t.values.get(n, index, sub).and_then(|e| e.last.as_ref()).unwrap();
             // An SDO transfer after the last PDO carries the last value then.
             if seen.via == crate::analysis::values::Via::Pdo {
-                assert_eq!(&seen.value, v, "{n} {index:04X}:{sub}");
+                assert_eq!(&seen.value, v, "{n:?} {index:04X}:{sub}");
                 compared += 1;
             }
         }

@@ -1,4 +1,4 @@
-//! The last value seen on the bus per node and object: every completed SDO transfer
+//! The last value seen on the bus per node (of its interface) and object: every completed SDO transfer
 //! (upload or download, cotui's own included: they come back as TX/RX frames) and every
 //! mapped PDO signal. What the Objects pane shows as "last value" and its age.
 //!
@@ -7,12 +7,14 @@
 //! formatting.
 
 use crate::decode::pdo::Pdo;
+use crate::frame::NodeKey;
 use crate::od::{Dictionary, Value};
 use crate::sdo::{Outcome, Transaction, TransferDirection};
 use std::collections::BTreeMap;
 
-/// An object of a node: (node, index, sub).
-pub type ObjectKey = (u8, u16, u8);
+/// An object of a node: (node of its interface, index, sub). Node 5 of can0 and node 5 of
+/// can1 are two nodes.
+pub type ObjectKey = (NodeKey, u16, u8);
 
 /// How a value was seen.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -86,12 +88,12 @@ pub struct Values {
 
 impl Values {
     /// What is known of (node, index, sub).
-    pub fn get(&self, node: u8, index: u16, sub: u8) -> Option<&Entry> {
+    pub fn get(&self, node: NodeKey, index: u16, sub: u8) -> Option<&Entry> {
         self.map.get(&(node, index, sub))
     }
 
     /// Every object of `node` something was seen of, in index order.
-    pub fn node(&self, node: u8) -> impl Iterator<Item = ((u16, u8), &Entry)> {
+    pub fn node(&self, node: NodeKey) -> impl Iterator<Item = ((u16, u8), &Entry)> {
         self.map
             .range((node, 0, 0)..=(node, u16::MAX, u8::MAX))
             .map(|((_, i, s), e)| ((*i, *s), e))
@@ -114,7 +116,7 @@ impl Values {
         if t.is_partial() || t.outcome == Outcome::Incomplete {
             return;
         }
-        let e = self.map.entry((t.node, t.index, t.sub)).or_default();
+        let e = self.map.entry((t.key(), t.index, t.sub)).or_default();
         if !t.is_ok() {
             let text = match &t.outcome {
                 Outcome::Aborted { code, text, by } => {
@@ -161,7 +163,7 @@ impl Values {
 
     /// Takes the signals of a PDO of `node` received at `ts_ns` (mode: the node's mode of
     /// operation then).
-    pub fn pdo(&mut self, node: u8, ts_ns: u64, p: &Pdo, mode: Option<i8>) {
+    pub fn pdo(&mut self, node: NodeKey, ts_ns: u64, p: &Pdo, mode: Option<i8>) {
         for s in &p.signals {
             let e = self.map.entry((node, s.index, s.sub)).or_default();
             match &mut e.last {
@@ -194,6 +196,9 @@ mod tests {
     use crate::frame::Frame;
     use crate::od::bind::Bindings;
 
+    /// Node 2 of the first interface.
+    const N2: NodeKey = NodeKey { iface: 0, node: 2 };
+
     /// Decodes `frames` (id, data, ms) for a node bound to the CiA 402 profile and feeds
     /// the store as the trace does.
     fn feed(frames: &[(u32, &[u8], u64)]) -> (Values, Decoder) {
@@ -207,7 +212,8 @@ mod tests {
             dec.set_seq(i as u64);
             let d = dec.decode(&f);
             if let (Body::Pdo(p), Some(n)) = (&d.body, d.node) {
-                v.pdo(n, f.ts_ns, p, dec.mode(crate::frame::NodeKey::of(&f, n)));
+                let key = NodeKey::of(&f, n);
+                v.pdo(key, f.ts_ns, p, dec.mode(key));
             }
             for t in dec.take_transactions() {
                 v.transaction(&t, dec.dictionary(t.node));
@@ -239,16 +245,16 @@ mod tests {
             (0x582, &[0x43, 0x00, 0x50, 0x01, 0xEF, 0xBE, 0xAD, 0xDE], 11),
         ]);
         let dict = dec.dictionary(2);
-        let mode = v.get(2, 0x6061, 0).unwrap();
+        let mode = v.get(N2, 0x6061, 0).unwrap();
         let seen = mode.last.as_ref().unwrap();
         assert_eq!(
             (seen.value.clone(), seen.ts_ns, seen.via),
             (Value::Signed(3), 2_000_000, Via::Upload)
         );
         assert_eq!(mode.text(dict, 0x6061, 0).as_deref(), Some("3 (Profile velocity)"));
-        let hb = v.get(2, 0x1017, 0).unwrap().last.as_ref().unwrap();
+        let hb = v.get(N2, 0x1017, 0).unwrap().last.as_ref().unwrap();
         assert_eq!((hb.value.clone(), hb.via), (Value::Unsigned(100), Via::Download));
-        let sw = v.get(2, 0x6041, 0).unwrap();
+        let sw = v.get(N2, 0x6041, 0).unwrap();
         let s = sw.last.as_ref().unwrap();
         assert_eq!(
             (s.value.clone(), s.ts_ns, s.via),
@@ -259,13 +265,13 @@ mod tests {
             "{:?}",
             sw.text(dict, 0x6041, 0)
         );
-        let raw = v.get(2, 0x5000, 1).unwrap();
+        let raw = v.get(N2, 0x5000, 1).unwrap();
         assert_eq!(
             raw.last.as_ref().unwrap().value,
             Value::Bytes(vec![0xEF, 0xBE, 0xAD, 0xDE])
         );
         assert_eq!(raw.text(dict, 0x5000, 1).as_deref(), Some("EF BE AD DE (3735928559)"));
-        let keys: Vec<(u16, u8)> = v.node(2).map(|(k, _)| k).collect();
+        let keys: Vec<(u16, u8)> = v.node(N2).map(|(k, _)| k).collect();
         assert_eq!(
             keys,
             [
@@ -277,7 +283,7 @@ mod tests {
                 (0x6061, 0)
             ]
         );
-        assert_eq!(v.node(3).count(), 0);
+        assert_eq!(v.node(NodeKey::new(0, 3)).count(), 0);
     }
 
     #[test]
@@ -290,13 +296,13 @@ mod tests {
             (0x602, &[0x40, 0x00, 0x50, 0x00, 0, 0, 0, 0], 5),
             (0x582, &[0x80, 0x00, 0x50, 0x00, 0x00, 0x00, 0x02, 0x06], 6),
         ]);
-        let e = v.get(2, 0x6061, 0).unwrap();
+        let e = v.get(N2, 0x6061, 0).unwrap();
         assert_eq!(e.last.as_ref().map(|s| s.value.clone()), Some(Value::Signed(3)));
         assert_eq!(
             e.failed.as_ref().map(|f| (f.text.as_str(), f.ts_ns)),
             Some(("abort 08000000: General error", 4_000_000))
         );
-        let missing = v.get(2, 0x5000, 0).unwrap();
+        let missing = v.get(N2, 0x5000, 0).unwrap();
         assert!(missing.last.is_none());
         assert_eq!(
             missing.failed.as_ref().map(|f| f.text.as_str()),
@@ -309,7 +315,7 @@ mod tests {
             (0x602, &[0x40, 0x61, 0x60, 0x00, 0, 0, 0, 0], 5),
             (0x582, &[0x4F, 0x61, 0x60, 0x00, 0x01, 0, 0, 0], 6),
         ]);
-        let e = v.get(2, 0x6061, 0).unwrap();
+        let e = v.get(N2, 0x6061, 0).unwrap();
         assert!(e.failed.is_none());
         assert_eq!(e.last.as_ref().map(|s| s.ts_ns), Some(6_000_000));
     }

@@ -1,10 +1,9 @@
 //! `cotui decode FILE...`: the headless decoder.
 
 use super::input;
-use crate::analysis::EventTracker;
-use crate::analysis::transfers::Transfers;
+use crate::analysis::trace::{Trace, Views};
 use crate::command::ExitCode;
-use crate::decode::{Decoder, Kind};
+use crate::decode::Decoder;
 use crate::frame::json::write_line;
 use crate::od::Dictionary;
 use crate::output::{jsonl, summary::Summary, text};
@@ -63,13 +62,11 @@ pub struct DecodeArgs {
     pub output: Option<String>,
 }
 
-/// What a decode run writes, chosen once from the arguments.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Mode {
-    Frames(OutputFormat),
-    Transactions(OutputFormat),
-    Summary(OutputFormat),
-    Events(OutputFormat),
+/// What a decode run keeps across its inputs, chosen once from the arguments: a bare
+/// decoder when it prints frames, else the trace that derives the one view it prints.
+enum Pipeline {
+    Frames(Decoder),
+    View(Trace),
 }
 
 /// Runs `cotui decode`; returns the exit status.
@@ -83,22 +80,25 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
     if args.format == OutputFormat::Parquet {
         return super::decode_parquet::run(args);
     }
-    let mut decoder = match super::bind::decoder(&args.profiles, &args.eds) {
+    let decoder = match super::bind::decoder(&args.profiles, &args.eds) {
         Ok(d) => d,
         Err(e) => {
             eprintln!("cotui decode: {e}");
             return ExitCode::Usage;
         }
     };
-    let mut events = EventTracker::new(|n| decoder.dictionary(n));
-    let mode = if args.events {
-        Mode::Events(args.format)
+    let view = if args.events {
+        Some(Views::Events)
     } else if args.summary {
-        Mode::Summary(args.format)
+        Some(Views::Summary)
     } else if args.transactions {
-        Mode::Transactions(args.format)
+        Some(Views::Transactions)
     } else {
-        Mode::Frames(args.format)
+        None
+    };
+    let mut run = match view {
+        Some(v) => Pipeline::View(Trace::headless(decoder, v)),
+        None => Pipeline::Frames(decoder),
     };
     let mut out = match super::decode_out::open(args.output.as_deref(), false) {
         Ok(o) => o,
@@ -107,8 +107,6 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
             return ExitCode::Usage;
         }
     };
-    let mut summary = Summary::default();
-    let mut transfers = Transfers::new();
     let mut names = Vec::new();
     let mut status = ExitCode::Ok;
     for path in &args.files {
@@ -116,13 +114,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
             status = ExitCode::Unavailable;
             continue;
         };
-        let mut sinks = Sinks {
-            summary: &mut summary,
-            events: &mut events,
-            transfers: &mut transfers,
-            names: &mut names,
-        };
-        match decode_stream(path, input, &mut decoder, mode, &mut sinks, &mut out) {
+        match decode_stream(path, input, &mut run, args.format, &mut names, &mut out) {
             Ok(()) => {}
             Err(e) if e.kind() == io::ErrorKind::BrokenPipe => return status,
             Err(e) => {
@@ -133,21 +125,11 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
             }
         }
     }
-    let result = finish(&mut decoder, mode, &mut summary, &mut transfers, &names, &mut out).and_then(|_| out.flush());
+    let result = finish(&mut run, args.format, &names, &mut out).and_then(|_| out.flush());
     match result {
         Err(e) if e.kind() != io::ErrorKind::BrokenPipe => out.blame().report(None, &e),
         _ => status,
     }
-}
-
-/// What the modes that look at the whole input keep across files.
-struct Sinks<'a> {
-    summary: &'a mut Summary,
-    events: &'a mut EventTracker,
-    /// The SDO transfers of `--transactions`, as the TUI's SDO pane takes them.
-    transfers: &'a mut Transfers,
-    /// Interface names of the input so far (see [`note_interfaces`]).
-    names: &'a mut Vec<String>,
 }
 
 /// Keeps `names` up with a source's interface table (which grows as names appear).
@@ -165,13 +147,14 @@ pub(super) fn shown_iface(names: &[String], iface: u16) -> Option<&str> {
     (names.len() > 1).then(|| names.get(usize::from(iface)).map_or("?", String::as_str))
 }
 
-/// Decodes one input into `out` (parsing runs on a second thread).
+/// Decodes one input into `out` (parsing runs on a second thread). `names`: the interface
+/// names of the input so far (see [`note_interfaces`]).
 fn decode_stream(
     path: &str,
     input: Box<dyn BufRead + Send>,
-    decoder: &mut Decoder,
-    mode: Mode,
-    sinks: &mut Sinks,
+    run: &mut Pipeline,
+    fmt: OutputFormat,
+    names: &mut Vec<String>,
     out: &mut impl Write,
 ) -> io::Result<()> {
     // Event text lines go to `buf`, all other lines to `json`; a run writes only one of
@@ -179,62 +162,34 @@ fn decode_stream(
     let mut buf = String::with_capacity(1 << 16);
     let mut json = Vec::with_capacity(1 << 16);
     let mut label = String::new();
+    if let Pipeline::View(trace) = run {
+        trace.new_input();
+    }
     let counts = input::for_each_frame(path, input, |frames| {
         let ifaces = frames.ifaces;
-        note_interfaces(sinks.names, ifaces);
-        sinks.summary.name_interfaces(ifaces);
-        for (line, frame) in frames {
-            match mode {
-                Mode::Summary(_) => {
-                    let (kind, node) = decoder.classify(frame);
-                    sinks.summary.add_on(frame.iface, kind, node);
-                }
-                Mode::Events(fmt) => {
-                    let events = &mut *sinks.events;
-                    // Only these kinds carry events; SDO frames are tracked by classify.
-                    match decoder.classify(frame) {
-                        (Kind::Heartbeat | Kind::Emcy | Kind::ErrorFrame, _) => {
-                            let d = decoder.decode(frame);
-                            events.frame(frame, ifaces.name(frame.iface), &d);
-                        }
-                        _ => events.tick(frame.ts_ns),
-                    }
-                    for t in decoder.take_transactions() {
-                        events.transaction(&t);
-                    }
-                    for e in events.take_events() {
-                        let iface = shown_iface(sinks.names, e.iface);
-                        match fmt {
-                            OutputFormat::Text => e.write_line_on(&mut buf, iface),
-                            // (pcapng and parquet never reach here: they are refused with --events)
-                            OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => {
-                                e.write_json_on(&mut json, iface)
-                            }
+        note_interfaces(names, ifaces);
+        match run {
+            Pipeline::Frames(decoder) => {
+                for (line, frame) in frames {
+                    let d = decoder.decode(frame);
+                    match fmt {
+                        OutputFormat::Text => text::write_line(&mut json, frame, ifaces, &d),
+                        OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => {
+                            jsonl::write_frame(&mut json, line, frame, ifaces, &d)
                         }
                     }
-                }
-                Mode::Frames(OutputFormat::Text) => {
-                    let d = decoder.decode(frame);
-                    text::write_line(&mut json, frame, ifaces, &d);
                     decoder.recycle(d);
                 }
-                Mode::Frames(OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet) => {
-                    let d = decoder.decode(frame);
-                    jsonl::write_frame(&mut json, line, frame, ifaces, &d);
-                    decoder.recycle(d);
-                }
-                Mode::Transactions(fmt) => {
-                    decoder.track(frame);
-                    for t in sinks.transfers.completed(decoder) {
-                        let iface = shown_iface(sinks.names, t.iface);
-                        write_transaction(&mut json, &mut label, &t, decoder.dictionary(t.node), iface, fmt);
-                    }
-                }
+                // Only --transactions prints them; dropping them keeps memory flat.
+                decoder.take_transactions();
             }
-        }
-        if !matches!(mode, Mode::Transactions(_)) {
-            // Only --transactions prints them; dropping the rest keeps memory flat.
-            decoder.take_transactions();
+            Pipeline::View(trace) => {
+                trace.name_interfaces(ifaces);
+                for (_, frame) in frames {
+                    trace.push(frame);
+                }
+                write_view(trace, fmt, names, &mut buf, &mut json, &mut label);
+            }
         }
         out.write_all(buf.as_bytes())?;
         out.write_all(&json)?;
@@ -244,6 +199,37 @@ fn decode_stream(
     })?;
     input::report_counts(path, &counts);
     Ok(())
+}
+
+/// Appends what the view of `trace` has to print so far: the SDO transfers it listed or
+/// the events it found (a summary prints at the end only).
+fn write_view(
+    trace: &mut Trace,
+    fmt: OutputFormat,
+    names: &[String],
+    buf: &mut String,
+    json: &mut Vec<u8>,
+    label: &mut String,
+) {
+    match trace.views() {
+        Views::Transactions => {
+            for t in trace.take_transactions() {
+                let iface = shown_iface(names, t.iface);
+                write_transaction(json, label, &t, trace.decoder().dictionary(t.node), iface, fmt);
+            }
+        }
+        Views::Events => {
+            for e in trace.events.take_events() {
+                let iface = shown_iface(names, e.iface);
+                match fmt {
+                    OutputFormat::Text => e.write_line_on(buf, iface),
+                    // (pcapng and parquet never reach here: they are refused with --events)
+                    OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => e.write_json_on(json, iface),
+                }
+            }
+        }
+        Views::All | Views::Summary | Views::Diagnosis => {}
+    }
 }
 
 /// Appends one transaction to `out`: its label line (built in the scratch `label`) or its
@@ -288,25 +274,19 @@ pub(super) fn write_summary(out: &mut Vec<u8>, summary: &mut Summary, fmt: Outpu
 }
 
 /// Writes what is due at the end of all inputs.
-fn finish(
-    decoder: &mut Decoder,
-    mode: Mode,
-    summary: &mut Summary,
-    transfers: &mut Transfers,
-    names: &[String],
-    out: &mut impl Write,
-) -> io::Result<()> {
+fn finish(run: &mut Pipeline, fmt: OutputFormat, names: &[String], out: &mut impl Write) -> io::Result<()> {
+    let Pipeline::View(trace) = run else {
+        return Ok(());
+    };
+    trace.end_of_input();
     let mut buf = Vec::new();
-    match mode {
-        Mode::Transactions(fmt) => {
-            let mut label = String::new();
-            for t in transfers.end(decoder) {
-                let iface = shown_iface(names, t.iface);
-                write_transaction(&mut buf, &mut label, &t, decoder.dictionary(t.node), iface, fmt);
-            }
-        }
-        Mode::Summary(fmt) => write_summary(&mut buf, summary, fmt),
-        Mode::Frames(_) | Mode::Events(_) => {}
+    if trace.views() == Views::Summary {
+        write_summary(&mut buf, &mut trace.summary, fmt);
+    } else {
+        let mut text = String::new();
+        let mut label = String::new();
+        write_view(trace, fmt, names, &mut text, &mut buf, &mut label);
+        out.write_all(text.as_bytes())?;
     }
     out.write_all(&buf)
 }

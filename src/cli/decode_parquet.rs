@@ -7,7 +7,7 @@ use super::decode::DecodeArgs;
 use super::input;
 use crate::command::ExitCode;
 use crate::decode::{Body, Decoded, Decoder};
-use crate::frame::{Flags, Frame};
+use crate::frame::{Flags, Frame, Interfaces};
 use crate::od::Dictionary;
 use crate::output::parquet::{Col, Table, Ty, V};
 use crate::sdo::{SdoCommand, Transaction};
@@ -51,12 +51,14 @@ pub const FRAME_COLS: [Col; 28] = [
     col("pdo_transmit", Ty::Bool, true),
 ];
 
-/// Columns of `values.parquet`: one row per SDO transaction and per PDO signal.
-pub const VALUE_COLS: [Col; 19] = [
+/// Columns of `values.parquet`: one row per SDO transaction and per PDO signal, of a node
+/// of an interface (node 5 of can0 and node 5 of can1 are two nodes).
+pub const VALUE_COLS: [Col; 20] = [
     col("file", Ty::Str, false),
     col("source", Ty::Str, false),
     col("ts", Ty::TimestampNs, false),
     col("start_ts", Ty::TimestampNs, false),
+    col("iface", Ty::Str, false),
     col("node", Ty::I32, false),
     col("index", Ty::I32, true),
     col("sub", Ty::I32, true),
@@ -147,20 +149,29 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
     };
     let mut status = ExitCode::Ok;
     let mut last_file = String::new();
+    // The interface names of the last input (the transfers it left running name theirs).
+    let mut ifaces = Interfaces::default();
     for path in &args.files {
         let Some(input) = input::open_input(path, "decode") else {
             status = ExitCode::Unavailable;
             continue;
         };
         last_file.clone_from(path);
-        if let Err(e) = write_stream(path, input, &mut decoder, &mut frames, &mut values) {
+        ifaces = Interfaces::default();
+        if let Err(e) = write_stream(path, input, &mut decoder, &mut ifaces, &mut frames, &mut values) {
             eprintln!("cotui decode: {path}: {e}");
             status = ExitCode::Unavailable;
         }
     }
     let mut end = || -> io::Result<()> {
         for t in decoder.finish() {
-            transaction_row(&mut values, &last_file, &t, decoder.dictionary(t.node))?;
+            transaction_row(
+                &mut values,
+                &last_file,
+                ifaces.name(t.iface),
+                &t,
+                decoder.dictionary(t.node),
+            )?;
         }
         Ok(())
     };
@@ -175,19 +186,25 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
     }
 }
 
-/// Decodes one input into the two tables (parsing runs on a second thread).
+/// Decodes one input into the two tables (parsing runs on a second thread); `names` keeps
+/// up with its interface table.
 fn write_stream(
     path: &str,
     input: Box<dyn BufRead + Send>,
     decoder: &mut Decoder,
+    names: &mut Interfaces,
     frames: &mut Writer,
     values: &mut Writer,
 ) -> io::Result<()> {
     let counts = input::for_each_frame(path, input, |batch| {
         let ifaces = batch.ifaces;
+        for name in ifaces.names().iter().skip(names.names().len()) {
+            names.intern(name);
+        }
         for (line, frame) in batch {
             let d = decoder.decode(frame);
-            frame_row(frames, path, line, frame, ifaces.name(frame.iface), &d)?;
+            let iface = ifaces.name(frame.iface);
+            frame_row(frames, path, line, frame, iface, &d)?;
             if let (Body::Pdo(p), Some(node)) = (&d.body, d.node) {
                 for s in &p.signals {
                     values.row(|r| {
@@ -196,6 +213,7 @@ fn write_stream(
                             .push(Some(V::Str("pdo")))?
                             .push(Some(ts.clone()))?
                             .push(Some(ts))?
+                            .push(Some(V::Str(iface)))?
                             .push(Some(V::I32(node as i32)))?
                             .push(Some(V::I32(s.index as i32)))?
                             .push(Some(V::I32(s.sub as i32)))?
@@ -216,7 +234,7 @@ fn write_stream(
                 }
             }
             for t in decoder.take_transactions() {
-                transaction_row(values, path, &t, decoder.dictionary(t.node))?;
+                transaction_row(values, path, ifaces.name(t.iface), &t, decoder.dictionary(t.node))?;
             }
         }
         Ok(())
@@ -303,11 +321,12 @@ fn frame_row<W: Write + Send>(
     })
 }
 
-/// One row of `values.parquet` for an SDO transaction; the decoded value, name and
-/// abort text are the ones `--transactions --format jsonl` gives.
+/// One row of `values.parquet` for an SDO transaction of interface `iface`; the decoded
+/// value, name and abort text are the ones `--transactions --format jsonl` gives.
 fn transaction_row<W: Write + Send>(
     t: &mut Table<W>,
     file: &str,
+    iface: &str,
     tr: &Transaction,
     dict: &Dictionary,
 ) -> io::Result<()> {
@@ -319,6 +338,7 @@ fn transaction_row<W: Write + Send>(
             .push(Some(V::Str("sdo")))?
             .push(Some(V::I64(ts(tr.end_ns))))?
             .push(Some(V::I64(ts(tr.start_ns))))?
+            .push(Some(V::Str(iface)))?
             .push(Some(V::I32(tr.node as i32)))?
             .push((!partial).then_some(V::I32(tr.index as i32)))?
             .push((!partial).then_some(V::I32(tr.sub as i32)))?
@@ -369,11 +389,11 @@ mod tests {
                 let d = decoder.decode(&f);
                 frame_row(&mut t, "fuzz", i as u64, &f, ifaces.name(0), &d).unwrap();
                 for tr in decoder.take_transactions() {
-                    transaction_row(&mut v, "fuzz", &tr, decoder.dictionary(tr.node)).unwrap();
+                    transaction_row(&mut v, "fuzz", ifaces.name(0), &tr, decoder.dictionary(tr.node)).unwrap();
                 }
             }
             for tr in decoder.finish() {
-                transaction_row(&mut v, "fuzz", &tr, decoder.dictionary(tr.node)).unwrap();
+                transaction_row(&mut v, "fuzz", ifaces.name(0), &tr, decoder.dictionary(tr.node)).unwrap();
             }
             t.finish().unwrap();
             v.finish().unwrap();

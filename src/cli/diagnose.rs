@@ -2,10 +2,9 @@
 //! ranked list of incidents.
 
 use super::input;
-use crate::analysis::{Diagnoser, Incident, Status, diagnose};
+use crate::analysis::trace::{Trace, Views};
+use crate::analysis::{Incident, Status};
 use crate::command::ExitCode;
-use crate::decode::Decoder;
-use crate::frame::Frame;
 use crate::frame::json::write_line;
 use clap::{Args, ValueEnum};
 use std::io::{self, Write};
@@ -49,14 +48,14 @@ pub struct DiagnoseArgs {
 
 /// Runs `cotui diagnose`; returns the exit status.
 pub fn run(args: &DiagnoseArgs) -> ExitCode {
-    let mut decoder = match super::bind::decoder(&args.profiles, &args.eds) {
+    let decoder = match super::bind::decoder(&args.profiles, &args.eds) {
         Ok(d) => d,
         Err(e) => {
             eprintln!("cotui diagnose: {e}");
             return ExitCode::Usage;
         }
     };
-    let mut diag = Diagnoser::new(|n| decoder.dictionary(n));
+    let mut trace = Trace::headless(decoder, Views::Diagnosis);
     if args.duration.is_some() && args.live.is_none() {
         eprintln!("cotui diagnose: --duration needs --live IFACE (a log ends by itself)");
         return ExitCode::Usage;
@@ -69,7 +68,7 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
     }
     let mut status = ExitCode::Ok;
     if let Some(iface) = &args.live
-        && let Err(e) = live::capture(iface, args.duration, &mut decoder, &mut diag)
+        && let Err(e) = live::capture(iface, args.duration, &mut trace)
     {
         eprintln!("cotui diagnose: {e}");
         return ExitCode::Unavailable;
@@ -81,10 +80,11 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
             continue;
         };
         opened = true;
+        trace.new_input();
         let result = input::for_each_frame(path, input, |frames| {
-            let ifaces = frames.ifaces;
+            trace.name_interfaces(frames.ifaces);
             for (_, frame) in frames {
-                feed(&mut decoder, &mut diag, frame, ifaces.name(frame.iface));
+                trace.push(frame);
             }
             Ok(())
         });
@@ -97,9 +97,8 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
         // Nothing was read: a report of "no problems" would be false; the errors are said.
         return status;
     }
-    for t in decoder.finish() {
-        diag.transaction(&t);
-    }
+    trace.end_of_input();
+    let diag = trace.diagnosis;
     let origin = diag.origin_ns();
     let frames = diag.frames();
     let incidents = diag.finish();
@@ -126,35 +125,18 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
     status
 }
 
-/// One frame of interface `iface` into the diagnosis (see [`diagnose::feed`]), with the
-/// SDO transactions it completed.
-fn feed(decoder: &mut Decoder, diag: &mut Diagnoser, frame: &Frame, iface: &str) {
-    let peeked = decoder.peek(frame);
-    if let Some(d) = diagnose::feed(decoder, diag, frame, peeked, iface) {
-        decoder.recycle(d);
-    }
-    for t in decoder.take_transactions() {
-        diag.transaction(&t);
-    }
-}
-
 /// `--live`: the frames of a SocketCAN interface, as they come.
 mod live {
-    use super::{Decoder, Diagnoser, feed};
+    use super::Trace;
     use std::time::Duration;
     use tokio::signal::unix::{SignalKind, signal};
 
     /// How often the capture clock advances on a quiet bus (heartbeats missed by then count).
     const TICK: Duration = Duration::from_millis(100);
 
-    /// Feeds the frames of `iface` (opened listen-only) to the diagnosis until SIGINT or
-    /// SIGTERM, or for `seconds`; the capture clock ends at the bus time then.
-    pub fn capture(
-        iface: &str,
-        seconds: Option<f64>,
-        decoder: &mut Decoder,
-        diag: &mut Diagnoser,
-    ) -> Result<(), String> {
+    /// Feeds the frames of `iface` (opened listen-only) to the diagnosis of `trace` until
+    /// SIGINT or SIGTERM, or for `seconds`; the capture clock ends at the bus time then.
+    pub fn capture(iface: &str, seconds: Option<f64>, trace: &mut Trace) -> Result<(), String> {
         let limit = match seconds {
             Some(s) => {
                 Some(Duration::try_from_secs_f64(s).map_err(|_| format!("--duration {s}: not a number of seconds"))?)
@@ -170,6 +152,8 @@ mod live {
             let (mut int, mut term) = (handler(SignalKind::interrupt())?, handler(SignalKind::terminate())?);
             let bus = crate::connect::open(iface, true).await.map_err(|e| e.to_string())?;
             let mut frames = bus.subscribe();
+            // The bus numbers its one interface 0.
+            trace.ifaces.intern(iface);
             let end = limit.map(|d| tokio::time::Instant::now() + d);
             let mut tick = tokio::time::interval(TICK);
             loop {
@@ -181,12 +165,12 @@ mod live {
                 };
                 tokio::select! {
                     got = frames.recv() => match got {
-                        Ok(f) => feed(decoder, diag, &f, iface),
+                        Ok(f) => trace.push(&f),
                         Err(crate::bus::BusError::Closed) => return Err(format!("{iface}: the bus was closed")),
                         // The interface went down or away: said, and the capture goes on.
                         Err(e) => eprintln!("cotui diagnose: {e}"),
                     },
-                    _ = tick.tick() => diag.tick(bus.now_ns()),
+                    _ = tick.tick() => trace.tick(bus.now_ns()),
                     _ = int.recv() => break,
                     _ = term.recv() => break,
                     _ = deadline => break,
@@ -194,9 +178,9 @@ mod live {
             }
             // Frames the kernel still holds are part of the capture.
             while let Some(Ok(f)) = frames.try_recv() {
-                feed(decoder, diag, &f, iface);
+                trace.push(&f);
             }
-            diag.tick(bus.now_ns());
+            trace.tick(bus.now_ns());
             Ok(())
         })
     }

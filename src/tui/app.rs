@@ -680,12 +680,12 @@ impl App {
         let keys = self.trace.series.keys();
         match done[..] {
             [] => {
-                let nodes: BTreeSet<u8> = keys.iter().map(|k| k.0).collect();
+                let nodes: BTreeSet<u8> = keys.iter().map(|k| k.0.node).collect();
                 nodes.iter().map(u8::to_string).collect()
             }
             [node] => keys
                 .iter()
-                .filter(|k| node.parse() == Ok(k.0))
+                .filter(|k| node.parse() == Ok(k.0.node))
                 .map(|k| format!("{:04X}:{:02X}", k.1, k.2))
                 .collect(),
             _ => Vec::new(),

@@ -290,3 +290,21 @@ fn parquet_needs_an_output_path_and_a_file_name_layout() {
     assert_eq!(got["ts"][0][1], "2023-11-14 22:13:20.018000");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_value_row_names_the_interface_of_its_node() {
+    // tests/fixtures/two_buses.log: a read of node 2 on can0 never answered, its answer
+    // seen on can1 only; two transfers of two nodes 2.
+    let log = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/two_buses.log");
+    let dir = std::env::temp_dir().join(format!("cotui-parquet-ifaces-{}", std::process::id()));
+    cotui(&["--format", "parquet", "-o", dir.to_str().unwrap()], &log);
+    let got = duckdb(
+        &dir,
+        &[(
+            "sdo",
+            "SELECT iface, node, outcome FROM 'DIR/values.parquet' WHERE source='sdo' ORDER BY iface".into(),
+        )],
+    );
+    assert_eq!(got["sdo"], json!([["can0", 2, "incomplete"], ["can1", 2, "ok"]]));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

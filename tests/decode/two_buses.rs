@@ -117,3 +117,54 @@ fn a_capture_of_one_interface_prints_no_interface() {
     ]);
     assert!(!json.contains("\"iface\""), "{json}");
 }
+
+/// The capture, then a read of node 5's heartbeat period (0x1017) on each bus, answered
+/// 100 ms on can0 and 200 ms on can1, through a trace keeping every view (the TUI's).
+fn trace_with_reads() -> cotui::analysis::trace::Trace {
+    use cotui::decode::Decoder;
+    let log = std::fs::read_to_string(LOG).unwrap();
+    let reads = [
+        "(1700000112.000000) can0 605#4017100000000000",
+        "(1700000112.001000) can0 585#4B17100064000000",
+        "(1700000112.002000) can1 605#4017100000000000",
+        "(1700000112.003000) can1 585#4B171000C8000000",
+    ];
+    let mut trace = cotui::analysis::trace::Trace::new(Decoder::new(Default::default(), Vec::new()), 500_000);
+    for line in log.lines().chain(reads) {
+        let parsed = cotui::log::candump::parse_line(line.as_bytes(), &mut trace.ifaces);
+        if let Ok(cotui::log::Line::Frame(f)) = parsed {
+            trace.push(&f);
+        }
+    }
+    trace
+}
+
+#[test]
+fn values_and_series_of_node_5_on_each_bus_are_kept_apart() {
+    use cotui::frame::NodeKey;
+    let trace = trace_with_reads();
+    let (can0, can1) = (NodeKey::new(0, 5), NodeKey::new(1, 5));
+    assert_eq!(trace.ifaces.name(1), "can1");
+    let last = |node| {
+        let e = trace.values.get(node, 0x1017, 0).and_then(|e| e.last.as_ref());
+        e.map(|s| s.value.clone())
+    };
+    // (The default dictionary does not type 0x1017: the bytes as read.)
+    assert_eq!(last(can0), Some(cotui::od::Value::Bytes(vec![100, 0])));
+    assert_eq!(last(can1), Some(cotui::od::Value::Bytes(vec![200, 0])));
+    assert_eq!(trace.values.node(can0).count(), 1);
+    let values = |node| {
+        let line = trace.series.get(&(node, 0x1017, 0));
+        line.map(|l| l.points.iter().map(|p| p.1).collect::<Vec<f64>>())
+    };
+    assert_eq!(values(can0), Some(vec![100.0]));
+    assert_eq!(values(can1), Some(vec![200.0]));
+    let fives: Vec<NodeKey> = trace
+        .series
+        .keys()
+        .into_iter()
+        .map(|k| k.0)
+        .filter(|k| k.node == 5)
+        .collect();
+    assert_eq!(fives, [can0, can1]);
+}

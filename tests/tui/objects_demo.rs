@@ -5,12 +5,16 @@
 
 use cotui::analysis::trace::Trace;
 use cotui::decode::Decoder;
+use cotui::frame::NodeKey;
 use cotui::tui::app::{App, SourceInfo, SourceKind};
 use cotui::tui::keymap::Keymap;
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::Terminal;
 use ratatui::backend::TestBackend;
 use std::time::{Duration, Instant};
+
+/// The demo's drive: node 2 of its one bus.
+const NODE2: NodeKey = NodeKey::new(0, 2);
 
 fn key(a: &mut App, code: KeyCode) {
     a.key(KeyEvent::new(code, KeyModifiers::NONE));
@@ -91,7 +95,7 @@ fn objects_pane_reads_an_object_of_a_demo_drive_and_prefills_its_write() {
     let s = until(&mut a, "the value read", |a, _| {
         a.trace
             .values
-            .get(2, 0x6060, 0)
+            .get(NODE2, 0x6060, 0)
             .and_then(|e| e.last.as_ref())
             .is_some_and(|s| s.via == cotui::analysis::values::Via::Upload)
     });
@@ -103,7 +107,7 @@ fn objects_pane_reads_an_object_of_a_demo_drive_and_prefills_its_write() {
     let shown = a
         .trace
         .values
-        .get(2, 0x6060, 0)
+        .get(NODE2, 0x6060, 0)
         .and_then(|e| e.text(a.trace.decoder().dictionary(2), 0x6060, 0))
         .unwrap();
     assert!(row.contains(&shown), "{row} / {shown}");
@@ -111,7 +115,7 @@ fn objects_pane_reads_an_object_of_a_demo_drive_and_prefills_its_write() {
     let raw = a
         .trace
         .values
-        .get(2, 0x6060, 0)
+        .get(NODE2, 0x6060, 0)
         .unwrap()
         .last
         .as_ref()
@@ -222,7 +226,7 @@ fn read_all_reads_what_drive_2_has_with_progress_and_lists_the_failures() {
     }
     // Every identity entry was read, and the drive's own objects.
     for (i, s) in [(0x1000, 0), (0x1018, 1), (0x1018, 2), (0x6060, 0), (0x2002, 1)] {
-        let e = a.trace.values.get(2, i, s).and_then(|e| e.last.as_ref());
+        let e = a.trace.values.get(NODE2, i, s).and_then(|e| e.last.as_ref());
         assert!(e.is_some(), "0x{i:04X}:{s:02X} read\n{summary}");
     }
 }

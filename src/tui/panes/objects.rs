@@ -185,6 +185,12 @@ fn matches(query: &str, index: u16, sub: Option<u8>, name: &str, alias: Option<&
     at.starts_with(q) || name.to_lowercase().contains(query) || alias.is_some_and(|a| a.to_lowercase().contains(query))
 }
 
+/// The node `node` of the bus the pane reads and writes (the first interface): the one
+/// whose last values it shows.
+fn bus_node(node: u8) -> crate::frame::NodeKey {
+    crate::frame::NodeKey::new(0, node)
+}
+
 /// A read-all in progress.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct ReadAll {
@@ -313,7 +319,7 @@ impl ObjectsPane {
         let seen: BTreeSet<u16> = ctx
             .trace
             .values
-            .node(node)
+            .node(bus_node(node))
             .map(|((i, _), _)| i)
             .filter(|i| in_range(dict.layers(), *i))
             .collect();
@@ -448,7 +454,11 @@ impl ObjectsPane {
                 access_word(info.access)
             ));
         }
-        let last = ctx.trace.values.get(node, index, sub).and_then(|e| e.last.as_ref());
+        let last = ctx
+            .trace
+            .values
+            .get(bus_node(node), index, sub)
+            .and_then(|e| e.last.as_ref());
         let value = last
             .map(|s| &s.value)
             .or(info.default.as_ref())
@@ -621,7 +631,7 @@ impl ObjectsPane {
             }
             Row::Entry { index, sub, child } => {
                 let info = dict.object(index, sub);
-                let entry = ctx.trace.values.get(node, index, sub);
+                let entry = ctx.trace.values.get(bus_node(node), index, sub);
                 let (value, style) = self.value_cell(node, index, sub, entry, dict);
                 let age = entry
                     .and_then(|e| e.last.as_ref())

@@ -29,6 +29,7 @@ pub fn candidates(trace: &Trace) -> Vec<Candidate> {
         .keys()
         .into_iter()
         .map(|key @ (node, index, sub)| {
+            let node = node.node;
             let dict = trace.decoder().dictionary(node);
             let name = dict
                 .name(index, sub)
@@ -161,10 +162,11 @@ impl SignalPicker {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::frame::NodeKey;
 
     fn c(node: u8, index: u16, text: &str) -> Candidate {
         Candidate {
-            key: (node, index, 0),
+            key: (NodeKey::new(0, node), index, 0),
             text: text.into(),
         }
     }
@@ -178,10 +180,11 @@ mod tests {
             c(1, 0x606C, "node 1   606C:00  Velocity actual value [rpm]"),
         ];
         let keys = |q: &str| -> Vec<SeriesKey> { matching(q, all.clone()).iter().map(|c| c.key).collect() };
-        assert_eq!(keys("stw"), [(1, 0x6041, 0), (2, 0x6041, 0)]);
-        assert_eq!(keys("stw node 2"), [(2, 0x6041, 0)]);
-        assert_eq!(keys("rpm"), [(1, 0x606C, 0)]);
-        assert_eq!(keys("606c"), [(1, 0x606C, 0)]);
+        let n = |node| NodeKey::new(0, node);
+        assert_eq!(keys("stw"), [(n(1), 0x6041, 0), (n(2), 0x6041, 0)]);
+        assert_eq!(keys("stw node 2"), [(n(2), 0x6041, 0)]);
+        assert_eq!(keys("rpm"), [(n(1), 0x606C, 0)]);
+        assert_eq!(keys("606c"), [(n(1), 0x606C, 0)]);
         assert_eq!(keys("zz"), Vec::<SeriesKey>::new());
         assert_eq!(keys("").len(), 4);
     }

@@ -80,11 +80,18 @@ impl PlotPane {
         self.signals = shown;
     }
 
-    /// Shows only the series of `node` `index`:`sub`; false when no such series was seen.
+    /// Shows only the series of `node` `index`:`sub` (of every interface with such a
+    /// node); false when no such series was seen.
     pub fn select(&mut self, trace: &Trace, node: u8, index: u16, sub: u8) -> bool {
-        let ok = trace.series.get(&(node, index, sub)).is_some();
+        let keys: Vec<SeriesKey> = trace
+            .series
+            .keys()
+            .into_iter()
+            .filter(|k| (k.0.node, k.1, k.2) == (node, index, sub))
+            .collect();
+        let ok = !keys.is_empty();
         if ok {
-            self.signals = vec![(node, index, sub)];
+            self.signals = keys;
         }
         ok
     }
@@ -259,12 +266,12 @@ fn render(p: &PlotPane, trace: &Trace, f: &mut Frame, area: Rect, focused: bool)
         .enumerate()
         .filter_map(|(i, key)| {
             let line = trace.series.get(&key)?;
-            let dict = trace.decoder().dictionary(key.0);
+            let dict = trace.decoder().dictionary(key.0.node);
             Some(Shown {
                 key,
                 line,
                 info: dict.object(key.1, key.2),
-                name: format!("n{} {}", key.0, dict.name(key.1, key.2).unwrap_or(&line.name)),
+                name: format!("n{} {}", key.0.node, dict.name(key.1, key.2).unwrap_or(&line.name)),
                 color: COLORS[i % COLORS.len()],
             })
         })

@@ -526,7 +526,11 @@ fn plot_picker_filters_signals_as_the_user_types() {
 fn plot_shows_signals_on_one_axis_with_units_legend_and_bit_lanes() {
     // The statusword is shown first; the picker adds the velocity and the mode.
     let (a, s) = plot_screen("pvel\npmodes\n", 160, 48);
-    assert_eq!(a.panes.plot.signals, [(1, 0x6041, 0), (1, 0x6044, 0), (1, 0x6061, 0)]);
+    let n1 = crate::frame::NodeKey::new(0, 1);
+    assert_eq!(
+        a.panes.plot.signals,
+        [(n1, 0x6041, 0), (n1, 0x6044, 0), (n1, 0x6061, 0)]
+    );
     assert!(s.contains("Plot: 3 of 3 signals"), "{s}");
     assert!(s.contains("n1 vl velocity actual value [rpm]"), "legend: {s}");
     assert!(s.contains("rpm"), "unit on the axis: {s}");
