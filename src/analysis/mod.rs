@@ -16,7 +16,6 @@ pub mod search;
 pub mod series;
 pub mod stats;
 pub mod store;
-mod texts;
 pub mod timing;
 pub mod trace;
 pub mod transfers;

@@ -415,7 +415,7 @@ fn second_master_from_segment_toggles_and_nmt_start_then_reset() {
     // A segment request with toggle bit 0 again 2 ms after the node answered the one with
     // toggle bit 0 (#7; the node aborts: toggle bit not alternated), and NMT reset node 2
     // 10 ms after NMT start node 2 (#11). (The near misses, a retry long after and a
-    // selection of nodes, are unit tests of src/analysis/diagnose.rs.)
+    // selection of nodes, are unit tests of src/analysis/diagnose/tests.rs.)
     let inc = golden("second_master_segments");
     assert_eq!(
         summary(&inc),

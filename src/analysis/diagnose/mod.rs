@@ -1,0 +1,505 @@
+//! The incident builder: decoded frames, SDO transactions and bus events in, a short
+//! ranked list of [`Incident`]s out. Pure: time only comes from frame timestamps.
+//!
+//! What it finds: nodes that never answer (missing), heartbeats that stop (for good, or
+//! for a while), unexpected reboots, refused SDO transfers (grouped per object), SDO
+//! requests left unanswered, CiA 402 faults with their cause (EMCY, 0x603F) and the fault
+//! resets that followed, EMCY not tied to a fault, CAN error frames and controller states,
+//! duplicate node-IDs (boot-ups close together, conflicting heartbeat states) and NMT
+//! commands a node did not follow.
+//!
+//! [`Diagnoser`] is the facade: it routes each frame, transaction and event to the
+//! detectors concerned, one module per kind of incident ([`heartbeat`], [`boot`], [`sdo`],
+//! [`masters`], [`drive`], [`emcy`], [`pdo`], [`sync`], [`bus`]), in a fixed order (the
+//! incidents' order depends on it). They share the clock, the node table and the incident
+//! book ([`timeline`]); the words of each kind are a table ([`texts`]).
+
+mod boot;
+mod bus;
+mod drive;
+mod emcy;
+mod heartbeat;
+mod masters;
+mod pdo;
+mod sdo;
+mod sync;
+mod texts;
+mod timeline;
+
+use super::events::{Event, What};
+use super::incident::{Incident, Problem};
+use super::liveness::EventTracker;
+use crate::decode::sdo::frame::SdoFrame;
+use crate::decode::{Body, Decoded, Decoder, Kind};
+use crate::frame::{Flags, Frame, NodeKey};
+use crate::od::{Dictionary, PdoMapping};
+use crate::sdo::transaction::{Outcome, Transaction, TransferDirection};
+use timeline::{At, Timeline};
+
+/// What every detector does as the capture goes on and when it ends (the frames each one
+/// reads, the facade hands it by their kind).
+trait Detector {
+    /// The capture clock reached `now` (ns), at a frame or a tick: what is overdue by then.
+    fn tick(&mut self, _tl: &mut Timeline, _now: u64) {}
+    /// A completed SDO transfer, right after the frame that ended it.
+    fn transaction(&mut self, _tl: &mut Timeline, _t: &Transaction) {}
+    /// The capture ended at `end`: what the detector holds for the whole bus.
+    fn end(&mut self, _tl: &mut Timeline, _end: At) {}
+    /// The capture ended at `end`: what the detector holds for node `n`.
+    fn end_node(&mut self, _tl: &mut Timeline, _n: NodeKey, _end: At) {}
+}
+
+/// The value of an SDO transfer's data (the first 4 bytes, little-endian).
+fn value(t: &Transaction) -> u32 {
+    t.data.iter().take(4).rev().fold(0u32, |a, b| a << 8 | u32::from(*b))
+}
+
+/// Builds incidents from the frames of one capture, in order. Incremental: frames go in
+/// one at a time ([`Diagnoser::frame`], [`Diagnoser::skip`]), the capture clock advances
+/// on a quiet bus with [`Diagnoser::tick`], and [`Diagnoser::incidents`] tells what is
+/// wrong so far without ending the capture.
+#[derive(Clone)]
+pub struct Diagnoser {
+    tracker: EventTracker,
+    tl: Timeline,
+    /// Interfaces seen so far: their nodes got the dictionaries' defaults.
+    ifaces_seen: u16,
+    heartbeats: heartbeat::Heartbeats,
+    boots: boot::Boots,
+    sdos: sdo::Sdos,
+    masters: masters::Masters,
+    drives: drive::Drives,
+    emcys: emcy::Emcys,
+    pdos: pdo::Pdos,
+    syncs: sync::Syncs,
+    bus: bus::Bus,
+}
+
+/// One frame of interface `iface` into the diagnosis, decoded only as far as it can tell
+/// the diagnosis something (SDO frames tracked without labels, SYNC, TIME, LSS, unknown
+/// COB-IDs and PDOs that [`Diagnoser::wants_pdo`] declines only routed). Returns the
+/// frame's full decoding when it made one. The SDO transactions the frame completed stay
+/// in the decoder: the caller takes them ([`Decoder::take_transactions`]) and hands them
+/// to [`Diagnoser::transaction`]. `peeked` is what [`Decoder::peek`] says of the frame.
+pub fn feed(
+    decoder: &mut Decoder,
+    diag: &mut Diagnoser,
+    frame: &Frame,
+    peeked: (Kind, Option<u8>, u16),
+    iface: &str,
+) -> Option<Decoded> {
+    let (kind, node, pdo) = peeked;
+    diag.name_interface(frame.iface, iface);
+    let skip = match kind {
+        Kind::Sync | Kind::Time | Kind::Lss | Kind::Other => true,
+        Kind::SdoRx | Kind::SdoTx => {
+            let s = decoder.sdo_frame(frame);
+            diag.sdo(frame, node.unwrap_or(0), kind == Kind::SdoRx, s.as_ref());
+            return None;
+        }
+        Kind::Tpdo | Kind::Rpdo => {
+            let n = NodeKey::of(frame, node.unwrap_or(0));
+            !diag.wants_pdo(n, pdo, decoder.mapping(n, kind == Kind::Tpdo, pdo))
+        }
+        _ => false,
+    };
+    if skip {
+        diag.skip(frame, kind, node, pdo);
+        return None;
+    }
+    let d = decoder.decode(frame);
+    diag.frame(frame, iface, &d);
+    Some(d)
+}
+
+impl Diagnoser {
+    /// A builder for nodes that use `dict(node)`: their default heartbeat periods (0x1017),
+    /// sync windows (0x1007) and TPDO transmission types (0x1800.. sub 2) hold until the
+    /// bus shows other values.
+    pub fn new<'a>(dict: impl Fn(u8) -> &'a Dictionary) -> Diagnoser {
+        let mut d = Diagnoser {
+            tracker: EventTracker::new(&dict),
+            tl: Timeline::default(),
+            ifaces_seen: 0,
+            heartbeats: Default::default(),
+            boots: Default::default(),
+            sdos: Default::default(),
+            masters: Default::default(),
+            drives: Default::default(),
+            emcys: Default::default(),
+            pdos: Default::default(),
+            syncs: Default::default(),
+            bus: Default::default(),
+        };
+        // Unbound nodes share one dictionary: each distinct one is read once.
+        let mut seen: Vec<(Vec<*const crate::od::Profile>, pdo::SyncDefaults)> = Vec::new();
+        for n in 1..128u8 {
+            let dict = dict(n);
+            let layers: Vec<_> = dict.layers().iter().map(std::sync::Arc::as_ptr).collect();
+            let known = match seen.iter().position(|(l, _)| *l == layers) {
+                Some(i) => i,
+                None => {
+                    seen.push((layers, pdo::sync_defaults(dict)));
+                    seen.len() - 1
+                }
+            };
+            d.pdos.add_defaults(n, &seen[known].1);
+        }
+        d.pdos.apply_defaults(0);
+        d.ifaces_seen = 1;
+        d
+    }
+
+    /// Names interface `iface` (as the frames of the source call it); a node of a capture
+    /// with several interfaces is then shown with its interface's name.
+    pub fn name_interface(&mut self, iface: u16, name: &str) {
+        let names = &mut self.tl.iface_names;
+        let i = iface as usize;
+        if i >= names.len() {
+            names.resize(i + 1, String::new());
+        }
+        if names[i].is_empty() {
+            names[i] = name.to_string();
+        }
+    }
+
+    /// Time of the first frame (ns): the origin of the times in the report.
+    pub fn origin_ns(&self) -> u64 {
+        self.tl.first_ns.unwrap_or(0)
+    }
+
+    /// Frames seen so far.
+    pub fn frames(&self) -> u64 {
+        self.tl.at.frame
+    }
+
+    /// The tracker's events, if any (checked per frame: most frames make none).
+    #[inline]
+    fn take_events(&mut self) {
+        if self.tracker.pending() > 0 {
+            for e in self.tracker.take_events() {
+                self.event(&e);
+            }
+        }
+    }
+
+    /// Frame number and time advance to `frame`'s.
+    #[inline]
+    fn advance(&mut self, frame: &Frame) {
+        self.tl.iface = frame.iface;
+        if frame.iface >= self.ifaces_seen {
+            self.new_interfaces(frame.iface);
+        }
+        self.tl.at = At {
+            frame: self.tl.at.frame + 1,
+            t: frame.ts_ns,
+        };
+        self.tl.first_ns.get_or_insert(frame.ts_ns);
+        self.clock(frame.ts_ns);
+    }
+
+    /// The detectors that watch the clock learn it reached `now`.
+    #[inline]
+    fn clock(&mut self, now: u64) {
+        self.sdos.tick(&mut self.tl, now);
+        self.pdos.tick(&mut self.tl, now);
+    }
+
+    /// Interfaces up to `iface` are seen: their nodes get the dictionaries' defaults.
+    #[cold]
+    fn new_interfaces(&mut self, iface: u16) {
+        for i in self.ifaces_seen..=iface {
+            self.pdos.apply_defaults(i);
+        }
+        self.ifaces_seen = iface.saturating_add(1);
+    }
+
+    /// True when a PDO of `node` can tell the diagnosis something: its `mapping` holds a
+    /// CiA 402 controlword, statusword or error code, or (mapping unknown) it is the
+    /// predefined TPDO1/RPDO1 of a CiA 402 device. Other PDOs need no decoding.
+    pub fn wants_pdo(&self, node: NodeKey, num: u16, mapping: Option<&PdoMapping>) -> bool {
+        match mapping {
+            Some(m) => drive::maps_drive_words(m),
+            None => num == 1 && self.tl.nodes.get(&node).is_some_and(|d| d.cia402),
+        }
+    }
+
+    /// A frame left undecoded (SYNC, TIME, LSS, unknown COB-IDs, PDOs that
+    /// [`Diagnoser::wants_pdo`] declines): time and frame number advance, and a TPDO
+    /// still shows that its node is there.
+    /// `pdo` is the PDO number (from [`crate::decode::Decoder::peek`]), 0 for other frames.
+    pub fn skip(&mut self, frame: &Frame, kind: Kind, node: Option<u8>, pdo: u16) {
+        self.advance(frame);
+        self.tracker.tick(frame.ts_ns);
+        self.take_events();
+        let node = node.map(|n| NodeKey::of(frame, n));
+        match (kind, node) {
+            (Kind::Sync, _) => self.syncs.sync(&self.tl),
+            (Kind::Tpdo | Kind::Rpdo, Some(n)) => {
+                self.pdos
+                    .arrived(&mut self.tl, n, kind == Kind::Tpdo, pdo, self.syncs.last)
+            }
+            _ => {}
+        }
+        if let (Kind::Tpdo, Some(n)) = (kind, node) {
+            let at = self.tl.at;
+            let node = self.tl.node(n);
+            node.heard = true;
+            node.last_any = Some(at);
+        }
+    }
+
+    /// One frame, in capture order, with its decoding; `iface` names its interface.
+    pub fn frame(&mut self, frame: &Frame, iface: &str, d: &Decoded) {
+        self.name_interface(frame.iface, iface);
+        self.advance(frame);
+        self.tracker.frame(frame, iface, d);
+        self.take_events();
+        let Some(n) = d.node else {
+            if d.kind == Kind::Sync {
+                self.syncs.sync(&self.tl);
+            }
+            if let Body::Nmt(nmt) = &d.body {
+                self.nmt(nmt.cs, nmt.target);
+            }
+            if d.kind == Kind::ErrorFrame {
+                self.bus.error_frame(&mut self.tl, &d.label);
+            }
+            return;
+        };
+        let n = NodeKey::of(frame, n);
+        let at = self.tl.at;
+        let tl = &mut self.tl;
+        if matches!(d.kind, Kind::Tpdo | Kind::SdoTx | Kind::Emcy)
+            || matches!(&d.body, Body::Heartbeat(h) if !h.request)
+        {
+            tl.node(n).last_any = Some(at);
+        }
+        if matches!(&d.body, Body::Heartbeat(h) if h.request) {
+            tl.node(n).beat.guarded = true;
+        }
+        match &d.body {
+            Body::Heartbeat(h) if !h.request => {
+                tl.node(n).heard = true;
+                if let Some(s) = h.state {
+                    self.heartbeats.heartbeat(tl, n, s);
+                    self.boots.heartbeat(tl, n, s);
+                }
+            }
+            Body::Emcy(e) => {
+                tl.node(n).heard = true;
+                self.emcys.emcy(tl, n, e);
+            }
+            Body::Sdo(s) => self.sdos.frame(tl, n, s, frame.flags.has(Flags::TX)),
+            Body::Pdo(p) => {
+                if p.transmit {
+                    tl.node(n).heard = true;
+                }
+                self.pdos.arrived(tl, n, p.transmit, p.num, self.syncs.last);
+                let mut words = Vec::new();
+                for s in &p.signals {
+                    let Some(v) = s.value.as_i64() else { continue };
+                    words.push((s.index, v as u16));
+                }
+                if p.signals.is_empty() && p.num == 1 && tl.node(n).cia402 && frame.payload().len() >= 2 {
+                    // CiA 402 predefined mapping: TPDO1 starts with the statusword, RPDO1
+                    // with the controlword.
+                    let w = u16::from_le_bytes([frame.payload()[0], frame.payload()[1]]);
+                    words.push((if p.transmit { 0x6041 } else { 0x6040 }, w));
+                }
+                for (index, w) in words {
+                    self.drives.word(tl, &mut self.emcys, n, index, w);
+                }
+            }
+            _ => {
+                if matches!(d.kind, Kind::Tpdo | Kind::SdoTx) {
+                    tl.node(n).heard = true;
+                }
+            }
+        }
+    }
+
+    /// An SDO frame of node `n` read by [`crate::decode::Decoder::sdo_frame`] (None: a
+    /// vendor command of the node's profile): the cheap twin of [`Diagnoser::frame`] for
+    /// SDO frames, which needs no label. `to_node` tells a client request.
+    pub fn sdo(&mut self, frame: &Frame, n: u8, to_node: bool, s: Option<&SdoFrame>) {
+        let n = NodeKey::of(frame, n);
+        self.advance(frame);
+        self.tracker.tick(frame.ts_ns);
+        self.take_events();
+        if !to_node {
+            let at = self.tl.at;
+            let node = self.tl.node(n);
+            node.last_any = Some(at);
+            node.heard = true;
+        }
+        if let Some(s) = s {
+            self.sdos.frame(&mut self.tl, n, s, frame.flags.has(Flags::TX));
+        }
+    }
+
+    /// An NMT command (specifier `cs`) to `target` (0: all nodes).
+    fn nmt(&mut self, cs: u8, target: u8) {
+        let Some((command, state)) = boot::nmt_command(cs) else {
+            return;
+        };
+        if cs != 0x01 {
+            self.pdos.pause(self.tl.iface, (target != 0).then_some(target));
+        }
+        self.masters.nmt(&mut self.tl, cs, target, command);
+        self.boots.command(&mut self.tl, command, state, target);
+    }
+
+    /// A bus event of the liveness tracker.
+    fn event(&mut self, e: &Event) {
+        let tl = &mut self.tl;
+        let Some(n) = e.key() else {
+            if let What::BusState { iface, to, detail, .. } = &e.what {
+                self.bus.state(tl, iface, to, detail, e.t_ns);
+            }
+            return;
+        };
+        let at = At {
+            frame: tl.at.frame,
+            t: e.t_ns,
+        };
+        match &e.what {
+            What::HeartbeatLost { silent_ms, .. } => self.heartbeats.lost(tl, n, at, *silent_ms),
+            What::HeartbeatBack { silent_ms } => self.heartbeats.back(tl, n, at, *silent_ms),
+            What::BootUp { rebooted, .. } => {
+                self.pdos.pause(n.iface, Some(n.node));
+                self.boots.boot_up(tl, n, at, *rebooted);
+            }
+            _ => {}
+        }
+    }
+
+    /// A completed SDO transfer (in order, right after the frame that ended it).
+    pub fn transaction(&mut self, t: &Transaction) {
+        self.tracker.transaction(t);
+        self.take_events();
+        let tl = &mut self.tl;
+        if t.outcome == Outcome::Ok && !t.data.is_empty() {
+            let v = value(t);
+            if (t.index, t.sub, t.direction) == (0x1000, 0, TransferDirection::Upload) {
+                tl.node(t.key()).cia402 = v & 0xFFFF == 402;
+            }
+            if t.sub == 0 {
+                self.drives.word(tl, &mut self.emcys, t.key(), t.index, v as u16);
+            }
+        }
+        let detectors: [&mut dyn Detector; 3] = [&mut self.pdos, &mut self.heartbeats, &mut self.sdos];
+        for d in detectors {
+            d.transaction(tl, t);
+        }
+    }
+
+    /// The capture clock reached `now_ns` with no frame since the last one (a quiet bus in
+    /// a live capture or a running replay): heartbeats and SDO answers overdue by then are
+    /// missed.
+    pub fn tick(&mut self, now_ns: u64) {
+        if now_ns <= self.tl.now.max(self.tl.at.t) {
+            return;
+        }
+        self.tl.now = now_ns;
+        self.tracker.tick(now_ns);
+        self.take_events();
+        self.clock(now_ns);
+    }
+
+    /// The incidents so far, ranked as [`Diagnoser::finish`] ranks them, as if the capture
+    /// ended now (the builder goes on).
+    pub fn incidents(&self) -> Vec<Incident> {
+        self.clone().finish()
+    }
+
+    /// The end of the capture: what is still wrong is open. Returns the incidents ranked,
+    /// open first, then recovered, then warnings; each by time.
+    pub fn finish(mut self) -> Vec<Incident> {
+        let end = At {
+            t: self.tl.at.t.max(self.tl.now),
+            ..self.tl.at
+        };
+        self.tracker.tick(end.t);
+        self.take_events();
+        let tl = &mut self.tl;
+        let bus: [&mut dyn Detector; 4] = [&mut self.sdos, &mut self.pdos, &mut self.syncs, &mut self.bus];
+        for d in bus {
+            d.end(tl, end);
+        }
+        let nodes: Vec<NodeKey> = tl.nodes.keys().copied().collect();
+        for n in nodes {
+            let per_node: [&mut dyn Detector; 4] =
+                [&mut self.emcys, &mut self.heartbeats, &mut self.drives, &mut self.sdos];
+            for d in per_node {
+                d.end_node(tl, n, end);
+            }
+        }
+        for (i, inc) in tl.incidents.iter_mut().enumerate() {
+            let facts = texts::Facts {
+                resets: self.drives.resets(i),
+                emcy: self.emcys.fault_code(i),
+                error_frames: self.bus.error_frames,
+                sdo: self.sdos.aborts(i),
+            };
+            texts::fill(inc, &facts);
+            // The device's own steps for its EMCY code come first.
+            if let Some(steps) = self.emcys.device_check(i) {
+                inc.check.splice(0..0, steps.iter().cloned());
+            }
+        }
+        // A PDO that stops because its node went silent for good is part of that silence.
+        let gone: Vec<Option<NodeKey>> = tl
+            .incidents
+            .iter()
+            .filter(|i| i.problem == Problem::Silent)
+            .map(Incident::key)
+            .collect();
+        tl.incidents
+            .retain(|i| !(i.problem == Problem::PdoMissing && gone.contains(&i.key())));
+        let mut out = merge_faults(std::mem::take(&mut tl.incidents));
+        for inc in &mut out {
+            inc.events.sort_by_key(|e| e.frame);
+        }
+        out.retain(|i| i.count > 0 || !i.events.is_empty());
+        out.sort_by_key(|i| (i.status, i.first_ns));
+        // Nodes on several interfaces: each node is shown with its interface's name.
+        let first = tl.nodes.keys().next().map(|k| k.iface);
+        if tl.nodes.keys().any(|k| Some(k.iface) != first) {
+            for inc in out.iter_mut().filter(|i| i.node.is_some()) {
+                inc.iface_name = tl
+                    .iface_names
+                    .get(inc.iface as usize)
+                    .filter(|n| !n.is_empty())
+                    .cloned();
+            }
+        }
+        out
+    }
+}
+
+/// Drive faults of one node and axes with the same title become one incident with a count.
+fn merge_faults(all: Vec<Incident>) -> Vec<Incident> {
+    let mut out: Vec<Incident> = Vec::with_capacity(all.len());
+    for inc in all {
+        if inc.problem == Problem::DriveFault
+            && let Some(prev) = out.iter_mut().find(|p| {
+                p.problem == Problem::DriveFault && p.key() == inc.key() && p.axes == inc.axes && p.cause == inc.cause
+            })
+        {
+            prev.count += inc.count;
+            prev.last_ns = inc.last_ns;
+            prev.status = inc.status;
+            prev.title = inc.title;
+            for s in inc.events {
+                prev.step(s.frame, s.t_ns, s.text);
+            }
+            continue;
+        }
+        out.push(inc);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests;
