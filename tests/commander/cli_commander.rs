@@ -84,13 +84,11 @@ fn drive_enable_and_failure_reason() {
     let (rc, v, _) = cotui_json(&["drive", "demo", "2", "status", "--json"]);
     assert_eq!((rc, v["state"].as_str()), (0, Some("switch_on_disabled")));
     let (rc, v, _) = cotui_json(&["drive", "demo", "9", "enable", "--json", "--timeout", "200"]);
-    assert_eq!(rc, 5);
-    assert!(
-        v["reason"]
-            .as_str()
-            .unwrap()
-            .starts_with("no SDO answer and no heartbeat from node 9"),
-        "{v}"
+    assert_eq!((rc, v["error"].as_str()), (4, Some("timeout")), "{v}");
+    assert_eq!(
+        v["message"],
+        "drive 9: read statusword failed: no SDO answer and no heartbeat from node 9: \
+         check the node id, bitrate, wiring and power"
     );
 }
 
