@@ -108,7 +108,7 @@ pub fn bindings_for_demo(
     for (node, mut layer) in sim.pdo_layers() {
         // The layer is the device's configuration; it goes by the profile bound to the node.
         layer.name = b.dictionary(node).profile_name().to_string();
-        b.bind_layer(node, layer);
+        b.bind_config(node, layer);
     }
     Ok(b)
 }

@@ -221,6 +221,12 @@ pub fn run_open(args: &OpenArgs) -> ExitCode {
     )
 }
 
+/// `x` as typed when it is short, else in scientific notation (`1e-300`, not 300 digits).
+fn short_number(x: f64) -> String {
+    let plain = x.to_string();
+    if plain.len() <= 12 { plain } else { format!("{x:e}") }
+}
+
 /// Runs `cotui replay`.
 pub fn run_replay(args: &ReplayArgs) -> ExitCode {
     if let Err(code) = check_file(&args.file) {
@@ -229,7 +235,7 @@ pub fn run_replay(args: &ReplayArgs) -> ExitCode {
     if !source::valid_speed(args.speed) {
         eprintln!(
             "cotui replay: --speed {} is out of range: 0 (as fast as possible) or 0.01 to 1000",
-            args.speed
+            short_number(args.speed)
         );
         return ExitCode::Usage;
     }

@@ -248,7 +248,12 @@ pub async fn drive(bus: &Bus, node: u8, action: DriveAction, timeout_ms: u64) ->
         Err(CommandError::Timeout(_)) => {
             // Give heartbeats a moment to tell whether the node is there at all.
             tokio::time::sleep(Duration::from_millis(timeout_ms.min(1500))).await;
-            return Err(failure(bus, &mut w, &probe, timeout_ms).await);
+            let e = failure(bus, &mut w, &probe, timeout_ms).await;
+            // Neither SDO nor heartbeat: no such node, a timeout as for `sdo read` (exit 4).
+            return Err(match w.obs.nmt {
+                None => CommandError::Timeout(e.to_string()),
+                Some(_) => e,
+            });
         }
         Err(e) => return Err(e),
     };

@@ -202,6 +202,7 @@ impl Drive {
             revision_number: o.uint(0x1018, 3) as u32,
             node_id: None,
             description: format!("{} as simulated by cotui sim", self.profile.device_name),
+            file_name: String::new(),
         };
         crate::od::dcf::write(&info, &o.dcf_entries())
     }

@@ -219,7 +219,7 @@ mod pdo_layer_tests {
         let sim = Simulation::demo();
         let mut bindings = Bindings::new().unwrap();
         for (node, layer) in sim.pdo_layers() {
-            bindings.bind_layer(node, layer);
+            bindings.bind_config(node, layer);
         }
         let mut decoder = Decoder::from_bindings(&bindings);
         let d = decoder.decode(&crate::frame::Frame::classic(0x182, &[0x50, 0x02, 0x03]));

@@ -1,19 +1,39 @@
 //! The terminal: raw mode, alternate screen and mouse on entry; always restored on exit,
-//! panic, Ctrl-C and SIGTERM. Input is read only when stdin is a terminal.
+//! panic, Ctrl-C, SIGTERM and SIGQUIT. Suspending (ctrl-z, or SIGTSTP from outside)
+//! restores it before the process stops; on SIGCONT it is set up again and redrawn.
+//! Input is read only when stdin is a terminal.
 
 use super::app::App;
 use super::ui;
-use crossterm::event::{self, DisableMouseCapture, EnableMouseCapture, Event, KeyEventKind};
+use crossterm::event::{
+    self, DisableMouseCapture, EnableMouseCapture, Event, KeyCode, KeyEvent, KeyEventKind, KeyModifiers,
+};
 use crossterm::execute;
+use crossterm::terminal::{EnterAlternateScreen, enable_raw_mode};
 use std::io::{IsTerminal, stdout};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-/// Set by SIGTERM / SIGINT / SIGHUP.
+/// Set by SIGTERM / SIGINT / SIGHUP / SIGQUIT.
 static STOP: AtomicBool = AtomicBool::new(false);
+
+/// Set by SIGTSTP: the loop restores the terminal, then stops the process.
+static SUSPEND: AtomicBool = AtomicBool::new(false);
 
 extern "C" fn on_signal(_: libc::c_int) {
     STOP.store(true, Ordering::SeqCst);
+}
+
+extern "C" fn on_suspend(_: libc::c_int) {
+    SUSPEND.store(true, Ordering::SeqCst);
+}
+
+/// Installs `handler` for `sig`.
+fn catch(sig: libc::c_int, handler: extern "C" fn(libc::c_int)) {
+    // SAFETY: the handlers only store to an atomic, which is async-signal-safe.
+    unsafe {
+        libc::signal(sig, handler as *const () as libc::sighandler_t);
+    }
 }
 
 /// Why the terminal loop could not run or stopped.
@@ -38,12 +58,10 @@ pub fn run(mut app: App) -> Result<(), TermError> {
     if !std::io::stdin().is_terminal() || !stdout().is_terminal() {
         return Err(TermError::NotATerminal);
     }
-    for sig in [libc::SIGTERM, libc::SIGINT, libc::SIGHUP] {
-        // SAFETY: the handler only stores to an atomic, which is async-signal-safe.
-        unsafe {
-            libc::signal(sig, on_signal as *const () as libc::sighandler_t);
-        }
+    for sig in [libc::SIGTERM, libc::SIGINT, libc::SIGHUP, libc::SIGQUIT] {
+        catch(sig, on_signal);
     }
+    catch(libc::SIGTSTP, on_suspend);
     // A hung-up terminal can keep crossterm's input poll from returning; after a signal
     // the loop gets half a second to finish, then this watchdog restores and exits.
     std::thread::spawn(|| {
@@ -83,6 +101,30 @@ pub fn step(app: &mut App) -> bool {
     more_input || more_work
 }
 
+/// Ctrl-z: in raw mode the terminal sends it as a key, not as SIGTSTP.
+fn is_suspend(k: &KeyEvent) -> bool {
+    k.code == KeyCode::Char('z') && k.modifiers.contains(KeyModifiers::CONTROL)
+}
+
+/// Gives the shell its terminal back and stops the process as SIGTSTP does; once
+/// continued (`fg`), takes the terminal again and has the next draw repaint all of it.
+fn suspend(terminal: &mut ratatui::DefaultTerminal) -> Result<(), TermError> {
+    let _ = execute!(stdout(), DisableMouseCapture);
+    ratatui::restore();
+    // SAFETY: the default action of SIGTSTP stops the process (the whole process, as the
+    // shell expects); it returns here on SIGCONT, and the handler is set again.
+    unsafe {
+        libc::signal(libc::SIGTSTP, libc::SIG_DFL);
+        libc::raise(libc::SIGTSTP);
+    }
+    catch(libc::SIGTSTP, on_suspend);
+    SUSPEND.store(false, Ordering::SeqCst);
+    enable_raw_mode().map_err(TermError::Setup)?;
+    execute!(stdout(), EnterAlternateScreen, EnableMouseCapture).map_err(TermError::Setup)?;
+    terminal.clear()?;
+    Ok(())
+}
+
 fn event_loop(terminal: &mut ratatui::DefaultTerminal, app: &mut App) -> Result<(), TermError> {
     let mut last_draw = Instant::now() - FRAME;
     // Input is answered at once; frames alone redraw at most every FRAME.
@@ -104,6 +146,10 @@ fn event_loop(terminal: &mut ratatui::DefaultTerminal, app: &mut App) -> Result<
             // Take every pending event before the next draw.
             loop {
                 match event::read()? {
+                    Event::Key(k) if k.kind != KeyEventKind::Release && is_suspend(&k) => {
+                        SUSPEND.store(true, Ordering::SeqCst);
+                        break;
+                    }
                     Event::Key(k) if k.kind != KeyEventKind::Release => {
                         app.key(k);
                         input = true;
@@ -122,6 +168,11 @@ fn event_loop(terminal: &mut ratatui::DefaultTerminal, app: &mut App) -> Result<
         }
         if app.quit || STOP.load(Ordering::SeqCst) {
             return Ok(());
+        }
+        if SUSPEND.load(Ordering::SeqCst) {
+            suspend(terminal)?;
+            app.dirty = true;
+            input = true;
         }
     }
 }

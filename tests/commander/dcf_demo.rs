@@ -67,6 +67,7 @@ async fn save_change_diff_and_load_restores() {
     assert!(saved.json["objects"].as_u64().unwrap() > 100, "{}", saved.json);
     assert_eq!(saved.json["refused"], Json::Array(vec![]));
     let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.starts_with("[FileInfo]\nFileName=node2.dcf\n"), "{text}");
     assert!(text.contains("[DeviceComissioning]\nNodeID=2\n"), "{text}");
     assert!(text.contains("[6083]\nParameterName=Profile acceleration\nObjectType=0x7\nDataType=0x0007\nAccessType=rw\nPDOMapping=0\nParameterValue=0x4E20\n"));
     // A second save to the same file is refused without --force.

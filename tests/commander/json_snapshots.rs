@@ -72,7 +72,7 @@ fn every_command_answers_json_as_documented() {
         (
             "drive_no_such_node",
             vec!["drive", "demo", "9", "enable", "--timeout", "100"],
-            5,
+            4,
         ),
         ("scan", vec!["scan", "demo"], 0),
         ("lss_switch", vec!["lss", "demo", "switch", "config"], 0),

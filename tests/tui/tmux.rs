@@ -119,6 +119,16 @@ impl Session {
         String::from_utf8_lossy(&out.stdout).into_owned()
     }
 
+    /// A tmux format of the pane, e.g. `#{alternate_on}` (1 while the alternate screen is
+    /// on) or `#{mouse_any_flag}` (1 while the program asked for mouse events).
+    pub fn format(&self, format: &str) -> String {
+        let out = Command::new("tmux")
+            .args(["display-message", "-p", "-t", &self.name, format])
+            .output()
+            .unwrap();
+        String::from_utf8_lossy(&out.stdout).trim().to_string()
+    }
+
     /// Waits until the screen satisfies `f` (60 s at most); returns the screen. Fails the
     /// test with the last screen on timeout.
     pub fn wait_for(&self, what: &str, f: impl Fn(&str) -> bool) -> String {

@@ -70,13 +70,22 @@ fn a_replay_speed_out_of_range_is_a_usage_error() {
     let dir = tempdir("speed");
     let log = dir.join("x.log");
     std::fs::write(&log, "(1.000000) can0 701#05\n").unwrap();
-    for bad in ["1e-300", "-1", "inf", "NaN", "5000"] {
+    for (bad, shown) in [
+        ("1e-300", "1e-300"),
+        ("1e300", "1e300"),
+        ("-1", "-1"),
+        ("inf", "inf"),
+        ("NaN", "NaN"),
+        ("5000", "5000"),
+        ("0.000123456789", "1.23456789e-4"),
+    ] {
         let out = cotui(&["replay", log.to_str().unwrap(), &format!("--speed={bad}")], &dir);
         assert_eq!(out.status.code(), Some(1), "{bad}");
         let err = String::from_utf8_lossy(&out.stderr);
-        assert!(
-            err.contains("out of range: 0 (as fast as possible) or 0.01 to 1000"),
-            "{bad}: {err}"
+        assert_eq!(
+            err.trim(),
+            format!("cotui replay: --speed {shown} is out of range: 0 (as fast as possible) or 0.01 to 1000"),
+            "{bad}"
         );
     }
     let _ = std::fs::remove_dir_all(&dir);

@@ -3,7 +3,8 @@
 //! comes back (the shell after cotui prints and the alternate screen is gone). A replay
 //! marks a node LOST while its log is silent (the replay clock); replay step, step back,
 //! `:goto`, `:time` (also after the end) and rewind move it as docs/TUI.md says. The
-//! demo with chosen drives takes `:sim` failures and `:lss` against its LSS slave.
+//! demo with chosen drives takes `:sim` failures and `:lss` against its LSS slave. Ctrl-z,
+//! SIGTSTP and SIGQUIT give the shell its terminal back; `fg` redraws.
 //! Needs tmux (scripts/install-test-deps.sh installs it).
 
 use crate::tmux::Session;
@@ -95,6 +96,60 @@ fn sigterm_restores_the_terminal() {
     assert!(t.contains("cotui-exit=0"), "{t}");
     assert!(!t.contains("Trace ["), "{t}");
     let _ = std::fs::remove_file(&pidfile);
+}
+
+/// Ctrl-z and SIGTSTP give the shell a usable terminal (no alternate screen, no mouse
+/// reports) and `fg` brings the screen back, redrawn and reading keys at once; SIGQUIT
+/// restores the terminal before cotui exits.
+#[test]
+fn suspend_resume_and_sigquit_restore_the_terminal() {
+    let bin = env!("CARGO_BIN_EXE_cotui");
+    let name = format!("cotui-tstp-{}", std::process::id());
+    let home = std::env::temp_dir().join(&name);
+    std::fs::create_dir_all(&home).unwrap();
+    let pidfile = home.join("pid");
+    let s = Session::start(&name, "env PS1='shell$ ' bash --norc --noprofile -i");
+    s.wait_for("the shell", |t| t.contains("shell$"));
+    s.type_text(&format!(
+        "sh -c 'echo $$ > {}; exec env XDG_CONFIG_HOME={} {bin} demo'",
+        pidfile.display(),
+        home.display()
+    ));
+    s.keys(&["Enter"]);
+    s.wait_for("the demo", |t| t.contains("demo bus |"));
+    assert_eq!((s.format("#{alternate_on}"), s.format("#{mouse_any_flag}")), ("1".into(), "1".into()));
+    let pid = std::fs::read_to_string(&pidfile).unwrap().trim().to_string();
+    let signal = |sig: &str| assert!(Command::new("kill").args([sig, &pid]).status().unwrap().success());
+    let shell_back = |what: &str| {
+        let t = s.wait_for(what, |t| t.contains("Stopped"));
+        assert!(!t.contains("demo bus |"), "alternate screen left behind:\n{t}");
+        assert_eq!(
+            (s.format("#{alternate_on}"), s.format("#{mouse_any_flag}")),
+            ("0".into(), "0".into()),
+            "{what}"
+        );
+    };
+    let resumed = |what: &str| {
+        s.type_text("clear; fg");
+        s.keys(&["Enter"]);
+        s.wait_for(what, |t| t.contains("demo bus |") && !t.contains("shell$"));
+        assert_eq!((s.format("#{alternate_on}"), s.format("#{mouse_any_flag}")), ("1".into(), "1".into()));
+        // Keys reach cotui one by one again (raw mode), no Enter needed.
+        s.keys(&["?"]);
+        s.wait_for("help after fg", |t| t.contains("Show or hide this help"));
+        s.keys(&["Escape"]);
+        s.wait_for("help to close", |t| !t.contains("Show or hide this help"));
+    };
+    s.keys(&["C-z"]);
+    shell_back("the shell after ctrl-z");
+    resumed("the screen redrawn after fg");
+    signal("-TSTP");
+    shell_back("the shell after SIGTSTP");
+    resumed("the screen redrawn after the second fg");
+    signal("-QUIT");
+    s.wait_for("the shell after SIGQUIT", |t| t.contains("shell$") && !t.contains("demo bus |"));
+    assert_eq!((s.format("#{alternate_on}"), s.format("#{mouse_any_flag}")), ("0".into(), "0".into()));
+    let _ = std::fs::remove_dir_all(&home);
 }
 
 #[test]

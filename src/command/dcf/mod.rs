@@ -214,6 +214,13 @@ async fn save(sdo: &mut Sdo<'_>, dict: &Dictionary, output: &str, force: bool) -
         revision_number: u32_at(0x1018, 3),
         node_id: Some(sdo.node),
         description: format!("configuration of node {} read by cotui", sdo.node),
+        file_name: match output {
+            "-" => String::new(),
+            path => std::path::Path::new(path)
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+        },
     };
     let text = crate::od::dcf::write(&info, &entries);
     crate::command::exec::write_output(output, text.as_bytes())?;

@@ -40,15 +40,18 @@ impl Pdo {
     /// Appends [`Pdo::label`] to `s`.
     pub fn write_label(&self, s: &mut String, node: u8, payload: &[u8]) {
         // `TPDO1 node 1: ` and, without signals, a classic payload: composed on the stack
-        // and appended at once (the hot path of text and JSONL output).
+        // and appended at once (the hot path of text and JSONL output). Nothing follows
+        // `TPDO1 node 1` (no signal, no data byte): no colon.
         let mut buf = [b' '; 48];
         buf[..4].copy_from_slice(if self.transmit { b"TPDO" } else { b"RPDO" });
         let mut n = 4 + decimal_into(&mut buf[4..], self.num);
         buf[n..n + 6].copy_from_slice(b" node ");
         n += 6;
         n += decimal_into(&mut buf[n..], node.into());
-        buf[n] = b':';
-        n += 2;
+        if !self.signals.is_empty() || !payload.is_empty() {
+            buf[n] = b':';
+            n += 2;
+        }
         if self.signals.is_empty() && payload.len() <= 8 {
             for (i, b) in payload.iter().enumerate() {
                 buf[n + 3 * i] = HEX[(b >> 4) as usize];
@@ -351,6 +354,7 @@ mod tests {
             source: None,
         };
         assert_eq!(pdo.label(3, &[1, 2]), "RPDO2 node 3: 01 02");
+        assert_eq!(pdo.label(34, &[]), "RPDO2 node 34", "nothing follows: no colon");
         assert_eq!(serde_json::to_value(pdo.to_json()).unwrap()["signals"], json!([]));
     }
 }

@@ -122,6 +122,8 @@ pub fn parse_node_arg(arg: &str) -> Result<(u8, &str), NodeArgError> {
 /// What is bound to one node.
 #[derive(Clone, Debug, Default)]
 struct NodeBinding {
+    /// The device's own configuration (e.g. the PDO mappings it starts with), above its EDS.
+    config: Option<Arc<Profile>>,
     eds: Option<Arc<Profile>>,
     profile: Option<Arc<Profile>>,
     /// Where the profile came from, to resolve `extends` next to it.
@@ -216,6 +218,15 @@ impl Bindings {
     /// configuration (e.g. the PDO mappings the demo's simulated drives start with).
     pub fn bind_layer(&mut self, node: u8, profile: Profile) {
         self.nodes.entry(node).or_default().eds = Some(Arc::new(profile));
+        self.rebuild(node, &|p| {
+            Err(std::io::Error::other(format!("{} not read", p.display())))
+        });
+    }
+
+    /// Binds what a node is configured with (e.g. the PDO mappings a simulated drive starts
+    /// with) above its EDS and profile, which keep giving names and types.
+    pub fn bind_config(&mut self, node: u8, profile: Profile) {
+        self.nodes.entry(node).or_default().config = Some(Arc::new(profile));
         self.rebuild(node, &|p| {
             Err(std::io::Error::other(format!("{} not read", p.display())))
         });
@@ -319,6 +330,11 @@ impl Bindings {
             return;
         };
         let mut layers: Vec<Arc<Profile>> = Vec::new();
+        if let Some(config) = &binding.config {
+            layers.push(config.clone());
+        }
+        // Where the EDS is, to enrich it from the layers below.
+        let at = layers.len();
         if let Some(eds) = &binding.eds {
             layers.push(eds.clone());
         }
@@ -361,9 +377,9 @@ impl Bindings {
             }
         }
         if binding.eds.is_some()
-            && let Some(top) = super::merge::enriched(&layers[0], &layers[1..])
+            && let Some(top) = super::merge::enriched(&layers[at], &layers[at + 1..])
         {
-            layers[0] = Arc::new(top);
+            layers[at] = Arc::new(top);
         }
         self.dictionaries.insert(node, Dictionary::new(layers));
     }

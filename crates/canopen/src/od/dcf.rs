@@ -32,6 +32,8 @@ pub struct DeviceInfo {
     pub node_id: Option<u8>,
     /// `[FileInfo] Description`.
     pub description: String,
+    /// `[FileInfo] FileName`: the name of the file written (empty when there is none).
+    pub file_name: String,
 }
 
 fn access_text(a: Access) -> &'static str {
@@ -100,7 +102,7 @@ pub fn write(info: &DeviceInfo, entries: &[DcfEntry]) -> String {
     indexes.dedup();
     let mut out = String::new();
     let _ = writeln!(out, "[FileInfo]");
-    let _ = writeln!(out, "FileName=");
+    let _ = writeln!(out, "FileName={}", info.file_name);
     let _ = writeln!(out, "FileVersion=1");
     let _ = writeln!(out, "FileRevision=0");
     let _ = writeln!(out, "EDSVersion=4.0");
@@ -208,9 +210,11 @@ mod tests {
         ];
         let info = DeviceInfo {
             node_id: Some(5),
+            file_name: "node5.dcf".into(),
             ..DeviceInfo::default()
         };
         let text = write(&info, &entries);
+        assert!(text.starts_with("[FileInfo]\nFileName=node5.dcf\n"), "{text}");
         assert!(text.contains("[DeviceComissioning]\nNodeID=5\n"));
         assert!(text.contains("[MandatoryObjects]\nSupportedObjects=2\n1=0x1000\n2=0x1018\n"));
         assert!(text.contains("[1018]\nParameterName=Identity\nObjectType=0x9\nSubNumber=3\n"));
