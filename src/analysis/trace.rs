@@ -92,8 +92,8 @@ impl Trace {
         Trace::with_views(decoder, bitrate, Views::All)
     }
 
-    /// An empty trace for a headless command: one that keeps `views`, without statistics
-    /// (so no bitrate to count bus load against).
+    /// An empty trace for a headless command, keeping `views` (the bus load, kept with
+    /// [`Views::All`] only, would be counted against 500 kbit/s).
     pub fn headless(decoder: Decoder, views: Views) -> Trace {
         Trace::with_views(decoder, 500_000, views)
     }

@@ -65,8 +65,8 @@ pub struct DecodeArgs {
 /// What a decode run keeps across its inputs, chosen once from the arguments: a bare
 /// decoder when it prints frames, else the trace that derives the one view it prints.
 enum Pipeline {
-    Frames(Decoder),
-    View(Trace),
+    Frames(Box<Decoder>),
+    View(Box<Trace>),
 }
 
 /// Runs `cotui decode`; returns the exit status.
@@ -97,8 +97,8 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
         None
     };
     let mut run = match view {
-        Some(v) => Pipeline::View(Trace::headless(decoder, v)),
-        None => Pipeline::Frames(decoder),
+        Some(v) => Pipeline::View(Box::new(Trace::headless(decoder, v))),
+        None => Pipeline::Frames(Box::new(decoder)),
     };
     let mut out = match super::decode_out::open(args.output.as_deref(), false) {
         Ok(o) => o,
