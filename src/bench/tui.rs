@@ -101,16 +101,16 @@ pub fn bench(frames: u64, json: bool) -> std::io::Result<()> {
     let start = Instant::now();
     let mut app = app_for((source::open(log.clone()), None), SourceKind::Open);
     let mut first_screen = None;
-    while !app.source.done {
+    while !app.source().done {
         step(&mut app);
-        if first_screen.is_none() && !app.trace.is_empty() {
+        if first_screen.is_none() && !app.trace().is_empty() {
             draw(&mut term, &mut app)?;
             first_screen = Some(start.elapsed().as_secs_f64());
         }
     }
     let indexed = start.elapsed().as_secs_f64();
-    let n = app.trace.len();
-    let store_per_frame = app.trace.store.bytes() as f64 / n.max(1) as f64;
+    let n = app.trace().len();
+    let store_per_frame = app.trace().store.bytes() as f64 / n.max(1) as f64;
     let rss_per_frame = (peak_rss_kib().saturating_sub(rss_before)) as f64 * 1024.0 / n.max(1) as f64;
 
     // Redraw figures with the whole log loaded.
@@ -136,7 +136,7 @@ pub fn bench(frames: u64, json: bool) -> std::io::Result<()> {
     let start = Instant::now();
     app.run_command("search \"no such label\"");
     let (mut turns, mut cpu) = (Vec::new(), Vec::new());
-    while app.search.as_ref().is_some_and(|s| !s.complete(&app.trace)) {
+    while app.screen().search().is_some_and(|s| !s.complete(app.trace())) {
         let (t, c) = (Instant::now(), thread_cpu_ms());
         step(&mut app);
         draw(&mut term, &mut app)?;
@@ -154,14 +154,14 @@ pub fn bench(frames: u64, json: bool) -> std::io::Result<()> {
     let mut responses = Vec::new();
     let down = KeyEvent::new(KeyCode::Down, KeyModifiers::NONE);
     let replay_start = Instant::now();
-    while !app.source.done && responses.len() < 200 {
+    while !app.source().done && responses.len() < 200 {
         let t = Instant::now();
         app.key(down);
         step(&mut app);
         draw(&mut term, &mut app)?;
         responses.push(t.elapsed().as_secs_f64() * 1e3);
     }
-    let replayed = app.trace.len();
+    let replayed = app.trace().len();
     let replay_rate = replayed as f64 / replay_start.elapsed().as_secs_f64();
     drop(app);
     let _ = std::fs::remove_dir_all(&dir);

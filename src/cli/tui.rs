@@ -176,10 +176,10 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> ExitCode {
         }
     };
     let mut app = App::new(Trace::new(decoder, ui.bitrate), keymap, src);
-    app.bindings = bindings;
+    app.set_bindings(bindings);
     if let Some(f) = &ui.filter {
         app.set_filter(f);
-        if let Some(m) = app.message.take() {
+        if let Some(m) = app.screen_mut().take_message() {
             eprintln!("cotui: --filter: {m}");
             return ExitCode::Usage;
         }

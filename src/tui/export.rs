@@ -1,6 +1,7 @@
 //! Export of the trace view (the rows the filter in force shows) to a file: candump `-l`,
 //! JSON lines (decoded, as `cotui decode --format jsonl`) or pcapng for Wireshark.
 
+use super::commands::CommandError;
 use crate::analysis::trace::Trace;
 use crate::analysis::view::View;
 use crate::log::writer::LogWriter;
@@ -91,6 +92,41 @@ pub fn export(trace: &Trace, view: &View, path: &Path, format: ExportFormat, for
     Ok(rows)
 }
 
+/// `export FILE [--format candump|jsonl|pcapng] [--force]` (the words after `export`):
+/// writes the rows `view` shows; the text says what was written.
+pub(crate) fn command(rest: &str, trace: &Trace, view: &View) -> Result<String, CommandError> {
+    let (mut file, mut format, mut force) = (None, None, false);
+    let mut words = rest.split_whitespace();
+    while let Some(w) = words.next() {
+        match w {
+            "--force" => force = true,
+            "--format" => {
+                let f = words.next().ok_or(CommandError::FormatMissing)?;
+                format = Some(ExportFormat::parse(f)?);
+            }
+            w if w.starts_with("--") => return Err(CommandError::ExportOption(w.to_string())),
+            w if file.is_none() => file = Some(w.to_string()),
+            w => return Err(CommandError::ExtraFile(w.to_string())),
+        }
+    }
+    let file = file.ok_or(CommandError::ExportUsage)?;
+    let path = Path::new(&file);
+    let format = format.unwrap_or_else(|| ExportFormat::of_path(path));
+    let scanned = view.progress(trace);
+    let n = export(trace, view, path, format, force).map_err(|source| CommandError::Export {
+        file: file.clone(),
+        source,
+    })?;
+    Ok(format!(
+        "exported {n} frames to {file} ({format:?}){}",
+        if scanned < 100 {
+            format!("; the filter had scanned {scanned}% of the trace")
+        } else {
+            String::new()
+        }
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -107,7 +143,14 @@ mod tests {
         // All frames as candump: read back, they are the frames.
         let log = dir.join("all.log");
         assert_eq!(
-            export(&a.trace, &a.panes.trace.view, &log, ExportFormat::Candump, false).unwrap(),
+            export(
+                a.trace(),
+                &a.screen().panes().trace.view,
+                &log,
+                ExportFormat::Candump,
+                false
+            )
+            .unwrap(),
             frames().len()
         );
         let back: Vec<_> = LogReader::new(io::BufReader::new(std::fs::File::open(&log).unwrap()))
@@ -123,13 +166,31 @@ mod tests {
             .collect();
         assert_eq!(back, want);
         // An existing file is refused unless forced.
-        assert!(export(&a.trace, &a.panes.trace.view, &log, ExportFormat::Candump, false).is_err());
-        assert!(export(&a.trace, &a.panes.trace.view, &log, ExportFormat::Candump, true).is_ok());
+        assert!(
+            export(
+                a.trace(),
+                &a.screen().panes().trace.view,
+                &log,
+                ExportFormat::Candump,
+                false
+            )
+            .is_err()
+        );
+        assert!(
+            export(
+                a.trace(),
+                &a.screen().panes().trace.view,
+                &log,
+                ExportFormat::Candump,
+                true
+            )
+            .is_ok()
+        );
         // The heartbeats of node 2 only, decoded, as JSON lines.
         let mut view = View::new(Filter::parse("node 2 kind hb").unwrap());
-        view.advance(&a.trace, Duration::from_secs(5));
+        view.advance(a.trace(), Duration::from_secs(5));
         let jsonl = dir.join("hb.jsonl");
-        let n = export(&a.trace, &view, &jsonl, ExportFormat::of_path(&jsonl), false).unwrap();
+        let n = export(a.trace(), &view, &jsonl, ExportFormat::of_path(&jsonl), false).unwrap();
         let text = std::fs::read_to_string(&jsonl).unwrap();
         assert_eq!((n, text.lines().count()), (7, 7));
         for l in text.lines() {
@@ -138,7 +199,7 @@ mod tests {
         }
         // pcapng: a section header, one interface, one packet block per frame.
         let cap = dir.join("hb.pcapng");
-        export(&a.trace, &view, &cap, ExportFormat::of_path(&cap), false).unwrap();
+        export(a.trace(), &view, &cap, ExportFormat::of_path(&cap), false).unwrap();
         let bytes = std::fs::read(&cap).unwrap();
         assert_eq!(&bytes[..4], &[0x0A, 0x0D, 0x0D, 0x0A]);
         std::fs::remove_dir_all(&dir).ok();

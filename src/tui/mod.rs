@@ -5,6 +5,9 @@
 //! and redraws at most 30 times a second and only when something changed.
 
 pub mod app;
+pub mod capture;
+pub mod commands;
+mod event;
 pub mod export;
 pub mod fuzzy;
 pub mod keymap;
@@ -13,8 +16,11 @@ pub mod messages;
 pub mod palette;
 pub mod panes;
 pub mod prompt;
+mod read_all;
 pub mod record;
 pub mod rows;
+pub mod screen;
 pub mod source;
+mod stop;
 pub mod term;
 pub mod ui;

@@ -185,6 +185,27 @@ impl PromptBar {
         self.editing = Some(Prompt::new(kind, text));
     }
 
+    /// Opens a `kind` prompt holding `text`, the cursor at character `cursor` (at most the
+    /// end of the text).
+    pub fn open_at(&mut self, kind: PromptKind, text: &str, cursor: usize) {
+        let mut p = Prompt::new(kind, text);
+        p.cursor = cursor.min(p.cursor);
+        self.editing = Some(p);
+    }
+
+    /// The line being edited, if any.
+    pub fn editing(&self) -> Option<&Prompt> {
+        self.editing.as_ref()
+    }
+
+    /// The text before the cursor of the line being edited (empty when none is).
+    pub fn before_cursor(&self) -> String {
+        self.editing
+            .as_ref()
+            .map(|p| p.text.chars().take(p.cursor).collect())
+            .unwrap_or_default()
+    }
+
     /// Handles a key while a prompt is open; `enter` keeps the line in the history.
     pub fn key(&mut self, ev: KeyEvent) -> Edit {
         let Some(p) = self.editing.as_mut() else {

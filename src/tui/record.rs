@@ -3,6 +3,9 @@
 //! lines only (a failed write cuts the file back to its last whole line, see
 //! [`crate::logio::sink`]).
 
+use super::capture::Capture;
+use super::event::{Event, Queue};
+use super::messages::Level;
 use crate::command::CommandError;
 use crate::command::record::{WriteMode, open_output};
 use crate::frame::{Frame, Interfaces};
@@ -94,6 +97,48 @@ impl Recorder {
         self.sink.flush()?;
         Ok(self.sink.lines())
     }
+}
+
+/// `record start FILE [--force | --append]` / `record stop` (the words after `record`):
+/// starts or ends the recording of `capture`; what the user is told goes to `q`.
+pub(crate) fn command(capture: &mut Capture, rest: &str, q: &mut Queue) {
+    let has_bus = capture.has_bus();
+    let recording = capture.recording_mut();
+    let (level, text) = match parse(rest) {
+        Err(e) => (Level::Error, e),
+        Ok(RecordCommand::Stop) => match recording.take() {
+            None => (Level::Info, "record: not recording".to_string()),
+            Some(r) => {
+                let file = r.file.clone();
+                match r.stop() {
+                    Ok(n) => (Level::Info, format!("record: stopped, {n} frames in {file}")),
+                    Err(e) => (Level::Error, format!("record: {file}: {e}")),
+                }
+            }
+        },
+        Ok(RecordCommand::Start { .. }) if !has_bus => (
+            Level::Error,
+            "record: only a live or demo session records what it receives; `export FILE` writes a log's view".into(),
+        ),
+        Ok(RecordCommand::Start { .. }) if recording.is_some() => {
+            let file = recording.as_ref().map(|r| r.file.clone()).unwrap_or_default();
+            (
+                Level::Error,
+                format!("record: already recording to {file} (`record stop` first)"),
+            )
+        }
+        Ok(RecordCommand::Start { file, mode }) => match Recorder::start(&file, mode) {
+            Ok(r) => {
+                *recording = Some(r);
+                (
+                    Level::Info,
+                    format!("record: recording the frames received to {file} (`record stop` ends it)"),
+                )
+            }
+            Err(e) => (Level::Error, format!("record: {e}")),
+        },
+    };
+    q.push(Event::Say(level, text));
 }
 
 #[cfg(test)]

@@ -131,9 +131,9 @@ fn event_loop(terminal: &mut ratatui::DefaultTerminal, app: &mut App) -> Result<
     let mut input = false;
     loop {
         let busy = step(app);
-        if app.dirty && (input || last_draw.elapsed() >= FRAME) {
+        if app.dirty() && (input || last_draw.elapsed() >= FRAME) {
             terminal.draw(|f| ui::draw(f, app))?;
-            app.dirty = false;
+            app.drawn();
             input = false;
             last_draw = Instant::now();
         }
@@ -158,7 +158,7 @@ fn event_loop(terminal: &mut ratatui::DefaultTerminal, app: &mut App) -> Result<
                         app.mouse(m);
                         input = true;
                     }
-                    Event::Resize(..) => app.dirty = true,
+                    Event::Resize(..) => app.redraw(),
                     _ => {}
                 }
                 if !event::poll(Duration::ZERO)? {
@@ -166,7 +166,7 @@ fn event_loop(terminal: &mut ratatui::DefaultTerminal, app: &mut App) -> Result<
                 }
             }
         }
-        if app.quit || STOP.load(Ordering::SeqCst) {
+        if app.quits() || STOP.load(Ordering::SeqCst) {
             return Ok(());
         }
         if SUSPEND.load(Ordering::SeqCst) {

@@ -32,9 +32,9 @@ pub fn draw(f: &mut Frame, app: &mut App) {
     } else {
         (body, None)
     };
-    app.layout.side = side.is_some();
+    app.screen_mut().layout_mut().side = side.is_some();
     // Too narrow for the side column: the Detail pane, when toggled, goes below the main pane.
-    let (main, below) = if side.is_none() && app.detail.shown {
+    let (main, below) = if side.is_none() && app.screen().detail().shown() {
         let [m, d] = Layout::vertical([Constraint::Percentage(40), Constraint::Percentage(60)]).areas(main);
         (m, Some(d))
     } else {
@@ -45,7 +45,7 @@ pub fn draw(f: &mut Frame, app: &mut App) {
         .enumerate()
         .map(|(i, p)| {
             let s = format!(" {} {} ", i + 1, p.title());
-            if *p == app.focus {
+            if *p == app.focus() {
                 Span::styled(s, Style::default().bg(Color::White).fg(Color::Black))
             } else {
                 Span::raw(s)
@@ -56,8 +56,10 @@ pub fn draw(f: &mut Frame, app: &mut App) {
 
     // Where the selectable rows are, for paging and mouse clicks.
     let inner = panes::block("", true).inner(main);
-    let (rows, strip) = app.panes.trace.split(&app.trace, main);
-    app.layout.table = match app.focus {
+    let trace_pane = &app.screen().panes().trace;
+    let (rows, strip) = trace_pane.split(app.trace(), main);
+    let tail = trace_pane.tail_positions(app.trace(), strip);
+    let table = match app.focus() {
         Pane::Trace => rows,
         Pane::Plot => Rect::default(),
         _ => Rect {
@@ -66,29 +68,31 @@ pub fn draw(f: &mut Frame, app: &mut App) {
             ..inner
         },
     };
-    let tail = app.panes.trace.tail_positions(&app.trace, strip);
-    app.prepare(app.layout.table.height as usize, rows.height as usize, &tail);
-    app.log_popup.page = panes::messages::height(body);
-    app.log_popup.width = panes::messages::width(body);
+    app.screen_mut().layout_mut().table = table;
+    app.prepare(table.height as usize, rows.height as usize, &tail);
+    app.screen_mut()
+        .log_popup_mut()
+        .set_size(panes::messages::height(body), panes::messages::width(body));
 
     let app = &*app;
+    let (screen, trace) = (app.screen(), app.trace());
     let ctx = app.ctx();
-    app.panes.get(app.focus).render(f, main, &ctx, true);
+    screen.panes().get(app.focus()).render(f, main, &ctx, true);
     let selected = app.selected();
     if let Some(side) = side {
-        let n = app.trace.nodes.len().clamp(1, 12) as u16 + 2;
+        let n = trace.nodes.len().clamp(1, 12) as u16 + 2;
         let [nodes, detail] = Layout::vertical([Constraint::Length(n), Constraint::Min(0)]).areas(side);
-        panes::nodes::render_compact(&app.trace, f, nodes);
-        app.detail.render(&app.trace, selected, f, detail);
+        panes::nodes::render_compact(trace, f, nodes);
+        screen.detail().render(trace, selected, f, detail);
     }
     if let Some(below) = below {
-        app.detail.render(&app.trace, selected, f, below);
+        screen.detail().render(trace, selected, f, below);
     }
     panes::status::render(app, f, bar, line);
-    if app.log_popup.shown {
-        app.log_popup.render(&app.messages, f, body);
+    if screen.log_popup().shown() {
+        screen.log_popup().render(screen.messages(), f, body);
     }
-    if app.help.shown {
-        app.help.render(&app.keymap, f, body);
+    if screen.help().shown() {
+        screen.help().render(app.keymap(), f, body);
     }
 }

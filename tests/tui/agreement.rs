@@ -81,14 +81,14 @@ fn opened(path: &Path) -> App {
     let src = SourceInfo::new(&name, SourceKind::Open, source::open(path.to_path_buf()), None);
     let mut app = App::new(Trace::new(decoder, 500_000), Keymap::default_map(), src);
     for _ in 0..10_000 {
-        if app.source.done {
+        if app.source().done {
             break;
         }
         if !app.ingest(Duration::from_millis(50)) {
             std::thread::sleep(Duration::from_millis(2));
         }
     }
-    assert!(app.source.done, "{name}: the log was not read to its end");
+    assert!(app.source().done, "{name}: the log was not read to its end");
     for pane in [
         Action::PaneProblems,
         Action::PaneNodes,
@@ -117,16 +117,16 @@ fn draw(app: &mut App, w: u16, h: u16) -> String {
 
 /// The SDO pane's transfers as `--transactions --format jsonl` records.
 fn sdo_rows(app: &App) -> Vec<String> {
-    let dec = app.trace.decoder();
+    let dec = app.trace().decoder();
     // Several interfaces: each transfer names its own, as decode --transactions does.
-    let several = app.trace.ifaces.names().len() > 1;
-    app.trace
+    let several = app.trace().ifaces.names().len() > 1;
+    app.trace()
         .transactions
         .iter()
         .map(|t| {
             let mut line = Vec::new();
             let mut json = t.to_json(dec.dictionary(t.node));
-            json.iface = several.then(|| app.trace.ifaces.name(t.iface));
+            json.iface = several.then(|| app.trace().ifaces.name(t.iface));
             write_line(&mut line, &json);
             String::from_utf8(line).unwrap().trim_end().to_string()
         })
@@ -172,9 +172,9 @@ fn the_tui_and_the_command_line_agree_on_every_fixture_and_real_world_log() {
 
         // Problems pane = diagnose.
         let want = cli(&["diagnose", "--format", "jsonl"], path);
-        let origin = app.trace.diagnosis.origin_ns();
+        let origin = app.trace().diagnosis.origin_ns();
         let mut got = Vec::new();
-        for i in app.panes.problems.incidents() {
+        for i in app.screen().panes().problems.incidents() {
             write_line(&mut got, &i.to_json(origin));
         }
         assert_eq!(String::from_utf8(got).unwrap(), want, "{name}: Problems pane incidents");
@@ -186,7 +186,7 @@ fn the_tui_and_the_command_line_agree_on_every_fixture_and_real_world_log() {
         let several = summary["by_node"].as_object().unwrap().keys().any(|k| k.contains('/'));
         let key = |n: &cotui::frame::NodeKey| {
             if several {
-                format!("{}/{}", app.trace.ifaces.name(n.iface), n.node)
+                format!("{}/{}", app.trace().ifaces.name(n.iface), n.node)
             } else {
                 n.node.to_string()
             }
@@ -203,19 +203,24 @@ fn the_tui_and_the_command_line_agree_on_every_fixture_and_real_world_log() {
         // A node-ID shows as a node once the bus proves a CANopen node is there (a clean
         // SDO transfer, two well-formed heartbeats); until then its frames count as the
         // pane's "other" frames. Together they are --summary's nodes.
-        let got: BTreeMap<String, u64> = app.trace.nodes.iter().map(|(n, info)| (key(n), info.frames)).collect();
+        let got: BTreeMap<String, u64> = app
+            .trace()
+            .nodes
+            .iter()
+            .map(|(n, info)| (key(n), info.frames))
+            .collect();
         for (n, frames) in &got {
             assert_eq!(want.get(n), Some(frames), "{name}: node {n} in the Nodes pane");
         }
         let others: u64 = want.iter().filter(|(n, _)| !got.contains_key(*n)).map(|(_, f)| f).sum();
         assert_eq!(
-            app.trace.nodes.other_frames(),
+            app.trace().nodes.other_frames(),
             others,
             "{name}: the Nodes pane's other frames"
         );
 
         // Receive list = --summary's frames, and per COB-ID the frames decode prints.
-        let got: BTreeMap<(bool, u32), u64> = app.trace.stats.iter().map(|(k, s)| (*k, s.count)).collect();
+        let got: BTreeMap<(bool, u32), u64> = app.trace().stats.iter().map(|(k, s)| (*k, s.count)).collect();
         assert_eq!(
             got.values().sum::<u64>(),
             summary["frames"].as_u64().unwrap(),

@@ -65,7 +65,7 @@ pub(crate) fn demo_app() -> App {
     let (rx, req) = cotui::tui::live::start("demo", false, bindings.clone(), None);
     let src = SourceInfo::live("demo", SourceKind::Demo { listen_only: false }, rx, req);
     let mut a = App::new(trace, Keymap::default_map(), src);
-    a.bindings = bindings;
+    a.set_bindings(bindings);
     a
 }
 
@@ -73,7 +73,7 @@ pub(crate) fn demo_app() -> App {
 fn objects_pane_reads_an_object_of_a_demo_drive_and_prefills_its_write() {
     let mut a = demo_app();
     until(&mut a, "node 2 to be listed", |a, _| {
-        a.trace.nodes.iter().any(|(n, _)| n.node == 2)
+        a.trace().nodes.iter().any(|(n, _)| n.node == 2)
     });
     key(&mut a, KeyCode::Char('6'));
     // Node 2 (the Nodes selection may be another node: `]` picks the next one).
@@ -93,7 +93,7 @@ fn objects_pane_reads_an_object_of_a_demo_drive_and_prefills_its_write() {
     // Nothing was read of it yet by anyone: the demo only exchanges PDOs and heartbeats.
     key(&mut a, KeyCode::Enter);
     let s = until(&mut a, "the value read", |a, _| {
-        a.trace
+        a.trace()
             .values
             .get(NODE2, 0x6060, 0)
             .and_then(|e| e.last.as_ref())
@@ -105,15 +105,15 @@ fn objects_pane_reads_an_object_of_a_demo_drive_and_prefills_its_write() {
         .unwrap_or_default()
         .to_string();
     let shown = a
-        .trace
+        .trace()
         .values
         .get(NODE2, 0x6060, 0)
-        .and_then(|e| e.text(a.trace.decoder().dictionary(2), 0x6060, 0))
+        .and_then(|e| e.text(a.trace().decoder().dictionary(2), 0x6060, 0))
         .unwrap();
     assert!(row.contains(&shown), "{row} / {shown}");
     assert!(row.contains(" ms"), "its age: {row}");
     let raw = a
-        .trace
+        .trace()
         .values
         .get(NODE2, 0x6060, 0)
         .unwrap()
@@ -124,12 +124,12 @@ fn objects_pane_reads_an_object_of_a_demo_drive_and_prefills_its_write() {
         .to_string();
     // `e`: the palette holds the typed write command with the value read.
     key(&mut a, KeyCode::Char('e'));
-    let p = a.prompt.editing.as_ref().expect("the palette is open");
+    let p = a.screen().prompt().editing.as_ref().expect("the palette is open");
     assert_eq!(p.text, format!("sdo write 2 0x6060:0x00 {raw} --type i8"));
     assert!(
-        a.message.as_deref().unwrap_or("").contains("will send: 602#2F606000"),
+        a.message().unwrap_or("").contains("will send: 602#2F606000"),
         "{:?}",
-        a.message
+        a.message()
     );
     key(&mut a, KeyCode::Esc);
 }
@@ -141,15 +141,15 @@ fn record_start_and_stop_from_the_palette_write_the_frames_received() {
     let file = dir.join("rec.log");
     let _ = std::fs::remove_file(&file);
     let mut a = demo_app();
-    until(&mut a, "frames", |a, _| a.trace.len() > 10);
+    until(&mut a, "frames", |a, _| a.trace().len() > 10);
     a.run_command(&format!("record start {}", file.display()));
     let s = until(&mut a, "REC in the status line", |a, s| {
-        a.recording.as_ref().is_some_and(|r| r.count() >= 50) && s.contains(&format!("REC {}", file.display()))
+        a.capture().recording().is_some_and(|r| r.count() >= 50) && s.contains(&format!("REC {}", file.display()))
     });
     assert!(s.contains(" frames) |"), "{s}");
-    let before = a.trace.len();
+    let before = a.trace().len();
     a.run_command("record stop");
-    let msg = a.message.clone().unwrap_or_default();
+    let msg = a.message().map(str::to_string).unwrap_or_default();
     assert!(msg.starts_with("record: stopped, "), "{msg}");
     let n: u64 = msg["record: stopped, ".len()..]
         .split(' ')
@@ -157,7 +157,7 @@ fn record_start_and_stop_from_the_palette_write_the_frames_received() {
         .unwrap()
         .parse()
         .unwrap();
-    assert!(a.recording.is_none());
+    assert!(a.capture().recording().is_none());
     // Whole candump -l lines, as many as said, each a frame the trace has.
     let text = std::fs::read_to_string(&file).unwrap();
     assert_eq!(text.lines().count() as u64, n);
@@ -172,15 +172,12 @@ fn record_start_and_stop_from_the_palette_write_the_frames_received() {
     // An existing file is refused without --force; stop when not recording says so.
     a.run_command(&format!("record start {}", file.display()));
     assert!(
-        a.message
-            .as_deref()
-            .unwrap_or("")
-            .contains("exists; --force overwrites it"),
+        a.message().unwrap_or("").contains("exists; --force overwrites it"),
         "{:?}",
-        a.message
+        a.message()
     );
     a.run_command("record stop");
-    assert_eq!(a.message.as_deref(), Some("record: not recording"));
+    assert_eq!(a.message(), Some("record: not recording"));
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -188,7 +185,7 @@ fn record_start_and_stop_from_the_palette_write_the_frames_received() {
 fn read_all_reads_what_drive_2_has_with_progress_and_lists_the_failures() {
     let mut a = demo_app();
     until(&mut a, "node 2 to be listed", |a, _| {
-        a.trace.nodes.iter().any(|(n, _)| n.node == 2)
+        a.trace().nodes.iter().any(|(n, _)| n.node == 2)
     });
     key(&mut a, KeyCode::Char('6'));
     for _ in 0..4 {
@@ -198,7 +195,7 @@ fn read_all_reads_what_drive_2_has_with_progress_and_lists_the_failures() {
         key(&mut a, KeyCode::Char(']'));
     }
     key(&mut a, KeyCode::Char('R'));
-    let started = a.message.clone().unwrap_or_default();
+    let started = a.message().map(str::to_string).unwrap_or_default();
     assert!(
         started.starts_with("read all node 2: reading ")
             && started.ends_with(" objects one after the other (R again stops)"),
@@ -211,9 +208,12 @@ fn read_all_reads_what_drive_2_has_with_progress_and_lists_the_failures() {
         .to_string();
     let s = until(&mut a, "progress in the title", |_, s| s.contains(" · read all "));
     assert!(s.contains(&format!(" of {total}")), "{s}");
-    until(&mut a, "the read-all to end", |a, _| a.panes.objects.read_all.is_none());
+    until(&mut a, "the read-all to end", |a, _| {
+        a.screen().panes().objects.read_all.is_none()
+    });
     let summary = a
-        .messages
+        .screen()
+        .messages()
         .iter()
         .map(|e| e.text.clone())
         .find(|t| t.starts_with("read all node 2: ") && t.contains(" entries read, "))
@@ -226,7 +226,7 @@ fn read_all_reads_what_drive_2_has_with_progress_and_lists_the_failures() {
     }
     // Every identity entry was read, and the drive's own objects.
     for (i, s) in [(0x1000, 0), (0x1018, 1), (0x1018, 2), (0x6060, 0), (0x2002, 1)] {
-        let e = a.trace.values.get(NODE2, i, s).and_then(|e| e.last.as_ref());
+        let e = a.trace().values.get(NODE2, i, s).and_then(|e| e.last.as_ref());
         assert!(e.is_some(), "0x{i:04X}:{s:02X} read\n{summary}");
     }
 }

@@ -51,7 +51,7 @@ fn until(a: &mut App, what: &str, f: impl Fn(&App, &str) -> bool) -> String {
 fn own_reads_of_missing_objects_do_not_hide_a_drive_fault_and_a_lost_node() {
     let mut a = demo_app();
     until(&mut a, "nodes 2 and 3 to be listed", |a, _| {
-        a.trace.nodes.iter().any(|(n, _)| n.node == 2) && a.trace.nodes.iter().any(|(n, _)| n.node == 3)
+        a.trace().nodes.iter().any(|(n, _)| n.node == 2) && a.trace().nodes.iter().any(|(n, _)| n.node == 3)
     });
     key(&mut a, KeyCode::Char('6'));
     for _ in 0..4 {
@@ -61,9 +61,12 @@ fn own_reads_of_missing_objects_do_not_hide_a_drive_fault_and_a_lost_node() {
         key(&mut a, KeyCode::Char(']'));
     }
     key(&mut a, KeyCode::Char('R'));
-    until(&mut a, "the read-all to end", |a, _| a.panes.objects.read_all.is_none());
+    until(&mut a, "the read-all to end", |a, _| {
+        a.screen().panes().objects.read_all.is_none()
+    });
     let summary = a
-        .messages
+        .screen()
+        .messages()
         .iter()
         .map(|e| e.text.clone())
         .find(|t| t.starts_with("read all node 2: ") && t.contains(" entries read"))

@@ -240,6 +240,21 @@ impl DetailPane {
         }
     }
 
+    /// True when toggled in below the main pane.
+    pub fn shown(&self) -> bool {
+        self.shown
+    }
+
+    /// Toggles the pane in below the main pane (a narrow terminal), or out.
+    pub fn toggle(&mut self) {
+        self.shown = !self.shown;
+    }
+
+    /// Takes the pane away from below the main pane.
+    pub fn hide(&mut self) {
+        self.shown = false;
+    }
+
     /// Forgets the decoded frame (the trace started over).
     pub fn reset(&mut self) {
         self.decoded = None;
@@ -295,10 +310,10 @@ mod tests {
         ] {
             t.push(&Frame::classic(id, &data));
         }
-        a.trace = t;
+        *a.capture_mut().trace_mut() = t;
         let lines = |a: &crate::tui::app::App, pos: usize| -> Vec<String> {
-            let d = a.trace.decode_positions(&[pos]).pop().unwrap();
-            frame_lines(&a.trace, &a.trace.store.frame(pos), &d, pos)
+            let d = a.trace().decode_positions(&[pos]).pop().unwrap();
+            frame_lines(a.trace(), &a.trace().store.frame(pos), &d, pos)
                 .iter()
                 .map(|l| l.spans.iter().map(|s| s.content.to_string()).collect())
                 .collect()

@@ -124,6 +124,21 @@ impl HelpPopup {
         true
     }
 
+    /// True while the popup is shown.
+    pub fn shown(&self) -> bool {
+        self.shown
+    }
+
+    /// Shows the popup (`help` in the palette).
+    pub fn show(&mut self) {
+        self.shown = true;
+    }
+
+    /// True while keys go to the text to find.
+    pub fn typing(&self) -> bool {
+        self.typing
+    }
+
     /// A key while typing the text to find: characters add to it (the first line holding
     /// it comes to the top), backspace takes away, enter keeps it, esc drops it.
     pub fn type_key(&mut self, ev: KeyEvent, keymap: &Keymap) {
@@ -303,7 +318,7 @@ mod tests {
 
     #[test]
     fn every_palette_command_has_its_syntax_in_the_help() {
-        for word in crate::tui::app::PALETTE_COMMANDS {
+        for word in crate::tui::commands::PALETTE_COMMANDS {
             assert!(
                 PALETTE_SYNTAX
                     .iter()

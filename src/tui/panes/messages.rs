@@ -48,6 +48,17 @@ pub struct MessagesPopup {
 }
 
 impl MessagesPopup {
+    /// True while the popup is shown.
+    pub fn shown(&self) -> bool {
+        self.shown
+    }
+
+    /// Notes the room the popup gets at the next draw: `page` lines of `width` characters.
+    pub fn set_size(&mut self, page: usize, width: usize) {
+        self.page = page;
+        self.width = width;
+    }
+
     /// Shows the popup at the newest entry.
     pub fn open(&mut self) {
         self.shown = true;

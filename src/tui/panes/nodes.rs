@@ -166,6 +166,13 @@ pub struct NodesPane {
     pub list: ListState,
 }
 
+impl NodesPane {
+    /// The node-ID of the selected row, if there is one.
+    pub fn selected_node(&self, trace: &Trace) -> Option<u8> {
+        trace.nodes.iter().nth(self.list.selected).map(|(n, _)| n.node)
+    }
+}
+
 impl Component for NodesPane {
     /// Moves the selection; `expand` shows the selected node's frames in the trace.
     fn handle(&mut self, action: Action, ctx: &Ctx) -> Outcome {

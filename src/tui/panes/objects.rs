@@ -1076,8 +1076,8 @@ mod tests {
         let mut src = SourceInfo::new("test.log", SourceKind::Open, rx, None);
         src.done = true;
         let mut a = App::new(trace, crate::tui::keymap::Keymap::default_map(), src);
-        a.bindings = b;
-        a.focus = crate::tui::panes::Pane::Objects;
+        a.set_bindings(b);
+        a.screen_mut().focus_on(crate::tui::panes::Pane::Objects);
         a
     }
 
@@ -1097,8 +1097,8 @@ mod tests {
         insta::assert_snapshot!(s);
         // Open the identity record: the vendor-ID read shows with its age.
         for _ in 0..40 {
-            if a.panes.objects.selected_entry().is_none()
-                && matches!(a.panes.objects.rows.get(a.panes.objects.list.selected), Some(Row::Record { obj, .. }) if a.panes.objects.catalog[*obj].index == 0x1018)
+            if a.screen().panes().objects.selected_entry().is_none()
+                && matches!(a.screen().panes().objects.rows.get(a.screen().panes().objects.list.selected), Some(Row::Record { obj, .. }) if a.screen().panes().objects.catalog[*obj].index == 0x1018)
             {
                 break;
             }
@@ -1131,12 +1131,12 @@ mod tests {
         assert!(!s.contains("1017:00"), "{s}");
         insta::assert_snapshot!(s);
         a.key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
-        assert_eq!(a.panes.objects.query, "h02");
+        assert_eq!(a.screen().panes().objects.query, "h02");
         // n goes to the next match; esc clears the find text.
         a.act(Action::NextMatch);
-        assert!(a.panes.objects.selected_entry().is_some());
+        assert!(a.screen().panes().objects.selected_entry().is_some());
         a.act(Action::Back);
-        assert_eq!(a.panes.objects.query, "");
+        assert_eq!(a.screen().panes().objects.query, "");
     }
 
     #[test]
@@ -1144,30 +1144,29 @@ mod tests {
         use crate::tui::panes::testutil::screen;
         let mut a = objects_app();
         a.run_command("filter node 1");
-        a.focus = crate::tui::panes::Pane::Objects;
-        a.panes.objects.set_query("1017");
+        a.screen_mut().focus_on(crate::tui::panes::Pane::Objects);
+        a.screen_mut().objects_mut().set_query("1017");
         let _ = screen(&mut a, 160, 48);
-        assert_eq!(a.panes.objects.selected_entry(), Some((0x1017, 0)));
+        assert_eq!(a.screen().panes().objects.selected_entry(), Some((0x1017, 0)));
         a.act(Action::Expand);
         assert_eq!(
-            a.message.as_deref(),
+            a.message(),
             Some(
                 "sdo read 1 0x1017:0x00: this source is a log file, there is no bus to read from (use `cotui live IFACE` or `cotui demo`)"
             )
         );
         a.act(Action::ReadAll);
         assert!(
-            a.message
-                .as_deref()
+            a.message()
                 .unwrap_or("")
                 .starts_with("read all node 1: this source is a log file")
         );
-        assert!(a.panes.objects.read_all.is_none());
+        assert!(a.screen().panes().objects.read_all.is_none());
         a.act(Action::EditObject);
-        let p = a.prompt.editing.as_ref().expect("the palette is open");
+        let p = a.screen().prompt().editing.as_ref().expect("the palette is open");
         assert_eq!(p.text, "sdo write 1 0x1017:0x00 100 --type u16");
         assert_eq!(p.cursor, "sdo write 1 0x1017:0x00 100".len());
-        let m = a.message.clone().unwrap_or_default();
+        let m = a.message().map(str::to_string).unwrap_or_default();
         assert!(
             m.starts_with(
                 "u16 value in ms: edit it and press enter · blocked: this source has no bus — would send 601#2B17100064000000"
@@ -1175,12 +1174,12 @@ mod tests {
             "{m}"
         );
         // A read-only entry is not offered for writing.
-        a.prompt.editing = None;
-        a.panes.objects.set_query("1018:01");
+        a.screen_mut().prompt_mut().editing = None;
+        a.screen_mut().objects_mut().set_query("1018:01");
         let _ = screen(&mut a, 160, 48);
         a.act(Action::EditObject);
-        assert!(a.prompt.editing.is_none());
-        assert_eq!(a.message.as_deref(), Some("0x1018:01 Vendor-ID is read-only (ro)"));
+        assert!(a.screen().prompt().editing.is_none());
+        assert_eq!(a.message(), Some("0x1018:01 Vendor-ID is read-only (ro)"));
     }
 
     #[test]
@@ -1188,25 +1187,25 @@ mod tests {
         let (_ftx, frx) = std::sync::mpsc::channel();
         let (rtx, mut rrx) = tokio::sync::mpsc::unbounded_channel();
         let mut a = objects_app();
-        a.source = crate::tui::app::SourceInfo::live(
+        *a.capture_mut().source_mut() = crate::tui::app::SourceInfo::live(
             "vcan0",
             crate::tui::app::SourceKind::Live { listen_only: true },
             frx,
             rtx,
         );
-        a.panes.objects.set_query("1017");
+        a.screen_mut().objects_mut().set_query("1017");
         let _ = crate::tui::panes::testutil::screen(&mut a, 160, 48);
         a.act(Action::Expand);
         a.act(Action::ReadAll);
         assert!(rrx.try_recv().is_err(), "nothing requested");
         assert_eq!(
-            a.message.as_deref(),
+            a.message(),
             Some("read all node 1: listen-only — nothing can be sent, so no object can be read")
         );
         a.act(Action::EditObject);
-        assert!(a.prompt.editing.is_none(), "no write offered");
+        assert!(a.screen().prompt().editing.is_none(), "no write offered");
         assert_eq!(
-            a.message.as_deref(),
+            a.message(),
             Some("write: listen-only — nothing can be sent, so no object can be written")
         );
     }

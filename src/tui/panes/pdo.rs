@@ -223,7 +223,7 @@ mod tests {
         let mut src = SourceInfo::new("demo.log", SourceKind::Open, rx, None);
         src.done = true;
         let mut a = App::new(trace, Keymap::default_map(), src);
-        a.focus = Pane::Pdo;
+        a.screen_mut().focus_on(Pane::Pdo);
         a
     }
 
@@ -258,7 +258,7 @@ mod tests {
         assert!(s.contains("node 2 TPDO1: mapping configured by cotui @"), "{s}");
         assert!(s.contains("  0x6064:00 Position actual value, 32 bits [Pul]"), "{s}");
         a.act(Action::Expand);
-        assert_eq!(a.focus, Pane::Trace);
+        assert_eq!(a.focus(), Pane::Trace);
         let s = screen(&mut a, 230, 20);
         assert!(s.contains("filter: id 182"), "{s}");
         assert!(s.contains("TPDO1 node 2: Statusword=0x0237"), "{s}");
@@ -268,7 +268,7 @@ mod tests {
     #[test]
     fn tiny_areas_and_no_pdos_do_not_panic() {
         let mut a = super::super::testutil::app();
-        a.focus = Pane::Pdo;
+        a.screen_mut().focus_on(Pane::Pdo);
         for (w, h) in [(0, 0), (10, 3), (40, 8), (80, 24)] {
             let _ = screen(&mut a, w, h);
         }

@@ -111,6 +111,24 @@ impl PlotPane {
         self.signals = shown;
     }
 
+    /// Gives a key to the signal picker while it is open; false when it is not (the key is
+    /// someone else's).
+    pub fn picker_key(&mut self, ev: crossterm::event::KeyEvent, trace: &Trace) -> bool {
+        use super::picker::PickerEdit;
+        let Some(picker) = self.picker.as_mut() else {
+            return false;
+        };
+        match picker.key(ev, trace) {
+            PickerEdit::Editing => {}
+            PickerEdit::Closed => self.picker = None,
+            PickerEdit::Toggle(k) => {
+                self.toggle(trace, k);
+                self.picker = None;
+            }
+        }
+        true
+    }
+
     /// Opens the signal picker.
     pub fn open_picker(&mut self) {
         self.picker = Some(SignalPicker::default());

@@ -30,7 +30,7 @@ fn scrolled_back_trace_keeps_a_tail_strip_of_the_newest_frames() {
 #[test]
 fn nodes_pane_shows_states_heartbeat_and_emcy() {
     let mut a = app();
-    a.focus = Pane::Nodes;
+    a.screen_mut().focus_on(Pane::Nodes);
     let s = screen(&mut a, 160, 14);
     assert!(s.contains("Operational"), "{s}");
     assert!(s.contains("Pre-operational"), "{s}");
@@ -41,12 +41,12 @@ fn nodes_pane_shows_states_heartbeat_and_emcy() {
 #[test]
 fn nodes_pane_marks_a_silent_node_lost_in_red_with_its_age() {
     let mut a = app();
-    a.focus = Pane::Nodes;
+    a.screen_mut().focus_on(Pane::Nodes);
     // 100 ms later node 1 (0x1017 = 100 ms, read by SDO) is on time; node 2 (every 14 ms,
     // measured) was due 21 ms after its last heartbeat.
     let mut f = crate::frame::Frame::classic(0x701, &[0x05]);
-    f.ts_ns = a.trace.nodes.now_ns() + 100_000_000;
-    a.trace.push(&f);
+    f.ts_ns = a.trace().nodes.now_ns() + 100_000_000;
+    a.capture_mut().trace_mut().push(&f);
     let s = screen(&mut a, 160, 14);
     assert!(s.contains("  1 Operational       14/100 ms"), "{s}");
     assert!(
@@ -104,7 +104,7 @@ fn two_bus_app() -> crate::tui::app::App {
 #[test]
 fn nodes_pane_shows_node_5_of_each_interface_with_its_interface() {
     let mut a = two_bus_app();
-    a.focus = Pane::Nodes;
+    a.screen_mut().focus_on(Pane::Nodes);
     let s = screen(&mut a, 160, 14);
     assert!(s.contains("iface  id nmt"), "{s}");
     let row = |iface: &str| {
@@ -123,8 +123,8 @@ fn nodes_pane_shows_node_5_of_each_interface_with_its_interface() {
 #[test]
 fn sdo_pane_names_the_interface_of_each_transfer_when_there_are_several() {
     let mut a = two_bus_app();
-    a.trace.end_of_input();
-    a.focus = Pane::Sdo;
+    a.capture_mut().trace_mut().end_of_input();
+    a.screen_mut().focus_on(Pane::Sdo);
     let s = screen(&mut a, 160, 14);
     assert!(s.contains("iface       time  nd"), "{s}");
     // The request on can0 is never answered there: its "answer" came on can1.
@@ -141,7 +141,7 @@ fn sdo_pane_names_the_interface_of_each_transfer_when_there_are_several() {
 #[test]
 fn sdo_pane_lists_transfers_and_expands_to_frames() {
     let mut a = app();
-    a.focus = Pane::Sdo;
+    a.screen_mut().focus_on(Pane::Sdo);
     let s = screen(&mut a, 140, 14);
     assert!(s.contains("1017:00"), "{s}");
     assert!(s.contains("abort 06020000"), "{s}");
@@ -161,7 +161,7 @@ fn sdo_pane_lists_transfers_and_expands_to_frames() {
 
 /// One expedited read of 0x1018:sub from node 1, `dt_ms` after the newest frame.
 fn read_identity(a: &mut crate::tui::app::App, sub: u8, dt_ms: u64) {
-    let t = a.trace.store.packed(a.trace.len() - 1).ts_ns + dt_ms * 1_000_000;
+    let t = a.trace().store.packed(a.trace().len() - 1).ts_ns + dt_ms * 1_000_000;
     for (i, (id, data)) in [
         (0x601, [0x40, 0x18, 0x10, sub, 0, 0, 0, 0]),
         (0x581, [0x43, 0x18, 0x10, sub, 0x78, 0x56, 0x34, 0x12]),
@@ -171,7 +171,7 @@ fn read_identity(a: &mut crate::tui::app::App, sub: u8, dt_ms: u64) {
     {
         let mut f = crate::frame::Frame::classic(id, &data);
         f.ts_ns = t + i as u64 * 1_000_000;
-        a.trace.push(&f);
+        a.capture_mut().trace_mut().push(&f);
     }
 }
 
@@ -191,7 +191,7 @@ fn selected_sdo_row(a: &mut crate::tui::app::App) -> String {
 #[test]
 fn the_sdo_pane_has_a_time_column_and_follows_the_newest_transfer_until_scrolled() {
     let mut a = app();
-    a.focus = Pane::Sdo;
+    a.screen_mut().focus_on(Pane::Sdo);
     let s = screen(&mut a, 140, 16);
     // Trace time, as the trace pane counts it: the 0x1017 read is frame 4, at 0.007 s.
     assert!(s.contains("      time  nd dir   object"), "{s}");
@@ -275,7 +275,7 @@ fn detail_pane_shows_statusword_bits_of_a_mapped_pdo() {
 #[test]
 fn stats_pane_shows_rates_and_bus_load() {
     let mut a = app();
-    a.focus = Pane::Stats;
+    a.screen_mut().focus_on(Pane::Stats);
     let s = screen(&mut a, 140, 24);
     assert!(s.contains("bus load"), "{s}");
     assert!(s.contains("701"), "{s}");
@@ -286,7 +286,7 @@ fn stats_pane_shows_rates_and_bus_load() {
 fn receive_list_shows_latest_data_periods_and_labels_sorted_by_a_key() {
     let mut a = app();
     a.act(Action::Sort);
-    assert_eq!(a.focus, Pane::Stats, "the sort key brings the receive list up");
+    assert_eq!(a.focus(), Pane::Stats, "the sort key brings the receive list up");
     let s = screen(&mut a, 80, 24);
     assert!(s.contains("Receive list by count"), "{s}");
     // 0x701 (7 heartbeats) first; its latest data and label.
@@ -311,13 +311,13 @@ fn receive_list_shows_latest_data_periods_and_labels_sorted_by_a_key() {
 fn receive_list_at_80x24_shows_the_age_and_dims_a_stale_row() {
     use ratatui::style::{Color, Modifier};
     let mut a = app();
-    a.focus = Pane::Stats;
+    a.screen_mut().focus_on(Pane::Stats);
     // 100 ms after the capture's last frame only node 1's heartbeat comes again: 0x181
     // (every 14 ms) is 7 periods late, stale; 0x701 was heard just now.
-    let end = a.trace.nodes.now_ns();
+    let end = a.trace().nodes.now_ns();
     let mut f = crate::frame::Frame::classic(0x701, &[0x05]);
     f.ts_ns = end + 100_000_000;
-    a.trace.push(&f);
+    a.capture_mut().trace_mut().push(&f);
     let s = screen(&mut a, 80, 24);
     assert!(s.contains("cob  rate/s     age    period  data"), "{s}");
     assert!(s.contains("181    29.4  106 ms   14.0 ms  37 02"), "{s}");
@@ -343,7 +343,7 @@ fn receive_list_at_80x24_shows_the_age_and_dims_a_stale_row() {
 #[test]
 fn receive_list_highlights_the_bytes_that_changed() {
     let mut a = app();
-    a.focus = Pane::Stats;
+    a.screen_mut().focus_on(Pane::Stats);
     let mut term = ratatui::Terminal::new(ratatui::backend::TestBackend::new(100, 20)).unwrap();
     term.draw(|fr| crate::tui::ui::draw(fr, &mut a)).unwrap();
     let buf = term.backend().buffer().clone();
@@ -364,7 +364,7 @@ fn receive_list_highlights_the_bytes_that_changed() {
 fn plot_pane_draws_a_series() {
     let mut a = app();
     a.act(Action::NextSeries);
-    assert_eq!(a.focus, Pane::Plot);
+    assert_eq!(a.focus(), Pane::Plot);
     let s = screen(&mut a, 100, 20);
     assert!(s.contains("Plot: 1 of 2 signals"), "{s}");
     assert!(s.contains("end 0.098 s  n1 0x6041:00 = 567"), "{s}");
@@ -433,8 +433,8 @@ fn filter_prompt_and_errors_show_in_the_bottom_line() {
 fn any_size_renders_without_panicking() {
     let mut a = app();
     for pane in Pane::ALL {
-        a.focus = pane;
-        a.help.shown = pane == Pane::Stats;
+        a.screen_mut().focus_on(pane);
+        a.screen_mut().help_mut().shown = pane == Pane::Stats;
         for (w, h) in [
             (0, 0),
             (1, 1),
@@ -457,11 +457,11 @@ fn a_replay_shows_its_position_and_progress_in_the_status_line() {
     use crate::tui::source::{Extent, Position};
     let mut a = app();
     let frames = super::testutil::frames();
-    a.source.kind = SourceKind::Replay { speed: 2.0 };
-    a.source.done = false;
-    a.source.paused = true;
+    a.capture_mut().source_mut().kind = SourceKind::Replay { speed: 2.0 };
+    a.capture_mut().source_mut().done = false;
+    a.capture_mut().source_mut().paused = true;
     let first = frames[0].ts_ns;
-    a.source.replay = (
+    a.capture_mut().source_mut().replay = (
         Some(Position {
             frames: 22,
             ts_ns: frames[21].ts_ns,
@@ -480,13 +480,13 @@ fn a_replay_shows_its_position_and_progress_in_the_status_line() {
     );
     insta::assert_snapshot!(status);
     // At the end it says so, and a log not measured yet shows only the time.
-    a.source.paused = false;
-    a.source.replay.0 = Some(Position {
+    a.capture_mut().source_mut().paused = false;
+    a.capture_mut().source_mut().replay.0 = Some(Position {
         frames: frames.len() as u64,
         ts_ns: frames.last().unwrap().ts_ns,
     });
     assert!(screen(&mut a, 80, 24).contains("replay test.log 100% 0.1 s / 0.1 s ×2 (end)"));
-    a.source.replay.1 = None;
+    a.capture_mut().source_mut().replay.1 = None;
     assert!(screen(&mut a, 80, 24).contains("replay test.log 0.1 s ×2 |"));
 }
 
@@ -494,7 +494,7 @@ fn a_replay_shows_its_position_and_progress_in_the_status_line() {
 fn plot_screen(keys: &str, w: u16, h: u16) -> (crate::tui::app::App, String) {
     use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
     let mut a = super::testutil::plot_app();
-    a.focus = Pane::Plot;
+    a.screen_mut().focus_on(Pane::Plot);
     let _ = screen(&mut a, w, h);
     for c in keys.chars() {
         let code = match c {
@@ -515,7 +515,7 @@ fn plot_picker_filters_signals_as_the_user_types() {
     assert!(s.contains("Pick signals (1 of 3)"), "{s}");
     assert!(s.contains("> vel_"), "{s}");
     assert!(s.contains("node 1   6044:00  vl velocity actual value [rpm]"), "{s}");
-    assert!(a.panes.plot.picker.is_some());
+    assert!(a.screen().panes().plot.picker.is_some());
     insta::assert_snapshot!("plot_picker_80x24", s);
     let (_, s) = plot_screen("p", 160, 48);
     assert!(s.contains("Pick signals (3 of 3)"), "{s}");
@@ -528,7 +528,7 @@ fn plot_shows_signals_on_one_axis_with_units_legend_and_bit_lanes() {
     let (a, s) = plot_screen("pvel\npmodes\n", 160, 48);
     let n1 = crate::frame::NodeKey::new(0, 1);
     assert_eq!(
-        a.panes.plot.signals,
+        a.screen().panes().plot.signals,
         [(n1, 0x6041, 0), (n1, 0x6044, 0), (n1, 0x6061, 0)]
     );
     assert!(s.contains("Plot: 3 of 3 signals"), "{s}");
@@ -547,7 +547,7 @@ fn plot_shows_signals_on_one_axis_with_units_legend_and_bit_lanes() {
 fn plot_cursor_reads_values_and_zoom_narrows_the_window() {
     // Right places the cursor mid-window, then moves it one column at a time.
     let (a, s) = plot_screen("pvel\n>>>>>", 80, 24);
-    let c = a.panes.plot.cursor.unwrap() - a.start_ns() as f64 / 1e9;
+    let c = a.screen().panes().plot.cursor.unwrap() - a.start_ns() as f64 / 1e9;
     assert!((0.2..0.25).contains(&c), "{c}");
     assert!(s.contains("cursor 0.2"), "{s}");
     assert!(s.contains("n1 Statusword = 0x0237"), "{s}");
@@ -556,13 +556,13 @@ fn plot_cursor_reads_values_and_zoom_narrows_the_window() {
     assert!(!s.contains(" 7 Warning"), "{s}");
     insta::assert_snapshot!("plot_cursor_80x24", s);
     let (a, s) = plot_screen("pvel\n>zz", 80, 24);
-    let w = a.panes.plot.window.unwrap();
+    let w = a.screen().panes().plot.window.unwrap();
     assert!((w.width() - 0.1).abs() < 0.01, "{w:?}");
     assert!(s.contains("Plot: 2 of 3 signals 0.1"), "{s}");
     // Home shows the whole span again.
     let mut a = a;
     a.act(crate::tui::keymap::Action::Top);
-    assert_eq!(a.panes.plot.window, None);
+    assert_eq!(a.screen().panes().plot.window, None);
 }
 
 #[test]
@@ -585,7 +585,7 @@ fn help_search_brings_the_first_line_found_to_the_top() {
 fn problems_pane_lists_the_incidents_and_opens_one_at_80x24() {
     let mut a = app();
     a.act(Action::PaneProblems);
-    assert_eq!(a.focus, Pane::Problems);
+    assert_eq!(a.focus(), Pane::Problems);
     let s = screen(&mut a, 80, 24);
     // Node 2 refused the read of 0x6041:00 and sent an EMCY; nothing recovered.
     assert!(s.contains("8 Problems"), "{s}");
@@ -613,9 +613,9 @@ fn problems_pane_at_160x48_and_its_frames_in_the_trace() {
     insta::assert_snapshot!("problems_160x48_list", s);
     // The first incident is the refused read (frame 13, the abort): `show_frames` shows it
     // in the trace; pressing it again in the trace goes on to the incident's next frame.
-    let first = a.panes.problems.incidents()[0].clone();
+    let first = a.screen().panes().problems.incidents()[0].clone();
     a.act(Action::ShowFrames);
-    assert_eq!(a.focus, Pane::Trace);
+    assert_eq!(a.focus(), Pane::Trace);
     assert_eq!(a.selected_position(), Some(first.events[0].frame as usize - 1));
     a.act(Action::ShowFrames);
     let next = first.events.get(1).unwrap_or(&first.events[0]).frame as usize - 1;
@@ -625,7 +625,7 @@ fn problems_pane_at_160x48_and_its_frames_in_the_trace() {
     let _ = screen(&mut a, 160, 48);
     a.act(Action::Expand);
     a.act(Action::Expand);
-    assert_eq!(a.focus, Pane::Trace);
+    assert_eq!(a.focus(), Pane::Trace);
     assert_eq!(a.selected_position(), Some(first.events[0].frame as usize - 1));
 }
 
@@ -724,7 +724,7 @@ mod demo {
         let mut src = SourceInfo::new("sim.log", SourceKind::Open, rx, None);
         src.done = true;
         let mut a = App::new(trace, crate::tui::keymap::Keymap::default_map(), src);
-        a.focus = Pane::Nodes;
+        a.screen_mut().focus_on(Pane::Nodes);
         let s = screen(&mut a, 200, 14);
         let row = |node: &str| {
             s.lines()
@@ -745,12 +745,14 @@ fn message_log_at_80x24_wraps_long_entries_scrolls_to_the_oldest_and_shows_one_w
     use std::time::{Duration, SystemTime};
     let mut a = app();
     let t = SystemTime::UNIX_EPOCH + Duration::from_secs(3600);
-    a.messages.push(t, Level::Info, "the oldest entry");
+    a.screen_mut().messages_mut().push(t, Level::Info, "the oldest entry");
     for i in 0..30 {
-        a.messages.push(t, Level::Info, &format!("filler {i}"));
+        a.screen_mut()
+            .messages_mut()
+            .push(t, Level::Info, &format!("filler {i}"));
     }
     let preview = "pdo 2 map tpdo1: will send: 602#2F00 1A 00 00 00 00 00 · 602#23 00 1A 01 10 00 41 60 · 602#2F 00 1A 00 01 00 00 00 · 602#2F 00 18 02 02 00 00 00 (node 2 must be pre-operational)";
-    a.messages.push(t, Level::Info, preview);
+    a.screen_mut().messages_mut().push(t, Level::Info, preview);
     a.act(Action::Messages);
     let s = screen(&mut a, 80, 24);
     // Every word of the long preview is on screen, in order, once the lines are joined.
@@ -777,7 +779,11 @@ fn message_log_at_80x24_wraps_long_entries_scrolls_to_the_oldest_and_shows_one_w
     assert!(!s.contains("pre-operational)"), "{s}");
     a.act(Action::Bottom);
     let s = screen(&mut a, 80, 24);
-    assert!(s.contains("pre-operational)"), "{s} {:?}", a.log_popup.selected);
+    assert!(
+        s.contains("pre-operational)"),
+        "{s} {:?}",
+        a.screen().log_popup().selected
+    );
     // Page up repeatedly also gets there.
     for _ in 0..10 {
         a.act(Action::PageUp);
@@ -786,7 +792,8 @@ fn message_log_at_80x24_wraps_long_entries_scrolls_to_the_oldest_and_shows_one_w
     // Enter shows the selected entry whole, even one taller than the popup.
     a.act(Action::Bottom);
     let scan: String = (1..=40).map(|n| format!("node {n}: 0x{n:08X}\n")).collect();
-    a.messages
+    a.screen_mut()
+        .messages_mut()
         .push(t, Level::Info, &format!("lss fastscan: 40 found\n{scan}"));
     a.act(Action::Expand);
     let s = screen(&mut a, 80, 24);
@@ -796,7 +803,7 @@ fn message_log_at_80x24_wraps_long_entries_scrolls_to_the_oldest_and_shows_one_w
     let s = screen(&mut a, 80, 24);
     assert!(s.contains("node 40: 0x00000028"), "{s}");
     a.act(Action::Back);
-    assert!(a.log_popup.shown && a.log_popup.whole.is_none());
+    assert!(a.screen().log_popup().shown && a.screen().log_popup().whole.is_none());
 }
 
 #[test]
@@ -817,7 +824,7 @@ fn every_pane_at_80x24() {
     ];
     for (pane, want) in wants {
         let mut a = app();
-        a.focus = pane;
+        a.screen_mut().focus_on(pane);
         let s = screen(&mut a, 80, 24);
         for w in want {
             assert!(s.contains(w), "{pane:?}: {w}\n{s}");

@@ -84,7 +84,7 @@ fn wrap_question(hint: &str, text: &str, width: usize, max: usize) -> Vec<Line<'
 /// A replay's position: ` 45% 12.3 s / 27.0 s` (percent of the frames, log time from the
 /// first frame), only the time until the log is measured, nothing before the first frame.
 fn replay_position(app: &App) -> String {
-    match app.source.replay {
+    match app.source().replay {
         (Some(p), Some(e)) if e.frames > 0 => format!(
             " {}% {:.1} s / {:.1} s",
             p.frames * 100 / e.frames,
@@ -100,21 +100,21 @@ fn replay_position(app: &App) -> String {
 
 /// The status bar text.
 pub fn text(app: &App) -> String {
-    let src = match app.source.kind {
-        SourceKind::Open => format!("open {}", app.source.name),
+    let src = match app.source().kind {
+        SourceKind::Open => format!("open {}", app.source().name),
         SourceKind::Replay { speed } => {
             let x = if speed <= 0.0 {
                 "max".to_string()
             } else {
                 speed.to_string()
             };
-            let looping = if app.source.looping { " loop" } else { "" };
-            format!("replay {}{} ×{x}{looping}", app.source.name, replay_position(app))
+            let looping = if app.source().looping { " loop" } else { "" };
+            format!("replay {}{} ×{x}{looping}", app.source().name, replay_position(app))
         }
         SourceKind::Live { listen_only } => {
             format!(
                 "live {}{}",
-                app.source.name,
+                app.source().name,
                 if listen_only { " (listen-only)" } else { "" }
             )
         }
@@ -122,50 +122,50 @@ pub fn text(app: &App) -> String {
             format!("demo bus{}", if listen_only { " (listen-only)" } else { "" })
         }
     };
-    let state = if app.source.done || app.source.replay_at_end() {
+    let state = if app.source().done || app.source().replay_at_end() {
         " (end)"
-    } else if app.source.paused {
+    } else if app.source().paused {
         " (paused)"
     } else {
         ""
     };
     let rec = app
-        .recording
-        .as_ref()
+        .capture()
+        .recording()
         .map(|r| format!(" | REC {} ({} frames)", r.file, r.count()))
         .unwrap_or_default();
-    let view = &app.panes.trace.view;
+    let view = app.screen().view();
     let filter = if view.filter.is_empty() {
         String::new()
     } else {
-        let p = view.progress(&app.trace);
+        let p = view.progress(app.trace());
         let prog = if p < 100 { format!(" {p}%") } else { String::new() };
         format!(
             " | filter: {} ({} rows{prog})",
             view.filter.source,
-            app.panes.trace.len(&app.trace)
+            view.len(app.trace())
         )
     };
     let search = app
-        .search
-        .as_ref()
-        .map(|s| format!(" | {}", s.summary(&app.trace)))
+        .screen()
+        .search()
+        .map(|s| format!(" | {}", s.summary(app.trace())))
         .unwrap_or_default();
     let stop = app
-        .keymap
+        .keymap()
         .key_for(Action::StopAll)
         .map(|k| format!(" | stop all: {k}"))
         .unwrap_or_default();
     let help = app
-        .keymap
+        .keymap()
         .key_for(Action::Help)
         .map(|k| format!(" | help: {k}"))
         .unwrap_or_default();
     format!(
         "{src}{state}{rec} | {} frames | {:.0} fr/s | drops {}{filter}{search}{stop}{help}",
-        app.trace.len(),
-        app.rate,
-        app.source.drops
+        app.trace().len(),
+        app.capture().rate(),
+        app.source().drops
     )
 }
 
@@ -217,15 +217,15 @@ pub fn fit_bar(bar: &str, path: &str, width: usize) -> String {
 
 /// Draws the status bar and, below it, the prompt or the last message.
 pub fn render(app: &App, f: &mut Frame, bar: Rect, line: Rect) {
-    let (txt, bg) = match (&app.source.bus_error, &app.prompt.editing, &app.message) {
+    let (txt, bg) = match (&app.source().bus_error, app.screen().prompt().editing(), app.message()) {
         // While typing, the bar shows what the line will do (preview or error).
-        (_, Some(_), Some(m)) => (m.clone(), Color::Magenta),
+        (_, Some(_), Some(m)) => (m.to_string(), Color::Magenta),
         // The error (with its fix) first, so a narrow terminal still shows it.
         (Some(e), _, _) => (format!("{e} | {}", text(app)), Color::Red),
         _ => (text(app), Color::Blue),
     };
-    let path = match app.source.kind {
-        SourceKind::Open | SourceKind::Replay { .. } => app.source.name.as_str(),
+    let path = match app.source().kind {
+        SourceKind::Open | SourceKind::Replay { .. } => app.source().name.as_str(),
         _ => "",
     };
     let txt = fit_bar(&txt, path, bar.width as usize);
@@ -234,14 +234,11 @@ pub fn render(app: &App, f: &mut Frame, bar: Rect, line: Rect) {
         f.render_widget(Paragraph::new(lines), line);
         return;
     }
-    if app.prompt.render(f, line) {
+    if app.screen().prompt().render(f, line) {
         return;
     }
-    if let Some(m) = &app.message {
-        f.render_widget(
-            Paragraph::new(m.as_str()).style(Style::default().fg(Color::Yellow)),
-            line,
-        );
+    if let Some(m) = app.message() {
+        f.render_widget(Paragraph::new(m).style(Style::default().fg(Color::Yellow)), line);
     }
 }
 

@@ -42,6 +42,37 @@ impl Default for TracePane {
 }
 
 impl TracePane {
+    /// The filtered view (what an export writes).
+    pub fn view(&self) -> &View {
+        &self.view
+    }
+
+    /// The filter in force.
+    pub fn filter(&self) -> &Filter {
+        &self.view.filter
+    }
+
+    /// Follows the newest frame (`true`) or stays on the selection.
+    pub fn set_follow(&mut self, on: bool) {
+        self.follow = on;
+    }
+
+    /// True while following the newest frame.
+    pub fn following(&self) -> bool {
+        self.follow
+    }
+
+    /// Scans the view on for up to `budget` (settled first when the source `done`);
+    /// returns (work is left, rows changed).
+    pub fn work(&mut self, trace: &Trace, done: bool, budget: Duration) -> (bool, bool) {
+        if done {
+            self.view.settle();
+        }
+        let before = self.view.len(trace);
+        let more = self.view.advance(trace, budget);
+        (more, self.view.len(trace) != before)
+    }
+
     /// Rows in the view.
     pub fn len(&self, trace: &Trace) -> usize {
         self.view.len(trace)
