@@ -102,7 +102,10 @@ fn a_keymap_that_cannot_quit_or_cannot_be_read_is_refused_and_located() {
             args.extend(["--keymap", k.to_str().unwrap()]);
         }
         let out = cotui(&args, &dir);
-        (out.status.code(), String::from_utf8_lossy(&out.stderr).trim().to_string())
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).trim().to_string(),
+        )
     };
     let empty = dir.join("empty.json");
     std::fs::write(&empty, "{}").unwrap();
