@@ -109,28 +109,40 @@ pub fn user_keymap_path() -> Option<PathBuf> {
     Some(base.join("cotui").join("keymap.json"))
 }
 
-/// A keymap file's text, read with the dictionary files' size cap.
-fn read_text(path: &std::path::Path) -> std::io::Result<String> {
-    String::from_utf8(crate::files::read_capped(path)?).map_err(|_| std::io::Error::other("not UTF-8"))
+/// A keymap file's text, read with the dictionary files' size cap; `None` when there is no
+/// such file. The error is the line cotui prints.
+fn read_text(path: &std::path::Path) -> Result<Option<String>, String> {
+    let name = path.display().to_string();
+    if path.is_dir() {
+        return Err(format!("keymap: {name}: is a directory, not a keymap file"));
+    }
+    match crate::files::read_capped(path) {
+        Ok(bytes) => keymap::utf8_text(&name, bytes)
+            .map(Some)
+            .map_err(|e| format!("keymap: {e}")),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(format!("keymap: {name}: {e}")),
+    }
 }
 
-/// Loads the keymap named by `--keymap` plus the user's overrides.
+/// Loads the keymap named by `--keymap` plus the user's overrides (a user keymap that
+/// cannot be read is an error, not ignored).
 pub fn load_keymap(choice: &str) -> Result<Keymap, String> {
     let file_text;
     let base: (&str, &str) = match choice {
         "default" => ("default", keymap::DEFAULT),
         "vim" => ("vim", keymap::VIM),
         path => {
-            file_text = read_text(std::path::Path::new(path)).map_err(|e| format!("--keymap {path}: {e}"))?;
+            file_text = read_text(std::path::Path::new(path))?
+                .ok_or_else(|| format!("--keymap {path}: no such file (or use `default`, `vim`)"))?;
             (path, &file_text)
         }
     };
-    let user = user_keymap_path().and_then(|p| read_text(&p).ok().map(|t| (p, t)));
-    let user_name = user.as_ref().map(|(p, _)| p.display().to_string());
-    let overrides: Vec<(&str, &str)> = match (&user, &user_name) {
-        (Some((_, t)), Some(n)) => vec![(n.as_str(), t.as_str())],
-        _ => Vec::new(),
+    let user = match user_keymap_path() {
+        Some(p) => read_text(&p)?.map(|t| (p.display().to_string(), t)),
+        None => None,
     };
+    let overrides: Vec<(&str, &str)> = user.iter().map(|(n, t)| (n.as_str(), t.as_str())).collect();
     Keymap::load(base, &overrides).map_err(|e: KeymapError| format!("keymap: {e}"))
 }
 

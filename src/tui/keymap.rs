@@ -271,24 +271,66 @@ impl<'de> serde::Deserialize<'de> for Entries {
     }
 }
 
-/// Line and column of the `nth` occurrence of `"key"` used as an object key in `text`.
-fn locate(text: &str, key: &str, nth: usize) -> (usize, usize) {
-    let quoted = serde_json::to_string(key).unwrap_or_default();
-    let mut seen = 0;
-    let mut from = 0;
-    while let Some(off) = text[from..].find(&quoted) {
-        let at = from + off;
-        from = at + quoted.len();
-        if text[from..].trim_start().starts_with(':') {
-            if seen == nth {
-                let line = text[..at].matches('\n').count() + 1;
-                let col = at - text[..at].rfind('\n').map(|i| i + 1).unwrap_or(0) + 1;
-                return (line, col);
+/// 1-based line and column (in characters) of byte offset `at` of `text`.
+fn line_column(text: &str, at: usize) -> (usize, usize) {
+    let before = &text[..at];
+    let start = before.rfind('\n').map_or(0, |i| i + 1);
+    (before.matches('\n').count() + 1, before[start..].chars().count() + 1)
+}
+
+/// Where each key of the top-level object of `text` starts (its opening quote), in file
+/// order: the keys as written, escapes (`\u0067`) and all, so every entry is located.
+fn key_positions(text: &str) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    let (mut depth, mut in_string, mut escaped) = (0usize, false, false);
+    // At depth 1, a string right after `{` or `,` is a key.
+    let mut expect_key = false;
+    for (i, c) in text.char_indices() {
+        if in_string {
+            match c {
+                _ if escaped => escaped = false,
+                '\\' => escaped = true,
+                '"' => in_string = false,
+                _ => {}
             }
-            seen += 1;
+            continue;
+        }
+        match c {
+            '"' => {
+                if depth == 1 && expect_key {
+                    out.push(line_column(text, i));
+                }
+                in_string = true;
+                expect_key = false;
+            }
+            '{' | '[' => {
+                depth += 1;
+                expect_key = depth == 1;
+            }
+            '}' | ']' => depth = depth.saturating_sub(1),
+            ',' => expect_key = depth == 1,
+            _ => {}
         }
     }
-    (1, 1)
+    out
+}
+
+/// A keymap file's bytes as text; bytes that are not UTF-8 are an error at their line
+/// and column.
+pub fn utf8_text(name: &str, bytes: Vec<u8>) -> Result<String, KeymapError> {
+    String::from_utf8(bytes).map_err(|e| {
+        let valid = e.utf8_error().valid_up_to();
+        let bytes = e.as_bytes();
+        // The prefix before the first bad byte is valid UTF-8.
+        let text = std::str::from_utf8(&bytes[..valid]).unwrap_or_default();
+        let (line, column) = line_column(text, valid);
+        KeymapError {
+            file: name.to_string(),
+            line,
+            column,
+            message: format!("not UTF-8 (byte 0x{:02X})", bytes[valid]),
+        }
+    })
 }
 
 /// A binding and where it was defined.
@@ -301,18 +343,21 @@ struct Origin {
 
 /// Parses one keymap file into (keys, action or None for `none`, origin).
 fn parse_file(name: &str, text: &str) -> Result<Vec<(Keys, Option<Action>, Origin)>, KeymapError> {
-    let entries: Entries = serde_json::from_str(text).map_err(|e| KeymapError {
-        file: name.to_string(),
-        line: e.line(),
-        column: e.column(),
-        message: e.to_string(),
+    let entries: Entries = serde_json::from_str(text).map_err(|e| {
+        let whole = e.to_string();
+        let at = format!(" at line {} column {}", e.line(), e.column());
+        KeymapError {
+            file: name.to_string(),
+            line: e.line(),
+            // serde_json says column 0 for an error at the end of a line.
+            column: e.column().max(1),
+            message: whole.strip_suffix(&at).unwrap_or(&whole).to_string(),
+        }
     })?;
     let mut out: Vec<(Keys, Option<Action>, Origin)> = Vec::new();
-    let mut counts: BTreeMap<String, usize> = BTreeMap::new();
-    for (spec, action) in entries.0 {
-        let nth = counts.entry(spec.clone()).or_default();
-        let (line, column) = locate(text, &spec, *nth);
-        *nth += 1;
+    let positions = key_positions(text);
+    for (i, (spec, action)) in entries.0.into_iter().enumerate() {
+        let (line, column) = positions.get(i).copied().unwrap_or((1, 1));
         let origin = Origin {
             file: name.to_string(),
             line,
@@ -368,25 +413,38 @@ pub enum Lookup {
 
 impl Keymap {
     /// Builds a keymap: `base` (name, text) overridden key by key by each of `overrides`.
+    /// A map with no key to quit is refused: only a signal could end the TUI.
     pub fn load(base: (&str, &str), overrides: &[(&str, &str)]) -> Result<Keymap, KeymapError> {
         let mut bindings: BTreeMap<Keys, (Action, Origin)> = BTreeMap::new();
+        // The file the map's last quit key went away in (else the base, which has none).
+        let mut quit_lost = Origin {
+            file: base.0.to_string(),
+            line: 1,
+            column: 1,
+        };
         for (i, (name, text)) in std::iter::once(&base).chain(overrides).enumerate() {
             for (keys, act, origin) in parse_file(name, text)? {
-                match act {
-                    Some(a) => bindings.insert(keys, (a, origin)),
+                let old = match act {
+                    Some(a) => bindings.insert(keys, (a, origin.clone())),
                     None if i > 0 => bindings.remove(&keys),
                     None => None,
                 };
+                let quits = |b: &BTreeMap<Keys, (Action, Origin)>| b.values().any(|(a, _)| *a == Action::Quit);
+                if old.is_some_and(|(a, _)| a == Action::Quit) && !quits(&bindings) {
+                    quit_lost = origin;
+                }
             }
         }
         let all: Vec<(&Keys, &Origin)> = bindings.iter().map(|(k, (_, o))| (k, o)).collect();
         for (a, oa) in &all {
-            for (b, _) in &all {
+            for (b, ob) in &all {
                 if a.len() < b.len() && b.starts_with(a) {
+                    // Blame the file that was given over the map it overrides.
+                    let blame = if oa.file == base.0 && ob.file != base.0 { ob } else { oa };
                     return Err(KeymapError {
-                        file: oa.file.clone(),
-                        line: oa.line,
-                        column: oa.column,
+                        file: blame.file.clone(),
+                        line: blame.line,
+                        column: blame.column,
                         message: format!(
                             "key \"{}\" is a prefix of \"{}\": the longer binding could never be typed",
                             keys_text(a),
@@ -395,6 +453,14 @@ impl Keymap {
                     });
                 }
             }
+        }
+        if !bindings.values().any(|(a, _)| *a == Action::Quit) {
+            return Err(KeymapError {
+                file: quit_lost.file,
+                line: quit_lost.line,
+                column: quit_lost.column,
+                message: "no key quits: bind one to \"quit\" (e.g. \"q\": \"quit\")".into(),
+            });
         }
         Ok(Keymap { bindings })
     }
@@ -504,6 +570,48 @@ mod tests {
         assert!(e.to_string().starts_with("user.json:1:2: key \"g\" is a prefix"), "{e}");
         assert!(Keymap::load(("k.json", r#"{"hyper-x": "quit"}"#), &[]).is_err());
         assert_eq!(Keymap::load(("k.json", "{\"q\": 1}"), &[]).unwrap_err().line, 1);
+    }
+
+    #[test]
+    fn a_map_without_quit_is_refused_where_the_quit_went() {
+        let e = Keymap::load(("k.json", "{}"), &[]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "k.json:1:1: no key quits: bind one to \"quit\" (e.g. \"q\": \"quit\")"
+        );
+        let user = "{\n  \"q\": \"none\",\n  \"ctrl-c\": \"help\"\n}";
+        let e = Keymap::load(("default", DEFAULT), &[("user.json", user)]).unwrap_err();
+        assert!(e.to_string().starts_with("user.json:3:3: no key quits"), "{e}");
+        // Moving quit to another key is fine.
+        let user = r#"{"q": "none", "ctrl-c": "none", "x": "quit"}"#;
+        assert!(Keymap::load(("default", DEFAULT), &[("user.json", user)]).is_ok());
+    }
+
+    #[test]
+    fn escapes_bad_bytes_and_prefixes_of_the_users_file_are_located() {
+        let escaped = "{\"q\": \"quit\",\n  \"\\u0067\": \"top\", \"x\": \"jump\"}";
+        assert_eq!(
+            Keymap::load(("k.json", escaped), &[]).unwrap_err().to_string(),
+            "k.json:2:20: unknown action \"jump\""
+        );
+        let bad_escape = "{\"q\": \"quit\",\n \"\\u00zz\": \"help\"}";
+        assert_eq!(
+            Keymap::load(("k.json", bad_escape), &[]).unwrap_err().to_string(),
+            "k.json:2:8: invalid escape"
+        );
+        let cut = "{\"q\": \"quit\",\n";
+        let e = Keymap::load(("k.json", cut), &[]).unwrap_err();
+        assert!((e.line, e.column) == (2, 1), "{e}");
+        // The user's longer key under a base key: the user's file is blamed, not `default`.
+        let user = "{\n  \"f x\": \"help\"}";
+        let e = Keymap::load(("default", DEFAULT), &[("user.json", user)]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "user.json:2:3: key \"f\" is a prefix of \"f x\": the longer binding could never be typed"
+        );
+        let e = utf8_text("k.json", b"{\"q\": \"quit\",\n \"\xC3x\": \"help\"}".to_vec()).unwrap_err();
+        assert_eq!(e.to_string(), "k.json:2:3: not UTF-8 (byte 0xC3)");
+        assert_eq!(utf8_text("k.json", b"{}".to_vec()).unwrap(), "{}");
     }
 
     #[test]

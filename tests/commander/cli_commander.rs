@@ -265,11 +265,17 @@ fn sdo_read_on_the_demo_takes_names_and_types_from_an_eds() {
     let bound = format!("2={}", eds.display());
     let (rc, v, err) = cotui_json(&["sdo", "read", "demo", "2", "drive status", "--eds", &bound, "--json"]);
     assert_eq!(rc, 0, "{err}");
-    assert_eq!((v["index"].as_u64(), v["name"].as_str()), (Some(0x6041), Some("Drive status")));
+    assert_eq!(
+        (v["index"].as_u64(), v["name"].as_str()),
+        (Some(0x6041), Some("Drive status"))
+    );
     // The EDS says OCTET_STRING where the built-in dictionary says VISIBLE_STRING.
     let (rc, out, err) = cotui(&["sdo", "read", "demo", "2", "0x1008", "--eds", &bound]);
     assert_eq!(rc, 0, "{err}");
-    assert!(out.starts_with("node 2 0x1008:00 Device name = 63 6F 74 75 69 20 "), "{out}");
+    assert!(
+        out.starts_with("node 2 0x1008:00 Device name = 63 6F 74 75 69 20 "),
+        "{out}"
+    );
     let (rc, _, err) = cotui(&["sdo", "read", "demo", "2", "no such thing", "--eds", &bound]);
     assert_eq!(rc, 1);
     assert_eq!(

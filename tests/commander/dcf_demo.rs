@@ -339,3 +339,28 @@ fn e_text(r: Result<Outcome, CommandError>) -> String {
         Err(e) => e.to_string(),
     }
 }
+
+/// A value the file gives in decimal is shown in the base of the node's value: both sides
+/// of an unsigned object in hex.
+#[tokio::test(start_paused = true)]
+async fn diff_shows_both_sides_in_one_base() {
+    let d = Demo::spawn(Simulation::demo(), false);
+    let out = dir("base").join("node2.dcf");
+    let file = out.to_str().unwrap();
+    run(&d, &format!("dcf save 2 -o {file}")).await.unwrap();
+    let text = std::fs::read_to_string(&out).unwrap();
+    let text = text.replacen("ParameterValue=0x4E20", "ParameterValue=30000", 1);
+    std::fs::write(&out, text).unwrap();
+    let (rc, v) = failed(run(&d, &format!("dcf diff 2 {file}")).await);
+    assert_eq!(rc, 6, "{v}");
+    let acc = v["differences"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|i| i["object"] == "0x6083:00")
+        .unwrap();
+    assert_eq!(
+        (acc["file"].as_str(), acc["node"].as_str()),
+        (Some("0x7530"), Some("0x4E20"))
+    );
+}

@@ -90,3 +90,65 @@ fn a_replay_speed_out_of_range_is_a_usage_error() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_keymap_that_cannot_quit_or_cannot_be_read_is_refused_and_located() {
+    let dir = tempdir("noquit");
+    let log = dir.join("x.log");
+    std::fs::write(&log, "(1.000000) can0 701#05\n").unwrap();
+    let open = |keymap: Option<&std::path::Path>| {
+        let mut args = vec!["open", log.to_str().unwrap()];
+        if let Some(k) = keymap {
+            args.extend(["--keymap", k.to_str().unwrap()]);
+        }
+        let out = cotui(&args, &dir);
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).trim().to_string(),
+        )
+    };
+    let empty = dir.join("empty.json");
+    std::fs::write(&empty, "{}").unwrap();
+    assert_eq!(
+        open(Some(&empty)),
+        (
+            Some(1),
+            format!(
+                "cotui: keymap: {}:1:1: no key quits: bind one to \"quit\" (e.g. \"q\": \"quit\")",
+                empty.display()
+            )
+        )
+    );
+    let latin1 = dir.join("latin1.json");
+    std::fs::write(&latin1, b"{\"q\": \"quit\",\n \"\xE9\": \"help\"}").unwrap();
+    assert_eq!(
+        open(Some(&latin1)),
+        (
+            Some(1),
+            format!("cotui: keymap: {}:2:3: not UTF-8 (byte 0xE9)", latin1.display())
+        )
+    );
+    // The user's keymap.json is never ignored silently: a directory, bad bytes.
+    let user = dir.join("cotui").join("keymap.json");
+    std::fs::create_dir_all(&user).unwrap();
+    assert_eq!(
+        open(None),
+        (
+            Some(1),
+            format!("cotui: keymap: {}: is a directory, not a keymap file", user.display())
+        )
+    );
+    std::fs::remove_dir(&user).unwrap();
+    std::fs::write(&user, b"{\"\\u0071\": \"none\",\n \"ctrl-c\": \"none\"}").unwrap();
+    assert_eq!(
+        open(None),
+        (
+            Some(1),
+            format!(
+                "cotui: keymap: {}:2:2: no key quits: bind one to \"quit\" (e.g. \"q\": \"quit\")",
+                user.display()
+            )
+        )
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

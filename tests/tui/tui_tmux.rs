@@ -117,7 +117,10 @@ fn suspend_resume_and_sigquit_restore_the_terminal() {
     ));
     s.keys(&["Enter"]);
     s.wait_for("the demo", |t| t.contains("demo bus |"));
-    assert_eq!((s.format("#{alternate_on}"), s.format("#{mouse_any_flag}")), ("1".into(), "1".into()));
+    assert_eq!(
+        (s.format("#{alternate_on}"), s.format("#{mouse_any_flag}")),
+        ("1".into(), "1".into())
+    );
     let pid = std::fs::read_to_string(&pidfile).unwrap().trim().to_string();
     let signal = |sig: &str| assert!(Command::new("kill").args([sig, &pid]).status().unwrap().success());
     let shell_back = |what: &str| {
@@ -133,7 +136,10 @@ fn suspend_resume_and_sigquit_restore_the_terminal() {
         s.type_text("clear; fg");
         s.keys(&["Enter"]);
         s.wait_for(what, |t| t.contains("demo bus |") && !t.contains("shell$"));
-        assert_eq!((s.format("#{alternate_on}"), s.format("#{mouse_any_flag}")), ("1".into(), "1".into()));
+        assert_eq!(
+            (s.format("#{alternate_on}"), s.format("#{mouse_any_flag}")),
+            ("1".into(), "1".into())
+        );
         // Keys reach cotui one by one again (raw mode), no Enter needed.
         s.keys(&["?"]);
         s.wait_for("help after fg", |t| t.contains("Show or hide this help"));
@@ -147,8 +153,13 @@ fn suspend_resume_and_sigquit_restore_the_terminal() {
     shell_back("the shell after SIGTSTP");
     resumed("the screen redrawn after the second fg");
     signal("-QUIT");
-    s.wait_for("the shell after SIGQUIT", |t| t.contains("shell$") && !t.contains("demo bus |"));
-    assert_eq!((s.format("#{alternate_on}"), s.format("#{mouse_any_flag}")), ("0".into(), "0".into()));
+    s.wait_for("the shell after SIGQUIT", |t| {
+        t.contains("shell$") && !t.contains("demo bus |")
+    });
+    assert_eq!(
+        (s.format("#{alternate_on}"), s.format("#{mouse_any_flag}")),
+        ("0".into(), "0".into())
+    );
     let _ = std::fs::remove_dir_all(&home);
 }
 
