@@ -141,7 +141,7 @@ impl App {
         self.dirty = false;
     }
 
-    /// Asks for a draw (the terminal was resized).
+    /// Asks for a draw (the terminal was resized, or given back after a suspend).
     pub fn redraw(&mut self) {
         self.dirty = true;
     }

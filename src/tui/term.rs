@@ -171,7 +171,7 @@ fn event_loop(terminal: &mut ratatui::DefaultTerminal, app: &mut App) -> Result<
         }
         if SUSPEND.load(Ordering::SeqCst) {
             suspend(terminal)?;
-            app.dirty = true;
+            app.redraw();
             input = true;
         }
     }
