@@ -1,7 +1,7 @@
 //! The application: routes keys, actions and the palette's lines between the capture side
 //! ([`Capture`]: the trace and what feeds it) and the screen side ([`Screen`]: the focus,
-//! the panes, the popups, the prompt). The parts and the panes answer with
-//! [`Event`](super::event::Event)s, which [`App`] routes; recording ([`super::record`]),
+//! the panes, the popups, the prompt). The parts and the panes answer with events
+//! (`src/tui/event.rs`), which [`App`] routes; recording ([`super::record`]),
 //! stop-all ([`super::stop`]), read-all ([`super::read_all`]) and export
 //! ([`super::export`]) live in their own modules. Pure state transitions: no terminal
 //! here, so tests drive it directly.
@@ -1001,7 +1001,7 @@ mod tests {
             a.key(key(c));
         }
         assert_eq!(
-            (a.selected_position(), a.screen().panes().trace.follow),
+            (a.selected_position(), a.screen().panes().trace.following()),
             (Some(0), false)
         );
         a.key(key('j'));
@@ -1011,7 +1011,7 @@ mod tests {
         assert_eq!((a.focus(), a.screen().panes().nodes.list.selected), (Pane::Nodes, 1));
         a.key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
         assert_eq!(a.focus(), Pane::Trace);
-        assert_eq!(a.screen().panes().trace.view.filter.source, "node 2");
+        assert_eq!(a.screen().panes().trace.filter().source, "node 2");
         a.key(key('F'));
         assert_eq!(
             a.screen().prompt().editing.as_ref().map(|p| p.text.as_str()),
@@ -1019,7 +1019,7 @@ mod tests {
         );
         a.key(KeyEvent::new(KeyCode::Esc, KeyModifiers::NONE));
         a.key(key('G'));
-        assert!(a.screen().panes().trace.follow);
+        assert!(a.screen().panes().trace.following());
     }
 
     #[test]
@@ -1034,7 +1034,7 @@ mod tests {
         };
         let last = a.selected_position();
         a.mouse(mouse(MouseEventKind::ScrollUp, 0));
-        assert!(!a.screen().panes().trace.follow);
+        assert!(!a.screen().panes().trace.following());
         assert_eq!(a.selected_position(), last.map(|p| p - 3));
         a.act(Action::PaneNodes);
         let _ = crate::tui::panes::testutil::screen(&mut a, 140, 20);
