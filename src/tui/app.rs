@@ -1,7 +1,7 @@
 //! The application: routes keys, actions and the palette's lines between the capture side
 //! ([`Capture`]: the trace and what feeds it) and the screen side ([`Screen`]: the focus,
-//! the panes, the popups, the prompt). The parts and the panes answer with
-//! [`Event`](super::event::Event)s, which [`App`] routes; recording ([`super::record`]),
+//! the panes, the popups, the prompt). The parts and the panes answer with events
+//! (`src/tui/event.rs`), which [`App`] routes; recording ([`super::record`]),
 //! stop-all ([`super::stop`]), read-all ([`super::read_all`]) and export
 //! ([`super::export`]) live in their own modules. Pure state transitions: no terminal
 //! here, so tests drive it directly.
@@ -10,7 +10,7 @@ pub use super::capture::{Capture, SourceInfo, SourceKind};
 pub use super::screen::{Layout, Screen};
 
 use super::capture::Flow;
-use super::commands::{CommandError, PALETTE_COMMANDS};
+use super::commands::{self, PALETTE_COMMANDS, Ran};
 use super::event::{Event, Queue};
 use super::keymap::{Action, Key, Keymap, Lookup};
 use super::live::Request;
@@ -19,10 +19,8 @@ use super::palette::{self, Planned, commander_words};
 use super::panes::objects::ObjectRequest;
 use super::panes::{Ctx, Pane, Selected};
 use super::prompt::{Edit, PromptKind};
-use super::source::Control;
-use super::{export, read_all, record, stop};
+use super::{read_all, record, stop};
 use crate::analysis::trace::Trace;
-use crate::command::Command;
 use crate::od::bind::Bindings;
 use crossterm::event::{KeyCode, KeyEvent, MouseEvent};
 use std::collections::BTreeSet;
@@ -209,6 +207,7 @@ impl App {
                 Event::Follow(on) => self.screen.follow(on),
                 Event::Object(r) => self.object_request(r, &mut q),
                 Event::Run(line) => self.run_command(&line),
+                Event::Act(a) => self.act(a),
                 Event::Replay(a) => self.capture.replay_key(a, &mut q),
                 Event::StopAll(nodes, options) => {
                     let objects = self.screen.objects_mut();
@@ -384,37 +383,6 @@ impl App {
         }
     }
 
-    /// `jobs` (list the running palette commands) or `jobs stop ID`: asks the live task.
-    fn jobs_command(&mut self, rest: &str) {
-        let request = match rest.split_whitespace().collect::<Vec<_>>()[..] {
-            [] => Request::ListJobs,
-            ["stop", id] if id.parse::<u32>().is_ok() => Request::StopJob(id.parse().unwrap_or(0)),
-            _ => return self.screen.say(Level::Error, "jobs: use `jobs` or `jobs stop ID`"),
-        };
-        if !self.capture.request(request) {
-            self.screen
-                .say(Level::Info, "jobs: this source has no bus, nothing runs");
-        }
-    }
-
-    /// `sim fault NODE CODE`, `sim silence NODE`, `sim reboot NODE`, ... on the demo's
-    /// simulated drives (the words of `cotui sim`'s stdin): asks the live task.
-    fn sim_command(&mut self, line: &str, rest: &str) {
-        let control = match crate::sim::control::Control::parse(rest) {
-            Ok(c) => c,
-            Err(e) => return self.screen.say(Level::Error, &format!("sim: {e}")),
-        };
-        let demo = matches!(self.capture.source().kind, SourceKind::Demo { .. });
-        let request = Request::Sim {
-            line: line.to_string(),
-            control,
-        };
-        if !(demo && self.capture.request(request)) {
-            self.screen
-                .say(Level::Error, "sim: only the demo's drives are simulated (`cotui demo`)");
-        }
-    }
-
     /// The drives stop-all stops: those cotui commanded, those seen powered, and `extra`.
     pub fn stop_targets(&self, extra: &[u8]) -> BTreeSet<u8> {
         stop::targets(&self.capture, extra)
@@ -463,93 +431,15 @@ impl App {
         let _ = self.screen.apply_filter(self.capture.trace(), text);
     }
 
-    /// Runs a palette command; the result goes to the status bar.
+    /// Runs a palette line: a built-in command ([`commands::run`]) or a commander line;
+    /// the result goes to the status bar.
     pub fn run_command(&mut self, line: &str) {
         self.dirty = true;
-        let (cmd, rest) = line.split_once(' ').unwrap_or((line, ""));
-        let rest = rest.trim();
         let mut q = Queue::default();
-        let result: Result<String, CommandError> = match cmd {
-            "" => Ok(String::new()),
-            "filter" => {
-                self.set_filter(rest);
-                return;
-            }
-            "search" => {
-                let _ = self.screen.apply_search(self.capture.trace(), rest);
-                return;
-            }
-            "goto" => rest
-                .parse::<usize>()
-                .map_err(|_| CommandError::NotAFrame(rest.to_string()))
-                .map(|n| {
-                    if !self.capture.replay_control(Control::GotoFrame(n as u64), &mut q) {
-                        self.screen.select_position(self.capture.trace(), n.saturating_sub(1));
-                    }
-                    format!("frame {n}")
-                }),
-            "time" => rest
-                .parse::<f64>()
-                .map_err(|_| CommandError::NotSeconds(rest.to_string()))
-                .map(|s| {
-                    let at = (s.max(0.0) * 1e9) as u64;
-                    if !self.capture.replay_control(Control::GotoTime(at), &mut q) {
-                        let trace = self.capture.trace();
-                        let pos = trace.store.position_at(super::panes::start_ns(trace) + at);
-                        self.screen.select_position(trace, pos);
-                    }
-                    format!("t = {s} s")
-                }),
-            "rewind" if self.capture.replay_control(Control::Rewind, &mut q) => Ok("rewind".into()),
-            "rewind" => Err(CommandError::NoReplay("rewind")),
-            "speed" => match rest.parse::<f64>() {
-                Ok(x) if super::source::valid_speed(x) => self.capture.set_speed(x).ok_or(CommandError::NoSpeed),
-                _ => Err(CommandError::NotAFactor(rest.to_string())),
-            },
-            "pause" | "resume" => {
-                self.capture.set_paused(cmd == "pause", &mut q);
-                Ok(String::new())
-            }
-            "plot" => self.plot_command(rest),
-            "help" => {
-                self.screen.show_help();
-                Ok(String::new())
-            }
-            "export" => export::command(rest, self.capture.trace(), self.screen.view())
-                .inspect(|text| self.screen.log(Level::Info, text)),
-            "messages" => {
-                self.screen.log_popup_mut().open();
-                Ok(String::new())
-            }
-            "loop" => return self.act(Action::Loop),
-            "quit" => return self.request_quit(),
-            "jobs" => return self.jobs_command(rest),
-            "record" => {
-                record::command(&mut self.capture, rest, &mut q);
-                return self.route(q);
-            }
-            "sim" => return self.sim_command(line, rest),
-            "stop" => {
-                match crate::command::parse_command(line) {
-                    Ok(Command::Stop { nodes, options, .. }) => q.push(Event::StopAll(nodes, options)),
-                    Ok(_) => {}
-                    Err(e) => q.push(Event::Say(Level::Error, format!("stop: {e}"))),
-                }
-                return self.route(q);
-            }
-            w if commander_words().contains(&w) => return self.commander(line),
-            other => Err(CommandError::Unknown(other.to_string())),
-        };
+        if commands::run(line, &mut self.capture, &mut self.screen, &mut q) == Ran::Commander {
+            self.commander(line);
+        }
         self.route(q);
-        let message = match result {
-            Ok(s) if s.is_empty() => None,
-            Ok(s) => Some(s),
-            Err(e) => {
-                self.screen.log(Level::Error, &format!("{line}: {e}"));
-                Some(e.to_string())
-            }
-        };
-        self.screen.set_message(message);
     }
 
     /// Does what the Objects pane asked.
@@ -577,23 +467,6 @@ impl App {
             }
             ObjectRequest::Find(text) => self.screen.prompt_mut().open(PromptKind::Find, &text),
             ObjectRequest::Note(text) => self.screen.set_message(Some(text)),
-        }
-    }
-
-    fn plot_command(&mut self, rest: &str) -> Result<String, CommandError> {
-        let mut it = rest.split_whitespace();
-        let (Some(node), Some(obj)) = (it.next(), it.next()) else {
-            return Err(CommandError::PlotUsage);
-        };
-        let node: u8 = node.parse().map_err(|_| CommandError::NotANode(node.to_string()))?;
-        let (i, s) = obj.split_once(':').unwrap_or((obj, "0"));
-        let index =
-            u16::from_str_radix(i.trim_start_matches("0x"), 16).map_err(|_| CommandError::BadIndex(i.to_string()))?;
-        let sub = u8::from_str_radix(s, 16).map_err(|_| CommandError::BadSub(s.to_string()))?;
-        if self.screen.plot(self.capture.trace(), node, index, sub) {
-            Ok(String::new())
-        } else {
-            Err(CommandError::NoSeries { node, index, sub })
         }
     }
 
@@ -666,7 +539,7 @@ mod tests {
     use super::*;
     use crate::command::stop::StopOptions;
     use crate::tui::panes::testutil::{app, frames};
-    use crate::tui::source::Feed;
+    use crate::tui::source::{Control, Feed};
     use crossterm::event::{KeyEvent, KeyModifiers};
     use crossterm::event::{MouseButton, MouseEventKind};
     use ratatui::layout::Rect;
@@ -1128,7 +1001,7 @@ mod tests {
             a.key(key(c));
         }
         assert_eq!(
-            (a.selected_position(), a.screen().panes().trace.follow),
+            (a.selected_position(), a.screen().panes().trace.following()),
             (Some(0), false)
         );
         a.key(key('j'));
@@ -1138,7 +1011,7 @@ mod tests {
         assert_eq!((a.focus(), a.screen().panes().nodes.list.selected), (Pane::Nodes, 1));
         a.key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
         assert_eq!(a.focus(), Pane::Trace);
-        assert_eq!(a.screen().panes().trace.view.filter.source, "node 2");
+        assert_eq!(a.screen().panes().trace.filter().source, "node 2");
         a.key(key('F'));
         assert_eq!(
             a.screen().prompt().editing.as_ref().map(|p| p.text.as_str()),
@@ -1146,7 +1019,7 @@ mod tests {
         );
         a.key(KeyEvent::new(KeyCode::Esc, KeyModifiers::NONE));
         a.key(key('G'));
-        assert!(a.screen().panes().trace.follow);
+        assert!(a.screen().panes().trace.following());
     }
 
     #[test]
@@ -1161,7 +1034,7 @@ mod tests {
         };
         let last = a.selected_position();
         a.mouse(mouse(MouseEventKind::ScrollUp, 0));
-        assert!(!a.screen().panes().trace.follow);
+        assert!(!a.screen().panes().trace.following());
         assert_eq!(a.selected_position(), last.map(|p| p - 3));
         a.act(Action::PaneNodes);
         let _ = crate::tui::panes::testutil::screen(&mut a, 140, 20);

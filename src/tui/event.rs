@@ -27,6 +27,8 @@ pub(crate) enum Event {
     Object(ObjectRequest),
     /// Run a palette line as if typed.
     Run(String),
+    /// Do what an action says, as if its key was pressed.
+    Act(Action),
     /// A replay key (pause, step, speed, seek, loop, rewind) for the capture source.
     Replay(Action),
     /// Stop every drive (and these nodes).

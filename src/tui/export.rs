@@ -143,14 +143,7 @@ mod tests {
         // All frames as candump: read back, they are the frames.
         let log = dir.join("all.log");
         assert_eq!(
-            export(
-                a.trace(),
-                &a.screen().panes().trace.view,
-                &log,
-                ExportFormat::Candump,
-                false
-            )
-            .unwrap(),
+            export(a.trace(), a.screen().view(), &log, ExportFormat::Candump, false).unwrap(),
             frames().len()
         );
         let back: Vec<_> = LogReader::new(io::BufReader::new(std::fs::File::open(&log).unwrap()))
@@ -166,26 +159,8 @@ mod tests {
             .collect();
         assert_eq!(back, want);
         // An existing file is refused unless forced.
-        assert!(
-            export(
-                a.trace(),
-                &a.screen().panes().trace.view,
-                &log,
-                ExportFormat::Candump,
-                false
-            )
-            .is_err()
-        );
-        assert!(
-            export(
-                a.trace(),
-                &a.screen().panes().trace.view,
-                &log,
-                ExportFormat::Candump,
-                true
-            )
-            .is_ok()
-        );
+        assert!(export(a.trace(), a.screen().view(), &log, ExportFormat::Candump, false).is_err());
+        assert!(export(a.trace(), a.screen().view(), &log, ExportFormat::Candump, true).is_ok());
         // The heartbeats of node 2 only, decoded, as JSON lines.
         let mut view = View::new(Filter::parse("node 2 kind hb").unwrap());
         view.advance(a.trace(), Duration::from_secs(5));

@@ -21,11 +21,11 @@ pub const TAIL: usize = 3;
 /// The Trace pane's state.
 pub struct TracePane {
     /// The filtered view of the trace.
-    pub view: View,
+    view: View,
     /// Scroll state (rows of the view).
-    pub list: ListState,
+    list: ListState,
     /// Follow the newest frame.
-    pub follow: bool,
+    follow: bool,
     /// Decoded rows of the visible window.
     rows: RowCache,
 }
