@@ -767,7 +767,7 @@ fn download(p: &mut Pending, ctx: &FrameCtx, out: &mut Out) -> Step {
                 // Picked up at an unmatched initiate response: it was segmented after all.
                 t.protocol = Protocol::Segmented;
             }
-            t.data.extend_from_slice(data.bytes());
+            t.append(data.bytes());
             p.phase = Phase::DownloadSegmentResponse { toggle, last };
         }
         (Phase::DownloadSegmentResponse { toggle: want, last }, Side::Server, DownloadSegmentResponse { toggle }) => {
@@ -814,7 +814,7 @@ fn upload(p: &mut Pending, ctx: &FrameCtx, out: &mut Out) -> Step {
         }
         (Phase::UploadSegmentResponse { toggle: want }, Side::Server, UploadSegmentResponse { toggle, last, data }) => {
             check_toggle(t, toggle, want, out);
-            t.data.extend_from_slice(data.bytes());
+            t.append(data.bytes());
             if last {
                 return Step::Complete(Outcome::Ok);
             }
