@@ -246,3 +246,17 @@ fn sdo_read_shows_identity_objects_and_cob_ids_in_hex_and_json_keeps_numbers() {
     assert_eq!(v["value"], 0x0002_0192);
     assert_eq!(v["text"], "0x00020192 (CiA 402, servo drive)");
 }
+
+#[test]
+fn a_domain_value_from_an_endless_file_is_refused_at_16_mib() {
+    let out = Command::new(env!("CARGO_BIN_EXE_cotui"))
+        .args(["sdo", "write", "demo", "2", "0x1008", "/dev/zero", "--type", "domain"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("cannot read /dev/zero: larger than 16 MiB, the most a domain write sends"),
+        "{err}"
+    );
+}
