@@ -48,6 +48,15 @@ const TWO_MASTERS_NS: u64 = 25 * MS;
 const STALL_NS: u64 = 1_000 * MS;
 /// Distinct abort codes an SDO incident's cause names (the others are counted).
 const CODES_TOLD: usize = 6;
+/// Objects refused on the bus that get an incident each; the refusals of further objects
+/// of a node group into one incident ("N more refusals of other objects"), so that a
+/// capture of a million distinct aborts keeps about this many incidents (~1.7 KB each).
+const REFUSED_KEPT: usize = 1_000;
+/// The `detail` of a node's incident of the refusals beyond [`REFUSED_KEPT`] objects (no
+/// object's `index << 8 | sub` is this large).
+const MORE_OBJECTS: u32 = u32::MAX;
+/// Distinct abort codes kept per incident (the first ones).
+const CODES_KEPT: usize = 64;
 /// Axes of a multi-axis drive (objects 0x6000 + 0x800 * (axis - 1)).
 const AXES: u16 = 8;
 
@@ -1316,12 +1325,20 @@ impl Diagnoser {
             true => (Problem::NotPresent, 0),
             false => (Problem::SdoRefused, (u32::from(index) << 8) | u32::from(sub)),
         };
+        let more = problem == Problem::SdoRefused
+            && self.aborts.len() >= REFUSED_KEPT
+            && !self.keyed.contains_key(&(Some(n), problem, detail));
+        let detail = if more { MORE_OBJECTS } else { detail };
+        let more = detail == MORE_OBJECTS;
         let i = self.grouped(Some(n), problem, detail, at.t);
+        let count = self.incidents[i].count;
         let meta = self.aborts.entry(i).or_default();
-        if !meta.codes.contains(&code) {
+        if meta.codes.len() < CODES_KEPT && !meta.codes.contains(&code) {
             meta.codes.push(code);
         }
-        meta.entries.insert((index, sub));
+        if absent {
+            meta.entries.insert((index, sub));
+        }
         if write {
             meta.writes = true;
         } else {
@@ -1341,7 +1358,13 @@ impl Diagnoser {
                 if meta.codes.len() > CODES_TOLD {
                     said.push(format!("{} more abort codes", meta.codes.len() - CODES_TOLD));
                 }
-                format!("0x{index:04X}:{sub:02X}: {}", said.join("; "))
+                match more {
+                    true => format!(
+                        "{count} more refusals of objects beyond the first {REFUSED_KEPT} refused on the bus: {}",
+                        said.join("; ")
+                    ),
+                    false => format!("0x{index:04X}:{sub:02X}: {}", said.join("; ")),
+                }
             }
         };
         let inc = &mut self.incidents[i];

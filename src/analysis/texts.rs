@@ -10,7 +10,7 @@ use std::collections::BTreeSet;
 pub struct SdoAborts {
     /// The distinct abort codes, first seen first.
     pub codes: Vec<u32>,
-    /// The entries aborted (index, sub-index).
+    /// The entries not present (index, sub-index), of a not-present incident only.
     pub entries: BTreeSet<(u16, u8)>,
     /// Some were reads (uploads).
     pub reads: bool,
