@@ -60,7 +60,7 @@ pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
     let filter = match Filter::parse_with(expr, &decoder) {
         Ok(f) => f,
         Err(e) => {
-            eprintln!("cotui decode: --filter {expr:?}: {e}");
+            eprintln!("cotui decode: --filter {:?}: {e}", e.excerpt(expr));
             return ExitCode::Usage;
         }
     };

@@ -284,7 +284,9 @@ pub fn write_data(
 ) -> Result<Vec<u8>, CommandError> {
     match ty.or_else(|| dict.object(index, sub).map(|o| o.data_type)) {
         Some(DataType::Domain) => {
-            std::fs::read(value).map_err(|e| CommandError::Usage(format!("cannot read {value}: {e}")))
+            let why = "the most a domain write sends";
+            crate::files::read_at_most(std::path::Path::new(value), crate::files::MAX_DOMAIN, why)
+                .map_err(|e| CommandError::Usage(format!("cannot read {value}: {e}")))
         }
         Some(t) => Ok(encode(value, t)?),
         None => Err(CommandError::Usage(format!(

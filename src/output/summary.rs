@@ -3,7 +3,10 @@
 use crate::decode::Kind;
 use crate::frame::{Interfaces, NodeKey};
 use serde::Serialize;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
+
+/// Counters of one node, by kind index.
+type Counts = [u64; Kind::ALL.len()];
 
 /// Running totals of frames by kind and by node.
 #[derive(Clone, Debug, Default)]
@@ -14,9 +17,13 @@ pub struct Summary {
     pub by_node: BTreeMap<NodeKey, BTreeMap<Kind, u64>>,
     /// Frames in all.
     pub frames: u64,
-    kind_counts: [u64; Kind::ALL.len()],
-    /// Per interface, 128 nodes' counters.
-    node_counts: Vec<[u64; Kind::ALL.len()]>,
+    kind_counts: Counts,
+    /// The first interface's 128 nodes' counters (made on its first node frame): the
+    /// common case of one bus stays an array increment.
+    first_counts: Vec<Counts>,
+    /// Counters of the nodes of every other interface, only of nodes seen: a log of
+    /// 40,000 interface names costs its nodes, not 40,000 x 128 counters.
+    other_counts: HashMap<NodeKey, Counts>,
     /// Interface names by index, as far as known: with nodes on several, a node is shown
     /// with its interface (`can1 node 5`, JSON key `"can1/5"`).
     ifaces: Vec<String>,
@@ -28,20 +35,23 @@ impl Summary {
         self.add_on(0, kind, node);
     }
 
-    /// Counts one frame of interface `iface` (a fixed-size array increment: this is the hot
-    /// path).
+    /// Counts one frame of interface `iface` (on the first interface a fixed-size array
+    /// increment: this is the hot path).
     #[inline]
     pub fn add_on(&mut self, iface: u16, kind: Kind, node: Option<u8>) {
         self.frames += 1;
         let k = kind.index();
         self.kind_counts[k] += 1;
-        if let Some(n) = node {
-            let i = usize::from(iface) * 128 + usize::from(n & 0x7F);
-            if i >= self.node_counts.len() {
-                self.node_counts
-                    .resize((usize::from(iface) + 1) * 128, [0; Kind::ALL.len()]);
+        let Some(n) = node else { return };
+        if iface == 0 {
+            if self.first_counts.is_empty() {
+                self.first_counts = vec![[0; Kind::ALL.len()]; 128];
             }
-            self.node_counts[i][k] += 1;
+            self.first_counts[usize::from(n & 0x7F)][k] += 1;
+        } else {
+            self.other_counts
+                .entry(NodeKey::new(iface, n & 0x7F))
+                .or_insert([0; Kind::ALL.len()])[k] += 1;
         }
     }
 
@@ -54,11 +64,16 @@ impl Summary {
         }
     }
 
-    /// The interface name to show with `node`: only when nodes were counted on several
-    /// interfaces (then node 5 of can0 and node 5 of can1 are told apart).
-    fn iface_of(&self, node: NodeKey) -> Option<&str> {
+    /// Whether nodes were counted on several interfaces (then node 5 of can0 and node 5 of
+    /// can1 are told apart). `by_node` is ordered by interface: the first and last differ.
+    fn several_ifaces(&self) -> bool {
         let first = self.by_node.keys().next().map(|k| k.iface);
-        let several = self.by_node.keys().any(|k| Some(k.iface) != first);
+        let last = self.by_node.keys().next_back().map(|k| k.iface);
+        first != last
+    }
+
+    /// The interface name to show with `node` when there are `several` interfaces.
+    fn iface_of(&self, several: bool, node: NodeKey) -> Option<&str> {
         several.then(|| self.ifaces.get(usize::from(node.iface)).map_or("?", String::as_str))
     }
 
@@ -71,8 +86,10 @@ impl Summary {
                 self.by_kind.insert(*k, self.kind_counts[i]);
             }
         }
-        for (n, counts) in self.node_counts.iter().enumerate() {
-            let key = NodeKey::new(u16::try_from(n / 128).unwrap_or(u16::MAX), (n % 128) as u8);
+        let first = self.first_counts.iter().enumerate();
+        let first = first.map(|(n, counts)| (NodeKey::new(0, n as u8), counts));
+        let others = self.other_counts.iter().map(|(key, counts)| (*key, counts));
+        for (key, counts) in first.chain(others) {
             for (i, k) in Kind::ALL.iter().enumerate() {
                 if counts[i] > 0 {
                     self.by_node.entry(key).or_default().insert(*k, counts[i]);
@@ -89,10 +106,11 @@ impl Summary {
             s.push_str(&format!("  {:<12} {n}\n", k.as_str()));
         }
         s.push_str("by node:\n");
+        let several = self.several_ifaces();
         for (node, kinds) in &self.by_node {
             let total: u64 = kinds.values().sum();
             let parts: Vec<String> = kinds.iter().map(|(k, n)| format!("{}={n}", k.as_str())).collect();
-            match self.iface_of(*node) {
+            match self.iface_of(several, *node) {
                 Some(iface) => s.push_str(&format!(
                     "  {iface} node {:<3} {total:>10}  {}\n",
                     node.node,
@@ -106,6 +124,7 @@ impl Summary {
 
     /// The JSON report of `--summary --format jsonl`.
     pub fn to_json(&self) -> SummaryJson {
+        let several = self.several_ifaces();
         let named = |kinds: &BTreeMap<Kind, u64>| kinds.iter().map(|(k, n)| (k.as_str(), *n)).collect();
         SummaryJson {
             by_kind: named(&self.by_kind),
@@ -113,7 +132,7 @@ impl Summary {
                 .by_node
                 .iter()
                 .map(|(node, kinds)| {
-                    let key = match self.iface_of(*node) {
+                    let key = match self.iface_of(several, *node) {
                         Some(iface) => format!("{iface}/{}", node.node),
                         None => node.node.to_string(),
                     };
@@ -157,5 +176,19 @@ mod tests {
         assert!(t.contains("  heartbeat    2"), "{t}");
         assert!(t.contains("node 5            2  heartbeat=2"), "{t}");
         assert_eq!(serde_json::to_value(s.to_json()).unwrap()["by_node"]["2"]["tpdo"], 1);
+    }
+
+    #[test]
+    fn nodes_of_other_interfaces_are_counted_apart() {
+        let mut s = Summary::default();
+        s.add_on(0, Kind::Heartbeat, Some(5));
+        s.add_on(40_000, Kind::Heartbeat, Some(5));
+        s.add_on(40_000, Kind::Heartbeat, Some(5));
+        s.ifaces = (0..=40_000).map(|i| format!("can{i}")).collect();
+        s.finish();
+        assert_eq!(s.other_counts.len(), 1, "only the nodes seen are kept");
+        let t = s.to_text();
+        assert!(t.contains("can0 node 5            1  heartbeat=1"), "{t}");
+        assert!(t.contains("can40000 node 5            2  heartbeat=2"), "{t}");
     }
 }

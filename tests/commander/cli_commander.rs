@@ -284,3 +284,17 @@ fn sdo_read_on_the_demo_takes_names_and_types_from_an_eds() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_domain_value_from_an_endless_file_is_refused_at_16_mib() {
+    let out = Command::new(env!("CARGO_BIN_EXE_cotui"))
+        .args(["sdo", "write", "demo", "2", "0x1008", "/dev/zero", "--type", "domain"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("cannot read /dev/zero: larger than 16 MiB, the most a domain write sends"),
+        "{err}"
+    );
+}

@@ -6,6 +6,7 @@
 #![allow(clippy::unwrap_used)]
 
 mod architecture;
+mod bounded_memory;
 mod cut_short;
 mod decode_golden;
 mod decode_proptest;

@@ -20,6 +20,15 @@ use std::collections::HashMap;
 const SDO_TIMEOUT_NS: u64 = 1_000 * MS;
 /// Distinct abort codes an SDO incident's cause names (the others are counted).
 const CODES_TOLD: usize = 6;
+/// Objects refused on the bus that get an incident each; the refusals of further objects
+/// of a node group into one incident ("N more refusals of other objects"), so that a
+/// capture of a million distinct aborts keeps about this many incidents (~1.7 KB each).
+const REFUSED_KEPT: usize = 1_000;
+/// The `detail` of a node's incident of the refusals beyond [`REFUSED_KEPT`] objects (no
+/// object's `index << 8 | sub` is this large).
+const MORE_OBJECTS: u32 = u32::MAX;
+/// Distinct abort codes kept per incident (the first ones).
+const CODES_KEPT: usize = 64;
 
 /// An SDO request waiting for its answer.
 #[derive(Clone, Copy, Debug)]
@@ -151,12 +160,20 @@ impl Sdos {
             true => (Problem::NotPresent, 0),
             false => (Problem::SdoRefused, (u32::from(index) << 8) | u32::from(sub)),
         };
+        let more = problem == Problem::SdoRefused
+            && self.aborts.len() >= REFUSED_KEPT
+            && tl.keyed(Some(n), problem, detail).is_none();
+        let detail = if more { MORE_OBJECTS } else { detail };
+        let more = detail == MORE_OBJECTS;
         let i = tl.grouped(Some(n), problem, detail, at.t);
+        let count = tl.incidents[i].count;
         let meta = self.aborts.entry(i).or_default();
-        if !meta.codes.contains(&code) {
+        if meta.codes.len() < CODES_KEPT && !meta.codes.contains(&code) {
             meta.codes.push(code);
         }
-        meta.entries.insert((index, sub));
+        if absent {
+            meta.entries.insert((index, sub));
+        }
         if write {
             meta.writes = true;
         } else {
@@ -176,7 +193,13 @@ impl Sdos {
                 if meta.codes.len() > CODES_TOLD {
                     said.push(format!("{} more abort codes", meta.codes.len() - CODES_TOLD));
                 }
-                format!("0x{index:04X}:{sub:02X}: {}", said.join("; "))
+                match more {
+                    true => format!(
+                        "{count} more refusals of objects beyond the first {REFUSED_KEPT} refused on the bus: {}",
+                        said.join("; ")
+                    ),
+                    false => format!("0x{index:04X}:{sub:02X}: {}", said.join("; ")),
+                }
             }
         };
         let inc = &mut tl.incidents[i];

@@ -12,7 +12,7 @@ use std::collections::BTreeSet;
 pub(super) struct SdoAborts {
     /// The distinct abort codes, first seen first.
     pub(super) codes: Vec<u32>,
-    /// The entries aborted (index, sub-index).
+    /// The entries not present (index, sub-index), of a not-present incident only.
     pub(super) entries: BTreeSet<(u16, u8)>,
     /// Some were reads (uploads).
     pub(super) reads: bool,

@@ -4,6 +4,7 @@
 use super::lex::{Cmp, Tok, Token};
 use super::{FilterError, Names};
 use crate::decode::Kind;
+use std::collections::HashMap;
 
 /// A parsed expression.
 #[derive(Clone, Debug, PartialEq)]
@@ -186,6 +187,9 @@ pub struct Parser<'a> {
     at: usize,
     end: usize,
     names: &'a dyn Names,
+    /// Names looked up so far: a name lookup scans the dictionaries, and every word of
+    /// an implicit `and` tries the names of up to [`MAX_NAME_WORDS`] words it starts.
+    looked_up: HashMap<String, Option<(u16, u8)>>,
     depth: usize,
 }
 
@@ -197,6 +201,7 @@ impl<'a> Parser<'a> {
             at: 0,
             end: len + 1,
             names,
+            looked_up: HashMap::new(),
             depth: 0,
         }
     }
@@ -212,6 +217,16 @@ impl<'a> Parser<'a> {
             Some(t) if t.tok == Tok::Close => Err(FilterError::new(t.column, "`)` without its `(`")),
             Some(t) => Err(FilterError::new(t.column, "unexpected token")),
         }
+    }
+
+    /// The object `text` names (looked up once per text).
+    fn name(&mut self, text: String) -> Option<(u16, u8)> {
+        if let Some(found) = self.looked_up.get(&text) {
+            return *found;
+        }
+        let found = self.names.object(&text);
+        self.looked_up.insert(text, found);
+        found
     }
 
     fn peek(&self) -> Option<&Token> {
@@ -412,7 +427,7 @@ impl<'a> Parser<'a> {
                 let object = match hex_object(&w) {
                     Ok(Some(o)) => Some(o),
                     Err((at, msg)) => return Err(FilterError::new(t.column + at, msg)),
-                    Ok(None) => self.names.object(&w).map(|(i, s)| (i, Some(s))),
+                    Ok(None) => self.name(w.clone()).map(|(i, s)| (i, Some(s))),
                 };
                 match object {
                     Some((index, sub)) => self.object(index, sub),
@@ -444,7 +459,7 @@ impl<'a> Parser<'a> {
             }
         }
         for n in (2..=words.len()).rev() {
-            if let Some((index, sub)) = self.names.object(&words[..n].join(" ")) {
+            if let Some((index, sub)) = self.name(words[..n].join(" ")) {
                 self.at += n - 1;
                 return self.object(index, Some(sub)).map(Some);
             }

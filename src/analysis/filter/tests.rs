@@ -393,3 +393,51 @@ fn transactions_are_judged_by_their_object_value_and_outcome() {
     assert_eq!(pick("node 1 not 1a00"), [(0x606C, 1)]);
     assert_eq!(pick("pdo"), Vec::<(u16, u8)>::new());
 }
+
+/// Names that count the lookups made of them (each scans the dictionaries).
+struct Counted(std::cell::Cell<usize>);
+
+impl Names for Counted {
+    fn object(&self, text: &str) -> Option<(u16, u8)> {
+        self.0.set(self.0.get() + 1);
+        (text == "status word").then_some((0x6041, 0))
+    }
+}
+
+#[test]
+fn conditions_side_by_side_look_each_name_up_once() {
+    // 16,000 words: each tries the names of up to 8 words it starts, but the same text
+    // is looked up once (this was 112,000 dictionary scans).
+    let text = vec!["sdo hb"; 8_000].join(" ");
+    let names = Counted(std::cell::Cell::new(0));
+    let f = Filter::parse_with(&text, &names).unwrap();
+    assert!(matches!(f.expr(), Some(Expr::And(parts)) if parts.len() == 16_000));
+    assert!(names.0.get() <= 16, "{} lookups", names.0.get());
+    let f = Filter::parse_with("sdo status word", &names).unwrap();
+    assert!(matches!(f.expr(), Some(Expr::And(parts)) if parts.len() == 2));
+}
+
+#[test]
+fn an_error_in_a_long_filter_quotes_a_window_around_its_column() {
+    let long = "x".repeat(10_000);
+    let text = format!(
+        "{} zz {} {long}",
+        vec!["sdo"; 5_000].join(" "),
+        vec!["hb"; 5_000].join(" ")
+    );
+    let e = Filter::parse_with(&text, &decoder()).unwrap_err();
+    assert_eq!(e.column, 20_001);
+    let window = e.excerpt(&text);
+    assert_eq!(window, format!("…{}zz {}h…", "sdo ".repeat(10), "hb ".repeat(12)));
+    // A word of 10,000 characters is quoted by its start.
+    let e = Filter::parse_with(&long, &decoder()).unwrap_err();
+    assert!(e.to_string().len() < 300, "{e}");
+    assert!(
+        e.to_string()
+            .starts_with(&format!("column 1: unknown word `{}…`", "x".repeat(39))),
+        "{e}"
+    );
+    // A short filter is quoted whole.
+    let e = Filter::parse_with("node 3 zz", &decoder()).unwrap_err();
+    assert_eq!(e.excerpt("node 3 zz"), "node 3 zz");
+}

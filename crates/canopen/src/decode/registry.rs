@@ -68,11 +68,12 @@ struct Bus {
     learning: HashMap<PdoKey, LearnedMapping>,
     /// PDO communication parameters seen in SDO transfers (reads and writes).
     comm: HashMap<PdoKey, CommParams>,
-    /// Per node: the last SDO request to it was ours (marked TX), so a mapping it writes
-    /// is "configured", not "sniffed".
-    ours: [bool; 128],
-    /// Mode of operation per node, from 0x6060/0x6061 traffic.
-    modes: [Option<i8>; 128],
+    /// Per node (bit = node-ID): the last SDO request to it was ours (marked TX), so a
+    /// mapping it writes is "configured", not "sniffed".
+    ours: u128,
+    /// Mode of operation per node, from 0x6060/0x6061 traffic (made on the first mode
+    /// seen: a bus costs little until it carries drives).
+    modes: Option<Box<[Option<i8>; 128]>>,
     /// SDO channels moved by 0x1200 writes: COB-ID -> (node, client_to_server).
     sdo_cobs: HashMap<u32, (u8, bool)>,
 }
@@ -84,14 +85,37 @@ impl Default for Bus {
             mappings: HashMap::new(),
             learning: HashMap::new(),
             comm: HashMap::new(),
-            ours: [false; 128],
-            modes: [None; 128],
+            ours: 0,
+            modes: None,
             sdo_cobs: HashMap::new(),
         }
     }
 }
 
 impl Bus {
+    /// The last mode of operation seen of `node`.
+    fn mode(&self, node: u8) -> Option<i8> {
+        self.modes.as_ref().and_then(|m| m[usize::from(node & 0x7F)])
+    }
+
+    /// Records the mode of operation of `node`.
+    fn set_mode(&mut self, node: u8, mode: Option<i8>) {
+        if mode.is_some() || self.modes.is_some() {
+            self.modes.get_or_insert_with(|| Box::new([None; 128]))[usize::from(node & 0x7F)] = mode;
+        }
+    }
+
+    /// Whether the last SDO request to `node` was ours.
+    fn is_ours(&self, node: u8) -> bool {
+        self.ours & (1 << (node & 0x7F)) != 0
+    }
+
+    /// Records whether the last SDO request to `node` was ours.
+    fn set_ours(&mut self, node: u8, ours: bool) {
+        let bit = 1u128 << (node & 0x7F);
+        self.ours = if ours { self.ours | bit } else { self.ours & !bit };
+    }
+
     fn install_default_mappings(&mut self, node: u8, dict: &Dictionary) {
         for layer in dict.layers().iter().rev() {
             for (transmit, maps) in [(false, &layer.rpdo), (true, &layer.tpdo)] {
@@ -126,7 +150,7 @@ impl Bus {
         let v = u32::from_le_bytes(b);
         self.select_pdo_set(node, t.index, t.sub, i64::from(v), dict);
         match (t.index, t.sub) {
-            (0x6060 | 0x6061, 0) => self.modes[(node & 0x7F) as usize] = Some(t.data[0] as i8),
+            (0x6060 | 0x6061, 0) => self.set_mode(node, Some(t.data[0] as i8)),
             (0x1005, 0) => self.assign_cob(
                 v,
                 Route {
@@ -167,7 +191,7 @@ impl Bus {
                 let ts_ns = t.end_ns;
                 let source = match t.direction {
                     TransferDirection::Upload => MappingSource::ReadFromNode { ts_ns },
-                    _ if self.ours[node as usize & 0x7F] => MappingSource::Configured { ts_ns },
+                    _ if self.is_ours(node) => MappingSource::Configured { ts_ns },
                     _ => MappingSource::Sniffed { ts_ns },
                 };
                 self.learn_mapping((node, transmit, num), sub, v, source);
@@ -282,8 +306,9 @@ impl Bus {
 pub struct Decoder {
     /// Per-node dictionaries, index = node id (0 unused).
     dicts: Vec<Dictionary>,
-    /// The state of each interface, index = `Frame::iface` (made on its first frame).
-    buses: Vec<Bus>,
+    /// The state of each interface, index = `Frame::iface` (made when something is learnt
+    /// of it; boxed, so that a capture of 40,000 interface names grows a table of pointers).
+    buses: Vec<Option<Box<Bus>>>,
     /// The state of an interface before its first frame (the bound nodes' defaults).
     fresh: Bus,
     /// SDO transfers of every interface (channels are per interface).
@@ -309,7 +334,7 @@ impl Decoder {
         }
         Decoder {
             dicts,
-            buses: vec![fresh.clone()],
+            buses: vec![Some(Box::new(fresh.clone()))],
             fresh,
             sdo: SdoTracker::new(),
             completed: Vec::new(),
@@ -330,17 +355,25 @@ impl Decoder {
     /// The state of interface `iface` (a fresh one before its first frame).
     #[inline]
     fn bus(&self, iface: u16) -> &Bus {
-        self.buses.get(iface as usize).unwrap_or(&self.fresh)
+        self.buses
+            .get(iface as usize)
+            .and_then(Option::as_deref)
+            .unwrap_or(&self.fresh)
     }
 
     /// The state of interface `iface`, made on first use.
     #[inline]
     fn bus_mut(&mut self, iface: u16) -> &mut Bus {
+        Self::bus_in(&mut self.buses, &self.fresh, iface)
+    }
+
+    /// The state of interface `iface` in `buses`, made from `fresh` on first use.
+    fn bus_in<'b>(buses: &'b mut Vec<Option<Box<Bus>>>, fresh: &Bus, iface: u16) -> &'b mut Bus {
         let i = iface as usize;
-        if i >= self.buses.len() {
-            self.buses.resize(i + 1, self.fresh.clone());
+        if i >= buses.len() {
+            buses.resize_with(i + 1, || None);
         }
-        &mut self.buses[i]
+        buses[i].get_or_insert_with(|| Box::new(fresh.clone()))
     }
 
     /// Numbers the frames that follow from `seq + 1` on (the numbers SDO transactions list in
@@ -369,7 +402,7 @@ impl Decoder {
 
     /// The last mode of operation seen for `node`.
     pub fn mode(&self, node: NodeKey) -> Option<i8> {
-        self.bus(node.iface).modes[(node.node & 0x7F) as usize]
+        self.bus(node.iface).mode(node.node)
     }
 
     /// Where a frame goes, without building its label (the cheap path for `--summary`).
@@ -484,11 +517,9 @@ impl Decoder {
                 let tracked = self.track_sdo(frame, route);
                 let mut s = labelled(tracked, payload, &self.dicts[n as usize]);
                 // Controlword and statusword bits are named per the node's mode in force.
-                if let (Some(mode), Some((index @ (0x6040 | 0x6041), 0)), Some(v)) = (
-                    self.bus(frame.iface).modes[n as usize & 0x7F],
-                    s.object,
-                    s.value.as_mut(),
-                ) && let Some(typed) = &v.typed
+                if let (Some(mode), Some((index @ (0x6040 | 0x6041), 0)), Some(v)) =
+                    (self.bus(frame.iface).mode(n), s.object, s.value.as_mut())
+                    && let Some(typed) = &v.typed
                 {
                     v.text = value_text::object_text(&self.dicts[n as usize], index, 0, typed, Some(mode));
                 }
@@ -567,18 +598,15 @@ impl Decoder {
         let c2s = route.kind == Kind::SdoRx;
         let key = NodeKey::of(frame, n);
         if c2s {
-            self.bus_mut(frame.iface).ours[n as usize & 0x7F] = frame.direction() == crate::frame::Direction::Tx;
+            let ours = frame.direction() == crate::frame::Direction::Tx;
+            self.bus_mut(frame.iface).set_ours(n, ours);
         }
         let dict = &self.dicts[n as usize & 0x7F];
         let s = self.sdo.track(self.seq, frame.ts_ns, key, c2s, frame.payload(), dict);
         for mut t in self.sdo.take_completed() {
             let dict = &self.dicts[t.node as usize & 0x7F];
-            let i = t.iface as usize;
-            if i >= self.buses.len() {
-                self.buses.resize(i + 1, self.fresh.clone());
-            }
-            let bus = &mut self.buses[i];
-            t.mode = bus.modes[(t.node & 0x7F) as usize];
+            let bus = Self::bus_in(&mut self.buses, &self.fresh, t.iface);
+            t.mode = bus.mode(t.node);
             bus.learn(&t, dict);
             self.completed.push(t);
         }
@@ -618,7 +646,10 @@ impl Decoder {
     fn note_mode(&mut self, n: NodeKey, signals: &[pdo::Signal]) {
         for s in signals {
             if matches!((s.index, s.sub), (0x6060 | 0x6061, 0)) {
-                self.bus_mut(n.iface).modes[n.node as usize & 0x7F] = s.value.as_i64().map(|m| m as i8);
+                let mode = s.value.as_i64().map(|m| m as i8);
+                if self.bus(n.iface).mode(n.node) != mode {
+                    self.bus_mut(n.iface).set_mode(n.node, mode);
+                }
             }
         }
     }
@@ -644,7 +675,7 @@ impl Decoder {
         let bus = self.bus(frame.iface);
         let (signals, source, problem) = match bus.mappings.get(&(n, transmit, route.pdo)) {
             Some(m) => {
-                let mode = bus.modes[n as usize & 0x7F];
+                let mode = bus.mode(n);
                 let (s, p) = pdo::decode_signals(payload, m, &self.dicts[n as usize & 0x7F], mode);
                 (s, Some(m.source.clone()), p)
             }
@@ -687,7 +718,8 @@ impl Decoder {
     /// parameters), in order of interface, node, RPDO before TPDO, number.
     pub fn known_pdos(&self) -> Vec<(NodeKey, PdoId)> {
         let mut out = Vec::new();
-        for (iface, bus) in self.buses.iter().enumerate() {
+        let buses = self.buses.iter().enumerate();
+        for (iface, bus) in buses.filter_map(|(i, b)| Some((i, b.as_deref()?))) {
             let mut keys: Vec<PdoKey> = bus.mappings.keys().chain(bus.comm.keys()).copied().collect();
             keys.sort_unstable();
             keys.dedup();
@@ -709,7 +741,7 @@ impl Decoder {
     pub fn finish(&mut self) -> Vec<Transaction> {
         let mut all = std::mem::take(&mut self.completed);
         all.extend(self.sdo.finish().into_iter().map(|mut t| {
-            t.mode = self.bus(t.iface).modes[(t.node & 0x7F) as usize];
+            t.mode = self.bus(t.iface).mode(t.node);
             t
         }));
         all

@@ -53,10 +53,19 @@ impl Ini {
     }
 }
 
-/// Splits the text into sections; malformed lines become warnings.
+/// Sections read of one file: the largest real EDS files have about 1,200 (a section per
+/// object and sub-object), so this is ~25 times that; memory stays proportional to it.
+pub const MAX_SECTIONS: usize = 32_768;
+/// `key=value` lines read of one file (real files have a few thousand).
+pub const MAX_KEYS: usize = 131_072;
+
+/// Splits the text into sections; malformed lines become warnings. Beyond
+/// [`MAX_SECTIONS`] sections or [`MAX_KEYS`] keys, the rest of the file is not read (a
+/// warning at the line where reading stopped).
 fn parse_ini(text: &str, w: &mut Vec<(usize, String)>) -> Ini {
     let mut sections: BTreeMap<String, Section> = BTreeMap::new();
     let mut current: Option<String> = None;
+    let mut keys = 0;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
@@ -64,6 +73,19 @@ fn parse_ini(text: &str, w: &mut Vec<(usize, String)>) -> Ini {
         if t.is_empty() || t.starts_with(';') || t.starts_with('#') {
             continue;
         }
+        let new_section = t.starts_with('[');
+        if (new_section && sections.len() >= MAX_SECTIONS) || (!new_section && keys >= MAX_KEYS) {
+            let (n, what) = match new_section {
+                true => (MAX_SECTIONS, "sections"),
+                false => (MAX_KEYS, "key=value lines"),
+            };
+            w.push((
+                line,
+                format!("more than {n} {what} (real EDS files have a few thousand): the rest of the file, from here, is not read"),
+            ));
+            break;
+        }
+        keys += usize::from(!new_section);
         if let Some(rest) = t.strip_prefix('[') {
             let Some(name) = rest.split_once(']').map(|(n, _)| n.trim().to_ascii_lowercase()) else {
                 w.push((line, format!("section header `{t}` has no `]`, skipped")));
@@ -639,4 +661,44 @@ pub fn parameter_values(text: &str) -> Vec<ParameterValue> {
             })
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_file_of_too_many_sections_is_read_up_to_the_bound_with_a_located_warning() {
+        let mut text = String::from("[DeviceInfo]\nVendorName=x\n");
+        for i in 0..MAX_SECTIONS as u32 + 10 {
+            text.push_str(&format!(
+                "[{:04X}]\nParameterName=p{i}\nObjectType=7\nDataType=7\nAccessType=rw\n",
+                0x2000 + i
+            ));
+        }
+        let (p, w) = import("big.eds", &text, 1);
+        // [DeviceInfo] and MAX_SECTIONS - 1 objects are read, the next one is not.
+        let stop = 3 + 5 * (MAX_SECTIONS - 1);
+        let said: Vec<String> = w
+            .iter()
+            .filter(|w| w.message.starts_with("more than"))
+            .map(|w| format!("{} {}", w.at, w.message))
+            .collect();
+        assert_eq!(
+            said,
+            [format!(
+                "line {stop} more than {MAX_SECTIONS} sections (real EDS files have a few thousand): the rest of the file, from here, is not read"
+            )]
+        );
+        assert_eq!(p.objects.len(), MAX_SECTIONS - 1);
+        let mut keys = String::from("[DeviceInfo]\n");
+        keys.push_str(&"VendorName=x\n".repeat(MAX_KEYS + 1));
+        let (_, w) = import("keys.eds", &keys, 1);
+        assert!(
+            w.iter().any(|w| w.at == format!("line {}", MAX_KEYS + 2)
+                && w.message.starts_with(&format!("more than {MAX_KEYS} key=value lines"))),
+            "{:?}",
+            w.last()
+        );
+    }
 }

@@ -125,7 +125,8 @@ impl Pending {
     }
 }
 
-/// Per-channel state.
+/// Per-channel state; an idle one (the default) is not kept, so a capture of many
+/// interfaces or channels costs only the transfers running.
 #[derive(Clone, Debug, Default)]
 struct ChannelState {
     pending: Option<Pending>,
@@ -134,6 +135,13 @@ struct ChannelState {
     unknown_request: bool,
     /// The previous frame fitted no transfer (it may begin a run of block segments).
     orphan: Option<Orphan>,
+}
+
+impl ChannelState {
+    /// Nothing running, nothing remembered: the same as no state.
+    fn is_idle(&self) -> bool {
+        self.pending.is_none() && !self.unknown_request && self.orphan.is_none()
+    }
 }
 
 /// What happened to one frame, as the tracker's result for it.
@@ -209,6 +217,9 @@ impl TransferTracker {
             // Shown as malformed, never allowed to disturb a running transfer.
             // A client's unknown command awaits a reply; a server's unknown command is that reply.
             state.unknown_request = side == Side::Client;
+            if state.is_idle() {
+                self.channels.remove(&channel);
+            }
             return tracked;
         }
         let ctx = FrameCtx {
@@ -240,6 +251,9 @@ impl TransferTracker {
             }
         };
         let pending = state.pending.as_ref().and_then(Pending::object);
+        if state.is_idle() {
+            self.channels.remove(&channel);
+        }
         tracked.object = tracked.object.or(ended).or(pending);
         tracked.problems = out.notes;
         tracked
@@ -753,7 +767,7 @@ fn download(p: &mut Pending, ctx: &FrameCtx, out: &mut Out) -> Step {
                 // Picked up at an unmatched initiate response: it was segmented after all.
                 t.protocol = Protocol::Segmented;
             }
-            t.data.extend_from_slice(data.bytes());
+            t.append(data.bytes());
             p.phase = Phase::DownloadSegmentResponse { toggle, last };
         }
         (Phase::DownloadSegmentResponse { toggle: want, last }, Side::Server, DownloadSegmentResponse { toggle }) => {
@@ -800,7 +814,7 @@ fn upload(p: &mut Pending, ctx: &FrameCtx, out: &mut Out) -> Step {
         }
         (Phase::UploadSegmentResponse { toggle: want }, Side::Server, UploadSegmentResponse { toggle, last, data }) => {
             check_toggle(t, toggle, want, out);
-            t.data.extend_from_slice(data.bytes());
+            t.append(data.bytes());
             if last {
                 return Step::Complete(Outcome::Ok);
             }

@@ -838,3 +838,43 @@ fn a_transfer_that_never_ends_keeps_memory_flat() {
     let j = serde_json::to_value(t.to_json(&bus.dict)).unwrap();
     assert_eq!(j["len"], t.len());
 }
+
+#[test]
+fn a_segmented_transfer_that_never_ends_keeps_memory_flat() {
+    use crate::sdo::transaction::DATA_KEPT;
+    let segments = DATA_KEPT / 7 + 2;
+    // An upload, then a download, each of segments of 7 bytes, the last with the c bit.
+    for upload in [true, false] {
+        let mut bus = Bus::new();
+        if upload {
+            bus.c(2, &[0x40, 0x50, 0x1F, 0x01, 0, 0, 0, 0]);
+            bus.s(2, &[0x40, 0x50, 0x1F, 0x01, 0, 0, 0, 0]); // size not indicated
+        } else {
+            bus.c(2, &[0x20, 0x50, 0x1F, 0x01, 0, 0, 0, 0]);
+            bus.s(2, &[0x60, 0x50, 0x1F, 0x01, 0, 0, 0, 0]);
+        }
+        for i in 0..segments {
+            let toggle = (i as u8 & 1) << 4;
+            let last = u8::from(i + 1 == segments);
+            let data = [(i % 251) as u8; 7];
+            let mut seg = [toggle | last; 8];
+            seg[1..].copy_from_slice(&data);
+            if upload {
+                bus.c(2, &[0x60 | toggle, 0, 0, 0, 0, 0, 0, 0]);
+                bus.s(2, &seg);
+            } else {
+                bus.c(2, &seg);
+                bus.s(2, &[0x20 | toggle, 0, 0, 0, 0, 0, 0, 0]);
+            }
+        }
+        let t = bus.one();
+        assert_eq!(t.protocol, Protocol::Segmented);
+        assert_eq!((t.outcome.clone(), t.problems.clone()), (Outcome::Ok, vec![]));
+        assert_eq!(t.data.len(), DATA_KEPT, "upload: {upload}");
+        assert_eq!(t.len(), segments * 7);
+        assert!(
+            t.label(&bus.dict)
+                .contains(&format!("{} bytes, first {DATA_KEPT} kept", t.len()))
+        );
+    }
+}

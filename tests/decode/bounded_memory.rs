@@ -1,0 +1,61 @@
+//! Memory bounded whatever the input: peak RSS of a child `cotui` on generated logs.
+
+use std::io::Write;
+use std::process::{Command, Stdio};
+
+/// Runs `cotui ARGS` with stdout to `out`; its exit code and peak RSS (KiB).
+fn peak_rss_kib(args: &[&str], out: &std::path::Path) -> (i32, u64) {
+    let child = Command::new(env!("CARGO_BIN_EXE_cotui"))
+        .args(args)
+        .stdout(std::fs::File::create(out).unwrap())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let (mut status, pid) = (0, child.id() as libc::pid_t);
+    // SAFETY: rusage is plain data; wait4 fills it for our child.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: pid is our child; status and usage point to valid memory.
+    assert!(unsafe { libc::wait4(pid, &mut status, 0, &mut usage) } > 0);
+    (libc::WEXITSTATUS(status), usage.ru_maxrss as u64)
+}
+
+fn temp(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("cotui-bounded-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+#[test]
+fn diagnose_of_60000_distinct_aborts_keeps_1000_incidents() {
+    // Node 7 refuses reads of 60,000 distinct objects, each once.
+    let log = temp("aborts.log");
+    let mut w = std::io::BufWriter::new(std::fs::File::create(&log).unwrap());
+    for i in 0..60_000u32 {
+        let (index, sub) = (0x2000 + (i >> 8) as u16, (i & 0xFF) as u8);
+        let [lo, hi] = index.to_le_bytes();
+        let t = f64::from(i) * 0.002;
+        writeln!(w, "({:.6}) can0 607#40{lo:02X}{hi:02X}{sub:02X}00000000", 1.7e9 + t).unwrap();
+        writeln!(
+            w,
+            "({:.6}) can0 587#80{lo:02X}{hi:02X}{sub:02X}00000206",
+            1.7e9 + t + 0.001
+        )
+        .unwrap();
+    }
+    w.flush().unwrap();
+    let out = temp("aborts.txt");
+    let (rc, rss) = peak_rss_kib(&["diagnose", log.to_str().unwrap()], &out);
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(rc, 0, "{}", &text[..text.len().min(2000)]);
+    // One incident per object for the first 1,000; the other 59,000 refusals are one.
+    assert_eq!(text.matches("Node 7: A value could not be read").count(), 1_001);
+    assert!(
+        text.contains("Cause: 59000 more refusals of objects beyond the first 1000 refused on the bus: "),
+        "{}",
+        &text[text.len().saturating_sub(3000)..]
+    );
+    assert!(text.len() < 4 << 20, "{} bytes of report", text.len());
+    // 60,000 incidents took ~100 MB.
+    assert!(rss < 48 << 10, "peak RSS {rss} KiB");
+    std::fs::remove_dir_all(log.parent().unwrap()).unwrap();
+}
