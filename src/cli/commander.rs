@@ -57,7 +57,7 @@ pub fn run_commander(c: &CliCommander) -> ExitCode {
             let result = super::bind::bindings_on(&bus.iface, &dict.profiles, &dict.eds)
                 .map_err(CommandError::from)
                 .and_then(|b| crate::command::pdo::dry_run(b.dictionary(spec.node), &spec))
-                .map(|(json, text)| Outcome { json, text });
+                .map(|(json, text)| Outcome::new(json, text));
             report(bus, what(c), result)
         }
         Command::Record {
@@ -182,7 +182,7 @@ pub fn report_to(args: &BusArgs, what: &str, to: Stream, result: Result<Outcome,
     match result {
         Ok(o) => {
             if args.json {
-                to.line(&o.json.to_string());
+                to.line(&o.json().to_string());
             } else if !o.text.is_empty() {
                 to.line(&o.text);
             }

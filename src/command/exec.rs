@@ -4,6 +4,7 @@
 use super::error::CommandError;
 use super::grammar::{Command, RunSpec, SdoOptions};
 use super::sdo::Timing;
+use super::spec::{Ctx, Outcome, Spec};
 use super::to_json;
 use super::value::{decode, encode};
 use crate::bus::{Bus, BusError};
@@ -13,14 +14,6 @@ use crate::od::bind::Bindings;
 use crate::od::{DataType, Dictionary};
 use serde::Serialize;
 use serde_json::Value as Json;
-use std::collections::BTreeMap;
-
-/// The result of a command: the `--json` object and the human text.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Outcome {
-    pub json: Json,
-    pub text: String,
-}
 
 /// Runs `cmd` on `bus`; `bindings` give node dictionaries (object names, aliases, types).
 /// A `record` without limits runs until its future is dropped (the log is flushed then).
@@ -36,16 +29,22 @@ pub async fn execute_until(
     cmd: &Command,
     bindings: &Bindings,
     progress: super::cyclic::Progress,
-    stop: impl std::future::Future<Output = ()>,
+    stop: impl std::future::Future<Output = ()> + Send,
 ) -> Result<Outcome, CommandError> {
+    let stop = std::pin::pin!(stop);
     if let Some(src) = super::cyclic::source(cmd, bindings) {
         let report = super::cyclic::transmit(bus, src?, progress, stop).await?;
-        return Ok(Outcome {
-            json: to_json(&report),
-            text: report.text(),
-        });
+        let text = report.text();
+        return Ok(Outcome::new(report, text));
     }
+    let ctx = Ctx {
+        bus,
+        bindings,
+        progress,
+        stop,
+    };
     let json = match cmd {
+        Command::Nmt(c) => return c.run(ctx).await,
         Command::Run(spec) => return run_procedure(bus, bindings, spec).await,
         Command::Dcf(c) => return super::dcf::execute(bus, bindings.dictionary(c.node), c).await,
         Command::Stop {
@@ -53,20 +52,6 @@ pub async fn execute_until(
             listen_ms,
             options,
         } => return super::stop::stop(bus, nodes, *listen_ms, *options).await?.into_result(),
-        Command::Nmt {
-            action,
-            node,
-            wait,
-            timeout_ms,
-        } => {
-            let seen = super::nmt::nmt(bus, *action, *node, *wait, *timeout_ms).await?;
-            to_json(&NmtSent {
-                ok: true,
-                action: action.as_str(),
-                node: *node,
-                confirmed: wait.then(|| seen.iter().map(|(n, s)| (n.to_string(), s.as_str())).collect()),
-            })
-        }
         Command::SdoRead {
             node,
             object,
@@ -137,7 +122,7 @@ pub async fn execute_until(
         Command::PdoRead { node, timeout_ms } => {
             let pdos = super::pdo::read_all(bus, *node, *timeout_ms).await?;
             let (json, text) = super::pdo::read_report(*node, bindings.dictionary(*node), &pdos);
-            return Ok(Outcome { json, text });
+            return Ok(Outcome::new(json, text));
         }
         Command::PdoMap(spec) => {
             let dict = bindings.dictionary(spec.node);
@@ -146,7 +131,7 @@ pub async fn execute_until(
             } else {
                 super::pdo::map(bus, dict, spec).await?
             };
-            return Ok(Outcome { json, text });
+            return Ok(Outcome::new(json, text));
         }
         Command::Record {
             output,
@@ -171,17 +156,7 @@ pub async fn execute_until(
         }
     };
     let text = text(cmd, &json);
-    Ok(Outcome { json, text })
-}
-
-/// `nmt --json`.
-#[derive(Serialize)]
-struct NmtSent {
-    ok: bool,
-    action: &'static str,
-    node: u8,
-    /// With `--wait`: node -> the state that confirmed the command; else null.
-    confirmed: Option<BTreeMap<String, &'static str>>,
+    Ok(Outcome::new(json, text))
 }
 
 /// `sdo read --json`.
@@ -231,7 +206,7 @@ fn timing(o: &SdoOptions) -> Timing {
 async fn run_procedure(bus: &Bus, bindings: &Bindings, spec: &RunSpec) -> Result<Outcome, CommandError> {
     let (json, text) = offline_run(bindings, spec)?;
     let Some(name) = spec.procedure.as_deref().filter(|_| !spec.dry_run) else {
-        return Ok(Outcome { json, text });
+        return Ok(Outcome::new(json, text));
     };
     let dict = bindings.dictionary(spec.node);
     let plan = super::run::plan(dict, spec.node, name, &spec.args)?;
@@ -239,10 +214,7 @@ async fn run_procedure(bus: &Bus, bindings: &Bindings, spec: &RunSpec) -> Result
     let json = super::run::run(bus, dict, &plan, spec.timeout_ms, &mut |l| lines.push(l.to_string())).await?;
     // The summary first: the palette's message line shows one line.
     lines.insert(0, run_summary(&json));
-    Ok(Outcome {
-        json,
-        text: lines.join("\n"),
-    })
+    Ok(Outcome::new(json, lines.join("\n")))
 }
 
 /// What `run` gives without a bus: the listing (no procedure) or the dry run (also used to
@@ -300,20 +272,6 @@ fn s(v: &Json) -> &str {
 /// The text form of a successful command's JSON object.
 pub fn text(cmd: &Command, v: &Json) -> String {
     match cmd {
-        Command::Nmt { node, .. } => {
-            let target = if *node == 0 {
-                "all nodes".to_string()
-            } else {
-                format!("node {node}")
-            };
-            let mut t = format!("NMT {} sent to {target}", s(&v["action"]));
-            if let Some(m) = v["confirmed"].as_object() {
-                for (n, state) in m {
-                    t.push_str(&format!("\nnode {n}: {}", s(state)));
-                }
-            }
-            t
-        }
         Command::SdoRead { .. } | Command::SdoWrite { .. } => {
             let obj = format!(
                 "node {} 0x{:04X}:{:02X}{}",
@@ -359,6 +317,8 @@ pub fn text(cmd: &Command, v: &Json) -> String {
         Command::Lss { .. } => s(&v["text"]).to_string(),
         Command::Record { .. } => format!("{} frames written to {}", v["frames"], s(&v["output"])),
         Command::Run(_) => run_summary(v),
+        // Moved commands make their own text.
+        Command::Nmt(_) => String::new(),
         // A stop's text comes from its report (see `stop::StopReport::text`).
         Command::Stop { .. } => String::new(),
         // A cyclic command's text comes from its report (see `cyclic::Report::text`).

@@ -6,54 +6,6 @@ use super::record::{Limits, LogFormat, WriteMode};
 use super::syntax::ParseError;
 use crate::od::DataType;
 
-/// An NMT command.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum NmtAction {
-    Start,
-    Stop,
-    PreOp,
-    ResetNode,
-    ResetComm,
-}
-
-impl NmtAction {
-    /// The NMT command specifier.
-    pub fn cs(self) -> u8 {
-        match self {
-            NmtAction::Start => 0x01,
-            NmtAction::Stop => 0x02,
-            NmtAction::PreOp => 0x80,
-            NmtAction::ResetNode => 0x81,
-            NmtAction::ResetComm => 0x82,
-        }
-    }
-    /// The word used on the command line.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            NmtAction::Start => "start",
-            NmtAction::Stop => "stop",
-            NmtAction::PreOp => "preop",
-            NmtAction::ResetNode => "reset-node",
-            NmtAction::ResetComm => "reset-comm",
-        }
-    }
-    /// Parses `start|stop|preop|reset-node|reset-comm`.
-    pub fn parse(word: &str) -> Result<NmtAction, ParseError> {
-        Ok(match word {
-            "start" => NmtAction::Start,
-            "stop" => NmtAction::Stop,
-            "preop" | "pre-op" | "preoperational" => NmtAction::PreOp,
-            "reset-node" => NmtAction::ResetNode,
-            "reset-comm" => NmtAction::ResetComm,
-            _ => {
-                return Err(ParseError::Invalid(format!(
-                    "unknown NMT command `{word}`: use start, stop, preop, reset-node or reset-comm"
-                )));
-            }
-        })
-    }
-}
-
 /// A CiA 402 drive command.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DriveAction {
@@ -182,12 +134,7 @@ pub const SCAN_LISTEN_MS: u64 = 1500;
 #[derive(Clone, Debug, PartialEq)]
 pub enum Command {
     /// `nmt ACTION NODE [--wait] [--timeout MS]` (NODE 0 = all nodes).
-    Nmt {
-        action: NmtAction,
-        node: u8,
-        wait: bool,
-        timeout_ms: u64,
-    },
+    Nmt(super::nmt::Nmt),
     /// `sdo read NODE OBJECT [--type T] [--block] [--timeout MS] [--deadline MS] [-o FILE]`.
     SdoRead {
         node: u8,

@@ -15,13 +15,16 @@ pub mod record;
 pub mod run;
 pub mod scan;
 pub mod sdo;
+pub mod spec;
 pub mod stop;
 pub mod syntax;
 pub mod value;
 
 pub use error::{CommandError, ExitCode};
-pub use exec::{Outcome, execute, execute_until};
-pub use grammar::{Command, DriveAction, NmtAction, RunSpec, SdoOptions};
+pub use exec::{execute, execute_until};
+pub use grammar::{Command, DriveAction, RunSpec, SdoOptions};
+pub use nmt::NmtAction;
+pub use spec::{Outcome, Reported};
 pub use syntax::{ParseError, parse_command};
 
 /// A command's `--json` object from its `#[derive(Serialize)]` form (serializing these plain

@@ -10,11 +10,12 @@ use super::cyclic::Schedule;
 use super::dcf::DcfAction;
 use super::grammar::parse_assignments;
 use super::grammar::{
-    Command, DEFAULT_TIMEOUT_MS, DriveAction, NMT_WAIT_MS, NmtAction, SCAN_LISTEN_MS, SCAN_TIMEOUT_MS, SdoOptions,
+    Command, DEFAULT_TIMEOUT_MS, DriveAction, SCAN_LISTEN_MS, SCAN_TIMEOUT_MS, SdoOptions,
     parse_int, parse_node, parse_type, run_spec,
 };
 use super::lss::{FASTSCAN_TIMEOUT_MS, LSS_TIMEOUT_MS, LSS_WORDS, LssAction, LssFlags};
 use super::pdo::MapSpec;
+use super::spec::CommandArgs;
 use super::record::{Limits, LogFormat, WriteMode};
 use super::stop::{DEFAULT_LISTEN_MS, DEFAULT_RAMP_MS, StopOptions};
 use crate::decode::pdo_config::PdoId;
@@ -97,7 +98,7 @@ pub struct On<B: Args, A: Args> {
 #[derive(Subcommand, Clone, Debug)]
 pub enum Commander<B: Args, D: Args> {
     /// Send an NMT command to a node (0 = all): start, stop, preop, reset-node, reset-comm.
-    Nmt(On<B, NmtArgs>),
+    Nmt(On<B, super::nmt::NmtArgs>),
     /// Read or write an object by SDO.
     #[command(subcommand)]
     Sdo(SdoCommand<B, D>),
@@ -209,23 +210,6 @@ pub enum SdoCommand<B: Args, D: Args> {
     Write(On<B, SdoWriteArgs<D>>),
 }
 
-/// `nmt ACTION NODE [--wait] [--timeout MS]`.
-#[derive(Args, Clone, Debug)]
-pub struct NmtArgs {
-    /// start, stop, preop, reset-node or reset-comm.
-    #[arg(value_parser = Words::new(NMT_WORDS, NmtAction::parse))]
-    pub action: NmtAction,
-    /// Node id 1..127, or 0 for all nodes.
-    #[arg(value_parser = node_or_all_arg)]
-    pub node: u8,
-    /// Wait for the heartbeat (or boot-up after a reset) that confirms the command.
-    #[arg(long)]
-    pub wait: bool,
-    /// How long --wait waits, in ms.
-    #[arg(long, value_parser = ms_arg, default_value_t = NMT_WAIT_MS)]
-    pub timeout: u64,
-}
-
 /// What `sdo read` and `sdo write` share.
 #[derive(Args, Clone, Debug)]
 pub struct Transfer<D: Args> {
@@ -235,7 +219,7 @@ pub struct Transfer<D: Args> {
     /// Object: 0x6041, 0x1018:1, or an object name from the node's profile.
     pub object: String,
     /// Value type: u8..u64, i8..i64, f32, f64, bool, string, octets (hex), domain (a file).
-    #[arg(long = "type", short = 't', value_parser = Words::new(TYPE_WORDS, parse_type))]
+    #[arg(long = "type", short = 't', value_parser = TypedWords::new(TYPE_WORDS, parse_type))]
     pub data_type: Option<DataType>,
     /// Force a block transfer.
     #[arg(long)]
@@ -289,7 +273,7 @@ pub struct DriveArgs {
     #[arg(value_parser = node_arg)]
     pub node: u8,
     /// enable, disable, quick-stop, fault-reset, status, or mode.
-    #[arg(value_parser = Words::new(DRIVE_WORDS, drive_word))]
+    #[arg(value_parser = TypedWords::new(DRIVE_WORDS, drive_word))]
     pub action: String,
     /// The mode for `mode`: pp, pv, pt, hm, ip, csp, csv, cst or a number.
     #[arg(allow_negative_numbers = true)]
@@ -354,7 +338,7 @@ pub struct RecordArgs {
     #[arg(long)]
     pub append: bool,
     /// The file format: candump (-l lines) or pcapng (for Wireshark; not to a terminal).
-    #[arg(long, default_value = "candump", value_parser = Words::new(&["candump", "pcapng"], LogFormat::parse))]
+    #[arg(long, default_value = "candump", value_parser = TypedWords::new(&["candump", "pcapng"], LogFormat::parse))]
     pub format: LogFormat,
 }
 
@@ -382,7 +366,7 @@ pub struct StopArgs {
 #[derive(Args, Clone, Debug)]
 pub struct LssArgs {
     /// The LSS service (its words follow).
-    #[arg(value_parser = Words::new(LSS_WORDS, LssAction::verb))]
+    #[arg(value_parser = TypedWords::new(LSS_WORDS, LssAction::verb))]
     pub action: String,
     /// The action's words: `switch [global] config|wait`, `select VENDOR PRODUCT REVISION
     /// SERIAL`, `set-node N`, `set-bitrate KBIT`, `activate-bitrate DELAY_MS`, `inquire
@@ -489,7 +473,7 @@ pub struct PdoArgs<D: Args> {
     #[arg(value_parser = node_arg)]
     pub node: u8,
     /// send (an RPDO) or map (remap a PDO); none: read every PDO's configuration.
-    #[arg(value_parser = Words::new(&["send", "map"], pdo_word))]
+    #[arg(value_parser = TypedWords::new(&["send", "map"], pdo_word))]
     pub action: Option<String>,
     /// The PDO: rpdo1, rpdo2, ... (send), tpdo1, rpdo1, ... (map).
     #[arg(value_parser = pdo_arg)]
@@ -636,12 +620,7 @@ impl<B: Args, D: Args> Commander<B, D> {
     /// The command the words make, or why they make none.
     pub fn command(&self) -> Result<Command, ParseError> {
         Ok(match self {
-            Commander::Nmt(On { args: a, .. }) => Command::Nmt {
-                action: a.action,
-                node: a.node,
-                wait: a.wait,
-                timeout_ms: a.timeout,
-            },
+            Commander::Nmt(o) => Command::Nmt(parsed::<D, _>(&o.args)?),
             Commander::Sdo(SdoCommand::Read(On { args: a, .. })) => Command::SdoRead {
                 node: a.t.node,
                 object: a.t.object.clone(),
@@ -734,6 +713,11 @@ impl<B: Args, D: Args> Commander<B, D> {
             }
         })
     }
+}
+
+/// The command `args` make (`D`: the dictionary options).
+fn parsed<D, A: CommandArgs<D>>(args: &A) -> Result<A::Spec, ParseError> {
+    args.spec()
 }
 
 /// A `dcf` command.
@@ -899,18 +883,18 @@ pub fn completions(before: &str, known: &dyn super::complete::Known) -> Vec<Stri
 
 /// A value parser that checks a word with `parse` and offers `words` for help and completion.
 #[derive(Clone)]
-struct Words<T> {
+pub(crate) struct TypedWords<T> {
     words: &'static [&'static str],
     parse: fn(&str) -> Result<T, ParseError>,
 }
 
-impl<T> Words<T> {
-    fn new(words: &'static [&'static str], parse: fn(&str) -> Result<T, ParseError>) -> Words<T> {
-        Words { words, parse }
+impl<T> TypedWords<T> {
+    pub(crate) fn new(words: &'static [&'static str], parse: fn(&str) -> Result<T, ParseError>) -> TypedWords<T> {
+        TypedWords { words, parse }
     }
 }
 
-impl<T: Clone + Send + Sync + 'static> TypedValueParser for Words<T> {
+impl<T: Clone + Send + Sync + 'static> TypedValueParser for TypedWords<T> {
     type Value = T;
 
     fn parse_ref(
@@ -927,7 +911,7 @@ impl<T: Clone + Send + Sync + 'static> TypedValueParser for Words<T> {
     }
 }
 
-const NMT_WORDS: &[&str] = &["start", "stop", "preop", "reset-node", "reset-comm"];
+pub(crate) const NMT_WORDS: &[&str] = &["start", "stop", "preop", "reset-node", "reset-comm"];
 const DRIVE_WORDS: &[&str] = &["enable", "disable", "quick-stop", "fault-reset", "status", "mode"];
 const TYPE_WORDS: &[&str] = &[
     "u8", "u16", "u32", "u64", "i8", "i16", "i32", "i64", "f32", "f64", "bool", "string", "octets", "domain",
@@ -1140,12 +1124,12 @@ mod tests {
         );
         assert_eq!(
             parse_command("nmt reset-node 0 --wait").unwrap(),
-            Command::Nmt {
-                action: NmtAction::ResetNode,
+            Command::Nmt(crate::command::nmt::Nmt {
+                action: crate::command::NmtAction::ResetNode,
                 node: 0,
                 wait: true,
-                timeout_ms: NMT_WAIT_MS,
-            }
+                timeout_ms: crate::command::grammar::NMT_WAIT_MS,
+            })
         );
         assert_eq!(
             parse_command("drive 3 mode csv").unwrap(),

@@ -6,7 +6,8 @@
 use super::live::UNKNOWN_STATE;
 use crate::command::lss::LssAction;
 use crate::command::run::Action;
-use crate::command::{Command, CommandError, NmtAction, RunSpec, candump, drive, nmt, parse_command, sdo};
+use crate::command::spec::{Known, Spec};
+use crate::command::{Command, CommandError, NmtAction, RunSpec, candump, drive, parse_command, sdo};
 use crate::decode::cia402::DriveState;
 use crate::frame::Frame;
 use crate::od::alias::resolve_object;
@@ -53,17 +54,12 @@ pub fn plan(
     let object = |node: u8, object: &str| {
         resolve_object(bindings.dictionary(node), object).map_err(|e| CommandError::Usage(e.to_string()))
     };
+    let known = Known {
+        bindings,
+        drive_state: &state,
+    };
     let (preview, confirm) = match &command {
-        Command::Nmt { action, node, .. } => {
-            let f = candump(&nmt::frame(*action, *node));
-            let reset = matches!(action, NmtAction::ResetNode | NmtAction::ResetComm);
-            let confirm = match (*node, reset) {
-                (0, _) => Some(format!("broadcast NMT {} to every node", action.as_str())),
-                (n, true) => Some(format!("NMT {} of node {n}", action.as_str())),
-                _ => None,
-            };
-            (f, confirm)
-        }
+        Command::Nmt(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
         Command::SdoRead {
             node,
             object: o,
