@@ -66,7 +66,7 @@ pub fn run_commander(c: &CliCommander) -> ExitCode {
             mode,
             format,
         } => super::record::run_record(bus, &output, limits, mode, format),
-        cmd @ (Command::Send { .. } | Command::Sync { .. } | Command::Pdo { .. }) => {
+        cmd @ (Command::Send(_) | Command::Sync(_) | Command::Pdo { .. }) => {
             let bindings = super::bind::bindings_on(&bus.iface, &dict.profiles, &dict.eds);
             run(bus, what(c), |bus| async move {
                 // Ctrl-C stops a cyclic send; the report follows.

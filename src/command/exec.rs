@@ -151,7 +151,7 @@ pub async fn execute_until(
             n.to_json(output)
         }
         // Handled above by `cyclic::source`.
-        Command::Send { .. } | Command::Sync { .. } | Command::Pdo { .. } => {
+        Command::Send(_) | Command::Sync(_) | Command::Pdo { .. } => {
             return Err(CommandError::Usage("internal: cyclic command without a source".into()));
         }
     };
@@ -322,7 +322,7 @@ pub fn text(cmd: &Command, v: &Json) -> String {
         // A stop's text comes from its report (see `stop::StopReport::text`).
         Command::Stop { .. } => String::new(),
         // A cyclic command's text comes from its report (see `cyclic::Report::text`).
-        Command::Send { .. } | Command::Sync { .. } | Command::Pdo { .. } => String::new(),
+        Command::Send(_) | Command::Sync(_) | Command::Pdo { .. } => String::new(),
         // `pdo` reads and maps return their own text (see `pdo::read_report`, `pdo::map`).
         Command::PdoRead { .. } | Command::PdoMap(_) => String::new(),
         // A dcf command's text comes from its report (see `dcf`).

@@ -185,17 +185,9 @@ pub enum Command {
         timeout_ms: u64,
     },
     /// `send FRAME [--every MS] [--count N]`: a raw frame in candump's compact form.
-    Send {
-        frame: crate::frame::Frame,
-        schedule: super::cyclic::Schedule,
-    },
+    Send(super::send::Send),
     /// `sync --period MS [--counter N] [--count N] [--cob-id ID]`: the SYNC producer.
-    Sync {
-        cob_id: u32,
-        /// The CiA 301 counter's overflow value (2..=240), if the counter is sent.
-        counter: Option<u8>,
-        schedule: super::cyclic::Schedule,
-    },
+    Sync(super::sync::Sync),
     /// `pdo NODE send rpdoK NAME=VALUE ... [--every MS] [--count N]`: an RPDO encoded
     /// through the node's mapping.
     Pdo {

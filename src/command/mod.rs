@@ -15,8 +15,10 @@ pub mod record;
 pub mod run;
 pub mod scan;
 pub mod sdo;
+pub mod send;
 pub mod spec;
 pub mod stop;
+pub mod sync;
 pub mod syntax;
 pub mod value;
 

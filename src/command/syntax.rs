@@ -119,10 +119,10 @@ pub enum Commander<B: Args, D: Args> {
     Lss(On<B, LssArgs>),
     /// Send a raw frame in candump's compact form (`601#4041600000000000`, `123#R`,
     /// `12345678#00`): once, --count N times, or --every MS (until stopped without --count).
-    Send(On<B, SendArgs>),
+    Send(On<B, super::send::SendArgs>),
     /// Produce SYNC every --period MS (COB-ID 0x080), with the CiA 301 counter 1..N when
     /// --counter N is given; until stopped without --count.
-    Sync(On<B, SyncArgs>),
+    Sync(On<B, super::sync::SyncArgs>),
     /// PDOs: `pdo 2` reads every PDO's configuration; `pdo 2 map tpdo1 0x6041 0x6064 --type
     /// sync:2` remaps one (CiA 301 sequence, read back); `pdo 2 send rpdo1 Controlword=0x0F
     /// "Target velocity=500" --every 10` sends an RPDO (mapped signals not given are sent as 0).
@@ -427,42 +427,12 @@ pub struct Repeat {
 }
 
 impl Repeat {
-    fn schedule(&self) -> Schedule {
+    pub(crate) fn schedule(&self) -> Schedule {
         Schedule {
             every_ms: self.every,
             count: self.count,
         }
     }
-}
-
-/// `send FRAME [--every MS] [--count N]`.
-#[derive(Args, Clone, Debug)]
-pub struct SendArgs {
-    /// The frame, as cansend takes it: `123#DEADBEEF`, `123#R`, 29-bit `12345678#00`.
-    #[arg(value_parser = frame_arg)]
-    pub frame: Frame,
-    #[command(flatten)]
-    pub repeat: Repeat,
-}
-
-/// `sync --period MS [--counter N] [--count N] [--cob-id ID]`.
-#[derive(Args, Clone, Debug)]
-pub struct SyncArgs {
-    /// The SYNC period in ms.
-    #[arg(long, value_parser = ms_arg)]
-    pub period: u64,
-    /// Send the CiA 301 SYNC counter, counting 1..N (N = 2..240).
-    #[arg(long, value_parser = counter_arg)]
-    pub counter: Option<u8>,
-    /// Stop after this many SYNCs.
-    #[arg(long, value_parser = count_arg)]
-    pub count: Option<u64>,
-    /// The SYNC COB-ID (11-bit).
-    #[arg(long, value_parser = cob_arg, default_value = "0x080")]
-    pub cob_id: u32,
-    /// Use a --cob-id that another service owns (an SDO, EMCY or heartbeat id...).
-    #[arg(long)]
-    pub force: bool,
 }
 
 /// `pdo NODE` (read every PDO), `pdo NODE send rpdoK NAME=VALUE ... [--every MS] [--count N]`,
@@ -673,23 +643,8 @@ impl<B: Args, D: Args> Commander<B, D> {
                 }
             }
             Commander::Lss(On { args: a, .. }) => a.command()?,
-            Commander::Send(On { args: a, .. }) => Command::Send {
-                frame: a.frame,
-                schedule: a.repeat.schedule(),
-            },
-            Commander::Sync(On { args: a, .. }) => Command::Sync {
-                cob_id: match a.cob_id {
-                    // SYNC's own COB-ID; any other service's needs --force.
-                    0x080 => 0x080,
-                    id if a.force => id,
-                    id => not_reserved(id, "the SYNC producer").map(|()| id)?,
-                },
-                counter: a.counter,
-                schedule: Schedule {
-                    every_ms: Some(a.period),
-                    count: a.count,
-                },
-            },
+            Commander::Send(o) => Command::Send(parsed::<D, _>(&o.args)?),
+            Commander::Sync(o) => Command::Sync(parsed::<D, _>(&o.args)?),
             Commander::Pdo(On { args: a, .. }) => a.command()?,
             Commander::Dcf(DcfCommand::Save(On { args: a, .. })) => dcf(
                 a.node,
@@ -945,7 +900,7 @@ pub fn ms_arg(text: &str) -> Result<u64, ParseError> {
 /// Blanks around the frame (a quoting artifact) are ignored; a `0x` before the id is
 /// refused with the cansend form to write instead (cansend's grammar is hex already); an FD
 /// flags digit must be 0..7 (1 BRS, 2 ESI, 4 FDF: bit 3 is no flag, and would be dropped).
-fn frame_arg(text: &str) -> Result<Frame, ParseError> {
+pub(crate) fn frame_arg(text: &str) -> Result<Frame, ParseError> {
     let text = text.trim();
     if let Some(rest) = text.strip_prefix("0x").or_else(|| text.strip_prefix("0X")) {
         return Err(ParseError::Invalid(format!(
@@ -1055,7 +1010,7 @@ fn pdo_cob_arg(text: &str) -> Result<u32, ParseError> {
 }
 
 /// Refuses a COB-ID another service owns ([`crate::decode::cob_id::reserved_for`]) for `user`.
-fn not_reserved(id: u32, user: &str) -> Result<(), ParseError> {
+pub(crate) fn not_reserved(id: u32, user: &str) -> Result<(), ParseError> {
     match crate::decode::cob_id::reserved_for(id) {
         Some(owner) => Err(ParseError::Invalid(format!(
             "--cob-id 0x{id:03X} is {owner}: {user} would collide with it; nothing sent (--force uses it anyway)"
@@ -1065,7 +1020,7 @@ fn not_reserved(id: u32, user: &str) -> Result<(), ParseError> {
 }
 
 /// Parses the SYNC counter's overflow value 2..=240.
-fn counter_arg(text: &str) -> Result<u8, ParseError> {
+pub(crate) fn counter_arg(text: &str) -> Result<u8, ParseError> {
     parse_int(text)
         .filter(|v| (2..=240).contains(v))
         .map(|v| v as u8)
@@ -1073,7 +1028,7 @@ fn counter_arg(text: &str) -> Result<u8, ParseError> {
 }
 
 /// Parses an 11-bit COB-ID.
-fn cob_arg(text: &str) -> Result<u32, ParseError> {
+pub(crate) fn cob_arg(text: &str) -> Result<u32, ParseError> {
     parse_int(text)
         .filter(|v| (1..=0x7FF).contains(v))
         .map(|v| v as u32)
@@ -1081,7 +1036,7 @@ fn cob_arg(text: &str) -> Result<u32, ParseError> {
 }
 
 /// Parses a positive count.
-fn count_arg(text: &str) -> Result<u64, ParseError> {
+pub(crate) fn count_arg(text: &str) -> Result<u64, ParseError> {
     parse_int(text)
         .filter(|v| *v > 0)
         .map(|v| v as u64)
@@ -1283,16 +1238,16 @@ mod tests {
         let every = |every_ms, count| Schedule { every_ms, count };
         assert!(matches!(
             parse_command("send 12345678#DEAD --every 5").unwrap(),
-            Command::Send { frame, schedule } if frame.id == 0x1234_5678 && frame.is_ext()
-                && schedule == every(Some(5), None)
+            Command::Send(s) if s.frame.id == 0x1234_5678 && s.frame.is_ext()
+                && s.schedule == every(Some(5), None)
         ));
         assert_eq!(
             parse_command("sync --period 10 --counter 240 --count 3").unwrap(),
-            Command::Sync {
+            Command::Sync(crate::command::sync::Sync {
                 cob_id: 0x080,
                 counter: Some(240),
                 schedule: every(Some(10), Some(3))
-            }
+            })
         );
         assert_eq!(
             parse_command("pdo 2 send rpdo1 Controlword=0x0F \"Target velocity=-5\" --count 2").unwrap(),

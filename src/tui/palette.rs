@@ -60,6 +60,8 @@ pub fn plan(
     };
     let (preview, confirm) = match &command {
         Command::Nmt(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
+        Command::Send(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
+        Command::Sync(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
         Command::SdoRead {
             node,
             object: o,
@@ -177,13 +179,10 @@ pub fn plan(
             });
             (action.preview(), confirm)
         }
-        Command::Send { .. } | Command::Sync { .. } | Command::Pdo { .. } => {
+        Command::Pdo { .. } => {
             let mut src = crate::command::cyclic::source(&command, bindings)
                 .unwrap_or_else(|| Err(CommandError::Usage("not a cyclic command".into())))?;
             let mut text = format!("{} {}", candump(&src.frame(0)), src.schedule.text());
-            if let Command::Sync { counter: Some(n), .. } = &command {
-                text.push_str(&format!(", counter 1..{n}"));
-            }
             if src.schedule.total().is_none() {
                 text.push_str(" (a job: `jobs` lists, `jobs stop ID` or stop-all stops)");
             }
