@@ -91,11 +91,10 @@ pub fn run_commander(c: &CliCommander) -> ExitCode {
 
 /// The subcommand's name, as failures are prefixed (`cotui sdo read: ...`).
 fn what(c: &CliCommander) -> &'static str {
-    use crate::command::syntax::{DcfCommand, SdoCommand};
+    use crate::command::syntax::DcfCommand;
     match c {
         Commander::Nmt(_) => "nmt",
-        Commander::Sdo(SdoCommand::Read(_)) => "sdo read",
-        Commander::Sdo(SdoCommand::Write(_)) => "sdo write",
+        Commander::Sdo(g) => crate::command::spec::Declared::<BusArgs, DictArgs>::name(g),
         Commander::Drive(_) => "drive",
         Commander::Run(_) => "run",
         Commander::Scan(_) => "scan",

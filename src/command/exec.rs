@@ -2,16 +2,12 @@
 //! TUI palette share. Each result comes as one JSON object plus its text form.
 
 use super::error::CommandError;
-use super::grammar::{Command, RunSpec, SdoOptions};
-use super::sdo::Timing;
+use super::grammar::{Command, RunSpec};
 use super::spec::{Ctx, Outcome, Spec};
 use super::to_json;
-use super::value::{decode, encode};
 use crate::bus::{Bus, BusError};
 use crate::decode::cia402::mode_name;
-use crate::od::alias::resolve_object;
 use crate::od::bind::Bindings;
-use crate::od::{DataType, Dictionary};
 use serde::Serialize;
 use serde_json::Value as Json;
 
@@ -52,56 +48,7 @@ pub async fn execute_until(
             listen_ms,
             options,
         } => return super::stop::stop(bus, nodes, *listen_ms, *options).await?.into_result(),
-        Command::SdoRead {
-            node,
-            object,
-            options,
-            output,
-        } => {
-            let dict = bindings.dictionary(*node);
-            let (index, sub) = resolve_object(dict, object).map_err(|e| CommandError::Usage(e.to_string()))?;
-            let data = super::sdo::upload_within(bus, *node, index, sub, options.block, timing(options)).await?;
-            if let Some(path) = output {
-                write_output(path, &data)?;
-            }
-            let ty = options
-                .data_type
-                .or_else(|| dict.object(index, sub).map(|o| o.data_type));
-            let value = decode(&data, ty);
-            let text = crate::decode::value_text::object_text(dict, index, sub, &value, None);
-            to_json(&SdoRead {
-                ok: true,
-                node: *node,
-                index,
-                sub,
-                name: dict.name(index, sub),
-                value: value.to_json(),
-                text,
-                data: crate::frame::hex::upper(&data),
-                len: data.len(),
-            })
-        }
-        Command::SdoWrite {
-            node,
-            object,
-            value,
-            options,
-        } => {
-            let dict = bindings.dictionary(*node);
-            let (index, sub) = resolve_object(dict, object).map_err(|e| CommandError::Usage(e.to_string()))?;
-            let data = write_data(dict, index, sub, value, options.data_type)?;
-            super::sdo::download_within(bus, *node, index, sub, data.clone(), options.block, timing(options)).await?;
-            to_json(&SdoWritten {
-                ok: true,
-                written: true,
-                node: *node,
-                index,
-                sub,
-                name: dict.name(index, sub),
-                data: crate::frame::hex::upper(&data),
-                len: data.len(),
-            })
-        }
+        Command::Sdo(c) => return c.run(ctx).await,
         Command::Drive {
             node,
             action,
@@ -159,46 +106,11 @@ pub async fn execute_until(
     Ok(Outcome::new(json, text))
 }
 
-/// `sdo read --json`.
-#[derive(Serialize)]
-struct SdoRead<'a> {
-    ok: bool,
-    node: u8,
-    index: u16,
-    sub: u8,
-    name: Option<&'a str>,
-    value: Json,
-    text: String,
-    data: String,
-    len: usize,
-}
-
-/// `sdo write --json`.
-#[derive(Serialize)]
-struct SdoWritten<'a> {
-    ok: bool,
-    written: bool,
-    node: u8,
-    index: u16,
-    sub: u8,
-    name: Option<&'a str>,
-    data: String,
-    len: usize,
-}
-
 /// `scan --json`.
 #[derive(Serialize)]
 struct Scanned {
     ok: bool,
     nodes: Vec<Json>,
-}
-
-/// The timeouts of an SDO command's options.
-fn timing(o: &SdoOptions) -> Timing {
-    Timing {
-        timeout_ms: o.timeout_ms,
-        deadline_ms: o.deadline_ms,
-    }
 }
 
 /// `run`: lists, dry-runs or runs a procedure; the text is a summary line, then every step
@@ -244,27 +156,6 @@ pub fn run_summary(v: &Json) -> String {
     )
 }
 
-/// The bytes to write: a file for domains, else the value encoded as its type.
-/// The bytes an SDO write of `value` sends: typed by `ty`, else by the dictionary; a
-/// domain value names the file to send.
-pub fn write_data(
-    dict: &Dictionary,
-    index: u16,
-    sub: u8,
-    value: &str,
-    ty: Option<DataType>,
-) -> Result<Vec<u8>, CommandError> {
-    match ty.or_else(|| dict.object(index, sub).map(|o| o.data_type)) {
-        Some(DataType::Domain) => {
-            std::fs::read(value).map_err(|e| CommandError::Usage(format!("cannot read {value}: {e}")))
-        }
-        Some(t) => Ok(encode(value, t)?),
-        None => Err(CommandError::Usage(format!(
-            "the type of {index:04X}:{sub:02X} is unknown: give --type (u8..u64, i8..i64, f32, f64, bool, string, octets, domain)"
-        ))),
-    }
-}
-
 fn s(v: &Json) -> &str {
     v.as_str().unwrap_or("")
 }
@@ -272,24 +163,6 @@ fn s(v: &Json) -> &str {
 /// The text form of a successful command's JSON object.
 pub fn text(cmd: &Command, v: &Json) -> String {
     match cmd {
-        Command::SdoRead { .. } | Command::SdoWrite { .. } => {
-            let obj = format!(
-                "node {} 0x{:04X}:{:02X}{}",
-                v["node"],
-                v["index"].as_u64().unwrap_or(0),
-                v["sub"].as_u64().unwrap_or(0),
-                v["name"].as_str().map(|n| format!(" {n}")).unwrap_or_default()
-            );
-            if v["written"].as_bool() == Some(true) {
-                return format!("{obj} written ({} bytes: {})", v["len"], s(&v["data"]));
-            }
-            let shown = match (&v["text"], &v["value"]) {
-                (Json::String(t), _) => t.clone(),
-                (_, Json::String(raw)) => raw.clone(),
-                (_, other) => other.to_string(),
-            };
-            format!("{obj} = {shown} (data {})", s(&v["data"]))
-        }
         Command::Drive { .. } => {
             let mut t = format!(
                 "node {}: {} (statusword {})",
@@ -318,7 +191,7 @@ pub fn text(cmd: &Command, v: &Json) -> String {
         Command::Record { .. } => format!("{} frames written to {}", v["frames"], s(&v["output"])),
         Command::Run(_) => run_summary(v),
         // Moved commands make their own text.
-        Command::Nmt(_) => String::new(),
+        Command::Nmt(_) | Command::Sdo(_) => String::new(),
         // A stop's text comes from its report (see `stop::StopReport::text`).
         Command::Stop { .. } => String::new(),
         // A cyclic command's text comes from its report (see `cyclic::Report::text`).

@@ -95,33 +95,8 @@ pub fn parse_mode(text: &str) -> Result<i8, ParseError> {
     })
 }
 
-/// Options of an SDO transfer.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct SdoOptions {
-    /// `--type`: how to encode/decode the value (else from the dictionary, else raw).
-    pub data_type: Option<DataType>,
-    /// `--block`: force a block transfer.
-    pub block: bool,
-    /// `--timeout`: ms to wait for each server response.
-    pub timeout_ms: u64,
-    /// `--deadline`: ms the whole transfer may take (`None`: the client's default, see
-    /// [`crate::sdo::client::ClientConfig::default_deadline_ns`]).
-    pub deadline_ms: Option<u64>,
-}
-
 /// Default SDO response timeout in ms.
 pub const DEFAULT_TIMEOUT_MS: u64 = 1000;
-
-impl Default for SdoOptions {
-    fn default() -> Self {
-        SdoOptions {
-            data_type: None,
-            block: false,
-            timeout_ms: DEFAULT_TIMEOUT_MS,
-            deadline_ms: None,
-        }
-    }
-}
 
 /// Default wait of `nmt --wait` in ms.
 pub const NMT_WAIT_MS: u64 = 2000;
@@ -135,21 +110,8 @@ pub const SCAN_LISTEN_MS: u64 = 1500;
 pub enum Command {
     /// `nmt ACTION NODE [--wait] [--timeout MS]` (NODE 0 = all nodes).
     Nmt(super::nmt::Nmt),
-    /// `sdo read NODE OBJECT [--type T] [--block] [--timeout MS] [--deadline MS] [-o FILE]`.
-    SdoRead {
-        node: u8,
-        object: String,
-        options: SdoOptions,
-        /// Also write the data read to this file (domains).
-        output: Option<String>,
-    },
-    /// `sdo write NODE OBJECT VALUE [--type T] [--block] [--timeout MS] [--deadline MS]` (a file path for domains).
-    SdoWrite {
-        node: u8,
-        object: String,
-        value: String,
-        options: SdoOptions,
-    },
+    /// `sdo read NODE OBJECT ...`, `sdo write NODE OBJECT VALUE ...`.
+    Sdo(super::object::Sdo),
     /// `drive NODE ACTION [MODE] [--timeout MS]`.
     Drive {
         node: u8,
@@ -212,7 +174,7 @@ impl Command {
     pub fn data_to_stdout(&self) -> bool {
         match self {
             Command::Record { output, .. } => output == "-",
-            Command::SdoRead { output, .. } => output.as_deref() == Some("-"),
+            Command::Sdo(c) => super::spec::Spec::data_to_stdout(c),
             Command::Dcf(d) => matches!(&d.action, super::dcf::DcfAction::Save { output, .. } if output == "-"),
             _ => false,
         }

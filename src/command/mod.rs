@@ -10,6 +10,7 @@ pub mod exec;
 pub mod grammar;
 pub mod lss;
 pub mod nmt;
+pub mod object;
 pub mod pdo;
 pub mod record;
 pub mod run;
@@ -24,7 +25,8 @@ pub mod value;
 
 pub use error::{CommandError, ExitCode};
 pub use exec::{execute, execute_until};
-pub use grammar::{Command, DriveAction, RunSpec, SdoOptions};
+pub use grammar::{Command, DriveAction, RunSpec};
+pub use object::SdoOptions;
 pub use nmt::NmtAction;
 pub use spec::{Outcome, Reported};
 pub use syntax::{ParseError, parse_command};

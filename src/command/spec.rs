@@ -157,3 +157,22 @@ pub trait CommandArgs<D>: clap::Args {
         None
     }
 }
+
+/// One entry of the commander's declaration: a command's words with the options in front
+/// of them (`B`, see `super::syntax::On`), or a group of commands (`sdo read|write`).
+pub trait Declared<B, D> {
+    /// The command the words make.
+    type Spec: Spec;
+
+    /// The options in front of the command (the command line's bus options).
+    fn bus(&self) -> &B;
+
+    /// The dictionary options, for a command that takes them.
+    fn dict(&self) -> Option<&D>;
+
+    /// What failures are prefixed with: `cotui sdo read: ...`.
+    fn name(&self) -> &'static str;
+
+    /// The command, or why the words make none.
+    fn spec(&self) -> Result<Self::Spec, ParseError>;
+}

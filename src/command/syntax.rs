@@ -10,17 +10,17 @@ use super::cyclic::Schedule;
 use super::dcf::DcfAction;
 use super::grammar::parse_assignments;
 use super::grammar::{
-    Command, DEFAULT_TIMEOUT_MS, DriveAction, SCAN_LISTEN_MS, SCAN_TIMEOUT_MS, SdoOptions,
-    parse_int, parse_node, parse_type, run_spec,
+    Command, DEFAULT_TIMEOUT_MS, DriveAction, SCAN_LISTEN_MS, SCAN_TIMEOUT_MS,
+    parse_int, parse_node, run_spec,
 };
 use super::lss::{FASTSCAN_TIMEOUT_MS, LSS_TIMEOUT_MS, LSS_WORDS, LssAction, LssFlags};
 use super::pdo::MapSpec;
-use super::spec::CommandArgs;
+use super::spec::{CommandArgs, Declared};
+pub(crate) use super::grammar::parse_type;
 use super::record::{Limits, LogFormat, WriteMode};
 use super::stop::{DEFAULT_LISTEN_MS, DEFAULT_RAMP_MS, StopOptions};
 use crate::decode::pdo_config::PdoId;
 use crate::frame::Frame;
-use crate::od::DataType;
 use clap::builder::{PossibleValue, TypedValueParser};
 use clap::error::ErrorKind;
 use clap::{Args, CommandFactory, Parser, Subcommand};
@@ -101,7 +101,7 @@ pub enum Commander<B: Args, D: Args> {
     Nmt(On<B, super::nmt::NmtArgs>),
     /// Read or write an object by SDO.
     #[command(subcommand)]
-    Sdo(SdoCommand<B, D>),
+    Sdo(super::object::SdoCommand<B, D>),
     /// CiA 402 drive: enable, disable, quick-stop, fault-reset, status, or mode MODE.
     Drive(On<B, DriveArgs>),
     /// Run a profile's procedure step by step (NAME=VALUE parameters); without PROCEDURE (or
@@ -199,71 +199,6 @@ pub struct DcfDiffArgs<D: Args> {
     pub timeout: u64,
     #[command(flatten)]
     pub dict: D,
-}
-
-/// `sdo read` and `sdo write`.
-#[derive(Subcommand, Clone, Debug)]
-pub enum SdoCommand<B: Args, D: Args> {
-    /// Read an object: `sdo read 2 0x6041`.
-    Read(On<B, SdoReadArgs<D>>),
-    /// Write an object: `sdo write 2 0x6060 3 --type i8`.
-    Write(On<B, SdoWriteArgs<D>>),
-}
-
-/// What `sdo read` and `sdo write` share.
-#[derive(Args, Clone, Debug)]
-pub struct Transfer<D: Args> {
-    /// Node id 1..127 (decimal or 0x hex).
-    #[arg(value_parser = node_arg)]
-    pub node: u8,
-    /// Object: 0x6041, 0x1018:1, or an object name from the node's profile.
-    pub object: String,
-    /// Value type: u8..u64, i8..i64, f32, f64, bool, string, octets (hex), domain (a file).
-    #[arg(long = "type", short = 't', value_parser = TypedWords::new(TYPE_WORDS, parse_type))]
-    pub data_type: Option<DataType>,
-    /// Force a block transfer.
-    #[arg(long)]
-    pub block: bool,
-    /// How long to wait for each server response, in ms.
-    #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
-    pub timeout: u64,
-    /// How long the whole transfer may take, in ms [default: the longer of 10 s and 10
-    /// timeouts, plus 1 ms per byte of the size written or announced by the server].
-    #[arg(long, value_parser = ms_arg)]
-    pub deadline: Option<u64>,
-    #[command(flatten)]
-    pub dict: D,
-}
-
-impl<D: Args> Transfer<D> {
-    fn options(&self) -> SdoOptions {
-        SdoOptions {
-            data_type: self.data_type,
-            block: self.block,
-            timeout_ms: self.timeout,
-            deadline_ms: self.deadline,
-        }
-    }
-}
-
-/// `sdo read NODE OBJECT [-o FILE] [transfer options]`.
-#[derive(Args, Clone, Debug)]
-pub struct SdoReadArgs<D: Args> {
-    #[command(flatten)]
-    pub t: Transfer<D>,
-    /// Write the data read to this file (for domains).
-    #[arg(long = "output", short = 'o')]
-    pub output: Option<String>,
-}
-
-/// `sdo write NODE OBJECT VALUE [transfer options]`.
-#[derive(Args, Clone, Debug)]
-pub struct SdoWriteArgs<D: Args> {
-    #[command(flatten)]
-    pub t: Transfer<D>,
-    /// The value (a file path for `--type domain`, hex bytes for `--type octets`); negative numbers need no `--`.
-    #[arg(allow_negative_numbers = true)]
-    pub value: String,
 }
 
 /// `drive NODE ACTION [MODE] [--timeout MS]`.
@@ -556,8 +491,7 @@ impl<B: Args, D: Args> Commander<B, D> {
     pub fn bus(&self) -> &B {
         match self {
             Commander::Nmt(o) => &o.bus,
-            Commander::Sdo(SdoCommand::Read(o)) => &o.bus,
-            Commander::Sdo(SdoCommand::Write(o)) => &o.bus,
+            Commander::Sdo(g) => g.bus(),
             Commander::Drive(o) => &o.bus,
             Commander::Run(o) => &o.bus,
             Commander::Scan(o) => &o.bus,
@@ -576,8 +510,7 @@ impl<B: Args, D: Args> Commander<B, D> {
     /// The dictionary options, for the commands that take them.
     pub fn dict(&self) -> Option<&D> {
         match self {
-            Commander::Sdo(SdoCommand::Read(o)) => Some(&o.args.t.dict),
-            Commander::Sdo(SdoCommand::Write(o)) => Some(&o.args.t.dict),
+            Commander::Sdo(g) => g.dict(),
             Commander::Run(o) => Some(&o.args.dict),
             Commander::Pdo(o) => Some(&o.args.dict),
             Commander::Dcf(DcfCommand::Save(o)) => Some(&o.args.dict),
@@ -591,18 +524,7 @@ impl<B: Args, D: Args> Commander<B, D> {
     pub fn command(&self) -> Result<Command, ParseError> {
         Ok(match self {
             Commander::Nmt(o) => Command::Nmt(parsed::<D, _>(&o.args)?),
-            Commander::Sdo(SdoCommand::Read(On { args: a, .. })) => Command::SdoRead {
-                node: a.t.node,
-                object: a.t.object.clone(),
-                options: a.t.options(),
-                output: a.output.clone(),
-            },
-            Commander::Sdo(SdoCommand::Write(On { args: a, .. })) => Command::SdoWrite {
-                node: a.t.node,
-                object: a.t.object.clone(),
-                value: a.value.clone(),
-                options: a.t.options(),
-            },
+            Commander::Sdo(g) => Command::Sdo(g.spec()?),
             Commander::Drive(On { args: a, .. }) => Command::Drive {
                 node: a.node,
                 action: DriveAction::parse(&a.action, a.mode.as_deref())?,
@@ -673,6 +595,27 @@ impl<B: Args, D: Args> Commander<B, D> {
 /// The command `args` make (`D`: the dictionary options).
 fn parsed<D, A: CommandArgs<D>>(args: &A) -> Result<A::Spec, ParseError> {
     args.spec()
+}
+
+/// A command's words after the options in front.
+impl<B: Args, D, A: CommandArgs<D>> Declared<B, D> for On<B, A> {
+    type Spec = A::Spec;
+
+    fn bus(&self) -> &B {
+        &self.bus
+    }
+
+    fn dict(&self) -> Option<&D> {
+        self.args.dict()
+    }
+
+    fn name(&self) -> &'static str {
+        self.args.name()
+    }
+
+    fn spec(&self) -> Result<A::Spec, ParseError> {
+        self.args.spec()
+    }
 }
 
 /// A `dcf` command.
@@ -868,7 +811,7 @@ impl<T: Clone + Send + Sync + 'static> TypedValueParser for TypedWords<T> {
 
 pub(crate) const NMT_WORDS: &[&str] = &["start", "stop", "preop", "reset-node", "reset-comm"];
 const DRIVE_WORDS: &[&str] = &["enable", "disable", "quick-stop", "fault-reset", "status", "mode"];
-const TYPE_WORDS: &[&str] = &[
+pub(crate) const TYPE_WORDS: &[&str] = &[
     "u8", "u16", "u32", "u64", "i8", "i16", "i32", "i64", "f32", "f64", "bool", "string", "octets", "domain",
 ];
 
@@ -1046,6 +989,8 @@ pub(crate) fn count_arg(text: &str) -> Result<u64, ParseError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::command::object::{Sdo, SdoOptions, SdoRead, SdoWrite};
+    use crate::od::DataType;
 
     /// Completions with nothing known of the bus.
     fn completions_of(before: &str) -> Vec<String> {
@@ -1056,16 +1001,16 @@ mod tests {
     fn palette_lines() {
         assert_eq!(
             parse_command("sdo read 2 0x6041").unwrap(),
-            Command::SdoRead {
+            Command::Sdo(Sdo::Read(SdoRead {
                 node: 2,
                 object: "0x6041".into(),
                 options: SdoOptions::default(),
                 output: None,
-            }
+            }))
         );
         assert_eq!(
             parse_command("sdo write 0x02 0x1008 \"my drive\" --type string --block --timeout 300").unwrap(),
-            Command::SdoWrite {
+            Command::Sdo(Sdo::Write(SdoWrite {
                 node: 2,
                 object: "0x1008".into(),
                 value: "my drive".into(),
@@ -1075,7 +1020,7 @@ mod tests {
                     timeout_ms: 300,
                     deadline_ms: None
                 }
-            }
+            }))
         );
         assert_eq!(
             parse_command("nmt reset-node 0 --wait").unwrap(),
@@ -1096,7 +1041,7 @@ mod tests {
         );
         assert_eq!(
             parse_command("sdo write 2 0x60FF -100 --type i32")
-                .map(|c| matches!(c, Command::SdoWrite { value, .. } if value == "-100")),
+                .map(|c| matches!(c, Command::Sdo(Sdo::Write(w)) if w.value == "-100")),
             Ok(true)
         );
         assert_eq!(

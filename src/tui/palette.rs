@@ -10,7 +10,6 @@ use crate::command::spec::{Known, Spec};
 use crate::command::{Command, CommandError, NmtAction, RunSpec, candump, drive, parse_command, sdo};
 use crate::decode::cia402::DriveState;
 use crate::frame::Frame;
-use crate::od::alias::resolve_object;
 use crate::od::bind::Bindings;
 
 /// The first words of commander lines, from the command declaration.
@@ -51,9 +50,6 @@ pub fn plan(
             "-o - (stdout) is for the command line; in the TUI give a file".into(),
         ));
     }
-    let object = |node: u8, object: &str| {
-        resolve_object(bindings.dictionary(node), object).map_err(|e| CommandError::Usage(e.to_string()))
-    };
     let known = Known {
         bindings,
         drive_state: &state,
@@ -62,37 +58,7 @@ pub fn plan(
         Command::Nmt(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
         Command::Send(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
         Command::Sync(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
-        Command::SdoRead {
-            node,
-            object: o,
-            options,
-            ..
-        } => {
-            let (i, s) = object(*node, o)?;
-            let first = candump(&sdo::first_upload_frame(*node, i, s, options.block));
-            let text = if options.block {
-                format!("{first} then the server's block segments")
-            } else {
-                first
-            };
-            (text, None)
-        }
-        Command::SdoWrite {
-            node,
-            object: o,
-            value,
-            options,
-        } => {
-            let dict = bindings.dictionary(*node);
-            let (i, s) = object(*node, o)?;
-            let data = crate::command::exec::write_data(dict, i, s, value, options.data_type)?;
-            let (first, then) = sdo::first_download_frame(*node, i, s, &data, options.block);
-            let text = match then {
-                Some(t) => format!("{} {t}", candump(&first)),
-                None => candump(&first),
-            };
-            (text, None)
-        }
+        Command::Sdo(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
         Command::Drive { node, action, .. } => {
             let st = state(*node);
             let frames = drive::frames(*node, *action, st.unwrap_or(UNKNOWN_STATE));
