@@ -78,7 +78,7 @@ pub struct Rpdo {
 
 /// The predefined COB-ID of RPDO `num` (1..=4) of `node`.
 fn default_rpdo_cob(node: u8, num: u16) -> Option<u32> {
-    (1..=4).contains(&num).then(|| 0x100 + 0x100 * num as u32 + node as u32)
+    (1..=4).contains(&num).then(|| crate::cob::rpdo(num as u8, node))
 }
 
 /// A signal's name as listed in errors: `Controlword (0x6040:00)`.

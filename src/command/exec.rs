@@ -6,7 +6,6 @@ use super::grammar::{Command, RunSpec};
 use super::spec::{Ctx, Outcome, Spec};
 use super::to_json;
 use crate::bus::{Bus, BusError};
-use crate::decode::cia402::mode_name;
 use crate::od::bind::Bindings;
 use serde::Serialize;
 use serde_json::Value as Json;
@@ -49,11 +48,7 @@ pub async fn execute_until(
             options,
         } => return super::stop::stop(bus, nodes, *listen_ms, *options).await?.into_result(),
         Command::Sdo(c) => return c.run(ctx).await,
-        Command::Drive {
-            node,
-            action,
-            timeout_ms,
-        } => super::drive::drive(bus, *node, *action, *timeout_ms).await?.to_json(),
+        Command::Drive(c) => return c.run(ctx).await,
         Command::Scan {
             listen_ms,
             probe,
@@ -163,35 +158,12 @@ fn s(v: &Json) -> &str {
 /// The text form of a successful command's JSON object.
 pub fn text(cmd: &Command, v: &Json) -> String {
     match cmd {
-        Command::Drive { .. } => {
-            let mut t = format!(
-                "node {}: {} (statusword {})",
-                v["node"],
-                s(&v["state_text"]),
-                s(&v["statusword"])
-            );
-            if let Some(cws) = v["controlwords"].as_array()
-                && !cws.is_empty()
-            {
-                let list: Vec<&str> = cws.iter().map(s).collect();
-                t.push_str(&format!(", controlwords {}", list.join(" -> ")));
-            }
-            if let Some(m) = v["mode_display"].as_i64() {
-                t.push_str(&format!(", mode {m} ({})", mode_name(m as i8)));
-            }
-            if let Some(e) = v["error_code"].as_str()
-                && e != "0x0000"
-            {
-                t.push_str(&format!(", error code {e}"));
-            }
-            t
-        }
         Command::Scan { .. } => scan_text(v),
         Command::Lss { .. } => s(&v["text"]).to_string(),
         Command::Record { .. } => format!("{} frames written to {}", v["frames"], s(&v["output"])),
         Command::Run(_) => run_summary(v),
         // Moved commands make their own text.
-        Command::Nmt(_) | Command::Sdo(_) => String::new(),
+        Command::Nmt(_) | Command::Sdo(_) | Command::Drive(_) => String::new(),
         // A stop's text comes from its report (see `stop::StopReport::text`).
         Command::Stop { .. } => String::new(),
         // A cyclic command's text comes from its report (see `cyclic::Report::text`).

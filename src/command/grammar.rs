@@ -6,72 +6,6 @@ use super::record::{Limits, LogFormat, WriteMode};
 use super::syntax::ParseError;
 use crate::od::DataType;
 
-/// A CiA 402 drive command.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum DriveAction {
-    Enable,
-    Disable,
-    QuickStop,
-    FaultReset,
-    Status,
-    /// Set the mode of operation (0x6060) and wait for 0x6061 to show it.
-    Mode(i8),
-}
-
-impl DriveAction {
-    /// Checks an action word: `enable|disable|quick-stop|fault-reset|status|mode`; gives
-    /// its usual spelling.
-    pub fn verb(word: &str) -> Result<&'static str, ParseError> {
-        Ok(match word {
-            "enable" => "enable",
-            "disable" => "disable",
-            "quick-stop" | "quickstop" => "quick-stop",
-            "fault-reset" => "fault-reset",
-            "status" => "status",
-            "mode" => "mode",
-            _ => {
-                return Err(ParseError::Invalid(format!(
-                    "unknown drive command `{word}`: use enable, disable, quick-stop, fault-reset, status or mode MODE"
-                )));
-            }
-        })
-    }
-    /// Parses `enable|disable|quick-stop|fault-reset|status|mode MODE`: `arg` is the MODE,
-    /// which only `mode` takes.
-    pub fn parse(word: &str, arg: Option<&str>) -> Result<DriveAction, ParseError> {
-        let action = match Self::verb(word)? {
-            "enable" => DriveAction::Enable,
-            "disable" => DriveAction::Disable,
-            "quick-stop" => DriveAction::QuickStop,
-            "fault-reset" => DriveAction::FaultReset,
-            "status" => DriveAction::Status,
-            _ => {
-                return Ok(DriveAction::Mode(parse_mode(arg.ok_or_else(|| {
-                    ParseError::Invalid("drive mode needs a MODE (e.g. pv, csp, 3)".into())
-                })?)?));
-            }
-        };
-        match arg {
-            Some(extra) => Err(ParseError::Invalid(format!(
-                "`drive {}` takes no MODE (got `{extra}`)",
-                action.as_str()
-            ))),
-            None => Ok(action),
-        }
-    }
-    /// The word used on the command line.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            DriveAction::Enable => "enable",
-            DriveAction::Disable => "disable",
-            DriveAction::QuickStop => "quick-stop",
-            DriveAction::FaultReset => "fault-reset",
-            DriveAction::Status => "status",
-            DriveAction::Mode(_) => "mode",
-        }
-    }
-}
-
 /// A mode of operation by CiA 402 abbreviation (`pp`, `pv`, `pt`, `hm`, `ip`, `csp`, `csv`, `cst`) or number.
 pub fn parse_mode(text: &str) -> Result<i8, ParseError> {
     Ok(match text.to_ascii_lowercase().as_str() {
@@ -113,11 +47,7 @@ pub enum Command {
     /// `sdo read NODE OBJECT ...`, `sdo write NODE OBJECT VALUE ...`.
     Sdo(super::object::Sdo),
     /// `drive NODE ACTION [MODE] [--timeout MS]`.
-    Drive {
-        node: u8,
-        action: DriveAction,
-        timeout_ms: u64,
-    },
+    Drive(super::drive::Drive),
     /// `scan [--listen MS] [--probe] [--timeout MS]`.
     Scan {
         listen_ms: u64,

@@ -25,7 +25,8 @@ pub mod value;
 
 pub use error::{CommandError, ExitCode};
 pub use exec::{execute, execute_until};
-pub use grammar::{Command, DriveAction, RunSpec};
+pub use drive::DriveAction;
+pub use grammar::{Command, RunSpec};
 pub use object::SdoOptions;
 pub use nmt::NmtAction;
 pub use spec::{Outcome, Reported};

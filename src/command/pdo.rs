@@ -17,6 +17,7 @@ use crate::od::alias::resolve_object;
 use crate::od::{Dictionary, MappedEntry, PdoMappable};
 use crate::sdo::abort_text;
 use remap::{Action, Mapping, Remap, remap_sequence};
+use crate::cob;
 use serde::Serialize;
 use serde_json::Value as Json;
 use std::time::Duration;
@@ -551,7 +552,7 @@ fn with_hint(e: CommandError, hint: String) -> CommandError {
 
 /// The NMT state the node's last heartbeat showed (waits for one up to [`HEARTBEAT_WAIT`]).
 async fn nmt_state(heartbeats: &mut Subscription, node: u8) -> Option<u8> {
-    let id = 0x700 + u32::from(node);
+    let id = cob::heartbeat(node);
     let mut last = None;
     while let Some(Ok(f)) = heartbeats.try_recv() {
         if f.id == id && f.len == 1 && !f.is_ext() {

@@ -10,7 +10,7 @@ use super::cyclic::Schedule;
 use super::dcf::DcfAction;
 use super::grammar::parse_assignments;
 use super::grammar::{
-    Command, DEFAULT_TIMEOUT_MS, DriveAction, SCAN_LISTEN_MS, SCAN_TIMEOUT_MS,
+    Command, DEFAULT_TIMEOUT_MS, SCAN_LISTEN_MS, SCAN_TIMEOUT_MS,
     parse_int, parse_node, run_spec,
 };
 use super::lss::{FASTSCAN_TIMEOUT_MS, LSS_TIMEOUT_MS, LSS_WORDS, LssAction, LssFlags};
@@ -103,7 +103,7 @@ pub enum Commander<B: Args, D: Args> {
     #[command(subcommand)]
     Sdo(super::object::SdoCommand<B, D>),
     /// CiA 402 drive: enable, disable, quick-stop, fault-reset, status, or mode MODE.
-    Drive(On<B, DriveArgs>),
+    Drive(On<B, super::drive::DriveArgs>),
     /// Run a profile's procedure step by step (NAME=VALUE parameters); without PROCEDURE (or
     /// with --list), list the node's procedures.
     Run(On<B, RunArgs<D>>),
@@ -199,23 +199,6 @@ pub struct DcfDiffArgs<D: Args> {
     pub timeout: u64,
     #[command(flatten)]
     pub dict: D,
-}
-
-/// `drive NODE ACTION [MODE] [--timeout MS]`.
-#[derive(Args, Clone, Debug)]
-pub struct DriveArgs {
-    /// Node id 1..127 (decimal or 0x hex).
-    #[arg(value_parser = node_arg)]
-    pub node: u8,
-    /// enable, disable, quick-stop, fault-reset, status, or mode.
-    #[arg(value_parser = TypedWords::new(DRIVE_WORDS, drive_word))]
-    pub action: String,
-    /// The mode for `mode`: pp, pv, pt, hm, ip, csp, csv, cst or a number.
-    #[arg(allow_negative_numbers = true)]
-    pub mode: Option<String>,
-    /// How long to wait for each SDO answer, and half of how long each step may take, in ms.
-    #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
-    pub timeout: u64,
 }
 
 /// `run NODE [PROCEDURE] [NAME=VALUE ...] [--list] [--dry-run] [--timeout MS]`.
@@ -523,13 +506,9 @@ impl<B: Args, D: Args> Commander<B, D> {
     /// The command the words make, or why they make none.
     pub fn command(&self) -> Result<Command, ParseError> {
         Ok(match self {
-            Commander::Nmt(o) => Command::Nmt(parsed::<D, _>(&o.args)?),
-            Commander::Sdo(g) => Command::Sdo(g.spec()?),
-            Commander::Drive(On { args: a, .. }) => Command::Drive {
-                node: a.node,
-                action: DriveAction::parse(&a.action, a.mode.as_deref())?,
-                timeout_ms: a.timeout,
-            },
+            Commander::Nmt(o) => Command::Nmt(Declared::<B, D>::spec(o)?),
+            Commander::Sdo(g) => Command::Sdo(Declared::<B, D>::spec(g)?),
+            Commander::Drive(o) => Command::Drive(Declared::<B, D>::spec(o)?),
             Commander::Run(On { args: a, .. }) => {
                 let words: Vec<&str> = a.words.iter().map(String::as_str).collect();
                 Command::Run(run_spec(a.node, &words, a.list, a.dry_run, a.timeout)?)
@@ -565,8 +544,8 @@ impl<B: Args, D: Args> Commander<B, D> {
                 }
             }
             Commander::Lss(On { args: a, .. }) => a.command()?,
-            Commander::Send(o) => Command::Send(parsed::<D, _>(&o.args)?),
-            Commander::Sync(o) => Command::Sync(parsed::<D, _>(&o.args)?),
+            Commander::Send(o) => Command::Send(Declared::<B, D>::spec(o)?),
+            Commander::Sync(o) => Command::Sync(Declared::<B, D>::spec(o)?),
             Commander::Pdo(On { args: a, .. }) => a.command()?,
             Commander::Dcf(DcfCommand::Save(On { args: a, .. })) => dcf(
                 a.node,
@@ -590,11 +569,6 @@ impl<B: Args, D: Args> Commander<B, D> {
             }
         })
     }
-}
-
-/// The command `args` make (`D`: the dictionary options).
-fn parsed<D, A: CommandArgs<D>>(args: &A) -> Result<A::Spec, ParseError> {
-    args.spec()
 }
 
 /// A command's words after the options in front.
@@ -810,15 +784,10 @@ impl<T: Clone + Send + Sync + 'static> TypedValueParser for TypedWords<T> {
 }
 
 pub(crate) const NMT_WORDS: &[&str] = &["start", "stop", "preop", "reset-node", "reset-comm"];
-const DRIVE_WORDS: &[&str] = &["enable", "disable", "quick-stop", "fault-reset", "status", "mode"];
+pub(crate) const DRIVE_WORDS: &[&str] = &["enable", "disable", "quick-stop", "fault-reset", "status", "mode"];
 pub(crate) const TYPE_WORDS: &[&str] = &[
     "u8", "u16", "u32", "u64", "i8", "i16", "i32", "i64", "f32", "f64", "bool", "string", "octets", "domain",
 ];
-
-/// A drive action word (its MODE is checked with it, see [`DriveAction::parse`]).
-fn drive_word(word: &str) -> Result<String, ParseError> {
-    DriveAction::verb(word).map(str::to_string)
-}
 
 /// Parses NODE 1..127 (decimal or 0x hex).
 pub fn node_arg(text: &str) -> Result<u8, ParseError> {
@@ -991,6 +960,7 @@ mod tests {
     use super::*;
     use crate::command::object::{Sdo, SdoOptions, SdoRead, SdoWrite};
     use crate::od::DataType;
+    use crate::command::DriveAction;
 
     /// Completions with nothing known of the bus.
     fn completions_of(before: &str) -> Vec<String> {
@@ -1033,11 +1003,11 @@ mod tests {
         );
         assert_eq!(
             parse_command("drive 3 mode csv").unwrap(),
-            Command::Drive {
+            Command::Drive(crate::command::drive::Drive {
                 node: 3,
                 action: DriveAction::Mode(9),
                 timeout_ms: DEFAULT_TIMEOUT_MS
-            }
+            })
         );
         assert_eq!(
             parse_command("sdo write 2 0x60FF -100 --type i32")
@@ -1117,6 +1087,8 @@ mod tests {
             err("drive 2 enable extra"),
             "`drive enable` takes no MODE (got `extra`)"
         );
+        assert!(err("drive 2 mode fly").contains("unknown mode `fly`"));
+        assert_eq!(err("drive 2 mode"), "drive mode needs a MODE (e.g. pv, csp, 3)");
         assert_eq!(err("scan extra"), "unexpected argument 'extra' found");
         assert_eq!(parse_command("sdo read 2 \"0x6041"), Err(ParseError::Quote));
         assert!(err("lss fly").contains("unknown LSS command `fly`"));

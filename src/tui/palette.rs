@@ -3,7 +3,6 @@
 //! controlwords, the LSS requests), and whether it needs confirming (broadcast NMT, resets,
 //! node 0, LSS services that change state).
 
-use super::live::UNKNOWN_STATE;
 use crate::command::lss::LssAction;
 use crate::command::run::Action;
 use crate::command::spec::{Known, Spec};
@@ -59,22 +58,7 @@ pub fn plan(
         Command::Send(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
         Command::Sync(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
         Command::Sdo(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
-        Command::Drive { node, action, .. } => {
-            let st = state(*node);
-            let frames = drive::frames(*node, *action, st.unwrap_or(UNKNOWN_STATE));
-            let from = st
-                .map(|s| s.text())
-                .unwrap_or("state unknown, assumed Switch on disabled");
-            let text = match action {
-                crate::command::DriveAction::Status => format!("reads 0x6041 of node {node}"),
-                crate::command::DriveAction::Mode(m) => {
-                    format!("{} (0x6060 = {m}), then reads 0x6061", listed(&frames))
-                }
-                _ if frames.is_empty() => format!("nothing to send (node {node}: {from})"),
-                _ => format!("{} (from {from})", listed(&frames)),
-            };
-            (text, None)
-        }
+        Command::Drive(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
         Command::Scan { .. } => (
             "listens for heartbeats, then reads 0x1018 of each node found".into(),
             None,

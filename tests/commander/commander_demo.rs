@@ -98,7 +98,7 @@ async fn enable_disable_quick_stop_and_fault_reset() {
         r.steps.iter().map(|s| s.controlword).collect::<Vec<_>>(),
         vec![6, 7, 0x0F]
     );
-    assert_eq!(r.to_json()["statusword"], "0x1637");
+    assert_eq!(r.report().statusword, "0x1637");
     let r = drive(&d.bus, 2, DriveAction::QuickStop, T).await.unwrap();
     assert_eq!(r.state, DriveState::QuickStopActive);
     let r = drive(&d.bus, 2, DriveAction::Enable, T).await.unwrap();
