@@ -59,7 +59,6 @@ impl DriveAction {
     }
 }
 
-
 /// The ACTION word of `drive`: an action, or `mode` (its MODE follows).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DriveVerb {
@@ -119,7 +118,9 @@ impl<D> CommandArgs<D> for DriveArgs {
     fn spec(&self) -> Result<Drive, ParseError> {
         let action = match (self.action, self.mode.clone()) {
             (DriveVerb::Mode, Some(m)) => DriveAction::Mode(m.mode?),
-            (DriveVerb::Mode, None) => return Err(ParseError::Invalid("drive mode needs a MODE (e.g. pv, csp, 3)".into())),
+            (DriveVerb::Mode, None) => {
+                return Err(ParseError::Invalid("drive mode needs a MODE (e.g. pv, csp, 3)".into()));
+            }
             (DriveVerb::Action(a), None) => a,
             (DriveVerb::Action(a), Some(m)) => {
                 return Err(ParseError::Invalid(format!(
@@ -163,7 +164,6 @@ impl Spec for Drive {
         Ok(Outcome::new(report, text))
     }
 }
-
 
 const FAULT_RESET: Step = Step {
     name: "fault reset (0x80)",

@@ -23,12 +23,12 @@ pub mod sync;
 pub mod syntax;
 pub mod value;
 
+pub use drive::DriveAction;
 pub use error::{CommandError, ExitCode};
 pub use exec::{execute, execute_until};
-pub use drive::DriveAction;
 pub use grammar::{Command, RunSpec};
-pub use object::SdoOptions;
 pub use nmt::NmtAction;
+pub use object::SdoOptions;
 pub use spec::{Outcome, Reported};
 pub use syntax::{ParseError, parse_command};
 

@@ -160,7 +160,6 @@ impl NmtAction {
     }
 }
 
-
 /// What `nmt --wait` saw: node -> state reported after the command.
 pub type Confirmed = BTreeMap<u8, NmtState>;
 
@@ -207,7 +206,9 @@ pub async fn nmt(
         if f.direction() != Direction::Rx || f.is_ext() || f.is_rtr() {
             continue;
         }
-        let Some(from) = cob::heartbeat_node(f.id) else { continue };
+        let Some(from) = cob::heartbeat_node(f.id) else {
+            continue;
+        };
         let Some(b) = f.payload().first() else { continue };
         let state = NmtState::from_byte(*b);
         if node != 0 && from != node {

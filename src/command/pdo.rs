@@ -9,6 +9,7 @@ use super::error::{CommandError, ExitCode};
 use super::sdo::{download, first_download_frame, first_upload_frame, upload};
 use super::{candump, to_json};
 use crate::bus::{Bus, Subscription};
+use crate::cob;
 use crate::decode::pdo::entry_from_u32;
 use crate::decode::pdo_config::{
     COMM_SUBS, Cob, CommJson, CommParams, EntryJson, PdoId, entry_text, event_text, inhibit_text, transmission_text,
@@ -17,7 +18,6 @@ use crate::od::alias::resolve_object;
 use crate::od::{Dictionary, MappedEntry, PdoMappable};
 use crate::sdo::abort_text;
 use remap::{Action, Mapping, Remap, remap_sequence};
-use crate::cob;
 use serde::Serialize;
 use serde_json::Value as Json;
 use std::time::Duration;

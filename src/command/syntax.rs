@@ -9,15 +9,12 @@
 use super::cyclic::Schedule;
 use super::dcf::DcfAction;
 use super::grammar::parse_assignments;
-use super::grammar::{
-    Command, DEFAULT_TIMEOUT_MS, SCAN_LISTEN_MS, SCAN_TIMEOUT_MS,
-    parse_int, parse_node, run_spec,
-};
+pub(crate) use super::grammar::parse_type;
+use super::grammar::{Command, DEFAULT_TIMEOUT_MS, SCAN_LISTEN_MS, SCAN_TIMEOUT_MS, parse_int, parse_node, run_spec};
 use super::lss::{FASTSCAN_TIMEOUT_MS, LSS_TIMEOUT_MS, LSS_WORDS, LssAction, LssFlags};
 use super::pdo::MapSpec;
-use super::spec::{CommandArgs, Declared};
-pub(crate) use super::grammar::parse_type;
 use super::record::{Limits, LogFormat, WriteMode};
+use super::spec::{CommandArgs, Declared};
 use super::stop::{DEFAULT_LISTEN_MS, DEFAULT_RAMP_MS, StopOptions};
 use crate::decode::pdo_config::PdoId;
 use crate::frame::Frame;
@@ -958,9 +955,9 @@ pub(crate) fn count_arg(text: &str) -> Result<u64, ParseError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::command::DriveAction;
     use crate::command::object::{Sdo, SdoOptions, SdoRead, SdoWrite};
     use crate::od::DataType;
-    use crate::command::DriveAction;
 
     /// Completions with nothing known of the bus.
     fn completions_of(before: &str) -> Vec<String> {

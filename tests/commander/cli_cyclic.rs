@@ -94,7 +94,10 @@ async fn sync_counts_1_to_n_at_the_period() {
     let mut watch = d.bus.subscribe();
     let sync = parse_command("sync --period 10 --counter 2 --count 5").unwrap();
     let o = execute(&d.bus, &sync, &b).await.unwrap();
-    assert_eq!((o.json()["count"].as_u64(), o.json()["seen"].as_u64()), (Some(5), Some(5)));
+    assert_eq!(
+        (o.json()["count"].as_u64(), o.json()["seen"].as_u64()),
+        (Some(5), Some(5))
+    );
     let mean = o.json()["mean_period_ms"].as_f64().unwrap();
     assert!((9.5..10.5).contains(&mean), "{mean}");
     tokio::time::sleep(Duration::from_millis(1)).await;

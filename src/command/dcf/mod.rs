@@ -8,8 +8,8 @@ pub mod plan;
 mod report;
 
 use super::error::{CommandError, ExitCode};
-use super::spec::Outcome;
 use super::sdo::{Timing, download_within, upload_within};
+use super::spec::Outcome;
 use crate::bus::Bus;
 use crate::od::dcf::{DcfEntry, DeviceInfo};
 use crate::od::{DataType, Dictionary};
