@@ -57,7 +57,7 @@ pub fn run_commander(c: &CliCommander) -> ExitCode {
             let result = super::bind::bindings_on(&bus.iface, &dict.profiles, &dict.eds)
                 .map_err(CommandError::from)
                 .and_then(|b| crate::command::pdo::dry_run(b.dictionary(spec.node), &spec))
-                .map(|(json, text)| Outcome { json, text });
+                .map(|(json, text)| Outcome::new(json, text));
             report(bus, what(c), result)
         }
         Command::Record {
@@ -66,7 +66,7 @@ pub fn run_commander(c: &CliCommander) -> ExitCode {
             mode,
             format,
         } => super::record::run_record(bus, &output, limits, mode, format),
-        cmd @ (Command::Send { .. } | Command::Sync { .. } | Command::Pdo { .. }) => {
+        cmd @ (Command::Send(_) | Command::Sync(_) | Command::Pdo { .. }) => {
             let bindings = super::bind::bindings_on(&bus.iface, &dict.profiles, &dict.eds);
             run(bus, what(c), |bus| async move {
                 // Ctrl-C stops a cyclic send; the report follows.
@@ -91,11 +91,10 @@ pub fn run_commander(c: &CliCommander) -> ExitCode {
 
 /// The subcommand's name, as failures are prefixed (`cotui sdo read: ...`).
 fn what(c: &CliCommander) -> &'static str {
-    use crate::command::syntax::{DcfCommand, SdoCommand};
+    use crate::command::syntax::DcfCommand;
     match c {
         Commander::Nmt(_) => "nmt",
-        Commander::Sdo(SdoCommand::Read(_)) => "sdo read",
-        Commander::Sdo(SdoCommand::Write(_)) => "sdo write",
+        Commander::Sdo(g) => crate::command::spec::Declared::<BusArgs, DictArgs>::name(g),
         Commander::Drive(_) => "drive",
         Commander::Run(_) => "run",
         Commander::Scan(_) => "scan",
@@ -182,7 +181,7 @@ pub fn report_to(args: &BusArgs, what: &str, to: Stream, result: Result<Outcome,
     match result {
         Ok(o) => {
             if args.json {
-                to.line(&o.json.to_string());
+                to.line(&o.json().to_string());
             } else if !o.text.is_empty() {
                 to.line(&o.text);
             }

@@ -19,7 +19,7 @@ pub fn run_run(bus: &BusArgs, dict: &DictArgs, spec: &RunSpec) -> ExitCode {
         Err(e) => return report(bus, "run", Err(e)),
     };
     let Some(name) = spec.procedure.clone().filter(|_| !spec.dry_run) else {
-        return report(bus, "run", Ok(Outcome { json, text }));
+        return report(bus, "run", Ok(Outcome::new(json, text)));
     };
     let (json_out, spec) = (bus.json, spec.clone());
     run(bus, "run", |bus| async move {
@@ -32,6 +32,6 @@ pub fn run_run(bus: &BusArgs, dict: &DictArgs, spec: &RunSpec) -> ExitCode {
         };
         let json = crate::command::run::run(&bus, dict, &plan, spec.timeout_ms, &mut print).await?;
         let text = run_summary(&json);
-        Ok(Outcome { json, text })
+        Ok(Outcome::new(json, text))
     })
 }

@@ -10,6 +10,7 @@
 
 use super::error::CommandError;
 use super::grammar::Command;
+use super::spec::{Ctx, Known, Outcome, Preview, Spec};
 use super::value::encode;
 use crate::bus::{Bus, Event};
 use crate::frame::{Direction, Flags, Frame};
@@ -77,7 +78,7 @@ pub struct Rpdo {
 
 /// The predefined COB-ID of RPDO `num` (1..=4) of `node`.
 fn default_rpdo_cob(node: u8, num: u16) -> Option<u32> {
-    (1..=4).contains(&num).then(|| 0x100 + 0x100 * num as u32 + node as u32)
+    (1..=4).contains(&num).then(|| crate::cob::rpdo(num as u8, node))
 }
 
 /// A signal's name as listed in errors: `Controlword (0x6040:00)`.
@@ -198,7 +199,7 @@ pub fn rpdo(bindings: &Bindings, node: u8, num: u16, assignments: &[(String, Str
 pub struct Source {
     /// What is sent, for reports and the jobs list (`SYNC 080`, `601#40..`, `RPDO1 node 2`).
     pub what: String,
-    next: Box<dyn FnMut(u64) -> Frame + Send>,
+    pub(crate) next: Box<dyn FnMut(u64) -> Frame + Send>,
     /// Mapped signals sent as 0 (pdo).
     pub defaulted: Vec<String>,
     pub schedule: Schedule,
@@ -214,28 +215,8 @@ impl Source {
 /// The source of a `send`, `sync` or `pdo` command (`None` for other commands).
 pub fn source(cmd: &Command, bindings: &Bindings) -> Option<Result<Source, CommandError>> {
     Some(match cmd {
-        Command::Send { frame, schedule } => {
-            let f = *frame;
-            Ok(Source {
-                what: super::candump(&f),
-                next: Box::new(move |_| f),
-                defaulted: Vec::new(),
-                schedule: *schedule,
-            })
-        }
-        Command::Sync {
-            cob_id,
-            counter,
-            schedule,
-        } => {
-            let (cob, counter) = (*cob_id, *counter);
-            Ok(Source {
-                what: format!("SYNC {cob:03X}"),
-                next: Box::new(move |i| sync_frame(cob, counter, i)),
-                defaulted: Vec::new(),
-                schedule: *schedule,
-            })
-        }
+        Command::Send(c) => return c.source(bindings),
+        Command::Sync(c) => return c.source(bindings),
         Command::Pdo {
             node,
             num,
@@ -252,6 +233,32 @@ pub fn source(cmd: &Command, bindings: &Bindings) -> Option<Result<Source, Comma
         }),
         _ => return None,
     })
+}
+
+/// The preview of a cyclic command: its first frame, its schedule, `extra` (the SYNC
+/// counter), whether it runs as a job and the mapped signals sent as 0.
+pub(crate) fn preview(cmd: &impl Spec, known: &Known<'_>, extra: &str) -> Result<Preview, CommandError> {
+    let mut src = cmd
+        .source(known.bindings)
+        .unwrap_or_else(|| Err(CommandError::Usage("not a cyclic command".into())))?;
+    let mut text = format!("{} {}{extra}", super::candump(&src.frame(0)), src.schedule.text());
+    if src.schedule.total().is_none() {
+        text.push_str(" (a job: `jobs` lists, `jobs stop ID` or stop-all stops)");
+    }
+    if !src.defaulted.is_empty() {
+        text.push_str(&format!("; not given, sent as 0: {}", src.defaulted.join(", ")));
+    }
+    Ok(Preview::sends(text))
+}
+
+/// Runs a cyclic command until its schedule ends or `ctx.stop` completes; its report.
+pub(crate) async fn run(cmd: &impl Spec, ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
+    let src = cmd
+        .source(ctx.bindings)
+        .unwrap_or_else(|| Err(CommandError::Usage("not a cyclic command".into())))?;
+    let report = transmit(ctx.bus, src, ctx.progress, ctx.stop).await?;
+    let text = report.text();
+    Ok(Outcome::new(report, text))
 }
 
 /// The timing of a cyclic command so far, shared with whoever lists or stops it.

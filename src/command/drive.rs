@@ -3,8 +3,10 @@
 //! runs them over SDO, watching heartbeats, EMCY and a statusword TPDO on the way.
 
 use super::error::CommandError;
-use super::grammar::DriveAction;
+use super::grammar::{DEFAULT_TIMEOUT_MS, parse_mode};
 use super::sdo::{download, upload};
+use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
+use super::syntax::{DRIVE_WORDS, ParseError, TypedWords, ms_arg, node_arg};
 use crate::bus::{Bus, Subscription};
 use crate::cob;
 use crate::decode::cia402::{DriveState, mode_name};
@@ -13,6 +15,155 @@ use crate::frame::Direction;
 use std::time::Duration;
 
 pub use crate::decode::stall::{Observation, Step, diagnose};
+
+/// A CiA 402 drive command.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DriveAction {
+    Enable,
+    Disable,
+    QuickStop,
+    FaultReset,
+    Status,
+    /// Set the mode of operation (0x6060) and wait for 0x6061 to show it.
+    Mode(i8),
+}
+
+impl DriveAction {
+    /// Parses an action word: `enable|disable|quick-stop|fault-reset|status`, or `mode`
+    /// (its MODE follows).
+    pub fn parse_verb(word: &str) -> Result<DriveVerb, ParseError> {
+        Ok(DriveVerb::Action(match word {
+            "enable" => DriveAction::Enable,
+            "disable" => DriveAction::Disable,
+            "quick-stop" | "quickstop" => DriveAction::QuickStop,
+            "fault-reset" => DriveAction::FaultReset,
+            "status" => DriveAction::Status,
+            "mode" => return Ok(DriveVerb::Mode),
+            _ => {
+                return Err(ParseError::Invalid(format!(
+                    "unknown drive command `{word}`: use enable, disable, quick-stop, fault-reset, status or mode MODE"
+                )));
+            }
+        }))
+    }
+    /// The word used on the command line.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            DriveAction::Enable => "enable",
+            DriveAction::Disable => "disable",
+            DriveAction::QuickStop => "quick-stop",
+            DriveAction::FaultReset => "fault-reset",
+            DriveAction::Status => "status",
+            DriveAction::Mode(_) => "mode",
+        }
+    }
+}
+
+/// The ACTION word of `drive`: an action, or `mode` (its MODE follows).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DriveVerb {
+    Action(DriveAction),
+    Mode,
+}
+
+/// The MODE word of `drive`, with its mode (or why it is none): whether it is one is
+/// said with the ACTION (only `mode` takes a MODE).
+#[derive(Clone, Debug)]
+pub struct ModeArg {
+    pub word: String,
+    pub mode: Result<i8, ParseError>,
+}
+
+/// Reads a MODE word (see [`ModeArg`]).
+fn mode_arg(word: &str) -> Result<ModeArg, ParseError> {
+    Ok(ModeArg {
+        word: word.to_string(),
+        mode: parse_mode(word),
+    })
+}
+
+/// `drive NODE ACTION [MODE] [--timeout MS]`.
+#[derive(clap::Args, Clone, Debug)]
+pub struct DriveArgs {
+    /// Node id 1..127 (decimal or 0x hex).
+    #[arg(value_parser = node_arg)]
+    pub node: u8,
+    /// enable, disable, quick-stop, fault-reset, status, or mode.
+    #[arg(value_parser = TypedWords::new(DRIVE_WORDS, DriveAction::parse_verb))]
+    pub action: DriveVerb,
+    /// The mode for `mode`: pp, pv, pt, hm, ip, csp, csv, cst or a number.
+    #[arg(allow_negative_numbers = true, value_parser = mode_arg)]
+    pub mode: Option<ModeArg>,
+    /// How long to wait for each SDO answer, and half of how long each step may take, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
+    pub timeout: u64,
+}
+
+/// A CiA 402 drive command to a node.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Drive {
+    pub node: u8,
+    pub action: DriveAction,
+    pub timeout_ms: u64,
+}
+
+impl<D> CommandArgs<D> for DriveArgs {
+    type Spec = Drive;
+
+    fn name(&self) -> &'static str {
+        "drive"
+    }
+
+    /// The action with its MODE: only `mode` takes one, and needs it.
+    fn spec(&self) -> Result<Drive, ParseError> {
+        let action = match (self.action, self.mode.clone()) {
+            (DriveVerb::Mode, Some(m)) => DriveAction::Mode(m.mode?),
+            (DriveVerb::Mode, None) => {
+                return Err(ParseError::Invalid("drive mode needs a MODE (e.g. pv, csp, 3)".into()));
+            }
+            (DriveVerb::Action(a), None) => a,
+            (DriveVerb::Action(a), Some(m)) => {
+                return Err(ParseError::Invalid(format!(
+                    "`drive {}` takes no MODE (got `{}`)",
+                    a.as_str(),
+                    m.word
+                )));
+            }
+        };
+        Ok(Drive {
+            node: self.node,
+            action,
+            timeout_ms: self.timeout,
+        })
+    }
+}
+
+/// The state a preview assumes for a drive not seen yet.
+pub const ASSUMED_STATE: DriveState = DriveState::SwitchOnDisabled;
+
+impl Spec for Drive {
+    /// The controlwords from the drive's last state seen (else [`ASSUMED_STATE`]).
+    fn preview(&self, known: &Known<'_>) -> Result<Preview, CommandError> {
+        let (node, st) = (self.node, (known.drive_state)(self.node));
+        let frames = frames(node, self.action, st.unwrap_or(ASSUMED_STATE));
+        let from = st
+            .map(|s| s.text())
+            .unwrap_or("state unknown, assumed Switch on disabled");
+        let listed = frames.iter().map(super::candump).collect::<Vec<_>>().join(", ");
+        Ok(Preview::sends(match self.action {
+            DriveAction::Status => format!("reads 0x6041 of node {node}"),
+            DriveAction::Mode(m) => format!("{listed} (0x6060 = {m}), then reads 0x6061"),
+            _ if frames.is_empty() => format!("nothing to send (node {node}: {from})"),
+            _ => format!("{listed} (from {from})"),
+        }))
+    }
+
+    async fn run(&self, ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
+        let report = drive(ctx.bus, self.node, self.action, self.timeout_ms).await?.report();
+        let text = report.text();
+        Ok(Outcome::new(report, text))
+    }
+}
 
 const FAULT_RESET: Step = Step {
     name: "fault reset (0x80)",
@@ -105,8 +256,8 @@ pub struct DriveReport {
 
 impl DriveReport {
     /// The `--json` object.
-    pub fn to_json(&self) -> serde_json::Value {
-        super::to_json(&DriveJson {
+    pub fn report(&self) -> DriveJson {
+        DriveJson {
             ok: true,
             node: self.node,
             action: self.action.as_str(),
@@ -117,7 +268,7 @@ impl DriveReport {
             mode_display: self.mode_display,
             error_code: self.error_code.map(|c| format!("0x{c:04X}")),
             source: self.source,
-        })
+        }
     }
 }
 
@@ -413,18 +564,38 @@ impl NodeStop {
 }
 
 /// `drive --json`: the outcome of a drive command.
-#[derive(serde::Serialize)]
-struct DriveJson {
+#[derive(Debug, serde::Serialize)]
+pub struct DriveJson {
     ok: bool,
     node: u8,
     action: &'static str,
-    statusword: String,
+    pub statusword: String,
     state: &'static str,
     state_text: &'static str,
     controlwords: Vec<String>,
     mode_display: Option<i8>,
     error_code: Option<String>,
     source: &'static str,
+}
+
+impl DriveJson {
+    /// `node 2: Operation enabled (statusword 0x0237), controlwords ..., mode ..., error code ...`.
+    fn text(&self) -> String {
+        let mut t = format!(
+            "node {}: {} (statusword {})",
+            self.node, self.state_text, self.statusword
+        );
+        if !self.controlwords.is_empty() {
+            t.push_str(&format!(", controlwords {}", self.controlwords.join(" -> ")));
+        }
+        if let Some(m) = self.mode_display {
+            t.push_str(&format!(", mode {m} ({})", mode_name(m)));
+        }
+        if let Some(e) = self.error_code.as_deref().filter(|e| *e != "0x0000") {
+            t.push_str(&format!(", error code {e}"));
+        }
+        t
+    }
 }
 
 /// One node of a stop report.

@@ -2,25 +2,13 @@
 //! TUI palette share. Each result comes as one JSON object plus its text form.
 
 use super::error::CommandError;
-use super::grammar::{Command, RunSpec, SdoOptions};
-use super::sdo::Timing;
+use super::grammar::{Command, RunSpec};
+use super::spec::{Ctx, Outcome, Spec};
 use super::to_json;
-use super::value::{decode, encode};
 use crate::bus::{Bus, BusError};
-use crate::decode::cia402::mode_name;
-use crate::od::alias::resolve_object;
 use crate::od::bind::Bindings;
-use crate::od::{DataType, Dictionary};
 use serde::Serialize;
 use serde_json::Value as Json;
-use std::collections::BTreeMap;
-
-/// The result of a command: the `--json` object and the human text.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Outcome {
-    pub json: Json,
-    pub text: String,
-}
 
 /// Runs `cmd` on `bus`; `bindings` give node dictionaries (object names, aliases, types).
 /// A `record` without limits runs until its future is dropped (the log is flushed then).
@@ -36,16 +24,22 @@ pub async fn execute_until(
     cmd: &Command,
     bindings: &Bindings,
     progress: super::cyclic::Progress,
-    stop: impl std::future::Future<Output = ()>,
+    stop: impl std::future::Future<Output = ()> + Send,
 ) -> Result<Outcome, CommandError> {
+    let stop = std::pin::pin!(stop);
     if let Some(src) = super::cyclic::source(cmd, bindings) {
         let report = super::cyclic::transmit(bus, src?, progress, stop).await?;
-        return Ok(Outcome {
-            json: to_json(&report),
-            text: report.text(),
-        });
+        let text = report.text();
+        return Ok(Outcome::new(report, text));
     }
+    let ctx = Ctx {
+        bus,
+        bindings,
+        progress,
+        stop,
+    };
     let json = match cmd {
+        Command::Nmt(c) => return c.run(ctx).await,
         Command::Run(spec) => return run_procedure(bus, bindings, spec).await,
         Command::Dcf(c) => return super::dcf::execute(bus, bindings.dictionary(c.node), c).await,
         Command::Stop {
@@ -53,75 +47,8 @@ pub async fn execute_until(
             listen_ms,
             options,
         } => return super::stop::stop(bus, nodes, *listen_ms, *options).await?.into_result(),
-        Command::Nmt {
-            action,
-            node,
-            wait,
-            timeout_ms,
-        } => {
-            let seen = super::nmt::nmt(bus, *action, *node, *wait, *timeout_ms).await?;
-            to_json(&NmtSent {
-                ok: true,
-                action: action.as_str(),
-                node: *node,
-                confirmed: wait.then(|| seen.iter().map(|(n, s)| (n.to_string(), s.as_str())).collect()),
-            })
-        }
-        Command::SdoRead {
-            node,
-            object,
-            options,
-            output,
-        } => {
-            let dict = bindings.dictionary(*node);
-            let (index, sub) = resolve_object(dict, object).map_err(|e| CommandError::Usage(e.to_string()))?;
-            let data = super::sdo::upload_within(bus, *node, index, sub, options.block, timing(options)).await?;
-            if let Some(path) = output {
-                write_output(path, &data)?;
-            }
-            let ty = options
-                .data_type
-                .or_else(|| dict.object(index, sub).map(|o| o.data_type));
-            let value = decode(&data, ty);
-            let text = crate::decode::value_text::object_text(dict, index, sub, &value, None);
-            to_json(&SdoRead {
-                ok: true,
-                node: *node,
-                index,
-                sub,
-                name: dict.name(index, sub),
-                value: value.to_json(),
-                text,
-                data: crate::frame::hex::upper(&data),
-                len: data.len(),
-            })
-        }
-        Command::SdoWrite {
-            node,
-            object,
-            value,
-            options,
-        } => {
-            let dict = bindings.dictionary(*node);
-            let (index, sub) = resolve_object(dict, object).map_err(|e| CommandError::Usage(e.to_string()))?;
-            let data = write_data(dict, index, sub, value, options.data_type)?;
-            super::sdo::download_within(bus, *node, index, sub, data.clone(), options.block, timing(options)).await?;
-            to_json(&SdoWritten {
-                ok: true,
-                written: true,
-                node: *node,
-                index,
-                sub,
-                name: dict.name(index, sub),
-                data: crate::frame::hex::upper(&data),
-                len: data.len(),
-            })
-        }
-        Command::Drive {
-            node,
-            action,
-            timeout_ms,
-        } => super::drive::drive(bus, *node, *action, *timeout_ms).await?.to_json(),
+        Command::Sdo(c) => return c.run(ctx).await,
+        Command::Drive(c) => return c.run(ctx).await,
         Command::Scan {
             listen_ms,
             probe,
@@ -137,7 +64,7 @@ pub async fn execute_until(
         Command::PdoRead { node, timeout_ms } => {
             let pdos = super::pdo::read_all(bus, *node, *timeout_ms).await?;
             let (json, text) = super::pdo::read_report(*node, bindings.dictionary(*node), &pdos);
-            return Ok(Outcome { json, text });
+            return Ok(Outcome::new(json, text));
         }
         Command::PdoMap(spec) => {
             let dict = bindings.dictionary(spec.node);
@@ -146,7 +73,7 @@ pub async fn execute_until(
             } else {
                 super::pdo::map(bus, dict, spec).await?
             };
-            return Ok(Outcome { json, text });
+            return Ok(Outcome::new(json, text));
         }
         Command::Record {
             output,
@@ -166,49 +93,12 @@ pub async fn execute_until(
             n.to_json(output)
         }
         // Handled above by `cyclic::source`.
-        Command::Send { .. } | Command::Sync { .. } | Command::Pdo { .. } => {
+        Command::Send(_) | Command::Sync(_) | Command::Pdo { .. } => {
             return Err(CommandError::Usage("internal: cyclic command without a source".into()));
         }
     };
     let text = text(cmd, &json);
-    Ok(Outcome { json, text })
-}
-
-/// `nmt --json`.
-#[derive(Serialize)]
-struct NmtSent {
-    ok: bool,
-    action: &'static str,
-    node: u8,
-    /// With `--wait`: node -> the state that confirmed the command; else null.
-    confirmed: Option<BTreeMap<String, &'static str>>,
-}
-
-/// `sdo read --json`.
-#[derive(Serialize)]
-struct SdoRead<'a> {
-    ok: bool,
-    node: u8,
-    index: u16,
-    sub: u8,
-    name: Option<&'a str>,
-    value: Json,
-    text: String,
-    data: String,
-    len: usize,
-}
-
-/// `sdo write --json`.
-#[derive(Serialize)]
-struct SdoWritten<'a> {
-    ok: bool,
-    written: bool,
-    node: u8,
-    index: u16,
-    sub: u8,
-    name: Option<&'a str>,
-    data: String,
-    len: usize,
+    Ok(Outcome::new(json, text))
 }
 
 /// `scan --json`.
@@ -218,20 +108,12 @@ struct Scanned {
     nodes: Vec<Json>,
 }
 
-/// The timeouts of an SDO command's options.
-fn timing(o: &SdoOptions) -> Timing {
-    Timing {
-        timeout_ms: o.timeout_ms,
-        deadline_ms: o.deadline_ms,
-    }
-}
-
 /// `run`: lists, dry-runs or runs a procedure; the text is a summary line, then every step
 /// line and result.
 async fn run_procedure(bus: &Bus, bindings: &Bindings, spec: &RunSpec) -> Result<Outcome, CommandError> {
     let (json, text) = offline_run(bindings, spec)?;
     let Some(name) = spec.procedure.as_deref().filter(|_| !spec.dry_run) else {
-        return Ok(Outcome { json, text });
+        return Ok(Outcome::new(json, text));
     };
     let dict = bindings.dictionary(spec.node);
     let plan = super::run::plan(dict, spec.node, name, &spec.args)?;
@@ -239,10 +121,7 @@ async fn run_procedure(bus: &Bus, bindings: &Bindings, spec: &RunSpec) -> Result
     let json = super::run::run(bus, dict, &plan, spec.timeout_ms, &mut |l| lines.push(l.to_string())).await?;
     // The summary first: the palette's message line shows one line.
     lines.insert(0, run_summary(&json));
-    Ok(Outcome {
-        json,
-        text: lines.join("\n"),
-    })
+    Ok(Outcome::new(json, lines.join("\n")))
 }
 
 /// What `run` gives without a bus: the listing (no procedure) or the dry run (also used to
@@ -272,29 +151,6 @@ pub fn run_summary(v: &Json) -> String {
     )
 }
 
-/// The bytes to write: a file for domains, else the value encoded as its type.
-/// The bytes an SDO write of `value` sends: typed by `ty`, else by the dictionary; a
-/// domain value names the file to send.
-pub fn write_data(
-    dict: &Dictionary,
-    index: u16,
-    sub: u8,
-    value: &str,
-    ty: Option<DataType>,
-) -> Result<Vec<u8>, CommandError> {
-    match ty.or_else(|| dict.object(index, sub).map(|o| o.data_type)) {
-        Some(DataType::Domain) => {
-            let why = "the most a domain write sends";
-            crate::files::read_at_most(std::path::Path::new(value), crate::files::MAX_DOMAIN, why)
-                .map_err(|e| CommandError::Usage(format!("cannot read {value}: {e}")))
-        }
-        Some(t) => Ok(encode(value, t)?),
-        None => Err(CommandError::Usage(format!(
-            "the type of {index:04X}:{sub:02X} is unknown: give --type (u8..u64, i8..i64, f32, f64, bool, string, octets, domain)"
-        ))),
-    }
-}
-
 fn s(v: &Json) -> &str {
     v.as_str().unwrap_or("")
 }
@@ -302,69 +158,16 @@ fn s(v: &Json) -> &str {
 /// The text form of a successful command's JSON object.
 pub fn text(cmd: &Command, v: &Json) -> String {
     match cmd {
-        Command::Nmt { node, .. } => {
-            let target = if *node == 0 {
-                "all nodes".to_string()
-            } else {
-                format!("node {node}")
-            };
-            let mut t = format!("NMT {} sent to {target}", s(&v["action"]));
-            if let Some(m) = v["confirmed"].as_object() {
-                for (n, state) in m {
-                    t.push_str(&format!("\nnode {n}: {}", s(state)));
-                }
-            }
-            t
-        }
-        Command::SdoRead { .. } | Command::SdoWrite { .. } => {
-            let obj = format!(
-                "node {} 0x{:04X}:{:02X}{}",
-                v["node"],
-                v["index"].as_u64().unwrap_or(0),
-                v["sub"].as_u64().unwrap_or(0),
-                v["name"].as_str().map(|n| format!(" {n}")).unwrap_or_default()
-            );
-            if v["written"].as_bool() == Some(true) {
-                return format!("{obj} written ({} bytes: {})", v["len"], s(&v["data"]));
-            }
-            let shown = match (&v["text"], &v["value"]) {
-                (Json::String(t), _) => t.clone(),
-                (_, Json::String(raw)) => raw.clone(),
-                (_, other) => other.to_string(),
-            };
-            format!("{obj} = {shown} (data {})", s(&v["data"]))
-        }
-        Command::Drive { .. } => {
-            let mut t = format!(
-                "node {}: {} (statusword {})",
-                v["node"],
-                s(&v["state_text"]),
-                s(&v["statusword"])
-            );
-            if let Some(cws) = v["controlwords"].as_array()
-                && !cws.is_empty()
-            {
-                let list: Vec<&str> = cws.iter().map(s).collect();
-                t.push_str(&format!(", controlwords {}", list.join(" -> ")));
-            }
-            if let Some(m) = v["mode_display"].as_i64() {
-                t.push_str(&format!(", mode {m} ({})", mode_name(m as i8)));
-            }
-            if let Some(e) = v["error_code"].as_str()
-                && e != "0x0000"
-            {
-                t.push_str(&format!(", error code {e}"));
-            }
-            t
-        }
         Command::Scan { .. } => scan_text(v),
         Command::Lss { .. } => s(&v["text"]).to_string(),
         Command::Record { .. } => format!("{} frames written to {}", v["frames"], s(&v["output"])),
         Command::Run(_) => run_summary(v),
+        // Moved commands make their own text.
+        Command::Nmt(_) | Command::Sdo(_) | Command::Drive(_) => String::new(),
         // A stop's text comes from its report (see `stop::StopReport::text`).
         Command::Stop { .. } => String::new(),
         // A cyclic command's text comes from its report (see `cyclic::Report::text`).
-        Command::Send { .. } | Command::Sync { .. } | Command::Pdo { .. } => String::new(),
+        Command::Send(_) | Command::Sync(_) | Command::Pdo { .. } => String::new(),
         // `pdo` reads and maps return their own text (see `pdo::read_report`, `pdo::map`).
         Command::PdoRead { .. } | Command::PdoMap(_) => String::new(),
         // A dcf command's text comes from its report (see `dcf`).

@@ -6,120 +6,6 @@ use super::record::{Limits, LogFormat, WriteMode};
 use super::syntax::ParseError;
 use crate::od::DataType;
 
-/// An NMT command.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum NmtAction {
-    Start,
-    Stop,
-    PreOp,
-    ResetNode,
-    ResetComm,
-}
-
-impl NmtAction {
-    /// The NMT command specifier.
-    pub fn cs(self) -> u8 {
-        match self {
-            NmtAction::Start => 0x01,
-            NmtAction::Stop => 0x02,
-            NmtAction::PreOp => 0x80,
-            NmtAction::ResetNode => 0x81,
-            NmtAction::ResetComm => 0x82,
-        }
-    }
-    /// The word used on the command line.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            NmtAction::Start => "start",
-            NmtAction::Stop => "stop",
-            NmtAction::PreOp => "preop",
-            NmtAction::ResetNode => "reset-node",
-            NmtAction::ResetComm => "reset-comm",
-        }
-    }
-    /// Parses `start|stop|preop|reset-node|reset-comm`.
-    pub fn parse(word: &str) -> Result<NmtAction, ParseError> {
-        Ok(match word {
-            "start" => NmtAction::Start,
-            "stop" => NmtAction::Stop,
-            "preop" | "pre-op" | "preoperational" => NmtAction::PreOp,
-            "reset-node" => NmtAction::ResetNode,
-            "reset-comm" => NmtAction::ResetComm,
-            _ => {
-                return Err(ParseError::Invalid(format!(
-                    "unknown NMT command `{word}`: use start, stop, preop, reset-node or reset-comm"
-                )));
-            }
-        })
-    }
-}
-
-/// A CiA 402 drive command.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum DriveAction {
-    Enable,
-    Disable,
-    QuickStop,
-    FaultReset,
-    Status,
-    /// Set the mode of operation (0x6060) and wait for 0x6061 to show it.
-    Mode(i8),
-}
-
-impl DriveAction {
-    /// Checks an action word: `enable|disable|quick-stop|fault-reset|status|mode`; gives
-    /// its usual spelling.
-    pub fn verb(word: &str) -> Result<&'static str, ParseError> {
-        Ok(match word {
-            "enable" => "enable",
-            "disable" => "disable",
-            "quick-stop" | "quickstop" => "quick-stop",
-            "fault-reset" => "fault-reset",
-            "status" => "status",
-            "mode" => "mode",
-            _ => {
-                return Err(ParseError::Invalid(format!(
-                    "unknown drive command `{word}`: use enable, disable, quick-stop, fault-reset, status or mode MODE"
-                )));
-            }
-        })
-    }
-    /// Parses `enable|disable|quick-stop|fault-reset|status|mode MODE`: `arg` is the MODE,
-    /// which only `mode` takes.
-    pub fn parse(word: &str, arg: Option<&str>) -> Result<DriveAction, ParseError> {
-        let action = match Self::verb(word)? {
-            "enable" => DriveAction::Enable,
-            "disable" => DriveAction::Disable,
-            "quick-stop" => DriveAction::QuickStop,
-            "fault-reset" => DriveAction::FaultReset,
-            "status" => DriveAction::Status,
-            _ => {
-                return Ok(DriveAction::Mode(parse_mode(arg.ok_or_else(|| {
-                    ParseError::Invalid("drive mode needs a MODE (e.g. pv, csp, 3)".into())
-                })?)?));
-            }
-        };
-        match arg {
-            Some(extra) => Err(ParseError::Invalid(format!(
-                "`drive {}` takes no MODE (got `{extra}`)",
-                action.as_str()
-            ))),
-            None => Ok(action),
-        }
-    }
-    /// The word used on the command line.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            DriveAction::Enable => "enable",
-            DriveAction::Disable => "disable",
-            DriveAction::QuickStop => "quick-stop",
-            DriveAction::FaultReset => "fault-reset",
-            DriveAction::Status => "status",
-            DriveAction::Mode(_) => "mode",
-        }
-    }
-}
-
 /// A mode of operation by CiA 402 abbreviation (`pp`, `pv`, `pt`, `hm`, `ip`, `csp`, `csv`, `cst`) or number.
 pub fn parse_mode(text: &str) -> Result<i8, ParseError> {
     Ok(match text.to_ascii_lowercase().as_str() {
@@ -143,33 +29,8 @@ pub fn parse_mode(text: &str) -> Result<i8, ParseError> {
     })
 }
 
-/// Options of an SDO transfer.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct SdoOptions {
-    /// `--type`: how to encode/decode the value (else from the dictionary, else raw).
-    pub data_type: Option<DataType>,
-    /// `--block`: force a block transfer.
-    pub block: bool,
-    /// `--timeout`: ms to wait for each server response.
-    pub timeout_ms: u64,
-    /// `--deadline`: ms the whole transfer may take (`None`: the client's default, see
-    /// [`crate::sdo::client::ClientConfig::default_deadline_ns`]).
-    pub deadline_ms: Option<u64>,
-}
-
 /// Default SDO response timeout in ms.
 pub const DEFAULT_TIMEOUT_MS: u64 = 1000;
-
-impl Default for SdoOptions {
-    fn default() -> Self {
-        SdoOptions {
-            data_type: None,
-            block: false,
-            timeout_ms: DEFAULT_TIMEOUT_MS,
-            deadline_ms: None,
-        }
-    }
-}
 
 /// Default wait of `nmt --wait` in ms.
 pub const NMT_WAIT_MS: u64 = 2000;
@@ -182,33 +43,11 @@ pub const SCAN_LISTEN_MS: u64 = 1500;
 #[derive(Clone, Debug, PartialEq)]
 pub enum Command {
     /// `nmt ACTION NODE [--wait] [--timeout MS]` (NODE 0 = all nodes).
-    Nmt {
-        action: NmtAction,
-        node: u8,
-        wait: bool,
-        timeout_ms: u64,
-    },
-    /// `sdo read NODE OBJECT [--type T] [--block] [--timeout MS] [--deadline MS] [-o FILE]`.
-    SdoRead {
-        node: u8,
-        object: String,
-        options: SdoOptions,
-        /// Also write the data read to this file (domains).
-        output: Option<String>,
-    },
-    /// `sdo write NODE OBJECT VALUE [--type T] [--block] [--timeout MS] [--deadline MS]` (a file path for domains).
-    SdoWrite {
-        node: u8,
-        object: String,
-        value: String,
-        options: SdoOptions,
-    },
+    Nmt(super::nmt::Nmt),
+    /// `sdo read NODE OBJECT ...`, `sdo write NODE OBJECT VALUE ...`.
+    Sdo(super::object::Sdo),
     /// `drive NODE ACTION [MODE] [--timeout MS]`.
-    Drive {
-        node: u8,
-        action: DriveAction,
-        timeout_ms: u64,
-    },
+    Drive(super::drive::Drive),
     /// `scan [--listen MS] [--probe] [--timeout MS]`.
     Scan {
         listen_ms: u64,
@@ -238,17 +77,9 @@ pub enum Command {
         timeout_ms: u64,
     },
     /// `send FRAME [--every MS] [--count N]`: a raw frame in candump's compact form.
-    Send {
-        frame: crate::frame::Frame,
-        schedule: super::cyclic::Schedule,
-    },
+    Send(super::send::Send),
     /// `sync --period MS [--counter N] [--count N] [--cob-id ID]`: the SYNC producer.
-    Sync {
-        cob_id: u32,
-        /// The CiA 301 counter's overflow value (2..=240), if the counter is sent.
-        counter: Option<u8>,
-        schedule: super::cyclic::Schedule,
-    },
+    Sync(super::sync::Sync),
     /// `pdo NODE send rpdoK NAME=VALUE ... [--every MS] [--count N]`: an RPDO encoded
     /// through the node's mapping.
     Pdo {
@@ -273,7 +104,7 @@ impl Command {
     pub fn data_to_stdout(&self) -> bool {
         match self {
             Command::Record { output, .. } => output == "-",
-            Command::SdoRead { output, .. } => output.as_deref() == Some("-"),
+            Command::Sdo(c) => super::spec::Spec::data_to_stdout(c),
             Command::Dcf(d) => matches!(&d.action, super::dcf::DcfAction::Save { output, .. } if output == "-"),
             _ => false,
         }

@@ -10,18 +10,26 @@ pub mod exec;
 pub mod grammar;
 pub mod lss;
 pub mod nmt;
+pub mod object;
 pub mod pdo;
 pub mod record;
 pub mod run;
 pub mod scan;
 pub mod sdo;
+pub mod send;
+pub mod spec;
 pub mod stop;
+pub mod sync;
 pub mod syntax;
 pub mod value;
 
+pub use drive::DriveAction;
 pub use error::{CommandError, ExitCode};
-pub use exec::{Outcome, execute, execute_until};
-pub use grammar::{Command, DriveAction, NmtAction, RunSpec, SdoOptions};
+pub use exec::{execute, execute_until};
+pub use grammar::{Command, RunSpec};
+pub use nmt::NmtAction;
+pub use object::SdoOptions;
+pub use spec::{Outcome, Reported};
 pub use syntax::{ParseError, parse_command};
 
 /// A command's `--json` object from its `#[derive(Serialize)]` form (serializing these plain

@@ -1,12 +1,164 @@
 //! NMT commands, optionally confirmed by the heartbeat or boot-up that follows.
 
 use super::error::CommandError;
-use super::grammar::NmtAction;
+use super::grammar::NMT_WAIT_MS;
+use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
+use super::syntax::{NMT_WORDS, ParseError, TypedWords, ms_arg, node_or_all_arg};
 use crate::bus::Bus;
+use crate::cob;
 use crate::decode::heartbeat::NmtState;
 use crate::frame::{Direction, Frame};
+use serde::Serialize;
 use std::collections::BTreeMap;
 use std::time::Duration;
+
+/// `nmt ACTION NODE [--wait] [--timeout MS]`.
+#[derive(clap::Args, Clone, Debug)]
+pub struct NmtArgs {
+    /// start, stop, preop, reset-node or reset-comm.
+    #[arg(value_parser = TypedWords::new(NMT_WORDS, NmtAction::parse))]
+    pub action: NmtAction,
+    /// Node id 1..127, or 0 for all nodes.
+    #[arg(value_parser = node_or_all_arg)]
+    pub node: u8,
+    /// Wait for the heartbeat (or boot-up after a reset) that confirms the command.
+    #[arg(long)]
+    pub wait: bool,
+    /// How long --wait waits, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = NMT_WAIT_MS)]
+    pub timeout: u64,
+}
+
+/// An NMT command to a node (0 = all), optionally confirmed.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Nmt {
+    pub action: NmtAction,
+    pub node: u8,
+    /// Wait for the heartbeat or boot-up that confirms it.
+    pub wait: bool,
+    pub timeout_ms: u64,
+}
+
+impl<D> CommandArgs<D> for NmtArgs {
+    type Spec = Nmt;
+
+    fn name(&self) -> &'static str {
+        "nmt"
+    }
+
+    fn spec(&self) -> Result<Nmt, ParseError> {
+        Ok(Nmt {
+            action: self.action,
+            node: self.node,
+            wait: self.wait,
+            timeout_ms: self.timeout,
+        })
+    }
+}
+
+/// `nmt --json`.
+#[derive(Debug, Serialize)]
+pub struct NmtSent {
+    ok: bool,
+    action: &'static str,
+    node: u8,
+    /// With `--wait`: node -> the state that confirmed the command; else null.
+    confirmed: Option<BTreeMap<String, &'static str>>,
+}
+
+impl NmtSent {
+    /// `NMT start sent to node 2`, then the confirming state of each node.
+    fn text(&self) -> String {
+        let target = if self.node == 0 {
+            "all nodes".to_string()
+        } else {
+            format!("node {}", self.node)
+        };
+        let mut t = format!("NMT {} sent to {target}", self.action);
+        for (n, state) in self.confirmed.iter().flatten() {
+            t.push_str(&format!("\nnode {n}: {state}"));
+        }
+        t
+    }
+}
+
+impl Spec for Nmt {
+    /// The NMT frame; a broadcast or a reset needs confirming.
+    fn preview(&self, _known: &Known<'_>) -> Result<Preview, CommandError> {
+        let reset = matches!(self.action, NmtAction::ResetNode | NmtAction::ResetComm);
+        let confirm = match (self.node, reset) {
+            (0, _) => Some(format!("broadcast NMT {} to every node", self.action.as_str())),
+            (n, true) => Some(format!("NMT {} of node {n}", self.action.as_str())),
+            _ => None,
+        };
+        Ok(Preview {
+            frames: super::candump(&frame(self.action, self.node)),
+            confirm,
+        })
+    }
+
+    async fn run(&self, ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
+        let seen = nmt(ctx.bus, self.action, self.node, self.wait, self.timeout_ms).await?;
+        let sent = NmtSent {
+            ok: true,
+            action: self.action.as_str(),
+            node: self.node,
+            confirmed: self
+                .wait
+                .then(|| seen.iter().map(|(n, s)| (n.to_string(), s.as_str())).collect()),
+        };
+        let text = sent.text();
+        Ok(Outcome::new(sent, text))
+    }
+}
+
+/// An NMT command.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NmtAction {
+    Start,
+    Stop,
+    PreOp,
+    ResetNode,
+    ResetComm,
+}
+
+impl NmtAction {
+    /// The NMT command specifier.
+    pub fn cs(self) -> u8 {
+        match self {
+            NmtAction::Start => 0x01,
+            NmtAction::Stop => 0x02,
+            NmtAction::PreOp => 0x80,
+            NmtAction::ResetNode => 0x81,
+            NmtAction::ResetComm => 0x82,
+        }
+    }
+    /// The word used on the command line.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            NmtAction::Start => "start",
+            NmtAction::Stop => "stop",
+            NmtAction::PreOp => "preop",
+            NmtAction::ResetNode => "reset-node",
+            NmtAction::ResetComm => "reset-comm",
+        }
+    }
+    /// Parses `start|stop|preop|reset-node|reset-comm`.
+    pub fn parse(word: &str) -> Result<NmtAction, ParseError> {
+        Ok(match word {
+            "start" => NmtAction::Start,
+            "stop" => NmtAction::Stop,
+            "preop" | "pre-op" | "preoperational" => NmtAction::PreOp,
+            "reset-node" => NmtAction::ResetNode,
+            "reset-comm" => NmtAction::ResetComm,
+            _ => {
+                return Err(ParseError::Invalid(format!(
+                    "unknown NMT command `{word}`: use start, stop, preop, reset-node or reset-comm"
+                )));
+            }
+        })
+    }
+}
 
 /// What `nmt --wait` saw: node -> state reported after the command.
 pub type Confirmed = BTreeMap<u8, NmtState>;
@@ -23,7 +175,7 @@ pub fn expected_state(action: NmtAction) -> NmtState {
 
 /// The NMT frame of `action` to `node` (0 = all).
 pub fn frame(action: NmtAction, node: u8) -> Frame {
-    Frame::classic(0x000, &[action.cs(), node])
+    Frame::classic(cob::NMT, &[action.cs(), node])
 }
 
 /// Sends `action` to `node` (0 = all). With `wait`, waits up to `timeout_ms` for the heartbeat
@@ -51,10 +203,12 @@ pub async fn nmt(
             Ok(Err(crate::bus::BusError::Closed)) => break,
             Ok(Err(_)) => continue,
         };
-        if f.direction() != Direction::Rx || f.is_ext() || f.is_rtr() || !(0x701..=0x77F).contains(&f.id) {
+        if f.direction() != Direction::Rx || f.is_ext() || f.is_rtr() {
             continue;
         }
-        let from = (f.id - 0x700) as u8;
+        let Some(from) = cob::heartbeat_node(f.id) else {
+            continue;
+        };
         let Some(b) = f.payload().first() else { continue };
         let state = NmtState::from_byte(*b);
         if node != 0 && from != node {

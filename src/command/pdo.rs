@@ -9,6 +9,7 @@ use super::error::{CommandError, ExitCode};
 use super::sdo::{download, first_download_frame, first_upload_frame, upload};
 use super::{candump, to_json};
 use crate::bus::{Bus, Subscription};
+use crate::cob;
 use crate::decode::pdo::entry_from_u32;
 use crate::decode::pdo_config::{
     COMM_SUBS, Cob, CommJson, CommParams, EntryJson, PdoId, entry_text, event_text, inhibit_text, transmission_text,
@@ -551,7 +552,7 @@ fn with_hint(e: CommandError, hint: String) -> CommandError {
 
 /// The NMT state the node's last heartbeat showed (waits for one up to [`HEARTBEAT_WAIT`]).
 async fn nmt_state(heartbeats: &mut Subscription, node: u8) -> Option<u8> {
-    let id = 0x700 + u32::from(node);
+    let id = cob::heartbeat(node);
     let mut last = None;
     while let Some(Ok(f)) = heartbeats.try_recv() {
         if f.id == id && f.len == 1 && !f.is_ext() {

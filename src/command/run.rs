@@ -3,7 +3,8 @@
 //! step by step through the same SDO and NMT paths as `sdo write` / `nmt`.
 
 use super::error::CommandError;
-use super::grammar::{NmtAction, parse_int};
+use super::grammar::parse_int;
+use super::nmt::NmtAction;
 use super::value::{decode, encode};
 use crate::bus::{Bus, BusError};
 use crate::decode::value_text::object_text;

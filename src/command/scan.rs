@@ -104,10 +104,10 @@ pub async fn scan(bus: &Bus, listen_ms: u64, probe: bool, timeout_ms: u64) -> Re
                 if f.direction() == Direction::Rx
                     && !f.is_ext()
                     && !f.is_rtr()
-                    && (0x701..=0x77F).contains(&f.id)
+                    && let Some(node) = crate::cob::heartbeat_node(f.id)
                     && let Some(b) = f.payload().first()
                 {
-                    heard.insert((f.id - 0x700) as u8, Some(NmtState::from_byte(*b)));
+                    heard.insert(node, Some(NmtState::from_byte(*b)));
                 }
             }
         }

@@ -447,7 +447,8 @@ mod tests {
 
     #[test]
     fn palette_and_cli_take_a_deadline() {
-        let Ok(crate::command::Command::SdoRead { options, .. }) =
+        use crate::command::object::Sdo;
+        let Ok(crate::command::Command::Sdo(Sdo::Read(crate::command::object::SdoRead { options, .. }))) =
             crate::command::parse_command("sdo read 2 0x1F50:1 --block --timeout 500 --deadline 60000")
         else {
             panic!("not an sdo read")

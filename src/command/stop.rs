@@ -163,7 +163,7 @@ impl StopReport {
     pub fn into_result(self) -> Result<super::Outcome, CommandError> {
         let (json, text) = (self.to_json(), self.text());
         if self.all_stopped() {
-            Ok(super::Outcome { json, text })
+            Ok(super::Outcome::new(json, text))
         } else {
             Err(CommandError::NotStopped {
                 report: Box::new(json),
@@ -396,6 +396,6 @@ mod tests {
             nodes: vec![ok],
             ..StopReport::default()
         };
-        assert_eq!(single.into_result().unwrap().json["ok"], true);
+        assert_eq!(single.into_result().unwrap().json()["ok"], true);
     }
 }

@@ -9,17 +9,15 @@
 use super::cyclic::Schedule;
 use super::dcf::DcfAction;
 use super::grammar::parse_assignments;
-use super::grammar::{
-    Command, DEFAULT_TIMEOUT_MS, DriveAction, NMT_WAIT_MS, NmtAction, SCAN_LISTEN_MS, SCAN_TIMEOUT_MS, SdoOptions,
-    parse_int, parse_node, parse_type, run_spec,
-};
+pub(crate) use super::grammar::parse_type;
+use super::grammar::{Command, DEFAULT_TIMEOUT_MS, SCAN_LISTEN_MS, SCAN_TIMEOUT_MS, parse_int, parse_node, run_spec};
 use super::lss::{FASTSCAN_TIMEOUT_MS, LSS_TIMEOUT_MS, LSS_WORDS, LssAction, LssFlags};
 use super::pdo::MapSpec;
 use super::record::{Limits, LogFormat, WriteMode};
+use super::spec::{CommandArgs, Declared};
 use super::stop::{DEFAULT_LISTEN_MS, DEFAULT_RAMP_MS, StopOptions};
 use crate::decode::pdo_config::PdoId;
 use crate::frame::Frame;
-use crate::od::DataType;
 use clap::builder::{PossibleValue, TypedValueParser};
 use clap::error::ErrorKind;
 use clap::{Args, CommandFactory, Parser, Subcommand};
@@ -97,12 +95,12 @@ pub struct On<B: Args, A: Args> {
 #[derive(Subcommand, Clone, Debug)]
 pub enum Commander<B: Args, D: Args> {
     /// Send an NMT command to a node (0 = all): start, stop, preop, reset-node, reset-comm.
-    Nmt(On<B, NmtArgs>),
+    Nmt(On<B, super::nmt::NmtArgs>),
     /// Read or write an object by SDO.
     #[command(subcommand)]
-    Sdo(SdoCommand<B, D>),
+    Sdo(super::object::SdoCommand<B, D>),
     /// CiA 402 drive: enable, disable, quick-stop, fault-reset, status, or mode MODE.
-    Drive(On<B, DriveArgs>),
+    Drive(On<B, super::drive::DriveArgs>),
     /// Run a profile's procedure step by step (NAME=VALUE parameters); without PROCEDURE (or
     /// with --list), list the node's procedures.
     Run(On<B, RunArgs<D>>),
@@ -118,10 +116,10 @@ pub enum Commander<B: Args, D: Args> {
     Lss(On<B, LssArgs>),
     /// Send a raw frame in candump's compact form (`601#4041600000000000`, `123#R`,
     /// `12345678#00`): once, --count N times, or --every MS (until stopped without --count).
-    Send(On<B, SendArgs>),
+    Send(On<B, super::send::SendArgs>),
     /// Produce SYNC every --period MS (COB-ID 0x080), with the CiA 301 counter 1..N when
     /// --counter N is given; until stopped without --count.
-    Sync(On<B, SyncArgs>),
+    Sync(On<B, super::sync::SyncArgs>),
     /// PDOs: `pdo 2` reads every PDO's configuration; `pdo 2 map tpdo1 0x6041 0x6064 --type
     /// sync:2` remaps one (CiA 301 sequence, read back); `pdo 2 send rpdo1 Controlword=0x0F
     /// "Target velocity=500" --every 10` sends an RPDO (mapped signals not given are sent as 0).
@@ -200,105 +198,6 @@ pub struct DcfDiffArgs<D: Args> {
     pub dict: D,
 }
 
-/// `sdo read` and `sdo write`.
-#[derive(Subcommand, Clone, Debug)]
-pub enum SdoCommand<B: Args, D: Args> {
-    /// Read an object: `sdo read 2 0x6041`.
-    Read(On<B, SdoReadArgs<D>>),
-    /// Write an object: `sdo write 2 0x6060 3 --type i8`.
-    Write(On<B, SdoWriteArgs<D>>),
-}
-
-/// `nmt ACTION NODE [--wait] [--timeout MS]`.
-#[derive(Args, Clone, Debug)]
-pub struct NmtArgs {
-    /// start, stop, preop, reset-node or reset-comm.
-    #[arg(value_parser = Words::new(NMT_WORDS, NmtAction::parse))]
-    pub action: NmtAction,
-    /// Node id 1..127, or 0 for all nodes.
-    #[arg(value_parser = node_or_all_arg)]
-    pub node: u8,
-    /// Wait for the heartbeat (or boot-up after a reset) that confirms the command.
-    #[arg(long)]
-    pub wait: bool,
-    /// How long --wait waits, in ms.
-    #[arg(long, value_parser = ms_arg, default_value_t = NMT_WAIT_MS)]
-    pub timeout: u64,
-}
-
-/// What `sdo read` and `sdo write` share.
-#[derive(Args, Clone, Debug)]
-pub struct Transfer<D: Args> {
-    /// Node id 1..127 (decimal or 0x hex).
-    #[arg(value_parser = node_arg)]
-    pub node: u8,
-    /// Object: 0x6041, 0x1018:1, or an object name from the node's profile.
-    pub object: String,
-    /// Value type: u8..u64, i8..i64, f32, f64, bool, string, octets (hex), domain (a file).
-    #[arg(long = "type", short = 't', value_parser = Words::new(TYPE_WORDS, parse_type))]
-    pub data_type: Option<DataType>,
-    /// Force a block transfer.
-    #[arg(long)]
-    pub block: bool,
-    /// How long to wait for each server response, in ms.
-    #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
-    pub timeout: u64,
-    /// How long the whole transfer may take, in ms [default: the longer of 10 s and 10
-    /// timeouts, plus 1 ms per byte of the size written or announced by the server].
-    #[arg(long, value_parser = ms_arg)]
-    pub deadline: Option<u64>,
-    #[command(flatten)]
-    pub dict: D,
-}
-
-impl<D: Args> Transfer<D> {
-    fn options(&self) -> SdoOptions {
-        SdoOptions {
-            data_type: self.data_type,
-            block: self.block,
-            timeout_ms: self.timeout,
-            deadline_ms: self.deadline,
-        }
-    }
-}
-
-/// `sdo read NODE OBJECT [-o FILE] [transfer options]`.
-#[derive(Args, Clone, Debug)]
-pub struct SdoReadArgs<D: Args> {
-    #[command(flatten)]
-    pub t: Transfer<D>,
-    /// Write the data read to this file (for domains).
-    #[arg(long = "output", short = 'o')]
-    pub output: Option<String>,
-}
-
-/// `sdo write NODE OBJECT VALUE [transfer options]`.
-#[derive(Args, Clone, Debug)]
-pub struct SdoWriteArgs<D: Args> {
-    #[command(flatten)]
-    pub t: Transfer<D>,
-    /// The value (a file path for `--type domain`, hex bytes for `--type octets`); negative numbers need no `--`.
-    #[arg(allow_negative_numbers = true)]
-    pub value: String,
-}
-
-/// `drive NODE ACTION [MODE] [--timeout MS]`.
-#[derive(Args, Clone, Debug)]
-pub struct DriveArgs {
-    /// Node id 1..127 (decimal or 0x hex).
-    #[arg(value_parser = node_arg)]
-    pub node: u8,
-    /// enable, disable, quick-stop, fault-reset, status, or mode.
-    #[arg(value_parser = Words::new(DRIVE_WORDS, drive_word))]
-    pub action: String,
-    /// The mode for `mode`: pp, pv, pt, hm, ip, csp, csv, cst or a number.
-    #[arg(allow_negative_numbers = true)]
-    pub mode: Option<String>,
-    /// How long to wait for each SDO answer, and half of how long each step may take, in ms.
-    #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
-    pub timeout: u64,
-}
-
 /// `run NODE [PROCEDURE] [NAME=VALUE ...] [--list] [--dry-run] [--timeout MS]`.
 #[derive(Args, Clone, Debug)]
 pub struct RunArgs<D: Args> {
@@ -354,7 +253,7 @@ pub struct RecordArgs {
     #[arg(long)]
     pub append: bool,
     /// The file format: candump (-l lines) or pcapng (for Wireshark; not to a terminal).
-    #[arg(long, default_value = "candump", value_parser = Words::new(&["candump", "pcapng"], LogFormat::parse))]
+    #[arg(long, default_value = "candump", value_parser = TypedWords::new(&["candump", "pcapng"], LogFormat::parse))]
     pub format: LogFormat,
 }
 
@@ -382,7 +281,7 @@ pub struct StopArgs {
 #[derive(Args, Clone, Debug)]
 pub struct LssArgs {
     /// The LSS service (its words follow).
-    #[arg(value_parser = Words::new(LSS_WORDS, LssAction::verb))]
+    #[arg(value_parser = TypedWords::new(LSS_WORDS, LssAction::verb))]
     pub action: String,
     /// The action's words: `switch [global] config|wait`, `select VENDOR PRODUCT REVISION
     /// SERIAL`, `set-node N`, `set-bitrate KBIT`, `activate-bitrate DELAY_MS`, `inquire
@@ -443,42 +342,12 @@ pub struct Repeat {
 }
 
 impl Repeat {
-    fn schedule(&self) -> Schedule {
+    pub(crate) fn schedule(&self) -> Schedule {
         Schedule {
             every_ms: self.every,
             count: self.count,
         }
     }
-}
-
-/// `send FRAME [--every MS] [--count N]`.
-#[derive(Args, Clone, Debug)]
-pub struct SendArgs {
-    /// The frame, as cansend takes it: `123#DEADBEEF`, `123#R`, 29-bit `12345678#00`.
-    #[arg(value_parser = frame_arg)]
-    pub frame: Frame,
-    #[command(flatten)]
-    pub repeat: Repeat,
-}
-
-/// `sync --period MS [--counter N] [--count N] [--cob-id ID]`.
-#[derive(Args, Clone, Debug)]
-pub struct SyncArgs {
-    /// The SYNC period in ms.
-    #[arg(long, value_parser = ms_arg)]
-    pub period: u64,
-    /// Send the CiA 301 SYNC counter, counting 1..N (N = 2..240).
-    #[arg(long, value_parser = counter_arg)]
-    pub counter: Option<u8>,
-    /// Stop after this many SYNCs.
-    #[arg(long, value_parser = count_arg)]
-    pub count: Option<u64>,
-    /// The SYNC COB-ID (11-bit).
-    #[arg(long, value_parser = cob_arg, default_value = "0x080")]
-    pub cob_id: u32,
-    /// Use a --cob-id that another service owns (an SDO, EMCY or heartbeat id...).
-    #[arg(long)]
-    pub force: bool,
 }
 
 /// `pdo NODE` (read every PDO), `pdo NODE send rpdoK NAME=VALUE ... [--every MS] [--count N]`,
@@ -489,7 +358,7 @@ pub struct PdoArgs<D: Args> {
     #[arg(value_parser = node_arg)]
     pub node: u8,
     /// send (an RPDO) or map (remap a PDO); none: read every PDO's configuration.
-    #[arg(value_parser = Words::new(&["send", "map"], pdo_word))]
+    #[arg(value_parser = TypedWords::new(&["send", "map"], pdo_word))]
     pub action: Option<String>,
     /// The PDO: rpdo1, rpdo2, ... (send), tpdo1, rpdo1, ... (map).
     #[arg(value_parser = pdo_arg)]
@@ -602,8 +471,7 @@ impl<B: Args, D: Args> Commander<B, D> {
     pub fn bus(&self) -> &B {
         match self {
             Commander::Nmt(o) => &o.bus,
-            Commander::Sdo(SdoCommand::Read(o)) => &o.bus,
-            Commander::Sdo(SdoCommand::Write(o)) => &o.bus,
+            Commander::Sdo(g) => g.bus(),
             Commander::Drive(o) => &o.bus,
             Commander::Run(o) => &o.bus,
             Commander::Scan(o) => &o.bus,
@@ -622,8 +490,7 @@ impl<B: Args, D: Args> Commander<B, D> {
     /// The dictionary options, for the commands that take them.
     pub fn dict(&self) -> Option<&D> {
         match self {
-            Commander::Sdo(SdoCommand::Read(o)) => Some(&o.args.t.dict),
-            Commander::Sdo(SdoCommand::Write(o)) => Some(&o.args.t.dict),
+            Commander::Sdo(g) => g.dict(),
             Commander::Run(o) => Some(&o.args.dict),
             Commander::Pdo(o) => Some(&o.args.dict),
             Commander::Dcf(DcfCommand::Save(o)) => Some(&o.args.dict),
@@ -636,29 +503,9 @@ impl<B: Args, D: Args> Commander<B, D> {
     /// The command the words make, or why they make none.
     pub fn command(&self) -> Result<Command, ParseError> {
         Ok(match self {
-            Commander::Nmt(On { args: a, .. }) => Command::Nmt {
-                action: a.action,
-                node: a.node,
-                wait: a.wait,
-                timeout_ms: a.timeout,
-            },
-            Commander::Sdo(SdoCommand::Read(On { args: a, .. })) => Command::SdoRead {
-                node: a.t.node,
-                object: a.t.object.clone(),
-                options: a.t.options(),
-                output: a.output.clone(),
-            },
-            Commander::Sdo(SdoCommand::Write(On { args: a, .. })) => Command::SdoWrite {
-                node: a.t.node,
-                object: a.t.object.clone(),
-                value: a.value.clone(),
-                options: a.t.options(),
-            },
-            Commander::Drive(On { args: a, .. }) => Command::Drive {
-                node: a.node,
-                action: DriveAction::parse(&a.action, a.mode.as_deref())?,
-                timeout_ms: a.timeout,
-            },
+            Commander::Nmt(o) => Command::Nmt(Declared::<B, D>::spec(o)?),
+            Commander::Sdo(g) => Command::Sdo(Declared::<B, D>::spec(g)?),
+            Commander::Drive(o) => Command::Drive(Declared::<B, D>::spec(o)?),
             Commander::Run(On { args: a, .. }) => {
                 let words: Vec<&str> = a.words.iter().map(String::as_str).collect();
                 Command::Run(run_spec(a.node, &words, a.list, a.dry_run, a.timeout)?)
@@ -694,23 +541,8 @@ impl<B: Args, D: Args> Commander<B, D> {
                 }
             }
             Commander::Lss(On { args: a, .. }) => a.command()?,
-            Commander::Send(On { args: a, .. }) => Command::Send {
-                frame: a.frame,
-                schedule: a.repeat.schedule(),
-            },
-            Commander::Sync(On { args: a, .. }) => Command::Sync {
-                cob_id: match a.cob_id {
-                    // SYNC's own COB-ID; any other service's needs --force.
-                    0x080 => 0x080,
-                    id if a.force => id,
-                    id => not_reserved(id, "the SYNC producer").map(|()| id)?,
-                },
-                counter: a.counter,
-                schedule: Schedule {
-                    every_ms: Some(a.period),
-                    count: a.count,
-                },
-            },
+            Commander::Send(o) => Command::Send(Declared::<B, D>::spec(o)?),
+            Commander::Sync(o) => Command::Sync(Declared::<B, D>::spec(o)?),
             Commander::Pdo(On { args: a, .. }) => a.command()?,
             Commander::Dcf(DcfCommand::Save(On { args: a, .. })) => dcf(
                 a.node,
@@ -733,6 +565,27 @@ impl<B: Args, D: Args> Commander<B, D> {
                 dcf(a.node, DcfAction::Diff { file: a.file.clone() }, a.timeout)
             }
         })
+    }
+}
+
+/// A command's words after the options in front.
+impl<B: Args, D, A: CommandArgs<D>> Declared<B, D> for On<B, A> {
+    type Spec = A::Spec;
+
+    fn bus(&self) -> &B {
+        &self.bus
+    }
+
+    fn dict(&self) -> Option<&D> {
+        self.args.dict()
+    }
+
+    fn name(&self) -> &'static str {
+        self.args.name()
+    }
+
+    fn spec(&self) -> Result<A::Spec, ParseError> {
+        self.args.spec()
     }
 }
 
@@ -899,18 +752,18 @@ pub fn completions(before: &str, known: &dyn super::complete::Known) -> Vec<Stri
 
 /// A value parser that checks a word with `parse` and offers `words` for help and completion.
 #[derive(Clone)]
-struct Words<T> {
+pub(crate) struct TypedWords<T> {
     words: &'static [&'static str],
     parse: fn(&str) -> Result<T, ParseError>,
 }
 
-impl<T> Words<T> {
-    fn new(words: &'static [&'static str], parse: fn(&str) -> Result<T, ParseError>) -> Words<T> {
-        Words { words, parse }
+impl<T> TypedWords<T> {
+    pub(crate) fn new(words: &'static [&'static str], parse: fn(&str) -> Result<T, ParseError>) -> TypedWords<T> {
+        TypedWords { words, parse }
     }
 }
 
-impl<T: Clone + Send + Sync + 'static> TypedValueParser for Words<T> {
+impl<T: Clone + Send + Sync + 'static> TypedValueParser for TypedWords<T> {
     type Value = T;
 
     fn parse_ref(
@@ -927,16 +780,11 @@ impl<T: Clone + Send + Sync + 'static> TypedValueParser for Words<T> {
     }
 }
 
-const NMT_WORDS: &[&str] = &["start", "stop", "preop", "reset-node", "reset-comm"];
-const DRIVE_WORDS: &[&str] = &["enable", "disable", "quick-stop", "fault-reset", "status", "mode"];
-const TYPE_WORDS: &[&str] = &[
+pub(crate) const NMT_WORDS: &[&str] = &["start", "stop", "preop", "reset-node", "reset-comm"];
+pub(crate) const DRIVE_WORDS: &[&str] = &["enable", "disable", "quick-stop", "fault-reset", "status", "mode"];
+pub(crate) const TYPE_WORDS: &[&str] = &[
     "u8", "u16", "u32", "u64", "i8", "i16", "i32", "i64", "f32", "f64", "bool", "string", "octets", "domain",
 ];
-
-/// A drive action word (its MODE is checked with it, see [`DriveAction::parse`]).
-fn drive_word(word: &str) -> Result<String, ParseError> {
-    DriveAction::verb(word).map(str::to_string)
-}
 
 /// Parses NODE 1..127 (decimal or 0x hex).
 pub fn node_arg(text: &str) -> Result<u8, ParseError> {
@@ -961,7 +809,7 @@ pub fn ms_arg(text: &str) -> Result<u64, ParseError> {
 /// Blanks around the frame (a quoting artifact) are ignored; a `0x` before the id is
 /// refused with the cansend form to write instead (cansend's grammar is hex already); an FD
 /// flags digit must be 0..7 (1 BRS, 2 ESI, 4 FDF: bit 3 is no flag, and would be dropped).
-fn frame_arg(text: &str) -> Result<Frame, ParseError> {
+pub(crate) fn frame_arg(text: &str) -> Result<Frame, ParseError> {
     let text = text.trim();
     if let Some(rest) = text.strip_prefix("0x").or_else(|| text.strip_prefix("0X")) {
         return Err(ParseError::Invalid(format!(
@@ -1071,7 +919,7 @@ fn pdo_cob_arg(text: &str) -> Result<u32, ParseError> {
 }
 
 /// Refuses a COB-ID another service owns ([`crate::decode::cob_id::reserved_for`]) for `user`.
-fn not_reserved(id: u32, user: &str) -> Result<(), ParseError> {
+pub(crate) fn not_reserved(id: u32, user: &str) -> Result<(), ParseError> {
     match crate::decode::cob_id::reserved_for(id) {
         Some(owner) => Err(ParseError::Invalid(format!(
             "--cob-id 0x{id:03X} is {owner}: {user} would collide with it; nothing sent (--force uses it anyway)"
@@ -1081,7 +929,7 @@ fn not_reserved(id: u32, user: &str) -> Result<(), ParseError> {
 }
 
 /// Parses the SYNC counter's overflow value 2..=240.
-fn counter_arg(text: &str) -> Result<u8, ParseError> {
+pub(crate) fn counter_arg(text: &str) -> Result<u8, ParseError> {
     parse_int(text)
         .filter(|v| (2..=240).contains(v))
         .map(|v| v as u8)
@@ -1089,7 +937,7 @@ fn counter_arg(text: &str) -> Result<u8, ParseError> {
 }
 
 /// Parses an 11-bit COB-ID.
-fn cob_arg(text: &str) -> Result<u32, ParseError> {
+pub(crate) fn cob_arg(text: &str) -> Result<u32, ParseError> {
     parse_int(text)
         .filter(|v| (1..=0x7FF).contains(v))
         .map(|v| v as u32)
@@ -1097,7 +945,7 @@ fn cob_arg(text: &str) -> Result<u32, ParseError> {
 }
 
 /// Parses a positive count.
-fn count_arg(text: &str) -> Result<u64, ParseError> {
+pub(crate) fn count_arg(text: &str) -> Result<u64, ParseError> {
     parse_int(text)
         .filter(|v| *v > 0)
         .map(|v| v as u64)
@@ -1107,6 +955,9 @@ fn count_arg(text: &str) -> Result<u64, ParseError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::command::DriveAction;
+    use crate::command::object::{Sdo, SdoOptions, SdoRead, SdoWrite};
+    use crate::od::DataType;
 
     /// Completions with nothing known of the bus.
     fn completions_of(before: &str) -> Vec<String> {
@@ -1117,16 +968,16 @@ mod tests {
     fn palette_lines() {
         assert_eq!(
             parse_command("sdo read 2 0x6041").unwrap(),
-            Command::SdoRead {
+            Command::Sdo(Sdo::Read(SdoRead {
                 node: 2,
                 object: "0x6041".into(),
                 options: SdoOptions::default(),
                 output: None,
-            }
+            }))
         );
         assert_eq!(
             parse_command("sdo write 0x02 0x1008 \"my drive\" --type string --block --timeout 300").unwrap(),
-            Command::SdoWrite {
+            Command::Sdo(Sdo::Write(SdoWrite {
                 node: 2,
                 object: "0x1008".into(),
                 value: "my drive".into(),
@@ -1136,28 +987,28 @@ mod tests {
                     timeout_ms: 300,
                     deadline_ms: None
                 }
-            }
+            }))
         );
         assert_eq!(
             parse_command("nmt reset-node 0 --wait").unwrap(),
-            Command::Nmt {
-                action: NmtAction::ResetNode,
+            Command::Nmt(crate::command::nmt::Nmt {
+                action: crate::command::NmtAction::ResetNode,
                 node: 0,
                 wait: true,
-                timeout_ms: NMT_WAIT_MS,
-            }
+                timeout_ms: crate::command::grammar::NMT_WAIT_MS,
+            })
         );
         assert_eq!(
             parse_command("drive 3 mode csv").unwrap(),
-            Command::Drive {
+            Command::Drive(crate::command::drive::Drive {
                 node: 3,
                 action: DriveAction::Mode(9),
                 timeout_ms: DEFAULT_TIMEOUT_MS
-            }
+            })
         );
         assert_eq!(
             parse_command("sdo write 2 0x60FF -100 --type i32")
-                .map(|c| matches!(c, Command::SdoWrite { value, .. } if value == "-100")),
+                .map(|c| matches!(c, Command::Sdo(Sdo::Write(w)) if w.value == "-100")),
             Ok(true)
         );
         assert_eq!(
@@ -1233,6 +1084,8 @@ mod tests {
             err("drive 2 enable extra"),
             "`drive enable` takes no MODE (got `extra`)"
         );
+        assert!(err("drive 2 mode fly").contains("unknown mode `fly`"));
+        assert_eq!(err("drive 2 mode"), "drive mode needs a MODE (e.g. pv, csp, 3)");
         assert_eq!(err("scan extra"), "unexpected argument 'extra' found");
         assert_eq!(parse_command("sdo read 2 \"0x6041"), Err(ParseError::Quote));
         assert!(err("lss fly").contains("unknown LSS command `fly`"));
@@ -1299,16 +1152,16 @@ mod tests {
         let every = |every_ms, count| Schedule { every_ms, count };
         assert!(matches!(
             parse_command("send 12345678#DEAD --every 5").unwrap(),
-            Command::Send { frame, schedule } if frame.id == 0x1234_5678 && frame.is_ext()
-                && schedule == every(Some(5), None)
+            Command::Send(s) if s.frame.id == 0x1234_5678 && s.frame.is_ext()
+                && s.schedule == every(Some(5), None)
         ));
         assert_eq!(
             parse_command("sync --period 10 --counter 240 --count 3").unwrap(),
-            Command::Sync {
+            Command::Sync(crate::command::sync::Sync {
                 cob_id: 0x080,
                 counter: Some(240),
                 schedule: every(Some(10), Some(3))
-            }
+            })
         );
         assert_eq!(
             parse_command("pdo 2 send rpdo1 Controlword=0x0F \"Target velocity=-5\" --count 2").unwrap(),

@@ -3,13 +3,12 @@
 //! controlwords, the LSS requests), and whether it needs confirming (broadcast NMT, resets,
 //! node 0, LSS services that change state).
 
-use super::live::UNKNOWN_STATE;
 use crate::command::lss::LssAction;
 use crate::command::run::Action;
-use crate::command::{Command, CommandError, NmtAction, RunSpec, candump, drive, nmt, parse_command, sdo};
+use crate::command::spec::{Known, Spec};
+use crate::command::{Command, CommandError, NmtAction, RunSpec, candump, drive, parse_command, sdo};
 use crate::decode::cia402::DriveState;
 use crate::frame::Frame;
-use crate::od::alias::resolve_object;
 use crate::od::bind::Bindings;
 
 /// The first words of commander lines, from the command declaration.
@@ -50,67 +49,16 @@ pub fn plan(
             "-o - (stdout) is for the command line; in the TUI give a file".into(),
         ));
     }
-    let object = |node: u8, object: &str| {
-        resolve_object(bindings.dictionary(node), object).map_err(|e| CommandError::Usage(e.to_string()))
+    let known = Known {
+        bindings,
+        drive_state: &state,
     };
     let (preview, confirm) = match &command {
-        Command::Nmt { action, node, .. } => {
-            let f = candump(&nmt::frame(*action, *node));
-            let reset = matches!(action, NmtAction::ResetNode | NmtAction::ResetComm);
-            let confirm = match (*node, reset) {
-                (0, _) => Some(format!("broadcast NMT {} to every node", action.as_str())),
-                (n, true) => Some(format!("NMT {} of node {n}", action.as_str())),
-                _ => None,
-            };
-            (f, confirm)
-        }
-        Command::SdoRead {
-            node,
-            object: o,
-            options,
-            ..
-        } => {
-            let (i, s) = object(*node, o)?;
-            let first = candump(&sdo::first_upload_frame(*node, i, s, options.block));
-            let text = if options.block {
-                format!("{first} then the server's block segments")
-            } else {
-                first
-            };
-            (text, None)
-        }
-        Command::SdoWrite {
-            node,
-            object: o,
-            value,
-            options,
-        } => {
-            let dict = bindings.dictionary(*node);
-            let (i, s) = object(*node, o)?;
-            let data = crate::command::exec::write_data(dict, i, s, value, options.data_type)?;
-            let (first, then) = sdo::first_download_frame(*node, i, s, &data, options.block);
-            let text = match then {
-                Some(t) => format!("{} {t}", candump(&first)),
-                None => candump(&first),
-            };
-            (text, None)
-        }
-        Command::Drive { node, action, .. } => {
-            let st = state(*node);
-            let frames = drive::frames(*node, *action, st.unwrap_or(UNKNOWN_STATE));
-            let from = st
-                .map(|s| s.text())
-                .unwrap_or("state unknown, assumed Switch on disabled");
-            let text = match action {
-                crate::command::DriveAction::Status => format!("reads 0x6041 of node {node}"),
-                crate::command::DriveAction::Mode(m) => {
-                    format!("{} (0x6060 = {m}), then reads 0x6061", listed(&frames))
-                }
-                _ if frames.is_empty() => format!("nothing to send (node {node}: {from})"),
-                _ => format!("{} (from {from})", listed(&frames)),
-            };
-            (text, None)
-        }
+        Command::Nmt(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
+        Command::Send(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
+        Command::Sync(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
+        Command::Sdo(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
+        Command::Drive(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
         Command::Scan { .. } => (
             "listens for heartbeats, then reads 0x1018 of each node found".into(),
             None,
@@ -181,13 +129,10 @@ pub fn plan(
             });
             (action.preview(), confirm)
         }
-        Command::Send { .. } | Command::Sync { .. } | Command::Pdo { .. } => {
+        Command::Pdo { .. } => {
             let mut src = crate::command::cyclic::source(&command, bindings)
                 .unwrap_or_else(|| Err(CommandError::Usage("not a cyclic command".into())))?;
             let mut text = format!("{} {}", candump(&src.frame(0)), src.schedule.text());
-            if let Command::Sync { counter: Some(n), .. } = &command {
-                text.push_str(&format!(", counter 1..{n}"));
-            }
             if src.schedule.total().is_none() {
                 text.push_str(" (a job: `jobs` lists, `jobs stop ID` or stop-all stops)");
             }

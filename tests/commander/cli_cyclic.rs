@@ -79,12 +79,12 @@ async fn the_drive_takes_the_rpdo_values() {
     execute(&d.bus, &start, &b).await.unwrap();
     let pdo = parse_command("pdo 2 send rpdo1 Controlword=0x06 \"Target velocity=500\" --every 10 --count 3").unwrap();
     let o = execute(&d.bus, &pdo, &b).await.unwrap();
-    assert_eq!(o.json["count"], 3);
+    assert_eq!(o.json()["count"], 3);
     let read = |object: &str| parse_command(&format!("sdo read 2 {object}")).unwrap();
     let v = execute(&d.bus, &read("0x60FF"), &b).await.unwrap();
-    assert_eq!(v.json["value"], 500);
+    assert_eq!(v.json()["value"], 500);
     let cw = execute(&d.bus, &read("0x6040"), &b).await.unwrap();
-    assert_eq!(cw.json["value"], 6);
+    assert_eq!(cw.json()["value"], 6);
 }
 
 #[tokio::test(start_paused = true)]
@@ -94,8 +94,11 @@ async fn sync_counts_1_to_n_at_the_period() {
     let mut watch = d.bus.subscribe();
     let sync = parse_command("sync --period 10 --counter 2 --count 5").unwrap();
     let o = execute(&d.bus, &sync, &b).await.unwrap();
-    assert_eq!((o.json["count"].as_u64(), o.json["seen"].as_u64()), (Some(5), Some(5)));
-    let mean = o.json["mean_period_ms"].as_f64().unwrap();
+    assert_eq!(
+        (o.json()["count"].as_u64(), o.json()["seen"].as_u64()),
+        (Some(5), Some(5))
+    );
+    let mean = o.json()["mean_period_ms"].as_f64().unwrap();
     assert!((9.5..10.5).contains(&mean), "{mean}");
     tokio::time::sleep(Duration::from_millis(1)).await;
     let mut counters = Vec::new();

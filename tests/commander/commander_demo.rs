@@ -98,7 +98,7 @@ async fn enable_disable_quick_stop_and_fault_reset() {
         r.steps.iter().map(|s| s.controlword).collect::<Vec<_>>(),
         vec![6, 7, 0x0F]
     );
-    assert_eq!(r.to_json()["statusword"], "0x1637");
+    assert_eq!(r.report().statusword, "0x1637");
     let r = drive(&d.bus, 2, DriveAction::QuickStop, T).await.unwrap();
     assert_eq!(r.state, DriveState::QuickStopActive);
     let r = drive(&d.bus, 2, DriveAction::Enable, T).await.unwrap();
@@ -234,7 +234,7 @@ async fn listen_only_sends_nothing_whatever_the_command() {
     let log = std::env::temp_dir().join(format!("cotui-lo-{}.log", std::process::id()));
     let rec = cotui::command::parse_command(&format!("record -o {} --count 3", log.display())).unwrap();
     let o = cotui::command::execute(bus, &rec, &b).await.unwrap();
-    assert_eq!(o.json["frames"], 3);
+    assert_eq!(o.json()["frames"], 3);
     std::fs::remove_file(&log).unwrap();
     // Only the simulated nodes talk: no SDO request, no RPDO, no NMT but the master's start.
     let mut seen = 0;
@@ -302,7 +302,7 @@ async fn palette_lines_run_through_execute() {
     let o = cotui::command::execute(&d.bus, &run("sdo read 2 statusword"), &b)
         .await
         .unwrap();
-    assert_eq!(o.json["value"], 0x0250);
+    assert_eq!(o.json()["value"], 0x0250);
     assert_eq!(
         o.text,
         "node 2 0x6041:00 Statusword = 0x0250 (Switch on disabled [voltage enabled, switch on disabled, remote]) (data 5002)"
@@ -310,7 +310,7 @@ async fn palette_lines_run_through_execute() {
     let o = cotui::command::execute(&d.bus, &run("sdo write 2 \"Target velocity\" -500"), &b)
         .await
         .unwrap();
-    assert_eq!(o.json["data"], "0CFEFFFF");
+    assert_eq!(o.json()["data"], "0CFEFFFF");
     let o = cotui::command::execute(&d.bus, &run("drive 2 enable"), &b)
         .await
         .unwrap();

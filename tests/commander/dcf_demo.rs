@@ -64,8 +64,8 @@ async fn save_change_diff_and_load_restores() {
     let out = dir("restore").join("node2.dcf");
     let file = out.to_str().unwrap();
     let saved = run(&d, &format!("dcf save 2 -o {file}")).await.unwrap();
-    assert!(saved.json["objects"].as_u64().unwrap() > 100, "{}", saved.json);
-    assert_eq!(saved.json["refused"], Json::Array(vec![]));
+    assert!(saved.json()["objects"].as_u64().unwrap() > 100, "{}", saved.json());
+    assert_eq!(saved.json()["refused"], Json::Array(vec![]));
     let text = std::fs::read_to_string(&out).unwrap();
     assert!(text.starts_with("[FileInfo]\nFileName=node2.dcf\n"), "{text}");
     assert!(text.contains("[DeviceComissioning]\nNodeID=2\n"), "{text}");
@@ -75,7 +75,7 @@ async fn save_change_diff_and_load_restores() {
     assert!(e.to_string().contains("exists; give --force"), "{e}");
 
     let same = run(&d, &format!("dcf diff 2 {file}")).await.unwrap();
-    assert_eq!(same.json["equal"], true);
+    assert_eq!(same.json()["equal"], true);
 
     // The engineer changes a parameter, the heartbeat and the TPDO1 mapping.
     download(&d.bus, 2, 0x6083, 0, 5000u32.to_le_bytes().to_vec(), false, T)
@@ -106,7 +106,7 @@ async fn save_change_diff_and_load_restores() {
 
     // --dry-run lists the writes and sends none.
     let dry = run(&d, &format!("dcf load 2 {file} --dry-run")).await.unwrap();
-    assert_eq!(dry.json["dry_run"], true);
+    assert_eq!(dry.json()["dry_run"], true);
     assert!(
         dry.text.contains("would write 0x6083:00 Profile acceleration = 0x4E20"),
         "{}",
@@ -118,7 +118,7 @@ async fn save_change_diff_and_load_restores() {
     );
 
     let loaded = run(&d, &format!("dcf load 2 {file} --store")).await.unwrap();
-    let v = &loaded.json;
+    let v = &loaded.json();
     assert_eq!(
         (v["ok"].as_bool(), v["stored"].as_bool()),
         (Some(true), Some(true)),
@@ -152,7 +152,7 @@ async fn save_change_diff_and_load_restores() {
         20_000u32.to_le_bytes()
     );
     let back = run(&d, &format!("dcf diff 2 {file}")).await.unwrap();
-    assert_eq!(back.json["equal"], true, "{}", back.json);
+    assert_eq!(back.json()["equal"], true, "{}", back.json());
 }
 
 #[tokio::test(start_paused = true)]
@@ -169,7 +169,7 @@ async fn bad_values_and_unknown_objects_are_located_and_the_rest_is_loaded() {
     std::fs::write(&path, dcf).unwrap();
     let file = path.to_str().unwrap();
     let loaded = run(&d, &format!("dcf load 2 {file}")).await.unwrap();
-    let v = &loaded.json;
+    let v = &loaded.json();
     assert_eq!(objects(v, "writes"), ["0x6060:00", "0x1017:00"], "{v}");
     let problems: Vec<&str> = v["problems"]
         .as_array()

@@ -80,6 +80,18 @@ fn every_command_answers_json_as_documented() {
         ("send", vec!["send", "demo", "123#11", "--count", "2"], 0),
         ("send_bad_frame", vec!["send", "demo", "123#1"], 1),
         ("sync", vec!["sync", "demo", "--period", "10", "--count", "2"], 0),
+        (
+            "sync_reserved_cob_id",
+            vec!["sync", "demo", "--period", "10", "--count", "2", "--cob-id", "0x602"],
+            1,
+        ),
+        ("nmt_no_wait", vec!["nmt", "demo", "preop", "2"], 0),
+        (
+            "pdo_send",
+            vec!["pdo", "demo", "2", "send", "rpdo1", "Controlword=0x0F", "--count", "1"],
+            0,
+        ),
+        ("run_dry_run", vec!["run", "demo", "2", "csp", "--dry-run"], 0),
         ("pdo_read", vec!["pdo", "demo", "2"], 0),
         (
             "pdo_map_dry_run",

@@ -22,7 +22,8 @@ async fn reads_every_pdo_of_a_demo_drive_in_words() {
     let o = execute(&d.bus, &parse_command("pdo 2").unwrap(), &bindings())
         .await
         .unwrap();
-    let pdos = o.json["pdos"].as_array().unwrap();
+    let json = o.json();
+    let pdos = json["pdos"].as_array().unwrap();
     let names: Vec<&str> = pdos.iter().map(|p| p["pdo"].as_str().unwrap()).collect();
     // 1..4 of each (the drive has no fifth: the read stops at the missing 0x1404 / 0x1804).
     assert_eq!(
@@ -65,13 +66,14 @@ async fn after_map_tpdo1_the_drive_sends_and_the_decoder_decodes_the_new_signals
         .unwrap();
     let map = parse_command("pdo 2 map tpdo1 Statusword 0x6064 --type sync:2 --event 50 --inhibit 1.5ms").unwrap();
     let o = execute(&d.bus, &map, &b).await.unwrap();
-    assert_eq!(o.json["verified"], true, "{}", o.json);
-    assert_eq!(o.json["comm"]["transmission_type"], 2);
-    assert_eq!(o.json["comm"]["inhibit_100us"], 15);
-    assert_eq!(o.json["comm"]["event_ms"], 50);
+    assert_eq!(o.json()["verified"], true, "{}", o.json());
+    assert_eq!(o.json()["comm"]["transmission_type"], 2);
+    assert_eq!(o.json()["comm"]["inhibit_100us"], 15);
+    assert_eq!(o.json()["comm"]["event_ms"], 50);
     // CiA 301: COB-ID invalid, the communication parameters while invalid, count 0,
     // entries, count, COB-ID valid again (the order `dcf load` writes too).
-    let order: Vec<&str> = o.json["steps"]
+    let json = o.json();
+    let order: Vec<&str> = json["steps"]
         .as_array()
         .unwrap()
         .iter()
@@ -309,7 +311,7 @@ async fn a_tpdo_mapped_sync_2_comes_on_every_second_sync() {
         .unwrap();
     let map = parse_command("pdo 2 map tpdo1 0x6041 --type sync:2").unwrap();
     let o = execute(&d.bus, &map, &b).await.unwrap();
-    assert_eq!(o.json["verified"], true, "{}", o.json);
+    assert_eq!(o.json()["verified"], true, "{}", o.json());
     let mut watch = d.bus.subscribe();
     tokio::time::sleep(Duration::from_millis(1_050)).await;
     let mut seen = String::new();

@@ -131,7 +131,7 @@ async fn the_palette_runs_a_line_and_shows_the_summary_first() {
     let lines: Vec<&str> = o.text.lines().collect();
     assert_eq!(lines[0], "`enable_checked` on node 2: 9 steps done");
     assert_eq!(lines[1], "step 1/9: nmt start to node 2  [000#0102]");
-    assert_eq!(o.json["steps"][1]["frame"], "602#23FF600005000000");
+    assert_eq!(o.json()["steps"][1]["frame"], "602#23FF600005000000");
     let cmd = parse_command("run 2 enable_checked --dry-run").unwrap();
     let o = execute(&d.bus, &cmd, &b).await.unwrap();
     assert!(

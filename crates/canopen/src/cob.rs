@@ -43,6 +43,15 @@ pub const fn heartbeat(node: u8) -> u32 {
     0x700 + node as u32
 }
 
+/// The node whose heartbeat (or boot-up) `id` is: 0x701..=0x77F give 1..=127.
+pub const fn heartbeat_node(id: u32) -> Option<u8> {
+    if id > heartbeat(0) && id <= heartbeat(127) {
+        Some((id - heartbeat(0)) as u8)
+    } else {
+        None
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -60,5 +69,9 @@ mod tests {
         );
         assert_eq!((sdo_response(127), sdo_request(127)), (0x5FF, 0x67F));
         assert_eq!(heartbeat(3), 0x703);
+        assert_eq!(
+            [0x700, 0x701, 0x77F, 0x780].map(heartbeat_node),
+            [None, Some(1), Some(127), None]
+        );
     }
 }

@@ -8,8 +8,8 @@ pub mod plan;
 mod report;
 
 use super::error::{CommandError, ExitCode};
-use super::exec::Outcome;
 use super::sdo::{Timing, download_within, upload_within};
+use super::spec::Outcome;
 use crate::bus::Bus;
 use crate::od::dcf::{DcfEntry, DeviceInfo};
 use crate::od::{DataType, Dictionary};
@@ -233,10 +233,8 @@ async fn save(sdo: &mut Sdo<'_>, dict: &Dictionary, output: &str, force: bool) -
         absent,
         warnings,
     };
-    Ok(Outcome {
-        json: super::to_json(&saved),
-        text: saved.text(),
-    })
+    let text = saved.text();
+    Ok(Outcome::new(saved, text))
 }
 
 /// Reads a DCF (at most 64 MiB).
@@ -287,7 +285,7 @@ async fn diff(sdo: &mut Sdo<'_>, dict: &Dictionary, file: &str) -> Result<Outcom
     let d = Diffed::new(sdo.node, file, &compared, problems);
     let (json, text) = (super::to_json(&d), d.text());
     if d.equal {
-        Ok(Outcome { json, text })
+        Ok(Outcome::new(json, text))
     } else {
         Err(CommandError::Report {
             exit: ExitCode::Differs,
@@ -390,7 +388,7 @@ async fn load(
     l.ok = l.refused.is_empty() && l.not_verified.is_empty();
     let (json, text) = (super::to_json(&l), l.text());
     if l.ok {
-        return Ok(Outcome { json, text });
+        return Ok(Outcome::new(json, text));
     }
     // An SDO abort first; then a PDO of the file refused before sending (a bad file: usage).
     let (exit, error) = if l.refused.iter().any(|r| r.abort_code.is_some()) {

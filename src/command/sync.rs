@@ -1,0 +1,84 @@
+//! `sync --period MS [--counter N] [--count N] [--cob-id ID]`: the SYNC producer, with the
+//! CiA 301 counter when asked (see [`super::cyclic`] for the timing and its report).
+
+use super::cyclic::{Schedule, Source, sync_frame};
+use super::error::CommandError;
+use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
+use super::syntax::{ParseError, cob_arg, count_arg, counter_arg, ms_arg, not_reserved};
+use crate::cob;
+use crate::od::bind::Bindings;
+
+/// `sync --period MS [--counter N] [--count N] [--cob-id ID]`.
+#[derive(clap::Args, Clone, Debug)]
+pub struct SyncArgs {
+    /// The SYNC period in ms.
+    #[arg(long, value_parser = ms_arg)]
+    pub period: u64,
+    /// Send the CiA 301 SYNC counter, counting 1..N (N = 2..240).
+    #[arg(long, value_parser = counter_arg)]
+    pub counter: Option<u8>,
+    /// Stop after this many SYNCs.
+    #[arg(long, value_parser = count_arg)]
+    pub count: Option<u64>,
+    /// The SYNC COB-ID (11-bit).
+    #[arg(long, value_parser = cob_arg, default_value = "0x080")]
+    pub cob_id: u32,
+    /// Use a --cob-id that another service owns (an SDO, EMCY or heartbeat id...).
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// The SYNC producer.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Sync {
+    pub cob_id: u32,
+    /// The CiA 301 counter's overflow value (2..=240), if the counter is sent.
+    pub counter: Option<u8>,
+    pub schedule: Schedule,
+}
+
+impl<D> CommandArgs<D> for SyncArgs {
+    type Spec = Sync;
+
+    fn name(&self) -> &'static str {
+        "sync"
+    }
+
+    fn spec(&self) -> Result<Sync, ParseError> {
+        Ok(Sync {
+            cob_id: match self.cob_id {
+                // SYNC's own COB-ID; any other service's needs --force.
+                cob::SYNC => cob::SYNC,
+                id if self.force => id,
+                id => not_reserved(id, "the SYNC producer").map(|()| id)?,
+            },
+            counter: self.counter,
+            schedule: Schedule {
+                every_ms: Some(self.period),
+                count: self.count,
+            },
+        })
+    }
+}
+
+impl Spec for Sync {
+    /// The first SYNC, the period and the counter's range.
+    fn preview(&self, known: &Known<'_>) -> Result<Preview, CommandError> {
+        let counter = self.counter.map(|n| format!(", counter 1..{n}")).unwrap_or_default();
+        super::cyclic::preview(self, known, &counter)
+    }
+
+    async fn run(&self, ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
+        super::cyclic::run(self, ctx).await
+    }
+
+    fn source(&self, _bindings: &Bindings) -> Option<Result<Source, CommandError>> {
+        let (cob, counter) = (self.cob_id, self.counter);
+        Some(Ok(Source {
+            what: format!("SYNC {cob:03X}"),
+            next: Box::new(move |i| sync_frame(cob, counter, i)),
+            defaulted: Vec::new(),
+            schedule: self.schedule,
+        }))
+    }
+}
