@@ -9,10 +9,11 @@
 //! commands a node did not follow.
 //!
 //! [`Diagnoser`] is the facade: it routes each frame, transaction and event to the
-//! detectors concerned, one module per kind of incident ([`heartbeat`], [`boot`], [`sdo`],
-//! [`masters`], [`drive`], [`emcy`], [`pdo`], [`sync`], [`bus`]), in a fixed order (the
-//! incidents' order depends on it). They share the clock, the node table and the incident
-//! book ([`timeline`]); the words of each kind are a table ([`texts`]).
+//! detectors concerned, one module per kind of incident (`heartbeat`, `boot`, `sdo`,
+//! `masters`, `drive`, `emcy`, `pdo`, `sync`, `bus`), in a fixed order (the incidents'
+//! order depends on it). They share the clock, the node table and the incident book
+//! (`timeline`); the words of each kind are a table (`texts`), the report's order is
+//! `rank`'s.
 
 mod boot;
 mod bus;
@@ -21,13 +22,14 @@ mod emcy;
 mod heartbeat;
 mod masters;
 mod pdo;
+mod rank;
 mod sdo;
 mod sync;
 mod texts;
 mod timeline;
 
 use super::events::{Event, What};
-use super::incident::{Incident, Problem};
+use super::incident::Incident;
 use super::liveness::EventTracker;
 use crate::decode::sdo::frame::SdoFrame;
 use crate::decode::{Body, Decoded, Decoder, Kind};
@@ -448,57 +450,8 @@ impl Diagnoser {
                 inc.check.splice(0..0, steps.iter().cloned());
             }
         }
-        // A PDO that stops because its node went silent for good is part of that silence.
-        let gone: Vec<Option<NodeKey>> = tl
-            .incidents
-            .iter()
-            .filter(|i| i.problem == Problem::Silent)
-            .map(Incident::key)
-            .collect();
-        tl.incidents
-            .retain(|i| !(i.problem == Problem::PdoMissing && gone.contains(&i.key())));
-        let mut out = merge_faults(std::mem::take(&mut tl.incidents));
-        for inc in &mut out {
-            inc.events.sort_by_key(|e| e.frame);
-        }
-        out.retain(|i| i.count > 0 || !i.events.is_empty());
-        out.sort_by_key(|i| (i.status, i.first_ns));
-        // Nodes on several interfaces: each node is shown with its interface's name.
-        let first = tl.nodes.keys().next().map(|k| k.iface);
-        if tl.nodes.keys().any(|k| Some(k.iface) != first) {
-            for inc in out.iter_mut().filter(|i| i.node.is_some()) {
-                inc.iface_name = tl
-                    .iface_names
-                    .get(inc.iface as usize)
-                    .filter(|n| !n.is_empty())
-                    .cloned();
-            }
-        }
-        out
+        rank::rank(std::mem::take(&mut tl.incidents), tl)
     }
-}
-
-/// Drive faults of one node and axes with the same title become one incident with a count.
-fn merge_faults(all: Vec<Incident>) -> Vec<Incident> {
-    let mut out: Vec<Incident> = Vec::with_capacity(all.len());
-    for inc in all {
-        if inc.problem == Problem::DriveFault
-            && let Some(prev) = out.iter_mut().find(|p| {
-                p.problem == Problem::DriveFault && p.key() == inc.key() && p.axes == inc.axes && p.cause == inc.cause
-            })
-        {
-            prev.count += inc.count;
-            prev.last_ns = inc.last_ns;
-            prev.status = inc.status;
-            prev.title = inc.title;
-            for s in inc.events {
-                prev.step(s.frame, s.t_ns, s.text);
-            }
-            continue;
-        }
-        out.push(inc);
-    }
-    out
 }
 
 #[cfg(test)]

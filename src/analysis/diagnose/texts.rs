@@ -536,3 +536,86 @@ pub(super) fn fill(inc: &mut Incident, facts: &Facts) {
     };
     inc.why = words.why.say(inc, facts, &node);
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::timeline::Timeline;
+    use super::*;
+    use crate::frame::NodeKey;
+
+    /// Every kind of incident: the match makes a new [`Problem`] fail to build here until
+    /// it is listed (and then has to have its words).
+    fn all() -> Vec<Problem> {
+        use Problem::*;
+        let all = [
+            Missing,
+            Silent,
+            SilentBack,
+            Rebooted,
+            SdoRefused,
+            SdoGarbled,
+            Unmonitored,
+            SdoTimeout,
+            DriveFault,
+            Emcy,
+            BusErrors,
+            DuplicateId,
+            NmtIgnored,
+            DriveStuck,
+            PdoMissing,
+            SyncJitter,
+            SecondMaster,
+            PdoLate,
+            NotPresent,
+        ];
+        for p in all {
+            match p {
+                Missing | Silent | SilentBack | Rebooted | SdoRefused | SdoGarbled | Unmonitored | SdoTimeout
+                | DriveFault | Emcy | BusErrors | DuplicateId | NmtIgnored | DriveStuck | PdoMissing | SyncJitter
+                | SecondMaster | PdoLate | NotPresent => {}
+            }
+        }
+        all.to_vec()
+    }
+
+    #[test]
+    fn every_kind_has_its_words_with_the_node_and_count_filled_in() {
+        for p in all() {
+            let mut tl = Timeline::default();
+            let i = tl.open(Some(NodeKey::new(0, 5)), p, 0);
+            let mut inc = tl.incidents[i].clone();
+            inc.count = 3;
+            fill(&mut inc, &Facts::default());
+            assert!(!inc.check.is_empty() && !inc.why.is_empty(), "{p:?}: {inc:?}");
+            let words = [inc.title.as_str(), inc.why.as_str()]
+                .into_iter()
+                .chain(inc.check.iter().map(String::as_str));
+            for w in words {
+                assert!(!w.contains('{'), "{p:?}: placeholder left in {w:?}");
+            }
+            let builder = [
+                Problem::DriveStuck,
+                Problem::PdoMissing,
+                Problem::SyncJitter,
+                Problem::PdoLate,
+            ];
+            assert_eq!(
+                inc.title.is_empty(),
+                builder.contains(&p),
+                "{p:?}: title {:?}",
+                inc.title
+            );
+        }
+        let mut tl = Timeline::default();
+        let i = tl.open(Some(NodeKey::new(0, 5)), Problem::DuplicateId, 0);
+        fill(&mut tl.incidents[i], &Facts::default());
+        assert_eq!(
+            tl.incidents[i].check[0],
+            "Check the node-ID switches or settings of every device: two have 5."
+        );
+        let i = tl.open(Some(NodeKey::new(0, 5)), Problem::SecondMaster, 0);
+        tl.incidents[i].count = 4;
+        fill(&mut tl.incidents[i], &Facts::default());
+        assert_eq!(tl.incidents[i].title, "Commands from two masters at once (4 times)");
+    }
+}
