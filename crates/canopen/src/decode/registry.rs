@@ -61,7 +61,7 @@ struct LearnedMapping {
 /// What decoding learns about one bus (interface): its moved COB-IDs, PDO mappings and
 /// communication parameters, modes of operation. Each interface has its own: node 5 on
 /// can0 and node 5 on can1 are two nodes.
-#[derive(Clone)]
+#[derive(Clone, Default)]
 struct Bus {
     cobs: CobTable,
     mappings: HashMap<PdoKey, PdoMapping>,
@@ -76,20 +76,6 @@ struct Bus {
     modes: Option<Box<[Option<i8>; 128]>>,
     /// SDO channels moved by 0x1200 writes: COB-ID -> (node, client_to_server).
     sdo_cobs: HashMap<u32, (u8, bool)>,
-}
-
-impl Default for Bus {
-    fn default() -> Self {
-        Bus {
-            cobs: CobTable::default(),
-            mappings: HashMap::new(),
-            learning: HashMap::new(),
-            comm: HashMap::new(),
-            ours: 0,
-            modes: None,
-            sdo_cobs: HashMap::new(),
-        }
-    }
 }
 
 impl Bus {
