@@ -35,6 +35,9 @@ pub struct App {
     bindings: Bindings,
     /// Set when the user quits.
     quit: bool,
+    /// Set when the user answered the quit question with "stop them first": the session
+    /// quits once the stop-all confirms every drive stopped.
+    quit_after_stop: bool,
     /// Set when something changed since the last draw.
     dirty: bool,
 }
@@ -65,6 +68,7 @@ impl App {
             keymap,
             bindings,
             quit: false,
+            quit_after_stop: false,
             dirty: true,
         }
     }
@@ -204,6 +208,7 @@ impl App {
                     let objects = self.screen.objects_mut();
                     read_all::result(&self.capture, objects, &self.bindings, &text, &mut q);
                 }
+                Event::Stopped(level, text, failed) => self.stopped(level, &text, &failed),
                 Event::Follow(on) => self.screen.follow(on),
                 Event::Object(r) => self.object_request(r, &mut q),
                 Event::Run(line) => self.run_command(&line),
@@ -232,7 +237,10 @@ impl App {
         if let Some(nodes) = self.screen.take_quit_confirm() {
             match ev.code {
                 KeyCode::Char('y') => self.quit = true,
-                KeyCode::Char('s') => self.stop_all(&nodes, Default::default()),
+                KeyCode::Char('s') => {
+                    self.quit_after_stop = true;
+                    self.stop_all(&nodes, Default::default());
+                }
                 _ => {
                     self.screen.set_message(Some("not quitting".into()));
                     self.reopen_prompt(&ev);
@@ -393,6 +401,26 @@ impl App {
         let mut q = Queue::default();
         q.push(Event::StopAll(extra.to_vec(), options));
         self.route(q);
+    }
+
+    /// A stop-all ended (`failed`: the nodes not confirmed stopped): says how, and quits
+    /// when the user asked to stop before quitting and every drive is confirmed stopped.
+    fn stopped(&mut self, level: Level, text: &str, failed: &[u8]) {
+        self.screen.say(level, text);
+        if !std::mem::take(&mut self.quit_after_stop) {
+            return;
+        }
+        if level == Level::Info && failed.is_empty() {
+            self.quit = true;
+        } else if failed.is_empty() {
+            self.screen.say(Level::Error, "not quitting: the stop-all failed (see the message log)");
+        } else {
+            let nodes = failed.iter().map(u8::to_string).collect::<Vec<_>>().join(", ");
+            self.screen.say(
+                Level::Error,
+                &format!("not quitting: node(s) {nodes} NOT confirmed stopped (see the message log)"),
+            );
+        }
     }
 
     /// Quits, unless a drive cotui commanded is still powered: then asks first.
@@ -951,6 +979,47 @@ mod tests {
         a.act(Action::Quit);
         a.key(key('y'));
         assert!(a.quits());
+    }
+
+    #[test]
+    fn stop_them_first_quits_once_every_drive_is_confirmed_stopped_and_stays_if_one_is_not() {
+        for (level, failed, quits) in [(Level::Info, vec![], true), (Level::Warn, vec![1u8], false)] {
+            let (ftx, frx) = std::sync::mpsc::channel();
+            let (rtx, mut req) = tokio::sync::mpsc::unbounded_channel();
+            let mut a = app();
+            *a.capture_mut().source_mut() =
+                SourceInfo::live("vcan0", SourceKind::Live { listen_only: false }, frx, rtx);
+            let mut cw = crate::frame::Frame::classic(0x601, &[0x2B, 0x40, 0x60, 0, 0x0F, 0, 0, 0]);
+            cw.flags.set(crate::frame::Flags::TX, true);
+            a.capture_mut().observe(&cw);
+            a.act(Action::Quit);
+            a.key(key('s'));
+            assert!(matches!(req.try_recv(), Ok(Request::StopAll { .. })));
+            assert!(!a.quits(), "the stop is under way: not quitting yet");
+            let text = if quits {
+                "stop all: 1 drive(s) stopped and confirmed"
+            } else {
+                "stop all: 1 of 1 drive(s) NOT confirmed stopped"
+            };
+            ftx.send(Feed::Stopped(level, text.into(), failed)).unwrap();
+            a.ingest(Duration::from_millis(50));
+            assert_eq!(a.quits(), quits, "{:?}", a.message());
+            if !quits {
+                assert_eq!(
+                    a.message(),
+                    Some("not quitting: node(s) 1 NOT confirmed stopped (see the message log)")
+                );
+            }
+        }
+        // A stop-all not asked for by quitting never quits.
+        let (ftx, frx) = std::sync::mpsc::channel();
+        let mut a = app();
+        *a.capture_mut().source_mut() = SourceInfo::new("demo", SourceKind::Demo { listen_only: false }, frx, None);
+        ftx.send(Feed::Stopped(Level::Info, "stop all: 1 drive(s) stopped and confirmed".into(), vec![]))
+            .unwrap();
+        a.ingest(Duration::from_millis(50));
+        assert!(!a.quits());
+        assert_eq!(a.message(), Some("stop all: 1 drive(s) stopped and confirmed"));
     }
 
     #[test]

@@ -267,6 +267,7 @@ impl Capture {
                 self.replay_end();
             }
             Ok(Feed::Result(level, s)) => q.push(Event::Result(level, s)),
+            Ok(Feed::Stopped(level, s, failed)) => q.push(Event::Stopped(level, s, failed)),
             Ok(Feed::Lost(n)) => self.source.drops += n,
             Ok(Feed::BusError(e)) => {
                 if self.source.bus_error.as_ref() != Some(&e) {

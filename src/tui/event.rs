@@ -21,6 +21,8 @@ pub(crate) enum Event {
     Reset,
     /// A palette command's result came back from the live task.
     Result(Level, String),
+    /// A stop-all's result came back: its text and the nodes not confirmed stopped.
+    Stopped(Level, String, Vec<u8>),
     /// The trace follows its newest frame (true) or stays where it is (false).
     Follow(bool),
     /// What the Objects pane asks (read, write, read all, find).

@@ -368,17 +368,18 @@ impl Jobs {
                 nodes.extend(self.commanded.nodes());
                 let stopped_tx = self.stopped_tx.clone();
                 tokio::spawn(async move {
-                    let (level, text) = match stop_nodes(&bus, &nodes, options).await {
+                    let (level, text, failed) = match stop_nodes(&bus, &nodes, options).await {
                         Ok(mut report) => {
                             report.cancelled = cancelled;
                             let _ =
                                 stopped_tx.send(report.nodes.iter().filter(|n| n.stopped).map(|n| n.node).collect());
                             let level = if report.all_stopped() { Level::Info } else { Level::Warn };
-                            (level, format!("stop all: {}", report.text()))
+                            let failed = report.nodes.iter().filter(|n| !n.stopped).map(|n| n.node).collect();
+                            (level, format!("stop all: {}", report.text()), failed)
                         }
-                        Err(e) => (Level::Error, e.to_string()),
+                        Err(e) => (Level::Error, e.to_string(), nodes.into_iter().collect()),
                     };
-                    let _ = tx.send(Feed::Result(level, text));
+                    let _ = tx.send(Feed::Stopped(level, text, failed));
                 });
             }
         }
@@ -402,16 +403,19 @@ impl Jobs {
             Request::Run { line, .. } => format!("{line}: not sent: {why}"),
             Request::ListJobs | Request::StopJob(_) => format!("jobs: the bus is unavailable ({why})"),
             Request::Sim { line, .. } => not_simulated(&line),
-            Request::StopAll { .. } => {
+            Request::StopAll { mut nodes, .. } => {
                 let cancelled = self.cancel_all();
-                format!(
+                nodes.extend(self.commanded.nodes());
+                let text = format!(
                     "stop all: NOTHING sent, the bus is unavailable ({why}); cancelled: {}",
                     if cancelled.is_empty() {
                         "nothing was running".into()
                     } else {
                         cancelled.join("; ")
                     }
-                )
+                );
+                let _ = tx.send(Feed::Stopped(Level::Error, text, nodes.into_iter().collect()));
+                return;
             }
         };
         let _ = tx.send(Feed::Result(Level::Error, text));
@@ -430,7 +434,7 @@ mod tests {
     async fn result(rx: &Receiver<Feed>) -> String {
         loop {
             match rx.try_recv() {
-                Ok(Feed::Result(_, text)) => return text,
+                Ok(Feed::Result(_, text) | Feed::Stopped(_, text, _)) => return text,
                 Ok(_) => {}
                 Err(_) => tokio::time::sleep(Duration::from_millis(5)).await,
             }

@@ -45,6 +45,9 @@ pub enum Feed {
     Extent(Extent),
     /// The result of a palette command, and how much it matters.
     Result(super::messages::Level, String),
+    /// The result of a stop-all, as [`Feed::Result`], with the nodes not confirmed stopped
+    /// (every target when nothing could be sent).
+    Stopped(super::messages::Level, String, Vec<u8>),
 }
 
 /// Replay commands.
