@@ -3,7 +3,7 @@
 //! parameters in words and its mapping. Built for the rows asked for only.
 
 use crate::decode::Decoder;
-use crate::decode::pdo::source_text;
+use crate::decode::pdo::source_text_since;
 use crate::decode::pdo_config::{CommParams, PdoId, event_text, inhibit_text, sync_start_text, transmission_text};
 use crate::frame::NodeKey;
 use crate::od::{MappingSource, PdoMapping};
@@ -93,9 +93,10 @@ impl PdoRow {
         ]
     }
 
-    /// Where the mapping came from, in full (`configured by cotui @ 12.5 s`).
-    pub fn source_text(&self) -> Option<String> {
-        self.mapping.as_ref().map(|m| source_text(&m.source))
+    /// Where the mapping came from, in full (`configured by cotui @ 12.500000 s`), its time
+    /// counted from `origin_ns` (the trace's first frame).
+    pub fn source_text(&self, origin_ns: u64) -> Option<String> {
+        self.mapping.as_ref().map(|m| source_text_since(&m.source, origin_ns))
     }
 }
 
@@ -161,6 +162,6 @@ mod tests {
         );
         assert_eq!(rows[0].cells(|_, _| None)[5], "100 ms");
         assert_eq!(rows[0].cells(|_, _| None)[7], "-", "no mapping known");
-        assert!(rows[1].source_text().unwrap().starts_with("configured by cotui @"));
+        assert!(rows[1].source_text(0).unwrap().starts_with("configured by cotui @"));
     }
 }

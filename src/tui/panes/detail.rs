@@ -137,7 +137,7 @@ fn frame_lines(trace: &Trace, f: &Frame, d: &Decoded, pos: usize) -> Vec<Line<'s
             if let Some(source) = &p.source {
                 v.push(Line::raw(format!(
                     "mapping: {}",
-                    crate::decode::pdo::source_text(source)
+                    crate::decode::pdo::source_text_since(source, super::start_ns(trace))
                 )));
             }
             for s in &p.signals {

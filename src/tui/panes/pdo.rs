@@ -149,7 +149,7 @@ impl Component for PdoPane {
                     "node {} {}: {}",
                     row.node,
                     row.id.title(),
-                    row.source_text()
+                    row.source_text(super::start_ns(ctx.trace))
                         .map_or("no mapping known".into(), |s| format!("mapping {s}"))
                 ),
                 width,
@@ -274,6 +274,6 @@ mod tests {
         }
         let s = screen(&mut a, 120, 16);
         assert!(s.contains("PDO — 1 known"), "{s}");
-        assert!(s.contains("node 1 TPDO1: mapping sniffed @ 1700000000.014000 s"), "{s}");
+        assert!(s.contains("node 1 TPDO1: mapping sniffed @ 0.014000 s"), "{s}");
     }
 }

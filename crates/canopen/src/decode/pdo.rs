@@ -132,12 +132,19 @@ pub struct SignalJson<'a> {
 /// Short text of a mapping source: `profile syntron-ds`, `eds drive.eds`, `sniffed @ 12.345678 s`
 /// (learned from another client's writes), `configured by cotui @ ...`, `read from node @ ...`.
 pub fn source_text(source: &MappingSource) -> String {
+    source_text_since(source, 0)
+}
+
+/// [`source_text`] with its time counted from `origin_ns` (a trace's first frame, as the
+/// trace's time column counts), not from the epoch.
+pub fn source_text_since(source: &MappingSource, origin_ns: u64) -> String {
+    let s = |ts_ns: &u64| ts_ns.saturating_sub(origin_ns) as f64 / 1e9;
     match source {
         MappingSource::Profile(p) => format!("profile {p}"),
         MappingSource::Eds(f) => format!("eds {f}"),
-        MappingSource::Sniffed { ts_ns } => format!("sniffed @ {:.6} s", *ts_ns as f64 / 1e9),
-        MappingSource::Configured { ts_ns } => format!("configured by cotui @ {:.6} s", *ts_ns as f64 / 1e9),
-        MappingSource::ReadFromNode { ts_ns } => format!("read from node @ {:.6} s", *ts_ns as f64 / 1e9),
+        MappingSource::Sniffed { ts_ns } => format!("sniffed @ {:.6} s", s(ts_ns)),
+        MappingSource::Configured { ts_ns } => format!("configured by cotui @ {:.6} s", s(ts_ns)),
+        MappingSource::ReadFromNode { ts_ns } => format!("read from node @ {:.6} s", s(ts_ns)),
     }
 }
 
