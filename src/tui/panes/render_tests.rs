@@ -833,3 +833,24 @@ fn every_pane_at_80x24() {
         insta::assert_snapshot!(format!("pane_{pane:?}_80x24").to_lowercase(), s);
     }
 }
+
+#[test]
+fn an_open_file_shows_neither_a_frame_rate_nor_the_stop_all_key_and_a_bus_does() {
+    use crate::tui::app::SourceKind;
+    let mut a = app();
+    let s = screen(&mut a, 160, 12);
+    let bar = |s: &str| s.lines().rev().find(|l| l.contains(" frames")).unwrap_or("").to_string();
+    assert!(bar(&s).contains("open test.log (end) | 44 frames | drops 0 | help: ?"), "{s}");
+    assert!(!s.contains("fr/s") && !s.contains("stop all"), "{s}");
+    for (kind, rate, stop) in [
+        (SourceKind::Demo { listen_only: false }, true, true),
+        (SourceKind::Live { listen_only: false }, true, true),
+        (SourceKind::Replay { speed: 1.0 }, true, true),
+    ] {
+        let name = format!("{kind:?}");
+        a.capture_mut().source_mut().kind = kind;
+        let b = bar(&screen(&mut a, 160, 12));
+        assert_eq!(b.contains(" fr/s | drops 0"), rate, "{name}: {b}");
+        assert_eq!(b.contains("stop all: ctrl-s"), stop, "{name}: {b}");
+    }
+}

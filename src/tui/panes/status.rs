@@ -151,20 +151,27 @@ pub fn text(app: &App) -> String {
         .search()
         .map(|s| format!(" | {}", s.summary(app.trace())))
         .unwrap_or_default();
+    // A loaded log has no bus to stop and no live rate: it was read as fast as it could be.
+    let file = matches!(app.source().kind, SourceKind::Open);
     let stop = app
         .keymap()
         .key_for(Action::StopAll)
+        .filter(|_| !file)
         .map(|k| format!(" | stop all: {k}"))
         .unwrap_or_default();
+    let rate = if file {
+        String::new()
+    } else {
+        format!(" | {:.0} fr/s", app.capture().rate())
+    };
     let help = app
         .keymap()
         .key_for(Action::Help)
         .map(|k| format!(" | help: {k}"))
         .unwrap_or_default();
     format!(
-        "{src}{state}{rec} | {} frames | {:.0} fr/s | drops {}{filter}{search}{stop}{help}",
+        "{src}{state}{rec} | {} frames{rate} | drops {}{filter}{search}{stop}{help}",
         app.trace().len(),
-        app.capture().rate(),
         app.source().drops
     )
 }
