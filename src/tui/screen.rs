@@ -49,6 +49,8 @@ pub struct Screen {
     quit_confirm: Option<Vec<u8>>,
     /// The keys of a binding typed so far.
     pending: Vec<Key>,
+    /// Text waiting to go to the terminal's clipboard (see [`Screen::take_clipboard`]).
+    clipboard: Option<String>,
 }
 
 impl Default for Screen {
@@ -67,6 +69,7 @@ impl Default for Screen {
             confirm: None,
             quit_confirm: None,
             pending: Vec::new(),
+            clipboard: None,
         }
     }
 }
@@ -406,6 +409,26 @@ impl Screen {
         self.message = self.question(keymap).map(|(hint, text)| format!("{hint} — {text}"));
     }
 
+    /// Puts the message log's selected entry, whole, on the clipboard and says so on the
+    /// status line (not in the log, so the entry selected stays the one copied).
+    fn copy_entry(&mut self) {
+        let Some(e) = self.log_popup.index(&self.messages).and_then(|i| self.messages.get(i)) else {
+            self.message = Some("nothing to copy: the message log is empty".into());
+            return;
+        };
+        self.message = Some(format!(
+            "copied the {} entry ({} lines) to the clipboard (OSC 52, if the terminal supports it)",
+            crate::tui::messages::clock(e.at),
+            e.text.lines().count().max(1)
+        ));
+        self.clipboard = Some(e.text.clone());
+    }
+
+    /// Takes the text waiting to go to the terminal's clipboard, if any.
+    pub fn take_clipboard(&mut self) -> Option<String> {
+        self.clipboard.take()
+    }
+
     /// Takes the drives a quit question is about, if one waits.
     pub(crate) fn take_quit_confirm(&mut self) -> Option<Vec<u8>> {
         self.quit_confirm.take()
@@ -452,6 +475,10 @@ impl Screen {
     /// what is the capture's (quit, stop-all, replay keys) and what the panes ask of the
     /// rest goes to `q`.
     pub(crate) fn act(&mut self, a: Action, trace: &Trace, paused: bool, keymap: &Keymap, q: &mut Queue) {
+        if self.log_popup.shown() && a == Action::Copy {
+            self.copy_entry();
+            return;
+        }
         if self.log_popup.shown() && self.log_popup.handle(a, &self.messages) {
             return;
         }
@@ -529,6 +556,7 @@ impl Screen {
             Action::PanePdo => self.focus = Pane::Pdo,
             Action::PaneObjects => self.focus = Pane::Objects,
             Action::PaneProblems => self.focus = Pane::Problems,
+            Action::Copy => self.message = Some("copy: only in the message log (m)".into()),
             Action::EditObject | Action::ReadAll => {
                 self.message = Some(format!("{}: only in the Objects pane", a.name().replace('_', " ")))
             }

@@ -166,6 +166,12 @@ fn event_loop(terminal: &mut ratatui::DefaultTerminal, app: &mut App) -> Result<
                 }
             }
         }
+        if let Some(text) = app.screen_mut().take_clipboard() {
+            use std::io::Write;
+            let mut out = stdout();
+            let _ = out.write_all(super::clipboard::osc52(&text).as_bytes());
+            let _ = out.flush();
+        }
         if app.quits() || STOP.load(Ordering::SeqCst) {
             return Ok(());
         }

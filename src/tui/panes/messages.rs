@@ -1,6 +1,6 @@
 //! The message log popup: every result, event and error with its time, newest at the
 //! bottom, wrapped to the popup's width; ↑↓ select an entry (the view follows it), enter
-//! shows the selected entry whole.
+//! shows the selected entry whole, `y` copies it (see `Screen::copy_entry`).
 
 use super::block;
 use crate::tui::keymap::Action;
@@ -192,7 +192,7 @@ impl MessagesPopup {
             let style = Style::default().fg(color(e.level));
             lines.extend(whole_lines(&e.text, width).into_iter().map(|l| Line::styled(l, style)));
             let body: Vec<Line> = lines.into_iter().skip(down).take(height).collect();
-            let title = " Message — ↑↓ scroll, enter/esc back to the log ";
+            let title = " Message — ↑↓ scroll · y: copy · enter/esc back to the log ";
             f.render_widget(Paragraph::new(body).block(block(title, true)), r);
             return;
         }
@@ -235,7 +235,7 @@ impl MessagesPopup {
             j += 1;
         }
         body.truncate(height);
-        let title = format!(" Messages ({count}) — ↑↓ select · enter: whole · esc closes ");
+        let title = format!(" Messages ({count}) — ↑↓ select · enter: whole · y: copy · esc closes ");
         f.render_widget(Paragraph::new(body).block(block(&title, true)), r);
     }
 }

@@ -854,3 +854,35 @@ fn an_open_file_shows_neither_a_frame_rate_nor_the_stop_all_key_and_a_bus_does()
         assert_eq!(b.contains("stop all: ctrl-s"), stop, "{name}: {b}");
     }
 }
+
+#[test]
+fn y_in_the_message_log_copies_the_selected_entry_whole_and_says_copied() {
+    use crate::tui::messages::Level;
+    use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+    let y = KeyEvent::new(KeyCode::Char('y'), KeyModifiers::NONE);
+    let mut a = app();
+    let t = std::time::SystemTime::UNIX_EPOCH;
+    let scan: String = (1..=30).map(|n| format!("node {n}: 0x{n:08X}\n")).collect();
+    let scan = format!("lss fastscan: 30 found\n{scan}");
+    a.screen_mut().messages_mut().push(t, Level::Info, &scan);
+    a.screen_mut().messages_mut().push(t, Level::Warn, "the newest entry");
+    a.act(Action::Messages);
+    a.act(Action::Up);
+    a.key(y);
+    assert_eq!(a.screen_mut().take_clipboard().as_deref(), Some(scan.as_str()));
+    let s = screen(&mut a, 80, 24);
+    assert!(s.contains("copied the "), "{s}");
+    assert!(s.contains("(31 lines) to the clipboard"), "{s}");
+    // From the whole-entry view too; the log keeps the same two entries.
+    a.act(Action::Down);
+    a.act(Action::Expand);
+    a.key(y);
+    assert_eq!(a.screen_mut().take_clipboard().as_deref(), Some("the newest entry"));
+    assert_eq!(a.screen().messages().len(), 2);
+    // Without the popup `y` copies nothing.
+    a.act(Action::Messages);
+    assert!(!a.screen().log_popup().shown);
+    a.key(y);
+    assert_eq!(a.screen_mut().take_clipboard(), None);
+    assert_eq!(a.message(), Some("copy: only in the message log (m)"));
+}
