@@ -413,7 +413,8 @@ impl App {
         if level == Level::Info && failed.is_empty() {
             self.quit = true;
         } else if failed.is_empty() {
-            self.screen.say(Level::Error, "not quitting: the stop-all failed (see the message log)");
+            self.screen
+                .say(Level::Error, "not quitting: the stop-all failed (see the message log)");
         } else {
             let nodes = failed.iter().map(u8::to_string).collect::<Vec<_>>().join(", ");
             self.screen.say(
@@ -1015,8 +1016,12 @@ mod tests {
         let (ftx, frx) = std::sync::mpsc::channel();
         let mut a = app();
         *a.capture_mut().source_mut() = SourceInfo::new("demo", SourceKind::Demo { listen_only: false }, frx, None);
-        ftx.send(Feed::Stopped(Level::Info, "stop all: 1 drive(s) stopped and confirmed".into(), vec![]))
-            .unwrap();
+        ftx.send(Feed::Stopped(
+            Level::Info,
+            "stop all: 1 drive(s) stopped and confirmed".into(),
+            vec![],
+        ))
+        .unwrap();
         a.ingest(Duration::from_millis(50));
         assert!(!a.quits());
         assert_eq!(a.message(), Some("stop all: 1 drive(s) stopped and confirmed"));

@@ -839,8 +839,17 @@ fn an_open_file_shows_neither_a_frame_rate_nor_the_stop_all_key_and_a_bus_does()
     use crate::tui::app::SourceKind;
     let mut a = app();
     let s = screen(&mut a, 160, 12);
-    let bar = |s: &str| s.lines().rev().find(|l| l.contains(" frames")).unwrap_or("").to_string();
-    assert!(bar(&s).contains("open test.log (end) | 44 frames | drops 0 | help: ?"), "{s}");
+    let bar = |s: &str| {
+        s.lines()
+            .rev()
+            .find(|l| l.contains(" frames"))
+            .unwrap_or("")
+            .to_string()
+    };
+    assert!(
+        bar(&s).contains("open test.log (end) | 44 frames | drops 0 | help: ?"),
+        "{s}"
+    );
     assert!(!s.contains("fr/s") && !s.contains("stop all"), "{s}");
     for (kind, rate, stop) in [
         (SourceKind::Demo { listen_only: false }, true, true),
