@@ -525,6 +525,10 @@ fn stop_all_in_the_live_task_cancels_a_running_procedure_first() {
                 }
             }
             Ok(Feed::Result(_, text)) => results.push(text),
+            Ok(Feed::Stopped(_, text, failed)) => {
+                assert!(failed.is_empty(), "every drive confirmed stopped: {text}");
+                results.push(text);
+            }
             Ok(_) | Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
             Err(e) => panic!("feed ended: {e}"),
         }
