@@ -6,7 +6,6 @@
 
 pub mod app;
 pub mod capture;
-mod clipboard;
 pub mod commands;
 mod event;
 pub mod export;

@@ -5,6 +5,7 @@
 
 use super::app::App;
 use super::ui;
+use crossterm::clipboard::CopyToClipboard;
 use crossterm::event::{
     self, DisableMouseCapture, EnableMouseCapture, Event, KeyCode, KeyEvent, KeyEventKind, KeyModifiers,
 };
@@ -167,10 +168,8 @@ fn event_loop(terminal: &mut ratatui::DefaultTerminal, app: &mut App) -> Result<
             }
         }
         if let Some(text) = app.screen_mut().take_clipboard() {
-            use std::io::Write;
-            let mut out = stdout();
-            let _ = out.write_all(super::clipboard::osc52(&text).as_bytes());
-            let _ = out.flush();
+            // OSC 52: a terminal that does not support it ignores the sequence.
+            let _ = execute!(stdout(), CopyToClipboard::to_clipboard_from(text));
         }
         if app.quits() || STOP.load(Ordering::SeqCst) {
             return Ok(());
