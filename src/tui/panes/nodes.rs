@@ -8,6 +8,7 @@ use crate::analysis::nodes::NodeInfo;
 use crate::analysis::trace::Trace;
 use crate::decode::cia402::mode_name;
 use crate::decode::heartbeat::NmtState;
+use crate::frame::NodeKey;
 use crate::tui::keymap::Action;
 use ratatui::Frame;
 use ratatui::layout::Rect;
@@ -167,9 +168,9 @@ pub struct NodesPane {
 }
 
 impl NodesPane {
-    /// The node-ID of the selected row, if there is one.
-    pub fn selected_node(&self, trace: &Trace) -> Option<u8> {
-        trace.nodes.iter().nth(self.list.selected).map(|(n, _)| n.node)
+    /// The node (on its interface) of the selected row, if there is one.
+    pub fn selected_node(&self, trace: &Trace) -> Option<NodeKey> {
+        trace.nodes.iter().nth(self.list.selected).map(|(n, _)| *n)
     }
 }
 

@@ -12,6 +12,7 @@
 
 use super::{Component, Ctx, ListState, Outcome, block, fit, header, selected};
 use crate::analysis::values::Entry;
+use crate::frame::NodeKey;
 use crate::od::{Access, DataType, Dictionary, ObjectInfo, Profile};
 use crate::sdo::abort::{AbortClass, abort_class};
 use crate::tui::keymap::Action;
@@ -185,12 +186,6 @@ fn matches(query: &str, index: u16, sub: Option<u8>, name: &str, alias: Option<&
     at.starts_with(q) || name.to_lowercase().contains(query) || alias.is_some_and(|a| a.to_lowercase().contains(query))
 }
 
-/// The node `node` of the bus the pane reads and writes (the first interface): the one
-/// whose last values it shows.
-fn bus_node(node: u8) -> crate::frame::NodeKey {
-    crate::frame::NodeKey::new(0, node)
-}
-
 /// A read-all in progress.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct ReadAll {
@@ -262,9 +257,9 @@ pub struct ObjectsPane {
     /// Scroll state.
     pub list: ListState,
     /// The node picked in the pane (overrides the Nodes selection until that changes).
-    picked: Option<u8>,
+    picked: Option<NodeKey>,
     /// The Nodes pane's selection, as the application last told.
-    from_nodes: Option<u8>,
+    from_nodes: Option<NodeKey>,
     /// Records shown open.
     open: BTreeSet<u16>,
     /// The find text (filters the rows while typed).
@@ -273,7 +268,7 @@ pub struct ObjectsPane {
     fresh_query: bool,
     /// The catalog, and what it was built from (node, layers, indexes seen in ranges).
     catalog: Vec<Obj>,
-    built: Option<(u8, Vec<usize>, BTreeSet<u16>)>,
+    built: Option<(NodeKey, Vec<usize>, BTreeSet<u16>)>,
     /// The rows shown, as last built.
     rows: Vec<Row>,
     /// The read-all in progress.
@@ -286,13 +281,14 @@ pub struct ObjectsPane {
 }
 
 impl ObjectsPane {
-    /// The node shown: the one picked in the pane, else the Nodes pane's selection.
-    pub fn node(&self) -> Option<u8> {
+    /// The node shown (on its interface): the one picked in the pane, else the Nodes
+    /// pane's selection.
+    pub fn node(&self) -> Option<NodeKey> {
         self.picked.or(self.from_nodes)
     }
 
     /// Tells the pane the Nodes pane's selection; a new one replaces a node picked here.
-    pub fn set_nodes_selection(&mut self, node: Option<u8>) {
+    pub fn set_nodes_selection(&mut self, node: Option<NodeKey>) {
         if node != self.from_nodes {
             self.from_nodes = node;
             self.picked = None;
@@ -308,22 +304,22 @@ impl ObjectsPane {
 
     /// Rebuilds the catalog when the node or its dictionary changed, then the rows.
     fn refresh(&mut self, ctx: &Ctx) {
-        let Some(node) = self.node() else {
+        let Some(key) = self.node() else {
             self.catalog.clear();
             self.rows.clear();
             self.built = None;
             return;
         };
-        let dict = ctx.trace.decoder().dictionary(node);
+        let dict = ctx.trace.decoder().dictionary(key.node);
         let layers: Vec<usize> = dict.layers().iter().map(|l| Arc::as_ptr(l) as usize).collect();
         let seen: BTreeSet<u16> = ctx
             .trace
             .values
-            .node(bus_node(node))
+            .node(key)
             .map(|((i, _), _)| i)
             .filter(|i| in_range(dict.layers(), *i))
             .collect();
-        let key = (node, layers, seen);
+        let key = (key, layers, seen);
         if self.built.as_ref() != Some(&key) {
             self.catalog = catalog(dict, &key.2);
             self.built = Some(key);
@@ -418,11 +414,11 @@ impl ObjectsPane {
 
     /// Moves the selection to the next (or previous) row whose own text matches the find text.
     fn jump(&mut self, forward: bool, ctx: &Ctx) -> Outcome {
-        let Some(node) = self.node() else { return Outcome::Done };
+        let Some(key) = self.node() else { return Outcome::Done };
         if self.query.is_empty() {
             return note("no find text: press the filter or search key to find an object");
         }
-        let dict = ctx.trace.decoder().dictionary(node);
+        let dict = ctx.trace.decoder().dictionary(key.node);
         let n = self.rows.len();
         let own = |r: &Row| self.row_matches(*r, dict);
         for step in 1..=n {
@@ -442,7 +438,8 @@ impl ObjectsPane {
 
     /// The palette line writing the selected entry: `sdo write N 0xIIII:SS VALUE --type T`,
     /// the value the last one seen (else the dictionary's default), raw.
-    fn edit(&self, node: u8, index: u16, sub: u8, ctx: &Ctx) -> ObjectRequest {
+    fn edit(&self, key: NodeKey, index: u16, sub: u8, ctx: &Ctx) -> ObjectRequest {
+        let node = key.node;
         let dict = ctx.trace.decoder().dictionary(node);
         let Some(info) = dict.object(index, sub) else {
             return ObjectRequest::Note(format!("0x{index:04X}:{sub:02X}: not in the dictionary"));
@@ -454,11 +451,7 @@ impl ObjectsPane {
                 access_word(info.access)
             ));
         }
-        let last = ctx
-            .trace
-            .values
-            .get(bus_node(node), index, sub)
-            .and_then(|e| e.last.as_ref());
+        let last = ctx.trace.values.get(key, index, sub).and_then(|e| e.last.as_ref());
         let value = last
             .map(|s| &s.value)
             .or(info.default.as_ref())
@@ -594,14 +587,21 @@ impl ObjectsPane {
 
     /// The pane title: node, profile, object count, find text, read-all progress.
     fn title(&self, ctx: &Ctx) -> String {
-        let Some(node) = self.node() else {
+        let Some(key) = self.node() else {
             return " Objects ".into();
         };
+        let node = key.node;
         let dict = ctx.trace.decoder().dictionary(node);
         let entries: usize = self.catalog.iter().map(|o| o.subs.len()).sum();
         let mut layers: Vec<&str> = dict.layers().iter().map(|l| l.name.as_str()).collect();
         layers.dedup();
-        let mut t = format!(" Objects · node {node} {} · {entries} entries", layers.join(" > "));
+        // Several interfaces: which one's node this is.
+        let on = if ctx.trace.ifaces.names().len() > 1 {
+            format!(" on {}", ctx.trace.ifaces.name(key.iface))
+        } else {
+            String::new()
+        };
+        let mut t = format!(" Objects · node {node}{on} {} · {entries} entries", layers.join(" > "));
         if !self.query.is_empty() {
             t.push_str(&format!(" · find `{}`", self.query));
         }
@@ -616,7 +616,8 @@ impl ObjectsPane {
     }
 
     /// The text and colour of a row, `now_ns` the capture time.
-    fn row(&self, r: Row, node: u8, ctx: &Ctx, w: &Widths) -> (String, Style) {
+    fn row(&self, r: Row, key: NodeKey, ctx: &Ctx, w: &Widths) -> (String, Style) {
+        let node = key.node;
         let dict = ctx.trace.decoder().dictionary(node);
         match r {
             Row::Record { obj, open } => {
@@ -631,7 +632,7 @@ impl ObjectsPane {
             }
             Row::Entry { index, sub, child } => {
                 let info = dict.object(index, sub);
-                let entry = ctx.trace.values.get(bus_node(node), index, sub);
+                let entry = ctx.trace.values.get(key, index, sub);
                 let (value, style) = self.value_cell(node, index, sub, entry, dict);
                 let age = entry
                     .and_then(|e| e.last.as_ref())
@@ -788,8 +789,8 @@ impl Component for ObjectsPane {
             self.scroll(delta, ctx);
             return Outcome::Done;
         }
-        let nodes: Vec<u8> = ctx.trace.nodes.iter().map(|(n, _)| n.node).collect();
-        let Some(node) = self.node() else {
+        let nodes: Vec<NodeKey> = ctx.trace.nodes.iter().map(|(n, _)| *n).collect();
+        let Some(key) = self.node() else {
             return match action {
                 Action::NextSeries | Action::PrevSeries | Action::Expand | Action::EditObject | Action::ReadAll => {
                     note("no node seen yet")
@@ -797,13 +798,14 @@ impl Component for ObjectsPane {
                 _ => Outcome::Ignored,
             };
         };
+        let node = key.node;
         let dict = ctx.trace.decoder().dictionary(node);
         match action {
             Action::NextSeries | Action::PrevSeries => {
                 if nodes.is_empty() {
                     return note("no node seen yet");
                 }
-                let at = nodes.iter().position(|n| *n == node);
+                let at = nodes.iter().position(|n| *n == key);
                 let k = match (at, action == Action::NextSeries) {
                     (Some(k), true) => (k + 1) % nodes.len(),
                     (Some(k), false) => (k + nodes.len() - 1) % nodes.len(),
@@ -832,7 +834,7 @@ impl Component for ObjectsPane {
                 None => Outcome::Done,
             },
             Action::EditObject => match self.selected_entry() {
-                Some((index, sub)) => Outcome::Object(self.edit(node, index, sub, ctx)),
+                Some((index, sub)) => Outcome::Object(self.edit(key, index, sub, ctx)),
                 None => note("select an entry (open the record with enter) to write it"),
             },
             Action::ReadAll => match self.stop_read_all() {

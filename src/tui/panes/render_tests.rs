@@ -80,11 +80,16 @@ fn nodes_pane_marks_a_silent_node_lost_in_red_with_its_age() {
 /// A capture of two buses, each with a node 5 (tests/fixtures/two_buses.log): node 5 on
 /// can1 goes silent for good while node 5 on can0 goes on.
 fn two_bus_app() -> crate::tui::app::App {
-    use crate::analysis::trace::Trace;
     use crate::decode::Decoder;
     use crate::od::Dictionary;
+    two_bus_app_with(Decoder::new(Dictionary::default(), Vec::new()))
+}
+
+/// [`two_bus_app`] decoding with `decoder`.
+fn two_bus_app_with(decoder: crate::decode::Decoder) -> crate::tui::app::App {
+    use crate::analysis::trace::Trace;
     use crate::tui::app::{SourceInfo, SourceKind};
-    let mut trace = Trace::new(Decoder::new(Dictionary::default(), Vec::new()), 500_000);
+    let mut trace = Trace::new(decoder, 500_000);
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/two_buses.log")).unwrap();
     for line in text.lines() {
         let mut ifaces = std::mem::take(&mut trace.ifaces);
@@ -894,4 +899,47 @@ fn y_in_the_message_log_copies_the_selected_entry_whole_and_says_copied() {
     a.key(y);
     assert_eq!(a.screen_mut().take_clipboard(), None);
     assert_eq!(a.message(), Some("copy: only in the message log (m)"));
+}
+
+#[test]
+fn nodes_and_objects_keep_the_two_node_5s_apart() {
+    // The two buses' node 5 each answer a read of their heartbeat time, with different values.
+    let bindings = crate::od::bind::Bindings::new().unwrap();
+    let mut a = two_bus_app_with(crate::decode::Decoder::from_bindings(&bindings));
+    let t = a.trace().store.packed(a.trace().len() - 1).ts_ns;
+    for (k, (iface, ms)) in [("can0", 100u16), ("can1", 250)].into_iter().enumerate() {
+        let iface = a.trace().ifaces.names().iter().position(|n| n == iface).unwrap() as u16;
+        let v = ms.to_le_bytes();
+        for (i, (id, data)) in [
+            (0x605, [0x40, 0x17, 0x10, 0x00, 0, 0, 0, 0]),
+            (0x585, [0x4B, 0x17, 0x10, 0x00, v[0], v[1], 0, 0]),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let mut f = crate::frame::Frame::classic(id, &data);
+            f.ts_ns = t + (2 * k + i + 1) as u64 * 1_000_000;
+            f.iface = iface;
+            a.capture_mut().trace_mut().push(&f);
+        }
+    }
+    a.capture_mut().trace_mut().end_of_input();
+    a.screen_mut().focus_on(Pane::Nodes);
+    let s = screen(&mut a, 120, 8);
+    insta::assert_snapshot!("two_buses_nodes", s);
+    // Node 5 of can1 selected: the Objects pane shows its own value, not can0's.
+    a.act(Action::Down);
+    a.act(Action::PaneObjects);
+    a.screen_mut().find_objects("heartbeat");
+    let s = screen(&mut a, 120, 10);
+    assert!(s.contains("Objects · node 5 on can1"), "{s}");
+    assert!(s.contains("250") && !s.contains(" 100 "), "{s}");
+    insta::assert_snapshot!("two_buses_objects_node_5_on_can1", s);
+    a.act(Action::PaneNodes);
+    a.act(Action::Up);
+    a.act(Action::PaneObjects);
+    let s = screen(&mut a, 120, 10);
+    assert!(s.contains("Objects · node 5 on can0"), "{s}");
+    assert!(s.contains("100") && !s.contains(" 250 "), "{s}");
+    insta::assert_snapshot!("two_buses_objects_node_5_on_can0", s);
 }
