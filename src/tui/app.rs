@@ -11,12 +11,11 @@ pub use super::screen::{Layout, Screen};
 
 use super::capture::Flow;
 use super::commands::{self, PALETTE_COMMANDS, Ran};
-use super::event::{Event, Queue};
+use super::event::{Event, ObjectRequest, Queue};
 use super::keymap::{Action, Key, Keymap, Lookup};
 use super::live::Request;
 use super::messages::Level;
 use super::palette::{self, Planned, commander_words};
-use super::panes::objects::ObjectRequest;
 use super::panes::{Ctx, Pane, Selected};
 use super::prompt::{Edit, PromptKind};
 use super::{read_all, record, stop};
@@ -211,6 +210,9 @@ impl App {
                 Event::Stopped(level, text, failed) => self.stopped(level, &text, &failed),
                 Event::Follow(on) => self.screen.follow(on),
                 Event::Object(r) => self.object_request(r, &mut q),
+                Event::Detail => self.screen.toggle_detail(),
+                Event::Filter(text) => self.screen.show_filtered(self.capture.trace(), &text),
+                Event::Show(pos) => self.screen.show(self.capture.trace(), pos),
                 Event::Run(line) => self.run_command(&line),
                 Event::Act(a) => self.act(a),
                 Event::Replay(a) => self.capture.replay_key(a, &mut q),

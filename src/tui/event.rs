@@ -1,10 +1,10 @@
 //! The application's internal events: what the capture side, the screen side and the panes
 //! ask of each other, queued and routed by [`crate::tui::app::App`] (the shape of gitui's
-//! `InternalEvent` queue). A part never reaches into another: it pushes an event.
+//! `InternalEvent` queue). A part never reaches into another: it pushes an event. A pane
+//! answers an action the same way ([`crate::tui::panes::Component::handle`]).
 
 use super::keymap::Action;
 use super::messages::Level;
-use super::panes::objects::ObjectRequest;
 use crate::command::stop::StopOptions;
 use std::collections::VecDeque;
 
@@ -27,6 +27,13 @@ pub(crate) enum Event {
     Follow(bool),
     /// What the Objects pane asks (read, write, read all, find).
     Object(ObjectRequest),
+    /// Open (or close) the Detail view of the selected row, below the main pane on a
+    /// narrow terminal.
+    Detail,
+    /// Show the trace with this filter.
+    Filter(String),
+    /// Show this trace position in the Trace pane, unfiltered.
+    Show(usize),
     /// Run a palette line as if typed.
     Run(String),
     /// Do what an action says, as if its key was pressed.
@@ -39,6 +46,22 @@ pub(crate) enum Event {
     Quit,
 }
 
+/// What the Objects pane asks of the application.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) enum ObjectRequest {
+    /// Read this entry (an SDO upload through the palette).
+    Read { node: u8, index: u16, sub: u8 },
+    /// Open the palette holding `text`, the cursor at character `cursor`; `note` for the
+    /// status line (the value's type and scaling).
+    Edit { text: String, cursor: usize, note: String },
+    /// Read these entries of `node`, one after the other.
+    ReadAll { node: u8, objects: Vec<(u16, u8)> },
+    /// Open the find prompt holding the current text.
+    Find(String),
+    /// Say this in the status line.
+    Note(String),
+}
+
 /// The events waiting to be routed, oldest first.
 #[derive(Debug, Default)]
 pub(crate) struct Queue(VecDeque<Event>);
@@ -47,6 +70,13 @@ impl Queue {
     /// Adds `e` at the end.
     pub(crate) fn push(&mut self, e: Event) {
         self.0.push_back(e);
+    }
+
+    /// Adds `e` at the end and says the action it answers was taken: how a pane answers
+    /// an action with an event.
+    pub(crate) fn answer(&mut self, e: Event) -> bool {
+        self.push(e);
+        true
     }
 
     /// Takes the oldest event.

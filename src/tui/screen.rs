@@ -11,7 +11,7 @@ use super::panes::detail::DetailPane;
 use super::panes::help::HelpPopup;
 use super::panes::messages::MessagesPopup;
 use super::panes::objects::ObjectsPane;
-use super::panes::{Component, Ctx, Outcome, Pane, Panes, Selected};
+use super::panes::{Component, Ctx, Pane, Panes, Selected};
 use super::prompt::{PromptBar, PromptKind};
 use crate::analysis::filter::{Filter, FilterError};
 use crate::analysis::search::{Found, Search};
@@ -316,7 +316,7 @@ impl Screen {
     }
 
     /// Shows trace position `pos` in the Trace pane, unfiltered.
-    fn show(&mut self, trace: &Trace, pos: usize) {
+    pub(crate) fn show(&mut self, trace: &Trace, pos: usize) {
         let page = self.page();
         self.panes.trace.show(trace, pos, page);
         self.focus = Pane::Trace;
@@ -491,32 +491,28 @@ impl Screen {
         }
         let focus = self.focus;
         let ctx = self.ctx(trace, paused);
-        let outcome = self.panes.get_mut(focus).handle(a, &ctx);
+        let taken = self.panes.get_mut(focus).handle(a, &ctx, q);
         if focus == Pane::Nodes {
             // A node selected in the Nodes pane is the one the Objects pane shows.
             self.sync_objects_node(trace);
         }
-        if !self.outcome(outcome, trace, q) {
+        if !taken {
             self.screen_action(a, trace, paused, q);
         }
     }
 
-    /// Does what a pane asked; false when it did not take the action.
-    fn outcome(&mut self, outcome: Outcome, trace: &Trace, q: &mut Queue) -> bool {
-        match outcome {
-            Outcome::Done => {}
-            Outcome::Ignored => return false,
-            // Beside the main pane on a wide terminal; toggled below it on a narrow one.
-            Outcome::Detail if !self.layout.side => self.detail.toggle(),
-            Outcome::Detail => {}
-            Outcome::Filter(text) => {
-                let _ = self.apply_filter(trace, &text);
-                self.focus = Pane::Trace;
-            }
-            Outcome::Show(pos) => self.show(trace, pos),
-            Outcome::Object(r) => q.push(Event::Object(r)),
+    /// Opens or closes the Detail view (`expand` in the trace): toggled below the main
+    /// pane on a narrow terminal; beside it on a wide one it is always shown.
+    pub(crate) fn toggle_detail(&mut self) {
+        if !self.layout.side {
+            self.detail.toggle();
         }
-        true
+    }
+
+    /// Shows the trace with the filter `text` (`expand` on a node, COB-ID or PDO row).
+    pub(crate) fn show_filtered(&mut self, trace: &Trace, text: &str) {
+        let _ = self.apply_filter(trace, text);
+        self.focus = Pane::Trace;
     }
 
     /// An action no pane took.
@@ -587,16 +583,14 @@ impl Screen {
             Action::Sort | Action::PlotPick | Action::ZoomIn | Action::ZoomOut => {
                 self.focus = if a == Action::Sort { Pane::Stats } else { Pane::Plot };
                 let ctx = self.ctx(trace, paused);
-                self.panes.get_mut(self.focus).handle(a, &ctx);
+                self.panes.get_mut(self.focus).handle(a, &ctx, q);
             }
             // From any pane: the next frame of the incident selected in the Problems pane, so
             // that pressing it again in the trace walks through the incident's frames.
             Action::ShowFrames => {
                 let ctx = self.ctx(trace, paused);
                 self.panes.problems.refresh(&ctx);
-                if let Outcome::Show(pos) = self.panes.problems.handle(a, &ctx) {
-                    self.show(trace, pos);
-                }
+                self.panes.problems.handle(a, &ctx, q);
             }
             // Taken by the help popup; row movement and `expand` in a pane without rows.
             Action::Help

@@ -1,5 +1,6 @@
 //! The panes, one module each: each owns its state, handles the actions meant for it
-//! ([`Component::handle`]) and draws itself; plus the shared styles.
+//! ([`Component::handle`], answering with events of [`crate::tui::event`]) and draws
+//! itself; plus the shared styles.
 
 pub mod detail;
 pub mod help;
@@ -17,6 +18,7 @@ pub mod trace;
 
 use crate::analysis::trace::Trace;
 use crate::decode::Kind;
+use crate::tui::event::Queue;
 use crate::tui::keymap::Action;
 use ratatui::Frame;
 use ratatui::layout::Rect;
@@ -86,7 +88,7 @@ pub struct Panes {
 
 impl Panes {
     /// The pane `p`.
-    pub fn get(&self, p: Pane) -> &dyn Component {
+    pub(crate) fn get(&self, p: Pane) -> &dyn Component {
         match p {
             Pane::Trace => &self.trace,
             Pane::Nodes => &self.nodes,
@@ -100,7 +102,7 @@ impl Panes {
     }
 
     /// The pane `p`, to change.
-    pub fn get_mut(&mut self, p: Pane) -> &mut dyn Component {
+    pub(crate) fn get_mut(&mut self, p: Pane) -> &mut dyn Component {
         match p {
             Pane::Trace => &mut self.trace,
             Pane::Nodes => &mut self.nodes,
@@ -125,23 +127,6 @@ pub struct Ctx<'a> {
     pub paused: bool,
 }
 
-/// What handling an action asks of the application.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Outcome {
-    /// The pane did it.
-    Done,
-    /// Not for this pane: the application handles it.
-    Ignored,
-    /// Open the selected row in the Detail view.
-    Detail,
-    /// Show the trace with this filter.
-    Filter(String),
-    /// Show this trace position in the Trace pane, unfiltered.
-    Show(usize),
-    /// What the Objects pane asks (read, write, read all, find).
-    Object(objects::ObjectRequest),
-}
-
 /// What the selected row of a pane is, for the Detail view.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Selected {
@@ -152,9 +137,11 @@ pub enum Selected {
 }
 
 /// A main-area pane.
-pub trait Component {
-    /// Handles `action` while the pane has the focus.
-    fn handle(&mut self, action: Action, ctx: &Ctx) -> Outcome;
+pub(crate) trait Component {
+    /// Handles `action` while the pane has the focus; false when it is not for this pane
+    /// (the screen handles it). What the pane asks of the rest of the application (show
+    /// the trace filtered, open the Detail view, read an object...) it pushes to `q`.
+    fn handle(&mut self, action: Action, ctx: &Ctx, q: &mut Queue) -> bool;
     /// Moves the selection by `delta` rows (mouse wheel); panes without rows ignore it.
     fn scroll(&mut self, _delta: isize, _ctx: &Ctx) {}
     /// Selects the `row`-th visible row (mouse click); panes without rows ignore it.

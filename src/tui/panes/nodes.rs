@@ -2,13 +2,14 @@
 //! timing, missed deadlines, boot-ups, the last EMCY, CiA 402 state and mode, frame rate
 //! and profile.
 
-use super::{Component, Ctx, ListState, Outcome, block, duration, fit, header, selected};
+use super::{Component, Ctx, ListState, block, duration, fit, header, selected};
 use crate::analysis::NodeLiveness;
 use crate::analysis::nodes::NodeInfo;
 use crate::analysis::trace::Trace;
 use crate::decode::cia402::mode_name;
 use crate::decode::heartbeat::NmtState;
 use crate::frame::NodeKey;
+use crate::tui::event::{Event, Queue};
 use crate::tui::keymap::Action;
 use ratatui::Frame;
 use ratatui::layout::Rect;
@@ -176,17 +177,17 @@ impl NodesPane {
 
 impl Component for NodesPane {
     /// Moves the selection; `expand` shows the selected node's frames in the trace.
-    fn handle(&mut self, action: Action, ctx: &Ctx) -> Outcome {
+    fn handle(&mut self, action: Action, ctx: &Ctx, q: &mut Queue) -> bool {
         if let Some(delta) = ListState::movement(action, ctx.page) {
             self.scroll(delta, ctx);
-            return Outcome::Done;
+            return true;
         }
         match action {
             Action::Expand => match ctx.trace.nodes.iter().nth(self.list.selected) {
-                Some((n, _)) => Outcome::Filter(format!("node {}", n.node)),
-                None => Outcome::Done,
+                Some((n, _)) => q.answer(Event::Filter(format!("node {}", n.node))),
+                None => true,
             },
-            _ => Outcome::Ignored,
+            _ => false,
         }
     }
 

@@ -10,11 +10,12 @@
 //! is rebuilt only when the node or its dictionary changes; row texts only for the rows
 //! shown.
 
-use super::{Component, Ctx, ListState, Outcome, block, fit, header, selected};
+use super::{Component, Ctx, ListState, block, fit, header, selected};
 use crate::analysis::values::Entry;
 use crate::frame::NodeKey;
 use crate::od::{Access, DataType, Dictionary, ObjectInfo, Profile};
 use crate::sdo::abort::{AbortClass, abort_class};
+use crate::tui::event::{Event, ObjectRequest, Queue};
 use crate::tui::keymap::Action;
 use ratatui::Frame;
 use ratatui::layout::Rect;
@@ -23,22 +24,6 @@ use ratatui::text::Line;
 use ratatui::widgets::Paragraph;
 use std::collections::{BTreeMap, BTreeSet, VecDeque};
 use std::sync::Arc;
-
-/// What the pane asks of the application (besides the common outcomes).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum ObjectRequest {
-    /// Read this entry (an SDO upload through the palette).
-    Read { node: u8, index: u16, sub: u8 },
-    /// Open the palette holding `text`, the cursor at character `cursor`; `note` for the
-    /// status line (the value's type and scaling).
-    Edit { text: String, cursor: usize, note: String },
-    /// Read these entries of `node`, one after the other.
-    ReadAll { node: u8, objects: Vec<(u16, u8)> },
-    /// Open the find prompt holding the current text.
-    Find(String),
-    /// Say this in the status line.
-    Note(String),
-}
 
 /// PDO parameter ranges of CiA 301 (communication and mapping, RPDO and TPDO): the pane
 /// lists their first [`RANGE_SHOWN`] records (PDOs 1-4, the predefined connection set).
@@ -413,10 +398,10 @@ impl ObjectsPane {
     }
 
     /// Moves the selection to the next (or previous) row whose own text matches the find text.
-    fn jump(&mut self, forward: bool, ctx: &Ctx) -> Outcome {
-        let Some(key) = self.node() else { return Outcome::Done };
+    fn jump(&mut self, forward: bool, ctx: &Ctx, q: &mut Queue) -> bool {
+        let Some(key) = self.node() else { return true };
         if self.query.is_empty() {
-            return note("no find text: press the filter or search key to find an object");
+            return note(q, "no find text: press the filter or search key to find an object");
         }
         let dict = ctx.trace.decoder().dictionary(key.node);
         let n = self.rows.len();
@@ -430,10 +415,10 @@ impl ObjectsPane {
             if own(&self.rows[k]) {
                 self.list.selected = k;
                 self.list.clamp(n, ctx.page);
-                return Outcome::Done;
+                return true;
             }
         }
-        note(&format!("no object matches `{}`", self.query))
+        note(q, &format!("no object matches `{}`", self.query))
     }
 
     /// The palette line writing the selected entry: `sdo write N 0xIIII:SS VALUE --type T`,
@@ -752,8 +737,9 @@ fn age(ns: u64) -> String {
     }
 }
 
-fn note(text: &str) -> Outcome {
-    Outcome::Object(ObjectRequest::Note(text.to_string()))
+/// Answers with `text` for the status line: the action was taken.
+fn note(q: &mut Queue, text: &str) -> bool {
+    q.answer(Event::Object(ObjectRequest::Note(text.to_string())))
 }
 
 /// Column widths for a pane width.
@@ -783,19 +769,19 @@ impl Widths {
 }
 
 impl Component for ObjectsPane {
-    fn handle(&mut self, action: Action, ctx: &Ctx) -> Outcome {
+    fn handle(&mut self, action: Action, ctx: &Ctx, q: &mut Queue) -> bool {
         self.refresh(ctx);
         if let Some(delta) = ListState::movement(action, ctx.page) {
             self.scroll(delta, ctx);
-            return Outcome::Done;
+            return true;
         }
         let nodes: Vec<NodeKey> = ctx.trace.nodes.iter().map(|(n, _)| *n).collect();
         let Some(key) = self.node() else {
             return match action {
                 Action::NextSeries | Action::PrevSeries | Action::Expand | Action::EditObject | Action::ReadAll => {
-                    note("no node seen yet")
+                    note(q, "no node seen yet")
                 }
-                _ => Outcome::Ignored,
+                _ => false,
             };
         };
         let node = key.node;
@@ -803,7 +789,7 @@ impl Component for ObjectsPane {
         match action {
             Action::NextSeries | Action::PrevSeries => {
                 if nodes.is_empty() {
-                    return note("no node seen yet");
+                    return note(q, "no node seen yet");
                 }
                 let at = nodes.iter().position(|n| *n == key);
                 let k = match (at, action == Action::NextSeries) {
@@ -813,7 +799,7 @@ impl Component for ObjectsPane {
                 };
                 self.picked = Some(nodes[k]);
                 self.list = ListState::default();
-                Outcome::Done
+                true
             }
             Action::Expand => match self.rows.get(self.list.selected).copied() {
                 Some(Row::Record { obj, open }) => {
@@ -823,34 +809,34 @@ impl Component for ObjectsPane {
                     } else {
                         self.open.insert(index);
                     }
-                    Outcome::Done
+                    true
                 }
                 Some(Row::Entry { index, sub, .. }) => {
                     if dict.object(index, sub).is_some_and(|o| o.access == Access::Wo) {
-                        return note(&format!("0x{index:04X}:{sub:02X} is write-only: it cannot be read"));
+                        return note(q, &format!("0x{index:04X}:{sub:02X} is write-only: it cannot be read"));
                     }
-                    Outcome::Object(ObjectRequest::Read { node, index, sub })
+                    q.answer(Event::Object(ObjectRequest::Read { node, index, sub }))
                 }
-                None => Outcome::Done,
+                None => true,
             },
             Action::EditObject => match self.selected_entry() {
-                Some((index, sub)) => Outcome::Object(self.edit(key, index, sub, ctx)),
-                None => note("select an entry (open the record with enter) to write it"),
+                Some((index, sub)) => q.answer(Event::Object(self.edit(key, index, sub, ctx))),
+                None => note(q, "select an entry (open the record with enter) to write it"),
             },
             Action::ReadAll => match self.stop_read_all() {
-                Some(summary) => note(&summary),
-                None => Outcome::Object(ObjectRequest::ReadAll {
+                Some(summary) => note(q, &summary),
+                None => q.answer(Event::Object(ObjectRequest::ReadAll {
                     node,
                     objects: self.readable(dict),
-                }),
+                })),
             },
-            Action::Filter | Action::Search => Outcome::Object(ObjectRequest::Find(self.query.clone())),
-            Action::NextMatch | Action::PrevMatch => self.jump(action == Action::NextMatch, ctx),
+            Action::Filter | Action::Search => q.answer(Event::Object(ObjectRequest::Find(self.query.clone()))),
+            Action::NextMatch | Action::PrevMatch => self.jump(action == Action::NextMatch, ctx, q),
             Action::Back if !self.query.is_empty() => {
                 self.set_query("");
-                Outcome::Done
+                true
             }
-            _ => Outcome::Ignored,
+            _ => false,
         }
     }
 

@@ -4,9 +4,10 @@
 //! table, the selected PDO's signals. Rows come from the decoder's state
 //! ([`crate::analysis::pdos`]), built for the visible window only.
 
-use super::{Component, Ctx, ListState, Outcome, block, fit, header, selected};
+use super::{Component, Ctx, ListState, block, fit, header, selected};
 use crate::analysis::pdos::{keys, rows};
 use crate::decode::pdo_config::entry_text;
+use crate::tui::event::{Event, Queue};
 use crate::tui::keymap::Action;
 use ratatui::Frame;
 use ratatui::layout::Rect;
@@ -33,16 +34,16 @@ impl PdoPane {
 
 impl Component for PdoPane {
     /// Moves the selection; `expand` shows the selected PDO's frames in the trace.
-    fn handle(&mut self, action: Action, ctx: &Ctx) -> Outcome {
+    fn handle(&mut self, action: Action, ctx: &Ctx, q: &mut Queue) -> bool {
         if let Some(delta) = ListState::movement(action, ctx.page) {
             self.scroll(delta, ctx);
-            return Outcome::Done;
+            return true;
         }
         match action {
             Action::Expand => {
                 let d = ctx.trace.decoder();
                 let Some(key) = keys(d).get(self.list.selected).copied() else {
-                    return Outcome::Done;
+                    return true;
                 };
                 let row = &rows(d, &[key])[0];
                 let cob = row.comm.as_ref().and_then(|c| c.cob());
@@ -50,12 +51,12 @@ impl Component for PdoPane {
                     .map(|c| (c.id, c.extended))
                     .or(row.id.predefined_cob(row.node).map(|c| (c, false)))
                 {
-                    Some((id, true)) => Outcome::Filter(format!("id {id:08X}")),
-                    Some((id, false)) => Outcome::Filter(format!("id {id:X}")),
-                    None => Outcome::Done,
+                    Some((id, true)) => q.answer(Event::Filter(format!("id {id:08X}"))),
+                    Some((id, false)) => q.answer(Event::Filter(format!("id {id:X}"))),
+                    None => true,
                 }
             }
-            _ => Outcome::Ignored,
+            _ => false,
         }
     }
 

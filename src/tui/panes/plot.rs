@@ -7,10 +7,11 @@
 //! the window are touched per draw (binary search, then at most four per column).
 
 use super::picker::SignalPicker;
-use super::{Component, Ctx, Outcome, block, fit};
+use super::{Component, Ctx, block, fit};
 use crate::analysis::series::{self, Line as Series, SeriesKey, TimeWindow};
 use crate::analysis::trace::Trace;
 use crate::od::{DataType, ObjectInfo, format_number};
+use crate::tui::event::Queue;
 use crate::tui::keymap::Action;
 use ratatui::Frame;
 use ratatui::layout::{Constraint, Layout, Rect};
@@ -180,13 +181,13 @@ impl Component for PlotPane {
     /// `time`/`goto`), zoom keys zoom around it, page keys pan, `top` shows the whole span,
     /// `bottom` puts the cursor on the newest value, `back` removes the cursor, `expand`
     /// opens the picker.
-    fn handle(&mut self, action: Action, ctx: &Ctx) -> Outcome {
+    fn handle(&mut self, action: Action, ctx: &Ctx, _q: &mut Queue) -> bool {
         if action == Action::Expand || action == Action::PlotPick {
             self.open_picker();
-            return Outcome::Done;
+            return true;
         }
         let Some(span) = self.span(ctx.trace) else {
-            return Outcome::Ignored;
+            return false;
         };
         let win = self.window_in(span);
         match action {
@@ -216,9 +217,9 @@ impl Component for PlotPane {
                 }
             }
             Action::Back if self.cursor.is_some() => self.cursor = None,
-            _ => return Outcome::Ignored,
+            _ => return false,
         }
-        Outcome::Done
+        true
     }
 
     fn render(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {

@@ -3,8 +3,9 @@
 //! check first, why it matters) and, on a timeline step, shows that frame in the trace;
 //! `show_frames` shows the selected incident's frames in the trace one after the other.
 
-use super::{Component, Ctx, ListState, Outcome, Selected, block, fit, header, selected};
+use super::{Component, Ctx, ListState, Selected, block, fit, header, selected};
 use crate::analysis::{Incident, Problem, Status};
+use crate::tui::event::{Event, Queue};
 use crate::tui::keymap::Action;
 use ratatui::Frame;
 use ratatui::layout::Rect;
@@ -132,10 +133,10 @@ impl ProblemsPane {
 impl Component for ProblemsPane {
     /// Moves the selection; `expand` opens an incident, and on a timeline step shows its
     /// frame in the trace; `show_frames` goes through the incident's frames; `back` closes.
-    fn handle(&mut self, action: Action, ctx: &Ctx) -> Outcome {
+    fn handle(&mut self, action: Action, ctx: &Ctx, q: &mut Queue) -> bool {
         if let Some(delta) = ListState::movement(action, ctx.page) {
             self.scroll(delta, ctx);
-            return Outcome::Done;
+            return true;
         }
         match action {
             Action::Expand if self.opened.is_none() => {
@@ -143,18 +144,18 @@ impl Component for ProblemsPane {
                     self.opened = Some(self.list.selected);
                     self.list = ListState::default();
                 }
-                Outcome::Done
+                true
             }
             Action::Expand => {
                 let step = self.current().and_then(|i| i.events.get(self.list.selected));
                 match step {
-                    Some(s) => Outcome::Show(s.frame.saturating_sub(1) as usize),
-                    None => Outcome::Done,
+                    Some(s) => q.answer(Event::Show(s.frame.saturating_sub(1) as usize)),
+                    None => true,
                 }
             }
             Action::ShowFrames => match self.next_frame() {
-                Some(pos) => Outcome::Show(pos),
-                None => Outcome::Done,
+                Some(pos) => q.answer(Event::Show(pos)),
+                None => true,
             },
             Action::Back => match self.opened.take() {
                 Some(o) => {
@@ -162,11 +163,11 @@ impl Component for ProblemsPane {
                         selected: o,
                         offset: o.saturating_sub(3),
                     };
-                    Outcome::Done
+                    true
                 }
-                None => Outcome::Ignored,
+                None => false,
             },
-            _ => Outcome::Ignored,
+            _ => false,
         }
     }
 

@@ -5,6 +5,7 @@
 use super::{Component, Ctx, ListState, Selected, block, duration, fit, header, selected};
 use crate::analysis::trace::Trace;
 use crate::sdo::{Outcome, Transaction};
+use crate::tui::event::{Event, Queue};
 use crate::tui::keymap::Action;
 use ratatui::Frame;
 use ratatui::layout::Rect;
@@ -169,13 +170,13 @@ impl SdoPane {
 impl Component for SdoPane {
     /// Moves the selection; `expand` opens the selected transfer to its frames, and on a
     /// frame shows it in the trace; `back` closes the transfer.
-    fn handle(&mut self, action: Action, ctx: &Ctx) -> super::Outcome {
+    fn handle(&mut self, action: Action, ctx: &Ctx, q: &mut Queue) -> bool {
         if let Some(delta) = ListState::movement(action, ctx.page) {
             self.scroll(delta, ctx);
             if action == Action::Bottom && self.expanded.is_none() {
                 self.follow = true;
             }
-            return super::Outcome::Done;
+            return true;
         }
         match action {
             Action::Expand if self.expanded.is_none() => {
@@ -184,11 +185,11 @@ impl Component for SdoPane {
                     self.expanded = Some(self.list.selected);
                     self.list = ListState::default();
                 }
-                super::Outcome::Done
+                true
             }
             Action::Expand => match self.selected_frame(ctx.trace) {
-                Some(pos) => super::Outcome::Show(pos),
-                None => super::Outcome::Done,
+                Some(pos) => q.answer(Event::Show(pos)),
+                None => true,
             },
             Action::Back => match self.expanded.take() {
                 Some(t) => {
@@ -196,11 +197,11 @@ impl Component for SdoPane {
                         selected: t,
                         offset: t.saturating_sub(3),
                     };
-                    super::Outcome::Done
+                    true
                 }
-                None => super::Outcome::Ignored,
+                None => false,
             },
-            _ => super::Outcome::Ignored,
+            _ => false,
         }
     }
 

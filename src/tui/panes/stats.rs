@@ -5,9 +5,10 @@
 //! decoded label; the bus load from the bit rate in the title. A row whose age passed 3 of
 //! its periods is dimmed (stale). A key cycles the sort.
 
-use super::{Component, Ctx, ListState, Outcome, block, duration, fit, header, selected};
+use super::{Component, Ctx, ListState, block, duration, fit, header, selected};
 use crate::analysis::stats::{IdStats, Stats};
 use crate::analysis::trace::Trace;
+use crate::tui::event::{Event, Queue};
 use crate::tui::keymap::Action;
 use ratatui::Frame;
 use ratatui::layout::Rect;
@@ -95,21 +96,21 @@ pub struct StatsPane {
 impl Component for StatsPane {
     /// Moves the selection; `sort` cycles the order; `expand` shows the selected COB-ID's
     /// frames in the trace.
-    fn handle(&mut self, action: Action, ctx: &Ctx) -> Outcome {
+    fn handle(&mut self, action: Action, ctx: &Ctx, q: &mut Queue) -> bool {
         if let Some(delta) = ListState::movement(action, ctx.page) {
             self.scroll(delta, ctx);
-            return Outcome::Done;
+            return true;
         }
         match action {
             Action::Sort => {
                 self.sort = self.sort.next();
-                Outcome::Done
+                true
             }
             Action::Expand => match sorted(&ctx.trace.stats, self.sort).get(self.list.selected) {
-                Some(((_, id), _)) => Outcome::Filter(format!("id {id:X}")),
-                None => Outcome::Done,
+                Some(((_, id), _)) => q.answer(Event::Filter(format!("id {id:X}"))),
+                None => true,
             },
-            _ => Outcome::Ignored,
+            _ => false,
         }
     }
 

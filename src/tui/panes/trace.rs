@@ -2,10 +2,11 @@
 //! the newest frames while scrolled back. It owns the view (the filter in force), the
 //! search, the selection and follow mode, and the decoded rows of the visible window.
 
-use super::{Component, Ctx, ListState, Outcome, block, fit, header, kind_color, selected};
+use super::{Component, Ctx, ListState, block, fit, header, kind_color, selected};
 use crate::analysis::filter::Filter;
 use crate::analysis::trace::Trace;
 use crate::analysis::view::View;
+use crate::tui::event::{Event, Queue};
 use crate::tui::keymap::Action;
 use crate::tui::rows::{Row, RowCache};
 use ratatui::Frame;
@@ -168,17 +169,17 @@ impl TracePane {
 }
 
 impl Component for TracePane {
-    fn handle(&mut self, action: Action, ctx: &Ctx) -> Outcome {
+    fn handle(&mut self, action: Action, ctx: &Ctx, q: &mut Queue) -> bool {
         if let Some(delta) = ListState::movement(action, ctx.page) {
             self.scroll(delta, ctx);
             if action == Action::Bottom {
                 self.follow = true;
             }
-            return Outcome::Done;
+            return true;
         }
         match action {
-            Action::Expand => Outcome::Detail,
-            _ => Outcome::Ignored,
+            Action::Expand => q.answer(Event::Detail),
+            _ => false,
         }
     }
 
