@@ -1054,18 +1054,18 @@ mod tests {
         assert!(lines[3].ends_with("  vcan0: interface went down; fix: sudo ip link set vcan0 up"));
         assert!(lines[4].ends_with("  vcan0: capturing again after 2.0 s without capture"));
         a.key(key('m'));
-        assert!(a.screen().log_popup().shown);
+        assert!(a.screen().log_popup().shown());
         let s = crate::tui::panes::testutil::screen(&mut a, 120, 20);
         assert!(s.contains("Messages (3)"), "{s}");
         assert!(s.contains("node 3 syntron-ds"), "{s}");
         a.act(Action::Up);
         assert_eq!(
-            a.screen().log_popup().selected,
+            a.screen().log_popup().index(a.screen().messages()),
             Some(1),
             "up selects the entry before the newest"
         );
         a.act(Action::Back);
-        assert!(!a.screen().log_popup().shown);
+        assert!(!a.screen().log_popup().shown());
     }
 
     #[test]
@@ -1077,17 +1077,20 @@ mod tests {
             a.key(key(c));
         }
         assert_eq!(
-            (a.selected_position(), a.screen().panes().trace.following()),
+            (a.selected_position(), a.screen().panes().trace().following()),
             (Some(0), false)
         );
         a.key(key('j'));
         assert_eq!(a.selected_position(), Some(1));
         a.key(key('2'));
         a.key(key('j'));
-        assert_eq!((a.focus(), a.screen().panes().nodes.list.selected), (Pane::Nodes, 1));
+        assert_eq!(
+            (a.focus(), a.screen().panes().nodes().selected_node(a.trace())),
+            (Pane::Nodes, Some(crate::frame::NodeKey::new(0, 2)))
+        );
         a.key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
         assert_eq!(a.focus(), Pane::Trace);
-        assert_eq!(a.screen().panes().trace.filter().source, "node 2");
+        assert_eq!(a.screen().panes().trace().filter().source, "node 2");
         a.key(key('F'));
         assert_eq!(
             a.screen().prompt().editing.as_ref().map(|p| p.text.as_str()),
@@ -1095,7 +1098,7 @@ mod tests {
         );
         a.key(KeyEvent::new(KeyCode::Esc, KeyModifiers::NONE));
         a.key(key('G'));
-        assert!(a.screen().panes().trace.following());
+        assert!(a.screen().panes().trace().following());
     }
 
     #[test]
@@ -1110,16 +1113,22 @@ mod tests {
         };
         let last = a.selected_position();
         a.mouse(mouse(MouseEventKind::ScrollUp, 0));
-        assert!(!a.screen().panes().trace.following());
+        assert!(!a.screen().panes().trace().following());
         assert_eq!(a.selected_position(), last.map(|p| p - 3));
         a.act(Action::PaneNodes);
         let _ = crate::tui::panes::testutil::screen(&mut a, 140, 20);
         let t = a.screen().layout().table;
         a.mouse(mouse(MouseEventKind::Down(MouseButton::Left), t.y + 1));
-        assert_eq!(a.screen().panes().nodes.list.selected, 1);
+        assert_eq!(
+            a.screen().panes().nodes().selected_node(a.trace()).map(|n| n.node),
+            Some(2)
+        );
         // A click below the last node selects nothing new.
         a.mouse(mouse(MouseEventKind::Down(MouseButton::Left), t.y + 5));
-        assert_eq!(a.screen().panes().nodes.list.selected, 1);
+        assert_eq!(
+            a.screen().panes().nodes().selected_node(a.trace()).map(|n| n.node),
+            Some(2)
+        );
     }
 
     #[test]
@@ -1131,7 +1140,8 @@ mod tests {
             a.act(Action::Down);
         }
         a.act(Action::Expand);
-        assert_eq!(a.screen().panes().sdo.expanded, Some(4));
+        let s = crate::tui::panes::testutil::screen(&mut a, 100, 14);
+        assert!(s.contains("SDO transfer 6041:00 node 2"), "{s}");
         a.act(Action::Down);
         a.act(Action::Expand);
         assert_eq!(a.focus(), Pane::Trace);

@@ -92,7 +92,7 @@ impl Screen {
 
     /// The Objects pane, for the read-all that runs through it.
     pub(crate) fn objects_mut(&mut self) -> &mut ObjectsPane {
-        &mut self.panes.objects
+        self.panes.objects_mut()
     }
 
     /// The Detail pane (beside the main pane, or toggled below it on a narrow terminal).
@@ -210,7 +210,7 @@ impl Screen {
         if self.message.as_deref() == Some("replay finished") {
             self.message = None;
         }
-        self.panes.trace.reset();
+        self.panes.trace_mut().reset();
         self.restart_search();
         self.detail.reset();
     }
@@ -218,7 +218,7 @@ impl Screen {
     /// Background work: filter scanning and the search; returns (work is left, something
     /// changed on screen).
     pub(crate) fn work(&mut self, trace: &Trace, done: bool, budget: Duration) -> (bool, bool) {
-        let (more, changed) = self.panes.trace.work(trace, done, budget);
+        let (more, changed) = self.panes.trace_mut().work(trace, done, budget);
         let (searching, found) = self.search_work(trace, done, budget);
         (more || searching, changed || found)
     }
@@ -243,7 +243,7 @@ impl Screen {
 
     /// Follows the newest frame (`true`) or stays on the selection.
     pub(crate) fn follow(&mut self, on: bool) {
-        self.panes.trace.set_follow(on);
+        self.panes.trace_mut().set_follow(on);
     }
 
     /// Parses a filter or search with the object names of the dictionaries in use.
@@ -255,7 +255,7 @@ impl Screen {
     pub(crate) fn apply_filter(&mut self, trace: &Trace, text: &str) -> Result<(), FilterError> {
         let f = self.parse_expr(trace, "filter", text)?;
         let page = self.page();
-        self.panes.trace.set_filter(trace, f, page);
+        self.panes.trace_mut().set_filter(trace, f, page);
         self.message = None;
         self.restart_search();
         Ok(())
@@ -268,7 +268,7 @@ impl Screen {
             self.search = None;
             return Ok(());
         }
-        let mut s = Search::new(f, self.panes.trace.filter());
+        let mut s = Search::new(f, self.panes.trace().filter());
         s.advance(trace, Duration::from_millis(30));
         self.search = Some(s);
         self.jump_match(trace, true);
@@ -282,12 +282,12 @@ impl Screen {
 
     /// The trace pane's view (the rows the filter in force shows).
     pub fn view(&self) -> &View {
-        self.panes.trace.view()
+        self.panes.trace().view()
     }
 
     /// Sets the Objects pane's query (what the Find prompt typed).
     pub(crate) fn find_objects(&mut self, text: &str) {
-        self.panes.objects.set_query(text);
+        self.panes.objects_mut().set_query(text);
     }
 
     /// After a prompt refused `text` (a bad expression): opens it again with the text, the
@@ -299,26 +299,26 @@ impl Screen {
     /// The search in force starts over (the filter it searches within changed).
     fn restart_search(&mut self) {
         if let Some(s) = self.search.take() {
-            self.search = Some(Search::new(s.filter, self.panes.trace.filter()));
+            self.search = Some(Search::new(s.filter, self.panes.trace().filter()));
         }
     }
 
     /// The trace position of the selected row of the trace.
     pub(crate) fn selected_position(&self, trace: &Trace) -> Option<usize> {
-        self.panes.trace.selected_position(trace)
+        self.panes.trace().selected_position(trace)
     }
 
     /// Shows trace position `pos` in the Trace pane.
     pub(crate) fn select_position(&mut self, trace: &Trace, pos: usize) {
         let page = self.page();
         self.focus = Pane::Trace;
-        self.panes.trace.select_position(trace, pos, page);
+        self.panes.trace_mut().select_position(trace, pos, page);
     }
 
     /// Shows trace position `pos` in the Trace pane, unfiltered.
     pub(crate) fn show(&mut self, trace: &Trace, pos: usize) {
         let page = self.page();
-        self.panes.trace.show(trace, pos, page);
+        self.panes.trace_mut().show(trace, pos, page);
         self.focus = Pane::Trace;
     }
 
@@ -364,7 +364,7 @@ impl Screen {
 
     /// `plot NODE INDEX:SUB`: shows that series in the Plot pane; false when none was seen.
     pub(crate) fn plot(&mut self, trace: &Trace, node: u8, index: u16, sub: u8) -> bool {
-        let ok = self.panes.plot.select(trace, node, index, sub);
+        let ok = self.panes.plot_mut().select(trace, node, index, sub);
         if ok {
             self.focus = Pane::Plot;
         }
@@ -383,8 +383,7 @@ impl Screen {
     /// there): when the user selects in the Nodes pane, or while the Objects pane has none.
     /// Not on every frame: a node appearing above the selection does not change it.
     fn sync_objects_node(&mut self, trace: &Trace) {
-        let n = self.panes.nodes.selected_node(trace);
-        self.panes.objects.set_nodes_selection(n);
+        self.panes.sync_objects_node(trace);
     }
 
     /// A commander line waiting for `y`: asks.
@@ -467,7 +466,7 @@ impl Screen {
             self.help.type_key(ev, keymap);
             return true;
         }
-        self.panes.plot.picker_key(ev, trace)
+        self.panes.plot_mut().picker_key(ev, trace)
     }
 
     /// Does what an action says: the message log popup takes it first while shown, then
@@ -535,8 +534,8 @@ impl Screen {
                 self.message = None;
             }
             Action::Follow => {
-                let on = !self.panes.trace.following();
-                self.panes.trace.set_follow(on);
+                let on = !self.panes.trace().following();
+                self.panes.trace_mut().set_follow(on);
                 self.focus = Pane::Trace;
             }
             Action::NextPane | Action::PrevPane => {
@@ -557,7 +556,7 @@ impl Screen {
                 self.message = Some(format!("{}: only in the Objects pane", a.name().replace('_', " ")))
             }
             Action::Filter => {
-                let text = self.panes.trace.filter().source.clone();
+                let text = self.panes.trace().filter().source.clone();
                 self.prompt.open(PromptKind::Filter, &text);
             }
             Action::Search => {
@@ -575,7 +574,7 @@ impl Screen {
             }
             Action::Palette => self.prompt.open(PromptKind::Palette, ""),
             Action::NextSeries | Action::PrevSeries => {
-                self.panes.plot.step(trace, a == Action::NextSeries);
+                self.panes.plot_mut().step(trace, a == Action::NextSeries);
                 self.focus = Pane::Plot;
             }
             // From another pane: the pane that does it comes to the front and takes it
@@ -589,8 +588,8 @@ impl Screen {
             // that pressing it again in the trace walks through the incident's frames.
             Action::ShowFrames => {
                 let ctx = self.ctx(trace, paused);
-                self.panes.problems.refresh(&ctx);
-                self.panes.problems.handle(a, &ctx, q);
+                self.panes.problems_mut().refresh(&ctx);
+                self.panes.problems_mut().handle(a, &ctx, q);
             }
             // Taken by the help popup; row movement and `expand` in a pane without rows.
             Action::Help
@@ -628,7 +627,7 @@ impl Screen {
     /// `height` rows, pins the trace selection to the newest row in follow mode, decodes the
     /// visible trace window (`rows` rows), the tail strip and what the Detail pane shows.
     pub fn prepare(&mut self, trace: &Trace, paused: bool, height: usize, rows: usize, tail: &[usize]) {
-        if self.panes.objects.node().is_none() {
+        if self.panes.objects().node().is_none() {
             self.sync_objects_node(trace);
         }
         let ctx = self.ctx(trace, paused);
@@ -642,7 +641,7 @@ impl Screen {
         ] {
             self.panes.get_mut(p).fit(height, &ctx);
         }
-        self.panes.trace.prepare(trace, rows, tail);
+        self.panes.trace_mut().prepare(trace, rows, tail);
         let selected = self.selected(trace, paused);
         self.detail.update(trace, selected);
     }

@@ -56,7 +56,7 @@ pub fn draw(f: &mut Frame, app: &mut App) {
 
     // Where the selectable rows are, for paging and mouse clicks.
     let inner = panes::block("", true).inner(main);
-    let trace_pane = &app.screen().panes().trace;
+    let trace_pane = app.screen().panes().trace();
     let (rows, strip) = trace_pane.split(app.trace(), main);
     let tail = trace_pane.tail_positions(app.trace(), strip);
     let table = match app.focus() {

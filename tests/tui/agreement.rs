@@ -174,7 +174,7 @@ fn the_tui_and_the_command_line_agree_on_every_fixture_and_real_world_log() {
         let want = cli(&["diagnose", "--format", "jsonl"], path);
         let origin = app.trace().diagnosis.origin_ns();
         let mut got = Vec::new();
-        for i in app.screen().panes().problems.incidents() {
+        for i in app.screen().panes().problems().incidents() {
             write_line(&mut got, &i.to_json(origin));
         }
         assert_eq!(String::from_utf8(got).unwrap(), want, "{name}: Problems pane incidents");

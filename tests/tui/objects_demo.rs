@@ -209,7 +209,7 @@ fn read_all_reads_what_drive_2_has_with_progress_and_lists_the_failures() {
     let s = until(&mut a, "progress in the title", |_, s| s.contains(" · read all "));
     assert!(s.contains(&format!(" of {total}")), "{s}");
     until(&mut a, "the read-all to end", |a, _| {
-        a.screen().panes().objects.read_all.is_none()
+        !a.screen().panes().objects().reading_all()
     });
     let summary = a
         .screen()

@@ -62,7 +62,7 @@ fn own_reads_of_missing_objects_do_not_hide_a_drive_fault_and_a_lost_node() {
     }
     key(&mut a, KeyCode::Char('R'));
     until(&mut a, "the read-all to end", |a, _| {
-        a.screen().panes().objects.read_all.is_none()
+        !a.screen().panes().objects().reading_all()
     });
     let summary = a
         .screen()

@@ -225,7 +225,7 @@ pub struct DetailPane {
     /// The frame shown, decoded, with its trace position.
     decoded: Option<(usize, Decoded)>,
     /// Shown below the main pane when the terminal is too narrow for the side column.
-    pub shown: bool,
+    shown: bool,
 }
 
 impl DetailPane {

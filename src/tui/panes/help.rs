@@ -80,7 +80,7 @@ const FILTER_SYNTAX: &[(&str, &str)] = &[
 #[derive(Default)]
 pub struct HelpPopup {
     /// The popup is shown.
-    pub shown: bool,
+    shown: bool,
     /// The first line shown.
     scroll: usize,
     /// Lines visible and the largest scroll at the last draw.
@@ -88,9 +88,9 @@ pub struct HelpPopup {
     /// Text width at the last draw (the lines wrap by it).
     width: Cell<usize>,
     /// The text searched for (case ignored); empty: none.
-    pub query: String,
+    query: String,
     /// Keys go to the query (after the filter or search key).
-    pub typing: bool,
+    typing: bool,
 }
 
 impl HelpPopup {

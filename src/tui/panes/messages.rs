@@ -35,16 +35,16 @@ pub fn width(area: Rect) -> usize {
 #[derive(Default)]
 pub struct MessagesPopup {
     /// The popup is shown.
-    pub shown: bool,
+    shown: bool,
     /// The selected entry by its number since the session began (entries dropped from the
     /// front count); `None` follows the newest.
-    pub selected: Option<u64>,
+    selected: Option<u64>,
     /// The selected entry is shown whole, scrolled this many lines down.
-    pub whole: Option<usize>,
+    whole: Option<usize>,
     /// Lines the popup showed at once in the last draw.
-    pub page: usize,
+    page: usize,
     /// Characters a line got in the last draw.
-    pub width: usize,
+    width: usize,
 }
 
 impl MessagesPopup {

@@ -69,24 +69,81 @@ impl Pane {
 #[derive(Default)]
 pub struct Panes {
     /// One row per frame of the filtered view.
-    pub trace: trace::TracePane,
+    trace: trace::TracePane,
     /// One row per node.
-    pub nodes: nodes::NodesPane,
+    nodes: nodes::NodesPane,
     /// One row per SDO transfer, or the frames of one.
-    pub sdo: sdo::SdoPane,
+    sdo: sdo::SdoPane,
     /// One row per COB-ID.
-    pub stats: stats::StatsPane,
+    stats: stats::StatsPane,
     /// Numeric signals over one time axis.
-    pub plot: plot::PlotPane,
+    plot: plot::PlotPane,
     /// The object dictionary of one node with the last values seen.
-    pub objects: objects::ObjectsPane,
+    objects: objects::ObjectsPane,
     /// One row per known PDO of each node.
-    pub pdo: pdo::PdoPane,
+    pdo: pdo::PdoPane,
     /// One row per incident of the diagnosis.
-    pub problems: problems::ProblemsPane,
+    problems: problems::ProblemsPane,
 }
 
 impl Panes {
+    /// The Trace pane (its view, filter, selection, follow mode).
+    pub fn trace(&self) -> &trace::TracePane {
+        &self.trace
+    }
+
+    /// The Trace pane, to change.
+    pub(crate) fn trace_mut(&mut self) -> &mut trace::TracePane {
+        &mut self.trace
+    }
+
+    /// The Nodes pane.
+    pub fn nodes(&self) -> &nodes::NodesPane {
+        &self.nodes
+    }
+
+    /// The SDO pane.
+    pub fn sdo(&self) -> &sdo::SdoPane {
+        &self.sdo
+    }
+
+    /// The Objects pane.
+    pub fn objects(&self) -> &objects::ObjectsPane {
+        &self.objects
+    }
+
+    /// The Objects pane, to change (reads, read-all, the find text).
+    pub(crate) fn objects_mut(&mut self) -> &mut objects::ObjectsPane {
+        &mut self.objects
+    }
+
+    /// The Plot pane, to change (the series shown, the picker).
+    pub(crate) fn plot_mut(&mut self) -> &mut plot::PlotPane {
+        &mut self.plot
+    }
+
+    /// The Problems pane.
+    pub fn problems(&self) -> &problems::ProblemsPane {
+        &self.problems
+    }
+
+    /// The Problems pane, to change.
+    pub(crate) fn problems_mut(&mut self) -> &mut problems::ProblemsPane {
+        &mut self.problems
+    }
+
+    /// The Plot pane.
+    pub fn plot(&self) -> &plot::PlotPane {
+        &self.plot
+    }
+
+    /// Tells the Objects pane the Nodes pane's selection (its node, unless one is picked
+    /// there).
+    pub(crate) fn sync_objects_node(&mut self, trace: &Trace) {
+        let n = self.nodes.selected_node(trace);
+        self.objects.set_nodes_selection(n);
+    }
+
     /// The pane `p`.
     pub(crate) fn get(&self, p: Pane) -> &dyn Component {
         match p {
@@ -120,11 +177,11 @@ impl Panes {
 #[derive(Clone, Copy)]
 pub struct Ctx<'a> {
     /// Frames and what is derived from them.
-    pub trace: &'a Trace,
+    pub(crate) trace: &'a Trace,
     /// Rows a page holds (the visible height of the main table).
-    pub page: usize,
+    pub(crate) page: usize,
     /// The capture is paused.
-    pub paused: bool,
+    pub(crate) paused: bool,
 }
 
 /// What the selected row of a pane is, for the Detail view.
@@ -160,9 +217,9 @@ pub(crate) trait Component {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ListState {
     /// Selected row.
-    pub selected: usize,
+    selected: usize,
     /// First visible row.
-    pub offset: usize,
+    offset: usize,
 }
 
 impl ListState {

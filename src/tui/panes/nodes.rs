@@ -165,7 +165,7 @@ pub fn row_text(id: u8, n: &NodeInfo, live: Option<&NodeLiveness>, now_ns: u64, 
 #[derive(Default)]
 pub struct NodesPane {
     /// Scroll state.
-    pub list: ListState,
+    list: ListState,
 }
 
 impl NodesPane {

@@ -175,23 +175,23 @@ fn matches(query: &str, index: u16, sub: Option<u8>, name: &str, alias: Option<&
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct ReadAll {
     /// The node read.
-    pub node: u8,
+    node: u8,
     /// Entries still to read.
     queue: VecDeque<(u16, u8)>,
     /// The line sent and waiting for its result.
     current: Option<(String, (u16, u8))>,
     /// Entries read so far (answered, ok or not).
-    pub done: usize,
+    done: usize,
     /// Entries in all.
-    pub total: usize,
+    total: usize,
     /// Entries left out: sub-indexes beyond what sub 0 says the node has, the rest of an
     /// object the node does not have.
-    pub skipped: usize,
+    skipped: usize,
     /// Entries that failed, with what went wrong.
-    pub failed: Vec<((u16, u8), String)>,
+    failed: Vec<((u16, u8), String)>,
     /// Entries the node answered it does not have (an abort of
     /// [`crate::sdo::abort::NOT_PRESENT`]): not failures.
-    pub not_present: usize,
+    not_present: usize,
 }
 
 impl ReadAll {
@@ -240,7 +240,7 @@ pub fn read_line(node: u8, index: u16, sub: u8) -> String {
 #[derive(Default)]
 pub struct ObjectsPane {
     /// Scroll state.
-    pub list: ListState,
+    list: ListState,
     /// The node picked in the pane (overrides the Nodes selection until that changes).
     picked: Option<NodeKey>,
     /// The Nodes pane's selection, as the application last told.
@@ -248,7 +248,7 @@ pub struct ObjectsPane {
     /// Records shown open.
     open: BTreeSet<u16>,
     /// The find text (filters the rows while typed).
-    pub query: String,
+    query: String,
     /// The find text changed since the rows were last built.
     fresh_query: bool,
     /// The catalog, and what it was built from (node, layers, indexes seen in ranges).
@@ -257,7 +257,7 @@ pub struct ObjectsPane {
     /// The rows shown, as last built.
     rows: Vec<Row>,
     /// The read-all in progress.
-    pub read_all: Option<ReadAll>,
+    read_all: Option<ReadAll>,
     /// Single reads sent and not answered yet: line -> (node, index, sub).
     reading: BTreeMap<String, (u8, u16, u8)>,
     /// The last failure of a read the pane sent, per (node, index, sub), with the capture
@@ -270,6 +270,11 @@ impl ObjectsPane {
     /// pane's selection.
     pub fn node(&self) -> Option<NodeKey> {
         self.picked.or(self.from_nodes)
+    }
+
+    /// True while a read-all goes on.
+    pub fn reading_all(&self) -> bool {
+        self.read_all.is_some()
     }
 
     /// Tells the pane the Nodes pane's selection; a new one replaces a node picked here.

@@ -23,7 +23,7 @@ const SIGNAL_LINES: u16 = 7;
 #[derive(Default)]
 pub struct PdoPane {
     /// Scroll state.
-    pub list: ListState,
+    list: ListState,
 }
 
 impl PdoPane {

@@ -17,9 +17,9 @@ use ratatui::widgets::{Clear, Paragraph};
 #[derive(Clone, Debug, PartialEq)]
 pub struct Candidate {
     /// The series.
-    pub key: SeriesKey,
+    key: SeriesKey,
     /// What is matched and shown: node, index:sub, name, alias, unit.
-    pub text: String,
+    text: String,
 }
 
 /// Every series of `trace` as picker candidates, in series order.
@@ -79,9 +79,9 @@ pub enum PickerEdit {
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct SignalPicker {
     /// The filter typed.
-    pub query: String,
+    query: String,
     /// The selected match (index into the matches).
-    pub selected: usize,
+    selected: usize,
 }
 
 impl SignalPicker {

@@ -38,14 +38,14 @@ pub const MAX_SIGNALS: usize = COLORS.len();
 #[derive(Default)]
 pub struct PlotPane {
     /// The signals shown, in the order added; empty: the first series seen.
-    pub signals: Vec<SeriesKey>,
+    signals: Vec<SeriesKey>,
     /// The time window (seconds, the frames' time base); None: the whole span, following
     /// new data.
-    pub window: Option<TimeWindow>,
+    window: Option<TimeWindow>,
     /// The cursor's time (seconds, the frames' time base).
-    pub cursor: Option<f64>,
+    cursor: Option<f64>,
     /// The signal picker, while open.
-    pub picker: Option<SignalPicker>,
+    picker: Option<SignalPicker>,
     /// Columns of the time axis at the last draw (the cursor moves one column a key).
     columns: Cell<usize>,
 }

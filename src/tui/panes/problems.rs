@@ -27,9 +27,9 @@ struct Jump {
 #[derive(Default)]
 pub struct ProblemsPane {
     /// Scroll state (incidents, or the timeline steps of the opened one).
-    pub list: ListState,
+    list: ListState,
     /// The opened incident (index into the ranked list).
-    pub opened: Option<usize>,
+    opened: Option<usize>,
     incidents: Vec<Incident>,
     /// The trace's diagnosis version the incidents were built at.
     version: Option<u64>,

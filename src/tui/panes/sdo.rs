@@ -128,12 +128,12 @@ fn color(t: &Transaction) -> Color {
 /// transfer opened to its frames.
 pub struct SdoPane {
     /// Scroll state (transfers, or the frames of the opened transfer).
-    pub list: ListState,
+    list: ListState,
     /// Select the newest transfer as transfers come (until the selection is moved; `end`
     /// follows again).
-    pub follow: bool,
+    follow: bool,
     /// The transfer opened to its frames (index into the transactions).
-    pub expanded: Option<usize>,
+    expanded: Option<usize>,
 }
 
 impl Default for SdoPane {

@@ -85,9 +85,9 @@ pub fn changed(prev: Option<&[u8]>, cur: &[u8]) -> Vec<bool> {
 #[derive(Default)]
 pub struct StatsPane {
     /// Scroll state.
-    pub list: ListState,
+    list: ListState,
     /// The order of the rows.
-    pub sort: Sort,
+    sort: Sort,
     /// Decoded labels by store position (the rows last drawn), so a row is decoded once
     /// per new frame of its COB-ID.
     labels: RefCell<HashMap<usize, String>>,
