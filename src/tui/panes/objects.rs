@@ -1,7 +1,8 @@
 //! The Objects pane: the object dictionary of one node (every object its dictionary layers
 //! know: EDS/DCF, vendor profile, CiA 402, CiA 301, the first layer that knows an entry
 //! wins) as a tree of index and sub-index with name, vendor alias, type, access, unit and
-//! the last value seen on the bus with its age ([`crate::analysis::values`]).
+//! the last value seen of that node on its own interface, with its age
+//! ([`crate::analysis::values`]).
 //!
 //! Records and arrays fold (`expand` opens and closes them); `expand` on an entry reads it,
 //! `edit_object` opens the palette with its write command, `read_all` reads every readable
