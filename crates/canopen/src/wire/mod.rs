@@ -20,7 +20,7 @@ mod tables;
 
 use crate::frame::{Flags, Frame};
 use std::fmt;
-use tables::{StuffState, crc_bit, crc15_bit, crc15_byte, stuff_byte, stuff_step};
+use tables::{StuffState, crc_bit, crc15_byte, stuff_byte, stuff_step};
 
 /// The bits between two frames (recessive), not part of either: [`Figures::bits`] leaves
 /// them out, bus load counts them.
@@ -326,37 +326,54 @@ impl Layout {
 }
 
 /// The figures of `frame` on the wire, without listing its bits (no allocation; classic
-/// frames by table, a byte at a time).
+/// frames a byte at a time by table, the frame held in one integer).
 pub fn figures(frame: &Frame) -> Result<Figures, WireError> {
-    let layout = Layout::of(frame)?;
-    if layout.fd {
+    if frame.is_fd() || frame.is_err() || frame.len > 8 {
+        let layout = Layout::of(frame)?;
         return Ok(walk(&layout, &mut |_| {}));
     }
-    let bits = &layout.bits;
-    let whole = bits.len / 8;
+    let ext = frame.is_ext();
+    if frame.id > if ext { 0x1FFF_FFFF } else { 0x7FF } {
+        return Err(WireError::IdRange { id: frame.id, ext });
+    }
+    let rtr = u128::from(frame.is_rtr());
+    let dlc = u128::from(if frame.len == 8 && (9..=15).contains(&frame.raw_dlc) {
+        frame.raw_dlc
+    } else {
+        frame.len
+    });
+    let id = u128::from(frame.id);
+    // SOF (0), identifier, [SRR, IDE, extension], RTR, IDE or r1, r0, DLC.
+    let (head, head_bits) = if ext {
+        ((id >> 18) << 27 | 0b11 << 25 | (id & 0x3FFFF) << 7 | rtr << 6 | dlc, 39)
+    } else {
+        (id << 7 | rtr << 6 | dlc, 19)
+    };
+    let payload = frame.payload();
+    let data_bits = 8 * payload.len() as u32;
+    let mut data = [0u8; 8];
+    data[..payload.len()].copy_from_slice(payload);
+    let data = u128::from(u64::from_be_bytes(data)) >> (64 - data_bits);
+    let stream = if data_bits == 0 { head } else { head << data_bits | data };
+    let n = head_bits + data_bits;
+    // Zeros before the stream leave a CRC register at 0 unchanged: whole bytes from the top.
     let mut crc = 0;
-    for &b in &bits.bytes[..whole] {
-        crc = crc15_byte(crc, b);
+    for k in (0..n.div_ceil(8)).rev() {
+        crc = crc15_byte(crc, (stream >> (8 * k)) as u8);
     }
-    for i in whole * 8..bits.len {
-        crc = crc15_bit(crc, bits.get(i));
-    }
-    let mut stuffed = *bits;
-    stuffed.push(crc, 15);
-    let whole = stuffed.len / 8;
+    // Stuffing over stream and CRC, after alternating bits that end recessive (so they
+    // stuff nothing and leave the state of before SOF) up to whole bytes.
+    let m = n + 15;
+    let pad = m.div_ceil(8) * 8 - m;
+    let full = stream << 15 | u128::from(crc) | u128::from(0x55u8 & ((1u8 << pad) - 1)) << m;
     let (mut state, mut stuffs): (StuffState, u32) = (tables::STUFF_START, 0);
-    for &b in &stuffed.bytes[..whole] {
-        let (next, n) = stuff_byte(state, b);
+    for k in (0..(m + pad) / 8).rev() {
+        let (next, s) = stuff_byte(state, (full >> (8 * k)) as u8);
         state = next;
-        stuffs += n;
-    }
-    for i in whole * 8..stuffed.len {
-        let (next, st) = stuff_step(state, stuffed.get(i));
-        state = next;
-        stuffs += u32::from(st);
+        stuffs += s;
     }
     Ok(Figures {
-        bits: stuffed.len as u32 + stuffs + TAIL,
+        bits: m + stuffs + TAIL,
         stuff_bits: stuffs,
         crc,
         crc_bits: 15,

@@ -1,6 +1,6 @@
 //! The two tables that make the per-frame figures cheap: CRC-15 one byte at a time, and
 //! the bit-stuffing state machine one byte at a time. Both are built at compile time from
-//! the bit-by-bit rule they replace ([`crc15_bit`], [`stuff_step`]).
+//! the bit-by-bit rule they replace ([`crc_bit`], [`stuff_step`]).
 
 /// The CRC-15 generator of classic CAN, x^15 + x^14 + x^10 + x^8 + x^7 + x^4 + x^3 + 1.
 pub(crate) const CRC15_POLY: u32 = 0x4599;
@@ -10,11 +10,6 @@ pub(crate) const fn crc_bit(crc: u32, bit: bool, width: u32, poly: u32) -> u32 {
     let top = ((crc >> (width - 1)) & 1 == 1) ^ bit;
     let shifted = (crc << 1) & ((1 << width) - 1);
     if top { shifted ^ poly } else { shifted }
-}
-
-/// One bit into a CRC-15 register.
-pub(crate) const fn crc15_bit(crc: u32, bit: bool) -> u32 {
-    crc_bit(crc, bit, 15, CRC15_POLY)
 }
 
 /// CRC-15 of every byte value fed into a zero register, MSB first.
@@ -106,7 +101,7 @@ mod tests {
     fn byte_tables_equal_their_bit_rules() {
         for start in [0u32, 1, 0x4599, 0x7FFF, 0x1234] {
             for byte in 0..=255u8 {
-                let bitwise = (0..8).fold(start, |c, k| crc15_bit(c, (byte >> (7 - k)) & 1 == 1));
+                let bitwise = (0..8).fold(start, |c, k| crc_bit(c, (byte >> (7 - k)) & 1 == 1, 15, CRC15_POLY));
                 assert_eq!(crc15_byte(start, byte), bitwise);
             }
         }
