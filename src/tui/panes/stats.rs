@@ -6,6 +6,7 @@
 //! its periods is dimmed (stale). A key cycles the sort.
 
 use super::{Component, Ctx, ListState, Outcome, block, duration, fit, header, selected};
+use crate::analysis::busload::BitrateSource;
 use crate::analysis::stats::{IdStats, Stats};
 use crate::analysis::trace::Trace;
 use crate::tui::keymap::Action;
@@ -134,11 +135,13 @@ impl Component for StatsPane {
 
     fn render(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
         let st = &ctx.trace.stats;
+        let rate = st.bitrate();
+        let assumed = if rate.source == BitrateSource::Assumed { " (assumed)" } else { "" };
         let title = format!(
-            " Receive list by {} — bus load {:.1}% at {} kbit/s, {} fr in the last 1 s ",
+            " Receive list by {} — bus load {:.1}% at {} kbit/s{assumed}, {} fr in the last 1 s ",
             self.sort.name(),
             st.load_percent(),
-            st.bitrate() / 1000,
+            rate.bps / 1000,
             st.window_frames(&ctx.trace.store)
         );
         f.render_widget(block(&title, focused), area);
