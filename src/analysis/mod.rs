@@ -5,7 +5,6 @@
 //! frames and their timestamps in, typed events and incidents out; time only advances
 //! through frame timestamps and explicit ticks.
 
-pub mod busload;
 pub mod diagnose;
 pub mod events;
 pub mod filter;

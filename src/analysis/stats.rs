@@ -7,8 +7,8 @@
 //! second; its age (time since its last frame) grows with later frames and ticks, and
 //! [`IdStats::stale`] tells when it passed [`STALE_PERIODS`] of its mean periods.
 
-use super::busload::Bitrate;
 use super::store::{Packed, Store};
+use crate::output::busload::Bitrate;
 use std::collections::BTreeMap;
 
 /// Statistics of one identifier.
@@ -263,8 +263,17 @@ mod tests {
         // 5 base frames of 8 bytes, their exact bits on the wire (crate::wire) in the last
         // second, of 125000.
         let bits: u64 = (0..5).map(|i| store.bus_bits(i)).sum();
-        assert_eq!(bits, (0..5u8).map(|i| crate::analysis::busload::bus_bits(&Frame::classic(0x181, &[i; 8]))).sum::<u64>());
-        assert!((st.load_percent() - bits as f64 * 100.0 / 125_000.0).abs() < 1e-9, "{}", st.load_percent());
+        assert_eq!(
+            bits,
+            (0..5u8)
+                .map(|i| crate::output::busload::bus_bits(&Frame::classic(0x181, &[i; 8])))
+                .sum::<u64>()
+        );
+        assert!(
+            (st.load_percent() - bits as f64 * 100.0 / 125_000.0).abs() < 1e-9,
+            "{}",
+            st.load_percent()
+        );
     }
 
     #[test]

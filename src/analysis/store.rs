@@ -76,7 +76,7 @@ impl Store {
     /// The bits frame `i` takes on the bus, its intermission included (exact: rebuilt as
     /// sent, see [`crate::wire`]; 0 for an error frame).
     pub fn bus_bits(&self, i: usize) -> u64 {
-        super::busload::bus_bits(&self.frame(i))
+        crate::output::busload::bus_bits(&self.frame(i))
     }
 
     /// Number of stored frames.

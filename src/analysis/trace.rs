@@ -14,7 +14,6 @@
 //! change state) and decodes `a..b`. So labels are exact, at most `CHECKPOINT` frames are
 //! replayed per window, and the checkpoints cost well under a byte per frame.
 
-use super::busload::Bitrate;
 use super::diagnose::{Diagnoser, feed};
 use super::liveness::EventTracker;
 use super::nodes::Nodes;
@@ -25,6 +24,7 @@ use super::transfers::Transfers;
 use super::values::Values;
 use crate::decode::{Body, Decoded, Decoder, Kind};
 use crate::frame::{Frame, Interfaces, NodeKey};
+use crate::output::busload::Bitrate;
 use crate::output::summary::Summary;
 use crate::sdo::Transaction;
 

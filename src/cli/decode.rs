@@ -1,12 +1,12 @@
 //! `cotui decode FILE...`: the headless decoder.
 
 use super::input;
-use crate::analysis::busload::{Bitrate, BusLoad};
 use crate::analysis::trace::{Trace, Views};
 use crate::command::ExitCode;
 use crate::decode::Decoder;
 use crate::frame::json::write_line;
 use crate::od::Dictionary;
+use crate::output::busload::{Bitrate, BusLoad};
 use crate::output::{jsonl, summary::Summary, text};
 use crate::sdo::Transaction;
 use clap::{Args, ValueEnum};

@@ -9,7 +9,7 @@ use crate::analysis::filter::{Facts, Filter};
 use crate::analysis::transfers::Transfers;
 use crate::command::ExitCode;
 use crate::decode::{Decoder, Kind};
-use crate::analysis::busload::{Bitrate, BusLoad};
+use crate::output::busload::{Bitrate, BusLoad};
 use crate::output::{jsonl, summary::Summary, text};
 use std::io::{self, Write};
 

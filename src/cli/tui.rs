@@ -1,8 +1,8 @@
 //! `cotui open FILE` and `cotui replay FILE`: the interactive analyzer on a log.
 
-use crate::analysis::busload::Bitrate;
 use crate::analysis::trace::Trace;
 use crate::command::ExitCode;
+use crate::output::busload::Bitrate;
 use crate::tui::app::{App, SourceInfo, SourceKind};
 use crate::tui::keymap::{self, Keymap, KeymapError};
 use crate::tui::source;

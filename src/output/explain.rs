@@ -62,7 +62,11 @@ pub fn data_fields(kind: Kind, payload: &[u8]) -> Vec<(Range<usize>, &'static st
         Kind::Nmt => &[(0..1, "command"), (1..2, "node")],
         Kind::Sync => &[(0..1, "counter")],
         Kind::Time => &[(0..4, "ms after midnight"), (4..6, "days since 1984")],
-        Kind::Emcy => &[(0..2, "error code"), (2..3, "error register"), (3..8, "manufacturer data")],
+        Kind::Emcy => &[
+            (0..2, "error code"),
+            (2..3, "error register"),
+            (3..8, "manufacturer data"),
+        ],
         Kind::Heartbeat => &[(0..1, "state")],
         Kind::Lss => &[(0..1, "command specifier"), (1..8, "data")],
         Kind::Tpdo | Kind::Rpdo => &[(0..64, "PDO data")],
@@ -222,7 +226,10 @@ impl Explained<'_> {
                 Some((w.figures.time_us(self.bitrate) * 1000.0).round() / 1000.0),
                 wire_groups(w)
                     .into_iter()
-                    .map(|(f, b)| WireField { field: f.as_str(), bits: b })
+                    .map(|(f, b)| WireField {
+                        field: f.as_str(),
+                        bits: b,
+                    })
                     .collect(),
                 None,
             ),
@@ -323,7 +330,10 @@ mod tests {
     #[test]
     fn sdo_fields_follow_the_command() {
         let init = data_fields(Kind::SdoRx, &[0x40, 0x41, 0x60, 0, 0, 0, 0, 0]);
-        assert_eq!(init.iter().map(|(_, n)| *n).collect::<Vec<_>>(), ["command", "index", "subindex", "data"]);
+        assert_eq!(
+            init.iter().map(|(_, n)| *n).collect::<Vec<_>>(),
+            ["command", "index", "subindex", "data"]
+        );
         let seg = data_fields(Kind::SdoTx, &[0x00, 1, 2, 3, 4, 5, 6, 7]);
         assert_eq!(seg[1], (1..8, "segment data"));
         assert_eq!(data_bytes(Kind::Heartbeat, &[0x05])[0].canopen_bits, [7, 0]);

@@ -1,6 +1,6 @@
 //! `--summary`: per-node and per-kind totals.
 
-use crate::analysis::busload::{BusJson, BusLoad};
+use super::busload::{BusJson, BusLoad};
 use crate::decode::Kind;
 use crate::frame::{Frame, Interfaces, NodeKey};
 use serde::Serialize;
@@ -35,7 +35,10 @@ pub struct Summary {
 impl Summary {
     /// Empty totals whose bits on the wire are counted by `bus` (its bit rate set).
     pub fn with_bus(bus: BusLoad) -> Summary {
-        Summary { bus, ..Summary::default() }
+        Summary {
+            bus,
+            ..Summary::default()
+        }
     }
 
     /// Counts one frame of the first interface.

@@ -50,14 +50,17 @@ fn explain_of_canworks_example_gives_its_figures() {
     assert_eq!(j["split"]["node"], 5);
     assert_eq!(j["data"][0]["canopen_bits"], serde_json::json!([7, 0]));
     let (_, text, _) = explain(&["--bitrate", "1M", "185#2500EA00"]);
-    assert!(text.contains("79 bits (+ 3 intermission), 3 stuff bits, CRC-15 0x47DC, 79.0 µs at 1000 kbit/s\n"), "{text}");
+    assert!(
+        text.contains("79 bits (+ 3 intermission), 3 stuff bits, CRC-15 0x47DC, 79.0 µs at 1000 kbit/s\n"),
+        "{text}"
+    );
 }
 
 #[test]
 fn a_malformed_frame_says_why_and_exits_1() {
     for (frame, why) in [
         ("800#11", "11-bit CAN id above 7FF"),
-        ("185#2500EA", "column"),
+        ("12345678#R9", "remote frame length must be a digit 0..8"),
         ("185##1000102030405060708090A0B0C", "no CAN FD DLC gives 13 bytes"),
         ("hello", "expected a CAN id"),
     ] {
@@ -78,7 +81,16 @@ fn a_malformed_frame_says_why_and_exits_1() {
 /// the second, 0.364 ms.
 #[test]
 fn summary_bus_figures_by_hand() {
-    let out = cotui(&["decode", "--summary", "--format", "jsonl", "tests/fixtures/bus_load.log"], None);
+    let out = cotui(
+        &[
+            "decode",
+            "--summary",
+            "--format",
+            "jsonl",
+            "tests/fixtures/bus_load.log",
+        ],
+        None,
+    );
     let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(
         j["bus"],
@@ -87,14 +99,34 @@ fn summary_bus_figures_by_hand() {
             "load": 0.000492, "by_node": {"5": 246}, "busiest_100ms": 0.00328, "longest_burst_ms": 0.364
         })
     );
-    let out = cotui(&["decode", "--summary", "--bitrate", "250k", "tests/fixtures/bus_load.log"], None);
+    let out = cotui(
+        &[
+            "decode",
+            "--summary",
+            "--bitrate",
+            "250k",
+            "tests/fixtures/bus_load.log",
+        ],
+        None,
+    );
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(
         text.contains("bus: 246 bits (9 stuff bits) at 250 kbit/s (given): load 0.10 %, busiest 100 ms 0.66 %, longest burst 0.528 ms\n  node 5          246 bits\n"),
         "{text}"
     );
     // The same figures through --filter (its own summary path).
-    let out = cotui(&["decode", "--summary", "--format", "jsonl", "--filter", "node 5", "tests/fixtures/bus_load.log"], None);
+    let out = cotui(
+        &[
+            "decode",
+            "--summary",
+            "--format",
+            "jsonl",
+            "--filter",
+            "node 5",
+            "tests/fixtures/bus_load.log",
+        ],
+        None,
+    );
     let f: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(f["bus"]["bits"], 246);
 }

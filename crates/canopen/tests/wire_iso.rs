@@ -122,7 +122,14 @@ fn check(f: &Frame) -> Result<(), TestCaseError> {
 }
 
 fn classic() -> impl Strategy<Value = Frame> {
-    (any::<bool>(), any::<u32>(), any::<bool>(), proptest::collection::vec(any::<u8>(), 0..=8), 9u8..=15, any::<bool>())
+    (
+        any::<bool>(),
+        any::<u32>(),
+        any::<bool>(),
+        proptest::collection::vec(any::<u8>(), 0..=8),
+        9u8..=15,
+        any::<bool>(),
+    )
         .prop_map(|(ext, id, rtr, data, raw, use_raw)| {
             let mut f = Frame::classic(0, &data);
             f.id = if ext { id & 0x1FFF_FFFF } else { id & 0x7FF };
@@ -140,9 +147,19 @@ fn classic() -> impl Strategy<Value = Frame> {
 
 fn fd() -> impl Strategy<Value = Frame> {
     let lens = prop::sample::select(vec![0u8, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64]);
-    (any::<bool>(), any::<u32>(), lens, proptest::collection::vec(any::<u8>(), 64), any::<bool>(), any::<bool>())
+    (
+        any::<bool>(),
+        any::<u32>(),
+        lens,
+        proptest::collection::vec(any::<u8>(), 64),
+        any::<bool>(),
+        any::<bool>(),
+    )
         .prop_map(|(ext, id, len, data, brs, esi)| {
-            let mut f = Frame { len, ..Frame::default() };
+            let mut f = Frame {
+                len,
+                ..Frame::default()
+            };
             f.data[..len as usize].copy_from_slice(&data[..len as usize]);
             f.id = if ext { id & 0x1FFF_FFFF } else { id & 0x7FF };
             f.flags.set(Flags::EXT, ext);
@@ -156,7 +173,11 @@ fn fd() -> impl Strategy<Value = Frame> {
 /// Runs of equal bytes (0x00, 0xFF) stuff the most: make them likely.
 fn sparse_classic() -> impl Strategy<Value = Frame> {
     let byte = prop::sample::select(vec![0x00u8, 0xFF, 0x0F, 0xF0, 0x7E, 0x81]);
-    (any::<bool>(), prop::sample::select(vec![0u32, 0x7FF, 0x1FFF_FFFF, 0x80, 0x3E0]), proptest::collection::vec(byte, 0..=8))
+    (
+        any::<bool>(),
+        prop::sample::select(vec![0u32, 0x7FF, 0x1FFF_FFFF, 0x80, 0x3E0]),
+        proptest::collection::vec(byte, 0..=8),
+    )
         .prop_map(|(ext, id, data)| {
             let mut f = Frame::classic(0, &data);
             f.id = if ext { id } else { id & 0x7FF };

@@ -212,7 +212,10 @@ pub fn wire_lines(f: &Frame, bitrate: u64) -> Vec<Line<'static>> {
         if wide && !line.is_empty() {
             v.push(Line::from(std::mem::take(&mut line)));
         }
-        line.push(Span::styled(format!("{} ", field.as_str()), Style::default().fg(Color::DarkGray)));
+        line.push(Span::styled(
+            format!("{} ", field.as_str()),
+            Style::default().fg(Color::DarkGray),
+        ));
         // Stuff bits come as `[b]`: shown as the bit alone, highlighted.
         let mut rest = bits.as_str();
         while !rest.is_empty() {

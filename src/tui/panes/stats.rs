@@ -6,9 +6,9 @@
 //! its periods is dimmed (stale). A key cycles the sort.
 
 use super::{Component, Ctx, ListState, Outcome, block, duration, fit, header, selected};
-use crate::analysis::busload::BitrateSource;
 use crate::analysis::stats::{IdStats, Stats};
 use crate::analysis::trace::Trace;
+use crate::output::busload::BitrateSource;
 use crate::tui::keymap::Action;
 use ratatui::Frame;
 use ratatui::layout::Rect;
@@ -136,7 +136,11 @@ impl Component for StatsPane {
     fn render(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
         let st = &ctx.trace.stats;
         let rate = st.bitrate();
-        let assumed = if rate.source == BitrateSource::Assumed { " (assumed)" } else { "" };
+        let assumed = if rate.source == BitrateSource::Assumed {
+            " (assumed)"
+        } else {
+            ""
+        };
         let title = format!(
             " Receive list by {} — bus load {:.1}% at {} kbit/s{assumed}, {} fr in the last 1 s ",
             self.sort.name(),

@@ -162,7 +162,10 @@ impl fmt::Display for WireError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
             WireError::ErrorFrame => {
-                write!(f, "an error frame is a report of the controller, not a frame on the wire")
+                write!(
+                    f,
+                    "an error frame is a report of the controller, not a frame on the wire"
+                )
             }
             WireError::IdRange { id, ext: false } => {
                 write!(f, "identifier 0x{id:X} does not fit 11 bits (at most 0x7FF)")
@@ -473,7 +476,12 @@ fn walk(layout: &Layout, out: &mut dyn FnMut(Bit)) -> Figures {
             }
         }
     }
-    for (field, n) in [(Field::CrcDelim, 1), (Field::AckSlot, 1), (Field::AckDelim, 1), (Field::Eof, 7)] {
+    for (field, n) in [
+        (Field::CrcDelim, 1),
+        (Field::AckSlot, 1),
+        (Field::AckDelim, 1),
+        (Field::Eof, 7),
+    ] {
         for _ in 0..n {
             emit(true, field, false);
         }

@@ -15,7 +15,14 @@ fn canworks_example() {
     assert_eq!(w.figures, f);
     assert_eq!(w.bits.len(), 79);
     assert_eq!(w.bits.iter().filter(|b| b.stuff).count(), 3);
-    assert_eq!(w.bits[0], Bit { level: false, field: Field::Sof, stuff: false });
+    assert_eq!(
+        w.bits[0],
+        Bit {
+            level: false,
+            field: Field::Sof,
+            stuff: false
+        }
+    );
     assert_eq!(w.bits.iter().filter(|b| b.field == Field::Eof).count(), 7);
 }
 
@@ -30,7 +37,11 @@ fn every_stuff_bit_follows_five_equal_bits_and_has_the_other_level() {
                 if b.stuff {
                     assert_eq!(run, (!b.level, 5), "{id:X} {data:?}");
                 }
-                run = if b.level == run.0 { (run.0, run.1 + 1) } else { (b.level, 1) };
+                run = if b.level == run.0 {
+                    (run.0, run.1 + 1)
+                } else {
+                    (b.level, 1)
+                };
                 assert!(run.1 <= 5, "six equal bits in {id:X} {data:?}");
             }
         }
@@ -51,7 +62,12 @@ fn refusals_say_why() {
     let mut fd = frame(0x185, &[]);
     fd.flags = Flags(Flags::FD);
     fd.len = 13;
-    assert!(figures(&fd).unwrap_err().to_string().contains("no CAN FD DLC gives 13 bytes"));
+    assert!(
+        figures(&fd)
+            .unwrap_err()
+            .to_string()
+            .contains("no CAN FD DLC gives 13 bytes")
+    );
     fd.len = 8;
     fd.flags = Flags(Flags::FD | Flags::RTR);
     assert_eq!(figures(&fd), Err(WireError::FdRemote));
@@ -67,7 +83,12 @@ fn remote_frames_carry_no_data_but_their_dlc() {
     r.len = 1;
     let w = rebuild(&r).unwrap();
     assert!(w.bits.iter().all(|b| b.field != Field::Data));
-    let dlc: Vec<bool> = w.bits.iter().filter(|b| b.field == Field::Dlc && !b.stuff).map(|b| b.level).collect();
+    let dlc: Vec<bool> = w
+        .bits
+        .iter()
+        .filter(|b| b.field == Field::Dlc && !b.stuff)
+        .map(|b| b.level)
+        .collect();
     assert_eq!(dlc, [false, false, false, true]);
     assert_eq!(figures(&r).unwrap(), w.figures);
 }
@@ -79,7 +100,11 @@ fn fd_frames_have_a_stuff_count_and_fixed_stuff_bits() {
     fd.len = 20;
     let w = rebuild(&fd).unwrap();
     assert_eq!(w.figures.crc_bits, 21);
-    let tail = w.bits.iter().skip_while(|b| !matches!(b.field, Field::StuffCount)).take_while(|b| b.field != Field::CrcDelim);
+    let tail = w
+        .bits
+        .iter()
+        .skip_while(|b| !matches!(b.field, Field::StuffCount))
+        .take_while(|b| b.field != Field::CrcDelim);
     // 4 stuff count bits + 21 CRC bits with 7 fixed stuff bits.
     let (fixed, plain): (Vec<&Bit>, Vec<&Bit>) = tail.partition(|b| b.stuff);
     assert_eq!((fixed.len(), plain.len()), (7, 25));

@@ -176,7 +176,9 @@ impl BusLoad {
     /// Every node's bits, in node order.
     pub fn by_node(&self) -> Vec<(NodeKey, u64)> {
         let first = self.first_nodes.iter().enumerate();
-        let first = first.filter(|(_, b)| **b > 0).map(|(n, b)| (NodeKey::new(0, n as u8), *b));
+        let first = first
+            .filter(|(_, b)| **b > 0)
+            .map(|(n, b)| (NodeKey::new(0, n as u8), *b));
         let mut all: Vec<(NodeKey, u64)> = first.chain(self.other_nodes.iter().map(|(k, b)| (*k, *b))).collect();
         all.sort();
         all
@@ -274,12 +276,18 @@ mod tests {
         assert_eq!(j["bitrate_source"], "assumed");
         assert_eq!(j["by_node"]["5"], 164);
         // The busiest 100 ms holds the first two frames: of the 50,000 bits 100 ms holds.
-        assert_eq!(j["busiest_100ms"], round6((82 + u64::from(sync.bus_bits())) as f64 / 50_000.0));
+        assert_eq!(
+            j["busiest_100ms"],
+            round6((82 + u64::from(sync.bus_bits())) as f64 / 50_000.0)
+        );
     }
 
     #[test]
     fn a_burst_lasts_while_frames_follow_each_other() {
-        let mut b = BusLoad::new(Bitrate { bps: 1_000_000, source: BitrateSource::Option });
+        let mut b = BusLoad::new(Bitrate {
+            bps: 1_000_000,
+            source: BitrateSource::Option,
+        });
         // 82 bits at 1 Mbit/s: 82 µs each; frames every 100 µs are one burst.
         for i in 0..10u64 {
             let mut f = at(0, 0x185, &[0x25, 0, 0xEA, 0]);
