@@ -63,12 +63,12 @@ pub fn run(args: &ExplainArgs) -> ExitCode {
                 continue;
             }
         };
-        if let Err(e) = crate::wire::figures(&frame) {
-            if !frame.is_err() {
-                eprintln!("cotui explain: {text}: {e}");
-                status = ExitCode::Usage;
-                continue;
-            }
+        if let Err(e) = crate::wire::figures(&frame)
+            && !frame.is_err()
+        {
+            eprintln!("cotui explain: {text}: {e}");
+            status = ExitCode::Usage;
+            continue;
         }
         let decoded = decoder.decode(&frame);
         let e = crate::output::explain::Explained {

@@ -201,7 +201,7 @@ impl BusLoad {
 
     /// The figures as text lines (after the summary's `by node:`), nodes named by `name`.
     pub fn to_text(&self, name: impl Fn(NodeKey) -> String) -> String {
-        let j = self.to_json(|k| name(k));
+        let j = self.to_json(name);
         let load = j.load.map_or("-".to_string(), |l| format!("{:.2} %", l * 100.0));
         let mut s = format!(
             "bus: {} bits ({} stuff bits) at {} kbit/s ({}): load {load}, busiest 100 ms {:.2} %, longest burst {:.3} ms\n",

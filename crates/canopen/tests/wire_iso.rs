@@ -3,6 +3,9 @@
 //! standard's shift-register pseudo-code, stuffing by scanning for runs. Thousands of
 //! random classic and CAN FD frames must give the same bits, stuff bits and CRC.
 
+// Test code may unwrap: a failed unwrap is a failed test with its location.
+#![allow(clippy::unwrap_used)]
+
 use canopen::frame::{Flags, Frame};
 use canopen::wire::{figures, rebuild};
 use proptest::prelude::*;

@@ -222,7 +222,7 @@ impl BitBuf {
     }
     /// Appends whole bytes (the data field).
     fn push_bytes(&mut self, data: &[u8]) {
-        if self.len % 8 == 0 {
+        if self.len.is_multiple_of(8) {
             self.bytes[self.len / 8..self.len / 8 + data.len()].copy_from_slice(data);
             self.len += 8 * data.len();
         } else {
@@ -446,7 +446,7 @@ fn walk(layout: &Layout, out: &mut dyn FnMut(Bit)) -> Figures {
         let mut last = state & 0b100 != 0;
         let count = stuffs % 8;
         let gray = count ^ (count >> 1);
-        let parity = (gray.count_ones() & 1) as u32;
+        let parity = gray.count_ones() & 1;
         let sc = (gray << 1) | parity;
         for k in (0..4).rev() {
             crc = crc_bit(crc, (sc >> k) & 1 == 1, crc_bits, poly);
