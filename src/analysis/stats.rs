@@ -8,6 +8,7 @@
 //! [`IdStats::stale`] tells when it passed [`STALE_PERIODS`] of its mean periods.
 
 use super::store::{Packed, Store};
+use crate::output::busload::Bitrate;
 use std::collections::BTreeMap;
 
 /// Statistics of one identifier.
@@ -90,7 +91,7 @@ pub struct Stats {
     entries: Vec<IdStats>,
     /// Index in `entries` (+1, 0 for none) of each 11-bit id: no map search per frame.
     base: Vec<u32>,
-    bitrate: u64,
+    bitrate: Bitrate,
     window_bits: u64,
     window_start: usize,
     now_ns: u64,
@@ -99,13 +100,17 @@ pub struct Stats {
 }
 
 impl Stats {
-    /// Empty statistics for a bus at `bitrate` bit/s.
-    pub fn new(bitrate: u64) -> Stats {
+    /// Empty statistics for a bus at `bitrate` (bit/s, or a [`Bitrate`] with its source).
+    pub fn new(bitrate: impl Into<Bitrate>) -> Stats {
+        let bitrate = bitrate.into();
         Stats {
             ids: BTreeMap::new(),
             entries: Vec::new(),
             base: vec![0; 0x800],
-            bitrate: bitrate.max(1),
+            bitrate: Bitrate {
+                bps: bitrate.bps.max(1),
+                ..bitrate
+            },
             window_bits: 0,
             window_start: 0,
             now_ns: 0,
@@ -133,8 +138,8 @@ impl Stats {
         self.now_ns
     }
 
-    /// The bus bit rate used for the load.
-    pub fn bitrate(&self) -> u64 {
+    /// The bus bit rate used for the load, and where it came from.
+    pub fn bitrate(&self) -> Bitrate {
         self.bitrate
     }
 
@@ -162,7 +167,7 @@ impl Stats {
         s.last_ns = p.ts_ns;
         s.in_window += 1;
         self.start_ns.get_or_insert(p.ts_ns);
-        self.window_bits += p.wire_bits();
+        self.window_bits += store.bus_bits(store.len() - 1);
         self.tick(p.ts_ns, store);
     }
 
@@ -176,7 +181,7 @@ impl Stats {
         };
         while self.window_start < store.len() && store.packed(self.window_start).ts_ns <= since {
             let old = *store.packed(self.window_start);
-            self.window_bits = self.window_bits.saturating_sub(old.wire_bits());
+            self.window_bits = self.window_bits.saturating_sub(store.bus_bits(self.window_start));
             let i = self.index(old.is_ext(), old.id);
             let e = &mut self.entries[i];
             e.in_window = e.in_window.saturating_sub(1);
@@ -205,7 +210,7 @@ impl Stats {
 
     /// Bus load in percent over the last second of the trace.
     pub fn load_percent(&self) -> f64 {
-        self.window_bits as f64 * 100.0 / self.bitrate as f64
+        self.window_bits as f64 * 100.0 / self.bitrate.bps as f64
     }
 
     /// Frames in the last second of the trace.
@@ -255,9 +260,20 @@ mod tests {
         assert!((st.rate(&s) - 125.0).abs() < 1e-6, "5 frames in 40 ms: {}", st.rate(&s));
         assert!((s.last_period().unwrap() - 0.008).abs() < 1e-9);
         assert_eq!((s.last_pos, s.prev_pos), (4, Some(3)));
-        // 5 base frames of 8 bytes, 135 bits each at worst (see store::wire_bits), in the
-        // last second: 675 bits of 125000 = 0.54 %.
-        assert!((st.load_percent() - 0.54).abs() < 1e-9, "{}", st.load_percent());
+        // 5 base frames of 8 bytes, their exact bits on the wire (crate::wire) in the last
+        // second, of 125000.
+        let bits: u64 = (0..5).map(|i| store.bus_bits(i)).sum();
+        assert_eq!(
+            bits,
+            (0..5u8)
+                .map(|i| crate::output::busload::bus_bits(&Frame::classic(0x181, &[i; 8])))
+                .sum::<u64>()
+        );
+        assert!(
+            (st.load_percent() - bits as f64 * 100.0 / 125_000.0).abs() < 1e-9,
+            "{}",
+            st.load_percent()
+        );
     }
 
     #[test]

@@ -57,53 +57,6 @@ impl Packed {
     pub fn is_ext(&self) -> bool {
         Flags(self.flags).has(Flags::EXT)
     }
-    /// Bits the frame takes on the wire at worst, for the bus load: see [`wire_bits`].
-    pub fn wire_bits(&self) -> u64 {
-        wire_bits(Flags(self.flags), self.len)
-    }
-}
-
-/// Bits after the CRC that are never stuffed: CRC delimiter, ACK slot, ACK delimiter (3),
-/// end of frame (7) and the intermission between frames (3).
-const TAIL_BITS: u64 = 3 + 7 + 3;
-
-/// The most bits a frame with `flags` and `len` payload bytes takes on the bus, the
-/// intermission after it included, in nominal bit times.
-///
-/// Classic CAN: the stuffed part is SOF, identifier, RTR, IDE, r0, DLC and CRC: 34 bits for a
-/// base frame (1 + 11 + 1 + 1 + 1 + 4 + 15), 54 for an extended one (1 + 11 + SRR 1 + IDE 1 +
-/// 18 + RTR 1 + r1 1 + r0 1 + 4 + 15), plus `8 * len` data bits (none for a remote frame).
-/// In the worst case a stuff bit follows the first 5 equal bits and then every 4 bits (the
-/// stuff bit starts the next run), so `L` stuffed bits gain `(L - 1) / 4`. Then the 13
-/// fixed tail bits. A base frame with n bytes is `34 + 8n + (33 + 8n) / 4 + 13` bits:
-/// 55 for n = 0, 135 for n = 8; an extended 8-byte frame is 160.
-///
-/// CAN FD: the dynamically stuffed part is SOF, identifier, RRS, IDE, FDF, res, BRS, ESI,
-/// DLC and data (22 + 8n base, 41 + 8n extended with SRR and the 18-bit extension); then
-/// the 4-bit stuff count and the CRC (17 bits up to 16 bytes, 21 above) with a fixed stuff
-/// bit before the stuff count and after every 4 bits (6 or 7), then the 13 tail bits.
-/// Approximation: every bit is counted at the nominal rate, so a frame with BRS (whose
-/// data phase runs faster, at a rate the trace does not know) counts as an upper bound.
-///
-/// SocketCAN error frames are reports of the controller, not frames on the wire: 0 bits.
-pub fn wire_bits(flags: Flags, len: u8) -> u64 {
-    if flags.has(Flags::ERR) {
-        return 0;
-    }
-    let ext = flags.has(Flags::EXT);
-    let n = u64::from(len);
-    let worst_stuff = |stuffed: u64| (stuffed - 1) / 4;
-    if flags.has(Flags::FD) {
-        let stuffed = if ext { 41 } else { 22 } + 8 * n;
-        let crc = if n > 16 { 21 } else { 17 };
-        let checked = 4 + crc;
-        let fixed_stuff = 1 + (checked - 1) / 4;
-        stuffed + worst_stuff(stuffed) + checked + fixed_stuff + TAIL_BITS
-    } else {
-        let data = if flags.has(Flags::RTR) { 0 } else { 8 * n };
-        let stuffed = if ext { 54 } else { 34 } + data;
-        stuffed + worst_stuff(stuffed) + TAIL_BITS
-    }
 }
 
 /// The trace store.
@@ -118,6 +71,12 @@ impl Store {
     /// An empty store.
     pub fn new() -> Store {
         Store::default()
+    }
+
+    /// The bits frame `i` takes on the bus, its intermission included (exact: rebuilt as
+    /// sent, see [`crate::wire`]; 0 for an error frame).
+    pub fn bus_bits(&self, i: usize) -> u64 {
+        crate::output::busload::bus_bits(&self.frame(i))
     }
 
     /// Number of stored frames.
@@ -247,41 +206,5 @@ mod tests {
         assert_eq!(s.packed(5).node(), Some(1));
         assert_eq!(s.packed(at).node(), None);
         assert_eq!(s.position_at(25), 3);
-    }
-
-    /// Worst-case bits, hand-computed as stuffed + (stuffed - 1) / 4 + 13 tail bits.
-    #[test]
-    fn wire_bits_of_classic_frames() {
-        let mut s = Store::new();
-        // SYNC, base, no data: 34 stuffed + 33/4 = 8 stuff bits + 13 = 55.
-        s.push(&Frame::classic(0x80, &[]), Kind::Sync, None);
-        // TPDO, base, 8 bytes: 34 + 64 = 98 stuffed + 97/4 = 24 + 13 = 135.
-        s.push(&Frame::classic(0x181, &[0; 8]), Kind::Tpdo, Some(1));
-        // Extended, 8 bytes: 54 + 64 = 118 stuffed + 117/4 = 29 + 13 = 160.
-        s.push(&Frame::classic(0x1234_5678, &[0; 8]), Kind::Other, None);
-        // Base, 1 byte: 42 stuffed + 41/4 = 10 + 13 = 65.
-        s.push(&Frame::classic(0x701, &[0x05]), Kind::Heartbeat, Some(1));
-        let bits: Vec<u64> = (0..4).map(|i| s.packed(i).wire_bits()).collect();
-        assert_eq!(bits, [55, 135, 160, 65]);
-    }
-
-    #[test]
-    fn wire_bits_of_remote_error_and_fd_frames() {
-        let rtr = Flags(Flags::RTR);
-        // A remote frame carries no data whatever its DLC: base 55, extended 54 + 53/4 = 13 + 13 = 80.
-        assert_eq!(wire_bits(rtr, 8), 55);
-        assert_eq!(wire_bits(Flags(Flags::RTR | Flags::EXT), 4), 80);
-        assert_eq!(wire_bits(Flags(Flags::ERR), 8), 0);
-        let fd = Flags(Flags::FD);
-        // FD base, 8 bytes: 22 + 64 = 86 stuffed + 85/4 = 21; stuff count + CRC-17 = 21 bits
-        // with 1 + 20/4 = 6 fixed stuff bits; + 13 tail: 86 + 21 + 21 + 6 + 13 = 147.
-        assert_eq!(wire_bits(fd, 8), 147);
-        // FD base, 64 bytes: 534 stuffed + 533/4 = 133; 4 + CRC-21 = 25 bits with 1 + 24/4 = 7
-        // fixed stuff bits; + 13: 534 + 133 + 25 + 7 + 13 = 712.
-        assert_eq!(wire_bits(fd, 64), 712);
-        // FD extended, 16 bytes (still CRC-17): 41 + 128 = 169 + 168/4 = 42; 21 + 6; 13: 251.
-        assert_eq!(wire_bits(Flags(Flags::FD | Flags::EXT), 16), 251);
-        // BRS changes nothing: counted at the nominal rate (an upper bound).
-        assert_eq!(wire_bits(Flags(Flags::FD | Flags::BRS), 8), 147);
     }
 }

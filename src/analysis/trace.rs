@@ -24,6 +24,7 @@ use super::transfers::Transfers;
 use super::values::Values;
 use crate::decode::{Body, Decoded, Decoder, Kind};
 use crate::frame::{Frame, Interfaces, NodeKey};
+use crate::output::busload::Bitrate;
 use crate::output::summary::Summary;
 use crate::sdo::Transaction;
 
@@ -88,18 +89,18 @@ pub struct Trace {
 
 impl Trace {
     /// An empty trace decoded with `decoder`, keeping every view (the TUI's).
-    pub fn new(decoder: Decoder, bitrate: u64) -> Trace {
+    pub fn new(decoder: Decoder, bitrate: impl Into<Bitrate>) -> Trace {
         Trace::with_views(decoder, bitrate, Views::All)
     }
 
     /// An empty trace for a headless command, keeping `views` (the bus load, kept with
     /// [`Views::All`] only, would be counted against 500 kbit/s).
     pub fn headless(decoder: Decoder, views: Views) -> Trace {
-        Trace::with_views(decoder, 500_000, views)
+        Trace::with_views(decoder, Bitrate::ASSUMED, views)
     }
 
     /// An empty trace decoded with `decoder` that keeps `views`.
-    pub fn with_views(decoder: Decoder, bitrate: u64, views: Views) -> Trace {
+    pub fn with_views(decoder: Decoder, bitrate: impl Into<Bitrate>, views: Views) -> Trace {
         let nodes = Nodes::new(&decoder);
         let diagnosis = Diagnoser::new(|n| decoder.dictionary(n));
         let events = EventTracker::new(|n| decoder.dictionary(n));
@@ -169,7 +170,7 @@ impl Trace {
             Views::All => self.index(frame),
             Views::Summary => {
                 let (kind, node) = self.decoder.classify(frame);
-                self.summary.add_on(frame.iface, kind, node);
+                self.summary.add_frame(frame, kind, node);
                 if matches!(kind, Kind::SdoRx | Kind::SdoTx) {
                     // Only SDO frames complete transfers; none is kept (memory stays flat).
                     self.decoder.take_transactions();

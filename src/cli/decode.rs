@@ -6,6 +6,7 @@ use crate::command::ExitCode;
 use crate::decode::Decoder;
 use crate::frame::json::write_line;
 use crate::od::Dictionary;
+use crate::output::busload::{Bitrate, BusLoad};
 use crate::output::{jsonl, summary::Summary, text};
 use crate::sdo::Transaction;
 use clap::{Args, ValueEnum};
@@ -43,6 +44,10 @@ pub struct DecodeArgs {
     /// Print per-node and per-kind totals only.
     #[arg(long, conflicts_with = "transactions")]
     pub summary: bool,
+    /// Bus bit rate for the `--summary` bus load, in bit/s (500000, 500k, 1M); without it
+    /// 500 kbit/s is assumed, and the summary says so.
+    #[arg(long, value_parser = super::tui::bitrate_arg, value_name = "R")]
+    pub bitrate: Option<u64>,
     /// Print bus events instead of frames: boot-up, NMT state change, heartbeat lost/back,
     /// heartbeat period (0x1017), EMCY, SDO abort, controller state (error frames).
     #[arg(long, conflicts_with_all = ["transactions", "summary"])]
@@ -97,7 +102,11 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
         None
     };
     let mut run = match view {
-        Some(v) => Pipeline::View(Box::new(Trace::headless(decoder, v))),
+        Some(v) => {
+            let mut trace = Trace::headless(decoder, v);
+            trace.summary.bus = BusLoad::new(Bitrate::given_or_assumed(args.bitrate));
+            Pipeline::View(Box::new(trace))
+        }
         None => Pipeline::Frames(Box::new(decoder)),
     };
     let mut out = match super::decode_out::open(args.output.as_deref(), false) {

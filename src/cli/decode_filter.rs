@@ -9,14 +9,15 @@ use crate::analysis::filter::{Facts, Filter};
 use crate::analysis::transfers::Transfers;
 use crate::command::ExitCode;
 use crate::decode::{Decoder, Kind};
+use crate::output::busload::{Bitrate, BusLoad};
 use crate::output::{jsonl, summary::Summary, text};
 use std::io::{self, Write};
 
 /// What a matching frame gives: its output line, or its kind and node for the totals.
 enum Out {
     Line(Vec<u8>),
-    /// A frame of (interface, kind, node) to count.
-    Count(u16, Kind, Option<u8>),
+    /// A frame with its kind and node to count.
+    Count(Box<crate::frame::Frame>, Kind, Option<u8>),
 }
 
 /// What a filtered run writes.
@@ -84,7 +85,7 @@ pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
         filter,
         mode,
         format: args.format,
-        summary: Summary::default(),
+        summary: Summary::with_bus(BusLoad::new(Bitrate::given_or_assumed(args.bitrate))),
         transfers: Transfers::new(),
         names: Vec::new(),
         pos: 0,
@@ -145,7 +146,7 @@ impl Run {
                 self.stream.frame(self.pos, facts, d, &done, |d| {
                     let mut s = Vec::new();
                     match (mode, format) {
-                        (Mode::Summary, _) => return Out::Count(frame.iface, d.kind, d.node),
+                        (Mode::Summary, _) => return Out::Count(Box::new(*frame), d.kind, d.node),
                         (_, OutputFormat::Text) => text::write_line(&mut s, frame, ifaces, d),
                         _ => jsonl::write_frame(&mut s, line, frame, ifaces, d),
                     }
@@ -167,7 +168,7 @@ impl Run {
     fn take(&mut self, buf: &mut Vec<u8>, ready: Vec<Out>) {
         for o in ready {
             match o {
-                Out::Count(iface, kind, node) => self.summary.add_on(iface, kind, node),
+                Out::Count(frame, kind, node) => self.summary.add_frame(&frame, kind, node),
                 Out::Line(s) => buf.extend_from_slice(&s),
             }
         }

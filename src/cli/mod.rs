@@ -7,6 +7,7 @@ mod decode_filter;
 mod decode_out;
 mod decode_parquet;
 pub mod diagnose;
+pub mod explain;
 pub mod input;
 pub mod record;
 pub mod run;
@@ -42,6 +43,9 @@ pub enum Command {
     Decode(decode::DecodeArgs),
     /// What went wrong on the bus, in plain words: incidents with cause, timeline and what to check.
     Diagnose(diagnose::DiagnoseArgs),
+    /// Explain frames: identifier split, CANopen meaning, data bits by field, and the frame
+    /// on the wire (stuff bits, CRC, bits and time at the bit rate).
+    Explain(explain::ExplainArgs),
     /// Print throughput and memory figures of the decoder on a generated log.
     Bench(crate::bench::BenchArgs),
     /// Open a log in the interactive analyzer (loads at once; browse, filter, search).
@@ -69,6 +73,7 @@ Browse a log:              cotui open FILE
 Replay a log:              cotui replay FILE [--speed 2]
 Decode a candump log:      cotui decode FILE [--format jsonl] [--transactions] [--summary]
 What went wrong:           cotui diagnose FILE [--format jsonl] [--check]
+A frame bit by bit:        cotui explain 185#2500EA00 [--bitrate 250k]
 All commands:              cotui --help
 ";
 
@@ -87,6 +92,7 @@ pub fn run() -> ExitCode {
         }
         Some(Command::Decode(args)) => decode::run(&args),
         Some(Command::Diagnose(args)) => diagnose::run(&args),
+        Some(Command::Explain(args)) => explain::run(&args),
         Some(Command::Bench(args)) => crate::bench::run(&args),
         Some(Command::Open(args)) => tui::run_open(&args),
         Some(Command::Replay(args)) => tui::run_replay(&args),

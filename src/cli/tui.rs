@@ -2,6 +2,7 @@
 
 use crate::analysis::trace::Trace;
 use crate::command::ExitCode;
+use crate::output::busload::Bitrate;
 use crate::tui::app::{App, SourceInfo, SourceKind};
 use crate::tui::keymap::{self, Keymap, KeymapError};
 use crate::tui::source;
@@ -15,9 +16,10 @@ pub struct UiArgs {
     /// directory then overrides key by key.
     #[arg(long, value_name = "NAME|FILE", default_value = "default")]
     pub keymap: String,
-    /// Nominal bus bit rate for the bus load figure, in bit/s (500000, 500k, 1M).
-    #[arg(long, value_parser = bitrate_arg, default_value_t = 500_000)]
-    pub bitrate: u64,
+    /// Nominal bus bit rate for the bus load figure, in bit/s (500000, 500k, 1M); without
+    /// it 500 kbit/s is assumed, and the Stats pane says so.
+    #[arg(long, value_parser = bitrate_arg)]
+    pub bitrate: Option<u64>,
     /// Initial filter (see the filter language in `?`).
     #[arg(long)]
     pub filter: Option<String>,
@@ -187,7 +189,7 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> ExitCode {
             SourceInfo::live(name, kind, rx, req)
         }
     };
-    let mut app = App::new(Trace::new(decoder, ui.bitrate), keymap, src);
+    let mut app = App::new(Trace::new(decoder, Bitrate::given_or_assumed(ui.bitrate)), keymap, src);
     app.set_bindings(bindings);
     if let Some(f) = &ui.filter {
         app.set_filter(f);

@@ -1,6 +1,8 @@
 //! Headless renderings of decoded frames: text lines, JSON lines, SDO
 //! transactions and summaries, pcapng capture files and Parquet tables. Pure formatting; the caller writes.
 
+pub mod busload;
+pub mod explain;
 pub mod jsonl;
 pub mod parquet;
 pub mod pcapng;

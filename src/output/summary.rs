@@ -1,7 +1,8 @@
 //! `--summary`: per-node and per-kind totals.
 
+use super::busload::{BusJson, BusLoad};
 use crate::decode::Kind;
-use crate::frame::{Interfaces, NodeKey};
+use crate::frame::{Frame, Interfaces, NodeKey};
 use serde::Serialize;
 use std::collections::{BTreeMap, HashMap};
 
@@ -17,6 +18,8 @@ pub struct Summary {
     pub by_node: BTreeMap<NodeKey, BTreeMap<Kind, u64>>,
     /// Frames in all.
     pub frames: u64,
+    /// The bits on the wire (set the bit rate with [`BusLoad::new`] before counting).
+    pub bus: BusLoad,
     kind_counts: Counts,
     /// The first interface's 128 nodes' counters (made on its first node frame): the
     /// common case of one bus stays an array increment.
@@ -30,6 +33,14 @@ pub struct Summary {
 }
 
 impl Summary {
+    /// Empty totals whose bits on the wire are counted by `bus` (its bit rate set).
+    pub fn with_bus(bus: BusLoad) -> Summary {
+        Summary {
+            bus,
+            ..Summary::default()
+        }
+    }
+
     /// Counts one frame of the first interface.
     pub fn add(&mut self, kind: Kind, node: Option<u8>) {
         self.add_on(0, kind, node);
@@ -53,6 +64,13 @@ impl Summary {
                 .entry(NodeKey::new(iface, n & 0x7F))
                 .or_insert([0; Kind::ALL.len()])[k] += 1;
         }
+    }
+
+    /// Counts one frame: its kind and node, and its bits on the wire.
+    #[inline]
+    pub fn add_frame(&mut self, frame: &Frame, kind: Kind, node: Option<u8>) {
+        self.add_on(frame.iface, kind, node);
+        self.bus.add(frame, node);
     }
 
     /// Takes note of the interface names of the frames counted (a source's table grows as
@@ -119,7 +137,19 @@ impl Summary {
                 None => s.push_str(&format!("  node {:<3} {total:>10}  {}\n", node.node, parts.join(" "))),
             }
         }
+        s.push_str(&self.bus.to_text(|k| match self.iface_of(several, k) {
+            Some(iface) => format!("{iface} node {}", k.node),
+            None => format!("node {}", k.node),
+        }));
         s
+    }
+
+    /// The JSON key of a node: its number, or `can1/5` when there are `several` interfaces.
+    fn node_key(&self, several: bool, node: NodeKey) -> String {
+        match self.iface_of(several, node) {
+            Some(iface) => format!("{iface}/{}", node.node),
+            None => node.node.to_string(),
+        }
     }
 
     /// The JSON report of `--summary --format jsonl`.
@@ -127,17 +157,12 @@ impl Summary {
         let several = self.several_ifaces();
         let named = |kinds: &BTreeMap<Kind, u64>| kinds.iter().map(|(k, n)| (k.as_str(), *n)).collect();
         SummaryJson {
+            bus: self.bus.to_json(|k| self.node_key(several, k)),
             by_kind: named(&self.by_kind),
             by_node: self
                 .by_node
                 .iter()
-                .map(|(node, kinds)| {
-                    let key = match self.iface_of(several, *node) {
-                        Some(iface) => format!("{iface}/{}", node.node),
-                        None => node.node.to_string(),
-                    };
-                    (key, named(kinds))
-                })
+                .map(|(node, kinds)| (self.node_key(several, *node), named(kinds)))
                 .collect(),
             frames: self.frames,
         }
@@ -148,6 +173,8 @@ impl Summary {
 /// keys, so nodes are in text order (`"10"` before `"2"`).
 #[derive(Clone, Debug, Serialize)]
 pub struct SummaryJson {
+    /// The bits on the wire and the bus load.
+    pub bus: BusJson,
     /// Frames per kind name.
     pub by_kind: BTreeMap<&'static str, u64>,
     /// Frames per node (its number as text; `"can1/5"` when the input has several

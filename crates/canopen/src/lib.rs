@@ -13,6 +13,8 @@
 //! - [`lss`]: the LSS master, fastscan and slave state machines.
 //! - [`decode`]: the decoder registry: every frame in, its service, node and label out,
 //!   with the bus state (SDO transfers, learned PDO mappings) kept between frames.
+//! - [`wire`]: a frame rebuilt as a controller sends it (stuff bits, CRC, EOF) and its
+//!   figures: bits, stuff bits, CRC, time on the bus.
 //!
 //! # Example
 //! Decode a candump log held in memory:
@@ -43,3 +45,4 @@ pub mod log;
 pub mod lss;
 pub mod od;
 pub mod sdo;
+pub mod wire;

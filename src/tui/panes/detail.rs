@@ -11,7 +11,7 @@ use crate::sdo::{Outcome, SdoCommand, Side, Transaction};
 use ratatui::Frame as TermFrame;
 use ratatui::layout::Rect;
 use ratatui::style::{Color, Modifier, Style};
-use ratatui::text::Line;
+use ratatui::text::{Line, Span};
 use ratatui::widgets::{Paragraph, Wrap};
 
 /// The bits of an SDO command byte, one line each.
@@ -58,6 +58,11 @@ fn frame_lines(trace: &Trace, f: &Frame, d: &Decoded, pos: usize) -> Vec<Line<'s
             d.kind.as_str(),
             d.node.map(|n| n.to_string()).unwrap_or_else(|| "-".into())
         )),
+        Line::raw(match crate::output::explain::split(f) {
+            Some(sp) => format!("{}: {} node {}", sp.text, sp.function, sp.node),
+            None if f.is_err() => format!("error class 0x{:X}", f.id),
+            None => "29-bit identifier: no CANopen split".to_string(),
+        }),
         Line::raw(format!(
             "len {}{}{}{}",
             f.len,
@@ -186,6 +191,55 @@ fn frame_lines(trace: &Trace, f: &Frame, d: &Decoded, pos: usize) -> Vec<Line<'s
         ))),
         _ => {}
     }
+    v.extend(wire_lines(f, trace.stats.bitrate().bps));
+    v
+}
+
+/// The frame on the wire: its figures, then its bits field by field, stuff bits marked.
+pub fn wire_lines(f: &Frame, bitrate: u64) -> Vec<Line<'static>> {
+    let wire = match crate::wire::rebuild(f) {
+        Ok(w) => w,
+        Err(e) => return vec![Line::raw(format!("on the wire: none ({e})"))],
+    };
+    let mut v = vec![Line::raw(format!(
+        "on the wire: {}",
+        crate::output::explain::figures_text(&wire, bitrate)
+    ))];
+    let stuff = Style::default().fg(Color::Yellow).add_modifier(Modifier::BOLD);
+    let mut line: Vec<Span<'static>> = Vec::new();
+    for (field, bits) in crate::output::explain::wire_groups(&wire) {
+        let wide = matches!(field, crate::wire::Field::Data | crate::wire::Field::Crc);
+        if wide && !line.is_empty() {
+            v.push(Line::from(std::mem::take(&mut line)));
+        }
+        line.push(Span::styled(
+            format!("{} ", field.as_str()),
+            Style::default().fg(Color::DarkGray),
+        ));
+        // Stuff bits come as `[b]`: shown as the bit alone, highlighted.
+        let mut rest = bits.as_str();
+        while !rest.is_empty() {
+            if let Some(after) = rest.strip_prefix('[') {
+                line.push(Span::styled(after[..1].to_string(), stuff));
+                rest = &after[2..];
+            } else {
+                let n = rest.find('[').unwrap_or(rest.len());
+                line.push(Span::raw(rest[..n].to_string()));
+                rest = &rest[n..];
+            }
+        }
+        line.push(Span::raw("  "));
+        if wide {
+            v.push(Line::from(std::mem::take(&mut line)));
+        }
+    }
+    if !line.is_empty() {
+        v.push(Line::from(line));
+    }
+    v.push(Line::styled(
+        "stuff bits highlighted; ACK slot as sent (recessive)",
+        Style::default().fg(Color::DarkGray),
+    ));
     v
 }
 

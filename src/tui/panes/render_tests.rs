@@ -267,6 +267,35 @@ fn detail_pane_breaks_the_selected_frame_into_fields() {
     insta::assert_snapshot!(s);
 }
 
+/// canworks' example frame in the Detail pane: the identifier split, then the frame on the
+/// wire field by field with its 3 stuff bits and figures.
+#[test]
+fn detail_pane_shows_the_frame_on_the_wire() {
+    let mut a = app();
+    let mut f = crate::frame::Frame::classic(0x185, &[0x25, 0x00, 0xEA, 0x00]);
+    f.ts_ns = a.trace().nodes.now_ns() + 1_000_000;
+    a.capture_mut().trace_mut().push(&f);
+    a.run_command("goto 45");
+    let s = screen(&mut a, 150, 40);
+    assert!(s.contains("0x185 = 3 x 0x80 + 5: TPDO1 node 5"), "{s}");
+    // (The figures wrap at the pane's width.)
+    assert!(s.contains("on the wire: 79 bits (+ 3 intermission),"), "{s}");
+    assert!(s.contains("3 stuff bits, CRC-15 0x47DC, 158.0 µs at"), "{s}");
+    assert!(s.contains("SOF 0  ID 00110000101  RTR 0  IDE 0  r0"), "{s}");
+    insta::assert_snapshot!(s);
+    // The 3 stuff bits are the only highlighted (yellow) bits.
+    let mut term = ratatui::Terminal::new(ratatui::backend::TestBackend::new(150, 40)).unwrap();
+    term.draw(|fr| crate::tui::ui::draw(fr, &mut a)).unwrap();
+    let buf = term.backend().buffer().clone();
+    let stuffed: Vec<&str> = buf
+        .content()
+        .iter()
+        .filter(|c| c.fg == ratatui::style::Color::Yellow && matches!(c.symbol(), "0" | "1"))
+        .map(|c| c.symbol())
+        .collect();
+    assert_eq!(stuffed, ["1", "1", "0"], "{s}");
+}
+
 #[test]
 fn detail_pane_shows_statusword_bits_of_a_mapped_pdo() {
     let mut a = app();

@@ -8,6 +8,7 @@
 use super::{Component, Ctx, ListState, block, duration, fit, header, selected};
 use crate::analysis::stats::{IdStats, Stats};
 use crate::analysis::trace::Trace;
+use crate::output::busload::BitrateSource;
 use crate::tui::event::{Event, Queue};
 use crate::tui::keymap::Action;
 use ratatui::Frame;
@@ -135,11 +136,17 @@ impl Component for StatsPane {
 
     fn render(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
         let st = &ctx.trace.stats;
+        let rate = st.bitrate();
+        let assumed = if rate.source == BitrateSource::Assumed {
+            " (assumed)"
+        } else {
+            ""
+        };
         let title = format!(
-            " Receive list by {} — bus load {:.1}% at {} kbit/s, {} fr in the last 1 s ",
+            " Receive list by {} — bus load {:.1}% at {} kbit/s{assumed}, {} fr in the last 1 s ",
             self.sort.name(),
             st.load_percent(),
-            st.bitrate() / 1000,
+            rate.bps / 1000,
             st.window_frames(&ctx.trace.store)
         );
         f.render_widget(block(&title, focused), area);

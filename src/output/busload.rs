@@ -1,0 +1,303 @@
+//! Exact bus load: every frame's bits on the wire (SOF to EOF, stuff bits, the 3-bit
+//! intermission; see [`crate::wire`]) summed over the capture, per node, in the busiest
+//! 100 ms and over the longest burst. Error frames are reports of the controller, not
+//! frames on the wire: they count nothing.
+
+use crate::frame::{Frame, NodeKey};
+use serde::Serialize;
+use std::collections::{HashMap, VecDeque};
+
+/// The window of [`BusLoad`]'s busiest stretch: 100 ms.
+const BUSY_WINDOW_NS: u64 = 100_000_000;
+
+/// Where the bit rate of the load came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BitrateSource {
+    /// `--bitrate`.
+    Option,
+    /// The interface's configured rate (live capture).
+    Interface,
+    /// Nobody said: 500 kbit/s is assumed.
+    Assumed,
+}
+
+impl BitrateSource {
+    /// How the text reports say it (`given`, `of the interface`, `assumed`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            BitrateSource::Option => "given",
+            BitrateSource::Interface => "of the interface",
+            BitrateSource::Assumed => "assumed",
+        }
+    }
+}
+
+/// A bus bit rate and where it came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Bitrate {
+    /// Bits per second (nominal, arbitration phase).
+    pub bps: u64,
+    /// Where it came from.
+    pub source: BitrateSource,
+}
+
+impl Bitrate {
+    /// The rate assumed when nobody gives one: 500 kbit/s.
+    pub const ASSUMED: Bitrate = Bitrate {
+        bps: 500_000,
+        source: BitrateSource::Assumed,
+    };
+    /// `--bitrate` when given, else [`Bitrate::ASSUMED`].
+    pub fn given_or_assumed(bps: Option<u64>) -> Bitrate {
+        bps.map_or(Bitrate::ASSUMED, |bps| Bitrate {
+            bps,
+            source: BitrateSource::Option,
+        })
+    }
+}
+
+/// A rate in bit/s someone gave (`--bitrate`).
+impl From<u64> for Bitrate {
+    fn from(bps: u64) -> Bitrate {
+        Bitrate {
+            bps,
+            source: BitrateSource::Option,
+        }
+    }
+}
+
+impl Default for Bitrate {
+    fn default() -> Self {
+        Bitrate::ASSUMED
+    }
+}
+
+/// The bits on the wire of `frame` with the intermission after it; 0 for an error frame
+/// (or a frame no controller could send).
+pub fn bus_bits(frame: &Frame) -> u64 {
+    crate::wire::figures(frame).map_or(0, |f| u64::from(f.bus_bits()))
+}
+
+/// Running bus-load totals of a capture.
+#[derive(Clone, Debug, Default)]
+pub struct BusLoad {
+    bitrate: Bitrate,
+    bits: u64,
+    stuff_bits: u64,
+    first_ns: Option<u64>,
+    last_ns: u64,
+    /// Bits of the first interface's 128 nodes (made on its first node frame).
+    first_nodes: Vec<u64>,
+    other_nodes: HashMap<NodeKey, u64>,
+    /// Frames of the last 100 ms: (time, bits).
+    window: VecDeque<(u64, u32)>,
+    window_bits: u64,
+    busiest_bits: u64,
+    /// The current burst: its start (ns) and the time its last frame ended.
+    burst: Option<(u64, u64)>,
+    longest_burst_ns: u64,
+}
+
+impl BusLoad {
+    /// Empty totals for a bus at `bitrate`.
+    pub fn new(bitrate: Bitrate) -> BusLoad {
+        BusLoad {
+            bitrate: Bitrate {
+                bps: bitrate.bps.max(1),
+                ..bitrate
+            },
+            ..BusLoad::default()
+        }
+    }
+
+    /// The bit rate the load is counted against.
+    pub fn bitrate(&self) -> Bitrate {
+        self.bitrate
+    }
+
+    /// Counts one frame (of `node`, when it has one). Frames are taken in time order; a
+    /// frame's timestamp is taken as the end of its EOF.
+    #[inline]
+    pub fn add(&mut self, frame: &Frame, node: Option<u8>) {
+        let Ok(fig) = crate::wire::figures(frame) else {
+            return;
+        };
+        let bits = fig.bus_bits();
+        self.bits += u64::from(bits);
+        self.stuff_bits += u64::from(fig.stuff_bits);
+        let t = frame.ts_ns;
+        self.first_ns.get_or_insert(t);
+        self.last_ns = self.last_ns.max(t);
+        if let Some(n) = node {
+            let key = NodeKey::new(frame.iface, n & 0x7F);
+            if key.iface == 0 {
+                if self.first_nodes.is_empty() {
+                    self.first_nodes = vec![0; 128];
+                }
+                self.first_nodes[usize::from(key.node)] += u64::from(bits);
+            } else {
+                *self.other_nodes.entry(key).or_insert(0) += u64::from(bits);
+            }
+        }
+        self.window.push_back((t, bits));
+        self.window_bits += u64::from(bits);
+        while let Some(&(old, b)) = self.window.front() {
+            if old + BUSY_WINDOW_NS > t {
+                break;
+            }
+            self.window_bits -= u64::from(b);
+            self.window.pop_front();
+        }
+        self.busiest_bits = self.busiest_bits.max(self.window_bits);
+        // A burst goes on while the bus stays idle for less than the next frame takes.
+        let took = u64::from(bits) * 1_000_000_000 / self.bitrate.bps;
+        let start = t.saturating_sub(took);
+        let burst = match self.burst {
+            Some((since, end)) if start < end.saturating_add(took) => (since, t.max(end)),
+            _ => (start, t),
+        };
+        self.longest_burst_ns = self.longest_burst_ns.max(burst.1 - burst.0);
+        self.burst = Some(burst);
+    }
+
+    /// Bits counted, intermissions included.
+    pub fn bits(&self) -> u64 {
+        self.bits
+    }
+
+    /// The load over the capture: bits / (bit rate x duration); None before two frames at
+    /// different times.
+    pub fn load(&self) -> Option<f64> {
+        let span = self.last_ns - self.first_ns?;
+        (span > 0).then(|| self.bits as f64 * 1e9 / (self.bitrate.bps as f64 * span as f64))
+    }
+
+    /// Every node's bits, in node order.
+    pub fn by_node(&self) -> Vec<(NodeKey, u64)> {
+        let first = self.first_nodes.iter().enumerate();
+        let first = first
+            .filter(|(_, b)| **b > 0)
+            .map(|(n, b)| (NodeKey::new(0, n as u8), *b));
+        let mut all: Vec<(NodeKey, u64)> = first.chain(self.other_nodes.iter().map(|(k, b)| (*k, *b))).collect();
+        all.sort();
+        all
+    }
+
+    /// The figures as JSON, nodes keyed by `key`.
+    pub fn to_json(&self, key: impl Fn(NodeKey) -> String) -> BusJson {
+        let window = self.bitrate.bps as f64 * BUSY_WINDOW_NS as f64 / 1e9;
+        BusJson {
+            bitrate: self.bitrate.bps,
+            bitrate_source: self.bitrate.source,
+            bits: self.bits,
+            stuff_bits: self.stuff_bits,
+            load: self.load().map(round6),
+            by_node: self.by_node().into_iter().map(|(k, b)| (key(k), b)).collect(),
+            busiest_100ms: round6(self.busiest_bits as f64 / window),
+            longest_burst_ms: round6(self.longest_burst_ns as f64 / 1e6),
+        }
+    }
+
+    /// The figures as text lines (after the summary's `by node:`), nodes named by `name`.
+    pub fn to_text(&self, name: impl Fn(NodeKey) -> String) -> String {
+        let j = self.to_json(name);
+        let load = j.load.map_or("-".to_string(), |l| format!("{:.2} %", l * 100.0));
+        let mut s = format!(
+            "bus: {} bits ({} stuff bits) at {} kbit/s ({}): load {load}, busiest 100 ms {:.2} %, longest burst {:.3} ms\n",
+            j.bits,
+            j.stuff_bits,
+            j.bitrate as f64 / 1000.0,
+            self.bitrate.source.as_str(),
+            j.busiest_100ms * 100.0,
+            j.longest_burst_ms,
+        );
+        for (node, bits) in &j.by_node {
+            s.push_str(&format!("  {node:<8} {bits:>10} bits\n"));
+        }
+        s
+    }
+}
+
+fn round6(x: f64) -> f64 {
+    (x * 1e6).round() / 1e6
+}
+
+/// The bus figures of `--summary --format jsonl` (fields in key order).
+#[derive(Clone, Debug, Serialize)]
+pub struct BusJson {
+    /// Bits per second.
+    pub bitrate: u64,
+    /// `option`, `interface` or `assumed`.
+    pub bitrate_source: BitrateSource,
+    /// Bits on the wire, intermissions included.
+    pub bits: u64,
+    /// Bits of the busiest 100 ms window / the bits 100 ms holds.
+    pub busiest_100ms: f64,
+    /// Bits per node (keyed as the summary's `by_node`).
+    pub by_node: std::collections::BTreeMap<String, u64>,
+    /// bits / (bitrate x capture duration); null for a capture of one instant.
+    pub load: Option<f64>,
+    /// The longest stretch in which the bus never stayed idle as long as the next frame took.
+    pub longest_burst_ms: f64,
+    /// Stuff bits among `bits`.
+    pub stuff_bits: u64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::Flags;
+
+    fn at(ms: u64, id: u32, data: &[u8]) -> Frame {
+        let mut f = Frame::classic(id, data);
+        f.ts_ns = ms * 1_000_000;
+        f
+    }
+
+    /// 185#2500EA00 is 79 + 3 = 82 bits (canworks' example); the SYNC's bits are those of
+    /// `wire::figures` (checked against the ISO reference in crates/canopen/tests).
+    #[test]
+    fn totals_per_node_and_load_by_hand() {
+        let sync = crate::wire::figures(&Frame::classic(0x80, &[])).unwrap();
+        let mut b = BusLoad::new(Bitrate::ASSUMED);
+        b.add(&at(0, 0x185, &[0x25, 0, 0xEA, 0]), Some(5));
+        b.add(&at(10, 0x80, &[]), None);
+        b.add(&at(1000, 0x185, &[0x25, 0, 0xEA, 0]), Some(5));
+        let mut err = at(500, 4, &[0; 8]);
+        err.flags = Flags(Flags::ERR);
+        b.add(&err, None);
+        let total = 82 * 2 + u64::from(sync.bus_bits());
+        assert_eq!(b.bits(), total);
+        assert_eq!(b.by_node(), [(NodeKey::new(0, 5), 164)]);
+        // Over 1 s at 500 kbit/s.
+        assert_eq!(b.load(), Some(total as f64 / 500_000.0));
+        let j = serde_json::to_value(b.to_json(|k| k.node.to_string())).unwrap();
+        assert_eq!(j["bitrate_source"], "assumed");
+        assert_eq!(j["by_node"]["5"], 164);
+        // The busiest 100 ms holds the first two frames: of the 50,000 bits 100 ms holds.
+        assert_eq!(
+            j["busiest_100ms"],
+            round6((82 + u64::from(sync.bus_bits())) as f64 / 50_000.0)
+        );
+    }
+
+    #[test]
+    fn a_burst_lasts_while_frames_follow_each_other() {
+        let mut b = BusLoad::new(Bitrate {
+            bps: 1_000_000,
+            source: BitrateSource::Option,
+        });
+        // 82 bits at 1 Mbit/s: 82 µs each; frames every 100 µs are one burst.
+        for i in 0..10u64 {
+            let mut f = at(0, 0x185, &[0x25, 0, 0xEA, 0]);
+            f.ts_ns = 1_000_000 + i * 100_000;
+            b.add(&f, Some(5));
+        }
+        // A frame 10 ms later starts a new one.
+        b.add(&at(20, 0x185, &[0x25, 0, 0xEA, 0]), Some(5));
+        // From the start of the first (1 ms - 82 µs) to the end of the tenth (1.9 ms).
+        assert_eq!(b.to_json(|k| k.node.to_string()).longest_burst_ms, 0.982);
+        assert_eq!(b.load(), Some(11.0 * 82.0 / 19_000.0));
+    }
+}
