@@ -9,7 +9,6 @@ mod decode_parquet;
 pub mod diagnose;
 pub mod input;
 pub mod record;
-pub mod run;
 pub mod sim;
 pub mod tui;
 
