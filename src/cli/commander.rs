@@ -3,8 +3,7 @@
 //! runtime, opening the bus and printing one result or failure.
 
 use crate::bus::Bus;
-use crate::command::syntax::Commander;
-use crate::command::{Command, CommandError, ExitCode, Outcome};
+use crate::command::{Command, CommandError, Commander, ExitCode, Outcome, Spec};
 use clap::Args;
 use std::future::Future;
 
@@ -37,77 +36,53 @@ pub struct DictArgs {
 
 /// Runs a commander subcommand; returns the exit status.
 pub fn run_commander(c: &CliCommander) -> ExitCode {
-    let (bus, mut dict) = (c.bus(), c.dict().cloned().unwrap_or_default());
+    let (bus, mut dict, what) = (c.bus(), c.dict().cloned().unwrap_or_default(), c.name());
     let cmd = match c.command() {
         Ok(cmd) => cmd,
-        Err(e) => return report(bus, what(c), Err(e.into())),
+        Err(e) => return report(bus, what, Err(e.into())),
     };
-    if let Command::Dcf(d) = &cmd {
+    if let Some(node) = cmd.node() {
         // `dcf ... --eds FILE`: the EDS of the one node the command is about.
         for e in &mut dict.eds {
             if !e.contains('=') {
-                *e = format!("{}={e}", d.node);
+                *e = format!("{node}={e}");
             }
         }
     }
-    match cmd {
-        Command::Run(spec) => super::run::run_run(bus, &dict, &spec),
-        // A dry run needs no bus (not even an interface that exists).
-        Command::PdoMap(spec) if spec.dry_run => {
-            let result = super::bind::bindings_on(&bus.iface, &dict.profiles, &dict.eds)
-                .map_err(CommandError::from)
-                .and_then(|b| crate::command::pdo::dry_run(b.dictionary(spec.node), &spec))
-                .map(|(json, text)| Outcome::new(json, text));
-            report(bus, what(c), result)
-        }
-        Command::Record {
-            output,
-            limits,
-            mode,
-            format,
-        } => super::record::run_record(bus, &output, limits, mode, format),
-        cmd @ (Command::Send(_) | Command::Sync(_) | Command::Pdo { .. }) => {
-            let bindings = super::bind::bindings_on(&bus.iface, &dict.profiles, &dict.eds);
-            run(bus, what(c), |bus| async move {
-                // Ctrl-C stops a cyclic send; the report follows.
-                let ctrl_c = async {
-                    if tokio::signal::ctrl_c().await.is_err() {
-                        std::future::pending::<()>().await;
-                    }
-                };
-                let progress = crate::command::cyclic::Progress::default();
-                crate::command::execute_until(&bus, &cmd, &bindings?, progress, ctrl_c).await
-            })
-        }
-        cmd => {
-            let bindings = super::bind::bindings_on(&bus.iface, &dict.profiles, &dict.eds);
-            let report_to = Stream::report_of(&cmd);
-            run_to(bus, what(c), report_to, |bus| async move {
-                crate::command::execute(&bus, &cmd, &bindings?).await
-            })
+    if let Command::Record(r) = &cmd {
+        // Signals stop a recording; its gaps are said after its report.
+        return super::record::run_record(bus, &r.output, r.limits, r.mode, r.format);
+    }
+    let bindings = super::bind::bindings_on(&bus.iface, &dict.profiles, &dict.eds).map_err(CommandError::from);
+    if cmd.answers_offline() {
+        // Checked (or answered: a listing, a dry run) before the bus is opened.
+        let offline = bindings.as_ref().map_err(Clone::clone).map(|b| cmd.offline(b));
+        match offline {
+            Err(e) => return report(bus, what, Err(e)),
+            Ok(Some(result)) => return report(bus, what, result),
+            Ok(None) => {}
         }
     }
-}
-
-/// The subcommand's name, as failures are prefixed (`cotui sdo read: ...`).
-fn what(c: &CliCommander) -> &'static str {
-    use crate::command::syntax::DcfCommand;
-    match c {
-        Commander::Nmt(_) => "nmt",
-        Commander::Sdo(g) => crate::command::spec::Declared::<BusArgs, DictArgs>::name(g),
-        Commander::Drive(_) => "drive",
-        Commander::Run(_) => "run",
-        Commander::Scan(_) => "scan",
-        Commander::Record(_) => "record",
-        Commander::Stop(_) => "stop",
-        Commander::Lss(_) => "lss",
-        Commander::Send(_) => "send",
-        Commander::Sync(_) => "sync",
-        Commander::Pdo(_) => "pdo",
-        Commander::Dcf(DcfCommand::Save(_)) => "dcf save",
-        Commander::Dcf(DcfCommand::Load(_)) => "dcf load",
-        Commander::Dcf(DcfCommand::Diff(_)) => "dcf diff",
-    }
+    let report_to = Stream::report_of(&cmd);
+    let (json, cyclic) = (bus.json, cmd.cyclic());
+    run_to(bus, what, report_to, |bus| async move {
+        let bindings = bindings?;
+        let progress = crate::command::cyclic::Progress::default();
+        // Each step of a `run` printed as it happens (not with --json).
+        let mut print = |line: &str| println!("{line}");
+        let lines: Option<&mut (dyn FnMut(&str) + Send)> = if json { None } else { Some(&mut print) };
+        if cyclic {
+            // Ctrl-C stops a cyclic send; the report follows.
+            let ctrl_c = async {
+                if tokio::signal::ctrl_c().await.is_err() {
+                    std::future::pending::<()>().await;
+                }
+            };
+            crate::command::execute_saying(&bus, &cmd, &bindings, progress, ctrl_c, lines).await
+        } else {
+            crate::command::execute_saying(&bus, &cmd, &bindings, progress, std::future::pending(), lines).await
+        }
+    })
 }
 
 /// Runs `body` on a fresh single-threaded tokio runtime with the bus of `args` open, then

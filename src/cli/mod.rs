@@ -10,7 +10,6 @@ pub mod diagnose;
 pub mod explain;
 pub mod input;
 pub mod record;
-pub mod run;
 pub mod sim;
 pub mod tui;
 

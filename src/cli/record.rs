@@ -5,13 +5,12 @@
 //! they happen and make the exit status 2.
 
 use super::commander::{BusArgs, Stream, report_to};
-use crate::command::exec::text;
 use crate::command::record::{Limits, LogFormat, Recorded, WriteMode, open_output, record};
-use crate::command::{Command, CommandError, ExitCode};
+use crate::command::{CommandError, ExitCode};
 use std::io::Write;
 use tokio::signal::unix::{SignalKind, signal};
 
-/// Runs `cotui record` (its arguments: [`crate::command::syntax::RecordArgs`]); returns the
+/// Runs `cotui record` (its arguments: [`crate::command::record::RecordArgs`]); returns the
 /// exit status: 0 complete, 2 when the bus could not be opened or the recording has gaps, 1
 /// for a usage or write error.
 pub fn run_record(bus: &BusArgs, path: &str, limits: Limits, mode: WriteMode, format: LogFormat) -> ExitCode {
@@ -36,18 +35,12 @@ pub fn run_record(bus: &BusArgs, path: &str, limits: Limits, mode: WriteMode, fo
         Ok(n) => n,
         Err(e) => return report_to(bus, "record", to, Err(e)),
     };
-    let cmd = Command::Record {
-        output: path.to_string(),
-        limits,
-        mode,
-        format,
-    };
-    let json = n.to_json(path);
+    let report = n.report(path);
     // After SIGHUP the terminal may be gone: printing must not fail the recording.
     if bus.json {
-        to.line(&json.to_string());
+        to.line(&crate::command::to_json(&report).to_string());
     } else {
-        to.line(&text(&cmd, &json));
+        to.line(&report.text());
     }
     if n.dropped > 0 {
         say(&format!(

@@ -81,19 +81,21 @@ pub fn parameters(dict: &Dictionary, name: &str, given: &[String]) -> Vec<String
 }
 
 /// The values for the positional argument `id` of a command: `node`/`nodes` the nodes
-/// heard, `object` the node's objects, `signals` the node's objects as `NAME=`, `words`
-/// (of `run`) a procedure first, then its parameters. `node` is the node given before,
-/// `before` the values given to `id` already. None: no such kind of argument.
-pub fn values(id: &str, node: Option<u8>, before: &[String], known: &dyn Known) -> Option<Vec<String>> {
+/// heard, `object` the node's objects, `signals` the node's objects as `NAME=`, `procedure`
+/// (of `run`) the node's procedures, `params` the procedure's parameters not given yet.
+/// `node` is the node given before, `given` the positional arguments given so far (id,
+/// value). None: no such kind of argument.
+pub fn values(id: &str, node: Option<u8>, given: &[(String, String)], known: &dyn Known) -> Option<Vec<String>> {
     let dict = |n: Option<u8>| n.map(|n| known.dictionary(n));
+    let of = |arg: &'static str| given.iter().filter(move |(a, _)| a == arg).map(|(_, v)| v.clone());
     Some(match id {
         "node" | "nodes" => known.nodes().iter().map(u8::to_string).collect(),
         "object" => dict(node).map(|d| objects(d, "")).unwrap_or_default(),
         "signals" => dict(node).map(|d| objects(d, "=")).unwrap_or_default(),
-        "words" => match (dict(node), before.first()) {
-            (Some(d), None) => procedures(d),
-            (Some(d), Some(proc)) => parameters(d, proc, &before[1..]),
-            (None, _) => Vec::new(),
+        "procedure" => dict(node).map(procedures).unwrap_or_default(),
+        "params" => match (dict(node), of("procedure").next()) {
+            (Some(d), Some(proc)) => parameters(d, &proc, &of("params").collect::<Vec<_>>()),
+            _ => Vec::new(),
         },
         _ => return None,
     })

@@ -9,8 +9,6 @@
 //! missed tick shows as one long gap in the jitter figures).
 
 use super::error::CommandError;
-use super::grammar::Command;
-use super::spec::{Ctx, Known, Outcome, Preview, Spec};
 use super::value::encode;
 use crate::bus::{Bus, Event};
 use crate::frame::{Direction, Flags, Frame};
@@ -210,55 +208,6 @@ impl Source {
     pub fn frame(&mut self, i: u64) -> Frame {
         (self.next)(i)
     }
-}
-
-/// The source of a `send`, `sync` or `pdo` command (`None` for other commands).
-pub fn source(cmd: &Command, bindings: &Bindings) -> Option<Result<Source, CommandError>> {
-    Some(match cmd {
-        Command::Send(c) => return c.source(bindings),
-        Command::Sync(c) => return c.source(bindings),
-        Command::Pdo {
-            node,
-            num,
-            assignments,
-            schedule,
-        } => rpdo(bindings, *node, *num, assignments).map(|r| {
-            let f = r.frame;
-            Source {
-                what: format!("RPDO{num} node {node} {}", super::candump(&f)),
-                next: Box::new(move |_| f),
-                defaulted: r.defaulted,
-                schedule: *schedule,
-            }
-        }),
-        _ => return None,
-    })
-}
-
-/// The preview of a cyclic command: its first frame, its schedule, `extra` (the SYNC
-/// counter), whether it runs as a job and the mapped signals sent as 0.
-pub(crate) fn preview(cmd: &impl Spec, known: &Known<'_>, extra: &str) -> Result<Preview, CommandError> {
-    let mut src = cmd
-        .source(known.bindings)
-        .unwrap_or_else(|| Err(CommandError::Usage("not a cyclic command".into())))?;
-    let mut text = format!("{} {}{extra}", super::candump(&src.frame(0)), src.schedule.text());
-    if src.schedule.total().is_none() {
-        text.push_str(" (a job: `jobs` lists, `jobs stop ID` or stop-all stops)");
-    }
-    if !src.defaulted.is_empty() {
-        text.push_str(&format!("; not given, sent as 0: {}", src.defaulted.join(", ")));
-    }
-    Ok(Preview::sends(text))
-}
-
-/// Runs a cyclic command until its schedule ends or `ctx.stop` completes; its report.
-pub(crate) async fn run(cmd: &impl Spec, ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
-    let src = cmd
-        .source(ctx.bindings)
-        .unwrap_or_else(|| Err(CommandError::Usage("not a cyclic command".into())))?;
-    let report = transmit(ctx.bus, src, ctx.progress, ctx.stop).await?;
-    let text = report.text();
-    Ok(Outcome::new(report, text))
 }
 
 /// The timing of a cyclic command so far, shared with whoever lists or stops it.

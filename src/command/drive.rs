@@ -6,7 +6,7 @@ use super::error::CommandError;
 use super::grammar::{DEFAULT_TIMEOUT_MS, parse_mode};
 use super::sdo::{download, upload};
 use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
-use super::syntax::{DRIVE_WORDS, ParseError, TypedWords, ms_arg, node_arg};
+use super::words::{DRIVE_WORDS, ParseError, TypedWords, ms_arg, node_arg};
 use crate::bus::{Bus, Subscription};
 use crate::cob;
 use crate::decode::cia402::{DriveState, mode_name};
@@ -110,9 +110,7 @@ pub struct Drive {
 impl<D> CommandArgs<D> for DriveArgs {
     type Spec = Drive;
 
-    fn name(&self) -> &'static str {
-        "drive"
-    }
+    const NAME: &'static str = "drive";
 
     /// The action with its MODE: only `mode` takes one, and needs it.
     fn spec(&self) -> Result<Drive, ParseError> {
@@ -532,18 +530,22 @@ pub struct NodeStop {
     pub reason: Option<String>,
 }
 
-impl NodeStop {
-    /// The JSON object of one node in a stop report.
-    pub fn to_json(&self) -> serde_json::Value {
-        super::to_json(&NodeStopJson {
+/// The JSON object of one node in a stop report.
+impl serde::Serialize for NodeStop {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        NodeStopJson {
             node: self.node,
             stopped: self.stopped,
             statusword: self.statusword.map(|s| format!("0x{s:04X}")),
             state: self.state.map(|s| s.as_str()),
             controlwords: self.sent.iter().map(|c| format!("0x{c:04X}")).collect(),
             reason: self.reason.as_deref(),
-        })
+        }
+        .serialize(s)
     }
+}
+
+impl NodeStop {
     /// One line: `node 2: stopped, Switch on disabled (0x0250) after 0x0002, 0x0000`.
     pub fn text(&self) -> String {
         let sent = self

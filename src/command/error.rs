@@ -1,9 +1,10 @@
 //! Why a command failed, with the exit status of each case.
 
-use super::syntax::ParseError;
+use super::report::Reported;
 use super::to_json;
 use crate::bus::BusError;
 use crate::sdo::abort_text;
+use clap::error::ErrorKind;
 use serde::Serialize;
 
 /// The process exit status of cotui, one value per kind of outcome (docs/COMMANDER.md,
@@ -39,6 +40,55 @@ impl ExitCode {
 impl PartialEq<i32> for ExitCode {
     fn eq(&self, other: &i32) -> bool {
         self.code() == *other
+    }
+}
+
+/// Why a command line is not a command.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ParseError {
+    /// A palette line with an unbalanced quote.
+    #[error("unterminated quote")]
+    Quote,
+    /// An empty palette line; the commands there are, comma-separated.
+    #[error("empty command; commands: {0}")]
+    Empty(String),
+    /// The declaration refused the words: an unknown flag, an extra or missing word, a bad
+    /// value. `message` is clap's error line (with its tips), `usage` the command's usage.
+    #[error("{message}")]
+    Rejected { message: String, usage: String },
+    /// `--help`: the help text.
+    #[error("{0}")]
+    Help(String),
+    /// Words the declaration accepts that do not make a command (e.g. a MODE after
+    /// `drive N enable`, a parameter before the procedure).
+    #[error("{0}")]
+    Invalid(String),
+}
+
+impl From<clap::Error> for ParseError {
+    fn from(e: clap::Error) -> Self {
+        let text = e.render().to_string();
+        if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+            return ParseError::Help(text.trim_end().to_string());
+        }
+        let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
+        let first = lines.next().unwrap_or("");
+        let mut message = first.strip_prefix("error: ").unwrap_or(first).to_string();
+        let mut usage = String::new();
+        for l in lines {
+            if let Some(u) = l.strip_prefix("Usage: ") {
+                usage = u.to_string();
+            } else if l.starts_with("For more information") {
+                break;
+            } else if l.starts_with("tip: to pass") {
+                // `-- --flag`: no line of ours takes a value that starts with `-`.
+            } else if usage.is_empty() {
+                // The arguments missing, the tips: part of the message.
+                message.push_str(if l.starts_with("tip: ") { "; " } else { " " });
+                message.push_str(l);
+            }
+        }
+        ParseError::Rejected { message, usage }
     }
 }
 
@@ -91,16 +141,13 @@ pub enum CommandError {
         procedure: String,
         step: usize,
         of: usize,
-        report: Box<serde_json::Value>,
+        report: Reported,
         cause: Box<CommandError>,
     },
     /// A stop did not confirm every drive stopped (or could not send at all); `report` is
     /// the stop's JSON (`nodes` with `stopped` and `reason` each), `text` its text.
     #[error("{text}")]
-    NotStopped {
-        report: Box<serde_json::Value>,
-        text: String,
-    },
+    NotStopped { report: Reported, text: String },
     /// A command that finished with a report that is a failure (`dcf diff` found
     /// differences, `dcf load` was refused, a `pdo map` did not read back as written):
     /// `report` is its JSON, `text` its text, `error` the JSON `error` word.
@@ -108,7 +155,7 @@ pub enum CommandError {
     Report {
         exit: ExitCode,
         error: &'static str,
-        report: Box<serde_json::Value>,
+        report: Reported,
         text: String,
     },
 }
@@ -180,7 +227,7 @@ impl CommandError {
                 message,
             }),
             CommandError::NotStopped { report, .. } => {
-                let mut v = (**report).clone();
+                let mut v = report.to_json();
                 if let Some(o) = v.as_object_mut() {
                     o.insert("ok".into(), false.into());
                     o.insert("error".into(), "not_stopped".into());
@@ -189,7 +236,7 @@ impl CommandError {
                 v
             }
             CommandError::Report { error, report, .. } => {
-                let mut v = (**report).clone();
+                let mut v = report.to_json();
                 if let Some(o) = v.as_object_mut() {
                     o.insert("ok".into(), false.into());
                     o.insert("error".into(), (*error).into());
@@ -208,6 +255,7 @@ impl CommandError {
                 step, report, cause, ..
             } => {
                 let mut v = cause.to_json();
+                let report = report.to_json();
                 if let (Some(out), Some(r)) = (v.as_object_mut(), report.as_object()) {
                     for (k, x) in r {
                         out.insert(k.clone(), x.clone());

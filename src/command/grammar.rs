@@ -1,9 +1,7 @@
-//! What the commander's command language means: the [`Command`] a line parses into (see
-//! [`super::syntax`] for the words), its actions and options, and the number, node and type
-//! parsers the declaration uses.
+//! The number, node, mode, type and NAME=VALUE parsers of the commander's declarations, and
+//! their defaults.
 
-use super::record::{Limits, LogFormat, WriteMode};
-use super::syntax::ParseError;
+use super::error::ParseError;
 use crate::od::DataType;
 
 /// A mode of operation by CiA 402 abbreviation (`pp`, `pv`, `pt`, `hm`, `ip`, `csp`, `csv`, `cst`) or number.
@@ -39,93 +37,6 @@ pub const SCAN_TIMEOUT_MS: u64 = 300;
 /// Default listening time of `scan` in ms (longer than common heartbeat periods).
 pub const SCAN_LISTEN_MS: u64 = 1500;
 
-/// One command of the commander (the interface is chosen separately).
-#[derive(Clone, Debug, PartialEq)]
-pub enum Command {
-    /// `nmt ACTION NODE [--wait] [--timeout MS]` (NODE 0 = all nodes).
-    Nmt(super::nmt::Nmt),
-    /// `sdo read NODE OBJECT ...`, `sdo write NODE OBJECT VALUE ...`.
-    Sdo(super::object::Sdo),
-    /// `drive NODE ACTION [MODE] [--timeout MS]`.
-    Drive(super::drive::Drive),
-    /// `scan [--listen MS] [--probe] [--timeout MS]`.
-    Scan {
-        listen_ms: u64,
-        probe: bool,
-        timeout_ms: u64,
-    },
-    /// `record -o FILE [--count N] [--duration MS] [--force | --append] [--format candump|pcapng]`.
-    Record {
-        output: String,
-        limits: Limits,
-        mode: WriteMode,
-        format: LogFormat,
-    },
-    /// `run NODE PROCEDURE [NAME=VALUE ...] [--dry-run] [--timeout MS]`, or `run NODE [--list]`.
-    Run(RunSpec),
-    /// `stop [NODE ...] [--listen MS] [--ramp MS] [--timeout MS]`: quick stop and disable
-    /// voltage on these nodes, or (none given) on every CiA 402 drive found powered.
-    Stop {
-        nodes: Vec<u8>,
-        listen_ms: u64,
-        options: super::stop::StopOptions,
-    },
-    /// `lss ACTION [WORDS...] [--timeout MS] [--vendor V] [--product P] [--store]`: an LSS
-    /// master service (CiA 305), addressed to every slave in configuration state.
-    Lss {
-        action: super::lss::LssAction,
-        timeout_ms: u64,
-    },
-    /// `send FRAME [--every MS] [--count N]`: a raw frame in candump's compact form.
-    Send(super::send::Send),
-    /// `sync --period MS [--counter N] [--count N] [--cob-id ID]`: the SYNC producer.
-    Sync(super::sync::Sync),
-    /// `pdo NODE send rpdoK NAME=VALUE ... [--every MS] [--count N]`: an RPDO encoded
-    /// through the node's mapping.
-    Pdo {
-        node: u8,
-        /// The RPDO number (1-based).
-        num: u16,
-        assignments: Vec<(String, String)>,
-        schedule: super::cyclic::Schedule,
-    },
-    /// `pdo NODE [--timeout MS]`: reads every PDO's communication and mapping parameters.
-    PdoRead { node: u8, timeout_ms: u64 },
-    /// `pdo NODE map PDO OBJECT... [--type T] [--event MS] [--inhibit T] [--cob-id ID]
-    /// [--dry-run] [--force] [--timeout MS]`: the CiA 301 remapping sequence.
-    PdoMap(super::pdo::MapSpec),
-    /// `dcf save|load|diff NODE ...`: a node's configuration as a CiA 306 DCF.
-    Dcf(super::dcf::DcfCommand),
-}
-
-impl Command {
-    /// True when the command writes its data to stdout (`-o -`): its report (text or JSON)
-    /// then goes to stderr, so that stdout is the data alone.
-    pub fn data_to_stdout(&self) -> bool {
-        match self {
-            Command::Record { output, .. } => output == "-",
-            Command::Sdo(c) => super::spec::Spec::data_to_stdout(c),
-            Command::Dcf(d) => matches!(&d.action, super::dcf::DcfAction::Save { output, .. } if output == "-"),
-            _ => false,
-        }
-    }
-}
-
-/// What `run` runs: a procedure of a node with its parameters, or (no procedure) the list.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct RunSpec {
-    /// The target node.
-    pub node: u8,
-    /// `None`: list the node's procedures.
-    pub procedure: Option<String>,
-    /// Parameters as given, `NAME=VALUE` split at the first `=`.
-    pub args: Vec<(String, String)>,
-    /// Show the steps and frames without sending anything.
-    pub dry_run: bool,
-    /// ms to wait for each SDO answer.
-    pub timeout_ms: u64,
-}
-
 /// Splits `NAME=VALUE` procedure arguments.
 pub fn parse_assignments(words: &[&str]) -> Result<Vec<(String, String)>, ParseError> {
     words
@@ -137,30 +48,6 @@ pub fn parse_assignments(words: &[&str]) -> Result<Vec<(String, String)>, ParseE
             ))),
         })
         .collect()
-}
-
-/// The `run` command from its words after NODE: `[PROCEDURE] [NAME=VALUE ...]`.
-pub fn run_spec(node: u8, rest: &[&str], list: bool, dry_run: bool, timeout_ms: u64) -> Result<RunSpec, ParseError> {
-    let (procedure, assignments) = match rest.split_first() {
-        Some((p, more)) if !p.contains('=') => (Some(p.to_string()), more),
-        _ => (None, rest),
-    };
-    let args = parse_assignments(assignments)?;
-    if procedure.is_none() && !args.is_empty() {
-        return Err(ParseError::Invalid(
-            "run: give the PROCEDURE before its NAME=VALUE parameters".into(),
-        ));
-    }
-    if list && procedure.is_some() {
-        return Err(ParseError::Invalid("run: give a PROCEDURE or --list, not both".into()));
-    }
-    Ok(RunSpec {
-        node,
-        procedure,
-        args,
-        dry_run,
-        timeout_ms,
-    })
 }
 
 /// Parses a number: decimal, `0x` hex, or negative decimal.

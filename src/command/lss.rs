@@ -7,9 +7,10 @@
 //! busy machine does not turn a prompt answer into a timeout. A listen-only bus refuses the
 //! first send ([`crate::bus::BusError::ListenOnly`]).
 
-use super::error::CommandError;
+use super::error::{CommandError, ParseError};
 use super::grammar::parse_int;
-use super::syntax::ParseError;
+use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
+use super::words::{TypedWords, ms_arg, u32_arg};
 use crate::bus::{Bus, BusError};
 use crate::frame::{Direction, Frame};
 use crate::lss::fastscan::{Fastscan, FastscanError, Found};
@@ -338,6 +339,87 @@ fn node_id(word: &str) -> Result<u8, ParseError> {
                 "node-ID `{word}` must be 1..127 (or 255 = unconfigured for set-node)"
             ))
         })
+}
+
+/// `lss ACTION [WORDS...] [--timeout MS] [--vendor V] [--product P] [--store]`.
+#[derive(clap::Args, Clone, Debug)]
+pub struct LssArgs {
+    /// The LSS service (its words follow).
+    #[arg(value_parser = TypedWords::new(LSS_WORDS, LssAction::verb))]
+    pub action: String,
+    /// The action's words: `switch [global] config|wait`, `select VENDOR PRODUCT REVISION
+    /// SERIAL`, `set-node N`, `set-bitrate KBIT`, `activate-bitrate DELAY_MS`, `inquire
+    /// [vendor|product|revision|serial|node|all]`, `identify VENDOR PRODUCT REV_LO REV_HI
+    /// SER_LO SER_HI`, `assign N`.
+    pub words: Vec<String>,
+    /// fastscan, assign: only a slave with this vendor-ID.
+    #[arg(long, value_parser = u32_arg)]
+    pub vendor: Option<u32>,
+    /// fastscan, assign: only a slave with this product code.
+    #[arg(long, value_parser = u32_arg)]
+    pub product: Option<u32>,
+    /// assign: also store the configuration.
+    #[arg(long)]
+    pub store: bool,
+    /// How long to wait for each answer, in ms [default: 100; fastscan and assign: 30 per
+    /// fastscan request].
+    #[arg(long, value_parser = ms_arg)]
+    pub timeout: Option<u64>,
+}
+
+/// An LSS master service (CiA 305), addressed to every slave in configuration state.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Lss {
+    pub action: LssAction,
+    pub timeout_ms: u64,
+}
+
+impl<D> CommandArgs<D> for LssArgs {
+    type Spec = Lss;
+    const NAME: &'static str = "lss";
+
+    fn spec(&self) -> Result<Lss, ParseError> {
+        let flags = LssFlags {
+            vendor: self.vendor,
+            product: self.product,
+            store: self.store,
+        };
+        let action = LssAction::parse(&self.action, &self.words, flags)?;
+        let default = match action {
+            LssAction::Fastscan { .. } | LssAction::Assign { .. } => FASTSCAN_TIMEOUT_MS,
+            _ => LSS_TIMEOUT_MS,
+        };
+        Ok(Lss {
+            action,
+            timeout_ms: self.timeout.unwrap_or(default),
+        })
+    }
+}
+
+impl Spec for Lss {
+    /// The first request; inquire and identify only ask, the others change the state of every
+    /// slave they reach and need confirming.
+    fn preview(&self, _known: &Known<'_>) -> Result<Preview, CommandError> {
+        let asks = matches!(
+            self.action,
+            LssAction::Inquire(_) | LssAction::Identify { .. } | LssAction::IdentifyUnconfigured
+        );
+        Ok(Preview {
+            frames: self.action.preview(),
+            confirm: (!asks).then(|| {
+                format!(
+                    "LSS {} addresses every LSS slave (in configuration state, or not yet configured)",
+                    self.action.as_str()
+                )
+            }),
+        })
+    }
+
+    async fn run(&self, ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
+        let report = lss(ctx.bus, self.action, self.timeout_ms).await?;
+        let text = report.text.clone();
+        Ok(Outcome::new(report, text))
+    }
 }
 
 /// The result of an LSS command (`--json`).

@@ -13,6 +13,8 @@ pub mod nmt;
 pub mod object;
 pub mod pdo;
 pub mod record;
+pub mod registry;
+pub mod report;
 pub mod run;
 pub mod scan;
 pub mod sdo;
@@ -22,15 +24,19 @@ pub mod stop;
 pub mod sync;
 pub mod syntax;
 pub mod value;
+pub mod words;
+pub mod write;
 
 pub use drive::DriveAction;
-pub use error::{CommandError, ExitCode};
-pub use exec::{execute, execute_until};
-pub use grammar::{Command, RunSpec};
+pub use error::{CommandError, ExitCode, ParseError};
+pub use exec::{execute, execute_saying, execute_until};
 pub use nmt::NmtAction;
 pub use object::SdoOptions;
-pub use spec::{Outcome, Reported};
-pub use syntax::{ParseError, parse_command};
+pub use registry::{Command, Commander};
+pub use report::Reported;
+pub use run::command::RunSpec;
+pub use spec::{Outcome, Spec};
+pub use syntax::parse_command;
 
 /// A command's `--json` object from its `#[derive(Serialize)]` form (serializing these plain
 /// structs cannot fail; a failure would give null).

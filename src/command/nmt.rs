@@ -3,7 +3,7 @@
 use super::error::CommandError;
 use super::grammar::NMT_WAIT_MS;
 use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
-use super::syntax::{NMT_WORDS, ParseError, TypedWords, ms_arg, node_or_all_arg};
+use super::words::{NMT_WORDS, ParseError, TypedWords, ms_arg, node_or_all_arg};
 use crate::bus::Bus;
 use crate::cob;
 use crate::decode::heartbeat::NmtState;
@@ -42,9 +42,7 @@ pub struct Nmt {
 impl<D> CommandArgs<D> for NmtArgs {
     type Spec = Nmt;
 
-    fn name(&self) -> &'static str {
-        "nmt"
-    }
+    const NAME: &'static str = "nmt";
 
     fn spec(&self) -> Result<Nmt, ParseError> {
         Ok(Nmt {

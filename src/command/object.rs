@@ -2,12 +2,12 @@
 //! index, index:sub or a name of the node's dictionary (the client is [`super::sdo`]).
 
 use super::error::CommandError;
-use super::exec::write_output;
 use super::grammar::DEFAULT_TIMEOUT_MS;
 use super::sdo::{Timing, download_within, first_download_frame, first_upload_frame, upload_within};
 use super::spec::{Ctx, Declared, Known, Outcome, Preview, Spec};
-use super::syntax::{On, ParseError, TYPE_WORDS, TypedWords, ms_arg, node_arg, parse_type};
 use super::value::{decode, encode};
+use super::words::{On, ParseError, TYPE_WORDS, TypedWords, ms_arg, node_arg, parse_type};
+use super::write::write_output;
 use crate::od::alias::resolve_object;
 use crate::od::bind::Bindings;
 use crate::od::{DataType, Dictionary, Value};

@@ -3,11 +3,13 @@
 //! [`remap`] (invalidate the COB-ID, communication parameters, count 0, entries, count,
 //! COB-ID valid again), each answer checked, the result read back, a refusal explained.
 
+pub mod command;
 pub mod remap;
 
+use super::candump;
 use super::error::{CommandError, ExitCode};
+use super::report::Reported;
 use super::sdo::{download, first_download_frame, first_upload_frame, upload};
-use super::{candump, to_json};
 use crate::bus::{Bus, Subscription};
 use crate::cob;
 use crate::decode::pdo::entry_from_u32;
@@ -19,7 +21,6 @@ use crate::od::{Dictionary, MappedEntry, PdoMappable};
 use crate::sdo::abort_text;
 use remap::{Action, Mapping, Remap, remap_sequence};
 use serde::Serialize;
-use serde_json::Value as Json;
 use std::time::Duration;
 
 /// Abort 0x06020000: the object does not exist (the PDO is not there).
@@ -285,39 +286,42 @@ pub fn assumed_cob(dict: &Dictionary, spec: &MapSpec) -> u32 {
 
 /// One step of a remapping as reported.
 #[derive(Serialize)]
-struct StepJson<'a> {
+struct StepJson {
     step: usize,
     object: String,
-    what: &'a str,
+    what: String,
     data: String,
     frame: String,
-    result: &'a str,
+    result: &'static str,
 }
 
 /// The report of a remapping (or its dry run).
 #[derive(Serialize)]
-struct MapJson<'a> {
+pub struct MapJson {
     ok: bool,
     node: u8,
     pdo: String,
     dry_run: bool,
     /// The COB-ID value read first (null in a dry run, which assumes one).
     cob_id_before: Option<u32>,
-    steps: Vec<StepJson<'a>>,
+    steps: Vec<StepJson>,
     mapping: Vec<EntryJson>,
     /// The communication parameters read back (null in a dry run).
     comm: Option<CommJson>,
     verified: bool,
+    /// Why what was read back differs from what was written.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    reason: Option<String>,
 }
 
-fn steps_json<'a>(node: u8, writes: &'a [Write], result: &'a str) -> Vec<StepJson<'a>> {
+fn steps_json(node: u8, writes: &[Write], result: &'static str) -> Vec<StepJson> {
     writes
         .iter()
         .enumerate()
         .map(|(k, w)| StepJson {
             step: k + 1,
             object: format!("0x{:04X}:{:02X}", w.index, w.sub),
-            what: &w.what,
+            what: w.what.clone(),
             data: crate::frame::hex::upper(&w.data),
             frame: candump(&w.frame(node)),
             result,
@@ -326,11 +330,11 @@ fn steps_json<'a>(node: u8, writes: &'a [Write], result: &'a str) -> Vec<StepJso
 }
 
 /// `pdo NODE map ... --dry-run`: the frames, nothing sent (needs no bus).
-pub fn dry_run(dict: &Dictionary, spec: &MapSpec) -> Result<(Json, String), CommandError> {
+pub fn dry_run(dict: &Dictionary, spec: &MapSpec) -> Result<(MapJson, String), CommandError> {
     let cob = assumed_cob(dict, spec);
     let writes = plan(dict, spec, cob)?;
     let entries = entries(dict, spec)?;
-    let json = to_json(&MapJson {
+    let json = MapJson {
         ok: true,
         node: spec.node,
         pdo: spec.pdo.name(),
@@ -340,7 +344,8 @@ pub fn dry_run(dict: &Dictionary, spec: &MapSpec) -> Result<(Json, String), Comm
         mapping: entries.iter().map(|e| EntryJson::new(e, dict)).collect(),
         comm: None,
         verified: false,
-    });
+        reason: None,
+    };
     let mut lines = vec![format!(
         "dry run: {} of node {}: reads 0x{:04X}:01 (assumed COB-ID 0x{cob:08X}), then {} writes, then reads back",
         spec.pdo.title(),
@@ -378,7 +383,7 @@ fn server_abort(e: &CommandError) -> Option<u32> {
 }
 
 /// `pdo NODE map ...`: runs the remapping on the node, then reads it back.
-pub async fn map(bus: &Bus, dict: &Dictionary, spec: &MapSpec) -> Result<(Json, String), CommandError> {
+pub async fn map(bus: &Bus, dict: &Dictionary, spec: &MapSpec) -> Result<(MapJson, String), CommandError> {
     let entries = entries(dict, spec)?;
     let (node, t) = (spec.node, spec.timeout_ms);
     let mut heartbeats = bus.subscribe();
@@ -394,30 +399,32 @@ pub async fn map(bus: &Bus, dict: &Dictionary, spec: &MapSpec) -> Result<(Json, 
     for (k, w) in writes.iter().enumerate() {
         if let Err(e) = download(bus, node, w.index, w.sub, w.data.clone(), false, t).await {
             let hint = refusal_hint(bus, &mut heartbeats, spec, &e, w.index, w.sub, k > 0).await;
-            let mut report = to_json(&MapJson {
+            let mut steps = steps_json(node, &writes[..=k], "written");
+            steps[k].result = "refused";
+            let report = MapJson {
                 ok: false,
                 node,
                 pdo: spec.pdo.name(),
                 dry_run: false,
                 cob_id_before: Some(current),
-                steps: steps_json(node, &writes[..=k], "written"),
+                steps,
                 mapping: entries.iter().map(|e| EntryJson::new(e, dict)).collect(),
                 comm: None,
                 verified: false,
-            });
-            report["steps"][k]["result"] = "refused".into();
+                reason: None,
+            };
             return Err(CommandError::Step {
                 procedure: format!("pdo map {}", spec.pdo.name()),
                 step: k + 1,
                 of: writes.len(),
-                report: Box::new(report),
+                report: Reported::new(report),
                 cause: Box::new(with_hint(e, hint)),
             });
         }
     }
     let back = read_back(bus, spec, t).await?;
     let differs = verify(&back, &entries, spec, &writes);
-    let mut json = to_json(&MapJson {
+    let json = MapJson {
         ok: differs.is_none(),
         node,
         pdo: spec.pdo.name(),
@@ -427,13 +434,13 @@ pub async fn map(bus: &Bus, dict: &Dictionary, spec: &MapSpec) -> Result<(Json, 
         mapping: entries.iter().map(|e| EntryJson::new(e, dict)).collect(),
         comm: Some(back.comm.to_json()),
         verified: differs.is_none(),
-    });
+        reason: differs.clone(),
+    };
     if let Some(reason) = differs {
-        json["reason"] = reason.clone().into();
         return Err(CommandError::Report {
             exit: ExitCode::Differs,
             error: "differs",
-            report: Box::new(json),
+            report: Reported::new(json),
             text: format!(
                 "{} of node {node} differs from what was written: {reason}",
                 spec.pdo.title()
@@ -704,25 +711,27 @@ pub async fn read_all(bus: &Bus, node: u8, timeout_ms: u64) -> Result<Vec<PdoRea
 
 /// One PDO of `pdo NODE --json`.
 #[derive(Serialize)]
-struct PdoJson<'a> {
+struct PdoJson {
     pdo: String,
     exists: bool,
     #[serde(flatten)]
     comm: CommJson,
     mapping: Vec<EntryJson>,
     mapped_bits: u32,
-    problems: &'a [String],
+    problems: Vec<String>,
+}
+
+/// `pdo NODE --json`.
+#[derive(Serialize)]
+pub struct PdosRead {
+    ok: bool,
+    node: u8,
+    pdos: Vec<PdoJson>,
 }
 
 /// The `--json` object and the text of `pdo NODE`.
-pub fn read_report(node: u8, dict: &Dictionary, pdos: &[PdoRead]) -> (Json, String) {
-    #[derive(Serialize)]
-    struct Report<'a> {
-        ok: bool,
-        node: u8,
-        pdos: Vec<PdoJson<'a>>,
-    }
-    let json = to_json(&Report {
+pub fn read_report(node: u8, dict: &Dictionary, pdos: &[PdoRead]) -> (PdosRead, String) {
+    let json = PdosRead {
         ok: true,
         node,
         pdos: pdos
@@ -733,10 +742,10 @@ pub fn read_report(node: u8, dict: &Dictionary, pdos: &[PdoRead]) -> (Json, Stri
                 comm: p.comm.to_json(),
                 mapping: p.entries.iter().map(|e| EntryJson::new(e, dict)).collect(),
                 mapped_bits: p.entries.iter().map(|e| u32::from(e.bits)).sum(),
-                problems: &p.problems,
+                problems: p.problems.clone(),
             })
             .collect(),
-    });
+    };
     let count = |transmit: bool| pdos.iter().filter(|p| p.exists && p.id.transmit == transmit).count();
     let mut lines = vec![format!("node {node}: {} RPDOs, {} TPDOs", count(false), count(true))];
     for p in pdos {

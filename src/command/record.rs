@@ -3,7 +3,9 @@
 //! still holds. Times when nothing could be captured (interface down or gone, bus-off) are
 //! the recording's gaps.
 
-use super::error::CommandError;
+use super::error::{CommandError, ParseError};
+use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
+use super::words::{TypedWords, count_arg, ms_arg};
 use crate::bus::{Bus, BusError, Event, StateChange};
 use crate::frame::Frame;
 use crate::log::writer::LogWriter;
@@ -62,10 +64,10 @@ pub struct Recorded {
 impl Recorded {
     /// The JSON summary: `frames`, `dropped`, `gaps: [{from, to, reason}]` (seconds since
     /// the Unix epoch, as the log's timestamps), `output`; `ok` is false when there are gaps.
-    pub fn to_json(&self, output: &str) -> serde_json::Value {
+    pub fn report(&self, output: &str) -> RecordedJson {
         let secs = |ns: u64| ns as f64 / 1e9;
         let message = self.gap_message(output);
-        super::to_json(&RecordedJson {
+        RecordedJson {
             ok: self.gaps.is_empty(),
             frames: self.frames,
             dropped: self.dropped,
@@ -75,13 +77,13 @@ impl Recorded {
                 .map(|g| GapJson {
                     from: secs(g.from_ns),
                     to: secs(g.to_ns),
-                    reason: &g.reason,
+                    reason: g.reason.clone(),
                 })
                 .collect(),
-            output,
+            output: output.to_string(),
             error: message.as_ref().map(|_| "bus"),
             message,
-        })
+        }
     }
     /// Why the recording is incomplete, if it has gaps.
     pub fn gap_message(&self, output: &str) -> Option<String> {
@@ -102,13 +104,13 @@ impl Recorded {
 }
 
 /// `record --json`: the summary of a recording.
-#[derive(serde::Serialize)]
-struct RecordedJson<'a> {
+#[derive(Debug, serde::Serialize)]
+pub struct RecordedJson {
     ok: bool,
     frames: u64,
     dropped: u64,
-    gaps: Vec<GapJson<'a>>,
-    output: &'a str,
+    gaps: Vec<GapJson>,
+    output: String,
     /// `bus` when the recording has gaps.
     #[serde(skip_serializing_if = "Option::is_none")]
     error: Option<&'static str>,
@@ -117,12 +119,108 @@ struct RecordedJson<'a> {
     message: Option<String>,
 }
 
+impl RecordedJson {
+    /// `12 frames written to out.log`.
+    pub fn text(&self) -> String {
+        format!("{} frames written to {}", self.frames, self.output)
+    }
+}
+
 /// A time nothing could be captured, in seconds since the Unix epoch.
-#[derive(serde::Serialize)]
-struct GapJson<'a> {
+#[derive(Debug, serde::Serialize)]
+struct GapJson {
     from: f64,
     to: f64,
-    reason: &'a str,
+    reason: String,
+}
+
+/// `record -o FILE [--count N] [--duration MS] [--force | --append] [--format F]`.
+#[derive(clap::Args, Clone, Debug)]
+pub struct RecordArgs {
+    /// The log file to write (candump -l format; `-` for stdout). An existing file is
+    /// refused unless --force or --append.
+    #[arg(short = 'o', long)]
+    pub output: String,
+    /// Stop after this many frames.
+    #[arg(long, value_parser = count_arg)]
+    pub count: Option<u64>,
+    /// Stop after this many ms (else at Ctrl-C, SIGTERM, SIGHUP or SIGQUIT).
+    #[arg(long, value_parser = ms_arg)]
+    pub duration: Option<u64>,
+    /// Overwrite an existing output file.
+    #[arg(long, conflicts_with = "append")]
+    pub force: bool,
+    /// Append to an existing output file.
+    #[arg(long)]
+    pub append: bool,
+    /// The file format: candump (-l lines) or pcapng (for Wireshark; not to a terminal).
+    #[arg(long, default_value = "candump", value_parser = TypedWords::new(&["candump", "pcapng"], LogFormat::parse))]
+    pub format: LogFormat,
+}
+
+/// A recording of the bus to a file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Record {
+    pub output: String,
+    pub limits: Limits,
+    pub mode: WriteMode,
+    pub format: LogFormat,
+}
+
+impl<D> CommandArgs<D> for RecordArgs {
+    type Spec = Record;
+    const NAME: &'static str = "record";
+
+    fn spec(&self) -> Result<Record, ParseError> {
+        Ok(Record {
+            output: self.output.clone(),
+            limits: Limits {
+                count: self.count,
+                duration_ms: self.duration,
+            },
+            mode: match (self.force, self.append) {
+                (true, _) => WriteMode::Overwrite,
+                (_, true) => WriteMode::Append,
+                _ => WriteMode::New,
+            },
+            format: self.format,
+        })
+    }
+}
+
+impl Spec for Record {
+    /// It sends nothing.
+    fn preview(&self, _known: &Known<'_>) -> Result<Preview, CommandError> {
+        Ok(Preview::sends(format!("nothing: records the bus to {}", self.output)))
+    }
+
+    /// The palette records with `record start FILE` (the TUI's own recording).
+    fn palette_refusal(&self) -> Option<CommandError> {
+        Some(CommandError::Usage(
+            "record runs from the command line (`cotui record IFACE -o FILE`)".into(),
+        ))
+    }
+
+    /// Records until a limit (a record without limits runs until its future is dropped; the
+    /// log is flushed then).
+    async fn run(&self, ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
+        let mut out = open_output(&self.output, self.mode, self.format)?;
+        let forever = std::future::pending::<()>();
+        let n = record(ctx.bus, &mut out, self.limits, self.format, forever, |_| {}).await?;
+        if let Some(m) = n.gap_message(&self.output) {
+            return Err(CommandError::Bus(BusError::Io {
+                iface: ctx.bus.name().to_string(),
+                reason: format!("{} frames written, but {m}", n.frames),
+            }));
+        }
+        let report = n.report(&self.output);
+        let text = report.text();
+        Ok(Outcome::new(report, text))
+    }
+
+    fn data_to_stdout(&self) -> bool {
+        self.output == "-"
+    }
 }
 
 /// Opens the log: `-` is stdout; an existing file is refused unless `mode` says overwrite or
@@ -284,11 +382,11 @@ pub enum LogFormat {
 
 impl LogFormat {
     /// Parses `candump` or `pcapng`.
-    pub fn parse(word: &str) -> Result<LogFormat, super::syntax::ParseError> {
+    pub fn parse(word: &str) -> Result<LogFormat, ParseError> {
         match word {
             "candump" | "log" => Ok(LogFormat::Candump),
             "pcapng" => Ok(LogFormat::Pcapng),
-            _ => Err(super::syntax::ParseError::Invalid(format!(
+            _ => Err(ParseError::Invalid(format!(
                 "unknown record format `{word}`: use candump or pcapng"
             ))),
         }
@@ -518,7 +616,7 @@ mod tests {
             dropped: 0,
             gaps: rec.gaps,
         };
-        let v = r.to_json("x.log");
+        let v = super::super::to_json(&r.report("x.log"));
         assert_eq!((v["ok"].as_bool(), v["error"].as_str()), (Some(false), Some("bus")));
         assert_eq!(v["gaps"][0]["from"], 2.0);
         assert_eq!(v["gaps"][1]["reason"], "bus-off");
@@ -526,7 +624,7 @@ mod tests {
             v["message"],
             "x.log has 2 gap(s), 2.5 s in all, when nothing could be captured (interface down, bus-off)"
         );
-        let clean = Recorded::default().to_json("x.log");
+        let clean = super::super::to_json(&Recorded::default().report("x.log"));
         assert_eq!(
             (clean["ok"].as_bool(), clean["gaps"].as_array().map(Vec::len)),
             (Some(true), Some(0))

@@ -2,9 +2,12 @@
 //! concrete steps (pure: objects resolved, values encoded, frames built) and then run
 //! step by step through the same SDO and NMT paths as `sdo write` / `nmt`.
 
+pub mod command;
+
 use super::error::CommandError;
 use super::grammar::parse_int;
 use super::nmt::NmtAction;
+use super::report::Reported;
 use super::value::{decode, encode};
 use crate::bus::{Bus, BusError};
 use crate::decode::value_text::object_text;
@@ -404,7 +407,7 @@ fn plan_step(
 }
 
 /// What a step did, its `result` in the JSON of a run.
-#[derive(Serialize)]
+#[derive(Debug, Serialize)]
 #[serde(untagged)]
 enum StepResult {
     /// `"written"`, `"sent"`, `"done"`, `"not sent"`.
@@ -418,91 +421,109 @@ enum StepResult {
 }
 
 /// One step in the JSON of a run.
-#[derive(Serialize)]
-struct StepJson<'a> {
+#[derive(Debug, Serialize)]
+struct StepJson {
     step: usize,
     kind: &'static str,
     object: Option<String>,
     value: Option<i64>,
-    frame: Option<&'a str>,
-    text: &'a str,
+    frame: Option<String>,
+    text: String,
     result: StepResult,
 }
 
-fn step_json(s: &PlannedStep, number: usize, result: StepResult) -> StepJson<'_> {
+fn step_json(s: &PlannedStep, number: usize, result: StepResult) -> StepJson {
     StepJson {
         step: number,
         kind: s.kind(),
         object: s.object(),
         value: s.value,
-        frame: s.frame.as_deref(),
-        text: &s.text,
+        frame: s.frame.clone(),
+        text: s.text.clone(),
         result,
     }
 }
 
 /// The JSON of a run (or dry run) of a procedure.
-#[derive(Serialize)]
-struct RunJson<'a> {
+#[derive(Debug, Serialize)]
+pub struct RunJson {
     ok: bool,
-    procedure: &'a str,
+    procedure: String,
     node: u8,
     /// Every parameter with the value used.
-    params: BTreeMap<&'a str, i64>,
-    steps: Vec<StepJson<'a>>,
+    params: BTreeMap<String, i64>,
+    steps: Vec<StepJson>,
     #[serde(skip_serializing_if = "Option::is_none")]
     dry_run: Option<bool>,
 }
 
-fn plan_json<'a>(plan: &'a RunPlan, steps: Vec<StepJson<'a>>, ok: bool) -> RunJson<'a> {
+impl RunJson {
+    /// The last line of a successful run.
+    pub fn summary(&self) -> String {
+        format!(
+            "`{}` on node {}: {} steps done",
+            self.procedure,
+            self.node,
+            self.steps.len()
+        )
+    }
+
+    /// A dry run made to check a procedure before running it says so.
+    pub(crate) fn checked(mut self) -> RunJson {
+        self.dry_run = Some(false);
+        self
+    }
+}
+
+fn plan_json(plan: &RunPlan, steps: Vec<StepJson>, ok: bool) -> RunJson {
     RunJson {
         ok,
-        procedure: &plan.procedure,
+        procedure: plan.procedure.clone(),
         node: plan.node,
-        params: plan.params.iter().map(|(n, v)| (n.as_str(), *v)).collect(),
+        params: plan.params.iter().map(|(n, v)| (n.clone(), *v)).collect(),
         steps,
         dry_run: None,
     }
 }
 
 /// `run --list --json`.
-#[derive(Serialize)]
-struct ListJson<'a> {
+#[derive(Debug, Serialize)]
+pub struct ListJson {
     ok: bool,
     node: u8,
-    procedures: Vec<ProcedureJson<'a>>,
+    procedures: Vec<ProcedureJson>,
 }
 
 /// One procedure of a listing.
-#[derive(Serialize)]
-struct ProcedureJson<'a> {
-    name: &'a str,
-    description: Option<&'a str>,
+#[derive(Debug, Serialize)]
+struct ProcedureJson {
+    name: String,
+    description: Option<String>,
     steps: usize,
-    params: Vec<ParamJson<'a>>,
+    params: Vec<ParamJson>,
 }
 
 /// One parameter of a procedure.
-#[derive(Serialize)]
-struct ParamJson<'a> {
-    name: &'a str,
-    unit: Option<&'a str>,
-    description: Option<&'a str>,
+#[derive(Debug, Serialize)]
+struct ParamJson {
+    name: String,
+    unit: Option<String>,
+    description: Option<String>,
     default: Option<i64>,
 }
 
 /// The outcome of `--dry-run`: every step with its frame, `result` "not sent"; the text's
 /// first line is the summary (the palette shows one line).
-pub fn dry_run(plan: &RunPlan) -> (Json, String) {
+pub fn dry_run(plan: &RunPlan) -> (RunJson, String) {
     let n = plan.steps.len();
     let steps = (1..)
         .zip(&plan.steps)
         .map(|(k, s)| step_json(s, k, StepResult::Word("not sent")))
         .collect();
-    let v = super::to_json(&RunJson {
+    let v = RunJson {
         dry_run: Some(true),
         ..plan_json(plan, steps, true)
-    });
+    };
     let mut lines = vec![format!(
         "dry run of `{}` on node {}: {n} steps, nothing sent",
         plan.procedure, plan.node
@@ -513,21 +534,21 @@ pub fn dry_run(plan: &RunPlan) -> (Json, String) {
 
 /// The procedures of `dict` with their descriptions and parameters (JSON and text; the
 /// text's first line names them all).
-pub fn list(dict: &Dictionary, node: u8) -> (Json, String) {
+pub fn list(dict: &Dictionary, node: u8) -> (ListJson, String) {
     let procs = dict.procedures();
     let items: Vec<ProcedureJson> = procs
         .iter()
         .map(|p| ProcedureJson {
-            name: &p.name,
-            description: p.description.as_deref(),
+            name: p.name.clone(),
+            description: p.description.clone(),
             steps: p.steps.len(),
             params: p
                 .params
                 .iter()
                 .map(|q| ParamJson {
-                    name: &q.name,
-                    unit: q.unit.as_deref(),
-                    description: q.description.as_deref(),
+                    name: q.name.clone(),
+                    unit: q.unit.clone(),
+                    description: q.description.clone(),
                     default: q.default,
                 })
                 .collect(),
@@ -552,11 +573,11 @@ pub fn list(dict: &Dictionary, node: u8) -> (Json, String) {
             .collect::<Vec<_>>()
             .join("\n")
     };
-    let json = super::to_json(&ListJson {
+    let json = ListJson {
         ok: true,
         node,
         procedures: items,
-    });
+    };
     (json, text)
 }
 
@@ -570,7 +591,7 @@ pub async fn run(
     plan: &RunPlan,
     timeout_ms: u64,
     progress: &mut (dyn FnMut(&str) + Send),
-) -> Result<Json, CommandError> {
+) -> Result<RunJson, CommandError> {
     if bus.is_listen_only() {
         return Err(BusError::ListenOnly.into());
     }
@@ -600,13 +621,13 @@ pub async fn run(
                     procedure: plan.procedure.clone(),
                     step: k,
                     of: n,
-                    report: Box::new(super::to_json(&plan_json(plan, done, false))),
+                    report: Reported::new(plan_json(plan, done, false)),
                     cause: Box::new(e),
                 });
             }
         }
     }
-    Ok(super::to_json(&plan_json(plan, done, true)))
+    Ok(plan_json(plan, done, true))
 }
 
 /// Runs one step; gives its `result` JSON and text.

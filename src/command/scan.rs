@@ -1,12 +1,16 @@
 //! `scan`: which nodes are on the bus (heartbeats and boot-ups heard), then who they
 //! are (SDO reads of 0x1000 device type, 0x1018 identity, 0x1008 device name).
 
-use super::error::CommandError;
+use super::error::{CommandError, ParseError};
+use super::grammar::{SCAN_LISTEN_MS, SCAN_TIMEOUT_MS};
 use super::sdo::upload;
+use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
+use super::words::ms_arg;
 use crate::bus::{Bus, BusError};
 use crate::decode::heartbeat::NmtState;
 use crate::frame::Direction;
 use crate::od::Value;
+use serde::Serialize;
 use std::collections::BTreeMap;
 use std::time::Duration;
 use tokio::task::JoinSet;
@@ -49,10 +53,10 @@ impl NodeInfo {
     pub fn device_profile(&self) -> Option<u16> {
         self.device_type.map(|t| t as u16)
     }
-    /// The `--json` object of the node.
-    pub fn to_json(&self) -> serde_json::Value {
+    /// The node in `scan --json`.
+    fn json(&self) -> NodeJson {
         let hex = |v: Option<u32>| v.map(|x| format!("0x{x:08X}"));
-        super::to_json(&NodeJson {
+        NodeJson {
             node: self.node,
             nmt: self.nmt.map(|s| s.as_str()),
             device_type: hex(self.device_type),
@@ -61,17 +65,17 @@ impl NodeInfo {
             product_code: hex(self.identity[1]),
             revision: hex(self.identity[2]),
             serial: hex(self.identity[3]),
-            device_name: self.device_name.as_deref(),
-            software_version: self.software_version.as_deref(),
-            profile: self.profile.as_deref(),
-            sdo_error: self.sdo_error.as_deref(),
-        })
+            device_name: self.device_name.clone(),
+            software_version: self.software_version.clone(),
+            profile: self.profile.clone(),
+            sdo_error: self.sdo_error.clone(),
+        }
     }
 }
 
 /// One node of `scan --json`.
-#[derive(serde::Serialize)]
-struct NodeJson<'a> {
+#[derive(Debug, Serialize)]
+struct NodeJson {
     node: u8,
     nmt: Option<&'static str>,
     device_type: Option<String>,
@@ -80,10 +84,106 @@ struct NodeJson<'a> {
     product_code: Option<String>,
     revision: Option<String>,
     serial: Option<String>,
-    device_name: Option<&'a str>,
-    software_version: Option<&'a str>,
-    profile: Option<&'a str>,
-    sdo_error: Option<&'a str>,
+    device_name: Option<String>,
+    software_version: Option<String>,
+    profile: Option<String>,
+    sdo_error: Option<String>,
+}
+
+/// `scan --json`.
+#[derive(Debug, Serialize)]
+struct Scanned {
+    ok: bool,
+    nodes: Vec<NodeJson>,
+}
+
+impl Scanned {
+    /// One line per node found, or what to try when none was.
+    fn text(&self) -> String {
+        if self.nodes.is_empty() {
+            return "no nodes found (no heartbeat or boot-up heard; try --probe)".into();
+        }
+        let or_dash = |x: &Option<String>| x.clone().unwrap_or_else(|| "-".into());
+        self.nodes
+            .iter()
+            .map(|n| {
+                // The node-ID unpadded, as the JSON number was written.
+                let mut line = format!(
+                    "node {}  {:<16} type {}  vendor {}  product {}  rev {}  serial {}  {}",
+                    n.node,
+                    n.nmt.unwrap_or("-"),
+                    or_dash(&n.device_type),
+                    or_dash(&n.vendor_id),
+                    or_dash(&n.product_code),
+                    or_dash(&n.revision),
+                    or_dash(&n.serial),
+                    n.device_name.as_ref().map(|d| format!("\"{d}\"")).unwrap_or_default()
+                );
+                if let Some(p) = &n.profile {
+                    line.push_str(&format!("  profile {p} (--profile {}={p})", n.node));
+                }
+                if let Some(e) = &n.sdo_error {
+                    line.push_str(&format!("  ({e})"));
+                }
+                line
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+    }
+}
+
+/// `scan [--listen MS] [--probe] [--timeout MS]`.
+#[derive(clap::Args, Clone, Debug)]
+pub struct ScanArgs {
+    /// How long to listen for heartbeats and boot-ups, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = SCAN_LISTEN_MS)]
+    pub listen: u64,
+    /// Also ask every node 1..127 for 0x1000 (finds nodes without heartbeat).
+    #[arg(long)]
+    pub probe: bool,
+    /// How long to wait for each SDO answer, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = SCAN_TIMEOUT_MS)]
+    pub timeout: u64,
+}
+
+/// A scan of the bus.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Scan {
+    pub listen_ms: u64,
+    pub probe: bool,
+    pub timeout_ms: u64,
+}
+
+impl<D> CommandArgs<D> for ScanArgs {
+    type Spec = Scan;
+    const NAME: &'static str = "scan";
+
+    fn spec(&self) -> Result<Scan, ParseError> {
+        Ok(Scan {
+            listen_ms: self.listen,
+            probe: self.probe,
+            timeout_ms: self.timeout,
+        })
+    }
+}
+
+impl Spec for Scan {
+    /// What it asks depends on who answers.
+    fn preview(&self, _known: &Known<'_>) -> Result<Preview, CommandError> {
+        Ok(Preview::sends(
+            "listens for heartbeats, then reads 0x1018 of each node found",
+        ))
+    }
+
+    async fn run(&self, ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
+        let nodes = scan(ctx.bus, self.listen_ms, self.probe, self.timeout_ms).await?;
+        let report = Scanned {
+            ok: true,
+            nodes: nodes.iter().map(NodeInfo::json).collect(),
+        };
+        let text = report.text();
+        Ok(Outcome::new(report, text))
+    }
 }
 
 /// Listens `listen_ms` for heartbeats and boot-ups (and, with `probe`, also asks every silent

@@ -4,7 +4,7 @@
 use super::cyclic::{Schedule, Source};
 use super::error::CommandError;
 use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
-use super::syntax::{ParseError, Repeat, frame_arg};
+use super::words::{ParseError, Repeat, frame_arg};
 use crate::frame::Frame;
 use crate::od::bind::Bindings;
 
@@ -28,9 +28,7 @@ pub struct Send {
 impl<D> CommandArgs<D> for SendArgs {
     type Spec = Send;
 
-    fn name(&self) -> &'static str {
-        "send"
-    }
+    const NAME: &'static str = "send";
 
     fn spec(&self) -> Result<Send, ParseError> {
         Ok(Send {
@@ -43,11 +41,15 @@ impl<D> CommandArgs<D> for SendArgs {
 impl Spec for Send {
     /// The frame and how often.
     fn preview(&self, known: &Known<'_>) -> Result<Preview, CommandError> {
-        super::cyclic::preview(self, known, "")
+        super::spec::cyclic_preview(self, known, "")
     }
 
     async fn run(&self, ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
-        super::cyclic::run(self, ctx).await
+        super::spec::cyclic_run(self, ctx).await
+    }
+
+    fn cyclic(&self) -> bool {
+        true
     }
 
     fn source(&self, _bindings: &Bindings) -> Option<Result<Source, CommandError>> {

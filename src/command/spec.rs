@@ -4,64 +4,13 @@
 //! Each command is one module implementing these; `super::registry` lists them.
 
 use super::cyclic::{Progress, Source};
-use super::error::CommandError;
-use super::syntax::ParseError;
+use super::error::{CommandError, ParseError};
+use super::report::{Report, Reported};
 use crate::bus::Bus;
 use crate::decode::cia402::DriveState;
 use crate::od::bind::Bindings;
-use std::fmt;
 use std::future::Future;
 use std::pin::Pin;
-use std::sync::Arc;
-
-/// A command's `--json` report: a `#[derive(Serialize)]` type, made JSON when it is written.
-pub trait Report: Send + Sync {
-    /// The JSON object written (keys sorted, as `--json` prints them).
-    fn to_json(&self) -> serde_json::Value;
-}
-
-impl<T: serde::Serialize + Send + Sync> Report for T {
-    fn to_json(&self) -> serde_json::Value {
-        // Serializing these plain structs cannot fail; a failure would give null.
-        serde_json::to_value(self).unwrap_or_default()
-    }
-}
-
-/// A typed report, shared (an [`Outcome`], or the report a failure carries).
-#[derive(Clone)]
-pub struct Reported(Arc<dyn Report>);
-
-impl Reported {
-    /// Keeps `report` as it is until written.
-    pub fn new(report: impl Report + 'static) -> Reported {
-        Reported(Arc::new(report))
-    }
-
-    /// The JSON object written.
-    pub fn to_json(&self) -> serde_json::Value {
-        self.0.to_json()
-    }
-}
-
-/// Shown as the JSON it writes.
-impl fmt::Debug for Reported {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.to_json())
-    }
-}
-
-/// Two reports are equal when they write the same JSON.
-impl PartialEq for Reported {
-    fn eq(&self, other: &Self) -> bool {
-        self.to_json() == other.to_json()
-    }
-}
-
-impl serde::Serialize for Reported {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        self.to_json().serialize(s)
-    }
-}
 
 /// The result of a command: its typed report (the `--json` object) and the human text.
 #[derive(Clone, Debug, PartialEq)]
@@ -119,6 +68,9 @@ pub struct Ctx<'a> {
     pub progress: Progress,
     /// Completes when a cyclic command (or a record) should stop.
     pub stop: Pin<&'a mut (dyn Future<Output = ()> + Send)>,
+    /// Where a command that runs in steps (`run`) says each step as it happens; `None`:
+    /// the steps are part of its text.
+    pub lines: Option<&'a mut (dyn FnMut(&str) + Send)>,
 }
 
 /// One command of the commander, parsed (see [`CommandArgs`] for its declaration).
@@ -134,9 +86,39 @@ pub trait Spec {
         None
     }
 
+    /// True when it runs until stopped or for a while on a schedule (send, sync, pdo send):
+    /// the command line then stops it at Ctrl-C, with its report.
+    fn cyclic(&self) -> bool {
+        false
+    }
+
     /// True when it writes its data to stdout (`-o -`): its report then goes to stderr.
     fn data_to_stdout(&self) -> bool {
         false
+    }
+
+    /// Why the TUI's palette does not run it, if it does not (data to stdout would land in
+    /// the middle of the screen).
+    fn palette_refusal(&self) -> Option<CommandError> {
+        self.data_to_stdout()
+            .then(|| CommandError::Usage("-o - (stdout) is for the command line; in the TUI give a file".into()))
+    }
+
+    /// True when its dictionaries are checked before the bus is opened, [`Spec::offline`]
+    /// answering without one (`run`, `pdo map --dry-run`).
+    fn answers_offline(&self) -> bool {
+        false
+    }
+
+    /// Its outcome without a bus (a listing, a dry run) or why it is refused before the bus
+    /// is opened; `None`: it runs on the bus.
+    fn offline(&self, _bindings: &Bindings) -> Option<Result<Outcome, CommandError>> {
+        None
+    }
+
+    /// The one node it is about, for a `--eds FILE` given without `NODE=` (`dcf`).
+    fn node(&self) -> Option<u8> {
+        None
     }
 }
 
@@ -147,7 +129,7 @@ pub trait CommandArgs<D>: clap::Args {
     type Spec: Spec;
 
     /// What failures are prefixed with: `cotui sdo read: ...`.
-    fn name(&self) -> &'static str;
+    const NAME: &'static str;
 
     /// The command, or why the words make none (checks clap cannot make alone).
     fn spec(&self) -> Result<Self::Spec, ParseError>;
@@ -159,7 +141,7 @@ pub trait CommandArgs<D>: clap::Args {
 }
 
 /// One entry of the commander's declaration: a command's words with the options in front
-/// of them (`B`, see `super::syntax::On`), or a group of commands (`sdo read|write`).
+/// of them (`B`, see `super::words::On`), or a group of commands (`sdo read|write`).
 pub trait Declared<B, D> {
     /// The command the words make.
     type Spec: Spec;
@@ -175,4 +157,30 @@ pub trait Declared<B, D> {
 
     /// The command, or why the words make none.
     fn spec(&self) -> Result<Self::Spec, ParseError>;
+}
+
+/// The preview of a cyclic command: its first frame, its schedule, `extra` (the SYNC
+/// counter), whether it runs as a job and the mapped signals sent as 0.
+pub(crate) fn cyclic_preview(cmd: &impl Spec, known: &Known<'_>, extra: &str) -> Result<Preview, CommandError> {
+    let mut src = cmd
+        .source(known.bindings)
+        .unwrap_or_else(|| Err(CommandError::Usage("not a cyclic command".into())))?;
+    let mut text = format!("{} {}{extra}", super::candump(&src.frame(0)), src.schedule.text());
+    if src.schedule.total().is_none() {
+        text.push_str(" (a job: `jobs` lists, `jobs stop ID` or stop-all stops)");
+    }
+    if !src.defaulted.is_empty() {
+        text.push_str(&format!("; not given, sent as 0: {}", src.defaulted.join(", ")));
+    }
+    Ok(Preview::sends(text))
+}
+
+/// Runs a cyclic command until its schedule ends or `ctx.stop` completes; its report.
+pub(crate) async fn cyclic_run(cmd: &impl Spec, ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
+    let src = cmd
+        .source(ctx.bindings)
+        .unwrap_or_else(|| Err(CommandError::Usage("not a cyclic command".into())))?;
+    let report = super::cyclic::transmit(ctx.bus, src, ctx.progress, ctx.stop).await?;
+    let text = report.text();
+    Ok(Outcome::new(report, text))
 }

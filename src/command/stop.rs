@@ -6,15 +6,18 @@
 //! (quick stop, wait for the ramp, disable voltage, statusword read back), all targets at
 //! once, and the report says per node whether the stop was confirmed.
 
-use super::drive::{NodeStop, stop as stop_drive};
-use super::error::CommandError;
+use super::drive::{NodeStop, STOP_CONTROLWORDS, controlword_frame, stop as stop_drive};
+use super::error::{CommandError, ParseError};
+use super::grammar::DEFAULT_TIMEOUT_MS;
+use super::report::Reported;
 use super::sdo::upload;
+use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
+use super::words::{ms_arg, node_arg};
 use crate::bus::{Bus, BusError};
 use crate::decode::cia402::DriveState;
 use crate::frame::{Direction, Frame};
 use crate::sdo::codec::{SdoCommand, Side, decode};
 use serde::Serialize;
-use serde_json::Value as Json;
 use std::collections::{BTreeMap, BTreeSet};
 use std::time::Duration;
 use tokio::task::JoinSet;
@@ -31,7 +34,7 @@ pub struct StopOptions {
 impl Default for StopOptions {
     fn default() -> Self {
         StopOptions {
-            timeout_ms: super::grammar::DEFAULT_TIMEOUT_MS,
+            timeout_ms: DEFAULT_TIMEOUT_MS,
             ramp_ms: DEFAULT_RAMP_MS,
         }
     }
@@ -41,6 +44,89 @@ impl Default for StopOptions {
 pub const DEFAULT_RAMP_MS: u64 = 1500;
 /// Default time `cotui stop` listens for nodes before reading their statuswords.
 pub const DEFAULT_LISTEN_MS: u64 = 1200;
+
+/// `stop [NODE ...] [--node N]... [--listen MS] [--ramp MS] [--timeout MS]`.
+#[derive(clap::Args, Clone, Debug)]
+pub struct StopArgs {
+    /// Stop these nodes. Without any, every CiA 402 drive found powered is stopped.
+    #[arg(value_parser = node_arg)]
+    pub nodes: Vec<u8>,
+    /// Stop this node too (repeatable; the same as naming it).
+    #[arg(long = "node", value_name = "N", value_parser = node_arg)]
+    pub node_flags: Vec<u8>,
+    /// How long to listen for nodes before reading their statuswords, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_LISTEN_MS)]
+    pub listen: u64,
+    /// How long a drive may take to finish its quick stop ramp before voltage is disabled, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_RAMP_MS)]
+    pub ramp: u64,
+    /// How long to wait for each SDO answer, in ms.
+    #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
+    pub timeout: u64,
+}
+
+/// Quick stop and disable voltage on these nodes, or (none given) on every CiA 402 drive
+/// found powered.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Stop {
+    pub nodes: Vec<u8>,
+    pub listen_ms: u64,
+    pub options: StopOptions,
+}
+
+impl<D> CommandArgs<D> for StopArgs {
+    type Spec = Stop;
+    const NAME: &'static str = "stop";
+
+    fn spec(&self) -> Result<Stop, ParseError> {
+        let mut nodes = self.nodes.clone();
+        nodes.extend(self.node_flags.iter().filter(|n| !self.nodes.contains(n)));
+        Ok(Stop {
+            nodes,
+            listen_ms: self.listen,
+            options: StopOptions {
+                timeout_ms: self.timeout,
+                ramp_ms: self.ramp,
+            },
+        })
+    }
+}
+
+impl Spec for Stop {
+    /// The controlwords of each node named (the drives found powered are known only then).
+    fn preview(&self, _known: &Known<'_>) -> Result<Preview, CommandError> {
+        let words = |cws: &[u16]| {
+            cws.iter()
+                .map(|c| format!("0x{c:04X}"))
+                .collect::<Vec<_>>()
+                .join(" then ")
+        };
+        let frames: Vec<String> = self
+            .nodes
+            .iter()
+            .flat_map(|n| STOP_CONTROLWORDS.map(|cw| super::candump(&controlword_frame(*n, cw))))
+            .collect();
+        Ok(Preview::sends(if self.nodes.is_empty() {
+            format!(
+                "cancels running commands, then controlwords {} (quick stop, disable voltage) to every \
+                 drive cotui commanded or sees powered",
+                words(&STOP_CONTROLWORDS)
+            )
+        } else {
+            format!(
+                "cancels running commands, then {} (quick stop, then disable voltage, per node), also to \
+                 every drive cotui commanded or sees powered",
+                frames.join(", ")
+            )
+        }))
+    }
+
+    async fn run(&self, ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
+        stop(ctx.bus, &self.nodes, self.listen_ms, self.options)
+            .await?
+            .into_result()
+    }
+}
 
 /// The nodes cotui commanded on the bus, learned from the frames it sent (marked TX): SDO
 /// writes to application objects (0x2000 and up: vendor and CiA 402 objects), vendor SDO
@@ -123,22 +209,6 @@ impl StopReport {
     pub fn all_stopped(&self) -> bool {
         self.nodes.iter().all(|n| n.stopped)
     }
-    /// The `--json` object.
-    pub fn to_json(&self) -> Json {
-        super::to_json(&StopJson {
-            ok: self.all_stopped(),
-            nodes: self.nodes.iter().map(NodeStop::to_json).collect(),
-            idle: self
-                .idle
-                .iter()
-                .map(|(n, s)| IdleJson {
-                    node: *n,
-                    state: s.as_str(),
-                })
-                .collect(),
-            cancelled: &self.cancelled,
-        })
-    }
     /// The text: a summary line, then one line per node.
     pub fn text(&self) -> String {
         let failed = self.nodes.iter().filter(|n| !n.stopped).count();
@@ -160,13 +230,13 @@ impl StopReport {
     }
     /// The report as a command result: `Ok` when all targets are confirmed stopped, else
     /// [`CommandError::NotStopped`] (exit status 5) carrying the same report.
-    pub fn into_result(self) -> Result<super::Outcome, CommandError> {
-        let (json, text) = (self.to_json(), self.text());
+    pub fn into_result(self) -> Result<Outcome, CommandError> {
+        let text = self.text();
         if self.all_stopped() {
-            Ok(super::Outcome::new(json, text))
+            Ok(Outcome::new(self, text))
         } else {
             Err(CommandError::NotStopped {
-                report: Box::new(json),
+                report: Reported::new(self),
                 text,
             })
         }
@@ -174,10 +244,30 @@ impl StopReport {
 }
 
 /// `stop --json`.
+impl Serialize for StopReport {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        StopJson {
+            ok: self.all_stopped(),
+            nodes: &self.nodes,
+            idle: self
+                .idle
+                .iter()
+                .map(|(n, s)| IdleJson {
+                    node: *n,
+                    state: s.as_str(),
+                })
+                .collect(),
+            cancelled: &self.cancelled,
+        }
+        .serialize(s)
+    }
+}
+
+/// `stop --json`, as written.
 #[derive(Serialize)]
 struct StopJson<'a> {
     ok: bool,
-    nodes: Vec<Json>,
+    nodes: &'a [NodeStop],
     idle: Vec<IdleJson>,
     cancelled: &'a [String],
 }
@@ -191,11 +281,11 @@ struct IdleJson {
 
 /// `stop --json` on a listen-only handle.
 #[derive(Serialize)]
-struct ListenOnlyJson<'a> {
+struct ListenOnlyJson {
     ok: bool,
     listen_only: bool,
     nodes: [u8; 0],
-    message: &'a str,
+    message: String,
 }
 
 /// Stops `nodes`, all at once; the report lists them in node order.
@@ -231,12 +321,12 @@ fn listen_only(nodes: &BTreeSet<u8>) -> CommandError {
         }
     );
     CommandError::NotStopped {
-        report: Box::new(super::to_json(&ListenOnlyJson {
+        report: Reported::new(ListenOnlyJson {
             ok: false,
             listen_only: true,
             nodes: [],
-            message: &text,
-        })),
+            message: text.clone(),
+        }),
         text,
     }
 }
@@ -385,7 +475,7 @@ mod tests {
             text.contains("node 4: Switch on disabled (not powered, nothing sent)"),
             "{text}"
         );
-        let j = r.to_json();
+        let j = super::super::to_json(&r);
         assert_eq!(j["ok"], false);
         assert_eq!(j["nodes"][0]["stopped"], true);
         assert_eq!(j["nodes"][0]["state"], "switch_on_disabled");

@@ -4,7 +4,7 @@
 use super::cyclic::{Schedule, Source, sync_frame};
 use super::error::CommandError;
 use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
-use super::syntax::{ParseError, cob_arg, count_arg, counter_arg, ms_arg, not_reserved};
+use super::words::{ParseError, cob_arg, count_arg, counter_arg, ms_arg, not_reserved};
 use crate::cob;
 use crate::od::bind::Bindings;
 
@@ -40,9 +40,7 @@ pub struct Sync {
 impl<D> CommandArgs<D> for SyncArgs {
     type Spec = Sync;
 
-    fn name(&self) -> &'static str {
-        "sync"
-    }
+    const NAME: &'static str = "sync";
 
     fn spec(&self) -> Result<Sync, ParseError> {
         Ok(Sync {
@@ -65,11 +63,15 @@ impl Spec for Sync {
     /// The first SYNC, the period and the counter's range.
     fn preview(&self, known: &Known<'_>) -> Result<Preview, CommandError> {
         let counter = self.counter.map(|n| format!(", counter 1..{n}")).unwrap_or_default();
-        super::cyclic::preview(self, known, &counter)
+        super::spec::cyclic_preview(self, known, &counter)
     }
 
     async fn run(&self, ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
-        super::cyclic::run(self, ctx).await
+        super::spec::cyclic_run(self, ctx).await
+    }
+
+    fn cyclic(&self) -> bool {
+        true
     }
 
     fn source(&self, _bindings: &Bindings) -> Option<Result<Source, CommandError>> {

@@ -316,7 +316,7 @@ impl App {
                 let words: Vec<String> = if let Some(rest) = before.strip_prefix("plot ") {
                     plot_completions(trace, rest)
                 } else if before.starts_with("record ") {
-                    record::WORDS.iter().map(|w| w.to_string()).collect()
+                    record::words()
                 } else if before.contains(' ') {
                     crate::command::syntax::completions(&before, &Heard(trace, &self.bindings))
                 } else {

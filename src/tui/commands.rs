@@ -174,7 +174,7 @@ pub(crate) fn run(line: &str, capture: &mut Capture, screen: &mut Screen, q: &mu
         }
         "stop" => {
             match crate::command::parse_command(line) {
-                Ok(Command::Stop { nodes, options, .. }) => q.push(Event::StopAll(nodes, options)),
+                Ok(Command::Stop(s)) => q.push(Event::StopAll(s.nodes, s.options)),
                 Ok(_) => {}
                 Err(e) => q.push(Event::Say(Level::Error, format!("stop: {e}"))),
             }

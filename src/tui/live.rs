@@ -9,7 +9,7 @@ use super::source::Feed;
 use crate::bus::{Bus, BusError, BusState, Event, StateChange};
 use crate::command::cyclic::{self, Progress};
 use crate::command::stop::{Commanded, StopOptions, stop_nodes};
-use crate::command::{self, Command};
+use crate::command::{self, Command, Spec};
 use crate::decode::cia402::DriveState;
 use crate::frame::Frame;
 use crate::od::bind::Bindings;
@@ -314,7 +314,8 @@ impl Jobs {
         let (bus, tx) = (bus.clone(), tx.clone());
         match r {
             Request::Run { line, command } => {
-                let cyclic = cyclic::source(&command, bindings)
+                let cyclic = command
+                    .source(bindings)
                     .and_then(Result::ok)
                     .map(|s| (Progress::default(), s.what, s.schedule.every_ms));
                 let progress = cyclic.as_ref().map(|c| c.0.clone()).unwrap_or_default();

@@ -3,12 +3,9 @@
 //! controlwords, the LSS requests), and whether it needs confirming (broadcast NMT, resets,
 //! node 0, LSS services that change state).
 
-use crate::command::lss::LssAction;
-use crate::command::run::Action;
-use crate::command::spec::{Known, Spec};
-use crate::command::{Command, CommandError, NmtAction, RunSpec, candump, drive, parse_command, sdo};
+use crate::command::spec::{Known, Preview, Spec};
+use crate::command::{Command, CommandError, parse_command};
 use crate::decode::cia402::DriveState;
-use crate::frame::Frame;
 use crate::od::bind::Bindings;
 
 /// The first words of commander lines, from the command declaration.
@@ -30,11 +27,6 @@ pub struct Planned {
     pub confirm: Option<String>,
 }
 
-/// A list of frames, candump style.
-fn listed(frames: &[Frame]) -> String {
-    frames.iter().map(candump).collect::<Vec<_>>().join(", ")
-}
-
 /// Plans a commander line; `bindings` give object names and types, `state` a node's known
 /// CiA 402 state for drive previews.
 pub fn plan(
@@ -43,156 +35,18 @@ pub fn plan(
     state: impl Fn(u8) -> Option<DriveState>,
 ) -> Result<Planned, CommandError> {
     let command = parse_command(line)?;
-    if command.data_to_stdout() && !matches!(command, Command::Record { .. }) {
-        // The TUI owns the terminal: data on stdout would land in the middle of the screen.
-        return Err(CommandError::Usage(
-            "-o - (stdout) is for the command line; in the TUI give a file".into(),
-        ));
+    if let Some(refused) = command.palette_refusal() {
+        return Err(refused);
     }
     let known = Known {
         bindings,
         drive_state: &state,
     };
-    let (preview, confirm) = match &command {
-        Command::Nmt(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
-        Command::Send(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
-        Command::Sync(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
-        Command::Sdo(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
-        Command::Drive(c) => c.preview(&known).map(|p| (p.frames, p.confirm))?,
-        Command::Scan { .. } => (
-            "listens for heartbeats, then reads 0x1018 of each node found".into(),
-            None,
-        ),
-        Command::Run(RunSpec {
-            node, procedure: None, ..
-        }) => (format!("nothing: lists the procedures of node {node}"), None),
-        Command::Run(RunSpec {
-            node,
-            procedure: Some(name),
-            args,
-            dry_run,
-            ..
-        }) => {
-            let p = crate::command::run::plan(bindings.dictionary(*node), *node, name, args)?;
-            let steps: Vec<String> = p.steps.iter().map(|s| s.preview()).collect();
-            let confirm = p.steps.iter().find_map(|s| match s.action {
-                Action::Nmt { action, target }
-                    if target == 0 || matches!(action, NmtAction::ResetNode | NmtAction::ResetComm) =>
-                {
-                    Some(format!("`{name}` sends {}", s.text))
-                }
-                _ => None,
-            });
-            if *dry_run {
-                (format!("nothing (dry run of {})", steps.join(", ")), None)
-            } else {
-                (steps.join(", "), confirm)
-            }
-        }
-        Command::Stop { nodes, .. } => {
-            let words = |cws: &[u16]| {
-                cws.iter()
-                    .map(|c| format!("0x{c:04X}"))
-                    .collect::<Vec<_>>()
-                    .join(" then ")
-            };
-            let frames: Vec<Frame> = nodes
-                .iter()
-                .flat_map(|n| drive::STOP_CONTROLWORDS.map(|cw| drive::controlword_frame(*n, cw)))
-                .collect();
-            let text = if nodes.is_empty() {
-                format!(
-                    "cancels running commands, then controlwords {} (quick stop, disable voltage) to every \
-                     drive cotui commanded or sees powered",
-                    words(&drive::STOP_CONTROLWORDS)
-                )
-            } else {
-                format!(
-                    "cancels running commands, then {} (quick stop, then disable voltage, per node), also to \
-                     every drive cotui commanded or sees powered",
-                    listed(&frames)
-                )
-            };
-            (text, None)
-        }
-        Command::Lss { action, .. } => {
-            // Inquire and identify only ask; the others change the state of every slave they reach.
-            let asks = matches!(
-                action,
-                LssAction::Inquire(_) | LssAction::Identify { .. } | LssAction::IdentifyUnconfigured
-            );
-            let confirm = (!asks).then(|| {
-                format!(
-                    "LSS {} addresses every LSS slave (in configuration state, or not yet configured)",
-                    action.as_str()
-                )
-            });
-            (action.preview(), confirm)
-        }
-        Command::Pdo { .. } => {
-            let mut src = crate::command::cyclic::source(&command, bindings)
-                .unwrap_or_else(|| Err(CommandError::Usage("not a cyclic command".into())))?;
-            let mut text = format!("{} {}", candump(&src.frame(0)), src.schedule.text());
-            if src.schedule.total().is_none() {
-                text.push_str(" (a job: `jobs` lists, `jobs stop ID` or stop-all stops)");
-            }
-            if !src.defaulted.is_empty() {
-                text.push_str(&format!("; not given, sent as 0: {}", src.defaulted.join(", ")));
-            }
-            (text, None)
-        }
-        Command::PdoRead { node, .. } => (
-            format!(
-                "{} then the other PDO records of node {node} (0x1400-0x1BFF, until one is missing)",
-                candump(&sdo::first_upload_frame(*node, 0x1400, 0, false))
-            ),
-            None,
-        ),
-        Command::PdoMap(spec) => {
-            let dict = bindings.dictionary(spec.node);
-            let writes = crate::command::pdo::plan(dict, spec, crate::command::pdo::assumed_cob(dict, spec))?;
-            let frames: Vec<Frame> = writes.iter().map(|w| w.frame(spec.node)).collect();
-            let read = candump(&sdo::first_upload_frame(spec.node, spec.pdo.comm_index(), 1, false));
-            if spec.dry_run {
-                (format!("nothing (dry run of {read}, {})", listed(&frames)), None)
-            } else {
-                (format!("{read} (COB-ID), {} then reads back", listed(&frames)), None)
-            }
-        }
-        Command::Dcf(d) => {
-            use crate::command::dcf::DcfAction;
-            let n = d.node;
-            match &d.action {
-                DcfAction::Save { output, .. } => (
-                    format!("reads every object node {n}'s dictionary knows by SDO, writes {output}"),
-                    None,
-                ),
-                DcfAction::Diff { file } => (format!("reads node {n} by SDO, compares with {file}"), None),
-                DcfAction::Load {
-                    file, dry_run: true, ..
-                } => (
-                    format!("reads node {n} by SDO, lists what {file} would write (writes nothing)"),
-                    None,
-                ),
-                DcfAction::Load { file, store, .. } => (
-                    format!(
-                        "reads node {n}, writes the values of {file} that differ (PDOs remapped), reads them back{}",
-                        if *store { ", stores (0x1010:01)" } else { "" }
-                    ),
-                    Some(format!("dcf load writes node {n}'s configuration from {file}")),
-                ),
-            }
-        }
-        Command::Record { .. } => {
-            return Err(CommandError::Usage(
-                "record runs from the command line (`cotui record IFACE -o FILE`)".into(),
-            ));
-        }
-    };
+    let Preview { frames, confirm } = command.preview(&known)?;
     Ok(Planned {
         line: line.trim().to_string(),
         command,
-        preview,
+        preview: frames,
         confirm,
     })
 }

@@ -6,8 +6,8 @@
 use super::capture::Capture;
 use super::event::{Event, Queue};
 use super::messages::Level;
-use crate::command::CommandError;
 use crate::command::record::{WriteMode, open_output};
+use crate::command::{CommandError, ParseError};
 use crate::frame::{Frame, Interfaces};
 use crate::log::writer::LogWriter;
 use crate::logio::sink::{LineSink, Target};
@@ -21,43 +21,82 @@ pub struct Recorder {
     line: String,
 }
 
-/// What `record` in the palette asks for.
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// What `record` in the palette asks for (the words after `record`, as clap declares them).
+#[derive(clap::Subcommand, Clone, Debug, PartialEq, Eq)]
 pub enum RecordCommand {
-    /// `record start FILE [--force | --append]`.
-    Start { file: String, mode: WriteMode },
-    /// `record stop`.
+    /// Record the frames the session receives to FILE (candump -l).
+    Start(StartArgs),
+    /// End the recording.
     Stop,
 }
 
-/// The words `record` takes in the palette (for completion).
-pub const WORDS: &[&str] = &["start", "stop", "--force", "--append"];
+/// `record start FILE [--force | --append]`.
+#[derive(clap::Args, Clone, Debug, PartialEq, Eq)]
+pub struct StartArgs {
+    /// The log to write. An existing file is refused unless --force or --append.
+    pub file: String,
+    /// Overwrite an existing file.
+    #[arg(long, conflicts_with = "append")]
+    pub force: bool,
+    /// Append to an existing file.
+    #[arg(long)]
+    pub append: bool,
+}
 
-/// How `record` is written in the palette.
-pub const USAGE: &str = "record: use `record start FILE [--force | --append]` or `record stop`";
-
-/// Parses the words after `record`.
-pub fn parse(rest: &str) -> Result<RecordCommand, String> {
-    let words: Vec<&str> = rest.split_whitespace().collect();
-    match words.as_slice() {
-        ["stop"] => Ok(RecordCommand::Stop),
-        ["start", more @ ..] => {
-            let (mut file, mut mode) = (None, WriteMode::New);
-            for w in more {
-                match *w {
-                    "--force" if mode == WriteMode::New => mode = WriteMode::Overwrite,
-                    "--append" if mode == WriteMode::New => mode = WriteMode::Append,
-                    "--force" | "--append" => return Err("record: --force and --append exclude each other".into()),
-                    w if w.starts_with("--") => return Err(format!("record: unknown option `{w}`; {USAGE}")),
-                    w if file.is_none() => file = Some(w.to_string()),
-                    w => return Err(format!("record: one FILE only (`{w}` is extra)")),
-                }
-            }
-            let file = file.ok_or_else(|| USAGE.to_string())?;
-            Ok(RecordCommand::Start { file, mode })
+impl StartArgs {
+    /// What to do when the file exists.
+    pub fn mode(&self) -> WriteMode {
+        match (self.force, self.append) {
+            (true, _) => WriteMode::Overwrite,
+            (_, true) => WriteMode::Append,
+            _ => WriteMode::New,
         }
-        _ => Err(USAGE.into()),
     }
+}
+
+/// The palette's `record` line.
+#[derive(clap::Parser, Debug)]
+#[command(
+    name = "record",
+    no_binary_name = true,
+    disable_help_subcommand = true,
+    disable_version_flag = true
+)]
+struct RecordLine {
+    #[command(subcommand)]
+    command: RecordCommand,
+}
+
+/// The declaration, built once.
+fn declaration() -> &'static clap::Command {
+    static CMD: std::sync::OnceLock<clap::Command> = std::sync::OnceLock::new();
+    CMD.get_or_init(|| {
+        let mut c = <RecordLine as clap::CommandFactory>::command();
+        c.build();
+        c
+    })
+}
+
+/// The words `record` takes in the palette (for completion), from the declaration: its
+/// subcommands, then their flags.
+pub fn words() -> Vec<String> {
+    let cmd = declaration();
+    let subs = cmd.get_subcommands();
+    let flags = cmd.get_subcommands().flat_map(|s| {
+        s.get_arguments()
+            .filter_map(|a| a.get_long())
+            .filter(|l| *l != "help")
+            .map(|l| format!("--{l}"))
+    });
+    subs.map(|s| s.get_name().to_string()).chain(flags).collect()
+}
+
+/// Parses the words after `record` (split like a shell line).
+pub fn parse(rest: &str) -> Result<RecordCommand, ParseError> {
+    let words = shlex::split(rest).ok_or(ParseError::Quote)?;
+    let matches = declaration().clone().try_get_matches_from(words)?;
+    let line = <RecordLine as clap::FromArgMatches>::from_arg_matches(&matches)?;
+    Ok(line.command)
 }
 
 impl Recorder {
@@ -105,7 +144,7 @@ pub(crate) fn command(capture: &mut Capture, rest: &str, q: &mut Queue) {
     let has_bus = capture.has_bus();
     let recording = capture.recording_mut();
     let (level, text) = match parse(rest) {
-        Err(e) => (Level::Error, e),
+        Err(e) => (Level::Error, format!("record: {e}")),
         Ok(RecordCommand::Stop) => match recording.take() {
             None => (Level::Info, "record: not recording".to_string()),
             Some(r) => {
@@ -116,23 +155,26 @@ pub(crate) fn command(capture: &mut Capture, rest: &str, q: &mut Queue) {
                 }
             }
         },
-        Ok(RecordCommand::Start { .. }) if !has_bus => (
+        Ok(RecordCommand::Start(_)) if !has_bus => (
             Level::Error,
             "record: only a live or demo session records what it receives; `export FILE` writes a log's view".into(),
         ),
-        Ok(RecordCommand::Start { .. }) if recording.is_some() => {
+        Ok(RecordCommand::Start(_)) if recording.is_some() => {
             let file = recording.as_ref().map(|r| r.file.clone()).unwrap_or_default();
             (
                 Level::Error,
                 format!("record: already recording to {file} (`record stop` first)"),
             )
         }
-        Ok(RecordCommand::Start { file, mode }) => match Recorder::start(&file, mode) {
+        Ok(RecordCommand::Start(start)) => match Recorder::start(&start.file, start.mode()) {
             Ok(r) => {
                 *recording = Some(r);
                 (
                     Level::Info,
-                    format!("record: recording the frames received to {file} (`record stop` ends it)"),
+                    format!(
+                        "record: recording the frames received to {} (`record stop` ends it)",
+                        start.file
+                    ),
                 )
             }
             Err(e) => (Level::Error, format!("record: {e}")),
@@ -148,19 +190,15 @@ mod tests {
     #[test]
     fn palette_words_parse_or_say_how() {
         assert_eq!(parse("stop"), Ok(RecordCommand::Stop));
-        assert_eq!(
-            parse("start a.log --append"),
-            Ok(RecordCommand::Start {
-                file: "a.log".into(),
-                mode: WriteMode::Append
-            })
-        );
-        assert_eq!(parse("start"), Err(USAGE.to_string()));
-        assert_eq!(parse("-o x.log"), Err(USAGE.to_string()));
-        assert_eq!(
-            parse("start a b"),
-            Err("record: one FILE only (`b` is extra)".to_string())
-        );
-        assert!(parse("start a --force --append").unwrap_err().contains("exclude"));
+        let Ok(RecordCommand::Start(start)) = parse("start a.log --append") else {
+            panic!("not a start");
+        };
+        assert_eq!((start.file.as_str(), start.mode()), ("a.log", WriteMode::Append));
+        let err = |rest: &str| parse(rest).unwrap_err().to_string();
+        assert!(err("start").contains("<FILE>"), "{}", err("start"));
+        assert!(err("-o x.log").contains("'-o'"), "{}", err("-o x.log"));
+        assert_eq!(err("start a b"), "unexpected argument 'b' found");
+        assert!(err("start a --force --append").contains("cannot be used with"));
+        assert_eq!(words(), ["start", "stop", "--force", "--append"]);
     }
 }

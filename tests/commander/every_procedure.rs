@@ -42,9 +42,10 @@ fn run_one(profile: &str, procedure: &str) -> (serde_json::Value, usize, Vec<i64
         let demo = Demo::spawn(sim, false);
         let dict = bindings.dictionary(NODE);
         let p = plan(dict, NODE, procedure, &[]).unwrap_or_else(|e| panic!("{profile} {procedure}: {e}"));
-        let v = run(&demo.bus, dict, &p, 500, &mut |_| {})
+        let run = run(&demo.bus, dict, &p, 500, &mut |_| {})
             .await
             .unwrap_or_else(|e| panic!("{profile} {procedure}: {e}"));
+        let v = serde_json::to_value(run).unwrap();
         tokio::time::sleep(Duration::from_secs(30)).await;
         let s = demo.sim.lock().unwrap();
         let od = s.drive(NODE).unwrap().objects();

@@ -11,7 +11,7 @@ fn stable(v: &mut Value, tmp: &str) {
     match v {
         Value::Object(map) => {
             for (key, value) in map.iter_mut() {
-                let measured = ["jitter", "mean_period", "elapsed", "took", "duration_ms"]
+                let measured = ["jitter", "mean_period", "elapsed", "took", "duration_ms", "after_ms"]
                     .iter()
                     .any(|m| key.contains(m));
                 if measured && value.is_number() {
@@ -115,6 +115,37 @@ fn every_command_answers_json_as_documented() {
             vec!["dcf", "diff", "demo", "2", "/nonexistent.dcf"],
             1,
         ),
+        (
+            "dcf_load_dry_run",
+            vec!["dcf", "load", "demo", "2", &dcf, "--dry-run"],
+            0,
+        ),
+        (
+            "dcf_load_missing",
+            vec!["dcf", "load", "demo", "2", "/nonexistent.dcf"],
+            1,
+        ),
+        (
+            "scan_probe_listen_only",
+            vec!["scan", "demo", "--probe", "--listen-only"],
+            2,
+        ),
+        ("stop_listen_only", vec!["stop", "demo", "2", "--listen-only"], 5),
+        (
+            "sync_listen_only",
+            vec!["sync", "demo", "--period", "10", "--count", "2", "--listen-only"],
+            2,
+        ),
+        ("lss_select_words", vec!["lss", "demo", "select", "1", "2", "3"], 1),
+        ("pdo_read_no_node", vec!["pdo", "demo", "9", "--timeout", "100"], 4),
+        ("pdo_map", vec!["pdo", "demo", "2", "map", "tpdo1", "0x6041"], 0),
+        (
+            "pdo_send_unknown_signal",
+            vec!["pdo", "demo", "2", "send", "rpdo1", "Nope=1"],
+            1,
+        ),
+        ("run_csp", vec!["run", "demo", "2", "csp"], 0),
+        ("run_listen_only", vec!["run", "demo", "2", "csp", "--listen-only"], 2),
     ];
     for (name, args, status) in cases {
         pinned(name, &args, status, tmp);

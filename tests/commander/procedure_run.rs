@@ -60,9 +60,10 @@ async fn waits_delays_and_raw_frames_run_in_order() {
     let p = plan(dict, 2, "enable_checked", &args).unwrap();
     let mut rx = d.bus.subscribe();
     let mut lines = Vec::new();
-    let v = run(&d.bus, dict, &p, 500, &mut |l| lines.push(l.to_string()))
+    let run = run(&d.bus, dict, &p, 500, &mut |l| lines.push(l.to_string()))
         .await
         .unwrap();
+    let v = serde_json::to_value(run).unwrap();
     assert_eq!(v["ok"], true);
     assert_eq!(v["steps"][3]["kind"], "wait");
     assert!(

@@ -276,13 +276,13 @@ async fn dexmart_sdo_procedures_show_the_value_and_fail_on_an_abort() {
     let bus = dexmart_peer();
     // "581 4B 00 30 0A 6E 09": Dynamic Data 10 = 096Eh = 2414, shown with the object's name.
     let p = plan(dict, 1, "read_dynamic_data", &[]).unwrap();
-    let v = run(&bus, dict, &p, 1000, &mut |_| {}).await.unwrap();
+    let v = serde_json::to_value(run(&bus, dict, &p, 1000, &mut |_| {}).await.unwrap()).unwrap();
     assert_eq!(v["steps"][0]["result"]["value"], 2414, "{v}");
     assert_eq!(v["steps"][0]["result"]["text"], "0x3000:0A = 2414", "{v}");
     assert_eq!(v["steps"][0]["text"], "sdo read 0x3000:0A Dynamic Data 10");
     // "601 2B 03 30 01 B8 0B 00 00" answered "581 60 03 30 01": written.
     let p = plan(dict, 1, "write_parameter", &[]).unwrap();
-    let v = run(&bus, dict, &p, 1000, &mut |_| {}).await.unwrap();
+    let v = serde_json::to_value(run(&bus, dict, &p, 1000, &mut |_| {}).await.unwrap()).unwrap();
     assert_eq!(v["steps"][0]["frame"], "601#2B033001B80B0000");
     assert_eq!(v["steps"][0]["result"], "written");
     // Objects the drive does not have: the abort fails the run with exit status 3.
@@ -525,7 +525,8 @@ async fn aimotor_homing(sw: u16) -> Result<serde_json::Value, cotui::command::Co
     let b = Bindings::from_args(&["1=aimotor".to_string()], &[], &|p| std::fs::read(p)).unwrap();
     let dict = b.dictionary(1);
     let p = cotui::command::run::plan(dict, 1, "hm", &[]).unwrap();
-    cotui::command::run::run(&bus, dict, &p, 1000, &mut |_| {}).await
+    let run = cotui::command::run::run(&bus, dict, &p, 1000, &mut |_| {}).await;
+    run.map(|r| serde_json::to_value(r).unwrap())
 }
 
 #[tokio::test(start_paused = true)]

@@ -4,10 +4,12 @@
 //! objects last), verifies and optionally stores; `diff` shows what differs. What is read
 //! and written, in which order, is planned by the pure [`plan`]; this module is the bus IO.
 
+pub mod command;
 pub mod plan;
 mod report;
 
 use super::error::{CommandError, ExitCode};
+use super::report::Reported;
 use super::sdo::{Timing, download_within, upload_within};
 use super::spec::Outcome;
 use crate::bus::Bus;
@@ -20,7 +22,7 @@ use std::io::Read;
 
 /// A `dcf` command.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct DcfCommand {
+pub struct Dcf {
     pub node: u8,
     pub action: DcfAction,
     /// How long to wait for each SDO answer, in ms.
@@ -42,7 +44,7 @@ pub enum DcfAction {
 const SILENT_LIMIT: u32 = 3;
 
 /// Runs a `dcf` command on `bus` with the node's dictionary.
-pub async fn execute(bus: &Bus, dict: &Dictionary, cmd: &DcfCommand) -> Result<Outcome, CommandError> {
+pub async fn execute(bus: &Bus, dict: &Dictionary, cmd: &Dcf) -> Result<Outcome, CommandError> {
     let mut sdo = Sdo {
         bus,
         node: cmd.node,
@@ -223,7 +225,7 @@ async fn save(sdo: &mut Sdo<'_>, dict: &Dictionary, output: &str, force: bool) -
         },
     };
     let text = crate::od::dcf::write(&info, &entries);
-    crate::command::exec::write_output(output, text.as_bytes())?;
+    crate::command::write::write_output(output, text.as_bytes())?;
     let saved = Saved {
         ok: true,
         node: sdo.node,
@@ -283,14 +285,14 @@ async fn compare_node(
 async fn diff(sdo: &mut Sdo<'_>, dict: &Dictionary, file: &str) -> Result<Outcome, CommandError> {
     let (compared, problems) = compare_node(sdo, dict, file).await?;
     let d = Diffed::new(sdo.node, file, &compared, problems);
-    let (json, text) = (super::to_json(&d), d.text());
+    let text = d.text();
     if d.equal {
-        Ok(Outcome::new(json, text))
+        Ok(Outcome::new(d, text))
     } else {
         Err(CommandError::Report {
             exit: ExitCode::Differs,
             error: "differs",
-            report: Box::new(json),
+            report: Reported::new(d),
             text,
         })
     }
@@ -386,9 +388,9 @@ async fn load(
         }
     }
     l.ok = l.refused.is_empty() && l.not_verified.is_empty();
-    let (json, text) = (super::to_json(&l), l.text());
+    let text = l.text();
     if l.ok {
-        return Ok(Outcome::new(json, text));
+        return Ok(Outcome::new(l, text));
     }
     // An SDO abort first; then a PDO of the file refused before sending (a bad file: usage).
     let (exit, error) = if l.refused.iter().any(|r| r.abort_code.is_some()) {
@@ -401,7 +403,7 @@ async fn load(
     Err(CommandError::Report {
         exit,
         error,
-        report: Box::new(json),
+        report: Reported::new(l),
         text,
     })
 }
