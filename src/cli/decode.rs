@@ -228,7 +228,7 @@ fn write_view(
                 }
             }
         }
-        Views::All | Views::Summary | Views::Diagnosis => {}
+        Views::All | Views::Summary | Views::Diagnosis | Views::Frames => {}
     }
 }
 
