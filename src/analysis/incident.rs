@@ -79,6 +79,29 @@ pub enum Problem {
 }
 
 impl Problem {
+    /// Every kind, in declaration order (the one list; a test holds it to the enum).
+    pub const ALL: [Problem; 19] = [
+        Problem::Missing,
+        Problem::Silent,
+        Problem::SilentBack,
+        Problem::Rebooted,
+        Problem::SdoRefused,
+        Problem::SdoGarbled,
+        Problem::Unmonitored,
+        Problem::SdoTimeout,
+        Problem::DriveFault,
+        Problem::Emcy,
+        Problem::BusErrors,
+        Problem::DuplicateId,
+        Problem::NmtIgnored,
+        Problem::DriveStuck,
+        Problem::PdoMissing,
+        Problem::SyncJitter,
+        Problem::SecondMaster,
+        Problem::PdoLate,
+        Problem::NotPresent,
+    ];
+
     /// JSON name, e.g. `sdo_refused`.
     pub fn as_str(self) -> &'static str {
         match self {
@@ -288,4 +311,19 @@ pub struct StepJson<'a> {
     /// Seconds since the capture's first frame.
     pub t: f64,
     pub text: &'a str,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Problem;
+
+    #[test]
+    fn all_lists_every_kind_once_in_declaration_order() {
+        for (i, p) in Problem::ALL.iter().enumerate() {
+            assert_eq!(*p as usize, i, "{p:?}");
+        }
+        // A kind declared after the last listed one is not in ALL: its JSON name is the
+        // exhaustive match, so this names the kind that must come last.
+        assert_eq!(Problem::ALL.last().map(|p| p.as_str()), Some("not_present"));
+    }
 }

@@ -2,7 +2,8 @@
 //! chosen at construction ([`Views`]) are derived from them as they come. The TUI keeps
 //! them all ([`Views::All`]); each headless command keeps only the view it prints
 //! ([`Views::Summary`], [`Views::Transactions`], [`Views::Events`], [`Views::Diagnosis`]),
-//! a fast path of the same `push`, not a copy of its loop.
+//! a fast path of the same `push`, not a copy of its loop; [`Views::Frames`] decodes every
+//! frame with its label for `cotui decode --filter`.
 //!
 //! Decoding is stateful (learned COB-IDs and PDO mappings, modes of operation, SDO transfer
 //! context), so a frame's label depends on everything before it. With every view, the indexing
@@ -48,6 +49,10 @@ pub enum Views {
     /// Only the diagnosis, [`Trace::diagnosis`] (`cotui diagnose`): frames are decoded as
     /// far as the diagnosis reads them.
     Diagnosis,
+    /// Every frame decoded with its label, [`Trace::take_decoded`], and the SDO transfers
+    /// each completes, [`Trace::take_transactions`] (`cotui decode --filter`, which judges
+    /// and prints them; the totals of `--filter --summary` go to [`Trace::summary`]).
+    Frames,
 }
 
 /// Frames between two decoder checkpoints.
@@ -57,6 +62,10 @@ pub const CHECKPOINT: usize = 8192;
 /// built incrementally.
 pub struct Trace {
     views: Views,
+    /// Frames pushed (the positions the decoder numbers them by).
+    pushed: u64,
+    /// With [`Views::Frames`]: the last frame, decoded, until taken.
+    decoded: Option<Decoded>,
     /// The frames (kept with [`Views::All`] only).
     pub store: Store,
     /// Interface names: those of the frames' source (see [`Trace::name_interfaces`]).
@@ -79,7 +88,8 @@ pub struct Trace {
     pub values: Values,
     /// What went wrong so far (the same diagnosis as `cotui diagnose`).
     pub diagnosis: Diagnoser,
-    /// Frames per kind and node (kept with [`Views::Summary`] only).
+    /// Frames per kind and node (kept with [`Views::Summary`]; with [`Views::Frames`],
+    /// the caller counts the frames its filter takes).
     pub summary: Summary,
     /// Bus events not yet taken (kept with [`Views::Events`] only).
     pub events: EventTracker,
@@ -106,6 +116,8 @@ impl Trace {
         let events = EventTracker::new(|n| decoder.dictionary(n));
         Trace {
             views,
+            pushed: 0,
+            decoded: None,
             diagnosis,
             summary: Summary::default(),
             events,
@@ -148,7 +160,7 @@ impl Trace {
         for name in source.names().iter().skip(known) {
             self.ifaces.intern(name);
         }
-        if self.views == Views::Summary {
+        if matches!(self.views, Views::Summary | Views::Frames) {
             self.summary.name_interfaces(source);
         }
     }
@@ -163,88 +175,107 @@ impl Trace {
         self.store.is_empty()
     }
 
-    /// Adds one frame: derives the views kept from it (with [`Views::All`]: classifies it,
-    /// updates nodes, statistics, series, values and the diagnosis).
+    /// Adds one frame: derives the views kept from it. One path for every mode: the
+    /// frame is numbered, decoded as far as the views need (with [`Views::All`]:
+    /// checkpointed, classified into the store, counted in nodes and statistics), then the
+    /// SDO transfers it completed go to the views that take them.
     pub fn push(&mut self, frame: &Frame) {
+        let pos = self.pushed;
+        self.pushed += 1;
+        let all = self.views == Views::All;
+        if all {
+            if (pos as usize).is_multiple_of(CHECKPOINT) {
+                self.checkpoints.push(self.decoder.clone());
+            }
+            self.nodes.tick(frame.ts_ns);
+            self.diagnosis_version += 1;
+        }
+        self.decoder.set_seq(pos);
         match self.views {
-            Views::All => self.index(frame),
-            Views::Summary => {
-                let (kind, node) = self.decoder.classify(frame);
-                self.summary.add_frame(frame, kind, node);
-                if matches!(kind, Kind::SdoRx | Kind::SdoTx) {
-                    // Only SDO frames complete transfers; none is kept (memory stays flat).
-                    self.decoder.take_transactions();
-                }
-            }
-            Views::Transactions => {
-                self.decoder.track(frame);
-                let done = self.transfers.completed(&mut self.decoder);
-                self.transactions.extend(done);
-            }
-            Views::Events => {
-                // Only these kinds carry events; SDO frames are tracked by classify.
-                match self.decoder.classify(frame) {
-                    (Kind::Heartbeat | Kind::Emcy | Kind::ErrorFrame, _) => {
-                        let d = self.decoder.decode(frame);
-                        self.events.frame(frame, self.ifaces.name(frame.iface), &d);
-                    }
-                    _ => self.events.tick(frame.ts_ns),
-                }
-                for t in self.decoder.take_transactions() {
-                    self.events.transaction(&t);
+            Views::All => {
+                let (kind, node) = self.diagnose(frame);
+                self.store.push(frame, kind, node);
+                let p = *self.store.packed(pos as usize);
+                self.stats.add(&p, &self.store);
+                if let Some(n) = node {
+                    self.nodes.frame(NodeKey::of(frame, n), frame.ts_ns);
                 }
             }
             Views::Diagnosis => {
-                let peeked = self.decoder.peek(frame);
-                let iface = self.ifaces.name(frame.iface);
-                if let Some(d) = feed(&mut self.decoder, &mut self.diagnosis, frame, peeked, iface) {
+                self.diagnose(frame);
+            }
+            Views::Summary => {
+                let (kind, node) = self.decoder.classify(frame);
+                self.summary.add_frame(frame, kind, node);
+            }
+            // Only the transfers are kept: frames are tracked, not labelled.
+            Views::Transactions => self.decoder.track(frame),
+            // Only these kinds carry events; SDO frames are tracked by classify.
+            Views::Events => match self.decoder.classify(frame) {
+                (Kind::Heartbeat | Kind::Emcy | Kind::ErrorFrame, _) => {
+                    let d = self.decoder.decode(frame);
+                    self.events.frame(frame, self.ifaces.name(frame.iface), &d);
                     self.decoder.recycle(d);
                 }
-                for t in self.decoder.take_transactions() {
-                    self.diagnosis.transaction(&t);
-                }
-            }
+                _ => self.events.tick(frame.ts_ns),
+            },
+            Views::Frames => self.decoded = Some(self.decoder.decode(frame)),
         }
+        self.completed();
     }
 
-    /// [`Trace::push`] with every view: the store, checkpoints and all that the panes show.
-    fn index(&mut self, frame: &Frame) {
-        let pos = self.store.len();
-        if pos.is_multiple_of(CHECKPOINT) {
-            self.checkpoints.push(self.decoder.clone());
-        }
-        self.nodes.tick(frame.ts_ns);
-        self.diagnosis_version += 1;
-        self.decoder.set_seq(pos as u64);
+    /// The frame as far as the diagnosis (and with [`Views::All`], the panes) read it:
+    /// PDOs decoded to their values, without the names, texts and labels that rows decode
+    /// anew from checkpoints; other frames through the diagnosis feed (SDO frames tracked
+    /// without labels, the rest only routed). Returns the frame's kind and node.
+    fn diagnose(&mut self, frame: &Frame) -> (Kind, Option<u8>) {
         let peeked @ (kind, node, _) = self.decoder.peek(frame);
         let iface = self.ifaces.name(frame.iface);
-        // PDOs: their values, without the names, texts and labels that rows decode anew
-        // from checkpoints. Other frames: as far as the diagnosis decodes them (SDO frames
-        // tracked without labels), the rest only routed.
-        if matches!(kind, Kind::Tpdo | Kind::Rpdo) {
+        let all = self.views == Views::All;
+        if all && matches!(kind, Kind::Tpdo | Kind::Rpdo) {
             let d = self.decoder.pdo_values(frame, peeked);
             self.diagnosis.frame(frame, iface, &d);
             self.observe(frame, &d);
         } else if let Some(d) = feed(&mut self.decoder, &mut self.diagnosis, frame, peeked, iface) {
-            match d.kind {
-                Kind::ErrorFrame => self.nodes.error_frame(frame.ts_ns, iface, frame.id, frame.payload()),
-                Kind::Emcy | Kind::Heartbeat => self.observe(frame, &d),
-                _ => {}
+            if all {
+                match d.kind {
+                    Kind::ErrorFrame => self.nodes.error_frame(frame.ts_ns, iface, frame.id, frame.payload()),
+                    Kind::Emcy | Kind::Heartbeat => self.observe(frame, &d),
+                    _ => {}
+                }
             }
+            self.decoder.recycle(d);
         }
-        self.store.push(frame, kind, node);
-        let p = *self.store.packed(pos);
-        self.stats.add(&p, &self.store);
-        if let Some(n) = node {
-            self.nodes.frame(NodeKey::of(frame, n), frame.ts_ns);
+        (kind, node)
+    }
+
+    /// The SDO transfers the last frame completed, to the views that take them.
+    fn completed(&mut self) {
+        let done = self.transfers.completed(&mut self.decoder);
+        if done.is_empty() {
+            return;
         }
-        for t in self.transfers.completed(&mut self.decoder) {
-            self.diagnosis.transaction(&t);
-            self.nodes.transaction(&t);
-            self.series.transaction(&t, self.decoder.dictionary(t.node));
-            self.values.transaction(&t, self.decoder.dictionary(t.node));
-            self.transactions.push(t);
+        match self.views {
+            Views::All => {
+                for t in done {
+                    self.diagnosis.transaction(&t);
+                    self.nodes.transaction(&t);
+                    self.series.transaction(&t, self.decoder.dictionary(t.node));
+                    self.values.transaction(&t, self.decoder.dictionary(t.node));
+                    self.transactions.push(t);
+                }
+            }
+            Views::Transactions | Views::Frames => self.transactions.extend(done),
+            Views::Events => done.iter().for_each(|t| self.events.transaction(t)),
+            Views::Diagnosis => done.iter().for_each(|t| self.diagnosis.transaction(t)),
+            // None is kept: memory stays flat.
+            Views::Summary => {}
         }
+    }
+
+    /// With [`Views::Frames`]: the last frame pushed, decoded with its label (once).
+    pub fn take_decoded(&mut self) -> Option<Decoded> {
+        self.decoded.take()
     }
 
     /// The input ended (a loaded log read to its end): the SDO transfers still running
@@ -260,7 +291,7 @@ impl Trace {
                     self.diagnosis.transaction(t);
                 }
             }
-            Views::Summary | Views::Events => {}
+            Views::Summary | Views::Events | Views::Frames => {}
         }
     }
 
@@ -300,7 +331,7 @@ impl Trace {
             }
             Views::Diagnosis => self.diagnosis.tick(now_ns),
             Views::Events => self.events.tick(now_ns),
-            Views::Summary | Views::Transactions => {}
+            Views::Summary | Views::Transactions | Views::Frames => {}
         }
     }
 

@@ -237,7 +237,7 @@ fn write_view(
                 }
             }
         }
-        Views::All | Views::Summary | Views::Diagnosis => {}
+        Views::All | Views::Summary | Views::Diagnosis | Views::Frames => {}
     }
 }
 

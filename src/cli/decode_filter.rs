@@ -1,22 +1,24 @@
 //! `cotui decode --filter EXPR`: the frames (or, with `--transactions`, the SDO transfers,
 //! or with `--summary` the totals of the frames) that match an expression of the TUI's
-//! filter language, judged as the TUI's filtered view judges them.
+//! filter language, judged as the TUI's filtered view judges them. The frames go through
+//! the one analysis pipeline ([`Trace`]): [`Views::Frames`] decodes them with their labels,
+//! [`Views::Transactions`] lists the transfers as `decode --transactions` does.
 
 use super::decode::{DecodeArgs, OutputFormat, write_summary, write_transaction};
 use super::input::{for_each_frame, open_input, report_counts};
 use crate::analysis::filter::stream::Stream;
 use crate::analysis::filter::{Facts, Filter};
-use crate::analysis::transfers::Transfers;
+use crate::analysis::trace::{Trace, Views};
 use crate::command::ExitCode;
-use crate::decode::{Decoder, Kind};
+use crate::decode::Kind;
 use crate::output::busload::{Bitrate, BusLoad};
-use crate::output::{jsonl, summary::Summary, text};
+use crate::output::{jsonl, text};
 use std::io::{self, Write};
 
 /// What a matching frame gives: its output line, or its kind and node for the totals.
 enum Out {
     Line(Vec<u8>),
-    /// A frame with its kind and node to count.
+    /// A frame of (interface, kind, node) to count.
     Count(Box<crate::frame::Frame>, Kind, Option<u8>),
 }
 
@@ -30,17 +32,16 @@ enum Mode {
 
 /// State carried across input files.
 struct Run {
-    decoder: Decoder,
+    /// The pipeline: with `--transactions` it lists the transfers (as the TUI's SDO pane
+    /// takes them), else it decodes every frame; `--summary` totals go to its summary.
+    trace: Trace,
     filter: Filter,
     mode: Mode,
     format: OutputFormat,
     stream: Stream<Out>,
-    summary: Summary,
-    /// The SDO transfers of `--transactions`, as the TUI's SDO pane takes them.
-    transfers: Transfers,
     /// Interface names of the input so far.
     names: Vec<String>,
-    /// Frames taken so far (the decoder's sequence numbers).
+    /// Frames taken so far (their positions in the stream).
     pos: u64,
     t0_ns: Option<u64>,
 }
@@ -79,14 +80,19 @@ pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
             return ExitCode::Usage;
         }
     };
+    let views = if mode == Mode::Transactions {
+        Views::Transactions
+    } else {
+        Views::Frames
+    };
+    let mut trace = Trace::headless(decoder, views);
+    trace.summary.bus = BusLoad::new(Bitrate::given_or_assumed(args.bitrate));
     let mut run = Run {
-        decoder,
+        trace,
         stream: Stream::new(filter.clone()),
         filter,
         mode,
         format: args.format,
-        summary: Summary::with_bus(BusLoad::new(Bitrate::given_or_assumed(args.bitrate))),
-        transfers: Transfers::new(),
         names: Vec::new(),
         pos: 0,
         t0_ns: None,
@@ -117,24 +123,24 @@ pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
 impl Run {
     fn file(&mut self, path: &str, input: Box<dyn io::BufRead + Send>, out: &mut impl Write) -> io::Result<()> {
         let mut buf = Vec::with_capacity(1 << 16);
+        self.trace.new_input();
         let counts = for_each_frame(path, input, |frames| {
             let ifaces = frames.ifaces;
             super::decode::note_interfaces(&mut self.names, ifaces);
-            self.summary.name_interfaces(ifaces);
+            self.trace.name_interfaces(ifaces);
             for (line, frame) in frames {
                 let t0 = *self.t0_ns.get_or_insert(frame.ts_ns);
-                self.decoder.set_seq(self.pos);
-                if self.mode == Mode::Transactions {
-                    // Only the transfers are printed: no frame labels.
-                    self.decoder.track(frame);
-                    for t in self.transfers.completed(&mut self.decoder) {
+                self.trace.push(frame);
+                let pos = self.pos;
+                self.pos += 1;
+                let Some(d) = self.trace.take_decoded() else {
+                    // --transactions: only the transfers are printed, no frame labels.
+                    for t in self.trace.take_transactions() {
                         self.transaction(&mut buf, &t, t0);
                     }
-                    self.pos += 1;
                     continue;
-                }
-                let d = self.decoder.decode(frame);
-                let done = self.decoder.take_transactions();
+                };
+                let done = self.trace.take_transactions();
                 let facts = Facts {
                     ts_ns: frame.ts_ns,
                     id: frame.id,
@@ -143,7 +149,7 @@ impl Run {
                     node: d.node,
                 };
                 let (mode, format) = (self.mode, self.format);
-                self.stream.frame(self.pos, facts, d, &done, |d| {
+                self.stream.frame(pos, facts, d, &done, |d| {
                     let mut s = Vec::new();
                     match (mode, format) {
                         (Mode::Summary, _) => return Out::Count(Box::new(*frame), d.kind, d.node),
@@ -152,7 +158,6 @@ impl Run {
                     }
                     Out::Line(s)
                 });
-                self.pos += 1;
                 let ready = self.stream.ready();
                 self.take(&mut buf, ready);
             }
@@ -168,14 +173,14 @@ impl Run {
     fn take(&mut self, buf: &mut Vec<u8>, ready: Vec<Out>) {
         for o in ready {
             match o {
-                Out::Count(frame, kind, node) => self.summary.add_frame(&frame, kind, node),
+                Out::Count(frame, kind, node) => self.trace.summary.add_frame(&frame, kind, node),
                 Out::Line(s) => buf.extend_from_slice(&s),
             }
         }
     }
 
     fn transaction(&self, buf: &mut Vec<u8>, t: &crate::sdo::Transaction, t0: u64) {
-        let dict = self.decoder.dictionary(t.node);
+        let dict = self.trace.decoder().dictionary(t.node);
         if !self.filter.matches_transaction(t, dict, t0) {
             return;
         }
@@ -189,7 +194,8 @@ impl Run {
         match self.mode {
             Mode::Transactions => {
                 let t0 = self.t0_ns.unwrap_or(0);
-                for t in self.transfers.end(&mut self.decoder) {
+                self.trace.end_of_input();
+                for t in self.trace.take_transactions() {
                     self.transaction(&mut buf, &t, t0);
                 }
             }
@@ -199,7 +205,7 @@ impl Run {
             }
         }
         if self.mode == Mode::Summary {
-            write_summary(&mut buf, &mut self.summary, self.format);
+            write_summary(&mut buf, &mut self.trace.summary, self.format);
         }
         out.write_all(&buf)
     }

@@ -543,44 +543,9 @@ mod tests {
     use super::*;
     use crate::frame::NodeKey;
 
-    /// Every kind of incident: the match makes a new [`Problem`] fail to build here until
-    /// it is listed (and then has to have its words).
-    fn all() -> Vec<Problem> {
-        use Problem::*;
-        let all = [
-            Missing,
-            Silent,
-            SilentBack,
-            Rebooted,
-            SdoRefused,
-            SdoGarbled,
-            Unmonitored,
-            SdoTimeout,
-            DriveFault,
-            Emcy,
-            BusErrors,
-            DuplicateId,
-            NmtIgnored,
-            DriveStuck,
-            PdoMissing,
-            SyncJitter,
-            SecondMaster,
-            PdoLate,
-            NotPresent,
-        ];
-        for p in all {
-            match p {
-                Missing | Silent | SilentBack | Rebooted | SdoRefused | SdoGarbled | Unmonitored | SdoTimeout
-                | DriveFault | Emcy | BusErrors | DuplicateId | NmtIgnored | DriveStuck | PdoMissing | SyncJitter
-                | SecondMaster | PdoLate | NotPresent => {}
-            }
-        }
-        all.to_vec()
-    }
-
     #[test]
     fn every_kind_has_its_words_with_the_node_and_count_filled_in() {
-        for p in all() {
+        for p in Problem::ALL {
             let mut tl = Timeline::default();
             let i = tl.open(Some(NodeKey::new(0, 5)), p, 0);
             let mut inc = tl.incidents[i].clone();
