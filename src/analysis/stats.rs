@@ -92,6 +92,8 @@ pub struct Stats {
     base: Vec<u32>,
     bitrate: u64,
     window_bits: u64,
+    /// The bits in the window per interface index (the bus load of each bus).
+    iface_bits: Vec<u64>,
     window_start: usize,
     now_ns: u64,
     /// The first frame's time.
@@ -107,6 +109,7 @@ impl Stats {
             base: vec![0; 0x800],
             bitrate: bitrate.max(1),
             window_bits: 0,
+            iface_bits: Vec::new(),
             window_start: 0,
             now_ns: 0,
             start_ns: None,
@@ -163,6 +166,11 @@ impl Stats {
         s.in_window += 1;
         self.start_ns.get_or_insert(p.ts_ns);
         self.window_bits += p.wire_bits();
+        let k = p.iface as usize;
+        if self.iface_bits.len() <= k {
+            self.iface_bits.resize(k + 1, 0);
+        }
+        self.iface_bits[k] += p.wire_bits();
         self.tick(p.ts_ns, store);
     }
 
@@ -177,6 +185,9 @@ impl Stats {
         while self.window_start < store.len() && store.packed(self.window_start).ts_ns <= since {
             let old = *store.packed(self.window_start);
             self.window_bits = self.window_bits.saturating_sub(old.wire_bits());
+            if let Some(b) = self.iface_bits.get_mut(old.iface as usize) {
+                *b = b.saturating_sub(old.wire_bits());
+            }
             let i = self.index(old.is_ext(), old.id);
             let e = &mut self.entries[i];
             e.in_window = e.in_window.saturating_sub(1);
@@ -206,6 +217,13 @@ impl Stats {
     /// Bus load in percent over the last second of the trace.
     pub fn load_percent(&self) -> f64 {
         self.window_bits as f64 * 100.0 / self.bitrate as f64
+    }
+
+    /// The load of one bus (interface index `iface`) in percent over the last second of the
+    /// trace; 0 for an interface without frames.
+    pub fn iface_load_percent(&self, iface: u16) -> f64 {
+        let bits = self.iface_bits.get(iface as usize).copied().unwrap_or(0);
+        bits as f64 * 100.0 / self.bitrate as f64
     }
 
     /// Frames in the last second of the trace.
@@ -258,6 +276,27 @@ mod tests {
         // 5 base frames of 8 bytes, 135 bits each at worst (see store::wire_bits), in the
         // last second: 675 bits of 125000 = 0.54 %.
         assert!((st.load_percent() - 0.54).abs() < 1e-9, "{}", st.load_percent());
+    }
+
+    #[test]
+    fn each_bus_has_its_own_load() {
+        let mut store = Store::new();
+        let mut st = Stats::new(125_000);
+        for (iface, t) in [(0u16, 0u64), (1, 5), (1, 10), (0, 1_500)] {
+            let mut f = Frame::classic(0x181, &[0; 8]);
+            (f.iface, f.ts_ns) = (iface, t * 1_000_000);
+            let at = store.push(&f, Kind::Tpdo, Some(1));
+            st.add(&store.packed(at).clone(), &store);
+        }
+        // In the last second (0.5 s to 1.5 s): one frame of can0 (135 bits), none of can1.
+        assert!(
+            (st.iface_load_percent(0) - 0.108).abs() < 1e-9,
+            "{}",
+            st.iface_load_percent(0)
+        );
+        assert_eq!(st.iface_load_percent(1), 0.0);
+        assert_eq!(st.iface_load_percent(7), 0.0, "an interface without frames");
+        assert!((st.load_percent() - st.iface_load_percent(0)).abs() < 1e-9);
     }
 
     #[test]

@@ -88,3 +88,12 @@ pub fn report_counts(path: &str, c: &Counts) {
         );
     }
 }
+
+/// The first name given twice among `names` (interfaces of one session), if any.
+pub fn repeated(names: &[String]) -> Option<&str> {
+    names
+        .iter()
+        .enumerate()
+        .find(|(i, n)| names[..*i].contains(n))
+        .map(|(_, n)| n.as_str())
+}
