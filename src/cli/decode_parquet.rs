@@ -12,7 +12,7 @@ use crate::od::Dictionary;
 use crate::output::parquet::{Col, Table, Ty, V};
 use crate::sdo::{SdoCommand, Transaction};
 use std::fs::File;
-use std::io::{self, BufRead, BufWriter, Write};
+use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 const fn col(name: &'static str, ty: Ty, null: bool) -> Col {
@@ -151,11 +151,12 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
     let mut last_file = String::new();
     // The interface names of the last input (the transfers it left running name theirs).
     let mut ifaces = Interfaces::default();
-    for path in &args.files {
-        let Some(input) = input::open_input(path, "decode") else {
-            status = ExitCode::Unavailable;
-            continue;
-        };
+    let (inputs, failed) = input::open_inputs(&args.files, "decode", args.iface_per_file);
+    if failed {
+        status = ExitCode::Unavailable;
+    }
+    for (path, input) in inputs {
+        let path = &path;
         last_file.clone_from(path);
         ifaces = Interfaces::default();
         if let Err(e) = write_stream(path, input, &mut decoder, &mut ifaces, &mut frames, &mut values) {
@@ -190,7 +191,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
 /// up with its interface table.
 fn write_stream(
     path: &str,
-    input: Box<dyn BufRead + Send>,
+    input: input::Input,
     decoder: &mut Decoder,
     names: &mut Interfaces,
     frames: &mut Writer,

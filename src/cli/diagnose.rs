@@ -21,10 +21,15 @@ pub enum DiagnoseFormat {
 /// Arguments of `cotui diagnose`.
 #[derive(Args, Debug)]
 pub struct DiagnoseArgs {
-    /// Log files (candump -l/-L, candump screen output, Vector ASC), read as one capture;
-    /// `-` reads stdin.
+    /// Log files (candump -l/-L, candump screen output, Vector ASC), merged by time into
+    /// one capture (an interface name in several files is the same bus unless
+    /// --iface-per-file); `-` reads stdin.
     #[arg(required_unless_present = "live")]
     pub files: Vec<String>,
+    /// With several files: each file's interfaces are its own buses, named FILE:IFACE
+    /// (two buses recorded apart, both as can0, stay apart).
+    #[arg(long, conflicts_with = "live")]
+    pub iface_per_file: bool,
     /// Diagnose live SocketCAN interfaces instead (listen-only: nothing is sent; several
     /// are captured together, each node known by interface and node-ID) until Ctrl-C
     /// (SIGINT or SIGTERM) or `--duration`, then report as for a log.
@@ -79,11 +84,12 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
         return ExitCode::Unavailable;
     }
     let mut opened = args.live.is_some();
-    for path in &args.files {
-        let Some(input) = input::open_input(path, "diagnose") else {
-            status = ExitCode::Unavailable;
-            continue;
-        };
+    let (inputs, failed) = input::open_inputs(&args.files, "diagnose", args.iface_per_file);
+    if failed {
+        status = ExitCode::Unavailable;
+    }
+    for (path, input) in inputs {
+        let path = &path;
         opened = true;
         trace.new_input();
         let result = input::for_each_frame(path, input, |frames| {

@@ -8,6 +8,7 @@ mod decode_out;
 mod decode_parquet;
 pub mod diagnose;
 pub mod input;
+mod merge;
 pub mod record;
 pub mod run;
 pub mod sim;

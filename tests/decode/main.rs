@@ -23,6 +23,7 @@ mod pcapng;
 mod profile_example;
 mod realworld_block;
 mod run;
+mod split_logs;
 mod track_path;
 mod two_buses;
 mod wireshark;
