@@ -6,6 +6,7 @@
 #![allow(clippy::unwrap_used)]
 
 mod architecture;
+mod bench_scratch;
 mod bounded_memory;
 mod cut_short;
 mod decode_golden;
