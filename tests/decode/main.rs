@@ -20,6 +20,7 @@ mod log_formats;
 mod log_fuzz;
 mod no_panic;
 mod parquet_duckdb;
+mod parquet_full;
 mod pcapng;
 mod profile_example;
 mod realworld_block;
