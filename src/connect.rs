@@ -7,9 +7,18 @@ use crate::bus::{Bus, BusError, socketcan};
 /// The interface name of the in-process simulated bus.
 pub const DEMO: &str = crate::sim::demo::BUS_NAME;
 
+/// The interface name of a second, independent simulated bus (the standard demo drives),
+/// for trying several interfaces at once without hardware (`cotui live demo demo2`).
+pub const DEMO2: &str = "demo2";
+
+/// True for the names of the simulated buses ([`DEMO`], [`DEMO2`]).
+pub fn is_demo(iface: &str) -> bool {
+    iface == DEMO || iface == DEMO2
+}
+
 /// Opens `iface` (see the module doc). Must be called inside a tokio runtime.
 pub async fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
-    if iface == DEMO {
+    if is_demo(iface) {
         Ok(crate::sim::demo::start(listen_only))
     } else {
         socketcan::open(iface, listen_only)

@@ -93,6 +93,8 @@ pub struct Stats {
     base: Vec<u32>,
     bitrate: Bitrate,
     window_bits: u64,
+    /// The bits in the window per interface index (the bus load of each bus).
+    iface_bits: Vec<u64>,
     window_start: usize,
     now_ns: u64,
     /// The first frame's time.
@@ -112,6 +114,7 @@ impl Stats {
                 ..bitrate
             },
             window_bits: 0,
+            iface_bits: Vec::new(),
             window_start: 0,
             now_ns: 0,
             start_ns: None,
@@ -167,7 +170,13 @@ impl Stats {
         s.last_ns = p.ts_ns;
         s.in_window += 1;
         self.start_ns.get_or_insert(p.ts_ns);
-        self.window_bits += store.bus_bits(store.len() - 1);
+        let bits = store.bus_bits(store.len() - 1);
+        self.window_bits += bits;
+        let k = p.iface as usize;
+        if self.iface_bits.len() <= k {
+            self.iface_bits.resize(k + 1, 0);
+        }
+        self.iface_bits[k] += bits;
         self.tick(p.ts_ns, store);
     }
 
@@ -181,7 +190,11 @@ impl Stats {
         };
         while self.window_start < store.len() && store.packed(self.window_start).ts_ns <= since {
             let old = *store.packed(self.window_start);
-            self.window_bits = self.window_bits.saturating_sub(store.bus_bits(self.window_start));
+            let bits = store.bus_bits(self.window_start);
+            self.window_bits = self.window_bits.saturating_sub(bits);
+            if let Some(b) = self.iface_bits.get_mut(old.iface as usize) {
+                *b = b.saturating_sub(bits);
+            }
             let i = self.index(old.is_ext(), old.id);
             let e = &mut self.entries[i];
             e.in_window = e.in_window.saturating_sub(1);
@@ -211,6 +224,13 @@ impl Stats {
     /// Bus load in percent over the last second of the trace.
     pub fn load_percent(&self) -> f64 {
         self.window_bits as f64 * 100.0 / self.bitrate.bps as f64
+    }
+
+    /// The load of one bus (interface index `iface`) in percent over the last second of the
+    /// trace; 0 for an interface without frames.
+    pub fn iface_load_percent(&self, iface: u16) -> f64 {
+        let bits = self.iface_bits.get(iface as usize).copied().unwrap_or(0);
+        bits as f64 * 100.0 / self.bitrate.bps as f64
     }
 
     /// Frames in the last second of the trace.
@@ -274,6 +294,28 @@ mod tests {
             "{}",
             st.load_percent()
         );
+    }
+
+    #[test]
+    fn each_bus_has_its_own_load() {
+        let mut store = Store::new();
+        let mut st = Stats::new(125_000);
+        for (iface, t) in [(0u16, 0u64), (1, 5), (1, 10), (0, 1_500)] {
+            let mut f = Frame::classic(0x181, &[0; 8]);
+            (f.iface, f.ts_ns) = (iface, t * 1_000_000);
+            let at = store.push(&f, Kind::Tpdo, Some(1));
+            st.add(&store.packed(at).clone(), &store);
+        }
+        // In the last second (0.5 s to 1.5 s): one frame of can0, none of can1.
+        let bits = crate::output::busload::bus_bits(&Frame::classic(0x181, &[0; 8]));
+        assert!(
+            (st.iface_load_percent(0) - bits as f64 * 100.0 / 125_000.0).abs() < 1e-9,
+            "{}",
+            st.iface_load_percent(0)
+        );
+        assert_eq!(st.iface_load_percent(1), 0.0);
+        assert_eq!(st.iface_load_percent(7), 0.0, "an interface without frames");
+        assert!((st.load_percent() - st.iface_load_percent(0)).abs() < 1e-9);
     }
 
     #[test]

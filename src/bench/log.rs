@@ -37,6 +37,18 @@ pub fn write_many_iface_log(path: &Path, frames: u64, ifaces: u32) -> std::io::R
     out.flush()
 }
 
+/// About how many bytes the logs of `frames` frames take per frame (a sample of the
+/// synthetic traffic as written, on interface `can0`; a longer name adds its length).
+pub fn bytes_per_frame() -> f64 {
+    const SAMPLE: u64 = 10_000;
+    let mut writer = LogWriter::new();
+    let mut line = String::new();
+    for frame in Traffic::new(SAMPLE, 1_700_000_000_000_000_000) {
+        writer.write_line(&mut line, &frame, "can0");
+    }
+    line.len() as f64 / SAMPLE as f64
+}
+
 fn write_frames(path: &Path, frames: u64, garbage_every: Option<u64>) -> std::io::Result<()> {
     let file = std::fs::File::create(path)?;
     let mut out = std::io::BufWriter::with_capacity(1 << 20, file);

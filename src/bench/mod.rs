@@ -7,6 +7,7 @@
 //! diagnosis, `canopen-lens` when installed.
 
 pub mod log;
+mod scratch;
 mod tui;
 
 use crate::command::ExitCode;
@@ -45,6 +46,19 @@ const STARTUP_TARGET_MS: f64 = 3.0;
 /// name made this log 100x slower, a hash index keeps it above a quarter of the rate.
 const MANY_IFACES: u32 = 40_000;
 const FEW_IFACES: u32 = 40;
+/// The most bytes the names of the many-interfaces log (`can39999`) add to a line.
+const MANY_IFACES_NAME_BYTES: f64 = 4.0;
+
+/// Bytes to ask for logs of about `estimate` bytes: 10 % more, and 1 MB for the small files.
+fn need_bytes(estimate: f64) -> u64 {
+    let bytes = estimate * 1.1 + 1e6;
+    if bytes >= u64::MAX as f64 {
+        u64::MAX
+    } else {
+        bytes as u64
+    }
+}
+
 /// `scan --probe` on the demo bus: how long it listens and waits for each answer (ms).
 const SCAN_LISTEN_MS: u64 = 100;
 const SCAN_TIMEOUT_MS: u64 = 300;
@@ -101,6 +115,7 @@ fn measure(program: &Path, args: &[&str]) -> std::io::Result<(f64, u64)> {
         .stderr(Stdio::null())
         .spawn()?;
     let pid = child.id() as libc::pid_t;
+    scratch::set_child(pid);
     let mut status = 0;
     // SAFETY: rusage is plain data; wait4 fills it for the child we just spawned.
     let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
@@ -109,6 +124,7 @@ fn measure(program: &Path, args: &[&str]) -> std::io::Result<(f64, u64)> {
     if r < 0 {
         return Err(std::io::Error::last_os_error());
     }
+    scratch::set_child(0);
     let secs = start.elapsed().as_secs_f64();
     if !libc::WIFEXITED(status) || libc::WEXITSTATUS(status) != 0 {
         return Err(std::io::Error::other(format!(
@@ -133,6 +149,11 @@ fn which(name: &str) -> Option<PathBuf> {
 pub fn run(args: &BenchArgs) -> ExitCode {
     match bench(args) {
         Ok(()) => ExitCode::Ok,
+        // Logs larger than the free space: give fewer frames (a usage error).
+        Err(e) if e.kind() == std::io::ErrorKind::StorageFull => {
+            eprintln!("cotui bench: --frames {}: {e}", args.frames);
+            ExitCode::Usage
+        }
         Err(e) => {
             eprintln!("cotui bench: {e}");
             ExitCode::Unavailable
@@ -149,9 +170,12 @@ fn bench(args: &BenchArgs) -> std::io::Result<()> {
     }
     let exe = std::env::current_exe()?;
     let dir = std::env::temp_dir().join(format!("cotui-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir)?;
-    let result = measure_all(args, &exe, &dir);
-    let _ = std::fs::remove_dir_all(&dir);
+    // The full log, three quarter-size ones (two with longer interface names) and a tiny one.
+    let per_frame = log::bytes_per_frame();
+    let need = args.frames as f64 * (per_frame * 1.75 + 2.0 * 0.25 * MANY_IFACES_NAME_BYTES);
+    let scratch = scratch::Scratch::create(dir, need_bytes(need))?;
+    let result = measure_all(args, &exe, scratch.path());
+    drop(scratch);
     report(args, &result?);
     Ok(())
 }

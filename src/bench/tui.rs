@@ -86,8 +86,9 @@ fn filter_seconds(app: &mut App, filter: &str) -> f64 {
 /// Runs the benchmark on `frames` generated frames.
 pub fn bench(frames: u64, json: bool) -> std::io::Result<()> {
     let dir = std::env::temp_dir().join(format!("cotui-bench-tui-{}", std::process::id()));
-    std::fs::create_dir_all(&dir)?;
-    let log = dir.join("bench.log");
+    let scratch =
+        super::scratch::Scratch::create(dir, super::need_bytes(frames as f64 * super::log::bytes_per_frame()))?;
+    let log = scratch.path().join("bench.log");
     super::log::write_log(&log, frames)?;
     let rss_before = peak_rss_kib();
     let mut term = Terminal::new(TestBackend::new(160, 50)).map_err(std::io::Error::other)?;
@@ -164,7 +165,7 @@ pub fn bench(frames: u64, json: bool) -> std::io::Result<()> {
     let replayed = app.trace().len();
     let replay_rate = replayed as f64 / replay_start.elapsed().as_secs_f64();
     drop(app);
-    let _ = std::fs::remove_dir_all(&dir);
+    drop(scratch);
     let key_mean = responses.iter().sum::<f64>() / responses.len().max(1) as f64;
     let key_max = responses.iter().copied().fold(0.0, f64::max);
     let first = first_screen.unwrap_or(f64::NAN);

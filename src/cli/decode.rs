@@ -10,7 +10,7 @@ use crate::output::busload::{Bitrate, BusLoad};
 use crate::output::{jsonl, summary::Summary, text};
 use crate::sdo::Transaction;
 use clap::{Args, ValueEnum};
-use std::io::{self, BufRead, Write};
+use std::io::{self, Write};
 
 /// Output formats of `cotui decode`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -33,8 +33,14 @@ pub enum OutputFormat {
 #[derive(Args, Debug)]
 pub struct DecodeArgs {
     /// Log files (candump -l/-L, candump screen output, Vector ASC); `-` reads stdin.
+    /// Several are merged by time into one capture; an interface name in several files is
+    /// the same bus (one bus's log split in parts) unless --iface-per-file.
     #[arg(required = true)]
     pub files: Vec<String>,
+    /// With several files: each file's interfaces are its own buses, named FILE:IFACE
+    /// (two buses recorded apart, both as can0, stay apart).
+    #[arg(long)]
+    pub iface_per_file: bool,
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     pub format: OutputFormat,
@@ -118,11 +124,12 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
     };
     let mut names = Vec::new();
     let mut status = ExitCode::Ok;
-    for path in &args.files {
-        let Some(input) = input::open_input(path, "decode") else {
-            status = ExitCode::Unavailable;
-            continue;
-        };
+    let (inputs, failed) = input::open_inputs(&args.files, "decode", args.iface_per_file);
+    if failed {
+        status = ExitCode::Unavailable;
+    }
+    for (path, input) in inputs {
+        let path = &path;
         match decode_stream(path, input, &mut run, args.format, &mut names, &mut out) {
             Ok(()) => {}
             Err(e) if e.kind() == io::ErrorKind::BrokenPipe => return status,
@@ -160,7 +167,7 @@ pub(super) fn shown_iface(names: &[String], iface: u16) -> Option<&str> {
 /// names of the input so far (see [`note_interfaces`]).
 fn decode_stream(
     path: &str,
-    input: Box<dyn BufRead + Send>,
+    input: input::Input,
     run: &mut Pipeline,
     fmt: OutputFormat,
     names: &mut Vec<String>,

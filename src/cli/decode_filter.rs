@@ -5,7 +5,7 @@
 //! [`Views::Transactions`] lists the transfers as `decode --transactions` does.
 
 use super::decode::{DecodeArgs, OutputFormat, write_summary, write_transaction};
-use super::input::{for_each_frame, open_input, report_counts};
+use super::input::{for_each_frame, report_counts};
 use crate::analysis::filter::stream::Stream;
 use crate::analysis::filter::{Facts, Filter};
 use crate::analysis::trace::{Trace, Views};
@@ -98,11 +98,12 @@ pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
         t0_ns: None,
     };
     let mut status = ExitCode::Ok;
-    for path in &args.files {
-        let Some(input) = open_input(path, "decode") else {
-            status = ExitCode::Unavailable;
-            continue;
-        };
+    let (inputs, failed) = super::input::open_inputs(&args.files, "decode", args.iface_per_file);
+    if failed {
+        status = ExitCode::Unavailable;
+    }
+    for (path, input) in inputs {
+        let path = &path;
         match run.file(path, input, &mut out) {
             Ok(()) => {}
             Err(e) if e.kind() == io::ErrorKind::BrokenPipe => return status,
@@ -121,7 +122,7 @@ pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
 }
 
 impl Run {
-    fn file(&mut self, path: &str, input: Box<dyn io::BufRead + Send>, out: &mut impl Write) -> io::Result<()> {
+    fn file(&mut self, path: &str, input: super::input::Input, out: &mut impl Write) -> io::Result<()> {
         let mut buf = Vec::with_capacity(1 << 16);
         self.trace.new_input();
         let counts = for_each_frame(path, input, |frames| {

@@ -12,7 +12,7 @@ use crate::od::Dictionary;
 use crate::output::parquet::{Col, Table, Ty, V};
 use crate::sdo::{SdoCommand, Transaction};
 use std::fs::File;
-use std::io::{self, BufRead, BufWriter, Write};
+use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 const fn col(name: &'static str, ty: Ty, null: bool) -> Col {
@@ -151,16 +151,30 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
     let mut last_file = String::new();
     // The interface names of the last input (the transfers it left running name theirs).
     let mut ifaces = Interfaces::default();
-    for path in &args.files {
-        let Some(input) = input::open_input(path, "decode") else {
-            status = ExitCode::Unavailable;
-            continue;
-        };
+    let (inputs, failed) = input::open_inputs(&args.files, "decode", args.iface_per_file);
+    if failed {
+        status = ExitCode::Unavailable;
+    }
+    for (path, input) in inputs {
+        let path = &path;
         last_file.clone_from(path);
         ifaces = Interfaces::default();
-        if let Err(e) = write_stream(path, input, &mut decoder, &mut ifaces, &mut frames, &mut values) {
-            eprintln!("cotui decode: {path}: {e}");
-            status = ExitCode::Unavailable;
+        let tables = Tables {
+            frames: &mut frames,
+            values: &mut values,
+            paths: (&frames_path, &values_path),
+        };
+        match write_stream(path, input, &mut decoder, &mut ifaces, tables) {
+            Ok(()) => {}
+            Err(Failed::Read(e)) => {
+                eprintln!("cotui decode: {path}: {e}");
+                status = ExitCode::Unavailable;
+            }
+            Err(Failed::Write(m)) => {
+                // The output is to blame (1); the tables are cut short, so no footer either.
+                eprintln!("cotui decode: {m}; stopped, the tables are incomplete");
+                return ExitCode::Usage;
+            }
         }
     }
     let mut end = || -> io::Result<()> {
@@ -175,28 +189,54 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
         }
         Ok(())
     };
-    let result = end().and_then(|_| frames.finish()).and_then(|_| values.finish());
+    fn at(table: &Path) -> impl Fn(io::Error) -> String + '_ {
+        move |e| format!("{}: {e}", table.display())
+    }
+    let result = end()
+        .map_err(at(&values_path))
+        .and_then(|_| frames.finish().map_err(at(&frames_path)))
+        .and_then(|_| values.finish().map_err(at(&values_path)));
     match result {
         Err(e) => {
             // Writing the tables failed: the output is to blame (1), not an input.
-            eprintln!("cotui decode: cannot write {output}: {e}");
+            eprintln!("cotui decode: cannot write {e}");
             ExitCode::Usage
         }
         Ok(()) => status,
     }
 }
 
+/// The two tables being written, and their paths (for a write error's message).
+struct Tables<'a> {
+    frames: &'a mut Writer,
+    values: &'a mut Writer,
+    paths: (&'a Path, &'a Path),
+}
+
+/// Why an input stopped: it could not be read, or a table could not be written (the
+/// message names the table and where in the input it stopped).
+enum Failed {
+    Read(io::Error),
+    Write(String),
+}
+
 /// Decodes one input into the two tables (parsing runs on a second thread); `names` keeps
 /// up with its interface table.
 fn write_stream(
     path: &str,
-    input: Box<dyn BufRead + Send>,
+    input: input::Input,
     decoder: &mut Decoder,
     names: &mut Interfaces,
-    frames: &mut Writer,
-    values: &mut Writer,
-) -> io::Result<()> {
-    let counts = input::for_each_frame(path, input, |batch| {
+    tables: Tables,
+) -> Result<(), Failed> {
+    let Tables { frames, values, paths } = tables;
+    // The first write error, said as the user reads it; reading stops there.
+    let mut write_error: Option<String> = None;
+    let mut wrote = |table: &Path, line: u64, e: io::Error| {
+        write_error.get_or_insert(format!("cannot write {}: {e} (at {path} line {line})", table.display()));
+        io::Error::other("write failed")
+    };
+    let result = input::for_each_frame(path, input, |batch| {
         let ifaces = batch.ifaces;
         for name in ifaces.names().iter().skip(names.names().len()) {
             names.intern(name);
@@ -204,43 +244,52 @@ fn write_stream(
         for (line, frame) in batch {
             let d = decoder.decode(frame);
             let iface = ifaces.name(frame.iface);
-            frame_row(frames, path, line, frame, iface, &d)?;
+            frame_row(frames, path, line, frame, iface, &d).map_err(|e| wrote(paths.0, line, e))?;
             if let (Body::Pdo(p), Some(node)) = (&d.body, d.node) {
                 for s in &p.signals {
-                    values.row(|r| {
-                        let ts = V::I64(ts(frame.ts_ns));
-                        r.push(Some(V::Str(path)))?
-                            .push(Some(V::Str("pdo")))?
-                            .push(Some(ts.clone()))?
-                            .push(Some(ts))?
-                            .push(Some(V::Str(iface)))?
-                            .push(Some(V::I32(node as i32)))?
-                            .push(Some(V::I32(s.index as i32)))?
-                            .push(Some(V::I32(s.sub as i32)))?
-                            .push(Some(V::Str(&s.name)))?
-                            .push(s.value.as_f64().map(V::F64))?
-                            .push(Some(V::Str(&s.text)))?
-                            .push(None)?
-                            .push(Some(V::Str(if p.transmit { "transmit" } else { "receive" })))?
-                            .push(None)?
-                            .push(None)?
-                            .push(None)?
-                            .push(None)?
-                            .push(Some(V::Bool(false)))?
-                            .push(Some(V::I32(p.num as i32)))?
-                            .push(Some(V::I64(1)))?;
-                        Ok(())
-                    })?;
+                    values
+                        .row(|r| {
+                            let ts = V::I64(ts(frame.ts_ns));
+                            r.push(Some(V::Str(path)))?
+                                .push(Some(V::Str("pdo")))?
+                                .push(Some(ts.clone()))?
+                                .push(Some(ts))?
+                                .push(Some(V::Str(iface)))?
+                                .push(Some(V::I32(node as i32)))?
+                                .push(Some(V::I32(s.index as i32)))?
+                                .push(Some(V::I32(s.sub as i32)))?
+                                .push(Some(V::Str(&s.name)))?
+                                .push(s.value.as_f64().map(V::F64))?
+                                .push(Some(V::Str(&s.text)))?
+                                .push(None)?
+                                .push(Some(V::Str(if p.transmit { "transmit" } else { "receive" })))?
+                                .push(None)?
+                                .push(None)?
+                                .push(None)?
+                                .push(None)?
+                                .push(Some(V::Bool(false)))?
+                                .push(Some(V::I32(p.num as i32)))?
+                                .push(Some(V::I64(1)))?;
+                            Ok(())
+                        })
+                        .map_err(|e| wrote(paths.1, line, e))?;
                 }
             }
             for t in decoder.take_transactions() {
-                transaction_row(values, path, ifaces.name(t.iface), &t, decoder.dictionary(t.node))?;
+                transaction_row(values, path, ifaces.name(t.iface), &t, decoder.dictionary(t.node))
+                    .map_err(|e| wrote(paths.1, line, e))?;
             }
         }
         Ok(())
-    })?;
-    input::report_counts(path, &counts);
-    Ok(())
+    });
+    match (result, write_error) {
+        (_, Some(m)) => Err(Failed::Write(m)),
+        (Err(e), None) => Err(Failed::Read(e)),
+        (Ok(counts), None) => {
+            input::report_counts(path, &counts);
+            Ok(())
+        }
+    }
 }
 
 /// A timestamp in ns as Parquet's signed INT64 (saturating past year 2262).

@@ -1,4 +1,4 @@
-//! `cotui diagnose FILE...` (or `--live IFACE`): what went wrong on the bus, as a short
+//! `cotui diagnose FILE...` (or `--live IFACE...`): what went wrong on the bus, as a short
 //! ranked list of incidents.
 
 use super::input;
@@ -21,14 +21,20 @@ pub enum DiagnoseFormat {
 /// Arguments of `cotui diagnose`.
 #[derive(Args, Debug)]
 pub struct DiagnoseArgs {
-    /// Log files (candump -l/-L, candump screen output, Vector ASC), read as one capture;
-    /// `-` reads stdin.
+    /// Log files (candump -l/-L, candump screen output, Vector ASC), merged by time into
+    /// one capture (an interface name in several files is the same bus unless
+    /// --iface-per-file); `-` reads stdin.
     #[arg(required_unless_present = "live")]
     pub files: Vec<String>,
-    /// Diagnose a live SocketCAN interface instead (listen-only: nothing is sent) until
-    /// Ctrl-C (SIGINT or SIGTERM) or `--duration`, then report as for a log.
-    #[arg(long, value_name = "IFACE", conflicts_with = "files")]
-    pub live: Option<String>,
+    /// With several files: each file's interfaces are its own buses, named FILE:IFACE
+    /// (two buses recorded apart, both as can0, stay apart).
+    #[arg(long, conflicts_with = "live")]
+    pub iface_per_file: bool,
+    /// Diagnose live SocketCAN interfaces instead (listen-only: nothing is sent; several
+    /// are captured together, each node known by interface and node-ID) until Ctrl-C
+    /// (SIGINT or SIGTERM) or `--duration`, then report as for a log.
+    #[arg(long, value_name = "IFACE", num_args = 1.., conflicts_with = "files")]
+    pub live: Option<Vec<String>>,
     /// With `--live`: stop after this many seconds.
     #[arg(long, value_name = "SECONDS")]
     pub duration: Option<f64>,
@@ -67,18 +73,23 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
         return ExitCode::Usage;
     }
     let mut status = ExitCode::Ok;
-    if let Some(iface) = &args.live
-        && let Err(e) = live::capture(iface, args.duration, &mut trace)
+    if let Some(twice) = args.live.as_deref().and_then(input::repeated) {
+        eprintln!("cotui diagnose: --live {twice} is given twice: name each interface once");
+        return ExitCode::Usage;
+    }
+    if let Some(ifaces) = &args.live
+        && let Err(e) = live::capture(ifaces, args.duration, &mut trace)
     {
         eprintln!("cotui diagnose: {e}");
         return ExitCode::Unavailable;
     }
     let mut opened = args.live.is_some();
-    for path in &args.files {
-        let Some(input) = input::open_input(path, "diagnose") else {
-            status = ExitCode::Unavailable;
-            continue;
-        };
+    let (inputs, failed) = input::open_inputs(&args.files, "diagnose", args.iface_per_file);
+    if failed {
+        status = ExitCode::Unavailable;
+    }
+    for (path, input) in inputs {
+        let path = &path;
         opened = true;
         trace.new_input();
         let result = input::for_each_frame(path, input, |frames| {
@@ -128,15 +139,35 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
 /// `--live`: the frames of a SocketCAN interface, as they come.
 mod live {
     use super::Trace;
+    use crate::bus::{BusError, Subscription};
+    use crate::frame::Frame;
+    use std::pin::Pin;
+    use std::task::Poll;
     use std::time::Duration;
     use tokio::signal::unix::{SignalKind, signal};
 
     /// How often the capture clock advances on a quiet bus (heartbeats missed by then count).
     const TICK: Duration = Duration::from_millis(100);
 
-    /// Feeds the frames of `iface` (opened listen-only) to the diagnosis of `trace` until
-    /// SIGINT or SIGTERM, or for `seconds`; the capture clock ends at the bus time then.
-    pub fn capture(iface: &str, seconds: Option<f64>, trace: &mut Trace) -> Result<(), String> {
+    /// The next frame of any of `subs`, with the index of its subscription.
+    async fn next(subs: &mut [Subscription]) -> (usize, Result<Frame, BusError>) {
+        type Recv<'a> = Pin<Box<dyn Future<Output = Result<Frame, BusError>> + 'a>>;
+        let mut waiting: Vec<Recv> = subs.iter_mut().map(|s| Box::pin(s.recv()) as Recv).collect();
+        std::future::poll_fn(|cx| {
+            for (i, w) in waiting.iter_mut().enumerate() {
+                if let Poll::Ready(got) = w.as_mut().poll(cx) {
+                    return Poll::Ready((i, got));
+                }
+            }
+            Poll::Pending
+        })
+        .await
+    }
+
+    /// Feeds the frames of `ifaces` (opened listen-only, each frame tagged with its
+    /// interface's index) to the diagnosis of `trace` until SIGINT or SIGTERM, or for
+    /// `seconds`; the capture clock ends at the bus time then.
+    pub fn capture(ifaces: &[String], seconds: Option<f64>, trace: &mut Trace) -> Result<(), String> {
         let limit = match seconds {
             Some(s) => {
                 Some(Duration::try_from_secs_f64(s).map_err(|_| format!("--duration {s}: not a number of seconds"))?)
@@ -150,10 +181,17 @@ mod live {
         rt.block_on(async {
             let handler = |kind| signal(kind).map_err(|e| format!("cannot install a signal handler: {e}"));
             let (mut int, mut term) = (handler(SignalKind::interrupt())?, handler(SignalKind::terminate())?);
-            let bus = crate::connect::open(iface, true).await.map_err(|e| e.to_string())?;
-            let mut frames = bus.subscribe();
-            // The bus numbers its one interface 0.
-            trace.ifaces.intern(iface);
+            let mut buses = Vec::new();
+            for iface in ifaces {
+                buses.push(crate::connect::open(iface, true).await.map_err(|e| e.to_string())?);
+                trace.ifaces.intern(iface);
+            }
+            let mut subs: Vec<Subscription> = buses.iter().map(|b| b.subscribe()).collect();
+            let clock = &buses[0];
+            let tagged = |i: usize, mut f: Frame| {
+                f.iface = i as u16;
+                f
+            };
             let end = limit.map(|d| tokio::time::Instant::now() + d);
             let mut tick = tokio::time::interval(TICK);
             loop {
@@ -164,23 +202,25 @@ mod live {
                     }
                 };
                 tokio::select! {
-                    got = frames.recv() => match got {
-                        Ok(f) => trace.push(&f),
-                        Err(crate::bus::BusError::Closed) => return Err(format!("{iface}: the bus was closed")),
+                    (i, got) = next(&mut subs) => match got {
+                        Ok(f) => trace.push(&tagged(i, f)),
+                        Err(BusError::Closed) => return Err(format!("{}: the bus was closed", ifaces[i])),
                         // The interface went down or away: said, and the capture goes on.
                         Err(e) => eprintln!("cotui diagnose: {e}"),
                     },
-                    _ = tick.tick() => trace.tick(bus.now_ns()),
+                    _ = tick.tick() => trace.tick(clock.now_ns()),
                     _ = int.recv() => break,
                     _ = term.recv() => break,
                     _ = deadline => break,
                 }
             }
             // Frames the kernel still holds are part of the capture.
-            while let Some(Ok(f)) = frames.try_recv() {
-                trace.push(&f);
+            for (i, sub) in subs.iter_mut().enumerate() {
+                while let Some(Ok(f)) = sub.try_recv() {
+                    trace.push(&tagged(i, f));
+                }
             }
-            trace.tick(bus.now_ns());
+            trace.tick(clock.now_ns());
             Ok(())
         })
     }

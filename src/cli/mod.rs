@@ -9,6 +9,7 @@ mod decode_parquet;
 pub mod diagnose;
 pub mod explain;
 pub mod input;
+mod merge;
 pub mod record;
 pub mod sim;
 pub mod tui;

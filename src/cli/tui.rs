@@ -78,8 +78,11 @@ pub struct ReplayArgs {
 /// Arguments of `cotui live`.
 #[derive(Args, Debug)]
 pub struct LiveArgs {
-    /// SocketCAN interface (e.g. can0, vcan0).
-    pub iface: String,
+    /// SocketCAN interfaces (e.g. can0, vcan0), captured together in one session: each
+    /// bus's load and state on the status line; palette commands go to the first. `demo`
+    /// and `demo2` are two independent simulated buses.
+    #[arg(required = true, value_name = "IFACE")]
+    pub iface: Vec<String>,
     /// Never send: the bus is opened without a send path.
     #[arg(long)]
     pub listen_only: bool,
@@ -152,8 +155,8 @@ pub fn load_keymap(choice: &str) -> Result<Keymap, String> {
 enum Feeding {
     /// A log task with an optional control line.
     Log(source::Feeds),
-    /// A live bus (interface, listen-only) that also runs commands.
-    Live(String, bool),
+    /// Live buses (interfaces, listen-only) that also run commands (on the first).
+    Live(Vec<String>, bool),
     /// The demo bus with these simulated drives (listen-only).
     Demo(crate::sim::Simulation, bool),
 }
@@ -168,7 +171,8 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> ExitCode {
     };
     let bindings = match &feed {
         Feeding::Demo(sim, _) => super::bind::bindings_for_demo(sim, &ui.profiles, &ui.eds),
-        _ => super::bind::bindings_on(name, &ui.profiles, &ui.eds),
+        Feeding::Live(ifaces, _) => super::bind::bindings_on(&ifaces[0], &ui.profiles, &ui.eds),
+        Feeding::Log(_) => super::bind::bindings_on(name, &ui.profiles, &ui.eds),
     };
     let bindings = match bindings {
         Ok(b) => b,
@@ -180,12 +184,13 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> ExitCode {
     let decoder = crate::decode::Decoder::from_bindings(&bindings);
     let src = match feed {
         Feeding::Log((rx, ctl)) => SourceInfo::new(name, kind, rx, ctl),
-        Feeding::Live(iface, listen_only) => {
-            let (rx, req) = crate::tui::live::start(&iface, listen_only, bindings.clone(), None);
+        Feeding::Live(ifaces, listen_only) => {
+            let (rx, req) = crate::tui::live::start(&ifaces, listen_only, bindings.clone(), None);
             SourceInfo::live(name, kind, rx, req)
         }
         Feeding::Demo(sim, listen_only) => {
-            let (rx, req) = crate::tui::live::start(crate::connect::DEMO, listen_only, bindings.clone(), Some(sim));
+            let demo = [crate::connect::DEMO.to_string()];
+            let (rx, req) = crate::tui::live::start(&demo, listen_only, bindings.clone(), Some(sim));
             SourceInfo::live(name, kind, rx, req)
         }
     };
@@ -263,13 +268,17 @@ pub fn run_replay(args: &ReplayArgs) -> ExitCode {
     )
 }
 
-/// Runs `cotui live IFACE`.
+/// Runs `cotui live IFACE...`.
 pub fn run_live(args: &LiveArgs) -> ExitCode {
+    if let Some(twice) = super::input::repeated(&args.iface) {
+        eprintln!("cotui live: {twice} is given twice: name each interface once");
+        return ExitCode::Usage;
+    }
     let kind = SourceKind::Live {
         listen_only: args.listen_only,
     };
     let feed = Feeding::Live(args.iface.clone(), args.listen_only);
-    start(&args.ui, &args.iface, kind, feed)
+    start(&args.ui, &args.iface.join(" "), kind, feed)
 }
 
 /// Runs `cotui demo`.

@@ -173,6 +173,12 @@ fn schema_line(c: &Col) -> String {
 }
 
 fn pq_err(e: parquet::errors::ParquetError) -> io::Error {
+    // A failed write of the file underneath (disk full) is that error, as the OS says it.
+    if let parquet::errors::ParquetError::External(inner) = &e
+        && let Some(io) = inner.downcast_ref::<io::Error>()
+    {
+        return io::Error::new(io.kind(), io.to_string());
+    }
     io::Error::other(format!("parquet: {e}"))
 }
 

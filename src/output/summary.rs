@@ -5,17 +5,19 @@ use crate::decode::Kind;
 use crate::frame::{Frame, Interfaces, NodeKey};
 use serde::Serialize;
 use std::collections::{BTreeMap, HashMap};
+use std::fmt::Write;
 
 /// Counters of one node, by kind index.
-type Counts = [u64; Kind::ALL.len()];
+pub type Counts = [u64; Kind::ALL.len()];
 
 /// Running totals of frames by kind and by node.
 #[derive(Clone, Debug, Default)]
 pub struct Summary {
     /// Frames per kind.
     pub by_kind: BTreeMap<Kind, u64>,
-    /// Frames per node (of its interface), split by kind.
-    pub by_node: BTreeMap<NodeKey, BTreeMap<Kind, u64>>,
+    /// Frames per node (of its interface) by kind index ([`Kind::index`]), in node order:
+    /// only nodes seen, after [`Summary::finish`].
+    pub by_node: Vec<(NodeKey, Counts)>,
     /// Frames in all.
     pub frames: u64,
     /// The bits on the wire (set the bit rate with [`BusLoad::new`] before counting).
@@ -25,8 +27,9 @@ pub struct Summary {
     /// common case of one bus stays an array increment.
     first_counts: Vec<Counts>,
     /// Counters of the nodes of every other interface, only of nodes seen: a log of
-    /// 40,000 interface names costs its nodes, not 40,000 x 128 counters.
-    other_counts: HashMap<NodeKey, Counts>,
+    /// 40,000 interface names costs its nodes, not 40,000 x 128 counters. A fast seeded
+    /// hash: this map is looked up per frame.
+    other_counts: HashMap<NodeKey, Counts, foldhash::fast::RandomState>,
     /// Interface names by index, as far as known: with nodes on several, a node is shown
     /// with its interface (`can1 node 5`, JSON key `"can1/5"`).
     ifaces: Vec<String>,
@@ -85,8 +88,8 @@ impl Summary {
     /// Whether nodes were counted on several interfaces (then node 5 of can0 and node 5 of
     /// can1 are told apart). `by_node` is ordered by interface: the first and last differ.
     fn several_ifaces(&self) -> bool {
-        let first = self.by_node.keys().next().map(|k| k.iface);
-        let last = self.by_node.keys().next_back().map(|k| k.iface);
+        let first = self.by_node.first().map(|k| k.0.iface);
+        let last = self.by_node.last().map(|k| k.0.iface);
         first != last
     }
 
@@ -105,15 +108,11 @@ impl Summary {
             }
         }
         let first = self.first_counts.iter().enumerate();
-        let first = first.map(|(n, counts)| (NodeKey::new(0, n as u8), counts));
-        let others = self.other_counts.iter().map(|(key, counts)| (*key, counts));
-        for (key, counts) in first.chain(others) {
-            for (i, k) in Kind::ALL.iter().enumerate() {
-                if counts[i] > 0 {
-                    self.by_node.entry(key).or_default().insert(*k, counts[i]);
-                }
-            }
-        }
+        let first = first.map(|(n, counts)| (NodeKey::new(0, n as u8), *counts));
+        let others = self.other_counts.iter().map(|(key, counts)| (*key, *counts));
+        self.by_node
+            .extend(first.chain(others).filter(|(_, c)| c.iter().any(|n| *n > 0)));
+        self.by_node.sort_unstable_by_key(|(key, _)| *key);
     }
 
     /// Text report.
@@ -125,17 +124,17 @@ impl Summary {
         }
         s.push_str("by node:\n");
         let several = self.several_ifaces();
-        for (node, kinds) in &self.by_node {
-            let total: u64 = kinds.values().sum();
-            let parts: Vec<String> = kinds.iter().map(|(k, n)| format!("{}={n}", k.as_str())).collect();
-            match self.iface_of(several, *node) {
-                Some(iface) => s.push_str(&format!(
-                    "  {iface} node {:<3} {total:>10}  {}\n",
-                    node.node,
-                    parts.join(" ")
-                )),
-                None => s.push_str(&format!("  node {:<3} {total:>10}  {}\n", node.node, parts.join(" "))),
+        for (node, counts) in &self.by_node {
+            let total: u64 = counts.iter().sum();
+            // Writing to a String cannot fail.
+            let _ = match self.iface_of(several, *node) {
+                Some(iface) => write!(s, "  {iface} node {:<3} {total:>10} ", node.node),
+                None => write!(s, "  node {:<3} {total:>10} ", node.node),
+            };
+            for (k, n) in kinds(counts) {
+                let _ = write!(s, " {}={n}", k.as_str());
             }
+            s.push('\n');
         }
         s.push_str(&self.bus.to_text(|k| match self.iface_of(several, k) {
             Some(iface) => format!("{iface} node {}", k.node),
@@ -162,11 +161,20 @@ impl Summary {
             by_node: self
                 .by_node
                 .iter()
-                .map(|(node, kinds)| (self.node_key(several, *node), named(kinds)))
+                .map(|(node, counts)| (self.node_key(several, *node), kinds(counts).map(|(k, n)| (k.as_str(), n)).collect()))
                 .collect(),
             frames: self.frames,
         }
     }
+}
+
+/// The kinds counted in `counts` and their counts, in kind order as `by_kind` ([`Kind::ALL`]
+/// is in that order).
+fn kinds(counts: &Counts) -> impl Iterator<Item = (Kind, u64)> + '_ {
+    Kind::ALL
+        .iter()
+        .map(|k| (*k, counts[k.index()]))
+        .filter(|(_, n)| *n > 0)
 }
 
 /// The summary as a JSON record (fields in key order). Maps are ordered by their JSON
@@ -198,7 +206,9 @@ mod tests {
         s.finish();
         assert_eq!(s.frames, 4);
         assert_eq!(s.by_kind[&Kind::Heartbeat], 2);
-        assert_eq!(s.by_node[&NodeKey::new(0, 5)][&Kind::Heartbeat], 2);
+        let node5 = s.by_node.iter().find(|(k, _)| *k == NodeKey::new(0, 5)).unwrap().1;
+        assert_eq!(node5[Kind::Heartbeat.index()], 2);
+        assert!(Kind::ALL.is_sorted(), "rows list kinds in the order of by_kind");
         let t = s.to_text();
         assert!(t.contains("  heartbeat    2"), "{t}");
         assert!(t.contains("node 5            2  heartbeat=2"), "{t}");

@@ -1039,12 +1039,21 @@ mod tests {
             "scan: 2 nodes\nnode 2 aimotor\nnode 3 syntron-ds".into(),
         ))
         .unwrap();
-        ftx.send(Feed::BusError(
-            "vcan0: interface went down; fix: sudo ip link set vcan0 up".into(),
-        ))
+        let note = |state, text: &str| crate::tui::source::BusNote {
+            iface: 0,
+            state,
+            text: text.into(),
+        };
+        ftx.send(Feed::BusError(note(
+            "interface down",
+            "vcan0: interface went down; fix: sudo ip link set vcan0 up",
+        )))
         .unwrap();
-        ftx.send(Feed::BusOk("vcan0: capturing again after 2.0 s without capture".into()))
-            .unwrap();
+        ftx.send(Feed::BusOk(note(
+            "error-active",
+            "vcan0: capturing again after 2.0 s without capture",
+        )))
+        .unwrap();
         a.ingest(Duration::from_millis(50));
         // The recovery is the latest news on the status line; the log has all three.
         assert_eq!(a.message(), Some("vcan0: capturing again after 2.0 s without capture"));

@@ -41,8 +41,12 @@ pub struct SourceInfo {
     pub done: bool,
     /// Frames the UI could not take (dropped).
     pub drops: u64,
-    /// The interface error in force (with the command that fixes it).
+    /// The interface error in force (with the command that fixes it): the first interface's
+    /// in trouble when there are several.
     pub bus_error: Option<String>,
+    /// Each live interface's condition by its index (`error-active`, `bus-off`, ...), and
+    /// its error in force.
+    pub buses: std::collections::BTreeMap<u16, (&'static str, Option<String>)>,
     /// A replay starts over at its end.
     pub looping: bool,
     /// Where a replay is, and the size of its log once measured.
@@ -62,6 +66,7 @@ impl SourceInfo {
             done: false,
             drops: 0,
             bus_error: None,
+            buses: std::collections::BTreeMap::new(),
             looping: false,
             replay: (None, None),
             feed: Some(feed),
@@ -269,18 +274,22 @@ impl Capture {
             Ok(Feed::Result(level, s)) => q.push(Event::Result(level, s)),
             Ok(Feed::Stopped(level, s, failed)) => q.push(Event::Stopped(level, s, failed)),
             Ok(Feed::Lost(n)) => self.source.drops += n,
-            Ok(Feed::BusError(e)) => {
-                if self.source.bus_error.as_ref() != Some(&e) {
-                    q.push(Event::Log(Level::Error, e.clone()));
+            Ok(Feed::BusError(note)) => {
+                let bus = self.source.buses.entry(note.iface).or_insert((note.state, None));
+                if bus.1.as_ref() != Some(&note.text) {
+                    q.push(Event::Log(Level::Error, note.text.clone()));
                 }
-                self.source.bus_error = Some(e);
+                *bus = (note.state, Some(note.text));
+                self.source.bus_error = self.source.buses.values().find_map(|b| b.1.clone());
                 self.clock = None;
             }
             Ok(Feed::BusOk(note)) => {
                 // A recovery is news (the error it ends was shown); the first "capturing" is not.
-                if self.source.bus_error.take().is_some() {
-                    q.push(Event::Say(Level::Info, note));
+                let was = self.source.buses.insert(note.iface, (note.state, None));
+                if was.and_then(|b| b.1).is_some() {
+                    q.push(Event::Say(Level::Info, note.text));
                 }
+                self.source.bus_error = self.source.buses.values().find_map(|b| b.1.clone());
             }
             Ok(Feed::Done) | Err(TryRecvError::Disconnected) => {
                 // Transfers the input cut off are listed, as `decode --transactions` lists them.

@@ -5,7 +5,7 @@
 //! cyclic SYNC/RPDO/raw senders first).
 
 use super::messages::Level;
-use super::source::Feed;
+use super::source::{BusNote, Feed};
 use crate::bus::{Bus, BusError, BusState, Event, StateChange};
 use crate::command::cyclic::{self, Progress};
 use crate::command::stop::{Commanded, StopOptions, stop_nodes};
@@ -46,17 +46,20 @@ const BATCH: usize = 1024;
 /// Capacity of the feed channel in batches; when full, frames are dropped and counted.
 const QUEUE: usize = 256;
 
-/// Starts capturing `iface` (`demo` for the simulated bus: `demo` runs that simulation,
-/// the standard demo when `None`); commands use `bindings` for object names and types.
+/// Starts capturing `ifaces` (at least one; `demo` and `demo2` are simulated buses: the
+/// first demo bus runs `demo`, the standard demo when `None`, the others the standard demo),
+/// one capture task per interface on one runtime, their frames tagged with the interface's
+/// index in `ifaces`. Palette commands go to the first interface; they use `bindings` for
+/// object names and types.
 pub fn start(
-    iface: &str,
+    ifaces: &[String],
     listen_only: bool,
     bindings: Bindings,
     demo: Option<crate::sim::Simulation>,
 ) -> (Receiver<Feed>, Requests) {
     let (tx, rx) = sync_channel(QUEUE);
     let (req_tx, req_rx) = unbounded_channel();
-    let iface = iface.to_string();
+    let ifaces = ifaces.to_vec();
     std::thread::spawn(move || {
         let rt = match tokio::runtime::Builder::new_current_thread().enable_all().build() {
             Ok(rt) => rt,
@@ -66,7 +69,28 @@ pub fn start(
                 return;
             }
         };
-        rt.block_on(capture(iface, listen_only, bindings, tx, req_rx, demo));
+        if tx.send(Feed::Interfaces(ifaces.clone())).is_err() {
+            return;
+        }
+        let mut demo = demo;
+        let mut first = Some(req_rx);
+        let local = tokio::task::LocalSet::new();
+        for (i, iface) in ifaces.into_iter().enumerate() {
+            let sim = if crate::connect::is_demo(&iface) {
+                Some(demo.take().unwrap_or_else(crate::sim::Simulation::demo))
+            } else {
+                None
+            };
+            let bus = Capture {
+                index: i as u16,
+                iface,
+                listen_only,
+            };
+            local.spawn_local(capture(bus, bindings.clone(), tx.clone(), first.take(), sim));
+        }
+        drop(tx);
+        // The capture ends when every interface's task has (the UI went away, or a bus closed).
+        rt.block_on(local);
     });
     (rx, req_tx)
 }
@@ -84,37 +108,66 @@ fn offer(tx: &SyncSender<Feed>, item: Feed, lost: &mut u64) -> bool {
     }
 }
 
+/// One interface a capture task opens.
+struct Capture {
+    /// Its index in the interface table (the frames' `iface`).
+    index: u16,
+    iface: String,
+    listen_only: bool,
+}
+
+impl Capture {
+    fn note(&self, state: &'static str, text: String) -> BusNote {
+        BusNote {
+            iface: self.index,
+            state,
+            text,
+        }
+    }
+}
+
+/// The next request, or never when this task takes none (an interface besides the first).
+async fn next_request(req: &mut Option<UnboundedReceiver<Request>>) -> Option<Request> {
+    match req {
+        Some(r) => r.recv().await,
+        None => std::future::pending().await,
+    }
+}
+
 /// Opens the bus (retrying every second until it can), then forwards frames in batches
 /// and every change of the interface or controller state: [`Feed::BusError`] (with the
 /// fix) when capture stops or the controller is in trouble, [`Feed::BusOk`] when it is
-/// back. The bus handle follows the interface by name, so capture resumes by itself.
+/// back. The bus handle follows the interface by name, so capture resumes by itself. With
+/// `req`, the task also runs the palette's commands on this bus; `demo` is the simulation
+/// of a demo bus.
 async fn capture(
-    iface: String,
-    listen_only: bool,
+    cap: Capture,
     bindings: Bindings,
     tx: SyncSender<Feed>,
-    mut req: UnboundedReceiver<Request>,
+    mut req: Option<UnboundedReceiver<Request>>,
     mut demo: Option<crate::sim::Simulation>,
 ) {
-    if tx.send(Feed::Interfaces(vec![iface.clone()])).is_err() {
-        return;
-    }
+    let Capture {
+        index,
+        ref iface,
+        listen_only,
+    } = cap;
     // Nodes a stop confirmed stopped, from the stop task back to this loop.
     let (stopped_tx, mut stopped) = unbounded_channel();
     let mut jobs = Jobs::new(stopped_tx);
     // The demo's simulation, for `sim` commands (none on a real interface).
     let mut sim: Option<Demo> = None;
     let bus = loop {
-        if iface == crate::connect::DEMO {
+        if crate::connect::is_demo(iface) {
             let d = Demo::spawn(demo.take().unwrap_or_else(crate::sim::Simulation::demo), listen_only);
             let bus = d.bus.clone();
             sim = Some(d);
             break bus;
         }
-        match crate::connect::open(&iface, listen_only).await {
+        match crate::connect::open(iface, listen_only).await {
             Ok(b) => break b,
             Err(e) => {
-                if tx.send(Feed::BusError(e.to_string())).is_err() {
+                if tx.send(Feed::BusError(cap.note("unavailable", e.to_string()))).is_err() {
                     return;
                 }
                 // Answer requests while waiting, so the palette never hangs.
@@ -123,7 +176,7 @@ async fn capture(
                 loop {
                     tokio::select! {
                         _ = &mut wait => break,
-                        r = req.recv() => match r {
+                        r = next_request(&mut req) => match r {
                             Some(r) => jobs.refuse(r, &e, &tx),
                             None => return,
                         },
@@ -132,7 +185,10 @@ async fn capture(
             }
         }
     };
-    if tx.send(Feed::BusOk(format!("{iface}: capturing"))).is_err() {
+    if tx
+        .send(Feed::BusOk(cap.note("capturing", format!("{iface}: capturing"))))
+        .is_err()
+    {
         return;
     }
     let mut lost = 0u64;
@@ -146,7 +202,7 @@ async fn capture(
         tokio::select! {
             got = sub.next() => match got {
                 Ok(Event::Frame(mut f)) => {
-                    f.iface = 0;
+                    f.iface = index;
                     jobs.observe(&f);
                     batch.push(f);
                     if batch.len() >= BATCH && !offer(&tx, Feed::Frames(std::mem::take(&mut batch)), &mut lost) {
@@ -158,14 +214,14 @@ async fn capture(
                     if !batch.is_empty() && !offer(&tx, Feed::Frames(std::mem::take(&mut batch)), &mut lost) {
                         return;
                     }
-                    if tx.send(state_feed(&iface, &s, &mut stopped_at)).is_err() {
+                    if tx.send(state_feed(&cap, &s, &mut stopped_at)).is_err() {
                         return;
                     }
                 }
                 Err(BusError::Closed) => {
                     offer(&tx, Feed::Frames(std::mem::take(&mut batch)), &mut lost);
-                    let _ = tx.send(Feed::BusError(BusError::Closed.to_string()));
-                    let _ = tx.send(Feed::Done);
+                    // The source ends once every interface's task has: the feed then closes.
+                    let _ = tx.send(Feed::BusError(cap.note("closed", format!("{iface}: {}", BusError::Closed))));
                     return;
                 }
                 Err(e) => {
@@ -184,7 +240,7 @@ async fn capture(
                     reported = sub.lost();
                 }
             }
-            r = req.recv() => match r {
+            r = next_request(&mut req) => match r {
                 Some(Request::Sim { line, control }) => {
                     let feed = simulate(sim.as_ref(), &line, control).await;
                     let _ = tx.send(feed);
@@ -223,19 +279,23 @@ async fn simulate(demo: Option<&Demo>, line: &str, control: Control) -> Feed {
 
 /// The feed item for a change of state: trouble (with the fix) or all well again (saying
 /// how long capture was stopped, if it was).
-fn state_feed(iface: &str, s: &StateChange, stopped_at: &mut Option<u64>) -> Feed {
+fn state_feed(cap: &Capture, s: &StateChange, stopped_at: &mut Option<u64>) -> Feed {
+    let (iface, state) = (cap.iface.as_str(), s.state.name());
     if !s.state.capturing() {
         stopped_at.get_or_insert(s.ts_ns);
     }
     if s.state != BusState::Active {
-        return Feed::BusError(s.text(iface));
+        return Feed::BusError(cap.note(state, s.text(iface)));
     }
     match stopped_at.take() {
-        Some(t) => Feed::BusOk(format!(
-            "{iface}: capturing again after {:.1} s without capture",
-            s.ts_ns.saturating_sub(t) as f64 / 1e9
+        Some(t) => Feed::BusOk(cap.note(
+            state,
+            format!(
+                "{iface}: capturing again after {:.1} s without capture",
+                s.ts_ns.saturating_sub(t) as f64 / 1e9
+            ),
         )),
-        None => Feed::BusOk(s.text(iface)),
+        None => Feed::BusOk(cap.note(state, s.text(iface))),
     }
 }
 

@@ -35,10 +35,10 @@ pub enum Feed {
     Lost(u64),
     /// The interface is unavailable, down, gone, or its controller is bus-off, error-passive
     /// or warning; the text says so, whether frames are captured, and the command that fixes it.
-    BusError(String),
+    BusError(BusNote),
     /// The interface is (again) capturing with an error-active controller; the text says so
     /// (and for how long capture had stopped).
-    BusOk(String),
+    BusOk(BusNote),
     /// Where a replay is (after its batches and every command).
     Position(Position),
     /// The size of a replayed log, once measured.
@@ -48,6 +48,18 @@ pub enum Feed {
     /// The result of a stop-all, as [`Feed::Result`], with the nodes not confirmed stopped
     /// (every target when nothing could be sent).
     Stopped(super::messages::Level, String, Vec<u8>),
+}
+
+/// A change of one interface's condition, from a live capture task.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BusNote {
+    /// The interface's index in the interface table (0 for the first one captured).
+    pub iface: u16,
+    /// Its condition in a word or two: `capturing`, `error-active`, `error-passive`,
+    /// `bus-off`, `interface down`, `unavailable` (see [`crate::bus::BusState::name`]).
+    pub state: &'static str,
+    /// What the user reads (with the fix, for trouble).
+    pub text: String,
 }
 
 /// Replay commands.

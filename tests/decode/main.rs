@@ -6,6 +6,7 @@
 #![allow(clippy::unwrap_used)]
 
 mod architecture;
+mod bench_scratch;
 mod bounded_memory;
 mod cut_short;
 mod decode_golden;
@@ -20,10 +21,12 @@ mod log_formats;
 mod log_fuzz;
 mod no_panic;
 mod parquet_duckdb;
+mod parquet_full;
 mod pcapng;
 mod profile_example;
 mod realworld_block;
 mod run;
+mod split_logs;
 mod track_path;
 mod two_buses;
 mod wireshark;

@@ -13,3 +13,4 @@ mod receive_list;
 mod tmux;
 mod tui_cli;
 mod tui_tmux;
+mod two_buses;

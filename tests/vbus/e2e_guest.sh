@@ -1047,6 +1047,21 @@ live7=$(jq -c 'select(.node == 7 and .status == "open") | [.status, .kind, .titl
     ok "diag: cotui diagnose --live vcan0 --check (stopped by SIGINT): exit 1, the same open incidents of node 7 as the recording" ||
     bad "diag: diagnose --live: rc=$live_rc node 7: $live7; $(cat diag_live.err)"
 
+# Two buses in one live diagnosis: node 5 beats on vcan0 and vcan1; on vcan1 it stops after
+# 10 beats, on vcan0 it goes on. The diagnosis knows node 5 per bus: one open silence, of
+# node 5 on vcan1 only.
+diagnose_two() {
+    ( for i in $(seq 60); do cansend vcan0 705#05; [ "$i" -le 10 ] && cansend vcan1 705#05; sleep 0.1; done ) &
+    beats=$!
+    c diagnose --live vcan0 vcan1 --duration 7 --format jsonl
+    wait "$beats"
+}
+diagnose_two
+two=$(echo "$out" | jq -c 'select(.node == 5 and .status == "open") | [.kind, .iface]' | sort | tr -d '\n')
+[ "$rc" = 0 ] && [ "$two" = '["silent","vcan1"]' ] &&
+    ok "two buses: cotui diagnose --live vcan0 vcan1: node 5 silent on vcan1 only" ||
+    bad "two buses: diagnose --live vcan0 vcan1: rc=$rc node 5: $two; $err"
+
 t_end=$(date +%s.%N)
 echo "$passed passed, $failed failed ($(awk -v a="$t_start" -v b="$t_end" 'BEGIN { printf "%.0f", b - a }') s in the guest)"
 [ "$failed" = 0 ]

@@ -142,10 +142,19 @@ impl Component for StatsPane {
         } else {
             ""
         };
+        let names = ctx.trace.ifaces.names();
+        let load = if names.len() > 1 {
+            // Several buses: each one's load (the bit rate is the same for all).
+            let each: Vec<String> = (0..names.len() as u16)
+                .map(|i| format!("{} {:.1}%", names[i as usize], st.iface_load_percent(i)))
+                .collect();
+            each.join(", ")
+        } else {
+            format!("{:.1}%", st.load_percent())
+        };
         let title = format!(
-            " Receive list by {} — bus load {:.1}% at {} kbit/s{assumed}, {} fr in the last 1 s ",
+            " Receive list by {} — bus load {load} at {} kbit/s{assumed}, {} fr in the last 1 s ",
             self.sort.name(),
-            st.load_percent(),
             rate.bps / 1000,
             st.window_frames(&ctx.trace.store)
         );

@@ -98,6 +98,25 @@ fn replay_position(app: &App) -> String {
     }
 }
 
+/// A live session of several interfaces: each bus's load over the last second and its
+/// condition, one field each (` | can0 12.3% error-active | can1 0.0% bus-off`); nothing
+/// for one interface or a log.
+fn buses(app: &App) -> String {
+    let live = matches!(app.source().kind, SourceKind::Live { .. } | SourceKind::Demo { .. });
+    let names = app.trace().ifaces.names();
+    if !live || names.len() < 2 {
+        return String::new();
+    }
+    let mut out = String::new();
+    for (i, name) in names.iter().enumerate() {
+        let i = i as u16;
+        let state = app.source().buses.get(&i).map_or("waiting", |b| b.0);
+        let load = app.trace().stats.iface_load_percent(i);
+        out.push_str(&format!(" | {name} {load:.1}% {state}"));
+    }
+    out
+}
+
 /// The status bar text.
 pub fn text(app: &App) -> String {
     let src = match app.source().kind {
@@ -170,9 +189,10 @@ pub fn text(app: &App) -> String {
         .map(|k| format!(" | help: {k}"))
         .unwrap_or_default();
     format!(
-        "{src}{state}{rec} | {} frames{rate} | drops {}{filter}{search}{stop}{help}",
+        "{src}{state}{rec} | {} frames{rate} | drops {}{}{filter}{search}{stop}{help}",
         app.trace().len(),
-        app.source().drops
+        app.source().drops,
+        buses(app)
     )
 }
 

@@ -221,7 +221,7 @@ impl IfaceCache {
             None if ifaces.names().len() >= u16::MAX as usize => {
                 return Err(err(at, "too many distinct interface names"));
             }
-            None => ifaces.intern(text),
+            None => ifaces.add(text),
         };
         // Only names that fit are cached; longer ones take the slow path every time.
         self.last = None;

@@ -1,0 +1,161 @@
+//! Several logs read as one capture (`cotui decode a.log b.log`): each file is parsed on its
+//! own thread and their frames are merged by timestamp (ties in the order the files were
+//! given). An interface name met in several files is the same bus (one bus's log split in
+//! parts); with `--iface-per-file` each file's interfaces are named `FILE:IFACE` instead, so
+//! buses recorded apart stay apart.
+
+use crate::frame::Interfaces;
+use crate::log::{Counts, LogReader, Outcome};
+use std::collections::VecDeque;
+use std::io::{self, BufRead};
+use std::sync::mpsc::{Receiver, sync_channel};
+
+/// Lines per batch, read and handed on.
+const BATCH: usize = 2048;
+
+/// What a file's reader thread sends.
+enum Piece {
+    /// Parsed lines and the interface names first seen in them.
+    Lines(Vec<(u64, Outcome)>, Vec<String>),
+    /// The end: the reader's counts and the read error that stopped it, if any.
+    End(Counts, Option<io::Error>),
+}
+
+/// One file being merged.
+struct Part {
+    path: String,
+    rx: Receiver<Piece>,
+    pending: VecDeque<(u64, Outcome)>,
+    /// The merged table's index of each of the file's own interface indices.
+    map: Vec<u16>,
+    end: Option<(Counts, Option<io::Error>)>,
+}
+
+impl Part {
+    /// The time of the next frame, reading on (warnings said as they pass) until there is
+    /// one; `None` at the end of the file.
+    fn head(&mut self, merged: &mut Interfaces, per_file: bool) -> Option<u64> {
+        loop {
+            while let Some((line, outcome)) = self.pending.front() {
+                match outcome {
+                    Outcome::Frame(f) => return Some(f.ts_ns),
+                    Outcome::Warning(msg) => eprintln!("{}:{line}: warning: {msg}", self.path),
+                    Outcome::Skip(_) => {}
+                }
+                self.pending.pop_front();
+            }
+            if self.end.is_some() {
+                return None;
+            }
+            match self.rx.recv() {
+                Ok(Piece::Lines(lines, names)) => {
+                    for name in names {
+                        let shown = if per_file {
+                            format!("{}:{name}", self.path)
+                        } else {
+                            name
+                        };
+                        self.map.push(merged.intern(&shown));
+                    }
+                    self.pending.extend(lines);
+                }
+                Ok(Piece::End(counts, error)) => self.end = Some((counts, error)),
+                Err(_) => self.end = Some((Counts::default(), None)),
+            }
+        }
+    }
+}
+
+/// Parses `input` and sends its lines in batches, then its counts.
+fn read(input: Box<dyn BufRead + Send>, tx: std::sync::mpsc::SyncSender<Piece>) {
+    let mut reader = match LogReader::new(input) {
+        Ok(r) => r,
+        Err(e) => {
+            let _ = tx.send(Piece::End(Counts::default(), Some(e)));
+            return;
+        }
+    };
+    let mut sent = 0;
+    loop {
+        let mut lines = Vec::with_capacity(BATCH);
+        let error = reader.fill(&mut lines, BATCH).err();
+        let done = lines.len() < BATCH || error.is_some();
+        let names = reader.interfaces().names()[sent..].to_vec();
+        sent += names.len();
+        if tx.send(Piece::Lines(lines, names)).is_err() {
+            return;
+        }
+        if done {
+            let _ = tx.send(Piece::End(reader.counts().clone(), error));
+            return;
+        }
+    }
+}
+
+/// Reads `inputs` (path, reader) as one capture and calls `consume` with batches of their
+/// frames merged by time, each frame's `iface` an index of the merged table (the second
+/// argument). Each file's counts are reported as it ends ([`super::input::report_counts`]);
+/// the first read error (naming its file) or error of `consume` is returned.
+pub fn for_each_merged(
+    inputs: Vec<(String, Box<dyn BufRead + Send>)>,
+    per_file: bool,
+    mut consume: impl FnMut(&[(u64, Outcome)], &Interfaces) -> io::Result<()>,
+) -> io::Result<()> {
+    std::thread::scope(|s| {
+        let mut parts: Vec<Part> = inputs
+            .into_iter()
+            .map(|(path, input)| {
+                let (tx, rx) = sync_channel(4);
+                s.spawn(move || read(input, tx));
+                Part {
+                    path,
+                    rx,
+                    pending: VecDeque::new(),
+                    map: Vec::new(),
+                    end: None,
+                }
+            })
+            .collect();
+        let mut merged = Interfaces::default();
+        let mut out: Vec<(u64, Outcome)> = Vec::with_capacity(BATCH);
+        let mut result = Ok(());
+        loop {
+            let mut next: Option<(u64, usize)> = None;
+            for (i, p) in parts.iter_mut().enumerate() {
+                if let Some(t) = p.head(&mut merged, per_file)
+                    && next.is_none_or(|(best, _)| t < best)
+                {
+                    next = Some((t, i));
+                }
+            }
+            let Some((_, i)) = next else { break };
+            let p = &mut parts[i];
+            if let Some((line, Outcome::Frame(mut f))) = p.pending.pop_front() {
+                f.iface = p.map.get(usize::from(f.iface)).copied().unwrap_or(0);
+                out.push((line, Outcome::Frame(f)));
+            }
+            if out.len() == BATCH {
+                result = consume(&out, &merged);
+                out.clear();
+                if result.is_err() {
+                    break;
+                }
+            }
+        }
+        if result.is_ok() && !out.is_empty() {
+            result = consume(&out, &merged);
+        }
+        // Dropping the parts ends readers still running (after an error of `consume`).
+        let mut first_error = None;
+        for p in parts {
+            let Part { path, end, .. } = p;
+            if let Some((counts, error)) = end {
+                super::input::report_counts(&path, &counts);
+                if let Some(e) = error {
+                    first_error.get_or_insert(io::Error::new(e.kind(), format!("{path}: {e}")));
+                }
+            }
+        }
+        result.and(first_error.map_or(Ok(()), Err))
+    })
+}

@@ -1,0 +1,95 @@
+//! One live session on two buses (`cotui live demo demo2`: two independent simulated
+//! buses, each with the standard demo drives): the frames of each come tagged with its
+//! interface, node 2 is known twice (once per bus), and the status bar and the Stats pane
+//! show each bus's load and state.
+
+use cotui::analysis::trace::Trace;
+use cotui::decode::Decoder;
+use cotui::frame::NodeKey;
+use cotui::tui::app::{App, SourceInfo, SourceKind};
+use cotui::tui::keymap::Keymap;
+use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+use ratatui::Terminal;
+use ratatui::backend::TestBackend;
+use std::time::{Duration, Instant};
+
+fn screen(a: &mut App) -> String {
+    let mut term = Terminal::new(TestBackend::new(200, 40)).unwrap();
+    term.draw(|f| cotui::tui::ui::draw(f, a)).unwrap();
+    let buf = term.backend().buffer().clone();
+    (0..buf.area.height)
+        .map(|y| {
+            (0..buf.area.width)
+                .map(|x| buf[(x, y)].symbol().to_string())
+                .collect::<String>()
+                + "\n"
+        })
+        .collect()
+}
+
+/// Takes frames in until `f` holds (60 s at most: the machine may be busy); the screen.
+fn until(a: &mut App, what: &str, f: impl Fn(&App, &str) -> bool) -> String {
+    let start = Instant::now();
+    loop {
+        a.ingest(Duration::from_millis(20));
+        let s = screen(a);
+        if f(a, &s) {
+            return s;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "timed out waiting for {what}:\n{s}"
+        );
+        std::thread::yield_now();
+    }
+}
+
+fn two_demo_buses() -> App {
+    let bindings = cotui::cli::bind::bindings_on("demo", &[], &[]).unwrap();
+    let trace = Trace::new(Decoder::from_bindings(&bindings), 500_000);
+    let ifaces = ["demo".to_string(), "demo2".to_string()];
+    let (rx, req) = cotui::tui::live::start(&ifaces, true, bindings.clone(), None);
+    let src = SourceInfo::live("demo demo2", SourceKind::Live { listen_only: true }, rx, req);
+    let mut a = App::new(trace, Keymap::default_map(), src);
+    a.set_bindings(bindings);
+    a
+}
+
+/// The status bar: the line that starts with the source.
+fn status_bar(s: &str) -> String {
+    s.lines()
+        .find(|l| l.starts_with("live demo demo2"))
+        .unwrap_or_default()
+        .to_string()
+}
+
+#[test]
+fn two_buses_in_one_session_each_with_its_load_state_and_nodes() {
+    let mut a = two_demo_buses();
+    let s = until(&mut a, "frames of node 2 on both buses", |a, _| {
+        let n = &a.trace().nodes;
+        [0, 1].iter().all(|&i| n.iter().any(|(k, _)| *k == NodeKey::new(i, 2))) && a.source().buses.len() == 2
+    });
+    assert_eq!(a.trace().ifaces.names(), ["demo", "demo2"]);
+    let bar = status_bar(&s);
+    for bus in ["demo", "demo2"] {
+        let field = bar.split(" | ").find(|f| f.starts_with(&format!("{bus} ")));
+        let field = field.unwrap_or_else(|| panic!("no field for {bus}: {bar}"));
+        // `demo 1.2% capturing`: the load over the last second, then the state.
+        let words: Vec<&str> = field.split(' ').collect();
+        assert_eq!(words.len(), 3, "{field}");
+        assert!(
+            words[1].ends_with('%') && words[1].trim_end_matches('%').parse::<f64>().is_ok(),
+            "{field}"
+        );
+        assert_eq!(words[2], "capturing", "{bar}");
+    }
+    // The Stats pane names each bus's load in its title.
+    a.key(KeyEvent::new(KeyCode::Char('4'), KeyModifiers::NONE));
+    let s = until(&mut a, "the Stats pane", |_, s| s.contains("Receive list by"));
+    let title = s.lines().find(|l| l.contains("Receive list by")).unwrap();
+    assert!(
+        title.contains("bus load demo ") && title.contains(", demo2 "),
+        "{title}"
+    );
+}
