@@ -3,7 +3,7 @@
 //! and the closing counts of what was skipped.
 
 use crate::frame::{Frame, Interfaces};
-use crate::log::{Counts, Outcome};
+use crate::log::{Counts, LogReader, Outcome};
 use crate::logio::read_ahead;
 use std::io::{self, BufRead, BufReader};
 
@@ -47,15 +47,20 @@ impl<'a> Iterator for Frames<'a> {
 }
 
 /// Reads `input` (named `path` in warnings) and calls `consume` with the frames of each
-/// batch, in order. Returns what the reader counted; a read error, or the first error of
-/// `consume` (which stops reading), is returned instead.
+/// batch, in order. What was detected beyond the format (a screen capture's timestamp
+/// mode) is said on stderr first. Returns what the reader counted; a read error, or the
+/// first error of `consume` (which stops reading), is returned instead.
 pub fn for_each_frame(
     path: &str,
     input: Box<dyn BufRead + Send>,
     mut consume: impl FnMut(Frames<'_>) -> io::Result<()>,
 ) -> io::Result<Counts> {
+    let reader = LogReader::new(input)?;
+    if let Some(what) = reader.detected() {
+        eprintln!("{path}: {what}");
+    }
     let mut ifaces = Interfaces::default();
-    let finished = read_ahead::for_each_batch(input, |batch| {
+    let finished = read_ahead::for_each_batch(reader, |batch| {
         for name in &batch.new_interfaces {
             ifaces.intern(name);
         }

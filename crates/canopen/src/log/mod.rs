@@ -207,13 +207,27 @@ pub struct LogReader<R> {
     ifaces: Interfaces,
     counts: Counts,
     frame: Frame,
+    detected: Option<&'static str>,
 }
 
 impl<R: BufRead> LogReader<R> {
     /// A reader that detects the format from the start of `src` (candump when undecided).
-    pub fn new(mut src: R) -> io::Result<Self> {
-        let format = detect(src.fill_buf()?).unwrap_or(Format::Candump);
-        Ok(LogReader::with_format(src, format))
+    pub fn new(src: R) -> io::Result<Self> {
+        LogReader::open(src, None)
+    }
+
+    /// A reader of `format`, or of the format detected from the start of `src` (candump
+    /// when undecided); the variant (screen timestamp mode) is detected in either case.
+    pub fn open(mut src: R, format: Option<Format>) -> io::Result<Self> {
+        let sample = src.fill_buf()?;
+        let format = format.or_else(|| detect(sample)).unwrap_or(Format::Candump);
+        let times = (format == Format::Screen).then(|| screen::detect_times(sample));
+        let mut reader = LogReader::with_format(src, format);
+        if let (Some(times), Parser::Screen(p)) = (times, &mut reader.parser) {
+            p.set_delta(times == screen::Times::Delta);
+            reader.detected = (times != screen::Times::None).then(|| times.label());
+        }
+        Ok(reader)
     }
 
     /// A reader for a known format.
@@ -232,15 +246,14 @@ impl<R: BufRead> LogReader<R> {
             ifaces: Interfaces::default(),
             counts: Counts::default(),
             frame: Frame::default(),
+            detected: None,
         }
     }
 
-    /// Reads screen timestamps as deltas (candump `-t d`) and sums them up.
-    pub fn screen_delta(mut self, on: bool) -> Self {
-        if let Parser::Screen(p) = &mut self.parser {
-            p.set_delta(on);
-        }
-        self
+    /// What [`LogReader::open`] detected beyond the format's name, for the user (e.g.
+    /// `candump screen output, delta times (-td)`); `None` for plain candump and ASC logs.
+    pub fn detected(&self) -> Option<&'static str> {
+        self.detected
     }
 
     /// The format being read.
