@@ -160,3 +160,16 @@ fn screen_output_in_every_timestamp_mode() {
         assert_eq!(rel, [0, 250_000, 250_100], "{mode}");
     }
 }
+
+/// python-can's public ASC log: its status lines (`CAN 1 Status:chip status error passive -
+/// TxErr: 132 RxErr: 0`) are bus-state events, no longer lost.
+#[test]
+fn asc_status_lines_are_bus_state_events() {
+    let log = "../shared/realworld/logs/python-can_logfile.asc";
+    let out = crate::run::cotui(&["decode", "--events", log], None);
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout),
+        "(0.015991)  bus       bus_state         can0: error active -> error passive \
+         (controller problem (TX error passive); error counters tx=132 rx=0)\n"
+    );
+}

@@ -20,6 +20,10 @@
 //! - `base dec` reads ids and data bytes as decimal (the DLC stays hex);
 //! - `ErrorFrame` has no detail in ASC, so it becomes a generic bus error: an error frame
 //!   with class `CAN_ERR_BUSERROR` (0x80) and 8 zero bytes;
+//! - a status line (`CAN 1 Status:chip status error passive - TxErr: 132 RxErr: 0`) becomes
+//!   the error frame a SocketCAN controller sends for the same state: bus off as
+//!   `CAN_ERR_BUSOFF`, error passive / warning level / error active as `CAN_ERR_CRTL` with
+//!   the TX or RX bit of the larger counter, and the counters (`CAN_ERR_CNT`) when given;
 //! - a `CANFD` line is an FD frame (with [`Flags::FDF`]) when its flags column has bit
 //!   0x1000 or is missing, else a classic frame (remote when bit 0x10 is set);
 //! - `Rx`/`Tx` set the direction; `TxRq`, `Start of measurement` and other events are
@@ -32,6 +36,13 @@ use crate::frame::{Flags, Frame, Interfaces};
 
 /// `CAN_ERR_BUSERROR`: the class given to ASC error frames.
 pub const CAN_ERR_BUSERROR: u32 = 0x80;
+
+/// `CAN_ERR_CRTL`, `CAN_ERR_BUSOFF` and `CAN_ERR_CNT` (linux/can/error.h): the classes of
+/// status lines; `CAN_ERR_CRTL_ACTIVE`: the data byte 1 of "error active".
+const CAN_ERR_CRTL: u32 = 0x004;
+const CAN_ERR_BUSOFF: u32 = 0x040;
+const CAN_ERR_CNT: u32 = 0x200;
+const CAN_ERR_CRTL_ACTIVE: u8 = 0x40;
 
 const ASC_F_RTR: u32 = 0x10;
 const ASC_F_FDF: u32 = 0x1000;
@@ -104,6 +115,17 @@ impl Parser {
                 f
             }
             b"CANXL" => return Ok(Line::Skip(SkipReason::CanXl)),
+            b"CAN" => {
+                let (ch_at, ch) = toks
+                    .next()
+                    .ok_or_else(|| err(s.len(), "expected a channel after CAN"))?;
+                let channel = dec_u32(ch).ok_or_else(|| err(ch_at, "expected a channel number"))?;
+                let Some(mut f) = status_line(&s[toks.pos()..]) else {
+                    return Ok(Line::Skip(SkipReason::Event));
+                };
+                f.iface = self.channel(ifaces, channel, ch_at)?;
+                f
+            }
             _ => match dec_u32(ch_tok) {
                 Some(channel) => {
                     let Some(mut f) = self.classic_line(&mut toks, s.len())? else {
@@ -307,6 +329,45 @@ impl Parser {
     }
 }
 
+/// The error frame of a status line's text after the channel (`Status:chip status error
+/// passive - TxErr: 132 RxErr: 0`); `None` when it is no controller state.
+fn status_line(rest: &[u8]) -> Option<Frame> {
+    let text = lex::skip_ws(rest, 0);
+    let rest = rest[text..].strip_prefix(b"Status:")?;
+    let has = |word: &[u8]| rest.windows(word.len()).any(|w| w.eq_ignore_ascii_case(word));
+    let counter = |name: &[u8]| {
+        let at = rest.windows(name.len()).position(|w| w == name)? + name.len();
+        let at = lex::skip_ws(rest, at);
+        dec_u32(&rest[at..lex::token_end(rest, at)])
+    };
+    let (tx, rx) = (counter(b"TxErr:"), counter(b"RxErr:"));
+    // The TX or RX bit of a CAN_ERR_CRTL state: the side with the larger counter.
+    let side = |tx_bit: u8, rx_bit: u8| if rx > tx { rx_bit } else { tx_bit };
+    let mut f = Frame::default();
+    f.flags.set(Flags::ERR, true);
+    f.len = 8;
+    if has(b"bus off") || has(b"busoff") {
+        f.id = CAN_ERR_BUSOFF;
+    } else if has(b"passive") {
+        f.id = CAN_ERR_CRTL;
+        f.data[1] = side(0x20, 0x10);
+    } else if has(b"warning") {
+        f.id = CAN_ERR_CRTL;
+        f.data[1] = side(0x08, 0x04);
+    } else if has(b"active") {
+        f.id = CAN_ERR_CRTL;
+        f.data[1] = CAN_ERR_CRTL_ACTIVE;
+    } else {
+        return None;
+    }
+    if let (Some(tx), Some(rx)) = (tx, rx) {
+        f.id |= CAN_ERR_CNT;
+        f.data[6] = tx.min(255) as u8;
+        f.data[7] = rx.min(255) as u8;
+    }
+    Some(f)
+}
+
 /// Reads `Rx`/`Tx` into the TX flag; `false` for other directions (`TxRq`).
 fn direction(f: &mut Frame, toks: &mut Tokens<'_>, end: usize) -> Result<bool, ParseError> {
     let (_, dir) = toks.next().ok_or_else(|| err(end, "expected Rx or Tx"))?;
@@ -417,6 +478,29 @@ mod tests {
         );
         assert_eq!((fs[0].id, fs[0].payload()), (0x123, &[17, 255][..]));
         assert_eq!((fs[1].id, fs[1].ts_ns), (0x7FF, 750_000_000));
+    }
+
+    #[test]
+    fn status_lines_are_controller_error_frames() {
+        let (fs, ifaces) = frames(
+            "   0.015991 CAN 1 Status:chip status error passive - TxErr: 132 RxErr: 0\n   0.015991 CAN 2 Status:chip status error active\n   1.0 CAN 1 Status:chip status warning level - TxErr: 3 RxErr: 97\n   2.0 CAN 1 Status:chip status bus off - TxErr: 300 RxErr: 0\n",
+        );
+        let got: Vec<_> = fs
+            .iter()
+            .map(|f| (ifaces.name(f.iface), f.flags.0, f.id, f.payload()))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                ("can0", Flags::ERR, 0x204, &[0, 0x20, 0, 0, 0, 0, 132, 0][..]),
+                ("can1", Flags::ERR, 0x004, &[0, 0x40, 0, 0, 0, 0, 0, 0][..]),
+                ("can0", Flags::ERR, 0x204, &[0, 0x04, 0, 0, 0, 0, 3, 97][..]),
+                ("can0", Flags::ERR, 0x240, &[0, 0, 0, 0, 0, 0, 255, 0][..]),
+            ]
+        );
+        let (lines, _) = parse_all("   1.0 CAN 1 Status:chip status something else\n   1.0 CAN x Status:\n");
+        assert_eq!(lines[0], Ok(Line::Skip(SkipReason::Event)));
+        assert_eq!(lines[1].unwrap_err().message, "expected a channel number");
     }
 
     #[test]
