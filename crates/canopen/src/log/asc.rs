@@ -30,47 +30,25 @@
 //!   skipped as [`SkipReason::Event`], `CANXL` lines as [`SkipReason::CanXl`], lines not
 //!   starting with a timestamp as [`SkipReason::Header`] or [`SkipReason::Comment`] (`//`).
 
-use super::lex::{self, IfaceCache, Tokens, dec_u32, err, hex_u32, trim_end};
+use super::lex::{self, Channels, Tokens, dec_u32, err, hex_u32, trim_end};
+use super::status::{self, State};
 use super::{Line, ParseError, SkipReason};
 use crate::frame::{Flags, Frame, Interfaces};
 
 /// `CAN_ERR_BUSERROR`: the class given to ASC error frames.
-pub const CAN_ERR_BUSERROR: u32 = 0x80;
-
-/// `CAN_ERR_CRTL`, `CAN_ERR_BUSOFF` and `CAN_ERR_CNT` (linux/can/error.h): the classes of
-/// status lines; `CAN_ERR_CRTL_ACTIVE`: the data byte 1 of "error active".
-const CAN_ERR_CRTL: u32 = 0x004;
-const CAN_ERR_BUSOFF: u32 = 0x040;
-const CAN_ERR_CNT: u32 = 0x200;
-const CAN_ERR_CRTL_ACTIVE: u8 = 0x40;
+pub const CAN_ERR_BUSERROR: u32 = status::CAN_ERR_BUSERROR;
 
 const ASC_F_RTR: u32 = 0x10;
 const ASC_F_FDF: u32 = 0x1000;
 
-/// Channels whose interface index is cached; higher ones are interned per line.
-const CACHED_CHANNELS: usize = 64;
-
 /// Parser state for ASC lines (number base, timestamp mode, channel names). Use one parser
 /// with one [`Interfaces`] table: it caches indexes into it.
-#[derive(Debug)]
+#[derive(Debug, Default)]
 pub struct Parser {
     decimal: bool,
     relative: bool,
     last_ns: u64,
-    channels: [Option<u16>; CACHED_CHANNELS],
-    iface: IfaceCache,
-}
-
-impl Default for Parser {
-    fn default() -> Self {
-        Parser {
-            decimal: false,
-            relative: false,
-            last_ns: 0,
-            channels: [None; CACHED_CHANNELS],
-            iface: IfaceCache::default(),
-        }
-    }
+    channels: Channels,
 }
 
 impl Parser {
@@ -111,7 +89,7 @@ impl Parser {
                 let Some(mut f) = self.fd_line(&mut toks, s.len())? else {
                     return Ok(Line::Skip(SkipReason::Event));
                 };
-                f.iface = self.channel(ifaces, channel, ch_at)?;
+                f.iface = self.channels.get(ifaces, channel, ch_at)?;
                 f
             }
             b"CANXL" => return Ok(Line::Skip(SkipReason::CanXl)),
@@ -123,7 +101,7 @@ impl Parser {
                 let Some(mut f) = status_line(&s[toks.pos()..]) else {
                     return Ok(Line::Skip(SkipReason::Event));
                 };
-                f.iface = self.channel(ifaces, channel, ch_at)?;
+                f.iface = self.channels.get(ifaces, channel, ch_at)?;
                 f
             }
             _ => match dec_u32(ch_tok) {
@@ -131,7 +109,7 @@ impl Parser {
                     let Some(mut f) = self.classic_line(&mut toks, s.len())? else {
                         return Ok(Line::Skip(SkipReason::Event));
                     };
-                    f.iface = self.channel(ifaces, channel, ch_at)?;
+                    f.iface = self.channels.get(ifaces, channel, ch_at)?;
                     f
                 }
                 None => return Ok(Line::Skip(SkipReason::Event)),
@@ -156,38 +134,6 @@ impl Parser {
                 _ => {}
             }
         }
-    }
-
-    /// Interface index of channel `n` (`can{n-1}`, `canX` for 0).
-    fn channel(&mut self, ifaces: &mut Interfaces, n: u32, at: usize) -> Result<u16, ParseError> {
-        if let Some(Some(idx)) = self.channels.get(n as usize) {
-            return Ok(*idx);
-        }
-        let mut buf = [0u8; 16];
-        buf[..3].copy_from_slice(b"can");
-        let len = if n == 0 {
-            buf[3] = b'X';
-            4
-        } else {
-            let mut digits = [0u8; 10];
-            let (mut k, mut v) = (digits.len(), n - 1);
-            loop {
-                k -= 1;
-                digits[k] = b'0' + (v % 10) as u8;
-                v /= 10;
-                if v == 0 {
-                    break;
-                }
-            }
-            let d = &digits[k..];
-            buf[3..3 + d.len()].copy_from_slice(d);
-            3 + d.len()
-        };
-        let idx = self.iface.get(ifaces, &buf[..len], at)?;
-        if let Some(slot) = self.channels.get_mut(n as usize) {
-            *slot = Some(idx);
-        }
-        Ok(idx)
     }
 }
 
@@ -221,10 +167,7 @@ impl Parser {
         let mut f = Frame::default();
         let (id_at, id) = toks.next().ok_or_else(|| err(end, "expected a CAN id"))?;
         if id == b"ErrorFrame" {
-            f.flags.set(Flags::ERR, true);
-            f.id = CAN_ERR_BUSERROR;
-            f.len = 8;
-            return Ok(Some(f));
+            return Ok(Some(status::bus_error()));
         }
         if !id[0].is_ascii_hexdigit() {
             return Ok(None);
@@ -340,32 +283,19 @@ fn status_line(rest: &[u8]) -> Option<Frame> {
         let at = lex::skip_ws(rest, at);
         dec_u32(&rest[at..lex::token_end(rest, at)])
     };
-    let (tx, rx) = (counter(b"TxErr:"), counter(b"RxErr:"));
-    // The TX or RX bit of a CAN_ERR_CRTL state: the side with the larger counter.
-    let side = |tx_bit: u8, rx_bit: u8| if rx > tx { rx_bit } else { tx_bit };
-    let mut f = Frame::default();
-    f.flags.set(Flags::ERR, true);
-    f.len = 8;
-    if has(b"bus off") || has(b"busoff") {
-        f.id = CAN_ERR_BUSOFF;
+    let state = if has(b"bus off") || has(b"busoff") {
+        State::BusOff
     } else if has(b"passive") {
-        f.id = CAN_ERR_CRTL;
-        f.data[1] = side(0x20, 0x10);
+        State::Passive
     } else if has(b"warning") {
-        f.id = CAN_ERR_CRTL;
-        f.data[1] = side(0x08, 0x04);
+        State::Warning
     } else if has(b"active") {
-        f.id = CAN_ERR_CRTL;
-        f.data[1] = CAN_ERR_CRTL_ACTIVE;
+        State::Active
     } else {
         return None;
-    }
-    if let (Some(tx), Some(rx)) = (tx, rx) {
-        f.id |= CAN_ERR_CNT;
-        f.data[6] = tx.min(255) as u8;
-        f.data[7] = rx.min(255) as u8;
-    }
-    Some(f)
+    };
+    let counters = counter(b"TxErr:").zip(counter(b"RxErr:"));
+    Some(status::state_frame(state, counters))
 }
 
 /// Reads `Rx`/`Tx` into the TX flag; `false` for other directions (`TxRq`).
