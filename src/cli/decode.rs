@@ -9,7 +9,7 @@ use crate::od::Dictionary;
 use crate::output::{jsonl, summary::Summary, text};
 use crate::sdo::Transaction;
 use clap::{Args, ValueEnum};
-use std::io::{self, BufRead, Write};
+use std::io::{self, Write};
 
 /// Output formats of `cotui decode`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -31,9 +31,11 @@ pub enum OutputFormat {
 /// Arguments of `cotui decode`.
 #[derive(Args, Debug)]
 pub struct DecodeArgs {
-    /// Log files (candump -l/-L, candump screen output, Vector ASC); `-` reads stdin.
+    /// Log files (candump -l/-L, candump screen output, Vector ASC, PEAK TRC, python-can CSV); `-` reads stdin.
     #[arg(required = true)]
     pub files: Vec<String>,
+    #[command(flatten)]
+    pub input: super::input::InputArgs,
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     pub format: OutputFormat,
@@ -110,7 +112,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
     let mut names = Vec::new();
     let mut status = ExitCode::Ok;
     for path in &args.files {
-        let Some(input) = input::open_input(path, "decode") else {
+        let Some(input) = input::open_input(path, "decode", args.input.format()) else {
             status = ExitCode::Unavailable;
             continue;
         };
@@ -151,7 +153,7 @@ pub(super) fn shown_iface(names: &[String], iface: u16) -> Option<&str> {
 /// names of the input so far (see [`note_interfaces`]).
 fn decode_stream(
     path: &str,
-    input: Box<dyn BufRead + Send>,
+    input: input::Input,
     run: &mut Pipeline,
     fmt: OutputFormat,
     names: &mut Vec<String>,

@@ -92,7 +92,7 @@ pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
     };
     let mut status = ExitCode::Ok;
     for path in &args.files {
-        let Some(input) = open_input(path, "decode") else {
+        let Some(input) = open_input(path, "decode", args.input.format()) else {
             status = ExitCode::Unavailable;
             continue;
         };
@@ -114,7 +114,7 @@ pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
 }
 
 impl Run {
-    fn file(&mut self, path: &str, input: Box<dyn io::BufRead + Send>, out: &mut impl Write) -> io::Result<()> {
+    fn file(&mut self, path: &str, input: super::input::Input, out: &mut impl Write) -> io::Result<()> {
         let mut buf = Vec::with_capacity(1 << 16);
         let counts = for_each_frame(path, input, |frames| {
             let ifaces = frames.ifaces;

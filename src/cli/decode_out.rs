@@ -5,7 +5,7 @@ use super::input;
 use crate::command::ExitCode;
 use crate::output::pcapng::PcapngWriter;
 use std::cell::Cell;
-use std::io::{self, BufRead, IsTerminal, Write};
+use std::io::{self, IsTerminal, Write};
 use std::rc::Rc;
 
 /// Why the output of `cotui decode` cannot be opened.
@@ -142,7 +142,7 @@ pub fn pcapng(args: &DecodeArgs) -> ExitCode {
     };
     let mut status = ExitCode::Ok;
     for path in &args.files {
-        let Some(input) = input::open_input(path, "decode") else {
+        let Some(input) = input::open_input(path, "decode", args.input.format()) else {
             status = ExitCode::Unavailable;
             continue;
         };
@@ -163,7 +163,7 @@ pub fn pcapng(args: &DecodeArgs) -> ExitCode {
 }
 
 /// Writes the frames of one input (parsed on a second thread); reports what was skipped.
-fn write_stream(path: &str, input: Box<dyn BufRead + Send>, w: &mut PcapngWriter<impl Write>) -> io::Result<()> {
+fn write_stream(path: &str, input: input::Input, w: &mut PcapngWriter<impl Write>) -> io::Result<()> {
     let counts = input::for_each_frame(path, input, |frames| {
         let ifaces = frames.ifaces;
         for (_, f) in frames {

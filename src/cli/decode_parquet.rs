@@ -12,7 +12,7 @@ use crate::od::Dictionary;
 use crate::output::parquet::{Col, Table, Ty, V};
 use crate::sdo::{SdoCommand, Transaction};
 use std::fs::File;
-use std::io::{self, BufRead, BufWriter, Write};
+use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 const fn col(name: &'static str, ty: Ty, null: bool) -> Col {
@@ -152,7 +152,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
     // The interface names of the last input (the transfers it left running name theirs).
     let mut ifaces = Interfaces::default();
     for path in &args.files {
-        let Some(input) = input::open_input(path, "decode") else {
+        let Some(input) = input::open_input(path, "decode", args.input.format()) else {
             status = ExitCode::Unavailable;
             continue;
         };
@@ -190,7 +190,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
 /// up with its interface table.
 fn write_stream(
     path: &str,
-    input: Box<dyn BufRead + Send>,
+    input: input::Input,
     decoder: &mut Decoder,
     names: &mut Interfaces,
     frames: &mut Writer,

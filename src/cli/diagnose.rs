@@ -21,10 +21,13 @@ pub enum DiagnoseFormat {
 /// Arguments of `cotui diagnose`.
 #[derive(Args, Debug)]
 pub struct DiagnoseArgs {
-    /// Log files (candump -l/-L, candump screen output, Vector ASC), read as one capture;
+    /// Log files (candump -l/-L, candump screen output, Vector ASC, PEAK TRC, python-can CSV),
+    /// read as one capture;
     /// `-` reads stdin.
     #[arg(required_unless_present = "live")]
     pub files: Vec<String>,
+    #[command(flatten)]
+    pub input: super::input::InputArgs,
     /// Diagnose a live SocketCAN interface instead (listen-only: nothing is sent) until
     /// Ctrl-C (SIGINT or SIGTERM) or `--duration`, then report as for a log.
     #[arg(long, value_name = "IFACE", conflicts_with = "files")]
@@ -75,7 +78,7 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
     }
     let mut opened = args.live.is_some();
     for path in &args.files {
-        let Some(input) = input::open_input(path, "diagnose") else {
+        let Some(input) = input::open_input(path, "diagnose", args.input.format()) else {
             status = ExitCode::Unavailable;
             continue;
         };

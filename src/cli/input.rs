@@ -3,18 +3,72 @@
 //! and the closing counts of what was skipped.
 
 use crate::frame::{Frame, Interfaces};
-use crate::log::{Counts, LogReader, Outcome};
+use crate::log::{Counts, Format, LogReader, Outcome};
 use crate::logio::read_ahead;
+use clap::{Args, ValueEnum};
 use std::io::{self, BufRead, BufReader};
 
-/// A log to read: stdin for `-`, else the file; `None` (with the message on stderr, `what`
-/// naming the command) when it cannot be opened.
-pub fn open_input(path: &str, what: &str) -> Option<Box<dyn BufRead + Send>> {
+/// The log formats a user can name with `--input-format`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum InputFormat {
+    /// candump -l / -L logs.
+    Candump,
+    /// candump's screen output (any -t mode).
+    Screen,
+    /// Vector ASC.
+    Asc,
+    /// PEAK TRC 1.0 to 2.1.
+    Trc,
+    /// python-can CSV.
+    Csv,
+}
+
+impl InputFormat {
+    /// The reader's format.
+    pub fn format(self) -> Format {
+        match self {
+            InputFormat::Candump => Format::Candump,
+            InputFormat::Screen => Format::Screen,
+            InputFormat::Asc => Format::Asc,
+            InputFormat::Trc => Format::Trc,
+            InputFormat::Csv => Format::Csv,
+        }
+    }
+}
+
+/// `--input-format`, shared by the commands that read logs.
+#[derive(Args, Debug, Clone, Copy, Default)]
+pub struct InputArgs {
+    /// Read the logs as this format instead of detecting it from their content.
+    #[arg(long = "input-format", value_enum, value_name = "FORMAT")]
+    pub input_format: Option<InputFormat>,
+}
+
+impl InputArgs {
+    /// The format to read logs as; `None`: detected from each log's content.
+    pub fn format(self) -> Option<Format> {
+        self.input_format.map(InputFormat::format)
+    }
+}
+
+/// An opened log and the format it is to be read as (`None`: detected).
+pub struct Input {
+    src: Box<dyn BufRead + Send>,
+    format: Option<Format>,
+}
+
+/// A log to read as `format` (`None`: detected): stdin for `-`, else the file; `None`
+/// (with the message on stderr, `what` naming the command) when it cannot be opened.
+pub fn open_input(path: &str, what: &str, format: Option<Format>) -> Option<Input> {
     if path == "-" {
-        return Some(Box::new(BufReader::with_capacity(1 << 16, io::stdin())));
+        let src = Box::new(BufReader::with_capacity(1 << 16, io::stdin()));
+        return Some(Input { src, format });
     }
     match std::fs::File::open(path) {
-        Ok(f) => Some(Box::new(BufReader::with_capacity(1 << 16, f))),
+        Ok(f) => Some(Input {
+            src: Box::new(BufReader::with_capacity(1 << 16, f)),
+            format,
+        }),
         Err(e) => {
             eprintln!("cotui {what}: {path}: {e}");
             None
@@ -52,10 +106,10 @@ impl<'a> Iterator for Frames<'a> {
 /// first error of `consume` (which stops reading), is returned instead.
 pub fn for_each_frame(
     path: &str,
-    input: Box<dyn BufRead + Send>,
+    input: Input,
     mut consume: impl FnMut(Frames<'_>) -> io::Result<()>,
 ) -> io::Result<Counts> {
-    let reader = LogReader::new(input)?;
+    let reader = LogReader::open(input.src, input.format)?;
     if let Some(what) = reader.detected() {
         eprintln!("{path}: {what}");
     }

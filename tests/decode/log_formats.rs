@@ -173,3 +173,31 @@ fn asc_status_lines_are_bus_state_events() {
          (controller problem (TX error passive); error counters tx=132 rx=0)\n"
     );
 }
+
+/// `--input-format` reads a log whose content does not tell its format: python-can CSV rows
+/// without the header line (`CSVWriter(append=True)`), on decode and diagnose alike.
+#[test]
+fn input_format_overrides_detection() {
+    let rows = "1700000000.5,0x701,0,0,0,1,BQ==\n1700000001.5,0x701,0,0,0,1,BQ==\n";
+    let detected = crate::run::cotui(&["decode", "--format", "jsonl", "-"], Some(rows));
+    assert_eq!(String::from_utf8_lossy(&detected.stdout), "");
+    let out = crate::run::cotui(
+        &["decode", "--input-format", "csv", "--format", "jsonl", "-"],
+        Some(rows),
+    );
+    let lines: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 2, "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        (lines[0]["id"].as_u64(), lines[0]["kind"].as_str()),
+        (Some(0x701), Some("heartbeat"))
+    );
+    assert_eq!(String::from_utf8_lossy(&out.stderr), "-: python-can CSV\n");
+    let out = crate::run::cotui(
+        &["diagnose", "--input-format", "csv", "--format", "jsonl", "-"],
+        Some(rows),
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+}
