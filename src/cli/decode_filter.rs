@@ -46,7 +46,12 @@ struct Run {
 
 /// Runs a filtered `cotui decode`; returns the exit status.
 pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
-    if args.events || matches!(args.format, OutputFormat::Pcapng | OutputFormat::Parquet) {
+    if args.events
+        || matches!(
+            args.format,
+            OutputFormat::Pcapng | OutputFormat::Parquet | OutputFormat::Asc | OutputFormat::Trc
+        )
+    {
         eprintln!("cotui decode: --filter goes with text or jsonl frames, --transactions or --summary");
         return ExitCode::Usage;
     }

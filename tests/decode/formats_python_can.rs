@@ -165,3 +165,90 @@ fn csv_from_python_can() {
     assert_frames("CSV", &got, &want, 1);
     assert!(t0.abs_diff(1_700_000_000_000_100_000) <= 1000, "{t0}");
 }
+
+/// The frames of [`MESSAGES`] as a candump log, for cotui to convert.
+const CANDUMP: &str = "(1700000000.000100) can0 181#1122
+(1700000000.001200) can1 01ABCDEF#0102030405060708 T
+(1700000000.002300) can0 701#R1
+(1700000000.003400) can0 123##1000102030405060708090A0B
+(1700000000.004500) can0 20000004#0020000000008400
+(1700000000.005600) can0 605#4017100000000000 T
+";
+
+/// python-can's reader of `kind` (asc or trc) on what `cotui decode --format KIND` made of
+/// [`CANDUMP`]: one line per message, `time id ext rtr fd brs err rx channel dlc data`.
+fn python_can_reads_cotui(kind: &str) -> Vec<(f64, String)> {
+    let dir = std::env::temp_dir().join(format!("cotui-pycan-out-{}-{kind}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (log, out) = (dir.join("in.log"), dir.join(format!("out.{kind}")));
+    std::fs::write(&log, CANDUMP).unwrap();
+    let run = crate::run::cotui(
+        &[
+            "decode",
+            "--format",
+            kind,
+            log.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let reader = if kind == "asc" { "ASCReader" } else { "TRCReader" };
+    let script = format!(
+        "import can, logging\nlogging.disable(logging.WARNING)\nfor m in can.{reader}({:?}):\n    \
+         print(f'{{m.timestamp:.6f}} {{m.arbitration_id:x}} {{int(m.is_extended_id)}} {{int(m.is_remote_frame)}} \
+         {{int(m.is_fd)}} {{int(m.bitrate_switch)}} {{int(m.is_error_frame)}} {{int(m.is_rx)}} {{m.channel}} {{m.dlc}} {{m.data.hex()}}')\n",
+        out.to_str().unwrap()
+    );
+    let py = Command::new("python3").args(["-c", &script]).output().expect("python3");
+    assert!(py.status.success(), "{}", String::from_utf8_lossy(&py.stderr));
+    std::fs::remove_dir_all(&dir).ok();
+    String::from_utf8_lossy(&py.stdout)
+        .lines()
+        .map(|l| {
+            let (t, rest) = l.split_once(' ').unwrap();
+            (t.parse().unwrap(), rest.trim_end().to_string())
+        })
+        .collect()
+}
+
+fn assert_messages(kind: &str, got: &[(f64, String)], want: &[(f64, &str)]) {
+    assert_eq!(got.len(), want.len(), "{kind}: {got:#?}");
+    for ((gt, g), (wt, w)) in got.iter().zip(want) {
+        assert!((gt - wt).abs() < 2e-6, "{kind}: time {gt} vs {wt}");
+        assert_eq!(g, w, "{kind}");
+    }
+}
+
+#[test]
+fn python_can_reads_cotuis_asc_and_trc() {
+    // ASC times are since the first frame; channel 1 is python-can's channel 0; the error
+    // frame is ASC's ErrorFrame (no detail).
+    assert_messages(
+        "asc",
+        &python_can_reads_cotui("asc"),
+        &[
+            (0.0, "181 0 0 0 0 0 1 0 2 1122"),
+            (0.0011, "1abcdef 1 0 0 0 0 0 1 8 0102030405060708"),
+            (0.0022, "701 0 1 0 0 0 1 0 1"),
+            (0.0033, "123 0 0 1 1 0 1 0 12 000102030405060708090a0b"),
+            (0.0044, "0 1 0 0 0 1 1 0 0"),
+            (0.0055, "605 0 0 0 0 0 0 0 8 4017100000000000"),
+        ],
+    );
+    // TRC 2.1 times are absolute ($STARTTIME); python-can keeps the bus number (1-based),
+    // the FD DLC (9 for 12 bytes), and skips ER lines.
+    let t = 1_700_000_000.0;
+    assert_messages(
+        "trc",
+        &python_can_reads_cotui("trc"),
+        &[
+            (t + 0.0001, "181 0 0 0 0 0 1 1 2 1122"),
+            (t + 0.0012, "1abcdef 1 0 0 0 0 0 2 8 0102030405060708"),
+            (t + 0.0023, "701 0 1 0 0 0 1 1 1"),
+            (t + 0.0034, "123 0 0 1 1 0 1 1 9 000102030405060708090a0b"),
+            (t + 0.0056, "605 0 0 0 0 0 0 1 8 4017100000000000"),
+        ],
+    );
+}

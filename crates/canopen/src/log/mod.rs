@@ -9,6 +9,7 @@
 pub mod asc;
 pub mod candump;
 pub mod csv;
+pub mod export;
 mod fast;
 mod lex;
 pub mod screen;
