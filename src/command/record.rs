@@ -6,6 +6,7 @@
 use super::error::CommandError;
 use crate::bus::{Bus, BusError, Event, StateChange};
 use crate::frame::Frame;
+use crate::log::export::{AscWriter, TrcWriter};
 use crate::log::writer::LogWriter;
 use crate::logio::sink::{LineSink, Target};
 use std::fs::{File, OpenOptions};
@@ -137,6 +138,11 @@ pub fn open_output(
         return Ok(LineSink::new(Box::new(std::io::stdout()), 0));
     }
     if mode == WriteMode::Append {
+        if matches!(format, LogFormat::Asc | LogFormat::Trc) {
+            return Err(CommandError::Usage(
+                "--append goes with candump or pcapng: an ASC or TRC log has one header, with its start time".into(),
+            ));
+        }
         refuse_other_format(path, format)?;
     }
     let mut o = OpenOptions::new();
@@ -257,6 +263,7 @@ pub async fn record<T: Target>(
             && rec.take(got, out, &mut note)?
         {}
     }
+    rec.writer.finish(out);
     rec.flush(out)?;
     if let Some((from_ns, reason)) = rec.open_gap.take() {
         rec.gaps.push(Gap {
@@ -280,16 +287,22 @@ pub enum LogFormat {
     Candump,
     /// pcapng for Wireshark (LINKTYPE_CAN_SOCKETCAN, nanosecond timestamps).
     Pcapng,
+    /// Vector ASC (the header comes with the first frame; no `--append`).
+    Asc,
+    /// PEAK TRC 2.1 (the header comes with the first frame; no `--append`).
+    Trc,
 }
 
 impl LogFormat {
-    /// Parses `candump` or `pcapng`.
+    /// Parses `candump`, `pcapng`, `asc` or `trc`.
     pub fn parse(word: &str) -> Result<LogFormat, super::syntax::ParseError> {
         match word {
             "candump" | "log" => Ok(LogFormat::Candump),
             "pcapng" => Ok(LogFormat::Pcapng),
+            "asc" => Ok(LogFormat::Asc),
+            "trc" => Ok(LogFormat::Trc),
             _ => Err(super::syntax::ParseError::Invalid(format!(
-                "unknown record format `{word}`: use candump or pcapng"
+                "unknown record format `{word}`: use candump, pcapng, asc or trc"
             ))),
         }
     }
@@ -301,6 +314,8 @@ enum Encoder {
     /// The interfaces described so far (a pcapng interface block precedes an interface's
     /// first frame).
     Pcapng(Vec<String>),
+    Asc(AscWriter, String),
+    Trc(TrcWriter, String),
 }
 
 impl Encoder {
@@ -313,6 +328,8 @@ impl Encoder {
                 out.end_record(false);
                 Encoder::Pcapng(Vec::new())
             }
+            LogFormat::Asc => Encoder::Asc(AscWriter::new(), String::new()),
+            LogFormat::Trc => Encoder::Trc(TrcWriter::new(), String::new()),
         }
     }
 
@@ -336,8 +353,30 @@ impl Encoder {
                 out.buffer()
                     .extend_from_slice(&crate::output::pcapng::enhanced_packet(id as u32, f));
             }
+            Encoder::Asc(w, text) => {
+                w.write_line(text, f, iface);
+                out.buffer().extend_from_slice(text.as_bytes());
+                text.clear();
+            }
+            Encoder::Trc(w, text) => {
+                w.write_line(text, f, iface);
+                out.buffer().extend_from_slice(text.as_bytes());
+                text.clear();
+            }
         }
         out.end_record(true);
+    }
+
+    /// Appends what closes the log (ASC's `End TriggerBlock`), not counted as a frame.
+    fn finish<T: Target>(&mut self, out: &mut LineSink<T>) {
+        if let Encoder::Asc(w, text) = self {
+            w.finish(text);
+            if !text.is_empty() {
+                out.buffer().extend_from_slice(text.as_bytes());
+                text.clear();
+                out.end_record(false);
+            }
+        }
     }
 }
 
