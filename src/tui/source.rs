@@ -575,8 +575,8 @@ mod tests {
     #[test]
     fn open_delivers_every_frame_then_done() {
         let l = log(10_000);
-        assert_eq!(drain(&open(l.0.clone())).0, 10_000);
-        let (n, _, notes) = drain(&open("/nonexistent/x.log".into()));
+        assert_eq!(drain(&open(l.0.clone(), None)).0, 10_000);
+        let (n, _, notes) = drain(&open("/nonexistent/x.log".into(), None));
         assert_eq!(n, 0);
         assert!(notes[0].starts_with("/nonexistent/x.log: "), "{notes:?}");
     }
