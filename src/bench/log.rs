@@ -165,12 +165,11 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let read = |path: &Path| -> Vec<(u64, u32, Vec<u8>)> {
             let r = LogReader::new(std::io::BufReader::new(std::fs::File::open(path).unwrap())).unwrap();
-            r.map(|item| match item.unwrap() {
+            r.filter_map(|item| match item.unwrap() {
                 (_, Outcome::Frame(f)) => Some((f.ts_ns / 1000, f.id, f.payload().to_vec())),
                 (n, Outcome::Warning(w)) => panic!("{}:{n}: {w}", path.display()),
                 _ => None,
             })
-            .flatten()
             .collect()
         };
         let candump = dir.join("bench.log");
