@@ -1,5 +1,7 @@
 //! The generated bench log: synthetic commissioning traffic written as candump `-l`.
 
+use crate::frame::{Flags, Frame};
+use crate::log::export::{AscWriter, TrcWriter};
 use crate::log::writer::LogWriter;
 use crate::sim::synth::Traffic;
 use std::io::Write;
@@ -74,3 +76,137 @@ const GARBAGE: [&str; 3] = [
     "# restarted capture after bus-off\n",
     "read: Network is down\n",
 ];
+
+/// The input formats `cotui bench` times besides candump, with their file names.
+pub const INPUT_FORMATS: [(&str, &str); 4] = [
+    ("screen", "bench-quarter.screen.txt"),
+    ("asc", "bench-quarter.asc"),
+    ("trc", "bench-quarter.trc"),
+    ("csv", "bench-quarter.csv"),
+];
+
+/// Writes the same synthetic frames as [`write_log`] in input format `format` (one of
+/// [`INPUT_FORMATS`]): candump screen output (`-ta`), Vector ASC, PEAK TRC 2.1 or
+/// python-can CSV.
+pub fn write_format_log(path: &Path, frames: u64, format: &str) -> std::io::Result<()> {
+    let file = std::fs::File::create(path)?;
+    let mut out = std::io::BufWriter::with_capacity(1 << 20, file);
+    let (mut asc, mut trc) = (AscWriter::new(), TrcWriter::new());
+    let mut line = String::with_capacity(1 << 16);
+    if format == "csv" {
+        line.push_str("timestamp,arbitration_id,extended,remote,error,dlc,data\n");
+    }
+    for frame in Traffic::new(frames, 1_700_000_000_000_000_000) {
+        match format {
+            "asc" => asc.write_line(&mut line, &frame, "can0"),
+            "trc" => trc.write_line(&mut line, &frame, "can0"),
+            "csv" => csv_line(&mut line, &frame),
+            _ => screen_line(&mut line, &frame),
+        }
+        if line.len() > 1 << 15 {
+            out.write_all(line.as_bytes())?;
+            line.clear();
+        }
+    }
+    asc.finish(&mut line);
+    out.write_all(line.as_bytes())?;
+    out.flush()
+}
+
+/// candump `-ta` screen output: ` (1700000000.000100)  can0  181   [2]  11 22`.
+fn screen_line(out: &mut String, f: &Frame) {
+    use std::fmt::Write as _;
+    let (s, us) = (f.ts_ns / 1_000_000_000, f.ts_ns / 1000 % 1_000_000);
+    let id = if f.flags.has(Flags::EXT) {
+        format!("{:08X}", f.id)
+    } else {
+        format!("{:03X}", f.id)
+    };
+    let _ = write!(out, " ({s}.{us:06})  can0  {id}   [{}] ", f.len);
+    if f.flags.has(Flags::RTR) {
+        out.push_str(" remote request");
+    } else {
+        for b in f.payload() {
+            let _ = write!(out, " {b:02X}");
+        }
+    }
+    out.push('\n');
+}
+
+/// A python-can CSV row: `1700000000.0001,0x181,0,0,0,2,ESI=`.
+fn csv_line(out: &mut String, f: &Frame) {
+    use std::fmt::Write as _;
+    const B64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let (s, us) = (f.ts_ns / 1_000_000_000, f.ts_ns / 1000 % 1_000_000);
+    let flag = |b: u8| if f.flags.has(b) { '1' } else { '0' };
+    let _ = write!(
+        out,
+        "{s}.{us:06},{:#x},{},{},{},{},",
+        f.id,
+        flag(Flags::EXT),
+        flag(Flags::RTR),
+        flag(Flags::ERR),
+        f.len
+    );
+    let data = if f.flags.has(Flags::RTR) { &[][..] } else { f.payload() };
+    for chunk in data.chunks(3) {
+        let n = chunk
+            .iter()
+            .enumerate()
+            .fold(0u32, |n, (k, &b)| n | u32::from(b) << (16 - 8 * k));
+        for k in 0..4 {
+            out.push(if k <= chunk.len() {
+                B64[(n >> (18 - 6 * k) & 63) as usize] as char
+            } else {
+                '='
+            });
+        }
+    }
+    out.push('\n');
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::log::{LogReader, Outcome};
+
+    /// Each input format's bench log reads back to the frames of the candump one.
+    #[test]
+    fn every_input_format_holds_the_same_frames() {
+        let dir = std::env::temp_dir().join(format!("cotui-bench-formats-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let read = |path: &Path| -> Vec<(u64, u32, Vec<u8>)> {
+            let r = LogReader::new(std::io::BufReader::new(std::fs::File::open(path).unwrap())).unwrap();
+            r.filter_map(|item| match item.unwrap() {
+                (_, Outcome::Frame(f)) => Some((f.ts_ns / 1000, f.id, f.payload().to_vec())),
+                (n, Outcome::Warning(w)) => panic!("{}:{n}: {w}", path.display()),
+                _ => None,
+            })
+            .collect()
+        };
+        let candump = dir.join("bench.log");
+        write_log(&candump, 500).unwrap();
+        let want = read(&candump);
+        assert_eq!(want.len(), 500);
+        for (format, name) in INPUT_FORMATS {
+            let path = dir.join(name);
+            write_format_log(&path, 500, format).unwrap();
+            let mut got = read(&path);
+            if format == "asc" {
+                // ASC times count from the first frame.
+                for g in &mut got {
+                    g.0 += want[0].0;
+                }
+            }
+            // TRC's $STARTTIME holds days to 12 decimals (86 ns): times agree within 1 µs.
+            assert_eq!(got.len(), want.len(), "{format}");
+            for (g, w) in got.iter().zip(&want) {
+                assert!(
+                    g.0.abs_diff(w.0) <= 1 && (g.1, &g.2) == (w.1, &w.2),
+                    "{format}: {g:?} vs {w:?}"
+                );
+            }
+        }
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}

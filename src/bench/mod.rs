@@ -261,6 +261,24 @@ fn measure_all(args: &BenchArgs, exe: &Path, dir: &Path) -> std::io::Result<Figu
             None,
         ),
     ];
+    // One row per input format, of the same frames as the quarter log.
+    let format_logs: Vec<(String, String)> = log::INPUT_FORMATS
+        .iter()
+        .map(|(format, name)| {
+            let path = dir.join(name);
+            log::write_format_log(&path, n / 4, format)
+                .map(|()| (format.to_string(), path.to_string_lossy().into_owned()))
+        })
+        .collect::<std::io::Result<_>>()?;
+    for (format, path) in &format_logs {
+        let (name, title) = match format.as_str() {
+            "screen" => ("summary-screen", "decode --summary, screen input (1/4 log)"),
+            "asc" => ("summary-asc", "decode --summary, ASC input (1/4 log)"),
+            "trc" => ("summary-trc", "decode --summary, TRC input (1/4 log)"),
+            _ => ("summary-csv", "decode --summary, CSV input (1/4 log)"),
+        };
+        runs.push(Run::new(name, title, &["decode", "--summary", path], n / 4, None));
+    }
     let log2asc = which("log2asc").map(|p| Run {
         program: Some(p),
         ..Run::new("log2asc", "log2asc", &["-I", &b, "-O", "/dev/null", "can0"], n, None)

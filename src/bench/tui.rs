@@ -100,7 +100,7 @@ pub fn bench(frames: u64, json: bool) -> std::io::Result<()> {
 
     // Open: first screen and full index.
     let start = Instant::now();
-    let mut app = app_for((source::open(log.clone()), None), SourceKind::Open);
+    let mut app = app_for((source::open(log.clone(), None), None), SourceKind::Open);
     let mut first_screen = None;
     while !app.source().done {
         step(&mut app);
@@ -150,7 +150,7 @@ pub fn bench(frames: u64, json: bool) -> std::io::Result<()> {
     drop(app);
 
     // Key response while replaying as fast as possible.
-    let (rx, ctl) = source::replay(log.clone(), 0.0);
+    let (rx, ctl) = source::replay(log.clone(), 0.0, None);
     let mut app = app_for((rx, Some(ctl)), SourceKind::Replay { speed: 0.0 });
     let mut responses = Vec::new();
     let down = KeyEvent::new(KeyCode::Down, KeyModifiers::NONE);

@@ -27,20 +27,28 @@ pub enum OutputFormat {
     /// see README, "Parquet tables").
     // `run` hands it to `decode_parquet` before decoding.
     Parquet,
+    /// A Vector ASC log (frames only).
+    // `run` hands it (and Trc) to `decode_out` before decoding.
+    Asc,
+    /// A PEAK TRC 2.1 log (frames only).
+    Trc,
 }
 
 /// Arguments of `cotui decode`.
 #[derive(Args, Debug)]
 pub struct DecodeArgs {
-    /// Log files (candump -l/-L, candump screen output, Vector ASC); `-` reads stdin.
-    /// Several are merged by time into one capture; an interface name in several files is
-    /// the same bus (one bus's log split in parts) unless --iface-per-file.
+    /// Log files (candump -l/-L, candump screen output, Vector ASC, PEAK TRC, python-can
+    /// CSV); `-` reads stdin. Several are merged by time into one capture; an interface
+    /// name in several files is the same bus (one bus's log split in parts) unless
+    /// --iface-per-file.
     #[arg(required = true)]
     pub files: Vec<String>,
     /// With several files: each file's interfaces are its own buses, named FILE:IFACE
     /// (two buses recorded apart, both as can0, stay apart).
     #[arg(long)]
     pub iface_per_file: bool,
+    #[command(flatten)]
+    pub input: super::input::InputArgs,
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     pub format: OutputFormat,
@@ -91,6 +99,9 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
     if args.format == OutputFormat::Parquet {
         return super::decode_parquet::run(args);
     }
+    if matches!(args.format, OutputFormat::Asc | OutputFormat::Trc) {
+        return super::decode_out::text_log(args, args.format == OutputFormat::Asc);
+    }
     let decoder = match super::bind::decoder(&args.profiles, &args.eds) {
         Ok(d) => d,
         Err(e) => {
@@ -124,7 +135,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
     };
     let mut names = Vec::new();
     let mut status = ExitCode::Ok;
-    let (inputs, failed) = input::open_inputs(&args.files, "decode", args.iface_per_file);
+    let (inputs, failed) = input::open_inputs(&args.files, "decode", args.iface_per_file, args.input.format());
     if failed {
         status = ExitCode::Unavailable;
     }
@@ -190,9 +201,11 @@ fn decode_stream(
                     let d = decoder.decode(frame);
                     match fmt {
                         OutputFormat::Text => text::write_line(&mut json, frame, ifaces, &d),
-                        OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => {
-                            jsonl::write_frame(&mut json, line, frame, ifaces, &d)
-                        }
+                        OutputFormat::Jsonl
+                        | OutputFormat::Pcapng
+                        | OutputFormat::Parquet
+                        | OutputFormat::Asc
+                        | OutputFormat::Trc => jsonl::write_frame(&mut json, line, frame, ifaces, &d),
                     }
                     decoder.recycle(d);
                 }
@@ -240,7 +253,11 @@ fn write_view(
                 match fmt {
                     OutputFormat::Text => e.write_line_on(buf, iface),
                     // (pcapng and parquet never reach here: they are refused with --events)
-                    OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => e.write_json_on(json, iface),
+                    OutputFormat::Jsonl
+                    | OutputFormat::Pcapng
+                    | OutputFormat::Parquet
+                    | OutputFormat::Asc
+                    | OutputFormat::Trc => e.write_json_on(json, iface),
                 }
             }
         }
@@ -272,7 +289,7 @@ pub(super) fn write_transaction(
             out.extend_from_slice(label.as_bytes());
             out.push(b'\n');
         }
-        OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => {
+        OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet | OutputFormat::Asc | OutputFormat::Trc => {
             let mut j = t.to_json(dict);
             j.iface = iface;
             write_line(out, &j)
@@ -285,7 +302,9 @@ pub(super) fn write_summary(out: &mut Vec<u8>, summary: &mut Summary, fmt: Outpu
     summary.finish();
     match fmt {
         OutputFormat::Text => out.extend_from_slice(summary.to_text().as_bytes()),
-        OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet => write_line(out, &summary.to_json()),
+        OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet | OutputFormat::Asc | OutputFormat::Trc => {
+            write_line(out, &summary.to_json())
+        }
     }
 }
 

@@ -48,7 +48,12 @@ struct Run {
 
 /// Runs a filtered `cotui decode`; returns the exit status.
 pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
-    if args.events || matches!(args.format, OutputFormat::Pcapng | OutputFormat::Parquet) {
+    if args.events
+        || matches!(
+            args.format,
+            OutputFormat::Pcapng | OutputFormat::Parquet | OutputFormat::Asc | OutputFormat::Trc
+        )
+    {
         eprintln!("cotui decode: --filter goes with text or jsonl frames, --transactions or --summary");
         return ExitCode::Usage;
     }
@@ -98,7 +103,7 @@ pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
         t0_ns: None,
     };
     let mut status = ExitCode::Ok;
-    let (inputs, failed) = super::input::open_inputs(&args.files, "decode", args.iface_per_file);
+    let (inputs, failed) = super::input::open_inputs(&args.files, "decode", args.iface_per_file, args.input.format());
     if failed {
         status = ExitCode::Unavailable;
     }

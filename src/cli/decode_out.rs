@@ -1,8 +1,10 @@
-//! Where `cotui decode` writes (`-o FILE`, `-o -` or stdout) and its pcapng export.
+//! Where `cotui decode` writes (`-o FILE`, `-o -` or stdout) and its pcapng, ASC and TRC
+//! exports.
 
 use super::decode::DecodeArgs;
 use super::input;
 use crate::command::ExitCode;
+use crate::log::export::{AscWriter, TrcWriter};
 use crate::output::pcapng::PcapngWriter;
 use std::cell::Cell;
 use std::io::{self, IsTerminal, Write};
@@ -141,7 +143,7 @@ pub fn pcapng(args: &DecodeArgs) -> ExitCode {
         Err(e) => return blame.report(None, &e),
     };
     let mut status = ExitCode::Ok;
-    let (inputs, failed) = input::open_inputs(&args.files, "decode", args.iface_per_file);
+    let (inputs, failed) = input::open_inputs(&args.files, "decode", args.iface_per_file, args.input.format());
     if failed {
         status = ExitCode::Unavailable;
     }
@@ -174,4 +176,72 @@ fn write_stream(path: &str, input: input::Input, w: &mut PcapngWriter<impl Write
     })?;
     input::report_counts(path, &counts);
     Ok(())
+}
+
+/// A text log writer: Vector ASC or PEAK TRC 2.1.
+enum LogOut {
+    Asc(AscWriter),
+    Trc(TrcWriter),
+}
+
+/// `cotui decode FILE... --format asc|trc`: every frame of every input, in order, as a
+/// Vector ASC (`asc`) or PEAK TRC 2.1 log.
+pub fn text_log(args: &DecodeArgs, asc: bool) -> ExitCode {
+    let name = if asc { "asc" } else { "trc" };
+    if args.transactions || args.summary || args.events {
+        eprintln!(
+            "cotui decode: --format {name} writes frames; it does not go with --transactions, --summary or --events"
+        );
+        return ExitCode::Usage;
+    }
+    let mut out = match open(args.output.as_deref(), false) {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("cotui decode: {e}");
+            return ExitCode::Usage;
+        }
+    };
+    let blame = out.blame();
+    let mut w = if asc {
+        LogOut::Asc(AscWriter::new())
+    } else {
+        LogOut::Trc(TrcWriter::new())
+    };
+    let mut status = ExitCode::Ok;
+    let mut text = String::with_capacity(1 << 16);
+    for path in &args.files {
+        let Some(input) = input::open_input(path, "decode", args.input.format()) else {
+            status = ExitCode::Unavailable;
+            continue;
+        };
+        let counts = input::for_each_frame(path, input, |frames| {
+            let ifaces = frames.ifaces;
+            for (_, f) in frames {
+                match &mut w {
+                    LogOut::Asc(a) => a.write_line(&mut text, f, ifaces.name(f.iface)),
+                    LogOut::Trc(t) => t.write_line(&mut text, f, ifaces.name(f.iface)),
+                }
+            }
+            out.write_all(text.as_bytes())?;
+            text.clear();
+            Ok(())
+        });
+        match counts {
+            Ok(c) => input::report_counts(path, &c),
+            Err(e) if e.kind() == io::ErrorKind::BrokenPipe => return status,
+            Err(e) => {
+                status = blame.report(Some(path), &e);
+                if blame.output_failed() {
+                    return status;
+                }
+            }
+        }
+    }
+    if let LogOut::Asc(a) = &mut w {
+        a.finish(&mut text);
+    }
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != io::ErrorKind::BrokenPipe => blame.report(None, &e),
+        _ => status,
+    }
 }

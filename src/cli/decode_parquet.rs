@@ -151,7 +151,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
     let mut last_file = String::new();
     // The interface names of the last input (the transfers it left running name theirs).
     let mut ifaces = Interfaces::default();
-    let (inputs, failed) = input::open_inputs(&args.files, "decode", args.iface_per_file);
+    let (inputs, failed) = input::open_inputs(&args.files, "decode", args.iface_per_file, args.input.format());
     if failed {
         status = ExitCode::Unavailable;
     }

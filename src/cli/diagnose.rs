@@ -21,15 +21,17 @@ pub enum DiagnoseFormat {
 /// Arguments of `cotui diagnose`.
 #[derive(Args, Debug)]
 pub struct DiagnoseArgs {
-    /// Log files (candump -l/-L, candump screen output, Vector ASC), merged by time into
-    /// one capture (an interface name in several files is the same bus unless
-    /// --iface-per-file); `-` reads stdin.
+    /// Log files (candump -l/-L, candump screen output, Vector ASC, PEAK TRC, python-can
+    /// CSV), merged by time into one capture (an interface name in several files is the
+    /// same bus unless --iface-per-file); `-` reads stdin.
     #[arg(required_unless_present = "live")]
     pub files: Vec<String>,
     /// With several files: each file's interfaces are its own buses, named FILE:IFACE
     /// (two buses recorded apart, both as can0, stay apart).
     #[arg(long, conflicts_with = "live")]
     pub iface_per_file: bool,
+    #[command(flatten)]
+    pub input: super::input::InputArgs,
     /// Diagnose live SocketCAN interfaces instead (listen-only: nothing is sent; several
     /// are captured together, each node known by interface and node-ID) until Ctrl-C
     /// (SIGINT or SIGTERM) or `--duration`, then report as for a log.
@@ -84,7 +86,7 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
         return ExitCode::Unavailable;
     }
     let mut opened = args.live.is_some();
-    let (inputs, failed) = input::open_inputs(&args.files, "diagnose", args.iface_per_file);
+    let (inputs, failed) = input::open_inputs(&args.files, "diagnose", args.iface_per_file, args.input.format());
     if failed {
         status = ExitCode::Unavailable;
     }

@@ -3,40 +3,103 @@
 //! and the closing counts of what was skipped.
 
 use crate::frame::{Frame, Interfaces};
-use crate::log::{Counts, Outcome};
+use crate::log::{Counts, Format, LogReader, Outcome};
 use crate::logio::read_ahead;
+use clap::{Args, ValueEnum};
 use std::io::{self, BufRead, BufReader};
+
+/// The log formats a user can name with `--input-format`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum InputFormat {
+    /// candump -l / -L logs.
+    Candump,
+    /// candump's screen output (any -t mode).
+    Screen,
+    /// Vector ASC.
+    Asc,
+    /// PEAK TRC 1.0 to 2.1.
+    Trc,
+    /// python-can CSV.
+    Csv,
+}
+
+impl InputFormat {
+    /// The reader's format.
+    pub fn format(self) -> Format {
+        match self {
+            InputFormat::Candump => Format::Candump,
+            InputFormat::Screen => Format::Screen,
+            InputFormat::Asc => Format::Asc,
+            InputFormat::Trc => Format::Trc,
+            InputFormat::Csv => Format::Csv,
+        }
+    }
+}
+
+/// `--input-format`, shared by the commands that read logs.
+#[derive(Args, Debug, Clone, Copy, Default)]
+pub struct InputArgs {
+    /// Read the logs as this format instead of detecting it from their content.
+    #[arg(long = "input-format", value_enum, value_name = "FORMAT")]
+    pub input_format: Option<InputFormat>,
+}
+
+impl InputArgs {
+    /// The format to read logs as; `None`: detected from each log's content.
+    pub fn format(self) -> Option<Format> {
+        self.input_format.map(InputFormat::format)
+    }
+}
+
+/// An opened log and the format it is to be read as (`None`: detected).
+pub struct Log {
+    src: Box<dyn BufRead + Send>,
+    format: Option<Format>,
+}
+
+impl Log {
+    /// The log's reader (the format detected unless named), after saying on stderr what
+    /// was detected beyond the format (a screen capture's timestamp mode).
+    pub fn reader(self, path: &str) -> io::Result<LogReader<Box<dyn BufRead + Send>>> {
+        let reader = LogReader::open(self.src, self.format)?;
+        if let Some(what) = reader.detected() {
+            eprintln!("{path}: {what}");
+        }
+        Ok(reader)
+    }
+}
 
 /// What a command reads: one log, or several merged by time into one capture (see
 /// [`super::merge`]).
 pub enum Input {
     /// One log.
-    One(Box<dyn BufRead + Send>),
-    /// Several logs (path, reader), and whether each file's interfaces are its own
+    One(Log),
+    /// Several logs (path, log), and whether each file's interfaces are its own
     /// (`FILE:IFACE`) rather than the same buses by name.
-    Merged(Vec<(String, Box<dyn BufRead + Send>)>, bool),
+    Merged(Vec<(String, Log)>, bool),
 }
 
-impl From<Box<dyn BufRead + Send>> for Input {
-    fn from(r: Box<dyn BufRead + Send>) -> Input {
-        Input::One(r)
+impl From<Log> for Input {
+    fn from(log: Log) -> Input {
+        Input::One(log)
     }
 }
 
-/// The inputs of a command given `files`: one log as it is, several as one merged capture
-/// named `a.log + b.log` (`per_file`: see [`Input::Merged`]). Files that cannot be opened
-/// are said on stderr and left out; the flag is true when one was.
-pub fn open_inputs(files: &[String], what: &str, per_file: bool) -> (Vec<(String, Input)>, bool) {
+/// The inputs of a command given `files`, read as `format` (`None`: detected): one log as
+/// it is, several as one merged capture named `a.log + b.log` (`per_file`: see
+/// [`Input::Merged`]). Files that cannot be opened are said on stderr and left out; the
+/// flag is true when one was.
+pub fn open_inputs(files: &[String], what: &str, per_file: bool, format: Option<Format>) -> (Vec<(String, Input)>, bool) {
     let mut opened = Vec::new();
     let mut failed = false;
     for path in files {
-        match open_input(path, what) {
-            Some(r) => opened.push((path.clone(), r)),
+        match open_input(path, what, format) {
+            Some(log) => opened.push((path.clone(), log)),
             None => failed = true,
         }
     }
     if files.len() < 2 {
-        return (opened.into_iter().map(|(p, r)| (p, Input::One(r))).collect(), failed);
+        return (opened.into_iter().map(|(p, log)| (p, Input::One(log))).collect(), failed);
     }
     if opened.is_empty() {
         return (Vec::new(), failed);
@@ -45,14 +108,18 @@ pub fn open_inputs(files: &[String], what: &str, per_file: bool) -> (Vec<(String
     (vec![(label, Input::Merged(opened, per_file))], failed)
 }
 
-/// A log to read: stdin for `-`, else the file; `None` (with the message on stderr, `what`
-/// naming the command) when it cannot be opened.
-pub fn open_input(path: &str, what: &str) -> Option<Box<dyn BufRead + Send>> {
+/// A log to read as `format` (`None`: detected): stdin for `-`, else the file; `None`
+/// (with the message on stderr, `what` naming the command) when it cannot be opened.
+pub fn open_input(path: &str, what: &str, format: Option<Format>) -> Option<Log> {
     if path == "-" {
-        return Some(Box::new(BufReader::with_capacity(1 << 16, io::stdin())));
+        let src = Box::new(BufReader::with_capacity(1 << 16, io::stdin()));
+        return Some(Log { src, format });
     }
     match std::fs::File::open(path) {
-        Ok(f) => Some(Box::new(BufReader::with_capacity(1 << 16, f))),
+        Ok(f) => Some(Log {
+            src: Box::new(BufReader::with_capacity(1 << 16, f)),
+            format,
+        }),
         Err(e) => {
             eprintln!("cotui {what}: {path}: {e}");
             None
@@ -85,16 +152,17 @@ impl<'a> Iterator for Frames<'a> {
 }
 
 /// Reads `input` (named `path` in warnings) and calls `consume` with the frames of each
-/// batch, in order. Returns what the reader counted; a read error, or the first error of
-/// `consume` (which stops reading), is returned instead. Merged logs report their counts
-/// file by file as they end (the counts returned are then empty).
+/// batch, in order. What was detected beyond the format (a screen capture's timestamp
+/// mode) is said on stderr first. Returns what the reader counted; a read error, or the
+/// first error of `consume` (which stops reading), is returned instead. Merged logs report
+/// their counts file by file as they end (the counts returned are then empty).
 pub fn for_each_frame(
     path: &str,
     input: impl Into<Input>,
     mut consume: impl FnMut(Frames<'_>) -> io::Result<()>,
 ) -> io::Result<Counts> {
-    let input = match input.into() {
-        Input::One(r) => r,
+    let log = match input.into() {
+        Input::One(log) => log,
         Input::Merged(inputs, per_file) => {
             super::merge::for_each_merged(inputs, per_file, |lines, ifaces| {
                 consume(Frames {
@@ -106,8 +174,9 @@ pub fn for_each_frame(
             return Ok(Counts::default());
         }
     };
+    let reader = log.reader(path)?;
     let mut ifaces = Interfaces::default();
-    let finished = read_ahead::for_each_batch(input, |batch| {
+    let finished = read_ahead::for_each_batch(reader, |batch| {
         for name in &batch.new_interfaces {
             ifaces.intern(name);
         }

@@ -5,9 +5,9 @@
 //! buses recorded apart stay apart.
 
 use crate::frame::Interfaces;
-use crate::log::{Counts, LogReader, Outcome};
+use crate::log::{Counts, Outcome};
 use std::collections::VecDeque;
-use std::io::{self, BufRead};
+use std::io;
 use std::sync::mpsc::{Receiver, sync_channel};
 
 /// Lines per batch, read and handed on.
@@ -67,8 +67,8 @@ impl Part {
 }
 
 /// Parses `input` and sends its lines in batches, then its counts.
-fn read(input: Box<dyn BufRead + Send>, tx: std::sync::mpsc::SyncSender<Piece>) {
-    let mut reader = match LogReader::new(input) {
+fn read(path: &str, input: super::input::Log, tx: std::sync::mpsc::SyncSender<Piece>) {
+    let mut reader = match input.reader(path) {
         Ok(r) => r,
         Err(e) => {
             let _ = tx.send(Piece::End(Counts::default(), Some(e)));
@@ -97,7 +97,7 @@ fn read(input: Box<dyn BufRead + Send>, tx: std::sync::mpsc::SyncSender<Piece>) 
 /// argument). Each file's counts are reported as it ends ([`super::input::report_counts`]);
 /// the first read error (naming its file) or error of `consume` is returned.
 pub fn for_each_merged(
-    inputs: Vec<(String, Box<dyn BufRead + Send>)>,
+    inputs: Vec<(String, super::input::Log)>,
     per_file: bool,
     mut consume: impl FnMut(&[(u64, Outcome)], &Interfaces) -> io::Result<()>,
 ) -> io::Result<()> {
@@ -106,7 +106,8 @@ pub fn for_each_merged(
             .into_iter()
             .map(|(path, input)| {
                 let (tx, rx) = sync_channel(4);
-                s.spawn(move || read(input, tx));
+                let name = path.clone();
+                s.spawn(move || read(&name, input, tx));
                 Part {
                     path,
                     rx,

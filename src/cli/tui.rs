@@ -57,8 +57,10 @@ pub fn bitrate_arg(text: &str) -> Result<u64, String> {
 /// Arguments of `cotui open`.
 #[derive(Args, Debug)]
 pub struct OpenArgs {
-    /// Log file (candump -l/-L, candump screen output, Vector ASC).
+    /// Log file (candump -l/-L, candump screen output, Vector ASC, PEAK TRC, python-can CSV).
     pub file: PathBuf,
+    #[command(flatten)]
+    pub input: super::input::InputArgs,
     #[command(flatten)]
     pub ui: UiArgs,
 }
@@ -66,8 +68,10 @@ pub struct OpenArgs {
 /// Arguments of `cotui replay`.
 #[derive(Args, Debug)]
 pub struct ReplayArgs {
-    /// Log file (candump -l/-L, candump screen output, Vector ASC).
+    /// Log file (candump -l/-L, candump screen output, Vector ASC, PEAK TRC, python-can CSV).
     pub file: PathBuf,
+    #[command(flatten)]
+    pub input: super::input::InputArgs,
     /// Speed factor (2 = twice as fast; 0 = as fast as possible).
     #[arg(long, default_value_t = 1.0)]
     pub speed: f64,
@@ -236,7 +240,7 @@ pub fn run_open(args: &OpenArgs) -> ExitCode {
         &args.ui,
         &name,
         SourceKind::Open,
-        Feeding::Log((source::open(args.file.clone()), None)),
+        Feeding::Log((source::open(args.file.clone(), args.input.format()), None)),
     )
 }
 
@@ -259,7 +263,7 @@ pub fn run_replay(args: &ReplayArgs) -> ExitCode {
         return ExitCode::Usage;
     }
     let name = args.file.display().to_string();
-    let (rx, ctl) = source::replay(args.file.clone(), args.speed);
+    let (rx, ctl) = source::replay(args.file.clone(), args.speed, args.input.format());
     start(
         &args.ui,
         &name,

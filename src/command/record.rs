@@ -8,6 +8,7 @@ use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
 use super::words::{TypedWords, count_arg, ms_arg};
 use crate::bus::{Bus, BusError, Event, StateChange};
 use crate::frame::Frame;
+use crate::log::export::{AscWriter, TrcWriter};
 use crate::log::writer::LogWriter;
 use crate::logio::sink::{LineSink, Target};
 use std::fs::{File, OpenOptions};
@@ -153,8 +154,9 @@ pub struct RecordArgs {
     /// Append to an existing output file.
     #[arg(long)]
     pub append: bool,
-    /// The file format: candump (-l lines) or pcapng (for Wireshark; not to a terminal).
-    #[arg(long, default_value = "candump", value_parser = TypedWords::new(&["candump", "pcapng"], LogFormat::parse))]
+    /// The file format: candump (-l lines), pcapng (for Wireshark; not to a terminal), asc
+    /// (Vector ASC) or trc (PEAK TRC 2.1).
+    #[arg(long, default_value = "candump", value_parser = TypedWords::new(&["candump", "pcapng", "asc", "trc"], LogFormat::parse))]
     pub format: LogFormat,
 }
 
@@ -235,6 +237,11 @@ pub fn open_output(
         return Ok(LineSink::new(Box::new(std::io::stdout()), 0));
     }
     if mode == WriteMode::Append {
+        if matches!(format, LogFormat::Asc | LogFormat::Trc) {
+            return Err(CommandError::Usage(
+                "--append goes with candump or pcapng: an ASC or TRC log has one header, with its start time".into(),
+            ));
+        }
         refuse_other_format(path, format)?;
     }
     let mut o = OpenOptions::new();
@@ -355,6 +362,7 @@ pub async fn record<T: Target>(
             && rec.take(got, out, &mut note)?
         {}
     }
+    rec.writer.finish(out);
     rec.flush(out)?;
     if let Some((from_ns, reason)) = rec.open_gap.take() {
         rec.gaps.push(Gap {
@@ -378,16 +386,22 @@ pub enum LogFormat {
     Candump,
     /// pcapng for Wireshark (LINKTYPE_CAN_SOCKETCAN, nanosecond timestamps).
     Pcapng,
+    /// Vector ASC (the header comes with the first frame; no `--append`).
+    Asc,
+    /// PEAK TRC 2.1 (the header comes with the first frame; no `--append`).
+    Trc,
 }
 
 impl LogFormat {
-    /// Parses `candump` or `pcapng`.
+    /// Parses `candump`, `pcapng`, `asc` or `trc`.
     pub fn parse(word: &str) -> Result<LogFormat, ParseError> {
         match word {
             "candump" | "log" => Ok(LogFormat::Candump),
             "pcapng" => Ok(LogFormat::Pcapng),
+            "asc" => Ok(LogFormat::Asc),
+            "trc" => Ok(LogFormat::Trc),
             _ => Err(ParseError::Invalid(format!(
-                "unknown record format `{word}`: use candump or pcapng"
+                "unknown record format `{word}`: use candump, pcapng, asc or trc"
             ))),
         }
     }
@@ -399,6 +413,8 @@ enum Encoder {
     /// The interfaces described so far (a pcapng interface block precedes an interface's
     /// first frame).
     Pcapng(Vec<String>),
+    Asc(AscWriter, String),
+    Trc(TrcWriter, String),
 }
 
 impl Encoder {
@@ -411,6 +427,8 @@ impl Encoder {
                 out.end_record(false);
                 Encoder::Pcapng(Vec::new())
             }
+            LogFormat::Asc => Encoder::Asc(AscWriter::new(), String::new()),
+            LogFormat::Trc => Encoder::Trc(TrcWriter::new(), String::new()),
         }
     }
 
@@ -434,8 +452,30 @@ impl Encoder {
                 out.buffer()
                     .extend_from_slice(&crate::output::pcapng::enhanced_packet(id as u32, f));
             }
+            Encoder::Asc(w, text) => {
+                w.write_line(text, f, iface);
+                out.buffer().extend_from_slice(text.as_bytes());
+                text.clear();
+            }
+            Encoder::Trc(w, text) => {
+                w.write_line(text, f, iface);
+                out.buffer().extend_from_slice(text.as_bytes());
+                text.clear();
+            }
         }
         out.end_record(true);
+    }
+
+    /// Appends what closes the log (ASC's `End TriggerBlock`), not counted as a frame.
+    fn finish<T: Target>(&mut self, out: &mut LineSink<T>) {
+        if let Encoder::Asc(w, text) = self {
+            w.finish(text);
+            if !text.is_empty() {
+                out.buffer().extend_from_slice(text.as_bytes());
+                text.clear();
+                out.end_record(false);
+            }
+        }
     }
 }
 

@@ -22,11 +22,11 @@ pub struct Finished {
     pub error: Option<io::Error>,
 }
 
-/// Parses `input` on a scoped thread and calls `consume` for every batch, in
+/// Runs `reader` on a scoped thread and calls `consume` for every batch, in
 /// order, on the calling thread. Returns the reader's counts (and the read
 /// error, if reading stopped on one) and whatever `consume` returned last.
 pub fn for_each_batch<R, E>(
-    input: R,
+    mut reader: LogReader<R>,
     mut consume: impl FnMut(&Batch) -> Result<(), E>,
 ) -> Result<Result<Finished, io::Error>, E>
 where
@@ -36,7 +36,6 @@ where
     let (recycle_tx, recycle_rx) = mpsc::channel::<Vec<(u64, Outcome)>>();
     std::thread::scope(|s| {
         let producer = s.spawn(move || -> Result<Finished, io::Error> {
-            let mut reader = LogReader::new(input)?;
             let mut sent_ifaces = 0;
             loop {
                 let mut lines = recycle_rx.try_recv().unwrap_or_else(|_| Vec::with_capacity(BATCH));
@@ -85,7 +84,7 @@ mod tests {
         let log: String = (0..n).map(|i| format!("(1.{i:06}) if{i} 181#01\n")).collect();
         let mut ifaces = Interfaces::default();
         let mut seen = Vec::new();
-        for_each_batch(log.as_bytes(), |batch| -> Result<(), ()> {
+        for_each_batch(LogReader::new(log.as_bytes()).unwrap(), |batch| -> Result<(), ()> {
             for name in &batch.new_interfaces {
                 ifaces.intern(name);
             }

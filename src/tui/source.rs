@@ -3,7 +3,7 @@
 //! paces it by its timestamps and obeys pause, step, speed and seek.
 
 use crate::frame::Frame;
-use crate::log::{LogReader, Outcome};
+use crate::log::{Format, LogReader, Outcome};
 use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
@@ -110,16 +110,17 @@ impl ReadError {
     }
 }
 
-fn reader(path: &Path) -> Result<LogReader<BufReader<File>>, ReadError> {
+/// A reader of `path` as `format` (`None`: detected from its content).
+fn reader(path: &Path, format: Option<Format>) -> Result<LogReader<BufReader<File>>, ReadError> {
     let file = File::open(path).map_err(|e| ReadError::new(path, e))?;
-    LogReader::new(BufReader::with_capacity(1 << 20, file)).map_err(|e| ReadError::new(path, e))
+    LogReader::open(BufReader::with_capacity(1 << 20, file), format).map_err(|e| ReadError::new(path, e))
 }
 
 /// Reads `path` as fast as possible.
-pub fn open(path: PathBuf) -> Receiver<Feed> {
+pub fn open(path: PathBuf, format: Option<Format>) -> Receiver<Feed> {
     let (tx, rx) = sync_channel(QUEUE);
     thread::spawn(move || {
-        let mut r = match reader(&path) {
+        let mut r = match reader(&path, format) {
             Ok(r) => r,
             Err(e) => {
                 let _ = tx.send(Feed::Status(e.to_string()));
@@ -200,13 +201,13 @@ pub fn valid_speed(x: f64) -> bool {
 /// feed and the control line. The replay sends [`Feed::Position`] with its batches and after
 /// every command, and [`Feed::Extent`] once a background pass has measured the log. At the
 /// end it says "replay finished" and waits for a seek back, a step back or a rewind.
-pub fn replay(path: PathBuf, speed: f64) -> (Receiver<Feed>, Sender<Control>) {
+pub fn replay(path: PathBuf, speed: f64, format: Option<Format>) -> (Receiver<Feed>, Sender<Control>) {
     let (tx, rx) = sync_channel(QUEUE);
     let (ctl_tx, ctl_rx) = channel();
     let measure = (path.clone(), tx.clone());
     thread::spawn(move || {
         let (path, tx) = measure;
-        if let Ok(mut r) = reader(&path) {
+        if let Ok(mut r) = reader(&path, format) {
             let (mut frames, mut first, mut last) = (0u64, None, 0u64);
             for item in r.by_ref() {
                 if let Ok((_, Outcome::Frame(f))) = item {
@@ -226,6 +227,7 @@ pub fn replay(path: PathBuf, speed: f64) -> (Receiver<Feed>, Sender<Control>) {
     thread::spawn(move || {
         let mut player = Player {
             path,
+            format,
             tx,
             ctl: ctl_rx,
             speed: if valid_speed(speed) { speed } else { 1.0 },
@@ -253,6 +255,8 @@ enum Target {
 /// The replay task's state.
 struct Player {
     path: PathBuf,
+    /// The format to read the log as (`None`: detected).
+    format: Option<Format>,
     tx: SyncSender<Feed>,
     ctl: Receiver<Control>,
     speed: f64,
@@ -362,7 +366,7 @@ impl Player {
     /// Plays the log from the start; frames up to the target go out at once. Returns why
     /// it stopped and where it was.
     fn play(&mut self) -> Result<(Stop, Position), ReadError> {
-        let mut r = reader(&self.path)?;
+        let mut r = reader(&self.path, self.format)?;
         let mut names = 0;
         let mut batch = Vec::with_capacity(256);
         // Log time `anchor_ts` is played at wall time `anchor_wall`.
@@ -583,8 +587,8 @@ mod tests {
     #[test]
     fn open_delivers_every_frame_then_done() {
         let l = log(10_000);
-        assert_eq!(drain(&open(l.0.clone())).0, 10_000);
-        let (n, _, notes) = drain(&open("/nonexistent/x.log".into()));
+        assert_eq!(drain(&open(l.0.clone(), None)).0, 10_000);
+        let (n, _, notes) = drain(&open("/nonexistent/x.log".into(), None));
         assert_eq!(n, 0);
         assert!(notes[0].starts_with("/nonexistent/x.log: "), "{notes:?}");
     }
@@ -629,7 +633,7 @@ mod tests {
     }
 
     fn all_frames(path: &Path) -> Vec<Frame> {
-        open(path.to_path_buf())
+        open(path.to_path_buf(), None)
             .iter()
             .take_while(|f| !matches!(f, Feed::Done))
             .flat_map(|f| match f {
@@ -644,7 +648,7 @@ mod tests {
         let l = log(3000);
         let frames = all_frames(&l.0);
         // So slow that no frame is due by time during the test: only commands move it.
-        let (rx, ctl) = replay(l.0.clone(), 0.01);
+        let (rx, ctl) = replay(l.0.clone(), 0.01, None);
         let mut ui = Ui::default();
         ctl.send(Control::Pause(true)).unwrap();
         ctl.send(Control::GotoFrame(10)).unwrap();
@@ -694,7 +698,7 @@ mod tests {
     fn a_looping_replay_starts_over_at_the_end() {
         let l = log(500);
         let frames = all_frames(&l.0);
-        let (rx, ctl) = replay(l.0.clone(), 0.0);
+        let (rx, ctl) = replay(l.0.clone(), 0.0, None);
         let mut ui = Ui::default();
         ui.until(&rx, |u| u.notes.iter().any(|n| n == "replay finished"));
         ui.at(&rx, 500, &frames);
@@ -726,7 +730,7 @@ mod tests {
         // 2000 frames 100 µs apart = 0.2 s of log; at speed 1 it takes about that long.
         let l = log(2000);
         let start = Instant::now();
-        let (rx, ctl) = replay(l.0.clone(), 1.0);
+        let (rx, ctl) = replay(l.0.clone(), 1.0, None);
         let mut ui = Ui::default();
         ui.until(&rx, |u| u.notes.iter().any(|n| n == "replay finished"));
         assert_eq!(ui.frames.len(), 2000);

@@ -194,3 +194,46 @@ fn diagnose_of_nothing_says_only_the_error_and_a_bad_duration_is_usage() {
         assert!(err.contains("--duration"), "{err}");
     }
 }
+
+/// `record --format asc|trc` writes a Vector ASC / PEAK TRC 2.1 log that reads back to the
+/// frames recorded (the header comes with the first frame); `--append` is refused for them.
+#[test]
+fn record_as_asc_and_trc_reads_back() {
+    use cotui::log::{Format, LogReader, Outcome};
+    for (fmt, format) in [("asc", Format::Asc), ("trc", Format::Trc)] {
+        let out = run(&["record", "demo", "-o", "-", "--count", "4", "--format", fmt]);
+        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        let mut r = LogReader::new(&out.stdout[..]).unwrap();
+        assert_eq!(r.format(), format);
+        let mut frames = 0;
+        while let Some((line, o)) = r.next_line().unwrap() {
+            match o {
+                Outcome::Frame(_) => frames += 1,
+                Outcome::Skip(_) => {}
+                Outcome::Warning(w) => panic!("{fmt} line {line}: {w}"),
+            }
+        }
+        assert_eq!(frames, 4, "{fmt}");
+        if fmt == "asc" {
+            assert!(out.stdout.ends_with(b"End TriggerBlock\n"));
+        }
+        let dir = std::env::temp_dir().join(format!("cotui-rec-{}-{fmt}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("x.log");
+        std::fs::write(&path, b"").unwrap();
+        let out = run(&[
+            "record",
+            "demo",
+            "-o",
+            path.to_str().unwrap(),
+            "--count",
+            "1",
+            "--format",
+            fmt,
+            "--append",
+        ]);
+        assert!(!out.status.success());
+        assert!(String::from_utf8_lossy(&out.stderr).contains("--append goes with candump or pcapng"));
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}

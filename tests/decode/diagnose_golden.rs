@@ -303,8 +303,15 @@ fn realworld_logs() {
     // ros2_canopen issue 46: requests to node 2 go unanswered before it answers.
     let inc = get("ros2_canopen_issue46_boot.txt");
     assert_eq!(summary(&inc), [s(Some(2), "sdo_timeout", "warning")]);
-    // A J1939 log is not CANopen: nothing to report, and no crash.
-    assert!(get("python-can_logfile.asc").is_empty());
+    // A J1939 log is not CANopen: only its ASC status lines (can0 error passive with
+    // TxErr 132, later 131; can1 error active) surface, as a bus_errors incident.
+    let inc = get("python-can_logfile.asc");
+    assert_eq!(summary(&inc), [s(None, "bus_errors", "open")]);
+    assert!(
+        inc[0]["cause"].as_str().unwrap().contains("TX error passive"),
+        "{}",
+        inc[0]["cause"]
+    );
 }
 
 #[test]

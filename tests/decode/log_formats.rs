@@ -111,3 +111,93 @@ fn whole_file_round_trips_through_io_writer() {
     }
     assert_eq!(out, text);
 }
+
+/// The same three frames as candump prints them with `-ta`, `-tz`, `-td` and `-tA`: each
+/// decodes to the same times (from the first frame on), and the mode is said on stderr.
+#[test]
+fn screen_output_in_every_timestamp_mode() {
+    let frames = ["can0  181   [1]  01", "can0  182   [1]  02", "can0  183   [1]  03"];
+    let modes: [(&str, [&str; 3], &str); 4] = [
+        (
+            "-ta",
+            ["1700000000.000000", "1700000000.250000", "1700000000.250100"],
+            "absolute times (-ta)",
+        ),
+        (
+            "-tz",
+            ["000.000000", "000.250000", "000.250100"],
+            "times since the start (-tz)",
+        ),
+        ("-td", ["000.000000", "000.250000", "000.000100"], "delta times (-td)"),
+        (
+            "-tA",
+            [
+                "2023-11-14 22:13:20.000000",
+                "2023-11-14 22:13:20.250000",
+                "2023-11-14 22:13:20.250100",
+            ],
+            "date and time (-tA)",
+        ),
+    ];
+    for (mode, times, said) in modes {
+        let text: String = times
+            .iter()
+            .zip(frames)
+            .map(|(t, f)| format!(" ({t})  {f}\n"))
+            .collect();
+        let out = crate::run::cotui(&["decode", "--format", "jsonl", "-"], Some(&text));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(stderr, format!("-: candump screen output, {said}\n"), "{mode}");
+        let ts: Vec<f64> = String::from_utf8_lossy(&out.stdout)
+            .lines()
+            .map(|l| {
+                serde_json::from_str::<serde_json::Value>(l).unwrap()["t"]
+                    .as_f64()
+                    .unwrap()
+            })
+            .collect();
+        let rel: Vec<i64> = ts.iter().map(|t| ((t - ts[0]) * 1e6).round() as i64).collect();
+        assert_eq!(rel, [0, 250_000, 250_100], "{mode}");
+    }
+}
+
+/// python-can's public ASC log: its status lines (`CAN 1 Status:chip status error passive -
+/// TxErr: 132 RxErr: 0`) are bus-state events, no longer lost.
+#[test]
+fn asc_status_lines_are_bus_state_events() {
+    let log = "../shared/realworld/logs/python-can_logfile.asc";
+    let out = crate::run::cotui(&["decode", "--events", log], None);
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout),
+        "(0.015991)  bus       bus_state         can0: error active -> error passive \
+         (controller problem (TX error passive); error counters tx=132 rx=0)\n"
+    );
+}
+
+/// `--input-format` reads a log whose content does not tell its format: python-can CSV rows
+/// without the header line (`CSVWriter(append=True)`), on decode and diagnose alike.
+#[test]
+fn input_format_overrides_detection() {
+    let rows = "1700000000.5,0x701,0,0,0,1,BQ==\n1700000001.5,0x701,0,0,0,1,BQ==\n";
+    let detected = crate::run::cotui(&["decode", "--format", "jsonl", "-"], Some(rows));
+    assert_eq!(String::from_utf8_lossy(&detected.stdout), "");
+    let out = crate::run::cotui(
+        &["decode", "--input-format", "csv", "--format", "jsonl", "-"],
+        Some(rows),
+    );
+    let lines: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 2, "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        (lines[0]["id"].as_u64(), lines[0]["kind"].as_str()),
+        (Some(0x701), Some("heartbeat"))
+    );
+    assert_eq!(String::from_utf8_lossy(&out.stderr), "-: python-can CSV\n");
+    let out = crate::run::cotui(
+        &["diagnose", "--input-format", "csv", "--format", "jsonl", "-"],
+        Some(rows),
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+}

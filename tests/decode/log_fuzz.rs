@@ -3,7 +3,7 @@
 
 use cotui::frame::{Flags, Frame, Interfaces};
 use cotui::log::writer::{LogWriter, Timestamps};
-use cotui::log::{Format, Line, LogReader, asc, candump, screen};
+use cotui::log::{Format, Line, LogReader, asc, candump, csv, screen, trc};
 use proptest::prelude::*;
 
 const SAMPLES: &[&str] = &[
@@ -18,6 +18,25 @@ const SAMPLES: &[&str] = &[
     "   0.176544 CANFD   1 Rx        305  fdMsg  1 0 9 12 11 22 33 44 55 66 77 88 99 AA BB CC   130000  130     3000 0 0",
     "   0.002000 2  1ABCDEFx        Tx   d F 01 02 03 04 05 06 07 08  Length = 0",
     "base dec  timestamps relative",
+    "   0.015991 CAN 1 Status:chip status error passive - TxErr: 132 RxErr: 0",
+    "     1)      1841  0001    8  00 01 02 03 04 05 06 07",
+    "     3)      1346.0  Warng  FFFFFFFF  4  00 00 00 08  BUSHEAVY",
+    "     1)      1.500 3  Tx         0300 -  1  BB",
+    "      2         0.200 FB  2  18FF0102 Tx -  9    00 01 02 03 04 05 06 07 08 09 0A 0B",
+    "      4         0.400 ST  1           Rx    00 04 00 00",
+    ";$STARTTIME=45244.9258101852",
+    ";$COLUMNS=N,O,T,B,I,d,R,L,D",
+    "1700000000.123456,0x181,0,0,0,2,ESI=",
+    "2.5,0x7ff,0,0,0,12,AAECAwQFBgcICQoL",
+];
+
+/// TRC header lines that put a parser in each version's layout.
+const TRC_VERSIONS: &[&str] = &[
+    ";$FILEVERSION=1.1",
+    ";$FILEVERSION=1.2",
+    ";$FILEVERSION=1.3",
+    ";$FILEVERSION=2.0",
+    ";$FILEVERSION=2.1",
 ];
 
 /// Runs every parser on `line`; the result does not matter, only that it returns.
@@ -30,6 +49,13 @@ fn parse_all(line: &[u8]) {
     let _ = screen::Parser::new().parse_line(line, &mut ifaces);
     let _ = asc::Parser::new().parse_line(line, &mut ifaces);
     let _ = candump::parse_compact(line);
+    let _ = csv::Parser::new().parse_line(line, &mut ifaces);
+    let _ = trc::Parser::new().parse_line(line, &mut ifaces);
+    for header in TRC_VERSIONS {
+        let mut t = trc::Parser::new();
+        let _ = t.parse_line(header.as_bytes(), &mut ifaces);
+        let _ = t.parse_line(line, &mut ifaces);
+    }
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -128,7 +154,7 @@ proptest! {
     #[test]
     fn arbitrary_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..200)) {
         parse_all(&bytes);
-        for format in [Format::Candump, Format::Screen, Format::Asc] {
+        for format in [Format::Candump, Format::Screen, Format::Asc, Format::Trc, Format::Csv] {
             let reader = LogReader::with_format(&bytes[..], format);
             for item in reader {
                 item.unwrap();

@@ -235,8 +235,9 @@ fn agree_with_wireshark(path: &str, tag: &str) -> usize {
         let Some(fc) = t[1] else {
             // Wireshark skips remote and 29-bit frames entirely (packet-canopen.c returns 0 when
             // CAN_RTR_FLAG/CAN_EFF_FLAG is set): node guarding requests are invisible to it.
+            // Error frames (CAN_ERR_FLAG) go to its CAN error dissector, not to CANopen.
             assert!(
-                o["rtr"] == true || o["ext"] == true,
+                o["rtr"] == true || o["ext"] == true || o["err"] == true,
                 "{ctx}: Wireshark did not decode it"
             );
             continue;

@@ -78,7 +78,7 @@ fn logs() -> Vec<PathBuf> {
 fn opened(path: &Path) -> App {
     let decoder = cotui::cli::bind::decoder(&[], &[]).unwrap();
     let name = path.display().to_string();
-    let src = SourceInfo::new(&name, SourceKind::Open, source::open(path.to_path_buf()), None);
+    let src = SourceInfo::new(&name, SourceKind::Open, source::open(path.to_path_buf(), None), None);
     let mut app = App::new(Trace::new(decoder, 500_000), Keymap::default_map(), src);
     for _ in 0..10_000 {
         if app.source().done {

@@ -20,46 +20,35 @@
 //! - `base dec` reads ids and data bytes as decimal (the DLC stays hex);
 //! - `ErrorFrame` has no detail in ASC, so it becomes a generic bus error: an error frame
 //!   with class `CAN_ERR_BUSERROR` (0x80) and 8 zero bytes;
+//! - a status line (`CAN 1 Status:chip status error passive - TxErr: 132 RxErr: 0`) becomes
+//!   the error frame a SocketCAN controller sends for the same state: bus off as
+//!   `CAN_ERR_BUSOFF`, error passive / warning level / error active as `CAN_ERR_CRTL` with
+//!   the TX or RX bit of the larger counter, and the counters (`CAN_ERR_CNT`) when given;
 //! - a `CANFD` line is an FD frame (with [`Flags::FDF`]) when its flags column has bit
 //!   0x1000 or is missing, else a classic frame (remote when bit 0x10 is set);
 //! - `Rx`/`Tx` set the direction; `TxRq`, `Start of measurement` and other events are
 //!   skipped as [`SkipReason::Event`], `CANXL` lines as [`SkipReason::CanXl`], lines not
 //!   starting with a timestamp as [`SkipReason::Header`] or [`SkipReason::Comment`] (`//`).
 
-use super::lex::{self, IfaceCache, Tokens, dec_u32, err, hex_u32, trim_end};
+use super::lex::{self, Channels, Tokens, dec_u32, err, hex_u32, trim_end};
+use super::status::{self, State};
 use super::{Line, ParseError, SkipReason};
 use crate::frame::{Flags, Frame, Interfaces};
 
 /// `CAN_ERR_BUSERROR`: the class given to ASC error frames.
-pub const CAN_ERR_BUSERROR: u32 = 0x80;
+pub const CAN_ERR_BUSERROR: u32 = status::CAN_ERR_BUSERROR;
 
 const ASC_F_RTR: u32 = 0x10;
 const ASC_F_FDF: u32 = 0x1000;
 
-/// Channels whose interface index is cached; higher ones are interned per line.
-const CACHED_CHANNELS: usize = 64;
-
 /// Parser state for ASC lines (number base, timestamp mode, channel names). Use one parser
 /// with one [`Interfaces`] table: it caches indexes into it.
-#[derive(Debug)]
+#[derive(Debug, Default)]
 pub struct Parser {
     decimal: bool,
     relative: bool,
     last_ns: u64,
-    channels: [Option<u16>; CACHED_CHANNELS],
-    iface: IfaceCache,
-}
-
-impl Default for Parser {
-    fn default() -> Self {
-        Parser {
-            decimal: false,
-            relative: false,
-            last_ns: 0,
-            channels: [None; CACHED_CHANNELS],
-            iface: IfaceCache::default(),
-        }
-    }
+    channels: Channels,
 }
 
 impl Parser {
@@ -100,16 +89,27 @@ impl Parser {
                 let Some(mut f) = self.fd_line(&mut toks, s.len())? else {
                     return Ok(Line::Skip(SkipReason::Event));
                 };
-                f.iface = self.channel(ifaces, channel, ch_at)?;
+                f.iface = self.channels.get(ifaces, channel, ch_at)?;
                 f
             }
             b"CANXL" => return Ok(Line::Skip(SkipReason::CanXl)),
+            b"CAN" => {
+                let (ch_at, ch) = toks
+                    .next()
+                    .ok_or_else(|| err(s.len(), "expected a channel after CAN"))?;
+                let channel = dec_u32(ch).ok_or_else(|| err(ch_at, "expected a channel number"))?;
+                let Some(mut f) = status_line(&s[toks.pos()..]) else {
+                    return Ok(Line::Skip(SkipReason::Event));
+                };
+                f.iface = self.channels.get(ifaces, channel, ch_at)?;
+                f
+            }
             _ => match dec_u32(ch_tok) {
                 Some(channel) => {
                     let Some(mut f) = self.classic_line(&mut toks, s.len())? else {
                         return Ok(Line::Skip(SkipReason::Event));
                     };
-                    f.iface = self.channel(ifaces, channel, ch_at)?;
+                    f.iface = self.channels.get(ifaces, channel, ch_at)?;
                     f
                 }
                 None => return Ok(Line::Skip(SkipReason::Event)),
@@ -134,38 +134,6 @@ impl Parser {
                 _ => {}
             }
         }
-    }
-
-    /// Interface index of channel `n` (`can{n-1}`, `canX` for 0).
-    fn channel(&mut self, ifaces: &mut Interfaces, n: u32, at: usize) -> Result<u16, ParseError> {
-        if let Some(Some(idx)) = self.channels.get(n as usize) {
-            return Ok(*idx);
-        }
-        let mut buf = [0u8; 16];
-        buf[..3].copy_from_slice(b"can");
-        let len = if n == 0 {
-            buf[3] = b'X';
-            4
-        } else {
-            let mut digits = [0u8; 10];
-            let (mut k, mut v) = (digits.len(), n - 1);
-            loop {
-                k -= 1;
-                digits[k] = b'0' + (v % 10) as u8;
-                v /= 10;
-                if v == 0 {
-                    break;
-                }
-            }
-            let d = &digits[k..];
-            buf[3..3 + d.len()].copy_from_slice(d);
-            3 + d.len()
-        };
-        let idx = self.iface.get(ifaces, &buf[..len], at)?;
-        if let Some(slot) = self.channels.get_mut(n as usize) {
-            *slot = Some(idx);
-        }
-        Ok(idx)
     }
 }
 
@@ -199,10 +167,7 @@ impl Parser {
         let mut f = Frame::default();
         let (id_at, id) = toks.next().ok_or_else(|| err(end, "expected a CAN id"))?;
         if id == b"ErrorFrame" {
-            f.flags.set(Flags::ERR, true);
-            f.id = CAN_ERR_BUSERROR;
-            f.len = 8;
-            return Ok(Some(f));
+            return Ok(Some(status::bus_error()));
         }
         if !id[0].is_ascii_hexdigit() {
             return Ok(None);
@@ -305,6 +270,32 @@ impl Parser {
         }
         Ok(Some(f))
     }
+}
+
+/// The error frame of a status line's text after the channel (`Status:chip status error
+/// passive - TxErr: 132 RxErr: 0`); `None` when it is no controller state.
+fn status_line(rest: &[u8]) -> Option<Frame> {
+    let text = lex::skip_ws(rest, 0);
+    let rest = rest[text..].strip_prefix(b"Status:")?;
+    let has = |word: &[u8]| rest.windows(word.len()).any(|w| w.eq_ignore_ascii_case(word));
+    let counter = |name: &[u8]| {
+        let at = rest.windows(name.len()).position(|w| w == name)? + name.len();
+        let at = lex::skip_ws(rest, at);
+        dec_u32(&rest[at..lex::token_end(rest, at)])
+    };
+    let state = if has(b"bus off") || has(b"busoff") {
+        State::BusOff
+    } else if has(b"passive") {
+        State::Passive
+    } else if has(b"warning") {
+        State::Warning
+    } else if has(b"active") {
+        State::Active
+    } else {
+        return None;
+    };
+    let counters = counter(b"TxErr:").zip(counter(b"RxErr:"));
+    Some(status::state_frame(state, counters))
 }
 
 /// Reads `Rx`/`Tx` into the TX flag; `false` for other directions (`TxRq`).
@@ -417,6 +408,29 @@ mod tests {
         );
         assert_eq!((fs[0].id, fs[0].payload()), (0x123, &[17, 255][..]));
         assert_eq!((fs[1].id, fs[1].ts_ns), (0x7FF, 750_000_000));
+    }
+
+    #[test]
+    fn status_lines_are_controller_error_frames() {
+        let (fs, ifaces) = frames(
+            "   0.015991 CAN 1 Status:chip status error passive - TxErr: 132 RxErr: 0\n   0.015991 CAN 2 Status:chip status error active\n   1.0 CAN 1 Status:chip status warning level - TxErr: 3 RxErr: 97\n   2.0 CAN 1 Status:chip status bus off - TxErr: 300 RxErr: 0\n",
+        );
+        let got: Vec<_> = fs
+            .iter()
+            .map(|f| (ifaces.name(f.iface), f.flags.0, f.id, f.payload()))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                ("can0", Flags::ERR, 0x204, &[0, 0x20, 0, 0, 0, 0, 132, 0][..]),
+                ("can1", Flags::ERR, 0x004, &[0, 0x40, 0, 0, 0, 0, 0, 0][..]),
+                ("can0", Flags::ERR, 0x204, &[0, 0x04, 0, 0, 0, 0, 3, 97][..]),
+                ("can0", Flags::ERR, 0x240, &[0, 0, 0, 0, 0, 0, 255, 0][..]),
+            ]
+        );
+        let (lines, _) = parse_all("   1.0 CAN 1 Status:chip status something else\n   1.0 CAN x Status:\n");
+        assert_eq!(lines[0], Ok(Line::Skip(SkipReason::Event)));
+        assert_eq!(lines[1].unwrap_err().message, "expected a channel number");
     }
 
     #[test]

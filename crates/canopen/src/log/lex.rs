@@ -236,3 +236,57 @@ impl IfaceCache {
         Ok(idx)
     }
 }
+
+/// Channels whose interface index is cached; higher ones are interned per line.
+const CACHED_CHANNELS: usize = 64;
+
+/// Interface names of numbered channels, as ASC and TRC logs number them: channel N is
+/// `can{N-1}` (channel 1 is `can0`), channel 0 is `canX` (as can-utils' `asc2log` names them).
+#[derive(Debug)]
+pub(crate) struct Channels {
+    slots: [Option<u16>; CACHED_CHANNELS],
+    iface: IfaceCache,
+}
+
+impl Default for Channels {
+    fn default() -> Self {
+        Channels {
+            slots: [None; CACHED_CHANNELS],
+            iface: IfaceCache::default(),
+        }
+    }
+}
+
+impl Channels {
+    /// Interface index of channel `n` (written at line index `at`), interning it on first sight.
+    pub(crate) fn get(&mut self, ifaces: &mut Interfaces, n: u32, at: usize) -> Result<u16, ParseError> {
+        if let Some(Some(idx)) = self.slots.get(n as usize) {
+            return Ok(*idx);
+        }
+        let mut buf = [0u8; 16];
+        buf[..3].copy_from_slice(b"can");
+        let len = if n == 0 {
+            buf[3] = b'X';
+            4
+        } else {
+            let mut digits = [0u8; 10];
+            let (mut k, mut v) = (digits.len(), n - 1);
+            loop {
+                k -= 1;
+                digits[k] = b'0' + (v % 10) as u8;
+                v /= 10;
+                if v == 0 {
+                    break;
+                }
+            }
+            let d = &digits[k..];
+            buf[3..3 + d.len()].copy_from_slice(d);
+            3 + d.len()
+        };
+        let idx = self.iface.get(ifaces, &buf[..len], at)?;
+        if let Some(slot) = self.slots.get_mut(n as usize) {
+            *slot = Some(idx);
+        }
+        Ok(idx)
+    }
+}

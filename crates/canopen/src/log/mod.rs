@@ -1,5 +1,5 @@
-//! Log formats: candump `-l` logs, candump's screen output and Vector ASC, plus a candump
-//! log writer.
+//! Log formats: candump `-l` logs, candump's screen output, Vector ASC, PEAK TRC and
+//! python-can CSV, plus a candump log writer.
 //!
 //! Each format has a line parser (`parse_line(&mut self, &[u8], &mut Interfaces)`) that
 //! works on bytes, allocates nothing per line and never panics. [`LogReader`] drives one
@@ -8,9 +8,13 @@
 
 pub mod asc;
 pub mod candump;
+pub mod csv;
+pub mod export;
 mod fast;
 mod lex;
 pub mod screen;
+mod status;
+pub mod trc;
 pub mod writer;
 
 use std::fmt;
@@ -27,6 +31,10 @@ pub enum Format {
     Screen,
     /// Vector ASC: `   0.001000 1  123             Rx   d 2 11 22`.
     Asc,
+    /// PEAK TRC 1.0 to 2.1: `      1         0.100 DT  1      0181 Rx -  2    11 22`.
+    Trc,
+    /// python-can CSV: `1700000000.1,0x181,0,0,0,2,ESI=`.
+    Csv,
 }
 
 /// Why a line was not a frame.
@@ -150,9 +158,21 @@ pub(crate) fn detect(sample: &[u8]) -> Option<Format> {
 /// The format one line belongs to, if it tells.
 fn detect_line(line: &[u8]) -> Option<Format> {
     let s = lex::trim_end(line);
+    if s.starts_with(b";$FILEVERSION") || s.starts_with(b";$STARTTIME") {
+        return Some(Format::Trc);
+    }
+    if s == csv::HEADER {
+        return Some(Format::Csv);
+    }
     let mut toks = lex::Tokens::new(s, 0);
     let (_, first) = toks.next()?;
     let second = toks.peek().map(|(_, t)| t);
+    // TRC 1.x: `     1)      1841  0001    8  00 ...`.
+    if let Some((b')', number)) = first.split_last()
+        && lex::dec_u32(number).is_some()
+    {
+        return Some(Format::Trc);
+    }
     if first.starts_with(b"(") {
         // candump log: `(ts) iface id#data`; screen: `(ts)  iface  id  [n] ...`.
         let third = lex::Tokens::new(s, toks.pos()).nth(1).map(|(_, t)| t);
@@ -179,12 +199,26 @@ fn detect_line(line: &[u8]) -> Option<Format> {
     None
 }
 
+/// What the user is told of a TRC file.
+fn trc_label(v: trc::Version) -> &'static str {
+    match v {
+        trc::Version::V1_0 => "PEAK TRC 1.0",
+        trc::Version::V1_1 => "PEAK TRC 1.1",
+        trc::Version::V1_2 => "PEAK TRC 1.2",
+        trc::Version::V1_3 => "PEAK TRC 1.3",
+        trc::Version::V2_0 => "PEAK TRC 2.0",
+        trc::Version::V2_1 => "PEAK TRC 2.1",
+    }
+}
+
 /// The parser of one format, with its state.
 #[derive(Debug)]
 enum Parser {
     Candump(candump::Parser),
     Screen(screen::Parser),
     Asc(Box<asc::Parser>),
+    Trc(Box<trc::Parser>),
+    Csv(csv::Parser),
 }
 
 /// The longest line a reader takes: a longer one (e.g. a file with no line ends) is
@@ -207,13 +241,33 @@ pub struct LogReader<R> {
     ifaces: Interfaces,
     counts: Counts,
     frame: Frame,
+    detected: Option<&'static str>,
 }
 
 impl<R: BufRead> LogReader<R> {
     /// A reader that detects the format from the start of `src` (candump when undecided).
-    pub fn new(mut src: R) -> io::Result<Self> {
-        let format = detect(src.fill_buf()?).unwrap_or(Format::Candump);
-        Ok(LogReader::with_format(src, format))
+    pub fn new(src: R) -> io::Result<Self> {
+        LogReader::open(src, None)
+    }
+
+    /// A reader of `format`, or of the format detected from the start of `src` (candump
+    /// when undecided); the variant (screen timestamp mode) is detected in either case.
+    pub fn open(mut src: R, format: Option<Format>) -> io::Result<Self> {
+        let sample = src.fill_buf()?;
+        let format = format.or_else(|| detect(sample)).unwrap_or(Format::Candump);
+        let times = (format == Format::Screen).then(|| screen::detect_times(sample));
+        let detected = match format {
+            Format::Trc => Some(trc_label(trc::detect_version(sample))),
+            Format::Csv => Some("python-can CSV"),
+            _ => None,
+        };
+        let mut reader = LogReader::with_format(src, format);
+        reader.detected = detected;
+        if let (Some(times), Parser::Screen(p)) = (times, &mut reader.parser) {
+            p.set_delta(times == screen::Times::Delta);
+            reader.detected = (times != screen::Times::None).then(|| times.label());
+        }
+        Ok(reader)
     }
 
     /// A reader for a known format.
@@ -222,6 +276,8 @@ impl<R: BufRead> LogReader<R> {
             Format::Candump => Parser::Candump(candump::Parser::new()),
             Format::Screen => Parser::Screen(screen::Parser::new()),
             Format::Asc => Parser::Asc(Box::default()),
+            Format::Trc => Parser::Trc(Box::default()),
+            Format::Csv => Parser::Csv(csv::Parser::new()),
         };
         LogReader {
             src,
@@ -232,15 +288,14 @@ impl<R: BufRead> LogReader<R> {
             ifaces: Interfaces::default(),
             counts: Counts::default(),
             frame: Frame::default(),
+            detected: None,
         }
     }
 
-    /// Reads screen timestamps as deltas (candump `-t d`) and sums them up.
-    pub fn screen_delta(mut self, on: bool) -> Self {
-        if let Parser::Screen(p) = &mut self.parser {
-            p.set_delta(on);
-        }
-        self
+    /// What [`LogReader::open`] detected beyond the format's name, for the user (e.g.
+    /// `candump screen output, delta times (-td)`); `None` for plain candump and ASC logs.
+    pub fn detected(&self) -> Option<&'static str> {
+        self.detected
     }
 
     /// The format being read.
@@ -383,7 +438,7 @@ impl Parser {
         match self {
             Parser::Candump(p) => p.ignored_tail(),
             Parser::Screen(p) => p.ignored_tail(),
-            Parser::Asc(_) => false,
+            Parser::Asc(_) | Parser::Trc(_) | Parser::Csv(_) => false,
         }
     }
 }
@@ -399,6 +454,8 @@ fn parse(
         Parser::Candump(p) => p.parse_into(line, ifaces, frame),
         Parser::Screen(p) => into(p.parse_line(line, ifaces), frame),
         Parser::Asc(p) => into(p.parse_line(line, ifaces), frame),
+        Parser::Trc(p) => into(p.parse_line(line, ifaces), frame),
+        Parser::Csv(p) => into(p.parse_line(line, ifaces), frame),
     }
 }
 
@@ -446,6 +503,15 @@ mod tests {
         assert_eq!(
             detect(b"   0.001000 1  123             Rx   d 1 11\n"),
             Some(Format::Asc)
+        );
+        assert_eq!(detect(b";$FILEVERSION=2.1\n;$STARTTIME=45244.5\n"), Some(Format::Trc));
+        assert_eq!(
+            detect(b";####\n;   Start time\n     1)      1841  0001    8  00 00\n"),
+            Some(Format::Trc)
+        );
+        assert_eq!(
+            detect(b"timestamp,arbitration_id,extended,remote,error,dlc,data\r\n"),
+            Some(Format::Csv)
         );
         assert_eq!(detect(b"hello\n\n"), None);
     }

@@ -22,6 +22,69 @@ use super::lex::{self, IfaceCache, Tokens, err, hex, hex_u32, skip_ws, trim_end}
 use super::{Line, ParseError, SkipReason};
 use crate::frame::{Flags, Frame, Interfaces};
 
+/// The timestamp column of screen output, by candump's `-t` option.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Times {
+    /// No timestamps.
+    #[default]
+    None,
+    /// `-ta`: seconds since the Unix epoch.
+    Absolute,
+    /// `-tz`: seconds since the first frame.
+    Zero,
+    /// `-td`: seconds since the previous frame (summed up when read).
+    Delta,
+    /// `-tA`: date and time (read as UTC).
+    Date,
+}
+
+impl Times {
+    /// What the user is told was detected, e.g. `candump screen output, delta times (-td)`.
+    pub fn label(self) -> &'static str {
+        match self {
+            Times::None => "candump screen output, no timestamps",
+            Times::Absolute => "candump screen output, absolute times (-ta)",
+            Times::Zero => "candump screen output, times since the start (-tz)",
+            Times::Delta => "candump screen output, delta times (-td)",
+            Times::Date => "candump screen output, date and time (-tA)",
+        }
+    }
+}
+
+/// Seconds from which a timestamp is taken for epoch time (`-ta`) rather than time since
+/// the start (about three years).
+const EPOCH_FROM_NS: u64 = 100_000_000 * 1_000_000_000;
+
+/// The timestamp mode of the screen lines in `sample` (the start of the input): a date
+/// means `-tA`; epoch-sized seconds `-ta`; small times that go back at least once `-td`
+/// (deltas), else `-tz`.
+pub(crate) fn detect_times(sample: &[u8]) -> Times {
+    let mut last = None;
+    let mut times = Times::None;
+    for line in sample.split(|&b| b == b'\n').take(256) {
+        let s = trim_end(line);
+        let at = skip_ws(s, 0);
+        if s.get(at) != Some(&b'(') {
+            continue;
+        }
+        let Ok((ns, _)) = timestamp(s, at + 1) else {
+            continue;
+        };
+        if s.get(at + 5) == Some(&b'-') {
+            return Times::Date;
+        }
+        if ns >= EPOCH_FROM_NS {
+            return Times::Absolute;
+        }
+        if last.is_some_and(|l| ns < l) {
+            return Times::Delta;
+        }
+        last = Some(ns);
+        times = Times::Zero;
+    }
+    times
+}
+
 /// Parser state for screen lines. Use one parser with one [`Interfaces`] table: it caches
 /// an index into it.
 #[derive(Debug, Default)]
@@ -337,6 +400,21 @@ mod tests {
             panic!()
         };
         assert_eq!(f.ts_ns, 1_250_000_000);
+    }
+
+    #[test]
+    fn timestamp_mode_is_detected_from_the_lines() {
+        let t = |s: &str| detect_times(s.as_bytes());
+        assert_eq!(t("  can0  123   [0]  \n"), Times::None);
+        assert_eq!(t(" (1700000000.123456)  can0  123   [0]  \n"), Times::Absolute);
+        assert_eq!(t(" (2023-11-14 22:13:20.500000)  can0  123   [0]  \n"), Times::Date);
+        let zero =
+            " (000.000000)  can0  123   [0]  \n (000.010000)  can0  123   [0]  \n (000.020000)  can0  123   [0]  \n";
+        assert_eq!(t(zero), Times::Zero);
+        let delta =
+            " (000.000000)  can0  123   [0]  \n (000.010000)  can0  123   [0]  \n (000.000005)  can0  123   [0]  \n";
+        assert_eq!(t(delta), Times::Delta);
+        assert_eq!(t("# (x\n (000.5)  can0  123   [0]  \n"), Times::Zero);
     }
 
     #[test]
