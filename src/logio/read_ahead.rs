@@ -1,7 +1,8 @@
 //! Reads and parses a log on a second thread, handing the caller batches of
 //! parsed lines: parsing and decoding then run on two cores at once.
 
-use crate::log::{Counts, LogReader, Outcome};
+use crate::log::{Counts, Outcome};
+use crate::logio::reader::Reader;
 use std::io::{self, BufRead};
 use std::sync::mpsc;
 
@@ -36,7 +37,7 @@ where
     let (recycle_tx, recycle_rx) = mpsc::channel::<Vec<(u64, Outcome)>>();
     std::thread::scope(|s| {
         let producer = s.spawn(move || -> Result<Finished, io::Error> {
-            let mut reader = LogReader::new(input)?;
+            let mut reader = Reader::new(input, None)?;
             let mut sent_ifaces = 0;
             loop {
                 let mut lines = recycle_rx.try_recv().unwrap_or_else(|_| Vec::with_capacity(BATCH));

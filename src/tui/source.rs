@@ -3,7 +3,8 @@
 //! paces it by its timestamps and obeys pause, step, speed and seek.
 
 use crate::frame::Frame;
-use crate::log::{LogReader, Outcome};
+use crate::log::Outcome;
+use crate::logio::reader::Reader;
 use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
@@ -98,9 +99,9 @@ impl ReadError {
     }
 }
 
-fn reader(path: &Path) -> Result<LogReader<BufReader<File>>, ReadError> {
+fn reader(path: &Path) -> Result<Reader<BufReader<File>>, ReadError> {
     let file = File::open(path).map_err(|e| ReadError::new(path, e))?;
-    LogReader::new(BufReader::with_capacity(1 << 20, file)).map_err(|e| ReadError::new(path, e))
+    Reader::new(BufReader::with_capacity(1 << 20, file), None).map_err(|e| ReadError::new(path, e))
 }
 
 /// Reads `path` as fast as possible.
@@ -158,7 +159,7 @@ pub fn open(path: PathBuf) -> Receiver<Feed> {
 fn send_batch<R: std::io::BufRead>(
     tx: &SyncSender<Feed>,
     batch: &mut Vec<Frame>,
-    r: &LogReader<R>,
+    r: &Reader<R>,
     names: &mut usize,
 ) -> bool {
     let ifaces = r.interfaces().names();
@@ -431,7 +432,7 @@ impl Player {
         anchor: &mut Option<(u64, Instant)>,
         at: Position,
         batch: &mut Vec<Frame>,
-        r: &LogReader<R>,
+        r: &Reader<R>,
         names: &mut usize,
     ) -> Wait {
         loop {
@@ -477,7 +478,7 @@ impl Player {
     fn flush<R: std::io::BufRead>(
         &self,
         batch: &mut Vec<Frame>,
-        r: &LogReader<R>,
+        r: &Reader<R>,
         names: &mut usize,
         at: Position,
     ) -> bool {

@@ -13,6 +13,7 @@ mod decode_proptest;
 mod diagnose_golden;
 mod diagnose_peer;
 mod eds_import;
+mod formats_binary;
 mod json_contract;
 mod log_can_utils;
 mod log_formats;
