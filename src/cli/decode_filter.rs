@@ -46,7 +46,12 @@ struct Run {
 
 /// Runs a filtered `cotui decode`; returns the exit status.
 pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
-    if args.events || matches!(args.format, OutputFormat::Pcapng | OutputFormat::Parquet) {
+    if args.events
+        || matches!(
+            args.format,
+            OutputFormat::Pcapng | OutputFormat::Blf | OutputFormat::Parquet
+        )
+    {
         eprintln!("cotui decode: --filter goes with text or jsonl frames, --transactions or --summary");
         return ExitCode::Usage;
     }
@@ -71,7 +76,7 @@ pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
     } else {
         Mode::Frames
     };
-    let mut out = match super::decode_out::open(args.output.as_deref(), false) {
+    let mut out = match super::decode_out::open(args.output.as_deref(), None) {
         Ok(o) => o,
         Err(e) => {
             eprintln!("cotui decode: {e}");

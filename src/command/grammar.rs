@@ -54,7 +54,7 @@ pub enum Command {
         probe: bool,
         timeout_ms: u64,
     },
-    /// `record -o FILE [--count N] [--duration MS] [--force | --append] [--format candump|pcapng]`.
+    /// `record -o FILE [--count N] [--duration MS] [--force | --append] [--format candump|pcapng|blf]`.
     Record {
         output: String,
         limits: Limits,

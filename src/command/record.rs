@@ -136,6 +136,11 @@ pub fn open_output(
     if path == "-" {
         return Ok(LineSink::new(Box::new(std::io::stdout()), 0));
     }
+    if mode == WriteMode::Append && format == LogFormat::Blf {
+        return Err(CommandError::Usage(
+            "a BLF file cannot be appended to (its header holds the totals): write another file".into(),
+        ));
+    }
     if mode == WriteMode::Append {
         refuse_other_format(path, format)?;
     }
@@ -171,6 +176,7 @@ fn refuse_other_format(path: &str, format: LogFormat) -> Result<(), CommandError
     let (is, given) = match (pcapng, format) {
         (true, LogFormat::Candump) => ("pcapng", "candump lines"),
         (false, LogFormat::Pcapng) => ("not pcapng (a text log?)", "pcapng"),
+        (_, LogFormat::Blf) => return Ok(()),
         _ => return Ok(()),
     };
     Err(CommandError::Usage(format!(
@@ -258,6 +264,12 @@ pub async fn record<T: Target>(
         {}
     }
     rec.flush(out)?;
+    rec.writer.finish(out).map_err(|e| {
+        CommandError::Usage(format!(
+            "writing the log failed: {e}; it ends with the last whole container ({} frames)",
+            out.lines()
+        ))
+    })?;
     if let Some((from_ns, reason)) = rec.open_gap.take() {
         rec.gaps.push(Gap {
             from_ns,
@@ -280,16 +292,19 @@ pub enum LogFormat {
     Candump,
     /// pcapng for Wireshark (LINKTYPE_CAN_SOCKETCAN, nanosecond timestamps).
     Pcapng,
+    /// Vector BLF for CANalyzer/CANoe and python-can (zlib containers, 1 ns timestamps).
+    Blf,
 }
 
 impl LogFormat {
-    /// Parses `candump` or `pcapng`.
+    /// Parses `candump`, `pcapng` or `blf`.
     pub fn parse(word: &str) -> Result<LogFormat, super::syntax::ParseError> {
         match word {
             "candump" | "log" => Ok(LogFormat::Candump),
             "pcapng" => Ok(LogFormat::Pcapng),
+            "blf" => Ok(LogFormat::Blf),
             _ => Err(super::syntax::ParseError::Invalid(format!(
-                "unknown record format `{word}`: use candump or pcapng"
+                "unknown record format `{word}`: use candump, pcapng or blf"
             ))),
         }
     }
@@ -301,6 +316,8 @@ enum Encoder {
     /// The interfaces described so far (a pcapng interface block precedes an interface's
     /// first frame).
     Pcapng(Vec<String>),
+    /// Frames gather into a container, which goes out at every flush.
+    Blf(Box<crate::output::blf::BlfEncoder>),
 }
 
 impl Encoder {
@@ -313,7 +330,29 @@ impl Encoder {
                 out.end_record(false);
                 Encoder::Pcapng(Vec::new())
             }
+            LogFormat::Blf => Encoder::Blf(Box::default()),
         }
+    }
+
+    /// Puts out what the encoder holds back (a BLF container), before the sink flushes.
+    fn flush<T: Target>(&mut self, out: &mut LineSink<T>) {
+        if let Encoder::Blf(enc) = self {
+            let n = enc.container(out.buffer());
+            if n > 0 {
+                out.end_frames(n);
+            }
+        }
+    }
+
+    /// The end of the recording: a BLF file gets its header (in a file, with its totals).
+    fn finish<T: Target>(&mut self, out: &mut LineSink<T>) -> std::io::Result<()> {
+        let Encoder::Blf(enc) = self else {
+            return Ok(());
+        };
+        let n = enc.finish(out.buffer());
+        out.end_frames(n);
+        out.flush()?;
+        out.target().rewrite_start(&enc.header())
     }
 
     /// Appends `f` (seen on `iface`) to `out` as one record.
@@ -335,6 +374,13 @@ impl Encoder {
                 };
                 out.buffer()
                     .extend_from_slice(&crate::output::pcapng::enhanced_packet(id as u32, f));
+            }
+            Encoder::Blf(enc) => {
+                let n = enc.frame(out.buffer(), iface, f);
+                if n > 0 {
+                    out.end_frames(n);
+                }
+                return;
             }
         }
         out.end_record(true);
@@ -406,6 +452,7 @@ impl Recording {
 
     fn flush<T: Target>(&mut self, out: &mut LineSink<T>) -> Result<(), CommandError> {
         self.flushed = Instant::now();
+        self.writer.flush(out);
         if !out.pending() {
             return Ok(());
         }
@@ -444,6 +491,10 @@ mod tests {
     impl Target for Mem {
         fn cut(&mut self, len: u64) -> std::io::Result<()> {
             self.0.truncate(len as usize);
+            Ok(())
+        }
+        fn rewrite_start(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+            self.0[..bytes.len()].copy_from_slice(bytes);
             Ok(())
         }
     }

@@ -252,8 +252,9 @@ pub struct RecordArgs {
     /// Append to an existing output file.
     #[arg(long)]
     pub append: bool,
-    /// The file format: candump (-l lines) or pcapng (for Wireshark; not to a terminal).
-    #[arg(long, default_value = "candump", value_parser = TypedWords::new(&["candump", "pcapng"], LogFormat::parse))]
+    /// The file format: candump (-l lines), pcapng (for Wireshark) or blf (Vector BLF, for
+    /// CANalyzer/CANoe and python-can); the binary ones not to a terminal.
+    #[arg(long, default_value = "candump", value_parser = TypedWords::new(&["candump", "pcapng", "blf"], LogFormat::parse))]
     pub format: LogFormat,
 }
 

@@ -225,3 +225,89 @@ proptest! {
         read_all(&bytes);
     }
 }
+
+#[test]
+fn python_can_reads_cotuis_blf_back_to_the_same_frames() {
+    let src = tmp("for_writer.blf");
+    write_blf(&src, 6, 128 * 1024);
+    let out = tmp("written_by_cotui.blf");
+    let status = Command::new(env!("CARGO_BIN_EXE_cotui"))
+        .args(["decode", "--format", "blf", "-o"])
+        .arg(&out)
+        .arg(&src)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let script = r#"
+import can, json, sys
+r = can.BLFReader(sys.argv[1])
+rows = [[m.timestamp, m.channel, m.arbitration_id, m.is_extended_id, m.is_remote_frame, m.is_error_frame,
+         m.is_fd, m.bitrate_switch, not m.is_rx, m.dlc, m.data.hex()] for m in r]
+print(json.dumps({"rows": rows, "objects": r.object_count, "start": r.start_timestamp}))
+"#;
+    let back: Value = serde_json::from_str(&python(script, &[&out.display().to_string()])).unwrap();
+    let want: Vec<Value> = serde_json::from_str(FRAMES).unwrap();
+    assert_eq!(back["objects"], want.len());
+    assert_eq!(back["start"], 1700000000.001);
+    let rows = back["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), want.len());
+    for (got, w) in rows.iter().zip(&want) {
+        let (got, w) = (got.as_array().unwrap(), w.as_array().unwrap());
+        assert!(
+            (got[0].as_f64().unwrap() - w[0].as_f64().unwrap()).abs() < 2e-6,
+            "{got:?} {w:?}"
+        );
+        // Everything else as python-can wrote it; an RTR frame has no data bytes either way.
+        assert_eq!(got[1..], w[1..], "{got:?}");
+    }
+}
+
+/// `record --format blf` and a candump recording of the same bus at the same time:
+/// python-can reads the BLF back frame for frame as the candump log has them, and the
+/// header's totals are filled in.
+#[tokio::test(start_paused = true)]
+async fn a_blf_recording_holds_what_a_candump_recording_of_the_same_bus_holds() {
+    use cotui::command::record::{Limits, LogFormat, WriteMode, open_output, record};
+    let (log, blf) = (tmp("demo.log"), tmp("demo.blf"));
+    for p in [&log, &blf] {
+        let _ = std::fs::remove_file(p);
+    }
+    let demo = cotui::sim::demo::Demo::spawn(cotui::sim::Simulation::demo(), false);
+    let limits = Limits {
+        count: Some(80),
+        duration_ms: None,
+    };
+    let mut a = open_output(log.to_str().unwrap(), WriteMode::New, LogFormat::Candump).unwrap();
+    let mut b = open_output(blf.to_str().unwrap(), WriteMode::New, LogFormat::Blf).unwrap();
+    let never = || std::future::pending::<()>();
+    let (ra, rb) = tokio::join!(
+        record(&demo.bus, &mut a, limits, LogFormat::Candump, never(), |_| {}),
+        record(&demo.bus, &mut b, limits, LogFormat::Blf, never(), |_| {}),
+    );
+    assert_eq!((ra.unwrap().frames, rb.unwrap().frames), (80, 80));
+    drop((a, b));
+    let script = r#"
+import can, sys
+r = can.BLFReader(sys.argv[1])
+for m in r:
+    print("(%.6f) can%d %03X#%s" % (m.timestamp, m.channel, m.arbitration_id, m.data.hex().upper()))
+print(r.object_count, r.file_size)
+"#;
+    let back = python(script, &[&blf.display().to_string()]);
+    let mut back: Vec<&str> = back.lines().collect();
+    let totals = back.pop().unwrap();
+    let size = std::fs::metadata(&blf).unwrap().len();
+    assert_eq!(totals, format!("80 {size}"));
+    let ours = std::fs::read_to_string(&log).unwrap();
+    let ours: Vec<&str> = ours.lines().collect();
+    assert_eq!(back.len(), 80);
+    for (got, want) in back.iter().zip(&ours) {
+        // python-can's float seconds may be 1 µs off the candump log's; compare the rest.
+        let (got_t, got_rest) = got.split_once(' ').unwrap();
+        let (want_t, want_rest) = want.split_once(' ').unwrap();
+        // The bus `demo` is the file's first channel (python-can counts it as channel 0).
+        assert_eq!(got_rest, want_rest.replacen("demo ", "can0 ", 1));
+        let t = |s: &str| s.trim_matches(['(', ')']).parse::<f64>().unwrap();
+        assert!((t(got_t) - t(want_t)).abs() < 2e-6, "{got} vs {want}");
+    }
+}
