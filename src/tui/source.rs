@@ -578,6 +578,23 @@ mod tests {
         assert!(notes[0].starts_with("/nonexistent/x.log: "), "{notes:?}");
     }
 
+    #[test]
+    fn open_reads_a_blf_log_as_it_reads_the_same_frames_as_candump() {
+        let l = log(5_000);
+        let blf = l.0.with_extension("blf");
+        let mut w = crate::output::blf::BlfWriter::new(File::create(&blf).unwrap());
+        let mut text = reader(&l.0).unwrap();
+        while let Some((_, outcome)) = text.next_line().unwrap() {
+            if let Outcome::Frame(f) = outcome {
+                w.write_frame(text.interfaces().name(f.iface), &f).unwrap();
+            }
+        }
+        w.finish().unwrap();
+        let (n, _, notes) = drain(&open(blf.clone()));
+        let _ = std::fs::remove_file(&blf);
+        assert_eq!((n, notes), (5_000, Vec::<String>::new()));
+    }
+
     /// What the UI has from a replay: the frames since the last reset, the resets, the
     /// notes and the position.
     #[derive(Default)]

@@ -102,10 +102,10 @@ pub fn file_header(b: &[u8]) -> Result<FileHeader, &'static str> {
 }
 
 /// A `SYSTEMTIME` (year, month, day of week, day, hour, minute, second, ms) in ns since
-/// the Unix epoch; 0 for an unset or impossible date.
+/// the Unix epoch; 0 for an unset or impossible date (or one past 2500, beyond u64 ns).
 fn systemtime_ns(st: [u16; 8]) -> u64 {
     let [year, month, _, day, hour, min, sec, ms] = st.map(u64::from);
-    if !(1970..=9999).contains(&year) || !(1..=12).contains(&month) || !(1..=31).contains(&day) {
+    if !(1970..=2500).contains(&year) || !(1..=12).contains(&month) || !(1..=31).contains(&day) {
         return 0;
     }
     if hour > 23 || min > 59 || sec > 60 || ms > 999 {
@@ -576,6 +576,7 @@ mod tests {
         assert_eq!(st, [2023, 11, 2, 14, 22, 13, 20, 123]);
         assert_eq!(systemtime_ns(st.try_into().unwrap()), ns);
         assert_eq!(systemtime_ns([0; 8]), 0);
+        assert_eq!(systemtime_ns([9999, 12, 0, 31, 23, 59, 59, 999]), 0, "past u64 ns");
     }
 
     #[test]
