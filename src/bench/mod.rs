@@ -195,6 +195,17 @@ fn measure_all(args: &BenchArgs, exe: &Path, dir: &Path) -> std::io::Result<Figu
     log::write_bench_log(&tiny, 10)?;
     log::write_many_iface_log(&many, args.frames / 4, MANY_IFACES)?;
     log::write_many_iface_log(&few, args.frames / 4, FEW_IFACES)?;
+    // The same frames as a BLF file, written by cotui itself.
+    let blf = dir.join("bench.blf");
+    let made = std::process::Command::new(exe)
+        .args(["decode", "--format", "blf", "-o"])
+        .arg(&blf)
+        .arg(&big)
+        .status()?;
+    if !made.success() {
+        return Err(std::io::Error::other("writing the BLF bench log failed"));
+    }
+    let blf = blf.to_string_lossy();
     let (b, s, t, m, f) = (
         big.to_string_lossy(),
         small.to_string_lossy(),
@@ -236,6 +247,13 @@ fn measure_all(args: &BenchArgs, exe: &Path, dir: &Path) -> std::io::Result<Figu
             "diagnose",
             "diagnose (target: within 2x of --summary)",
             &["diagnose", "--format", "jsonl", &b],
+            n,
+            None,
+        ),
+        Run::new(
+            "summary-blf",
+            "decode --summary, the same frames as BLF",
+            &["decode", "--summary", &blf],
             n,
             None,
         ),

@@ -23,6 +23,10 @@ pub enum OutputFormat {
     // `run` hands it to `decode_out` before decoding, so the matches below that pair it
     // with `Jsonl` never see it.
     Pcapng,
+    /// A Vector BLF log for CANalyzer/CANoe and python-can (binary: with -o FILE or a
+    /// redirected stdout; the header's totals are filled in only in a file).
+    // `run` hands it to `decode_out` before decoding, as pcapng.
+    Blf,
     /// Two Parquet tables, frames and decoded values (with -o DIR or -o NAME.parquet;
     /// see README, "Parquet tables").
     // `run` hands it to `decode_parquet` before decoding.
@@ -93,8 +97,8 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
     if let Some(expr) = &args.filter {
         return super::decode_filter::run(args, expr);
     }
-    if args.format == OutputFormat::Pcapng {
-        return super::decode_out::pcapng(args);
+    if matches!(args.format, OutputFormat::Pcapng | OutputFormat::Blf) {
+        return super::decode_out::frames(args);
     }
     if args.format == OutputFormat::Parquet {
         return super::decode_parquet::run(args);
@@ -126,7 +130,7 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
         }
         None => Pipeline::Frames(Box::new(decoder)),
     };
-    let mut out = match super::decode_out::open(args.output.as_deref(), false) {
+    let mut out = match super::decode_out::open(args.output.as_deref(), None) {
         Ok(o) => o,
         Err(e) => {
             eprintln!("cotui decode: {e}");
@@ -205,7 +209,8 @@ fn decode_stream(
                         | OutputFormat::Pcapng
                         | OutputFormat::Parquet
                         | OutputFormat::Asc
-                        | OutputFormat::Trc => jsonl::write_frame(&mut json, line, frame, ifaces, &d),
+                        | OutputFormat::Trc
+                        | OutputFormat::Blf => jsonl::write_frame(&mut json, line, frame, ifaces, &d),
                     }
                     decoder.recycle(d);
                 }
@@ -252,12 +257,13 @@ fn write_view(
                 let iface = shown_iface(names, e.iface);
                 match fmt {
                     OutputFormat::Text => e.write_line_on(buf, iface),
-                    // (pcapng and parquet never reach here: they are refused with --events)
+                    // (pcapng, blf and parquet never reach here: they are refused with --events)
                     OutputFormat::Jsonl
                     | OutputFormat::Pcapng
                     | OutputFormat::Parquet
                     | OutputFormat::Asc
-                    | OutputFormat::Trc => e.write_json_on(json, iface),
+                    | OutputFormat::Trc
+                    | OutputFormat::Blf => e.write_json_on(json, iface),
                 }
             }
         }
@@ -289,7 +295,12 @@ pub(super) fn write_transaction(
             out.extend_from_slice(label.as_bytes());
             out.push(b'\n');
         }
-        OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet | OutputFormat::Asc | OutputFormat::Trc => {
+        OutputFormat::Jsonl
+        | OutputFormat::Pcapng
+        | OutputFormat::Parquet
+        | OutputFormat::Asc
+        | OutputFormat::Trc
+        | OutputFormat::Blf => {
             let mut j = t.to_json(dict);
             j.iface = iface;
             write_line(out, &j)
@@ -302,9 +313,12 @@ pub(super) fn write_summary(out: &mut Vec<u8>, summary: &mut Summary, fmt: Outpu
     summary.finish();
     match fmt {
         OutputFormat::Text => out.extend_from_slice(summary.to_text().as_bytes()),
-        OutputFormat::Jsonl | OutputFormat::Pcapng | OutputFormat::Parquet | OutputFormat::Asc | OutputFormat::Trc => {
-            write_line(out, &summary.to_json())
-        }
+        OutputFormat::Jsonl
+        | OutputFormat::Pcapng
+        | OutputFormat::Parquet
+        | OutputFormat::Asc
+        | OutputFormat::Trc
+        | OutputFormat::Blf => write_line(out, &summary.to_json()),
     }
 }
 

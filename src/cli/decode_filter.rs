@@ -51,7 +51,7 @@ pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
     if args.events
         || matches!(
             args.format,
-            OutputFormat::Pcapng | OutputFormat::Parquet | OutputFormat::Asc | OutputFormat::Trc
+            OutputFormat::Pcapng | OutputFormat::Parquet | OutputFormat::Asc | OutputFormat::Trc | OutputFormat::Blf
         )
     {
         eprintln!("cotui decode: --filter goes with text or jsonl frames, --transactions or --summary");
@@ -78,7 +78,7 @@ pub fn run(args: &DecodeArgs, expr: &str) -> ExitCode {
     } else {
         Mode::Frames
     };
-    let mut out = match super::decode_out::open(args.output.as_deref(), false) {
+    let mut out = match super::decode_out::open(args.output.as_deref(), None) {
         Ok(o) => o,
         Err(e) => {
             eprintln!("cotui decode: {e}");

@@ -1,10 +1,12 @@
-//! Where `cotui decode` writes (`-o FILE`, `-o -` or stdout) and its pcapng, ASC and TRC
-//! exports.
+//! Where `cotui decode` writes (`-o FILE`, `-o -` or stdout) and its pcapng, BLF, ASC
+//! and TRC exports.
 
 use super::decode::DecodeArgs;
 use super::input;
 use crate::command::ExitCode;
+use crate::frame::Frame;
 use crate::log::export::{AscWriter, TrcWriter};
+use crate::output::blf::BlfWriter;
 use crate::output::pcapng::PcapngWriter;
 use std::cell::Cell;
 use std::io::{self, IsTerminal, Write};
@@ -13,10 +15,10 @@ use std::rc::Rc;
 /// Why the output of `cotui decode` cannot be opened.
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {
-    #[error("pcapng is binary: not writing it to a terminal (use -o FILE, or redirect stdout)")]
-    BinaryToTerminal,
-    #[error("{0}: pcapng is binary: not writing it to a terminal")]
-    BinaryToTerminalFile(String),
+    #[error("{0} is binary: not writing it to a terminal (use -o FILE, or redirect stdout)")]
+    BinaryToTerminal(&'static str),
+    #[error("{0}: {1} is binary: not writing it to a terminal")]
+    BinaryToTerminalFile(String, &'static str),
     #[error("{path}: {source}")]
     Create { path: String, source: io::Error },
 }
@@ -94,24 +96,29 @@ impl Write for Output {
     }
 }
 
-/// The output stream: `path` (`None` or `-` is stdout). Binary output is refused when
-/// it would go to a terminal.
-pub fn open(path: Option<&str>, binary: bool) -> Result<Output, OutputError> {
+/// The output stream: `path` (`None` or `-` is stdout). Binary output (`binary` names its
+/// format) is refused when it would go to a terminal.
+pub fn open(path: Option<&str>, binary: Option<&'static str>) -> Result<Output, OutputError> {
     let name = path.filter(|p| *p != "-").unwrap_or("stdout");
     open_stream(path, binary).map(|w| Output::new(w, name))
 }
 
-fn open_stream(path: Option<&str>, binary: bool) -> Result<Box<dyn Write>, OutputError> {
+fn open_stream(path: Option<&str>, binary: Option<&'static str>) -> Result<Box<dyn Write>, OutputError> {
     match path {
         None | Some("-") => {
             let stdout = io::stdout();
-            if binary && stdout.is_terminal() {
-                return Err(OutputError::BinaryToTerminal);
+            if let Some(format) = binary
+                && stdout.is_terminal()
+            {
+                return Err(OutputError::BinaryToTerminal(format));
             }
             Ok(Box::new(io::BufWriter::with_capacity(1 << 16, stdout.lock())))
         }
         Some(p) => match std::fs::File::create(p) {
-            Ok(f) if binary && f.is_terminal() => Err(OutputError::BinaryToTerminalFile(p.to_string())),
+            Ok(f) if binary.is_some() && f.is_terminal() => Err(OutputError::BinaryToTerminalFile(
+                p.to_string(),
+                binary.unwrap_or_default(),
+            )),
             Ok(f) => Ok(Box::new(io::BufWriter::with_capacity(1 << 16, f))),
             Err(source) => Err(OutputError::Create {
                 path: p.to_string(),
@@ -121,16 +128,63 @@ fn open_stream(path: Option<&str>, binary: bool) -> Result<Box<dyn Write>, Outpu
     }
 }
 
-/// `cotui decode FILE... --format pcapng`: every frame of every input, in order, one
-/// interface description per interface name.
-pub fn pcapng(args: &DecodeArgs) -> ExitCode {
+/// A binary log of frames that `cotui decode` writes frame by frame.
+trait FrameOut {
+    fn write_frame(&mut self, iface: &str, f: &Frame) -> io::Result<()>;
+    /// Writes what is left and flushes.
+    fn finish(&mut self) -> io::Result<()>;
+}
+
+impl<W: Write> FrameOut for PcapngWriter<W> {
+    fn write_frame(&mut self, iface: &str, f: &Frame) -> io::Result<()> {
+        PcapngWriter::write_frame(self, iface, f)
+    }
+    fn finish(&mut self) -> io::Result<()> {
+        self.flush()
+    }
+}
+
+/// A BLF writer and the file (if any) whose header gets the final totals.
+struct BlfOut<W: Write> {
+    w: BlfWriter<W>,
+    file: Option<String>,
+}
+
+impl<W: Write> FrameOut for BlfOut<W> {
+    fn write_frame(&mut self, iface: &str, f: &Frame) -> io::Result<()> {
+        self.w.write_frame(iface, f)
+    }
+    fn finish(&mut self) -> io::Result<()> {
+        let header = self.w.finish()?;
+        match &self.file {
+            Some(path) => {
+                use std::os::unix::fs::FileExt;
+                std::fs::OpenOptions::new()
+                    .write(true)
+                    .open(path)?
+                    .write_all_at(&header, 0)
+            }
+            None => Ok(()),
+        }
+    }
+}
+
+/// `cotui decode FILE... --format pcapng|blf`: every frame of every input, in order (one
+/// pcapng interface description per interface name; BLF channels by name).
+pub fn frames(args: &DecodeArgs) -> ExitCode {
+    let name = if args.format == super::decode::OutputFormat::Blf {
+        "BLF"
+    } else {
+        "pcapng"
+    };
     if args.transactions || args.summary || args.events {
         eprintln!(
-            "cotui decode: --format pcapng writes frames; it does not go with --transactions, --summary or --events"
+            "cotui decode: --format {} writes frames; it does not go with --transactions, --summary or --events",
+            name.to_lowercase()
         );
         return ExitCode::Usage;
     }
-    let out = match open(args.output.as_deref(), true) {
+    let out = match open(args.output.as_deref(), Some(name)) {
         Ok(o) => o,
         Err(e) => {
             eprintln!("cotui decode: {e}");
@@ -138,9 +192,16 @@ pub fn pcapng(args: &DecodeArgs) -> ExitCode {
         }
     };
     let blame = out.blame();
-    let mut w = match PcapngWriter::new(out) {
-        Ok(w) => w,
-        Err(e) => return blame.report(None, &e),
+    let mut w: Box<dyn FrameOut> = if name == "BLF" {
+        Box::new(BlfOut {
+            w: BlfWriter::new(out),
+            file: args.output.clone().filter(|p| p != "-"),
+        })
+    } else {
+        match PcapngWriter::new(out) {
+            Ok(w) => Box::new(w),
+            Err(e) => return blame.report(None, &e),
+        }
     };
     let mut status = ExitCode::Ok;
     let (inputs, failed) = input::open_inputs(&args.files, "decode", args.iface_per_file, args.input.format());
@@ -149,7 +210,7 @@ pub fn pcapng(args: &DecodeArgs) -> ExitCode {
     }
     for (path, input) in inputs {
         let path = &path;
-        if let Err(e) = write_stream(path, input, &mut w) {
+        if let Err(e) = write_stream(path, input, w.as_mut()) {
             if e.kind() == io::ErrorKind::BrokenPipe {
                 return status;
             }
@@ -159,14 +220,14 @@ pub fn pcapng(args: &DecodeArgs) -> ExitCode {
             }
         }
     }
-    match w.flush() {
+    match w.finish() {
         Err(e) if e.kind() != io::ErrorKind::BrokenPipe => blame.report(None, &e),
         _ => status,
     }
 }
 
 /// Writes the frames of one input (parsed on a second thread); reports what was skipped.
-fn write_stream(path: &str, input: input::Input, w: &mut PcapngWriter<impl Write>) -> io::Result<()> {
+fn write_stream(path: &str, input: input::Input, w: &mut dyn FrameOut) -> io::Result<()> {
     let counts = input::for_each_frame(path, input, |frames| {
         let ifaces = frames.ifaces;
         for (_, f) in frames {
@@ -194,7 +255,7 @@ pub fn text_log(args: &DecodeArgs, asc: bool) -> ExitCode {
         );
         return ExitCode::Usage;
     }
-    let mut out = match open(args.output.as_deref(), false) {
+    let mut out = match open(args.output.as_deref(), None) {
         Ok(o) => o,
         Err(e) => {
             eprintln!("cotui decode: {e}");

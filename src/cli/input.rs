@@ -3,8 +3,9 @@
 //! and the closing counts of what was skipped.
 
 use crate::frame::{Frame, Interfaces};
-use crate::log::{Counts, Format, LogReader, Outcome};
+use crate::log::{Counts, Format, Outcome};
 use crate::logio::read_ahead;
+use crate::logio::reader::{Binary, ReadAs, Reader};
 use clap::{Args, ValueEnum};
 use std::io::{self, BufRead, BufReader};
 
@@ -21,17 +22,20 @@ pub enum InputFormat {
     Trc,
     /// python-can CSV.
     Csv,
+    /// Vector BLF.
+    Blf,
 }
 
 impl InputFormat {
     /// The reader's format.
-    pub fn format(self) -> Format {
+    pub fn format(self) -> ReadAs {
         match self {
-            InputFormat::Candump => Format::Candump,
-            InputFormat::Screen => Format::Screen,
-            InputFormat::Asc => Format::Asc,
-            InputFormat::Trc => Format::Trc,
-            InputFormat::Csv => Format::Csv,
+            InputFormat::Candump => ReadAs::Text(Format::Candump),
+            InputFormat::Screen => ReadAs::Text(Format::Screen),
+            InputFormat::Asc => ReadAs::Text(Format::Asc),
+            InputFormat::Trc => ReadAs::Text(Format::Trc),
+            InputFormat::Csv => ReadAs::Text(Format::Csv),
+            InputFormat::Blf => ReadAs::Binary(Binary::Blf),
         }
     }
 }
@@ -46,7 +50,7 @@ pub struct InputArgs {
 
 impl InputArgs {
     /// The format to read logs as; `None`: detected from each log's content.
-    pub fn format(self) -> Option<Format> {
+    pub fn format(self) -> Option<ReadAs> {
         self.input_format.map(InputFormat::format)
     }
 }
@@ -54,14 +58,14 @@ impl InputArgs {
 /// An opened log and the format it is to be read as (`None`: detected).
 pub struct Log {
     src: Box<dyn BufRead + Send>,
-    format: Option<Format>,
+    format: Option<ReadAs>,
 }
 
 impl Log {
     /// The log's reader (the format detected unless named), after saying on stderr what
     /// was detected beyond the format (a screen capture's timestamp mode).
-    pub fn reader(self, path: &str) -> io::Result<LogReader<Box<dyn BufRead + Send>>> {
-        let reader = LogReader::open(self.src, self.format)?;
+    pub fn reader(self, path: &str) -> io::Result<Reader<Box<dyn BufRead + Send>>> {
+        let reader = Reader::open(self.src, self.format)?;
         if let Some(what) = reader.detected() {
             eprintln!("{path}: {what}");
         }
@@ -89,7 +93,12 @@ impl From<Log> for Input {
 /// it is, several as one merged capture named `a.log + b.log` (`per_file`: see
 /// [`Input::Merged`]). Files that cannot be opened are said on stderr and left out; the
 /// flag is true when one was.
-pub fn open_inputs(files: &[String], what: &str, per_file: bool, format: Option<Format>) -> (Vec<(String, Input)>, bool) {
+pub fn open_inputs(
+    files: &[String],
+    what: &str,
+    per_file: bool,
+    format: Option<ReadAs>,
+) -> (Vec<(String, Input)>, bool) {
     let mut opened = Vec::new();
     let mut failed = false;
     for path in files {
@@ -99,7 +108,10 @@ pub fn open_inputs(files: &[String], what: &str, per_file: bool, format: Option<
         }
     }
     if files.len() < 2 {
-        return (opened.into_iter().map(|(p, log)| (p, Input::One(log))).collect(), failed);
+        return (
+            opened.into_iter().map(|(p, log)| (p, Input::One(log))).collect(),
+            failed,
+        );
     }
     if opened.is_empty() {
         return (Vec::new(), failed);
@@ -110,7 +122,7 @@ pub fn open_inputs(files: &[String], what: &str, per_file: bool, format: Option<
 
 /// A log to read as `format` (`None`: detected): stdin for `-`, else the file; `None`
 /// (with the message on stderr, `what` naming the command) when it cannot be opened.
-pub fn open_input(path: &str, what: &str, format: Option<Format>) -> Option<Log> {
+pub fn open_input(path: &str, what: &str, format: Option<ReadAs>) -> Option<Log> {
     if path == "-" {
         let src = Box::new(BufReader::with_capacity(1 << 16, io::stdin()));
         return Some(Log { src, format });

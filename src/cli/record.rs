@@ -14,14 +14,15 @@ use tokio::signal::unix::{SignalKind, signal};
 /// exit status: 0 complete, 2 when the bus could not be opened or the recording has gaps, 1
 /// for a usage or write error.
 pub fn run_record(bus: &BusArgs, path: &str, limits: Limits, mode: WriteMode, format: LogFormat) -> ExitCode {
-    if format == LogFormat::Pcapng && path == "-" && std::io::IsTerminal::is_terminal(&std::io::stdout()) {
+    if format != LogFormat::Candump && path == "-" && std::io::IsTerminal::is_terminal(&std::io::stdout()) {
         return report_to(
             bus,
             "record",
             Stream::Stderr,
-            Err(CommandError::Usage(
-                "pcapng is binary: write it to a file (-o FILE) or a pipe, not to a terminal".into(),
-            )),
+            Err(CommandError::Usage(format!(
+                "{} is binary: write it to a file (-o FILE) or a pipe, not to a terminal",
+                if format == LogFormat::Blf { "BLF" } else { "pcapng" }
+            ))),
         );
     }
     let result = tokio::runtime::Builder::new_current_thread()

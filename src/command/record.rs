@@ -154,9 +154,10 @@ pub struct RecordArgs {
     /// Append to an existing output file.
     #[arg(long)]
     pub append: bool,
-    /// The file format: candump (-l lines), pcapng (for Wireshark; not to a terminal), asc
-    /// (Vector ASC) or trc (PEAK TRC 2.1).
-    #[arg(long, default_value = "candump", value_parser = TypedWords::new(&["candump", "pcapng", "asc", "trc"], LogFormat::parse))]
+    /// The file format: candump (-l lines), pcapng (for Wireshark), asc (Vector ASC), trc
+    /// (PEAK TRC 2.1) or blf (Vector BLF, for CANalyzer/CANoe and python-can); the binary
+    /// ones not to a terminal.
+    #[arg(long, default_value = "candump", value_parser = TypedWords::new(&["candump", "pcapng", "asc", "trc", "blf"], LogFormat::parse))]
     pub format: LogFormat,
 }
 
@@ -236,6 +237,11 @@ pub fn open_output(
     if path == "-" {
         return Ok(LineSink::new(Box::new(std::io::stdout()), 0));
     }
+    if mode == WriteMode::Append && format == LogFormat::Blf {
+        return Err(CommandError::Usage(
+            "a BLF file cannot be appended to (its header holds the totals): write another file".into(),
+        ));
+    }
     if mode == WriteMode::Append {
         if matches!(format, LogFormat::Asc | LogFormat::Trc) {
             return Err(CommandError::Usage(
@@ -276,6 +282,7 @@ fn refuse_other_format(path: &str, format: LogFormat) -> Result<(), CommandError
     let (is, given) = match (pcapng, format) {
         (true, LogFormat::Candump) => ("pcapng", "candump lines"),
         (false, LogFormat::Pcapng) => ("not pcapng (a text log?)", "pcapng"),
+        (_, LogFormat::Blf) => return Ok(()),
         _ => return Ok(()),
     };
     Err(CommandError::Usage(format!(
@@ -362,8 +369,13 @@ pub async fn record<T: Target>(
             && rec.take(got, out, &mut note)?
         {}
     }
-    rec.writer.finish(out);
     rec.flush(out)?;
+    rec.writer.finish(out).map_err(|e| {
+        CommandError::Usage(format!(
+            "writing the end of the log failed: {e} ({} frames written)",
+            out.lines()
+        ))
+    })?;
     if let Some((from_ns, reason)) = rec.open_gap.take() {
         rec.gaps.push(Gap {
             from_ns,
@@ -390,18 +402,21 @@ pub enum LogFormat {
     Asc,
     /// PEAK TRC 2.1 (the header comes with the first frame; no `--append`).
     Trc,
+    /// Vector BLF for CANalyzer/CANoe and python-can (zlib containers, 1 ns timestamps).
+    Blf,
 }
 
 impl LogFormat {
-    /// Parses `candump`, `pcapng`, `asc` or `trc`.
+    /// Parses `candump`, `pcapng`, `asc`, `trc` or `blf`.
     pub fn parse(word: &str) -> Result<LogFormat, ParseError> {
         match word {
             "candump" | "log" => Ok(LogFormat::Candump),
             "pcapng" => Ok(LogFormat::Pcapng),
             "asc" => Ok(LogFormat::Asc),
             "trc" => Ok(LogFormat::Trc),
+            "blf" => Ok(LogFormat::Blf),
             _ => Err(ParseError::Invalid(format!(
-                "unknown record format `{word}`: use candump, pcapng, asc or trc"
+                "unknown record format `{word}`: use candump, pcapng, asc, trc or blf"
             ))),
         }
     }
@@ -415,6 +430,8 @@ enum Encoder {
     Pcapng(Vec<String>),
     Asc(AscWriter, String),
     Trc(TrcWriter, String),
+    /// Frames gather into a container, which goes out at every flush.
+    Blf(Box<crate::output::blf::BlfEncoder>),
 }
 
 impl Encoder {
@@ -429,6 +446,39 @@ impl Encoder {
             }
             LogFormat::Asc => Encoder::Asc(AscWriter::new(), String::new()),
             LogFormat::Trc => Encoder::Trc(TrcWriter::new(), String::new()),
+            LogFormat::Blf => Encoder::Blf(Box::default()),
+        }
+    }
+
+    /// Puts out what the encoder holds back (a BLF container), before the sink flushes.
+    fn flush<T: Target>(&mut self, out: &mut LineSink<T>) {
+        if let Encoder::Blf(enc) = self {
+            let n = enc.container(out.buffer());
+            if n > 0 {
+                out.end_frames(n);
+            }
+        }
+    }
+
+    /// The end of the recording: a BLF file gets its header (in a file, with its totals).
+    fn finish<T: Target>(&mut self, out: &mut LineSink<T>) -> std::io::Result<()> {
+        match self {
+            Encoder::Asc(w, text) => {
+                w.finish(text);
+                if !text.is_empty() {
+                    out.buffer().extend_from_slice(text.as_bytes());
+                    text.clear();
+                    out.end_record(false);
+                }
+                out.flush()
+            }
+            Encoder::Blf(enc) => {
+                let n = enc.finish(out.buffer());
+                out.end_frames(n);
+                out.flush()?;
+                out.target().rewrite_start(&enc.header())
+            }
+            Encoder::Candump(_) | Encoder::Pcapng(_) | Encoder::Trc(..) => Ok(()),
         }
     }
 
@@ -462,20 +512,15 @@ impl Encoder {
                 out.buffer().extend_from_slice(text.as_bytes());
                 text.clear();
             }
-        }
-        out.end_record(true);
-    }
-
-    /// Appends what closes the log (ASC's `End TriggerBlock`), not counted as a frame.
-    fn finish<T: Target>(&mut self, out: &mut LineSink<T>) {
-        if let Encoder::Asc(w, text) = self {
-            w.finish(text);
-            if !text.is_empty() {
-                out.buffer().extend_from_slice(text.as_bytes());
-                text.clear();
-                out.end_record(false);
+            Encoder::Blf(enc) => {
+                let n = enc.frame(out.buffer(), iface, f);
+                if n > 0 {
+                    out.end_frames(n);
+                }
+                return;
             }
         }
+        out.end_record(true);
     }
 }
 
@@ -544,6 +589,7 @@ impl Recording {
 
     fn flush<T: Target>(&mut self, out: &mut LineSink<T>) -> Result<(), CommandError> {
         self.flushed = Instant::now();
+        self.writer.flush(out);
         if !out.pending() {
             return Ok(());
         }
@@ -582,6 +628,10 @@ mod tests {
     impl Target for Mem {
         fn cut(&mut self, len: u64) -> std::io::Result<()> {
             self.0.truncate(len as usize);
+            Ok(())
+        }
+        fn rewrite_start(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+            self.0[..bytes.len()].copy_from_slice(bytes);
             Ok(())
         }
     }

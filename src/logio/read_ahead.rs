@@ -1,7 +1,8 @@
 //! Reads and parses a log on a second thread, handing the caller batches of
 //! parsed lines: parsing and decoding then run on two cores at once.
 
-use crate::log::{Counts, LogReader, Outcome};
+use crate::log::{Counts, Outcome};
+use crate::logio::reader::Reader;
 use std::io::{self, BufRead};
 use std::sync::mpsc;
 
@@ -26,7 +27,7 @@ pub struct Finished {
 /// order, on the calling thread. Returns the reader's counts (and the read
 /// error, if reading stopped on one) and whatever `consume` returned last.
 pub fn for_each_batch<R, E>(
-    mut reader: LogReader<R>,
+    mut reader: Reader<R>,
     mut consume: impl FnMut(&Batch) -> Result<(), E>,
 ) -> Result<Result<Finished, io::Error>, E>
 where
@@ -84,7 +85,7 @@ mod tests {
         let log: String = (0..n).map(|i| format!("(1.{i:06}) if{i} 181#01\n")).collect();
         let mut ifaces = Interfaces::default();
         let mut seen = Vec::new();
-        for_each_batch(LogReader::new(log.as_bytes()).unwrap(), |batch| -> Result<(), ()> {
+        for_each_batch(Reader::open(log.as_bytes(), None).unwrap(), |batch| -> Result<(), ()> {
             for name in &batch.new_interfaces {
                 ifaces.intern(name);
             }

@@ -9,6 +9,9 @@ use std::io::{self, Seek, SeekFrom, Write};
 pub trait Target: Write {
     /// Cuts the output back to `len` bytes. Streams cannot take bytes back and do nothing.
     fn cut(&mut self, len: u64) -> io::Result<()>;
+    /// Writes `bytes` over the output's first bytes (a BLF header's final totals), then
+    /// goes on at the end. Streams cannot and do nothing.
+    fn rewrite_start(&mut self, bytes: &[u8]) -> io::Result<()>;
 }
 
 impl Target for File {
@@ -16,10 +19,17 @@ impl Target for File {
         self.set_len(len)?;
         self.seek(SeekFrom::Start(len)).map(|_| ())
     }
+    fn rewrite_start(&mut self, bytes: &[u8]) -> io::Result<()> {
+        use std::os::unix::fs::FileExt;
+        self.write_all_at(bytes, 0)
+    }
 }
 
 impl Target for io::Stdout {
     fn cut(&mut self, _len: u64) -> io::Result<()> {
+        Ok(())
+    }
+    fn rewrite_start(&mut self, _bytes: &[u8]) -> io::Result<()> {
         Ok(())
     }
 }
@@ -27,6 +37,9 @@ impl Target for io::Stdout {
 impl<T: Target + ?Sized> Target for Box<T> {
     fn cut(&mut self, len: u64) -> io::Result<()> {
         (**self).cut(len)
+    }
+    fn rewrite_start(&mut self, bytes: &[u8]) -> io::Result<()> {
+        (**self).rewrite_start(bytes)
     }
 }
 
@@ -38,8 +51,9 @@ pub struct LineSink<T: Target> {
     kept: u64,
     /// Frame records this sink wrote out.
     lines: u64,
-    /// Where each record in `buf` ends, and whether it holds a frame (a pcapng header does not).
-    ends: std::collections::VecDeque<(usize, bool)>,
+    /// Where each record in `buf` ends, and how many frames it holds (a pcapng header none,
+    /// a BLF container many).
+    ends: std::collections::VecDeque<(usize, u64)>,
 }
 
 impl<T: Target> LineSink<T> {
@@ -60,7 +74,15 @@ impl<T: Target> LineSink<T> {
     /// Marks the end of the record just appended; `frame` when it holds a frame (counted
     /// in [`LineSink::lines`]).
     pub fn end_record(&mut self, frame: bool) {
-        self.ends.push_back((self.buf.len(), frame));
+        self.end_frames(frame as u64);
+    }
+    /// Marks the end of the record just appended, which holds `frames` frames.
+    pub fn end_frames(&mut self, frames: u64) {
+        self.ends.push_back((self.buf.len(), frames));
+    }
+    /// The output, to write over its start (see [`Target::rewrite_start`]).
+    pub fn target(&mut self) -> &mut T {
+        &mut self.out
     }
     /// True when lines are waiting to be written.
     pub fn pending(&self) -> bool {
@@ -94,7 +116,7 @@ impl<T: Target> LineSink<T> {
                 break;
             }
             whole = end;
-            self.lines += frame as u64;
+            self.lines += frame;
             self.ends.pop_front();
         }
         if failed.is_none() {
@@ -145,6 +167,10 @@ mod tests {
     impl Target for SmallDisk {
         fn cut(&mut self, len: u64) -> io::Result<()> {
             self.data.truncate(len as usize);
+            Ok(())
+        }
+        fn rewrite_start(&mut self, bytes: &[u8]) -> io::Result<()> {
+            self.data[..bytes.len()].copy_from_slice(bytes);
             Ok(())
         }
     }

@@ -1,6 +1,7 @@
 //! Headless renderings of decoded frames: text lines, JSON lines, SDO
-//! transactions and summaries, pcapng capture files and Parquet tables. Pure formatting; the caller writes.
+//! transactions and summaries, pcapng capture files, BLF logs and Parquet tables. Pure formatting; the caller writes.
 
+pub mod blf;
 pub mod busload;
 pub mod explain;
 pub mod jsonl;

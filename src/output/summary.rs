@@ -161,7 +161,12 @@ impl Summary {
             by_node: self
                 .by_node
                 .iter()
-                .map(|(node, counts)| (self.node_key(several, *node), kinds(counts).map(|(k, n)| (k.as_str(), n)).collect()))
+                .map(|(node, counts)| {
+                    (
+                        self.node_key(several, *node),
+                        kinds(counts).map(|(k, n)| (k.as_str(), n)).collect(),
+                    )
+                })
                 .collect(),
             frames: self.frames,
         }

@@ -3,7 +3,8 @@
 //! paces it by its timestamps and obeys pause, step, speed and seek.
 
 use crate::frame::Frame;
-use crate::log::{Format, LogReader, Outcome};
+use crate::log::Outcome;
+use crate::logio::reader::{ReadAs, Reader};
 use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
@@ -111,13 +112,13 @@ impl ReadError {
 }
 
 /// A reader of `path` as `format` (`None`: detected from its content).
-fn reader(path: &Path, format: Option<Format>) -> Result<LogReader<BufReader<File>>, ReadError> {
+fn reader(path: &Path, format: Option<ReadAs>) -> Result<Reader<BufReader<File>>, ReadError> {
     let file = File::open(path).map_err(|e| ReadError::new(path, e))?;
-    LogReader::open(BufReader::with_capacity(1 << 20, file), format).map_err(|e| ReadError::new(path, e))
+    Reader::open(BufReader::with_capacity(1 << 20, file), format).map_err(|e| ReadError::new(path, e))
 }
 
 /// Reads `path` as fast as possible.
-pub fn open(path: PathBuf, format: Option<Format>) -> Receiver<Feed> {
+pub fn open(path: PathBuf, format: Option<ReadAs>) -> Receiver<Feed> {
     let (tx, rx) = sync_channel(QUEUE);
     thread::spawn(move || {
         let mut r = match reader(&path, format) {
@@ -171,7 +172,7 @@ pub fn open(path: PathBuf, format: Option<Format>) -> Receiver<Feed> {
 fn send_batch<R: std::io::BufRead>(
     tx: &SyncSender<Feed>,
     batch: &mut Vec<Frame>,
-    r: &LogReader<R>,
+    r: &Reader<R>,
     names: &mut usize,
 ) -> bool {
     let ifaces = r.interfaces().names();
@@ -201,7 +202,7 @@ pub fn valid_speed(x: f64) -> bool {
 /// feed and the control line. The replay sends [`Feed::Position`] with its batches and after
 /// every command, and [`Feed::Extent`] once a background pass has measured the log. At the
 /// end it says "replay finished" and waits for a seek back, a step back or a rewind.
-pub fn replay(path: PathBuf, speed: f64, format: Option<Format>) -> (Receiver<Feed>, Sender<Control>) {
+pub fn replay(path: PathBuf, speed: f64, format: Option<ReadAs>) -> (Receiver<Feed>, Sender<Control>) {
     let (tx, rx) = sync_channel(QUEUE);
     let (ctl_tx, ctl_rx) = channel();
     let measure = (path.clone(), tx.clone());
@@ -256,7 +257,7 @@ enum Target {
 struct Player {
     path: PathBuf,
     /// The format to read the log as (`None`: detected).
-    format: Option<Format>,
+    format: Option<ReadAs>,
     tx: SyncSender<Feed>,
     ctl: Receiver<Control>,
     speed: f64,
@@ -447,7 +448,7 @@ impl Player {
         anchor: &mut Option<(u64, Instant)>,
         at: Position,
         batch: &mut Vec<Frame>,
-        r: &LogReader<R>,
+        r: &Reader<R>,
         names: &mut usize,
     ) -> Wait {
         loop {
@@ -493,7 +494,7 @@ impl Player {
     fn flush<R: std::io::BufRead>(
         &self,
         batch: &mut Vec<Frame>,
-        r: &LogReader<R>,
+        r: &Reader<R>,
         names: &mut usize,
         at: Position,
     ) -> bool {
@@ -591,6 +592,23 @@ mod tests {
         let (n, _, notes) = drain(&open("/nonexistent/x.log".into(), None));
         assert_eq!(n, 0);
         assert!(notes[0].starts_with("/nonexistent/x.log: "), "{notes:?}");
+    }
+
+    #[test]
+    fn open_reads_a_blf_log_as_it_reads_the_same_frames_as_candump() {
+        let l = log(5_000);
+        let blf = l.0.with_extension("blf");
+        let mut w = crate::output::blf::BlfWriter::new(File::create(&blf).unwrap());
+        let mut text = reader(&l.0, None).unwrap();
+        while let Some((_, outcome)) = text.next_line().unwrap() {
+            if let Outcome::Frame(f) = outcome {
+                w.write_frame(text.interfaces().name(f.iface), &f).unwrap();
+            }
+        }
+        w.finish().unwrap();
+        let (n, _, notes) = drain(&open(blf.clone(), None));
+        let _ = std::fs::remove_file(&blf);
+        assert_eq!((n, notes), (5_000, Vec::<String>::new()));
     }
 
     /// What the UI has from a replay: the frames since the last reset, the resets, the

@@ -15,6 +15,7 @@ mod diagnose_golden;
 mod diagnose_peer;
 mod eds_import;
 mod explain_golden;
+mod formats_binary;
 mod formats_python_can;
 mod json_contract;
 mod log_can_utils;

@@ -1,5 +1,6 @@
 //! Log formats: candump `-l` logs, candump's screen output, Vector ASC, PEAK TRC and
-//! python-can CSV, plus a candump log writer.
+//! python-can CSV, plus a candump log writer; [`blf`] holds the byte-level half of Vector
+//! BLF (its file IO and zlib live in cotui's `logio`).
 //!
 //! Each format has a line parser (`parse_line(&mut self, &[u8], &mut Interfaces)`) that
 //! works on bytes, allocates nothing per line and never panics. [`LogReader`] drives one
@@ -7,6 +8,7 @@
 //! line buffer when a line straddles it), and counts what it saw.
 
 pub mod asc;
+pub mod blf;
 pub mod candump;
 pub mod csv;
 pub mod export;
@@ -145,6 +147,14 @@ impl Counts {
     /// Lines skipped for any reason.
     pub fn skipped_total(&self) -> u64 {
         self.skipped.iter().sum()
+    }
+    /// Counts one outcome of a reader outside this module (the binary log readers).
+    pub fn record(&mut self, outcome: &Outcome) {
+        match outcome {
+            Outcome::Frame(_) => self.frames += 1,
+            Outcome::Skip(r) => self.skipped[r.index()] += 1,
+            Outcome::Warning(_) => self.warnings += 1,
+        }
     }
 }
 
