@@ -62,6 +62,8 @@ fn need_bytes(estimate: f64) -> u64 {
 /// `scan --probe` on the demo bus: how long it listens and waits for each answer (ms).
 const SCAN_LISTEN_MS: u64 = 100;
 const SCAN_TIMEOUT_MS: u64 = 300;
+/// Target wall time of `decode --format parquet -o DIR` as a multiple of JSONL's.
+const PARQUET_TARGET_VS_JSONL: f64 = 1.5;
 
 /// One way of running the decoder, and its measurements.
 struct Run {
@@ -214,6 +216,8 @@ fn measure_all(args: &BenchArgs, exe: &Path, dir: &Path) -> std::io::Result<Figu
         few.to_string_lossy(),
     );
     let n = args.frames;
+    let pq = dir.join("pq");
+    let pq = pq.to_string_lossy();
     let mut runs = vec![
         Run::new(
             "summary",
@@ -242,6 +246,13 @@ fn measure_all(args: &BenchArgs, exe: &Path, dir: &Path) -> std::io::Result<Figu
             &["decode", "--format", "jsonl", &b],
             n,
             Some(4.0),
+        ),
+        Run::new(
+            "parquet",
+            "decode --format parquet -o DIR",
+            &["decode", "--format", "parquet", "-o", &pq, &b],
+            n,
+            None,
         ),
         Run::new(
             "diagnose",
@@ -363,6 +374,12 @@ fn many_ifaces_ratio(runs: &[Run]) -> Option<f64> {
     Some(rate("summary-many-ifaces")? / rate("summary-few-ifaces")?)
 }
 
+/// Parquet's wall time as a multiple of JSONL's on the same log.
+fn parquet_vs_jsonl(runs: &[Run]) -> Option<f64> {
+    let secs = |name| runs.iter().find(|r| r.name == name).map(Run::seconds);
+    Some(secs("parquet")? / secs("jsonl")?)
+}
+
 /// The 1-minute load average (from /proc/loadavg), when known.
 fn load_average() -> Option<String> {
     let text = std::fs::read_to_string("/proc/loadavg").ok()?;
@@ -393,6 +410,7 @@ fn report(args: &BenchArgs, f: &Figures) {
                 "canopen_lens_frames_per_s": f.lens_rate,
                 "scan_probe_s": f.scan_s, "scan_probe_target_s": scan_target_s(),
                 "many_ifaces_vs_few": many_ifaces_ratio(runs),
+                "parquet_vs_jsonl": parquet_vs_jsonl(runs), "parquet_vs_jsonl_target": PARQUET_TARGET_VS_JSONL,
             })
         );
         return;
@@ -414,6 +432,12 @@ fn report(args: &BenchArgs, f: &Figures) {
             r.rate(),
             r.seconds(),
             r.peak_rss_kib
+        );
+    }
+    if let Some(r) = parquet_vs_jsonl(runs) {
+        println!(
+            "  {:<32} {r:>12.2}x JSONL's wall time (target <= {PARQUET_TARGET_VS_JSONL}x)",
+            "parquet vs jsonl"
         );
     }
     match base {

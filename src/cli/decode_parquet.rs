@@ -20,10 +20,11 @@ const fn col(name: &'static str, ty: Ty, null: bool) -> Col {
 }
 
 /// Columns of `frames.parquet`, one row per frame.
-pub const FRAME_COLS: [Col; 28] = [
+pub const FRAME_COLS: [Col; 29] = [
     col("file", Ty::Str, false),
     col("line", Ty::I64, false),
-    col("ts", Ty::TimestampNs, false),
+    col("ts", Ty::TimestampUs, false),
+    col("ts_ns", Ty::I64, false),
     col("iface", Ty::Str, false),
     col("id", Ty::I32, false),
     col("ext", Ty::Bool, false),
@@ -35,7 +36,7 @@ pub const FRAME_COLS: [Col; 28] = [
     col("data", Ty::Bin, false),
     col("kind", Ty::Str, false),
     col("node", Ty::I32, true),
-    col("label", Ty::Str, false),
+    col("label", Ty::Text, false),
     col("malformed", Ty::Str, true),
     col("nmt_command", Ty::Str, true),
     col("nmt_target", Ty::I32, true),
@@ -53,11 +54,13 @@ pub const FRAME_COLS: [Col; 28] = [
 
 /// Columns of `values.parquet`: one row per SDO transaction and per PDO signal, of a node
 /// of an interface (node 5 of can0 and node 5 of can1 are two nodes).
-pub const VALUE_COLS: [Col; 20] = [
+pub const VALUE_COLS: [Col; 22] = [
     col("file", Ty::Str, false),
     col("source", Ty::Str, false),
-    col("ts", Ty::TimestampNs, false),
-    col("start_ts", Ty::TimestampNs, false),
+    col("ts", Ty::TimestampUs, false),
+    col("ts_ns", Ty::I64, false),
+    col("start_ts", Ty::TimestampUs, false),
+    col("start_ts_ns", Ty::I64, false),
     col("iface", Ty::Str, false),
     col("node", Ty::I32, false),
     col("index", Ty::I32, true),
@@ -249,11 +252,13 @@ fn write_stream(
                 for s in &p.signals {
                     values
                         .row(|r| {
-                            let ts = V::I64(ts(frame.ts_ns));
+                            let (us, ns) = (V::I64(ts_us(frame.ts_ns)), V::I64(ts_ns(frame.ts_ns)));
                             r.push(Some(V::Str(path)))?
                                 .push(Some(V::Str("pdo")))?
-                                .push(Some(ts.clone()))?
-                                .push(Some(ts))?
+                                .push(Some(us.clone()))?
+                                .push(Some(ns.clone()))?
+                                .push(Some(us))?
+                                .push(Some(ns))?
                                 .push(Some(V::Str(iface)))?
                                 .push(Some(V::I32(node as i32)))?
                                 .push(Some(V::I32(s.index as i32)))?
@@ -293,8 +298,13 @@ fn write_stream(
 }
 
 /// A timestamp in ns as Parquet's signed INT64 (saturating past year 2262).
-fn ts(ns: u64) -> i64 {
+fn ts_ns(ns: u64) -> i64 {
     i64::try_from(ns).unwrap_or(i64::MAX)
+}
+
+/// A timestamp in ns as the microseconds of a TIMESTAMP(MICROS) column (truncated).
+fn ts_us(ns: u64) -> i64 {
+    (ns / 1000) as i64
 }
 
 fn frame_row<W: Write + Send>(
@@ -340,7 +350,8 @@ fn frame_row<W: Write + Send>(
     t.row(|r| {
         r.push(Some(V::Str(file)))?
             .push(Some(V::I64(line as i64)))?
-            .push(Some(V::I64(ts(f.ts_ns))))?
+            .push(Some(V::I64(ts_us(f.ts_ns))))?
+            .push(Some(V::I64(ts_ns(f.ts_ns))))?
             .push(Some(V::Str(iface)))?
             .push(i32v(f.id as i32))?
             .push(Some(V::Bool(f.is_ext())))?
@@ -385,8 +396,10 @@ fn transaction_row<W: Write + Send>(
     t.row(|r| {
         r.push(Some(V::Str(file)))?
             .push(Some(V::Str("sdo")))?
-            .push(Some(V::I64(ts(tr.end_ns))))?
-            .push(Some(V::I64(ts(tr.start_ns))))?
+            .push(Some(V::I64(ts_us(tr.end_ns))))?
+            .push(Some(V::I64(ts_ns(tr.end_ns))))?
+            .push(Some(V::I64(ts_us(tr.start_ns))))?
+            .push(Some(V::I64(ts_ns(tr.start_ns))))?
             .push(Some(V::Str(iface)))?
             .push(Some(V::I32(tr.node as i32)))?
             .push((!partial).then_some(V::I32(tr.index as i32)))?

@@ -3,13 +3,24 @@
 //! comes first, so memory stays flat whatever the input size.
 //!
 //! The schema is a list of [`Col`]umns (name, type, nullable); rows are pushed value by
-//! value in schema order through [`Table::row`]. The file is Snappy-compressed.
+//! value in schema order through [`Table::row`]. Values are buffered column by column
+//! (strings and bytes of a column in one buffer, no allocation per value) and handed to
+//! the Parquet encoder a column at a time when the row group is written. Short, repeated
+//! strings ([`Ty::Str`]: kinds, interface and file names) are dictionary-encoded; free
+//! text ([`Ty::Text`]) and bytes are plain-encoded without statistics (a dictionary of
+//! values that hardly repeat only costs hashing). The file is Snappy-compressed.
+//!
+//! Every type is one Spark, Trino and DuckDB read as written: signed INT32/INT64 (no
+//! unsigned annotations), DOUBLE, BOOLEAN, BYTE_ARRAY (UTF8 or plain binary) and
+//! INT64 TIMESTAMP(MICROS, UTC) (Spark rejects TIMESTAMP(NANOS)).
 
+use bytes::Bytes;
 use parquet::basic::Compression;
 use parquet::data_type::{BoolType, ByteArray, ByteArrayType, DoubleType, Int32Type, Int64Type};
-use parquet::file::properties::WriterProperties;
+use parquet::file::properties::{EnabledStatistics, WriterProperties};
 use parquet::file::writer::SerializedFileWriter;
 use parquet::schema::parser::parse_message_type;
+use parquet::schema::types::ColumnPath;
 use std::io::{self, Write};
 use std::sync::Arc;
 
@@ -20,8 +31,13 @@ pub const ROW_GROUP_ROWS: usize = 65_536;
 /// rows: a table whose rows trickle in (SDO transactions) must not grow until 65536.
 pub const ROW_GROUP_BYTES: usize = 16 << 20;
 
-/// Estimated buffer cost of one value besides its bytes (the `ByteArray` handle).
-const VALUE_OVERHEAD: usize = 48;
+/// Values handed to the column encoder per step.
+const WRITE_BATCH: usize = 8192;
+
+/// Estimated buffer cost of one string or bytes value besides its bytes (its end offset,
+/// and its `ByteArray` handle when the group is written).
+const VALUE_OVERHEAD: usize = 40;
+
 /// Physical and logical type of a column.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Ty {
@@ -29,10 +45,12 @@ pub enum Ty {
     I32,
     I64,
     F64,
-    /// INT64 nanoseconds since the Unix epoch, TIMESTAMP(NANOS, UTC).
-    TimestampNs,
-    /// UTF-8 text (BYTE_ARRAY, UTF8).
+    /// INT64 microseconds since the Unix epoch, TIMESTAMP(MICROS, UTC).
+    TimestampUs,
+    /// UTF-8 text with few distinct values (BYTE_ARRAY, UTF8), dictionary-encoded.
     Str,
+    /// UTF-8 text with mostly distinct values (BYTE_ARRAY, UTF8), plain-encoded.
+    Text,
     /// Raw bytes (BYTE_ARRAY).
     Bin,
 }
@@ -63,7 +81,11 @@ enum Values {
     I32(Vec<i32>),
     I64(Vec<i64>),
     F64(Vec<f64>),
-    Bytes(Vec<ByteArray>),
+    /// All values' bytes back to back, and where each value ends in `buf`.
+    Bytes {
+        buf: Vec<u8>,
+        ends: Vec<usize>,
+    },
 }
 
 struct Column {
@@ -78,9 +100,12 @@ impl Column {
         let values = match col.ty {
             Ty::Bool => Values::Bool(Vec::new()),
             Ty::I32 => Values::I32(Vec::new()),
-            Ty::I64 | Ty::TimestampNs => Values::I64(Vec::new()),
+            Ty::I64 | Ty::TimestampUs => Values::I64(Vec::new()),
             Ty::F64 => Values::F64(Vec::new()),
-            Ty::Str | Ty::Bin => Values::Bytes(Vec::new()),
+            Ty::Str | Ty::Text | Ty::Bin => Values::Bytes {
+                buf: Vec::new(),
+                ends: Vec::new(),
+            },
         };
         Column {
             col,
@@ -91,6 +116,7 @@ impl Column {
 
     /// Appends one value and returns its estimated buffer cost; a value of the wrong type
     /// or a null in a required column is an error naming the column.
+    #[inline]
     fn push(&mut self, v: Option<V>) -> io::Result<usize> {
         let cost = match &v {
             Some(V::Str(s)) => VALUE_OVERHEAD + s.len(),
@@ -119,12 +145,14 @@ impl Column {
                 b.push(x);
                 true
             }
-            (Values::Bytes(b), Some(V::Str(s))) if self.col.ty == Ty::Str => {
-                b.push(ByteArray::from(s.as_bytes().to_vec()));
+            (Values::Bytes { buf, ends }, Some(V::Str(s))) if self.col.ty != Ty::Bin => {
+                buf.extend_from_slice(s.as_bytes());
+                ends.push(buf.len());
                 true
             }
-            (Values::Bytes(b), Some(V::Bin(s))) if self.col.ty == Ty::Bin => {
-                b.push(ByteArray::from(s.to_vec()));
+            (Values::Bytes { buf, ends }, Some(V::Bin(s))) if self.col.ty == Ty::Bin => {
+                buf.extend_from_slice(s);
+                ends.push(buf.len());
                 true
             }
             _ => false,
@@ -148,8 +176,29 @@ impl Column {
             Values::I32(v) => v.clear(),
             Values::I64(v) => v.clear(),
             Values::F64(v) => v.clear(),
-            Values::Bytes(v) => v.clear(),
+            Values::Bytes { buf, ends } => {
+                buf.clear();
+                ends.clear();
+            }
         }
+    }
+
+    /// The buffered strings or bytes as `ByteArray`s into `out` (cleared first): slices
+    /// of one shared buffer, so no copy or allocation per value.
+    fn byte_arrays(&mut self, out: &mut Vec<ByteArray>) {
+        out.clear();
+        let Values::Bytes { buf, ends } = &mut self.values else {
+            return;
+        };
+        // The next group's values need as much room again: keep the capacity.
+        let data = Bytes::from(std::mem::replace(buf, Vec::with_capacity(buf.capacity())));
+        let mut start = 0;
+        out.extend(ends.iter().map(|&end| {
+            let v = ByteArray::from(data.slice(start..end));
+            start = end;
+            v
+        }));
+        ends.clear();
     }
 }
 
@@ -161,12 +210,12 @@ fn schema_line(c: &Col) -> String {
         Ty::I32 => "INT32",
         Ty::I64 => "INT64",
         Ty::F64 => "DOUBLE",
-        Ty::TimestampNs => "INT64",
-        Ty::Str | Ty::Bin => "BYTE_ARRAY",
+        Ty::TimestampUs => "INT64",
+        Ty::Str | Ty::Text | Ty::Bin => "BYTE_ARRAY",
     };
     let logical = match c.ty {
-        Ty::TimestampNs => " (TIMESTAMP(NANOS,true))",
-        Ty::Str => " (UTF8)",
+        Ty::TimestampUs => " (TIMESTAMP(MICROS,true))",
+        Ty::Str | Ty::Text => " (UTF8)",
         _ => "",
     };
     format!("  {rep} {ty} {}{logical};\n", c.name)
@@ -189,6 +238,8 @@ pub struct Table<W: Write + Send> {
     rows: usize,
     /// Estimated bytes buffered in `columns`.
     bytes: usize,
+    /// The `ByteArray`s of the string or bytes column being written (reused).
+    arrays: Vec<ByteArray>,
 }
 
 /// One row being pushed: values go to the columns in schema order.
@@ -200,6 +251,7 @@ pub struct Row<'t> {
 
 impl Row<'_> {
     /// Pushes the next column's value (`None` for null).
+    #[inline]
     pub fn push(&mut self, v: Option<V>) -> io::Result<&mut Self> {
         let Some(c) = self.columns.get_mut(self.at) else {
             return Err(io::Error::other("parquet: more values than columns in a row"));
@@ -219,16 +271,25 @@ impl<W: Write + Send> Table<W> {
         }
         schema.push('}');
         let schema = Arc::new(parse_message_type(&schema).map_err(pq_err)?);
-        let props = WriterProperties::builder()
+        let mut props = WriterProperties::builder()
             .set_compression(Compression::SNAPPY)
             .set_created_by(format!("cotui {}", env!("CARGO_PKG_VERSION")))
-            .build();
+            // Values go to the encoder a row group at a time: bigger steps, less overhead.
+            .set_write_batch_size(WRITE_BATCH);
+        for c in cols.iter().filter(|c| matches!(c.ty, Ty::Text | Ty::Bin)) {
+            let path = ColumnPath::from(c.name);
+            props = props
+                .set_column_dictionary_enabled(path.clone(), false)
+                .set_column_statistics_enabled(path, EnabledStatistics::None);
+        }
+        let props = props.build();
         let writer = SerializedFileWriter::new(out, schema, Arc::new(props)).map_err(pq_err)?;
         Ok(Table {
             writer,
             columns: cols.iter().map(|c| Column::new(*c)).collect(),
             rows: 0,
             bytes: 0,
+            arrays: Vec::new(),
         })
     }
 
@@ -267,15 +328,17 @@ impl<W: Write + Send> Table<W> {
                     "parquet: fewer columns in the file than in the schema",
                 ));
             };
+            c.byte_arrays(&mut self.arrays);
             let defs = c.col.null.then_some(c.defs.as_slice());
             match &c.values {
                 Values::Bool(v) => w.typed::<BoolType>().write_batch(v, defs, None),
                 Values::I32(v) => w.typed::<Int32Type>().write_batch(v, defs, None),
                 Values::I64(v) => w.typed::<Int64Type>().write_batch(v, defs, None),
                 Values::F64(v) => w.typed::<DoubleType>().write_batch(v, defs, None),
-                Values::Bytes(v) => w.typed::<ByteArrayType>().write_batch(v, defs, None),
+                Values::Bytes { .. } => w.typed::<ByteArrayType>().write_batch(&self.arrays, defs, None),
             }
             .map_err(pq_err)?;
+            self.arrays.clear();
             w.close().map_err(pq_err)?;
             c.clear();
         }
@@ -310,7 +373,7 @@ mod tests {
         },
         Col {
             name: "t",
-            ty: Ty::TimestampNs,
+            ty: Ty::TimestampUs,
             null: false,
         },
     ];

@@ -1,6 +1,6 @@
 //! Integration tests of the headless decoder and its inputs and outputs: golden output of
 //! `cotui decode`/`diagnose`, log formats against can-utils, Wireshark's dissector, EDS import
-//! against python canopen, pcapng/Parquet read back by their own tools, fuzzing.
+//! against python canopen, pcapng/Parquet read back by their own tools (Parquet also by Spark), fuzzing.
 
 // Test code may unwrap: a failed unwrap is a failed test with its location.
 #![allow(clippy::unwrap_used)]
@@ -24,6 +24,7 @@ mod log_fuzz;
 mod no_panic;
 mod parquet_duckdb;
 mod parquet_full;
+mod parquet_spark;
 mod pcapng;
 mod profile_example;
 mod realworld_block;

@@ -8,7 +8,8 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-fn logs() -> Vec<PathBuf> {
+/// The fixture logs and the real-world logs, as absolute paths.
+pub(super) fn logs() -> Vec<PathBuf> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut out = Vec::new();
     for (dir, suffix) in [
@@ -28,7 +29,8 @@ fn logs() -> Vec<PathBuf> {
     out
 }
 
-fn cotui(args: &[&str], log: &Path) -> std::process::Output {
+/// Runs `cotui decode ARGS LOG`, which must succeed.
+pub(super) fn cotui(args: &[&str], log: &Path) -> std::process::Output {
     let out = Command::new(env!("CARGO_BIN_EXE_cotui"))
         .args(["decode"])
         .args(args)
@@ -44,6 +46,44 @@ fn cotui(args: &[&str], log: &Path) -> std::process::Output {
     out
 }
 
+/// Writes each log's two tables to `DIR/NN/` (`-o DIR`, the layout of a fleet of logs).
+pub(super) fn write_tables(dir: &Path, logs: &[PathBuf]) {
+    let _ = std::fs::remove_dir_all(dir);
+    for (i, log) in logs.iter().enumerate() {
+        let out = dir.join(format!("{i:02}"));
+        cotui(&["--format", "parquet", "-o", out.to_str().unwrap()], log);
+        assert!(out.join("frames.parquet").is_file() && out.join("values.parquet").is_file());
+    }
+}
+
+/// `--summary` of `log` as sorted rows: frames per kind (`[kind, n]`) and per node-ID and
+/// kind (`[node, kind, n]`; nodes of several interfaces, keyed `can1/5`, add up per node-ID
+/// as a query of the frames table counts them).
+pub(super) fn summary_counts(log: &Path) -> (Vec<Value>, Vec<Value>) {
+    let summary = &json_lines(&cotui(&["--summary", "--format", "jsonl"], log))[0];
+    let kinds = summary["by_kind"]
+        .as_object()
+        .unwrap()
+        .iter()
+        .map(|(k, n)| json!([k, n]))
+        .collect();
+    let mut per_node: BTreeMap<(u64, String), u64> = BTreeMap::new();
+    for (key, per_kind) in summary["by_node"].as_object().unwrap() {
+        let node = key.rsplit('/').next().unwrap().parse::<u64>().unwrap();
+        for (k, n) in per_kind.as_object().unwrap() {
+            *per_node.entry((node, k.clone())).or_default() += n.as_u64().unwrap();
+        }
+    }
+    let nodes = per_node.into_iter().map(|((node, k), n)| json!([node, k, n])).collect();
+    (sorted(kinds), sorted(nodes))
+}
+
+/// `v` sorted by its JSON text (the order rows are compared in).
+pub(super) fn sorted(mut v: Vec<Value>) -> Vec<Value> {
+    v.sort_by_key(|r| r.to_string());
+    v
+}
+
 fn json_lines(out: &std::process::Output) -> Vec<Value> {
     String::from_utf8(out.stdout.clone())
         .unwrap()
@@ -54,7 +94,7 @@ fn json_lines(out: &std::process::Output) -> Vec<Value> {
 
 /// Runs `sql` queries in DuckDB over the tables under `dir`; each answer is a list of
 /// rows (lists of values). A missing duckdb package fails the test with how to fix it.
-fn duckdb(dir: &Path, queries: &[(&str, String)]) -> BTreeMap<String, Value> {
+pub(super) fn duckdb(dir: &Path, queries: &[(&str, String)]) -> BTreeMap<String, Value> {
     let script = r#"
 import json, sys
 try:
@@ -83,14 +123,8 @@ print(json.dumps(out, default=str))
 #[test]
 fn duckdb_counts_and_decoded_fields_agree_with_summary_jsonl_and_transactions() {
     let dir = std::env::temp_dir().join(format!("cotui-parquet-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
     let logs = logs();
-    // One directory per log, the layout a fleet of logs gets (`-o DIR`).
-    for (i, log) in logs.iter().enumerate() {
-        let out = dir.join(format!("{i:02}"));
-        cotui(&["--format", "parquet", "-o", out.to_str().unwrap()], log);
-        assert!(out.join("frames.parquet").is_file() && out.join("values.parquet").is_file());
-    }
+    write_tables(&dir, &logs);
     let got = duckdb(
         &dir,
         &[
@@ -118,7 +152,8 @@ fn duckdb_counts_and_decoded_fields_agree_with_summary_jsonl_and_transactions() 
             ),
             (
                 "frames",
-                "SELECT file, line, epoch_ns(ts), id, hex(data), label FROM 'DIR/*/frames.parquet'".into(),
+                "SELECT file, line, ts_ns, id, hex(data), label, epoch_us(ts) = ts_ns // 1000 FROM 'DIR/*/frames.parquet'"
+                    .into(),
             ),
             (
                 "transactions",
@@ -143,40 +178,22 @@ fn duckdb_counts_and_decoded_fields_agree_with_summary_jsonl_and_transactions() 
         v.sort_by_key(|r| r.to_string());
         v
     };
-    let sorted = |mut v: Vec<Value>| {
-        v.sort_by_key(|r| r.to_string());
-        v
-    };
-    let mut emcy_by_node: BTreeMap<String, u64> = BTreeMap::new();
+    let mut emcy_by_node: BTreeMap<u64, u64> = BTreeMap::new();
     let (mut emcy_seen, mut aborts_seen, mut signals_seen) = (0, 0, 0);
     for log in &logs {
         let file = log.to_str().unwrap();
         // Per-kind and per-node counts: --summary.
-        let summary = &json_lines(&cotui(&["--summary", "--format", "jsonl"], log))[0];
-        let mut kinds = Vec::new();
-        for (k, n) in summary["by_kind"].as_object().unwrap() {
-            kinds.push(json!([k, n]));
+        let (kinds, nodes) = summary_counts(log);
+        assert_eq!(rows("kinds", file), kinds, "{file}: frames per kind");
+        assert_eq!(rows("nodes", file), nodes, "{file}: frames per node and kind");
+        for r in nodes.iter().filter(|r| r[1] == "emcy") {
+            *emcy_by_node.entry(r[0].as_u64().unwrap()).or_default() += r[2].as_u64().unwrap();
         }
-        assert_eq!(rows("kinds", file), sorted(kinds), "{file}: frames per kind");
-        // With nodes on several interfaces the summary keys are `can1/5`: the frames table
-        // query counts per node-ID, so those add up here.
-        let mut per_node: BTreeMap<(u64, String), u64> = BTreeMap::new();
-        for (key, per_kind) in summary["by_node"].as_object().unwrap() {
-            let node = key.rsplit('/').next().unwrap().to_string();
-            for (k, n) in per_kind.as_object().unwrap() {
-                *per_node.entry((node.parse::<u64>().unwrap(), k.clone())).or_default() += n.as_u64().unwrap();
-            }
-            if let Some(n) = per_kind.get("emcy") {
-                *emcy_by_node.entry(node).or_default() += n.as_u64().unwrap();
-            }
-        }
-        let nodes: Vec<Value> = per_node.into_iter().map(|((node, k), n)| json!([node, k, n])).collect();
-        assert_eq!(rows("nodes", file), sorted(nodes), "{file}: frames per node and kind");
 
         // Decoded fields: the JSONL frames.
         let (mut emcy, mut aborts, mut frames, mut signals) = (vec![], vec![], vec![], vec![]);
         for f in json_lines(&cotui(&["--format", "jsonl"], log)) {
-            let t = (f["t"].as_f64().unwrap() * 1e9).round() as i64;
+            let t = f["t"].as_f64().unwrap();
             frames.push((
                 f["line"].as_i64().unwrap(),
                 t,
@@ -212,12 +229,12 @@ fn duckdb_counts_and_decoded_fields_agree_with_summary_jsonl_and_transactions() 
         assert_eq!(pq_frames.len(), frames.len(), "{file}: frame count");
         for (p, (line, t, id, data, label)) in pq_frames.iter().zip(&frames) {
             assert_eq!(p[0].as_i64(), Some(*line), "{file}");
-            // Timestamps to the microsecond (the JSONL `t` is a float of seconds).
-            assert!(
-                (p[1].as_i64().unwrap() - t).abs() < 1000,
-                "{file}:{line}: time {p} vs {t}"
-            );
+            // `ts_ns` is the JSONL `t` (a float of seconds, so to the microsecond), and `ts`
+            // is `ts_ns` truncated to microseconds.
+            let ns = p[1].as_i64().unwrap();
+            assert!((ns as f64 / 1e9 - t).abs() < 1e-6, "{file}:{line}: time {p} vs {t}");
             assert_eq!((&p[2], &p[3], &p[4]), (id, data, label), "{file}:{line}");
+            assert_eq!(p[5], true, "{file}:{line}: ts is ts_ns in microseconds");
         }
 
         // SDO transactions: --transactions.
@@ -236,10 +253,7 @@ fn duckdb_counts_and_decoded_fields_agree_with_summary_jsonl_and_transactions() 
         assert_eq!(rows("transactions", file), sorted(tr), "{file}: SDO transactions");
     }
     // The README's query over the whole fleet.
-    let mut fleet: Vec<Value> = emcy_by_node
-        .iter()
-        .map(|(n, c)| json!([n.parse::<u64>().unwrap(), c]))
-        .collect();
+    let mut fleet: Vec<Value> = emcy_by_node.iter().map(|(n, c)| json!([n, c])).collect();
     fleet.sort_by_key(|r| r.to_string());
     let mut q = got["emcy_by_node"].as_array().unwrap().clone();
     q.sort_by_key(|r| r.to_string());
@@ -306,5 +320,36 @@ fn a_value_row_names_the_interface_of_its_node() {
         )],
     );
     assert_eq!(got["sdo"], json!([["can0", 2, "incomplete"], ["can1", 2, "ok"]]));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_schema_is_the_documented_one() {
+    // The column names, physical types, nullability and annotations of both tables (the
+    // README's "Parquet tables"): only types Spark and Trino accept (signed integers,
+    // TIMESTAMP_MICROS rather than NANOS), pinned so a change is deliberate.
+    let log = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/cia301_mix.log");
+    let dir = std::env::temp_dir().join(format!("cotui-parquet-schema-{}", std::process::id()));
+    cotui(&["--format", "parquet", "-o", dir.to_str().unwrap()], &log);
+    let query = |table: &str| {
+        format!(
+            "SELECT name, type, repetition_type, converted_type FROM parquet_schema('DIR/{table}.parquet') WHERE type IS NOT NULL"
+        )
+    };
+    let got = duckdb(&dir, &[("frames", query("frames")), ("values", query("values"))]);
+    let mut text = String::new();
+    for table in ["frames", "values"] {
+        text.push_str(&format!("{table}.parquet\n"));
+        for col in got[table].as_array().unwrap() {
+            let c: Vec<&str> = col
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_str().unwrap_or("-"))
+                .collect();
+            text.push_str(&format!("  {}\n", c.join(" ")));
+        }
+    }
+    insta::assert_snapshot!("parquet_schema", text);
     std::fs::remove_dir_all(&dir).unwrap();
 }
