@@ -2,13 +2,13 @@
 # Installs what the test suite needs on a fresh Debian machine: real peers to test
 # against (can-utils, Wireshark's tshark, the python canopen library, DuckDB for the Parquet
 # tests, canopen-lens for `cotui diagnose`), tmux for the end-to-end TUI tests, jq for
-# tests/vbus/e2e.sh, a JRE and pyspark for the Spark check of the Parquet tables, and qemu + busybox for the real SocketCAN bus (tests/vbus/install.sh;
+# tests/vbus/e2e.sh, GNU time for the bounded-memory tests, a JRE and pyspark for the Spark check of the Parquet tables, and qemu + busybox for the real SocketCAN bus (tests/vbus/install.sh;
 # tests/vbus/run.sh fetches the kernel itself).
 # Idempotent and quiet when done.
 set -euo pipefail
 
 need_apt=()
-for pkg in can-utils tshark tmux jq qemu-system-x86 busybox-static openjdk-17-jre-headless; do
+for pkg in can-utils tshark tmux jq qemu-system-x86 busybox-static openjdk-17-jre-headless time; do
   dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "ok installed" || need_apt+=("$pkg")
 done
 if [ ${#need_apt[@]} -gt 0 ]; then

@@ -79,6 +79,12 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
         eprintln!("cotui diagnose: --live {twice} is given twice: name each interface once");
         return ExitCode::Usage;
     }
+    // `--live IFACE...` takes every word after it: a log among them is a log given with
+    // --live, refused as when it comes first.
+    if let Some(log) = args.live.iter().flatten().find(|n| std::path::Path::new(n).is_file()) {
+        eprintln!("cotui diagnose: {log} is a file: diagnose reads logs, or --live interfaces, not both");
+        return ExitCode::Usage;
+    }
     if let Some(ifaces) = &args.live
         && let Err(e) = live::capture(ifaces, args.duration, &mut trace)
     {

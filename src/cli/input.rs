@@ -5,9 +5,10 @@
 use crate::frame::{Frame, Interfaces};
 use crate::log::{Counts, Format, Outcome};
 use crate::logio::read_ahead;
-use crate::logio::reader::{Binary, ReadAs, Reader};
+pub use crate::logio::reader::report_counts;
+use crate::logio::reader::{Binary, Log, ReadAs};
 use clap::{Args, ValueEnum};
-use std::io::{self, BufRead, BufReader};
+use std::io::{self, BufReader};
 
 /// The log formats a user can name with `--input-format`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -52,24 +53,6 @@ impl InputArgs {
     /// The format to read logs as; `None`: detected from each log's content.
     pub fn format(self) -> Option<ReadAs> {
         self.input_format.map(InputFormat::format)
-    }
-}
-
-/// An opened log and the format it is to be read as (`None`: detected).
-pub struct Log {
-    src: Box<dyn BufRead + Send>,
-    format: Option<ReadAs>,
-}
-
-impl Log {
-    /// The log's reader (the format detected unless named), after saying on stderr what
-    /// was detected beyond the format (a screen capture's timestamp mode).
-    pub fn reader(self, path: &str) -> io::Result<Reader<Box<dyn BufRead + Send>>> {
-        let reader = Reader::open(self.src, self.format)?;
-        if let Some(what) = reader.detected() {
-            eprintln!("{path}: {what}");
-        }
-        Ok(reader)
     }
 }
 
@@ -125,13 +108,10 @@ pub fn open_inputs(
 pub fn open_input(path: &str, what: &str, format: Option<ReadAs>) -> Option<Log> {
     if path == "-" {
         let src = Box::new(BufReader::with_capacity(1 << 16, io::stdin()));
-        return Some(Log { src, format });
+        return Some(Log::new(src, format));
     }
     match std::fs::File::open(path) {
-        Ok(f) => Some(Log {
-            src: Box::new(BufReader::with_capacity(1 << 16, f)),
-            format,
-        }),
+        Ok(f) => Some(Log::new(Box::new(BufReader::with_capacity(1 << 16, f)), format)),
         Err(e) => {
             eprintln!("cotui {what}: {path}: {e}");
             None
@@ -201,24 +181,6 @@ pub fn for_each_frame(
     match finished.error {
         Some(e) => Err(e),
         None => Ok(finished.counts),
-    }
-}
-
-/// Prints what a reader skipped or could not read in `path` (nothing when every line was a frame).
-pub fn report_counts(path: &str, c: &Counts) {
-    if c.warnings > 0 || c.skipped_total() > 0 {
-        eprintln!(
-            "{path}: {} frames, {} lines skipped, {} malformed lines",
-            c.frames,
-            c.skipped_total(),
-            c.warnings
-        );
-    }
-    if let Some(first) = c.first_ignored_tail {
-        eprintln!(
-            "{path}: {} frame lines had text after the frame, not read (comments; first: line {first})",
-            c.ignored_tail
-        );
     }
 }
 

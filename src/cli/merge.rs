@@ -6,6 +6,7 @@
 
 use crate::frame::Interfaces;
 use crate::log::{Counts, Outcome};
+use crate::logio::reader::{Log, report_counts};
 use std::collections::VecDeque;
 use std::io;
 use std::sync::mpsc::{Receiver, sync_channel};
@@ -67,7 +68,7 @@ impl Part {
 }
 
 /// Parses `input` and sends its lines in batches, then its counts.
-fn read(path: &str, input: super::input::Log, tx: std::sync::mpsc::SyncSender<Piece>) {
+fn read(path: &str, input: Log, tx: std::sync::mpsc::SyncSender<Piece>) {
     let mut reader = match input.reader(path) {
         Ok(r) => r,
         Err(e) => {
@@ -94,10 +95,10 @@ fn read(path: &str, input: super::input::Log, tx: std::sync::mpsc::SyncSender<Pi
 
 /// Reads `inputs` (path, reader) as one capture and calls `consume` with batches of their
 /// frames merged by time, each frame's `iface` an index of the merged table (the second
-/// argument). Each file's counts are reported as it ends ([`super::input::report_counts`]);
+/// argument). Each file's counts are reported as it ends ([`report_counts`]);
 /// the first read error (naming its file) or error of `consume` is returned.
 pub fn for_each_merged(
-    inputs: Vec<(String, super::input::Log)>,
+    inputs: Vec<(String, Log)>,
     per_file: bool,
     mut consume: impl FnMut(&[(u64, Outcome)], &Interfaces) -> io::Result<()>,
 ) -> io::Result<()> {
@@ -151,7 +152,7 @@ pub fn for_each_merged(
         for p in parts {
             let Part { path, end, .. } = p;
             if let Some((counts, error)) = end {
-                super::input::report_counts(&path, &counts);
+                report_counts(&path, &counts);
                 if let Some(e) = error {
                     first_error.get_or_insert(io::Error::new(e.kind(), format!("{path}: {e}")));
                 }

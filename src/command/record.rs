@@ -282,7 +282,7 @@ fn refuse_other_format(path: &str, format: LogFormat) -> Result<(), CommandError
     let (is, given) = match (pcapng, format) {
         (true, LogFormat::Candump) => ("pcapng", "candump lines"),
         (false, LogFormat::Pcapng) => ("not pcapng (a text log?)", "pcapng"),
-        (_, LogFormat::Blf) => return Ok(()),
+        // BLF, ASC and TRC are refused before (they cannot be appended to at all).
         _ => return Ok(()),
     };
     Err(CommandError::Usage(format!(

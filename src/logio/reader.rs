@@ -103,3 +103,44 @@ impl<R: BufRead> Iterator for Reader<R> {
         self.next_line().transpose()
     }
 }
+
+/// An opened log and the format it is to be read as (`None`: detected).
+pub struct Log {
+    src: Box<dyn BufRead + Send>,
+    format: Option<ReadAs>,
+}
+
+impl Log {
+    /// The log `src`, to be read as `format` (`None`: detected).
+    pub fn new(src: Box<dyn BufRead + Send>, format: Option<ReadAs>) -> Log {
+        Log { src, format }
+    }
+
+    /// The log's reader (the format detected unless named), after saying on stderr what
+    /// was detected beyond the format (a screen capture's timestamp mode).
+    pub fn reader(self, path: &str) -> io::Result<Reader<Box<dyn BufRead + Send>>> {
+        let reader = Reader::open(self.src, self.format)?;
+        if let Some(what) = reader.detected() {
+            eprintln!("{path}: {what}");
+        }
+        Ok(reader)
+    }
+}
+
+/// Prints what a reader skipped or could not read in `path` (nothing when every line was a frame).
+pub fn report_counts(path: &str, c: &Counts) {
+    if c.warnings > 0 || c.skipped_total() > 0 {
+        eprintln!(
+            "{path}: {} frames, {} lines skipped, {} malformed lines",
+            c.frames,
+            c.skipped_total(),
+            c.warnings
+        );
+    }
+    if let Some(first) = c.first_ignored_tail {
+        eprintln!(
+            "{path}: {} frame lines had text after the frame, not read (comments; first: line {first})",
+            c.ignored_tail
+        );
+    }
+}

@@ -4,21 +4,31 @@ use std::io::Write;
 use std::process::{Command, Stdio};
 
 /// Runs `cotui ARGS` with stdout to `out`; its exit code and peak RSS (KiB).
-// The child is reaped by wait4 (which gives its rusage), not by Child::wait.
-#[allow(clippy::zombie_processes)]
+///
+/// Measured by GNU time, which forks the child from its own small process: the rusage of
+/// a child spawned straight from this test process would count this process's own peak
+/// (Linux carries the spawning image's high-water mark over `exec`), which grows with
+/// whatever the other tests of this binary do in parallel.
 fn peak_rss_kib(args: &[&str], out: &std::path::Path) -> (i32, u64) {
-    let child = Command::new(env!("CARGO_BIN_EXE_cotui"))
+    let rss_file = out.with_extension("rss");
+    let status = Command::new("/usr/bin/time")
+        .arg("-f")
+        .arg("%M")
+        .arg("-o")
+        .arg(&rss_file)
+        .arg(env!("CARGO_BIN_EXE_cotui"))
         .args(args)
         .stdout(std::fs::File::create(out).unwrap())
         .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let (mut status, pid) = (0, child.id() as libc::pid_t);
-    // SAFETY: rusage is plain data; wait4 fills it for our child.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    // SAFETY: pid is our child; status and usage point to valid memory.
-    assert!(unsafe { libc::wait4(pid, &mut status, 0, &mut usage) } > 0);
-    (libc::WEXITSTATUS(status), usage.ru_maxrss as u64)
+        .status()
+        .expect("GNU time (scripts/install-test-deps.sh installs it)");
+    let text = std::fs::read_to_string(&rss_file).unwrap();
+    // With a non-zero exit, GNU time writes "Command exited with non-zero status N" first.
+    let rss = text.lines().last().and_then(|l| l.trim().parse().ok());
+    (
+        status.code().unwrap_or(-1),
+        rss.unwrap_or_else(|| panic!("no peak RSS from time: {text}")),
+    )
 }
 
 fn temp(name: &str) -> std::path::PathBuf {
