@@ -38,6 +38,7 @@
 
 #![deny(unsafe_code)]
 
+mod calendar;
 pub mod cob;
 pub mod decode;
 pub mod frame;

@@ -14,7 +14,7 @@ pub struct Time {
 impl Time {
     /// The calendar date and time, `YYYY-MM-DD hh:mm:ss.mmm`.
     pub fn datetime(&self) -> String {
-        let (y, m, d) = civil_from_days(self.days as i64 + DAYS_1970_TO_1984);
+        let (y, m, d) = crate::calendar::civil_from_days(self.days as i64 + DAYS_1970_TO_1984);
         let ms = self.ms % 86_400_000;
         format!(
             "{y:04}-{m:02}-{d:02} {:02}:{:02}:{:02}.{:03}",
@@ -49,20 +49,6 @@ pub struct TimeJson {
 
 /// Days from 1970-01-01 to 1984-01-01.
 const DAYS_1970_TO_1984: i64 = 5113;
-
-/// Gregorian date of a day count since 1970-01-01 (H. Hinnant's algorithm).
-fn civil_from_days(z: i64) -> (i64, u32, u32) {
-    let z = z + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z.rem_euclid(146_097);
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = (doy - (153 * mp + 2) / 5 + 1) as u32;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
-    let y = yoe + era * 400 + i64::from(m <= 2);
-    (y, m, d)
-}
 
 /// Decodes a TIME payload; the second value explains a rule broken.
 pub fn decode(payload: &[u8]) -> (Time, Option<String>) {

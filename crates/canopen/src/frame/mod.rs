@@ -50,6 +50,19 @@ pub enum Direction {
     Tx,
 }
 
+/// Bytes of a CAN FD frame with each DLC (0..15).
+pub(crate) const FD_LENS: [u8; 16] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64];
+
+/// The DLC of a CAN FD frame of `len` bytes, rounded up to the next length a DLC gives.
+pub(crate) fn fd_dlc_at_least(len: u8) -> u8 {
+    FD_LENS.iter().position(|&n| n >= len).unwrap_or(15) as u8
+}
+
+/// The DLC of a CAN FD payload of exactly `len` bytes (`None`: no DLC gives it).
+pub(crate) fn fd_dlc_exact(len: u8) -> Option<u8> {
+    FD_LENS.iter().position(|&n| n == len).map(|d| d as u8)
+}
+
 /// One CAN / CAN FD / error frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Frame {

@@ -111,33 +111,9 @@ fn systemtime_ns(st: [u16; 8]) -> u64 {
     if hour > 23 || min > 59 || sec > 60 || ms > 999 {
         return 0;
     }
-    let days = days_from_civil(year as i64, month as i64, day as i64);
+    let days = crate::calendar::days_from_civil(year as i64, month as i64, day as i64);
     let secs = days as u64 * 86_400 + hour * 3600 + min * 60 + sec;
     secs * 1_000_000_000 + ms * 1_000_000
-}
-
-/// Days since 1970-01-01 of a proleptic Gregorian date (Howard Hinnant's algorithm).
-fn days_from_civil(y: i64, m: i64, d: i64) -> i64 {
-    let y = if m <= 2 { y - 1 } else { y };
-    let era = y.div_euclid(400);
-    let yoe = y - era * 400;
-    let mp = (m + 9) % 12;
-    let doy = (153 * mp + 2) / 5 + d - 1;
-    let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
-    era * 146_097 + doe - 719_468
-}
-
-/// The inverse of [`days_from_civil`]: (year, month, day).
-fn civil_from_days(z: i64) -> (i64, i64, i64) {
-    let z = z + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = doy - (153 * mp + 2) / 5 + 1;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 };
-    (if m <= 2 { yoe + era * 400 + 1 } else { yoe + era * 400 }, m, d)
 }
 
 /// The common object header.
@@ -376,7 +352,7 @@ fn classic_len(f: &mut Frame, dlc: u8) {
 
 /// Fills an FD frame: length from the DLC (checked against the valid byte count).
 fn fd_frame(f: &mut Frame, dlc: u8, valid: u8, data: &[u8], brs: bool, esi: bool) -> Result<(), &'static str> {
-    let len = dlc_len(dlc & 0x0F);
+    let len = usize::from(crate::frame::FD_LENS[usize::from(dlc & 0x0F)]);
     if valid > 64 {
         return Err("more valid data bytes than a CAN FD frame holds");
     }
@@ -387,26 +363,6 @@ fn fd_frame(f: &mut Frame, dlc: u8, valid: u8, data: &[u8], brs: bool, esi: bool
     let n = (valid as usize).min(len).min(data.len());
     f.data[..n].copy_from_slice(&data[..n]);
     Ok(())
-}
-
-/// Bytes of a CAN FD frame with this DLC.
-fn dlc_len(dlc: u8) -> usize {
-    const LENS: [usize; 16] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64];
-    LENS[(dlc & 0x0F) as usize]
-}
-
-/// The DLC of an FD frame of `len` bytes (rounded up to the next FD length).
-fn len_dlc(len: u8) -> u8 {
-    match len {
-        0..=8 => len,
-        9..=12 => 9,
-        13..=16 => 10,
-        17..=20 => 11,
-        21..=24 => 12,
-        25..=32 => 13,
-        33..=48 => 14,
-        _ => 15,
-    }
 }
 
 /// The interface name of BLF channel `n`: `can{n-1}`, `canX` for 0.
@@ -436,15 +392,15 @@ fn put_systemtime(out: &mut Vec<u8>, ns: u64) {
     }
     let secs = ns / 1_000_000_000;
     let days = (secs / 86_400) as i64;
-    let (y, m, d) = civil_from_days(days);
+    let (y, m, d) = crate::calendar::civil_from_days(days);
     let sod = secs % 86_400;
     let dow = (days + 4).rem_euclid(7); // 1970-01-01 was a Thursday (Sunday = 0).
     let ms = (ns / 1_000_000) % 1000;
     for v in [
         y,
-        m,
+        i64::from(m),
         dow,
-        d,
+        i64::from(d),
         (sod / 3600) as i64,
         (sod / 60 % 60) as i64,
         (sod % 60) as i64,
@@ -506,7 +462,7 @@ pub fn encode_frame(out: &mut Vec<u8>, f: &Frame, channel: u16, start_ns: u64) {
         (CAN_ERROR_EXT, 32)
     } else if f.is_fd() {
         body[0] = channel.min(255) as u8;
-        body[1] = len_dlc(f.len);
+        body[1] = crate::frame::fd_dlc_at_least(f.len);
         body[2] = f.len.min(64);
         body[4..8].copy_from_slice(&id.to_le_bytes());
         let mut flags = FD64_EDL;

@@ -18,20 +18,6 @@ fn channel(index: u16, name: &str) -> u32 {
         .unwrap_or(u32::from(index) + 1)
 }
 
-/// The DLC of a CAN FD length (the next length a DLC gives).
-fn fd_dlc(len: u8) -> u8 {
-    match len {
-        0..=8 => len,
-        9..=12 => 9,
-        13..=16 => 10,
-        17..=20 => 11,
-        21..=24 => 12,
-        25..=32 => 13,
-        33..=48 => 14,
-        _ => 15,
-    }
-}
-
 /// A classic frame's DLC: the raw DLC when one above 8 was kept.
 fn classic_dlc(f: &Frame) -> u8 {
     if f.raw_dlc > 8 { f.raw_dlc } else { f.len }
@@ -52,19 +38,19 @@ fn civil(ns: u64) -> (i64, usize, i64, usize, u64, u64, u64, u64) {
     let secs = ns / 1_000_000_000;
     let days = (secs / 86_400) as i64;
     let rem = secs % 86_400;
-    // Howard Hinnant's civil_from_days.
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = doy - (153 * mp + 2) / 5 + 1;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 };
-    let y = yoe + era * 400 + i64::from(m <= 2);
+    let (y, m, d) = crate::calendar::civil_from_days(days);
     let weekday = (days + 4).rem_euclid(7) as usize;
     let ms = ns / 1_000_000 % 1000;
-    (y, m as usize, d, weekday, rem / 3600, rem / 60 % 60, rem % 60, ms)
+    (
+        y,
+        m as usize,
+        i64::from(d),
+        weekday,
+        rem / 3600,
+        rem / 60 % 60,
+        rem % 60,
+        ms,
+    )
 }
 
 /// Writes Vector ASC: a header (`date`, `base hex  timestamps absolute`, `Begin
@@ -122,7 +108,7 @@ impl AscWriter {
                 "",
                 u8::from(frame.flags.has(Flags::BRS)),
                 u8::from(frame.flags.has(Flags::ESI)),
-                fd_dlc(frame.len),
+                crate::frame::fd_dlc_at_least(frame.len),
                 frame.len
             );
             push_bytes(out, frame.payload());
@@ -206,7 +192,7 @@ impl TrcWriter {
             format!("{:04X}", frame.id)
         };
         let dlc = if frame.flags.has(Flags::FD) {
-            fd_dlc(frame.len)
+            crate::frame::fd_dlc_at_least(frame.len)
         } else {
             classic_dlc(frame)
         };

@@ -309,23 +309,12 @@ fn timestamp(s: &[u8], i: usize) -> Result<(u64, usize), ParseError> {
     if !(1..=12).contains(&mo) || !(1..=31).contains(&d) || h > 23 || mi > 59 || y < 1970 {
         return Err(err(i, "date timestamp out of range"));
     }
-    let secs = (days_from_civil(y, mo, d) * 86_400 + h * 3600 + mi * 60) as u64;
+    let secs = (crate::calendar::days_from_civil(y, mo, d) * 86_400 + h * 3600 + mi * 60) as u64;
     let ns = secs
         .checked_mul(1_000_000_000)
         .and_then(|v| v.checked_add(sec_frac))
         .ok_or_else(|| err(i, "timestamp is too large"))?;
     Ok((ns, end + 1))
-}
-
-/// Days since 1970-01-01 of a proleptic Gregorian date (Howard Hinnant's algorithm).
-fn days_from_civil(y: i64, m: i64, d: i64) -> i64 {
-    let y = if m <= 2 { y - 1 } else { y };
-    let era = y.div_euclid(400);
-    let yoe = y - era * 400;
-    let mp = (m + 9) % 12;
-    let doy = (153 * mp + 2) / 5 + d - 1;
-    let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
-    era * 146_097 + doe - 719_468
 }
 
 #[cfg(test)]

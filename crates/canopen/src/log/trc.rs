@@ -319,8 +319,7 @@ impl Parser {
 
 /// The length of FD DLC `dlc`.
 fn fd_len(dlc: u32) -> Option<u32> {
-    const LEN: [u32; 16] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64];
-    LEN.get(dlc as usize).copied()
+    crate::frame::FD_LENS.get(dlc as usize).map(|&n| u32::from(n))
 }
 
 fn frame_kind(dir: &[u8]) -> Kind {

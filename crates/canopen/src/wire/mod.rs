@@ -185,21 +185,6 @@ impl fmt::Display for WireError {
 
 impl std::error::Error for WireError {}
 
-/// The DLC of a CAN FD payload of `len` bytes.
-fn fd_dlc(len: u8) -> Option<u8> {
-    match len {
-        0..=8 => Some(len),
-        12 => Some(9),
-        16 => Some(10),
-        20 => Some(11),
-        24 => Some(12),
-        32 => Some(13),
-        48 => Some(14),
-        64 => Some(15),
-        _ => None,
-    }
-}
-
 /// Bits before stuffing, MSB first (a frame up to its CRC: at most 41 + 512 + 21).
 #[derive(Clone, Copy)]
 struct BitBuf {
@@ -262,7 +247,7 @@ impl Layout {
             if rtr {
                 return Err(WireError::FdRemote);
             }
-            fd_dlc(frame.len).ok_or(WireError::FdLength(frame.len))?
+            crate::frame::fd_dlc_exact(frame.len).ok_or(WireError::FdLength(frame.len))?
         } else if frame.len > 8 {
             return Err(WireError::ClassicLength(frame.len));
         } else if frame.len == 8 && (9..=15).contains(&frame.raw_dlc) {
