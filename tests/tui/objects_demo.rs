@@ -9,9 +9,6 @@ use cotui::frame::NodeKey;
 use cotui::tui::app::{App, SourceInfo, SourceKind};
 use cotui::tui::keymap::Keymap;
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
-use ratatui::Terminal;
-use ratatui::backend::TestBackend;
-use std::time::{Duration, Instant};
 
 /// The demo's drive: node 2 of its one bus.
 const NODE2: NodeKey = NodeKey::new(0, 2);
@@ -26,36 +23,12 @@ fn typed(a: &mut App, text: &str) {
     }
 }
 
-/// The whole screen as text.
 fn screen(a: &mut App) -> String {
-    let mut term = Terminal::new(TestBackend::new(160, 40)).unwrap();
-    term.draw(|f| cotui::tui::ui::draw(f, a)).unwrap();
-    let buf = term.backend().buffer().clone();
-    (0..buf.area.height)
-        .map(|y| {
-            (0..buf.area.width)
-                .map(|x| buf[(x, y)].symbol().to_string())
-                .collect::<String>()
-                + "\n"
-        })
-        .collect()
+    crate::screen::screen_at(a, 160, 40)
 }
 
-/// Takes frames in until `f` holds (60 s at most: the machine may be busy); the screen.
 fn until(a: &mut App, what: &str, f: impl Fn(&App, &str) -> bool) -> String {
-    let start = Instant::now();
-    loop {
-        a.ingest(Duration::from_millis(20));
-        let s = screen(a);
-        if f(a, &s) {
-            return s;
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "timed out waiting for {what}:\n{s}"
-        );
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    crate::screen::until_at(a, (160, 40), what, f)
 }
 
 /// The TUI on the demo bus, as `cotui demo` starts it (shared with `own_reads`).

@@ -5,46 +5,16 @@
 //! them as not present, not as failed.
 
 use crate::objects_demo::demo_app;
+use crate::screen::screen_at;
 use cotui::tui::app::App;
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
-use ratatui::Terminal;
-use ratatui::backend::TestBackend;
-use std::time::{Duration, Instant};
 
 fn key(a: &mut App, code: KeyCode) {
     a.key(KeyEvent::new(code, KeyModifiers::NONE));
 }
 
-/// The whole screen as text, at `w`x`h`.
-fn screen_at(a: &mut App, w: u16, h: u16) -> String {
-    let mut term = Terminal::new(TestBackend::new(w, h)).unwrap();
-    term.draw(|f| cotui::tui::ui::draw(f, a)).unwrap();
-    let buf = term.backend().buffer().clone();
-    (0..buf.area.height)
-        .map(|y| {
-            (0..buf.area.width)
-                .map(|x| buf[(x, y)].symbol().to_string())
-                .collect::<String>()
-                + "\n"
-        })
-        .collect()
-}
-
-/// Takes frames in until `f` holds (90 s at most: the machine may be busy); the screen.
 fn until(a: &mut App, what: &str, f: impl Fn(&App, &str) -> bool) -> String {
-    let start = Instant::now();
-    loop {
-        a.ingest(Duration::from_millis(20));
-        let s = screen_at(a, 80, 24);
-        if f(a, &s) {
-            return s;
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(90),
-            "timed out waiting for {what}:\n{s}"
-        );
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    crate::screen::until_at(a, (80, 24), what, f)
 }
 
 #[test]

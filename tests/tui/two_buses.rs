@@ -9,39 +9,9 @@ use cotui::frame::NodeKey;
 use cotui::tui::app::{App, SourceInfo, SourceKind};
 use cotui::tui::keymap::Keymap;
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
-use ratatui::Terminal;
-use ratatui::backend::TestBackend;
-use std::time::{Duration, Instant};
 
-fn screen(a: &mut App) -> String {
-    let mut term = Terminal::new(TestBackend::new(200, 40)).unwrap();
-    term.draw(|f| cotui::tui::ui::draw(f, a)).unwrap();
-    let buf = term.backend().buffer().clone();
-    (0..buf.area.height)
-        .map(|y| {
-            (0..buf.area.width)
-                .map(|x| buf[(x, y)].symbol().to_string())
-                .collect::<String>()
-                + "\n"
-        })
-        .collect()
-}
-
-/// Takes frames in until `f` holds (60 s at most: the machine may be busy); the screen.
 fn until(a: &mut App, what: &str, f: impl Fn(&App, &str) -> bool) -> String {
-    let start = Instant::now();
-    loop {
-        a.ingest(Duration::from_millis(20));
-        let s = screen(a);
-        if f(a, &s) {
-            return s;
-        }
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "timed out waiting for {what}:\n{s}"
-        );
-        std::thread::yield_now();
-    }
+    crate::screen::until_at(a, (200, 40), what, f)
 }
 
 fn two_demo_buses() -> App {
