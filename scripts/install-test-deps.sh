@@ -27,6 +27,12 @@ if ! python3 -c "import can, canopen, duckdb" 2>/dev/null; then
   python3 -m pip install -q "python-can>=4.3" "canopen>=2.3" "duckdb>=1.1"
 fi
 
+# asammdf: python-can's MF4Writer writes the MDF4 test files with it (tests/decode/formats_mf4.rs).
+if ! python3 -c "import asammdf" 2>/dev/null; then
+  echo "install-test-deps: pip install asammdf"
+  python3 -m pip install -q --break-system-packages "asammdf>=8.0"
+fi
+
 # pyspark: local-mode Spark reads the Parquet tables (tests/decode/parquet_spark.rs).
 if ! python3 -c "import pyspark" 2>/dev/null; then
   echo "install-test-deps: pip install pyspark"

@@ -25,6 +25,8 @@ pub enum InputFormat {
     Csv,
     /// Vector BLF.
     Blf,
+    /// ASAM MDF4 bus logging (a file, not stdin).
+    Mf4,
 }
 
 impl InputFormat {
@@ -37,6 +39,7 @@ impl InputFormat {
             InputFormat::Trc => ReadAs::Text(Format::Trc),
             InputFormat::Csv => ReadAs::Text(Format::Csv),
             InputFormat::Blf => ReadAs::Binary(Binary::Blf),
+            InputFormat::Mf4 => ReadAs::Binary(Binary::Mf4),
         }
     }
 }
@@ -111,7 +114,7 @@ pub fn open_input(path: &str, what: &str, format: Option<ReadAs>) -> Option<Log>
         return Some(Log::new(src, format));
     }
     match std::fs::File::open(path) {
-        Ok(f) => Some(Log::new(Box::new(BufReader::with_capacity(1 << 16, f)), format)),
+        Ok(f) => Some(Log::file(f, format)),
         Err(e) => {
             eprintln!("cotui {what}: {path}: {e}");
             None

@@ -114,7 +114,7 @@ impl ReadError {
 /// A reader of `path` as `format` (`None`: detected from its content).
 fn reader(path: &Path, format: Option<ReadAs>) -> Result<Reader<BufReader<File>>, ReadError> {
     let file = File::open(path).map_err(|e| ReadError::new(path, e))?;
-    Reader::open(BufReader::with_capacity(1 << 20, file), format).map_err(|e| ReadError::new(path, e))
+    Reader::open_file(file, format, |f| BufReader::with_capacity(1 << 20, f)).map_err(|e| ReadError::new(path, e))
 }
 
 /// Reads `path` as fast as possible.

@@ -1,6 +1,6 @@
 //! Log formats: candump `-l` logs, candump's screen output, Vector ASC, PEAK TRC and
-//! python-can CSV, plus a candump log writer; [`blf`] holds the byte-level half of Vector
-//! BLF (its file IO and zlib live in cotui's `logio`).
+//! python-can CSV, plus a candump log writer; [`blf`] and [`mf4`] hold the byte-level halves
+//! of Vector BLF and ASAM MDF4 bus logging (their file IO and zlib live in cotui's `logio`).
 //!
 //! Each format has a line parser (`parse_line(&mut self, &[u8], &mut Interfaces)`) that
 //! works on bytes, allocates nothing per line and never panics. [`LogReader`] drives one
@@ -14,6 +14,7 @@ pub mod csv;
 pub mod export;
 mod fast;
 mod lex;
+pub mod mf4;
 pub mod screen;
 mod status;
 pub mod trc;
