@@ -113,7 +113,9 @@ impl<S: Source> Mf4Reader<S> {
                 .filter_map(|(i, h)| h.as_ref().map(|(_, f)| (f.ts_ns, i)))
                 .min();
             let Some((_, i)) = first else { break };
-            let Some((bus, mut frame)) = self.heads[i].take() else { break };
+            let Some((bus, mut frame)) = self.heads[i].take() else {
+                break;
+            };
             frame.iface = match self.buses.iter().find(|(b, _)| *b == bus) {
                 Some(&(_, iface)) => iface,
                 None => {
@@ -272,14 +274,20 @@ impl<S: Source> Mf4Reader<S> {
             }
         }
         let acq = self.text(cg.acq_name)?;
-        let Some(kind) = channels.iter().find_map(|(n, _)| Kind::of(n)).or_else(|| Kind::of(&acq)) else {
+        let Some(kind) = channels
+            .iter()
+            .find_map(|(n, _)| Kind::of(n))
+            .or_else(|| Kind::of(&acq))
+        else {
             return Ok(Ok(None));
         };
         let Some((_, master)) = channels
             .iter()
             .find(|(_, c)| c.cn_type == mf4::CN_MASTER && c.sync_type == 1)
         else {
-            return Ok(Err(format!("byte {at}: CAN frame group without a time channel; not read")));
+            return Ok(Err(format!(
+                "byte {at}: CAN frame group without a time channel; not read"
+            )));
         };
         let conv = if master.conversion == 0 {
             Linear::IDENTITY
@@ -486,7 +494,10 @@ impl Bytes {
                 if seek_read(src, pos, &mut self.buf[start..])?.is_err() {
                     self.buf.truncate(start);
                     self.plain = (0, 0);
-                    warn.push(format!("byte {}: data block cut short at the end of the file", self.block_at));
+                    warn.push(format!(
+                        "byte {}: data block cut short at the end of the file",
+                        self.block_at
+                    ));
                     continue;
                 }
                 self.plain = (pos + n as u64, left - n as u64);
@@ -540,7 +551,10 @@ impl Bytes {
 
     fn inflate(&mut self, at: u64, z: &mf4::Zipped) -> Result<(), String> {
         if z.original_len > MAX_UNPACKED {
-            return Err(format!("byte {at}: ##DZ block of {} bytes unpacked, too large", z.original_len));
+            return Err(format!(
+                "byte {at}: ##DZ block of {} bytes unpacked, too large",
+                z.original_len
+            ));
         }
         let mut data = Vec::with_capacity(z.original_len as usize);
         let mut inflater = flate2::read::ZlibDecoder::new(z.data).take(z.original_len);
@@ -552,7 +566,9 @@ impl Bytes {
             None => self.buf.extend_from_slice(&data),
         }
         if damaged {
-            return Err(format!("byte {at}: ##DZ zlib data damaged or cut short; its records are lost"));
+            return Err(format!(
+                "byte {at}: ##DZ zlib data damaged or cut short; its records are lost"
+            ));
         }
         Ok(())
     }
@@ -585,7 +601,10 @@ enum Vlsd {
     None,
     /// Signal data blocks of their own, read along with the records; `offset`: of the next
     /// entry.
-    Stream { bytes: Box<Bytes>, offset: u64 },
+    Stream {
+        bytes: Box<Bytes>,
+        offset: u64,
+    },
     /// VLSD records of the group with this record id.
     Group(u64),
 }
@@ -685,9 +704,10 @@ impl Stream {
                     let want = layout.vlsd_offset(&self.record);
                     let rid = *rid;
                     let entry = self.groups.iter().find_map(|g| match &g.what {
-                        What::Vlsd { last: Some((off, bytes)), .. } if g.record_id == rid && Some(*off) == want => {
-                            Some(bytes)
-                        }
+                        What::Vlsd {
+                            last: Some((off, bytes)),
+                            ..
+                        } if g.record_id == rid && Some(*off) == want => Some(bytes),
                         _ => None,
                     });
                     match entry {
@@ -720,8 +740,7 @@ impl Stream {
         if self.bytes.available().iter().any(|&b| b != 0) {
             return Ok(Some(Err(format!(
                 "data group at byte {}: record {} cut short at the end of its data",
-                self.at,
-                self.records
+                self.at, self.records
             ))));
         }
         Ok(None)

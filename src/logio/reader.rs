@@ -30,8 +30,7 @@ impl Binary {
 }
 
 /// Why an MF4 log cannot be read from a stream.
-const MF4_NEEDS_A_FILE: &str =
-    "an MF4 file is read by random access: give its path, not standard input or a pipe";
+const MF4_NEEDS_A_FILE: &str = "an MF4 file is read by random access: give its path, not standard input or a pipe";
 
 /// A log reader of any format, yielding `(position, Outcome)`: the line number of a text
 /// log, the object number of a binary one (its warnings give byte offsets).

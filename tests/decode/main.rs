@@ -16,6 +16,7 @@ mod diagnose_peer;
 mod eds_import;
 mod explain_golden;
 mod formats_binary;
+mod formats_mf4;
 mod formats_python_can;
 mod json_contract;
 mod log_can_utils;

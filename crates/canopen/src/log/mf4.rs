@@ -32,7 +32,10 @@ pub struct Head {
 
 /// Reads a block header from the start of `b`.
 pub fn head(b: &[u8]) -> Result<Head, &'static str> {
-    let id: [u8; 4] = b.get(..4).and_then(|s| s.try_into().ok()).ok_or("block header cut short")?;
+    let id: [u8; 4] = b
+        .get(..4)
+        .and_then(|s| s.try_into().ok())
+        .ok_or("block header cut short")?;
     if &id[..2] != b"##" {
         return Err("no block id (`##`) where a link points");
     }
@@ -141,7 +144,11 @@ impl Field {
             raw[..bytes.len()].copy_from_slice(bytes);
             u64::from_le_bytes(raw) >> self.bit
         };
-        Some(if self.bits >= 64 { v } else { v & ((1u64 << self.bits) - 1) })
+        Some(if self.bits >= 64 {
+            v
+        } else {
+            v & ((1u64 << self.bits) - 1)
+        })
     }
     /// The value as a float (floats of 32 or 64 bits, integers converted).
     pub fn float(&self, rec: &[u8]) -> Option<f64> {
@@ -250,7 +257,10 @@ pub struct Linear {
 
 impl Linear {
     /// No conversion.
-    pub const IDENTITY: Linear = Linear { offset: 0.0, factor: 1.0 };
+    pub const IDENTITY: Linear = Linear {
+        offset: 0.0,
+        factor: 1.0,
+    };
 }
 
 /// Reads a `##CC` block as a linear conversion (the only kinds a time channel uses).
@@ -539,7 +549,7 @@ impl Layout {
         if !secs.is_finite() {
             return Err("time is not a number");
         }
-        let ts = i128::from(start_ns) + (secs * 1e9).round() as i128;
+        let ts = i128::from(start_ns).saturating_add((secs * 1e9).round() as i128);
         let mut f = Frame {
             ts_ns: u64::try_from(ts.max(0)).unwrap_or(u64::MAX),
             ..Frame::default()
@@ -592,7 +602,9 @@ impl Layout {
             None if len == 0 => &[],
             None => Err("CAN frame group without a DataBytes channel")?,
         };
-        let data = bytes.get(..f.len as usize).ok_or("fewer data bytes than the data length")?;
+        let data = bytes
+            .get(..f.len as usize)
+            .ok_or("fewer data bytes than the data length")?;
         f.data[..data.len()].copy_from_slice(data);
         Ok((bus, f))
     }
@@ -685,7 +697,10 @@ mod tests {
         let mut rec = 1.5f64.to_le_bytes().to_vec();
         rec.extend_from_slice(&[2, 0x81, 1, 0, 0, 2, 0xAA, 0xBB]);
         let (bus, f) = l.frame(&rec, None, 1_000_000_000).unwrap();
-        assert_eq!((bus, f.id, f.payload(), f.ts_ns), (2, 0x181, &[0xAA, 0xBB][..], 2_500_000_000));
+        assert_eq!(
+            (bus, f.id, f.payload(), f.ts_ns),
+            (2, 0x181, &[0xAA, 0xBB][..], 2_500_000_000)
+        );
         rec[13] = 9;
         assert_eq!(l.frame(&rec, None, 0), Err("data length above what the frame can hold"));
     }
