@@ -78,17 +78,21 @@ const GARBAGE: [&str; 3] = [
 ];
 
 /// The input formats `cotui bench` times besides candump, with their file names.
-pub const INPUT_FORMATS: [(&str, &str); 4] = [
+pub const INPUT_FORMATS: [(&str, &str); 5] = [
     ("screen", "bench-quarter.screen.txt"),
     ("asc", "bench-quarter.asc"),
     ("trc", "bench-quarter.trc"),
     ("csv", "bench-quarter.csv"),
+    ("mf4", "bench-quarter.mf4"),
 ];
 
 /// Writes the same synthetic frames as [`write_log`] in input format `format` (one of
-/// [`INPUT_FORMATS`]): candump screen output (`-ta`), Vector ASC, PEAK TRC 2.1 or
-/// python-can CSV.
+/// [`INPUT_FORMATS`]): candump screen output (`-ta`), Vector ASC, PEAK TRC 2.1,
+/// python-can CSV or ASAM MDF4.
 pub fn write_format_log(path: &Path, frames: u64, format: &str) -> std::io::Result<()> {
+    if format == "mf4" {
+        return super::mf4::write_mf4_log(path, frames);
+    }
     let file = std::fs::File::create(path)?;
     let mut out = std::io::BufWriter::with_capacity(1 << 20, file);
     let (mut asc, mut trc) = (AscWriter::new(), TrcWriter::new());
@@ -168,7 +172,8 @@ fn csv_line(out: &mut String, f: &Frame) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::log::{LogReader, Outcome};
+    use crate::log::Outcome;
+    use crate::logio::reader::Reader;
 
     /// Each input format's bench log reads back to the frames of the candump one.
     #[test]
@@ -176,7 +181,8 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("cotui-bench-formats-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let read = |path: &Path| -> Vec<(u64, u32, Vec<u8>)> {
-            let r = LogReader::new(std::io::BufReader::new(std::fs::File::open(path).unwrap())).unwrap();
+            let file = std::fs::File::open(path).unwrap();
+            let r = Reader::open_file(file, None, std::io::BufReader::new).unwrap();
             r.filter_map(|item| match item.unwrap() {
                 (_, Outcome::Frame(f)) => Some((f.ts_ns / 1000, f.id, f.payload().to_vec())),
                 (n, Outcome::Warning(w)) => panic!("{}:{n}: {w}", path.display()),

@@ -7,6 +7,7 @@
 //! diagnosis, `canopen-lens` when installed.
 
 pub mod log;
+mod mf4;
 mod scratch;
 mod tui;
 
@@ -304,6 +305,7 @@ fn measure_all(args: &BenchArgs, exe: &Path, dir: &Path) -> std::io::Result<Figu
             "screen" => ("summary-screen", "decode --summary, screen input (1/4 log)"),
             "asc" => ("summary-asc", "decode --summary, ASC input (1/4 log)"),
             "trc" => ("summary-trc", "decode --summary, TRC input (1/4 log)"),
+            "mf4" => ("summary-mf4", "decode --summary, MF4 input (1/4 log)"),
             _ => ("summary-csv", "decode --summary, CSV input (1/4 log)"),
         };
         runs.push(Run::new(name, title, &["decode", "--summary", path], n / 4, None));
