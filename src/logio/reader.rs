@@ -102,6 +102,22 @@ impl<R: BufRead> Reader<R> {
         }
     }
 
+    /// The format being read, as the user is told it (`Vector BLF`, `PEAK TRC 2.1`,
+    /// `candump screen output, delta times (-td)`).
+    pub fn format_name(&self) -> &'static str {
+        match self {
+            Reader::Text(r) => r.detected().unwrap_or(match r.format() {
+                Format::Candump => "candump log",
+                Format::Screen => "candump screen output",
+                Format::Asc => "Vector ASC",
+                Format::Trc => "PEAK TRC",
+                Format::Csv => "python-can CSV",
+            }),
+            Reader::Blf(_) => "Vector BLF",
+            Reader::Mf4(_) => "ASAM MDF4",
+        }
+    }
+
     /// Interface names seen so far (frames hold indexes into it).
     pub fn interfaces(&self) -> &Interfaces {
         match self {

@@ -129,6 +129,7 @@ pub fn open(path: PathBuf, format: Option<ReadAs>) -> Receiver<Feed> {
                 return;
             }
         };
+        let _ = tx.send(Feed::Status(opened(&path, &r)));
         let mut batch = Vec::with_capacity(BATCH);
         let mut lines = Vec::with_capacity(LINES);
         let mut names = 0;
@@ -166,6 +167,12 @@ pub fn open(path: PathBuf, format: Option<ReadAs>) -> Receiver<Feed> {
         let _ = tx.send(Feed::Done);
     });
     rx
+}
+
+/// What the status line says of an opened log: its name and the format detected.
+fn opened<R: std::io::BufRead>(path: &Path, r: &Reader<R>) -> String {
+    let name = path.file_name().unwrap_or(path.as_os_str()).to_string_lossy();
+    format!("{name}: {}", r.format_name())
 }
 
 /// Sends the batch (and new interface names first); false when the UI is gone.
@@ -236,6 +243,7 @@ pub fn replay(path: PathBuf, speed: f64, format: Option<ReadAs>) -> (Receiver<Fe
             target: None,
             first_ns: None,
             looping: false,
+            said_format: false,
         };
         if let Err(e) = player.run() {
             let _ = player.tx.send(Feed::Status(e.to_string()));
@@ -268,6 +276,8 @@ struct Player {
     first_ns: Option<u64>,
     /// At the end, start over.
     looping: bool,
+    /// The format detected was said (on the first play only).
+    said_format: bool,
 }
 
 /// Why the replay loop stopped reading.
@@ -368,6 +378,10 @@ impl Player {
     /// it stopped and where it was.
     fn play(&mut self) -> Result<(Stop, Position), ReadError> {
         let mut r = reader(&self.path, self.format)?;
+        if !self.said_format {
+            self.said_format = true;
+            let _ = self.tx.send(Feed::Status(opened(&self.path, &r)));
+        }
         let mut names = 0;
         let mut batch = Vec::with_capacity(256);
         // Log time `anchor_ts` is played at wall time `anchor_wall`.
@@ -608,7 +622,10 @@ mod tests {
         w.finish().unwrap();
         let (n, _, notes) = drain(&open(blf.clone(), None));
         let _ = std::fs::remove_file(&blf);
-        assert_eq!((n, notes), (5_000, Vec::<String>::new()));
+        let name = blf.file_name().unwrap().to_string_lossy();
+        assert_eq!((n, notes), (5_000, vec![format!("{name}: Vector BLF")]), "the format detected is said");
+        let (_, _, notes) = drain(&open(l.0.clone(), None));
+        assert!(notes[0].ends_with(".log: candump log"), "{notes:?}");
     }
 
     /// What the UI has from a replay: the frames since the last reset, the resets, the
