@@ -623,7 +623,11 @@ mod tests {
         let (n, _, notes) = drain(&open(blf.clone(), None));
         let _ = std::fs::remove_file(&blf);
         let name = blf.file_name().unwrap().to_string_lossy();
-        assert_eq!((n, notes), (5_000, vec![format!("{name}: Vector BLF")]), "the format detected is said");
+        assert_eq!(
+            (n, notes),
+            (5_000, vec![format!("{name}: Vector BLF")]),
+            "the format detected is said"
+        );
         let (_, _, notes) = drain(&open(l.0.clone(), None));
         assert!(notes[0].ends_with(".log: candump log"), "{notes:?}");
     }

@@ -17,6 +17,7 @@ mod eds_import;
 mod explain_golden;
 mod formats_binary;
 mod formats_mf4;
+mod formats_mixed;
 mod formats_python_can;
 mod json_contract;
 mod log_can_utils;
