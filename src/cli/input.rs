@@ -23,6 +23,8 @@ pub enum InputFormat {
     Trc,
     /// python-can CSV.
     Csv,
+    /// SavvyCAN CSV (`Time Stamp,ID,Extended,Dir,Bus,LEN,D1,...`).
+    Savvycan,
     /// Vector BLF.
     Blf,
     /// ASAM MDF4 bus logging (a file, not stdin).
@@ -38,6 +40,7 @@ impl InputFormat {
             InputFormat::Asc => ReadAs::Text(Format::Asc),
             InputFormat::Trc => ReadAs::Text(Format::Trc),
             InputFormat::Csv => ReadAs::Text(Format::Csv),
+            InputFormat::Savvycan => ReadAs::Text(Format::Savvycan),
             InputFormat::Blf => ReadAs::Binary(Binary::Blf),
             InputFormat::Mf4 => ReadAs::Binary(Binary::Mf4),
         }

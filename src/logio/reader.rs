@@ -112,6 +112,7 @@ impl<R: BufRead> Reader<R> {
                 Format::Asc => "Vector ASC",
                 Format::Trc => "PEAK TRC",
                 Format::Csv => "python-can CSV",
+                Format::Savvycan => "SavvyCAN CSV",
             }),
             Reader::Blf(_) => "Vector BLF",
             Reader::Mf4(_) => "ASAM MDF4",

@@ -201,3 +201,49 @@ fn input_format_overrides_detection() {
     );
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
 }
+
+/// A SavvyCAN CSV save (written here in the shape SavvyCAN writes: µs times, hex ids,
+/// `Dir` and `Bus` columns, empty data columns past `LEN`) decodes by content: bus numbers
+/// become interfaces, `Tx` rows are ours, a row with a bad byte is a located warning.
+#[test]
+fn savvycan_csv_decodes_by_content() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("savvycan");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("capture.csv");
+    std::fs::write(
+        &path,
+        "Time Stamp,ID,Extended,Dir,Bus,LEN,D1,D2,D3,D4,D5,D6,D7,D8\n\
+         1700000000001000,00000701,false,Rx,0,1,05,,,,,,,\n\
+         1700000000002000,00000601,false,Tx,1,8,40,00,10,00,00,00,00,00,\n\
+         1700000000003000,00000581,false,Rx,1,8,43,00,10,00,92,01,02,00,\n\
+         1700000000004000,18FF0102,true,Rx,0,2,ZZ,01,,,,,,\n",
+    )
+    .unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_cotui"))
+        .args(["decode", "--format", "jsonl"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let lines: Vec<serde_json::Value> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 3);
+    assert_eq!(lines[0]["label"], "Heartbeat node 1: Operational");
+    assert_eq!(
+        (lines[1]["iface"].as_str(), lines[1]["dir"].as_str()),
+        (Some("can1"), Some("tx"))
+    );
+    assert_eq!(lines[2]["t"], 1700000000.003);
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.starts_with(&format!("{}: SavvyCAN CSV\n", path.display())),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains(":5: warning: column 39: expected a hex data byte"),
+        "{stderr}"
+    );
+}

@@ -3,7 +3,7 @@
 
 use cotui::frame::{Flags, Frame, Interfaces};
 use cotui::log::writer::{LogWriter, Timestamps};
-use cotui::log::{Format, Line, LogReader, asc, candump, csv, screen, trc};
+use cotui::log::{Format, Line, LogReader, asc, candump, csv, savvycan, screen, trc};
 use proptest::prelude::*;
 
 const SAMPLES: &[&str] = &[
@@ -51,6 +51,14 @@ fn parse_all(line: &[u8]) {
     let _ = candump::parse_compact(line);
     let _ = csv::Parser::new().parse_line(line, &mut ifaces);
     let _ = trc::Parser::new().parse_line(line, &mut ifaces);
+    for header in [
+        "Time Stamp,ID,Extended,Dir,Bus,LEN,D1,D2",
+        "Time Stamp,ID,Extended,Bus,LEN,D1",
+    ] {
+        let mut p = savvycan::Parser::new();
+        let _ = p.parse_line(header.as_bytes(), &mut ifaces);
+        let _ = p.parse_line(line, &mut ifaces);
+    }
     for header in TRC_VERSIONS {
         let mut t = trc::Parser::new();
         let _ = t.parse_line(header.as_bytes(), &mut ifaces);
@@ -154,7 +162,7 @@ proptest! {
     #[test]
     fn arbitrary_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..200)) {
         parse_all(&bytes);
-        for format in [Format::Candump, Format::Screen, Format::Asc, Format::Trc, Format::Csv] {
+        for format in [Format::Candump, Format::Screen, Format::Asc, Format::Trc, Format::Csv, Format::Savvycan] {
             let reader = LogReader::with_format(&bytes[..], format);
             for item in reader {
                 item.unwrap();

@@ -1,5 +1,5 @@
-//! Log formats: candump `-l` logs, candump's screen output, Vector ASC, PEAK TRC and
-//! python-can CSV, plus a candump log writer; [`blf`] and [`mf4`] hold the byte-level halves
+//! Log formats: candump `-l` logs, candump's screen output, Vector ASC, PEAK TRC,
+//! python-can CSV and SavvyCAN CSV, plus a candump log writer; [`blf`] and [`mf4`] hold the byte-level halves
 //! of Vector BLF and ASAM MDF4 bus logging (their file IO and zlib live in cotui's `logio`).
 //!
 //! Each format has a line parser (`parse_line(&mut self, &[u8], &mut Interfaces)`) that
@@ -15,6 +15,7 @@ pub mod export;
 mod fast;
 mod lex;
 pub mod mf4;
+pub mod savvycan;
 pub mod screen;
 mod status;
 pub mod trc;
@@ -38,6 +39,8 @@ pub enum Format {
     Trc,
     /// python-can CSV: `1700000000.1,0x181,0,0,0,2,ESI=`.
     Csv,
+    /// SavvyCAN CSV: `166064000,00000181,false,Rx,0,2,11,22,`.
+    Savvycan,
 }
 
 /// Why a line was not a frame.
@@ -175,6 +178,9 @@ fn detect_line(line: &[u8]) -> Option<Format> {
     if s == csv::HEADER {
         return Some(Format::Csv);
     }
+    if s.starts_with(savvycan::HEADER_START) {
+        return Some(Format::Savvycan);
+    }
     let mut toks = lex::Tokens::new(s, 0);
     let (_, first) = toks.next()?;
     let second = toks.peek().map(|(_, t)| t);
@@ -230,6 +236,7 @@ enum Parser {
     Asc(Box<asc::Parser>),
     Trc(Box<trc::Parser>),
     Csv(csv::Parser),
+    Savvycan(savvycan::Parser),
 }
 
 /// The longest line a reader takes: a longer one (e.g. a file with no line ends) is
@@ -270,6 +277,7 @@ impl<R: BufRead> LogReader<R> {
         let detected = match format {
             Format::Trc => Some(trc_label(trc::detect_version(sample))),
             Format::Csv => Some("python-can CSV"),
+            Format::Savvycan => Some("SavvyCAN CSV"),
             _ => None,
         };
         let mut reader = LogReader::with_format(src, format);
@@ -289,6 +297,7 @@ impl<R: BufRead> LogReader<R> {
             Format::Asc => Parser::Asc(Box::default()),
             Format::Trc => Parser::Trc(Box::default()),
             Format::Csv => Parser::Csv(csv::Parser::new()),
+            Format::Savvycan => Parser::Savvycan(savvycan::Parser::new()),
         };
         LogReader {
             src,
@@ -449,7 +458,7 @@ impl Parser {
         match self {
             Parser::Candump(p) => p.ignored_tail(),
             Parser::Screen(p) => p.ignored_tail(),
-            Parser::Asc(_) | Parser::Trc(_) | Parser::Csv(_) => false,
+            Parser::Asc(_) | Parser::Trc(_) | Parser::Csv(_) | Parser::Savvycan(_) => false,
         }
     }
 }
@@ -467,6 +476,7 @@ fn parse(
         Parser::Asc(p) => into(p.parse_line(line, ifaces), frame),
         Parser::Trc(p) => into(p.parse_line(line, ifaces), frame),
         Parser::Csv(p) => into(p.parse_line(line, ifaces), frame),
+        Parser::Savvycan(p) => into(p.parse_line(line, ifaces), frame),
     }
 }
 
@@ -523,6 +533,10 @@ mod tests {
         assert_eq!(
             detect(b"timestamp,arbitration_id,extended,remote,error,dlc,data\r\n"),
             Some(Format::Csv)
+        );
+        assert_eq!(
+            detect(b"Time Stamp,ID,Extended,Dir,Bus,LEN,D1,D2,D3,D4,D5,D6,D7,D8\n"),
+            Some(Format::Savvycan)
         );
         assert_eq!(detect(b"hello\n\n"), None);
     }
