@@ -14,7 +14,7 @@
 use crate::frame::Interfaces;
 use crate::log::mf4::{self, Block, Kind, Layout, Linear};
 use crate::log::{Counts, Outcome};
-use std::collections::VecDeque;
+use std::collections::{HashSet, VecDeque};
 use std::io::{self, Read, Seek, SeekFrom};
 
 /// A file MDF can be read from: random access.
@@ -41,6 +41,8 @@ pub struct Mf4Reader<S> {
     heads: Vec<Option<(u64, crate::frame::Frame)>>,
     pending: VecDeque<Outcome>,
     buses: Vec<(u64, u16)>,
+    /// The group and channel blocks read (a loop of links is read once).
+    visited: HashSet<u64>,
     ifaces: Interfaces,
     counts: Counts,
     n: u64,
@@ -57,6 +59,7 @@ impl<S: Source> Mf4Reader<S> {
             heads: Vec::new(),
             pending: VecDeque::new(),
             buses: Vec::new(),
+            visited: HashSet::new(),
             ifaces: Interfaces::default(),
             counts: Counts::default(),
             n: 0,
@@ -165,9 +168,13 @@ impl<S: Source> Mf4Reader<S> {
         };
         self.start_ns = mf4::start_ns(&hd).unwrap_or(0);
         let mut dg_at = hd.link(0);
-        let mut seen = 0;
-        while dg_at != 0 && seen < MAX_CHAIN {
-            seen += 1;
+        while dg_at != 0 {
+            if !self.first_visit(dg_at) {
+                warn.push(format!(
+                    "byte {dg_at}: a data group linked twice (a loop); not read again"
+                ));
+                break;
+            }
             let bytes = match read_block(&mut self.src, dg_at, b"##DG")? {
                 Ok(b) => b,
                 Err(why) => {
@@ -195,6 +202,12 @@ impl<S: Source> Mf4Reader<S> {
         let mut groups = Vec::new();
         let mut cg_at = dg.first_group;
         while cg_at != 0 && groups.len() < MAX_CHAIN {
+            if !self.first_visit(cg_at) {
+                warn.push(format!(
+                    "byte {cg_at}: a channel group linked twice (a loop); not read again"
+                ));
+                break;
+            }
             let bytes = match read_block(&mut self.src, cg_at, b"##CG")? {
                 Ok(b) => b,
                 Err(why) => {
@@ -256,7 +269,7 @@ impl<S: Source> Mf4Reader<S> {
         let mut channels = Vec::new();
         let mut chains = vec![cg.first_channel];
         while let Some(mut cn_at) = chains.pop() {
-            while cn_at != 0 && channels.len() < MAX_CHAIN {
+            while cn_at != 0 && channels.len() < MAX_CHAIN && self.first_visit(cn_at) {
                 let bytes = match read_block(&mut self.src, cn_at, b"##CN")? {
                     Ok(b) => b,
                     Err(why) => return Ok(Err(format!("{why}; channel group at byte {at} not read"))),
@@ -337,6 +350,12 @@ impl<S: Source> Mf4Reader<S> {
             bytes: Box::new(Bytes::new(blocks)),
             offset: 0,
         })
+    }
+
+    /// Whether the block at `at` is met for the first time (links of a damaged file may
+    /// loop).
+    fn first_visit(&mut self, at: u64) -> bool {
+        self.visited.insert(at)
     }
 
     /// The text of the `##TX` block at `at` (empty when none or damaged).
@@ -422,9 +441,14 @@ fn block_list<S: Source>(src: &mut S, at: u64, warn: &mut Vec<String>) -> io::Re
         _ => at,
     };
     let mut blocks = Vec::new();
-    let mut lists = 0;
-    while dl_at != 0 && lists < MAX_CHAIN {
-        lists += 1;
+    let mut lists = HashSet::new();
+    while dl_at != 0 && lists.len() < MAX_CHAIN {
+        if !lists.insert(dl_at) {
+            warn.push(format!(
+                "byte {dl_at}: a data list linked twice (a loop); not read again"
+            ));
+            break;
+        }
         let list = match read_block(src, dl_at, b"##DL")? {
             Ok(b) => Block::parse(&b).and_then(|b| mf4::data_list(&b)),
             Err(why) => {

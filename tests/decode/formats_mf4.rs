@@ -276,3 +276,17 @@ proptest! {
         read_all(bytes);
     }
 }
+
+/// A damaged link that loops (a data group whose next is itself) is read once, with where.
+#[test]
+fn a_loop_of_links_is_read_once() {
+    let mut bytes = std::fs::read(&written()[0]).unwrap();
+    let dg = nth_block(&bytes, b"##DG", 0);
+    bytes[dg + 24..dg + 32].copy_from_slice(&(dg as u64).to_le_bytes());
+    let (frames, warnings) = read(bytes);
+    assert_eq!(
+        warnings,
+        [format!("byte {dg}: a data group linked twice (a loop); not read again")]
+    );
+    assert_frames(&frames, &[0, 1, 3, 5, 6]);
+}
