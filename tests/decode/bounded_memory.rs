@@ -76,10 +76,13 @@ fn diagnose_of_60000_distinct_aborts_keeps_1000_incidents() {
 /// of a file 8 times larger peaks within a few MiB of the smaller one's.
 #[test]
 fn mf4_reading_is_flat_in_file_size() {
-    let (small, big) = (temp("small.mf4"), temp("big.mf4"));
+    // A directory of its own: the other test removes the shared one when it ends.
+    let dir = std::env::temp_dir().join(format!("cotui-bounded-mf4-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (small, big) = (dir.join("small.mf4"), dir.join("big.mf4"));
     cotui::bench::log::write_format_log(&small, 50_000, "mf4").unwrap();
     cotui::bench::log::write_format_log(&big, 400_000, "mf4").unwrap();
-    let out = temp("mf4.out");
+    let out = dir.join("mf4.out");
     let (code, small_kib) = peak_rss_kib(&["decode", "--summary", small.to_str().unwrap()], &out);
     assert_eq!(code, 0);
     let (code, big_kib) = peak_rss_kib(&["decode", "--summary", big.to_str().unwrap()], &out);
@@ -89,7 +92,5 @@ fn mf4_reading_is_flat_in_file_size() {
         big_kib < small_kib + 4096,
         "peak {big_kib} KiB for a {size} KiB file, {small_kib} KiB for one 8 times smaller"
     );
-    for p in [small, big, out] {
-        let _ = std::fs::remove_file(p);
-    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
