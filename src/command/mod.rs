@@ -22,6 +22,8 @@ pub mod send;
 pub mod spec;
 pub mod stop;
 pub mod sync;
+pub mod transmit_list;
+pub mod transmit_run;
 pub mod syntax;
 pub mod value;
 pub mod words;

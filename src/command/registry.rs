@@ -140,8 +140,10 @@ commands! {
     /// inquire, identify, identify-unconfigured, fastscan, or assign N (fastscan + set-node).
     Lss(On<B, lss::LssArgs>) => lss::Lss;
     /// Send a raw frame in candump's compact form (`601#4041600000000000`, `123#R`,
-    /// `12345678#00`): once, --count N times, or --every MS (until stopped without --count).
-    Send(On<B, send::SendArgs>) => send::Send;
+    /// `12345678#00`): once, --count N times, or --every MS (until stopped without --count);
+    /// or a transmit list: `send IFACE --list FILE [--duration MS]` (raw frames and RPDO
+    /// signals by name, each on its own period).
+    Send(On<B, send::SendArgs<D>>) => send::Send;
     /// Produce SYNC every --period MS (COB-ID 0x080), with the CiA 301 counter 1..N when
     /// --counter N is given; until stopped without --count.
     Sync(On<B, sync::SyncArgs>) => sync::Sync;
