@@ -26,6 +26,8 @@ pub mod transmit_list;
 pub mod transmit_run;
 pub mod syntax;
 pub mod value;
+pub mod watch;
+pub mod watch_table;
 pub mod words;
 pub mod write;
 

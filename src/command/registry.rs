@@ -8,7 +8,7 @@ use super::cyclic::Source;
 use super::error::{CommandError, ParseError};
 use super::spec::{Ctx, Declared, Known, Outcome, Preview, Spec};
 use super::words::On;
-use super::{dcf, drive, lss, nmt, object, pdo, record, run, scan, send, stop, sync};
+use super::{dcf, drive, lss, nmt, object, pdo, record, run, scan, send, stop, sync, watch};
 use crate::od::bind::Bindings;
 
 /// Makes [`Commander`] and [`Command`] of the list of commands: `Variant(Declaration) => Spec;`,
@@ -155,4 +155,7 @@ commands! {
     /// differ, PDOs remapped), or show what differs.
     #[command(subcommand)]
     Dcf(dcf::command::DcfCommand<B, D>) => dcf::Dcf;
+    /// A watch list: objects polled by SDO every --every MS (`watch 2 0x6041 0x6064 3
+    /// 0x6041`), one round per period, written as a text table, CSV or JSON lines.
+    Watch(On<B, watch::WatchArgs<D>>) => watch::Watch;
 }
