@@ -77,7 +77,10 @@ pub fn load_list(path: &str, bindings: &Bindings) -> Result<Vec<Resolved>, Comma
         let lines: Vec<String> = e.problems.iter().map(|p| format!("{path}: {p}")).collect();
         CommandError::Usage(lines.join("\n"))
     };
-    TransmitList::parse(&text).map_err(fail)?.resolve(bindings).map_err(fail)
+    TransmitList::parse(&text)
+        .map_err(fail)?
+        .resolve(bindings)
+        .map_err(fail)
 }
 
 /// The preview of a list: each entry's frame and schedule.
@@ -85,7 +88,11 @@ fn list_preview(entries: &[Resolved], duration_ms: Option<u64>) -> String {
     let items: Vec<String> = entries
         .iter()
         .map(|e| {
-            let state = if e.enabled { e.schedule.text() } else { "disabled".into() };
+            let state = if e.enabled {
+                e.schedule.text()
+            } else {
+                "disabled".into()
+            };
             format!("#{} {} {state}", e.index, e.what)
         })
         .collect();

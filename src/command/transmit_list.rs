@@ -297,7 +297,11 @@ fn entry(text: &str, line: usize) -> Result<Entry, (usize, String)> {
     };
     let every_ms = match e.every_ms {
         None => None,
-        Some(PeriodJson::Ms(0)) => return Err(bad("`every_ms` is 0: give a period > 0, or leave it out to send once".into())),
+        Some(PeriodJson::Ms(0)) => {
+            return Err(bad(
+                "`every_ms` is 0: give a period > 0, or leave it out to send once".into()
+            ));
+        }
         Some(PeriodJson::Ms(ms)) => Some(ms),
         Some(PeriodJson::Text(t)) => Some(ms_arg(&t).map_err(|err| bad(format!("`every_ms`: {err}")))?),
     };

@@ -188,10 +188,7 @@ pub async fn transmit_list(
     let deadline = duration_ms.map(|ms| start + Duration::from_millis(ms));
     tokio::pin!(stop);
     let mut stopped_by = None;
-    loop {
-        let Some(next) = run.iter().filter_map(|r| r.due).min() else {
-            break;
-        };
+    while let Some(next) = run.iter().filter_map(|r| r.due).min() {
         if deadline.is_some_and(|d| next >= d) {
             // Nothing more is due inside the duration.
             break;
@@ -218,7 +215,7 @@ pub async fn transmit_list(
         }
         let now = Instant::now();
         for (k, r) in run.iter_mut().enumerate() {
-            if !r.due.is_some_and(|d| d <= now) {
+            if r.due.is_none_or(|d| d > now) {
                 continue;
             }
             bus.send(&r.entry.frame).await?;
@@ -242,9 +239,8 @@ pub async fn transmit_list(
     }
     // The echoes still queued (or on their way) of the frames sent.
     let until = Instant::now() + ECHO_WAIT;
-    let waiting = |progress: &ListProgress, run: &[Running]| {
-        lock_all(progress).iter().zip(run).any(|(t, r)| t.seen < r.sent)
-    };
+    let waiting =
+        |progress: &ListProgress, run: &[Running]| lock_all(progress).iter().zip(run).any(|(t, r)| t.seen < r.sent);
     while waiting(&progress, &run) {
         match tokio::time::timeout_at(until, rx.next()).await {
             Ok(Ok(Event::Frame(f))) => note_echo(&f, &run, &progress),

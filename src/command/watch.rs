@@ -77,7 +77,9 @@ pub fn targets(words: &[String]) -> Result<Vec<(u8, String)>, ParseError> {
             if let Some(n) = node
                 && !out.iter().any(|(o, _)| *o == n)
             {
-                return Err(ParseError::Invalid(format!("node {n}: name its objects before the next node")));
+                return Err(ParseError::Invalid(format!(
+                    "node {n}: name its objects before the next node"
+                )));
             }
             node = Some(node_arg(w)?);
             continue;
@@ -90,9 +92,9 @@ pub fn targets(words: &[String]) -> Result<Vec<(u8, String)>, ParseError> {
         out.push((n, w.clone()));
     }
     match node {
-        Some(n) if !out.iter().any(|(o, _)| *o == n) => {
-            Err(ParseError::Invalid(format!("node {n}: name the objects to watch on it")))
-        }
+        Some(n) if !out.iter().any(|(o, _)| *o == n) => Err(ParseError::Invalid(format!(
+            "node {n}: name the objects to watch on it"
+        ))),
         _ => Ok(out),
     }
 }
@@ -142,7 +144,10 @@ impl WatchReport {
                     "{} reads, {} failed{}",
                     o.reads,
                     o.failures,
-                    o.last_error.as_ref().map(|e| format!(" (last: {e})")).unwrap_or_default()
+                    o.last_error
+                        .as_ref()
+                        .map(|e| format!(" (last: {e})"))
+                        .unwrap_or_default()
                 )
             };
             lines.push(format!("  {}: {state}", o.title()));
@@ -158,8 +163,8 @@ impl Watch {
             .iter()
             .map(|(node, text)| {
                 let dict = bindings.dictionary(*node);
-                let (index, sub) = resolve_object(dict, text)
-                    .map_err(|e| CommandError::Usage(format!("node {node}: {e}")))?;
+                let (index, sub) =
+                    resolve_object(dict, text).map_err(|e| CommandError::Usage(format!("node {node}: {e}")))?;
                 Ok(Watched::new(dict, *node, index, sub))
             })
             .collect()
@@ -333,9 +338,24 @@ mod tests {
             targets(&words(&["2", "0x6041", "Statusword", "3", "0x6064"])).unwrap(),
             [(2, "0x6041".into()), (2, "Statusword".into()), (3, "0x6064".into())]
         );
-        assert!(targets(&words(&["0x6041"])).unwrap_err().to_string().contains("node first"));
-        assert!(targets(&words(&["2", "3", "0x6041"])).unwrap_err().to_string().contains("node 2"));
-        assert!(targets(&words(&["2", "0x6041", "3"])).unwrap_err().to_string().contains("node 3"));
+        assert!(
+            targets(&words(&["0x6041"]))
+                .unwrap_err()
+                .to_string()
+                .contains("node first")
+        );
+        assert!(
+            targets(&words(&["2", "3", "0x6041"]))
+                .unwrap_err()
+                .to_string()
+                .contains("node 2")
+        );
+        assert!(
+            targets(&words(&["2", "0x6041", "3"]))
+                .unwrap_err()
+                .to_string()
+                .contains("node 3")
+        );
         assert!(targets(&words(&["200", "0x6041"])).is_err());
     }
 }

@@ -267,7 +267,10 @@ mod tests {
     fn csv_names_the_objects_and_text_keeps_min_and_max() {
         let d = demo_dict();
         let mut objs = vec![Watched::new(&d, 2, 0x6041, 0), Watched::new(&d, 2, 0x6064, 0)];
-        assert_eq!(csv_header(&objs), "time_s,2:0x6041 Statusword,2:0x6064 Position actual value");
+        assert_eq!(
+            csv_header(&objs),
+            "time_s,2:0x6041 Statusword,2:0x6064 Position actual value"
+        );
         for (pos, t) in [(100i64, 0.0), (-20, 0.05)] {
             let samples = [Sample::Value(Value::Unsigned(0x237)), Sample::Value(Value::Signed(pos))];
             objs.iter_mut().zip(&samples).for_each(|(o, s)| o.take(&d, s));
@@ -279,7 +282,10 @@ mod tests {
                 assert!(table.contains("max 100"), "{table}");
             }
         }
-        let samples = [Sample::Failed("timeout".into()), Sample::Absent("abort 0x06020000".into())];
+        let samples = [
+            Sample::Failed("timeout".into()),
+            Sample::Absent("abort 0x06020000".into()),
+        ];
         assert_eq!(csv_row(0.1, &objs, &samples), "0.100,timeout,absent");
         let rows = jsonl_rows(0.1, &objs, &[Sample::Skipped, Sample::Failed("timeout".into())]);
         assert_eq!(rows.len(), 1);

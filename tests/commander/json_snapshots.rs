@@ -11,9 +11,17 @@ fn stable(v: &mut Value, tmp: &str) {
     match v {
         Value::Object(map) => {
             for (key, value) in map.iter_mut() {
-                let measured = ["jitter", "mean_period", "elapsed", "took", "duration_ms", "after_ms", "span"]
-                    .iter()
-                    .any(|m| key.contains(m));
+                let measured = [
+                    "jitter",
+                    "mean_period",
+                    "elapsed",
+                    "took",
+                    "duration_ms",
+                    "after_ms",
+                    "span",
+                ]
+                .iter()
+                .any(|m| key.contains(m));
                 if measured && value.is_number() {
                     *value = Value::String("[measured]".into());
                 } else {
@@ -93,7 +101,17 @@ fn every_command_answers_json_as_documented() {
         ("send_list_bad_entry", vec!["send", "demo", "--list", &bad_list], 1),
         (
             "watch",
-            vec!["watch", "demo", "2", "0x6041", "0x2999", "--duration", "200"],
+            vec![
+                "watch",
+                "demo",
+                "2",
+                "0x6041",
+                "0x2999",
+                "--duration",
+                "1000",
+                "--every",
+                "5000",
+            ],
             0,
         ),
         ("watch_unknown_object", vec!["watch", "demo", "2", "Nonsense"], 1),

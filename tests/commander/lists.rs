@@ -51,19 +51,29 @@ async fn each_entry_is_sent_on_its_period_counted_by_receive_timestamps() {
     for (what, period) in [("123#11", 20.0), ("202#0600F4010000", 50.0)] {
         let n = in_window(of(&frames, what));
         let expected = 1000.0 / period;
-        assert!((n - expected).abs() <= 0.15 * expected, "{what}: {n} frames, expected {expected}");
+        assert!(
+            (n - expected).abs() <= 0.15 * expected,
+            "{what}: {n} frames, expected {expected}"
+        );
     }
     assert_eq!(of(&frames, "124#22").len(), 3);
     assert!(of(&frames, "000#0100").is_empty(), "a disabled entry was sent");
     let j = o.json();
-    let sent: Vec<u64> = j["entries"].as_array().unwrap().iter().map(|e| e["sent"].as_u64().unwrap()).collect();
+    let sent: Vec<u64> = j["entries"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["sent"].as_u64().unwrap())
+        .collect();
     assert_eq!(sent, [50, 20, 3, 0], "{j}");
     assert_eq!(j["entries"][1]["frame"], "202#0600F4010000");
     assert_eq!(j["entries"][1]["what"], "RPDO1 node 2 202#0600F4010000");
     assert_eq!(j["entries"][0]["comment"], "fast");
     assert_eq!(j["entries"][3]["enabled"], false);
     // The drive took the RPDO's values.
-    let v = execute(&d.bus, &parse_command("sdo read 2 0x60FF").unwrap(), &b).await.unwrap();
+    let v = execute(&d.bus, &parse_command("sdo read 2 0x60FF").unwrap(), &b)
+        .await
+        .unwrap();
     assert_eq!(v.json()["value"], 500);
 }
 
@@ -120,9 +130,18 @@ fn the_command_line_reports_per_entry_counts_and_refuses_bad_lists() {
     );
     let (rc, _, err) = cotui_json(&["send", "demo", "--list", &bad]);
     assert_eq!(rc, 1);
-    assert!(err.contains(&format!("{bad}: entry 2 (line 3): `601#4G` is not a frame")), "{err}");
-    assert!(err.contains(&format!("{bad}: entry 3 (line 4): `1#` is not a frame")), "{err}");
-    assert!(err.contains(&format!("{bad}: entry 4 (line 5): `every_ms` is 0")), "{err}");
+    assert!(
+        err.contains(&format!("{bad}: entry 2 (line 3): `601#4G` is not a frame")),
+        "{err}"
+    );
+    assert!(
+        err.contains(&format!("{bad}: entry 3 (line 4): `1#` is not a frame")),
+        "{err}"
+    );
+    assert!(
+        err.contains(&format!("{bad}: entry 4 (line 5): `every_ms` is 0")),
+        "{err}"
+    );
     let signal = list_file(
         "signal",
         "{\"entries\": [\n  {\"rpdo\": \"rpdo1\", \"node\": 2,\n   \"signals\": {\"Speed\": 3}}\n]}",
@@ -130,7 +149,10 @@ fn the_command_line_reports_per_entry_counts_and_refuses_bad_lists() {
     let (rc, v, _) = cotui_json(&["send", "demo", "--list", &signal, "--json"]);
     assert_eq!(rc, 1);
     let m = v["message"].as_str().unwrap();
-    assert!(m.starts_with(&format!("{signal}: entry 1 (line 2): unknown object `Speed`")), "{m}");
+    assert!(
+        m.starts_with(&format!("{signal}: entry 1 (line 2): unknown object `Speed`")),
+        "{m}"
+    );
     assert!(m.contains("RPDO1 of node 2 maps: Controlword (0x6040:00)"), "{m}");
 }
 
@@ -138,7 +160,17 @@ fn the_command_line_reports_per_entry_counts_and_refuses_bad_lists() {
 fn watch_writes_a_csv_row_per_round_with_the_objects_named() {
     let out = Command::new(env!("CARGO_BIN_EXE_cotui"))
         .args([
-            "watch", "demo", "2", "0x6041", "0x6064", "--every", "50", "--duration", "1000", "--format", "csv",
+            "watch",
+            "demo",
+            "2",
+            "0x6041",
+            "0x6064",
+            "--every",
+            "50",
+            "--duration",
+            "1000",
+            "--format",
+            "csv",
         ])
         .output()
         .unwrap();
@@ -167,8 +199,21 @@ fn watch_writes_a_csv_row_per_round_with_the_objects_named() {
 fn a_missing_node_times_out_in_its_column_and_a_missing_object_is_absent_once() {
     let out = Command::new(env!("CARGO_BIN_EXE_cotui"))
         .args([
-            "watch", "demo", "2", "0x6041", "0x2999", "9", "0x6041", "--every", "100", "--duration", "650",
-            "--timeout", "50", "--format", "csv",
+            "watch",
+            "demo",
+            "2",
+            "0x6041",
+            "0x2999",
+            "9",
+            "0x6041",
+            "--every",
+            "100",
+            "--duration",
+            "650",
+            "--timeout",
+            "50",
+            "--format",
+            "csv",
         ])
         .output()
         .unwrap();
