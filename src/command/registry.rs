@@ -141,7 +141,7 @@ commands! {
     Lss(On<B, lss::LssArgs>) => lss::Lss;
     /// Send a raw frame in candump's compact form (`601#4041600000000000`, `123#R`,
     /// `12345678#00`): once, --count N times, or --every MS (until stopped without --count);
-    /// or a transmit list: `send IFACE --list FILE [--duration MS]` (raw frames and RPDO
+    /// or a transmit list: `send --list FILE [--duration MS]` (raw frames and RPDO
     /// signals by name, each on its own period).
     Send(On<B, send::SendArgs<D>>) => send::Send;
     /// Produce SYNC every --period MS (COB-ID 0x080), with the CiA 301 counter 1..N when

@@ -6,7 +6,7 @@
 use super::cyclic::{Schedule, Source};
 use super::error::CommandError;
 use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
-use super::transmit_list::{Resolved, TransmitList};
+use super::transmit_list::Resolved;
 use super::transmit_run::{ListProgress, transmit_list};
 use super::words::{ParseError, Repeat, frame_arg, ms_arg};
 use crate::frame::Frame;
@@ -22,7 +22,7 @@ pub struct SendArgs<D: clap::Args> {
     /// name, each with its period, count, enabled flag, comment; README "Transmit list").
     #[arg(long, value_name = "FILE", conflicts_with_all = ["frame", "every", "count"])]
     pub list: Option<String>,
-    /// With --list: stop after this many ms (else when every entry is done, or at Ctrl-C).
+    /// With --list: stop this many ms after the first frames (else when every entry is done, or at Ctrl-C).
     #[arg(long, value_parser = ms_arg)]
     pub duration: Option<u64>,
     #[command(flatten)]
@@ -77,10 +77,7 @@ pub fn load_list(path: &str, bindings: &Bindings) -> Result<Vec<Resolved>, Comma
         let lines: Vec<String> = e.problems.iter().map(|p| format!("{path}: {p}")).collect();
         CommandError::Usage(lines.join("\n"))
     };
-    TransmitList::parse(&text)
-        .map_err(fail)?
-        .resolve(bindings)
-        .map_err(fail)
+    super::transmit_list::load(&text, bindings).map_err(fail)
 }
 
 /// The preview of a list: each entry's frame and schedule.

@@ -43,6 +43,8 @@ pub struct TransmitList {
 /// One entry of a transmit list.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Entry {
+    /// Its index in the list, from 1.
+    pub index: usize,
     /// Its line in the file (from 1): where its object starts.
     pub line: usize,
     pub what: What,
@@ -162,77 +164,100 @@ impl TransmitList {
     /// Parses the text of a list file; every bad entry is reported (with its line), not
     /// only the first.
     pub fn parse(text: &str) -> Result<TransmitList, ListError> {
-        let file: FileJson = serde_json::from_str(text).map_err(|e| ListError {
-            problems: vec![Problem {
-                entry: None,
-                line: e.line().max(1),
-                message: format!(
-                    "not a transmit list ({e}); write {{\"entries\": [{{\"frame\": \"601#40...\", \"every_ms\": 100}}, ...]}}"
-                ),
-            }],
-        })?;
-        let mut entries = Vec::new();
-        let mut problems = Vec::new();
-        for (k, raw) in file.entries.iter().enumerate() {
-            let offset = raw.get().as_ptr() as usize - text.as_ptr() as usize;
-            let line = line_of(text, offset);
-            match entry(raw.get(), line) {
-                Ok(e) => entries.push(e),
-                Err((at, message)) => problems.push(Problem {
-                    entry: Some(k + 1),
-                    line: at,
-                    message,
-                }),
-            }
-        }
+        let (entries, problems): (Vec<_>, Vec<_>) = parse_entries(text)?.into_iter().partition(Result::is_ok);
         if problems.is_empty() {
-            Ok(TransmitList { entries })
+            Ok(TransmitList {
+                entries: entries.into_iter().flatten().collect(),
+            })
         } else {
-            Err(ListError { problems })
+            Err(ListError {
+                problems: problems.into_iter().filter_map(Result::err).collect(),
+            })
         }
     }
 
     /// Each entry's exact frame through the node dictionaries of `bindings` (RPDO entries
     /// through the node's mapping); every entry that cannot be encoded is reported.
     pub fn resolve(&self, bindings: &Bindings) -> Result<Vec<Resolved>, ListError> {
-        let mut out = Vec::new();
-        let mut problems = Vec::new();
-        for (k, e) in self.entries.iter().enumerate() {
-            let (frame, what, defaulted) = match &e.what {
-                What::Frame(f) => (*f, super::candump(f), Vec::new()),
-                What::Rpdo { node, num, signals } => match rpdo(bindings, *node, *num, signals) {
-                    Ok(r) => (
-                        r.frame,
-                        format!("RPDO{num} node {node} {}", super::candump(&r.frame)),
-                        r.defaulted,
-                    ),
-                    Err(err) => {
-                        problems.push(Problem {
-                            entry: Some(k + 1),
-                            line: e.line,
-                            message: err.to_string(),
-                        });
-                        continue;
-                    }
-                },
-            };
-            out.push(Resolved {
-                index: k + 1,
-                line: e.line,
-                frame,
-                what,
-                schedule: e.schedule,
-                enabled: e.enabled,
-                comment: e.comment.clone(),
-                defaulted,
-            });
-        }
-        if problems.is_empty() {
-            Ok(out)
-        } else {
-            Err(ListError { problems })
-        }
+        gather(self.entries.iter().map(|e| resolve(e, bindings)).collect())
     }
+}
+
+/// Parses and resolves the text of a list file at once: every bad entry is reported, those
+/// the parser refuses (a bad frame, a period of 0) and those the dictionaries refuse (an
+/// unknown signal) alike, in the order of the file.
+pub fn load(text: &str, bindings: &Bindings) -> Result<Vec<Resolved>, ListError> {
+    gather(
+        parse_entries(text)?
+            .into_iter()
+            .map(|e| e.and_then(|e| resolve(&e, bindings)))
+            .collect(),
+    )
+}
+
+/// The entries, or every problem among them.
+fn gather(all: Vec<Result<Resolved, Problem>>) -> Result<Vec<Resolved>, ListError> {
+    let (ok, problems): (Vec<_>, Vec<_>) = all.into_iter().partition(Result::is_ok);
+    if problems.is_empty() {
+        Ok(ok.into_iter().flatten().collect())
+    } else {
+        Err(ListError {
+            problems: problems.into_iter().filter_map(Result::err).collect(),
+        })
+    }
+}
+
+/// Each entry of the file parsed, or its problem; the file itself not a list: an error.
+fn parse_entries(text: &str) -> Result<Vec<Result<Entry, Problem>>, ListError> {
+    let file: FileJson = serde_json::from_str(text).map_err(|e| ListError {
+        problems: vec![Problem {
+            entry: None,
+            line: e.line().max(1),
+            message: format!(
+                "not a transmit list ({e}); write {{\"entries\": [{{\"frame\": \"601#40...\", \"every_ms\": 100}}, ...]}}"
+            ),
+        }],
+    })?;
+    Ok(file
+        .entries
+        .iter()
+        .enumerate()
+        .map(|(k, raw)| {
+            let offset = raw.get().as_ptr() as usize - text.as_ptr() as usize;
+            let line = line_of(text, offset);
+            entry(raw.get(), k + 1, line).map_err(|(at, message)| Problem {
+                entry: Some(k + 1),
+                line: at,
+                message,
+            })
+        })
+        .collect())
+}
+
+/// An entry's exact frame through the node dictionaries of `bindings`.
+fn resolve(e: &Entry, bindings: &Bindings) -> Result<Resolved, Problem> {
+    let (frame, what, defaulted) = match &e.what {
+        What::Frame(f) => (*f, super::candump(f), Vec::new()),
+        What::Rpdo { node, num, signals } => {
+            let r = rpdo(bindings, *node, *num, signals).map_err(|err| Problem {
+                entry: Some(e.index),
+                line: e.line,
+                message: err.to_string(),
+            })?;
+            let what = format!("RPDO{num} node {node} {}", super::candump(&r.frame));
+            (r.frame, what, r.defaulted)
+        }
+    };
+    Ok(Resolved {
+        index: e.index,
+        line: e.line,
+        frame,
+        what,
+        schedule: e.schedule,
+        enabled: e.enabled,
+        comment: e.comment.clone(),
+        defaulted,
+    })
 }
 
 impl From<ListError> for CommandError {
@@ -241,8 +266,8 @@ impl From<ListError> for CommandError {
     }
 }
 
-/// One entry from its JSON text, which starts at `line`; on error, the line and why.
-fn entry(text: &str, line: usize) -> Result<Entry, (usize, String)> {
+/// Entry `index` from its JSON text, which starts at `line`; on error, the line and why.
+fn entry(text: &str, index: usize, line: usize) -> Result<Entry, (usize, String)> {
     let e: EntryJson =
         serde_json::from_str(text).map_err(|err| (line + err.line().saturating_sub(1), err.to_string()))?;
     let bad = |m: String| (line, m);
@@ -309,6 +334,7 @@ fn entry(text: &str, line: usize) -> Result<Entry, (usize, String)> {
         return Err(bad("`count` is 0: give a count > 0, or leave it out".into()));
     }
     Ok(Entry {
+        index,
         line,
         what,
         schedule: Schedule {
@@ -379,6 +405,10 @@ mod tests {
             .to_string();
         assert!(e.starts_with("entry 2 (line 4): "), "{e}");
         assert!(e.contains("RPDO1 of node 2 maps: Controlword (0x6040:00)"), "{e}");
+        let both = "{\"entries\": [\n{\"frame\": \"601#4G\"},\n{\"rpdo\": \"rpdo1\", \"node\": 2, \"signals\": {\"Speed\": 3}}]}";
+        let e = load(both, &demo_bindings()).unwrap_err();
+        let at: Vec<(Option<usize>, usize)> = e.problems.iter().map(|p| (p.entry, p.line)).collect();
+        assert_eq!(at, [(Some(1), 2), (Some(2), 3)], "{e}");
         let e = TransmitList::parse("{\"entries\": 3}").unwrap_err().to_string();
         assert!(e.starts_with("line 1: not a transmit list"), "{e}");
         let e = TransmitList::parse("{\"entries\": [{\"rpdo\": \"tpdo1\", \"node\": 2}]}")

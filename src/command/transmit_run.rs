@@ -159,7 +159,7 @@ pub fn lock_all(p: &ListProgress) -> std::sync::MutexGuard<'_, Vec<Tally>> {
     p.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// Sends `entries` on `bus` for `duration_ms` (or until every entry is done, `stop`
+/// Sends `entries` on `bus` for `duration_ms` from the first frames sent (or until every entry is done, `stop`
 /// completes, or a quick stop by someone else is seen), noting counts in `progress`; then
 /// waits (up to a second) for the echoes of the frames sent and reports. A listen-only bus
 /// is refused before anything.
@@ -185,9 +185,10 @@ pub async fn transmit_list(
             sent: 0,
         })
         .collect();
-    let deadline = duration_ms.map(|ms| start + Duration::from_millis(ms));
+    let mut deadline = duration_ms.map(|ms| start + Duration::from_millis(ms));
     tokio::pin!(stop);
     let mut stopped_by = None;
+    let mut anchored = false;
     while let Some(next) = run.iter().filter_map(|r| r.due).min() {
         if deadline.is_some_and(|d| next >= d) {
             // Nothing more is due inside the duration.
@@ -235,6 +236,14 @@ pub async fn transmit_list(
                 }
                 (false, Some(_), None) => None,
             };
+        }
+        if !anchored {
+            // The grid and the duration start when the first frames are out: a slow first
+            // send (a cold start) shifts them instead of dropping the ticks it took.
+            anchored = true;
+            let lag = Instant::now().saturating_duration_since(start);
+            deadline = deadline.map(|d| d + lag);
+            run.iter_mut().filter_map(|r| r.due.as_mut()).for_each(|d| *d += lag);
         }
     }
     // The echoes still queued (or on their way) of the frames sent.

@@ -33,7 +33,7 @@ pub struct WatchArgs<D: clap::Args> {
     /// A node, then the objects to watch on it (0x6041, 0x1018:1, a name of the node's
     /// profile or EDS); another node and its objects may follow: `2 0x6041 0x6064 3 0x6041`.
     /// A word of 1 to 3 decimal digits is a node, anything else an object.
-    #[arg(value_name = "NODE OBJECT", num_args = 2.., required = true)]
+    #[arg(value_name = "NODE OBJECT", num_args = 1.., required = true)]
     pub words: Vec<String>,
     /// Poll every MS ms.
     #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_EVERY_MS)]
