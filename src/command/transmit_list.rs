@@ -175,12 +175,6 @@ impl TransmitList {
             })
         }
     }
-
-    /// Each entry's exact frame through the node dictionaries of `bindings` (RPDO entries
-    /// through the node's mapping); every entry that cannot be encoded is reported.
-    pub fn resolve(&self, bindings: &Bindings) -> Result<Vec<Resolved>, ListError> {
-        gather(self.entries.iter().map(|e| resolve(e, bindings)).collect())
-    }
 }
 
 /// Parses and resolves the text of a list file at once: every bad entry is reported, those
@@ -379,7 +373,7 @@ mod tests {
             }
         );
         assert!(!list.entries[2].enabled);
-        let r = list.resolve(&demo_bindings()).unwrap();
+        let r = load(LIST, &demo_bindings()).unwrap();
         let whats: Vec<&str> = r.iter().map(|e| e.what.as_str()).collect();
         assert_eq!(
             whats,
@@ -398,11 +392,7 @@ mod tests {
         assert!(lines[1].starts_with("entry 2 (line 3): `every_ms` is 0"), "{e}");
         assert!(lines[2].starts_with("entry 3 (line 4): unknown field `evry_ms`"), "{e}");
         let text = "{\"entries\": [\n{\"frame\": \"601#40\"},\n\n{\"rpdo\": \"rpdo1\", \"node\": 2,\n \"signals\": {\"Speed\": 3}}]}";
-        let e = TransmitList::parse(text)
-            .unwrap()
-            .resolve(&demo_bindings())
-            .unwrap_err()
-            .to_string();
+        let e = load(text, &demo_bindings()).unwrap_err().to_string();
         assert!(e.starts_with("entry 2 (line 4): "), "{e}");
         assert!(e.contains("RPDO1 of node 2 maps: Controlword (0x6040:00)"), "{e}");
         let both = "{\"entries\": [\n{\"frame\": \"601#4G\"},\n{\"rpdo\": \"rpdo1\", \"node\": 2, \"signals\": {\"Speed\": 3}}]}";
