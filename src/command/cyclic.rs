@@ -241,6 +241,11 @@ impl Tally {
         self.seen += 1;
     }
 
+    /// The time from the first echo to the last, ns (none before the first).
+    pub fn span_ns(&self) -> Option<u64> {
+        self.first_ns.map(|f| self.last_ns.saturating_sub(f))
+    }
+
     /// The report of the timing: counts, mean period, jitter (deviation of each interval
     /// from `period_ns`) p99 and max.
     pub fn report(&self, what: &str, period_ms: Option<u64>, defaulted: &[String]) -> Report {

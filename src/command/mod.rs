@@ -23,7 +23,11 @@ pub mod spec;
 pub mod stop;
 pub mod sync;
 pub mod syntax;
+pub mod transmit_list;
+pub mod transmit_run;
 pub mod value;
+pub mod watch;
+pub mod watch_table;
 pub mod words;
 pub mod write;
 

@@ -8,7 +8,7 @@ use super::cyclic::Source;
 use super::error::{CommandError, ParseError};
 use super::spec::{Ctx, Declared, Known, Outcome, Preview, Spec};
 use super::words::On;
-use super::{dcf, drive, lss, nmt, object, pdo, record, run, scan, send, stop, sync};
+use super::{dcf, drive, lss, nmt, object, pdo, record, run, scan, send, stop, sync, watch};
 use crate::od::bind::Bindings;
 
 /// Makes [`Commander`] and [`Command`] of the list of commands: `Variant(Declaration) => Spec;`,
@@ -140,8 +140,10 @@ commands! {
     /// inquire, identify, identify-unconfigured, fastscan, or assign N (fastscan + set-node).
     Lss(On<B, lss::LssArgs>) => lss::Lss;
     /// Send a raw frame in candump's compact form (`601#4041600000000000`, `123#R`,
-    /// `12345678#00`): once, --count N times, or --every MS (until stopped without --count).
-    Send(On<B, send::SendArgs>) => send::Send;
+    /// `12345678#00`): once, --count N times, or --every MS (until stopped without --count);
+    /// or a transmit list: `send --list FILE [--duration MS]` (raw frames and RPDO
+    /// signals by name, each on its own period).
+    Send(On<B, send::SendArgs<D>>) => send::Send;
     /// Produce SYNC every --period MS (COB-ID 0x080), with the CiA 301 counter 1..N when
     /// --counter N is given; until stopped without --count.
     Sync(On<B, sync::SyncArgs>) => sync::Sync;
@@ -153,4 +155,7 @@ commands! {
     /// differ, PDOs remapped), or show what differs.
     #[command(subcommand)]
     Dcf(dcf::command::DcfCommand<B, D>) => dcf::Dcf;
+    /// A watch list: objects polled by SDO every --every MS (`watch 2 0x6041 0x6064 3
+    /// 0x6041`), one round per period, written as a text table, CSV or JSON lines.
+    Watch(On<B, watch::WatchArgs<D>>) => watch::Watch;
 }

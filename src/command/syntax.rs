@@ -369,8 +369,8 @@ mod tests {
         let every = |every_ms, count| Schedule { every_ms, count };
         assert!(matches!(
             parse_command("send 12345678#DEAD --every 5").unwrap(),
-            Command::Send(s) if s.frame.id == 0x1234_5678 && s.frame.is_ext()
-                && s.schedule == every(Some(5), None)
+            Command::Send(crate::command::send::Send::Frame { frame, schedule }) if frame.id == 0x1234_5678
+                && frame.is_ext() && schedule == every(Some(5), None)
         ));
         assert_eq!(
             parse_command("sync --period 10 --counter 240 --count 3").unwrap(),

@@ -578,4 +578,69 @@ mod tests {
         jobs.start(&bus, Request::ListJobs, &bindings, &tx);
         assert_eq!(result(&rx).await, "jobs: nothing running");
     }
+
+    #[tokio::test(start_paused = true)]
+    async fn stop_all_disables_every_entry_of_a_transmit_list_before_it_stops_the_drives() {
+        let bus = crate::sim::demo::start(false);
+        let bindings = crate::cli::bind::bindings_on(crate::connect::DEMO, &[], &[]).unwrap();
+        let path = std::env::temp_dir().join(format!("cotui-live-list-{}.json", std::process::id()));
+        std::fs::write(
+            &path,
+            r#"{"entries": [{"frame": "123#01", "every_ms": 10}, {"frame": "124#02", "every_ms": 30}]}"#,
+        )
+        .unwrap();
+        let line = format!("send --list {}", path.display());
+        let (tx, rx) = sync_channel(64);
+        let (stopped_tx, _stopped) = unbounded_channel();
+        let mut jobs = Jobs::new(stopped_tx);
+        let mut sub = bus.subscribe();
+        let command = parse_command(&line).unwrap();
+        jobs.start(
+            &bus,
+            Request::Run {
+                line: line.clone(),
+                command,
+            },
+            &bindings,
+            &tx,
+        );
+        let listed = |f: &Frame| f.direction() == crate::frame::Direction::Tx && (f.id == 0x123 || f.id == 0x124);
+        let mut seen = 0;
+        while seen < 6 {
+            seen += listed(&sub.recv().await.unwrap()) as u32;
+        }
+        let options = StopOptions {
+            timeout_ms: 50,
+            ramp_ms: 10,
+        };
+        jobs.start(
+            &bus,
+            Request::StopAll {
+                nodes: BTreeSet::from([2]),
+                options,
+            },
+            &bindings,
+            &tx,
+        );
+        // Every frame of the list still queued went out before the stop's first frame, none after.
+        let mut stop_seen = false;
+        let report = loop {
+            while let Some(Ok(f)) = sub.try_recv() {
+                if f.id == crate::cob::sdo_request(2) {
+                    stop_seen = true;
+                }
+                assert!(!(stop_seen && listed(&f)), "a list frame after the stop: {f:?}");
+            }
+            if let Ok(Feed::Stopped(_, text, _)) = rx.try_recv() {
+                break text;
+            }
+            tokio::time::sleep(Duration::from_millis(5)).await;
+        };
+        assert!(stop_seen);
+        assert!(report.contains(&format!("cancelled: {line}")), "{report}");
+        tokio::time::sleep(Duration::from_millis(200)).await;
+        while let Some(Ok(f)) = sub.try_recv() {
+            assert!(!listed(&f), "a list frame after the stop: {f:?}");
+        }
+    }
 }

@@ -11,9 +11,17 @@ fn stable(v: &mut Value, tmp: &str) {
     match v {
         Value::Object(map) => {
             for (key, value) in map.iter_mut() {
-                let measured = ["jitter", "mean_period", "elapsed", "took", "duration_ms", "after_ms"]
-                    .iter()
-                    .any(|m| key.contains(m));
+                let measured = [
+                    "jitter",
+                    "mean_period",
+                    "elapsed",
+                    "took",
+                    "duration_ms",
+                    "after_ms",
+                    "span",
+                ]
+                .iter()
+                .any(|m| key.contains(m));
                 if measured && value.is_number() {
                     *value = Value::String("[measured]".into());
                 } else {
@@ -51,6 +59,16 @@ fn every_command_answers_json_as_documented() {
     let tmp = dir.to_str().unwrap();
     let dcf = format!("{tmp}/node2.dcf");
     let log = format!("{tmp}/three.log");
+    let list = format!("{tmp}/list.json");
+    std::fs::write(
+        &list,
+        r#"{"entries": [{"frame": "123#11", "count": 2, "comment": "twice"},
+            {"rpdo": "rpdo1", "node": 2, "signals": {"Controlword": "0x06"}},
+            {"frame": "000#0100", "enabled": false}]}"#,
+    )
+    .unwrap();
+    let bad_list = format!("{tmp}/bad_list.json");
+    std::fs::write(&bad_list, "{\"entries\": [\n  {\"frame\": \"123#1\"}\n]}").unwrap();
     let cases: Vec<(&str, Vec<&str>, i32)> = vec![
         ("nmt", vec!["nmt", "demo", "start", "2", "--wait"], 0),
         ("nmt_no_such_bus", vec!["nmt", "can9", "start", "2"], 2),
@@ -79,6 +97,24 @@ fn every_command_answers_json_as_documented() {
         ("lss_inquire_timeout", vec!["lss", "demo", "inquire", "all"], 4),
         ("send", vec!["send", "demo", "123#11", "--count", "2"], 0),
         ("send_bad_frame", vec!["send", "demo", "123#1"], 1),
+        ("send_list", vec!["send", "demo", "--list", &list], 0),
+        ("send_list_bad_entry", vec!["send", "demo", "--list", &bad_list], 1),
+        (
+            "watch",
+            vec![
+                "watch",
+                "demo",
+                "2",
+                "0x6041",
+                "0x2999",
+                "--duration",
+                "1000",
+                "--every",
+                "5000",
+            ],
+            0,
+        ),
+        ("watch_unknown_object", vec!["watch", "demo", "2", "Nonsense"], 1),
         ("sync", vec!["sync", "demo", "--period", "10", "--count", "2"], 0),
         (
             "sync_reserved_cob_id",

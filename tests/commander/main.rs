@@ -16,6 +16,7 @@ mod commander_demo;
 mod dcf_demo;
 mod every_procedure;
 mod json_snapshots;
+mod lists;
 mod lss_sim;
 mod pdo_config;
 mod procedure_run;

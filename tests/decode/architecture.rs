@@ -417,7 +417,7 @@ const KNOWN_CYCLES: &[&str] = &[
     "src: bus, bus::socketcan, bus::state",
     "src: cli::commander, cli::record",
     "src: cli::decode, cli::decode_filter, cli::decode_out, cli::decode_parquet",
-    "src: command, command::cyclic, command::dcf, command::dcf::plan, command::dcf::report, command::drive, command::error, command::exec, command::grammar, command::lss, command::nmt, command::object, command::pdo, command::record, command::registry, command::run, command::run::command, command::scan, command::sdo, command::send, command::spec, command::stop, command::sync, command::syntax, command::value, command::words, command::write",
+    "src: command, command::cyclic, command::dcf, command::dcf::plan, command::dcf::report, command::drive, command::error, command::exec, command::grammar, command::lss, command::nmt, command::object, command::pdo, command::record, command::registry, command::run, command::run::command, command::scan, command::sdo, command::send, command::spec, command::stop, command::sync, command::syntax, command::transmit_list, command::transmit_run, command::value, command::watch, command::watch_table, command::words, command::write",
     "src: sim::profile, sim::vendor",
     "src: tui::capture, tui::record",
     "src: tui::commands, tui::export",

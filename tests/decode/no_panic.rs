@@ -117,3 +117,33 @@ fn deep_nesting_is_an_error_not_a_crash() {
     let text = format!("{{\"name\": \"x\", \"objects\": {}}}", "{\"a\":".repeat(10_000));
     assert!(load_profile("deep.json", &text).is_err());
 }
+
+/// JSON fragments that look like a transmit list (`send --list FILE`).
+fn list_piece() -> impl Strategy<Value = String> {
+    prop_oneof![
+        Just("{".to_string()),
+        Just("}".to_string()),
+        Just("[".to_string()),
+        Just("]".to_string()),
+        Just(",".to_string()),
+        Just(":".to_string()),
+        Just("\n".to_string()),
+        "\"(entries|frame|rpdo|node|signals|every_ms|enabled|count|comment|Controlword|0x6040|rpdo[0-9]{1,3}|tpdo1|[0-9A-F]{3,8}#[0-9A-FR#]{0,17}|[0-9]{1,4}(ms|s)?)\"",
+        "-?[0-9]{1,20}(\\.[0-9]{1,3})?",
+        Just("null".to_string()),
+        Just("true".to_string()),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+    #[test]
+    fn transmit_lists_never_panic(pieces in prop::collection::vec(list_piece(), 0..40), text in ".{0,200}") {
+        let b = Bindings::new().unwrap();
+        let joined = pieces.concat();
+        let _ = cotui::command::transmit_list::load(&format!("{{\"entries\": [{joined}]}}"), &b);
+        let _ = cotui::command::transmit_list::load(&joined, &b);
+        let _ = cotui::command::transmit_list::load(&text, &b);
+    }
+}

@@ -789,6 +789,29 @@ data=$(awk '$3 ~ /^202#/ { print $3; exit }' cyc.log)
 [ "$rc" = 0 ] && near "$n" 50 0.2 && near "$median" 20 0.1 && near "$mean" 20 0.25 && [ "$data" = 202#0F0009 ] &&
     ok "pdo rpdo1 every 20 ms x50: candump saw $n x $data, period median $median ms, mean $mean ms" ||
     bad "pdo: rc=$rc candump $n frames ($data), median $median ms, mean $mean ms; $out $err"
+# The transmit list: each enabled entry on its own period for 2 s, counted by candump.
+cat > txlist.json << 'EOF'
+{"entries": [{"frame": "321#01", "every_ms": 20}, {"frame": "322#0203", "every_ms": 50},
+             {"frame": "323#04", "enabled": false}]}
+EOF
+candump -L vcan0,320:7FC > txl.log 2> /dev/null &
+txldump=$!
+wait_socket $txldump || bad "transmit list: candump opened no socket"
+c send vcan0 --list txlist.json --duration 2000 --json
+sleep 0.3
+kill -INT $txldump
+wait $txldump
+# Counted by candump's receive timestamps: the frames of each id in the 2 s from the first.
+in2s() { awk -v id="$2" '{ split($3, f, "#"); t = substr($1, 2, length($1) - 2) } f[1] == id { if (!a) a = t; if (t - a < 2.0) n++ } END { print n + 0 }' "$1"; }
+n1=$(in2s txl.log 321)
+n2=$(in2s txl.log 322)
+all1=$(grep -c ' 321#' txl.log)
+all2=$(grep -c ' 322#' txl.log)
+n3=$(grep -c ' 323#' txl.log)
+[ "$rc" = 0 ] && near "$n1" 100 0.15 && near "$n2" 40 0.15 && [ "$n3" = 0 ] &&
+    [ "$(echo "$out" | j '.entries[0].sent')" = "$all1" ] && [ "$(echo "$out" | j '.entries[1].sent')" = "$all2" ] &&
+    ok "send --list for 2 s: candump saw $n1 x 321#01 (every 20 ms), $n2 x 322#0203 (every 50 ms), none of the disabled entry; cotui's counts agree" ||
+    bad "send --list: rc=$rc candump $n1 / $n2 / $n3 frames in 2 s ($all1 / $all2 in all); $out $err"
 # The palette: `sync --period 10` runs as a job; `jobs` lists it, ctrl-s stops it first.
 export TERM=xterm-256color
 tmux new-session -d -s cyc -x 200 -y 45 "XDG_CONFIG_HOME=$work $cotui live vcan0; echo cotui-exit=\$?; sleep 60"
