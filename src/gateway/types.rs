@@ -73,7 +73,7 @@ impl GwType {
     }
 
     /// The size in bytes of a value of the type; `None` for the strings, domains and `hex`.
-    pub fn len(self) -> Option<usize> {
+    pub fn size(self) -> Option<usize> {
         match self {
             GwType::Bool => Some(1),
             GwType::Int(n) | GwType::Uint(n) | GwType::Hex(n) => Some(n as usize),
@@ -85,7 +85,7 @@ impl GwType {
 
     /// The value of `data` as canopend prints it (data of another length than the type's: as `hex`).
     pub fn print(self, data: &[u8]) -> String {
-        if self.len().is_some_and(|n| n != data.len()) {
+        if self.size().is_some_and(|n| n != data.len()) {
             return hex_bytes(data);
         }
         let mut le = [0u8; 8];
