@@ -27,6 +27,10 @@ pub struct GatewayArgs {
     /// gateway only reads (`read`), answering the others ERROR:100 and sending nothing.
     #[arg(long)]
     pub allow_writes: bool,
+    /// Write notifications (EMCY, NMT state changes) to the clients as they happen, between
+    /// answers; without it they are kept for the `log` request, as canopend keeps them.
+    #[arg(long)]
+    pub notify: bool,
     /// Open the bus without a send path: every request that would send is answered ERROR:102.
     #[arg(long)]
     pub listen_only: bool,
@@ -68,6 +72,7 @@ async fn serve(args: &GatewayArgs) -> Result<(), GatewayError> {
     let bus = crate::connect::open(&args.iface, args.listen_only).await?;
     let policy = Policy {
         allow_writes: args.allow_writes,
+        notify: args.notify,
     };
     let gw = Gateway::start(bus, policy);
     let io = |what: String| move |source| GatewayError::Io { what, source };

@@ -1,6 +1,7 @@
 //! The gateway's IO: clients on stdin/stdout, a Unix socket or a TCP address, each with
 //! its own [`Session`]; lines read with a bounded length; notifications from one watch of
-//! the bus, written to every client between its answers.
+//! the bus, kept by every session for `log` and, with [`Policy::notify`], written to the
+//! client between its answers.
 //!
 //! Requests of different clients that go on the bus run one after another (one lock):
 //! two SDO transfers to the same node at once would take each other's answers.
@@ -80,11 +81,17 @@ impl Gateway {
                             session.keep(&line);
                             line
                         }
-                        Err(broadcast::error::RecvError::Lagged(k)) => format!("... {k} notifications dropped (the client read too slowly)\r\n"),
+                        Err(broadcast::error::RecvError::Lagged(k)) => {
+                            let line = format!("... {k} notifications dropped (the client read too slowly)\r\n");
+                            session.keep(&line);
+                            line
+                        }
                         Err(broadcast::error::RecvError::Closed) => continue,
                     };
-                    writer.write_all(text.as_bytes()).await?;
-                    writer.flush().await?;
+                    if session.policy().notify {
+                        writer.write_all(text.as_bytes()).await?;
+                        writer.flush().await?;
+                    }
                 }
                 line = lines.next() => {
                     let answer = match line? {

@@ -21,6 +21,10 @@ use std::collections::VecDeque;
 pub struct Policy {
     /// `--allow-writes`: SDO writes, NMT and LSS commands go on the bus.
     pub allow_writes: bool,
+    /// `--notify`: notifications are written to the clients as they happen (between
+    /// answers), besides being kept for `log`. Off by default, as in canopend: a client like
+    /// `cocomm` takes the first line after a request for its answer.
+    pub notify: bool,
 }
 
 /// The default SDO timeout of a session, in ms (canopend's).
@@ -50,6 +54,11 @@ impl Session {
             block: false,
             log: VecDeque::new(),
         }
+    }
+
+    /// The session's policy.
+    pub fn policy(&self) -> Policy {
+        self.policy
     }
 
     /// Keeps a notification line for `log`.
@@ -271,7 +280,8 @@ cotui gateway: CiA 309-3 ASCII requests, canopend's command set. Each line:
   set sdo_timeout MS | set sdo_block 0|1
   help [datatype|lss] | log         this text, types, LSS commands; kept notifications
 Comments start with #. One network: NET is accepted and not used. Notifications (EMCY,
-NMT state changes from heartbeats and boot-ups) arrive as lines between answers.";
+NMT state changes from heartbeats and boot-ups) are kept for `log` (with --notify: written
+as lines between answers too).";
 
 const HELP_TYPES: &str = "
 Data types:

@@ -24,7 +24,10 @@ fn sent(rx: &mut Subscription) -> Vec<Frame> {
 }
 
 fn writes(allow_writes: bool) -> Policy {
-    Policy { allow_writes }
+    Policy {
+        allow_writes,
+        notify: false,
+    }
 }
 
 #[tokio::test(start_paused = true)]

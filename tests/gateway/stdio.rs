@@ -71,7 +71,7 @@ fn without_allow_writes_write_nmt_and_lss_are_refused_and_the_value_stays() {
 
 #[test]
 fn writes_read_back_and_nmt_changes_are_notified() {
-    let mut g = Gateway::start(&["--allow-writes"]);
+    let mut g = Gateway::start(&["--allow-writes", "--notify"]);
     let c = &mut g.client;
     assert_eq!(c.ask("[1] 2 write 0x1017 0 u16 1000"), "[1] OK");
     assert_eq!(c.ask("[2] 2 read 0x1017 0 u16"), "[2] 1000");
@@ -160,7 +160,7 @@ fn bad_lines_get_a_clear_error_and_the_gateway_goes_on() {
 
 #[test]
 fn listen_only_sends_nothing_even_with_allow_writes() {
-    let mut g = Gateway::start(&["--listen-only", "--allow-writes"]);
+    let mut g = Gateway::start(&["--listen-only", "--allow-writes", "--notify"]);
     let c = &mut g.client;
     for (n, line) in ["2 r 0x1017 0 u16", "2 w 0x1017 0 u16 1", "0 start", "lss_get_node"]
         .iter()
@@ -176,4 +176,34 @@ fn listen_only_sends_nothing_even_with_allow_writes() {
     }
     // It still hears the bus.
     c.notice("NMT state changed to: \"operational\"");
+}
+
+#[test]
+fn without_notify_the_notifications_wait_for_log() {
+    let mut g = Gateway::start(&["--allow-writes"]);
+    let c = &mut g.client;
+    // The demo starts its nodes 0.8 s after power-on: ask until `log` has that.
+    let mut seq = 0;
+    let log = loop {
+        seq += 1;
+        assert_eq!(c.ask(&format!("[{seq}] 2 r 0x1017 0 u16")), format!("[{seq}] 500"));
+        seq += 1;
+        c.send(format!("[{seq}] log\r\n").as_bytes());
+        let log = c.text();
+        if log
+            .iter()
+            .any(|l| l.contains("0x03 (index = 1): NMT state changed to: \"operational\" (5)"))
+        {
+            break log;
+        }
+    };
+    assert!(
+        log.iter().all(|l| l.contains("NMT state changed") || l.is_empty()),
+        "{log:?}"
+    );
+    assert!(
+        c.notices.iter().all(String::is_empty),
+        "no line besides the answers: {:?}",
+        c.notices
+    );
 }

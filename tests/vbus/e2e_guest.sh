@@ -1085,7 +1085,7 @@ gw_is() {
     [ "$got" = "[$1] $2" ] && ok "gateway: $3" || bad "gateway: $3: want [$1] $2, got: $got ($(cat gw.err))"
 }
 if wait_for gw_peer.out 900 "sdo_server ready vcan0 21"; then
-    gw_run --allow-writes
+    gw_run --allow-writes --notify
     domain_hex=$(awk 'BEGIN { for (i = 0; i < 300; i++) printf "%s%02X", (i ? " " : ""), i % 256 }')
     printf '%s\n' '[1] 21 read 0x2001 0 x16' '[2] 21 r 0x2004 0 vs' '[3] set node 21' '[4] set sdo_block 1' \
         '[5] r 0x2005 0 hex' '[6] set sdo_block 0' '[7] w 0x2001 0 u16 0xBEEF' '[8] r 0x2001 0 u16' \
