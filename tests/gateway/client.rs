@@ -31,7 +31,8 @@ pub fn lines_of(r: impl std::io::Read + Send + 'static) -> Receiver<String> {
 
 /// One connection: where requests go, where answers come from.
 pub struct Client<W: Write> {
-    to: W,
+    /// Where requests go.
+    pub to: W,
     from: Receiver<String>,
     /// The notification lines read so far.
     pub notices: Vec<String>,

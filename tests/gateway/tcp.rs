@@ -73,3 +73,38 @@ fn read_only_over_tcp_refuses_writes() {
     let _ = child.kill();
     let _ = child.wait();
 }
+
+#[test]
+fn past_the_client_limit_a_connect_is_told_and_closed_and_the_others_go_on() {
+    let (mut child, addr) = start(&[]);
+    let mut first = connect(&addr);
+    assert_eq!(first.ask("[1] 2 r 0x1017 0 u16"), "[1] 500");
+    // Fill the gateway: each connection answered once, so it is counted in.
+    let mut held = Vec::new();
+    for n in 1..cotui::gateway::serve::MAX_CLIENTS {
+        let mut c = connect(&addr);
+        assert_eq!(c.ask(&format!("[{n}] set node 2")), format!("[{n}] OK"));
+        held.push(c);
+    }
+    let mut extra = connect(&addr);
+    let told = extra.next_line();
+    assert!(
+        told.starts_with("[0] ERROR:102") && told.contains("clients are served already"),
+        "{told}"
+    );
+    assert_eq!(
+        first.ask("[2] 2 r 0x1017 0 u16"),
+        "[2] 500",
+        "the others are still served"
+    );
+    held.pop().unwrap().to.shutdown(std::net::Shutdown::Both).unwrap();
+    // A freed place is taken by the next connect (once the gateway saw the close).
+    let served = (0..200).any(|k| {
+        let mut c = connect(&addr);
+        c.send(format!("[{k}] set node 3\r\n").as_bytes());
+        c.next_line() == format!("[{k}] OK")
+    });
+    assert!(served, "a place freed by a client that left is taken again");
+    let _ = child.kill();
+    let _ = child.wait();
+}
