@@ -6,7 +6,7 @@
 //! commands and the two front ends (TUI and CLI). The core's modules are re-exported here
 //! under their own names, so `cotui::decode` is `canopen::decode`.
 
-pub use canopen::{cob, decode, frame, log, lss, od, sdo, wire};
+pub use canopen::{calendar, cob, decode, frame, log, lss, od, sdo, wire};
 
 pub mod analysis;
 pub mod bench;
@@ -15,6 +15,7 @@ pub mod cli;
 pub mod command;
 pub mod connect;
 pub mod files;
+pub mod gateway;
 pub mod logio;
 pub mod output;
 pub mod sim;

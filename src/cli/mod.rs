@@ -8,6 +8,7 @@ mod decode_out;
 mod decode_parquet;
 pub mod diagnose;
 pub mod explain;
+pub mod gateway;
 pub mod input;
 mod merge;
 pub mod record;
@@ -62,6 +63,10 @@ pub enum Command {
     /// Simulated CiA 402 drives on a SocketCAN interface for other tools to talk to (SDO,
     /// NMT, PDO, SYNC, EMCY, LSS); stdin lines make them fail: fault/silence/reboot NODE.
     Sim(sim::SimArgs),
+    /// A CiA 309-3 ASCII gateway (CANopenNode canopend's commands and answers) on stdio, a
+    /// Unix socket or TCP, for scripts: `[1] 2 read 0x1017 0 u16`. Read-only unless
+    /// --allow-writes.
+    Gateway(gateway::GatewayArgs),
 }
 
 /// Short usage printed by `cotui` without arguments.
@@ -99,6 +104,7 @@ pub fn run() -> ExitCode {
         Some(Command::Live(args)) => tui::run_live(&args),
         Some(Command::Demo(args)) => tui::run_demo(&args),
         Some(Command::Sim(args)) => sim::run_sim(&args),
+        Some(Command::Gateway(args)) => gateway::run_gateway(&args),
         Some(Command::Commander(c)) => commander::run_commander(&c),
     }
 }

@@ -6,7 +6,7 @@
 # (cangen, cansend, candump), the python canopen peers (peers/sdo_server.py node 5,
 # peers/drive402.py node 2 (sections 2-5, stopped with sdo_server.py after section 5) and node 12
 # (section 14); peers/dcf_node.py nodes 10 and 11 in section 15; peers/diag_node.py node 7 in
-# section 16) and tmux.
+# section 16; peers/sdo_server.py node 21 in section 17) and tmux.
 # Prints one line per check ("ok   ..." or "FAIL ...") and "N passed, N failed"; exits 1
 # on any failure.
 set -uo pipefail
@@ -1084,6 +1084,65 @@ two=$(echo "$out" | jq -c 'select(.node == 5 and .status == "open") | [.kind, .i
 [ "$rc" = 0 ] && [ "$two" = '["silent","vcan1"]' ] &&
     ok "two buses: cotui diagnose --live vcan0 vcan1: node 5 silent on vcan1 only" ||
     bad "two buses: diagnose --live vcan0 vcan1: rc=$rc node 5: $two; $err"
+
+# ---- 17 gateway: cotui gateway vcan0 --stdio (CiA 309-3) against canopen's LocalNode -------
+# A client of canopend's lines through a fifo; what the gateway did on the bus is checked by
+# the python peer (sdo_server.py node 21: "sdo_server wrote ..."), not by cotui.
+python3 "$here/peers/sdo_server.py" vcan0 21 --heartbeat-ms 200 > gw_peer.out 2>&1 &
+gw_peer=$!
+pids+=($gw_peer)
+# gw_run ARGS...: the gateway on vcan0 --stdio ARGS, its input the fifo gw.in (fd 7), its
+# answers in gw.out.
+gw_run() {
+    rm -f gw.in && mkfifo gw.in
+    timeout 120 "$cotui" gateway vcan0 --stdio "$@" < gw.in > gw.out 2> gw.err &
+    gw=$!
+    exec 7> gw.in
+}
+gw_stop() { exec 7>&-; wait "$gw"; }
+# gw_is SEQ WANT LABEL: the answer to [SEQ] (CR LF cut) is exactly WANT
+gw_is() {
+    wait_for gw.out 300 "[$1] " || true
+    local got
+    got=$(tr -d '\r' < gw.out | grep -m1 -F "[$1] ")
+    [ "$got" = "[$1] $2" ] && ok "gateway: $3" || bad "gateway: $3: want [$1] $2, got: $got ($(cat gw.err))"
+}
+if wait_for gw_peer.out 900 "sdo_server ready vcan0 21"; then
+    gw_run --allow-writes --notify
+    domain_hex=$(awk 'BEGIN { for (i = 0; i < 300; i++) printf "%s%02X", (i ? " " : ""), i % 256 }')
+    printf '%s\n' '[1] 21 read 0x2001 0 x16' '[2] 21 r 0x2004 0 vs' '[3] set node 21' '[4] set sdo_block 1' \
+        '[5] r 0x2005 0 hex' '[6] set sdo_block 0' '[7] w 0x2001 0 u16 0xBEEF' '[8] r 0x2001 0 u16' \
+        '[9] r 0x7777 0' '[10] w 0x2006 0 u32 1' '[11] w 0x2004 0 vs "by the gateway"' '[12] r 0x2003 0 i32' >&7
+    gw_is 1 0x1234 "read x16 0x2001 of the LocalNode"
+    gw_is 2 '"hello from vbus"' "segmented read of a visible string"
+    gw_is 5 "$domain_hex" "block read of the 300-byte domain (set sdo_block 1)"
+    gw_is 7 OK "write u16 0x2001 = 0xBEEF"
+    python_wrote_21() { wait_for gw_peer.out 30 "sdo_server wrote $1 $2"; }
+    python_wrote_21 2001:00 EFBE && ok "gateway: the peer stored EFBE in 0x2001" || bad "gateway: peer: $(grep wrote gw_peer.out)"
+    gw_is 8 48879 "read back 0x2001"
+    gw_is 9 "ERROR:0x06020000 #Object does not exist in the object dictionary." "abort of a missing object"
+    gw_is 10 "ERROR:0x06010002 #Attempt to write a read only object." "abort of a write to a read-only object"
+    gw_is 11 OK "segmented write of a visible string"
+    python_wrote_21 2004:00 "$(printf 'by the gateway' | od -An -tx1 | tr -d ' \n' | tr a-f A-F)" &&
+        ok "gateway: the peer stored the string" || bad "gateway: peer: $(grep 'wrote 2004' gw_peer.out)"
+    gw_is 12 -123456 "read i32"
+    wait_for gw.out 100 "CANopen Remote node ID = 0x15 (index = " &&
+        ok "gateway: the peer's heartbeat is notified ($(tr -d '\r' < gw.out | grep -m1 'Remote node ID = 0x15' | cut -d' ' -f3-))" ||
+        bad "gateway: no notification of node 21: $(tr -d '\r' < gw.out | grep -v '^\[')"
+    gw_stop
+    # Read-only (no --allow-writes): refused, and the peer stores nothing.
+    writes_before=$(grep -c wrote gw_peer.out)
+    gw_run
+    printf '%s\n' '[1] 21 w 0x2001 0 u16 7' '[2] 21 start' '[3] 21 r 0x2001 0 x16' >&7
+    gw_is 1 "ERROR:100 #Request not supported. the gateway is read-only: start it with --allow-writes for write, NMT and LSS (nothing was sent)" "read-only: write refused"
+    gw_is 3 0xBEEF "read-only: the value stayed"
+    gw_stop
+    [ "$(grep -c wrote gw_peer.out)" = "$writes_before" ] && ok "gateway: read-only, the peer saw no write" ||
+        bad "gateway: read-only, yet the peer stored: $(grep wrote gw_peer.out | tail -1)"
+else
+    bad "gateway: sdo_server.py node 21 not ready: $(cat gw_peer.out)"
+fi
+kill -TERM "$gw_peer" 2> /dev/null
 
 t_end=$(date +%s.%N)
 echo "$passed passed, $failed failed ($(awk -v a="$t_start" -v b="$t_end" 'BEGIN { printf "%.0f", b - a }') s in the guest)"

@@ -3,6 +3,7 @@
 //! Everything here takes bytes and returns values: no IO, no clock, no terminal, no async
 //! runtime. The modules, from the bottom up:
 //!
+//! - [`calendar`]: civil dates from day counts, and UTC date-time text.
 //! - [`cob`]: the COB-IDs of the predefined connection set (`cob::sdo_request(node)`).
 //! - [`frame`]: the [`frame::Frame`] value (classic and FD, 11/29-bit, flags, timestamp).
 //! - [`log`]: streaming parsers of candump `-l`/`-L` logs, candump screen output and Vector
@@ -38,7 +39,7 @@
 
 #![deny(unsafe_code)]
 
-mod calendar;
+pub mod calendar;
 pub mod cob;
 pub mod decode;
 pub mod frame;
