@@ -17,5 +17,6 @@ pub mod connect;
 pub mod files;
 pub mod logio;
 pub mod output;
+pub mod serve;
 pub mod sim;
 pub mod tui;

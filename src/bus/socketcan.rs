@@ -156,7 +156,7 @@ pub fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
         events,
         sender,
         socket: Some(Arc::new(Shared { task, link, catch_up })),
-        clock: None,
+        clock: super::Clock::Wall,
     })
 }
 

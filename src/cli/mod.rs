@@ -11,6 +11,7 @@ pub mod explain;
 pub mod input;
 mod merge;
 pub mod record;
+pub mod serve;
 pub mod sim;
 pub mod tui;
 
@@ -62,6 +63,10 @@ pub enum Command {
     /// Simulated CiA 402 drives on a SocketCAN interface for other tools to talk to (SDO,
     /// NMT, PDO, SYNC, EMCY, LSS); stdin lines make them fail: fault/silence/reboot NODE.
     Sim(sim::SimArgs),
+    /// Serve a bus (SocketCAN, `demo`) over the socketcand protocol to python-can, SavvyCAN
+    /// or `cotui ... socketcand://HOST:PORT/IFACE` on other machines; loopback and receive-only
+    /// unless --bind and --allow-send.
+    Serve(serve::ServeArgs),
 }
 
 /// Short usage printed by `cotui` without arguments.
@@ -99,6 +104,7 @@ pub fn run() -> ExitCode {
         Some(Command::Live(args)) => tui::run_live(&args),
         Some(Command::Demo(args)) => tui::run_demo(&args),
         Some(Command::Sim(args)) => sim::run_sim(&args),
+        Some(Command::Serve(args)) => serve::run_serve(&args),
         Some(Command::Commander(c)) => commander::run_commander(&c),
     }
 }
