@@ -271,7 +271,8 @@ fn drops_of(sock: &Socket) -> u64 {
 }
 
 /// Sets an integer `SOL_SOCKET` option.
-fn setsockopt_int(fd: i32, opt: i32, value: i32) -> io::Result<()> {
+/// Sets the `SOL_SOCKET` option `opt` of `fd` to `value`.
+pub(crate) fn setsockopt_int(fd: i32, opt: i32, value: i32) -> io::Result<()> {
     // SAFETY: `value` is a valid c_int for the duration of the call.
     let r = unsafe {
         libc::setsockopt(

@@ -108,11 +108,18 @@ mod tests {
         assert_eq!(listen_addr("localhost:5", None), Ok("127.0.0.1:5".parse().unwrap()));
         assert_eq!(listen_addr("[::1]:5", None), Ok("[::1]:5".parse().unwrap()));
         let e = listen_addr("0.0.0.0:29536", None).unwrap_err();
-        assert!(e.contains("not a loopback address") && e.ends_with("--bind 0.0.0.0"), "{e}");
+        assert!(
+            e.contains("not a loopback address") && e.ends_with("--bind 0.0.0.0"),
+            "{e}"
+        );
         let any: IpAddr = "0.0.0.0".parse().unwrap();
         assert_eq!(listen_addr("29536", Some(any)), Ok("0.0.0.0:29536".parse().unwrap()));
         assert_eq!(listen_addr("0.0.0.0:1", Some(any)), Ok("0.0.0.0:1".parse().unwrap()));
         assert!(listen_addr("10.0.0.1:1", Some(any)).is_err());
-        assert!(listen_addr("can0", None).unwrap_err().contains("give PORT or ADDR:PORT"));
+        assert!(
+            listen_addr("can0", None)
+                .unwrap_err()
+                .contains("give PORT or ADDR:PORT")
+        );
     }
 }

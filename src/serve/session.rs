@@ -204,7 +204,10 @@ mod tests {
         );
         say(&mut s, "open can0");
         let got = say(&mut s, "send 601 0");
-        assert_eq!(got[0], Action::Reply("< error send refused: start the server with --allow-send >".into()));
+        assert_eq!(
+            got[0],
+            Action::Reply("< error send refused: start the server with --allow-send >".into())
+        );
         assert!(matches!(got[1], Action::Refused(f) if f.id == 0x601));
         assert_eq!(
             say(&mut s, "cotui_send_policy"),

@@ -127,7 +127,9 @@ fn python_can_receives_the_bus_and_reads_an_sdo_with_allow_send() {
     assert!(out.contains("heartbeat 05 ts 1"), "{out}");
     // Expedited upload response of 0x1017:00 = 500 ms.
     assert!(out.contains("answer 4b171000f4010000"), "{out}");
-    s.wait_line("the audit of the frame sent", |l| l.ends_with("sent 602#4017100000000000"));
+    s.wait_line("the audit of the frame sent", |l| {
+        l.ends_with("sent 602#4017100000000000")
+    });
     s.wait_line("the disconnect", |l| {
         l.contains("disconnected (closed by the client): 1 frames sent, 0 sends refused")
     });
@@ -140,7 +142,9 @@ fn without_allow_send_nothing_is_sent_and_the_client_is_told() {
     // python-can fails its next read on the server's error; no answer ever came.
     assert!(out.contains("error True") || out.contains("answer None"), "{out}");
     assert!(!out.contains("answer 4b"), "{out}");
-    s.wait_line("the refusal", |l| l.ends_with("send refused (no --allow-send): 602#4017100000000000"));
+    s.wait_line("the refusal", |l| {
+        l.ends_with("send refused (no --allow-send): 602#4017100000000000")
+    });
     assert!(!s.lines().iter().any(|l| l.contains(" sent 602#")), "{:?}", s.lines());
     // The raw protocol: the refusal is an error element naming the fix.
     let mut c = Raw::open(s.port);
@@ -157,7 +161,11 @@ fn without_allow_send_nothing_is_sent_and_the_client_is_told() {
         "{}",
         text(&o)
     );
-    assert!(text(&o).contains("fix: start the server with --allow-send"), "{}", text(&o));
+    assert!(
+        text(&o).contains("fix: start the server with --allow-send"),
+        "{}",
+        text(&o)
+    );
     assert!(t.elapsed() < Duration::from_secs(30));
 }
 
@@ -218,7 +226,10 @@ impl Raw {
     fn open(port: u16) -> Raw {
         let sock = TcpStream::connect(("127.0.0.1", port)).unwrap();
         sock.set_read_timeout(Some(Duration::from_millis(200))).unwrap();
-        let mut r = Raw { sock, got: String::new() };
+        let mut r = Raw {
+            sock,
+            got: String::new(),
+        };
         r.until("< hi >");
         r.say("< open demo >");
         r.until("< ok >");
@@ -309,7 +320,9 @@ fn a_client_beyond_max_clients_is_refused_with_an_error() {
     let mut got = String::new();
     second.read_to_string(&mut got).unwrap();
     assert_eq!(got, "< error too many clients (1 connected) >");
-    s.wait_line("the refusal", |l| l.contains("refused: 1 clients connected already (--max-clients)"));
+    s.wait_line("the refusal", |l| {
+        l.contains("refused: 1 clients connected already (--max-clients)")
+    });
 }
 
 #[test]
@@ -323,8 +336,73 @@ fn the_server_refuses_other_addresses_without_bind_and_send_under_listen_only() 
     assert!(text(&o).contains("a listen-only bus cannot send"), "{}", text(&o));
     let o = cotui(&["serve", "demo", "--socketcand", "0", "--beacon"]);
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
-    assert!(text(&o).contains("--beacon announces the bus to the network"), "{}", text(&o));
+    assert!(
+        text(&o).contains("--beacon announces the bus to the network"),
+        "{}",
+        text(&o)
+    );
     let o = cotui(&["sdo", "read", "socketcand://127.0.0.1:1/demo", "2", "0x1017"]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("cannot connect to 127.0.0.1:1"), "{}", text(&o));
+}
+
+/// A client that opens raw mode and never reads (a small receive buffer), while another
+/// client sends 30,000 frames: the frames to the first are dropped and counted, the
+/// sender's frames all go out, and the server still answers.
+#[test]
+fn a_client_that_never_reads_loses_frames_counted_and_the_server_goes_on() {
+    let s = Server::demo(&["--allow-send"]);
+    let stuck = r#"
+import socket, sys, time
+s = socket.socket()
+s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+s.connect(("127.0.0.1", int(sys.argv[1])))
+s.sendall(b"< open demo >< rawmode >")
+print("connected", flush=True)
+sys.stdin.read()
+"#;
+    let mut py = Command::new("python3")
+        .arg("-c")
+        .arg(stuck)
+        .arg(s.port.to_string())
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(py.stdout.take().unwrap()).read_line(&mut line).unwrap();
+    assert_eq!(line.trim(), "connected");
+    s.wait_line("the stuck client", |l| {
+        l.contains("client 1 (") && l.ends_with("connected")
+    });
+    let mut blaster = Raw::open(s.port);
+    let burst: String = (0..30_000)
+        .map(|i| format!("< send 123 2 {:x} {:x} >", i % 256, i / 256))
+        .collect();
+    blaster.say(&burst);
+    blaster.say("< echo >");
+    blaster.until("< echo >");
+    s.wait_line("the first drop", |l| {
+        l.contains("client 1 (") && l.contains("does not read fast enough: dropping frames")
+    });
+    s.wait_line("the last frame sent", |l| l.ends_with("sent 123#2F75"));
+    // The stuck client leaves: its line counts what it lost.
+    drop(py.stdin.take());
+    let _ = py.wait();
+    let gone = s.wait_line("the stuck client's disconnect", |l| {
+        l.contains("client 1 (") && l.contains("disconnected")
+    });
+    let dropped: u64 = gone
+        .split(" frames received, ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(dropped > 1000, "{gone}");
+    let mut late = Raw::open(s.port);
+    late.say("< echo >");
+    late.until("< echo >");
 }

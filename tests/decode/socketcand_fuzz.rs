@@ -23,16 +23,20 @@ fn piece() -> impl Strategy<Value = Vec<u8>> {
 }
 
 fn classic() -> impl Strategy<Value = Frame> {
-    (any::<bool>(), any::<u32>(), proptest::collection::vec(any::<u8>(), 0..=8), any::<u64>()).prop_map(
-        |(ext, id, data, ts)| {
+    (
+        any::<bool>(),
+        any::<u32>(),
+        proptest::collection::vec(any::<u8>(), 0..=8),
+        any::<u64>(),
+    )
+        .prop_map(|(ext, id, data, ts)| {
             let id = if ext { id & 0x1FFF_FFFF } else { id & 0x7FF };
             let mut f = Frame::classic(id, &data);
             f.flags.set(Flags::EXT, ext);
             // The protocol carries microseconds.
             f.ts_ns = (ts % 4_000_000_000_000_000) / 1000 * 1000;
             f
-        },
-    )
+        })
 }
 
 /// The text inside `< >` of an element.

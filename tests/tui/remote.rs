@@ -49,7 +49,9 @@ fn the_tui_attaches_to_a_remote_bus_with_the_palette_and_follows_the_server() {
     a.set_bindings(bindings);
     until(&mut a, "node 2 and 3 from the remote bus", |a, _| {
         let n = &a.trace().nodes;
-        [2, 3].iter().all(|&node| n.iter().any(|(k, _)| *k == NodeKey::new(0, node)))
+        [2, 3]
+            .iter()
+            .all(|&node| n.iter().any(|(k, _)| *k == NodeKey::new(0, node)))
     });
     a.run_command("sdo read 2 0x1017");
     until(&mut a, "the SDO answer in the message line", |a, _| {
@@ -58,7 +60,9 @@ fn the_tui_attaches_to_a_remote_bus_with_the_palette_and_follows_the_server() {
     // The server goes away: the bus state says so; it comes back on the same port: capture resumes.
     let _ = server.kill();
     let _ = server.wait();
-    until(&mut a, "the lost connection", |_, s| s.contains("connection to the server lost"));
+    until(&mut a, "the lost connection", |_, s| {
+        s.contains("connection to the server lost")
+    });
     let (mut again, _) = serve(port);
     let before = a.trace().len();
     until(&mut a, "frames again", |a, s| {

@@ -70,14 +70,23 @@ pub fn parse_url(url: &str) -> Result<Remote, BusError> {
         reason: why.to_string(),
         fix: "write socketcand://HOST:PORT/CHANNEL, e.g. socketcand://192.168.1.20:29536/can0".into(),
     };
-    let rest = url.strip_prefix(SCHEME).ok_or_else(|| bad("not a socketcand:// address"))?;
+    let rest = url
+        .strip_prefix(SCHEME)
+        .ok_or_else(|| bad("not a socketcand:// address"))?;
     let (authority, channel) = rest.split_once('/').ok_or_else(|| bad("no /CHANNEL"))?;
-    if channel.is_empty() || channel.len() > 64 || !channel.bytes().all(|b| b.is_ascii_graphic() && b != b'<' && b != b'>') {
+    if channel.is_empty()
+        || channel.len() > 64
+        || !channel.bytes().all(|b| b.is_ascii_graphic() && b != b'<' && b != b'>')
+    {
         return Err(bad("the channel must be a bus name on the server (e.g. can0)"));
     }
     let (host, port) = authority.rsplit_once(':').ok_or_else(|| bad("no :PORT"))?;
     let host = host.strip_prefix('[').and_then(|h| h.strip_suffix(']')).unwrap_or(host);
-    let port = port.parse::<u16>().ok().filter(|p| *p != 0).ok_or_else(|| bad("the port must be 1..65535"))?;
+    let port = port
+        .parse::<u16>()
+        .ok()
+        .filter(|p| *p != 0)
+        .ok_or_else(|| bad("the port must be 1..65535"))?;
     if host.is_empty() {
         return Err(bad("no host"));
     }
@@ -128,13 +137,15 @@ impl Link {
             return Err(BusError::Unavailable {
                 iface: self.name.clone(),
                 reason: format!("the server does not let clients send ({why})"),
-                fix: "start the server with --allow-send (cotui serve IFACE --socketcand ADDR:PORT --allow-send)".into(),
+                fix: "start the server with --allow-send (cotui serve IFACE --socketcand ADDR:PORT --allow-send)"
+                    .into(),
             });
         }
         let Some(text) = wire::send_element(frame) else {
             return Err(BusError::Io {
                 iface: self.name.clone(),
-                reason: "socketcand carries classic data frames only (no CAN FD, remote request or error frames)".into(),
+                reason: "socketcand carries classic data frames only (no CAN FD, remote request or error frames)"
+                    .into(),
             });
         };
         let mut w = self.writer.lock().await;
@@ -241,7 +252,9 @@ async fn handshake(name: &str, remote: &Remote) -> Result<Connected, BusError> {
                         wire::printable(&t, 40)
                     ))),
                 },
-                Some(Err(e)) => Err(unavailable(format!("the server sent garbage ({e}): is this a socketcand server?"))),
+                Some(Err(e)) => Err(unavailable(format!(
+                    "the server sent garbage ({e}): is this a socketcand server?"
+                ))),
                 None => Err(unavailable("the server closed the connection".into())),
             }
         };

@@ -195,7 +195,8 @@ fn number(s: &str, what: &str) -> Result<u64, WireError> {
     if s.is_empty() || s.len() > 9 || !s.bytes().all(|b| b.is_ascii_digit()) {
         return Err(syntax(format!("{what}: {} is not a number", printable(s, 16))));
     }
-    s.parse().map_err(|_| syntax(format!("{what}: {} is not a number", printable(s, 16))))
+    s.parse()
+        .map_err(|_| syntax(format!("{what}: {} is not a number", printable(s, 16))))
 }
 
 /// A CAN identifier in hex: 8 digits are a 29-bit identifier, fewer an 11-bit one.
@@ -324,7 +325,7 @@ fn frac_len(s: &str) -> u32 {
 
 /// Up to 8 bytes in hex, two digits each.
 fn parse_hex(s: &str) -> Result<Vec<u8>, WireError> {
-    if s.len() % 2 != 0 || s.len() > 16 || !s.bytes().all(|b| b.is_ascii_hexdigit()) {
+    if !s.len().is_multiple_of(2) || s.len() > 16 || !s.bytes().all(|b| b.is_ascii_hexdigit()) {
         return Err(syntax(format!(
             "frame data {} is not up to 8 bytes in hex",
             printable(s, 24)
@@ -341,7 +342,13 @@ pub fn printable(s: &str, max: usize) -> String {
     let mut out: String = s
         .chars()
         .take(max)
-        .map(|c| if c.is_ascii_graphic() && c != '<' && c != '>' { c } else { '?' })
+        .map(|c| {
+            if c.is_ascii_graphic() && c != '<' && c != '>' {
+                c
+            } else {
+                '?'
+            }
+        })
         .collect();
     if s.chars().count() > max {
         out.push_str("...");
@@ -399,7 +406,13 @@ pub fn error_element(text: &str) -> String {
 fn printable_words(text: &str) -> String {
     text.chars()
         .take(200)
-        .map(|c| if (c.is_ascii_graphic() || c == ' ') && c != '<' && c != '>' { c } else { '?' })
+        .map(|c| {
+            if (c.is_ascii_graphic() || c == ' ') && c != '<' && c != '>' {
+                c
+            } else {
+                '?'
+            }
+        })
         .collect()
 }
 
@@ -427,10 +440,7 @@ mod tests {
     #[test]
     fn elements_are_split_across_reads_and_without_separators() {
         let out = split(&[b"< hi >< open de", b"mo >\n< rawmode>"]);
-        assert_eq!(
-            out,
-            vec![Ok("hi".into()), Ok("open demo".into()), Ok("rawmode".into())]
-        );
+        assert_eq!(out, vec![Ok("hi".into()), Ok("open demo".into()), Ok("rawmode".into())]);
     }
 
     #[test]
@@ -456,12 +466,17 @@ mod tests {
         let Ok(Request::Send(f)) = parse_request("send 601 8 40 17 10 0 0 0 0 0") else {
             panic!()
         };
-        assert_eq!((f.id, f.is_ext(), f.payload()), (0x601, false, &[0x40, 0x17, 0x10, 0, 0, 0, 0, 0][..]));
+        assert_eq!(
+            (f.id, f.is_ext(), f.payload()),
+            (0x601, false, &[0x40, 0x17, 0x10, 0, 0, 0, 0, 0][..])
+        );
         let Ok(Request::Send(f)) = parse_request("send 1AAAAAAA 2 1 f1") else {
             panic!()
         };
         assert_eq!((f.id, f.is_ext(), f.payload()), (0x1AAA_AAAA, true, &[1, 0xF1][..]));
-        let Ok(Request::Send(f)) = parse_request("send 123 0") else { panic!() };
+        let Ok(Request::Send(f)) = parse_request("send 123 0") else {
+            panic!()
+        };
         assert_eq!(f.len, 0);
         assert_eq!(
             parse_request("subscribe 1 500000 123"),
@@ -479,7 +494,10 @@ mod tests {
         let e = |t| parse_request(t).unwrap_err().to_string();
         assert_eq!(e("send 601 2 40"), "send: length 2 but 1 data bytes");
         assert_eq!(e("send 601 9 1 2 3 4 5 6 7 8 9"), "send: length 9 is not 0..8");
-        assert_eq!(e("send 901 0"), "identifier 901 does not fit 11 bits (write 8 hex digits for a 29-bit identifier)");
+        assert_eq!(
+            e("send 901 0"),
+            "identifier 901 does not fit 11 bits (write 8 hex digits for a 29-bit identifier)"
+        );
         assert_eq!(e("send 601 1 1ff"), "send: 1ff is not a byte in hex");
         assert_eq!(e("frobnicate <x>"), "unknown command frobnicate");
         assert_eq!(e(""), "empty command");
@@ -507,8 +525,14 @@ mod tests {
         };
         assert!(err.is_err());
         assert_eq!((err.id, err.ts_ns), (4, 5_000_001_000));
-        assert_eq!(parse_reply("error could not open bus"), Ok(Reply::Error("could not open bus".into())));
-        assert_eq!(parse_reply("frame 123 1.5 ABC").unwrap_err().to_string(), "frame data ABC is not up to 8 bytes in hex");
+        assert_eq!(
+            parse_reply("error could not open bus"),
+            Ok(Reply::Error("could not open bus".into()))
+        );
+        assert_eq!(
+            parse_reply("frame 123 1.5 ABC").unwrap_err().to_string(),
+            "frame data ABC is not up to 8 bytes in hex"
+        );
         assert_eq!(parse_reply("frame 123 1.5 AB"), {
             let mut g = Frame::classic(0x123, &[0xAB]);
             g.ts_ns = 1_500_000_000;
