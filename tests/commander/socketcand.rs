@@ -406,3 +406,69 @@ sys.stdin.read()
     late.say("< echo >");
     late.until("< echo >");
 }
+
+/// A TCP proxy that delays every chunk by argv[2] seconds each way (argv[1]: the server's
+/// port); prints the port it listens on.
+const DELAY_PROXY: &str = r#"
+import asyncio, sys
+target, delay = int(sys.argv[1]), float(sys.argv[2])
+async def pipe(r, w):
+    q = asyncio.Queue()
+    async def later():
+        while True:
+            t, data = await q.get()
+            if data is None:
+                break
+            await asyncio.sleep(max(0, t - asyncio.get_running_loop().time()))
+            w.write(data)
+            await w.drain()
+        w.close()
+    task = asyncio.create_task(later())
+    while True:
+        data = await r.read(65536)
+        await q.put((asyncio.get_running_loop().time() + delay, data or None))
+        if not data:
+            break
+    await task
+async def handle(cr, cw):
+    sr, sw = await asyncio.open_connection("127.0.0.1", target)
+    await asyncio.gather(pipe(cr, sw), pipe(sr, cw), return_exceptions=True)
+async def main():
+    srv = await asyncio.start_server(handle, "127.0.0.1", 0)
+    print(srv.sockets[0].getsockname()[1], flush=True)
+    async with srv:
+        await srv.serve_forever()
+asyncio.run(main())
+"#;
+
+/// 300 ms each way (a 600 ms round trip) and `--timeout 200`: the answer, 1 ms after the
+/// request on the remote bus, is taken; a node that is not there still times out.
+#[test]
+fn sdo_timeouts_count_on_the_remote_bus_not_across_the_network() {
+    let s = Server::demo(&["--allow-send"]);
+    let mut proxy = Command::new("python3")
+        .arg("-c")
+        .arg(DELAY_PROXY)
+        .arg(s.port.to_string())
+        .arg("0.3")
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(proxy.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let url = format!("socketcand://127.0.0.1:{}/demo", line.trim());
+    let o = cotui(&["sdo", "read", &url, "2", "0x1017", "--timeout", "200"]);
+    let missing = cotui(&["sdo", "read", &url, "9", "0x1017", "--timeout", "200"]);
+    let _ = proxy.kill();
+    let _ = proxy.wait();
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("Producer heartbeat time = 500 ms"), "{}", text(&o));
+    assert_eq!(missing.status.code(), Some(4), "{}", text(&missing));
+    assert!(
+        text(&missing).contains("node 9 did not answer within 200 ms"),
+        "{}",
+        text(&missing)
+    );
+}
