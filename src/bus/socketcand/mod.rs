@@ -113,6 +113,8 @@ pub(super) struct Link {
     offset_ns: AtomicI64,
     /// The last measured round trip, ns.
     rtt_ns: AtomicU64,
+    /// The timestamp of the last echo of a frame sent.
+    last_echo_ns: AtomicU64,
     /// Why the server refuses this client's frames (none: it accepts them).
     refused: Mutex<Option<String>>,
 }
@@ -158,7 +160,10 @@ impl Link {
         }
         drop(w);
         let mut echo = *frame;
-        echo.ts_ns = self.now_ns().saturating_add(self.rtt_ns.load(Ordering::Relaxed));
+        // Monotonic, although the offset and the round trip change between two sends.
+        let at = self.now_ns().saturating_add(self.rtt_ns.load(Ordering::Relaxed));
+        let last = self.last_echo_ns.fetch_max(at, Ordering::Relaxed);
+        echo.ts_ns = at.max(last);
         let _ = self.events.send(Carried {
             origin: OWN,
             item: Item::Frame(echo),
@@ -318,6 +323,7 @@ pub async fn open(url: &str, listen_only: bool) -> Result<Bus, BusError> {
         writer: tokio::sync::Mutex::new(Some(c.write)),
         offset_ns: AtomicI64::new(c.offset_ns.unwrap_or(0)),
         rtt_ns: AtomicU64::new(c.rtt_ns),
+        last_echo_ns: AtomicU64::new(0),
         refused: Mutex::new(c.refused),
     });
     let reader = Reader {
