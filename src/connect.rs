@@ -1,8 +1,9 @@
 //! Picks the bus behind an interface name: `demo` is the in-process virtual bus with the
-//! simulated drives ([`crate::sim::demo`]), anything else a SocketCAN interface. The one
-//! place that knows both, so the bus layer does not depend on the simulator.
+//! simulated drives ([`crate::sim::demo`]), `socketcand://HOST:PORT/CHANNEL` a bus on another
+//! machine through a socketcand server ([`socketcand`]), anything else a SocketCAN
+//! interface. The one place that knows them all, so the bus layer does not depend on the simulator.
 
-use crate::bus::{Bus, BusError, socketcan};
+use crate::bus::{Bus, BusError, socketcan, socketcand};
 
 /// The interface name of the in-process simulated bus.
 pub const DEMO: &str = crate::sim::demo::BUS_NAME;
@@ -20,6 +21,8 @@ pub fn is_demo(iface: &str) -> bool {
 pub async fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
     if is_demo(iface) {
         Ok(crate::sim::demo::start(listen_only))
+    } else if socketcand::is_url(iface) {
+        socketcand::open(iface, listen_only).await
     } else {
         socketcan::open(iface, listen_only)
     }

@@ -18,5 +18,6 @@ pub mod files;
 pub mod gateway;
 pub mod logio;
 pub mod output;
+pub mod serve;
 pub mod sim;
 pub mod tui;

@@ -7,12 +7,16 @@
 //! A listen-only handle has no send path at all: [`Bus::send`] returns
 //! [`BusError::ListenOnly`] and nothing is written.
 //!
+//! A third kind of handle reaches a bus on another machine through a socketcand server
+//! ([`socketcand::open`], `socketcand://HOST:PORT/CHANNEL`); it behaves as a SocketCAN handle.
+//!
 //! A SocketCAN handle follows its interface by name: down and up, deleted and created
 //! again, bus-off and error-passive from error frames. Each change reaches the
 //! subscriptions as an [`Event::State`] in order with the frames ([`Subscription::next`]);
 //! [`Subscription::recv`] gives frames only and turns a loss of capture into an error.
 
 pub mod socketcan;
+pub mod socketcand;
 pub mod state;
 pub mod virt;
 
@@ -82,6 +86,18 @@ pub enum Event {
 enum Sender {
     Virtual(virt::Port),
     Socket(Arc<socketcan::Writer>),
+    Remote(Arc<socketcand::Link>),
+}
+
+/// The clock of a handle's frame timestamps.
+#[derive(Clone)]
+enum Clock {
+    /// `CLOCK_REALTIME`, as `SO_TIMESTAMPNS` (SocketCAN).
+    Wall,
+    /// The virtual bus's clock.
+    Virtual(virt::Clock),
+    /// The server's clock as seen from here; holds the reader of the connection.
+    Remote(Arc<socketcand::Shared>),
 }
 
 /// A handle on one bus: subscribe to frames, send frames (unless listen-only).
@@ -93,8 +109,8 @@ pub struct Bus {
     sender: Option<Sender>,
     /// The SocketCAN reader task and its socket (none on the virtual bus).
     socket: Option<Arc<socketcan::Shared>>,
-    /// The virtual bus's clock; `None` on SocketCAN, whose timestamps are `CLOCK_REALTIME`.
-    clock: Option<virt::Clock>,
+    /// The clock of the frames' timestamps.
+    clock: Clock,
 }
 
 impl fmt::Debug for Bus {
@@ -133,11 +149,13 @@ impl Bus {
     }
     /// The bus time now in nanoseconds, on the clock of the frames' receive timestamps
     /// ([`Frame::ts_ns`]): the wall clock (`CLOCK_REALTIME`, as `SO_TIMESTAMPNS`) on SocketCAN,
-    /// the virtual bus's clock (which follows tokio's, paused or not) on a virtual bus.
+    /// the virtual bus's clock (which follows tokio's, paused or not) on a virtual bus, the
+    /// server's clock less the network delay on a socketcand bus (see [`socketcand`]).
     pub fn now_ns(&self) -> u64 {
         match &self.clock {
-            Some(c) => c.now_ns(),
-            None => std::time::SystemTime::now()
+            Clock::Virtual(c) => c.now_ns(),
+            Clock::Remote(r) => r.link.now_ns(),
+            Clock::Wall => std::time::SystemTime::now()
                 .duration_since(std::time::UNIX_EPOCH)
                 .map_or(0, |d| d.as_nanos() as u64),
         }
@@ -168,6 +186,7 @@ impl Bus {
             None => Err(BusError::ListenOnly),
             Some(Sender::Virtual(port)) => port.send(self.endpoint, frame),
             Some(Sender::Socket(w)) => w.write(&frame).await,
+            Some(Sender::Remote(l)) => l.write(&frame).await,
         }
     }
 }

@@ -156,7 +156,7 @@ pub fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
         events,
         sender,
         socket: Some(Arc::new(Shared { task, link, catch_up })),
-        clock: None,
+        clock: super::Clock::Wall,
     })
 }
 
@@ -271,7 +271,8 @@ fn drops_of(sock: &Socket) -> u64 {
 }
 
 /// Sets an integer `SOL_SOCKET` option.
-fn setsockopt_int(fd: i32, opt: i32, value: i32) -> io::Result<()> {
+/// Sets the `SOL_SOCKET` option `opt` of `fd` to `value`.
+pub(crate) fn setsockopt_int(fd: i32, opt: i32, value: i32) -> io::Result<()> {
     // SAFETY: `value` is a valid c_int for the duration of the call.
     let r = unsafe {
         libc::setsockopt(

@@ -22,6 +22,9 @@ pub enum BusState {
     /// Not capturing: the interface is gone (unplugged, `ip link del`). It is reopened by
     /// name when it is back.
     Missing,
+    /// Not capturing: the connection to a socketcand server is lost. The handle reconnects
+    /// every second.
+    Disconnected,
 }
 
 impl BusState {
@@ -47,6 +50,7 @@ impl BusState {
             BusState::BusOff => "bus-off",
             BusState::Down => "interface down",
             BusState::Missing => "interface missing",
+            BusState::Disconnected => "connection lost",
         }
     }
     /// What the user can do about the state (none when all is well).
@@ -64,6 +68,9 @@ impl BusState {
             BusState::Missing => Some(format!(
                 "plug it back in (a vcan: sudo ip link add dev {iface} type vcan && sudo ip link set {iface} up)"
             )),
+            BusState::Disconnected => {
+                Some("check that the server runs and the network reaches it (reconnecting every second)".into())
+            }
         }
     }
 }
@@ -92,6 +99,7 @@ impl StateChange {
             BusState::BusOff => format!("{iface}: bus-off{counters}, not capturing"),
             BusState::Down => format!("{iface}: interface is down, not capturing"),
             BusState::Missing => format!("{iface}: interface is gone, not capturing"),
+            BusState::Disconnected => format!("{iface}: connection to the server lost, not capturing"),
         };
         match self.state.fix(iface) {
             Some(fix) => format!("{what}; fix: {fix}"),
@@ -105,6 +113,7 @@ impl StateChange {
             reason: match self.state {
                 BusState::BusOff => "controller is bus-off".to_string(),
                 BusState::Down => "interface is down".to_string(),
+                BusState::Disconnected => "connection to the server lost".to_string(),
                 _ => "interface is gone".to_string(),
             },
             fix: self.state.fix(iface).unwrap_or_default(),

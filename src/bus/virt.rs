@@ -83,7 +83,7 @@ impl VirtualBus {
                 })
             }),
             socket: None,
-            clock: Some(self.clock),
+            clock: super::Clock::Virtual(self.clock),
         }
     }
     /// The bus time now in nanoseconds, as frames sent now would be stamped.

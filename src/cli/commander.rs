@@ -13,7 +13,8 @@ pub type CliCommander = Commander<BusArgs, DictArgs>;
 /// Options every commander subcommand takes, before its own.
 #[derive(Args, Debug, Clone)]
 pub struct BusArgs {
-    /// SocketCAN interface (e.g. can0, vcan0), or `demo` for the built-in simulated bus.
+    /// SocketCAN interface (e.g. can0, vcan0), `demo` for the built-in simulated bus, or
+    /// socketcand://HOST:PORT/CHANNEL for a bus served by `cotui serve` or socketcand.
     pub iface: String,
     /// Open the bus without a send path: nothing is ever written to it.
     #[arg(long)]

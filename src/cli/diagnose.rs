@@ -32,7 +32,7 @@ pub struct DiagnoseArgs {
     pub iface_per_file: bool,
     #[command(flatten)]
     pub input: super::input::InputArgs,
-    /// Diagnose live SocketCAN interfaces instead (listen-only: nothing is sent; several
+    /// Diagnose live SocketCAN interfaces (or socketcand://HOST:PORT/CHANNEL) instead (listen-only: nothing is sent; several
     /// are captured together, each node known by interface and node-ID) until Ctrl-C
     /// (SIGINT or SIGTERM) or `--duration`, then report as for a log.
     #[arg(long, value_name = "IFACE", num_args = 1.., conflicts_with = "files")]

@@ -12,6 +12,7 @@ pub mod gateway;
 pub mod input;
 mod merge;
 pub mod record;
+pub mod serve;
 pub mod sim;
 pub mod tui;
 
@@ -67,6 +68,10 @@ pub enum Command {
     /// Unix socket or TCP, for scripts: `[1] 2 read 0x1017 0 u16`. Read-only unless
     /// --allow-writes.
     Gateway(gateway::GatewayArgs),
+    /// Serve a bus (SocketCAN, `demo`) over the socketcand protocol to python-can, SavvyCAN
+    /// or `cotui ... socketcand://HOST:PORT/IFACE` on other machines; loopback and receive-only
+    /// unless --bind and --allow-send.
+    Serve(serve::ServeArgs),
 }
 
 /// Short usage printed by `cotui` without arguments.
@@ -105,6 +110,7 @@ pub fn run() -> ExitCode {
         Some(Command::Demo(args)) => tui::run_demo(&args),
         Some(Command::Sim(args)) => sim::run_sim(&args),
         Some(Command::Gateway(args)) => gateway::run_gateway(&args),
+        Some(Command::Serve(args)) => serve::run_serve(&args),
         Some(Command::Commander(c)) => commander::run_commander(&c),
     }
 }

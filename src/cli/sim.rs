@@ -17,7 +17,7 @@ use tokio::signal::unix::{SignalKind, signal};
 /// Arguments of `cotui sim`.
 #[derive(Args, Debug)]
 pub struct SimArgs {
-    /// SocketCAN interface.
+    /// SocketCAN interface (or socketcand://HOST:PORT/CHANNEL, served with --allow-send).
     pub iface: String,
     /// A simulated drive: NODE=MODEL[@SERIAL], MODEL one of aimotor, syntron-ds,
     /// dexmart-dev, aqmd2405, servo; NODE `ff` (or 255) for a drive without node-ID that only

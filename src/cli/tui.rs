@@ -84,7 +84,8 @@ pub struct ReplayArgs {
 pub struct LiveArgs {
     /// SocketCAN interfaces (e.g. can0, vcan0), captured together in one session: each
     /// bus's load and state on the status line; palette commands go to the first. `demo`
-    /// and `demo2` are two independent simulated buses.
+    /// and `demo2` are two independent simulated buses; socketcand://HOST:PORT/CHANNEL a bus
+    /// on another machine (`cotui serve`).
     #[arg(required = true, value_name = "IFACE")]
     pub iface: Vec<String>,
     /// Never send: the bus is opened without a send path.

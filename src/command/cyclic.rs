@@ -251,7 +251,7 @@ impl Tally {
     pub fn report(&self, what: &str, period_ms: Option<u64>, defaulted: &[String]) -> Report {
         let ms = |ns: u64| ns as f64 / 1e6;
         let mean = match (self.first_ns, self.seen) {
-            (Some(f), n) if n > 1 && period_ms.is_some() => Some(ms(self.last_ns - f) / (n - 1) as f64),
+            (Some(f), n) if n > 1 && period_ms.is_some() => Some(ms(self.last_ns.saturating_sub(f)) / (n - 1) as f64),
             _ => None,
         };
         let p99 = period_ms.filter(|_| !self.intervals.is_empty()).map(|p| {

@@ -25,3 +25,4 @@ mod sdo_client_misbehave;
 mod sdo_client_server;
 mod sdo_proptest;
 mod socketcan_live;
+mod socketcand;

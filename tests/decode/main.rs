@@ -31,6 +31,7 @@ mod pcapng;
 mod profile_example;
 mod realworld_block;
 mod run;
+mod socketcand_fuzz;
 mod split_logs;
 mod track_path;
 mod two_buses;

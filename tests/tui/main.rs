@@ -10,6 +10,7 @@ mod objects_tmux;
 mod own_reads;
 mod problems;
 mod receive_list;
+mod remote;
 mod screen;
 mod tmux;
 mod tui_cli;

@@ -1143,6 +1143,47 @@ else
     bad "gateway: sdo_server.py node 21 not ready: $(cat gw_peer.out)"
 fi
 kill -TERM "$gw_peer" 2> /dev/null
+# ---- 18. socketcand: cotui serve vcan0 for python-can and for cotui's own client ----------
+# python-can's socketcand interface receives a cansend frame through the server and sends one
+# that candump sees on vcan0; `cotui record socketcand://...` records cansend frames.
+"$cotui" serve vcan0 --socketcand 29536 --allow-send 2> serve.err &
+served=$!
+wait_for serve.err 100 "socketcand on 127.0.0.1:29536"
+timeout 30 candump -n 1 vcan0,321:7FF > sc_dump.txt &
+dump=$!
+wait_socket "$dump"
+python3 - > sc_py.out 2>&1 <<'PY' &
+import can, time
+bus = can.Bus(interface="socketcand", host="127.0.0.1", port=29536, channel="vcan0")
+print("open", flush=True)
+end = time.time() + 20
+while time.time() < end:
+    m = bus.recv(0.5)
+    if m is not None and m.arbitration_id == 0x123:
+        print("got", m.data.hex(), flush=True)
+        break
+bus.send(can.Message(arbitration_id=0x321, data=[0x22], is_extended_id=False))
+time.sleep(0.5)
+bus.shutdown()
+PY
+py=$!
+wait_for sc_py.out 100 open
+for _ in $(seq 50); do cansend vcan0 123#11; grep -q got sc_py.out && break; sleep 0.2; done
+wait "$py"
+wait "$dump"
+grep -q "got 11" sc_py.out && grep -qE "321 +\[1\] +22" sc_dump.txt && grep -q "sent 321#22" serve.err &&
+    ok "socketcand: python-can through cotui serve vcan0 receives a cansend frame and sends one candump sees (audited)" ||
+    bad "socketcand: python-can: $(cat sc_py.out) / candump: $(cat sc_dump.txt) / $(tail -3 serve.err)"
+timeout 30 "$cotui" record socketcand://127.0.0.1:29536/vcan0 -o sc_rec.log --count 3 > sc_rec.out 2>&1 &
+rec=$!
+wait_for serve.err 100 "client 2 ("
+for _ in $(seq 50); do cansend vcan0 124#33; kill -0 "$rec" 2> /dev/null || break; sleep 0.2; done
+wait "$rec"
+[ "$(grep -c ' socketcand://127.0.0.1:29536/vcan0 124#33' sc_rec.log 2> /dev/null)" = 3 ] &&
+    ok "socketcand: cotui record socketcand://127.0.0.1:29536/vcan0 records cansend frames" ||
+    bad "socketcand: record: $(cat sc_rec.out) $(head -3 sc_rec.log 2> /dev/null)"
+kill "$served" 2> /dev/null
+wait "$served" 2> /dev/null
 
 t_end=$(date +%s.%N)
 echo "$passed passed, $failed failed ($(awk -v a="$t_start" -v b="$t_end" 'BEGIN { printf "%.0f", b - a }') s in the guest)"

@@ -1,0 +1,73 @@
+//! `cotui live socketcand://127.0.0.1:PORT/demo`: the analyzer on a bus served by `cotui
+//! serve demo` in another process, with the full palette (an SDO read answered over the
+//! network), a lost server shown as the bus state and capture resuming when it is back.
+
+use cotui::analysis::trace::Trace;
+use cotui::decode::Decoder;
+use cotui::frame::NodeKey;
+use cotui::tui::app::{App, SourceInfo, SourceKind};
+use cotui::tui::keymap::Keymap;
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc;
+use std::time::Duration;
+
+/// `cotui serve demo --socketcand PORT --allow-send`; the port it listens on once it does.
+fn serve(port: u16) -> (Child, u16) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_cotui"))
+        .args(["serve", "demo", "--socketcand", &port.to_string(), "--allow-send"])
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let err = child.stderr.take().unwrap();
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        for l in BufReader::new(err).lines().map_while(Result::ok) {
+            let _ = tx.send(l);
+        }
+    });
+    let first = rx.recv_timeout(Duration::from_secs(60)).unwrap();
+    let port = first.split("socketcand on 127.0.0.1:").nth(1).unwrap();
+    (child, port.split(',').next().unwrap().parse().unwrap())
+}
+
+fn until(a: &mut App, what: &str, f: impl Fn(&App, &str) -> bool) -> String {
+    crate::screen::until_at(a, (200, 40), what, f)
+}
+
+#[test]
+fn the_tui_attaches_to_a_remote_bus_with_the_palette_and_follows_the_server() {
+    let (mut server, port) = serve(0);
+    let url = format!("socketcand://127.0.0.1:{port}/demo");
+    let bindings = cotui::cli::bind::bindings_on(&url, &[], &[]).unwrap();
+    let trace = Trace::new(Decoder::from_bindings(&bindings), 500_000);
+    let (rx, req) = cotui::tui::live::start(std::slice::from_ref(&url), false, bindings.clone(), None);
+    let src = SourceInfo::live(&url, SourceKind::Live { listen_only: false }, rx, req);
+    let mut a = App::new(trace, Keymap::default_map(), src);
+    a.set_bindings(bindings);
+    until(&mut a, "node 2 and 3 from the remote bus", |a, _| {
+        let n = &a.trace().nodes;
+        [2, 3]
+            .iter()
+            .all(|&node| n.iter().any(|(k, _)| *k == NodeKey::new(0, node)))
+    });
+    a.run_command("sdo read 2 0x1017");
+    until(&mut a, "the SDO answer in the message line", |a, _| {
+        a.message().is_some_and(|m| m.contains("500 ms"))
+    });
+    // The server goes away: the bus state says so; it comes back on the same port: capture resumes.
+    let _ = server.kill();
+    let _ = server.wait();
+    until(&mut a, "the lost connection", |_, s| {
+        s.contains("connection to the server lost")
+    });
+    let (mut again, _) = serve(port);
+    let before = a.trace().len();
+    until(&mut a, "frames again", |a, s| {
+        a.trace().len() > before + 20 && !s.contains("connection to the server lost")
+    });
+    let _ = again.kill();
+    let _ = again.wait();
+}
