@@ -192,7 +192,8 @@ struct Tally {
     dropped: u64,
     /// Frames the session itself missed (it fell behind the bus).
     lagged: u64,
-    bad: u64,
+    /// Errors answered (garbled, unknown or refused commands).
+    errors: u64,
 }
 
 impl Tally {
@@ -252,12 +253,12 @@ async fn client(id: u64, stream: TcpStream, peer: SocketAddr, shared: Arc<Shared
     // a client that does not read.
     let _ = tokio::time::timeout(Duration::from_secs(1), writer).await;
     audit(&format!(
-        "{who} disconnected ({end}): {} frames sent, {} sends refused, {} frames received, {} dropped (queue full), {} bad commands",
+        "{who} disconnected ({end}): {} frames sent, {} sends refused, {} frames received, {} dropped (queue full), {} errors answered",
         tally.sent,
         tally.refused,
         tally.forwarded,
         tally.dropped + tally.lagged,
-        tally.bad
+        tally.errors
     ));
 }
 
@@ -297,15 +298,13 @@ async fn session(
                     hold = None;
                 }
                 for e in elements.drain(..) {
-                    if e.is_err() {
-                        tally.bad += 1;
-                    }
                     let was_raw = s.raw();
                     for action in s.on_element(e) {
                         match action {
                             Action::Reply(text) => {
+                                // Every garbled, unknown or refused command is answered with an error.
                                 if text.starts_with("< error") {
-                                    tally.bad += 1;
+                                    tally.errors += 1;
                                 }
                                 if tx.send(text).await.is_err() {
                                     return "write failed";
