@@ -145,7 +145,8 @@ pub struct RecordArgs {
     /// Stop after this many frames.
     #[arg(long, value_parser = count_arg)]
     pub count: Option<u64>,
-    /// Stop after this many ms (else at Ctrl-C, SIGTERM, SIGHUP or SIGQUIT).
+    /// Stop after DUR (a bare number is ms, or 30s, 2min; else at Ctrl-C, SIGTERM, SIGHUP
+    /// or SIGQUIT).
     #[arg(long, value_parser = ms_arg)]
     pub duration: Option<u64>,
     /// Overwrite an existing output file.
