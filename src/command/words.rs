@@ -128,27 +128,23 @@ pub fn node_or_all_arg(text: &str) -> Result<u8, ParseError> {
     parse_node(text, true)
 }
 
-/// The units a duration takes, with their length in ms (the first is what a bare number
-/// means to [`ms_arg`]).
-const DURATION_UNITS: &[(&str, f64)] = &[("ms", 1.0), ("s", 1e3), ("min", 60e3), ("h", 3600e3)];
-
 /// Parses a positive duration, in ms: a bare number is ms (decimal or 0x hex, as always);
 /// with a unit, `500ms`, `30s`, `1.5s`, `2min`, `1h` (decimals allowed, rounded to the ms).
 pub fn ms_arg(text: &str) -> Result<u64, ParseError> {
-    duration_ms(text, 1.0)
+    crate::analysis::duration::ms(text, 1.0)
         .filter(|v| *v > 0)
         .ok_or_else(|| ParseError::Invalid(duration_error(text, "ms")))
 }
 
 /// Parses a duration of 0 or more ms (0: off), as [`ms_arg`].
 pub fn ms_or_zero_arg(text: &str) -> Result<u64, ParseError> {
-    duration_ms(text, 1.0).ok_or_else(|| ParseError::Invalid(duration_error(text, "ms")))
+    crate::analysis::duration::ms(text, 1.0).ok_or_else(|| ParseError::Invalid(duration_error(text, "ms")))
 }
 
 /// Parses a positive duration where a bare number is seconds (`diagnose --duration`,
 /// seconds since before units), in ms: `30`, `0.5`, `500ms`, `2min`.
 pub fn seconds_arg(text: &str) -> Result<u64, ParseError> {
-    duration_ms(text, 1e3)
+    crate::analysis::duration::ms(text, 1e3)
         .filter(|v| *v > 0)
         .ok_or_else(|| ParseError::Invalid(duration_error(text, "seconds")))
 }
@@ -157,29 +153,6 @@ fn duration_error(text: &str, bare: &str) -> String {
     format!(
         "`{text}` is not a duration above 0: a number of {bare}, or a number with a unit (500ms, 30s, 1.5s, 2min, 1h)"
     )
-}
-
-/// `text` as whole ms; a bare number counts `bare` ms each (an integer, or 0x hex, for ms).
-fn duration_ms(text: &str, bare: f64) -> Option<u64> {
-    let t = text.trim();
-    if bare == 1.0 && (t.starts_with("0x") || t.starts_with("0X")) {
-        return parse_int(t).filter(|v| *v >= 0).map(|v| v as u64);
-    }
-    let split = t
-        .find(|c: char| !(c.is_ascii_digit() || c == '.' || c == '_'))
-        .unwrap_or(t.len());
-    let (number, unit) = t.split_at(split);
-    let scale = if unit.is_empty() {
-        if bare == 1.0 {
-            return parse_int(t).filter(|v| *v >= 0).map(|v| v as u64);
-        }
-        bare
-    } else {
-        DURATION_UNITS.iter().find(|(u, _)| *u == unit.trim())?.1
-    };
-    let n: f64 = number.replace('_', "").parse().ok()?;
-    let ms = (n * scale).round();
-    (n.is_finite() && (0.0..1.8e16).contains(&ms)).then_some(ms as u64)
 }
 
 /// Parses a frame in candump's compact form with the log reader's parser.
