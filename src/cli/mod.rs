@@ -12,6 +12,7 @@ pub mod input;
 mod merge;
 pub mod record;
 pub mod sim;
+pub mod trigger;
 pub mod tui;
 
 use crate::command::{CommandError, ExitCode, ParseError};
@@ -90,6 +91,7 @@ pub fn run() -> ExitCode {
             print!("{USAGE}");
             ExitCode::Ok
         }
+        Some(Command::Decode(args)) if args.trigger.is_some() => trigger::run_decode(&args),
         Some(Command::Decode(args)) => decode::run(&args),
         Some(Command::Diagnose(args)) => diagnose::run(&args),
         Some(Command::Explain(args)) => explain::run(&args),

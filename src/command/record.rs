@@ -423,8 +423,8 @@ impl LogFormat {
     }
 }
 
-/// Turns frames into the records of a log format.
-enum Encoder {
+/// Turns frames into the records of a log format (a recording's, a trigger window's).
+pub(crate) enum Encoder {
     Candump(LogWriter),
     /// The interfaces described so far (a pcapng interface block precedes an interface's
     /// first frame).
@@ -437,7 +437,7 @@ enum Encoder {
 
 impl Encoder {
     /// A fresh encoder; a pcapng one starts the file with its section header.
-    fn start<T: Target>(format: LogFormat, out: &mut LineSink<T>) -> Encoder {
+    pub(crate) fn start<T: Target>(format: LogFormat, out: &mut LineSink<T>) -> Encoder {
         match format {
             LogFormat::Candump => Encoder::Candump(LogWriter::new()),
             LogFormat::Pcapng => {
@@ -452,7 +452,7 @@ impl Encoder {
     }
 
     /// Puts out what the encoder holds back (a BLF container), before the sink flushes.
-    fn flush<T: Target>(&mut self, out: &mut LineSink<T>) {
+    pub(crate) fn flush<T: Target>(&mut self, out: &mut LineSink<T>) {
         if let Encoder::Blf(enc) = self {
             let n = enc.container(out.buffer());
             if n > 0 {
@@ -462,7 +462,7 @@ impl Encoder {
     }
 
     /// The end of the recording: a BLF file gets its header (in a file, with its totals).
-    fn finish<T: Target>(&mut self, out: &mut LineSink<T>) -> std::io::Result<()> {
+    pub(crate) fn finish<T: Target>(&mut self, out: &mut LineSink<T>) -> std::io::Result<()> {
         match self {
             Encoder::Asc(w, text) => {
                 w.finish(text);
@@ -484,7 +484,7 @@ impl Encoder {
     }
 
     /// Appends `f` (seen on `iface`) to `out` as one record.
-    fn frame<T: Target>(&mut self, out: &mut LineSink<T>, f: &Frame, iface: &str) {
+    pub(crate) fn frame<T: Target>(&mut self, out: &mut LineSink<T>, f: &Frame, iface: &str) {
         match self {
             // Writing to a Vec cannot fail.
             Encoder::Candump(w) => {

@@ -31,5 +31,6 @@ mod realworld_block;
 mod run;
 mod split_logs;
 mod track_path;
+mod triggers;
 mod two_buses;
 mod wireshark;

@@ -38,7 +38,7 @@
 
 #![deny(unsafe_code)]
 
-mod calendar;
+pub mod calendar;
 pub mod cob;
 pub mod decode;
 pub mod frame;
