@@ -50,6 +50,9 @@ pub fn run_commander(c: &CliCommander) -> ExitCode {
         }
     }
     if let Command::Record(r) = &cmd {
+        if let Some(t) = &r.trigger {
+            return super::trigger_live::run(bus, r, t);
+        }
         // Signals stop a recording; its gaps are said after its report.
         return super::record::run_record(bus, &r.output, r.limits, r.mode, r.format);
     }

@@ -13,6 +13,7 @@ mod merge;
 pub mod record;
 pub mod sim;
 pub mod trigger;
+pub mod trigger_live;
 pub mod tui;
 
 use crate::command::{CommandError, ExitCode, ParseError};

@@ -268,6 +268,95 @@ fn create_unique(dir: &Path, base: &str, ext: &str) -> io::Result<(PathBuf, File
     unreachable!("an unbounded range ends only by returning")
 }
 
+/// The flight recorder: the trigger's detector, the windows and their files, fed one
+/// stream (a log's frames, or a live bus's frames, clock ticks and state changes).
+pub struct Flight {
+    detector: Detector,
+    windows: Windows,
+    recorder: Recorder,
+    outs: Vec<Out>,
+    hits: Vec<Hit>,
+}
+
+impl Flight {
+    /// A flight recorder of `trigger` writing into `dir` (or JSON lines on stdout).
+    pub fn new(
+        trigger: Trigger,
+        decoder: Decoder,
+        settings: &Settings,
+        dir: Option<&Path>,
+        format: LogFormat,
+    ) -> Result<Flight, String> {
+        let detector = Detector::new(&trigger, &decoder);
+        let ms = 1_000_000;
+        let windows = Windows::new(settings.pre_ms.saturating_mul(ms), settings.post_ms.saturating_mul(ms));
+        Ok(Flight {
+            detector,
+            windows,
+            recorder: Recorder::new(dir, format, trigger, settings, decoder)?,
+            outs: Vec::new(),
+            hits: Vec::new(),
+        })
+    }
+
+    /// Takes note of the frames' interface table.
+    pub fn name_interfaces(&mut self, ifaces: &Interfaces) {
+        self.detector.name_interfaces(ifaces);
+        self.recorder.name_interfaces(ifaces);
+    }
+
+    /// The next frame: into the ring or the open window, then judged by the trigger.
+    pub fn frame(&mut self, f: &Frame) -> io::Result<()> {
+        self.windows.frame(f, &mut self.outs);
+        self.detector.frame(f, &mut self.hits);
+        self.write()
+    }
+
+    /// The clock reached `now_ns` without a frame.
+    pub fn tick(&mut self, now_ns: u64) -> io::Result<()> {
+        self.detector.tick(now_ns, &mut self.hits);
+        for h in self.hits.drain(..) {
+            self.windows.hit(h, &mut self.outs);
+        }
+        self.windows.tick(now_ns, &mut self.outs);
+        self.write()?;
+        self.recorder.flush()
+    }
+
+    /// The live interface changed state.
+    pub fn link(&mut self, t_ns: u64, link: crate::analysis::trigger::detect::Link) -> io::Result<()> {
+        self.detector.link(t_ns, link, &mut self.hits);
+        self.write()
+    }
+
+    /// The stream ended: an open window closes with what it has.
+    pub fn finish(&mut self) -> io::Result<()> {
+        self.detector.finish(&mut self.hits);
+        for h in self.hits.drain(..) {
+            self.windows.hit(h, &mut self.outs);
+        }
+        self.windows.finish(&mut self.outs);
+        self.recorder.take(&mut self.outs)
+    }
+
+    /// Windows written (closed) so far.
+    pub fn windows(&self) -> u64 {
+        self.recorder.windows
+    }
+
+    /// True while a window is open.
+    pub fn is_open(&self) -> bool {
+        self.windows.is_open()
+    }
+
+    fn write(&mut self) -> io::Result<()> {
+        for h in self.hits.drain(..) {
+            self.windows.hit(h, &mut self.outs);
+        }
+        self.recorder.take(&mut self.outs)
+    }
+}
+
 /// Parses `--trigger` for command `cmd`, its error with the column and the excerpt.
 pub fn parse(cmd: &str, expr: &str, decoder: &Decoder) -> Result<Trigger, String> {
     Trigger::parse(expr, decoder).map_err(|e| format!("{cmd}: --trigger {:?}: {e}", e.excerpt(expr)))
@@ -323,32 +412,23 @@ pub fn run_decode(args: &DecodeArgs) -> ExitCode {
             return ExitCode::Usage;
         }
     };
-    let mut detector = Detector::new(&trigger, &decoder);
-    let mut rec = match Recorder::new(dir.as_deref(), format, trigger, settings, decoder) {
-        Ok(r) => r,
+    let mut flight = match Flight::new(trigger, decoder, settings, dir.as_deref(), format) {
+        Ok(f) => f,
         Err(e) => {
             eprintln!("cotui decode: {e}");
             return ExitCode::Usage;
         }
     };
-    let mut windows = Windows::new(settings.pre_ms * 1_000_000, settings.post_ms * 1_000_000);
     let mut status = ExitCode::Ok;
     let (inputs, failed) = super::input::open_inputs(&args.files, "decode", args.iface_per_file, args.input.format());
     if failed {
         status = ExitCode::Unavailable;
     }
-    let (mut outs, mut hits) = (Vec::new(), Vec::new());
     for (path, input) in inputs {
         let counts = for_each_frame(&path, input, |frames| {
-            detector.name_interfaces(frames.ifaces);
-            rec.name_interfaces(frames.ifaces);
+            flight.name_interfaces(frames.ifaces);
             for (_, frame) in frames {
-                windows.frame(frame, &mut outs);
-                detector.frame(frame, &mut hits);
-                for h in hits.drain(..) {
-                    windows.hit(h, &mut outs);
-                }
-                rec.take(&mut outs)?;
+                flight.frame(frame)?;
             }
             Ok(())
         });
@@ -360,16 +440,11 @@ pub fn run_decode(args: &DecodeArgs) -> ExitCode {
             }
         }
     }
-    detector.finish(&mut hits);
-    for h in hits.drain(..) {
-        windows.hit(h, &mut outs);
-    }
-    windows.finish(&mut outs);
-    if let Err(e) = rec.take(&mut outs) {
+    if let Err(e) = flight.finish() {
         eprintln!("cotui decode: {e}");
         return ExitCode::Unavailable;
     }
-    if rec.windows == 0 {
+    if flight.windows() == 0 {
         eprintln!("cotui decode: the trigger `{}` never fired", settings.expr);
     }
     status

@@ -5,7 +5,7 @@
 
 use super::error::{CommandError, ParseError};
 use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
-use super::words::{TypedWords, count_arg, ms_arg};
+use super::words::{TypedWords, count_arg, ms_arg, ms_or_zero_arg};
 use crate::bus::{Bus, BusError, Event, StateChange};
 use crate::frame::Frame;
 use crate::log::export::{AscWriter, TrcWriter};
@@ -160,6 +160,29 @@ pub struct RecordArgs {
     /// ones not to a terminal.
     #[arg(long, default_value = "candump", value_parser = TypedWords::new(&["candump", "pcapng", "asc", "trc", "blf"], LogFormat::parse))]
     pub format: LogFormat,
+    /// Flight recorder: keep the last --pre in memory and write a window file (into -o
+    /// DIR, with a JSON sidecar) around each hit of EXPR: a filter, `hb lost`, `bootup`,
+    /// `bus-off`, `error-passive`, `iface down`, `incident KIND`, `A then B within DUR`;
+    /// --count is then a number of windows (README, "Capture triggers").
+    #[arg(long, value_name = "EXPR")]
+    pub trigger: Option<String>,
+    /// With --trigger: keep DUR before each hit (`30s`, `500ms`; a bare number is ms).
+    #[arg(long, value_name = "DUR", default_value = "10s", value_parser = ms_or_zero_arg, requires = "trigger")]
+    pub pre: u64,
+    /// With --trigger: keep DUR after each hit (hits inside a window extend it).
+    #[arg(long, value_name = "DUR", default_value = "10s", value_parser = ms_or_zero_arg, requires = "trigger")]
+    pub post: u64,
+}
+
+/// `record --trigger`: the trigger's words and its window (ms before and after a hit).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct TriggerWords {
+    /// The trigger (parsed by the front end, with the session's dictionaries).
+    pub expr: String,
+    /// ms kept before a hit.
+    pub pre_ms: u64,
+    /// ms kept after a hit.
+    pub post_ms: u64,
 }
 
 /// A recording of the bus to a file.
@@ -169,6 +192,8 @@ pub struct Record {
     pub limits: Limits,
     pub mode: WriteMode,
     pub format: LogFormat,
+    /// `--trigger`: windows around its hits instead of the whole bus.
+    pub trigger: Option<TriggerWords>,
 }
 
 impl<D> CommandArgs<D> for RecordArgs {
@@ -188,6 +213,11 @@ impl<D> CommandArgs<D> for RecordArgs {
                 _ => WriteMode::New,
             },
             format: self.format,
+            trigger: self.trigger.as_ref().map(|expr| TriggerWords {
+                expr: expr.clone(),
+                pre_ms: self.pre,
+                post_ms: self.post,
+            }),
         })
     }
 }

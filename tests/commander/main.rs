@@ -24,3 +24,4 @@ mod sdo_client_misbehave;
 mod sdo_client_server;
 mod sdo_proptest;
 mod socketcan_live;
+mod trigger_live;

@@ -15,6 +15,15 @@ use crate::analysis::trace::{Trace, Views};
 use crate::decode::Decoder;
 use crate::frame::{Frame, Interfaces};
 
+/// How often (stream time) the detector asks the diagnosis for its incidents as if the
+/// capture ended then: some detectors open their incident only after a while (an EMCY
+/// waits to be grouped with the fault that follows it), so an `incident KIND` hit comes at
+/// most this late after the diagnosis would report it.
+const SNAPSHOT_NS: u64 = 100_000_000;
+
+/// An incident's identity across looks: kind, interface, node, first occurrence.
+type IncidentKey = (crate::analysis::Problem, u16, Option<u8>, u64);
+
 /// A change of the live interface's state (from the bus layer).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Link {
@@ -47,9 +56,12 @@ pub struct Detector {
     within_ns: Option<u64>,
     /// Bus events, when an atom names one a frame can show.
     events: Option<Box<Trace>>,
-    /// The diagnosis, when an atom names an incident; with the counts of its incidents
-    /// seen so far (index: the incident book's order).
-    diagnosis: Option<(Box<Trace>, Vec<u64>)>,
+    /// The diagnosis, when an atom names an incident.
+    diagnosis: Option<Box<Trace>>,
+    /// The incidents seen so far, by (kind, interface, node, first time), with their counts.
+    incidents: Vec<(IncidentKey, u64)>,
+    /// Stream time of the last full look at the diagnosis ([`SNAPSHOT_NS`]).
+    snapshot_ns: u64,
     /// The time and words of the last hit of A (`A then B`).
     armed: Option<(u64, String)>,
     now_ns: u64,
@@ -79,7 +91,7 @@ impl Detector {
                 }
                 Atom::Incident(p) => {
                     if diagnosis.is_none() {
-                        diagnosis = Some((Box::new(Trace::headless(decoder.clone(), Views::Diagnosis)), Vec::new()));
+                        diagnosis = Some(Box::new(Trace::headless(decoder.clone(), Views::Diagnosis)));
                     }
                     (Watch::Incident(*p), format!("incident {}", p.as_str()))
                 }
@@ -90,6 +102,8 @@ impl Detector {
             within_ns: trigger.then.as_ref().map(|(_, w)| *w),
             events,
             diagnosis,
+            incidents: Vec::new(),
+            snapshot_ns: 0,
             armed: None,
             now_ns: 0,
         }
@@ -109,7 +123,7 @@ impl Detector {
         });
         filters
             .chain(self.events.as_deref_mut())
-            .chain(self.diagnosis.as_mut().map(|(t, _)| &mut **t))
+            .chain(self.diagnosis.as_deref_mut())
     }
 
     /// Judges the next frame; its hits (and those it decided for earlier frames) go to `hits`.
@@ -138,7 +152,7 @@ impl Detector {
         if let Some(t) = &mut self.events {
             t.push(f);
         }
-        if let Some((t, _)) = &mut self.diagnosis {
+        if let Some(t) = &mut self.diagnosis {
             t.push(f);
         }
         self.derived(&mut found);
@@ -151,7 +165,7 @@ impl Detector {
         if let Some(t) = &mut self.events {
             t.tick(now_ns);
         }
-        if let Some((t, _)) = &mut self.diagnosis {
+        if let Some(t) = &mut self.diagnosis {
             t.tick(now_ns);
         }
         let mut found = Vec::new();
@@ -208,21 +222,32 @@ impl Detector {
                 }
             }
         }
-        if let Some((t, counts)) = &mut self.diagnosis {
-            let book: &[Incident] = t.diagnosis.opened();
-            for (k, inc) in book.iter().enumerate() {
-                let before = counts.get(k).copied().unwrap_or(0);
-                if inc.count <= before {
-                    continue;
-                }
-                for (i, (w, _)) in self.watches.iter().enumerate() {
-                    if matches!(w, Watch::Incident(p) if *p == inc.problem) {
-                        found.push((i, with_node(&format!("incident {}", inc.problem.as_str()), inc.node)));
-                    }
+        let Some(t) = &self.diagnosis else { return };
+        let look = self.now_ns >= self.snapshot_ns.saturating_add(SNAPSHOT_NS);
+        let snapshot;
+        let book: &[Incident] = if look {
+            self.snapshot_ns = self.now_ns;
+            snapshot = t.diagnosis.incidents();
+            &snapshot
+        } else {
+            t.diagnosis.opened()
+        };
+        for inc in book {
+            let key = (inc.problem, inc.iface, inc.node, inc.first_ns);
+            let seen = self.incidents.iter_mut().find(|(k, _)| *k == key);
+            let before = seen.as_ref().map_or(0, |(_, c)| *c);
+            if inc.count <= before {
+                continue;
+            }
+            match seen {
+                Some((_, c)) => *c = inc.count,
+                None => self.incidents.push((key, inc.count)),
+            }
+            for (i, (w, _)) in self.watches.iter().enumerate() {
+                if matches!(w, Watch::Incident(p) if *p == inc.problem) {
+                    found.push((i, with_node(&format!("incident {}", inc.problem.as_str()), inc.node)));
                 }
             }
-            counts.clear();
-            counts.extend(book.iter().map(|i| i.count));
         }
     }
 
