@@ -4,13 +4,13 @@
 //! `--duration` or after `--count` windows; on stop, the frames the kernel still holds
 //! are taken first, then an open window is closed with what it has.
 
-use super::commander::{BusArgs, Stream, report_to};
 use super::trigger::{Flight, Settings};
 use crate::analysis::trigger::detect::Link;
 use crate::bus::{Bus, BusError, BusState, Event};
 use crate::command::record::{Record, TriggerWords};
 use crate::command::{CommandError, ExitCode};
 use std::future::Future;
+use std::io::Write;
 use std::path::Path;
 use std::time::Duration;
 use tokio::signal::unix::{SignalKind, signal};
@@ -32,78 +32,75 @@ pub struct Triggered {
     pub output: String,
 }
 
-/// Runs `record --trigger`; returns the exit status (1: usage, 2: the bus).
-pub fn run(bus: &BusArgs, r: &Record, t: &TriggerWords) -> ExitCode {
-    let usage = |m: String| report_to(bus, "record", Stream::Stdout, Err(CommandError::Usage(m)));
+/// Runs `record --trigger` on `iface` (opened listen-only if asked): what it wrote, or why
+/// it could not (the caller reports it as any command's failure).
+pub fn run(iface: &str, listen_only: bool, r: &Record, t: &TriggerWords) -> Result<Triggered, CommandError> {
     if r.output == "-" {
-        return usage("--trigger writes window files: give -o DIR".into());
+        return Err(CommandError::Usage("--trigger writes window files: give -o DIR".into()));
     }
-    let decoder = match super::bind::decoder(&[], &[]) {
-        Ok(d) => d,
-        Err(e) => return usage(e.to_string()),
-    };
-    let trigger = match super::trigger::parse("--trigger", &t.expr, &decoder) {
-        Ok(x) => x,
-        Err(e) => return usage(e),
-    };
+    let decoder = super::bind::decoder(&[], &[]).map_err(|e| CommandError::Usage(e.to_string()))?;
+    let trigger = super::trigger::parse("--trigger", &t.expr, &decoder).map_err(CommandError::Usage)?;
     let settings = Settings {
         expr: t.expr.clone(),
         pre_ms: t.pre_ms,
         post_ms: t.post_ms,
     };
-    let mut flight = match Flight::new(trigger, decoder, &settings, Some(Path::new(&r.output)), r.format) {
-        Ok(f) => f,
-        Err(e) => return usage(e),
-    };
-    let result = tokio::runtime::Builder::new_current_thread()
+    let mut flight =
+        Flight::new(trigger, decoder, &settings, Some(Path::new(&r.output)), r.format).map_err(CommandError::Usage)?;
+    let rt = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()
-        .map_err(|e| CommandError::Usage(format!("cannot start the runtime: {e}")))
-        .and_then(|rt| {
-            rt.block_on(async {
-                let handler = |kind: SignalKind| {
-                    signal(kind).map_err(|e| CommandError::Usage(format!("cannot install a signal handler: {e}")))
-                };
-                let mut signals = [
-                    handler(SignalKind::interrupt())?,
-                    handler(SignalKind::terminate())?,
-                    handler(SignalKind::hangup())?,
-                    handler(SignalKind::quit())?,
-                ];
-                let b = crate::connect::open(&bus.iface, bus.listen_only).await?;
-                let [int, term, hup, quit] = &mut signals;
-                let stop = async {
-                    tokio::select! {
-                        _ = int.recv() => {}
-                        _ = term.recv() => {}
-                        _ = hup.recv() => {}
-                        _ = quit.recv() => {}
-                    }
-                };
-                capture(&b, &mut flight, r.limits.count, r.limits.duration_ms, stop).await
-            })
-        });
-    let mut n = match result {
-        Ok(n) => n,
-        Err(e) => return report_to(bus, "record", Stream::Stdout, Err(e)),
-    };
+        .map_err(|e| CommandError::Usage(format!("cannot start the runtime: {e}")))?;
+    let mut n = rt.block_on(async {
+        let handler = |kind: SignalKind| {
+            signal(kind).map_err(|e| CommandError::Usage(format!("cannot install a signal handler: {e}")))
+        };
+        let mut signals = [
+            handler(SignalKind::interrupt())?,
+            handler(SignalKind::terminate())?,
+            handler(SignalKind::hangup())?,
+            handler(SignalKind::quit())?,
+        ];
+        let b = crate::connect::open(iface, listen_only).await?;
+        let [int, term, hup, quit] = &mut signals;
+        let stop = async {
+            tokio::select! {
+                _ = int.recv() => {}
+                _ = term.recv() => {}
+                _ = hup.recv() => {}
+                _ = quit.recv() => {}
+            }
+        };
+        capture(&b, &mut flight, r.limits.count, r.limits.duration_ms, stop).await
+    })?;
     n.output = r.output.clone();
-    if bus.json {
-        Stream::Stdout.line(&crate::command::to_json(&n).to_string());
-    } else {
-        Stream::Stdout.line(&format!(
-            "{} window(s) written to {} ({} frames seen)",
-            n.windows, n.output, n.frames
-        ));
-    }
-    if n.dropped > 0 {
-        eprintln!(
+    Ok(n)
+}
+
+impl Triggered {
+    /// Prints the report (JSON or a line) and says dropped frames on stderr; the exit status
+    /// (2 when frames were dropped).
+    pub fn say(&self, json: bool) -> ExitCode {
+        let line = if json {
+            crate::command::to_json(self).to_string()
+        } else {
+            format!(
+                "{} window(s) written to {} ({} frames seen)",
+                self.windows, self.output, self.frames
+            )
+        };
+        // After SIGHUP the terminal may be gone: printing must not fail the recording.
+        let _ = writeln!(std::io::stdout(), "{line}");
+        if self.dropped == 0 {
+            return ExitCode::Ok;
+        }
+        let _ = writeln!(
+            std::io::stderr(),
             "cotui record: {} frames were dropped before they could be judged (the machine was too busy)",
-            n.dropped
+            self.dropped
         );
-        return ExitCode::Unavailable;
+        ExitCode::Unavailable
     }
-    ExitCode::Ok
 }
 
 /// Feeds `bus` to `flight` until `stop` resolves, `duration_ms` passes or `max_windows`

@@ -95,3 +95,63 @@ async fn a_faulted_drive_gives_a_window_with_every_frame_of_the_bus_in_it() {
             .any(|(_, id, data)| *id == 0x82 && data[..2] == [0x10, 0x23])
     );
 }
+
+/// SIGTERM during a window closes it with what it has: the file and its sidecar are whole,
+/// the sidecar says the window was cut short. A trigger that does not parse says its column.
+#[test]
+fn sigterm_closes_the_open_window_and_a_bad_trigger_says_its_column() {
+    use std::process::{Command, Stdio};
+    let bin = env!("CARGO_BIN_EXE_cotui");
+    let dir = std::env::temp_dir().join(format!("cotui-trigger-term-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let d = dir.to_str().unwrap();
+    let args = [
+        "record",
+        "demo",
+        "--trigger",
+        "id 702",
+        "--pre",
+        "100ms",
+        "--post",
+        "1h",
+        "-o",
+        d,
+    ];
+    let child = Command::new(bin)
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait for the window's first frames to be on disk (written at least every 100 ms).
+    let log = loop {
+        let found = std::fs::read_dir(&dir).ok().and_then(|r| {
+            r.map(|e| e.unwrap().path())
+                .find(|p| p.extension().is_some_and(|e| e == "log"))
+        });
+        if let Some(p) = found
+            && std::fs::read_to_string(&p).unwrap().lines().count() >= 3
+        {
+            break p;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    // SAFETY: plain kill(2) on our own child.
+    assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGTERM) }, 0);
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stdout).starts_with("1 window(s) written to"));
+    let side: Value = serde_json::from_str(&std::fs::read_to_string(log.with_extension("json")).unwrap()).unwrap();
+    assert_eq!(side["cut_short"], true);
+    let lines = std::fs::read_to_string(&log).unwrap().lines().count();
+    assert_eq!(side["frames"].as_u64().unwrap() as usize, lines);
+    assert!(side["hits"][0]["what"] == "id 702", "{side}");
+
+    let out = Command::new(bin)
+        .args(["record", "demo", "--trigger", "node 2 and sdo nonsense", "-o", d])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("column 16: unknown word `nonsense`"), "{err}");
+}
