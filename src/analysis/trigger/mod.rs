@@ -140,7 +140,7 @@ impl Trigger {
 
 /// The 1-based column of byte offset `at` in `text`.
 fn column(text: &str, at: usize) -> usize {
-    text[..at.min(text.len())].chars().count() + 1
+    text.char_indices().take_while(|(i, _)| *i < at).count() + 1
 }
 
 /// The byte offset of `word` as a whole word of `text` outside quotes.
