@@ -6,6 +6,7 @@
 //! through frame timestamps and explicit ticks.
 
 pub mod diagnose;
+pub mod duration;
 pub mod events;
 pub mod filter;
 pub mod incident;
@@ -19,6 +20,7 @@ pub mod store;
 pub mod timing;
 pub mod trace;
 pub mod transfers;
+pub mod trigger;
 pub mod values;
 pub mod view;
 

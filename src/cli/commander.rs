@@ -51,6 +51,12 @@ pub fn run_commander(c: &CliCommander) -> ExitCode {
         }
     }
     if let Command::Record(r) = &cmd {
+        if let Some(t) = &r.trigger {
+            return match super::trigger_live::run(&bus.iface, bus.listen_only, r, t) {
+                Ok(n) => n.say(bus.json),
+                Err(e) => report(bus, what, Err(e)),
+            };
+        }
         // Signals stop a recording; its gaps are said after its report.
         return super::record::run_record(bus, &r.output, r.limits, r.mode, r.format);
     }

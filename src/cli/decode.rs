@@ -80,9 +80,22 @@ pub struct DecodeArgs {
     /// frames) matching EXPR, in the TUI's filter language (docs/TUI.md, "Filter and search").
     #[arg(long, value_name = "EXPR")]
     pub filter: Option<String>,
-    /// Write to FILE instead of stdout (`-` is stdout).
+    /// Write to FILE instead of stdout (`-` is stdout); with --trigger, the directory of
+    /// the window files.
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     pub output: Option<String>,
+    /// Capture windows around each hit of EXPR (a filter, `hb lost`, `bootup`, `bus-off`,
+    /// `error-passive`, `incident KIND`, or `A then B within DUR`): one file per window in
+    /// -o DIR (candump -l, or --format pcapng|asc|trc|blf) with a JSON sidecar; with
+    /// --format jsonl and no -o, one JSON line per window (README, "Capture triggers").
+    #[arg(long, value_name = "EXPR")]
+    pub trigger: Option<String>,
+    /// With --trigger: keep DUR before each hit (`30s`, `500ms`; a bare number is ms).
+    #[arg(long, value_name = "DUR", default_value = "10s", value_parser = crate::command::words::ms_or_zero_arg, requires = "trigger")]
+    pub pre: u64,
+    /// With --trigger: keep DUR after each hit (hits inside a window extend it).
+    #[arg(long, value_name = "DUR", default_value = "10s", value_parser = crate::command::words::ms_or_zero_arg, requires = "trigger")]
+    pub post: u64,
 }
 
 /// What a decode run keeps across its inputs, chosen once from the arguments: a bare

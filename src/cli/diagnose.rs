@@ -37,9 +37,9 @@ pub struct DiagnoseArgs {
     /// (SIGINT or SIGTERM) or `--duration`, then report as for a log.
     #[arg(long, value_name = "IFACE", num_args = 1.., conflicts_with = "files")]
     pub live: Option<Vec<String>>,
-    /// With `--live`: stop after this many seconds.
-    #[arg(long, value_name = "SECONDS")]
-    pub duration: Option<f64>,
+    /// With `--live`: stop after DUR (a bare number is seconds; or `500ms`, `30s`, `2min`).
+    #[arg(long, value_name = "DUR", value_parser = crate::command::words::seconds_arg)]
+    pub duration: Option<u64>,
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     pub format: DiagnoseFormat,
@@ -66,12 +66,6 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
     let mut trace = Trace::headless(decoder, Views::Diagnosis);
     if args.duration.is_some() && args.live.is_none() {
         eprintln!("cotui diagnose: --duration needs --live IFACE (a log ends by itself)");
-        return ExitCode::Usage;
-    }
-    if let Some(s) = args.duration
-        && !(s.is_finite() && s > 0.0 && s < 1e9)
-    {
-        eprintln!("cotui diagnose: --duration {s}: give a number of seconds above 0 (e.g. 30 or 0.5)");
         return ExitCode::Usage;
     }
     let mut status = ExitCode::Ok;
@@ -174,14 +168,9 @@ mod live {
 
     /// Feeds the frames of `ifaces` (opened listen-only, each frame tagged with its
     /// interface's index) to the diagnosis of `trace` until SIGINT or SIGTERM, or for
-    /// `seconds`; the capture clock ends at the bus time then.
-    pub fn capture(ifaces: &[String], seconds: Option<f64>, trace: &mut Trace) -> Result<(), String> {
-        let limit = match seconds {
-            Some(s) => {
-                Some(Duration::try_from_secs_f64(s).map_err(|_| format!("--duration {s}: not a number of seconds"))?)
-            }
-            None => None,
-        };
+    /// `duration_ms`; the capture clock ends at the bus time then.
+    pub fn capture(ifaces: &[String], duration_ms: Option<u64>, trace: &mut Trace) -> Result<(), String> {
+        let limit = duration_ms.map(Duration::from_millis);
         let rt = tokio::runtime::Builder::new_current_thread()
             .enable_all()
             .build()

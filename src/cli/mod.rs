@@ -14,6 +14,8 @@ mod merge;
 pub mod record;
 pub mod serve;
 pub mod sim;
+pub mod trigger;
+pub mod trigger_live;
 pub mod tui;
 
 use crate::command::{CommandError, ExitCode, ParseError};
@@ -100,6 +102,7 @@ pub fn run() -> ExitCode {
             print!("{USAGE}");
             ExitCode::Ok
         }
+        Some(Command::Decode(args)) if args.trigger.is_some() => trigger::run_decode(&args),
         Some(Command::Decode(args)) => decode::run(&args),
         Some(Command::Diagnose(args)) => diagnose::run(&args),
         Some(Command::Explain(args)) => explain::run(&args),

@@ -24,8 +24,9 @@ pub struct SimArgs {
     /// answers LSS until one is configured and the node reset. Default: 2=aimotor 3=syntron-ds.
     #[arg(long = "node", value_name = "NODE=MODEL[@SERIAL]")]
     pub nodes: Vec<String>,
-    /// Also produce SYNC every MS milliseconds (off by default: the master's job).
-    #[arg(long, value_name = "MS", default_value_t = 0)]
+    /// Also produce SYNC every DUR (a bare number is ms, or `10ms`, `1s`; 0, the default,
+    /// is off: the master's job).
+    #[arg(long, value_name = "DUR", default_value_t = 0, value_parser = crate::command::words::ms_or_zero_arg)]
     pub sync: u64,
     /// Write each node's EDS to DIR/node<N>.eds (node ff: DIR/lss-<SERIAL>.eds) first, for
     /// the tools that talk to the simulation.

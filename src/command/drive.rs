@@ -94,7 +94,7 @@ pub struct DriveArgs {
     /// The mode for `mode`: pp, pv, pt, hm, ip, csp, csv, cst or a number.
     #[arg(allow_negative_numbers = true, value_parser = mode_arg)]
     pub mode: Option<ModeArg>,
-    /// How long to wait for each SDO answer, and half of how long each step may take, in ms.
+    /// How long to wait for each SDO answer, and half of how long each step may take (DUR: a bare number is ms, or 500ms, 2s, 1min).
     #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
     pub timeout: u64,
 }

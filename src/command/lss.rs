@@ -19,7 +19,7 @@ use crate::lss::{Address, MASTER_ID, Part, SLAVE_ID, UNCONFIGURED, bit_rate_inde
 use serde::Serialize;
 use std::time::Duration;
 
-/// Default wait for each LSS answer, in ms.
+/// Default wait for each LSS answer (DUR: a bare number is ms, or 500ms, 2s, 1min).
 pub const LSS_TIMEOUT_MS: u64 = 100;
 /// Default wait for the answers to each fastscan request, in ms (a scan sends about 130).
 pub const FASTSCAN_TIMEOUT_MS: u64 = 30;

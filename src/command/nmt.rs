@@ -24,7 +24,7 @@ pub struct NmtArgs {
     /// Wait for the heartbeat (or boot-up after a reset) that confirms the command.
     #[arg(long)]
     pub wait: bool,
-    /// How long --wait waits, in ms.
+    /// How long --wait waits (DUR: a bare number is ms, or 500ms, 2s, 1min).
     #[arg(long, value_parser = ms_arg, default_value_t = NMT_WAIT_MS)]
     pub timeout: u64,
 }

@@ -37,7 +37,7 @@ pub struct Transfer<D: Args> {
     /// Force a block transfer.
     #[arg(long)]
     pub block: bool,
-    /// How long to wait for each server response, in ms.
+    /// How long to wait for each server response (DUR: a bare number is ms, or 500ms, 2s, 1min).
     #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
     pub timeout: u64,
     /// How long the whole transfer may take, in ms [default: the longer of 10 s and 10

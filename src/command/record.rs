@@ -5,7 +5,7 @@
 
 use super::error::{CommandError, ParseError};
 use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
-use super::words::{TypedWords, count_arg, ms_arg};
+use super::words::{TypedWords, count_arg, ms_arg, ms_or_zero_arg};
 use crate::bus::{Bus, BusError, Event, StateChange};
 use crate::frame::Frame;
 use crate::log::export::{AscWriter, TrcWriter};
@@ -145,7 +145,8 @@ pub struct RecordArgs {
     /// Stop after this many frames.
     #[arg(long, value_parser = count_arg)]
     pub count: Option<u64>,
-    /// Stop after this many ms (else at Ctrl-C, SIGTERM, SIGHUP or SIGQUIT).
+    /// Stop after DUR (a bare number is ms, or 30s, 2min; else at Ctrl-C, SIGTERM, SIGHUP
+    /// or SIGQUIT).
     #[arg(long, value_parser = ms_arg)]
     pub duration: Option<u64>,
     /// Overwrite an existing output file.
@@ -159,6 +160,29 @@ pub struct RecordArgs {
     /// ones not to a terminal.
     #[arg(long, default_value = "candump", value_parser = TypedWords::new(&["candump", "pcapng", "asc", "trc", "blf"], LogFormat::parse))]
     pub format: LogFormat,
+    /// Flight recorder: keep the last --pre in memory and write a window file (into -o
+    /// DIR, with a JSON sidecar) around each hit of EXPR: a filter, `hb lost`, `bootup`,
+    /// `bus-off`, `error-passive`, `iface down`, `incident KIND`, `A then B within DUR`;
+    /// --count is then a number of windows (README, "Capture triggers").
+    #[arg(long, value_name = "EXPR")]
+    pub trigger: Option<String>,
+    /// With --trigger: keep DUR before each hit (`30s`, `500ms`; a bare number is ms).
+    #[arg(long, value_name = "DUR", default_value = "10s", value_parser = ms_or_zero_arg, requires = "trigger")]
+    pub pre: u64,
+    /// With --trigger: keep DUR after each hit (hits inside a window extend it).
+    #[arg(long, value_name = "DUR", default_value = "10s", value_parser = ms_or_zero_arg, requires = "trigger")]
+    pub post: u64,
+}
+
+/// `record --trigger`: the trigger's words and its window (ms before and after a hit).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct TriggerWords {
+    /// The trigger (parsed by the front end, with the session's dictionaries).
+    pub expr: String,
+    /// ms kept before a hit.
+    pub pre_ms: u64,
+    /// ms kept after a hit.
+    pub post_ms: u64,
 }
 
 /// A recording of the bus to a file.
@@ -168,6 +192,8 @@ pub struct Record {
     pub limits: Limits,
     pub mode: WriteMode,
     pub format: LogFormat,
+    /// `--trigger`: windows around its hits instead of the whole bus.
+    pub trigger: Option<TriggerWords>,
 }
 
 impl<D> CommandArgs<D> for RecordArgs {
@@ -187,6 +213,11 @@ impl<D> CommandArgs<D> for RecordArgs {
                 _ => WriteMode::New,
             },
             format: self.format,
+            trigger: self.trigger.as_ref().map(|expr| TriggerWords {
+                expr: expr.clone(),
+                pre_ms: self.pre,
+                post_ms: self.post,
+            }),
         })
     }
 }
@@ -422,8 +453,8 @@ impl LogFormat {
     }
 }
 
-/// Turns frames into the records of a log format.
-enum Encoder {
+/// Turns frames into the records of a log format (a recording's, a trigger window's).
+pub(crate) enum Encoder {
     Candump(LogWriter),
     /// The interfaces described so far (a pcapng interface block precedes an interface's
     /// first frame).
@@ -436,7 +467,7 @@ enum Encoder {
 
 impl Encoder {
     /// A fresh encoder; a pcapng one starts the file with its section header.
-    fn start<T: Target>(format: LogFormat, out: &mut LineSink<T>) -> Encoder {
+    pub(crate) fn start<T: Target>(format: LogFormat, out: &mut LineSink<T>) -> Encoder {
         match format {
             LogFormat::Candump => Encoder::Candump(LogWriter::new()),
             LogFormat::Pcapng => {
@@ -451,7 +482,7 @@ impl Encoder {
     }
 
     /// Puts out what the encoder holds back (a BLF container), before the sink flushes.
-    fn flush<T: Target>(&mut self, out: &mut LineSink<T>) {
+    pub(crate) fn flush<T: Target>(&mut self, out: &mut LineSink<T>) {
         if let Encoder::Blf(enc) = self {
             let n = enc.container(out.buffer());
             if n > 0 {
@@ -461,7 +492,7 @@ impl Encoder {
     }
 
     /// The end of the recording: a BLF file gets its header (in a file, with its totals).
-    fn finish<T: Target>(&mut self, out: &mut LineSink<T>) -> std::io::Result<()> {
+    pub(crate) fn finish<T: Target>(&mut self, out: &mut LineSink<T>) -> std::io::Result<()> {
         match self {
             Encoder::Asc(w, text) => {
                 w.finish(text);
@@ -483,7 +514,7 @@ impl Encoder {
     }
 
     /// Appends `f` (seen on `iface`) to `out` as one record.
-    fn frame<T: Target>(&mut self, out: &mut LineSink<T>, f: &Frame, iface: &str) {
+    pub(crate) fn frame<T: Target>(&mut self, out: &mut LineSink<T>, f: &Frame, iface: &str) {
         match self {
             // Writing to a Vec cannot fail.
             Encoder::Candump(w) => {

@@ -135,13 +135,13 @@ impl Scanned {
 /// `scan [--listen MS] [--probe] [--timeout MS]`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct ScanArgs {
-    /// How long to listen for heartbeats and boot-ups, in ms.
+    /// How long to listen for heartbeats and boot-ups (DUR: a bare number is ms, or 500ms, 2s, 1min).
     #[arg(long, value_parser = ms_arg, default_value_t = SCAN_LISTEN_MS)]
     pub listen: u64,
     /// Also ask every node 1..127 for 0x1000 (finds nodes without heartbeat).
     #[arg(long)]
     pub probe: bool,
-    /// How long to wait for each SDO answer, in ms.
+    /// How long to wait for each SDO answer (DUR: a bare number is ms, or 500ms, 2s, 1min).
     #[arg(long, value_parser = ms_arg, default_value_t = SCAN_TIMEOUT_MS)]
     pub timeout: u64,
 }

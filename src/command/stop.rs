@@ -54,13 +54,13 @@ pub struct StopArgs {
     /// Stop this node too (repeatable; the same as naming it).
     #[arg(long = "node", value_name = "N", value_parser = node_arg)]
     pub node_flags: Vec<u8>,
-    /// How long to listen for nodes before reading their statuswords, in ms.
+    /// How long to listen for nodes before reading their statuswords (DUR: a bare number is ms, or 500ms, 2s, 1min).
     #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_LISTEN_MS)]
     pub listen: u64,
-    /// How long a drive may take to finish its quick stop ramp before voltage is disabled, in ms.
+    /// How long a drive may take to finish its quick stop ramp before voltage is disabled (DUR: a bare number is ms, or 500ms, 2s, 1min).
     #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_RAMP_MS)]
     pub ramp: u64,
-    /// How long to wait for each SDO answer, in ms.
+    /// How long to wait for each SDO answer (DUR: a bare number is ms, or 500ms, 2s, 1min).
     #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
     pub timeout: u64,
 }

@@ -243,6 +243,7 @@ mod tests {
                 limits: Limits::default(),
                 mode: WriteMode::New,
                 format: LogFormat::Candump,
+                trigger: None,
             })
         );
         assert_eq!(
@@ -255,6 +256,7 @@ mod tests {
                 },
                 mode: WriteMode::Append,
                 format: LogFormat::Candump,
+                trigger: None,
             })
         );
         assert!(matches!(

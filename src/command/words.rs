@@ -43,7 +43,8 @@ pub(crate) fn u32_arg(text: &str) -> Result<u32, ParseError> {
 /// How often `send`, `sync` and `pdo` send.
 #[derive(Args, Clone, Debug)]
 pub struct Repeat {
-    /// Send every MS ms (until stopped: Ctrl-C, or stop-all / `jobs stop ID` in the TUI).
+    /// Send every DUR (`100`: ms, or `500ms`, `1s`) until stopped: Ctrl-C, or stop-all /
+    /// `jobs stop ID` in the TUI.
     #[arg(long, value_parser = ms_arg)]
     pub every: Option<u64>,
     /// Send this many frames (with --every: then stop).
@@ -127,12 +128,31 @@ pub fn node_or_all_arg(text: &str) -> Result<u8, ParseError> {
     parse_node(text, true)
 }
 
-/// Parses a positive number of ms.
+/// Parses a positive duration, in ms: a bare number is ms (decimal or 0x hex, as always);
+/// with a unit, `500ms`, `30s`, `1.5s`, `2min`, `1h` (decimals allowed, rounded to the ms).
 pub fn ms_arg(text: &str) -> Result<u64, ParseError> {
-    parse_int(text)
+    crate::analysis::duration::ms(text, 1.0)
         .filter(|v| *v > 0)
-        .map(|v| v as u64)
-        .ok_or_else(|| ParseError::Invalid(format!("`{text}` must be a positive number of ms")))
+        .ok_or_else(|| ParseError::Invalid(duration_error(text, "ms")))
+}
+
+/// Parses a duration of 0 or more ms (0: off), as [`ms_arg`].
+pub fn ms_or_zero_arg(text: &str) -> Result<u64, ParseError> {
+    crate::analysis::duration::ms(text, 1.0).ok_or_else(|| ParseError::Invalid(duration_error(text, "ms")))
+}
+
+/// Parses a positive duration where a bare number is seconds (`diagnose --duration`,
+/// seconds since before units), in ms: `30`, `0.5`, `500ms`, `2min`.
+pub fn seconds_arg(text: &str) -> Result<u64, ParseError> {
+    crate::analysis::duration::ms(text, 1e3)
+        .filter(|v| *v > 0)
+        .ok_or_else(|| ParseError::Invalid(duration_error(text, "seconds")))
+}
+
+fn duration_error(text: &str, bare: &str) -> String {
+    format!(
+        "`{text}` is not a duration above 0: a number of {bare}, or a number with a unit (500ms, 30s, 1.5s, 2min, 1h)"
+    )
 }
 
 /// Parses a frame in candump's compact form with the log reader's parser.
@@ -281,4 +301,50 @@ pub(crate) fn count_arg(text: &str) -> Result<u64, ParseError> {
         .filter(|v| *v > 0)
         .map(|v| v as u64)
         .ok_or_else(|| ParseError::Invalid(format!("`{text}` must be a positive number")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn durations_take_a_unit_and_a_bare_number_is_ms() {
+        let ok = |t: &str| ms_arg(t).unwrap();
+        assert_eq!(
+            [
+                ok("250"),
+                ok("0x10"),
+                ok("500ms"),
+                ok("30s"),
+                ok("1.5s"),
+                ok("2min"),
+                ok("1h"),
+                ok(" 2s ")
+            ],
+            [250, 16, 500, 30_000, 1_500, 120_000, 3_600_000, 2_000]
+        );
+        assert_eq!(seconds_arg("30").unwrap(), 30_000);
+        assert_eq!(seconds_arg("0.5").unwrap(), 500);
+        assert_eq!(seconds_arg("250ms").unwrap(), 250);
+        assert_eq!(ms_or_zero_arg("0").unwrap(), 0);
+        for bad in ["0", "0s", "-5", "5x", "1.5", "s", "", "2 mins", "1e3ms"] {
+            let e = ms_arg(bad).unwrap_err().to_string();
+            assert!(e.contains("500ms, 30s, 1.5s, 2min, 1h"), "{bad}: {e}");
+        }
+    }
+
+    /// Through clap (the command line and the palette), the error names the flag and its value.
+    #[test]
+    fn a_bad_duration_names_the_flag() {
+        #[derive(clap::Parser, Debug)]
+        struct T {
+            #[arg(long, value_parser = ms_arg)]
+            every: u64,
+        }
+        use clap::Parser;
+        assert_eq!(T::try_parse_from(["t", "--every", "2min"]).unwrap().every, 120_000);
+        let e = T::try_parse_from(["t", "--every", "2mn"]).unwrap_err().to_string();
+        assert!(e.contains("'2mn' for '--every <EVERY>'"), "{e}");
+        assert!(e.contains("with a unit (500ms"), "{e}");
+    }
 }

@@ -110,11 +110,11 @@ fn the_palette_and_the_command_line_give_the_same_command_or_the_same_error() {
         ),
         (
             "sdo read 2 0x6041 --timeout 0",
-            "invalid value '0' for '--timeout <TIMEOUT>': `0` must be a positive number of ms",
+            "invalid value '0' for '--timeout <TIMEOUT>': `0` is not a duration above 0: a number of ms, or a number with a unit (500ms, 30s, 1.5s, 2min, 1h)",
         ),
         (
             "scan --listen soon",
-            "invalid value 'soon' for '--listen <LISTEN>': `soon` must be a positive number of ms",
+            "invalid value 'soon' for '--listen <LISTEN>': `soon` is not a duration above 0: a number of ms, or a number with a unit (500ms, 30s, 1.5s, 2min, 1h)",
         ),
         (
             "nmt go 2",

@@ -26,3 +26,4 @@ mod sdo_client_server;
 mod sdo_proptest;
 mod socketcan_live;
 mod socketcand;
+mod trigger_live;

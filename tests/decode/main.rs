@@ -34,5 +34,6 @@ mod run;
 mod socketcand_fuzz;
 mod split_logs;
 mod track_path;
+mod triggers;
 mod two_buses;
 mod wireshark;

@@ -85,6 +85,14 @@ proptest! {
         let b = Bindings::new().unwrap();
         let _ = resolve_object(b.dictionary(1), &text);
     }
+
+    #[test]
+    fn triggers_never_panic(text in "(incident|then|within|hb lost|emcy|node|\"|é|[ 0-9a-z_]){0,12}") {
+        use cotui::analysis::filter::NoNames;
+        if let Err(e) = cotui::analysis::trigger::Trigger::parse(&text, &NoNames) {
+            prop_assert!(e.column >= 1 && e.column <= text.chars().count() + 2, "{text:?}: {e}");
+        }
+    }
 }
 
 proptest! {

@@ -1184,6 +1184,41 @@ wait "$rec"
     bad "socketcand: record: $(cat sc_rec.out) $(head -3 sc_rec.log 2> /dev/null)"
 kill "$served" 2> /dev/null
 wait "$served" 2> /dev/null
+# ---- 19 trigger: record --trigger's window equals candump's frames in it ----------------
+# cotui sim with one drive; candump -l records everything; cotui record --trigger emcy keeps
+# 2 s before and 1 s after; the drive is faulted on cotui sim's stdin. The window file must
+# hold exactly candump's frames inside [start, end] of its sidecar: none lost between the
+# ring and the file.
+rm -rf trigwin; mkfifo trig.in
+"$cotui" sim vcan0 --node 2=aimotor < trig.in > trigsim.out 2>&1 &
+trigsim=$!
+pids+=($trigsim)
+exec 8> trig.in
+wait_for trigsim.out 300 "commands on stdin" || bad "trigger: cotui sim start: $(cat trigsim.out)"
+candump -l -f trigall.log vcan0 2> /dev/null &
+trigdump=$!
+wait_socket $trigdump
+"$cotui" record vcan0 --listen-only --trigger emcy --pre 2s --post 1s --count 1 -o trigwin > trigrec.out 2>&1 &
+trigrec=$!
+wait_socket $trigrec
+sleep 3
+echo "fault 2 0x2310" >&8
+for _ in $(seq 100); do kill -0 $trigrec 2> /dev/null || break; sleep 0.1; done
+wait $trigrec; trig_rc=$?
+sleep 0.2; kill $trigdump; wait $trigdump 2> /dev/null
+exec 8>&-; kill -TERM $trigsim; wait $trigsim
+side=$(ls trigwin/*.json 2> /dev/null | head -1)
+if [ "$trig_rc" = 0 ] && [ -n "$side" ]; then
+    start=$(jq -r .start "$side"); end=$(jq -r .end "$side")
+    awk -v a="$start" -v b="$end" '{ t = substr($1, 2, length($1) - 2) + 0; if (t >= a && t <= b) print $1, $3 }' trigall.log > trig_want.txt
+    awk '{ print $1, $3 }' "trigwin/$(jq -r .file "$side")" > trig_got.txt
+    n=$(wc -l < trig_got.txt)
+    [ "$n" -gt 20 ] && cmp -s trig_want.txt trig_got.txt && [ "$(jq .frames "$side")" = "$n" ] &&
+        ok "trigger: cotui record vcan0 --trigger emcy: the window ($n frames) equals candump's frames in [$start, $end]" ||
+        bad "trigger: window differs from candump's: $(diff trig_want.txt trig_got.txt | head -5)"
+else
+    bad "trigger: record --trigger rc=$trig_rc, no window: $(cat trigrec.out)"
+fi
 
 t_end=$(date +%s.%N)
 echo "$passed passed, $failed failed ($(awk -v a="$t_start" -v b="$t_end" 'BEGIN { printf "%.0f", b - a }') s in the guest)"

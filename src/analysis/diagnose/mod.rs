@@ -409,6 +409,13 @@ impl Diagnoser {
         self.clock(now_ns);
     }
 
+    /// The incidents opened so far as they stand, in the order they were opened (no
+    /// ranking, no end-of-capture pass): cheap enough to look at after every frame (a
+    /// trigger on `incident KIND`).
+    pub fn opened(&self) -> &[Incident] {
+        &self.tl.incidents
+    }
+
     /// The incidents so far, ranked as [`Diagnoser::finish`] ranks them, as if the capture
     /// ended now (the builder goes on).
     pub fn incidents(&self) -> Vec<Incident> {

@@ -33,7 +33,7 @@ pub struct DcfSaveArgs<D: Args> {
     /// Overwrite an existing output file.
     #[arg(long)]
     pub force: bool,
-    /// How long to wait for each SDO answer, in ms.
+    /// How long to wait for each SDO answer (DUR: a bare number is ms, or 500ms, 2s, 1min).
     #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
     pub timeout: u64,
     #[command(flatten)]
@@ -54,7 +54,7 @@ pub struct DcfLoadArgs<D: Args> {
     /// Read the node and print what would be written; write nothing.
     #[arg(long)]
     pub dry_run: bool,
-    /// How long to wait for each SDO answer, in ms.
+    /// How long to wait for each SDO answer (DUR: a bare number is ms, or 500ms, 2s, 1min).
     #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
     pub timeout: u64,
     #[command(flatten)]
@@ -69,7 +69,7 @@ pub struct DcfDiffArgs<D: Args> {
     pub node: u8,
     /// The DCF to compare with.
     pub file: String,
-    /// How long to wait for each SDO answer, in ms.
+    /// How long to wait for each SDO answer (DUR: a bare number is ms, or 500ms, 2s, 1min).
     #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
     pub timeout: u64,
     #[command(flatten)]

@@ -55,7 +55,7 @@ pub struct PdoArgs<D: clap::Args> {
     /// another service owns.
     #[arg(long)]
     pub force: bool,
-    /// read, map: how long to wait for each SDO answer, in ms.
+    /// read, map: how long to wait for each SDO answer (DUR: a bare number is ms, or 500ms, 2s, 1min).
     #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
     pub timeout: u64,
     #[command(flatten)]

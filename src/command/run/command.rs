@@ -30,7 +30,7 @@ pub struct RunArgs<D: clap::Args> {
     /// Print the steps and their frames without sending anything.
     #[arg(long)]
     pub dry_run: bool,
-    /// How long to wait for each SDO answer, in ms.
+    /// How long to wait for each SDO answer (DUR: a bare number is ms, or 500ms, 2s, 1min).
     #[arg(long, value_parser = ms_arg, default_value_t = DEFAULT_TIMEOUT_MS)]
     pub timeout: u64,
     #[command(flatten)]
