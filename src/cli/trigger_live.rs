@@ -183,7 +183,7 @@ fn take(got: Result<Event, BusError>, iface: &str, flight: &mut Flight, frames: 
         Ok(Event::State(s)) => {
             eprintln!("cotui record: {}", s.text(iface));
             let link = match s.state {
-                BusState::Down | BusState::Missing => Some(Link::Down),
+                BusState::Down | BusState::Missing | BusState::Disconnected => Some(Link::Down),
                 BusState::BusOff => Some(Link::BusOff),
                 BusState::Passive => Some(Link::Passive),
                 BusState::Active | BusState::Warning => None,
