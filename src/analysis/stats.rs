@@ -9,7 +9,7 @@
 
 use super::store::{Packed, Store};
 use crate::output::busload::Bitrate;
-use crate::wire::FiguresCache;
+use crate::wire::cache::FiguresCache;
 use std::collections::{BTreeMap, VecDeque};
 
 /// Statistics of one identifier.

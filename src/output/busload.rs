@@ -101,7 +101,7 @@ pub struct BusLoad {
     /// n (made by [`BusLoad::new`]; a division per frame otherwise).
     took_ns: Vec<u64>,
     /// The figures of the frames seen, for those that come again.
-    figures: crate::wire::FiguresCache,
+    figures: crate::wire::cache::FiguresCache,
 }
 
 /// More bits than any classic frame takes with its intermission (at most 160).

@@ -7,7 +7,8 @@
 #![allow(clippy::unwrap_used)]
 
 use canopen::frame::{Flags, Frame};
-use canopen::wire::{FiguresCache, figures, rebuild};
+use canopen::wire::cache::FiguresCache;
+use canopen::wire::{figures, rebuild};
 use proptest::prelude::*;
 
 /// `n` bits of `v`, MSB first.

@@ -16,10 +16,8 @@
 //! [`figures`] is the cheap path for bus load (table-driven CRC and stuffing for classic
 //! frames, no allocation); [`rebuild`] lists every bit with its field for display.
 
-mod cache;
+pub mod cache;
 mod tables;
-
-pub use cache::FiguresCache;
 
 use crate::frame::{Flags, Frame};
 use std::fmt;
