@@ -9,7 +9,8 @@
 
 use super::store::{Packed, Store};
 use crate::output::busload::Bitrate;
-use std::collections::BTreeMap;
+use crate::wire::cache::FiguresCache;
+use std::collections::{BTreeMap, VecDeque};
 
 /// Statistics of one identifier.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -96,6 +97,11 @@ pub struct Stats {
     /// The bits in the window per interface index (the bus load of each bus).
     iface_bits: Vec<u64>,
     window_start: usize,
+    /// The bus bits of the frames in the window (store positions `window_start..`): each
+    /// frame's bits are counted once, as it comes, not again as it leaves.
+    window: VecDeque<u32>,
+    /// The figures of the frames seen, for those that come again.
+    figures: FiguresCache,
     now_ns: u64,
     /// The first frame's time.
     start_ns: Option<u64>,
@@ -116,6 +122,8 @@ impl Stats {
             window_bits: 0,
             iface_bits: Vec::new(),
             window_start: 0,
+            window: VecDeque::new(),
+            figures: FiguresCache::new(),
             now_ns: 0,
             start_ns: None,
         }
@@ -170,7 +178,9 @@ impl Stats {
         s.last_ns = p.ts_ns;
         s.in_window += 1;
         self.start_ns.get_or_insert(p.ts_ns);
-        let bits = store.bus_bits(store.len() - 1);
+        let frame = store.frame(store.len() - 1);
+        let bits = self.figures.figures(&frame).map_or(0, |f| u64::from(f.bus_bits()));
+        self.window.push_back(bits as u32);
         self.window_bits += bits;
         let k = p.iface as usize;
         if self.iface_bits.len() <= k {
@@ -190,7 +200,7 @@ impl Stats {
         };
         while self.window_start < store.len() && store.packed(self.window_start).ts_ns <= since {
             let old = *store.packed(self.window_start);
-            let bits = store.bus_bits(self.window_start);
+            let bits = self.window.pop_front().map_or(0, u64::from);
             self.window_bits = self.window_bits.saturating_sub(bits);
             if let Some(b) = self.iface_bits.get_mut(old.iface as usize) {
                 *b = b.saturating_sub(bits);

@@ -15,11 +15,14 @@ use crate::output::busload::{Bitrate, BusLoad};
 use crate::output::{jsonl, text};
 use std::io::{self, Write};
 
-/// What a matching frame gives: its output line, or its kind and node for the totals.
+/// What a matching frame gives: its output line, or the frame with its kind and node for
+/// the totals.
 enum Out {
+    /// The frame's line as written.
     Line(Vec<u8>),
-    /// A frame of (interface, kind, node) to count.
-    Count(Box<crate::frame::Frame>, Kind, Option<u8>),
+    /// A frame to count in the `--summary` totals (held by value: no allocation per
+    /// matching frame), with its kind and node.
+    Count(crate::frame::Frame, Kind, Option<u8>),
 }
 
 /// What a filtered run writes.
@@ -158,7 +161,7 @@ impl Run {
                 self.stream.frame(pos, facts, d, &done, |d| {
                     let mut s = Vec::new();
                     match (mode, format) {
-                        (Mode::Summary, _) => return Out::Count(Box::new(*frame), d.kind, d.node),
+                        (Mode::Summary, _) => return Out::Count(*frame, d.kind, d.node),
                         (_, OutputFormat::Text) => text::write_line(&mut s, frame, ifaces, d),
                         _ => jsonl::write_frame(&mut s, line, frame, ifaces, d),
                     }

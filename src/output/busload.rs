@@ -97,16 +97,23 @@ pub struct BusLoad {
     /// The current burst: its start (ns) and the time its last frame ended.
     burst: Option<(u64, u64)>,
     longest_burst_ns: u64,
+    /// The nanoseconds a frame of n bits takes at the bit rate, for every classic frame's
+    /// n (made by [`BusLoad::new`]; a division per frame otherwise).
+    took_ns: Vec<u64>,
+    /// The figures of the frames seen, for those that come again.
+    figures: crate::wire::cache::FiguresCache,
 }
+
+/// More bits than any classic frame takes with its intermission (at most 160).
+const TOOK_TABLE: u64 = 192;
 
 impl BusLoad {
     /// Empty totals for a bus at `bitrate`.
     pub fn new(bitrate: Bitrate) -> BusLoad {
+        let bps = bitrate.bps.max(1);
         BusLoad {
-            bitrate: Bitrate {
-                bps: bitrate.bps.max(1),
-                ..bitrate
-            },
+            bitrate: Bitrate { bps, ..bitrate },
+            took_ns: (0..TOOK_TABLE).map(|bits| took_ns(bits, bps)).collect(),
             ..BusLoad::default()
         }
     }
@@ -120,7 +127,7 @@ impl BusLoad {
     /// frame's timestamp is taken as the end of its EOF.
     #[inline]
     pub fn add(&mut self, frame: &Frame, node: Option<u8>) {
-        let Ok(fig) = crate::wire::figures(frame) else {
+        let Ok(fig) = self.figures.figures(frame) else {
             return;
         };
         let bits = fig.bus_bits();
@@ -151,7 +158,10 @@ impl BusLoad {
         }
         self.busiest_bits = self.busiest_bits.max(self.window_bits);
         // A burst goes on while the bus stays idle for less than the next frame takes.
-        let took = u64::from(bits) * 1_000_000_000 / self.bitrate.bps;
+        let took = match self.took_ns.get(bits as usize) {
+            Some(&ns) => ns,
+            None => took_ns(u64::from(bits), self.bitrate.bps),
+        };
         let start = t.saturating_sub(took);
         let burst = match self.burst {
             Some((since, end)) if start < end.saturating_add(took) => (since, t.max(end)),
@@ -217,6 +227,11 @@ impl BusLoad {
         }
         s
     }
+}
+
+/// Nanoseconds `bits` take at `bps` bit/s (whole, rounded down).
+fn took_ns(bits: u64, bps: u64) -> u64 {
+    bits * 1_000_000_000 / bps.max(1)
 }
 
 fn round6(x: f64) -> f64 {

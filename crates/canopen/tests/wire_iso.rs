@@ -7,6 +7,7 @@
 #![allow(clippy::unwrap_used)]
 
 use canopen::frame::{Flags, Frame};
+use canopen::wire::cache::FiguresCache;
 use canopen::wire::{figures, rebuild};
 use proptest::prelude::*;
 
@@ -202,6 +203,45 @@ proptest! {
     #[test]
     fn long_runs_match_the_iso_reference(f in sparse_classic()) {
         check(&f)?;
+    }
+}
+
+/// Frames that repeat (a pool of a few, picked again and again) and near repeats (the same
+/// identifier with other data or length, bytes past the length set), classic and CAN FD,
+/// 11- and 29-bit, and identifiers out of range.
+fn repeating() -> impl Strategy<Value = Vec<Frame>> {
+    let any_frame = prop_oneof![classic(), sparse_classic(), fd()];
+    (
+        proptest::collection::vec(any_frame, 1..12),
+        proptest::collection::vec((any::<prop::sample::Index>(), any::<u8>(), 0u8..4), 1..200),
+    )
+        .prop_map(|(pool, picks)| {
+            picks
+                .into_iter()
+                .map(|(i, byte, change)| {
+                    let mut f = *i.get(&pool);
+                    match change {
+                        // Another first byte, or a byte past the length (not on the wire).
+                        1 => f.data[0] = byte,
+                        2 if !f.is_fd() && f.len < 8 => f.data[usize::from(f.len)] = byte,
+                        3 if !f.is_fd() => f.id = u32::from(byte) << 21,
+                        _ => {}
+                    }
+                    f
+                })
+                .collect()
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(500))]
+    /// The memo gives what `figures` gives, frame after frame, refusals included.
+    #[test]
+    fn the_figures_cache_gives_the_figures(frames in repeating()) {
+        let mut cache = FiguresCache::new();
+        for f in &frames {
+            prop_assert_eq!(cache.figures(f), figures(f), "{:?}", f);
+        }
     }
 }
 

@@ -16,11 +16,12 @@
 //! [`figures`] is the cheap path for bus load (table-driven CRC and stuffing for classic
 //! frames, no allocation); [`rebuild`] lists every bit with its field for display.
 
+pub mod cache;
 mod tables;
 
 use crate::frame::{Flags, Frame};
 use std::fmt;
-use tables::{StuffState, crc_bit, crc15_byte, stuff_byte, stuff_step};
+use tables::{crc_bit, crc15_byte, stuff_byte, stuff_step};
 
 /// The bits between two frames (recessive), not part of either: [`Figures::bits`] leaves
 /// them out, bus load counts them.
@@ -313,8 +314,10 @@ impl Layout {
     }
 }
 
-/// The figures of `frame` on the wire, without listing its bits (no allocation; classic
-/// frames a byte at a time by table, the frame held in one integer).
+/// The figures of `frame` on the wire, without listing its bits (no allocation). Classic
+/// frames go a whole byte at a time through the CRC and stuffing tables: the fields from
+/// SOF to the DLC end where the data bytes start, so the frame up to its CRC is whole bytes
+/// once a few bits go before SOF (see [`classic_head`]).
 pub fn figures(frame: &Frame) -> Result<Figures, WireError> {
     if frame.is_fd() || frame.is_err() || frame.len > 8 {
         let layout = Layout::of(frame)?;
@@ -324,48 +327,55 @@ pub fn figures(frame: &Frame) -> Result<Figures, WireError> {
     if frame.id > if ext { 0x1FFF_FFFF } else { 0x7FF } {
         return Err(WireError::IdRange { id: frame.id, ext });
     }
-    let rtr = u128::from(frame.is_rtr());
-    let dlc = u128::from(if frame.len == 8 && (9..=15).contains(&frame.raw_dlc) {
-        frame.raw_dlc
-    } else {
-        frame.len
-    });
-    let id = u128::from(frame.id);
-    // SOF (0), identifier, [SRR, IDE, extension], RTR, IDE or r1, r0, DLC.
-    let (head, head_bits) = if ext {
-        ((id >> 18) << 27 | 0b11 << 25 | (id & 0x3FFFF) << 7 | rtr << 6 | dlc, 39)
-    } else {
-        (id << 7 | rtr << 6 | dlc, 19)
-    };
-    let payload = frame.payload();
-    let data_bits = 8 * payload.len() as u32;
-    let mut data = [0u8; 8];
-    data[..payload.len()].copy_from_slice(payload);
-    let data = u128::from(u64::from_be_bytes(data)) >> (64 - data_bits);
-    let stream = if data_bits == 0 { head } else { head << data_bits | data };
-    let n = head_bits + data_bits;
-    // Zeros before the stream leave a CRC register at 0 unchanged: whole bytes from the top.
-    let mut crc = 0;
-    for k in (0..n.div_ceil(8)).rev() {
-        crc = crc15_byte(crc, (stream >> (8 * k)) as u8);
-    }
-    // Stuffing over stream and CRC, after alternating bits that end recessive (so they
-    // stuff nothing and leave the state of before SOF) up to whole bytes.
-    let m = n + 15;
-    let pad = m.div_ceil(8) * 8 - m;
-    let full = stream << 15 | u128::from(crc) | u128::from(0x55u8 & ((1u8 << pad) - 1)) << m;
-    let (mut state, mut stuffs): (StuffState, u32) = (tables::STUFF_START, 0);
-    for k in (0..(m + pad) / 8).rev() {
-        let (next, s) = stuff_byte(state, (full >> (8 * k)) as u8);
-        state = next;
+    let (head, padded, head_bytes) = classic_head(frame, ext);
+    let (mut crc, mut state, mut stuffs) = (0, tables::STUFF_START, 0);
+    for k in (0..head_bytes).rev() {
+        crc = crc15_byte(crc, (head >> (8 * k)) as u8);
+        let s;
+        (state, s) = stuff_byte(state, (padded >> (8 * k)) as u8);
         stuffs += s;
     }
+    let payload = frame.payload();
+    for &b in payload {
+        crc = crc15_byte(crc, b);
+        let s;
+        (state, s) = stuff_byte(state, b);
+        stuffs += s;
+    }
+    // The CRC, then one bit of the other level than its last: that bit stuffs nothing
+    // (after a stuff bit it makes a run of 2) and makes the CRC two whole bytes.
+    let tail = (crc << 1) | (!crc & 1);
+    let (state, s) = stuff_byte(state, (tail >> 8) as u8);
+    let (_, s2) = stuff_byte(state, tail as u8);
+    let stuffs = stuffs + s + s2;
+    let unstuffed = if ext { 39 } else { 19 } + 8 * payload.len() as u32 + 15;
     Ok(Figures {
-        bits: m + stuffs + TAIL,
+        bits: unstuffed + stuffs + TAIL,
         stuff_bits: stuffs,
         crc,
         crc_bits: 15,
     })
+}
+
+/// SOF, identifier, [SRR, IDE, extension], RTR, IDE or r1, r0 and DLC of a classic frame
+/// (19 or 39 bits) in the low bits of whole bytes: (for the CRC, zeros above them: zeros
+/// before SOF leave a CRC register at 0 unchanged; for stuffing, alternating bits ending
+/// recessive above them: they stuff nothing and end on the level before SOF; the bytes).
+fn classic_head(frame: &Frame, ext: bool) -> (u64, u64, u32) {
+    let rtr = u64::from(frame.is_rtr());
+    let dlc = u64::from(if frame.len == 8 && (9..=15).contains(&frame.raw_dlc) {
+        frame.raw_dlc
+    } else {
+        frame.len
+    });
+    let id = u64::from(frame.id);
+    if ext {
+        let head = (id >> 18) << 27 | 0b11 << 25 | (id & 0x3FFFF) << 7 | rtr << 6 | dlc;
+        (head, head | 1 << 39, 5)
+    } else {
+        let head = id << 7 | rtr << 6 | dlc;
+        (head, head | 0b10101 << 19, 3)
+    }
 }
 
 /// A frame on the wire: every bit from SOF to EOF, and the figures.
