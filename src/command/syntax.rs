@@ -455,7 +455,7 @@ mod tests {
         assert_eq!(
             commander_words(),
             [
-                "nmt", "sdo", "drive", "run", "scan", "record", "stop", "lss", "send", "sync", "pdo", "dcf"
+                "nmt", "sdo", "drive", "run", "scan", "record", "stop", "lss", "send", "sync", "pdo", "dcf", "watch"
             ]
         );
         assert_eq!(completions_of("sdo "), ["read", "write"]);
