@@ -51,7 +51,7 @@ pub fn run_commander(c: &CliCommander) -> ExitCode {
     }
     if let Command::Record(r) = &cmd {
         // Signals stop a recording; its gaps are said after its report.
-        return super::record::run_record(bus, &r.output, r.limits, r.mode, r.format);
+        return super::record::run_record(bus, r);
     }
     let bindings = super::bind::bindings_on(&bus.iface, &dict.profiles, &dict.eds).map_err(CommandError::from);
     if cmd.answers_offline() {

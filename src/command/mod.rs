@@ -22,6 +22,7 @@ pub mod send;
 pub mod spec;
 pub mod stop;
 pub mod sync;
+pub mod time_order;
 pub mod syntax;
 pub mod value;
 pub mod words;
