@@ -1,6 +1,6 @@
 //! `--summary`: per-node and per-kind totals.
 
-use super::busload::{BusJson, BusLoad};
+use super::busload::{BusJson, BusLoad, IfaceJson};
 use crate::decode::Kind;
 use crate::frame::{Frame, Interfaces, NodeKey};
 use serde::Serialize;
@@ -140,7 +140,30 @@ impl Summary {
             Some(iface) => format!("{iface} node {}", k.node),
             None => format!("node {}", k.node),
         }));
+        let buses = self.by_iface();
+        if buses.len() > 1 {
+            s.push_str("by bus:\n");
+            for b in &buses {
+                let load = b.load.map_or("-".to_string(), |l| format!("{:.2} %", l * 100.0));
+                let _ = writeln!(
+                    s,
+                    "  {:<8} {:>10} frames {:>12} bits: load {load}, busiest 100 ms {:.2} %, longest burst {:.3} ms",
+                    b.iface,
+                    b.frames,
+                    b.bits,
+                    b.busiest_100ms * 100.0,
+                    b.longest_burst_ms
+                );
+            }
+        }
         s
+    }
+
+    /// Each interface's bus figures, in interface order.
+    fn by_iface(&self) -> Vec<IfaceJson> {
+        let name = |i: u16| self.ifaces.get(usize::from(i)).map_or("?", String::as_str);
+        let all = self.bus.by_iface().into_iter();
+        all.map(|(i, figures)| self.bus.iface_json(name(i), &figures)).collect()
     }
 
     /// The JSON key of a node: its number, or `can1/5` when there are `several` interfaces.
@@ -157,6 +180,7 @@ impl Summary {
         let named = |kinds: &BTreeMap<Kind, u64>| kinds.iter().map(|(k, n)| (k.as_str(), *n)).collect();
         SummaryJson {
             bus: self.bus.to_json(|k| self.node_key(several, k)),
+            by_iface: self.by_iface(),
             by_kind: named(&self.by_kind),
             by_node: self
                 .by_node
@@ -188,6 +212,9 @@ fn kinds(counts: &Counts) -> impl Iterator<Item = (Kind, u64)> + '_ {
 pub struct SummaryJson {
     /// The bits on the wire and the bus load.
     pub bus: BusJson,
+    /// Each interface's frames, bits, load, busiest 100 ms and longest burst, in interface
+    /// order (one entry, the capture's figures, for a capture of one interface).
+    pub by_iface: Vec<IfaceJson>,
     /// Frames per kind name.
     pub by_kind: BTreeMap<&'static str, u64>,
     /// Frames per node (its number as text; `"can1/5"` when the input has several
