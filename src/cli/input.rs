@@ -156,7 +156,7 @@ pub fn for_each_frame(
     let log = match input.into() {
         Input::One(log) => log,
         Input::Merged(inputs, per_file) => {
-            super::merge::for_each_merged(inputs, per_file, |lines, ifaces| {
+            super::merge::for_each_merged(inputs, per_file, |said| said.to_stderr(), |lines, ifaces| {
                 consume(Frames {
                     path,
                     lines: lines.iter(),

@@ -10,6 +10,7 @@ pub mod diagnose;
 pub mod explain;
 pub mod input;
 mod merge;
+pub mod open_logs;
 pub mod record;
 pub mod sim;
 pub mod tui;
