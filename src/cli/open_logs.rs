@@ -5,8 +5,8 @@
 
 use super::merge::{Said, for_each_merged};
 use crate::logio::reader::{Log, ReadAs};
-use std::path::PathBuf;
 use crate::tui::source::Feed;
+use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, sync_channel};
 
 /// Batches the UI may have queued before the reader waits.
@@ -66,7 +66,9 @@ pub fn merged_feed(inputs: Vec<(String, Log)>, per_file: bool) -> Receiver<Feed>
             let _ = tx.send(Feed::Status(e.to_string()));
         }
         if let Some(first) = first {
-            let _ = tx.send(Feed::Status(format!("{warnings} malformed lines skipped (first: {first})")));
+            let _ = tx.send(Feed::Status(format!(
+                "{warnings} malformed lines skipped (first: {first})"
+            )));
         }
         for s in skipped {
             let _ = tx.send(Feed::Status(s));

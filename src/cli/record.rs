@@ -23,7 +23,9 @@ pub fn run_record(bus: &BusArgs, r: &Record) -> ExitCode {
             bus,
             "record",
             Stream::Stderr,
-            Err(CommandError::Usage(format!("{twice} is given twice: name each interface once"))),
+            Err(CommandError::Usage(format!(
+                "{twice} is given twice: name each interface once"
+            ))),
         );
     }
     if format != LogFormat::Candump && path == "-" && std::io::IsTerminal::is_terminal(&std::io::stdout()) {

@@ -243,12 +243,16 @@ pub fn run_open(args: &OpenArgs) -> ExitCode {
             return code;
         }
     }
-    if let Some(twice) = super::input::repeated(&args.files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>()) {
+    if let Some(twice) = super::input::repeated(&args.files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>())
+    {
         eprintln!("cotui open: {twice} is given twice");
         return ExitCode::Usage;
     }
     let (name, rx) = match args.files.as_slice() {
-        [one] => (one.display().to_string(), source::open(one.clone(), args.input.format())),
+        [one] => (
+            one.display().to_string(),
+            source::open(one.clone(), args.input.format()),
+        ),
         several => match super::open_logs::open(several, args.iface_per_file, args.input.format()) {
             Some(feed) => feed,
             None => return ExitCode::Unavailable,

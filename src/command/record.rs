@@ -5,8 +5,8 @@
 
 use super::error::{CommandError, ParseError};
 use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
-use super::words::{TypedWords, count_arg, ms_arg};
 use super::time_order::{self, TimeOrder};
+use super::words::{TypedWords, count_arg, ms_arg};
 use crate::bus::{Bus, BusError, Event, StateChange, Subscription};
 use crate::frame::Frame;
 use crate::log::export::{AscWriter, TrcWriter};
@@ -660,7 +660,11 @@ impl Recording {
     /// Writes the held frames whose turn has come (`all`: every one, at the end).
     fn release<T: Target>(&mut self, out: &mut LineSink<T>, all: bool) {
         let now = Instant::now();
-        while let Some(f) = if all { self.order.pop() } else { self.order.pop_ready(now) } {
+        while let Some(f) = if all {
+            self.order.pop()
+        } else {
+            self.order.pop_ready(now)
+        } {
             self.writer.frame(out, &f, &self.ifaces[usize::from(f.iface)]);
         }
     }

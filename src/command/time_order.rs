@@ -100,7 +100,9 @@ mod tests {
         o.push(at(10, 1), t0);
         assert_eq!(o.pop_ready(t0), None, "nothing later than both by the hold yet");
         o.push(at(80, 0), t0);
-        let ts: Vec<u64> = std::iter::from_fn(|| o.pop_ready(t0)).map(|f| f.ts_ns / 1_000_000).collect();
+        let ts: Vec<u64> = std::iter::from_fn(|| o.pop_ready(t0))
+            .map(|f| f.ts_ns / 1_000_000)
+            .collect();
         assert_eq!(ts, [10, 12]);
         // A quiet bus: the last frame goes on once it has waited the hold.
         assert_eq!(o.pop_ready(t0 + HOLD / 2), None);

@@ -90,7 +90,8 @@ pub struct BusLoad {
     last_ns: u64,
     /// Bits of the first interface's 128 nodes (made on its first node frame).
     first_nodes: Vec<u64>,
-    other_nodes: HashMap<NodeKey, u64>,
+    /// Bits of the nodes of every other interface (a fast seeded hash: looked up per frame).
+    other_nodes: HashMap<NodeKey, u64, foldhash::fast::RandomState>,
     /// Frames of the last 100 ms: (time, bits, interface).
     window: VecDeque<(u64, u32, u16)>,
     window_bits: u64,
@@ -288,7 +289,7 @@ impl BusLoad {
             .filter(|(_, b)| **b > 0)
             .map(|(n, b)| (NodeKey::new(0, n as u8), *b));
         let mut all: Vec<(NodeKey, u64)> = first.chain(self.other_nodes.iter().map(|(k, b)| (*k, *b))).collect();
-        all.sort();
+        all.sort_unstable();
         all
     }
 
@@ -307,23 +308,30 @@ impl BusLoad {
         }
     }
 
-    /// The figures as text lines (after the summary's `by node:`), nodes named by `name`.
-    pub fn to_text(&self, name: impl Fn(NodeKey) -> String) -> String {
-        let j = self.to_json(name);
-        let load = j.load.map_or("-".to_string(), |l| format!("{:.2} %", l * 100.0));
-        let mut s = format!(
-            "bus: {} bits ({} stuff bits) at {} kbit/s ({}): load {load}, busiest 100 ms {:.2} %, longest burst {:.3} ms\n",
-            j.bits,
-            j.stuff_bits,
-            j.bitrate as f64 / 1000.0,
+    /// Appends the figures as text lines (after the summary's `by node:`) to `out`, nodes in
+    /// node order, each named by `name` (which writes the name into the buffer it is given).
+    pub fn to_text(&self, out: &mut String, name: impl Fn(&mut String, NodeKey)) {
+        use std::fmt::Write;
+        let load = self.load().map(round6);
+        let load = load.map_or("-".to_string(), |l| format!("{:.2} %", l * 100.0));
+        // Writing to a String cannot fail.
+        let _ = writeln!(
+            out,
+            "bus: {} bits ({} stuff bits) at {} kbit/s ({}): load {load}, busiest 100 ms {:.2} %, longest burst {:.3} ms",
+            self.bits,
+            self.stuff_bits,
+            self.bitrate.bps as f64 / 1000.0,
             self.bitrate.source.as_str(),
-            j.busiest_100ms * 100.0,
-            j.longest_burst_ms,
+            round6(self.busiest_bits as f64 / self.window_capacity()) * 100.0,
+            round6(self.longest_burst_ns as f64 / 1e6),
         );
-        for (node, bits) in &j.by_node {
-            s.push_str(&format!("  {node:<8} {bits:>10} bits\n"));
+        // One name buffer for every row: a capture of 40,000 interfaces has many.
+        let mut shown = String::new();
+        for (node, bits) in self.by_node() {
+            shown.clear();
+            name(&mut shown, node);
+            let _ = writeln!(out, "  {shown:<8} {bits:>10} bits");
         }
-        s
     }
 }
 

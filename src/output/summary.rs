@@ -136,10 +136,12 @@ impl Summary {
             }
             s.push('\n');
         }
-        s.push_str(&self.bus.to_text(|k| match self.iface_of(several, k) {
-            Some(iface) => format!("{iface} node {}", k.node),
-            None => format!("node {}", k.node),
-        }));
+        self.bus.to_text(&mut s, |out, k| {
+            let _ = match self.iface_of(several, k) {
+                Some(iface) => write!(out, "{iface} node {}", k.node),
+                None => write!(out, "node {}", k.node),
+            };
+        });
         let buses = self.by_iface();
         if buses.len() > 1 {
             s.push_str("by bus:\n");

@@ -19,7 +19,9 @@ fn record(format: &str) -> std::path::PathBuf {
     let path = dir.join(format!("two.{format}"));
     let n = FRAMES.to_string();
     let p = path.to_str().unwrap();
-    let out = cotui(&["record", "demo", "demo2", "-o", p, "--count", &n, "--format", format, "--force", "--json"]);
+    let out = cotui(&[
+        "record", "demo", "demo2", "-o", p, "--count", &n, "--format", format, "--force", "--json",
+    ]);
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     let report: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(report["frames"], FRAMES as u64, "{report}");
@@ -44,13 +46,19 @@ fn decoded(path: &std::path::Path) -> Vec<(String, f64)> {
 fn assert_two_buses_by_time(frames: &[(String, f64)], names: [&str; 2], what: &str) {
     assert_eq!(frames.len(), FRAMES, "{what}: {frames:?}");
     for name in names {
-        assert!(frames.iter().any(|(i, _)| i == name), "{what}: no frame of {name}: {frames:?}");
+        assert!(
+            frames.iter().any(|(i, _)| i == name),
+            "{what}: no frame of {name}: {frames:?}"
+        );
     }
     assert!(
         frames.iter().all(|(i, _)| names.contains(&i.as_str())),
         "{what}: {frames:?}"
     );
-    assert!(frames.windows(2).all(|w| w[0].1 <= w[1].1), "{what}: not by time: {frames:?}");
+    assert!(
+        frames.windows(2).all(|w| w[0].1 <= w[1].1),
+        "{what}: not by time: {frames:?}"
+    );
 }
 
 #[test]

@@ -20,11 +20,17 @@ fn open(per_file: bool) -> App {
     let (name, rx) = cotui::cli::open_logs::open(&files, per_file, None).unwrap();
     assert_eq!(name, format!("{A} + {B}"));
     let trace = Trace::new(Decoder::new(Default::default(), Vec::new()), 500_000);
-    App::new(trace, Keymap::default_map(), SourceInfo::new(&name, SourceKind::Open, rx, None))
+    App::new(
+        trace,
+        Keymap::default_map(),
+        SourceInfo::new(&name, SourceKind::Open, rx, None),
+    )
 }
 
 fn all_frames(a: &mut App) -> String {
-    crate::screen::until_at(a, (160, 40), "every frame of both logs", |a, _| a.trace().len() == FRAMES)
+    crate::screen::until_at(a, (160, 40), "every frame of both logs", |a, _| {
+        a.trace().len() == FRAMES
+    })
 }
 
 #[test]
@@ -41,7 +47,10 @@ fn two_logs_with_iface_per_file_are_two_buses_merged_by_time() {
     // The second frame of the capture is B's first heartbeat (100.050), between A's.
     assert_eq!(ifaces[..3], [0, 1, 0]);
     for i in [0, 1] {
-        assert!(t.nodes.iter().any(|(k, _)| *k == NodeKey::new(i, 5)), "node 5 on bus {i}");
+        assert!(
+            t.nodes.iter().any(|(k, _)| *k == NodeKey::new(i, 5)),
+            "node 5 on bus {i}"
+        );
     }
     // The Nodes pane has node 5 once per bus: on A's still heartbeating, on B's lost (B's
     // log ends after 1 s, A's goes on for 10 s), as for `two_buses.log`.
