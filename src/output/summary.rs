@@ -125,14 +125,23 @@ impl Summary {
         s.push_str("by node:\n");
         let several = self.several_ifaces();
         for (node, counts) in &self.by_node {
+            // Pieces pushed, not `write!`: a capture of 40,000 interfaces has as many rows.
             let total: u64 = counts.iter().sum();
-            // Writing to a String cannot fail.
-            let _ = match self.iface_of(several, *node) {
-                Some(iface) => write!(s, "  {iface} node {:<3} {total:>10} ", node.node),
-                None => write!(s, "  node {:<3} {total:>10} ", node.node),
-            };
+            s.push_str("  ");
+            if let Some(iface) = self.iface_of(several, *node) {
+                s.push_str(iface);
+                s.push(' ');
+            }
+            s.push_str("node ");
+            push_num(&mut s, u64::from(node.node), -3);
+            s.push(' ');
+            push_num(&mut s, total, 10);
+            s.push(' ');
             for (k, n) in kinds(counts) {
-                let _ = write!(s, " {}={n}", k.as_str());
+                s.push(' ');
+                s.push_str(k.as_str());
+                s.push('=');
+                push_num(&mut s, n, 0);
             }
             s.push('\n');
         }
@@ -199,6 +208,32 @@ impl Summary {
     }
 }
 
+/// Appends `n` in decimal, padded with spaces to `width` (right-aligned; a negative width:
+/// left-aligned), as `{n:>w}` / `{n:<w}` write it.
+fn push_num(s: &mut String, n: u64, width: i32) {
+    let mut digits = [0u8; 20];
+    let mut at = digits.len();
+    let mut v = n;
+    loop {
+        at -= 1;
+        digits[at] = b'0' + (v % 10) as u8;
+        v /= 10;
+        if v == 0 {
+            break;
+        }
+    }
+    let len = digits.len() - at;
+    let pad = (width.unsigned_abs() as usize).saturating_sub(len);
+    if width > 0 {
+        s.extend(std::iter::repeat_n(' ', pad));
+    }
+    // ASCII digits.
+    s.extend(digits[at..].iter().map(|&d| char::from(d)));
+    if width < 0 {
+        s.extend(std::iter::repeat_n(' ', pad));
+    }
+}
+
 /// The kinds counted in `counts` and their counts, in kind order as `by_kind` ([`Kind::ALL`]
 /// is in that order).
 fn kinds(counts: &Counts) -> impl Iterator<Item = (Kind, u64)> + '_ {
@@ -247,6 +282,22 @@ mod tests {
         assert!(t.contains("  heartbeat    2"), "{t}");
         assert!(t.contains("node 5            2  heartbeat=2"), "{t}");
         assert_eq!(serde_json::to_value(s.to_json()).unwrap()["by_node"]["2"]["tpdo"], 1);
+    }
+
+    #[test]
+    fn numbers_pad_as_format_pads_them() {
+        for n in [0, 7, 42, 123, 9999, u64::MAX] {
+            for (w, want) in [
+                (3, format!("{n:>3}")),
+                (-3, format!("{n:<3}")),
+                (10, format!("{n:>10}")),
+                (0, n.to_string()),
+            ] {
+                let mut s = String::new();
+                push_num(&mut s, n, w);
+                assert_eq!(s, want);
+            }
+        }
     }
 
     #[test]
