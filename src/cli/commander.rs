@@ -52,13 +52,18 @@ pub fn run_commander(c: &CliCommander) -> ExitCode {
     }
     if let Command::Record(r) = &cmd {
         if let Some(t) = &r.trigger {
+            if !r.more.is_empty() {
+                let several =
+                    "--trigger records one interface: give one IFACE (several buses: one `record --trigger` each)";
+                return report(bus, what, Err(CommandError::Usage(several.into())));
+            }
             return match super::trigger_live::run(&bus.iface, bus.listen_only, r, t) {
                 Ok(n) => n.say(bus.json),
                 Err(e) => report(bus, what, Err(e)),
             };
         }
         // Signals stop a recording; its gaps are said after its report.
-        return super::record::run_record(bus, &r.output, r.limits, r.mode, r.format);
+        return super::record::run_record(bus, r);
     }
     let bindings = super::bind::bindings_on(&bus.iface, &dict.profiles, &dict.eds).map_err(CommandError::from);
     if cmd.answers_offline() {

@@ -162,13 +162,18 @@ pub fn for_each_frame(
     let log = match input.into() {
         Input::One(log) => log,
         Input::Merged(inputs, per_file) => {
-            super::merge::for_each_merged(inputs, per_file, |lines, ifaces| {
-                consume(Frames {
-                    path,
-                    lines: lines.iter(),
-                    ifaces,
-                })
-            })?;
+            super::merge::for_each_merged(
+                inputs,
+                per_file,
+                |said| said.to_stderr(),
+                |lines, ifaces| {
+                    consume(Frames {
+                        path,
+                        lines: lines.iter(),
+                        ifaces,
+                    })
+                },
+            )?;
             return Ok(Counts::default());
         }
     };

@@ -22,6 +22,25 @@ enum Piece {
     End(Counts, Option<io::Error>),
 }
 
+/// What the merge has to say about its files: a malformed line, or a file's closing
+/// counts.
+pub enum Said<'a> {
+    /// A malformed line (1-based) of a file, and why.
+    Warning { path: &'a str, line: u64, message: &'a str },
+    /// A file has ended: what its reader counted.
+    Counts { path: &'a str, counts: &'a Counts },
+}
+
+impl Said<'_> {
+    /// Says it on stderr, as a command that reads logs does (`FILE:LINE: warning: ...`).
+    pub fn to_stderr(&self) {
+        match self {
+            Said::Warning { path, line, message } => eprintln!("{path}:{line}: warning: {message}"),
+            Said::Counts { path, counts } => report_counts(path, counts),
+        }
+    }
+}
+
 /// One file being merged.
 struct Part {
     path: String,
@@ -35,12 +54,16 @@ struct Part {
 impl Part {
     /// The time of the next frame, reading on (warnings said as they pass) until there is
     /// one; `None` at the end of the file.
-    fn head(&mut self, merged: &mut Interfaces, per_file: bool) -> Option<u64> {
+    fn head(&mut self, merged: &mut Interfaces, per_file: bool, say: &mut impl FnMut(Said<'_>)) -> Option<u64> {
         loop {
             while let Some((line, outcome)) = self.pending.front() {
                 match outcome {
                     Outcome::Frame(f) => return Some(f.ts_ns),
-                    Outcome::Warning(msg) => eprintln!("{}:{line}: warning: {msg}", self.path),
+                    Outcome::Warning(message) => say(Said::Warning {
+                        path: &self.path,
+                        line: *line,
+                        message,
+                    }),
                     Outcome::Skip(_) => {}
                 }
                 self.pending.pop_front();
@@ -95,11 +118,12 @@ fn read(path: &str, input: Log, tx: std::sync::mpsc::SyncSender<Piece>) {
 
 /// Reads `inputs` (path, reader) as one capture and calls `consume` with batches of their
 /// frames merged by time, each frame's `iface` an index of the merged table (the second
-/// argument). Each file's counts are reported as it ends ([`report_counts`]);
-/// the first read error (naming its file) or error of `consume` is returned.
+/// argument). Malformed lines and each file's counts (at the end) go to `say`; the first
+/// read error (naming its file) or error of `consume` is returned.
 pub fn for_each_merged(
     inputs: Vec<(String, Log)>,
     per_file: bool,
+    mut say: impl FnMut(Said<'_>),
     mut consume: impl FnMut(&[(u64, Outcome)], &Interfaces) -> io::Result<()>,
 ) -> io::Result<()> {
     std::thread::scope(|s| {
@@ -124,7 +148,7 @@ pub fn for_each_merged(
         loop {
             let mut next: Option<(u64, usize)> = None;
             for (i, p) in parts.iter_mut().enumerate() {
-                if let Some(t) = p.head(&mut merged, per_file)
+                if let Some(t) = p.head(&mut merged, per_file, &mut say)
                     && next.is_none_or(|(best, _)| t < best)
                 {
                     next = Some((t, i));
@@ -152,7 +176,10 @@ pub fn for_each_merged(
         for p in parts {
             let Part { path, end, .. } = p;
             if let Some((counts, error)) = end {
-                report_counts(&path, &counts);
+                say(Said::Counts {
+                    path: &path,
+                    counts: &counts,
+                });
                 if let Some(e) = error {
                     first_error.get_or_insert(io::Error::new(e.kind(), format!("{path}: {e}")));
                 }

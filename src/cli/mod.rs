@@ -11,6 +11,7 @@ pub mod explain;
 pub mod gateway;
 pub mod input;
 mod merge;
+pub mod open_logs;
 pub mod record;
 pub mod serve;
 pub mod sim;

@@ -1,11 +1,12 @@
-//! `cotui record IFACE -o FILE [--count N] [--duration MS] [--force | --append]`: a candump
-//! `-l` log of the bus. Stops on SIGINT, SIGTERM, SIGHUP or SIGQUIT (after writing every frame
+//! `cotui record IFACE [IFACE...] -o FILE [--count N] [--duration MS] [--force | --append]`:
+//! a candump `-l` log of the bus (of several buses: one log, frames in time order, each with
+//! its interface). Stops on SIGINT, SIGTERM, SIGHUP or SIGQUIT (after writing every frame
 //! the kernel still holds) or at a limit; lines go out at least every 200 ms, so `kill -9`
 //! loses at most that much. Gaps (interface down or gone, bus-off) are reported on stderr as
 //! they happen and make the exit status 2.
 
 use super::commander::{BusArgs, Stream, report_to};
-use crate::command::record::{Limits, LogFormat, Recorded, WriteMode, open_output, record};
+use crate::command::record::{LogFormat, Record, Recorded, open_output, record};
 use crate::command::{CommandError, ExitCode};
 use std::io::Write;
 use tokio::signal::unix::{SignalKind, signal};
@@ -13,7 +14,20 @@ use tokio::signal::unix::{SignalKind, signal};
 /// Runs `cotui record` (its arguments: [`crate::command::record::RecordArgs`]); returns the
 /// exit status: 0 complete, 2 when the bus could not be opened or the recording has gaps, 1
 /// for a usage or write error.
-pub fn run_record(bus: &BusArgs, path: &str, limits: Limits, mode: WriteMode, format: LogFormat) -> ExitCode {
+pub fn run_record(bus: &BusArgs, r: &Record) -> ExitCode {
+    let (path, format) = (r.output.as_str(), r.format);
+    let mut ifaces = vec![bus.iface.clone()];
+    ifaces.extend(r.more.iter().cloned());
+    if let Some(twice) = super::input::repeated(&ifaces) {
+        return report_to(
+            bus,
+            "record",
+            Stream::Stderr,
+            Err(CommandError::Usage(format!(
+                "{twice} is given twice: name each interface once"
+            ))),
+        );
+    }
     if format != LogFormat::Candump && path == "-" && std::io::IsTerminal::is_terminal(&std::io::stdout()) {
         return report_to(
             bus,
@@ -29,7 +43,7 @@ pub fn run_record(bus: &BusArgs, path: &str, limits: Limits, mode: WriteMode, fo
         .enable_all()
         .build()
         .map_err(|e| CommandError::Usage(format!("cannot start the runtime: {e}")))
-        .and_then(|rt| rt.block_on(capture(bus, path, (limits, format), mode)));
+        .and_then(|rt| rt.block_on(capture(bus, &ifaces, r)));
     // `-o -`: stdout is the log; every report goes to stderr.
     let to = if path == "-" { Stream::Stderr } else { Stream::Stdout };
     let n = match result {
@@ -59,13 +73,8 @@ pub fn run_record(bus: &BusArgs, path: &str, limits: Limits, mode: WriteMode, fo
     }
 }
 
-/// Opens the bus and the log, and records until a signal or a limit.
-async fn capture(
-    args: &BusArgs,
-    path: &str,
-    (limits, format): (Limits, LogFormat),
-    mode: WriteMode,
-) -> Result<Recorded, CommandError> {
+/// Opens the buses and the log, and records until a signal or a limit.
+async fn capture(args: &BusArgs, ifaces: &[String], r: &Record) -> Result<Recorded, CommandError> {
     // Handlers first: from here on a signal stops the recording cleanly instead of killing it.
     let handler = |kind: SignalKind| {
         signal(kind).map_err(|e| CommandError::Usage(format!("cannot install a signal handler: {e}")))
@@ -76,8 +85,11 @@ async fn capture(
         handler(SignalKind::hangup())?,
         handler(SignalKind::quit())?,
     ];
-    let bus = crate::connect::open(&args.iface, args.listen_only).await?;
-    let mut out = open_output(path, mode, format)?;
+    let mut buses = Vec::with_capacity(ifaces.len());
+    for iface in ifaces {
+        buses.push((iface.clone(), crate::connect::open(iface, args.listen_only).await?));
+    }
+    let mut out = open_output(&r.output, r.mode, r.format)?;
     let [int, term, hup, quit] = &mut signals;
     let stop = async {
         tokio::select! {
@@ -87,7 +99,7 @@ async fn capture(
             _ = quit.recv() => {}
         }
     };
-    record(&bus, &mut out, limits, format, stop, |line| say(&line)).await
+    record(&buses, &mut out, r.limits, r.format, stop, |line| say(&line)).await
 }
 
 /// One line on stderr; a closed terminal is not an error.

@@ -166,7 +166,7 @@ impl Recorder {
                 let base = format!("{}-{}", stamp(hit.t_ns), self.trigger.slug());
                 let (path, f) = create_unique(dir, &base, extension(self.format))?;
                 let mut sink: LineSink<Box<dyn Target + Send>> = LineSink::new(Box::new(f), 0);
-                let enc = Encoder::start(self.format, &mut sink);
+                let enc = Encoder::start(self.format, &mut sink, &[]);
                 Some((path, sink, enc))
             }
         };

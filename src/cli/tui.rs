@@ -57,8 +57,14 @@ pub fn bitrate_arg(text: &str) -> Result<u64, String> {
 /// Arguments of `cotui open`.
 #[derive(Args, Debug)]
 pub struct OpenArgs {
-    /// Log file (candump -l/-L, candump screen output, Vector ASC, PEAK TRC, python-can CSV).
-    pub file: PathBuf,
+    /// Log files (candump -l/-L, candump screen output, Vector ASC, PEAK TRC, python-can CSV,
+    /// BLF). Several are merged by time into one capture; an interface name in several files
+    /// is the same bus unless --iface-per-file.
+    #[arg(required = true, value_name = "FILE")]
+    pub files: Vec<PathBuf>,
+    /// With several files: each file's interfaces are its own buses, named FILE:IFACE.
+    #[arg(long)]
+    pub iface_per_file: bool,
     #[command(flatten)]
     pub input: super::input::InputArgs,
     #[command(flatten)]
@@ -233,16 +239,27 @@ fn check_file(path: &std::path::Path) -> Result<(), ExitCode> {
 
 /// Runs `cotui open`.
 pub fn run_open(args: &OpenArgs) -> ExitCode {
-    if let Err(code) = check_file(&args.file) {
-        return code;
+    for f in &args.files {
+        if let Err(code) = check_file(f) {
+            return code;
+        }
     }
-    let name = args.file.display().to_string();
-    start(
-        &args.ui,
-        &name,
-        SourceKind::Open,
-        Feeding::Log((source::open(args.file.clone(), args.input.format()), None)),
-    )
+    if let Some(twice) = super::input::repeated(&args.files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>())
+    {
+        eprintln!("cotui open: {twice} is given twice");
+        return ExitCode::Usage;
+    }
+    let (name, rx) = match args.files.as_slice() {
+        [one] => (
+            one.display().to_string(),
+            source::open(one.clone(), args.input.format()),
+        ),
+        several => match super::open_logs::open(several, args.iface_per_file, args.input.format()) {
+            Some(feed) => feed,
+            None => return ExitCode::Unavailable,
+        },
+    };
+    start(&args.ui, &name, SourceKind::Open, Feeding::Log((rx, None)))
 }
 
 /// `x` as typed when it is short, else in scientific notation (`1e-300`, not 300 digits).

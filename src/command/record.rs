@@ -5,8 +5,9 @@
 
 use super::error::{CommandError, ParseError};
 use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
+use super::time_order::{self, TimeOrder};
 use super::words::{TypedWords, count_arg, ms_arg, ms_or_zero_arg};
-use crate::bus::{Bus, BusError, Event, StateChange};
+use crate::bus::{Bus, BusError, Event, StateChange, Subscription};
 use crate::frame::Frame;
 use crate::log::export::{AscWriter, TrcWriter};
 use crate::log::writer::LogWriter;
@@ -42,6 +43,8 @@ pub enum WriteMode {
 /// A time when nothing could be captured.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Gap {
+    /// The interface.
+    pub iface: String,
     /// Start, ns since the Unix epoch.
     pub from_ns: u64,
     /// End (capture resumed, or the recording stopped), ns since the Unix epoch.
@@ -76,6 +79,7 @@ impl Recorded {
                 .gaps
                 .iter()
                 .map(|g| GapJson {
+                    iface: g.iface.clone(),
                     from: secs(g.from_ns),
                     to: secs(g.to_ns),
                     reason: g.reason.clone(),
@@ -89,6 +93,8 @@ impl Recorded {
     /// Why the recording is incomplete, if it has gaps.
     pub fn gap_message(&self, output: &str) -> Option<String> {
         let total: u64 = self.gaps.iter().map(|g| g.to_ns.saturating_sub(g.from_ns)).sum();
+        // With gaps on several buses, each says its bus.
+        let several = self.gaps.iter().any(|g| g.iface != self.gaps[0].iface);
         (!self.gaps.is_empty()).then(|| {
             format!(
                 "{output} has {} gap(s), {:.1} s in all, when nothing could be captured ({})",
@@ -96,7 +102,11 @@ impl Recorded {
                 total as f64 / 1e9,
                 self.gaps
                     .iter()
-                    .map(|g| g.reason.as_str())
+                    .map(|g| if several {
+                        format!("{} {}", g.iface, g.reason)
+                    } else {
+                        g.reason.clone()
+                    })
                     .collect::<Vec<_>>()
                     .join(", ")
             )
@@ -130,6 +140,7 @@ impl RecordedJson {
 /// A time nothing could be captured, in seconds since the Unix epoch.
 #[derive(Debug, serde::Serialize)]
 struct GapJson {
+    iface: String,
     from: f64,
     to: f64,
     reason: String,
@@ -138,6 +149,10 @@ struct GapJson {
 /// `record -o FILE [--count N] [--duration MS] [--force | --append] [--format F]`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct RecordArgs {
+    /// More interfaces recorded into the same log, after the first (each frame keeps its
+    /// interface: its candump name, a pcapng interface, ASC/TRC/BLF channels 1, 2, ...).
+    #[arg(value_name = "IFACE")]
+    pub more: Vec<String>,
     /// The log file to write (candump -l format; `-` for stdout). An existing file is
     /// refused unless --force or --append.
     #[arg(short = 'o', long)]
@@ -188,6 +203,8 @@ pub struct TriggerWords {
 /// A recording of the bus to a file.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Record {
+    /// The interfaces recorded besides the command's bus.
+    pub more: Vec<String>,
     pub output: String,
     pub limits: Limits,
     pub mode: WriteMode,
@@ -202,6 +219,7 @@ impl<D> CommandArgs<D> for RecordArgs {
 
     fn spec(&self) -> Result<Record, ParseError> {
         Ok(Record {
+            more: self.more.clone(),
             output: self.output.clone(),
             limits: Limits {
                 count: self.count,
@@ -238,9 +256,15 @@ impl Spec for Record {
     /// Records until a limit (a record without limits runs until its future is dropped; the
     /// log is flushed then).
     async fn run(&self, ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
+        if !self.more.is_empty() {
+            return Err(CommandError::Usage(
+                "several interfaces are recorded from the command line (`cotui record IF1 IF2 -o FILE`)".into(),
+            ));
+        }
         let mut out = open_output(&self.output, self.mode, self.format)?;
         let forever = std::future::pending::<()>();
-        let n = record(ctx.bus, &mut out, self.limits, self.format, forever, |_| {}).await?;
+        let bus = [(ctx.bus.name().to_string(), ctx.bus.clone())];
+        let n = record(&bus, &mut out, self.limits, self.format, forever, |_| {}).await?;
         if let Some(m) = n.gap_message(&self.output) {
             return Err(CommandError::Bus(BusError::Io {
                 iface: ctx.bus.name().to_string(),
@@ -322,28 +346,25 @@ fn refuse_other_format(path: &str, format: LogFormat) -> Result<(), CommandError
     )))
 }
 
-/// Records frames from `bus` into `out` until `stop` resolves or a limit is reached; then
-/// reads every frame still queued, writes it, and flushes. Each change of the bus state
-/// goes to `note` as a line for the user. A write error stops the recording (the log keeps
-/// whole lines only).
+/// Records frames from `buses` (each with the interface name its frames are logged with)
+/// into `out` until `stop` resolves, a limit is reached or every bus is closed; then reads
+/// every frame still queued, writes it, and flushes. Frames of several buses are written in
+/// the order of their timestamps ([`TimeOrder`]), each with its bus: a candump interface
+/// name, a pcapng interface, an ASC/TRC/BLF channel (1, 2, ... in the order given). Each
+/// change of a bus's state goes to `note` as a line for the user. A write error stops the
+/// recording (the log keeps whole lines only).
 pub async fn record<T: Target>(
-    bus: &Bus,
+    buses: &[(String, Bus)],
     out: &mut LineSink<T>,
     limits: Limits,
     format: LogFormat,
     stop: impl Future<Output = ()>,
     mut note: impl FnMut(String),
 ) -> Result<Recorded, CommandError> {
-    let mut rx = bus.subscribe();
-    let mut rec = Recording {
-        writer: Encoder::start(format, out),
-        iface: bus.name().to_string(),
-        frames: 0,
-        count: limits.count,
-        open_gap: None,
-        gaps: Vec::new(),
-        flushed: Instant::now(),
-    };
+    let mut rxs: Vec<Subscription> = buses.iter().map(|(_, b)| b.subscribe()).collect();
+    let names: Vec<String> = buses.iter().map(|(n, _)| n.clone()).collect();
+    let mut rec = Recording::new(Encoder::start(format, out, &names), names, limits.count);
+    let mut closed = vec![false; buses.len()];
     let deadline = limits
         .duration_ms
         .map(|ms| tokio::time::Instant::now() + Duration::from_millis(ms));
@@ -353,42 +374,47 @@ pub async fn record<T: Target>(
             None => std::future::pending().await,
         }
     };
+    // Held frames of several buses go on after at most the hold, also when no frame comes.
+    let mut release = tokio::time::interval(time_order::HOLD / 2);
+    release.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
     tokio::pin!(stop);
     tokio::pin!(until);
-    let mut closed = false;
-    while rec.more() {
+    while rec.more() && closed.contains(&false) {
         tokio::select! {
             _ = &mut stop => break,
             _ = &mut until => break,
-            got = rx.next() => {
+            _ = release.tick(), if !rec.order.is_empty() => {
+                rec.release(out, false);
+                rec.flush(out)?;
+            }
+            (i, got) = next_of(&mut rxs, &closed) => {
                 // Write whatever else is queued before polling the stop conditions again.
-                let mut next = Some(got);
-                while let Some(got) = next {
-                    if !rec.take(got, out, &mut note)? {
-                        closed = true;
-                        break;
+                let mut next = Some((i, got));
+                while let Some((i, got)) = next {
+                    if !rec.take(i, got, out, &mut note)? {
+                        closed[i] = true;
                     }
-                    next = if rec.more() { rx.try_next() } else { None };
+                    next = if rec.more() { try_next_of(&mut rxs, &closed) } else { None };
                     if next.is_some() && rec.flushed.elapsed() >= Duration::from_millis(FLUSH_MS) {
                         rec.flush(out)?;
                     }
                 }
                 rec.flush(out)?;
-                if closed {
-                    break;
-                }
             }
         }
     }
-    if rec.more() && !closed {
+    if rec.more() && closed.contains(&false) {
         // Stopped: what the kernel queued before the stop belongs to the recording.
-        let caught = bus.catch_up();
+        let caught = futures_all(buses.iter().map(|(_, b)| b.catch_up()));
         tokio::pin!(caught);
         loop {
             tokio::select! {
                 biased;
-                got = rx.next() => {
-                    if !rec.take(got, out, &mut note)? || !rec.more() {
+                (i, got) = next_of(&mut rxs, &closed) => {
+                    if !rec.take(i, got, out, &mut note)? {
+                        closed[i] = true;
+                    }
+                    if !rec.more() || !closed.contains(&false) {
                         break;
                     }
                 }
@@ -396,10 +422,14 @@ pub async fn record<T: Target>(
             }
         }
         while rec.more()
-            && let Some(got) = rx.try_next()
-            && rec.take(got, out, &mut note)?
-        {}
+            && let Some((i, got)) = try_next_of(&mut rxs, &closed)
+        {
+            if !rec.take(i, got, out, &mut note)? {
+                closed[i] = true;
+            }
+        }
     }
+    rec.release(out, true);
     rec.flush(out)?;
     rec.writer.finish(out).map_err(|e| {
         CommandError::Usage(format!(
@@ -407,18 +437,60 @@ pub async fn record<T: Target>(
             out.lines()
         ))
     })?;
-    if let Some((from_ns, reason)) = rec.open_gap.take() {
-        rec.gaps.push(Gap {
-            from_ns,
-            to_ns: now_ns(),
-            reason,
-        });
+    let end = now_ns();
+    for (i, open) in rec.open_gaps.iter_mut().enumerate() {
+        if let Some((from_ns, reason)) = open.take() {
+            rec.gaps.push(Gap {
+                iface: rec.ifaces[i].clone(),
+                from_ns,
+                to_ns: end,
+                reason,
+            });
+        }
     }
+    let dropped = buses.iter().map(|(_, b)| b.dropped()).sum::<u64>() + rxs.iter().map(Subscription::lost).sum::<u64>();
     Ok(Recorded {
         frames: out.lines(),
-        dropped: bus.dropped() + rx.lost(),
+        dropped,
         gaps: rec.gaps,
     })
+}
+
+/// The next event of any bus not closed, with the bus's index (pending when all are).
+async fn next_of(rxs: &mut [Subscription], closed: &[bool]) -> (usize, Result<Event, BusError>) {
+    // One receive per bus, kept across polls (each holds its waker); a broadcast receive is
+    // cancel-safe: those dropped unfinished lose nothing.
+    let mut waits: Vec<_> = rxs
+        .iter_mut()
+        .enumerate()
+        .filter(|(i, _)| !closed[*i])
+        .map(|(i, rx)| Box::pin(async move { (i, rx.next().await) }))
+        .collect();
+    std::future::poll_fn(|cx| {
+        waits
+            .iter_mut()
+            .find_map(|w| match w.as_mut().poll(cx) {
+                std::task::Poll::Ready(got) => Some(got),
+                std::task::Poll::Pending => None,
+            })
+            .map_or(std::task::Poll::Pending, std::task::Poll::Ready)
+    })
+    .await
+}
+
+/// An event already queued on any bus not closed, with the bus's index.
+fn try_next_of(rxs: &mut [Subscription], closed: &[bool]) -> Option<(usize, Result<Event, BusError>)> {
+    rxs.iter_mut()
+        .enumerate()
+        .filter(|(i, _)| !closed[*i])
+        .find_map(|(i, rx)| rx.try_next().map(|got| (i, got)))
+}
+
+/// Resolves when every future of `all` has.
+async fn futures_all<F: Future<Output = ()>>(all: impl Iterator<Item = F>) {
+    for f in all {
+        f.await;
+    }
 }
 
 /// The file format of a recording.
@@ -466,10 +538,11 @@ pub(crate) enum Encoder {
 }
 
 impl Encoder {
-    /// A fresh encoder; a pcapng one starts the file with its section header.
-    pub(crate) fn start<T: Target>(format: LogFormat, out: &mut LineSink<T>) -> Encoder {
+    /// A fresh encoder for the buses `ifaces`; a pcapng one starts the file with its section
+    /// header, candump lines pad the names as `candump -l IF1 IF2` does.
+    pub(crate) fn start<T: Target>(format: LogFormat, out: &mut LineSink<T>, ifaces: &[String]) -> Encoder {
         match format {
-            LogFormat::Candump => Encoder::Candump(LogWriter::new()),
+            LogFormat::Candump => Encoder::Candump(LogWriter::new().pad_to(ifaces)),
             LogFormat::Pcapng => {
                 out.buffer().extend_from_slice(&crate::output::pcapng::section_header());
                 out.end_record(false);
@@ -558,63 +631,100 @@ impl Encoder {
 /// A recording in progress.
 struct Recording {
     writer: Encoder,
-    iface: String,
-    /// Frames taken (written to the sink's buffer).
+    /// The interface name of each bus, by index.
+    ifaces: Vec<String>,
+    /// Frames taken (written to the sink's buffer, or held in `order`).
     frames: u64,
     count: Option<u64>,
-    /// Start (ns) and reason of the gap in progress.
-    open_gap: Option<(u64, String)>,
+    /// Frames of several buses waiting for their turn (unused with one bus).
+    order: TimeOrder,
+    /// Per bus: start (ns) and reason of the gap in progress.
+    open_gaps: Vec<Option<(u64, String)>>,
     gaps: Vec<Gap>,
     flushed: Instant,
 }
 
 impl Recording {
+    fn new(writer: Encoder, ifaces: Vec<String>, count: Option<u64>) -> Recording {
+        Recording {
+            writer,
+            open_gaps: vec![None; ifaces.len()],
+            ifaces,
+            frames: 0,
+            count,
+            order: TimeOrder::default(),
+            gaps: Vec::new(),
+            flushed: Instant::now(),
+        }
+    }
+
     fn more(&self) -> bool {
         self.count.is_none_or(|c| self.frames < c)
     }
 
-    /// Takes one event; false when the bus is closed.
+    /// Takes one event of bus `bus`; false when that bus is closed.
     fn take<T: Target>(
         &mut self,
+        bus: usize,
         got: Result<Event, BusError>,
         out: &mut LineSink<T>,
         note: &mut impl FnMut(String),
     ) -> Result<bool, CommandError> {
         match got {
-            Ok(Event::Frame(f)) => {
-                self.writer.frame(out, &f, &self.iface);
+            Ok(Event::Frame(mut f)) => {
+                f.iface = bus as u16;
                 self.frames += 1;
+                if self.ifaces.len() == 1 {
+                    self.writer.frame(out, &f, &self.ifaces[0]);
+                } else {
+                    self.order.push(f, Instant::now());
+                    self.release(out, false);
+                }
             }
-            Ok(Event::State(s)) => self.state(s, note),
+            Ok(Event::State(s)) => self.state(bus, s, note),
             Err(BusError::Closed) => return Ok(false),
             Err(e) => note(e.to_string()),
         }
         Ok(true)
     }
 
-    fn state(&mut self, s: StateChange, note: &mut impl FnMut(String)) {
-        match (&self.open_gap, s.state.capturing()) {
+    /// Writes the held frames whose turn has come (`all`: every one, at the end).
+    fn release<T: Target>(&mut self, out: &mut LineSink<T>, all: bool) {
+        let now = Instant::now();
+        while let Some(f) = if all {
+            self.order.pop()
+        } else {
+            self.order.pop_ready(now)
+        } {
+            self.writer.frame(out, &f, &self.ifaces[usize::from(f.iface)]);
+        }
+    }
+
+    fn state(&mut self, bus: usize, s: StateChange, note: &mut impl FnMut(String)) {
+        let iface = &self.ifaces[bus];
+        let open = &mut self.open_gaps[bus];
+        match (&open, s.state.capturing()) {
             (None, false) => {
-                self.open_gap = Some((s.ts_ns, s.state.name().to_string()));
-                note(format!("{}; a gap in the recording starts", s.text(&self.iface)));
+                *open = Some((s.ts_ns, s.state.name().to_string()));
+                note(format!("{}; a gap in the recording starts", s.text(iface)));
             }
             (Some((from, reason)), true) => {
                 note(format!(
-                    "{}: capturing again after {:.1} s ({reason}); the gap ends",
-                    self.iface,
+                    "{iface}: capturing again after {:.1} s ({reason}); the gap ends",
                     s.ts_ns.saturating_sub(*from) as f64 / 1e9
                 ));
                 self.gaps.push(Gap {
+                    iface: iface.clone(),
                     from_ns: *from,
                     to_ns: s.ts_ns,
                     reason: reason.clone(),
                 });
-                self.open_gap = None;
+                *open = None;
                 if s.state != crate::bus::BusState::Active {
-                    note(s.text(&self.iface));
+                    note(s.text(iface));
                 }
             }
-            _ => note(s.text(&self.iface)),
+            _ => note(s.text(iface)),
         }
     }
 
@@ -677,15 +787,7 @@ mod tests {
 
     #[test]
     fn loss_of_capture_is_a_gap_with_its_reason_and_notes() {
-        let mut rec = Recording {
-            writer: Encoder::Candump(LogWriter::new()),
-            iface: "vcan0".into(),
-            frames: 0,
-            count: None,
-            open_gap: None,
-            gaps: Vec::new(),
-            flushed: Instant::now(),
-        };
+        let mut rec = Recording::new(Encoder::Candump(LogWriter::new()), vec!["vcan0".into()], None);
         let mut out = LineSink::new(Mem(Vec::new()), 0);
         let mut notes = Vec::new();
         let mut f = Frame::classic(0x123, &[1]);
@@ -703,12 +805,13 @@ mod tests {
         ];
         let taken: Vec<bool> = events
             .into_iter()
-            .map(|e| rec.take(e, &mut out, &mut |n| notes.push(n)).unwrap())
+            .map(|e| rec.take(0, e, &mut out, &mut |n| notes.push(n)).unwrap())
             .collect();
         assert_eq!(taken, [true, true, true, true, true, true, true, false]);
         rec.flush(&mut out).unwrap();
         assert_eq!(out.lines(), 1);
         let gap = |from_ns, to_ns, reason: &str| Gap {
+            iface: "vcan0".into(),
             from_ns,
             to_ns,
             reason: reason.into(),

@@ -239,6 +239,7 @@ mod tests {
         assert_eq!(
             parse_command("record -o out.log").unwrap(),
             Command::Record(Record {
+                more: Vec::new(),
                 output: "out.log".into(),
                 limits: Limits::default(),
                 mode: WriteMode::New,
@@ -249,6 +250,7 @@ mod tests {
         assert_eq!(
             parse_command("record -o out.log --append --count 5").unwrap(),
             Command::Record(Record {
+                more: Vec::new(),
                 output: "out.log".into(),
                 limits: Limits {
                     count: Some(5),

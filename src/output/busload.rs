@@ -83,15 +83,17 @@ pub fn bus_bits(frame: &Frame) -> u64 {
 #[derive(Clone, Debug, Default)]
 pub struct BusLoad {
     bitrate: Bitrate,
+    frames: u64,
     bits: u64,
     stuff_bits: u64,
     first_ns: Option<u64>,
     last_ns: u64,
     /// Bits of the first interface's 128 nodes (made on its first node frame).
     first_nodes: Vec<u64>,
-    other_nodes: HashMap<NodeKey, u64>,
-    /// Frames of the last 100 ms: (time, bits).
-    window: VecDeque<(u64, u32)>,
+    /// Bits of the nodes of every other interface (a fast seeded hash: looked up per frame).
+    other_nodes: HashMap<NodeKey, u64, foldhash::fast::RandomState>,
+    /// Frames of the last 100 ms: (time, bits, interface).
+    window: VecDeque<(u64, u32, u16)>,
     window_bits: u64,
     busiest_bits: u64,
     /// The current burst: its start (ns) and the time its last frame ended.
@@ -102,6 +104,36 @@ pub struct BusLoad {
     took_ns: Vec<u64>,
     /// The figures of the frames seen, for those that come again.
     figures: crate::wire::cache::FiguresCache,
+    /// Each interface's figures by index, once a second interface is seen (until then the
+    /// capture's figures are the first interface's): plain counters, no allocation per
+    /// interface.
+    ifaces: Vec<IfaceLoad>,
+}
+
+/// The figures of one interface of a capture of several.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct IfaceLoad {
+    /// Frames (error frames included).
+    pub frames: u64,
+    /// Bits on the wire.
+    pub bits: u64,
+    first_ns: Option<u64>,
+    last_ns: u64,
+    /// Bits of this interface among [`BusLoad`]'s last 100 ms.
+    window_bits: u64,
+    busiest_bits: u64,
+    burst: Option<(u64, u64)>,
+    longest_burst_ns: u64,
+}
+
+/// The burst after a frame of `took` ns that ended at `t`, and the one before: it goes on
+/// while the bus stays idle for less than the frame takes.
+fn next_burst(burst: Option<(u64, u64)>, t: u64, took: u64) -> (u64, u64) {
+    let start = t.saturating_sub(took);
+    match burst {
+        Some((since, end)) if start < end.saturating_add(took) => (since, t.max(end)),
+        _ => (start, t),
+    }
 }
 
 /// More bits than any classic frame takes with its intermission (at most 160).
@@ -127,6 +159,11 @@ impl BusLoad {
     /// frame's timestamp is taken as the end of its EOF.
     #[inline]
     pub fn add(&mut self, frame: &Frame, node: Option<u8>) {
+        let per_iface = frame.iface != 0 || !self.ifaces.is_empty();
+        if per_iface {
+            self.iface_frame(frame.iface);
+        }
+        self.frames += 1;
         let Ok(fig) = self.figures.figures(frame) else {
             return;
         };
@@ -147,28 +184,101 @@ impl BusLoad {
                 *self.other_nodes.entry(key).or_insert(0) += u64::from(bits);
             }
         }
-        self.window.push_back((t, bits));
+        self.window.push_back((t, bits, frame.iface));
         self.window_bits += u64::from(bits);
-        while let Some(&(old, b)) = self.window.front() {
+        while let Some(&(old, b, i)) = self.window.front() {
             if old + BUSY_WINDOW_NS > t {
                 break;
             }
             self.window_bits -= u64::from(b);
+            // Frames come in time order: a frame of another interface that leaves the
+            // window now has left it at that interface's next frame too.
+            if let Some(iface) = self.ifaces.get_mut(usize::from(i)) {
+                iface.window_bits -= u64::from(b);
+            }
             self.window.pop_front();
         }
         self.busiest_bits = self.busiest_bits.max(self.window_bits);
-        // A burst goes on while the bus stays idle for less than the next frame takes.
         let took = match self.took_ns.get(bits as usize) {
             Some(&ns) => ns,
             None => took_ns(u64::from(bits), self.bitrate.bps),
         };
-        let start = t.saturating_sub(took);
-        let burst = match self.burst {
-            Some((since, end)) if start < end.saturating_add(took) => (since, t.max(end)),
-            _ => (start, t),
-        };
+        let burst = next_burst(self.burst, t, took);
         self.longest_burst_ns = self.longest_burst_ns.max(burst.1 - burst.0);
         self.burst = Some(burst);
+        if per_iface {
+            let s = &mut self.ifaces[usize::from(frame.iface)];
+            s.bits += u64::from(bits);
+            s.first_ns.get_or_insert(t);
+            s.last_ns = s.last_ns.max(t);
+            s.window_bits += u64::from(bits);
+            s.busiest_bits = s.busiest_bits.max(s.window_bits);
+            let burst = next_burst(s.burst, t, took);
+            s.longest_burst_ns = s.longest_burst_ns.max(burst.1 - burst.0);
+            s.burst = Some(burst);
+        }
+    }
+
+    /// Counts a frame of `iface` among the interfaces' figures; on the first frame of a
+    /// second interface, the first interface's figures are the capture's so far.
+    #[cold]
+    fn iface_frame(&mut self, iface: u16) {
+        if self.ifaces.is_empty() {
+            self.ifaces.push(IfaceLoad {
+                frames: self.frames,
+                bits: self.bits,
+                first_ns: self.first_ns,
+                last_ns: self.last_ns,
+                window_bits: self.window_bits,
+                busiest_bits: self.busiest_bits,
+                burst: self.burst,
+                longest_burst_ns: self.longest_burst_ns,
+            });
+        }
+        let i = usize::from(iface);
+        if i >= self.ifaces.len() {
+            self.ifaces.resize(i + 1, IfaceLoad::default());
+        }
+        self.ifaces[i].frames += 1;
+    }
+
+    /// Each interface's figures (by index; interfaces without frames left out). A capture
+    /// of one interface has one entry, the capture's figures.
+    pub fn by_iface(&self) -> Vec<(u16, IfaceLoad)> {
+        if self.ifaces.is_empty() {
+            let whole = IfaceLoad {
+                frames: self.frames,
+                bits: self.bits,
+                first_ns: self.first_ns,
+                last_ns: self.last_ns,
+                window_bits: self.window_bits,
+                busiest_bits: self.busiest_bits,
+                burst: self.burst,
+                longest_burst_ns: self.longest_burst_ns,
+            };
+            return if self.frames > 0 { vec![(0, whole)] } else { Vec::new() };
+        }
+        let all = self.ifaces.iter().enumerate();
+        all.filter(|(_, s)| s.frames > 0).map(|(i, s)| (i as u16, *s)).collect()
+    }
+
+    /// The figures of `iface` (named `name`) as JSON.
+    pub fn iface_json(&self, name: &str, iface: &IfaceLoad) -> IfaceJson {
+        IfaceJson {
+            bitrate: self.bitrate.bps,
+            bitrate_source: self.bitrate.source,
+            bits: iface.bits,
+            busiest_100ms: round6(iface.busiest_bits as f64 / self.window_capacity()),
+            frames: iface.frames,
+            iface: name.to_string(),
+            load: load(iface.bits, iface.first_ns, iface.last_ns, self.bitrate.bps).map(round6),
+            longest_burst_ms: round6(iface.longest_burst_ns as f64 / 1e6),
+        }
+    }
+
+    /// The bits 100 ms holds at the bit rate.
+    fn window_capacity(&self) -> f64 {
+        self.bitrate.bps as f64 * BUSY_WINDOW_NS as f64 / 1e9
     }
 
     /// Bits counted, intermissions included.
@@ -179,8 +289,7 @@ impl BusLoad {
     /// The load over the capture: bits / (bit rate x duration); None before two frames at
     /// different times.
     pub fn load(&self) -> Option<f64> {
-        let span = self.last_ns - self.first_ns?;
-        (span > 0).then(|| self.bits as f64 * 1e9 / (self.bitrate.bps as f64 * span as f64))
+        load(self.bits, self.first_ns, self.last_ns, self.bitrate.bps)
     }
 
     /// Every node's bits, in node order.
@@ -190,13 +299,13 @@ impl BusLoad {
             .filter(|(_, b)| **b > 0)
             .map(|(n, b)| (NodeKey::new(0, n as u8), *b));
         let mut all: Vec<(NodeKey, u64)> = first.chain(self.other_nodes.iter().map(|(k, b)| (*k, *b))).collect();
-        all.sort();
+        all.sort_unstable();
         all
     }
 
     /// The figures as JSON, nodes keyed by `key`.
     pub fn to_json(&self, key: impl Fn(NodeKey) -> String) -> BusJson {
-        let window = self.bitrate.bps as f64 * BUSY_WINDOW_NS as f64 / 1e9;
+        let window = self.window_capacity();
         BusJson {
             bitrate: self.bitrate.bps,
             bitrate_source: self.bitrate.source,
@@ -209,29 +318,42 @@ impl BusLoad {
         }
     }
 
-    /// The figures as text lines (after the summary's `by node:`), nodes named by `name`.
-    pub fn to_text(&self, name: impl Fn(NodeKey) -> String) -> String {
-        let j = self.to_json(name);
-        let load = j.load.map_or("-".to_string(), |l| format!("{:.2} %", l * 100.0));
-        let mut s = format!(
-            "bus: {} bits ({} stuff bits) at {} kbit/s ({}): load {load}, busiest 100 ms {:.2} %, longest burst {:.3} ms\n",
-            j.bits,
-            j.stuff_bits,
-            j.bitrate as f64 / 1000.0,
+    /// Appends the figures as text lines (after the summary's `by node:`) to `out`, nodes in
+    /// node order, each named by `name` (which writes the name into the buffer it is given).
+    pub fn to_text(&self, out: &mut String, name: impl Fn(&mut String, NodeKey)) {
+        use std::fmt::Write;
+        let load = self.load().map(round6);
+        let load = load.map_or("-".to_string(), |l| format!("{:.2} %", l * 100.0));
+        // Writing to a String cannot fail.
+        let _ = writeln!(
+            out,
+            "bus: {} bits ({} stuff bits) at {} kbit/s ({}): load {load}, busiest 100 ms {:.2} %, longest burst {:.3} ms",
+            self.bits,
+            self.stuff_bits,
+            self.bitrate.bps as f64 / 1000.0,
             self.bitrate.source.as_str(),
-            j.busiest_100ms * 100.0,
-            j.longest_burst_ms,
+            round6(self.busiest_bits as f64 / self.window_capacity()) * 100.0,
+            round6(self.longest_burst_ns as f64 / 1e6),
         );
-        for (node, bits) in &j.by_node {
-            s.push_str(&format!("  {node:<8} {bits:>10} bits\n"));
+        // One name buffer for every row: a capture of 40,000 interfaces has many.
+        let mut shown = String::new();
+        for (node, bits) in self.by_node() {
+            shown.clear();
+            name(&mut shown, node);
+            let _ = writeln!(out, "  {shown:<8} {bits:>10} bits");
         }
-        s
     }
 }
 
 /// Nanoseconds `bits` take at `bps` bit/s (whole, rounded down).
 fn took_ns(bits: u64, bps: u64) -> u64 {
     bits * 1_000_000_000 / bps.max(1)
+}
+
+/// bits / (bit rate x the time from `first` to `last`); None for one instant.
+fn load(bits: u64, first_ns: Option<u64>, last_ns: u64, bps: u64) -> Option<f64> {
+    let span = last_ns - first_ns?;
+    (span > 0).then(|| bits as f64 * 1e9 / (bps as f64 * span as f64))
 }
 
 fn round6(x: f64) -> f64 {
@@ -257,6 +379,27 @@ pub struct BusJson {
     pub longest_burst_ms: f64,
     /// Stuff bits among `bits`.
     pub stuff_bits: u64,
+}
+
+/// One interface's figures in `--summary --format jsonl` (`by_iface`; fields in key order).
+#[derive(Clone, Debug, Serialize)]
+pub struct IfaceJson {
+    /// Bits per second (the capture's).
+    pub bitrate: u64,
+    /// `option`, `interface` or `assumed`.
+    pub bitrate_source: BitrateSource,
+    /// Bits on the wire of this interface's frames.
+    pub bits: u64,
+    /// Bits of its busiest 100 ms window / the bits 100 ms holds.
+    pub busiest_100ms: f64,
+    /// Frames (error frames included).
+    pub frames: u64,
+    /// The interface's name.
+    pub iface: String,
+    /// bits / (bitrate x the time from its first frame to its last); null for one instant.
+    pub load: Option<f64>,
+    /// Its longest burst.
+    pub longest_burst_ms: f64,
 }
 
 #[cfg(test)]

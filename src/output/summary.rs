@@ -1,6 +1,6 @@
 //! `--summary`: per-node and per-kind totals.
 
-use super::busload::{BusJson, BusLoad};
+use super::busload::{BusJson, BusLoad, IfaceJson};
 use crate::decode::Kind;
 use crate::frame::{Frame, Interfaces, NodeKey};
 use serde::Serialize;
@@ -125,22 +125,56 @@ impl Summary {
         s.push_str("by node:\n");
         let several = self.several_ifaces();
         for (node, counts) in &self.by_node {
+            // Pieces pushed, not `write!`: a capture of 40,000 interfaces has as many rows.
             let total: u64 = counts.iter().sum();
-            // Writing to a String cannot fail.
-            let _ = match self.iface_of(several, *node) {
-                Some(iface) => write!(s, "  {iface} node {:<3} {total:>10} ", node.node),
-                None => write!(s, "  node {:<3} {total:>10} ", node.node),
-            };
+            s.push_str("  ");
+            if let Some(iface) = self.iface_of(several, *node) {
+                s.push_str(iface);
+                s.push(' ');
+            }
+            s.push_str("node ");
+            push_num(&mut s, u64::from(node.node), -3);
+            s.push(' ');
+            push_num(&mut s, total, 10);
+            s.push(' ');
             for (k, n) in kinds(counts) {
-                let _ = write!(s, " {}={n}", k.as_str());
+                s.push(' ');
+                s.push_str(k.as_str());
+                s.push('=');
+                push_num(&mut s, n, 0);
             }
             s.push('\n');
         }
-        s.push_str(&self.bus.to_text(|k| match self.iface_of(several, k) {
-            Some(iface) => format!("{iface} node {}", k.node),
-            None => format!("node {}", k.node),
-        }));
+        self.bus.to_text(&mut s, |out, k| {
+            let _ = match self.iface_of(several, k) {
+                Some(iface) => write!(out, "{iface} node {}", k.node),
+                None => write!(out, "node {}", k.node),
+            };
+        });
+        let buses = self.by_iface();
+        if buses.len() > 1 {
+            s.push_str("by bus:\n");
+            for b in &buses {
+                let load = b.load.map_or("-".to_string(), |l| format!("{:.2} %", l * 100.0));
+                let _ = writeln!(
+                    s,
+                    "  {:<8} {:>10} frames {:>12} bits: load {load}, busiest 100 ms {:.2} %, longest burst {:.3} ms",
+                    b.iface,
+                    b.frames,
+                    b.bits,
+                    b.busiest_100ms * 100.0,
+                    b.longest_burst_ms
+                );
+            }
+        }
         s
+    }
+
+    /// Each interface's bus figures, in interface order.
+    fn by_iface(&self) -> Vec<IfaceJson> {
+        let name = |i: u16| self.ifaces.get(usize::from(i)).map_or("?", String::as_str);
+        let all = self.bus.by_iface().into_iter();
+        all.map(|(i, figures)| self.bus.iface_json(name(i), &figures)).collect()
     }
 
     /// The JSON key of a node: its number, or `can1/5` when there are `several` interfaces.
@@ -157,6 +191,7 @@ impl Summary {
         let named = |kinds: &BTreeMap<Kind, u64>| kinds.iter().map(|(k, n)| (k.as_str(), *n)).collect();
         SummaryJson {
             bus: self.bus.to_json(|k| self.node_key(several, k)),
+            by_iface: self.by_iface(),
             by_kind: named(&self.by_kind),
             by_node: self
                 .by_node
@@ -170,6 +205,32 @@ impl Summary {
                 .collect(),
             frames: self.frames,
         }
+    }
+}
+
+/// Appends `n` in decimal, padded with spaces to `width` (right-aligned; a negative width:
+/// left-aligned), as `{n:>w}` / `{n:<w}` write it.
+fn push_num(s: &mut String, n: u64, width: i32) {
+    let mut digits = [0u8; 20];
+    let mut at = digits.len();
+    let mut v = n;
+    loop {
+        at -= 1;
+        digits[at] = b'0' + (v % 10) as u8;
+        v /= 10;
+        if v == 0 {
+            break;
+        }
+    }
+    let len = digits.len() - at;
+    let pad = (width.unsigned_abs() as usize).saturating_sub(len);
+    if width > 0 {
+        s.extend(std::iter::repeat_n(' ', pad));
+    }
+    // ASCII digits.
+    s.extend(digits[at..].iter().map(|&d| char::from(d)));
+    if width < 0 {
+        s.extend(std::iter::repeat_n(' ', pad));
     }
 }
 
@@ -188,6 +249,9 @@ fn kinds(counts: &Counts) -> impl Iterator<Item = (Kind, u64)> + '_ {
 pub struct SummaryJson {
     /// The bits on the wire and the bus load.
     pub bus: BusJson,
+    /// Each interface's frames, bits, load, busiest 100 ms and longest burst, in interface
+    /// order (one entry, the capture's figures, for a capture of one interface).
+    pub by_iface: Vec<IfaceJson>,
     /// Frames per kind name.
     pub by_kind: BTreeMap<&'static str, u64>,
     /// Frames per node (its number as text; `"can1/5"` when the input has several
@@ -218,6 +282,22 @@ mod tests {
         assert!(t.contains("  heartbeat    2"), "{t}");
         assert!(t.contains("node 5            2  heartbeat=2"), "{t}");
         assert_eq!(serde_json::to_value(s.to_json()).unwrap()["by_node"]["2"]["tpdo"], 1);
+    }
+
+    #[test]
+    fn numbers_pad_as_format_pads_them() {
+        for n in [0, 7, 42, 123, 9999, u64::MAX] {
+            for (w, want) in [
+                (3, format!("{n:>3}")),
+                (-3, format!("{n:<3}")),
+                (10, format!("{n:>10}")),
+                (0, n.to_string()),
+            ] {
+                let mut s = String::new();
+                push_num(&mut s, n, w);
+                assert_eq!(s, want);
+            }
+        }
     }
 
     #[test]

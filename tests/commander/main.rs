@@ -20,6 +20,7 @@ mod lists;
 mod lss_sim;
 mod pdo_config;
 mod procedure_run;
+mod record_buses;
 mod run;
 mod sdo_client_misbehave;
 mod sdo_client_server;

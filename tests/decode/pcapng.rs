@@ -287,9 +287,10 @@ async fn a_pcapng_recording_holds_what_a_candump_recording_of_the_same_bus_holds
     let mut a = open_output(log.to_str().unwrap(), WriteMode::New, LogFormat::Candump).unwrap();
     let mut b = open_output(cap.to_str().unwrap(), WriteMode::New, LogFormat::Pcapng).unwrap();
     let never = || std::future::pending::<()>();
+    let bus = [("demo".to_string(), demo.bus.clone())];
     let (ra, rb) = tokio::join!(
-        record(&demo.bus, &mut a, limits, LogFormat::Candump, never(), |_| {}),
-        record(&demo.bus, &mut b, limits, LogFormat::Pcapng, never(), |_| {}),
+        record(&bus, &mut a, limits, LogFormat::Candump, never(), |_| {}),
+        record(&bus, &mut b, limits, LogFormat::Pcapng, never(), |_| {}),
     );
     assert_eq!((ra.unwrap().frames, rb.unwrap().frames), (80, 80));
     drop((a, b));

@@ -87,6 +87,79 @@ fn the_summary_has_a_row_per_node_of_each_interface() {
     assert!(json["by_node"].get("5").is_none(), "{json}");
 }
 
+/// `by_iface`: each bus's own frames, bits, load, busiest 100 ms and longest burst, besides
+/// the whole capture's `bus` figures; the text summary lists them `by bus:`.
+#[test]
+fn the_summary_has_the_bus_figures_of_each_interface() {
+    let json: serde_json::Value =
+        serde_json::from_str(&stdout(&["decode", "--summary", "--format", "jsonl", LOG])).unwrap();
+    let buses = json["by_iface"].as_array().unwrap();
+    let names: Vec<&str> = buses.iter().map(|b| b["iface"].as_str().unwrap()).collect();
+    assert_eq!(names, ["can0", "can1"], "{json}");
+    let node_bits = |key: &str| json["bus"]["by_node"][key].as_u64().unwrap();
+    let (can0, can1) = (&buses[0], &buses[1]);
+    // can0: 101 heartbeats and the SDO request; can1: 11 heartbeats and the answer.
+    assert_eq!(
+        (can0["frames"].as_u64(), can1["frames"].as_u64()),
+        (Some(102), Some(12))
+    );
+    assert_eq!(can0["bits"].as_u64(), Some(node_bits("can0/5") + node_bits("can0/2")));
+    assert_eq!(can1["bits"].as_u64(), Some(node_bits("can1/5") + node_bits("can1/2")));
+    assert_eq!(
+        can0["bits"].as_u64().unwrap() + can1["bits"].as_u64().unwrap(),
+        json["bus"]["bits"].as_u64().unwrap()
+    );
+    // can0 spans 10 s (100.000 to 110.000), can1 1 s (100.050 to 101.050), at 500 kbit/s.
+    let load = |b: &serde_json::Value, span_s: f64| b["bits"].as_u64().unwrap() as f64 / (500_000.0 * span_s);
+    assert!(
+        (can0["load"].as_f64().unwrap() - load(can0, 10.0)).abs() < 1e-6,
+        "{can0}"
+    );
+    assert!(
+        (can1["load"].as_f64().unwrap() - load(can1, 1.0)).abs() < 1e-6,
+        "{can1}"
+    );
+    // can1's busiest 100 ms: the SDO answer (100.521) and the heartbeat after it (100.550),
+    // not can0's frames in between.
+    let heartbeat = node_bits("can1/5") / 11;
+    let busiest = (node_bits("can1/2") + heartbeat) as f64 / 50_000.0;
+    assert!(
+        (can1["busiest_100ms"].as_f64().unwrap() - busiest).abs() < 1e-6,
+        "{can1}"
+    );
+    assert!(json["bus"]["busiest_100ms"].as_f64().unwrap() > busiest);
+    for b in buses {
+        assert_eq!(
+            (b["bitrate"].as_u64(), b["bitrate_source"].as_str()),
+            (Some(500_000), Some("assumed"))
+        );
+        assert!(b["longest_burst_ms"].as_f64().unwrap() > 0.0);
+    }
+    let text = stdout(&["decode", "--summary", LOG]);
+    let at = text.find("by bus:\n").unwrap_or_else(|| panic!("{text}"));
+    let rows: Vec<&str> = text[at..].lines().skip(1).collect();
+    assert_eq!(rows.len(), 2, "{text}");
+    assert!(rows[0].starts_with("  can0            102 frames "), "{text}");
+    assert!(rows[1].starts_with("  can1             12 frames "), "{text}");
+    assert!(
+        rows[1].contains(&format!("busiest 100 ms {:.2} %", busiest * 100.0)),
+        "{text}"
+    );
+    // One bus: one entry (the capture's figures), no `by bus:` lines.
+    let one: serde_json::Value = serde_json::from_str(&stdout(&[
+        "decode",
+        "--summary",
+        "--format",
+        "jsonl",
+        "tests/fixtures/heartbeat_stops.log",
+    ]))
+    .unwrap();
+    assert_eq!(one["by_iface"].as_array().map(Vec::len), Some(1), "{one}");
+    assert_eq!(one["by_iface"][0]["bits"], one["bus"]["bits"]);
+    assert_eq!(one["by_iface"][0]["busiest_100ms"], one["bus"]["busiest_100ms"]);
+    assert!(!stdout(&["decode", "--summary", "tests/fixtures/heartbeat_stops.log"]).contains("by bus:"));
+}
+
 #[test]
 fn events_name_the_interface_of_each_node() {
     let text = stdout(&["decode", "--events", LOG]);

@@ -7,6 +7,7 @@ mod agreement;
 mod filter_search;
 mod objects_demo;
 mod objects_tmux;
+mod open_logs;
 mod own_reads;
 mod problems;
 mod receive_list;
