@@ -1149,7 +1149,7 @@ kill -TERM "$gw_peer" 2> /dev/null
 "$cotui" serve vcan0 --socketcand 29536 --allow-send 2> serve.err &
 served=$!
 wait_for serve.err 100 "socketcand on 127.0.0.1:29536"
-timeout 30 candump -n 1 vcan0,321:7FF > sc_dump.txt &
+timeout 180 candump -n 1 vcan0,321:7FF > sc_dump.txt &
 dump=$!
 wait_socket "$dump"
 python3 - > sc_py.out 2>&1 <<'PY' &
@@ -1195,7 +1195,7 @@ trigsim=$!
 pids+=($trigsim)
 exec 8> trig.in
 wait_for trigsim.out 300 "commands on stdin" || bad "trigger: cotui sim start: $(cat trigsim.out)"
-candump -l -f trigall.log vcan0 2> /dev/null &
+candump -L vcan0 > trigall.log 2> /dev/null &
 trigdump=$!
 wait_socket $trigdump
 "$cotui" record vcan0 --listen-only --trigger emcy --pre 2s --post 1s --count 1 -o trigwin > trigrec.out 2>&1 &
