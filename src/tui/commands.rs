@@ -8,6 +8,7 @@ use super::keymap::Action;
 use super::live::Request;
 use super::messages::Level;
 use super::palette::commander_words;
+use super::panes::trace_time::TimeMode;
 use super::screen::Screen;
 use super::source::Control;
 use super::{export, record};
@@ -27,8 +28,8 @@ pub enum CommandError {
     /// `goto` without a frame number.
     #[error("goto: `{0}` is not a frame number")]
     NotAFrame(String),
-    /// `time` without seconds.
-    #[error("time: `{0}` is not seconds")]
+    /// `time` without seconds or a time mode.
+    #[error("time: `{0}` is not seconds nor a time mode (start, absolute, delta, delta-id, mark)")]
     NotSeconds(String),
     /// `speed` without a factor.
     #[error("speed: `{0}` is not a factor from 0.01 to 1000 (0 = as fast as possible)")]
@@ -120,6 +121,11 @@ pub(crate) fn run(line: &str, capture: &mut Capture, screen: &mut Screen, q: &mu
                 }
                 format!("frame {n}")
             }),
+        "time" if TimeMode::from_name(rest).is_some() || rest.is_empty() => {
+            let mode = TimeMode::from_name(rest).unwrap_or_else(|| screen.time_mode().next());
+            screen.set_time_mode(mode);
+            Ok(format!("time column: {}", mode.name()))
+        }
         "time" => rest
             .parse::<f64>()
             .map_err(|_| CommandError::NotSeconds(rest.to_string()))

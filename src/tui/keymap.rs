@@ -92,6 +92,9 @@ actions! {
     Sort = "sort": "Stats: cycle the sort (COB-ID, count, period, last heard)",
     EditObject = "edit_object": "Objects: write the entry (palette prefilled)",
     ReadAll = "read_all": "Objects: read every readable entry (again: stop)",
+    TimeMode = "time_mode": "Trace: next time mode (since start, absolute, delta, delta same COB-ID, from the bookmark)",
+    Bookmark = "bookmark": "Trace: set (or remove) a bookmark on the selected frame",
+    NextBookmark = "next_bookmark": "Trace: jump to the next bookmark (wraps)",
     ShowFrames = "show_frames": "Problems: show the selected incident's frames in the trace (first, then the next at each press)",
 }
 

@@ -4,9 +4,10 @@
 //! new frames are kept; new positions are decoded by a decoder that goes on from where the
 //! last window ended, so following the tail decodes only the new frames.
 
+use super::panes::trace_time::{SAME_ID_BOUND, Stamps};
 use crate::analysis::trace::Trace;
 use crate::decode::{Decoder, Kind};
-use crate::frame::hex;
+use crate::frame::{Flags, hex};
 use std::collections::HashMap;
 
 /// One formatted row.
@@ -14,8 +15,8 @@ use std::collections::HashMap;
 pub struct Row {
     /// Trace position.
     pub pos: usize,
-    /// Time since the first frame, seconds.
-    pub time: f64,
+    /// The timestamps the time column reads in each mode.
+    pub stamps: Stamps,
     /// COB-ID text (`181`, `18FF1234`), `R` suffix for remote frames.
     pub cob: String,
     /// Kind.
@@ -60,7 +61,12 @@ impl RowCache {
             };
             let row = Row {
                 pos,
-                time: f.ts_ns.saturating_sub(t0) as f64 / 1e9,
+                stamps: Stamps {
+                    ts_ns: f.ts_ns,
+                    start_ns: t0,
+                    prev_ns: pos.checked_sub(1).map(|p| trace.store.packed(p).ts_ns),
+                    prev_id_ns: prev_same_id(trace, pos),
+                },
                 cob: if f.is_rtr() { format!("{cob}R") } else { cob },
                 kind: d.kind,
                 node: d.node.map(|n| n.to_string()).unwrap_or_default(),
@@ -76,4 +82,16 @@ impl RowCache {
     pub fn get(&self, pos: usize) -> Option<&Row> {
         self.rows.get(&pos)
     }
+}
+
+/// The timestamp of the frame before `pos` with the same identifier (and frame format),
+/// looking back at most [`SAME_ID_BOUND`] frames.
+fn prev_same_id(trace: &Trace, pos: usize) -> Option<u64> {
+    let this = trace.store.packed(pos);
+    let key = |p: &crate::analysis::store::Packed| (p.id, p.flags & (Flags::EXT | Flags::ERR));
+    (pos.saturating_sub(SAME_ID_BOUND)..pos)
+        .rev()
+        .map(|i| trace.store.packed(i))
+        .find(|p| key(p) == key(this))
+        .map(|p| p.ts_ns)
 }

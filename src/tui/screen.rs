@@ -11,6 +11,7 @@ use super::panes::detail::DetailPane;
 use super::panes::help::HelpPopup;
 use super::panes::messages::MessagesPopup;
 use super::panes::objects::ObjectsPane;
+use super::panes::trace_time::TimeMode;
 use super::panes::{Component, Ctx, Pane, Panes, Selected};
 use super::prompt::{PromptBar, PromptKind};
 use crate::analysis::filter::{Filter, FilterError};
@@ -308,6 +309,16 @@ impl Screen {
         self.panes.trace().selected_position(trace)
     }
 
+    /// What the Trace pane's time column shows.
+    pub(crate) fn time_mode(&self) -> TimeMode {
+        self.panes.trace().time_mode()
+    }
+
+    /// Shows the Trace pane's time column in `mode`.
+    pub(crate) fn set_time_mode(&mut self, mode: TimeMode) {
+        self.panes.trace_mut().set_time_mode(mode);
+    }
+
     /// Shows trace position `pos` in the Trace pane.
     pub(crate) fn select_position(&mut self, trace: &Trace, pos: usize) {
         let page = self.page();
@@ -579,6 +590,11 @@ impl Screen {
             }
             // From another pane: the pane that does it comes to the front and takes it
             // (sorting: the Stats pane; picking, zooming: the Plot pane).
+            Action::TimeMode | Action::Bookmark | Action::NextBookmark => {
+                self.focus = Pane::Trace;
+                let ctx = self.ctx(trace, paused);
+                self.panes.get_mut(self.focus).handle(a, &ctx, q);
+            }
             Action::Sort | Action::PlotPick | Action::ZoomIn | Action::ZoomOut => {
                 self.focus = if a == Action::Sort { Pane::Stats } else { Pane::Plot };
                 let ctx = self.ctx(trace, paused);

@@ -17,6 +17,10 @@ pub const PALETTE_SYNTAX: &[(&str, &str)] = &[
     ("search EXPR", "Search (same language as the filter)"),
     ("goto N", "Frame N (a replay plays or seeks to just after it)"),
     ("time SECONDS", "Time from the first frame (a replay seeks there)"),
+    (
+        "time [MODE]",
+        "Trace time column: start, absolute, delta, delta-id, mark (none: the next)",
+    ),
     ("speed X", "Replay speed: 0 = as fast as possible, else 0.01 to 1000"),
     ("pause", "Pause the capture / replay"),
     ("resume", "Resume it"),

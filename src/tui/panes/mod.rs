@@ -15,6 +15,7 @@ pub mod sdo;
 pub mod stats;
 pub mod status;
 pub mod trace;
+pub mod trace_time;
 
 use crate::analysis::trace::Trace;
 use crate::decode::Kind;

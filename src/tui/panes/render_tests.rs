@@ -967,3 +967,56 @@ fn nodes_and_objects_keep_the_two_node_5s_apart() {
     assert!(s.contains("100") && !s.contains(" 250 "), "{s}");
     insta::assert_snapshot!("two_buses_objects_node_5_on_can0", s);
 }
+
+#[test]
+fn the_time_key_cycles_the_trace_time_modes_shown_in_the_title() {
+    let mut a = app();
+    let _ = screen(&mut a, 170, 14);
+    a.act(Action::Top);
+    for _ in 0..3 {
+        a.act(Action::Down);
+    }
+    a.act(Action::Bookmark);
+    // Frame 4 (0x601 at 7 ms) is marked; the next 0x601 comes 2 ms after it.
+    let expect = [
+        ("start", "    0.007000 601"),
+        ("absolute", "22:13:20.007 601"),
+        ("delta", "   +0.001000 601"),
+        ("delta-id", "   +0.002000 601"),
+        ("mark", "   -0.007000 701"),
+    ];
+    for (i, (mode, cell)) in expect.into_iter().enumerate() {
+        let s = screen(&mut a, 170, 14);
+        assert!(s.contains(&format!("[time: {mode}]")), "{s}");
+        assert!(s.contains(cell), "{mode}: {s}");
+        insta::assert_snapshot!(format!("trace_time_mode_{i}_{mode}"), s);
+        a.act(Action::TimeMode);
+    }
+}
+
+#[test]
+fn bookmarks_are_listed_in_the_title_and_the_jump_key_walks_them_wrapping() {
+    let mut a = app();
+    let _ = screen(&mut a, 170, 14);
+    a.act(Action::Top);
+    a.act(Action::Down);
+    a.act(Action::Bookmark);
+    for _ in 0..4 {
+        a.act(Action::Down);
+    }
+    a.act(Action::Bookmark);
+    a.act(Action::Top);
+    a.act(Action::NextBookmark);
+    assert_eq!(a.selected_position(), Some(1));
+    a.act(Action::NextBookmark);
+    assert_eq!(a.selected_position(), Some(5));
+    a.act(Action::NextBookmark);
+    assert_eq!(a.selected_position(), Some(1), "wraps to the first");
+    let s = screen(&mut a, 170, 14);
+    assert!(s.contains("[marks #2 #6]"), "{s}");
+    insta::assert_snapshot!(s);
+    // Set again on a marked frame: removed.
+    a.act(Action::Bookmark);
+    let s = screen(&mut a, 170, 14);
+    assert!(s.contains("[marks #6]"), "{s}");
+}

@@ -2,6 +2,7 @@
 //! the newest frames while scrolled back. It owns the view (the filter in force), the
 //! search, the selection and follow mode, and the decoded rows of the visible window.
 
+use super::trace_time::{self, TimeMode};
 use super::{Component, Ctx, ListState, block, fit, header, kind_color, selected};
 use crate::analysis::filter::Filter;
 use crate::analysis::trace::Trace;
@@ -14,6 +15,7 @@ use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::{Color, Style};
 use ratatui::text::{Line, Span};
 use ratatui::widgets::Paragraph;
+use std::collections::BTreeSet;
 use std::time::Duration;
 
 /// Rows of the tail strip.
@@ -29,6 +31,13 @@ pub struct TracePane {
     follow: bool,
     /// Decoded rows of the visible window.
     rows: RowCache,
+    /// What the time column shows.
+    time_mode: TimeMode,
+    /// Bookmarked trace positions.
+    marks: BTreeSet<usize>,
+    /// The current bookmark (last set or jumped to) and its timestamp: what the `mark` time
+    /// mode counts from.
+    mark: Option<(usize, u64)>,
 }
 
 impl Default for TracePane {
@@ -38,6 +47,9 @@ impl Default for TracePane {
             list: ListState::default(),
             follow: true,
             rows: RowCache::default(),
+            time_mode: TimeMode::default(),
+            marks: BTreeSet::new(),
+            mark: None,
         }
     }
 }
@@ -72,6 +84,49 @@ impl TracePane {
         let before = self.view.len(trace);
         let more = self.view.advance(trace, budget);
         (more, self.view.len(trace) != before)
+    }
+
+    /// What the time column shows.
+    pub fn time_mode(&self) -> TimeMode {
+        self.time_mode
+    }
+
+    /// Shows the time column in `mode`.
+    pub fn set_time_mode(&mut self, mode: TimeMode) {
+        self.time_mode = mode;
+    }
+
+    /// Bookmarked trace positions, rising.
+    pub fn marks(&self) -> impl Iterator<Item = usize> + '_ {
+        self.marks.iter().copied()
+    }
+
+    /// Sets a bookmark on the selected frame, or removes the one there.
+    fn toggle_mark(&mut self, trace: &Trace) {
+        let Some(pos) = self.selected_position(trace) else {
+            return;
+        };
+        if self.marks.remove(&pos) {
+            if self.mark.is_some_and(|(m, _)| m == pos) {
+                self.mark = self.marks.iter().next().map(|&p| (p, trace.store.packed(p).ts_ns));
+            }
+        } else {
+            self.marks.insert(pos);
+            self.mark = Some((pos, trace.store.packed(pos).ts_ns));
+        }
+    }
+
+    /// Selects the next bookmark after the selected frame (wrapping to the first).
+    fn next_mark(&mut self, trace: &Trace, page: usize) {
+        let from = self.selected_position(trace);
+        let next = from
+            .and_then(|p| self.marks.range(p + 1..).next())
+            .or_else(|| self.marks.iter().next())
+            .copied();
+        if let Some(pos) = next {
+            self.mark = Some((pos, trace.store.packed(pos).ts_ns));
+            self.select_position(trace, pos, page);
+        }
     }
 
     /// Rows in the view.
@@ -164,7 +219,31 @@ impl TracePane {
     }
 
     fn cells(&self, pos: usize, width: u16) -> Vec<Span<'static>> {
-        cells(self.row(pos), pos, width)
+        let time = Time {
+            mode: self.time_mode,
+            mark_ns: self.mark.map(|(_, ns)| ns),
+            marked: self.marks.contains(&pos),
+        };
+        cells(self.row(pos), pos, width, &time)
+    }
+
+    /// The title: follow state, time mode, bookmarks.
+    fn title(&self, paused: bool) -> String {
+        let mut marks: Vec<String> = self.marks.iter().take(6).map(|p| format!("#{}", p + 1)).collect();
+        if self.marks.len() > 6 {
+            marks.push(format!("+{}", self.marks.len() - 6));
+        }
+        format!(
+            " Trace {}{} [time: {}]{} ",
+            if self.follow { "[follow]" } else { "[scrolled]" },
+            if paused { " [paused]" } else { "" },
+            self.time_mode.name(),
+            if marks.is_empty() {
+                String::new()
+            } else {
+                format!(" [marks {}]", marks.join(" "))
+            }
+        )
     }
 }
 
@@ -179,6 +258,18 @@ impl Component for TracePane {
         }
         match action {
             Action::Expand => q.answer(Event::Detail),
+            Action::TimeMode => {
+                self.time_mode = self.time_mode.next();
+                true
+            }
+            Action::Bookmark => {
+                self.toggle_mark(ctx.trace);
+                true
+            }
+            Action::NextBookmark => {
+                self.next_mark(ctx.trace, ctx.page);
+                true
+            }
             _ => false,
         }
     }
@@ -195,11 +286,7 @@ impl Component for TracePane {
 
     /// Draws the pane; [`TracePane::prepare`] must have made the rows.
     fn render(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
-        let title = format!(
-            " Trace {}{} ",
-            if self.follow { "[follow]" } else { "[scrolled]" },
-            if ctx.paused { " [paused]" } else { "" }
-        );
+        let title = self.title(ctx.paused);
         f.render_widget(block(&title, focused), area);
         let inner = block("", true).inner(area);
         if inner.height == 0 {
@@ -250,8 +337,30 @@ fn compact(width: u16) -> bool {
     width < COMPACT_BELOW
 }
 
+/// How the time column reads: the mode, the current bookmark's time, this row is marked.
+struct Time {
+    mode: TimeMode,
+    mark_ns: Option<u64>,
+    marked: bool,
+}
+
+impl Time {
+    /// The time cell of `row`, `width` wide with `decimals`, and a trailing space.
+    fn cell(&self, row: &Row, width: usize, decimals: usize) -> Span<'static> {
+        let text = format!(
+            "{} ",
+            trace_time::format(self.mode, &row.stamps, self.mark_ns, width, decimals)
+        );
+        if self.marked {
+            Span::styled(text, Style::default().fg(Color::Black).bg(Color::Yellow))
+        } else {
+            Span::raw(text)
+        }
+    }
+}
+
 /// The cells of one row: the decoded `row` of trace position `pos`, or just its number.
-fn cells(row: Option<&Row>, pos: usize, width: u16) -> Vec<Span<'static>> {
+fn cells(row: Option<&Row>, pos: usize, width: u16, time: &Time) -> Vec<Span<'static>> {
     let Some(r) = row else {
         return vec![Span::raw(format!("{:>12}", pos + 1))];
     };
@@ -263,7 +372,7 @@ fn cells(row: Option<&Row>, pos: usize, width: u16) -> Vec<Span<'static>> {
             k => k.as_str(),
         };
         let cols = [
-            format!("{:>9.3} ", r.time),
+            time.cell(r, 9, 3).content.into_owned(),
             format!("{:<4} ", r.cob),
             format!("{:<6} ", kind),
             format!("{:>3} ", r.node),
@@ -276,9 +385,9 @@ fn cells(row: Option<&Row>, pos: usize, width: u16) -> Vec<Span<'static>> {
         } else {
             fit(&r.label, label_w)
         };
-        let [time, cob, kind, node, data] = cols;
+        let [_, cob, kind, node, data] = cols;
         return vec![
-            Span::raw(time),
+            time.cell(r, 9, 3),
             Span::styled(cob, Style::default().fg(color)),
             Span::styled(kind, Style::default().fg(color)),
             Span::raw(node),
@@ -296,7 +405,7 @@ fn cells(row: Option<&Row>, pos: usize, width: u16) -> Vec<Span<'static>> {
         label = format!("! {}", fit(&r.label, label_w - 2));
     }
     vec![
-        Span::raw(format!("{:>12.6} ", r.time)),
+        time.cell(r, 12, 6),
         Span::styled(format!("{:<9} ", r.cob), Style::default().fg(color)),
         Span::styled(format!("{:<9} ", r.kind.as_str()), Style::default().fg(color)),
         Span::raw(format!("{:>3} ", r.node)),
