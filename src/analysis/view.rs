@@ -115,6 +115,7 @@ impl View {
         Subject {
             facts,
             t0_ns,
+            iface: trace.ifaces.name(trace.store.packed(pos).iface),
             decoded,
             transfer,
         }

@@ -158,7 +158,8 @@ impl Run {
                     node: d.node,
                 };
                 let (mode, format) = (self.mode, self.format);
-                self.stream.frame(pos, facts, d, &done, |d| {
+                let iface = self.trace.ifaces.name(frame.iface);
+                self.stream.frame(pos, (facts, iface), d, &done, |d| {
                     let mut s = Vec::new();
                     match (mode, format) {
                         (Mode::Summary, _) => return Out::Count(*frame, d.kind, d.node),
@@ -190,7 +191,10 @@ impl Run {
 
     fn transaction(&self, buf: &mut Vec<u8>, t: &crate::sdo::Transaction, t0: u64) {
         let dict = self.trace.decoder().dictionary(t.node);
-        if !self.filter.matches_transaction(t, dict, t0) {
+        if !self
+            .filter
+            .matches_transaction(t, self.trace.ifaces.name(t.iface), dict, t0)
+        {
             return;
         }
         let iface = super::decode::shown_iface(&self.names, t.iface);

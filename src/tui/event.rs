@@ -6,6 +6,7 @@
 use super::keymap::Action;
 use super::messages::Level;
 use crate::command::stop::StopOptions;
+use crate::frame::NodeKey;
 use std::collections::VecDeque;
 
 /// One thing a part of the application asks the others.
@@ -50,12 +51,12 @@ pub(crate) enum Event {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub(crate) enum ObjectRequest {
     /// Read this entry (an SDO upload through the palette).
-    Read { node: u8, index: u16, sub: u8 },
+    Read { node: NodeKey, index: u16, sub: u8 },
     /// Open the palette holding `text`, the cursor at character `cursor`; `note` for the
     /// status line (the value's type and scaling).
     Edit { text: String, cursor: usize, note: String },
     /// Read these entries of `node`, one after the other.
-    ReadAll { node: u8, objects: Vec<(u16, u8)> },
+    ReadAll { node: NodeKey, objects: Vec<(u16, u8)> },
     /// Open the find prompt holding the current text.
     Find(String),
     /// Say this in the status line.

@@ -9,6 +9,7 @@ use super::live::Request;
 use super::messages::Level;
 use super::palette;
 use super::panes::objects::{ObjectsPane, Step, read_line};
+use crate::frame::NodeKey;
 use crate::od::bind::Bindings;
 
 /// True when SDO reads can go out; else says why not (listen-only, or a log: no bus).
@@ -37,10 +38,10 @@ pub(crate) fn read(
     capture: &Capture,
     objects: &mut ObjectsPane,
     bindings: &Bindings,
-    (node, index, sub): (u8, u16, u8),
+    (node, index, sub): (NodeKey, u16, u8),
     q: &mut Queue,
 ) {
-    let line = read_line(node, index, sub);
+    let line = read_line(node.node, index, sub);
     if !can_read(capture, &line, q) {
         return;
     }
@@ -62,10 +63,10 @@ pub(crate) fn start(
     objects_pane: &mut ObjectsPane,
     bindings: &Bindings,
     keymap: &Keymap,
-    (node, objects): (u8, Vec<(u16, u8)>),
+    (node, objects): (NodeKey, Vec<(u16, u8)>),
     q: &mut Queue,
 ) {
-    let what = format!("read all node {node}");
+    let what = format!("read all node {}", node.node);
     if objects.is_empty() {
         q.push(Event::Say(Level::Info, format!("{what}: no readable object known")));
     } else if can_read(capture, &what, q) {

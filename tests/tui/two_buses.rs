@@ -63,3 +63,52 @@ fn two_buses_in_one_session_each_with_its_load_state_and_nodes() {
         "{title}"
     );
 }
+
+/// Enter on a Nodes row filters that node on its own interface: on a log of two buses,
+/// each with a node 5, can1's node 5 shows its three frames and none of can0's.
+#[test]
+fn enter_on_a_node_of_one_bus_filters_that_node_on_that_bus_only() {
+    let dir = std::env::temp_dir().join(format!("cotui-enter-node-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let log = dir.join("two.log");
+    std::fs::write(
+        &log,
+        "(1700000000.000000) can0 705#05\n\
+         (1700000000.100000) can1 705#7F\n\
+         (1700000000.200000) can0 706#05\n\
+         (1700000000.300000) can1 605#4000100000000000\n\
+         (1700000000.400000) can1 585#4300100092010200\n\
+         (1700000000.500000) can0 705#05\n",
+    )
+    .unwrap();
+    let (name, rx) = cotui::cli::open_logs::open(&[log], false, None).unwrap();
+    let trace = Trace::new(Decoder::new(Default::default(), Vec::new()), 500_000);
+    let mut a = App::new(
+        trace,
+        Keymap::default_map(),
+        SourceInfo::new(&name, SourceKind::Open, rx, None),
+    );
+    until(&mut a, "the six frames", |a, _| a.trace().len() == 6);
+    let key = |a: &mut App, c: KeyCode| a.key(KeyEvent::new(c, KeyModifiers::NONE));
+    key(&mut a, KeyCode::Char('2'));
+    // Rows by interface, then node-ID: can0 5, can0 6, can1 5.
+    key(&mut a, KeyCode::Down);
+    key(&mut a, KeyCode::Down);
+    key(&mut a, KeyCode::Enter);
+    until(&mut a, "the filtered view", |a, s| {
+        a.screen().view().scanned() == 6 && s.contains("iface can1 and node 5")
+    });
+    let shown: Vec<(u16, u32)> = a
+        .screen()
+        .view()
+        .positions()
+        .iter()
+        .map(|&p| {
+            let f = a.trace().store.frame(p as usize);
+            (f.iface, f.id)
+        })
+        .collect();
+    let can1 = a.trace().ifaces.find("can1").unwrap();
+    assert_eq!(shown, [(can1, 0x705), (can1, 0x605), (can1, 0x585)]);
+    std::fs::remove_dir_all(&dir).ok();
+}

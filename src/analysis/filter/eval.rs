@@ -80,6 +80,8 @@ pub struct Subject<'a> {
     pub facts: Facts,
     /// Timestamp of the first frame of the capture (for `time`).
     pub t0_ns: u64,
+    /// The name of the frame's interface (for `iface`).
+    pub iface: &'a str,
     /// The decoded frame, when decoded.
     pub decoded: Option<&'a Decoded>,
     /// Its SDO transfer.
@@ -136,6 +138,7 @@ fn term(t: &Term, s: &Subject) -> Tri {
     let f = &s.facts;
     match t {
         Term::Node(lo, hi) => Tri::of(f.node.is_some_and(|n| (*lo..=*hi).contains(&n))),
+        Term::Iface(name) => Tri::of(s.iface == name),
         Term::Kinds(ks) => Tri::of(ks.contains(&f.kind)),
         Term::Id(m) => Tri::of(id_matches(*m, f.id)),
         Term::Tx(tx) => Tri::of(Flags(f.flags).has(Flags::TX) == *tx),
@@ -222,10 +225,11 @@ pub fn needs_transfer(e: &Expr) -> bool {
 
 /// Judges `e` on one SDO transfer (for `cotui decode --transactions`): node, SDO kinds,
 /// COB-IDs of its channel, its start time, object and (typed) value, abort, label text.
-/// Direction and the other kinds never match a transfer.
-pub fn eval_transaction(e: &Expr, t: &Transaction, dict: &Dictionary, t0_ns: u64) -> bool {
+/// Direction and the other kinds never match a transfer. `iface` names its interface.
+pub fn eval_transaction(e: &Expr, t: &Transaction, iface: &str, dict: &Dictionary, t0_ns: u64) -> bool {
     let term = |x: &Term| match x {
         Term::Node(lo, hi) => (*lo..=*hi).contains(&t.node),
+        Term::Iface(name) => iface == name,
         Term::Kinds(ks) => ks.iter().any(|k| is_sdo(*k)),
         Term::Id(m) => id_matches(*m, t.channel.request_cob) || id_matches(*m, t.channel.response_cob),
         Term::Tx(_) => false,

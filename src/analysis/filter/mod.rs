@@ -7,6 +7,7 @@
 //! | condition | matches |
 //! |---|---|
 //! | `node N`, `node=N`, `node 2-5` | frames of node N (decimal, or hex with `0x`), or of a range of nodes |
+//! | `iface NAME`, `iface=NAME` | frames of the interface so named (`iface can1 and node 5`: node 5 of can1) |
 //! | `kind K`, `kind=K`, or just `K` | frames of kind K (`nmt sync emcy time tpdo rpdo pdo sdo sdo_tx sdo_rx heartbeat hb lss error other`) |
 //! | `id 181`, `id 700-77f`, `id 180/780` | COB-ID (hex), a range, or a mask (`id & 780 == 180`) |
 //! | `tx`, `rx` | frames cotui sent (candump's `T`), frames received |
@@ -188,11 +189,11 @@ impl Filter {
         }
     }
 
-    /// Judges one SDO transfer (`t0_ns`: the first frame's time).
-    pub fn matches_transaction(&self, t: &Transaction, dict: &Dictionary, t0_ns: u64) -> bool {
+    /// Judges one SDO transfer of interface `iface` (`t0_ns`: the first frame's time).
+    pub fn matches_transaction(&self, t: &Transaction, iface: &str, dict: &Dictionary, t0_ns: u64) -> bool {
         self.expr
             .as_ref()
-            .is_none_or(|e| eval::eval_transaction(e, t, dict, t0_ns))
+            .is_none_or(|e| eval::eval_transaction(e, t, iface, dict, t0_ns))
     }
 }
 

@@ -64,6 +64,8 @@ impl CodePrefix {
 pub enum Term {
     /// Frames of nodes `lo..=hi`.
     Node(u8, u8),
+    /// Frames of the interface so named (`iface can1`).
+    Iface(String),
     /// Frames of any of these kinds.
     Kinds(Vec<Kind>),
     /// Frames whose COB-ID matches.
@@ -113,8 +115,8 @@ pub fn kinds(word: &str) -> Option<Vec<Kind>> {
 const MAX_DEPTH: usize = 64;
 
 /// Words that start a condition of their own, never an object name.
-const KEYWORDS: [&str; 11] = [
-    "node", "kind", "id", "tx", "rx", "time", "abort", "aborts", "and", "or", "not",
+const KEYWORDS: [&str; 12] = [
+    "node", "iface", "kind", "id", "tx", "rx", "time", "abort", "aborts", "and", "or", "not",
 ];
 
 /// Words a multi-word object name may have.
@@ -379,6 +381,7 @@ impl<'a> Parser<'a> {
                     _ => Err(bad()),
                 }
             }
+            "iface" => Ok(Term::Iface(self.value(&t, "an interface name")?.1)),
             "kind" => {
                 let (c, v) = self.value(&t, "a kind")?;
                 kinds(&v).map(Term::Kinds).ok_or_else(|| {

@@ -13,7 +13,7 @@ use std::collections::{HashMap, VecDeque};
 struct Entry<T> {
     pos: u64,
     out: Option<T>,
-    waiting: Option<(Facts, Decoded)>,
+    waiting: Option<(Facts, Decoded, String)>,
 }
 
 /// The filter over a stream; `T` is what a matching frame gives (e.g. its output line).
@@ -34,12 +34,12 @@ impl<T> Stream<T> {
     }
 
     /// Takes the frame at position `pos` (0-based, the decoder's sequence numbers minus
-    /// one), decoded as `d`; `completed` are the transfers its decoding completed. `out`
+    /// one), with what the store keeps of it and its interface's name, decoded as `d`; `completed` are the transfers its decoding completed. `out`
     /// makes what a match gives (called only for frames that match or may match).
     pub fn frame(
         &mut self,
         pos: u64,
-        facts: Facts,
+        (facts, iface): (Facts, &str),
         d: Decoded,
         completed: &[Transaction],
         out: impl FnOnce(&Decoded) -> T,
@@ -68,6 +68,7 @@ impl<T> Stream<T> {
         let subject = |decoded| Subject {
             facts,
             t0_ns: t0,
+            iface,
             decoded,
             transfer,
         };
@@ -84,7 +85,7 @@ impl<T> Stream<T> {
                 Tri::True => entry.out = Some(out(&d)),
                 Tri::Unknown => {
                     entry.out = Some(out(&d));
-                    entry.waiting = Some((facts, d));
+                    entry.waiting = Some((facts, d, iface.to_string()));
                 }
             },
         }
@@ -116,10 +117,11 @@ impl<T> Stream<T> {
 
 /// Judges a waiting entry now that its transfer is known.
 fn judge<T>(filter: &Filter, e: &mut Entry<T>, t0_ns: u64, transfer: Transfer) {
-    let Some((facts, d)) = &e.waiting else { return };
+    let Some((facts, d, iface)) = &e.waiting else { return };
     let s = Subject {
         facts: *facts,
         t0_ns,
+        iface,
         decoded: Some(d),
         transfer,
     };
@@ -174,7 +176,7 @@ mod tests {
                     kind: d.kind,
                     node: d.node,
                 };
-                s.frame(i as u64, facts, d, &done, |_| i as u64);
+                s.frame(i as u64, (facts, ""), d, &done, |_| i as u64);
                 got.extend(s.ready());
             }
             got.extend(s.finish());

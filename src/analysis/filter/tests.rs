@@ -283,12 +283,14 @@ fn matches(text: &str, frames: &[Frame]) -> Vec<usize> {
             let cheap = f.eval(&Subject {
                 facts,
                 t0_ns: t0,
+                iface: IFACES[usize::from(frames[i].iface)],
                 decoded: None,
                 transfer: Transfer::Unknown,
             });
             let full = f.eval(&Subject {
                 facts,
                 t0_ns: t0,
+                iface: IFACES[usize::from(frames[i].iface)],
                 decoded: Some(d),
                 transfer: Transfer::Known(of.get(&i).map(|&k| &txs[k])),
             });
@@ -327,6 +329,52 @@ fn capture() -> Vec<Frame> {
     ours.flags.set(Flags::TX, true);
     v.push(ours); // 14
     v
+}
+
+/// The interface names of the test captures (`Frame::iface` indexes it).
+const IFACES: [&str; 2] = ["can0", "can1"];
+
+#[test]
+fn iface_picks_the_frames_of_one_interface() {
+    assert_eq!(parse("iface can1"), term(Term::Iface("can1".into())));
+    assert_eq!(parse("iface=vcan0"), term(Term::Iface("vcan0".into())));
+    assert_eq!(err("node 5 iface"), "column 13: `iface` needs an interface name");
+    // Node 5 on both buses: a heartbeat and an SDO read on each.
+    let mut c = Vec::new();
+    for (k, (iface, id, data)) in [
+        (0u16, 0x705, &[0x05][..]),
+        (1, 0x705, &[0x7F][..]),
+        (1, 0x605, &[0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0][..]),
+        (1, 0x585, &[0x43, 0x00, 0x10, 0x00, 0x92, 0x01, 0x02, 0x00][..]),
+        (0, 0x706, &[0x05][..]),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut f = Frame::classic(id, data);
+        f.iface = iface;
+        f.ts_ns = 1_000 + k as u64;
+        c.push(f);
+    }
+    assert_eq!(matches("iface can1 and node 5", &c), [1, 2, 3]);
+    assert_eq!(matches("iface can0 node 5", &c), [0]);
+    assert_eq!(matches("node 5 not iface can1", &c), [0]);
+    assert_eq!(matches("iface can9", &c), Vec::<usize>::new());
+    // A transfer is judged by its own interface.
+    let mut dec = decoder();
+    let mut txs = Vec::new();
+    for (i, fr) in c.iter().enumerate() {
+        dec.set_seq(i as u64);
+        dec.decode(fr);
+        txs.extend(dec.take_transactions());
+    }
+    assert_eq!(txs.len(), 1);
+    let on = |text: &str| {
+        let f = Filter::parse(text).unwrap();
+        f.matches_transaction(&txs[0], IFACES[usize::from(txs[0].iface)], dec.dictionary(5), 0)
+    };
+    assert!(on("iface can1 node 5"));
+    assert!(!on("iface can0"));
 }
 
 #[test]
@@ -384,7 +432,7 @@ fn transactions_are_judged_by_their_object_value_and_outcome() {
     let pick = |text: &str| -> Vec<(u16, u8)> {
         let f = Filter::parse_with(text, &dec).unwrap();
         txs.iter()
-            .filter(|t| f.matches_transaction(t, dec.dictionary(t.node), c[0].ts_ns))
+            .filter(|t| f.matches_transaction(t, IFACES[usize::from(t.iface)], dec.dictionary(t.node), c[0].ts_ns))
             .map(|t| (t.index, t.node))
             .collect()
     };

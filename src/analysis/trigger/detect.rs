@@ -144,7 +144,8 @@ impl Detector {
                         kind: d.kind,
                         node: d.node,
                     };
-                    j.stream.frame(pos, facts, d, &done, |_| f.ts_ns);
+                    j.stream
+                        .frame(pos, (facts, j.trace.ifaces.name(f.iface)), d, &done, |_| f.ts_ns);
                 }
                 found.extend(j.stream.ready().into_iter().map(|_| (i, words.clone())));
             }

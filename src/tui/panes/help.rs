@@ -53,6 +53,10 @@ pub const PALETTE_SYNTAX: &[(&str, &str)] = &[
 const FILTER_SYNTAX: &[(&str, &str)] = &[
     ("node 3, node 2-5", "frames of a node, of a range of nodes"),
     (
+        "iface can1",
+        "frames of one interface (iface can1 node 5: node 5 of can1)",
+    ),
+    (
         "sdo, kind hb",
         "frames of a kind (nmt sync emcy time tpdo rpdo pdo sdo hb lss ...)",
     ),

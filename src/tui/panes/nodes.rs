@@ -176,7 +176,8 @@ impl NodesPane {
 }
 
 impl Component for NodesPane {
-    /// Moves the selection; `expand` shows the selected node's frames in the trace.
+    /// Moves the selection; `expand` shows the selected node's frames in the trace (of its
+    /// own interface when there are several).
     fn handle(&mut self, action: Action, ctx: &Ctx, q: &mut Queue) -> bool {
         if let Some(delta) = ListState::movement(action, ctx.page) {
             self.scroll(delta, ctx);
@@ -184,6 +185,12 @@ impl Component for NodesPane {
         }
         match action {
             Action::Expand => match ctx.trace.nodes.iter().nth(self.list.selected) {
+                // Several interfaces: that node on its own bus only.
+                Some((n, _)) if ctx.trace.ifaces.names().len() > 1 => q.answer(Event::Filter(format!(
+                    "iface {} and node {}",
+                    ctx.trace.ifaces.name(n.iface),
+                    n.node
+                ))),
                 Some((n, _)) => q.answer(Event::Filter(format!("node {}", n.node))),
                 None => true,
             },

@@ -175,8 +175,8 @@ fn matches(query: &str, index: u16, sub: Option<u8>, name: &str, alias: Option<&
 /// A read-all in progress.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct ReadAll {
-    /// The node read.
-    node: u8,
+    /// The node read (on its interface).
+    node: NodeKey,
     /// Entries still to read.
     queue: VecDeque<(u16, u8)>,
     /// The line sent and waiting for its result.
@@ -260,10 +260,10 @@ pub struct ObjectsPane {
     /// The read-all in progress.
     read_all: Option<ReadAll>,
     /// Single reads sent and not answered yet: line -> (node, index, sub).
-    reading: BTreeMap<String, (u8, u16, u8)>,
-    /// The last failure of a read the pane sent, per (node, index, sub), with the capture
-    /// time it was told (a value seen after it shows instead).
-    errors: BTreeMap<(u8, u16, u8), (String, u64)>,
+    reading: BTreeMap<String, (NodeKey, u16, u8)>,
+    /// The last failure of a read the pane sent, per (node on its interface, index, sub),
+    /// with the capture time it was told (a value seen after it shows instead).
+    errors: BTreeMap<(NodeKey, u16, u8), (String, u64)>,
 }
 
 impl ObjectsPane {
@@ -513,13 +513,13 @@ impl ObjectsPane {
     }
 
     /// Notes a single read sent for (node, index, sub) by `line`.
-    pub fn sent(&mut self, line: &str, node: u8, index: u16, sub: u8) {
+    pub fn sent(&mut self, line: &str, node: NodeKey, index: u16, sub: u8) {
         self.errors.remove(&(node, index, sub));
         self.reading.insert(line.to_string(), (node, index, sub));
     }
 
     /// Starts reading `objects` of `node`; the first line to send.
-    pub fn start_read_all(&mut self, node: u8, objects: Vec<(u16, u8)>) -> Step {
+    pub fn start_read_all(&mut self, node: NodeKey, objects: Vec<(u16, u8)>) -> Step {
         self.read_all = Some(ReadAll {
             node,
             total: objects.len(),
@@ -534,7 +534,7 @@ impl ObjectsPane {
         let r = self.read_all.take()?;
         Some(format!(
             "read all node {}: stopped after {} of {} entries ({} not present, {} failed)",
-            r.node,
+            r.node.node,
             r.done + r.skipped,
             r.total,
             r.not_present,
@@ -549,7 +549,7 @@ impl ObjectsPane {
         };
         match r.queue.pop_front() {
             Some((i, s)) => {
-                let line = read_line(r.node, i, s);
+                let line = read_line(r.node.node, i, s);
                 r.current = Some((line.clone(), (i, s)));
                 Step::Next(line)
             }
@@ -557,7 +557,7 @@ impl ObjectsPane {
                 let r = self.read_all.take().unwrap_or_default();
                 let mut text = format!(
                     "read all node {}: {} entries read, {} not present, {} failed",
-                    r.node,
+                    r.node.node,
                     r.done - r.failed.len() - r.not_present,
                     r.not_present,
                     r.failed.len()
@@ -624,7 +624,7 @@ impl ObjectsPane {
             Row::Entry { index, sub, child } => {
                 let info = dict.object(index, sub);
                 let entry = ctx.trace.values.get(key, index, sub);
-                let (value, style) = self.value_cell(node, index, sub, entry, dict);
+                let (value, style) = self.value_cell(key, index, sub, entry, dict);
                 let age = entry
                     .and_then(|e| e.last.as_ref())
                     .map(|s| age(ctx.trace.nodes.now_ns().saturating_sub(s.ts_ns)))
@@ -659,7 +659,7 @@ impl ObjectsPane {
 
     /// The value cell: the pane's read failure, the last failure seen after the last
     /// value, or the last value's text.
-    fn value_cell(&self, node: u8, index: u16, sub: u8, e: Option<&Entry>, dict: &Dictionary) -> (String, Style) {
+    fn value_cell(&self, node: NodeKey, index: u16, sub: u8, e: Option<&Entry>, dict: &Dictionary) -> (String, Style) {
         let red = Style::default().fg(Color::LightRed);
         if let Some((why, at)) = self.errors.get(&(node, index, sub))
             && e.and_then(|e| e.last.as_ref()).is_none_or(|s| s.ts_ns <= *at)
@@ -686,7 +686,6 @@ fn in_range(layers: &[Arc<Profile>], index: u16) -> bool {
         .any(|l| l.ranges.iter().any(|r| (r.first..=r.last).contains(&index)))
 }
 
-/// What went wrong, when a command result says so (`error: ...`, `not sent: ...`).
 /// The abort code of a failure text (`... aborted by the server: 0x06020000 ...`): its
 /// first `0x` with eight hex digits.
 fn abort_code(why: &str) -> Option<u32> {
@@ -696,6 +695,7 @@ fn abort_code(why: &str) -> Option<u32> {
         .and_then(|h| u32::from_str_radix(h, 16).ok())
 }
 
+/// What went wrong, when a command result says so (`error: ...`, `not sent: ...`).
 fn failure(rest: &str) -> Option<&str> {
     rest.strip_prefix("error: ")
         .or_else(|| rest.starts_with("not sent").then_some(rest))
@@ -821,7 +821,7 @@ impl Component for ObjectsPane {
                     if dict.object(index, sub).is_some_and(|o| o.access == Access::Wo) {
                         return note(q, &format!("0x{index:04X}:{sub:02X} is write-only: it cannot be read"));
                     }
-                    q.answer(Event::Object(ObjectRequest::Read { node, index, sub }))
+                    q.answer(Event::Object(ObjectRequest::Read { node: key, index, sub }))
                 }
                 None => true,
             },
@@ -832,7 +832,7 @@ impl Component for ObjectsPane {
             Action::ReadAll => match self.stop_read_all() {
                 Some(summary) => note(q, &summary),
                 None => q.answer(Event::Object(ObjectRequest::ReadAll {
-                    node,
+                    node: key,
                     objects: self.readable(dict),
                 })),
             },
@@ -961,7 +961,7 @@ mod tests {
     #[test]
     fn a_read_all_goes_on_result_by_result_and_sums_up_failures() {
         let mut p = ObjectsPane::default();
-        let first = p.start_read_all(2, vec![(0x1000, 0), (0x1008, 0), (0x6041, 0)]);
+        let first = p.start_read_all(NodeKey::new(0, 2), vec![(0x1000, 0), (0x1008, 0), (0x6041, 0)]);
         assert_eq!(first, Step::Next("sdo read 2 0x1000:0x00".into()));
         // Someone else's result changes nothing.
         assert_eq!(p.result("nmt start 2: NMT start sent to node 2", 0), Step::NotOurs);
@@ -992,13 +992,13 @@ mod tests {
         );
         assert!(p.read_all.is_none());
         assert_eq!(
-            p.errors.get(&(2, 0x1008, 0)).map(|(e, _)| e.as_str()),
+            p.errors.get(&(NodeKey::new(0, 2), 0x1008, 0)).map(|(e, _)| e.as_str()),
             Some(
                 "SDO 1008:00 on node 2 aborted by the server: 0x06020000 Object does not exist in the object dictionary"
             )
         );
         // Stopped half-way: a summary, and later results are no longer ours.
-        p.start_read_all(3, vec![(0x1000, 0), (0x1001, 0)]);
+        p.start_read_all(NodeKey::new(0, 3), vec![(0x1000, 0), (0x1001, 0)]);
         assert_eq!(
             p.stop_read_all().as_deref(),
             Some("read all node 3: stopped after 0 of 2 entries (0 not present, 0 failed)")
@@ -1013,7 +1013,7 @@ mod tests {
             (0x1010, 0),
             (0x1010, 1),
         ];
-        p.start_read_all(2, all);
+        p.start_read_all(NodeKey::new(0, 2), all);
         assert_eq!(
             p.result(
                 "sdo read 2 0x1003:0x00: node 2 0x1003:00 Number of errors = 1 (data 01)",
@@ -1035,6 +1035,30 @@ mod tests {
                     .into()
             )
         );
+    }
+
+    #[test]
+    fn read_errors_are_kept_per_interface() {
+        let (can0, can1) = (NodeKey::new(0, 5), NodeKey::new(1, 5));
+        let line = read_line(5, 0x1008, 0);
+        let mut p = ObjectsPane::default();
+        p.sent(&line, can1, 0x1008, 0);
+        assert_eq!(p.result(&format!("{line}: error: SDO timeout"), 7), Step::Noted);
+        // Node 5 of can0 reads the same entry fine: can1's node 5 keeps its error.
+        p.sent(&line, can0, 0x1008, 0);
+        assert_eq!(
+            p.result(&format!("{line}: node 5 0x1008:00 Device name = \"x\""), 8),
+            Step::Noted
+        );
+        let dict = Dictionary::default();
+        let cell = |p: &ObjectsPane, k| p.value_cell(k, 0x1008, 0, None, &dict).0;
+        assert_eq!(cell(&p, can1), "✗ SDO timeout");
+        assert_eq!(cell(&p, can0), "");
+        // A read-all of can0's node 5 that fails leaves can1's error as it was.
+        p.start_read_all(can0, vec![(0x1008, 0)]);
+        p.result(&format!("{line}: error: SDO abort 0x08000000: General error"), 9);
+        assert_eq!(cell(&p, can0), "✗ SDO abort 0x08000000: General error");
+        assert_eq!(cell(&p, can1), "✗ SDO timeout");
     }
 
     /// The test capture with node 1 bound to the aimotor profile (CiA 402, CiA 301 below it)
