@@ -1185,10 +1185,11 @@ wait "$rec"
 kill "$served" 2> /dev/null
 wait "$served" 2> /dev/null
 # ---- 19 trigger: record --trigger's window equals candump's frames in it ----------------
-# cotui sim with one drive; candump -l records everything; cotui record --trigger emcy keeps
-# 2 s before and 1 s after; the drive is faulted on cotui sim's stdin. The window file must
-# hold exactly candump's frames inside [start, end] of its sidecar: none lost between the
-# ring and the file.
+# cotui sim with one drive; cangen adds 200 frames/s (0x380, no CANopen node's object) so the
+# window holds hundreds of frames; candump -L records everything; cotui record --trigger emcy
+# keeps 2 s before and 1 s after; the drive is faulted on cotui sim's stdin. The window file
+# must hold exactly candump's frames inside [start, end] of its sidecar: none lost between
+# the ring and the file.
 rm -rf trigwin; mkfifo trig.in
 "$cotui" sim vcan0 --node 2=aimotor < trig.in > trigsim.out 2>&1 &
 trigsim=$!
@@ -1201,10 +1202,13 @@ wait_socket $trigdump
 "$cotui" record vcan0 --listen-only --trigger emcy --pre 2s --post 1s --count 1 -o trigwin > trigrec.out 2>&1 &
 trigrec=$!
 wait_socket $trigrec
+cangen vcan0 -g 5 -I 380 -L 8 -D i &
+trigload=$!
 sleep 3
 echo "fault 2 0x2310" >&8
 for _ in $(seq 100); do kill -0 $trigrec 2> /dev/null || break; sleep 0.1; done
 wait $trigrec; trig_rc=$?
+kill $trigload; wait $trigload 2> /dev/null
 sleep 0.2; kill $trigdump; wait $trigdump 2> /dev/null
 exec 8>&-; kill -TERM $trigsim; wait $trigsim
 side=$(ls trigwin/*.json 2> /dev/null | head -1)
@@ -1215,7 +1219,7 @@ if [ "$trig_rc" = 0 ] && [ -n "$side" ]; then
     n=$(wc -l < trig_got.txt)
     [ "$n" -gt 20 ] && cmp -s trig_want.txt trig_got.txt && [ "$(jq .frames "$side")" = "$n" ] &&
         ok "trigger: cotui record vcan0 --trigger emcy: the window ($n frames) equals candump's frames in [$start, $end]" ||
-        bad "trigger: window differs from candump's: $(diff trig_want.txt trig_got.txt | head -5)"
+        bad "trigger: window of $n frames (sidecar: $(jq .frames "$side")) differs from candump's $(wc -l < trig_want.txt) in [$start, $end]: $(diff trig_want.txt trig_got.txt | head -5)"
 else
     bad "trigger: record --trigger rc=$trig_rc, no window: $(cat trigrec.out)"
 fi
