@@ -13,6 +13,7 @@
 use super::state::{Action, BusState, StateChange, SysLink, decide};
 use super::{Bus, BusError, Carried, Item, QUEUE_DEPTH, Sender};
 use crate::decode::error_frame::controller_state;
+use crate::frame::linux::{CAN_EFF_FLAG, CAN_EFF_MASK, CAN_ERR_FLAG, CAN_RTR_FLAG, CANFD_BRS, CANFD_ESI, CANFD_FDF};
 use crate::frame::{Flags, Frame};
 use socketcan::{CanFdSocket, Socket as _, SocketOptions};
 use std::io;
@@ -24,16 +25,10 @@ use tokio::io::Interest;
 use tokio::io::unix::AsyncFd;
 use tokio::sync::{broadcast, mpsc, oneshot};
 
-const CAN_EFF_FLAG: u32 = 0x8000_0000;
-const CAN_RTR_FLAG: u32 = 0x4000_0000;
-const CAN_ERR_FLAG: u32 = 0x2000_0000;
-const CAN_EFF_MASK: u32 = 0x1FFF_FFFF;
-const CAN_ERR_MASK: u32 = 0x1FFF_FFFF;
+/// `CAN_ERR_MASK`: the error class bits of an error frame's identifier.
+const CAN_ERR_MASK: u32 = CAN_EFF_MASK;
 /// All error classes (`CAN_ERR_MASK`).
-const ERR_MASK_ALL: u32 = 0x1FFF_FFFF;
-const CANFD_BRS: u8 = 0x01;
-const CANFD_ESI: u8 = 0x02;
-const CANFD_FDF: u8 = 0x04;
+const ERR_MASK_ALL: u32 = CAN_ERR_MASK;
 /// Size of `struct can_frame`.
 pub const CAN_MTU: usize = 16;
 /// Size of `struct canfd_frame`.

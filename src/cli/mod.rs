@@ -1,6 +1,7 @@
 //! The command line: clap definitions and one module per subcommand.
 
 pub mod bind;
+pub mod bus_run;
 pub mod commander;
 pub mod decode;
 mod decode_filter;

@@ -5,7 +5,7 @@
 //! loses at most that much. Gaps (interface down or gone, bus-off) are reported on stderr as
 //! they happen and make the exit status 2.
 
-use super::commander::{BusArgs, Stream, report_to};
+use super::bus_run::{BusArgs, Stream, report_to};
 use crate::command::record::{LogFormat, Record, Recorded, open_output, record};
 use crate::command::{CommandError, ExitCode};
 use std::io::Write;

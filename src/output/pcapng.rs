@@ -21,23 +21,12 @@
 //! [`PcapngWriter`] writes incrementally (header, then frame by frame, flush), so a
 //! recorder can stream into it; the block builders are pure functions of their inputs.
 
+use crate::frame::linux::{CAN_EFF_FLAG, CAN_ERR_FLAG, CAN_RTR_FLAG, CANFD_BRS, CANFD_ESI, CANFD_FDF};
 use crate::frame::{Flags, Frame};
 use std::io::{self, Write};
 
 /// `LINKTYPE_CAN_SOCKETCAN`.
 pub const LINKTYPE_CAN_SOCKETCAN: u16 = 227;
-/// `CAN_EFF_FLAG`: 29-bit identifier.
-pub const CAN_EFF_FLAG: u32 = 0x8000_0000;
-/// `CAN_RTR_FLAG`: remote transmission request.
-pub const CAN_RTR_FLAG: u32 = 0x4000_0000;
-/// `CAN_ERR_FLAG`: error frame.
-pub const CAN_ERR_FLAG: u32 = 0x2000_0000;
-/// `CANFD_BRS`: bit rate switch.
-pub const CANFD_BRS: u8 = 0x01;
-/// `CANFD_ESI`: error state indicator.
-pub const CANFD_ESI: u8 = 0x02;
-/// `CANFD_FDF`: this is a CAN FD frame.
-pub const CANFD_FDF: u8 = 0x04;
 
 const SHB: u32 = 0x0A0D_0D0A;
 const IDB: u32 = 0x0000_0001;

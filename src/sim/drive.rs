@@ -12,7 +12,8 @@
 //! Pure: frames and the current time in, frames out.
 
 use super::od::DeviceObjects;
-use super::profile::{self, Kind};
+use super::profile;
+use super::vendor::Kind;
 use super::vendor::Vendor;
 use crate::cob;
 use crate::decode::cia402::DriveState;

@@ -3,18 +3,8 @@
 //! built-in profile the drive is modelled after, with its default PDO set.
 
 use super::od::DeviceObjects;
+use super::vendor::{Kind, PdoDefault, fill_pdos, init_objects};
 use crate::od::{Access, DataType};
-
-/// How a simulated drive behaves: which objects it acts on.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Kind {
-    /// A CiA 402 drive: state machine, modes of operation (AIMOTOR, Syn-tron, servo).
-    Cia402,
-    /// The Dexmart DEV dual-motor controller: Multi-Drive RPDO commands per motor (M1/M2).
-    Dexmart,
-    /// The AQMD DC motor driver: control command, target speed, direction, position.
-    Aqmd,
-}
 
 /// The drive models `--node NODE=MODEL` accepts (`cotui sim`, `cotui demo`): the built-in
 /// device profiles plus `servo`, a plain CiA 402 drive.
@@ -217,7 +207,7 @@ pub fn drive_objects(node: u8, p: DriveProfile) -> DeviceObjects {
         s.add(0x1011, 0, "Highest sub-index supported", U8, Const, 1);
         s.add(0x1011, 1, "Restore all default parameters", U32, Rw, 1);
     }
-    super::vendor::init_objects(p.kind, &mut s);
+    init_objects(p.kind, &mut s);
     s
 }
 
@@ -241,9 +231,6 @@ fn add_cia402_objects(s: &mut DeviceObjects) {
     s.add(0x6502, 0, "Supported drive modes", U32, Ro, 0b11_1010_1101);
 }
 
-/// One PDO's start-up mapping (entries as in 0x1600/0x1A00) and transmission type.
-type PdoDefault = (Vec<u32>, u8);
-
 /// The PDOs a drive starts with (RPDO1..4, TPDO1..4). CiA 402 drives: RPDO1 controlword +
 /// target velocity, TPDO1 statusword + mode display, TPDO2 position + velocity, both on
 /// every SYNC. The others: the default PDO set of their profile.
@@ -264,20 +251,6 @@ fn default_pdos(p: &DriveProfile) -> ([PdoDefault; 4], [PdoDefault; 4]) {
         fill_pdos(&mut tpdo, &set.tpdo);
     }
     (rpdo, tpdo)
-}
-
-/// The templates of a profile's PDO set as start-up mappings (PDOs 1..4).
-pub(super) fn fill_pdos(out: &mut [PdoDefault; 4], set: &std::collections::BTreeMap<u8, crate::od::PdoTemplate>) {
-    for (n, t) in set {
-        if let Some(slot) = (*n as usize).checked_sub(1).and_then(|i| out.get_mut(i)) {
-            let entries = t
-                .entries
-                .iter()
-                .map(|e| (e.index as u32) << 16 | (e.sub as u32) << 8 | e.bits as u32)
-                .collect();
-            *slot = (entries, t.transmission_type.unwrap_or(0xFF));
-        }
-    }
 }
 
 /// Adds the objects of built-in profile `name` and of the profiles it extends (not CiA 301:

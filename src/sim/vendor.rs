@@ -8,7 +8,17 @@
 //! Pure: the objects and elapsed time in, objects changed.
 
 use super::od::DeviceObjects;
-use super::profile::Kind;
+
+/// How a simulated drive behaves: which objects it acts on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// A CiA 402 drive: state machine, modes of operation (AIMOTOR, Syn-tron, servo).
+    Cia402,
+    /// The Dexmart DEV dual-motor controller: Multi-Drive RPDO commands per motor (M1/M2).
+    Dexmart,
+    /// The AQMD DC motor driver: control command, target speed, direction, position.
+    Aqmd,
+}
 
 /// Dexmart 09-26 CANopen PDO Mapping (mapping set 0 or 1).
 const DEX_MAPPING: (u16, u8) = (0x3009, 26);
@@ -229,6 +239,23 @@ fn aqmd_command(motor: &mut Motor, od: &DeviceObjects, faulted: bool) {
     };
 }
 
+/// One PDO's start-up mapping (entries as in 0x1600/0x1A00) and transmission type.
+pub(super) type PdoDefault = (Vec<u32>, u8);
+
+/// The templates of a profile's PDO set as start-up mappings (PDOs 1..4).
+pub(super) fn fill_pdos(out: &mut [PdoDefault; 4], set: &std::collections::BTreeMap<u8, crate::od::PdoTemplate>) {
+    for (n, t) in set {
+        if let Some(slot) = (*n as usize).checked_sub(1).and_then(|i| out.get_mut(i)) {
+            let entries = t
+                .entries
+                .iter()
+                .map(|e| (e.index as u32) << 16 | (e.sub as u32) << 8 | e.bits as u32)
+                .collect();
+            *slot = (entries, t.transmission_type.unwrap_or(0xFF));
+        }
+    }
+}
+
 /// Writes the PDO mapping of Dexmart mapping set `set` (09-26) into 0x1600.. and 0x1A00..
 fn select_mapping_set(od: &mut DeviceObjects, dictionary: &str, set: i64) {
     let Some(Ok((profile, _))) = crate::od::bind::shared_builtin(dictionary) else {
@@ -242,8 +269,8 @@ fn select_mapping_set(od: &mut DeviceObjects, dictionary: &str, set: i64) {
         return;
     };
     for (map, templates) in [(0x1600u16, &chosen.rpdo), (0x1A00, &chosen.tpdo)] {
-        let mut pdos: [(Vec<u32>, u8); 4] = std::array::from_fn(|_| (Vec::new(), 0xFF));
-        super::profile::fill_pdos(&mut pdos, templates);
+        let mut pdos: [PdoDefault; 4] = std::array::from_fn(|_| (Vec::new(), 0xFF));
+        fill_pdos(&mut pdos, templates);
         for (k, (entries, _)) in pdos.iter().enumerate() {
             let map = map + k as u16;
             od.set_int(map, 0, entries.len() as i64);

@@ -55,38 +55,15 @@ pub enum CommandError {
     /// `plot` of an object with no numeric value seen.
     #[error("plot: no numeric values of node {node} 0x{index:04X}:{sub:02X} seen")]
     NoSeries { node: u8, index: u16, sub: u8 },
-    /// `export --format` without a format.
-    #[error("export: --format needs candump, jsonl or pcapng")]
-    FormatMissing,
-    /// `export --format` with an unknown format.
-    #[error("export: {0}")]
-    Format(#[from] super::export::UnknownFormat),
-    /// `export` with an unknown option.
-    #[error("export: unknown option `{0}`")]
-    ExportOption(String),
-    /// `export` with more than one file.
-    #[error("export: one FILE only (`{0}` is extra)")]
-    ExtraFile(String),
-    /// `export` without a file.
-    #[error("export: usage `export FILE [--format candump|jsonl|pcapng] [--force]`")]
-    ExportUsage,
-    /// The export file could not be written.
-    #[error("export: {file}: {source}{hint}", hint = overwrite_hint(source))]
-    Export { file: String, source: std::io::Error },
+    /// `export` failed (its words, or writing the file).
+    #[error(transparent)]
+    Export(#[from] super::export::ExportError),
     /// A word that is no command.
     #[error("unknown command `{0}` (commands: {palette} {commander})", palette = PALETTE_COMMANDS.join(" "), commander = commander_words().join(" "))]
     Unknown(String),
 }
 
 /// What to add to an export error: how to overwrite an existing file.
-fn overwrite_hint(e: &std::io::Error) -> &'static str {
-    if e.kind() == std::io::ErrorKind::AlreadyExists {
-        " (add --force to overwrite)"
-    } else {
-        ""
-    }
-}
-
 /// What [`run`] made of a palette line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Ran {
@@ -153,7 +130,9 @@ pub(crate) fn run(line: &str, capture: &mut Capture, screen: &mut Screen, q: &mu
             screen.show_help();
             Ok(String::new())
         }
-        "export" => export::command(rest, capture.trace(), screen.view()).inspect(|text| screen.log(Level::Info, text)),
+        "export" => export::command(rest, capture.trace(), screen.view())
+            .map_err(CommandError::from)
+            .inspect(|text| screen.log(Level::Info, text)),
         "messages" => {
             screen.log_popup_mut().open();
             Ok(String::new())
@@ -171,7 +150,7 @@ pub(crate) fn run(line: &str, capture: &mut Capture, screen: &mut Screen, q: &mu
             return Ran::Done;
         }
         "record" => {
-            record::command(capture, rest, q);
+            record::command(capture.has_bus(), capture.recording_mut(), rest, q);
             return Ran::Done;
         }
         "sim" => {

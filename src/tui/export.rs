@@ -1,7 +1,6 @@
 //! Export of the trace view (the rows the filter in force shows) to a file: candump `-l`,
 //! JSON lines (decoded, as `cotui decode --format jsonl`) or pcapng for Wireshark.
 
-use super::commands::CommandError;
 use crate::analysis::trace::Trace;
 use crate::analysis::view::View;
 use crate::log::writer::LogWriter;
@@ -15,6 +14,37 @@ use std::path::Path;
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[error("unknown export format `{0}`: use candump, jsonl or pcapng")]
 pub struct UnknownFormat(pub String);
+
+/// Why `export` failed; the text is what the status bar shows.
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    /// `export --format` without a format.
+    #[error("export: --format needs candump, jsonl or pcapng")]
+    FormatMissing,
+    /// `export --format` with an unknown format.
+    #[error("export: {0}")]
+    Format(#[from] UnknownFormat),
+    /// `export` with an unknown option.
+    #[error("export: unknown option `{0}`")]
+    UnknownOption(String),
+    /// `export` with more than one file.
+    #[error("export: one FILE only (`{0}` is extra)")]
+    ExtraFile(String),
+    /// `export` without a file.
+    #[error("export: usage `export FILE [--format candump|jsonl|pcapng] [--force]`")]
+    Usage,
+    /// The export file could not be written.
+    #[error("export: {file}: {source}{hint}", hint = overwrite_hint(source))]
+    Write { file: String, source: std::io::Error },
+}
+
+fn overwrite_hint(e: &std::io::Error) -> &'static str {
+    if e.kind() == std::io::ErrorKind::AlreadyExists {
+        " (add --force to overwrite)"
+    } else {
+        ""
+    }
+}
 
 /// The formats the view exports to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -94,26 +124,26 @@ pub fn export(trace: &Trace, view: &View, path: &Path, format: ExportFormat, for
 
 /// `export FILE [--format candump|jsonl|pcapng] [--force]` (the words after `export`):
 /// writes the rows `view` shows; the text says what was written.
-pub(crate) fn command(rest: &str, trace: &Trace, view: &View) -> Result<String, CommandError> {
+pub(crate) fn command(rest: &str, trace: &Trace, view: &View) -> Result<String, ExportError> {
     let (mut file, mut format, mut force) = (None, None, false);
     let mut words = rest.split_whitespace();
     while let Some(w) = words.next() {
         match w {
             "--force" => force = true,
             "--format" => {
-                let f = words.next().ok_or(CommandError::FormatMissing)?;
+                let f = words.next().ok_or(ExportError::FormatMissing)?;
                 format = Some(ExportFormat::parse(f)?);
             }
-            w if w.starts_with("--") => return Err(CommandError::ExportOption(w.to_string())),
+            w if w.starts_with("--") => return Err(ExportError::UnknownOption(w.to_string())),
             w if file.is_none() => file = Some(w.to_string()),
-            w => return Err(CommandError::ExtraFile(w.to_string())),
+            w => return Err(ExportError::ExtraFile(w.to_string())),
         }
     }
-    let file = file.ok_or(CommandError::ExportUsage)?;
+    let file = file.ok_or(ExportError::Usage)?;
     let path = Path::new(&file);
     let format = format.unwrap_or_else(|| ExportFormat::of_path(path));
     let scanned = view.progress(trace);
-    let n = export(trace, view, path, format, force).map_err(|source| CommandError::Export {
+    let n = export(trace, view, path, format, force).map_err(|source| ExportError::Write {
         file: file.clone(),
         source,
     })?;

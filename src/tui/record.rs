@@ -3,7 +3,6 @@
 //! lines only (a failed write cuts the file back to its last whole line, see
 //! [`crate::logio::sink`]).
 
-use super::capture::Capture;
 use super::event::{Event, Queue};
 use super::messages::Level;
 use crate::command::record::{WriteMode, open_output};
@@ -139,10 +138,9 @@ impl Recorder {
 }
 
 /// `record start FILE [--force | --append]` / `record stop` (the words after `record`):
-/// starts or ends the recording of `capture`; what the user is told goes to `q`.
-pub(crate) fn command(capture: &mut Capture, rest: &str, q: &mut Queue) {
-    let has_bus = capture.has_bus();
-    let recording = capture.recording_mut();
+/// starts or ends `recording` (of a capture with a bus when `has_bus`); what the user is
+/// told goes to `q`.
+pub(crate) fn command(has_bus: bool, recording: &mut Option<Recorder>, rest: &str, q: &mut Queue) {
     let (level, text) = match parse(rest) {
         Err(e) => (Level::Error, format!("record: {e}")),
         Ok(RecordCommand::Stop) => match recording.take() {

@@ -1,7 +1,7 @@
 //! COB-ID classification: the CiA 301 predefined connection set, plus COB-IDs
 //! moved by a profile, an EDS/DCF or a sniffed SDO write.
 
-use super::Kind;
+use super::kind::Kind;
 use std::collections::HashMap;
 
 /// What a COB-ID is used for.

@@ -4,11 +4,12 @@
 
 use super::cob_id::{CobId, CobTable, Route};
 use super::heartbeat::Heartbeat;
+use super::kind::Kind;
 use super::pdo::{self, Pdo};
 use super::pdo_config::{CommParams, PdoId};
 use super::sdo::tracker::{labelled, unlabelled};
 use super::sdo::{SdoFrame, SdoTracker};
-use super::{Kind, emcy, error_frame, heartbeat, lss, nmt, sync, time, value_text, vendor_sdo};
+use super::{emcy, error_frame, heartbeat, lss, nmt, sync, time, value_text, vendor_sdo};
 use crate::frame::{Frame, NodeKey};
 use crate::od::{Dictionary, MappingSource, PdoMapping, resolve_object};
 use crate::sdo::tracker::Tracked;

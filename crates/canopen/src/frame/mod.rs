@@ -8,6 +8,7 @@ use std::collections::HashMap;
 
 pub mod hex;
 pub mod json;
+pub mod linux;
 
 /// Flag bits of a [`Frame`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

@@ -22,10 +22,8 @@
 
 use super::lex::{self, IfaceCache, err, hex, is_ws, skip_ws, token_end, trim_end};
 use super::{Line, ParseError, SkipReason};
+use crate::frame::linux::CAN_ERR_FLAG;
 use crate::frame::{Flags, Frame, Interfaces};
-
-/// `CAN_ERR_FLAG` of the Linux CAN id.
-pub const CAN_ERR_FLAG: u32 = 0x2000_0000;
 
 /// Parser state for candump log lines (remembers the last interface to intern nothing per
 /// line). Use one parser with one [`Interfaces`] table: it caches an index into it.

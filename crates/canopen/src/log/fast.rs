@@ -9,8 +9,8 @@
 //! general parser ([`super::candump`]) reads the line, with its located messages. So what
 //! this path accepts it reads exactly as the general parser does (tested below against it).
 
-use super::candump::CAN_ERR_FLAG;
 use super::lex::{HEX, IfaceCache};
+use crate::frame::linux::CAN_ERR_FLAG;
 use crate::frame::{Flags, Frame, Interfaces};
 
 /// Parses the common line at the start of `buf` into `frame`; returns the bytes it took,

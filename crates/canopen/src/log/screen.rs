@@ -181,7 +181,7 @@ impl Parser {
             f.id = raw;
         } else if raw & 0xC000_0000 != 0 {
             return Err(err(id_at, "29-bit CAN id with bit 30 or 31 set"));
-        } else if raw & super::candump::CAN_ERR_FLAG != 0 {
+        } else if raw & crate::frame::linux::CAN_ERR_FLAG != 0 {
             f.flags.set(Flags::ERR, true);
             f.id = raw & 0x1FFF_FFFF;
         } else {

@@ -19,7 +19,7 @@
 
 use std::io;
 
-use super::candump::CAN_ERR_FLAG;
+use crate::frame::linux::CAN_ERR_FLAG;
 use crate::frame::{Flags, Frame};
 
 const DIGITS: &[u8; 16] = b"0123456789ABCDEF";
