@@ -12,6 +12,7 @@ pub mod picker;
 pub mod plot;
 pub mod problems;
 pub mod sdo;
+mod sdo_seq;
 pub mod stats;
 pub mod status;
 pub mod trace;
@@ -73,7 +74,7 @@ pub struct Panes {
     trace: trace::TracePane,
     /// One row per node.
     nodes: nodes::NodesPane,
-    /// One row per SDO transfer, or the frames of one.
+    /// One row per SDO transfer, or the sequence diagram of one.
     sdo: sdo::SdoPane,
     /// One row per COB-ID.
     stats: stats::StatsPane,
