@@ -57,9 +57,7 @@ impl Sequence {
             };
             let block_segment = in_sub_block && side == data_side;
             match decode(side, f.payload(), block_segment) {
-                SdoCommand::BlockDownloadInitiateResponse { .. } | SdoCommand::BlockUploadStart => {
-                    in_sub_block = true
-                }
+                SdoCommand::BlockDownloadInitiateResponse { .. } | SdoCommand::BlockUploadStart => in_sub_block = true,
                 SdoCommand::BlockSegment { last: true, .. } => {
                     in_sub_block = false;
                     data_done = true;
@@ -101,10 +99,14 @@ impl Sequence {
             Outcome::Aborted { by, .. } => format!("aborted by the {}", by.as_str()),
             o => o.as_str().to_string(),
         };
+        // The protocol is unknown when the first answer never came.
+        let protocol = match t.protocol {
+            Protocol::Unknown => String::new(),
+            p => format!("{} ", p.as_str()),
+        };
         format!(
-            " SDO transfer {object} node {} — {} {}, {outcome} ",
+            " SDO transfer {object} node {} — {protocol}{}, {outcome} ",
             t.node,
-            t.protocol.as_str(),
             t.direction.as_str()
         )
     }
@@ -142,7 +144,8 @@ impl Sequence {
         if let Some(last) = trailer(t, self.steps.last()) {
             let i = self.steps.len();
             if i >= offset && i < offset + rows {
-                let text = format!("{:>TIME$} {}", "", last);
+                let inner = lane.saturating_sub(2);
+                let text = format!("{:>TIME$} │{:^inner$}│", "", fit(&last, inner));
                 lines.push(row(fit(&text, width), Style::default().fg(Color::Gray), i == chosen));
             }
         }
@@ -267,8 +270,13 @@ fn label(cmd: &SdoCommand) -> String {
             blksize,
             pst,
             ..
-        } => format!("initiate block upload {} blksize={blksize} pst={pst}", object(index, sub)),
-        BlockUploadInitiateResponse { index, sub, size: s, .. } => {
+        } => format!(
+            "initiate block upload {} blksize={blksize} pst={pst}",
+            object(index, sub)
+        ),
+        BlockUploadInitiateResponse {
+            index, sub, size: s, ..
+        } => {
             format!("block upload response {}{}", object(index, sub), size(s))
         }
         BlockUploadStart => "start block upload".to_string(),
@@ -291,7 +299,10 @@ mod tests {
     #[test]
     fn labels_name_the_fields_a_user_checks() {
         let abort = decode(Side::Server, &[0x80, 0x00, 0x20, 0x00, 0x00, 0x00, 0x02, 0x06], false);
-        assert_eq!(label(&abort), "ABORT 0x06020000 Object does not exist in the object dictionary");
+        assert_eq!(
+            label(&abort),
+            "ABORT 0x06020000 Object does not exist in the object dictionary"
+        );
         let seg = decode(Side::Client, &[0x85, 1, 2, 3, 4, 5, 6, 7], true);
         assert_eq!(label(&seg), "block seq 5 last");
         let ack = decode(Side::Server, &[0xA2, 0x7F, 0x7F, 0, 0, 0, 0, 0], false);
