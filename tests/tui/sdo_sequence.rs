@@ -202,3 +202,26 @@ fn enter_on_an_arrow_shows_its_frame_in_the_trace_and_detail() {
     let s = draw(&mut app, 160, 30);
     assert!(s.contains("SDO transfers ("), "{s}");
 }
+
+#[test]
+fn a_block_upload_has_the_segments_from_the_server_and_the_acknowledge_from_the_client() {
+    let Some(rw) = realworld() else {
+        println!("note: ../shared/realworld/logs not found; skipped");
+        return;
+    };
+    let mut app = opened(&rw.join("canopendemo_sdo_block_interlaced.txt"));
+    let all = &app.trace().transactions;
+    let i = all
+        .iter()
+        .position(|t| t.node == 3)
+        .unwrap_or_else(|| panic!("{}", all.len()));
+    open_diagram(&mut app, i);
+    let s = draw(&mut app, 120, 40);
+    assert!(s.contains("SDO transfer ????:?? node 3 — block upload"), "{s}");
+    assert!(s.contains("client (0x603)"), "{s}");
+    // The client acknowledges (→) the sub-block the server sent (←).
+    assert!(s.contains("│ block ack ackseq=127 blksize=127 ──"), "{s}");
+    assert!(s.contains("─ block seq 1 │"), "{s}");
+    assert!(!s.contains("│ block seq"), "{s}");
+    insta::assert_snapshot!(pane(&s));
+}

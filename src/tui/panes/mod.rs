@@ -384,10 +384,15 @@ pub(crate) mod testutil {
 
     /// An app holding [`frames`] (fully ingested), default keymap.
     pub fn app() -> App {
+        app_of(&frames())
+    }
+
+    /// An app holding `frames` (fully ingested, on can0), default keymap.
+    pub fn app_of(frames: &[Frame]) -> App {
         let mut trace = Trace::new(Decoder::new(Dictionary::default(), Vec::new()), 500_000);
         trace.ifaces.intern("can0");
-        for f in frames() {
-            trace.push(&f);
+        for f in frames {
+            trace.push(f);
         }
         let (_tx, rx) = std::sync::mpsc::channel();
         let mut src = SourceInfo::new("test.log", SourceKind::Open, rx, None);
