@@ -55,7 +55,7 @@ actions! {
     Bottom = "bottom": "Last row (and follow)",
     Follow = "follow": "Toggle follow mode",
     Pause = "pause": "Pause or resume the capture / replay",
-    Expand = "expand": "Open the selected row (SDO transfer frames, signal to plot, PDO frames; Objects: read; message log: the whole entry)",
+    Expand = "expand": "Open the selected row (SDO transfer as a sequence diagram, its frame in the trace, signal to plot, PDO frames; Objects: read; message log: the whole entry)",
     Back = "back": "Close popup, clear search, leave expanded view",
     NextPane = "next_pane": "Next pane",
     PrevPane = "prev_pane": "Previous pane",

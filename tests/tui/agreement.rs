@@ -34,7 +34,7 @@ fn cli(args: &[&str], path: &Path) -> String {
 
 /// The public real-world logs, beside the checkout (`../shared/realworld/logs`, or two
 /// levels up from a worktree); None when they are not there.
-fn realworld() -> Option<PathBuf> {
+pub(crate) fn realworld() -> Option<PathBuf> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     [
         root.join("../shared/realworld/logs"),
@@ -75,7 +75,7 @@ fn logs() -> Vec<PathBuf> {
 
 /// An App that loaded `path` as `cotui open PATH` does, to the end of the input, and drew
 /// its SDO pane once (so every pane model is up to date).
-fn opened(path: &Path) -> App {
+pub(crate) fn opened(path: &Path) -> App {
     let decoder = cotui::cli::bind::decoder(&[], &[]).unwrap();
     let name = path.display().to_string();
     let src = SourceInfo::new(&name, SourceKind::Open, source::open(path.to_path_buf(), None), None);

@@ -13,6 +13,7 @@ mod problems;
 mod receive_list;
 mod remote;
 mod screen;
+mod sdo_sequence;
 mod tmux;
 mod tui_cli;
 mod tui_tmux;

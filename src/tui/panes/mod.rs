@@ -12,6 +12,7 @@ pub mod picker;
 pub mod plot;
 pub mod problems;
 pub mod sdo;
+mod sdo_seq;
 pub mod stats;
 pub mod status;
 pub mod trace;
@@ -73,7 +74,7 @@ pub struct Panes {
     trace: trace::TracePane,
     /// One row per node.
     nodes: nodes::NodesPane,
-    /// One row per SDO transfer, or the frames of one.
+    /// One row per SDO transfer, or the sequence diagram of one.
     sdo: sdo::SdoPane,
     /// One row per COB-ID.
     stats: stats::StatsPane,
@@ -383,10 +384,15 @@ pub(crate) mod testutil {
 
     /// An app holding [`frames`] (fully ingested), default keymap.
     pub fn app() -> App {
+        app_of(&frames())
+    }
+
+    /// An app holding `frames` (fully ingested, on can0), default keymap.
+    pub fn app_of(frames: &[Frame]) -> App {
         let mut trace = Trace::new(Decoder::new(Dictionary::default(), Vec::new()), 500_000);
         trace.ifaces.intern("can0");
-        for f in frames() {
-            trace.push(&f);
+        for f in frames {
+            trace.push(f);
         }
         let (_tx, rx) = std::sync::mpsc::channel();
         let mut src = SourceInfo::new("test.log", SourceKind::Open, rx, None);

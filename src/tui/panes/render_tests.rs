@@ -1020,3 +1020,95 @@ fn bookmarks_are_listed_in_the_title_and_the_jump_key_walks_them_wrapping() {
     let s = screen(&mut a, 170, 14);
     assert!(s.contains("[marks #6]"), "{s}");
 }
+
+/// A whole block download of `len` bytes to 0x1F50:01 of node 1 (blksize 127, CRC),
+/// one frame every 100 µs: initiate, sub-blocks and their acknowledges, end, end response.
+fn block_download(len: usize) -> Vec<crate::frame::Frame> {
+    use crate::sdo::SdoCommand;
+    use crate::sdo::codec::{encode, sub_block};
+    let data: Vec<u8> = (0..len).map(|i| (i * 7 + 3) as u8).collect();
+    // CRC-16/XMODEM, as CiA 301 block transfers carry it.
+    let crc = data.iter().fold(0u16, |mut crc, &b| {
+        crc ^= u16::from(b) << 8;
+        for _ in 0..8 {
+            crc = if crc & 0x8000 != 0 {
+                (crc << 1) ^ 0x1021
+            } else {
+                crc << 1
+            };
+        }
+        crc
+    });
+    let mut cmds = vec![
+        (
+            0x601,
+            SdoCommand::BlockDownloadInitiate {
+                index: 0x1F50,
+                sub: 1,
+                crc: true,
+                size: Some(len as u32),
+            },
+        ),
+        (
+            0x581,
+            SdoCommand::BlockDownloadInitiateResponse {
+                index: 0x1F50,
+                sub: 1,
+                crc: true,
+                blksize: 127,
+            },
+        ),
+    ];
+    let mut pos = 0;
+    while pos < len {
+        let (segments, n) = sub_block(&data, pos, 127);
+        let ackseq = segments.len() as u8;
+        cmds.extend(segments.into_iter().map(|s| (0x601, s)));
+        cmds.push((0x581, SdoCommand::BlockDownloadAck { ackseq, blksize: 127 }));
+        pos += n;
+    }
+    let unused = ((7 - len % 7) % 7) as u8;
+    cmds.push((0x601, SdoCommand::BlockDownloadEnd { unused, crc }));
+    cmds.push((0x581, SdoCommand::BlockDownloadEndResponse));
+    cmds.iter()
+        .enumerate()
+        .map(|(i, (id, c))| {
+            let mut f = crate::frame::Frame::classic(*id, &encode(c));
+            f.ts_ns = 1_700_000_000_000_000_000 + i as u64 * 100_000;
+            f
+        })
+        .collect()
+}
+
+#[test]
+fn a_block_download_of_thousands_of_frames_opens_as_a_sequence_diagram_with_its_crc() {
+    // 20000 bytes: 2858 segments in 23 sub-blocks, the last of 64 segments.
+    let mut a = super::testutil::app_of(&block_download(20_000));
+    assert_eq!(a.trace().transactions.len(), 1);
+    assert!(a.trace().transactions[0].is_ok(), "{:?}", a.trace().transactions[0]);
+    a.screen_mut().focus_on(Pane::Sdo);
+    let _ = screen(&mut a, 140, 14);
+    let opened = std::time::Instant::now();
+    a.act(Action::Expand);
+    let s = screen(&mut a, 140, 14);
+    println!("opened 2885 frames and drew the window in {:?}", opened.elapsed());
+    assert!(s.contains("SDO transfer 1F50:01 node 1 — block download, ok"), "{s}");
+    assert!(
+        s.contains("│ initiate block download 0x1F50:01 size 20000 crc ──"),
+        "{s}"
+    );
+    assert!(s.contains(" block download response 0x1F50:01 blksize=127 │"), "{s}");
+    assert!(s.contains("│ block seq 1 ──"), "{s}");
+    insta::assert_snapshot!("sdo_sequence_block_download_start", s);
+    // The end: the last sub-block's last segment, its acknowledge, the CRC.
+    let drew = std::time::Instant::now();
+    a.act(Action::Bottom);
+    let s = screen(&mut a, 140, 14);
+    println!("moved to the end and drew in {:?}", drew.elapsed());
+    assert!(s.contains("+288.100 ms │ block seq 64 last ──"), "{s}");
+    assert!(s.contains(" block ack ackseq=64 blksize=127 │"), "{s}");
+    assert!(s.contains("│ end block crc 0x"), "{s}");
+    assert!(s.contains(" end block response │"), "{s}");
+    assert!(!s.contains("no answer"), "{s}");
+    insta::assert_snapshot!("sdo_sequence_block_download_end", s);
+}

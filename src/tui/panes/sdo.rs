@@ -1,7 +1,8 @@
 //! The SDO pane: one row per transfer (start time, object, value, duration, outcome,
 //! abort text), the newest selected until the user moves the selection (as the trace
-//! follows); `expand` opens a transfer's frames.
+//! follows); `expand` opens a transfer as a sequence diagram (`sdo_seq.rs`).
 
+use super::sdo_seq::Sequence;
 use super::{Component, Ctx, ListState, Selected, block, duration, fit, header, selected};
 use crate::analysis::trace::Trace;
 use crate::sdo::{Outcome, Transaction};
@@ -125,15 +126,15 @@ fn color(t: &Transaction) -> Color {
 }
 
 /// The SDO pane's state: the selection, whether it follows the newest transfer, and the
-/// transfer opened to its frames.
+/// transfer opened as a sequence diagram.
 pub struct SdoPane {
-    /// Scroll state (transfers, or the frames of the opened transfer).
+    /// Scroll state (transfers, or the rows of the opened transfer's diagram).
     list: ListState,
     /// Select the newest transfer as transfers come (until the selection is moved; `end`
     /// follows again).
     follow: bool,
-    /// The transfer opened to its frames (index into the transactions).
-    expanded: Option<usize>,
+    /// The transfer opened as a sequence diagram.
+    opened: Option<Sequence>,
 }
 
 impl Default for SdoPane {
@@ -141,48 +142,50 @@ impl Default for SdoPane {
         SdoPane {
             list: ListState::default(),
             follow: true,
-            expanded: None,
+            opened: None,
         }
     }
 }
 
 impl SdoPane {
-    /// The opened transfer, if any.
-    fn opened<'t>(&self, trace: &'t Trace) -> Option<&'t Transaction> {
-        self.expanded.and_then(|i| trace.transactions.get(i))
+    /// The opened transfer and its diagram, if any.
+    fn opened<'t>(&self, trace: &'t Trace) -> Option<(&Sequence, &'t Transaction)> {
+        let s = self.opened.as_ref()?;
+        Some((s, trace.transactions.get(s.transfer)?))
     }
 
-    /// Rows of the list: transfers, or the frames of the opened transfer.
+    /// Rows of the list: transfers, or the rows of the opened transfer's diagram.
     fn len(&self, trace: &Trace) -> usize {
-        match self.expanded {
-            Some(_) => self.opened(trace).map(|t| t.frames.len()).unwrap_or(0),
+        match self.opened {
+            Some(_) => self.opened(trace).map(|(s, t)| s.len(t)).unwrap_or(0),
             None => trace.transactions.len(),
         }
     }
 
-    /// The trace position of the selected frame of the opened transfer.
+    /// The trace position of the frame of the selected arrow of the opened transfer.
     fn selected_frame(&self, trace: &Trace) -> Option<usize> {
-        let seq = self.opened(trace)?.frames.get(self.list.selected)?;
-        Some(seq.saturating_sub(1) as usize)
+        let (s, _) = self.opened(trace)?;
+        s.position(self.list.selected)
     }
 }
 
 impl Component for SdoPane {
-    /// Moves the selection; `expand` opens the selected transfer to its frames, and on a
-    /// frame shows it in the trace; `back` closes the transfer.
+    /// Moves the selection; `expand` opens the selected transfer as a sequence diagram,
+    /// and on an arrow shows its frame in the trace (and so in Detail); `back` closes the
+    /// diagram.
     fn handle(&mut self, action: Action, ctx: &Ctx, q: &mut Queue) -> bool {
         if let Some(delta) = ListState::movement(action, ctx.page) {
             self.scroll(delta, ctx);
-            if action == Action::Bottom && self.expanded.is_none() {
+            if action == Action::Bottom && self.opened.is_none() {
                 self.follow = true;
             }
             return true;
         }
         match action {
-            Action::Expand if self.expanded.is_none() => {
-                if !ctx.trace.transactions.is_empty() {
+            Action::Expand if self.opened.is_none() => {
+                if let Some(s) = Sequence::open(ctx.trace, self.list.selected) {
                     self.follow = false;
-                    self.expanded = Some(self.list.selected);
+                    self.opened = Some(s);
                     self.list = ListState::default();
                 }
                 true
@@ -191,8 +194,9 @@ impl Component for SdoPane {
                 Some(pos) => q.answer(Event::Show(pos)),
                 None => true,
             },
-            Action::Back => match self.expanded.take() {
-                Some(t) => {
+            Action::Back => match self.opened.take() {
+                Some(s) => {
+                    let t = s.transfer;
                     self.list = ListState {
                         selected: t,
                         offset: t.saturating_sub(3),
@@ -218,15 +222,15 @@ impl Component for SdoPane {
     /// Keeps the selection visible; when following, on the newest transfer.
     fn fit(&mut self, height: usize, ctx: &Ctx) {
         let n = self.len(ctx.trace);
-        if self.follow && self.expanded.is_none() {
+        if self.follow && self.opened.is_none() {
             self.list.selected = n.saturating_sub(1);
         }
         self.list.clamp(n, height);
     }
 
-    /// The selected transfer, or the selected frame of the opened one.
+    /// The selected transfer, or the frame of the selected arrow of the opened one.
     fn selected(&self, ctx: &Ctx) -> Option<Selected> {
-        match self.expanded {
+        match self.opened {
             Some(_) => self.selected_frame(ctx.trace).map(Selected::Frame),
             None => Some(Selected::Transfer(self.list.selected)),
         }
@@ -234,52 +238,26 @@ impl Component for SdoPane {
 
     fn render(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
         match self.opened(ctx.trace) {
-            Some(t) => self.render_frames(t, f, area, ctx, focused),
+            Some((s, t)) => {
+                f.render_widget(block(&Sequence::title(t), focused), area);
+                let inner = block("", true).inner(area);
+                let l = self.list;
+                let lines = s.lines(
+                    ctx.trace,
+                    t,
+                    inner.width as usize,
+                    inner.height as usize,
+                    l.offset,
+                    l.selected,
+                );
+                f.render_widget(Paragraph::new(lines), inner);
+            }
             None => self.render_transfers(f, area, ctx, focused),
         }
     }
 }
 
 impl SdoPane {
-    /// Draws the frames of the opened transfer `t`.
-    fn render_frames(&self, t: &Transaction, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
-        let l = self.list;
-        let title = format!(" SDO transfer {:04X}:{:02X} node {} — frames ", t.index, t.sub, t.node);
-        f.render_widget(block(&title, focused), area);
-        let inner = block("", true).inner(area);
-        let positions: Vec<usize> = t
-            .frames
-            .iter()
-            .skip(l.offset)
-            .take(inner.height as usize)
-            .map(|s| s.saturating_sub(1) as usize)
-            .collect();
-        let t0 = super::start_ns(ctx.trace);
-        let decoded = ctx.trace.decode_positions(&positions);
-        let lines: Vec<Line> = positions
-            .iter()
-            .zip(decoded)
-            .enumerate()
-            .map(|(i, (p, d))| {
-                let fr = ctx.trace.store.frame(*p);
-                let text = format!(
-                    "{:>12.6} {:03X} {:<23} {}",
-                    fr.ts_ns.saturating_sub(t0) as f64 / 1e9,
-                    fr.id,
-                    crate::frame::hex::spaced(fr.payload()),
-                    d.label
-                );
-                let line = Line::raw(fit(&text, inner.width as usize));
-                if i + l.offset == l.selected {
-                    line.style(selected())
-                } else {
-                    line
-                }
-            })
-            .collect();
-        f.render_widget(Paragraph::new(lines), inner);
-    }
-
     /// Draws the list of transfers.
     fn render_transfers(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
         let l = self.list;
