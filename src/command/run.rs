@@ -15,9 +15,8 @@ use crate::frame::Frame;
 use crate::frame::hex;
 use crate::od::alias::resolve_object;
 use crate::od::procedure::{NmtCommand, Procedure, Step, fill_object, frame_bytes};
-use crate::od::{DataType, Dictionary};
+use crate::od::{DataType, Dictionary, Value};
 use serde::Serialize;
-use serde_json::Value as Json;
 use std::collections::BTreeMap;
 use std::time::Duration;
 
@@ -413,7 +412,7 @@ enum StepResult {
     /// `"written"`, `"sent"`, `"done"`, `"not sent"`.
     Word(&'static str),
     /// An SDO read: the value, its meaning, the bytes.
-    Read { value: Json, text: String, data: String },
+    Read { value: Value, text: String, data: String },
     /// A wait reached: the value read, its meaning, after how long.
     Reached { value: i64, text: String, after_ms: u64 },
     /// The step that failed.
@@ -650,7 +649,7 @@ async fn run_step(
             let text = read_text(dict, *index, *sub, *ty, &data, mode);
             (
                 StepResult::Read {
-                    value: decode(&data, *ty).to_json(),
+                    value: decode(&data, *ty),
                     text: text.clone(),
                     data: hex::upper(&data),
                 },
