@@ -14,10 +14,10 @@ pub struct BusArgs {
     /// socketcand://HOST:PORT/CHANNEL for a bus served by `cotui serve` or socketcand.
     pub iface: String,
     /// Open the bus without a send path: nothing is ever written to it.
-    #[arg(long)]
+    #[arg(long, global = true)]
     pub listen_only: bool,
     /// Print one JSON object instead of text (failures included).
-    #[arg(long)]
+    #[arg(long, global = true)]
     pub json: bool,
 }
 

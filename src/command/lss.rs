@@ -10,7 +10,7 @@
 use super::error::{CommandError, ParseError};
 use super::grammar::parse_int;
 use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
-use super::words::{TypedWords, ms_arg, u32_arg};
+use super::words::{ms_arg, u32_arg};
 use crate::bus::{Bus, BusError};
 use crate::frame::{Direction, Frame};
 use crate::lss::fastscan::{Fastscan, FastscanError, Found};
@@ -74,184 +74,253 @@ pub enum LssAction {
     },
 }
 
-/// The words of the LSS commands, for help and completion.
-pub const LSS_WORDS: &[&str] = &[
-    "switch",
-    "select",
-    "set-node",
-    "set-bitrate",
-    "activate-bitrate",
-    "store",
-    "inquire",
-    "identify",
-    "identify-unconfigured",
-    "fastscan",
-    "assign",
-];
-
-/// The flags of `lss` that only some commands take.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct LssFlags {
-    /// `--vendor V` (fastscan, assign).
-    pub vendor: Option<u32>,
-    /// `--product P` (fastscan, assign).
-    pub product: Option<u32>,
-    /// `--store` (assign).
-    pub store: bool,
+/// A number 0..0xFFFFFFFF (an LSS address part).
+fn number(word: &str) -> Result<u32, ParseError> {
+    u32_arg(word)
 }
 
-fn number(word: &str, what: &str) -> Result<u32, ParseError> {
+/// A node-ID for `set-node`: 1..127, or 255 (unconfigured).
+fn set_node_id(word: &str) -> Result<u8, ParseError> {
     parse_int(word)
-        .filter(|v| (0..=u32::MAX as i64).contains(v))
-        .map(|v| v as u32)
-        .ok_or_else(|| ParseError::Invalid(format!("{what} `{word}` must be a number 0..0xFFFFFFFF")))
+        .filter(|n| (1..=127).contains(n) || *n == i64::from(UNCONFIGURED))
+        .map(|n| n as u8)
+        .ok_or_else(|| ParseError::Invalid(format!("node-ID `{word}` must be 1..127 (or 255 = unconfigured)")))
+}
+
+/// A node-ID for `assign`: 1..127.
+fn assign_node_id(word: &str) -> Result<u8, ParseError> {
+    parse_int(word)
+        .filter(|n| (1..=127).contains(n))
+        .map(|n| n as u8)
+        .ok_or_else(|| ParseError::Invalid(format!("node-ID `{word}` must be 1..127")))
+}
+
+/// A bit rate of the CiA 305 table, in kbit/s.
+fn kbit_arg(word: &str) -> Result<u32, ParseError> {
+    let kbit = u32_arg(word)?;
+    bit_rate_index(kbit).map(|_| kbit).ok_or_else(|| {
+        ParseError::Invalid(format!(
+            "bit rate `{kbit}` kbit/s is not in the CiA 305 table: use 1000, 800, 500, 250, 125, 50, 20 or 10"
+        ))
+    })
+}
+
+/// The switch delay of `activate-bitrate`, ms.
+fn delay_arg(word: &str) -> Result<u16, ParseError> {
+    u32_arg(word)
+        .ok()
+        .and_then(|v| u16::try_from(v).ok())
+        .ok_or_else(|| ParseError::Invalid(format!("DELAY_MS `{word}` must be 0..65535")))
+}
+
+/// The words of `lss switch`: `[global] config|wait`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SwitchWord {
+    /// Switch state global (the only switch there is without an address).
+    Global,
+    /// To configuration state.
+    #[value(alias = "configuration")]
+    Config,
+    /// To waiting state.
+    #[value(alias = "waiting")]
+    Wait,
+}
+
+/// What `lss inquire` asks for.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InquireWord {
+    /// The vendor-ID.
+    Vendor,
+    /// The product code.
+    Product,
+    /// The revision number.
+    Revision,
+    /// The serial number.
+    Serial,
+    /// The node-ID.
+    #[value(alias = "node-id")]
+    Node,
+    /// The whole address and the node-ID.
+    All,
+}
+
+/// The CiA 305 services of `lss`, each with its own words.
+#[derive(clap::Subcommand, Clone, Debug)]
+pub enum LssService {
+    /// Every slave to configuration or waiting state: `switch [global] config|wait`.
+    Switch {
+        /// `[global] config|wait`.
+        #[arg(value_enum, num_args = 1..=2, required = true, value_name = "[global] config|wait")]
+        words: Vec<SwitchWord>,
+    },
+    /// The slave with this LSS address to configuration state.
+    Select {
+        /// Vendor-ID (0x1018:1).
+        #[arg(value_parser = number)]
+        vendor: u32,
+        /// Product code (0x1018:2).
+        #[arg(value_parser = number)]
+        product: u32,
+        /// Revision number (0x1018:3).
+        #[arg(value_parser = number)]
+        revision: u32,
+        /// Serial number (0x1018:4).
+        #[arg(value_parser = number)]
+        serial: u32,
+    },
+    /// Configure the node-ID of the slave in configuration state (255 = unconfigured).
+    SetNode {
+        /// The node-ID, 1..127 (255: unconfigured).
+        #[arg(value_parser = set_node_id)]
+        node: u8,
+    },
+    /// Configure bit timing (CiA 305 table 0), in kbit/s.
+    SetBitrate {
+        /// 1000, 800, 500, 250, 125, 50, 20 or 10.
+        #[arg(value_parser = kbit_arg)]
+        kbit: u32,
+    },
+    /// Activate the bit timing after a switch delay (no answer).
+    ActivateBitrate {
+        /// The switch delay, ms (0..65535): each period before and after the switch.
+        #[arg(value_parser = delay_arg)]
+        delay_ms: u16,
+    },
+    /// Store the configuration of the slave in configuration state.
+    Store,
+    /// Ask the slave in configuration state for a part of its address, its node-ID, or all.
+    Inquire {
+        /// The part asked for.
+        #[arg(value_enum, default_value = "all")]
+        what: InquireWord,
+    },
+    /// Identify remote slaves in an address range.
+    Identify {
+        /// Vendor-ID.
+        #[arg(value_parser = number)]
+        vendor: u32,
+        /// Product code.
+        #[arg(value_parser = number)]
+        product: u32,
+        /// Lowest revision number.
+        #[arg(value_parser = number)]
+        rev_lo: u32,
+        /// Highest revision number.
+        #[arg(value_parser = number)]
+        rev_hi: u32,
+        /// Lowest serial number.
+        #[arg(value_parser = number)]
+        ser_lo: u32,
+        /// Highest serial number.
+        #[arg(value_parser = number)]
+        ser_hi: u32,
+    },
+    /// Identify non-configured remote slaves.
+    IdentifyUnconfigured,
+    /// Find one non-configured slave and leave it in configuration state.
+    Fastscan {
+        #[command(flatten)]
+        narrow: Narrow,
+    },
+    /// Fastscan (narrowed like `fastscan`), configure node-ID N, (store,) switch global waiting.
+    Assign {
+        /// The node-ID to give the slave found, 1..127.
+        #[arg(value_parser = assign_node_id)]
+        node: u8,
+        /// Also store the configuration.
+        #[arg(long)]
+        store: bool,
+        #[command(flatten)]
+        narrow: Narrow,
+    },
+}
+
+/// What narrows a fastscan: the parts of the address known.
+#[derive(clap::Args, Clone, Copy, Debug, Default)]
+pub struct Narrow {
+    /// Only a slave with this vendor-ID.
+    #[arg(long, value_parser = number)]
+    pub vendor: Option<u32>,
+    /// Only a slave with this product code.
+    #[arg(long, value_parser = number)]
+    pub product: Option<u32>,
+}
+
+impl LssService {
+    /// The action, with the checks clap cannot make (a range upside down, the switch words).
+    fn action(&self) -> Result<LssAction, ParseError> {
+        Ok(match *self {
+            LssService::Switch { ref words } => match words.as_slice() {
+                [SwitchWord::Global, m] | [m] if *m != SwitchWord::Global => LssAction::Switch {
+                    config: *m == SwitchWord::Config,
+                },
+                _ => return Err(ParseError::Invalid("`lss switch` takes [global] config|wait".into())),
+            },
+            LssService::Select {
+                vendor,
+                product,
+                revision,
+                serial,
+            } => LssAction::Select(Address {
+                vendor,
+                product,
+                revision,
+                serial,
+            }),
+            LssService::SetNode { node } => LssAction::SetNode(node),
+            LssService::SetBitrate { kbit } => LssAction::SetBitrate {
+                kbit,
+                index: bit_rate_index(kbit).unwrap_or_default(),
+            },
+            LssService::ActivateBitrate { delay_ms } => LssAction::ActivateBitrate { delay_ms },
+            LssService::Store => LssAction::Store,
+            LssService::Inquire { what } => LssAction::Inquire(match what {
+                InquireWord::Vendor => Inquiry::Part(Part::Vendor),
+                InquireWord::Product => Inquiry::Part(Part::Product),
+                InquireWord::Revision => Inquiry::Part(Part::Revision),
+                InquireWord::Serial => Inquiry::Part(Part::Serial),
+                InquireWord::Node => Inquiry::NodeId,
+                InquireWord::All => Inquiry::All,
+            }),
+            LssService::Identify {
+                vendor,
+                product,
+                rev_lo,
+                rev_hi,
+                ser_lo,
+                ser_hi,
+            } => LssAction::Identify {
+                vendor,
+                product,
+                revision: range(rev_lo, rev_hi, "REV")?,
+                serial: range(ser_lo, ser_hi, "SER")?,
+            },
+            LssService::IdentifyUnconfigured => LssAction::IdentifyUnconfigured,
+            LssService::Fastscan { narrow } => LssAction::Fastscan {
+                vendor: narrow.vendor,
+                product: narrow.product,
+            },
+            LssService::Assign { node, store, narrow } => LssAction::Assign {
+                node,
+                store,
+                vendor: narrow.vendor,
+                product: narrow.product,
+            },
+        })
+    }
+}
+
+/// An `identify` range LO..HI, refused upside down (no slave would answer).
+fn range(lo: u32, hi: u32, what: &str) -> Result<(u32, u32), ParseError> {
+    if lo > hi {
+        return Err(ParseError::Invalid(format!(
+            "`lss identify`: {what}_LO 0x{lo:08X} is above {what}_HI 0x{hi:08X}: the range is LO..HI (no slave would answer; nothing sent)"
+        )));
+    }
+    Ok((lo, hi))
 }
 
 impl LssAction {
-    /// Checks an action word (its arguments are checked by [`LssAction::parse`]).
-    pub fn verb(word: &str) -> Result<String, ParseError> {
-        if LSS_WORDS.contains(&word) {
-            Ok(word.to_string())
-        } else {
-            Err(ParseError::Invalid(format!(
-                "unknown LSS command `{word}`: use {}",
-                LSS_WORDS.join(", ")
-            )))
-        }
-    }
-
-    /// The command from its word, the words after it and the flags.
-    pub fn parse(word: &str, args: &[String], flags: LssFlags) -> Result<LssAction, ParseError> {
-        let want = |n: usize, usage: &str| {
-            if args.len() == n {
-                Ok(())
-            } else {
-                Err(ParseError::Invalid(format!(
-                    "`lss {word}` takes {usage} (got {} word{})",
-                    args.len(),
-                    if args.len() == 1 { "" } else { "s" }
-                )))
-            }
-        };
-        let a = |i: usize, what: &str| number(&args[i], what);
-        let action = match word {
-            "switch" => {
-                let words: Vec<&str> = args.iter().map(String::as_str).collect();
-                let mode = match words.as_slice() {
-                    ["global", m] | [m] => *m,
-                    _ => "",
-                };
-                match mode {
-                    "config" | "configuration" => LssAction::Switch { config: true },
-                    "wait" | "waiting" => LssAction::Switch { config: false },
-                    _ => return Err(ParseError::Invalid("`lss switch` takes [global] config|wait".into())),
-                }
-            }
-            "select" => {
-                want(4, "VENDOR PRODUCT REVISION SERIAL")?;
-                LssAction::Select(Address {
-                    vendor: a(0, "VENDOR")?,
-                    product: a(1, "PRODUCT")?,
-                    revision: a(2, "REVISION")?,
-                    serial: a(3, "SERIAL")?,
-                })
-            }
-            "set-node" => {
-                want(1, "a node-ID N (1..127, 255 = unconfigured)")?;
-                LssAction::SetNode(node_id(&args[0])?)
-            }
-            "set-bitrate" => {
-                want(1, "a bit rate in kbit/s")?;
-                let kbit = a(0, "KBIT")?;
-                let index = bit_rate_index(kbit).ok_or_else(|| {
-                    ParseError::Invalid(format!(
-                        "bit rate `{kbit}` kbit/s is not in the CiA 305 table: use 1000, 800, 500, 250, 125, 50, 20 or 10"
-                    ))
-                })?;
-                LssAction::SetBitrate { kbit, index }
-            }
-            "activate-bitrate" => {
-                want(1, "the switch delay DELAY_MS")?;
-                let delay_ms = u16::try_from(a(0, "DELAY_MS")?)
-                    .map_err(|_| ParseError::Invalid("DELAY_MS must be 0..65535".into()))?;
-                LssAction::ActivateBitrate { delay_ms }
-            }
-            "store" => {
-                want(0, "no words")?;
-                LssAction::Store
-            }
-            "inquire" => {
-                let what = match args.iter().map(String::as_str).collect::<Vec<_>>().as_slice() {
-                    [] | ["all"] => Inquiry::All,
-                    ["vendor"] => Inquiry::Part(Part::Vendor),
-                    ["product"] => Inquiry::Part(Part::Product),
-                    ["revision"] => Inquiry::Part(Part::Revision),
-                    ["serial"] => Inquiry::Part(Part::Serial),
-                    ["node"] | ["node-id"] => Inquiry::NodeId,
-                    _ => {
-                        return Err(ParseError::Invalid(
-                            "`lss inquire` takes vendor, product, revision, serial, node or all".into(),
-                        ));
-                    }
-                };
-                LssAction::Inquire(what)
-            }
-            "identify" => {
-                want(6, "VENDOR PRODUCT REV_LO REV_HI SER_LO SER_HI")?;
-                let range = |lo: usize, hi: usize, what: &str| {
-                    let (l, h) = (a(lo, &format!("{what}_LO"))?, a(hi, &format!("{what}_HI"))?);
-                    if l > h {
-                        return Err(ParseError::Invalid(format!(
-                            "`lss identify`: {what}_LO 0x{l:08X} is above {what}_HI 0x{h:08X}: the range is LO..HI (no slave would answer; nothing sent)"
-                        )));
-                    }
-                    Ok((l, h))
-                };
-                LssAction::Identify {
-                    vendor: a(0, "VENDOR")?,
-                    product: a(1, "PRODUCT")?,
-                    revision: range(2, 3, "REV")?,
-                    serial: range(4, 5, "SER")?,
-                }
-            }
-            "identify-unconfigured" => {
-                want(0, "no words")?;
-                LssAction::IdentifyUnconfigured
-            }
-            "fastscan" => {
-                want(0, "no words (--vendor V, --product P narrow the scan)")?;
-                LssAction::Fastscan {
-                    vendor: flags.vendor,
-                    product: flags.product,
-                }
-            }
-            "assign" => {
-                want(1, "a node-ID N (1..127)")?;
-                let node = node_id(&args[0])?;
-                if node == UNCONFIGURED {
-                    return Err(ParseError::Invalid("`lss assign` takes a node-ID 1..127".into()));
-                }
-                LssAction::Assign {
-                    node,
-                    store: flags.store,
-                    vendor: flags.vendor,
-                    product: flags.product,
-                }
-            }
-            other => return Err(Self::verb(other).err().unwrap_or(ParseError::Invalid(other.into()))),
-        };
-        if flags.store && !matches!(action, LssAction::Assign { .. }) {
-            return Err(ParseError::Invalid("--store goes with `lss assign`".into()));
-        }
-        let scans = matches!(action, LssAction::Fastscan { .. } | LssAction::Assign { .. });
-        if (flags.vendor.is_some() || flags.product.is_some()) && !scans {
-            return Err(ParseError::Invalid(
-                "--vendor and --product go with `lss fastscan` and `lss assign`".into(),
-            ));
-        }
-        Ok(action)
-    }
-
     /// The command's word.
     pub fn as_str(&self) -> &'static str {
         match self {
@@ -330,40 +399,20 @@ impl LssAction {
     }
 }
 
-fn node_id(word: &str) -> Result<u8, ParseError> {
-    parse_int(word)
-        .filter(|n| (1..=127).contains(n) || *n == i64::from(UNCONFIGURED))
-        .map(|n| n as u8)
-        .ok_or_else(|| {
-            ParseError::Invalid(format!(
-                "node-ID `{word}` must be 1..127 (or 255 = unconfigured for set-node)"
-            ))
-        })
-}
-
-/// `lss ACTION [WORDS...] [--timeout MS] [--vendor V] [--product P] [--store]`.
+/// `lss SERVICE [WORDS...] [--timeout MS]`.
 #[derive(clap::Args, Clone, Debug)]
+#[command(
+    subcommand_value_name = "SERVICE",
+    subcommand_help_heading = "Services",
+    disable_help_subcommand = true
+)]
 pub struct LssArgs {
-    /// The LSS service (its words follow).
-    #[arg(value_parser = TypedWords::new(LSS_WORDS, LssAction::verb))]
-    pub action: String,
-    /// The action's words: `switch [global] config|wait`, `select VENDOR PRODUCT REVISION
-    /// SERIAL`, `set-node N`, `set-bitrate KBIT`, `activate-bitrate DELAY_MS`, `inquire
-    /// [vendor|product|revision|serial|node|all]`, `identify VENDOR PRODUCT REV_LO REV_HI
-    /// SER_LO SER_HI`, `assign N`.
-    pub words: Vec<String>,
-    /// fastscan, assign: only a slave with this vendor-ID.
-    #[arg(long, value_parser = u32_arg)]
-    pub vendor: Option<u32>,
-    /// fastscan, assign: only a slave with this product code.
-    #[arg(long, value_parser = u32_arg)]
-    pub product: Option<u32>,
-    /// assign: also store the configuration.
-    #[arg(long)]
-    pub store: bool,
+    /// The LSS service and its words.
+    #[command(subcommand)]
+    pub service: LssService,
     /// How long to wait for each answer, in ms [default: 100; fastscan and assign: 30 per
     /// fastscan request].
-    #[arg(long, value_parser = ms_arg)]
+    #[arg(long, global = true, value_parser = ms_arg)]
     pub timeout: Option<u64>,
 }
 
@@ -379,12 +428,7 @@ impl<D> CommandArgs<D> for LssArgs {
     const NAME: &'static str = "lss";
 
     fn spec(&self) -> Result<Lss, ParseError> {
-        let flags = LssFlags {
-            vendor: self.vendor,
-            product: self.product,
-            store: self.store,
-        };
-        let action = LssAction::parse(&self.action, &self.words, flags)?;
+        let action = self.service.action()?;
         let default = match action {
             LssAction::Fastscan { .. } | LssAction::Assign { .. } => FASTSCAN_TIMEOUT_MS,
             _ => LSS_TIMEOUT_MS,
@@ -947,36 +991,28 @@ mod tests {
 
     #[test]
     fn words_parse_and_previews_come_from_the_protocol_layer() {
-        let p = |w: &str, args: &[&str], flags| {
-            let args: Vec<String> = args.iter().map(|s| s.to_string()).collect();
-            LssAction::parse(w, &args, flags)
+        let p = |line: &str| match crate::command::parse_command(line) {
+            Ok(crate::command::Command::Lss(l)) => Ok(l.action),
+            Ok(other) => panic!("{line}: {other:?}"),
+            Err(e) => Err(e.to_string()),
         };
-        let none = LssFlags::default();
+        assert_eq!(p("lss switch global config"), Ok(LssAction::Switch { config: true }));
+        assert_eq!(p("lss switch wait"), Ok(LssAction::Switch { config: false }));
+        assert!(p("lss switch global").unwrap_err().contains("[global] config|wait"));
         assert_eq!(
-            p("switch", &["global", "config"], none),
-            Ok(LssAction::Switch { config: true })
-        );
-        assert_eq!(p("switch", &["wait"], none), Ok(LssAction::Switch { config: false }));
-        assert_eq!(
-            p("set-bitrate", &["250"], none),
+            p("lss set-bitrate 250"),
             Ok(LssAction::SetBitrate { kbit: 250, index: 3 })
         );
         assert!(
-            p("set-bitrate", &["300"], none)
+            p("lss set-bitrate 300")
                 .unwrap_err()
-                .to_string()
                 .contains("not in the CiA 305 table")
         );
-        assert!(
-            p("set-node", &["0"], none)
-                .unwrap_err()
-                .to_string()
-                .contains("must be 1..127")
-        );
-        assert!(p("store", &[], LssFlags { store: true, ..none }).is_err());
-        assert_eq!(p("set-node", &["10"], none).unwrap().preview(), "7E5#110A000000000000");
+        assert!(p("lss set-node 0").unwrap_err().contains("must be 1..127"));
+        assert!(p("lss store --store").is_err());
+        assert_eq!(p("lss set-node 10").unwrap().preview(), "7E5#110A000000000000");
         assert_eq!(
-            p("select", &["0x3A", "0x1234", "2", "0x99"], none).unwrap().preview(),
+            p("lss select 0x3A 0x1234 2 0x99").unwrap().preview(),
             "7E5#403A000000000000, 7E5#4134120000000000, 7E5#4202000000000000, 7E5#4399000000000000"
         );
     }

@@ -309,12 +309,16 @@ mod tests {
         assert_eq!(err("drive 2 mode"), "drive mode needs a MODE (e.g. pv, csp, 3)");
         assert_eq!(err("scan extra"), "unexpected argument 'extra' found");
         assert_eq!(parse_command("sdo read 2 \"0x6041"), Err(ParseError::Quote));
-        assert!(err("lss fly").contains("unknown LSS command `fly`"));
+        assert_eq!(err("lss fly"), "unrecognized subcommand 'fly'");
         assert_eq!(
             err("lss set-node"),
-            "`lss set-node` takes a node-ID N (1..127, 255 = unconfigured) (got 0 words)"
+            "the following required arguments were not provided: <NODE>"
         );
-        assert_eq!(err("lss inquire node --store"), "--store goes with `lss assign`");
+        assert_eq!(err("lss inquire node --store"), "unexpected argument '--store' found");
+        assert_eq!(
+            err("lss select 1 2 3"),
+            "the following required arguments were not provided: <SERIAL>"
+        );
     }
 
     #[test]

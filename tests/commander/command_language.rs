@@ -143,15 +143,12 @@ fn the_palette_and_the_command_line_give_the_same_command_or_the_same_error() {
         ),
         (
             "lss set-node 200",
-            "node-ID `200` must be 1..127 (or 255 = unconfigured for set-node)",
+            "invalid value '200' for '<NODE>': node-ID `200` must be 1..127 (or 255 = unconfigured)",
         ),
-        (
-            "lss store --vendor 1",
-            "--vendor and --product go with `lss fastscan` and `lss assign`",
-        ),
+        ("lss store --vendor 1", "unexpected argument '--vendor' found"),
         (
             "lss select 1 2 3",
-            "`lss select` takes VENDOR PRODUCT REVISION SERIAL (got 3 words)",
+            "the following required arguments were not provided: <SERIAL>",
         ),
     ];
     for (line, want) in bad {
