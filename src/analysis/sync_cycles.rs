@@ -13,6 +13,10 @@ use crate::od::Dictionary;
 use crate::sdo::transaction::{Outcome, Transaction};
 use std::collections::{BTreeMap, VecDeque};
 
+/// TPDOs a cycle keeps: a SYNC that never comes again leaves its cycle open while
+/// TPDOs go on, and memory stays flat (the others are counted in [`Cycle::dropped`]).
+pub const SLOTS_KEPT: usize = 1024;
+
 /// One synchronous TPDO of a cycle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Slot {
@@ -43,8 +47,10 @@ pub struct Cycle {
     pub counter: Option<u8>,
     /// The synchronous window (0x1007, µs) in force when it opened, if known.
     pub window_us: Option<u64>,
-    /// The synchronous TPDOs, in order of arrival.
+    /// The synchronous TPDOs, in order of arrival (the first [`SLOTS_KEPT`]).
     pub frames: Vec<Slot>,
+    /// Synchronous TPDOs beyond [`SLOTS_KEPT`], not kept (nor judged late).
+    pub dropped: u64,
 }
 
 impl Cycle {
@@ -215,6 +221,7 @@ impl SyncCycles {
             counter: frame.payload().first().copied(),
             window_us: self.bus_window.get(&frame.iface).copied(),
             frames: Vec::new(),
+            dropped: 0,
         });
         self.open[i] = Some(self.base + self.cycles.len() - 1);
     }
@@ -232,6 +239,10 @@ impl SyncCycles {
         let Some(c) = open.and_then(|a| self.cycles.get_mut(a - self.base)) else {
             return;
         };
+        if c.frames.len() >= SLOTS_KEPT {
+            c.dropped += 1;
+            return;
+        }
         let offset_us = frame.ts_ns.saturating_sub(c.start_ns) / 1000;
         let late = window.is_some_and(|w| offset_us > w);
         if late {
@@ -432,6 +443,17 @@ mod tests {
         assert_eq!(s.take_closed().len(), 0);
         s.end();
         assert_eq!(s.take_closed().len(), 1);
+    }
+
+    #[test]
+    fn a_cycle_whose_sync_never_comes_again_keeps_a_bounded_number_of_tpdos() {
+        let mut s = SyncCycles::default();
+        push(&mut s, &frame(0x080, &[], 0.0), 0);
+        for i in 0..SLOTS_KEPT + 10 {
+            push(&mut s, &frame(0x181, &[], 1.0 + i as f64), i as u64 + 1);
+        }
+        let c = &s.cycles()[0];
+        assert_eq!((c.frames.len(), c.dropped), (SLOTS_KEPT, 10));
     }
 
     #[test]

@@ -21,6 +21,13 @@ struct CycleJson<'a> {
     late: usize,
     /// The synchronous window 0x1007 (µs); null when unknown.
     window_us: Option<u64>,
+    /// TPDOs beyond those a cycle keeps (only when some were not kept).
+    #[serde(skip_serializing_if = "is_zero")]
+    dropped: u64,
+}
+
+fn is_zero(n: &u64) -> bool {
+    *n == 0
 }
 
 #[derive(Serialize)]
@@ -68,6 +75,7 @@ pub(super) fn write_cycle(json: &mut Vec<u8>, text: &mut String, c: &Cycle, name
                 .collect(),
             late: c.late(),
             window_us: c.window_us,
+            dropped: c.dropped,
         };
         write_line(json, &j);
         return;

@@ -123,3 +123,19 @@ fn sync_cycles_write_text_or_jsonl_only() {
     assert_eq!(out.status.code(), Some(1), "clap refuses the pair");
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot be used with"));
 }
+
+#[test]
+fn a_tpdo_event_driven_by_its_eds_default_has_no_lane() {
+    // The EDS gives 0x1800 sub 2 = 254 (event-driven): node 3's TPDO1 is not in the
+    // cycle; node 4's, of unknown type, is.
+    let log = "(1.000000) can0 080#\n(1.000300) can0 183#01\n(1.000500) can0 184#02\n(1.010000) can0 080#\n";
+    let eds = "3=../shared/realworld/eds/canopennode_DS301_profile.eds";
+    let out = cotui(
+        &["decode", "--sync-cycles", "--format", "jsonl", "--eds", eds, "-"],
+        Some(log),
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let first: Value = serde_json::from_str(text.lines().next().unwrap()).unwrap();
+    assert_eq!(lanes(&first), [(0x184, 500, false)], "{text}");
+}
