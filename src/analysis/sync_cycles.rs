@@ -45,7 +45,8 @@ pub struct Cycle {
     pub period_ns: Option<u64>,
     /// The SYNC's counter byte, when it carries one.
     pub counter: Option<u8>,
-    /// The synchronous window (0x1007, µs) in force when it opened, if known.
+    /// The synchronous window (0x1007, µs) in force when it opened, if known: the last
+    /// one written on the interface, else a node's dictionary default.
     pub window_us: Option<u64>,
     /// The synchronous TPDOs, in order of arrival (the first [`SLOTS_KEPT`]).
     pub frames: Vec<Slot>,
@@ -219,11 +220,20 @@ impl SyncCycles {
             start_ns: frame.ts_ns,
             period_ns: None,
             counter: frame.payload().first().copied(),
-            window_us: self.bus_window.get(&frame.iface).copied(),
+            window_us: self.window_of(frame.iface),
             frames: Vec::new(),
             dropped: 0,
         });
         self.open[i] = Some(self.base + self.cycles.len() - 1);
+    }
+
+    /// The window of interface `iface`: the last 0x1007 written there, else that of its
+    /// lowest node with one (a dictionary default).
+    fn window_of(&self, iface: u16) -> Option<u64> {
+        let nodes = self
+            .windows
+            .range(NodeKey::new(iface, 0)..=NodeKey::new(iface, u8::MAX));
+        self.bus_window.get(&iface).or(nodes.map(|(_, w)| w).next()).copied()
     }
 
     fn tpdo(&mut self, frame: &Frame, key: NodeKey, pdo: u16) {
@@ -454,6 +464,22 @@ mod tests {
         }
         let c = &s.cycles()[0];
         assert_eq!((c.frames.len(), c.dropped), (SLOTS_KEPT, 10));
+    }
+
+    #[test]
+    fn a_dictionary_default_window_holds_until_the_bus_writes_one() {
+        let mut s = SyncCycles::default();
+        s.defaults.push((2, Some(1500), vec![(1, 1)]));
+        push(&mut s, &frame(0x080, &[], 0.0), 0);
+        push(&mut s, &frame(0x182, &[], 1.6), 1);
+        s.transaction(&write(1, 0x1007, 0, &[0xD0, 0x07, 0, 0]));
+        push(&mut s, &frame(0x080, &[], 10.0), 2);
+        push(&mut s, &frame(0x181, &[], 11.6), 3);
+        let c = s.cycles();
+        assert_eq!(c[0].window_us, Some(1500));
+        assert!(c[0].frames[0].late, "1600 µs after the SYNC, window 1500 µs");
+        assert_eq!(c[1].window_us, Some(2000));
+        assert!(!c[1].frames[0].late, "node 1 has the window written: 2000 µs");
     }
 
     #[test]
