@@ -326,6 +326,13 @@ impl Screen {
         self.panes.trace_mut().select_position(trace, pos, page);
     }
 
+    /// Selects trace position `pos` in the Trace pane (the nearest row its filter
+    /// shows), the focus staying.
+    pub(crate) fn select_in_trace(&mut self, trace: &Trace, pos: usize) {
+        let page = self.page();
+        self.panes.trace_mut().select_position(trace, pos, page);
+    }
+
     /// Shows trace position `pos` in the Trace pane, unfiltered.
     pub(crate) fn show(&mut self, trace: &Trace, pos: usize) {
         let page = self.page();

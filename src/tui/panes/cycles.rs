@@ -2,8 +2,8 @@
 //! period (time since the first frame, period, SYNC counter, late TPDOs), then one lane per
 //! synchronous TPDO COB-ID of the visible cycles with its time after the SYNC, the late
 //! ones red with `!`. `slowest_cycle` selects the cycle of the longest period,
-//! `next_late_cycle` the next one with a late TPDO; `expand` shows the cycle's SYNC frame
-//! in the trace. Cycles come from [`crate::analysis::sync_cycles`].
+//! `next_late_cycle` the next one with a late TPDO (each selects the cycle's SYNC frame in
+//! the Trace pane too); `expand` shows that frame in the trace. Cycles come from [`crate::analysis::sync_cycles`].
 
 use super::{Ctx, ListState, Selected, block, fit, header, selected};
 use crate::analysis::sync_cycles::Cycle;
@@ -36,11 +36,15 @@ impl CyclesView {
         ctx.trace.cycles.cycles().len()
     }
 
-    /// Selects cycle `i`, shown about a third down the page.
-    fn select(&mut self, i: usize, ctx: &Ctx) {
+    /// Selects cycle `i`, shown about a third down the page, and its SYNC frame in the
+    /// Trace pane.
+    fn select(&mut self, i: usize, ctx: &Ctx, q: &mut Queue) {
         self.list.selected = i;
         self.list.offset = i.saturating_sub(ctx.page / 3);
         self.list.clamp(Self::len(ctx), ctx.page);
+        if let Some(c) = ctx.trace.cycles.cycles().get(i) {
+            q.push(Event::Select(c.sync_pos as usize));
+        }
     }
 
     /// Moves the selection; the jumps; `expand` shows the SYNC frame in the trace.
@@ -52,7 +56,7 @@ impl CyclesView {
         let cycles = &ctx.trace.cycles;
         match action {
             Action::SlowestCycle => match cycles.slowest() {
-                Some(i) => self.select(i, ctx),
+                Some(i) => self.select(i, ctx, q),
                 None => q.push(Event::Note("no SYNC cycle with a period yet".into())),
             },
             Action::NextLateCycle => {
@@ -60,7 +64,7 @@ impl CyclesView {
                 match cycles.next_late(after) {
                     Some(i) => {
                         self.jumped = true;
-                        self.select(i, ctx);
+                        self.select(i, ctx, q);
                     }
                     None => q.push(Event::Note("no SYNC cycle with a late TPDO".into())),
                 }

@@ -146,6 +146,11 @@ fn sync_cycles_show_lanes_per_tpdo_and_the_keys_jump_to_the_slowest_and_late_cyc
     let sync = |a: &crate::tui::app::App, pos: usize| a.trace().store.frame(pos).id;
     let slow = row(&a);
     assert_eq!((slow, sync(&a, slow)), (19, 0x080));
+    // The Trace pane's selection went to that SYNC, the focus stayed.
+    assert_eq!((a.focus(), a.selected_position()), (Pane::Stats, Some(19)));
+    // Detail shows the selected cycle's SYNC.
+    let s = screen(&mut a, 120, 20);
+    assert!(s.contains("SYNC counter 4"), "{s}");
     // The late jumps: the second cycle, the fifth, then round again.
     let mut late = Vec::new();
     for _ in 0..3 {
