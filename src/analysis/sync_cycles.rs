@@ -17,6 +17,10 @@ use std::collections::{BTreeMap, VecDeque};
 /// TPDOs go on, and memory stays flat (the others are counted in [`Cycle::dropped`]).
 pub const SLOTS_KEPT: usize = 1024;
 
+/// Cycles waiting behind an open cycle of another interface before
+/// [`SyncCycles::take_closed`] ends that one (its SYNC stopped), keeping memory flat.
+const BACKLOG: usize = 4096;
+
 /// One synchronous TPDO of a cycle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Slot {
@@ -310,6 +314,15 @@ impl SyncCycles {
     /// Takes the cycles that are closed, up to the first still open (a headless command
     /// prints them as they close, keeping memory flat).
     pub fn take_closed(&mut self) -> Vec<Cycle> {
+        if self.cycles.len() > BACKLOG {
+            // An interface whose SYNC stopped holds the others' cycles back: its cycle
+            // ends without a period.
+            let front = self.base;
+            self.open
+                .iter_mut()
+                .filter(|o| **o == Some(front))
+                .for_each(|o| *o = None);
+        }
         let first_open = self.open.iter().flatten().min().copied().unwrap_or(usize::MAX);
         let n = first_open.saturating_sub(self.base).min(self.cycles.len());
         self.base += n;
@@ -480,6 +493,21 @@ mod tests {
         assert!(c[0].frames[0].late, "1600 µs after the SYNC, window 1500 µs");
         assert_eq!(c[1].window_us, Some(2000));
         assert!(!c[1].frames[0].late, "node 1 has the window written: 2000 µs");
+    }
+
+    #[test]
+    fn an_interface_whose_sync_stopped_does_not_hold_back_the_others() {
+        let mut s = SyncCycles::default();
+        let mut quiet = frame(0x080, &[], 0.0);
+        quiet.iface = 1;
+        push(&mut s, &quiet, 0);
+        for i in 0..BACKLOG as u64 + 2 {
+            push(&mut s, &frame(0x080, &[], 1.0 + i as f64), i + 1);
+        }
+        let taken = s.take_closed();
+        assert_eq!(taken.len(), BACKLOG + 2, "all but can0's open cycle");
+        assert_eq!((taken[0].iface, taken[0].period_ns), (1, None));
+        assert!(s.take_closed().is_empty());
     }
 
     #[test]
