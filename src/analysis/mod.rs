@@ -17,6 +17,7 @@ pub mod search;
 pub mod series;
 pub mod stats;
 pub mod store;
+pub mod sync_cycles;
 pub mod timing;
 pub mod trace;
 pub mod transfers;

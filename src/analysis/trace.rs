@@ -1,7 +1,8 @@
 //! The trace: the one analysis pipeline. Frames go in through [`Trace::push`]; the views
 //! chosen at construction ([`Views`]) are derived from them as they come. The TUI keeps
 //! them all ([`Views::All`]); each headless command keeps only the view it prints
-//! ([`Views::Summary`], [`Views::Transactions`], [`Views::Events`], [`Views::Diagnosis`]),
+//! ([`Views::Summary`], [`Views::Transactions`], [`Views::Events`], [`Views::Diagnosis`],
+//! [`Views::SyncCycles`]),
 //! a fast path of the same `push`, not a copy of its loop; [`Views::Frames`] decodes every
 //! frame with its label for `cotui decode --filter`.
 //!
@@ -21,6 +22,7 @@ use super::nodes::Nodes;
 use super::series::Series;
 use super::stats::Stats;
 use super::store::Store;
+use super::sync_cycles::SyncCycles;
 use super::transfers::Transfers;
 use super::values::Values;
 use crate::decode::{Body, Decoded, Decoder, Kind};
@@ -49,6 +51,9 @@ pub enum Views {
     /// Only the diagnosis, [`Trace::diagnosis`] (`cotui diagnose`): frames are decoded as
     /// far as the diagnosis reads them.
     Diagnosis,
+    /// Only the SYNC cycles, [`Trace::cycles`] (`cotui decode --sync-cycles`): frames are
+    /// routed, SDO frames tracked (for the windows and transmission types they write).
+    SyncCycles,
     /// Every frame decoded with its label, [`Trace::take_decoded`], and the SDO transfers
     /// each completes, [`Trace::take_transactions`] (`cotui decode --filter`, which judges
     /// and prints them; the totals of `--filter --summary` go to [`Trace::summary`]).
@@ -91,6 +96,9 @@ pub struct Trace {
     /// Frames per kind and node (kept with [`Views::Summary`]; with [`Views::Frames`],
     /// the caller counts the frames its filter takes).
     pub summary: Summary,
+    /// The SYNC cycles and their synchronous TPDOs (kept with [`Views::All`] and
+    /// [`Views::SyncCycles`]).
+    pub cycles: SyncCycles,
     /// Bus events not yet taken (kept with [`Views::Events`] only).
     pub events: EventTracker,
     /// Changes of [`Trace::diagnosis`] (frames and clock ticks taken), for caches.
@@ -114,7 +122,12 @@ impl Trace {
         let nodes = Nodes::new(&decoder);
         let diagnosis = Diagnoser::new(|n| decoder.dictionary(n));
         let events = EventTracker::new(|n| decoder.dictionary(n));
+        let cycles = match views {
+            Views::All | Views::SyncCycles => SyncCycles::new(|n| decoder.dictionary(n)),
+            _ => SyncCycles::default(),
+        };
         Trace {
+            cycles,
             views,
             pushed: 0,
             decoded: None,
@@ -193,7 +206,8 @@ impl Trace {
         self.decoder.set_seq(pos);
         match self.views {
             Views::All => {
-                let (kind, node) = self.diagnose(frame);
+                let peeked @ (kind, node, _) = self.diagnose(frame);
+                self.cycles.frame(frame, pos, peeked);
                 self.store.push(frame, kind, node);
                 let p = *self.store.packed(pos as usize);
                 self.stats.add(&p, &self.store);
@@ -219,6 +233,13 @@ impl Trace {
                 }
                 _ => self.events.tick(frame.ts_ns),
             },
+            Views::SyncCycles => {
+                let peeked = self.decoder.peek(frame);
+                if matches!(peeked.0, Kind::SdoRx | Kind::SdoTx) {
+                    self.decoder.classify(frame);
+                }
+                self.cycles.frame(frame, pos, peeked);
+            }
             Views::Frames => self.decoded = Some(self.decoder.decode(frame)),
         }
         self.completed();
@@ -227,9 +248,9 @@ impl Trace {
     /// The frame as far as the diagnosis (and with [`Views::All`], the panes) read it:
     /// PDOs decoded to their values, without the names, texts and labels that rows decode
     /// anew from checkpoints; other frames through the diagnosis feed (SDO frames tracked
-    /// without labels, the rest only routed). Returns the frame's kind and node.
-    fn diagnose(&mut self, frame: &Frame) -> (Kind, Option<u8>) {
-        let peeked @ (kind, node, _) = self.decoder.peek(frame);
+    /// without labels, the rest only routed). Returns the frame's kind, node and PDO number.
+    fn diagnose(&mut self, frame: &Frame) -> (Kind, Option<u8>, u16) {
+        let peeked @ (kind, _, _) = self.decoder.peek(frame);
         let iface = self.ifaces.name(frame.iface);
         let all = self.views == Views::All;
         if all && matches!(kind, Kind::Tpdo | Kind::Rpdo) {
@@ -246,7 +267,7 @@ impl Trace {
             }
             self.decoder.recycle(d);
         }
-        (kind, node)
+        peeked
     }
 
     /// The SDO transfers the last frame completed, to the views that take them.
@@ -262,12 +283,14 @@ impl Trace {
                     self.nodes.transaction(&t);
                     self.series.transaction(&t, self.decoder.dictionary(t.node));
                     self.values.transaction(&t, self.decoder.dictionary(t.node));
+                    self.cycles.transaction(&t);
                     self.transactions.push(t);
                 }
             }
             Views::Transactions | Views::Frames => self.transactions.extend(done),
             Views::Events => done.iter().for_each(|t| self.events.transaction(t)),
             Views::Diagnosis => done.iter().for_each(|t| self.diagnosis.transaction(t)),
+            Views::SyncCycles => done.iter().for_each(|t| self.cycles.transaction(t)),
             // None is kept: memory stays flat.
             Views::Summary => {}
         }
@@ -291,6 +314,7 @@ impl Trace {
                     self.diagnosis.transaction(t);
                 }
             }
+            Views::SyncCycles => self.cycles.end(),
             Views::Summary | Views::Events | Views::Frames => {}
         }
     }
@@ -331,7 +355,7 @@ impl Trace {
             }
             Views::Diagnosis => self.diagnosis.tick(now_ns),
             Views::Events => self.events.tick(now_ns),
-            Views::Summary | Views::Transactions | Views::Frames => {}
+            Views::Summary | Views::Transactions | Views::SyncCycles | Views::Frames => {}
         }
     }
 

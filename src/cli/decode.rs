@@ -70,6 +70,11 @@ pub struct DecodeArgs {
     /// heartbeat period (0x1017), EMCY, SDO abort, controller state (error frames).
     #[arg(long, conflicts_with_all = ["transactions", "summary"])]
     pub events: bool,
+    /// Print one record per SYNC cycle instead of frames: its synchronous TPDOs with their
+    /// time after the SYNC, the window 0x1007 and the TPDOs after it (late); text ends
+    /// with a summary (cycles, mean and longest period, the slowest cycle, late TPDOs).
+    #[arg(long, conflicts_with_all = ["transactions", "summary", "events", "filter", "trigger"])]
+    pub sync_cycles: bool,
     /// Bind a device profile to a node: NODE=NAME (a name in decoders/ or a JSON path).
     #[arg(long = "profile", value_name = "NODE=NAME")]
     pub profiles: Vec<String>,
@@ -107,6 +112,10 @@ enum Pipeline {
 
 /// Runs `cotui decode`; returns the exit status.
 pub fn run(args: &DecodeArgs) -> ExitCode {
+    if args.sync_cycles && !matches!(args.format, OutputFormat::Text | OutputFormat::Jsonl) {
+        eprintln!("cotui decode: --sync-cycles writes text or jsonl");
+        return ExitCode::Usage;
+    }
     if let Some(expr) = &args.filter {
         return super::decode_filter::run(args, expr);
     }
@@ -126,7 +135,9 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
             return ExitCode::Usage;
         }
     };
-    let view = if args.events {
+    let view = if args.sync_cycles {
+        Some(Views::SyncCycles)
+    } else if args.events {
         Some(Views::Events)
     } else if args.summary {
         Some(Views::Summary)
@@ -280,6 +291,16 @@ fn write_view(
                 }
             }
         }
+        Views::SyncCycles => {
+            let first = trace.cycles.taken() == 0;
+            let done = trace.cycles.take_closed();
+            if first && !done.is_empty() && fmt == OutputFormat::Text {
+                super::decode_sync::write_header(buf);
+            }
+            for c in &done {
+                super::decode_sync::write_cycle(json, buf, c, names, fmt != OutputFormat::Text);
+            }
+        }
         Views::All | Views::Summary | Views::Diagnosis | Views::Frames => {}
     }
 }
@@ -348,6 +369,9 @@ fn finish(run: &mut Pipeline, fmt: OutputFormat, names: &[String], out: &mut imp
         let mut text = String::new();
         let mut label = String::new();
         write_view(trace, fmt, names, &mut text, &mut buf, &mut label);
+        if trace.views() == Views::SyncCycles && fmt == OutputFormat::Text {
+            super::decode_sync::write_totals(&mut text, &trace.cycles.totals(), names);
+        }
         out.write_all(text.as_bytes())?;
     }
     out.write_all(&buf)

@@ -7,6 +7,7 @@ pub mod decode;
 mod decode_filter;
 mod decode_out;
 mod decode_parquet;
+mod decode_sync;
 pub mod diagnose;
 pub mod explain;
 pub mod gateway;

@@ -213,6 +213,7 @@ impl App {
                 Event::Detail => self.screen.toggle_detail(),
                 Event::Filter(text) => self.screen.show_filtered(self.capture.trace(), &text),
                 Event::Show(pos) => self.screen.show(self.capture.trace(), pos),
+                Event::Select(pos) => self.screen.select_in_trace(self.capture.trace(), pos),
                 Event::Run(line) => self.run_command(&line),
                 Event::Act(a) => self.act(a),
                 Event::Replay(a) => self.capture.replay_key(a, &mut q),

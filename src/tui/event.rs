@@ -35,6 +35,9 @@ pub(crate) enum Event {
     Filter(String),
     /// Show this trace position in the Trace pane, unfiltered.
     Show(usize),
+    /// Select this trace position (or the nearest row the filter shows) in the Trace
+    /// pane, the focus staying where it is.
+    Select(usize),
     /// Run a palette line as if typed.
     Run(String),
     /// Do what an action says, as if its key was pressed.

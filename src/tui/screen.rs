@@ -326,6 +326,13 @@ impl Screen {
         self.panes.trace_mut().select_position(trace, pos, page);
     }
 
+    /// Selects trace position `pos` in the Trace pane (the nearest row its filter
+    /// shows), the focus staying.
+    pub(crate) fn select_in_trace(&mut self, trace: &Trace, pos: usize) {
+        let page = self.page();
+        self.panes.trace_mut().select_position(trace, pos, page);
+    }
+
     /// Shows trace position `pos` in the Trace pane, unfiltered.
     pub(crate) fn show(&mut self, trace: &Trace, pos: usize) {
         let page = self.page();
@@ -589,14 +596,24 @@ impl Screen {
                 self.focus = Pane::Plot;
             }
             // From another pane: the pane that does it comes to the front and takes it
-            // (sorting: the Stats pane; picking, zooming: the Plot pane).
+            // (sorting, SYNC cycles: the Stats pane; picking, zooming: the Plot pane).
             Action::TimeMode | Action::Bookmark | Action::NextBookmark => {
                 self.focus = Pane::Trace;
                 let ctx = self.ctx(trace, paused);
                 self.panes.get_mut(self.focus).handle(a, &ctx, q);
             }
-            Action::Sort | Action::PlotPick | Action::ZoomIn | Action::ZoomOut => {
-                self.focus = if a == Action::Sort { Pane::Stats } else { Pane::Plot };
+            Action::Sort
+            | Action::SyncCycles
+            | Action::SlowestCycle
+            | Action::NextLateCycle
+            | Action::PlotPick
+            | Action::ZoomIn
+            | Action::ZoomOut => {
+                let stats = matches!(
+                    a,
+                    Action::Sort | Action::SyncCycles | Action::SlowestCycle | Action::NextLateCycle
+                );
+                self.focus = if stats { Pane::Stats } else { Pane::Plot };
                 let ctx = self.ctx(trace, paused);
                 self.panes.get_mut(self.focus).handle(a, &ctx, q);
             }

@@ -33,6 +33,7 @@ mod realworld_block;
 mod run;
 mod socketcand_fuzz;
 mod split_logs;
+mod sync_cycles;
 mod track_path;
 mod triggers;
 mod two_buses;

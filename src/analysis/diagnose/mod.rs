@@ -134,14 +134,17 @@ impl Diagnoser {
             bus: Default::default(),
         };
         // Unbound nodes share one dictionary: each distinct one is read once.
-        let mut seen: Vec<(Vec<*const crate::od::Profile>, pdo::SyncDefaults)> = Vec::new();
+        let mut seen: Vec<(
+            Vec<*const crate::od::Profile>,
+            crate::analysis::sync_cycles::SyncDefaults,
+        )> = Vec::new();
         for n in 1..128u8 {
             let dict = dict(n);
             let layers: Vec<_> = dict.layers().iter().map(std::sync::Arc::as_ptr).collect();
             let known = match seen.iter().position(|(l, _)| *l == layers) {
                 Some(i) => i,
                 None => {
-                    seen.push((layers, pdo::sync_defaults(dict)));
+                    seen.push((layers, crate::analysis::sync_cycles::sync_defaults(dict)));
                     seen.len() - 1
                 }
             };

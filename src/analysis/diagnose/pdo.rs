@@ -6,52 +6,15 @@
 use super::Detector;
 use super::timeline::{At, Timeline};
 use crate::analysis::incident::{Problem, Status};
+use crate::analysis::sync_cycles::SyncDefaults;
 use crate::analysis::timing::{PdoGap, PdoKey, PdoTiming, PeriodFrom};
 use crate::decode::heartbeat::NmtState;
 use crate::frame::NodeKey;
-use crate::od::Dictionary;
 use crate::sdo::transaction::{Outcome, Transaction};
 use std::collections::{BTreeMap, HashMap};
 
-/// A dictionary's default sync window (µs) and TPDO transmission types (PDO number, type).
-pub(super) type SyncDefaults = (Option<u64>, Vec<(u16, u8)>);
-
 /// A node-ID's default sync window (ns) and TPDO transmission types, for each interface.
 type NodeDefaults = (u8, Option<u64>, Vec<(u16, u8)>);
-
-/// The sync window (0x1007, µs) and the transmission types of the TPDOs (0x1800.. sub 2)
-/// that `dict` gives as default values (EDS `DefaultValue`, profile `default`).
-pub(super) fn sync_defaults(dict: &Dictionary) -> SyncDefaults {
-    let default = |index: u16, sub: u8| dict.object(index, sub)?.default.as_ref()?.as_i64();
-    let window = default(0x1007, 0)
-        .and_then(|v| u64::try_from(v).ok())
-        .filter(|v| *v > 0);
-    // Only indexes some layer names (objects or index ranges) can have a default.
-    let mut indexes: Vec<u16> = Vec::new();
-    for layer in dict.layers() {
-        indexes.extend(
-            layer
-                .objects
-                .range((0x1800, 2)..=(0x19FF, 2))
-                .filter(|(k, _)| k.1 == 2)
-                .map(|(k, _)| k.0),
-        );
-        for r in layer
-            .ranges
-            .iter()
-            .filter(|r| r.subs.get(&2).is_some_and(|o| o.default.is_some()))
-        {
-            indexes.extend(r.first.max(0x1800)..=r.last.min(0x19FF));
-        }
-    }
-    indexes.sort_unstable();
-    indexes.dedup();
-    let types = indexes
-        .into_iter()
-        .filter_map(|i| Some((i - 0x1800 + 1, u8::try_from(default(i, 2)?).ok()?)))
-        .collect();
-    (window, types)
-}
 
 /// `TPDO3` or `RPDO1`.
 fn pdo_name((_, transmit, num): PdoKey) -> String {

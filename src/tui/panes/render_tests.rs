@@ -87,10 +87,16 @@ fn two_bus_app() -> crate::tui::app::App {
 
 /// [`two_bus_app`] decoding with `decoder`.
 fn two_bus_app_with(decoder: crate::decode::Decoder) -> crate::tui::app::App {
+    log_app("two_buses.log", decoder)
+}
+
+/// An app holding the candump log `tests/fixtures/NAME`, read to its end.
+fn log_app(name: &str, decoder: crate::decode::Decoder) -> crate::tui::app::App {
     use crate::analysis::trace::Trace;
     use crate::tui::app::{SourceInfo, SourceKind};
     let mut trace = Trace::new(decoder, 500_000);
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/two_buses.log")).unwrap();
+    let path = format!("{}/tests/fixtures/{name}", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(path).unwrap();
     for line in text.lines() {
         let mut ifaces = std::mem::take(&mut trace.ifaces);
         if let Ok(crate::log::Line::Frame(f)) = crate::log::candump::parse_line(line.as_bytes(), &mut ifaces) {
@@ -101,9 +107,64 @@ fn two_bus_app_with(decoder: crate::decode::Decoder) -> crate::tui::app::App {
         }
     }
     let (_tx, rx) = std::sync::mpsc::channel();
-    let mut src = SourceInfo::new("two_buses.log", SourceKind::Open, rx, None);
+    let mut src = SourceInfo::new(name, SourceKind::Open, rx, None);
     src.done = true;
     crate::tui::app::App::new(trace, crate::tui::keymap::Keymap::default_map(), src)
+}
+
+/// tests/fixtures/sync_cycles.log: SYNC every 10 ms (one period of 12.5 ms), TPDO1 of
+/// nodes 1 and 2 synchronous, a window of 2000 µs from the second cycle on, one TPDO late
+/// in the second and in the fifth cycle.
+#[test]
+fn sync_cycles_show_lanes_per_tpdo_and_the_keys_jump_to_the_slowest_and_late_cycles() {
+    use crate::decode::Decoder;
+    use crate::od::Dictionary;
+    let mut a = log_app("sync_cycles.log", Decoder::new(Dictionary::default(), Vec::new()));
+    a.act(Action::SyncCycles);
+    assert_eq!(a.focus(), Pane::Stats, "the cycles key brings the Stats pane up");
+    let s = screen(&mut a, 120, 20);
+    assert!(
+        s.contains("SYNC cycles: 6, period mean 10.500 ms, slowest 12.500 ms, 2 late TPDOs in 2 cycles"),
+        "{s}"
+    );
+    assert!(s.contains("   start s  period ms  ctr late      181     182"), "{s}");
+    assert!(s.contains("     0.020     10.000    2    1     +400  +3500!"), "{s}");
+    assert!(s.contains("     0.052     10.000    5    1   +2600!    +900"), "{s}");
+    assert!(
+        s.contains("     0.062          -    6    0     +400    +900"),
+        "the last cycle: {s}"
+    );
+    // TPDO2 of node 1 is event-driven: no lane.
+    assert!(!s.contains("281"), "{s}");
+    insta::assert_snapshot!("sync_cycles_120x20", s);
+    let row = |a: &crate::tui::app::App| match a.selected() {
+        Some(crate::tui::panes::Selected::Frame(p)) => p,
+        other => panic!("{other:?}"),
+    };
+    // The slowest cycle (12.5 ms) opens with the SYNC at frame 19 (0-based position).
+    a.act(Action::SlowestCycle);
+    let sync = |a: &crate::tui::app::App, pos: usize| a.trace().store.frame(pos).id;
+    let slow = row(&a);
+    assert_eq!((slow, sync(&a, slow)), (19, 0x080));
+    // The Trace pane's selection went to that SYNC, the focus stayed.
+    assert_eq!((a.focus(), a.selected_position()), (Pane::Stats, Some(19)));
+    // Detail shows the selected cycle's SYNC.
+    let s = screen(&mut a, 120, 20);
+    assert!(s.contains("SYNC counter 4"), "{s}");
+    // The late jumps: the second cycle, the fifth, then round again.
+    let mut late = Vec::new();
+    for _ in 0..3 {
+        a.act(Action::NextLateCycle);
+        late.push(row(&a));
+    }
+    assert_eq!(late, [11, 22, 11]);
+    // Enter shows the selected cycle's SYNC frame in the trace.
+    a.act(Action::Expand);
+    assert_eq!(a.focus(), Pane::Trace);
+    assert_eq!(a.selected_position(), Some(11));
+    // The cycles key again: the receive list.
+    a.act(Action::SyncCycles);
+    assert!(screen(&mut a, 120, 20).contains("Receive list by cob-id"));
 }
 
 #[test]

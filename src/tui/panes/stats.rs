@@ -82,9 +82,13 @@ pub fn changed(prev: Option<&[u8]>, cur: &[u8]) -> Vec<bool> {
         .collect()
 }
 
-/// The Stats pane's state: the selection, the sort, the labels decoded.
+/// The Stats pane's state: the selection, the sort, the labels decoded; or the SYNC
+/// cycles view in its place.
 #[derive(Default)]
 pub struct StatsPane {
+    /// The SYNC cycles view, shown instead of the receive list while `show_cycles`.
+    cycles: super::cycles::CyclesView,
+    show_cycles: bool,
     /// Scroll state.
     list: ListState,
     /// The order of the rows.
@@ -97,7 +101,24 @@ pub struct StatsPane {
 impl Component for StatsPane {
     /// Moves the selection; `sort` cycles the order; `expand` shows the selected COB-ID's
     /// frames in the trace.
+    /// `sync_cycles` shows the SYNC cycles instead (again: the receive list), and the
+    /// cycle jumps show them; there `sort` goes back to the receive list.
     fn handle(&mut self, action: Action, ctx: &Ctx, q: &mut Queue) -> bool {
+        match action {
+            Action::SyncCycles => {
+                self.show_cycles = !self.show_cycles;
+                return true;
+            }
+            Action::SlowestCycle | Action::NextLateCycle => self.show_cycles = true,
+            Action::Sort if self.show_cycles => {
+                self.show_cycles = false;
+                return true;
+            }
+            _ => {}
+        }
+        if self.show_cycles {
+            return self.cycles.handle(action, ctx, q);
+        }
         if let Some(delta) = ListState::movement(action, ctx.page) {
             self.scroll(delta, ctx);
             return true;
@@ -116,25 +137,40 @@ impl Component for StatsPane {
     }
 
     fn scroll(&mut self, delta: isize, ctx: &Ctx) {
+        if self.show_cycles {
+            return self.cycles.scroll(delta, ctx);
+        }
         self.list.scroll(delta, ctx.trace.stats.len(), ctx.page);
     }
 
     fn click(&mut self, row: usize, ctx: &Ctx) {
+        if self.show_cycles {
+            return self.cycles.click(row, ctx);
+        }
         self.list.click(row, ctx.trace.stats.len(), ctx.page);
     }
 
     fn fit(&mut self, height: usize, ctx: &Ctx) {
+        if self.show_cycles {
+            return self.cycles.fit(height, ctx);
+        }
         self.list.clamp(ctx.trace.stats.len(), height);
     }
 
     /// The Detail view shows the selected COB-ID's latest frame.
     fn selected(&self, ctx: &Ctx) -> Option<super::Selected> {
+        if self.show_cycles {
+            return self.cycles.selected(ctx);
+        }
         let rows = sorted(&ctx.trace.stats, self.sort);
         rows.get(self.list.selected)
             .map(|(_, s)| super::Selected::Frame(s.last_pos))
     }
 
     fn render(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
+        if self.show_cycles {
+            return self.cycles.render(f, area, ctx, focused);
+        }
         let st = &ctx.trace.stats;
         let rate = st.bitrate();
         let assumed = if rate.source == BitrateSource::Assumed {
