@@ -7,6 +7,7 @@ mod decode_filter;
 mod decode_out;
 mod decode_parquet;
 pub mod diagnose;
+mod expect;
 pub mod explain;
 pub mod gateway;
 pub mod input;
