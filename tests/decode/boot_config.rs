@@ -114,6 +114,31 @@ fn a_second_boot_that_differs_has_one_finding_of_each_kind_and_check_fails() {
 }
 
 #[test]
+fn a_boot_cut_short_by_the_end_of_the_capture_has_no_missing_writes() {
+    // Boot 2 writes 0x1017, then 0x1800:02 gets no answer before the capture ends; the
+    // reference's 0x1400:02 and 0x2000:01 are not "missing" (the boot did not finish).
+    let (incidents, code) = jsonl(&["--check", "tests/fixtures/boot/boot_cut.log"]);
+    assert_eq!(code, 1);
+    let found = boot_config(&incidents);
+    assert_eq!(found.len(), 1, "{incidents:?}");
+    assert_eq!(
+        found[0]["findings"],
+        json!([{"against": "reference", "frame": 17, "index": "0x1800", "kind": "unanswered", "reference": "0x01",
+                "reference_boot": 1, "subindex": 2, "t": 1.12, "value": "0x01"}])
+    );
+    let text =
+        String::from_utf8(cotui(&["diagnose", "--boots", "tests/fixtures/boot/boot_cut.log"], None).stdout).unwrap();
+    assert!(
+        text.contains("Node 5, boot 2 at 1.000 s, did not reach operational\n"),
+        "{text}"
+    );
+    assert!(
+        text.contains("      1.120 s  #17      write 0x1800:02 = 0x01  not answered\n"),
+        "{text}"
+    );
+}
+
+#[test]
 fn expect_compares_every_boot_with_the_dcf() {
     // Both boots write what the DCF says except 0x2002 (not its default); 0x2000:01 is at
     // its default and is written with it; 0x1018:01 is read-only.
