@@ -139,6 +139,23 @@ fn a_boot_cut_short_by_the_end_of_the_capture_has_no_missing_writes() {
 }
 
 #[test]
+fn across_the_files_of_one_run_the_first_files_boot_is_the_reference() {
+    // boots_differ.log cut in two: the first file holds boot 1, the second boot 2.
+    let (incidents, code) = jsonl(&[
+        "--check",
+        "tests/fixtures/boot/run_part1.log",
+        "tests/fixtures/boot/run_part2.log",
+    ]);
+    assert_eq!(code, 1);
+    let found = boot_config(&incidents);
+    assert_eq!(found.len(), 1, "{incidents:?}");
+    assert_eq!(
+        found[0]["title"],
+        "Boot 2 configured otherwise than boot 1 (1 different, 1 missing, 1 extra, 1 refused, 1 unanswered)"
+    );
+}
+
+#[test]
 fn expect_compares_every_boot_with_the_dcf() {
     // Both boots write what the DCF says except 0x2002 (not its default); 0x2000:01 is at
     // its default and is written with it; 0x1018:01 is read-only.

@@ -13,10 +13,14 @@ use crate::analysis::boot_story::{
 use crate::analysis::incident::{Problem, Status};
 use crate::frame::NodeKey;
 use crate::sdo::transaction::{Outcome, Transaction, TransferDirection};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// A boot-up this soon after an NMT reset answers it (the same boot).
 const RESET_BOOT_NS: u64 = 5_000 * MS;
+/// Boots kept per node: a node's later boots are not told (memory stays bounded).
+const MAX_BOOTS: usize = 1_000;
+/// Steps kept per boot (real boots write a few hundred objects at most).
+const MAX_STEPS: usize = 10_000;
 
 /// The boot stories of a capture and the expected configurations.
 #[derive(Clone, Default)]
@@ -26,11 +30,17 @@ pub(super) struct BootConfigs {
     reset_all: BTreeMap<u16, (At, &'static str)>,
     /// Expected values by node-ID (any interface).
     expected: BTreeMap<u8, Vec<Expected>>,
+    /// Nodes that booted more than [`MAX_BOOTS`] times: nothing more is told of them.
+    full: BTreeSet<NodeKey>,
+    /// Nodes whose last boot has not reached Operational yet.
+    awaiting: BTreeSet<NodeKey>,
 }
 
-/// The boot still going on (not Operational yet), if any.
+/// The boot still going on (not Operational yet) with room for one more step, if any.
 fn open_boot(boots: &mut [Boot]) -> Option<&mut Boot> {
-    boots.last_mut().filter(|b| b.operational.is_none())
+    boots
+        .last_mut()
+        .filter(|b| b.operational.is_none() && b.steps.len() < MAX_STEPS)
 }
 
 impl BootConfigs {
@@ -42,6 +52,12 @@ impl BootConfigs {
     /// A new boot of `n` beginning at `at` with `first`.
     fn begin(&mut self, n: NodeKey, at: At, first: BootStep) {
         let boots = self.stories.entry(n).or_default();
+        if boots.len() >= MAX_BOOTS {
+            self.full.insert(n);
+            self.awaiting.remove(&n);
+            return;
+        }
+        self.awaiting.insert(n);
         boots.push(Boot {
             node: n,
             number: boots.len() as u32 + 1,
@@ -56,6 +72,9 @@ impl BootConfigs {
 
     /// The boot-up message of `n` (the frame being read).
     pub(super) fn boot_up(&mut self, tl: &Timeline, n: NodeKey) {
+        if self.full.contains(&n) {
+            return;
+        }
         let at = tl.at;
         let step = BootStep::BootUp {
             frame: at.frame,
@@ -108,6 +127,9 @@ impl BootConfigs {
             self.reset_all.insert(iface, (at, command));
         }
         for n in nodes {
+            if self.full.contains(&n) {
+                continue;
+            }
             if reset {
                 self.begin(n, at, step.clone());
             } else if let Some(b) = self.stories.get_mut(&n).and_then(|b| open_boot(b)) {
@@ -118,7 +140,16 @@ impl BootConfigs {
 
     /// `n` showed it is Operational (`by`: heartbeat or TPDO): its boot is complete.
     pub(super) fn operational(&mut self, tl: &Timeline, n: NodeKey, by: &'static str) {
-        if let Some(b) = self.stories.get_mut(&n).and_then(|b| open_boot(b)) {
+        // Every heartbeat and TPDO comes here: once all boots are complete, nothing to do.
+        if self.awaiting.is_empty() || !self.awaiting.remove(&n) {
+            return;
+        }
+        if let Some(b) = self
+            .stories
+            .get_mut(&n)
+            .and_then(|b| b.last_mut())
+            .filter(|b| b.operational.is_none())
+        {
             b.operational = Some(Operational {
                 frame: tl.at.frame,
                 t_ns: tl.at.t,
@@ -159,12 +190,15 @@ impl BootConfigs {
 impl Detector for BootConfigs {
     /// A download to a node during one of its boots is a configuration write.
     fn transaction(&mut self, tl: &mut Timeline, t: &Transaction) {
-        if t.direction != TransferDirection::Download {
+        if t.direction != TransferDirection::Download || self.full.contains(&t.key()) {
             return;
         }
         let Some(b) = self.stories.get_mut(&t.key()).and_then(|b| b.last_mut()) else {
             return;
         };
+        if b.steps.len() >= MAX_STEPS {
+            return;
+        }
         // A transfer that ended later (left unanswered) belongs to the boot it began in.
         if t.start_ns < b.t_ns || b.operational.is_some_and(|op| t.start_ns > op.t_ns) {
             return;
