@@ -109,9 +109,13 @@ impl Boot {
         })
     }
 
-    /// The last write of each object, by (index, sub).
+    /// The last write of each object that is configuration (not a command or a
+    /// set-point: [`crate::od::not_configuration`]), by (index, sub).
     fn last_writes(&self) -> BTreeMap<(u16, u8), &Write> {
-        self.writes().map(|w| ((w.index, w.sub), w)).collect()
+        self.writes()
+            .filter(|w| crate::od::not_configuration(w.index).is_none())
+            .map(|w| ((w.index, w.sub), w))
+            .collect()
     }
 }
 
@@ -636,8 +640,11 @@ mod tests {
                 write(0x1800, &[1], WriteResult::Refused("no".into())),
                 write(0x1801, &[1], WriteResult::Unanswered),
                 write(0x2000, &[7], ok.clone()),
+                // A command (store all) is in the story, not compared.
+                write(0x1010, &[0x73, 0x61, 0x76, 0x65], ok.clone()),
             ],
         );
+        assert_eq!(b.writes().count(), 6);
         let got: Vec<String> = against_reference(&b, &r).iter().map(Finding::text).collect();
         assert_eq!(
             got,
