@@ -32,6 +32,55 @@ impl WriteResult {
     }
 }
 
+/// Bytes of a written value kept (a longer one, e.g. a domain, is kept as its length and
+/// a digest of all its bytes, so memory stays small).
+pub const DATA_KEPT: usize = 64;
+
+/// A value written: its first [`DATA_KEPT`] bytes, its length and a digest of all of it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Bytes {
+    /// The first bytes (little-endian, as on the wire).
+    pub head: Vec<u8>,
+    /// All bytes.
+    pub len: usize,
+    /// FNV-1a of all bytes.
+    digest: u64,
+}
+
+impl Bytes {
+    /// The value of `b`.
+    pub fn of(b: &[u8]) -> Bytes {
+        let digest = b.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, x| {
+            (h ^ u64::from(*x)).wrapping_mul(0x100_0000_01b3)
+        });
+        Bytes {
+            head: b[..b.len().min(DATA_KEPT)].to_vec(),
+            len: b.len(),
+            digest,
+        }
+    }
+
+    /// The same value: numbers (up to 8 bytes) compared as numbers are, the shorter one
+    /// padded with zero bytes (a client may send a 16-bit value in 4 bytes); longer values
+    /// byte for byte.
+    pub fn same(&self, other: &Bytes) -> bool {
+        if self.len <= 8 && other.len <= 8 {
+            same_bytes(&self.head, &other.head)
+        } else {
+            self.len == other.len && self.digest == other.digest
+        }
+    }
+
+    /// The value in words ([`value_text`]; a longer one cut, with its length).
+    pub fn text(&self) -> String {
+        let mut s = value_text(&self.head);
+        if self.len > self.head.len() {
+            let _ = write!(s, " … ({} bytes)", self.len);
+        }
+        s
+    }
+}
+
 /// One SDO download to the node during a boot.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Write {
@@ -41,8 +90,8 @@ pub struct Write {
     pub t_ns: u64,
     pub index: u16,
     pub sub: u8,
-    /// The bytes written (little-endian).
-    pub data: Vec<u8>,
+    /// The value written.
+    pub data: Bytes,
     pub result: WriteResult,
 }
 
@@ -125,7 +174,7 @@ pub struct Expected {
     pub index: u16,
     pub sub: u8,
     /// The value (little-endian bytes of its type).
-    pub bytes: Vec<u8>,
+    pub bytes: Bytes,
     /// The value differs from the object's default: a boot must write it.
     pub must_write: bool,
 }
@@ -175,24 +224,23 @@ pub struct Finding {
     pub index: u16,
     pub sub: u8,
     /// The value this boot wrote (None: not written).
-    pub value: Option<Vec<u8>>,
+    pub value: Option<Bytes>,
     /// The reference's or expected value (None: none there).
-    pub wanted: Option<Vec<u8>>,
+    pub wanted: Option<Bytes>,
     /// The abort text of a refused write.
     pub abort: Option<String>,
     /// Frame and time of this boot's write (None: not written).
     pub at: Option<(u64, u64)>,
 }
 
-/// Whether two writes hold the same value: compared as numbers are, the shorter one
-/// padded with zero bytes (a client may send a 16-bit value in 4 bytes).
-pub fn same_bytes(a: &[u8], b: &[u8]) -> bool {
+/// Whether two values hold the same number: the shorter one padded with zero bytes.
+fn same_bytes(a: &[u8], b: &[u8]) -> bool {
     let at = |v: &[u8], i: usize| v.get(i).copied().unwrap_or(0);
     (0..a.len().max(b.len())).all(|i| at(a, i) == at(b, i))
 }
 
 /// The finding of a write that did not go through, if it did not.
-fn failed(w: &Write, against: Against, wanted: Option<&[u8]>) -> Option<Finding> {
+fn failed(w: &Write, against: Against, wanted: Option<&Bytes>) -> Option<Finding> {
     let (kind, abort) = match &w.result {
         WriteResult::Ok => return None,
         WriteResult::Refused(text) => (FindingKind::Refused, Some(text.clone())),
@@ -204,21 +252,21 @@ fn failed(w: &Write, against: Against, wanted: Option<&[u8]>) -> Option<Finding>
         index: w.index,
         sub: w.sub,
         value: Some(w.data.clone()),
-        wanted: wanted.map(<[u8]>::to_vec),
+        wanted: wanted.cloned(),
         abort,
         at: Some((w.frame, w.t_ns)),
     })
 }
 
 /// A finding of write `w` (or of none) against `against`.
-fn finding(kind: FindingKind, against: Against, key: (u16, u8), w: Option<&Write>, wanted: Option<&[u8]>) -> Finding {
+fn finding(kind: FindingKind, against: Against, key: (u16, u8), w: Option<&Write>, wanted: Option<&Bytes>) -> Finding {
     Finding {
         kind,
         against,
         index: key.0,
         sub: key.1,
         value: w.map(|w| w.data.clone()),
-        wanted: wanted.map(<[u8]>::to_vec),
+        wanted: wanted.cloned(),
         abort: None,
         at: w.map(|w| (w.frame, w.t_ns)),
     }
@@ -234,7 +282,7 @@ pub fn against_reference(boot: &Boot, reference: &Boot) -> Vec<Finding> {
     let mut out = Vec::new();
     for (key, w) in &mine {
         let r = theirs.get(key);
-        let wanted = r.map(|r| r.data.as_slice());
+        let wanted = r.map(|r| &r.data);
         if let Some(f) = failed(w, against, wanted) {
             // A write refused the same way in the reference is how the node is.
             if r.is_none_or(|r| r.result != w.result) {
@@ -244,7 +292,7 @@ pub fn against_reference(boot: &Boot, reference: &Boot) -> Vec<Finding> {
         }
         match r {
             None => out.push(finding(FindingKind::Extra, against, *key, Some(w), None)),
-            Some(r) if r.result == WriteResult::Ok && !same_bytes(&w.data, &r.data) => {
+            Some(r) if r.result == WriteResult::Ok && !w.data.same(&r.data) => {
                 out.push(finding(FindingKind::Different, against, *key, Some(w), wanted))
             }
             Some(_) => {}
@@ -271,16 +319,14 @@ pub fn against_expected(boot: &Boot, expected: &[Expected]) -> Vec<Finding> {
     let want: BTreeMap<(u16, u8), &Expected> = expected.iter().map(|e| ((e.index, e.sub), e)).collect();
     let mut out = Vec::new();
     for (key, w) in &mine {
-        let e = want.get(key).map(|e| e.bytes.as_slice());
+        let e = want.get(key).map(|e| &e.bytes);
         if let Some(f) = failed(w, against, e) {
             out.push(f);
             continue;
         }
         match e {
             None => out.push(finding(FindingKind::Extra, against, *key, Some(w), None)),
-            Some(e) if !same_bytes(&w.data, e) => {
-                out.push(finding(FindingKind::Different, against, *key, Some(w), Some(e)))
-            }
+            Some(e) if !w.data.same(e) => out.push(finding(FindingKind::Different, against, *key, Some(w), Some(e))),
             Some(_) => {}
         }
     }
@@ -326,8 +372,8 @@ impl Finding {
     /// What it is, in words: `0x1017:00 written 0x03E8, boot 1 wrote 0x01F4`.
     pub fn text(&self) -> String {
         let obj = object_text(self.index, self.sub);
-        let value = self.value.as_deref().map(value_text).unwrap_or_default();
-        let wanted = self.wanted.as_deref().map(value_text).unwrap_or_default();
+        let value = self.value.as_ref().map(Bytes::text).unwrap_or_default();
+        let wanted = self.wanted.as_ref().map(Bytes::text).unwrap_or_default();
         let (had, lacks) = match self.against {
             Against::Reference(n) => (format!("boot {n} wrote"), format!("boot {n} did not write it")),
             Against::Expected => ("the DCF says".to_string(), "the DCF does not have it".to_string()),
@@ -346,7 +392,7 @@ impl Finding {
 
     /// The JSON object of a finding (times since `origin`).
     pub fn to_json(&self, origin: u64) -> FindingJson<'_> {
-        let wanted = self.wanted.as_deref().map(value_text);
+        let wanted = self.wanted.as_ref().map(Bytes::text);
         let (reference, expected) = match self.against {
             Against::Reference(_) => (wanted, None),
             Against::Expected => (None, wanted),
@@ -368,7 +414,7 @@ impl Finding {
             },
             subindex: self.sub,
             t: self.at.map(|a| secs(a.1, origin)),
-            value: self.value.as_deref().map(value_text),
+            value: self.value.as_ref().map(Bytes::text),
         }
     }
 }
@@ -473,7 +519,7 @@ impl Boot {
                         (j.frame, j.t) = (w.frame, secs(w.t_ns, origin));
                         j.index = Some(format!("0x{:04X}", w.index));
                         j.subindex = Some(w.sub);
-                        j.value = Some(value_text(&w.data));
+                        j.value = Some(w.data.text());
                         j.result = Some(w.result.as_str());
                         if let WriteResult::Refused(text) = &w.result {
                             j.abort = Some(text.clone());
@@ -535,7 +581,7 @@ impl Boot {
                         t(w.t_ns),
                         w.frame,
                         object_text(w.index, w.sub),
-                        value_text(&w.data)
+                        w.data.text()
                     );
                     match &w.result {
                         WriteResult::Ok => out.push('\n'),
@@ -596,7 +642,7 @@ mod tests {
             t_ns: 0,
             index,
             sub: 0,
-            data: data.to_vec(),
+            data: Bytes::of(data),
             result,
         })
     }
@@ -664,5 +710,19 @@ mod tests {
             ..short
         };
         assert!(against_reference(&cut, &r).is_empty());
+    }
+
+    #[test]
+    fn a_long_value_is_kept_short_and_compared_whole() {
+        let mut long = vec![0x41u8; 100];
+        let a = Bytes::of(&long);
+        long[90] = 0x42;
+        let b = Bytes::of(&long);
+        assert_eq!(a.head.len(), DATA_KEPT);
+        assert!(!a.same(&b) && a.same(&Bytes::of(&[0x41; 100])));
+        assert!(a.text().ends_with("41 41 … (100 bytes)"), "{}", a.text());
+        // Numbers: one sent in 4 bytes is the same as in 2.
+        assert!(Bytes::of(&[0xE8, 0x03]).same(&Bytes::of(&[0xE8, 0x03, 0, 0])));
+        assert_eq!(Bytes::of(&[0xE8, 0x03]).text(), "0x03E8");
     }
 }

@@ -1,7 +1,7 @@
 //! `diagnose --expect NODE=FILE.dcf`: a DCF read as the configuration a node's boots
 //! should write, typed here at the edge so the diagnosis gets plain values.
 
-use crate::analysis::boot_story::Expected;
+use crate::analysis::boot_story::{Bytes, Expected};
 use crate::command::dcf::plan::{never_written, read_dcf, same_value, value_bytes};
 use crate::od::eds::{import, key_values};
 use crate::od::{Access, Dictionary};
@@ -36,7 +36,7 @@ pub fn read<'a>(arg: &str, dict: impl Fn(u8) -> &'a Dictionary) -> Result<(u8, V
                 index: v.index,
                 sub: v.sub,
                 must_write: default.is_none_or(|d| !same_value(v.data_type, &v.bytes, &d)),
-                bytes: v.bytes,
+                bytes: Bytes::of(&v.bytes),
             }
         })
         .collect();

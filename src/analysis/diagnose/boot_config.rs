@@ -7,7 +7,7 @@
 use super::Detector;
 use super::timeline::{At, MS, Timeline};
 use crate::analysis::boot_story::{
-    Against, Boot, BootStep, Expected, FindingKind, Operational, Write, WriteResult, against_expected,
+    Against, Boot, BootStep, Bytes, Expected, FindingKind, Operational, Write, WriteResult, against_expected,
     against_reference,
 };
 use crate::analysis::incident::{Problem, Status};
@@ -18,9 +18,9 @@ use std::collections::{BTreeMap, BTreeSet};
 /// A boot-up this soon after an NMT reset answers it (the same boot).
 const RESET_BOOT_NS: u64 = 5_000 * MS;
 /// Boots kept per node: a node's later boots are not told (memory stays bounded).
-const MAX_BOOTS: usize = 1_000;
+const MAX_BOOTS: usize = 200;
 /// Steps kept per boot (real boots write a few hundred objects at most).
-const MAX_STEPS: usize = 10_000;
+const MAX_STEPS: usize = 2_000;
 
 /// The boot stories of a capture and the expected configurations.
 #[derive(Clone, Default)]
@@ -220,7 +220,7 @@ impl Detector for BootConfigs {
                 t_ns: t.start_ns,
                 index: t.index,
                 sub: t.sub,
-                data: t.data.clone(),
+                data: Bytes::of(&t.data),
                 result,
             }),
         );
