@@ -44,7 +44,8 @@ pub struct DiagnoseArgs {
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     pub format: DiagnoseFormat,
-    /// Exit status 1 when an incident is still open at the end of the capture.
+    /// Exit status 1 when an incident is still open at the end of the capture (a boot
+    /// configured otherwise than its reference or --expect is one).
     #[arg(long)]
     pub check: bool,
     /// Bind a device profile to a node: NODE=NAME (a name in decoders/ or a JSON path).
