@@ -101,7 +101,13 @@ impl BootConfigs {
                 all: true,
             };
             self.begin(n, reset, nmt);
-            if let Some(b) = self.stories.get_mut(&n).and_then(|b| b.last_mut()) {
+            // (Not when the node has no room for a new boot: nothing more is told of it.)
+            if let Some(b) = self
+                .stories
+                .get_mut(&n)
+                .filter(|_| !self.full.contains(&n))
+                .and_then(|b| open_boot(b))
+            {
                 b.steps.push(step);
             }
             return;
