@@ -2,6 +2,7 @@
 //! Built by [`super::diagnose::Diagnoser`]; rendered as text (`cotui diagnose`) and as one
 //! JSON object per incident (`--format jsonl`, field names are a public API).
 
+use super::boot_story::{Finding, FindingJson};
 use serde::Serialize;
 use std::fmt::Write;
 
@@ -73,6 +74,9 @@ pub enum Problem {
     SecondMaster,
     /// A synchronous TPDO sent after the SYNC window (0x1007) closed.
     PdoLate,
+    /// A boot whose configuration writes differ from the node's first complete boot or
+    /// from the expected configuration (`--expect NODE=FILE.dcf`).
+    BootConfig,
     /// Entries a node does not have, asked for by reads the capturing host sent (cotui's
     /// own, or TX-marked in a log): one info row per node, not an incident per entry.
     NotPresent,
@@ -80,7 +84,7 @@ pub enum Problem {
 
 impl Problem {
     /// Every kind, in declaration order (the one list; a test holds it to the enum).
-    pub const ALL: [Problem; 19] = [
+    pub const ALL: [Problem; 20] = [
         Problem::Missing,
         Problem::Silent,
         Problem::SilentBack,
@@ -99,6 +103,7 @@ impl Problem {
         Problem::SyncJitter,
         Problem::SecondMaster,
         Problem::PdoLate,
+        Problem::BootConfig,
         Problem::NotPresent,
     ];
 
@@ -123,6 +128,7 @@ impl Problem {
             Problem::SyncJitter => "sync_jitter",
             Problem::SecondMaster => "second_master",
             Problem::PdoLate => "pdo_late",
+            Problem::BootConfig => "boot_config",
             Problem::NotPresent => "not_present",
         }
     }
@@ -171,6 +177,8 @@ pub struct Incident {
     pub first_ns: u64,
     /// Last occurrence (ns).
     pub last_ns: u64,
+    /// What differs, object by object (a `boot_config` incident only).
+    pub findings: Vec<Finding>,
 }
 
 /// Seconds since `origin` with µs precision, for JSON.
@@ -232,6 +240,7 @@ impl Incident {
                     text: &e.text,
                 })
                 .collect(),
+            findings: self.findings.iter().map(|f| f.to_json(origin)).collect(),
             first: secs(self.first_ns, origin),
             iface: self.iface_name.as_deref().filter(|_| self.node.is_some()),
             kind: self.problem.as_str(),
@@ -288,6 +297,9 @@ pub struct IncidentJson<'a> {
     pub count: u64,
     /// The timeline (the first steps).
     pub events: Vec<StepJson<'a>>,
+    /// What differs, object by object (`boot_config` only; absent otherwise).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub findings: Vec<FindingJson<'a>>,
     /// Seconds since the capture's first frame.
     pub first: f64,
     /// The node's interface, only when the capture has several interfaces.

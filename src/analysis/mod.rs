@@ -5,6 +5,7 @@
 //! frames and their timestamps in, typed events and incidents out; time only advances
 //! through frame timestamps and explicit ticks.
 
+pub mod boot_story;
 pub mod diagnose;
 pub mod duration;
 pub mod events;

@@ -2,6 +2,7 @@
 //! ranked list of incidents.
 
 use super::input;
+use crate::analysis::boot_story::Boot;
 use crate::analysis::trace::{Trace, Views};
 use crate::analysis::{Incident, Status};
 use crate::command::ExitCode;
@@ -43,7 +44,8 @@ pub struct DiagnoseArgs {
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     pub format: DiagnoseFormat,
-    /// Exit status 1 when an incident is still open at the end of the capture.
+    /// Exit status 1 when an incident is still open at the end of the capture (a boot
+    /// configured otherwise than its reference or --expect is one).
     #[arg(long)]
     pub check: bool,
     /// Bind a device profile to a node: NODE=NAME (a name in decoders/ or a JSON path).
@@ -52,6 +54,14 @@ pub struct DiagnoseArgs {
     /// Bind an EDS/DCF file to a node: NODE=FILE.
     #[arg(long = "eds", value_name = "NODE=FILE")]
     pub eds: Vec<String>,
+    /// The configuration a node's boots should write: NODE=FILE.dcf (the ParameterValue
+    /// of each writable object; one equal to its DefaultValue need not be written).
+    #[arg(long = "expect", value_name = "NODE=FILE")]
+    pub expect: Vec<String>,
+    /// List each node's boots (boot-up or NMT reset up to Operational) with their
+    /// configuration writes, NMT commands and findings, instead of the incidents.
+    #[arg(long)]
+    pub boots: bool,
 }
 
 /// Runs `cotui diagnose`; returns the exit status.
@@ -63,7 +73,25 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
             return ExitCode::Usage;
         }
     };
+    let mut expected = Vec::new();
+    for arg in &args.expect {
+        match super::expect::read(arg, |n| decoder.dictionary(n)) {
+            Ok((node, values, warnings)) => {
+                for w in warnings {
+                    eprintln!("cotui diagnose: warning: {w}");
+                }
+                expected.push((node, values));
+            }
+            Err(e) => {
+                eprintln!("cotui diagnose: {e}");
+                return ExitCode::Usage;
+            }
+        }
+    }
     let mut trace = Trace::headless(decoder, Views::Diagnosis);
+    for (node, values) in expected {
+        trace.diagnosis.expect(node, values);
+    }
     if args.duration.is_some() && args.live.is_none() {
         eprintln!("cotui diagnose: --duration needs --live IFACE (a log ends by itself)");
         return ExitCode::Usage;
@@ -114,8 +142,16 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
     let diag = trace.diagnosis;
     let origin = diag.origin_ns();
     let frames = diag.frames();
-    let incidents = diag.finish();
+    let (incidents, boots) = diag.finish_with_boots();
     let out = match args.format {
+        DiagnoseFormat::Text if args.boots => boots_report(&boots, origin).into_bytes(),
+        DiagnoseFormat::Jsonl if args.boots => {
+            let mut out = Vec::new();
+            for b in &boots {
+                write_line(&mut out, &b.to_json(origin));
+            }
+            out
+        }
         DiagnoseFormat::Text => report(&incidents, origin, frames).into_bytes(),
         DiagnoseFormat::Jsonl => {
             let mut out = Vec::new();
@@ -220,6 +256,30 @@ mod live {
             trace.tick(clock.now_ns());
             Ok(())
         })
+    }
+}
+
+/// The text of `--boots`: a headline with the counts, then one block per boot.
+fn boots_report(boots: &[Boot], origin: u64) -> String {
+    let nodes: std::collections::BTreeSet<_> = boots.iter().map(|b| b.node).collect();
+    let differ = boots.iter().filter(|b| !b.findings.is_empty()).count();
+    let mut out = format!(
+        "{} of {}, {differ} with findings.\n",
+        plural(boots.len(), "boot"),
+        plural(nodes.len(), "node")
+    );
+    for b in boots {
+        out.push('\n');
+        b.write_text(origin, &mut out);
+    }
+    out
+}
+
+fn plural(n: usize, one: &str) -> String {
+    if n == 1 {
+        format!("1 {one}")
+    } else {
+        format!("{n} {one}s")
     }
 }
 

@@ -9,6 +9,7 @@ mod decode_out;
 mod decode_parquet;
 mod decode_sync;
 pub mod diagnose;
+mod expect;
 pub mod explain;
 pub mod gateway;
 pub mod input;

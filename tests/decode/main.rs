@@ -7,6 +7,7 @@
 
 mod architecture;
 mod bench_scratch;
+mod boot_config;
 mod bounded_memory;
 mod cut_short;
 mod decode_golden;

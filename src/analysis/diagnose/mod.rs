@@ -6,16 +6,18 @@
 //! requests left unanswered, CiA 402 faults with their cause (EMCY, 0x603F) and the fault
 //! resets that followed, EMCY not tied to a fault, CAN error frames and controller states,
 //! duplicate node-IDs (boot-ups close together, conflicting heartbeat states) and NMT
-//! commands a node did not follow.
+//! commands a node did not follow; boots whose configuration writes differ from the
+//! node's first complete boot or from an expected configuration.
 //!
 //! [`Diagnoser`] is the facade: it routes each frame, transaction and event to the
 //! detectors concerned, one module per kind of incident (`heartbeat`, `boot`, `sdo`,
-//! `masters`, `drive`, `emcy`, `pdo`, `sync`, `bus`), in a fixed order (the incidents'
+//! `masters`, `drive`, `emcy`, `pdo`, `sync`, `bus`, `boot_config`), in a fixed order (the incidents'
 //! order depends on it). They share the clock, the node table and the incident book
 //! (`timeline`); the words of each kind are a table (`texts`), the report's order is
 //! `rank`'s.
 
 mod boot;
+mod boot_config;
 mod bus;
 mod drive;
 mod emcy;
@@ -28,9 +30,11 @@ mod sync;
 mod texts;
 mod timeline;
 
+use super::boot_story::{Boot, Expected};
 use super::events::{Event, What};
 use super::incident::Incident;
 use super::liveness::EventTracker;
+use crate::decode::heartbeat::NmtState;
 use crate::decode::sdo::frame::SdoFrame;
 use crate::decode::{Body, Decoded, Decoder, Kind};
 use crate::frame::{Flags, Frame, NodeKey};
@@ -75,6 +79,7 @@ pub struct Diagnoser {
     pdos: pdo::Pdos,
     syncs: sync::Syncs,
     bus: bus::Bus,
+    boot_configs: boot_config::BootConfigs,
 }
 
 /// One frame of interface `iface` into the diagnosis, decoded only as far as it can tell
@@ -132,6 +137,7 @@ impl Diagnoser {
             pdos: Default::default(),
             syncs: Default::default(),
             bus: Default::default(),
+            boot_configs: Default::default(),
         };
         // Unbound nodes share one dictionary: each distinct one is read once.
         let mut seen: Vec<(
@@ -153,6 +159,12 @@ impl Diagnoser {
         d.pdos.apply_defaults(0);
         d.ifaces_seen = 1;
         d
+    }
+
+    /// Node `node` (on any interface) should be configured with `values` (a DCF's, typed):
+    /// every boot is compared with them too.
+    pub fn expect(&mut self, node: u8, values: Vec<Expected>) {
+        self.boot_configs.expect(node, values);
     }
 
     /// Names interface `iface` (as the frames of the source call it); a node of a capture
@@ -247,6 +259,7 @@ impl Diagnoser {
             _ => {}
         }
         if let (Kind::Tpdo, Some(n)) = (kind, node) {
+            self.boot_configs.operational(&self.tl, n, "TPDO");
             let at = self.tl.at;
             let node = self.tl.node(n);
             node.heard = true;
@@ -289,6 +302,11 @@ impl Diagnoser {
                 if let Some(s) = h.state {
                     self.heartbeats.heartbeat(tl, n, s);
                     self.boots.heartbeat(tl, n, s);
+                    match s {
+                        NmtState::BootUp => self.boot_configs.boot_up(tl, n),
+                        NmtState::Operational => self.boot_configs.operational(tl, n, "heartbeat"),
+                        _ => {}
+                    }
                 }
             }
             Body::Emcy(e) => {
@@ -299,6 +317,7 @@ impl Diagnoser {
             Body::Pdo(p) => {
                 if p.transmit {
                     tl.node(n).heard = true;
+                    self.boot_configs.operational(tl, n, "TPDO");
                 }
                 self.pdos.arrived(tl, n, p.transmit, p.num, self.syncs.last);
                 let mut words = Vec::new();
@@ -353,6 +372,8 @@ impl Diagnoser {
         }
         self.masters.nmt(&mut self.tl, cs, target, command);
         self.boots.command(&mut self.tl, command, state, target);
+        self.boot_configs
+            .command(&self.tl, command, target, state == NmtState::BootUp);
     }
 
     /// A bus event of the liveness tracker.
@@ -393,7 +414,12 @@ impl Diagnoser {
                 self.drives.word(tl, &mut self.emcys, t.key(), t.index, v as u16);
             }
         }
-        let detectors: [&mut dyn Detector; 3] = [&mut self.pdos, &mut self.heartbeats, &mut self.sdos];
+        let detectors: [&mut dyn Detector; 4] = [
+            &mut self.pdos,
+            &mut self.heartbeats,
+            &mut self.sdos,
+            &mut self.boot_configs,
+        ];
         for d in detectors {
             d.transaction(tl, t);
         }
@@ -427,7 +453,13 @@ impl Diagnoser {
 
     /// The end of the capture: what is still wrong is open. Returns the incidents ranked,
     /// open first, then recovered, then warnings; each by time.
-    pub fn finish(mut self) -> Vec<Incident> {
+    pub fn finish(self) -> Vec<Incident> {
+        self.finish_with_boots().0
+    }
+
+    /// [`Diagnoser::finish`], and the boot stories of every node (by node, then boot)
+    /// with what each differs in from its reference and the expected configuration.
+    pub fn finish_with_boots(mut self) -> (Vec<Incident>, Vec<Boot>) {
         let end = At {
             t: self.tl.at.t.max(self.tl.now),
             ..self.tl.at
@@ -435,7 +467,13 @@ impl Diagnoser {
         self.tracker.tick(end.t);
         self.take_events();
         let tl = &mut self.tl;
-        let bus: [&mut dyn Detector; 4] = [&mut self.sdos, &mut self.pdos, &mut self.syncs, &mut self.bus];
+        let bus: [&mut dyn Detector; 5] = [
+            &mut self.sdos,
+            &mut self.pdos,
+            &mut self.syncs,
+            &mut self.bus,
+            &mut self.boot_configs,
+        ];
         for d in bus {
             d.end(tl, end);
         }
@@ -460,7 +498,10 @@ impl Diagnoser {
                 inc.check.splice(0..0, steps.iter().cloned());
             }
         }
-        rank::rank(std::mem::take(&mut tl.incidents), tl)
+        (
+            rank::rank(std::mem::take(&mut tl.incidents), tl),
+            self.boot_configs.stories(),
+        )
     }
 }
 

@@ -414,6 +414,19 @@ const WORDS: &[Words] = &[
         ),
     },
     Words {
+        problem: Problem::BootConfig,
+        with_cause: false,
+        title: None,
+        check: Steps::Fixed(&[
+            "Compare the master's configuration for node {node} between the boots: a changed file, a parameter read from another source, or a step skipped after an error.",
+            "For a refused or unanswered write, check the object (index, sub-index, size, access) against the device's EDS and the node's state at that moment.",
+            "Against a DCF: check that the DCF given is the one the master uses for this node.",
+        ]),
+        why: Text::Fixed(
+            "The node runs with another configuration than before (or than planned): PDOs, heartbeat or limits may differ without any error shown.",
+        ),
+    },
+    Words {
         problem: Problem::NotPresent,
         with_cause: false,
         title: Some(Text::Made(|inc, f| {
@@ -563,6 +576,7 @@ mod tests {
                 Problem::PdoMissing,
                 Problem::SyncJitter,
                 Problem::PdoLate,
+                Problem::BootConfig,
             ];
             assert_eq!(
                 inc.title.is_empty(),

@@ -90,6 +90,7 @@ impl Timeline {
             count: 0,
             first_ns: t,
             last_ns: t,
+            findings: Vec::new(),
         });
         self.incidents.len() - 1
     }

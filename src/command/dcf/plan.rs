@@ -253,20 +253,9 @@ fn trim_nul(b: &[u8]) -> &[u8] {
     &b[..end]
 }
 
-/// Why a load never writes an object, whatever the file says: commands rather than
-/// configuration (store/restore, program control, the controlword) and the CiA 402
-/// set-points that move a motor (target position, velocity, torque).
-pub fn never_written(index: u16) -> Option<&'static str> {
-    match index {
-        0x1010 => Some("store command (use --store)"),
-        0x1011 => Some("restore-defaults command"),
-        0x1003 => Some("error history (writing clears it)"),
-        0x1F50..=0x1F57 => Some("program download/control"),
-        0x6040 => Some("controlword (a command, not configuration)"),
-        0x6042 | 0x6071 | 0x607A | 0x60C1 | 0x60FF => Some("set-point (moves the motor), not configuration"),
-        _ => None,
-    }
-}
+/// Why a load never writes an object, whatever the file says (commands and set-points,
+/// not configuration): [`crate::od::not_configuration`].
+pub use crate::od::not_configuration as never_written;
 
 /// What a file value is against the node.
 #[derive(Clone, Debug, PartialEq, Eq)]

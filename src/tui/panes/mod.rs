@@ -401,6 +401,24 @@ pub(crate) mod testutil {
         App::new(trace, Keymap::default_map(), src)
     }
 
+    /// An app holding the frames of the candump log at `path` (relative to the checkout).
+    pub fn app_of_log(path: &str) -> App {
+        let path = format!("{}/{path}", env!("CARGO_MANIFEST_DIR"));
+        let text = std::fs::read(&path).unwrap();
+        let mut reader = crate::log::LogReader::new(std::io::BufReader::new(text.as_slice())).unwrap();
+        let mut trace = Trace::new(Decoder::new(Dictionary::default(), Vec::new()), 500_000);
+        trace.ifaces.intern("can0");
+        while let Some((_, outcome)) = reader.next_line().unwrap() {
+            if let crate::log::Outcome::Frame(f) = outcome {
+                trace.push(&f);
+            }
+        }
+        let (_tx, rx) = std::sync::mpsc::channel();
+        let mut src = SourceInfo::new("boot.log", SourceKind::Open, rx, None);
+        src.done = true;
+        App::new(trace, Keymap::default_map(), src)
+    }
+
     /// A drive (node 1, CiA 402 dictionary) whose TPDO1 carries the statusword, the vl
     /// velocity actual value (rpm) and the mode display: 40 PDOs 10 ms apart, enabled at
     /// the 10th, a speed ramp, profile velocity mode from the 20th, a fault at the 35th.

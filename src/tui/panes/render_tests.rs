@@ -1,6 +1,6 @@
 //! Rendering tests: every pane on a fixed capture, snapshotted with TestBackend.
 
-use super::testutil::{app, screen};
+use super::testutil::{app, app_of_log, screen};
 use crate::tui::keymap::Action;
 use crate::tui::panes::Pane;
 
@@ -692,6 +692,29 @@ fn problems_pane_lists_the_incidents_and_opens_one_at_80x24() {
     assert!(s.contains("Check first"), "{s}");
     assert!(s.contains("Why it matters"), "{s}");
     insta::assert_snapshot!("problems_80x24_opened", s);
+}
+
+#[test]
+fn problems_pane_shows_a_boot_that_differs_with_its_findings_as_steps() {
+    let mut a = app_of_log("tests/fixtures/boot/boots_differ.log");
+    a.act(Action::PaneProblems);
+    let s = screen(&mut a, 160, 40);
+    assert!(
+        s.contains("OPEN      Node 5           1    1.000    1.000  Boot 2 configured otherwise than boot 1 (1 different, 1 missing,"),
+        "{s}"
+    );
+    a.act(Action::Expand);
+    let s = screen(&mut a, 160, 40);
+    for step in [
+        "Boot 2 began",
+        "0x1017:00 written 0x00C8, boot 1 wrote 0x0064",
+        "0x2001:00 written 0x01, boot 1 did not write it",
+        "0x1400:02 write of 0xFE refused: Invalid value for parameter (download only)",
+        "0x2000:01 write of 0x00000007 not answered",
+        "0x1800:02 not written, boot 1 wrote 0x01",
+    ] {
+        assert!(s.contains(step), "{step}: {s}");
+    }
 }
 
 #[test]

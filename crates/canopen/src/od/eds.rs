@@ -647,12 +647,18 @@ pub struct ParameterValue {
 /// Every non-empty `ParameterValue` of a DCF (`[IIII]` is sub 0, `[IIIIsubS]` sub S), by
 /// (index, sub). Problems of the text itself are [`import`]'s warnings.
 pub fn parameter_values(text: &str) -> Vec<ParameterValue> {
+    key_values(text, "parametervalue")
+}
+
+/// Every non-empty value of `key` (lower case, e.g. `datatype`) in the object sections of
+/// `text`, as [`parameter_values`] reads `ParameterValue`.
+pub fn key_values(text: &str, key: &str) -> Vec<ParameterValue> {
     let ini = parse_ini(text, &mut Vec::new());
     ini.sections
         .iter()
         .filter_map(|(name, sec)| {
             let (index, sub) = section_index(name)?;
-            let (v, line) = sec.get("parametervalue").filter(|(v, _)| !v.is_empty())?;
+            let (v, line) = sec.get(key).filter(|(v, _)| !v.is_empty())?;
             Some(ParameterValue {
                 index,
                 sub: sub.unwrap_or(0),

@@ -506,6 +506,22 @@ impl Dictionary {
     }
 }
 
+/// Why writing an object is no configuration, whatever a DCF says: commands (store and
+/// restore, program control, clearing the error history, the CiA 402 controlword) and the
+/// CiA 402 set-points that move a motor (target position, velocity, torque). None: it may
+/// be configuration.
+pub fn not_configuration(index: u16) -> Option<&'static str> {
+    match index {
+        0x1010 => Some("store command (use --store)"),
+        0x1011 => Some("restore-defaults command"),
+        0x1003 => Some("error history (writing clears it)"),
+        0x1F50..=0x1F57 => Some("program download/control"),
+        0x6040 => Some("controlword (a command, not configuration)"),
+        0x6042 | 0x6071 | 0x607A | 0x60C1 | 0x60FF => Some("set-point (moves the motor), not configuration"),
+        _ => None,
+    }
+}
+
 /// Formats a decoded value for a label: enum text, scaled value with unit, or the raw value.
 ///
 /// `0x0006` of a U16 with values {6: "Shutdown"} -> `6 (Shutdown)`;
