@@ -415,7 +415,6 @@ fn cycle_groups(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<(String, Vec<
 const KNOWN_CYCLES: &[&str] = &[
     "crates/canopen/src: od, od::alias, od::bind, od::device, od::eds, od::family, od::fields, od::json, od::merge, od::procedure",
     "src: analysis::diagnose, analysis::diagnose::boot, analysis::diagnose::drive, analysis::diagnose::emcy, analysis::diagnose::heartbeat, analysis::diagnose::masters, analysis::diagnose::sdo, analysis::diagnose::timeline",
-    "src: analysis::filter, analysis::filter::eval, analysis::filter::lex, analysis::filter::parse",
     "src: bus, bus::socketcan, bus::state",
     "src: cli::decode, cli::decode_filter, cli::decode_out, cli::decode_parquet",
     "src: command, command::cyclic, command::dcf, command::dcf::plan, command::dcf::report, command::drive, command::error, command::exec, command::grammar, command::lss, command::nmt, command::object, command::pdo, command::record, command::registry, command::run, command::run::command, command::scan, command::sdo, command::send, command::spec, command::stop, command::sync, command::syntax, command::transmit_list, command::transmit_run, command::value, command::watch, command::watch_table, command::words, command::write",

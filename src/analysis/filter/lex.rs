@@ -1,6 +1,6 @@
 //! Tokens of the filter language, each with its 1-based column.
 
-use super::FilterError;
+use super::error::FilterError;
 
 /// A comparison operator.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -19,116 +19,21 @@
 //!
 //! Any other word is an error with its column: free text must be quoted.
 
+mod error;
 mod eval;
 mod lex;
+mod names;
 mod parse;
 pub mod stream;
 
+pub use error::FilterError;
 pub use eval::{Facts, Subject, Transfer, Tri};
 pub use lex::Cmp;
+pub use names::{Names, NoNames};
 pub use parse::{CodePrefix, Expr, IdMatch, Term, Test, kinds};
 
-use crate::decode::Decoder;
 use crate::od::Dictionary;
 use crate::sdo::Transaction;
-
-/// Resolves object names and vendor aliases to (index, sub).
-pub trait Names {
-    /// The object `text` names, if any.
-    fn object(&self, text: &str) -> Option<(u16, u8)>;
-}
-
-/// No names: only hex object forms.
-pub struct NoNames;
-
-impl Names for NoNames {
-    fn object(&self, _: &str) -> Option<(u16, u8)> {
-        None
-    }
-}
-
-/// Names of every dictionary a decoder uses (the default and each bound profile).
-impl Names for Decoder {
-    fn object(&self, text: &str) -> Option<(u16, u8)> {
-        let mut seen: Vec<&Dictionary> = Vec::new();
-        for node in 0..128u8 {
-            let d = self.dictionary(node);
-            let same = |o: &&Dictionary| {
-                o.layers().len() == d.layers().len()
-                    && o.layers()
-                        .iter()
-                        .zip(d.layers())
-                        .all(|(a, b)| std::sync::Arc::ptr_eq(a, b))
-            };
-            if seen.iter().any(same) {
-                continue;
-            }
-            seen.push(d);
-            if let Ok(r) = crate::od::resolve_object(d, text) {
-                return Some(r);
-            }
-        }
-        None
-    }
-}
-
-/// A filter that did not parse: 1-based column and what was wrong.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("column {column}: {message}")]
-pub struct FilterError {
-    /// 1-based column.
-    pub column: usize,
-    /// What was wrong.
-    pub message: String,
-}
-
-/// Characters of a word quoted in a message, and of the filter shown either side of an
-/// error's column: a filter of 16,000 words is not repeated in its error.
-const QUOTE_CHARS: usize = 40;
-
-impl FilterError {
-    fn new(column: usize, message: impl Into<String>) -> FilterError {
-        FilterError {
-            column,
-            message: clip_words(message.into()),
-        }
-    }
-
-    /// The part of `text` (the filter it was parsed from) around the error's column: at
-    /// most [`QUOTE_CHARS`] characters either side, `…` where cut.
-    pub fn excerpt(&self, text: &str) -> String {
-        let at = self.column.saturating_sub(1);
-        let from = at.saturating_sub(QUOTE_CHARS);
-        let len = text.chars().count();
-        let mut s: String = text.chars().skip(from).take(2 * QUOTE_CHARS).collect();
-        if from > 0 {
-            s.insert(0, '…');
-        }
-        if from + 2 * QUOTE_CHARS < len {
-            s.push('…');
-        }
-        s
-    }
-}
-
-/// `message` with each word longer than [`QUOTE_CHARS`] cut to its start, `…` and its
-/// closing punctuation (a backquote, a quote).
-fn clip_words(message: String) -> String {
-    if !message.split(' ').any(|w| w.chars().count() > QUOTE_CHARS) {
-        return message;
-    }
-    let clip = |w: &str| {
-        if w.chars().count() <= QUOTE_CHARS {
-            return w.to_string();
-        }
-        let mut s: String = w.chars().take(QUOTE_CHARS).collect();
-        s.push('…');
-        let tail: Vec<char> = w.chars().rev().take_while(|c| !c.is_alphanumeric()).take(2).collect();
-        s.extend(tail.into_iter().rev());
-        s
-    };
-    message.split(' ').map(clip).collect::<Vec<_>>().join(" ")
-}
 
 /// A parsed filter.
 #[derive(Clone, Debug, Default, PartialEq)]

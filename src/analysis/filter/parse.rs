@@ -1,8 +1,9 @@
 //! The parser: tokens to an expression tree. `or` binds loosest, then `and` (or two
 //! conditions side by side), then `not`/`!`; parentheses group.
 
+use super::error::FilterError;
 use super::lex::{Cmp, Tok, Token};
-use super::{FilterError, Names};
+use super::names::Names;
 use crate::decode::Kind;
 use std::collections::HashMap;
 

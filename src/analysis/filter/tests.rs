@@ -1,7 +1,7 @@
 //! Parser and evaluator tests.
 
 use super::*;
-use crate::decode::Kind;
+use crate::decode::{Decoder, Kind};
 use crate::frame::{Flags, Frame};
 use std::collections::HashMap;
 
