@@ -4,7 +4,7 @@
 //! configuration; a boot that differs is a `boot_config` incident whose steps are its
 //! findings (the comparisons: `crate::analysis::boot_story`).
 
-use super::Detector;
+use super::detector::Detector;
 use super::timeline::{At, MS, Timeline};
 use crate::analysis::boot_story::{
     Against, Boot, BootStep, Bytes, Expected, FindingKind, Operational, Write, WriteResult, against_expected,

@@ -1,7 +1,7 @@
 //! Bus detector (`bus_errors`): CAN error frames and the controller states (error
 //! passive, bus off) the source reports.
 
-use super::Detector;
+use super::detector::Detector;
 use super::timeline::{At, Timeline};
 use crate::analysis::incident::{Problem, Status};
 use std::collections::BTreeMap;

@@ -4,7 +4,7 @@
 //! Reads the controlword, statusword and error code of each axis from PDOs and SDO
 //! transfers.
 
-use super::Detector;
+use super::detector::Detector;
 use super::emcy::Emcys;
 use super::timeline::{At, MS, Timeline};
 use crate::analysis::incident::{Problem, Status};

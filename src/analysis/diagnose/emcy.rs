@@ -2,7 +2,7 @@
 //! error code and ended by an error reset (EMCY 0x0000). An EMCY right before a CiA 402
 //! fault is that fault's cause instead ([`super::drive`] asks for it).
 
-use super::Detector;
+use super::detector::Detector;
 use super::timeline::{At, MS, Timeline};
 use crate::analysis::incident::{Problem, Status};
 use crate::decode::emcy::Emcy;

@@ -3,7 +3,7 @@
 //! devices with one node-ID), and a node nobody watches (`unmonitored`: 0x1017 = 0 and no
 //! node guarding).
 
-use super::Detector;
+use super::detector::Detector;
 use super::timeline::{At, Timeline};
 use crate::analysis::incident::{Problem, Status};
 use crate::decode::heartbeat::NmtState;
@@ -106,7 +106,7 @@ impl Detector for Heartbeats {
             return;
         }
         let at = tl.at;
-        let off = super::value(t) & 0xFFFF == 0;
+        let off = super::detector::value(t) & 0xFFFF == 0;
         tl.node(t.key()).beat.heartbeat_off = off.then_some(at);
     }
 

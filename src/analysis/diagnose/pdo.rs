@@ -3,7 +3,7 @@
 //! SYNC window 0x1007 closed (`pdo_late`). Starts from the dictionaries' sync windows and
 //! TPDO transmission types, and follows what SDO transfers write to them.
 
-use super::Detector;
+use super::detector::Detector;
 use super::timeline::{At, Timeline};
 use crate::analysis::incident::{Problem, Status};
 use crate::analysis::sync_cycles::SyncDefaults;
@@ -162,7 +162,7 @@ impl Detector for Pdos {
         if t.outcome != Outcome::Ok || t.data.is_empty() {
             return;
         }
-        let v = super::value(t);
+        let v = super::detector::value(t);
         match (t.index, t.sub) {
             (0x1800..=0x19FF, 5) => self
                 .timing

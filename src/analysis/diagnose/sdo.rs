@@ -4,7 +4,7 @@
 //! `missing` when nothing at all came from the node), and SDO requests of two clients
 //! that overlap (reported as `second_master`).
 
-use super::Detector;
+use super::detector::Detector;
 use super::masters;
 use super::texts::SdoAborts;
 use super::timeline::{At, MS, Timeline};

@@ -1,7 +1,7 @@
 //! SYNC detector (`sync_jitter`): SYNC intervals off the SYNC period become one warning
 //! with the jitter figures. Keeps the last SYNC for [`super::pdo`]'s SYNC window.
 
-use super::Detector;
+use super::detector::Detector;
 use super::timeline::{At, Timeline};
 use crate::analysis::incident::{Problem, Status};
 use crate::analysis::timing::SyncTiming;
