@@ -406,11 +406,11 @@ mod tests {
             a.iter().map(|(n, v)| (n.to_string(), v.to_string())).collect()
         };
         let r = rpdo(&b, 2, 1, &args(&[("Controlword", "0x0F"), ("Target velocity", "500")])).unwrap();
-        assert_eq!(super::super::candump(&r.frame), "202#0F00F4010000");
+        assert_eq!(super::super::spec::candump(&r.frame), "202#0F00F4010000");
         assert!(r.defaulted.is_empty());
         // By index:sub, negative velocity, controlword left out (sent as 0).
         let r = rpdo(&b, 2, 1, &args(&[("0x60FF:0", "-2")])).unwrap();
-        assert_eq!(super::super::candump(&r.frame), "202#0000FEFFFFFF");
+        assert_eq!(super::super::spec::candump(&r.frame), "202#0000FEFFFFFF");
         assert_eq!(r.defaulted, ["Controlword"]);
         let e = rpdo(&b, 2, 1, &args(&[("0x6060", "3")])).unwrap_err().to_string();
         assert!(e.contains("not mapped in RPDO1 of node 2"), "{e}");
@@ -459,7 +459,7 @@ mod tests {
             ("0x2000:2".to_string(), "0xABC".to_string()),
         ];
         let r = encode_rpdo(&dict, 5, 3, &m, &a).unwrap();
-        assert_eq!(super::super::candump(&r.frame), "405#C1AB");
+        assert_eq!(super::super::spec::candump(&r.frame), "405#C1AB");
     }
 
     #[test]

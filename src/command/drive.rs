@@ -147,7 +147,7 @@ impl Spec for Drive {
         let from = st
             .map(|s| s.text())
             .unwrap_or("state unknown, assumed Switch on disabled");
-        let listed = frames.iter().map(super::candump).collect::<Vec<_>>().join(", ");
+        let listed = frames.iter().map(super::spec::candump).collect::<Vec<_>>().join(", ");
         Ok(Preview::sends(match self.action {
             DriveAction::Status => format!("reads 0x6041 of node {node}"),
             DriveAction::Mode(m) => format!("{listed} (0x6060 = {m}), then reads 0x6061"),

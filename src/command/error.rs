@@ -1,7 +1,7 @@
 //! Why a command failed, with the exit status of each case.
 
 use super::report::Reported;
-use super::to_json;
+use super::report::to_json;
 use crate::bus::BusError;
 use crate::sdo::abort_text;
 use clap::error::ErrorKind;

@@ -382,9 +382,14 @@ impl LssAction {
             LssAction::Inquire(Inquiry::All) => {
                 let mut frames = self.frames();
                 frames.push(Frame::classic(MASTER_ID, &crate::lss::Request::InquireNodeId.encode()));
-                frames.iter().map(super::candump).collect::<Vec<_>>().join(", ")
+                frames.iter().map(super::spec::candump).collect::<Vec<_>>().join(", ")
             }
-            _ => self.frames().iter().map(super::candump).collect::<Vec<_>>().join(", "),
+            _ => self
+                .frames()
+                .iter()
+                .map(super::spec::candump)
+                .collect::<Vec<_>>()
+                .join(", "),
         }
     }
 

@@ -39,19 +39,7 @@ pub use nmt::NmtAction;
 pub use object::SdoOptions;
 pub use registry::{Command, Commander};
 pub use report::Reported;
+pub(crate) use report::to_json;
 pub use run::command::RunSpec;
-pub use spec::{Outcome, Spec};
+pub use spec::{Outcome, Spec, candump};
 pub use syntax::parse_command;
-
-/// A command's `--json` object from its `#[derive(Serialize)]` form (serializing these plain
-/// structs cannot fail; a failure would give null).
-pub(crate) fn to_json(v: &impl serde::Serialize) -> serde_json::Value {
-    serde_json::to_value(v).unwrap_or_default()
-}
-
-/// A frame in candump's compact form (`602#2B40600006000000`), as previews show frames.
-pub fn candump(f: &crate::frame::Frame) -> String {
-    let mut s = String::new();
-    crate::log::writer::push_compact(&mut s, f);
-    s
-}

@@ -90,7 +90,7 @@ impl Spec for Nmt {
             _ => None,
         };
         Ok(Preview {
-            frames: super::candump(&frame(self.action, self.node)),
+            frames: super::spec::candump(&frame(self.action, self.node)),
             confirm,
         })
     }

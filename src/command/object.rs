@@ -244,7 +244,7 @@ impl Spec for SdoRead {
     /// The client's first frame (and that block segments follow).
     fn preview(&self, known: &Known<'_>) -> Result<Preview, CommandError> {
         let (i, s) = object(known.bindings, self.node, &self.object)?;
-        let first = super::candump(&first_upload_frame(self.node, i, s, self.options.block));
+        let first = super::spec::candump(&first_upload_frame(self.node, i, s, self.options.block));
         Ok(Preview::sends(if self.options.block {
             format!("{first} then the server's block segments")
         } else {
@@ -293,8 +293,8 @@ impl Spec for SdoWrite {
         let data = write_data(dict, i, s, &self.value, self.options.data_type)?;
         let (first, then) = first_download_frame(self.node, i, s, &data, self.options.block);
         Ok(Preview::sends(match then {
-            Some(t) => format!("{} {t}", super::candump(&first)),
-            None => super::candump(&first),
+            Some(t) => format!("{} {t}", super::spec::candump(&first)),
+            None => super::spec::candump(&first),
         }))
     }
 

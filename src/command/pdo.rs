@@ -6,10 +6,10 @@
 pub mod command;
 pub mod remap;
 
-use super::candump;
 use super::error::{CommandError, ExitCode};
 use super::report::Reported;
 use super::sdo::{download, first_download_frame, first_upload_frame, upload};
+use super::spec::candump;
 use crate::bus::{Bus, Subscription};
 use crate::cob;
 use crate::decode::pdo::entry_from_u32;

@@ -53,3 +53,9 @@ impl serde::Serialize for Reported {
         self.to_json().serialize(s)
     }
 }
+
+/// A command's `--json` object from its `#[derive(Serialize)]` form (serializing these plain
+/// structs cannot fail; a failure would give null).
+pub(crate) fn to_json(v: &impl serde::Serialize) -> serde_json::Value {
+    serde_json::to_value(v).unwrap_or_default()
+}

@@ -294,7 +294,7 @@ fn plan_step(
             let data = encode(&v.to_string(), ty)?;
             let shown = object_text(dict, index, sub, &ty.decode(&data), None);
             let text = format!("sdo write {} = {shown}", object_name(dict, index, sub));
-            let frame = super::candump(&super::sdo::first_download_frame(node, index, sub, &data, false).0);
+            let frame = super::spec::candump(&super::sdo::first_download_frame(node, index, sub, &data, false).0);
             PlannedStep {
                 action: Action::SdoWrite { index, sub, data },
                 text,
@@ -312,7 +312,9 @@ fn plan_step(
                 },
                 text: format!("sdo read {}", object_name(dict, index, sub)),
                 value: None,
-                frame: Some(super::candump(&super::sdo::first_upload_frame(node, index, sub, false))),
+                frame: Some(super::spec::candump(&super::sdo::first_upload_frame(
+                    node, index, sub, false,
+                ))),
             }
         }
         Step::Nmt { command, node: to } => {
@@ -337,7 +339,7 @@ fn plan_step(
                 action: Action::Nmt { action, target },
                 text: format!("nmt {} to {whom}", nmt_word(*command)),
                 value: None,
-                frame: Some(super::candump(&f)),
+                frame: Some(super::spec::candump(&f)),
             }
         }
         Step::Frame { id, data } => {
@@ -347,7 +349,7 @@ fn plan_step(
                 .filter(|i| *i <= 0x1FFF_FFFF)
                 .ok_or(StepError::FrameId(id))?;
             let f = Frame::classic(id, &frame_bytes(data, vars)?);
-            let c = super::candump(&f);
+            let c = super::spec::candump(&f);
             PlannedStep {
                 action: Action::Frame(f),
                 text: format!("frame {c}"),
@@ -393,7 +395,9 @@ fn plan_step(
                     fails_on
                 ),
                 value: Some(equals),
-                frame: Some(super::candump(&super::sdo::first_upload_frame(node, index, sub, false))),
+                frame: Some(super::spec::candump(&super::sdo::first_upload_frame(
+                    node, index, sub, false,
+                ))),
             }
         }
         Step::Delay { ms } => PlannedStep {

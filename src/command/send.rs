@@ -151,7 +151,7 @@ impl Spec for Send {
         };
         let f = *frame;
         Some(Ok(Source {
-            what: super::candump(&f),
+            what: super::spec::candump(&f),
             next: Box::new(move |_| f),
             defaulted: Vec::new(),
             schedule: *schedule,

@@ -34,6 +34,13 @@ impl Outcome {
     }
 }
 
+/// A frame in candump's compact form (`602#2B40600006000000`), as previews show frames.
+pub fn candump(f: &crate::frame::Frame) -> String {
+    let mut s = String::new();
+    crate::log::writer::push_compact(&mut s, f);
+    s
+}
+
 /// What a command will send, shown before it is sent.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Preview {
@@ -165,7 +172,7 @@ pub(crate) fn cyclic_preview(cmd: &impl Spec, known: &Known<'_>, extra: &str) ->
     let mut src = cmd
         .source(known.bindings)
         .unwrap_or_else(|| Err(CommandError::Usage("not a cyclic command".into())))?;
-    let mut text = format!("{} {}{extra}", super::candump(&src.frame(0)), src.schedule.text());
+    let mut text = format!("{} {}{extra}", candump(&src.frame(0)), src.schedule.text());
     if src.schedule.total().is_none() {
         text.push_str(" (a job: `jobs` lists, `jobs stop ID` or stop-all stops)");
     }

@@ -104,7 +104,7 @@ impl Spec for Stop {
         let frames: Vec<String> = self
             .nodes
             .iter()
-            .flat_map(|n| STOP_CONTROLWORDS.map(|cw| super::candump(&controlword_frame(*n, cw))))
+            .flat_map(|n| STOP_CONTROLWORDS.map(|cw| super::spec::candump(&controlword_frame(*n, cw))))
             .collect();
         Ok(Preview::sends(if self.nodes.is_empty() {
             format!(

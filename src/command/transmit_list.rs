@@ -231,14 +231,14 @@ fn parse_entries(text: &str) -> Result<Vec<Result<Entry, Problem>>, ListError> {
 /// An entry's exact frame through the node dictionaries of `bindings`.
 fn resolve(e: &Entry, bindings: &Bindings) -> Result<Resolved, Problem> {
     let (frame, what, defaulted) = match &e.what {
-        What::Frame(f) => (*f, super::candump(f), Vec::new()),
+        What::Frame(f) => (*f, super::spec::candump(f), Vec::new()),
         What::Rpdo { node, num, signals } => {
             let r = rpdo(bindings, *node, *num, signals).map_err(|err| Problem {
                 entry: Some(e.index),
                 line: e.line,
                 message: err.to_string(),
             })?;
-            let what = format!("RPDO{num} node {node} {}", super::candump(&r.frame));
+            let what = format!("RPDO{num} node {node} {}", super::spec::candump(&r.frame));
             (r.frame, what, r.defaulted)
         }
     };

@@ -268,7 +268,7 @@ pub async fn transmit_list(
             EntryReport {
                 entry: e.index,
                 line: e.line,
-                frame: super::candump(&e.frame),
+                frame: super::spec::candump(&e.frame),
                 what: e.what.clone(),
                 every_ms: e.schedule.every_ms,
                 count: e.schedule.count,

@@ -22,9 +22,9 @@ pub enum ValueError {
     Domain,
 }
 
-impl From<ValueError> for super::CommandError {
+impl From<ValueError> for super::error::CommandError {
     fn from(e: ValueError) -> Self {
-        super::CommandError::Usage(e.to_string())
+        super::error::CommandError::Usage(e.to_string())
     }
 }
 

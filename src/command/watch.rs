@@ -227,7 +227,7 @@ impl Spec for Watch {
         let objs = self.resolve(known.bindings)?;
         let frames: Vec<String> = objs
             .iter()
-            .map(|o| super::candump(&first_upload_frame(o.node, o.index, o.sub, false)))
+            .map(|o| super::spec::candump(&first_upload_frame(o.node, o.index, o.sub, false)))
             .collect();
         Ok(Preview::sends(format!(
             "{} every {} ms{}",

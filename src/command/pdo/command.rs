@@ -3,11 +3,11 @@
 //! RPDO of [`crate::command::cyclic::rpdo`]) and the run.
 
 use super::{MapSpec, assumed_cob, dry_run, map, plan, read_all, read_report};
-use crate::command::candump;
 use crate::command::cyclic::{Schedule, Source, rpdo};
 use crate::command::error::{CommandError, ParseError};
 use crate::command::grammar::{DEFAULT_TIMEOUT_MS, parse_assignments};
 use crate::command::sdo::first_upload_frame;
+use crate::command::spec::candump;
 use crate::command::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
 use crate::command::words::{
     Repeat, TypedWords, inhibit_arg, ms_arg, node_arg, not_reserved, pdo_arg, pdo_cob_arg, pdo_word, transmission_arg,
