@@ -170,6 +170,11 @@ pub fn text(app: &App) -> String {
         .search()
         .map(|s| format!(" | {}", s.summary(app.trace())))
         .unwrap_or_default();
+    let trigger = app
+        .screen()
+        .trigger()
+        .map(|t| format!(" | {}", t.summary(app.trace())))
+        .unwrap_or_default();
     // A loaded log has no bus to stop and no live rate: it was read as fast as it could be.
     let file = matches!(app.source().kind, SourceKind::Open);
     let stop = app
@@ -189,7 +194,7 @@ pub fn text(app: &App) -> String {
         .map(|k| format!(" | help: {k}"))
         .unwrap_or_default();
     format!(
-        "{src}{state}{rec} | {} frames{rate} | drops {}{}{filter}{search}{stop}{help}",
+        "{src}{state}{rec} | {} frames{rate} | drops {}{}{filter}{search}{trigger}{stop}{help}",
         app.trace().len(),
         app.source().drops,
         buses(app)
