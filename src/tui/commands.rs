@@ -188,16 +188,11 @@ pub(crate) fn run(line: &str, capture: &mut Capture, screen: &mut Screen, q: &mu
             }
         }
         "record" => {
-            if let Some(t) = screen.trigger().filter(|_| rest.starts_with("start")) {
-                q.push(Event::Say(
-                    Level::Warn,
-                    format!(
-                        "record: the trigger `{}` only marks hits here: recording takes every frame (windows: `cotui record IFACE --trigger`)",
-                        t.trigger.source
-                    ),
-                ));
-            }
-            record::command(capture.has_bus(), capture.recording_mut(), rest, q);
+            let gate = screen
+                .trigger()
+                .filter(|_| rest.starts_with("start"))
+                .map(|t| record::Gate::new(&t.trigger, t.pre_ms, t.post_ms, capture.trace().decoder()));
+            record::command(capture.has_bus(), capture.recording_mut(), rest, gate, q);
             return Ran::Done;
         }
         "sim" => {

@@ -151,7 +151,13 @@ pub fn text(app: &App) -> String {
     let rec = app
         .capture()
         .recording()
-        .map(|r| format!(" | REC {} ({} frames)", r.file, r.count()))
+        .map(|r| {
+            let gate = r
+                .gated()
+                .map(|t| format!(", windows of trigger {t}"))
+                .unwrap_or_default();
+            format!(" | REC {} ({} frames{gate})", r.file, r.count())
+        })
         .unwrap_or_default();
     let view = app.screen().view();
     let filter = if view.filter.is_empty() {
