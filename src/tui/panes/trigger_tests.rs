@@ -121,3 +121,17 @@ fn a_bookmark_goes_to_the_sidecar_file_and_comes_back_when_the_log_is_opened_aga
     assert!(text.contains("\"bookmarks\": []"), "{text}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn the_plot_title_counts_the_trigger_hits_in_its_window() {
+    let mut a = super::testutil::plot_app();
+    a.screen_mut().focus_on(crate::tui::panes::Pane::Plot);
+    let before = screen(&mut a, 120, 30);
+    assert!(!before.contains("trigger hits"), "{before}");
+    // The drive faults at its 35th TPDO: 5 TPDOs carry the fault bit.
+    type_keys(&mut a, ":trigger Statusword & 0x0008\n");
+    a.screen_mut().focus_on(crate::tui::panes::Pane::Plot);
+    let s = screen(&mut a, 120, 30);
+    assert!(s.contains("trigger Statusword & 0x0008: armed, 5 hits"), "{s}");
+    assert!(s.contains("5 trigger hits shown"), "{s}");
+}
