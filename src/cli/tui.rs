@@ -193,6 +193,7 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> ExitCode {
         }
     };
     let decoder = crate::decode::Decoder::from_bindings(&bindings);
+    let open_file = matches!(kind, SourceKind::Open) && std::path::Path::new(name).is_file();
     let src = match feed {
         Feeding::Log((rx, ctl)) => SourceInfo::new(name, kind, rx, ctl),
         Feeding::Live(ifaces, listen_only) => {
@@ -207,6 +208,10 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> ExitCode {
     };
     let mut app = App::new(Trace::new(decoder, Bitrate::given_or_assumed(ui.bitrate)), keymap, src);
     app.set_bindings(bindings);
+    // `cotui open FILE`: the bookmarks are kept beside the log (README, "Bookmarks").
+    if open_file {
+        app.screen_mut().keep_bookmarks(std::path::Path::new(name));
+    }
     if let Some(f) = &ui.filter {
         app.set_filter(f);
         if let Some(m) = app.screen_mut().take_message() {

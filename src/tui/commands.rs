@@ -17,8 +17,24 @@ use crate::command::Command;
 
 /// Names the palette completes.
 pub const PALETTE_COMMANDS: &[&str] = &[
-    "filter", "search", "goto", "time", "speed", "pause", "resume", "rewind", "loop", "plot", "export", "help",
-    "messages", "quit", "jobs", "sim",
+    "filter",
+    "search",
+    "goto",
+    "time",
+    "speed",
+    "pause",
+    "resume",
+    "rewind",
+    "loop",
+    "plot",
+    "export",
+    "help",
+    "messages",
+    "quit",
+    "jobs",
+    "sim",
+    "trigger",
+    "bookmarks",
 ];
 
 /// Why a built-in palette command (`goto`, `time`, `speed`, `plot`, `export`, ...) failed;
@@ -149,8 +165,34 @@ pub(crate) fn run(line: &str, capture: &mut Capture, screen: &mut Screen, q: &mu
             jobs(rest, capture, q);
             return Ran::Done;
         }
+        "trigger" => {
+            match screen.apply_trigger(capture.trace(), rest) {
+                Ok(text) => screen.set_message(Some(text)),
+                Err(e) => {
+                    screen.log(Level::Error, &e);
+                    screen.set_message(Some(e));
+                }
+            }
+            return Ran::Done;
+        }
+        "bookmarks" => {
+            let lines = screen.bookmark_lines(capture.trace());
+            if lines.is_empty() {
+                Ok("no bookmarks (the bookmark key sets one on the selected frame)".into())
+            } else {
+                for l in &lines {
+                    screen.log(Level::Info, &format!("bookmark {l}"));
+                }
+                screen.log_popup_mut().open();
+                Ok(format!("{} bookmarks: {}", lines.len(), lines.join(", ")))
+            }
+        }
         "record" => {
-            record::command(capture.has_bus(), capture.recording_mut(), rest, q);
+            let gate = screen
+                .trigger()
+                .filter(|_| rest.starts_with("start"))
+                .map(|t| record::Gate::new(&t.trigger, t.pre_ms, t.post_ms, capture.trace().decoder()));
+            record::command(capture.has_bus(), capture.recording_mut(), rest, gate, q);
             return Ran::Done;
         }
         "sim" => {

@@ -5,6 +5,7 @@
 //! and redraws at most 30 times a second and only when something changed.
 
 pub mod app;
+pub mod bookmarks;
 pub mod capture;
 pub mod commands;
 mod event;
@@ -23,4 +24,5 @@ pub mod screen;
 pub mod source;
 mod stop;
 pub mod term;
+pub mod trigger;
 pub mod ui;

@@ -3,6 +3,7 @@
 //! the questions waiting for a key, and where the last draw put things. It sees the trace
 //! but never changes it; what the capture must do goes out as [`Event`]s.
 
+use super::bookmarks::Sidecar;
 use super::event::{Event, Queue};
 use super::keymap::{Action, Key, Keymap};
 use super::messages::{Level, Messages};
@@ -14,6 +15,7 @@ use super::panes::objects::ObjectsPane;
 use super::panes::trace_time::TimeMode;
 use super::panes::{Component, Ctx, Pane, Panes, Selected};
 use super::prompt::{PromptBar, PromptKind};
+use super::trigger::TriggerScan;
 use crate::analysis::filter::{Filter, FilterError};
 use crate::analysis::search::{Found, Search};
 use crate::analysis::trace::Trace;
@@ -52,6 +54,8 @@ pub struct Screen {
     pending: Vec<Key>,
     /// Text waiting to go to the terminal's clipboard (see [`Screen::take_clipboard`]).
     clipboard: Option<String>,
+    /// Where the bookmarks of the log opened go (`cotui open FILE`; none live).
+    bookmarks: Option<Sidecar>,
 }
 
 impl Default for Screen {
@@ -71,6 +75,7 @@ impl Default for Screen {
             quit_confirm: None,
             pending: Vec::new(),
             clipboard: None,
+            bookmarks: None,
         }
     }
 }
@@ -220,6 +225,10 @@ impl Screen {
     /// changed on screen).
     pub(crate) fn work(&mut self, trace: &Trace, done: bool, budget: Duration) -> (bool, bool) {
         let (more, changed) = self.panes.trace_mut().work(trace, done, budget);
+        if changed && let Some(t) = self.panes.trace().trigger() {
+            let hits: Vec<u64> = t.hits().iter().map(|&p| trace.store.packed(p).ts_ns).collect();
+            self.panes.plot_mut().set_hits(hits);
+        }
         let (searching, found) = self.search_work(trace, done, budget);
         (more || searching, changed || found)
     }
@@ -274,6 +283,91 @@ impl Screen {
         self.search = Some(s);
         self.jump_match(trace, true);
         Ok(())
+    }
+
+    /// `:trigger EXPR [--pre DUR] [--post DUR]` puts a trigger in force (its hits marked
+    /// in the Trace and the Plot, walked with `n`/`N` when no search is); `:trigger off`
+    /// or an empty text ends it. A parse error (with its column) goes to the status bar.
+    pub(crate) fn apply_trigger(&mut self, trace: &Trace, text: &str) -> Result<String, String> {
+        if text.is_empty() || text == "off" {
+            self.panes.trace_mut().set_trigger(None);
+            self.panes.plot_mut().set_hits(Vec::new());
+            return Ok("trigger off".into());
+        }
+        let mut t = TriggerScan::parse(text, trace).map_err(|e| format!("trigger: {e}"))?;
+        t.advance(trace, Duration::from_millis(30));
+        let hits: Vec<u64> = t.hits().iter().map(|&p| trace.store.packed(p).ts_ns).collect();
+        let summary = t.summary(trace);
+        self.panes.trace_mut().set_trigger(Some(t));
+        self.panes.plot_mut().set_hits(hits);
+        Ok(summary)
+    }
+
+    /// The trigger in force.
+    pub fn trigger(&self) -> Option<&TriggerScan> {
+        self.panes.trace().trigger()
+    }
+
+    /// Keeps the bookmarks of `log` (opened with `cotui open`) in its sidecar file, and
+    /// shows those kept there.
+    pub fn keep_bookmarks(&mut self, log: &std::path::Path) {
+        let mut side = Sidecar::of(log);
+        match side.load() {
+            Ok(marks) => {
+                if !marks.is_empty() {
+                    self.message = Some(format!("{} bookmarks from {}", marks.len(), side.path.display()));
+                }
+                self.panes.trace_mut().set_marks(marks);
+            }
+            Err(e) => self.log(Level::Warn, &format!("bookmarks not loaded: {e}")),
+        }
+        self.bookmarks = Some(side);
+    }
+
+    /// The bookmarks, one line each: `#FRAME at T s (note)`.
+    pub fn bookmark_lines(&self, trace: &Trace) -> Vec<String> {
+        let start = super::panes::start_ns(trace);
+        self.panes
+            .trace()
+            .marks_with_times(trace)
+            .into_iter()
+            .map(|(p, ns)| {
+                let note = self
+                    .bookmarks
+                    .as_ref()
+                    .and_then(|b| b.note(p))
+                    .map(|n| format!(" ({n})"))
+                    .unwrap_or_default();
+                format!("#{} at {:.6} s{note}", p + 1, ns.saturating_sub(start) as f64 / 1e9)
+            })
+            .collect()
+    }
+
+    /// Writes the bookmarks to the sidecar file (when the log has one).
+    fn save_bookmarks(&mut self, trace: &Trace) {
+        let Some(side) = &self.bookmarks else { return };
+        if let Err(e) = side.save(&self.panes.trace().marks_with_times(trace)) {
+            self.log(Level::Error, &format!("bookmarks not saved: {e}"));
+            self.message = Some(format!("bookmarks not saved: {e}"));
+        }
+    }
+
+    /// Jumps to the next (or previous) hit of the trigger, wrapping.
+    fn jump_hit(&mut self, trace: &Trace, forward: bool) {
+        let from = self.selected_position(trace);
+        let Some(t) = self.panes.trace().trigger() else { return };
+        let Some((rank, pos, wrapped)) = t.step(from, forward) else {
+            self.message = Some(format!("trigger {}: no hit yet", t.trigger.source));
+            return;
+        };
+        let wrap = if wrapped { " (wrapped around)" } else { "" };
+        self.message = Some(format!(
+            "trigger hit {} of {} at frame {}{wrap}",
+            rank + 1,
+            t.hits().len(),
+            pos + 1
+        ));
+        self.select_position(trace, pos);
     }
 
     /// Shows the help popup (`help` in the palette).
@@ -516,6 +610,9 @@ impl Screen {
         if !taken {
             self.screen_action(a, trace, paused, q);
         }
+        if a == Action::Bookmark {
+            self.save_bookmarks(trace);
+        }
     }
 
     /// Opens or closes the Detail view (`expand` in the trace): toggled below the main
@@ -584,6 +681,9 @@ impl Screen {
                     .map(|s| s.filter.source.clone())
                     .unwrap_or_default();
                 self.prompt.open(PromptKind::Search, &text);
+            }
+            Action::NextMatch | Action::PrevMatch if self.search.is_none() && self.trigger().is_some() => {
+                self.jump_hit(trace, a == Action::NextMatch)
             }
             Action::NextMatch => self.jump_match(trace, true),
             Action::PrevMatch => self.jump_match(trace, false),

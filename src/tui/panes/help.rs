@@ -36,6 +36,14 @@ pub const PALETTE_SYNTAX: &[(&str, &str)] = &[
         "Live/demo: record the frames received to a candump -l log",
     ),
     ("record stop", "End the recording"),
+    (
+        "trigger EXPR [--pre DUR] [--post DUR] | off",
+        "Mark the hits of a trigger (n/N walk them; record start: only its windows)",
+    ),
+    (
+        "bookmarks",
+        "List the bookmarks (open FILE: kept in FILE.cotui-bookmarks.json)",
+    ),
     ("help", "This help"),
     ("messages", "The message log"),
     ("quit", "Quit"),

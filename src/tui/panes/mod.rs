@@ -479,3 +479,5 @@ pub(crate) mod testutil {
 
 #[cfg(test)]
 mod render_tests;
+#[cfg(test)]
+mod trigger_tests;

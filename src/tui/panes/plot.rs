@@ -48,9 +48,16 @@ pub struct PlotPane {
     picker: Option<SignalPicker>,
     /// Columns of the time axis at the last draw (the cursor moves one column a key).
     columns: Cell<usize>,
+    /// The times (ns) of the trigger's hits, drawn as vertical marks.
+    hits: Vec<u64>,
 }
 
 impl PlotPane {
+    /// The trigger's hits to mark (ns, rising; empty: no trigger).
+    pub fn set_hits(&mut self, hits: Vec<u64>) {
+        self.hits = hits;
+    }
+
     /// The signals drawn: those chosen that exist, else the first series.
     pub fn shown(&self, trace: &Trace) -> Vec<SeriesKey> {
         let chosen: Vec<SeriesKey> = self
@@ -311,7 +318,18 @@ fn render(p: &PlotPane, trace: &Trace, f: &mut Frame, area: Rect, focused: bool)
     } else {
         String::new()
     };
-    let title = format!(" Plot: {} of {} signals{zoom} ", shown.len(), trace.series.len());
+    let hits_in: Vec<f64> = p
+        .hits
+        .iter()
+        .map(|&ns| ns as f64 / 1e9)
+        .filter(|t| (win.start..=win.end).contains(t))
+        .collect();
+    let marks = if p.hits.is_empty() {
+        String::new()
+    } else {
+        format!(", {} trigger hits shown", hits_in.len())
+    };
+    let title = format!(" Plot: {} of {} signals{zoom}{marks} ", shown.len(), trace.series.len());
     f.render_widget(block(&title, focused), area);
     let inner = block("", true).inner(area);
     if inner.height < 3 || inner.width < 20 {
@@ -336,7 +354,7 @@ fn render(p: &PlotPane, trace: &Trace, f: &mut Frame, area: Rect, focused: bool)
     let label_w = (inner.width / 4).clamp(8, 24);
     p.columns.set((inner.width - label_w - 1).max(1) as usize);
     if !values.is_empty() {
-        chart(&values, win, t0, p.cursor, f, chart_area);
+        chart(&values, win, t0, p.cursor, &hits_in, f, chart_area);
     }
     if !bits.is_empty() {
         lanes(&bits, win, p.cursor, label_w, f, lanes_area);
@@ -350,8 +368,8 @@ fn secs(s: f64) -> String {
 }
 
 /// The value signals on one chart: a shared time axis, the legend, units on the value axis,
-/// the cursor as a vertical line.
-fn chart(values: &[&Shown], win: TimeWindow, t0: f64, cursor: Option<f64>, f: &mut Frame, area: Rect) {
+/// the cursor as a vertical line, the trigger's hits (`hits`, seconds) as red ones.
+fn chart(values: &[&Shown], win: TimeWindow, t0: f64, cursor: Option<f64>, hits: &[f64], f: &mut Frame, area: Rect) {
     let columns = area.width as usize * 2;
     let data: Vec<Vec<(f64, f64)>> = values
         .iter()
@@ -383,6 +401,14 @@ fn chart(values: &[&Shown], win: TimeWindow, t0: f64, cursor: Option<f64>, f: &m
         .filter(|c| (win.start..=win.end).contains(c))
         .map(|c| vec![(c - t0, lo), (c - t0, hi)])
         .unwrap_or_default();
+    // One line per column at most: hits closer than a column draw the same mark.
+    let step = (win.end - win.start) / columns.max(1) as f64;
+    let mut hit_lines: Vec<[(f64, f64); 2]> = Vec::new();
+    for &h in hits {
+        if hit_lines.last().is_none_or(|l| h - t0 - l[0].0 >= step) {
+            hit_lines.push([(h - t0, lo), (h - t0, hi)]);
+        }
+    }
     let mut sets: Vec<Dataset> = values
         .iter()
         .zip(&data)
@@ -403,6 +429,15 @@ fn chart(values: &[&Shown], win: TimeWindow, t0: f64, cursor: Option<f64>, f: &m
                 .graph_type(GraphType::Line)
                 .style(Style::default().fg(Color::White))
                 .data(&cursor_line),
+        );
+    }
+    for l in &hit_lines {
+        sets.push(
+            Dataset::default()
+                .marker(Marker::Braille)
+                .graph_type(GraphType::Line)
+                .style(Style::default().fg(Color::LightRed))
+                .data(l),
         );
     }
     let mut units: Vec<&str> = values.iter().filter_map(|s| s.unit()).collect();

@@ -151,7 +151,13 @@ pub fn text(app: &App) -> String {
     let rec = app
         .capture()
         .recording()
-        .map(|r| format!(" | REC {} ({} frames)", r.file, r.count()))
+        .map(|r| {
+            let gate = r
+                .gated()
+                .map(|t| format!(", windows of trigger {t}"))
+                .unwrap_or_default();
+            format!(" | REC {} ({} frames{gate})", r.file, r.count())
+        })
         .unwrap_or_default();
     let view = app.screen().view();
     let filter = if view.filter.is_empty() {
@@ -169,6 +175,11 @@ pub fn text(app: &App) -> String {
         .screen()
         .search()
         .map(|s| format!(" | {}", s.summary(app.trace())))
+        .unwrap_or_default();
+    let trigger = app
+        .screen()
+        .trigger()
+        .map(|t| format!(" | {}", t.summary(app.trace())))
         .unwrap_or_default();
     // A loaded log has no bus to stop and no live rate: it was read as fast as it could be.
     let file = matches!(app.source().kind, SourceKind::Open);
@@ -189,7 +200,7 @@ pub fn text(app: &App) -> String {
         .map(|k| format!(" | help: {k}"))
         .unwrap_or_default();
     format!(
-        "{src}{state}{rec} | {} frames{rate} | drops {}{}{filter}{search}{stop}{help}",
+        "{src}{state}{rec} | {} frames{rate} | drops {}{}{filter}{search}{trigger}{stop}{help}",
         app.trace().len(),
         app.source().drops,
         buses(app)

@@ -1,6 +1,7 @@
 //! The Trace pane: one row per frame of the view, coloured by kind, with a tail strip of
 //! the newest frames while scrolled back. It owns the view (the filter in force), the
-//! search, the selection and follow mode, and the decoded rows of the visible window.
+//! search, the selection and follow mode, the decoded rows of the visible window, and the
+//! trigger in force (its hits marked `*` after the time).
 
 use super::trace_time::{self, TimeMode};
 use super::{Component, Ctx, ListState, block, fit, header, kind_color, selected};
@@ -10,6 +11,7 @@ use crate::analysis::view::View;
 use crate::tui::event::{Event, Queue};
 use crate::tui::keymap::Action;
 use crate::tui::rows::{Row, RowCache};
+use crate::tui::trigger::TriggerScan;
 use ratatui::Frame;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::{Color, Style};
@@ -38,6 +40,10 @@ pub struct TracePane {
     /// The current bookmark (last set or jumped to) and its timestamp: what the `mark` time
     /// mode counts from.
     mark: Option<(usize, u64)>,
+    /// The trigger in force (`:trigger EXPR`).
+    trigger: Option<TriggerScan>,
+    /// The bookmarks loaded from the sidecar file, with their timestamps.
+    loaded: Vec<(usize, u64)>,
 }
 
 impl Default for TracePane {
@@ -50,6 +56,8 @@ impl Default for TracePane {
             time_mode: TimeMode::default(),
             marks: BTreeSet::new(),
             mark: None,
+            trigger: None,
+            loaded: Vec::new(),
         }
     }
 }
@@ -82,8 +90,24 @@ impl TracePane {
             self.view.settle();
         }
         let before = self.view.len(trace);
-        let more = self.view.advance(trace, budget);
-        (more, self.view.len(trace) != before)
+        let mut more = self.view.advance(trace, budget);
+        let mut changed = self.view.len(trace) != before;
+        if let Some(t) = &mut self.trigger {
+            let hits = t.hits().len();
+            more |= t.advance(trace, budget);
+            changed |= t.hits().len() != hits;
+        }
+        (more, changed)
+    }
+
+    /// The trigger in force.
+    pub fn trigger(&self) -> Option<&TriggerScan> {
+        self.trigger.as_ref()
+    }
+
+    /// Puts `trigger` in force (none: `:trigger off`).
+    pub fn set_trigger(&mut self, trigger: Option<TriggerScan>) {
+        self.trigger = trigger;
     }
 
     /// What the time column shows.
@@ -99,6 +123,29 @@ impl TracePane {
     /// Bookmarked trace positions, rising.
     pub fn marks(&self) -> impl Iterator<Item = usize> + '_ {
         self.marks.iter().copied()
+    }
+
+    /// Bookmarked trace positions with their timestamps (those of frames not arrived yet:
+    /// as loaded).
+    pub fn marks_with_times(&self, trace: &Trace) -> Vec<(usize, u64)> {
+        self.marks
+            .iter()
+            .map(|&p| {
+                let ns = match self.loaded.iter().find(|(q, _)| *q == p) {
+                    Some((_, ns)) if p >= trace.store.len() => *ns,
+                    _ if p < trace.store.len() => trace.store.packed(p).ts_ns,
+                    _ => 0,
+                };
+                (p, ns)
+            })
+            .collect()
+    }
+
+    /// Bookmarks as loaded from a sidecar file (position, timestamp).
+    pub fn set_marks(&mut self, marks: Vec<(usize, u64)>) {
+        self.marks = marks.iter().map(|(p, _)| *p).collect();
+        self.mark = marks.first().copied();
+        self.loaded = marks;
     }
 
     /// Sets a bookmark on the selected frame, or removes the one there.
@@ -223,6 +270,7 @@ impl TracePane {
             mode: self.time_mode,
             mark_ns: self.mark.map(|(_, ns)| ns),
             marked: self.marks.contains(&pos),
+            hit: self.trigger.as_ref().is_some_and(|t| t.is_hit(pos)),
         };
         cells(self.row(pos), pos, width, &time)
     }
@@ -342,17 +390,22 @@ struct Time {
     mode: TimeMode,
     mark_ns: Option<u64>,
     marked: bool,
+    /// This row is a hit of the trigger in force.
+    hit: bool,
 }
 
 impl Time {
     /// The time cell of `row`, `width` wide with `decimals`, and a trailing space.
     fn cell(&self, row: &Row, width: usize, decimals: usize) -> Span<'static> {
         let text = format!(
-            "{} ",
-            trace_time::format(self.mode, &row.stamps, self.mark_ns, width, decimals)
+            "{}{}",
+            trace_time::format(self.mode, &row.stamps, self.mark_ns, width, decimals),
+            if self.hit { '*' } else { ' ' }
         );
         if self.marked {
             Span::styled(text, Style::default().fg(Color::Black).bg(Color::Yellow))
+        } else if self.hit {
+            Span::styled(text, Style::default().fg(Color::LightRed))
         } else {
             Span::raw(text)
         }
