@@ -169,7 +169,8 @@ fn asc_status_lines_are_bus_state_events() {
     let out = crate::run::cotui(&["decode", "--events", log], None);
     assert_eq!(
         String::from_utf8_lossy(&out.stdout),
-        "(0.015991)  bus       bus_state         can0: error active -> error passive \
+        // The file's `date` line (Sam Sep 30 15:06:13.191 2017, as UTC) plus 0.015991 s.
+        "(1506783973.206991)  bus       bus_state         can0: error active -> error passive \
          (controller problem (TX error passive); error counters tx=132 rx=0)\n"
     );
 }
