@@ -290,3 +290,23 @@ fn trc_status_and_error_lines_are_bus_state_events_and_bus_errors() {
         );
     }
 }
+
+/// A TRC 1.0 log (no `$FILEVERSION`): a status line is id FFFFFFFF, an error frame has
+/// `ERROR` in place of its data; both count in diagnose's `bus_errors`.
+#[test]
+fn trc_1_0_error_frames_and_status_lines() {
+    let v10 = "     1)       0.1  0701  1  05\n     2)     100.0  FFFFFFFF  4  00 00 00 04\n     3)     200.0  0008  4  ERROR 00 19 08 08\n     4)     400.0  FFFFFFFF  4  00 00 00 10\n";
+    let out = crate::run::cotui(&["decode", "--events", "-"], Some(v10));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout),
+        "(0.000100)  node   1  state             Operational (first heartbeat)\n\
+         (0.100000)  bus       bus_state         can0: error active -> error warning (controller problem (TX error warning))\n\
+         (0.400000)  bus       bus_state         can0: error warning -> bus off (bus off)\n"
+    );
+    let out = crate::run::cotui(&["diagnose", "--format", "jsonl", "-"], Some(v10));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("\"count\":3,") && text.contains("\"kind\":\"bus_errors\""),
+        "{text}"
+    );
+}
