@@ -223,18 +223,18 @@ fn assert_messages(kind: &str, got: &[(f64, String)], want: &[(f64, &str)]) {
 
 #[test]
 fn python_can_reads_cotuis_asc_and_trc() {
-    // ASC times are since the first frame; channel 1 is python-can's channel 0; the error
+    // ASC times are since the `date` line (the first frame's time to the ms); channel 1 is python-can's channel 0; the error
     // frame is ASC's ErrorFrame (no detail).
     assert_messages(
         "asc",
         &python_can_reads_cotui("asc"),
         &[
-            (0.0, "181 0 0 0 0 0 1 0 2 1122"),
-            (0.0011, "1abcdef 1 0 0 0 0 0 1 8 0102030405060708"),
-            (0.0022, "701 0 1 0 0 0 1 0 1"),
-            (0.0033, "123 0 0 1 1 0 1 0 12 000102030405060708090a0b"),
-            (0.0044, "0 1 0 0 0 1 1 0 0"),
-            (0.0055, "605 0 0 0 0 0 0 0 8 4017100000000000"),
+            (0.0001, "181 0 0 0 0 0 1 0 2 1122"),
+            (0.0012, "1abcdef 1 0 0 0 0 0 1 8 0102030405060708"),
+            (0.0023, "701 0 1 0 0 0 1 0 1"),
+            (0.0034, "123 0 0 1 1 0 1 0 12 000102030405060708090a0b"),
+            (0.0045, "0 1 0 0 0 1 1 0 0"),
+            (0.0056, "605 0 0 0 0 0 0 0 8 4017100000000000"),
         ],
     );
     // TRC 2.1 times are absolute ($STARTTIME); python-can keeps the bus number (1-based),

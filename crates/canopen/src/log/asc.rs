@@ -80,10 +80,9 @@ impl Parser {
                 && toks
                     .next()
                     .is_some_and(|(_, t)| t.eq_ignore_ascii_case(b"Triggerblock"))
+                && let Some(start) = super::asc_date::parse(&mut toks)
             {
-                if let Some(start) = super::asc_date::parse(&mut toks) {
-                    self.start_ns = start;
-                }
+                self.start_ns = start;
             }
             return Ok(Line::Skip(SkipReason::Header));
         }

@@ -88,7 +88,7 @@ fn clock(word: &[u8]) -> Option<(u32, u32, u64)> {
 
 /// Days from 1970-01-01 to `year-month-day` (proleptic Gregorian; `year` >= 1970).
 fn days_since_epoch(year: u32, month: u32, day: u32) -> u64 {
-    let leap = |y: u32| (y % 4 == 0 && y % 100 != 0) || y % 400 == 0;
+    let leap = |y: u32| (y.is_multiple_of(4) && !y.is_multiple_of(100)) || y.is_multiple_of(400);
     const BEFORE: [u32; 12] = [0, 31, 59, 90, 120, 151, 181, 212, 243, 273, 304, 334];
     let full_years: u64 = (1970..year).map(|y| if leap(y) { 366 } else { 365 }).sum();
     let in_year = BEFORE[(month - 1) as usize] + u32::from(month > 2 && leap(year)) + day - 1;
