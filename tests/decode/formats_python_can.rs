@@ -223,18 +223,18 @@ fn assert_messages(kind: &str, got: &[(f64, String)], want: &[(f64, &str)]) {
 
 #[test]
 fn python_can_reads_cotuis_asc_and_trc() {
-    // ASC times are since the first frame; channel 1 is python-can's channel 0; the error
+    // ASC times are since the `date` line (the first frame's time to the ms); channel 1 is python-can's channel 0; the error
     // frame is ASC's ErrorFrame (no detail).
     assert_messages(
         "asc",
         &python_can_reads_cotui("asc"),
         &[
-            (0.0, "181 0 0 0 0 0 1 0 2 1122"),
-            (0.0011, "1abcdef 1 0 0 0 0 0 1 8 0102030405060708"),
-            (0.0022, "701 0 1 0 0 0 1 0 1"),
-            (0.0033, "123 0 0 1 1 0 1 0 12 000102030405060708090a0b"),
-            (0.0044, "0 1 0 0 0 1 1 0 0"),
-            (0.0055, "605 0 0 0 0 0 0 0 8 4017100000000000"),
+            (0.0001, "181 0 0 0 0 0 1 0 2 1122"),
+            (0.0012, "1abcdef 1 0 0 0 0 0 1 8 0102030405060708"),
+            (0.0023, "701 0 1 0 0 0 1 0 1"),
+            (0.0034, "123 0 0 1 1 0 1 0 12 000102030405060708090a0b"),
+            (0.0045, "0 1 0 0 0 1 1 0 0"),
+            (0.0056, "605 0 0 0 0 0 0 0 8 4017100000000000"),
         ],
     );
     // TRC 2.1 times are absolute ($STARTTIME); python-can keeps the bus number (1-based),
@@ -251,4 +251,76 @@ fn python_can_reads_cotuis_asc_and_trc() {
             (t + 0.0056, "605 0 0 0 0 0 0 1 8 4017100000000000"),
         ],
     );
+}
+
+/// The times python-can's `ASCReader` gives the messages of `asc` (read in UTC), in ns.
+fn python_can_asc_times(asc: &[u8]) -> Vec<u64> {
+    let path = std::env::temp_dir().join(format!("cotui-pycan-times-{}.asc", std::process::id()));
+    std::fs::write(&path, asc).unwrap();
+    let script = format!(
+        "import can, logging\nlogging.disable(logging.WARNING)\nfor m in can.ASCReader({:?}, relative_timestamp=False):\n    print(f'{{m.timestamp:.6f}}')\n",
+        path.to_str().unwrap()
+    );
+    let py = Command::new("python3")
+        .args(["-c", &script])
+        .env("TZ", "UTC")
+        .output()
+        .expect("python3");
+    std::fs::remove_file(&path).ok();
+    assert!(py.status.success(), "{}", String::from_utf8_lossy(&py.stderr));
+    String::from_utf8_lossy(&py.stdout)
+        .lines()
+        .map(|l| {
+            let (s, us) = l.split_once('.').unwrap();
+            s.parse::<u64>().unwrap() * 1_000_000_000 + us.parse::<u64>().unwrap() * 1000
+        })
+        .collect()
+}
+
+#[test]
+fn asc_date_line_gives_the_absolute_times_python_can_reads() {
+    // python-can's ASCWriter writes a `date` line (the time of writing), a `Begin
+    // Triggerblock` line with the first message's date and times since it; its ASCReader
+    // (`relative_timestamp=False`) adds them, as cotui does (in UTC).
+    let asc = python_can_file("dated.asc", "can.ASCWriter(path)");
+    assert!(asc.starts_with(b"date "), "{}", String::from_utf8_lossy(&asc));
+    let theirs = python_can_asc_times(&asc);
+    let mut r = LogReader::new(&asc[..]).unwrap();
+    let mut ours = Vec::new();
+    while let Some((_, outcome)) = r.next_line().unwrap() {
+        if let Outcome::Frame(f) = outcome {
+            ours.push(f.ts_ns);
+        }
+    }
+    assert_eq!(ours.len(), theirs.len());
+    // The first message's own time (python-can writes the trigger block's date to 0.1 s).
+    assert!(ours[0].abs_diff(1_700_000_000_000_100_000) < 100_000_000, "{}", ours[0]);
+    for (o, t) in ours.iter().zip(&theirs) {
+        assert!(o.abs_diff(*t) <= 1000, "{o} vs python-can {t}");
+    }
+}
+
+#[test]
+fn decode_jsonl_times_of_an_asc_are_its_date_plus_the_offsets() {
+    let dir = std::env::temp_dir().join(format!("cotui-asc-date-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("rel.asc");
+    // Relative timestamps: each time is added to the last (the event line's too).
+    std::fs::write(
+        &path,
+        "date Tue Mar 5 10:00:00.000 am 2024\nbase hex  timestamps relative\ninternal events logged\nBegin Triggerblock Tue Mar 5 10:00:00.000 am 2024\n   0.001000 1  701             Rx   d 1 00\n   0.500000 Start of measurement\n   0.000250 1  181             Rx   d 2 11 22\nEnd TriggerBlock\n",
+    )
+    .unwrap();
+    let run = crate::run::cotui(&["decode", "--format", "jsonl", path.to_str().unwrap()], None);
+    std::fs::remove_dir_all(&dir).ok();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let times: Vec<String> = String::from_utf8_lossy(&run.stdout)
+        .lines()
+        .map(|l| {
+            let t = &l[l.find("\"t\":").unwrap() + 4..];
+            t[..t.find(',').unwrap()].to_string()
+        })
+        .collect();
+    // 2024-03-05 10:00:00 UTC is 1709632800.
+    assert_eq!(times, ["1709632800.001000000", "1709632800.501250000"]);
 }

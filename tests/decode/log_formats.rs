@@ -169,7 +169,8 @@ fn asc_status_lines_are_bus_state_events() {
     let out = crate::run::cotui(&["decode", "--events", log], None);
     assert_eq!(
         String::from_utf8_lossy(&out.stdout),
-        "(0.015991)  bus       bus_state         can0: error active -> error passive \
+        // The file's `date` line (Sam Sep 30 15:06:13.191 2017, as UTC) plus 0.015991 s.
+        "(1506783973.206991)  bus       bus_state         can0: error active -> error passive \
          (controller problem (TX error passive); error counters tx=132 rx=0)\n"
     );
 }
@@ -245,5 +246,67 @@ fn savvycan_csv_decodes_by_content() {
     assert!(
         stderr.contains(":5: warning: column 39: expected a hex data byte"),
         "{stderr}"
+    );
+}
+
+/// Hand-made PEAK TRC 2.1 and 1.1 logs (after PEAK's format description) with status
+/// (`ST`, 1.1 `Warng` with id FFFFFFFF: the PCAN status code in the last four bytes) and
+/// error lines (`ER`, 1.1 `Error`): status lines are bus-state events, and with the error
+/// lines they are diagnose's `bus_errors` incident; an `EC` line is skipped.
+#[test]
+fn trc_status_and_error_lines_are_bus_state_events_and_bus_errors() {
+    let v21 = ";$FILEVERSION=2.1\n;$STARTTIME=45244.5\n;$COLUMNS=N,O,T,B,I,d,R,L,D\n      1         0.100 DT  1      0701 Rx -  1    05\n      2       100.000 ST  1           Rx    00 00 00 08\n      3       200.000 ER  1           Rx    04 00 02 00 00\n      4       300.000 ST  1           Rx    00 04 00 00\n      5       400.000 ST  1           Rx    00 00 00 10\n      6       500.000 EC  1           Rx    00 80\n";
+    let v11 = ";$FILEVERSION=1.1\n;$STARTTIME=45244.5\n     1)       0.1  Rx         0701  1  05\n     2)     100.0  Warng  FFFFFFFF  4  00 00 00 08  BUSHEAVY\n     3)     200.0  Error      0100  3  00 19 08\n     4)     400.0  Warng  FFFFFFFF  4  00 00 00 10  BUSOFF\n";
+    let warning = "(1699963200.100000)  bus       bus_state         can0: error active -> error warning (controller problem (TX error warning))\n";
+    let passive = "(1699963200.300000)  bus       bus_state         can0: error warning -> error passive (controller problem (TX error passive))\n";
+    let off =
+        |from: &str| format!("(1699963200.400000)  bus       bus_state         can0: {from} -> bus off (bus off)\n");
+    let boot = "(1699963200.000100)  node   1  state             Operational (first heartbeat)\n";
+    for (name, log, want, errors) in [
+        (
+            "2.1",
+            v21,
+            format!("{boot}{warning}{passive}{}", off("error passive")),
+            4,
+        ),
+        ("1.1", v11, format!("{boot}{warning}{}", off("error warning")), 3),
+    ] {
+        let out = crate::run::cotui(&["decode", "--events", "-"], Some(log));
+        assert_eq!(String::from_utf8_lossy(&out.stdout), want, "TRC {name}");
+        let out = crate::run::cotui(&["diagnose", "--format", "jsonl", "-"], Some(log));
+        let incidents: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect();
+        let bus = incidents
+            .iter()
+            .find(|i| i["kind"] == "bus_errors")
+            .unwrap_or_else(|| panic!("TRC {name}: no bus_errors in {incidents:?}"));
+        assert_eq!(bus["count"], errors, "TRC {name}");
+        assert_eq!(
+            bus["title"],
+            format!("{errors} CAN error frames (the controller went bus off)"),
+            "TRC {name}"
+        );
+    }
+}
+
+/// A TRC 1.0 log (no `$FILEVERSION`): a status line is id FFFFFFFF, an error frame has
+/// `ERROR` in place of its data; both count in diagnose's `bus_errors`.
+#[test]
+fn trc_1_0_error_frames_and_status_lines() {
+    let v10 = "     1)       0.1  0701  1  05\n     2)     100.0  FFFFFFFF  4  00 00 00 04\n     3)     200.0  0008  4  ERROR 00 19 08 08\n     4)     400.0  FFFFFFFF  4  00 00 00 10\n";
+    let out = crate::run::cotui(&["decode", "--events", "-"], Some(v10));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout),
+        "(0.000100)  node   1  state             Operational (first heartbeat)\n\
+         (0.100000)  bus       bus_state         can0: error active -> error warning (controller problem (TX error warning))\n\
+         (0.400000)  bus       bus_state         can0: error warning -> bus off (bus off)\n"
+    );
+    let out = crate::run::cotui(&["diagnose", "--format", "jsonl", "-"], Some(v10));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("\"count\":3,") && text.contains("\"kind\":\"bus_errors\""),
+        "{text}"
     );
 }

@@ -18,12 +18,19 @@ const SAMPLES: &[&str] = &[
     "   0.176544 CANFD   1 Rx        305  fdMsg  1 0 9 12 11 22 33 44 55 66 77 88 99 AA BB CC   130000  130     3000 0 0",
     "   0.002000 2  1ABCDEFx        Tx   d F 01 02 03 04 05 06 07 08  Length = 0",
     "base dec  timestamps relative",
+    "date Tue Mar 5 10:00:00.000 am 2024",
+    "date Sam Sep 30 15:06:13.191 2017",
+    "Begin Triggerblock Tue Nov 14 22:13:20.0 2023",
     "   0.015991 CAN 1 Status:chip status error passive - TxErr: 132 RxErr: 0",
     "     1)      1841  0001    8  00 01 02 03 04 05 06 07",
     "     3)      1346.0  Warng  FFFFFFFF  4  00 00 00 08  BUSHEAVY",
     "     1)      1.500 3  Tx         0300 -  1  BB",
     "      2         0.200 FB  2  18FF0102 Tx -  9    00 01 02 03 04 05 06 07 08 09 0A 0B",
     "      4         0.400 ST  1           Rx    00 04 00 00",
+    "      5         0.500 ER  1           Rx    04 00 02 00 00",
+    "      6       500.000 EC  1           Rx    00 80",
+    "     4)      1349.8  Error      0100  3  00 19 08",
+    "     2)      1842  0008    4  ERROR 00 19 08 08",
     ";$STARTTIME=45244.9258101852",
     ";$COLUMNS=N,O,T,B,I,d,R,L,D",
     "1700000000.123456,0x181,0,0,0,2,ESI=",
@@ -38,6 +45,9 @@ const TRC_VERSIONS: &[&str] = &[
     ";$FILEVERSION=2.0",
     ";$FILEVERSION=2.1",
 ];
+
+/// ASC header lines that give a parser a date (times become absolute) or relative times.
+const ASC_HEADERS: &[&str] = &["date Fri Dec 31 11:59:59.999 pm 9999", "base hex  timestamps relative"];
 
 /// Runs every parser on `line`; the result does not matter, only that it returns.
 fn parse_all(line: &[u8]) {
@@ -58,6 +68,11 @@ fn parse_all(line: &[u8]) {
         let mut p = savvycan::Parser::new();
         let _ = p.parse_line(header.as_bytes(), &mut ifaces);
         let _ = p.parse_line(line, &mut ifaces);
+    }
+    for header in ASC_HEADERS {
+        let mut a = asc::Parser::new();
+        let _ = a.parse_line(header.as_bytes(), &mut ifaces);
+        let _ = a.parse_line(line, &mut ifaces);
     }
     for header in TRC_VERSIONS {
         let mut t = trc::Parser::new();

@@ -15,8 +15,11 @@
 //! ```
 //! Lines are split on any run of blanks. Choices, all as can-utils' `asc2log` makes them:
 //! - channel N is interface `can{N-1}` (channel 1 is `can0`); channel 0 is `canX`;
-//! - timestamps are kept as written: seconds since the start of the measurement (the `date`
-//!   line is not read); with `timestamps relative` each line's time is added to the last;
+//! - times are seconds since the start of the measurement, which the `date` line names,
+//!   or the date of the `Begin Triggerblock` line that follows it (as python-can's
+//!   `ASCReader` takes them; dates as UTC, see `asc_date.rs`): with a readable date frames
+//!   carry absolute times (ns since 1970), without one the times as written; with
+//!   `timestamps relative` each timed line's time (events too) is added to the last;
 //! - `base dec` reads ids and data bytes as decimal (the DLC stays hex);
 //! - `ErrorFrame` has no detail in ASC, so it becomes a generic bus error: an error frame
 //!   with class `CAN_ERR_BUSERROR` (0x80) and 8 zero bytes;
@@ -48,6 +51,7 @@ pub struct Parser {
     decimal: bool,
     relative: bool,
     last_ns: u64,
+    start_ns: u64,
     channels: Channels,
 }
 
@@ -70,6 +74,15 @@ impl Parser {
         if !first[0].is_ascii_digit() {
             if first == b"base" {
                 self.base_line(&mut toks);
+            } else if first == b"date" {
+                self.start_ns = super::asc_date::parse(&mut toks).unwrap_or(0);
+            } else if first == b"Begin"
+                && toks
+                    .next()
+                    .is_some_and(|(_, t)| t.eq_ignore_ascii_case(b"Triggerblock"))
+                && let Some(start) = super::asc_date::parse(&mut toks)
+            {
+                self.start_ns = start;
             }
             return Ok(Line::Skip(SkipReason::Header));
         }
@@ -77,6 +90,11 @@ impl Parser {
         if end != at + first.len() {
             return Err(err(end, "expected a timestamp like 1.000000"));
         }
+        if self.relative {
+            ts = self.last_ns.saturating_add(ts);
+            self.last_ns = ts;
+        }
+        let ts = self.start_ns.saturating_add(ts);
         let (ch_at, ch_tok) = toks
             .next()
             .ok_or_else(|| err(s.len(), "expected a channel or event after the time"))?;
@@ -115,10 +133,6 @@ impl Parser {
                 None => return Ok(Line::Skip(SkipReason::Event)),
             },
         };
-        if self.relative {
-            ts = self.last_ns.saturating_add(ts);
-        }
-        self.last_ns = ts;
         f.ts_ns = ts;
         Ok(Line::Frame(f))
     }
@@ -408,6 +422,23 @@ mod tests {
         );
         assert_eq!((fs[0].id, fs[0].payload()), (0x123, &[17, 255][..]));
         assert_eq!((fs[1].id, fs[1].ts_ns), (0x7FF, 750_000_000));
+    }
+
+    #[test]
+    fn the_date_line_makes_times_absolute_and_relative_times_sum_over_events() {
+        let (fs, _) = frames(
+            "date Tue Nov 14 10:13:20.000 pm 2023\nbase hex  timestamps relative\n   0.500000 1  123  Rx   d 0\n   0.100000 Start of measurement\n   0.250000 1  124  Rx   d 0\n",
+        );
+        let t0 = 1_700_000_000_000_000_000;
+        assert_eq!((fs[0].ts_ns - t0, fs[1].ts_ns - t0), (500_000_000, 850_000_000));
+        // A trigger block's date is the base of the times after it.
+        let (fs, _) = frames(
+            "date Wed Dec 02 15:21:53.870 2026\nBegin Triggerblock Tue Nov 14 22:13:20.0 2023\n   0.000100 1  123  Rx   d 0\n",
+        );
+        assert_eq!(fs[0].ts_ns, t0 + 100_000);
+        // An unreadable date leaves the times as written.
+        let (fs, _) = frames("date someday\n   1.500000 1  123  Rx   d 0\n");
+        assert_eq!(fs[0].ts_ns, 1_500_000_000);
     }
 
     #[test]

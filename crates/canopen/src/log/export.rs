@@ -1,10 +1,11 @@
 //! Writers of Vector ASC and PEAK TRC 2.1 logs, so that a capture opens where users
 //! already work (CANalyzer/CANoe, PCAN-View, python-can). Both read back through
-//! [`super::LogReader`] to the same frames (times relative to the first frame for ASC).
+//! [`super::LogReader`] to the same frames and times (ASC's from its `date` line).
 //!
 //! Channel numbers: interface `canN` is channel N+1 (as the readers name channels back);
 //! any other name is channel (its index in the interface table + 1). The header is written
-//! with the first frame, whose time is the measurement's start.
+//! with the first frame, whose time is the measurement's start (ASC: to the ms, as its
+//! `date` line has it; times are offsets from that date).
 
 use std::fmt::Write as _;
 
@@ -84,7 +85,7 @@ impl AscWriter {
                 out,
                 "date {date}\nbase hex  timestamps absolute\nno internal events logged\n// cotui\nBegin Triggerblock {date}\n   0.000000 Start of measurement\n"
             );
-            frame.ts_ns
+            frame.ts_ns - frame.ts_ns % 1_000_000
         });
         let t = frame.ts_ns.saturating_sub(start);
         let _ = write!(out, "{:>4}.{:06} ", t / 1_000_000_000, t / 1000 % 1_000_000);
@@ -274,7 +275,7 @@ mod tests {
         }
         a.finish(&mut asc);
         assert!(asc.starts_with("date Tue Nov 14 22:13:20.000 2023\n"), "{asc}");
-        for (text, format, t0) in [(&asc, Format::Asc, 1_700_000_000_000_100_000), (&trc, Format::Trc, 0)] {
+        for (text, format, t0) in [(&asc, Format::Asc, 0), (&trc, Format::Trc, 0)] {
             let (got_format, got, ifaces) = read_back(text);
             assert_eq!(got_format, format);
             let want = frames();

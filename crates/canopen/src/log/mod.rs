@@ -8,6 +8,7 @@
 //! line buffer when a line straddles it), and counts what it saw.
 
 pub mod asc;
+mod asc_date;
 pub mod blf;
 pub mod candump;
 pub mod csv;

@@ -24,7 +24,8 @@
 //! their `L` a DLC up to 15 (`l`: the length); status lines (1.x `Warng` with id
 //! `FFFFFFFF`, 2.x `ST`) are controller states from the PCAN status code in the last four
 //! bytes (`BUSOFF` 0x10, `BUSPASSIVE` 0x40000, `BUSHEAVY` 0x08 and `BUSLIGHT` 0x04 warning
-//! level, 0 error active); error lines (1.x `Error`, 2.x `ER`) are bus errors. Other
+//! level, 0 error active); error lines (1.0 `ERROR` in place of the data, 1.1 to 1.3 `Error`,
+//! 2.x `ER`) are bus errors. Other
 //! events (`EC`, `EV`, ...) are skipped.
 
 use super::lex::{self, Channels, Tokens, dec_u32, err, hex, hex_u32, trim_end};
@@ -206,6 +207,11 @@ impl Parser {
             Kind::Status
         } else {
             kind
+        };
+        // 1.0 error frames: `2)  1842  0008  4  ERROR  00 19 08 08` (the id is the error type).
+        let kind = match kind {
+            Kind::Frame { .. } if toks.peek().is_some_and(|(_, t)| t == b"ERROR") => Kind::Error,
+            k => k,
         };
         let f = match kind {
             Kind::Frame { tx, .. } => {
@@ -474,7 +480,7 @@ mod tests {
     #[test]
     fn version_1_0_and_1_1() {
         let (fs, _) = frames(
-            ";##########\n;   Start time: 12.11.2007 17:28:14.109\n     1)      1841  0001    8  00 01 02 03 04 05 06 07\n     2)      1842  00000100  2  RTR\n     3)      1843  FFFFFFFF  4  00 00 00 10\n",
+            ";##########\n;   Start time: 12.11.2007 17:28:14.109\n     1)      1841  0001    8  00 01 02 03 04 05 06 07\n     2)      1842  00000100  2  RTR\n     3)      1843  FFFFFFFF  4  00 00 00 10\n     4)      1844  0008    4  ERROR 00 19 08 08\n",
         );
         assert_eq!(
             (fs[0].ts_ns, fs[0].id, fs[0].len, fs[0].data[7]),
@@ -485,6 +491,10 @@ mod tests {
             (0x100, Flags::EXT | Flags::RTR, 2)
         );
         assert_eq!((fs[2].flags.0, fs[2].id), (Flags::ERR, 0x40));
+        assert_eq!(
+            (fs[3].flags.0, fs[3].id, fs[3].ts_ns),
+            (Flags::ERR, 0x88, 1_844_000_000)
+        );
         let (fs, _) = frames(
             ";$FILEVERSION=1.1\n;$STARTTIME=25569.5\n     1)      1059.9  Rx         0300  8  00 00 00 00 00 00 00 01\n     2)      1298.9  Tx     00000100  8  RTR\n     3)      1346.0  Warng  FFFFFFFF  4  00 00 00 08  BUSHEAVY\n     4)      1349.8  Error      0100  3  00 19 08\n     5)      1350.0  Bogus      0100  0\n",
         );
