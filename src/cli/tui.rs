@@ -97,6 +97,10 @@ pub struct LiveArgs {
     /// Never send: the bus is opened without a send path.
     #[arg(long)]
     pub listen_only: bool,
+    /// A transmit list (the JSON of `send --list`) for the Transmit pane (9): its enabled
+    /// entries are sent from the start; a bad entry is shown with its line, the rest works.
+    #[arg(long, value_name = "FILE")]
+    pub transmit: Option<PathBuf>,
     #[command(flatten)]
     pub ui: UiArgs,
 }
@@ -107,6 +111,10 @@ pub struct DemoArgs {
     /// Never send: watch the simulated drives only.
     #[arg(long)]
     pub listen_only: bool,
+    /// A transmit list (the JSON of `send --list`) for the Transmit pane (9): its enabled
+    /// entries are sent from the start; a bad entry is shown with its line, the rest works.
+    #[arg(long, value_name = "FILE")]
+    pub transmit: Option<PathBuf>,
     /// A simulated drive: NODE=MODEL[@SERIAL], MODEL one of aimotor, syntron-ds,
     /// dexmart-dev, aqmd2405, servo; NODE `ff` for a drive without node-ID (LSS only).
     /// Repeatable. Default: 2=aimotor 3=syntron-ds.
@@ -172,7 +180,7 @@ enum Feeding {
     Demo(crate::sim::Simulation, bool),
 }
 
-fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> ExitCode {
+fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding, transmit: Option<&std::path::Path>) -> ExitCode {
     let keymap = match load_keymap(&ui.keymap) {
         Ok(k) => k,
         Err(e) => {
@@ -207,6 +215,12 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> ExitCode {
     };
     let mut app = App::new(Trace::new(decoder, Bitrate::given_or_assumed(ui.bitrate)), keymap, src);
     app.set_bindings(bindings);
+    if let Some(path) = transmit
+        && let Err(e) = app.load_transmit(path)
+    {
+        eprintln!("cotui: {e}");
+        return ExitCode::Usage;
+    }
     if let Some(f) = &ui.filter {
         app.set_filter(f);
         if let Some(m) = app.screen_mut().take_message() {
@@ -259,7 +273,7 @@ pub fn run_open(args: &OpenArgs) -> ExitCode {
             None => return ExitCode::Unavailable,
         },
     };
-    start(&args.ui, &name, SourceKind::Open, Feeding::Log((rx, None)))
+    start(&args.ui, &name, SourceKind::Open, Feeding::Log((rx, None)), None)
 }
 
 /// `x` as typed when it is short, else in scientific notation (`1e-300`, not 300 digits).
@@ -287,6 +301,7 @@ pub fn run_replay(args: &ReplayArgs) -> ExitCode {
         &name,
         SourceKind::Replay { speed: args.speed },
         Feeding::Log((rx, Some(ctl))),
+        None,
     )
 }
 
@@ -300,7 +315,7 @@ pub fn run_live(args: &LiveArgs) -> ExitCode {
         listen_only: args.listen_only,
     };
     let feed = Feeding::Live(args.iface.clone(), args.listen_only);
-    start(&args.ui, &args.iface.join(" "), kind, feed)
+    start(&args.ui, &args.iface.join(" "), kind, feed, args.transmit.as_deref())
 }
 
 /// Runs `cotui demo`.
@@ -316,7 +331,7 @@ pub fn run_demo(args: &DemoArgs) -> ExitCode {
         }
     };
     let feed = Feeding::Demo(crate::sim::Simulation::demo_with(drives), args.listen_only);
-    start(&args.ui, crate::connect::DEMO, kind, feed)
+    start(&args.ui, crate::connect::DEMO, kind, feed, args.transmit.as_deref())
 }
 
 #[cfg(test)]

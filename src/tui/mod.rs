@@ -23,4 +23,5 @@ pub mod screen;
 pub mod source;
 mod stop;
 pub mod term;
+mod transmit;
 pub mod ui;
