@@ -189,10 +189,13 @@ pub fn load(text: &str, bindings: &Bindings) -> Result<Vec<Resolved>, ListError>
     )
 }
 
+/// One entry of [`load_each`]: its JSON text and what it resolves to, or its problem.
+pub type EachEntry = (String, Result<Resolved, Problem>);
+
 /// Each entry of a list file (its JSON text and what it resolves to, or its located
 /// problem), so that a bad entry does not keep the others from being used (the TUI's
 /// Transmit pane); the file itself not a list: an error.
-pub fn load_each(text: &str, bindings: &Bindings) -> Result<Vec<(String, Result<Resolved, Problem>)>, ListError> {
+pub fn load_each(text: &str, bindings: &Bindings) -> Result<Vec<EachEntry>, ListError> {
     let raws = raw_entries(text)?;
     Ok(parse_entries(text)?
         .into_iter()

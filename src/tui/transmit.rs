@@ -134,7 +134,7 @@ pub(crate) fn ask(
 ) -> Option<(String, usize)> {
     match ask {
         TransmitAsk::Toggle(k) => {
-            let Some(row) = pane.rows.get(k) else { return None };
+            let row = pane.rows.get(k)?;
             let on = match &row.entry {
                 Ok(e) => !e.enabled,
                 Err(why) => {
