@@ -314,7 +314,9 @@ mod tests {
     #[test]
     fn a_list_loads_with_its_bad_entry_located_and_the_rest_is_sent() {
         let (mut a, mut req) = live_app(false);
-        let path = list_file("load");
+        // A name of fixed length: the title and the message show it (the snapshot).
+        let path = std::env::temp_dir().join("cotui-transmit-pane-snapshot.json");
+        std::fs::write(&path, LIST).unwrap();
         a.load_transmit(&path).unwrap();
         assert_eq!(
             last_sent(&mut req).unwrap(),
@@ -382,6 +384,19 @@ mod tests {
         assert_eq!(back.len(), 3, "{saved}");
         assert!(back[0].1.as_ref().is_ok_and(|e| !e.enabled), "{saved}");
         assert!(back[2].1.is_err(), "the bad entry is kept as written: {saved}");
+    }
+
+    #[test]
+    fn an_empty_pane_says_how_to_add_an_entry_and_w_says_there_is_no_file() {
+        let (mut a, _req) = live_app(false);
+        a.act(Action::PaneTransmit);
+        let s = screen(&mut a, 160, 12);
+        assert!(s.contains("no entries (a: add one)"), "{s}");
+        key(&mut a, 'w');
+        assert_eq!(
+            a.message(),
+            Some("transmit: no file to save to (start with --transmit FILE)")
+        );
     }
 
     #[test]

@@ -118,7 +118,7 @@ impl Component for TransmitPane {
             .unwrap_or_else(|| "no file".into());
         let title = format!(" Transmit — {file} — space: on/off  a: add  e: edit  d: delete  w: save ");
         let height = area.height.saturating_sub(3) as usize;
-        let rows: Vec<Row> = self
+        let mut rows: Vec<Row> = self
             .rows
             .iter()
             .enumerate()
@@ -152,6 +152,13 @@ impl Component for TransmitPane {
                 Row::new(cells).style(style)
             })
             .collect();
+        if self.rows.is_empty() {
+            rows.push(Row::new([
+                String::new(),
+                String::new(),
+                "no entries (a: add one)".into(),
+            ]));
+        }
         let table = Table::new(
             rows,
             [
