@@ -97,6 +97,10 @@ pub struct LiveArgs {
     /// Never send: the bus is opened without a send path.
     #[arg(long)]
     pub listen_only: bool,
+    /// A transmit list (the JSON of `send --list`) for the Transmit pane (9): its enabled
+    /// entries are sent from the start; a bad entry is shown with its line, the rest works.
+    #[arg(long, value_name = "FILE")]
+    pub transmit: Option<PathBuf>,
     #[command(flatten)]
     pub ui: UiArgs,
 }
@@ -107,6 +111,10 @@ pub struct DemoArgs {
     /// Never send: watch the simulated drives only.
     #[arg(long)]
     pub listen_only: bool,
+    /// A transmit list (the JSON of `send --list`) for the Transmit pane (9): its enabled
+    /// entries are sent from the start; a bad entry is shown with its line, the rest works.
+    #[arg(long, value_name = "FILE")]
+    pub transmit: Option<PathBuf>,
     /// A simulated drive: NODE=MODEL[@SERIAL], MODEL one of aimotor, syntron-ds,
     /// dexmart-dev, aqmd2405, servo; NODE `ff` for a drive without node-ID (LSS only).
     /// Repeatable. Default: 2=aimotor 3=syntron-ds.
@@ -172,7 +180,7 @@ enum Feeding {
     Demo(crate::sim::Simulation, bool),
 }
 
-fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> ExitCode {
+fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding, transmit: Option<&std::path::Path>) -> ExitCode {
     let keymap = match load_keymap(&ui.keymap) {
         Ok(k) => k,
         Err(e) => {
@@ -211,6 +219,12 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding) -> ExitCode {
     // `cotui open FILE`: the bookmarks are kept beside the log (README, "Bookmarks").
     if open_file {
         app.screen_mut().keep_bookmarks(std::path::Path::new(name));
+    }
+    if let Some(path) = transmit
+        && let Err(e) = app.load_transmit(path)
+    {
+        eprintln!("cotui: {e}");
+        return ExitCode::Usage;
     }
     if let Some(f) = &ui.filter {
         app.set_filter(f);
@@ -264,7 +278,7 @@ pub fn run_open(args: &OpenArgs) -> ExitCode {
             None => return ExitCode::Unavailable,
         },
     };
-    start(&args.ui, &name, SourceKind::Open, Feeding::Log((rx, None)))
+    start(&args.ui, &name, SourceKind::Open, Feeding::Log((rx, None)), None)
 }
 
 /// `x` as typed when it is short, else in scientific notation (`1e-300`, not 300 digits).
@@ -292,6 +306,7 @@ pub fn run_replay(args: &ReplayArgs) -> ExitCode {
         &name,
         SourceKind::Replay { speed: args.speed },
         Feeding::Log((rx, Some(ctl))),
+        None,
     )
 }
 
@@ -305,7 +320,7 @@ pub fn run_live(args: &LiveArgs) -> ExitCode {
         listen_only: args.listen_only,
     };
     let feed = Feeding::Live(args.iface.clone(), args.listen_only);
-    start(&args.ui, &args.iface.join(" "), kind, feed)
+    start(&args.ui, &args.iface.join(" "), kind, feed, args.transmit.as_deref())
 }
 
 /// Runs `cotui demo`.
@@ -321,7 +336,7 @@ pub fn run_demo(args: &DemoArgs) -> ExitCode {
         }
     };
     let feed = Feeding::Demo(crate::sim::Simulation::demo_with(drives), args.listen_only);
-    start(&args.ui, crate::connect::DEMO, kind, feed)
+    start(&args.ui, crate::connect::DEMO, kind, feed, args.transmit.as_deref())
 }
 
 #[cfg(test)]

@@ -189,6 +189,45 @@ pub fn load(text: &str, bindings: &Bindings) -> Result<Vec<Resolved>, ListError>
     )
 }
 
+/// One entry of [`load_each`]: its JSON text and what it resolves to, or its problem.
+pub type EachEntry = (String, Result<Resolved, Problem>);
+
+/// Each entry of a list file (its JSON text and what it resolves to, or its located
+/// problem), so that a bad entry does not keep the others from being used (the TUI's
+/// Transmit pane); the file itself not a list: an error.
+pub fn load_each(text: &str, bindings: &Bindings) -> Result<Vec<EachEntry>, ListError> {
+    let raws = raw_entries(text)?;
+    Ok(parse_entries(text)?
+        .into_iter()
+        .zip(raws)
+        .map(|(e, raw)| (raw, e.and_then(|e| resolve(&e, bindings))))
+        .collect())
+}
+
+/// One entry from its JSON text alone (`{"frame": "123#01", "every_ms": 100}`, as typed in
+/// the TUI), entry `index` of its list, resolved through `bindings`.
+pub fn load_entry(text: &str, index: usize, bindings: &Bindings) -> Result<Resolved, Problem> {
+    entry(text, index, 1)
+        .map_err(|(line, message)| Problem {
+            entry: Some(index),
+            line,
+            message,
+        })
+        .and_then(|e| resolve(&e, bindings))
+}
+
+/// The JSON text of each entry of a list file.
+fn raw_entries(text: &str) -> Result<Vec<String>, ListError> {
+    let file: FileJson = serde_json::from_str(text).map_err(|e| ListError {
+        problems: vec![Problem {
+            entry: None,
+            line: e.line().max(1),
+            message: format!("not a transmit list ({e})"),
+        }],
+    })?;
+    Ok(file.entries.iter().map(|r| r.get().to_string()).collect())
+}
+
 /// The entries, or every problem among them.
 fn gather(all: Vec<Result<Resolved, Problem>>) -> Result<Vec<Resolved>, ListError> {
     let (ok, problems): (Vec<_>, Vec<_>) = all.into_iter().partition(Result::is_ok);

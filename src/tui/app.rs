@@ -18,7 +18,7 @@ use super::messages::Level;
 use super::palette::{self, Planned, commander_words};
 use super::panes::{Ctx, Pane, Selected};
 use super::prompt::{Edit, PromptKind};
-use super::{read_all, record, stop};
+use super::{read_all, record, stop, transmit};
 use crate::analysis::trace::Trace;
 use crate::od::bind::Bindings;
 use crossterm::event::{KeyCode, KeyEvent, MouseEvent};
@@ -218,10 +218,18 @@ impl App {
                 Event::Act(a) => self.act(a),
                 Event::Replay(a) => self.capture.replay_key(a, &mut q),
                 Event::StopAll(nodes, options) => {
+                    let pane = self.screen.transmit_mut();
+                    transmit::disable_all(&self.capture, pane, &self.bindings, &mut q);
                     let objects = self.screen.objects_mut();
                     stop::stop_all(&self.capture, objects, &nodes, options, &mut q);
                 }
                 Event::Quit => self.request_quit(),
+                Event::Transmit(ask) => {
+                    let pane = self.screen.transmit_mut();
+                    if let Some((text, cursor)) = transmit::ask(&self.capture, pane, &self.bindings, ask, &mut q) {
+                        self.screen.prompt_mut().open_at(PromptKind::Transmit, &text, cursor);
+                    }
+                }
             }
         }
     }
@@ -451,6 +459,20 @@ impl App {
                 self.screen.find_objects(text);
                 Ok(())
             }
+            PromptKind::Transmit => {
+                let mut q = Queue::default();
+                let pane = self.screen.transmit_mut();
+                match transmit::submit(&self.capture, pane, &self.bindings, text, &mut q) {
+                    Ok(()) => self.route(q),
+                    Err(e) => {
+                        self.screen
+                            .prompt_mut()
+                            .open_at(PromptKind::Transmit, text, text.chars().count());
+                        self.screen.set_message(Some(e));
+                    }
+                }
+                return;
+            }
         };
         // A bad expression keeps the prompt open with the text, the cursor where it is wrong.
         if let Err(e) = applied {
@@ -461,6 +483,16 @@ impl App {
     /// Applies a filter text; a parse error goes to the status bar and keeps the old filter.
     pub fn set_filter(&mut self, text: &str) {
         let _ = self.screen.apply_filter(self.capture.trace(), text);
+    }
+
+    /// Loads the transmit list file at `path` into the Transmit pane and sends its enabled
+    /// entries (`--transmit FILE`); a bad entry is shown with its line, the others work.
+    pub fn load_transmit(&mut self, path: &std::path::Path) -> Result<(), String> {
+        let mut q = Queue::default();
+        let pane = self.screen.transmit_mut();
+        transmit::load(&self.capture, pane, &self.bindings, path, &mut q)?;
+        self.route(q);
+        Ok(())
     }
 
     /// Runs a palette line: a built-in command ([`commands::run`]) or a commander line;

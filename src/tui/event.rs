@@ -48,6 +48,23 @@ pub(crate) enum Event {
     StopAll(Vec<u8>, StopOptions),
     /// Quit (asking first while a commanded drive is powered).
     Quit,
+    /// What the Transmit pane asks.
+    Transmit(TransmitAsk),
+}
+
+/// What the Transmit pane asks of the application (row numbers from 0).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum TransmitAsk {
+    /// Enable or disable this entry.
+    Toggle(usize),
+    /// Open the prompt for a new entry.
+    Add,
+    /// Open the prompt holding this entry.
+    Edit(usize),
+    /// Delete this entry.
+    Delete(usize),
+    /// Save the list to its file.
+    Save,
 }
 
 /// What the Objects pane asks of the application.

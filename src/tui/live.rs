@@ -9,6 +9,8 @@ use super::source::{BusNote, Feed};
 use crate::bus::{Bus, BusError, BusState, Event, StateChange};
 use crate::command::cyclic::{self, Progress};
 use crate::command::stop::{Commanded, StopOptions, stop_nodes};
+use crate::command::transmit_list::Resolved;
+use crate::command::transmit_run::{ListProgress, transmit_list};
 use crate::command::{self, Command, Spec};
 use crate::decode::cia402::DriveState;
 use crate::frame::Frame;
@@ -36,6 +38,12 @@ pub enum Request {
     /// `sim fault|silence|resume|reboot|mains|status ...` (`line` as typed): make a node of
     /// the demo's simulation fail; refused on other sources.
     Sim { line: String, control: Control },
+    /// The Transmit pane's list changed: stop sending the previous one, send `entries`
+    /// (the disabled ones listed, not sent), counts in `progress` (one per entry).
+    Transmit {
+        entries: Vec<Resolved>,
+        progress: ListProgress,
+    },
 }
 
 /// A handle to send requests to the live task.
@@ -346,6 +354,8 @@ struct Jobs {
     commanded: Commanded,
     /// Where a stop task sends the nodes it confirmed stopped (see [`Jobs::stopped`]).
     stopped_tx: UnboundedSender<Vec<u8>>,
+    /// The Transmit pane's list being sent (one at a time: a new list replaces it).
+    transmit: Option<AbortHandle>,
 }
 
 impl Jobs {
@@ -355,6 +365,7 @@ impl Jobs {
             next_id: 1,
             commanded: Commanded::default(),
             stopped_tx,
+            transmit: None,
         }
     }
 
@@ -399,6 +410,24 @@ impl Jobs {
             }
             Request::Sim { line, .. } => {
                 let _ = tx.send(Feed::Result(Level::Error, not_simulated(&line)));
+            }
+            Request::Transmit { entries, progress } => {
+                if let Some(t) = self.transmit.take() {
+                    t.abort();
+                }
+                let task = tokio::spawn(async move {
+                    let stop = std::future::pending();
+                    let text = match transmit_list(&bus, "Transmit pane", entries, None, progress, stop).await {
+                        Ok(r) => r
+                            .stopped_by
+                            .map(|why| (Level::Warn, format!("transmit: every entry disabled: {why}"))),
+                        Err(e) => Some((Level::Error, format!("transmit: not sent: {e}"))),
+                    };
+                    if let Some((level, text)) = text {
+                        let _ = tx.send(Feed::Result(level, text));
+                    }
+                });
+                self.transmit = Some(task.abort_handle());
             }
             Request::ListJobs => {
                 let text = if self.running.is_empty() {
@@ -449,12 +478,19 @@ impl Jobs {
     /// Aborts every running command, cyclic ones (SYNC, RPDOs, raw frames) first; returns
     /// their lines (a cyclic one's with its timing report).
     fn cancel_all(&mut self) -> Vec<String> {
+        let mut cancelled = Vec::new();
+        if let Some(t) = self.transmit.take().filter(|t| !t.is_finished()) {
+            t.abort();
+            cancelled.push("the Transmit pane's list".to_string());
+        }
         self.running.sort_by_key(|j| j.cyclic.is_none());
-        self.running
-            .drain(..)
-            .filter(|j| !j.task.is_finished())
-            .map(Job::cancel)
-            .collect()
+        cancelled.extend(
+            self.running
+                .drain(..)
+                .filter(|j| !j.task.is_finished())
+                .map(Job::cancel),
+        );
+        cancelled
     }
 
     /// Answers a request while the bus is unavailable (`why`): nothing can be sent, but a
@@ -463,6 +499,7 @@ impl Jobs {
         let text = match r {
             Request::Run { line, .. } => format!("{line}: not sent: {why}"),
             Request::ListJobs | Request::StopJob(_) => format!("jobs: the bus is unavailable ({why})"),
+            Request::Transmit { .. } => format!("transmit: not sent: {why}"),
             Request::Sim { line, .. } => not_simulated(&line),
             Request::StopAll { mut nodes, .. } => {
                 let cancelled = self.cancel_all();
@@ -641,6 +678,68 @@ mod tests {
         tokio::time::sleep(Duration::from_millis(200)).await;
         while let Some(Ok(f)) = sub.try_recv() {
             assert!(!listed(&f), "a list frame after the stop: {f:?}");
+        }
+    }
+
+    #[tokio::test(start_paused = true)]
+    async fn the_transmit_pane_list_sends_its_enabled_entries_on_their_period_and_stop_all_cancels_it() {
+        use crate::command::transmit_list::load_entry;
+        let bus = crate::sim::demo::start(false);
+        let bindings = crate::cli::bind::bindings_on(crate::connect::DEMO, &[], &[]).unwrap();
+        let (tx, rx) = sync_channel(64);
+        let (stopped_tx, _stopped) = unbounded_channel();
+        let mut jobs = Jobs::new(stopped_tx);
+        let mut sub = bus.subscribe();
+        let entries = vec![
+            load_entry(r#"{"frame": "123#01", "every_ms": 10}"#, 1, &bindings).unwrap(),
+            load_entry(r#"{"frame": "124#02", "every_ms": 10, "enabled": false}"#, 2, &bindings).unwrap(),
+        ];
+        let progress = ListProgress::default();
+        jobs.start(
+            &bus,
+            Request::Transmit {
+                entries,
+                progress: progress.clone(),
+            },
+            &bindings,
+            &tx,
+        );
+        // 200 ms of bus time from our first frame, by the frames' own timestamps.
+        let mut first = None;
+        let mut in_window = 0u64;
+        loop {
+            let f = sub.recv().await.unwrap();
+            assert!(f.id != 0x124, "a disabled entry was sent: {f:?}");
+            if f.id != 0x123 || f.direction() != crate::frame::Direction::Tx {
+                continue;
+            }
+            let t0 = *first.get_or_insert(f.ts_ns);
+            if f.ts_ns - t0 >= 200_000_000 {
+                break;
+            }
+            in_window += 1;
+        }
+        assert_eq!(in_window, 20, "one frame every 10 ms");
+        assert!(crate::command::transmit_run::lock_all(&progress)[0].sent >= 21);
+        let options = StopOptions {
+            timeout_ms: 50,
+            ramp_ms: 10,
+        };
+        jobs.start(
+            &bus,
+            Request::StopAll {
+                nodes: BTreeSet::new(),
+                options,
+            },
+            &bindings,
+            &tx,
+        );
+        let report = result(&rx).await;
+        assert!(report.contains("cancelled: the Transmit pane's list"), "{report}");
+        while sub.try_recv().is_some() {}
+        tokio::time::sleep(Duration::from_millis(100)).await;
+        while let Some(Ok(f)) = sub.try_recv() {
+            assert!(f.id != 0x123, "a list frame after the stop: {f:?}");
         }
     }
 }

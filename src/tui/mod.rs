@@ -24,5 +24,6 @@ pub mod screen;
 pub mod source;
 mod stop;
 pub mod term;
+mod transmit;
 pub mod trigger;
 pub mod ui;

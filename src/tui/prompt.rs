@@ -18,6 +18,8 @@ pub enum PromptKind {
     Palette,
     /// Finding an object in the Objects pane (the rows follow each key).
     Find,
+    /// An entry of the Transmit pane, in the list file's JSON.
+    Transmit,
 }
 
 impl PromptKind {
@@ -28,6 +30,7 @@ impl PromptKind {
             PromptKind::Search => "search: ",
             PromptKind::Palette => ":",
             PromptKind::Find => "find object: ",
+            PromptKind::Transmit => "transmit entry: ",
         }
     }
 }

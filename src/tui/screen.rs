@@ -97,6 +97,11 @@ impl Screen {
     }
 
     /// The Objects pane, for the read-all that runs through it.
+    pub(crate) fn transmit_mut(&mut self) -> &mut super::panes::transmit::TransmitPane {
+        self.panes.transmit_mut()
+    }
+
+    /// The Objects pane, to change.
     pub(crate) fn objects_mut(&mut self) -> &mut ObjectsPane {
         self.panes.objects_mut()
     }
@@ -666,6 +671,10 @@ impl Screen {
             Action::PanePdo => self.focus = Pane::Pdo,
             Action::PaneObjects => self.focus = Pane::Objects,
             Action::PaneProblems => self.focus = Pane::Problems,
+            Action::PaneTransmit => self.focus = Pane::Transmit,
+            Action::TransmitAdd | Action::TransmitDelete => {
+                self.message = Some(format!("{}: only in the Transmit pane (9)", a.name().replace('_', " ")))
+            }
             Action::Copy => self.message = Some("copy: only in the message log (m)".into()),
             Action::EditObject | Action::ReadAll => {
                 self.message = Some(format!("{}: only in the Objects pane", a.name().replace('_', " ")))
@@ -771,6 +780,7 @@ impl Screen {
             Pane::Objects,
             Pane::Pdo,
             Pane::Problems,
+            Pane::Transmit,
         ] {
             self.panes.get_mut(p).fit(height, &ctx);
         }

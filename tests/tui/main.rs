@@ -15,6 +15,7 @@ mod remote;
 mod screen;
 mod sdo_sequence;
 mod tmux;
+mod transmit_demo;
 mod tui_cli;
 mod tui_tmux;
 mod two_buses;

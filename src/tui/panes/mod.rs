@@ -18,6 +18,7 @@ pub mod stats;
 pub mod status;
 pub mod trace;
 pub mod trace_time;
+pub mod transmit;
 
 use crate::analysis::trace::Trace;
 use crate::decode::Kind;
@@ -39,11 +40,12 @@ pub enum Pane {
     Objects,
     Pdo,
     Problems,
+    Transmit,
 }
 
 impl Pane {
     /// Every pane in tab order.
-    pub const ALL: [Pane; 8] = [
+    pub const ALL: [Pane; 9] = [
         Pane::Trace,
         Pane::Nodes,
         Pane::Sdo,
@@ -52,6 +54,7 @@ impl Pane {
         Pane::Objects,
         Pane::Pdo,
         Pane::Problems,
+        Pane::Transmit,
     ];
     /// Tab title.
     pub fn title(self) -> &'static str {
@@ -64,6 +67,7 @@ impl Pane {
             Pane::Objects => "Objects",
             Pane::Pdo => "PDO",
             Pane::Problems => "Problems",
+            Pane::Transmit => "Transmit",
         }
     }
 }
@@ -87,6 +91,8 @@ pub struct Panes {
     pdo: pdo::PdoPane,
     /// One row per incident of the diagnosis.
     problems: problems::ProblemsPane,
+    /// One row per entry of the transmit list.
+    transmit: transmit::TransmitPane,
 }
 
 impl Panes {
@@ -135,6 +141,16 @@ impl Panes {
         &mut self.problems
     }
 
+    /// The Transmit pane.
+    pub fn transmit(&self) -> &transmit::TransmitPane {
+        &self.transmit
+    }
+
+    /// The Transmit pane, to change (its entries, what they sent).
+    pub(crate) fn transmit_mut(&mut self) -> &mut transmit::TransmitPane {
+        &mut self.transmit
+    }
+
     /// The Plot pane.
     pub fn plot(&self) -> &plot::PlotPane {
         &self.plot
@@ -158,6 +174,7 @@ impl Panes {
             Pane::Objects => &self.objects,
             Pane::Pdo => &self.pdo,
             Pane::Problems => &self.problems,
+            Pane::Transmit => &self.transmit,
         }
     }
 
@@ -172,6 +189,7 @@ impl Panes {
             Pane::Objects => &mut self.objects,
             Pane::Pdo => &mut self.pdo,
             Pane::Problems => &mut self.problems,
+            Pane::Transmit => &mut self.transmit,
         }
     }
 }
