@@ -14,6 +14,7 @@ pub mod incident;
 pub mod liveness;
 pub mod nodes;
 pub mod pdos;
+pub mod producers;
 pub mod search;
 pub mod series;
 pub mod stats;

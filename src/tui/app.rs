@@ -364,7 +364,7 @@ impl App {
             } else {
                 None
             };
-            let said = match palette::plan(&p.text, &self.bindings, |n| self.capture.drive_state(n)) {
+            let said = match self.plan(&p.text) {
                 Ok(pl) => match blocked {
                     Some(why) => format!("blocked: {why} — would send {}", pl.preview),
                     None => format!("will send: {}", pl.preview),
@@ -375,9 +375,18 @@ impl App {
         }
     }
 
+    /// Plans a commander line ([`palette::plan`]), with the second-producer warning
+    /// ([`palette::warn_second_producer`]).
+    fn plan(&self, line: &str) -> Result<Planned, crate::command::CommandError> {
+        let mut p = palette::plan(line, &self.bindings, |n| self.capture.drive_state(n))?;
+        let trace = self.capture.trace();
+        palette::warn_second_producer(&mut p, trace, crate::tui::panes::start_ns(trace));
+        Ok(p)
+    }
+
     /// Runs a commander line: asks for confirmation first when it needs one.
     fn commander(&mut self, line: &str) {
-        match palette::plan(line, &self.bindings, |n| self.capture.drive_state(n)) {
+        match self.plan(line) {
             Ok(p) => match p.confirm.clone() {
                 Some(why) => self.screen.ask_confirm(p, &why),
                 None => self.send(p),
@@ -790,7 +799,7 @@ mod tests {
             ("speed 2", "speed: only a replay has a speed".into()),
             (
                 "plot 1",
-                "plot: usage `plot NODE INDEX[:SUB]`, e.g. `plot 1 6064:00`".into(),
+                "plot: usage `plot NODE INDEX[:SUB]` (e.g. `plot 1 6064:00`) or `plot mode MODE`".into(),
             ),
             ("plot 1 60z1", "plot: bad index `60z1`".into()),
             ("plot 9 6041", "plot: no numeric values of node 9 0x6041:00 seen".into()),
@@ -855,7 +864,10 @@ mod tests {
         // A log has no bus: the preview says so before enter.
         assert_eq!(
             a.message(),
-            Some("blocked: this source has no bus — would send 000#8100")
+            // The fixture's own NMT frame (another master's, received) is warned of.
+            Some(
+                "blocked: this source has no bus — would send 000#8100 — warning: another NMT master is on the bus: 0x000 seen 1 time in the last 2 s, last at 0.006 s"
+            )
         );
         a.key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
         assert!(a.screen().confirming());
@@ -968,14 +980,24 @@ mod tests {
         for c in "nmt stop 2".chars() {
             a.key(key(c));
         }
-        assert_eq!(a.message(), Some("blocked: listen-only — would send 000#0202"));
+        assert_eq!(
+            a.message(),
+            Some(
+                "blocked: listen-only — would send 000#0202 — warning: another NMT master is on the bus: 0x000 seen 1 time in the last 2 s, last at 0.006 s"
+            )
+        );
         // A session that can send previews what goes out.
         let (mut a, _req) = live_app(false);
         a.key(key(':'));
         for c in "nmt stop 2".chars() {
             a.key(key(c));
         }
-        assert_eq!(a.message(), Some("will send: 000#0202"));
+        assert_eq!(
+            a.message(),
+            Some(
+                "will send: 000#0202 — warning: another NMT master is on the bus: 0x000 seen 1 time in the last 2 s, last at 0.006 s"
+            )
+        );
     }
 
     #[test]

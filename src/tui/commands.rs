@@ -8,6 +8,7 @@ use super::keymap::Action;
 use super::live::Request;
 use super::messages::Level;
 use super::palette::commander_words;
+use super::panes::plot::PlotMode;
 use super::panes::trace_time::TimeMode;
 use super::screen::Screen;
 use super::source::Control;
@@ -57,8 +58,11 @@ pub enum CommandError {
     #[error("speed: only a replay has a speed")]
     NoSpeed,
     /// `plot` without a node and an object.
-    #[error("plot: usage `plot NODE INDEX[:SUB]`, e.g. `plot 1 6064:00`")]
+    #[error("plot: usage `plot NODE INDEX[:SUB]` (e.g. `plot 1 6064:00`) or `plot mode MODE`")]
     PlotUsage,
+    /// `plot mode` without a mode.
+    #[error("plot: usage `plot mode lanes|normalised|shared|range LO HI` (LO < HI)")]
+    PlotModeUsage,
     /// `plot` with a bad node-ID.
     #[error("plot: `{0}` is not a node-ID")]
     NotANode(String),
@@ -146,6 +150,11 @@ pub(crate) fn run(line: &str, capture: &mut Capture, screen: &mut Screen, q: &mu
             screen.show_help();
             Ok(String::new())
         }
+        "export" if rest.starts_with("plot") && rest.split_whitespace().next() == Some("plot") => {
+            super::export_plot::command(rest.trim_start_matches("plot"), capture.trace(), screen.panes().plot())
+                .map_err(CommandError::from)
+                .inspect(|text| screen.log(Level::Info, text))
+        }
         "export" => export::command(rest, capture.trace(), screen.view())
             .map_err(CommandError::from)
             .inspect(|text| screen.log(Level::Info, text)),
@@ -222,8 +231,14 @@ pub(crate) fn run(line: &str, capture: &mut Capture, screen: &mut Screen, q: &mu
     Ran::Done
 }
 
-/// `plot NODE INDEX[:SUB]`: shows that series in the Plot pane.
+/// `plot NODE INDEX[:SUB]`: shows that series in the Plot pane; `plot mode
+/// lanes|normalised|shared|range LO HI`: lays out its y axes.
 fn plot(rest: &str, trace: &Trace, screen: &mut Screen) -> Result<String, CommandError> {
+    if let Some(words) = rest.strip_prefix("mode") {
+        let mode = PlotMode::parse(words).ok_or(CommandError::PlotModeUsage)?;
+        screen.set_plot_mode(mode);
+        return Ok(format!("plot: {}", mode.name()));
+    }
     let mut it = rest.split_whitespace();
     let (Some(node), Some(obj)) = (it.next(), it.next()) else {
         return Err(CommandError::PlotUsage);

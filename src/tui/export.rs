@@ -33,6 +33,12 @@ pub enum ExportError {
     /// `export` without a file.
     #[error("export: usage `export FILE [--format candump|jsonl|pcapng] [--force]`")]
     Usage,
+    /// `export plot` without a file.
+    #[error("export: usage `export plot FILE.csv [--all] [--force]`")]
+    PlotUsage,
+    /// `export plot` with no signal in the Plot pane.
+    #[error("export plot: no signal is plotted")]
+    NothingPlotted,
     /// The export file could not be written.
     #[error("export: {file}: {source}{hint}", hint = overwrite_hint(source))]
     Write { file: String, source: std::io::Error },

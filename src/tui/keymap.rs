@@ -90,6 +90,7 @@ actions! {
     NextSeries = "next_series": "Plot: next signal (Objects: next node)",
     PrevSeries = "prev_series": "Plot: previous signal (Objects: previous node)",
     PlotPick = "plot_pick": "Plot: pick signals (type to filter, enter adds or removes)",
+    PlotMode = "plot_mode": "Plot: cycle the y axes (lanes, normalised, shared by unit)",
     ZoomIn = "zoom_in": "Plot: zoom in around the cursor (page keys pan, home: all)",
     ZoomOut = "zoom_out": "Plot: zoom out",
     Sort = "sort": "Stats: cycle the sort (COB-ID, count, period, last heard)",

@@ -10,6 +10,7 @@ pub mod capture;
 pub mod commands;
 mod event;
 pub mod export;
+mod export_plot;
 pub mod fuzzy;
 pub mod keymap;
 pub mod live;

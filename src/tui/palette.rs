@@ -3,6 +3,8 @@
 //! controlwords, the LSS requests), and whether it needs confirming (broadcast NMT, resets,
 //! node 0, LSS services that change state).
 
+use crate::analysis::producers;
+use crate::analysis::trace::Trace;
 use crate::command::spec::{Known, Preview, Spec};
 use crate::command::{Command, CommandError, parse_command};
 use crate::decode::cia402::DriveState;
@@ -51,12 +53,91 @@ pub fn plan(
     })
 }
 
+/// Before `sync` (a second SYNC producer) or `nmt` (a second NMT master): when another
+/// producer of that COB-ID was heard in the last 2 s (not cotui's own frames), the preview
+/// says so and the line must be confirmed. `t0_ns` is the trace's start (times are shown
+/// from it, as the trace's).
+pub fn warn_second_producer(p: &mut Planned, trace: &Trace, t0_ns: u64) {
+    let (cob_id, who) = match &p.command {
+        Command::Sync(s) => (s.cob_id, "SYNC producer"),
+        Command::Nmt(_) => (0x000, "NMT master"),
+        _ => return,
+    };
+    let Some(h) = producers::heard(trace, cob_id) else {
+        return;
+    };
+    let warning = format!(
+        "another {who} is on the bus: 0x{cob_id:03X} seen {} time{} in the last {} s, last at {:.3} s",
+        h.count,
+        if h.count == 1 { "" } else { "s" },
+        producers::RECENT_NS / 1_000_000_000,
+        h.last_ns.saturating_sub(t0_ns) as f64 / 1e9
+    );
+    p.preview = format!("{} — warning: {warning}", p.preview);
+    p.confirm = Some(match p.confirm.take() {
+        Some(why) => format!("{why}; {warning}"),
+        None => warning,
+    });
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn b() -> Bindings {
         Bindings::new().unwrap()
+    }
+
+    /// A trace of `n` frames 10 ms apart: SYNCs (cotui's own when `own`) with heartbeats
+    /// of node 2 between them.
+    fn trace_with_syncs(n: u64, own: bool) -> Trace {
+        use crate::frame::{Flags, Frame};
+        let mut trace = Trace::new(crate::decode::Decoder::from_bindings(&b()), 500_000);
+        trace.ifaces.intern("can0");
+        for i in 0..n {
+            let mut f = if i % 2 == 0 {
+                Frame::classic(0x080, &[])
+            } else {
+                Frame::classic(0x702, &[5])
+            };
+            f.ts_ns = 1_000_000_000 + i * 10_000_000;
+            f.flags.set(Flags::TX, own && f.id == 0x080);
+            trace.push(&f);
+        }
+        trace
+    }
+
+    #[test]
+    fn sync_and_nmt_previews_warn_of_another_producer_heard() {
+        let planned = |line: &str, trace: &Trace| {
+            let mut p = plan(line, &b(), |_| None).unwrap();
+            warn_second_producer(&mut p, trace, 1_000_000_000);
+            p
+        };
+        // 400 frames over 4 s: the last 2 s hold 100 SYNCs of another producer.
+        let other = trace_with_syncs(400, false);
+        let p = planned("sync --period 10", &other);
+        let warning = "another SYNC producer is on the bus: 0x080 seen 100 times in the last 2 s, last at 3.980 s";
+        assert!(p.preview.starts_with("080# every 10 ms"), "{}", p.preview);
+        assert!(p.preview.ends_with(&format!(" — warning: {warning}")), "{}", p.preview);
+        assert_eq!(p.confirm.as_deref(), Some(warning));
+        // cotui's own SYNCs (TX) are no other producer; nor is an empty bus.
+        for trace in [trace_with_syncs(400, true), trace_with_syncs(0, false)] {
+            let p = planned("sync --period 10", &trace);
+            assert!(!p.preview.contains("warning"), "{}", p.preview);
+            assert_eq!(p.confirm, None);
+        }
+        // A SYNC on another COB-ID is not the one heard.
+        assert_eq!(planned("sync --period 10 --cob-id 0x081 --force", &other).confirm, None);
+        // NMT: the heartbeats are no NMT frames; another master's "start all" is.
+        assert_eq!(planned("nmt start 2", &other).confirm, None);
+        let mut other = other;
+        let mut f = crate::frame::Frame::classic(0x000, &[0x01, 0x00]);
+        f.ts_ns = 5_000_000_000;
+        other.push(&f);
+        let p = planned("nmt start 2", &other);
+        let warning = "another NMT master is on the bus: 0x000 seen 1 time in the last 2 s, last at 4.000 s";
+        assert_eq!(p.confirm.as_deref(), Some(warning));
     }
 
     #[test]

@@ -488,6 +488,12 @@ impl Screen {
         ok
     }
 
+    /// `plot mode ...`: lays out the Plot pane's y axes; the Plot pane comes to the front.
+    pub(crate) fn set_plot_mode(&mut self, mode: super::panes::plot::PlotMode) {
+        self.panes.plot_mut().set_mode(mode);
+        self.focus = Pane::Plot;
+    }
+
     /// What the Detail pane shows: the focused pane's selection, else the trace's.
     pub fn selected(&self, trace: &Trace, paused: bool) -> Option<Selected> {
         self.panes
@@ -716,6 +722,7 @@ impl Screen {
             | Action::SlowestCycle
             | Action::NextLateCycle
             | Action::PlotPick
+            | Action::PlotMode
             | Action::ZoomIn
             | Action::ZoomOut => {
                 let stats = matches!(

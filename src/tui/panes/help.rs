@@ -28,8 +28,16 @@ pub const PALETTE_SYNTAX: &[(&str, &str)] = &[
     ("loop", "Replay: loop at the end (on/off)"),
     ("plot NODE INDEX:SUB", "Plot a signal of a node"),
     (
+        "plot mode lanes|normalised|shared|range LO HI",
+        "Plot y axes: a lane each, 0..1, one per unit, fixed",
+    ),
+    (
         "export FILE [--format candump|jsonl|pcapng] [--force]",
         "Write the rows the view shows",
+    ),
+    (
+        "export plot FILE.csv [--all] [--force]",
+        "The plotted signals as CSV (visible window; --all: every point)",
     ),
     (
         "record start FILE [--force|--append]",

@@ -480,6 +480,35 @@ pub(crate) mod testutil {
         App::new(trace, Keymap::default_map(), src)
     }
 
+    /// Node 1's TPDO1 mapped (sniffed SDO writes) to the position actual value, a constant
+    /// 0x1000, and the velocity actual value, a ramp 0 to 975 over 40 frames 10 ms apart.
+    pub fn constant_and_ramp_app() -> App {
+        let bindings = crate::od::bind::Bindings::new().unwrap();
+        let mut trace = Trace::new(Decoder::from_bindings(&bindings), 500_000);
+        trace.ifaces.intern("can0");
+        let mut t = 1_700_000_000_000_000_000u64;
+        let mut add = |id: u32, data: &[u8], dt_ms: u64| {
+            t += dt_ms * 1_000_000;
+            let mut f = Frame::classic(id, data);
+            f.ts_ns = t;
+            trace.push(&f);
+        };
+        add(0x701, &[0x00], 0);
+        for (sub, value) in [(0u8, 0u32), (1, 0x6064_0020), (2, 0x606C_0020), (0, 2)] {
+            let v = value.to_le_bytes();
+            add(0x601, &[0x23, 0x00, 0x1A, sub, v[0], v[1], v[2], v[3]], 1);
+            add(0x581, &[0x60, 0x00, 0x1A, sub, 0, 0, 0, 0], 1);
+        }
+        for i in 0..40i32 {
+            let (p, v) = (0x1000i32.to_le_bytes(), (i * 25).to_le_bytes());
+            add(0x181, &[p[0], p[1], p[2], p[3], v[0], v[1], v[2], v[3]], 10);
+        }
+        let (_tx, rx) = std::sync::mpsc::channel();
+        let mut src = SourceInfo::new("ramp.log", SourceKind::Open, rx, None);
+        src.done = true;
+        App::new(trace, Keymap::default_map(), src)
+    }
+
     /// Renders the whole screen of `app` at `w`×`h` and returns the text.
     pub fn screen(app: &mut App, w: u16, h: u16) -> String {
         let mut term = Terminal::new(TestBackend::new(w, h)).unwrap();

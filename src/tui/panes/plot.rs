@@ -1,6 +1,8 @@
 //! The Plot pane: numeric PDO signals and SDO-read values over one time axis.
 //!
-//! Several signals share the axis (legend with colours); state signals (objects with value
+//! Value signals are laid out by [`PlotMode`]: each in its own lane with its own y axis
+//! (the default), normalised 0..1 on one axis, one axis per unit, or a fixed range; so a
+//! constant 0x1000 next to a velocity never flattens it. State signals (objects with value
 //! texts or named bits, booleans) are drawn as steps, never as slopes; objects with named
 //! bits (statusword, controlword) get one lane per bit. A cursor reads every signal's
 //! value at its time; the window zooms and pans within the span seen. Only the points in
@@ -48,8 +50,60 @@ pub struct PlotPane {
     picker: Option<SignalPicker>,
     /// Columns of the time axis at the last draw (the cursor moves one column a key).
     columns: Cell<usize>,
+    /// How the value axes are laid out.
+    mode: PlotMode,
     /// The times (ns) of the trigger's hits, drawn as vertical marks.
     hits: Vec<u64>,
+}
+
+/// How the plot lays out the value signals' y axes.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum PlotMode {
+    /// Each signal in its own horizontal lane, with its own y axis and unit.
+    #[default]
+    Lanes,
+    /// One axis, each signal scaled 0..1 over the visible window.
+    Normalised,
+    /// One axis per unit: signals of the same unit share it (different units: one lane each).
+    Shared,
+    /// One axis with a fixed y range (in the signals' units).
+    Range(f64, f64),
+}
+
+impl PlotMode {
+    /// Parses `lanes`, `normalised` (`normalized`), `shared` or `range LO HI`.
+    pub fn parse(words: &str) -> Option<PlotMode> {
+        let w: Vec<&str> = words.split_whitespace().collect();
+        match w[..] {
+            ["lanes"] => Some(PlotMode::Lanes),
+            ["normalised" | "normalized"] => Some(PlotMode::Normalised),
+            ["shared"] => Some(PlotMode::Shared),
+            ["range", lo, hi] => {
+                let (lo, hi) = (lo.parse::<f64>().ok()?, hi.parse::<f64>().ok()?);
+                (lo.is_finite() && hi.is_finite() && lo < hi).then_some(PlotMode::Range(lo, hi))
+            }
+            _ => None,
+        }
+    }
+
+    /// The mode the cycle key goes to: lanes, normalised, shared, lanes (a range: lanes).
+    pub fn next(self) -> PlotMode {
+        match self {
+            PlotMode::Lanes => PlotMode::Normalised,
+            PlotMode::Normalised => PlotMode::Shared,
+            PlotMode::Shared | PlotMode::Range(..) => PlotMode::Lanes,
+        }
+    }
+
+    /// The mode's name, as the title and `plot mode` say it.
+    pub fn name(self) -> String {
+        match self {
+            PlotMode::Lanes => "lanes".into(),
+            PlotMode::Normalised => "normalised".into(),
+            PlotMode::Shared => "shared".into(),
+            PlotMode::Range(lo, hi) => format!("range {} {}", format_number(lo), format_number(hi)),
+        }
+    }
 }
 
 impl PlotPane {
@@ -137,6 +191,21 @@ impl PlotPane {
         true
     }
 
+    /// The y axis layout.
+    pub fn mode(&self) -> PlotMode {
+        self.mode
+    }
+
+    /// Sets the y axis layout.
+    pub fn set_mode(&mut self, mode: PlotMode) {
+        self.mode = mode;
+    }
+
+    /// The time window drawn (None: nothing to draw).
+    pub fn visible_window(&self, trace: &Trace) -> Option<TimeWindow> {
+        self.span(trace).map(|s| self.window_in(s))
+    }
+
     /// Opens the signal picker.
     pub fn open_picker(&mut self) {
         self.picker = Some(SignalPicker::default());
@@ -191,6 +260,10 @@ impl Component for PlotPane {
     fn handle(&mut self, action: Action, ctx: &Ctx, _q: &mut Queue) -> bool {
         if action == Action::Expand || action == Action::PlotPick {
             self.open_picker();
+            return true;
+        }
+        if action == Action::PlotMode {
+            self.mode = self.mode.next();
             return true;
         }
         let Some(span) = self.span(ctx.trace) else {
@@ -318,6 +391,12 @@ fn render(p: &PlotPane, trace: &Trace, f: &mut Frame, area: Rect, focused: bool)
     } else {
         String::new()
     };
+    let (bits, values): (Vec<&Shown>, Vec<&Shown>) = shown.iter().partition(|s| s.bits().is_some());
+    let groups = groups(&values, p.mode);
+    let mode = match p.mode {
+        PlotMode::Shared if groups.len() > 1 => "shared: units differ, one lane per unit".to_string(),
+        m => m.name(),
+    };
     let hits_in: Vec<f64> = p
         .hits
         .iter()
@@ -329,13 +408,16 @@ fn render(p: &PlotPane, trace: &Trace, f: &mut Frame, area: Rect, focused: bool)
     } else {
         format!(", {} trigger hits shown", hits_in.len())
     };
-    let title = format!(" Plot: {} of {} signals{zoom}{marks} ", shown.len(), trace.series.len());
+    let title = format!(
+        " Plot: {} of {} signals, {mode}{zoom}{marks} ",
+        shown.len(),
+        trace.series.len()
+    );
     f.render_widget(block(&title, focused), area);
     let inner = block("", true).inner(area);
     if inner.height < 3 || inner.width < 20 {
         return;
     }
-    let (bits, values): (Vec<&Shown>, Vec<&Shown>) = shown.iter().partition(|s| s.bits().is_some());
     let lane_rows: u16 = bits.iter().map(|s| s.bits().map_or(0, |b| b.len() as u16) + 1).sum();
     let readout_text = readout_line(&shown, p.cursor, win, t0);
     let readout_h = (readout_text.width() as u16).div_ceil(inner.width).clamp(1, 3);
@@ -353,8 +435,37 @@ fn render(p: &PlotPane, trace: &Trace, f: &mut Frame, area: Rect, focused: bool)
     .areas(inner);
     let label_w = (inner.width / 4).clamp(8, 24);
     p.columns.set((inner.width - label_w - 1).max(1) as usize);
-    if !values.is_empty() {
-        chart(&values, win, t0, p.cursor, &hits_in, f, chart_area);
+    let scale = match p.mode {
+        PlotMode::Normalised => Scale::Normalised,
+        PlotMode::Range(lo, hi) => Scale::Fixed(lo, hi),
+        PlotMode::Lanes | PlotMode::Shared => Scale::Auto,
+    };
+    let areas =
+        Layout::vertical(vec![Constraint::Ratio(1, groups.len().max(1) as u32); groups.len()]).split(chart_area);
+    let axes = Axes {
+        win,
+        t0,
+        scale,
+        time_labels: false,
+        hits: &hits_in,
+    };
+    let plots: Vec<Plotted> = groups
+        .iter()
+        .map(|g| plotted(g, axes, chart_area.width as usize * 2))
+        .collect();
+    // As wide in every lane (the bottom one's first time label widens its own).
+    let first_time = format!("{:.3}s", win.start - t0).chars().count();
+    let y_label_w = plots
+        .iter()
+        .flat_map(|p| p.labels())
+        .map(|l| l.chars().count())
+        .fold(first_time, usize::max);
+    for (i, ((group, plot), area)) in groups.iter().zip(&plots).zip(areas.iter()).enumerate() {
+        let axes = Axes {
+            time_labels: i + 1 == groups.len(),
+            ..axes
+        };
+        chart(group, plot, axes, y_label_w, p.cursor, f, *area);
     }
     if !bits.is_empty() {
         lanes(&bits, win, p.cursor, label_w, f, lanes_area);
@@ -367,11 +478,79 @@ fn secs(s: f64) -> String {
     format!("{s:.3}")
 }
 
-/// The value signals on one chart: a shared time axis, the legend, units on the value axis,
-/// the cursor as a vertical line, the trigger's hits (`hits`, seconds) as red ones.
-fn chart(values: &[&Shown], win: TimeWindow, t0: f64, cursor: Option<f64>, hits: &[f64], f: &mut Frame, area: Rect) {
-    let columns = area.width as usize * 2;
-    let data: Vec<Vec<(f64, f64)>> = values
+/// The value signals split into the charts drawn one above the other: one per signal
+/// (lanes), one per unit (shared), else all on one.
+fn groups<'a, 'b>(values: &[&'a Shown<'b>], mode: PlotMode) -> Vec<Vec<&'a Shown<'b>>> {
+    match mode {
+        PlotMode::Lanes => values.iter().map(|s| vec![*s]).collect(),
+        PlotMode::Shared => {
+            let mut out: Vec<Vec<&Shown>> = Vec::new();
+            for s in values {
+                match out.iter_mut().find(|g| g[0].unit() == s.unit()) {
+                    Some(g) => g.push(s),
+                    None => out.push(vec![*s]),
+                }
+            }
+            out
+        }
+        PlotMode::Normalised | PlotMode::Range(..) if values.is_empty() => Vec::new(),
+        PlotMode::Normalised | PlotMode::Range(..) => vec![values.to_vec()],
+    }
+}
+
+/// How one chart scales its values.
+#[derive(Clone, Copy)]
+enum Scale {
+    /// From the lowest to the highest value in the window.
+    Auto,
+    /// Each signal 0..1 over its own lowest and highest value in the window.
+    Normalised,
+    /// A fixed range.
+    Fixed(f64, f64),
+}
+
+/// The axes of one chart: the window, the time base, the scale, whether this chart
+/// carries the time labels (the bottom one), and the trigger's hits (seconds) to mark.
+#[derive(Clone, Copy)]
+struct Axes<'a> {
+    win: TimeWindow,
+    t0: f64,
+    scale: Scale,
+    time_labels: bool,
+    hits: &'a [f64],
+}
+
+/// Lowest and highest of `pts`' values (a flat line: ±1 around it; none: 0..1).
+fn bounds<'a>(pts: impl Iterator<Item = &'a (f64, f64)>) -> (f64, f64) {
+    let (mut lo, mut hi) = pts.fold((f64::MAX, f64::MIN), |(lo, hi), (_, v)| (lo.min(*v), hi.max(*v)));
+    if lo > hi {
+        (lo, hi) = (0.0, 1.0);
+    }
+    if (hi - lo).abs() < f64::EPSILON {
+        lo -= 1.0;
+        hi += 1.0;
+    }
+    (lo, hi)
+}
+
+/// One chart's points (as drawn: scaled, normalised, steps) and its value bounds.
+struct Plotted {
+    data: Vec<Vec<(f64, f64)>>,
+    lo: f64,
+    hi: f64,
+}
+
+impl Plotted {
+    /// The value axis labels (lowest, highest).
+    fn labels(&self) -> [String; 2] {
+        [format_number(self.lo), format_number(self.hi)]
+    }
+}
+
+/// The points of `values` in the window, `columns` wide, scaled as `axes` says.
+fn plotted(values: &[&Shown], axes: Axes, columns: usize) -> Plotted {
+    let Axes { win, t0, scale, .. } = axes;
+    let mut data: Vec<Vec<(f64, f64)>> = values
         .iter()
         .map(|s| {
             let pts: Vec<(f64, f64)> = series::decimate(s.line.window(win.start, win.end), win.start, win.end, columns)
@@ -386,23 +565,37 @@ fn chart(values: &[&Shown], win: TimeWindow, t0: f64, cursor: Option<f64>, hits:
             }
         })
         .collect();
-    let (mut lo, mut hi) = data
-        .iter()
-        .flatten()
-        .fold((f64::MAX, f64::MIN), |(lo, hi), (_, v)| (lo.min(*v), hi.max(*v)));
-    if lo > hi {
-        (lo, hi) = (0.0, 1.0);
-    }
-    if (hi - lo).abs() < f64::EPSILON {
-        lo -= 1.0;
-        hi += 1.0;
-    }
+    let (lo, hi) = match scale {
+        Scale::Auto => bounds(data.iter().flatten()),
+        Scale::Fixed(lo, hi) => (lo, hi),
+        Scale::Normalised => {
+            for d in &mut data {
+                let (a, b) = bounds(d.iter());
+                for p in d.iter_mut() {
+                    p.1 = (p.1 - a) / (b - a);
+                }
+            }
+            (0.0, 1.0)
+        }
+    };
+    Plotted { data, lo, hi }
+}
+
+/// Signals on one chart: the time axis, the legend, units (or the scale) on the value axis
+/// (its labels `label_w` wide, so that lanes share the time columns), the cursor as a
+/// vertical line.
+fn chart(values: &[&Shown], p: &Plotted, axes: Axes, label_w: usize, cursor: Option<f64>, f: &mut Frame, area: Rect) {
+    let Axes {
+        win, t0, scale, hits, ..
+    } = axes;
+    let Plotted { data, lo, hi } = p;
+    let (lo, hi) = (*lo, *hi);
     let cursor_line: Vec<(f64, f64)> = cursor
         .filter(|c| (win.start..=win.end).contains(c))
         .map(|c| vec![(c - t0, lo), (c - t0, hi)])
         .unwrap_or_default();
     // One line per column at most: hits closer than a column draw the same mark.
-    let step = (win.end - win.start) / columns.max(1) as f64;
+    let step = (win.end - win.start) / (area.width as usize * 2).max(1) as f64;
     let mut hit_lines: Vec<[(f64, f64); 2]> = Vec::new();
     for &h in hits {
         if hit_lines.last().is_none_or(|l| h - t0 - l[0].0 >= step) {
@@ -411,7 +604,7 @@ fn chart(values: &[&Shown], win: TimeWindow, t0: f64, cursor: Option<f64>, hits:
     }
     let mut sets: Vec<Dataset> = values
         .iter()
-        .zip(&data)
+        .zip(data)
         .map(|(s, d)| {
             let unit = s.unit().map(|u| format!(" [{u}]")).unwrap_or_default();
             Dataset::default()
@@ -442,19 +635,27 @@ fn chart(values: &[&Shown], win: TimeWindow, t0: f64, cursor: Option<f64>, hits:
     }
     let mut units: Vec<&str> = values.iter().filter_map(|s| s.unit()).collect();
     units.dedup();
+    let y_title = match scale {
+        Scale::Normalised => "normalised".to_string(),
+        Scale::Auto | Scale::Fixed(..) => units.join(", "),
+    };
     let (x0, x1) = (win.start - t0, win.end - t0);
-    let chart = Chart::new(sets)
-        .hidden_legend_constraints((Constraint::Ratio(2, 3), Constraint::Ratio(2, 3)))
-        .x_axis(Axis::default().bounds([x0, x1]).labels([
+    let mut x_axis = Axis::default().bounds([x0, x1]);
+    if axes.time_labels {
+        x_axis = x_axis.labels([
             Line::raw(format!("{x0:.3}s")),
             Line::raw(format!("{:.3}s", (x0 + x1) / 2.0)),
             Line::raw(format!("{x1:.3}s")),
-        ]))
+        ]);
+    }
+    let chart = Chart::new(sets)
+        .hidden_legend_constraints((Constraint::Ratio(2, 3), Constraint::Ratio(2, 3)))
+        .x_axis(x_axis)
         .y_axis(
             Axis::default()
-                .title(units.join(", "))
+                .title(y_title)
                 .bounds([lo, hi])
-                .labels([Line::raw(format_number(lo)), Line::raw(format_number(hi))]),
+                .labels(p.labels().map(|l| Line::raw(format!("{l:<label_w$}")))),
         );
     f.render_widget(chart, area);
 }

@@ -590,8 +590,12 @@ fn a_replay_shows_its_position_and_progress_in_the_status_line() {
 
 /// The plot of [`plot_app`] with `keys` typed (through the keymap) first.
 fn plot_screen(keys: &str, w: u16, h: u16) -> (crate::tui::app::App, String) {
+    typed_plot(super::testutil::plot_app(), keys, w, h)
+}
+
+/// The plot of `a` with `keys` typed (through the keymap) first.
+fn typed_plot(mut a: crate::tui::app::App, keys: &str, w: u16, h: u16) -> (crate::tui::app::App, String) {
     use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
-    let mut a = super::testutil::plot_app();
     a.screen_mut().focus_on(Pane::Plot);
     let _ = screen(&mut a, w, h);
     for c in keys.chars() {
@@ -651,11 +655,14 @@ fn plot_cursor_reads_values_and_zoom_narrows_the_window() {
     assert!(!s.contains(" 7 Warning"), "{s}");
     insta::assert_snapshot!("plot_cursor_80x24", s);
     let (mut a, s) = plot_screen("pvel\n>zz", 80, 24);
-    assert!(s.contains("Plot: 2 of 3 signals 0.1"), "{s}");
+    assert!(s.contains("Plot: 2 of 3 signals, lanes 0.1"), "{s}");
     // Home shows the whole span again.
     a.act(crate::tui::keymap::Action::Top);
     let s = screen(&mut a, 80, 24);
-    assert!(s.contains("Plot: 2 of 3 signals") && !s.contains("signals 0.1"), "{s}");
+    assert!(
+        s.contains("Plot: 2 of 3 signals, lanes ━") && !s.contains("lanes 0.1"),
+        "{s}"
+    );
 }
 
 #[test]
@@ -1195,4 +1202,68 @@ fn a_block_download_of_thousands_of_frames_opens_as_a_sequence_diagram_with_its_
     assert!(s.contains(" end block response │"), "{s}");
     assert!(!s.contains("no answer"), "{s}");
     insta::assert_snapshot!("sdo_sequence_block_download_end", s);
+}
+
+/// The rows of the Plot pane's chart area from `s` (the lines starting with the pane's
+/// border), and how many of them have a braille dot in the columns right of the y axis.
+fn rows_with_dots(s: &str) -> usize {
+    s.lines()
+        .filter(|l| l.contains('│'))
+        .filter(|l| l.chars().any(|c| ('\u{2801}'..='\u{28FF}').contains(&c)))
+        .count()
+}
+
+#[test]
+fn plot_lanes_keep_a_ramp_readable_next_to_a_constant() {
+    // Position 0x1000 constant, velocity a ramp: each its own lane, own axis and unit.
+    let (a, s) = typed_plot(super::testutil::constant_and_ramp_app(), "pvel\n", 100, 30);
+    let n1 = crate::frame::NodeKey::new(0, 1);
+    assert_eq!(
+        a.screen().panes().plot().shown(a.trace()),
+        [(n1, 0x6064, 0), (n1, 0x606C, 0)]
+    );
+    assert!(s.contains("Plot: 2 of 2 signals, lanes"), "{s}");
+    assert!(s.contains("4096"), "the constant's own axis: {s}");
+    assert!(s.contains("975"), "the ramp's own axis: {s}");
+    // The ramp climbs over every row of its lane (shared with the constant: 6 of 22).
+    assert!(rows_with_dots(&s) >= 9, "{s}");
+    insta::assert_snapshot!("plot_lanes_100x30", s);
+}
+
+#[test]
+fn plot_normalised_and_range_modes_scale_the_axis() {
+    let app = super::testutil::constant_and_ramp_app;
+    // P cycles lanes → normalised: one axis 0..1, the ramp still spans it.
+    let (_, s) = typed_plot(app(), "pvel\nP", 100, 30);
+    assert!(s.contains("Plot: 2 of 2 signals, normalised"), "{s}");
+    assert!(s.contains("│normalised"), "the axis title: {s}");
+    assert!(rows_with_dots(&s) > 8, "{s}");
+    assert!(
+        s.lines().any(|l| l.starts_with("┃1 ") && l.contains("│normalised")),
+        "{s}"
+    );
+    assert!(s.lines().any(|l| l.starts_with("┃0 ")), "{s}");
+    insta::assert_snapshot!("plot_normalised_100x30", s);
+    // Then shared: neither has a unit, so they share one axis (the ramp flat by the
+    // constant: what the other modes avoid).
+    let (_, s) = typed_plot(app(), "pvel\nPP", 100, 30);
+    assert!(s.contains("Plot: 2 of 2 signals, shared ━"), "{s}");
+    assert!(rows_with_dots(&s) <= 7, "{s}");
+    // rpm and no unit are never mixed on one axis: one lane per unit, said in the title.
+    let (_, s) = plot_screen("pvel\npmodes\nPP", 160, 48);
+    assert!(
+        s.contains("Plot: 3 of 3 signals, shared: units differ, one lane per unit"),
+        "{s}"
+    );
+    // `plot mode range 0 100`: a fixed axis; the palette says the mode.
+    let (mut a, _) = typed_plot(app(), "pvel\n", 100, 30);
+    a.run_command("plot mode range 0 100");
+    let s = screen(&mut a, 100, 30);
+    assert!(s.contains("Plot: 2 of 2 signals, range 0 100"), "{s}");
+    a.run_command("plot mode sideways");
+    let s = screen(&mut a, 100, 30);
+    assert!(
+        s.contains("plot: usage `plot mode lanes|normalised|shared|range LO HI`"),
+        "{s}"
+    );
 }

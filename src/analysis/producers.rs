@@ -1,0 +1,38 @@
+//! Other producers of a broadcast service heard lately: who else sent SYNC (0x080) or NMT
+//! (0x000) frames in the seconds before the newest frame, not counting the frames cotui sent
+//! itself (those carry the TX flag). The palette warns with it before starting a second
+//! SYNC producer or commanding as a second NMT master.
+
+use super::trace::Trace;
+use crate::frame::Flags;
+
+/// How far back [`heard`] looks, before the newest frame (2 s).
+pub const RECENT_NS: u64 = 2_000_000_000;
+
+/// Frames of one COB-ID from another producer, in the last [`RECENT_NS`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Heard {
+    /// How many.
+    pub count: usize,
+    /// The newest one's timestamp (ns, the frames' time base).
+    pub last_ns: u64,
+}
+
+/// Classic 11-bit frames with `cob_id`, not sent by cotui, in the [`RECENT_NS`] before the
+/// trace's newest frame; None when there were none.
+pub fn heard(trace: &Trace, cob_id: u32) -> Option<Heard> {
+    let n = trace.store.len();
+    let newest = trace.store.packed(n.checked_sub(1)?).ts_ns;
+    let from = trace.store.position_at(newest.saturating_sub(RECENT_NS));
+    let mut out: Option<Heard> = None;
+    for i in from..n {
+        let p = trace.store.packed(i);
+        let flags = Flags(p.flags);
+        if p.id == cob_id && !flags.has(Flags::TX) && !flags.has(Flags::EXT) && !flags.has(Flags::ERR) {
+            let h = out.get_or_insert(Heard { count: 0, last_ns: 0 });
+            h.count += 1;
+            h.last_ns = h.last_ns.max(p.ts_ns);
+        }
+    }
+    out
+}
