@@ -40,11 +40,14 @@ pub fn draw(f: &mut Frame, app: &mut App) {
     } else {
         (main, None)
     };
+    // Each tab padded by a space both sides; on a narrow screen (80 columns) one space apart.
+    let padded: usize = Pane::ALL.iter().map(|p| p.title().chars().count() + 4).sum();
+    let pad = if padded > usize::from(tabs.width) { "" } else { " " };
     let spans: Vec<Span> = Pane::ALL
         .iter()
         .enumerate()
         .map(|(i, p)| {
-            let s = format!(" {} {} ", i + 1, p.title());
+            let s = format!(" {} {}{pad}", i + 1, p.title());
             if *p == app.focus() {
                 Span::styled(s, Style::default().bg(Color::White).fg(Color::Black))
             } else {
