@@ -23,10 +23,15 @@ pub struct Heard {
 pub fn heard(trace: &Trace, cob_id: u32) -> Option<Heard> {
     let n = trace.store.len();
     let newest = trace.store.packed(n.checked_sub(1)?).ts_ns;
-    let from = trace.store.position_at(newest.saturating_sub(RECENT_NS));
+    let since = newest.saturating_sub(RECENT_NS);
     let mut out: Option<Heard> = None;
-    for i in from..n {
+    // Back from the newest frame to the first one before the window (a bus that carries
+    // frames of several clocks is never searched as if sorted).
+    for i in (0..n).rev() {
         let p = trace.store.packed(i);
+        if p.ts_ns < since {
+            break;
+        }
         let flags = Flags(p.flags);
         if p.id == cob_id && !flags.has(Flags::TX) && !flags.has(Flags::EXT) && !flags.has(Flags::ERR) {
             let h = out.get_or_insert(Heard { count: 0, last_ns: 0 });

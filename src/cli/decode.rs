@@ -1,107 +1,14 @@
 //! `cotui decode FILE...`: the headless decoder.
 
+use super::decode_args::{DecodeArgs, OutputFormat};
+use super::decode_records::{note_interfaces, shown_iface, write_summary, write_transaction};
 use super::input;
 use crate::analysis::trace::{Trace, Views};
 use crate::command::ExitCode;
 use crate::decode::Decoder;
-use crate::frame::json::write_line;
-use crate::od::Dictionary;
 use crate::output::busload::{Bitrate, BusLoad};
-use crate::output::{jsonl, summary::Summary, text};
-use crate::sdo::Transaction;
-use clap::{Args, ValueEnum};
+use crate::output::{jsonl, text};
 use std::io::{self, Write};
-
-/// Output formats of `cotui decode`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum OutputFormat {
-    /// candump-like lines with the decoded label.
-    Text,
-    /// One JSON object per frame (see README, "JSONL contract").
-    Jsonl,
-    /// A pcapng capture for Wireshark (binary: with -o FILE or a redirected stdout).
-    // `run` hands it to `decode_out` before decoding, so the matches below that pair it
-    // with `Jsonl` never see it.
-    Pcapng,
-    /// A Vector BLF log for CANalyzer/CANoe and python-can (binary: with -o FILE or a
-    /// redirected stdout; the header's totals are filled in only in a file).
-    // `run` hands it to `decode_out` before decoding, as pcapng.
-    Blf,
-    /// Two Parquet tables, frames and decoded values (with -o DIR or -o NAME.parquet;
-    /// see README, "Parquet tables").
-    // `run` hands it to `decode_parquet` before decoding.
-    Parquet,
-    /// A Vector ASC log (frames only).
-    // `run` hands it (and Trc) to `decode_out` before decoding.
-    Asc,
-    /// A PEAK TRC 2.1 log (frames only).
-    Trc,
-}
-
-/// Arguments of `cotui decode`.
-#[derive(Args, Debug)]
-pub struct DecodeArgs {
-    /// Log files (candump -l/-L, candump screen output, Vector ASC, PEAK TRC, python-can
-    /// CSV); `-` reads stdin. Several are merged by time into one capture; an interface
-    /// name in several files is the same bus (one bus's log split in parts) unless
-    /// --iface-per-file.
-    #[arg(required = true)]
-    pub files: Vec<String>,
-    /// With several files: each file's interfaces are its own buses, named FILE:IFACE
-    /// (two buses recorded apart, both as can0, stay apart).
-    #[arg(long)]
-    pub iface_per_file: bool,
-    #[command(flatten)]
-    pub input: super::input::InputArgs,
-    /// Output format.
-    #[arg(long, value_enum, default_value = "text")]
-    pub format: OutputFormat,
-    /// Print reassembled SDO transactions instead of frames.
-    #[arg(long)]
-    pub transactions: bool,
-    /// Print per-node and per-kind totals only.
-    #[arg(long, conflicts_with = "transactions")]
-    pub summary: bool,
-    /// Bus bit rate for the `--summary` bus load, in bit/s (500000, 500k, 1M); without it
-    /// 500 kbit/s is assumed, and the summary says so.
-    #[arg(long, value_parser = super::tui::bitrate_arg, value_name = "R")]
-    pub bitrate: Option<u64>,
-    /// Print bus events instead of frames: boot-up, NMT state change, heartbeat lost/back,
-    /// heartbeat period (0x1017), EMCY, SDO abort, controller state (error frames).
-    #[arg(long, conflicts_with_all = ["transactions", "summary"])]
-    pub events: bool,
-    /// Print one record per SYNC cycle instead of frames: its synchronous TPDOs with their
-    /// time after the SYNC, the window 0x1007 and the TPDOs after it (late); text ends
-    /// with a summary (cycles, mean and longest period, the slowest cycle, late TPDOs).
-    #[arg(long, conflicts_with_all = ["transactions", "summary", "events", "filter", "trigger"])]
-    pub sync_cycles: bool,
-    /// Bind a device profile to a node: NODE=NAME (a name in decoders/ or a JSON path).
-    #[arg(long = "profile", value_name = "NODE=NAME")]
-    pub profiles: Vec<String>,
-    /// Bind an EDS/DCF file to a node: NODE=FILE.
-    #[arg(long = "eds", value_name = "NODE=FILE")]
-    pub eds: Vec<String>,
-    /// Only frames (or with --transactions, SDO transfers; with --summary, the totals of
-    /// frames) matching EXPR, in the TUI's filter language (docs/TUI.md, "Filter and search").
-    #[arg(long, value_name = "EXPR")]
-    pub filter: Option<String>,
-    /// Write to FILE instead of stdout (`-` is stdout); with --trigger, the directory of
-    /// the window files.
-    #[arg(short = 'o', long = "output", value_name = "FILE")]
-    pub output: Option<String>,
-    /// Capture windows around each hit of EXPR (a filter, `hb lost`, `bootup`, `bus-off`,
-    /// `error-passive`, `incident KIND`, or `A then B within DUR`): one file per window in
-    /// -o DIR (candump -l, or --format pcapng|asc|trc|blf) with a JSON sidecar; with
-    /// --format jsonl and no -o, one JSON line per window (README, "Capture triggers").
-    #[arg(long, value_name = "EXPR")]
-    pub trigger: Option<String>,
-    /// With --trigger: keep DUR before each hit (`30s`, `500ms`; a bare number is ms).
-    #[arg(long, value_name = "DUR", default_value = "10s", value_parser = crate::command::words::ms_or_zero_arg, requires = "trigger")]
-    pub pre: u64,
-    /// With --trigger: keep DUR after each hit (hits inside a window extend it).
-    #[arg(long, value_name = "DUR", default_value = "10s", value_parser = crate::command::words::ms_or_zero_arg, requires = "trigger")]
-    pub post: u64,
-}
 
 /// What a decode run keeps across its inputs, chosen once from the arguments: a bare
 /// decoder when it prints frames, else the trace that derives the one view it prints.
@@ -185,21 +92,6 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
         Err(e) if e.kind() != io::ErrorKind::BrokenPipe => out.blame().report(None, &e),
         _ => status,
     }
-}
-
-/// Keeps `names` up with a source's interface table (which grows as names appear).
-pub(super) fn note_interfaces(names: &mut Vec<String>, ifaces: &crate::frame::Interfaces) {
-    let all = ifaces.names();
-    if all.len() > names.len() {
-        names.extend(all[names.len()..].iter().cloned());
-    }
-}
-
-/// The interface name shown with a node-level record (event, transaction, summary row):
-/// only when the input has several interfaces, so that node 5 of can0 and node 5 of can1
-/// tell apart; a capture of one interface prints as it always did.
-pub(super) fn shown_iface(names: &[String], iface: u16) -> Option<&str> {
-    (names.len() > 1).then(|| names.get(usize::from(iface)).map_or("?", String::as_str))
 }
 
 /// Decodes one input into `out` (parsing runs on a second thread). `names`: the interface
@@ -302,57 +194,6 @@ fn write_view(
             }
         }
         Views::All | Views::Summary | Views::Diagnosis | Views::Frames => {}
-    }
-}
-
-/// Appends one transaction to `out`: its label line (built in the scratch `label`) or its
-/// JSON line.
-pub(super) fn write_transaction(
-    out: &mut Vec<u8>,
-    label: &mut String,
-    t: &Transaction,
-    dict: &Dictionary,
-    iface: Option<&str>,
-    fmt: OutputFormat,
-) {
-    match fmt {
-        OutputFormat::Text => {
-            label.clear();
-            // Several interfaces: `can1 node 2: Upload 0x6041:00 ...`.
-            if let Some(i) = iface {
-                label.push_str(i);
-                label.push_str(" node ");
-                label.push_str(&t.node.to_string());
-                label.push_str(": ");
-            }
-            t.write_label(label, dict);
-            out.extend_from_slice(label.as_bytes());
-            out.push(b'\n');
-        }
-        OutputFormat::Jsonl
-        | OutputFormat::Pcapng
-        | OutputFormat::Parquet
-        | OutputFormat::Asc
-        | OutputFormat::Trc
-        | OutputFormat::Blf => {
-            let mut j = t.to_json(dict);
-            j.iface = iface;
-            write_line(out, &j)
-        }
-    }
-}
-
-/// Appends the totals of a `--summary` run in `fmt`.
-pub(super) fn write_summary(out: &mut Vec<u8>, summary: &mut Summary, fmt: OutputFormat) {
-    summary.finish();
-    match fmt {
-        OutputFormat::Text => out.extend_from_slice(summary.to_text().as_bytes()),
-        OutputFormat::Jsonl
-        | OutputFormat::Pcapng
-        | OutputFormat::Parquet
-        | OutputFormat::Asc
-        | OutputFormat::Trc
-        | OutputFormat::Blf => write_line(out, &summary.to_json()),
     }
 }
 

@@ -4,7 +4,8 @@
 //! the one analysis pipeline ([`Trace`]): [`Views::Frames`] decodes them with their labels,
 //! [`Views::Transactions`] lists the transfers as `decode --transactions` does.
 
-use super::decode::{DecodeArgs, OutputFormat, write_summary, write_transaction};
+use super::decode_args::{DecodeArgs, OutputFormat};
+use super::decode_records::{write_summary, write_transaction};
 use super::input::{for_each_frame, report_counts};
 use crate::analysis::filter::stream::Stream;
 use crate::analysis::filter::{Facts, Filter};
@@ -135,7 +136,7 @@ impl Run {
         self.trace.new_input();
         let counts = for_each_frame(path, input, |frames| {
             let ifaces = frames.ifaces;
-            super::decode::note_interfaces(&mut self.names, ifaces);
+            super::decode_records::note_interfaces(&mut self.names, ifaces);
             self.trace.name_interfaces(ifaces);
             for (line, frame) in frames {
                 let t0 = *self.t0_ns.get_or_insert(frame.ts_ns);
@@ -197,7 +198,7 @@ impl Run {
         {
             return;
         }
-        let iface = super::decode::shown_iface(&self.names, t.iface);
+        let iface = super::decode_records::shown_iface(&self.names, t.iface);
         write_transaction(buf, &mut String::new(), t, dict, iface, self.format);
     }
 

@@ -1,7 +1,7 @@
 //! Where `cotui decode` writes (`-o FILE`, `-o -` or stdout) and its pcapng, BLF, ASC
 //! and TRC exports.
 
-use super::decode::DecodeArgs;
+use super::decode_args::DecodeArgs;
 use super::input;
 use crate::command::ExitCode;
 use crate::frame::Frame;
@@ -172,7 +172,7 @@ impl<W: Write> FrameOut for BlfOut<W> {
 /// `cotui decode FILE... --format pcapng|blf`: every frame of every input, in order (one
 /// pcapng interface description per interface name; BLF channels by name).
 pub fn frames(args: &DecodeArgs) -> ExitCode {
-    let name = if args.format == super::decode::OutputFormat::Blf {
+    let name = if args.format == super::decode_args::OutputFormat::Blf {
         "BLF"
     } else {
         "pcapng"

@@ -3,7 +3,7 @@
 //! Trino. Column names and types are a public contract, listed in the README
 //! ("Parquet tables").
 
-use super::decode::DecodeArgs;
+use super::decode_args::DecodeArgs;
 use super::input;
 use crate::command::ExitCode;
 use crate::decode::{Body, Decoded, Decoder};

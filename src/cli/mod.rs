@@ -4,9 +4,11 @@ pub mod bind;
 pub mod bus_run;
 pub mod commander;
 pub mod decode;
+pub mod decode_args;
 mod decode_filter;
 mod decode_out;
 mod decode_parquet;
+mod decode_records;
 mod decode_sync;
 pub mod diagnose;
 mod expect;
@@ -48,7 +50,7 @@ pub fn verbose() -> bool {
 #[derive(Subcommand, Debug)]
 pub enum Command {
     /// Decode candump / ASC logs to text, JSON lines, SDO transactions, a summary or pcapng.
-    Decode(decode::DecodeArgs),
+    Decode(decode_args::DecodeArgs),
     /// What went wrong on the bus, in plain words: incidents with cause, timeline and what to check.
     Diagnose(diagnose::DiagnoseArgs),
     /// Explain frames: identifier split, CANopen meaning, data bits by field, and the frame

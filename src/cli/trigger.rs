@@ -5,7 +5,7 @@
 //! stdout. `decode --trigger` over logs ([`run_decode`]) and `record --trigger` on a live
 //! bus (`super::trigger_live`) both write through [`Recorder`].
 
-use super::decode::{DecodeArgs, OutputFormat};
+use super::decode_args::{DecodeArgs, OutputFormat};
 use super::input::{for_each_frame, report_counts};
 use crate::analysis::trace::{Trace, Views};
 use crate::analysis::trigger::Trigger;
