@@ -12,7 +12,7 @@ use super::error::CommandError;
 use super::value::encode;
 use crate::bus::{Bus, Event};
 use crate::frame::{Direction, Flags, Frame};
-use crate::od::alias::resolve_object;
+use crate::od::resolve_object;
 use crate::od::bind::Bindings;
 use crate::od::{DataType, Dictionary, PdoMapping};
 use serde::Serialize;

@@ -8,7 +8,7 @@ use super::spec::{Ctx, Declared, Known, Outcome, Preview, Spec};
 use super::value::{decode, encode};
 use super::words::{On, ParseError, TYPE_WORDS, TypedWords, ms_arg, node_arg, parse_type};
 use super::write::write_output;
-use crate::od::alias::resolve_object;
+use crate::od::resolve_object;
 use crate::od::bind::Bindings;
 use crate::od::{DataType, Dictionary, Value};
 use clap::Args;

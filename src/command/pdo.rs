@@ -16,7 +16,7 @@ use crate::decode::pdo::entry_from_u32;
 use crate::decode::pdo_config::{
     COMM_SUBS, Cob, CommJson, CommParams, EntryJson, PdoId, entry_text, event_text, inhibit_text, transmission_text,
 };
-use crate::od::alias::resolve_object;
+use crate::od::resolve_object;
 use crate::od::{Dictionary, MappedEntry, PdoMappable};
 use crate::sdo::abort_text;
 use remap::{Action, Mapping, Remap, remap_sequence};

@@ -13,7 +13,7 @@ use crate::bus::{Bus, BusError};
 use crate::decode::value_text::object_text;
 use crate::frame::Frame;
 use crate::frame::hex;
-use crate::od::alias::resolve_object;
+use crate::od::resolve_object;
 use crate::od::procedure::{NmtCommand, Procedure, Step, fill_object, frame_bytes};
 use crate::od::{DataType, Dictionary, Value};
 use serde::Serialize;

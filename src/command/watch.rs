@@ -15,7 +15,7 @@ use super::value::decode;
 use super::watch_table::{Sample, WatchFormat, Watched, csv_header, csv_row, jsonl_rows, text_table};
 use super::words::{TypedWords, ms_arg, node_arg};
 use crate::bus::Bus;
-use crate::od::alias::resolve_object;
+use crate::od::resolve_object;
 use crate::od::bind::Bindings;
 use serde::Serialize;
 use std::time::Duration;

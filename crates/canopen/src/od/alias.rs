@@ -1,8 +1,5 @@
-//! Vendor parameter aliases: rules like `F{x:hex}.{y:hex}.{z:hex}` -> index/sub,
-//! and resolving any text a user types (`0x1018:1`, `statusword`, `F0.3.018`)
-//! to an (index, sub) through a node's [`Dictionary`].
+//! Vendor parameter aliases: rules like `F{x:hex}.{y:hex}.{z:hex}` -> index/sub.
 
-use super::Dictionary;
 use super::expr::Expr;
 
 /// One piece of an alias pattern.
@@ -202,55 +199,6 @@ fn parse_hexish(t: &str, bare_is_hex: bool) -> Option<u32> {
     } else {
         t.parse().ok()
     }
-}
-
-/// Resolves what a user typed to (index, sub) through `dict`.
-///
-/// Accepts, in this order: an index form (`0x6041`, `0x1018:1`, `0x1018sub1`,
-/// `6041h`, `6041`), a vendor alias (primary `alias`, the `aliases` table, then
-/// `alias_rules`; each searched from the most specific layer), then an object
-/// name (case-insensitive, the first layer that has it; `Identity object:1`
-/// names a sub by number).
-pub fn resolve_object(dict: &Dictionary, text: &str) -> Result<(u16, u8), ObjectError> {
-    let t = text.trim();
-    if t.is_empty() {
-        return Err(ObjectError::Empty);
-    }
-    if let Some(r) = parse_object_ref(t) {
-        return Ok(r);
-    }
-    for layer in dict.layers() {
-        if let Some((k, _)) = layer.find_entry(|o| o.alias.as_deref().is_some_and(|a| a.eq_ignore_ascii_case(t))) {
-            return Ok(k);
-        }
-        if let Some((_, r)) = layer.aliases.iter().find(|(a, _)| a.eq_ignore_ascii_case(t)) {
-            return Ok(*r);
-        }
-    }
-    for layer in dict.layers() {
-        if let Some(r) = layer.alias_rules.iter().find_map(|rule| rule.apply(t)) {
-            return Ok(r);
-        }
-    }
-    let (name, sub) = match t.rsplit_once(':') {
-        Some((n, s)) => match s.trim().parse::<u8>() {
-            Ok(s) => (n.trim(), Some(s)),
-            Err(_) => (t, None),
-        },
-        None => (t, None),
-    };
-    for layer in dict.layers() {
-        if let Some(i) = layer.find_name(|n| n.eq_ignore_ascii_case(name)) {
-            return Ok((i, sub.unwrap_or(0)));
-        }
-        if let Some(((i, s), _)) = layer.find_entry(|o| o.name.eq_ignore_ascii_case(name)) {
-            return Ok((i, sub.unwrap_or(s)));
-        }
-    }
-    Err(ObjectError::Unknown {
-        text: t.to_string(),
-        profile: dict.profile_name().to_string(),
-    })
 }
 
 #[cfg(test)]

@@ -9,8 +9,12 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, OnceLock};
 
+use super::dictionary::Dictionary;
 use super::json::{LoadError, load_builtin_profile, load_profile};
-use super::{Dictionary, MappingSource, Profile, Value, Warning};
+use super::mapping::MappingSource;
+use super::object::Warning;
+use super::profile::Profile;
+use super::value::Value;
 
 /// The profiles built into the binary: name and JSON text. To add one, put
 /// `decoders/<name>.json` in the repository and add a line here.

@@ -3,7 +3,8 @@
 //! tools (the python `canopen` library, CANopen Magic, PLC configurators) can load it.
 //! Pure: entries in, text out.
 
-use super::{Access, DataType};
+use super::object::Access;
+use super::value::DataType;
 use std::fmt::Write;
 
 /// One (index, sub) to write.

@@ -4,8 +4,11 @@
 use std::collections::BTreeMap;
 use std::sync::OnceLock;
 
+use super::expr::Expr;
 use super::family::Numbered;
-use super::{Expr, MappedEntry, MappingSource, ObjectInfo, PdoMapping, Value};
+use super::mapping::{MappedEntry, MappingSource, PdoMapping};
+use super::object::ObjectInfo;
+use super::value::Value;
 
 /// A PDO of a mapping set before it is placed on a node.
 #[derive(Clone, Debug, PartialEq)]

@@ -9,11 +9,12 @@
 
 use std::collections::BTreeMap;
 
+use super::device::{IdCondition, IdTest};
 use super::json::parse_access;
-use super::{
-    Access, DataType, IdCondition, IdTest, MappedEntry, MappingSource, ObjectInfo, PdoMappable, PdoMapping, Profile,
-    Value, Warning,
-};
+use super::mapping::{MappedEntry, MappingSource, PdoMapping};
+use super::object::{Access, ObjectInfo, PdoMappable, Warning};
+use super::profile::Profile;
+use super::value::{DataType, Value};
 
 /// One `[section]` with its `key=value` lines (keys lower-cased).
 #[derive(Debug, Default)]

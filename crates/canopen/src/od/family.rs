@@ -5,7 +5,7 @@
 
 use std::sync::OnceLock;
 
-use super::ObjectInfo;
+use super::object::ObjectInfo;
 
 /// The entries of one index at subs `first..=last`, made from one template.
 #[derive(Clone, Debug)]

@@ -59,7 +59,7 @@ impl ByteField {
                 width = 2 * self.length as usize
             )
         } else if self.scale.is_some() || self.unit.is_some() {
-            let mut s = super::format_number(raw as f64 * self.scale.unwrap_or(1.0));
+            let mut s = super::number::format_number(raw as f64 * self.scale.unwrap_or(1.0));
             if let Some(u) = &self.unit {
                 s.push(' ');
                 s.push_str(u);

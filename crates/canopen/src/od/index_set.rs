@@ -1,7 +1,7 @@
 //! The indexes one dictionary layer knows anything about, as a bit per index, so that a
 //! lookup passes over the layers that have nothing there without searching them.
 
-use super::Profile;
+use super::profile::Profile;
 
 /// A set of object indexes (0x0000..=0xFFFF).
 #[derive(Clone, Debug)]

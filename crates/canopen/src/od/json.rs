@@ -13,16 +13,16 @@ use std::ops::RangeInclusive;
 use serde_json::Value as Json;
 
 use super::alias::{AliasRule, parse_object_ref};
+use super::device::{Axis, IdCondition, IdTest, IndexRange, PdoSet, PdoTemplate, TextMatch};
 use super::expr::{Expr, parse_int};
 use super::family::{Numbered, SubFamily, fill};
 use super::fields::{ByteField, SdoCommand, SdoDirection};
+use super::mapping::MappingSource;
+use super::object::{ObjectInfo, PdoMappable, Warning};
 use super::procedure::{
     FailIf, NmtCommand, ProcParam, Procedure, ProcedureError, Step, object_variables, parse_frame_data,
 };
-use super::{
-    Axis, IdCondition, IdTest, IndexRange, MappingSource, ObjectInfo, PdoMappable, PdoSet, PdoTemplate, Profile,
-    TextMatch, Warning,
-};
+use super::profile::Profile;
 
 /// The newest profile format this loader knows.
 pub(crate) const FORMAT_VERSION: u64 = 1;

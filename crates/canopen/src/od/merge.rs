@@ -4,7 +4,8 @@
 //! (vendor profile, CiA 402, CiA 301) that has them for the same (index, sub) and the same
 //! data type. What the top layer gives itself always wins.
 
-use super::{ObjectInfo, Profile};
+use super::object::ObjectInfo;
+use super::profile::Profile;
 use std::sync::Arc;
 
 /// `top` with each entry completed from `lower` (first layer first); `None` when no

@@ -1,8 +1,8 @@
 //! Named procedures from profiles: command sequences such as "enable and run
 //! in profile velocity mode", as data for the commander to execute.
 
-use super::DataType;
 use super::expr::{Expr, ExprError};
+use super::value::DataType;
 
 /// What is wrong with a procedure step in a profile.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
