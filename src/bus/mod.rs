@@ -15,11 +15,13 @@
 //! subscriptions as an [`Event::State`] in order with the frames ([`Subscription::next`]);
 //! [`Subscription::recv`] gives frames only and turns a loss of capture into an error.
 
+mod error;
 pub mod socketcan;
 pub mod socketcand;
 pub mod state;
 pub mod virt;
 
+pub use error::BusError;
 pub use state::{BusState, StateChange};
 
 use crate::frame::{Flags, Frame};
@@ -29,32 +31,6 @@ use tokio::sync::{broadcast, oneshot};
 
 /// Frames buffered per subscription before the slowest one starts losing frames.
 pub const QUEUE_DEPTH: usize = 8192;
-
-/// Why the bus could not be used.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum BusError {
-    /// The interface is missing, down, not CAN, or not permitted; `fix` names the command that helps.
-    Unavailable { iface: String, reason: String, fix: String },
-    /// The handle was opened with `--listen-only`; nothing was sent.
-    ListenOnly,
-    /// Reading or writing failed on an open interface.
-    Io { iface: String, reason: String },
-    /// Every sender of the bus is gone.
-    Closed,
-}
-
-impl fmt::Display for BusError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            BusError::Unavailable { iface, reason, fix } => write!(f, "{iface}: {reason}; fix: {fix}"),
-            BusError::ListenOnly => write!(f, "listen-only: this handle cannot send (drop --listen-only to send)"),
-            BusError::Io { iface, reason } => write!(f, "{iface}: {reason}"),
-            BusError::Closed => write!(f, "the bus was closed"),
-        }
-    }
-}
-
-impl std::error::Error for BusError {}
 
 /// One item on the broadcast channel: the endpoint that sent it (0 = another node or the reader) and what.
 #[derive(Clone, Copy, Debug)]

@@ -10,6 +10,7 @@
 //! our own `recvmsg` because the crate does not expose `msg_flags`, which is the only
 //! way to tell our own frames from those of other programs.
 
+use super::error::{missing_fix, up_fix};
 use super::state::{Action, BusState, StateChange, SysLink, decide};
 use super::{Bus, BusError, Carried, Item, QUEUE_DEPTH, Sender};
 use crate::decode::error_frame::controller_state;
@@ -40,19 +41,6 @@ pub const CANFD_MTU: usize = 72;
 pub const RCVBUF_BYTES: i32 = 8 << 20;
 /// `ARPHRD_CAN` in `/sys/class/net/IFACE/type`.
 const ARPHRD_CAN: u32 = 280;
-
-/// The commands that bring a CAN interface up, for error messages.
-pub fn up_fix(iface: &str) -> String {
-    format!("sudo ip link set {iface} up type can bitrate 500000 (a vcan: sudo ip link set {iface} up)")
-}
-
-/// The commands that create a virtual CAN interface, for error messages.
-pub fn missing_fix(iface: &str) -> String {
-    format!(
-        "plug in the adapter and check `ip link`, or create a virtual one: \
-         sudo modprobe vcan && sudo ip link add dev {iface} type vcan && sudo ip link set {iface} up"
-    )
-}
 
 /// Checks `/sys/class/net/IFACE`: present, CAN, up.
 fn check_interface(iface: &str) -> Result<(), BusError> {

@@ -2,8 +2,7 @@
 //! text and fix shown to the user, and the reader's pure decision of what to do with its
 //! socket given what `/sys/class/net/IFACE` says.
 
-use super::BusError;
-use super::socketcan::up_fix;
+use super::error::{BusError, up_fix};
 use crate::decode::error_frame::ControllerState;
 
 /// The state of a bus handle's interface and controller.
