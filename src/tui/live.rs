@@ -4,6 +4,7 @@
 //! stopped one by one by `jobs stop ID`, cancelled by stop-all before it stops the drives,
 //! cyclic SYNC/RPDO/raw senders first).
 
+use super::frame_feed::{BACKLOG_FRAMES, FrameFeed};
 use super::messages::Level;
 use super::source::{BusNote, Feed};
 use crate::bus::{Bus, BusError, BusState, Event, StateChange};
@@ -18,7 +19,7 @@ use crate::od::bind::Bindings;
 use crate::sim::control::Control;
 use crate::sim::demo::Demo;
 use std::collections::BTreeSet;
-use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::time::Duration;
 use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
 use tokio::task::AbortHandle;
@@ -51,7 +52,8 @@ pub type Requests = UnboundedSender<Request>;
 
 /// Frames per batch.
 const BATCH: usize = 1024;
-/// Capacity of the feed channel in batches; when full, frames are dropped and counted.
+/// Capacity of the feed channel in batches; when full, frames wait in the
+/// [`FrameFeed`]'s backlog.
 const QUEUE: usize = 256;
 
 /// Starts capturing `ifaces` (at least one; `demo` and `demo2` are simulated buses: the
@@ -101,19 +103,6 @@ pub fn start(
         rt.block_on(local);
     });
     (rx, req_tx)
-}
-
-/// Sends a feed item; a full queue drops frames (counted) but never blocks the bus task.
-fn offer(tx: &SyncSender<Feed>, item: Feed, lost: &mut u64) -> bool {
-    match tx.try_send(item) {
-        Ok(()) => true,
-        Err(TrySendError::Full(Feed::Frames(b))) => {
-            *lost += b.len() as u64;
-            true
-        }
-        Err(TrySendError::Full(other)) => tx.send(other).is_ok(),
-        Err(TrySendError::Disconnected(_)) => false,
-    }
 }
 
 /// One interface a capture task opens.
@@ -199,6 +188,8 @@ async fn capture(
     {
         return;
     }
+    let mut feed = FrameFeed::new(tx.clone(), BACKLOG_FRAMES);
+    // Frames dropped (past the backlog's bound) not yet reported.
     let mut lost = 0u64;
     let mut sub = bus.subscribe();
     let mut reported = 0u64;
@@ -213,23 +204,20 @@ async fn capture(
                     f.iface = index;
                     jobs.observe(&f);
                     batch.push(f);
-                    if batch.len() >= BATCH && !offer(&tx, Feed::Frames(std::mem::take(&mut batch)), &mut lost) {
+                    if batch.len() >= BATCH && !feed.frames(std::mem::take(&mut batch)) {
                         return;
                     }
                 }
                 Ok(Event::State(s)) => {
                     // Frames before the change first, so the trace and the notice agree.
-                    if !batch.is_empty() && !offer(&tx, Feed::Frames(std::mem::take(&mut batch)), &mut lost) {
-                        return;
-                    }
-                    if tx.send(state_feed(&cap, &s, &mut stopped_at)).is_err() {
+                    if !feed.frames(std::mem::take(&mut batch)) || !feed.send(state_feed(&cap, &s, &mut stopped_at)) {
                         return;
                     }
                 }
                 Err(BusError::Closed) => {
-                    offer(&tx, Feed::Frames(std::mem::take(&mut batch)), &mut lost);
+                    feed.frames(std::mem::take(&mut batch));
                     // The source ends once every interface's task has: the feed then closes.
-                    let _ = tx.send(Feed::BusError(cap.note("closed", format!("{iface}: {}", BusError::Closed))));
+                    let _ = feed.send(Feed::BusError(cap.note("closed", format!("{iface}: {}", BusError::Closed))));
                     return;
                 }
                 Err(e) => {
@@ -239,11 +227,12 @@ async fn capture(
                 }
             },
             _ = flush.tick() => {
-                if !batch.is_empty() && !offer(&tx, Feed::Frames(std::mem::take(&mut batch)), &mut lost) {
+                if !feed.frames(std::mem::take(&mut batch)) {
                     return;
                 }
+                lost += feed.take_lost();
                 let total = lost + sub.lost() - reported;
-                if total > 0 && tx.try_send(Feed::Lost(total)).is_ok() {
+                if total > 0 && feed.channel().try_send(Feed::Lost(total)).is_ok() {
                     lost = 0;
                     reported = sub.lost();
                 }

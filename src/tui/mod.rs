@@ -11,6 +11,7 @@ pub mod commands;
 mod event;
 pub mod export;
 mod export_plot;
+mod frame_feed;
 pub mod fuzzy;
 pub mod keymap;
 pub mod live;
