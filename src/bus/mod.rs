@@ -16,6 +16,7 @@
 //! [`Subscription::recv`] gives frames only and turns a loss of capture into an error.
 
 mod error;
+mod pace;
 pub mod socketcan;
 pub mod socketcand;
 pub mod state;

@@ -11,6 +11,7 @@
 //! way to tell our own frames from those of other programs.
 
 use super::error::{missing_fix, up_fix};
+use super::pace::Pace;
 use super::state::{Action, BusState, StateChange, SysLink, decide};
 use super::{Bus, BusError, Carried, Item, QUEUE_DEPTH, Sender};
 use crate::decode::error_frame::controller_state;
@@ -276,8 +277,6 @@ const CHECK_TROUBLED: Duration = Duration::from_millis(100);
 /// How often it does while capturing (an interface deleted and re-created under a quiet
 /// socket reports no error on it).
 const CHECK_HEALTHY: Duration = Duration::from_secs(1);
-/// Frames read in a row before the reader lets the subscribers run.
-const READ_RUN: usize = 64;
 
 /// The reader task: reads the socket into the broadcast channel, follows the interface
 /// (down, deleted, re-created: reopened by name) and the controller state from error frames.
@@ -333,22 +332,12 @@ impl Reader {
 
     /// Reads until the socket's queue is empty (or fails), letting the subscribers run between runs.
     async fn read_queued(&mut self, sock: &Socket) {
-        let mut run = 0;
+        let mut pace = Pace::default();
         loop {
             match recv(sock.as_raw_fd()) {
                 Ok((frame, own)) => {
                     self.on_frame(frame, own);
-                    run += 1;
-                    if run == READ_RUN {
-                        run = 0;
-                        if self.events.len() > QUEUE_DEPTH / 2 {
-                            // The subscribers are behind: give them time before they lose
-                            // frames (still 64 frames/ms, faster than any CAN bus).
-                            tokio::time::sleep(Duration::from_millis(1)).await;
-                        } else {
-                            tokio::task::yield_now().await;
-                        }
-                    }
+                    pace.published(&self.events).await;
                 }
                 Err(e) if e.kind() == io::ErrorKind::WouldBlock => return,
                 Err(e) if e.kind() == io::ErrorKind::Interrupted => {}

@@ -23,6 +23,7 @@
 
 pub mod wire;
 
+use super::pace::Pace;
 use super::state::{BusState, StateChange};
 use super::{Bus, BusError, Carried, Clock, Item, QUEUE_DEPTH, Sender};
 use crate::frame::Frame;
@@ -393,10 +394,14 @@ impl Reader {
     async fn run(mut self, mut conn: Conn) {
         let mut echo = tokio::time::interval(ECHO_EVERY);
         echo.tick().await;
+        let mut pace = Pace::default();
         loop {
             tokio::select! {
                 got = conn.next() => match got {
-                    Some(Ok(text)) => self.element(&text),
+                    Some(Ok(text)) => {
+                        self.element(&text);
+                        pace.published(&self.link.events).await;
+                    }
                     Some(Err(_)) => {}
                     None => conn = self.reconnect().await,
                 },
