@@ -407,38 +407,53 @@ fn cycle_groups(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<(String, Vec<
         .collect()
 }
 
-/// Groups of files that import each other today, to be broken (issue 23, item 7: "no
-/// import cycles between modules"): the diagnoser's timeline, which holds each detector's
-/// per-node state, and those detectors. The test
-/// fails on any group not listed here, and on a listed one that changed (shrink it then).
-const KNOWN_CYCLES: &[&str] = &[
-    "src: analysis::diagnose::boot, analysis::diagnose::detector, analysis::diagnose::drive, analysis::diagnose::emcy, analysis::diagnose::heartbeat, analysis::diagnose::masters, analysis::diagnose::sdo, analysis::diagnose::timeline",
-];
-
+/// No files import each other, directly or around a cycle (issue 23, item 7: "no import
+/// cycles between modules"): the test names each group it finds, with one cycle through it.
 #[test]
 fn no_file_imports_a_file_that_imports_it_back() {
-    let mut seen = BTreeMap::new();
+    let mut found = Vec::new();
     for src in ["src", "crates/canopen/src"] {
         let graph = file_graph(&root().join(src));
         assert!(graph.len() > 40, "{src}: only {} files", graph.len());
         for (group, cycle) in cycle_groups(&graph) {
-            seen.insert(format!("{src}: {group}"), cycle.join(" -> "));
+            found.push(format!("    {src}: {group} (cycle: {})", cycle.join(" -> ")));
         }
     }
-    let known: BTreeSet<&str> = KNOWN_CYCLES.iter().copied().collect();
-    let new: Vec<String> = seen
-        .iter()
-        .filter(|(g, _)| !known.contains(g.as_str()))
-        .map(|(g, c)| format!("    {g:?}, (cycle: {c})"))
-        .collect();
-    let gone: Vec<&&str> = known.iter().filter(|g| !seen.contains_key(**g)).collect();
     assert!(
-        new.is_empty(),
+        found.is_empty(),
         "files importing each other (break the cycle):\n{}",
-        new.join("\n")
+        found.join("\n")
     );
+}
+
+/// The diagnoser's detectors import no other detector: besides the facade
+/// (`analysis::diagnose`, which owns them all and carries what one tells another), a file
+/// of `src/analysis/diagnose/` imports only the modules they share.
+#[test]
+fn no_detector_imports_another_detector() {
+    const SHARED: [&str; 4] = ["timeline", "detector", "texts", "two_masters"];
+    let facade = "analysis::diagnose";
+    let graph = file_graph(&root().join("src"));
+    let inside = |m: &str| {
+        m.strip_prefix(facade)
+            .and_then(|r| r.strip_prefix("::"))
+            .map(str::to_string)
+    };
+    // (The unit tests, `diagnose::tests`, may use anything.)
+    let detectors: Vec<&String> = graph
+        .keys()
+        .filter(|m| inside(m).is_some_and(|name| name != "tests"))
+        .collect();
+    assert!(detectors.len() > 10, "only {} files in {facade}", detectors.len());
+    let wrong: Vec<String> = detectors
+        .iter()
+        .flat_map(|m| graph[*m].iter().map(move |t| (m, t)))
+        .filter(|(_, t)| inside(t).is_some_and(|name| !SHARED.contains(&name.as_str())))
+        .map(|(m, t)| format!("    {m} -> {t}"))
+        .collect();
     assert!(
-        gone.is_empty(),
-        "groups in KNOWN_CYCLES no longer exist as listed (update them): {gone:?}"
+        wrong.is_empty(),
+        "diagnose files importing a detector (route it through the Diagnoser):\n{}",
+        wrong.join("\n")
     );
 }

@@ -2,7 +2,7 @@
 //! the boot-up), two boot-ups of one node-ID close together (`duplicate_id`), and NMT
 //! commands a node did not follow (`nmt_ignored`).
 
-use super::timeline::{At, MS, Timeline};
+use super::timeline::{At, MS, PerNode, Timeline};
 use crate::analysis::incident::{Problem, Status};
 use crate::decode::heartbeat::NmtState;
 use crate::frame::NodeKey;
@@ -26,7 +26,7 @@ struct Expect {
 
 /// The boot-ups and NMT commands of one node.
 #[derive(Clone, Debug, Default)]
-pub(super) struct NodeBoot {
+struct NodeBoot {
     last_boot: Option<u64>,
     reset_asked: Option<u64>,
     expect: Option<Expect>,
@@ -52,6 +52,7 @@ pub(super) fn nmt_command(cs: u8) -> Option<(&'static str, NmtState)> {
 pub(super) struct Boots {
     /// The last NMT reset addressed to all nodes, per interface.
     reset_all: BTreeMap<u16, u64>,
+    nodes: PerNode<NodeBoot>,
 }
 
 impl Boots {
@@ -69,11 +70,11 @@ impl Boots {
             if target == 0 {
                 self.reset_all.insert(iface, at.t);
             } else {
-                tl.node(NodeKey::new(iface, target)).boot.reset_asked = Some(at.t);
+                self.nodes.of(tl, NodeKey::new(iface, target)).reset_asked = Some(at.t);
             }
         }
         for n in known {
-            tl.node(n).boot.expect = Some(Expect {
+            self.nodes.of(tl, n).expect = Some(Expect {
                 at,
                 target: state,
                 command,
@@ -85,27 +86,26 @@ impl Boots {
     /// A heartbeat of `n` in state `s`: an NMT command followed, late or not at all.
     pub(super) fn heartbeat(&mut self, tl: &mut Timeline, n: NodeKey, s: NmtState) {
         let at = tl.at;
-        let node = tl.node(n);
-        if let Some((i, target)) = node.boot.ignored
+        let boot = self.nodes.of(tl, n);
+        if let Some((i, target)) = boot.ignored
             && target == s
         {
-            node.boot.ignored = None;
+            boot.ignored = None;
             tl.incidents[i].status = Status::Warning;
             tl.step(i, at, format!("Reached {} later", s.text()));
         }
-        let node = tl.node(n);
-        let Some(mut ex) = node.boot.expect else { return };
+        let Some(mut ex) = boot.expect else { return };
         if ex.target == s {
-            node.boot.expect = None;
+            boot.expect = None;
             return;
         }
         if s == NmtState::BootUp {
             return;
         }
         ex.wrong += 1;
-        node.boot.expect = Some(ex);
+        boot.expect = Some(ex);
         if ex.wrong >= 2 && at.t.saturating_sub(ex.at.t) >= NMT_GRACE_NS {
-            node.boot.expect = None;
+            boot.expect = None;
             let i = tl.grouped(
                 Some(n),
                 Problem::NmtIgnored,
@@ -116,34 +116,32 @@ impl Boots {
             tl.incidents[i].cause = Some(format!("NMT {} sent, node stays {}", ex.command, s.text()));
             tl.step(i, ex.at, format!("NMT {} sent", ex.command));
             tl.step(i, at, format!("Node still says {}", s.text()));
-            tl.node(n).boot.ignored = Some((i, ex.target));
+            boot.ignored = Some((i, ex.target));
         }
     }
 
     /// A boot-up of `n` at `at` (`rebooted`: the node was heard before).
     pub(super) fn boot_up(&mut self, tl: &mut Timeline, n: NodeKey, at: At, rebooted: bool) {
         let reset_all = self.reset_all.get(&n.iface).copied();
-        let node = tl.node(n);
+        let boot = self.nodes.of(tl, n);
         // (Equal times say nothing: logs without timestamps.)
-        let close = node
-            .boot
+        let close = boot
             .last_boot
             .is_some_and(|t| at.t > t && at.t - t <= DUPLICATE_BOOT_NS);
-        let asked = node
-            .boot
+        let asked = boot
             .reset_asked
             .max(reset_all)
             .is_some_and(|t| at.t.saturating_sub(t) <= RESET_BOOT_NS);
-        node.boot.last_boot = Some(at.t);
-        node.boot.expect = None;
+        boot.last_boot = Some(at.t);
+        boot.expect = None;
+        if asked {
+            boot.reset_asked = None;
+        }
+        let node = tl.node(n);
         node.last_state = None;
-        node.beat.state_before = None;
         // A silence that ends in a boot-up is part of the restart (expected when a reset
         // was asked for).
         let silence = node.silence.take();
-        if asked {
-            node.boot.reset_asked = None;
-        }
         if close {
             let i = tl.grouped(Some(n), Problem::DuplicateId, 0, at.t);
             tl.step(i, at, "A second boot-up with the same node-ID right after the first");

@@ -5,8 +5,7 @@
 //! transfers.
 
 use super::detector::Detector;
-use super::emcy::Emcys;
-use super::timeline::{At, MS, Timeline};
+use super::timeline::{At, MS, PerNode, Timeline};
 use crate::analysis::incident::{Problem, Status};
 use crate::decode::cia402::DriveState;
 use crate::decode::stall::{self, Observation, Step};
@@ -56,13 +55,13 @@ struct Axis {
 
 /// The CiA 402 axes of one node.
 #[derive(Clone, Debug, Default)]
-pub(super) struct NodeDrive {
+struct NodeDrive {
     axes: BTreeMap<u8, Axis>,
 }
 
 impl NodeDrive {
     /// The open fault incidents of the node's axes.
-    pub(super) fn faults(&self) -> impl Iterator<Item = usize> + '_ {
+    fn faults(&self) -> impl Iterator<Item = usize> + '_ {
         self.axes.values().filter_map(|a| a.fault)
     }
 }
@@ -72,6 +71,7 @@ impl NodeDrive {
 pub(super) struct Drives {
     /// The fault resets sent for each drive-fault incident.
     resets: HashMap<usize, u32>,
+    nodes: PerNode<NodeDrive>,
 }
 
 impl Drives {
@@ -80,14 +80,22 @@ impl Drives {
         self.resets.get(&i).copied().unwrap_or(0)
     }
 
+    /// The open fault incidents of `n`'s axes.
+    pub(super) fn faults(&self, n: NodeKey) -> impl Iterator<Item = usize> + '_ {
+        self.nodes.get(n).into_iter().flat_map(NodeDrive::faults)
+    }
+
     /// A CiA 402 object value `w` of `n` at `index` (from a PDO or an SDO transfer).
-    pub(super) fn word(&mut self, tl: &mut Timeline, emcy: &mut Emcys, n: NodeKey, index: u16, w: u16) {
+    /// Returns the fault incident it opened, if it did: its cause, a recent EMCY of the
+    /// node, is the EMCY detector's to give (the facade asks it).
+    pub(super) fn word(&mut self, tl: &mut Timeline, n: NodeKey, index: u16, w: u16) -> Option<usize> {
         if let Some(axis) = axis_of(index, 0x6041) {
-            self.statusword(tl, emcy, n, axis, w);
-        } else if let Some(axis) = axis_of(index, 0x6040) {
+            return self.statusword(tl, n, axis, w);
+        }
+        if let Some(axis) = axis_of(index, 0x6040) {
             self.controlword(tl, n, axis, w);
         } else if let Some(axis) = axis_of(index, 0x603F) {
-            let fault = tl.node(n).drive.axes.get(&axis).and_then(|a| a.fault);
+            let fault = self.nodes.of(tl, n).axes.get(&axis).and_then(|a| a.fault);
             if let Some(i) = fault
                 && w != 0
             {
@@ -103,18 +111,22 @@ impl Drives {
                 }
             }
         }
+        None
     }
 
-    fn statusword(&mut self, tl: &mut Timeline, emcy: &mut Emcys, n: NodeKey, axis: u8, sw: u16) {
+    /// A statusword `sw` of `n`'s `axis`; the fault incident it opened, if it did.
+    fn statusword(&mut self, tl: &mut Timeline, n: NodeKey, axis: u8, sw: u16) -> Option<usize> {
         let at = tl.at;
         let state = DriveState::from_statusword(sw);
-        stall_check(tl, n, axis, sw, state);
+        let node = self.nodes.of(tl, n);
+        stall_check(tl, node, n, axis, sw, state);
         let faulted = matches!(state, DriveState::Fault | DriveState::FaultReactionActive);
-        let a = tl.node(n).drive.axes.entry(axis).or_default().clone();
+        let a = node.axes.entry(axis).or_default().clone();
+        let mut opened = None;
         match (a.fault, faulted) {
             (None, true) => {
                 // Another axis of the node faulted just now: one incident.
-                let together = tl.nodes[&n].drive.faults().find(|i| {
+                let together = node.faults().find(|i| {
                     at.t.saturating_sub(tl.incidents[*i].first_ns) <= AXES_TOGETHER_NS
                         && tl.incidents[*i].status == Status::Open
                 });
@@ -134,20 +146,20 @@ impl Drives {
                             at,
                             format!("Fault: the drive switched the motor torque off (statusword 0x{sw:04X})"),
                         );
-                        emcy.absorb(tl, n, i);
+                        opened = Some(i);
                         i
                     }
                 };
-                let ax = tl.node(n).drive.axes.entry(axis).or_default();
+                let ax = node.axes.entry(axis).or_default();
                 ax.fault = Some(i);
                 ax.cleared = None;
             }
             (Some(i), false) => {
-                let ax = tl.node(n).drive.axes.entry(axis).or_default();
+                let ax = node.axes.entry(axis).or_default();
                 ax.fault = None;
                 ax.cleared = Some(i);
                 // The incident is recovered once every faulted axis is clear.
-                let still = tl.nodes[&n].drive.faults().any(|f| f == i);
+                let still = node.faults().any(|f| f == i);
                 if !still {
                     tl.incidents[i].status = Status::Recovered;
                     tl.incidents[i].last_ns = at.t;
@@ -161,28 +173,30 @@ impl Drives {
             _ => {}
         }
         if state == DriveState::OperationEnabled
-            && let Some(i) = tl.node(n).drive.axes.get_mut(&axis).and_then(|a| a.cleared.take())
+            && let Some(i) = node.axes.get_mut(&axis).and_then(|a| a.cleared.take())
         {
-            let others_running = tl.nodes[&n].drive.axes.values().any(|x| x.cleared == Some(i));
+            let others_running = node.axes.values().any(|x| x.cleared == Some(i));
             if !others_running {
                 tl.step(i, at, "Running again (operation enabled)");
             }
         }
+        opened
     }
 
     fn controlword(&mut self, tl: &mut Timeline, n: NodeKey, axis: u8, cw: u16) {
         let at = tl.at;
-        let ax = tl.node(n).drive.axes.entry(axis).or_default().clone();
+        let node = self.nodes.of(tl, n);
+        let ax = node.axes.entry(axis).or_default().clone();
         if ax.cw != Some(cw)
             && let Some(step) = stall::requested(cw)
         {
-            let a = tl.node(n).drive.axes.entry(axis).or_default();
+            let a = node.axes.entry(axis).or_default();
             let done =
                 a.sw.is_some_and(|sw| stall::reached(&step, DriveState::from_statusword(sw)));
             a.asked = (!done).then_some((at, step, a.sw));
         }
         let rising = cw & 0x80 != 0 && ax.cw.is_none_or(|p| p & 0x80 == 0);
-        tl.node(n).drive.axes.entry(axis).or_default().cw = Some(cw);
+        node.axes.entry(axis).or_default().cw = Some(cw);
         // A reset in the same cycle as the clear (the statusword went out first) counts too.
         let just_cleared = ax
             .cleared
@@ -209,12 +223,12 @@ impl Drives {
 
 /// A statusword `sw` of an axis asked to change state: reached (a stuck incident
 /// recovers), a fault (the fault incident tells it), or still not there after
-/// [`STALL_NS`]: the drive is stuck, with the reason the bus shows.
-fn stall_check(tl: &mut Timeline, n: NodeKey, axis: u8, sw: u16, state: DriveState) {
+/// [`STALL_NS`]: the drive is stuck, with the reason the bus shows. `node` is `n`'s state.
+fn stall_check(tl: &mut Timeline, node: &mut NodeDrive, n: NodeKey, axis: u8, sw: u16, state: DriveState) {
     let at = tl.at;
     let nmt = tl.nodes.get(&n).and_then(|d| d.last_state.map(|(_, s)| s));
     let emcy = tl.nodes.get(&n).and_then(|d| d.last_emcy);
-    let a = tl.node(n).drive.axes.entry(axis).or_default();
+    let a = node.axes.entry(axis).or_default();
     a.sw = Some(sw);
     let stuck = a.stuck;
     let cw = a.cw;
@@ -278,15 +292,16 @@ fn stall_check(tl: &mut Timeline, n: NodeKey, axis: u8, sw: u16, state: DriveSta
         at,
         format!("Still {} (statusword 0x{sw:04X}) after {waited:.2} s", state.text()),
     );
-    tl.node(n).drive.axes.entry(axis).or_default().stuck = Some(i);
+    node.axes.entry(axis).or_default().stuck = Some(i);
 }
 
 impl Detector for Drives {
     fn end_node(&mut self, tl: &mut Timeline, n: NodeKey, end: At) {
-        let stuck: Vec<(usize, u16)> = tl.nodes[&n]
-            .drive
-            .axes
-            .values()
+        let stuck: Vec<(usize, u16)> = self
+            .nodes
+            .get(n)
+            .into_iter()
+            .flat_map(|d| d.axes.values())
             .filter_map(|a| Some((a.stuck?, a.sw?)))
             .collect();
         for (i, sw) in stuck {

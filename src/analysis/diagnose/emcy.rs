@@ -1,9 +1,10 @@
 //! EMCY detector (`emcy`): emergency messages not tied to a drive fault, grouped per
 //! error code and ended by an error reset (EMCY 0x0000). An EMCY right before a CiA 402
-//! fault is that fault's cause instead ([`super::drive`] asks for it).
+//! fault is that fault's cause instead (the facade tells which faults [`super::drive`]
+//! has open, and which one it just opened).
 
 use super::detector::Detector;
-use super::timeline::{At, MS, Timeline};
+use super::timeline::{At, MS, PerNode, Timeline};
 use crate::analysis::incident::{Problem, Status};
 use crate::decode::emcy::Emcy;
 use crate::frame::NodeKey;
@@ -14,7 +15,7 @@ pub(super) const EMCY_CAUSE_NS: u64 = 100 * MS;
 
 /// The EMCY of one node not given to an incident yet (a fault may follow at once).
 #[derive(Clone, Debug, Default)]
-pub(super) struct NodeEmcy {
+struct NodeEmcy {
     waiting: Vec<(At, Emcy)>,
 }
 
@@ -25,6 +26,7 @@ pub(super) struct Emcys {
     device_check: HashMap<usize, Vec<String>>,
     /// The EMCY code given as the cause of a drive-fault incident.
     fault_codes: HashMap<usize, u16>,
+    nodes: PerNode<NodeEmcy>,
 }
 
 /// An EMCY in words: its text, code and manufacturer fields.
@@ -47,8 +49,8 @@ impl Emcys {
         self.device_check.get(&i)
     }
 
-    /// An EMCY `e` of node `n`.
-    pub(super) fn emcy(&mut self, tl: &mut Timeline, n: NodeKey, e: &Emcy) {
+    /// An EMCY `e` of node `n`, whose open drive-fault incidents are `faults`.
+    pub(super) fn emcy(&mut self, tl: &mut Timeline, n: NodeKey, e: &Emcy, faults: impl IntoIterator<Item = usize>) {
         let at = tl.at;
         tl.node(n).last_emcy = Some(e.code);
         self.flush(tl, n, at.t.saturating_sub(EMCY_CAUSE_NS));
@@ -67,10 +69,10 @@ impl Emcys {
             }
             return;
         }
-        let fault = tl.nodes[&n].drive.faults().find(|i| tl.incidents[*i].cause.is_none());
+        let fault = faults.into_iter().find(|i| tl.incidents[*i].cause.is_none());
         match fault {
             Some(i) => self.give_cause(tl, i, at, e),
-            None => tl.node(n).emcy.waiting.push((at, e.clone())),
+            None => self.nodes.of(tl, n).waiting.push((at, e.clone())),
         }
     }
 
@@ -88,7 +90,7 @@ impl Emcys {
     pub(super) fn absorb(&mut self, tl: &mut Timeline, n: NodeKey, i: usize) {
         let t = tl.at.t;
         self.flush(tl, n, t.saturating_sub(EMCY_CAUSE_NS));
-        if let Some((at, e)) = tl.node(n).emcy.waiting.pop() {
+        if let Some((at, e)) = self.nodes.of(tl, n).waiting.pop() {
             self.give_cause(tl, i, at, &e);
         }
         self.flush(tl, n, u64::MAX);
@@ -96,7 +98,7 @@ impl Emcys {
 
     /// EMCY of `n` older than `before` become EMCY incidents (grouped per code).
     fn flush(&mut self, tl: &mut Timeline, n: NodeKey, before: u64) {
-        let node = &mut tl.node(n).emcy;
+        let node = self.nodes.of(tl, n);
         let keep = node
             .waiting
             .iter()

@@ -4,7 +4,7 @@
 //! node guarding).
 
 use super::detector::Detector;
-use super::timeline::{At, Timeline};
+use super::timeline::{At, PerNode, Timeline};
 use crate::analysis::incident::{Problem, Status};
 use crate::decode::heartbeat::NmtState;
 use crate::frame::NodeKey;
@@ -13,15 +13,15 @@ use std::collections::BTreeMap;
 
 /// The heartbeat state of one node.
 #[derive(Clone, Debug, Default)]
-pub(super) struct NodeBeat {
+struct NodeBeat {
     /// A heartbeat (not a boot-up) came since the last boot-up.
-    pub(super) beating: bool,
+    beating: bool,
     last_hb: Option<At>,
     /// The heartbeat state before the last change.
-    pub(super) state_before: Option<NmtState>,
+    state_before: Option<NmtState>,
     conflicts: u32,
     /// A node guarding request (RTR) was seen.
-    pub(super) guarded: bool,
+    guarded: bool,
     /// 0x1017 = 0 seen on the bus, and when.
     heartbeat_off: Option<At>,
 }
@@ -31,26 +31,27 @@ pub(super) struct NodeBeat {
 pub(super) struct Heartbeats {
     /// Longest silence per node that came back (ms).
     silent_max: BTreeMap<NodeKey, f64>,
+    nodes: PerNode<NodeBeat>,
 }
 
 impl Heartbeats {
     /// A heartbeat of `n` in state `s`.
     pub(super) fn heartbeat(&mut self, tl: &mut Timeline, n: NodeKey, s: NmtState) {
         let at = tl.at;
-        let node = tl.node(n);
-        node.beat.last_hb = Some(at);
-        node.beat.beating = s != NmtState::BootUp;
+        let beat = self.nodes.of(tl, n);
+        beat.last_hb = Some(at);
+        beat.beating = s != NmtState::BootUp;
         if s == NmtState::BootUp {
             return;
         }
         // Two devices with one node-ID: heartbeat states that flip back and forth
         // (A, B, A, B...), which one node changing state never does.
-        if let (Some((_, s1)), Some(s2)) = (node.last_state, node.beat.state_before)
+        if let (Some((_, s1)), Some(s2)) = (tl.node(n).last_state, beat.state_before)
             && s != s1
             && s == s2
         {
-            node.beat.conflicts += 1;
-            if node.beat.conflicts == 3 {
+            beat.conflicts += 1;
+            if beat.conflicts == 3 {
                 let i = tl.grouped(Some(n), Problem::DuplicateId, 0, at.t);
                 tl.step(
                     i,
@@ -61,20 +62,30 @@ impl Heartbeats {
         }
         let node = tl.node(n);
         if node.last_state.is_some_and(|(_, s1)| s1 != s) {
-            node.beat.state_before = node.last_state.map(|(_, s1)| s1);
+            beat.state_before = node.last_state.map(|(_, s1)| s1);
         }
         node.last_state = Some((at.t, s));
+    }
+
+    /// A boot-up of `n`: the states before it say nothing of the states after.
+    pub(super) fn boot_up(&mut self, tl: &mut Timeline, n: NodeKey) {
+        self.nodes.of(tl, n).state_before = None;
+    }
+
+    /// A node guarding request (RTR) to `n`: the node is watched.
+    pub(super) fn guarded(&mut self, tl: &mut Timeline, n: NodeKey) {
+        self.nodes.of(tl, n).guarded = true;
     }
 
     /// The tracker lost `n`'s heartbeat at `at` after `silent_ms`; a heartbeat that has
     /// not started since the boot-up did not stop.
     pub(super) fn lost(&mut self, tl: &mut Timeline, n: NodeKey, at: At, silent_ms: f64) {
-        let node = tl.node(n);
-        if !node.beat.beating {
+        let beat = self.nodes.of(tl, n);
+        if !beat.beating {
             return;
         }
-        let last = node.beat.last_hb.unwrap_or(at);
-        node.silence = Some((last, at.t, silent_ms));
+        let last = beat.last_hb.unwrap_or(at);
+        tl.node(n).silence = Some((last, at.t, silent_ms));
     }
 
     /// `n`'s heartbeat came back at `at` after `silent_ms`.
@@ -107,7 +118,7 @@ impl Detector for Heartbeats {
         }
         let at = tl.at;
         let off = super::detector::value(t) & 0xFFFF == 0;
-        tl.node(t.key()).beat.heartbeat_off = off.then_some(at);
+        self.nodes.of(tl, t.key()).heartbeat_off = off.then_some(at);
     }
 
     fn end_node(&mut self, tl: &mut Timeline, n: NodeKey, end: At) {
@@ -121,7 +132,7 @@ impl Detector for Heartbeats {
             tl.step(i, end, "Nothing after that, until the end of the capture");
             tl.incidents[i].last_ns = end.t;
         }
-        let beat = &tl.nodes[&n].beat;
+        let Some(beat) = self.nodes.get(n) else { return };
         if let Some(at) = beat.heartbeat_off.filter(|_| !beat.guarded) {
             let i = tl.grouped(Some(n), Problem::Unmonitored, 0, at.t);
             tl.incidents[i].status = Status::Warning;

@@ -1,13 +1,9 @@
 //! Second-master detector (`second_master`): NMT commands that undo each other at once,
 //! and (reported by [`super::sdo`]) SDO requests or segments of two clients that overlap.
 
-use super::timeline::{At, MS, Timeline};
-use crate::analysis::incident::{Problem, Status};
+use super::timeline::{At, Timeline};
+use super::two_masters::{TWO_MASTERS_NS, second_master};
 use crate::frame::NodeKey;
-
-/// An SDO request this soon after another one to the same node that is still going on,
-/// or NMT commands this close that undo each other, come from a second master.
-pub(super) const TWO_MASTERS_NS: u64 = 25 * MS;
 
 /// Finds NMT commands of two masters.
 #[derive(Clone, Default)]
@@ -52,17 +48,4 @@ impl Masters {
             second_master(tl, node, "NMT commands that undo each other", at, text);
         }
     }
-}
-
-/// Commands from two masters at `at` (`what`), for `cause`: one warning per node.
-pub(super) fn second_master(tl: &mut Timeline, node: Option<NodeKey>, cause: &str, at: At, what: String) {
-    let i = tl.grouped(node, Problem::SecondMaster, 0, at.t);
-    let inc = &mut tl.incidents[i];
-    inc.status = Status::Warning;
-    inc.cause = match inc.cause.take() {
-        Some(c) if c.contains(cause) => Some(c),
-        Some(c) => Some(format!("{c}; {cause}")),
-        None => Some(cause.to_string()),
-    };
-    tl.step(i, at, what);
 }

@@ -13,8 +13,9 @@
 //! detectors concerned, one module per kind of incident (`heartbeat`, `boot`, `sdo`,
 //! `masters`, `drive`, `emcy`, `pdo`, `sync`, `bus`, `boot_config`), in a fixed order (the incidents'
 //! order depends on it). They share the clock, the node table and the incident book
-//! (`timeline`); the words of each kind are a table (`texts`), the report's order is
-//! `rank`'s.
+//! (`timeline`); each keeps its own state of each node, and what one detector tells
+//! another goes through the facade (no detector imports another). The words of each kind
+//! are a table (`texts`), the report's order is `rank`'s.
 
 mod boot;
 mod boot_config;
@@ -30,6 +31,7 @@ mod sdo;
 mod sync;
 mod texts;
 mod timeline;
+mod two_masters;
 
 use super::boot_story::{Boot, Expected};
 use super::events::{Event, What};
@@ -278,7 +280,7 @@ impl Diagnoser {
             tl.node(n).last_any = Some(at);
         }
         if matches!(&d.body, Body::Heartbeat(h) if h.request) {
-            tl.node(n).beat.guarded = true;
+            self.heartbeats.guarded(tl, n);
         }
         match &d.body {
             Body::Heartbeat(h) if !h.request => {
@@ -295,7 +297,7 @@ impl Diagnoser {
             }
             Body::Emcy(e) => {
                 tl.node(n).heard = true;
-                self.emcys.emcy(tl, n, e);
+                self.emcys.emcy(tl, n, e, self.drives.faults(n));
             }
             Body::Sdo(s) => self.sdos.frame(tl, n, s, frame.flags.has(Flags::TX)),
             Body::Pdo(p) => {
@@ -316,7 +318,7 @@ impl Diagnoser {
                     words.push((if p.transmit { 0x6041 } else { 0x6040 }, w));
                 }
                 for (index, w) in words {
-                    self.drives.word(tl, &mut self.emcys, n, index, w);
+                    self.drive_word(n, index, w);
                 }
             }
             _ => {
@@ -343,6 +345,14 @@ impl Diagnoser {
         }
         if let Some(s) = s {
             self.sdos.frame(&mut self.tl, n, s, frame.flags.has(Flags::TX));
+        }
+    }
+
+    /// A CiA 402 object value `w` of `n` at `index`: a fault it starts gets its cause from
+    /// a recent EMCY of the node.
+    fn drive_word(&mut self, n: NodeKey, index: u16, w: u16) {
+        if let Some(i) = self.drives.word(&mut self.tl, n, index, w) {
+            self.emcys.absorb(&mut self.tl, n, i);
         }
     }
 
@@ -379,6 +389,7 @@ impl Diagnoser {
             What::BootUp { rebooted, .. } => {
                 self.pdos.pause(n.iface, Some(n.node));
                 self.boots.boot_up(tl, n, at, *rebooted);
+                self.heartbeats.boot_up(tl, n);
             }
             _ => {}
         }
@@ -388,16 +399,16 @@ impl Diagnoser {
     pub fn transaction(&mut self, t: &Transaction) {
         self.tracker.transaction(t);
         self.take_events();
-        let tl = &mut self.tl;
         if t.outcome == Outcome::Ok && !t.data.is_empty() {
             let v = value(t);
             if (t.index, t.sub, t.direction) == (0x1000, 0, TransferDirection::Upload) {
-                tl.node(t.key()).cia402 = v & 0xFFFF == 402;
+                self.tl.node(t.key()).cia402 = v & 0xFFFF == 402;
             }
             if t.sub == 0 {
-                self.drives.word(tl, &mut self.emcys, t.key(), t.index, v as u16);
+                self.drive_word(t.key(), t.index, v as u16);
             }
         }
+        let tl = &mut self.tl;
         let detectors: [&mut dyn Detector; 4] = [
             &mut self.pdos,
             &mut self.heartbeats,

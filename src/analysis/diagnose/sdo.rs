@@ -5,9 +5,9 @@
 //! that overlap (reported as `second_master`).
 
 use super::detector::Detector;
-use super::masters;
 use super::texts::SdoAborts;
-use super::timeline::{At, MS, Timeline};
+use super::timeline::{At, MS, PerNode, Timeline};
+use super::two_masters::{TWO_MASTERS_NS, second_master};
 use crate::analysis::incident::{Problem, Status, TIMELINE_KEPT};
 use crate::decode::sdo::frame::{Chunk8, SdoFrame};
 use crate::frame::NodeKey;
@@ -53,7 +53,7 @@ struct Segment {
 
 /// The SDO requests and segments of one node.
 #[derive(Clone, Debug, Default)]
-pub(super) struct NodeSdo {
+struct NodeSdo {
     pending: Option<Request>,
     /// The last SDO request was a write.
     download: bool,
@@ -69,6 +69,17 @@ pub(super) struct NodeSdo {
     segment: Option<Segment>,
 }
 
+impl NodeSdo {
+    /// Request `r` to the node went unanswered.
+    fn unanswered(&mut self, r: Request) {
+        self.n_unanswered += 1;
+        self.answered_after = false;
+        if self.unanswered.len() < TIMELINE_KEPT {
+            self.unanswered.push(r);
+        }
+    }
+}
+
 /// Finds SDO incidents.
 #[derive(Clone, Default)]
 pub(super) struct Sdos {
@@ -76,6 +87,7 @@ pub(super) struct Sdos {
     deadline: Option<u64>,
     /// The abort codes and directions of each SDO incident.
     aborts: HashMap<usize, SdoAborts>,
+    nodes: PerNode<NodeSdo>,
 }
 
 impl Sdos {
@@ -89,21 +101,20 @@ impl Sdos {
     pub(super) fn frame(&mut self, tl: &mut Timeline, n: NodeKey, s: &SdoFrame, ours: bool) {
         let at = tl.at;
         if s.side == Side::Server {
-            let node = tl.node(n);
-            node.heard = true;
-            node.sdo.pending = None;
-            node.sdo.answered_after = true;
+            tl.node(n).heard = true;
+            let node = self.nodes.of(tl, n);
+            node.pending = None;
+            node.answered_after = true;
             if matches!(
                 s.command,
                 SdoCommand::DownloadSegmentResponse { .. } | SdoCommand::UploadSegmentResponse { .. }
-            ) && let Some(seg) = &mut node.sdo.segment
+            ) && let Some(seg) = &mut node.segment
             {
                 seg.answered.get_or_insert(at);
             }
             if let SdoCommand::Abort { index, sub, code } = s.command {
-                let node = tl.node(n);
-                node.sdo.segmenting = None;
-                node.sdo.segment = None;
+                node.segmenting = None;
+                node.segment = None;
                 self.refused(tl, n, index, sub, code);
             } else if s.problems.iter().any(|p| p == "outside any transfer seen") {
                 garbled(tl, n, format!("{} frame outside any transfer", s.command.cs_name()));
@@ -112,15 +123,17 @@ impl Sdos {
         }
         match s.command {
             SdoCommand::DownloadSegment { toggle, .. } => {
-                tl.node(n).sdo.segmenting = Some(at);
-                segment_request(tl, n, toggle, Some(s.raw));
+                let node = self.nodes.of(tl, n);
+                node.segmenting = Some(at);
+                segment_request(tl, node, n, toggle, Some(s.raw));
             }
             SdoCommand::UploadSegment { toggle } => {
-                tl.node(n).sdo.segmenting = Some(at);
-                segment_request(tl, n, toggle, None);
+                let node = self.nodes.of(tl, n);
+                node.segmenting = Some(at);
+                segment_request(tl, node, n, toggle, None);
             }
             // A new transfer (or its end) starts the toggle bit over.
-            _ if s.command.object().is_some() => tl.node(n).sdo.segment = None,
+            _ if s.command.object().is_some() => self.nodes.of(tl, n).segment = None,
             _ => {}
         }
         // Only initiate frames start a request (segments carry no object themselves).
@@ -128,16 +141,16 @@ impl Sdos {
             && s.command.cs_name() != "abort"
         {
             // The other client's request may well be answered: not counted as unanswered.
-            let overlap = overlapping_request(tl, n, index, sub);
-            let node = &mut tl.node(n).sdo;
+            let node = self.nodes.of(tl, n);
+            let overlap = overlapping_request(tl, node, n, index, sub);
             node.download = matches!(s.command.cs_name(), "initiate_download" | "block_download");
             node.ours = ours;
             if let Some(old) = node.pending.take()
                 && !overlap
             {
-                unanswered(tl, n, Request { replaced: true, ..old });
+                node.unanswered(Request { replaced: true, ..old });
             }
-            tl.node(n).sdo.pending = Some(Request {
+            node.pending = Some(Request {
                 at,
                 replaced: false,
                 index,
@@ -152,7 +165,8 @@ impl Sdos {
     fn refused(&mut self, tl: &mut Timeline, n: NodeKey, index: u16, sub: u8, code: u32) {
         let at = tl.at;
         let text = abort_text(code);
-        let (write, ours) = (tl.node(n).sdo.download, tl.node(n).sdo.ours);
+        let node = self.nodes.of(tl, n);
+        let (write, ours) = (node.download, node.ours);
         // A read the capturing host sent (cotui's own, or a TX-marked line of a log) of an
         // entry the node does not have: worth knowing, not a problem of the node.
         let absent = ours && !write && abort_class(code) == AbortClass::NotPresent;
@@ -216,19 +230,20 @@ impl Sdos {
 
     /// Requests unanswered for longer than the SDO timeout at `now`.
     pub(super) fn timeouts(&mut self, tl: &mut Timeline, now: u64) {
-        let late: Vec<(NodeKey, Request)> = tl
+        let late: Vec<(NodeKey, Request)> = self
             .nodes
             .iter()
-            .filter_map(|(n, d)| d.sdo.pending.filter(|r| r.at.t + SDO_TIMEOUT_NS < now).map(|r| (*n, r)))
+            .filter_map(|(n, d)| d.pending.filter(|r| r.at.t + SDO_TIMEOUT_NS < now).map(|r| (*n, r)))
             .collect();
         for (n, r) in late {
-            tl.node(n).sdo.pending = None;
-            unanswered(tl, n, r);
+            let node = self.nodes.of(tl, n);
+            node.pending = None;
+            node.unanswered(r);
         }
-        self.deadline = tl
+        self.deadline = self
             .nodes
-            .values()
-            .filter_map(|d| d.sdo.pending.map(|r| r.at.t + SDO_TIMEOUT_NS))
+            .iter()
+            .filter_map(|(_, d)| d.pending.map(|r| r.at.t + SDO_TIMEOUT_NS))
             .min();
     }
 }
@@ -242,7 +257,7 @@ impl Detector for Sdos {
     }
 
     fn transaction(&mut self, tl: &mut Timeline, t: &Transaction) {
-        tl.node(t.key()).sdo.segmenting = None;
+        self.nodes.of(tl, t.key()).segmenting = None;
         if t.outcome != Outcome::Ok || t.data.is_empty() {
             return;
         }
@@ -261,12 +276,12 @@ impl Detector for Sdos {
     }
 
     fn end_node(&mut self, tl: &mut Timeline, n: NodeKey, end: At) {
-        let node = &tl.nodes[&n];
-        if node.sdo.n_unanswered == 0 {
+        let Some(node) = self.nodes.get(n).filter(|d| d.n_unanswered > 0) else {
             return;
-        }
-        let (heard, answered_after, count) = (node.heard, node.sdo.answered_after, node.sdo.n_unanswered);
-        let requests = node.sdo.unanswered.clone();
+        };
+        let heard = tl.nodes[&n].heard;
+        let (answered_after, count) = (node.answered_after, node.n_unanswered);
+        let requests = node.unanswered.clone();
         let problem = if heard { Problem::SdoTimeout } else { Problem::Missing };
         let i = tl.grouped(Some(n), problem, 0, requests[0].at.t);
         tl.incidents[i].count = count;
@@ -298,23 +313,12 @@ fn garbled(tl: &mut Timeline, n: NodeKey, what: String) {
     tl.step(i, at, format!("Node sent an SDO {what}"));
 }
 
-/// Request `r` to `n` went unanswered.
-fn unanswered(tl: &mut Timeline, n: NodeKey, r: Request) {
-    let node = &mut tl.node(n).sdo;
-    node.n_unanswered += 1;
-    node.answered_after = false;
-    if node.unanswered.len() < TIMELINE_KEPT {
-        node.unanswered.push(r);
-    }
-}
-
 /// An SDO request for `index:sub` to node `n` while another one is going on (sent just
 /// before and not answered, or a segmented transfer in mid-flow): two clients. True when
-/// it is one.
-fn overlapping_request(tl: &mut Timeline, n: NodeKey, index: u16, sub: u8) -> bool {
+/// it is one. `node` is `n`'s state.
+fn overlapping_request(tl: &mut Timeline, node: &mut NodeSdo, n: NodeKey, index: u16, sub: u8) -> bool {
     let at = tl.at;
-    let node = &mut tl.node(n).sdo;
-    let young = |a: At| at.t.saturating_sub(a.t) < masters::TWO_MASTERS_NS;
+    let young = |a: At| at.t.saturating_sub(a.t) < TWO_MASTERS_NS;
     let what = match (node.pending, node.segmenting) {
         (Some(r), _) if young(r.at) && (r.index, r.sub) != (index, sub) => format!(
             "Request for 0x{index:04X}:{sub:02X} while the request for 0x{:04X}:{:02X} (#{}) still waits for its answer",
@@ -329,20 +333,20 @@ fn overlapping_request(tl: &mut Timeline, n: NodeKey, index: u16, sub: u8) -> bo
         _ => return false,
     };
     node.segmenting = None;
-    masters::second_master(tl, Some(n), "SDO requests to the node overlap", at, what);
+    second_master(tl, Some(n), "SDO requests to the node overlap", at, what);
     true
 }
 
 /// A segment request with toggle bit `toggle` to node `n`. One client alternates the bit
-/// and waits for each answer; the same bit again within [`masters::TWO_MASTERS_NS`] of
+/// and waits for each answer; the same bit again within [`TWO_MASTERS_NS`] of
 /// the request before (still unanswered) or of its answer is a second client's transfer
 /// interleaving. A retry after a timeout repeats the bit too, but much later; the same
 /// download segment again (same bytes) is a retransmission or a frame captured twice; and
-/// equal times (a log without timestamps) say nothing.
-fn segment_request(tl: &mut Timeline, n: NodeKey, toggle: bool, data: Option<Chunk8>) {
+/// equal times (a log without timestamps) say nothing. `node` is `n`'s state.
+fn segment_request(tl: &mut Timeline, node: &mut NodeSdo, n: NodeKey, toggle: bool, data: Option<Chunk8>) {
     let at = tl.at;
-    let young = |a: At| at.t > a.t && at.t - a.t < masters::TWO_MASTERS_NS;
-    let Some(prev) = tl.node(n).sdo.segment.replace(Segment {
+    let young = |a: At| at.t > a.t && at.t - a.t < TWO_MASTERS_NS;
+    let Some(prev) = node.segment.replace(Segment {
         at,
         toggle,
         data,
@@ -365,5 +369,5 @@ fn segment_request(tl: &mut Timeline, n: NodeKey, toggle: bool, data: Option<Chu
         ),
         _ => return,
     };
-    masters::second_master(tl, Some(n), "SDO segments of two clients interleave", at, what);
+    second_master(tl, Some(n), "SDO segments of two clients interleave", at, what);
 }

@@ -1,12 +1,8 @@
 //! What every detector shares: the capture clock (frame number and time), the node table
-//! (each node's facts several detectors read, and each detector's own state of the node)
-//! and the incident book (incidents opened, grouped per key, with their timelines).
+//! (each node's facts several detectors read) and the incident book (incidents opened,
+//! grouped per key, with their timelines). Each detector keeps its own state of a node in
+//! a [`PerNode`] table; the timeline knows no detector.
 
-use super::boot::NodeBoot;
-use super::drive::NodeDrive;
-use super::emcy::NodeEmcy;
-use super::heartbeat::NodeBeat;
-use super::sdo::NodeSdo;
 use crate::analysis::incident::{Incident, Problem, Status};
 use crate::decode::heartbeat::NmtState;
 use crate::frame::NodeKey;
@@ -37,16 +33,29 @@ pub(super) struct Node {
     pub(super) cia402: bool,
     /// The last EMCY error code.
     pub(super) last_emcy: Option<u16>,
-    /// Heartbeat state ([`super::heartbeat`]).
-    pub(super) beat: NodeBeat,
-    /// Boot-ups and NMT commands ([`super::boot`]).
-    pub(super) boot: NodeBoot,
-    /// SDO requests and segments ([`super::sdo`]).
-    pub(super) sdo: NodeSdo,
-    /// CiA 402 axes ([`super::drive`]).
-    pub(super) drive: NodeDrive,
-    /// EMCY not given to an incident yet ([`super::emcy`]).
-    pub(super) emcy: NodeEmcy,
+}
+
+/// A detector's own state of each node, made on first use. Making it puts the node in the
+/// timeline's table too: the end of the capture goes through that table.
+#[derive(Clone, Debug, Default)]
+pub(super) struct PerNode<T>(BTreeMap<NodeKey, T>);
+
+impl<T: Default> PerNode<T> {
+    /// Node `n`'s state, made on first use (and the node in `tl`'s table).
+    pub(super) fn of(&mut self, tl: &mut Timeline, n: NodeKey) -> &mut T {
+        tl.node(n);
+        self.0.entry(n).or_default()
+    }
+
+    /// Node `n`'s state, if it was made.
+    pub(super) fn get(&self, n: NodeKey) -> Option<&T> {
+        self.0.get(&n)
+    }
+
+    /// The nodes with a state, in key order.
+    pub(super) fn iter(&self) -> impl Iterator<Item = (&NodeKey, &T)> {
+        self.0.iter()
+    }
 }
 
 /// The clock, the nodes and the incidents of one capture.
