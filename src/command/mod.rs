@@ -28,6 +28,7 @@ pub mod transmit_list;
 pub mod transmit_run;
 pub mod value;
 pub mod watch;
+pub mod watch_poll;
 pub mod watch_table;
 pub mod words;
 pub mod write;

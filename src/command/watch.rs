@@ -2,28 +2,25 @@
 //! text|csv|jsonl]`: CANopen Magic's watch list on the command line. Objects are read by
 //! SDO upload ([`super::sdo`]) every MS ms, the nodes of a round in parallel and the objects
 //! of one node one after the other, so polls never overlap per node; a round still running
-//! when the next is due makes that one skipped (never a burst). A timeout or an abort shows
+//! when the next is due makes that one skipped (never a burst): the round and its period
+//! are [`super::watch_poll`]'s, which the TUI's Watch pane runs too. A timeout or an abort shows
 //! in that round's row and the rest goes on; an object the node lacks (abort 0x06020000, or
 //! 0x06090011 for a sub) is shown as absent once and not polled again. Rows are written as
 //! they come ([`super::watch_table`] for the three formats); the report sums each object up.
 
 use super::error::{CommandError, ParseError};
 use super::grammar::DEFAULT_TIMEOUT_MS;
-use super::sdo::{first_upload_frame, upload};
+use super::sdo::first_upload_frame;
 use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
-use super::value::decode;
-use super::watch_table::{Sample, WatchFormat, Watched, csv_header, csv_row, jsonl_rows, text_table};
+use super::watch_poll::{NodeLocks, Schedule, Target, round};
+use super::watch_table::{WatchFormat, Watched, csv_header, csv_row, jsonl_rows, text_table};
 use super::words::{TypedWords, ms_arg, node_arg};
-use crate::bus::Bus;
 use crate::od::bind::Bindings;
 use crate::od::resolve_object;
 use serde::Serialize;
 use std::time::Duration;
-use tokio::task::JoinSet;
-use tokio::time::{Instant, MissedTickBehavior};
+use tokio::time::Instant;
 
-/// Abort codes that say the object is not on the node: no object, no sub-index.
-const ABSENT: [u32; 2] = [0x0602_0000, 0x0609_0011];
 /// The default poll period, ms.
 pub const DEFAULT_EVERY_MS: u64 = 500;
 
@@ -158,7 +155,7 @@ impl WatchReport {
 
 impl Watch {
     /// The objects resolved through the node dictionaries.
-    fn resolve(&self, bindings: &Bindings) -> Result<Vec<Watched>, CommandError> {
+    pub fn resolve(&self, bindings: &Bindings) -> Result<Vec<Watched>, CommandError> {
         self.objects
             .iter()
             .map(|(node, text)| {
@@ -171,54 +168,12 @@ impl Watch {
     }
 }
 
-/// What a failed poll shows.
-fn sample_of_error(e: &CommandError) -> Sample {
-    match e {
-        CommandError::Abort {
-            code, by_server: true, ..
-        } if ABSENT.contains(code) => Sample::Absent(format!("abort 0x{code:08X} {}", crate::sdo::abort_text(*code))),
-        CommandError::Abort { code, .. } => Sample::Failed(format!("abort 0x{code:08X}")),
-        CommandError::Timeout(_) => Sample::Failed("timeout".into()),
-        other => Sample::Failed(other.to_string()),
-    }
-}
-
-/// One round: the nodes in parallel, each node's objects in turn (none absent before).
-async fn round(bus: &Bus, objects: &[Watched], bindings: &Bindings, timeout_ms: u64) -> Vec<Sample> {
-    let mut nodes: Vec<u8> = objects.iter().map(|o| o.node).collect();
-    nodes.sort_unstable();
-    nodes.dedup();
-    let mut set = JoinSet::new();
-    for node in nodes {
-        let polls: Vec<(usize, u16, u8, Option<crate::od::DataType>)> = objects
-            .iter()
-            .enumerate()
-            .filter(|(_, o)| o.node == node && !o.absent)
-            .map(|(k, o)| {
-                let ty = bindings.dictionary(node).object(o.index, o.sub).map(|i| i.data_type);
-                (k, o.index, o.sub, ty)
-            })
-            .collect();
-        let bus = bus.clone();
-        set.spawn(async move {
-            let mut out = Vec::with_capacity(polls.len());
-            for (k, index, sub, ty) in polls {
-                let s = match upload(&bus, node, index, sub, false, timeout_ms).await {
-                    Ok(data) => Sample::Value(decode(&data, ty)),
-                    Err(e) => sample_of_error(&e),
-                };
-                out.push((k, s));
-            }
-            out
-        });
-    }
-    let mut samples = vec![Sample::Skipped; objects.len()];
-    while let Some(done) = set.join_next().await {
-        for (k, s) in done.unwrap_or_default() {
-            samples[k] = s;
-        }
-    }
-    samples
+/// What a round reads of `objects`: each one not found absent before (None: skipped).
+fn targets_of(objects: &[Watched], bindings: &Bindings) -> Vec<Option<Target>> {
+    objects
+        .iter()
+        .map(|o| (!o.absent).then(|| Target::of(o, bindings.dictionary(o.node))))
+        .collect()
 }
 
 impl Spec for Watch {
@@ -260,26 +215,21 @@ impl Spec for Watch {
             }
         };
         tokio::pin!(until);
-        let mut tick = tokio::time::interval(Duration::from_millis(self.every_ms));
-        tick.set_missed_tick_behavior(MissedTickBehavior::Skip);
-        let (mut rounds, mut skipped) = (0u64, 0u64);
-        let mut last_tick: Option<Instant> = None;
+        let mut schedule = Schedule::every(self.every_ms);
+        let locks = NodeLocks::default();
+        let mut rounds = 0u64;
         loop {
-            let at = tokio::select! {
+            tokio::select! {
                 _ = &mut ctx.stop => break,
                 _ = &mut until => break,
-                at = tick.tick() => at,
+                _ = schedule.next() => {}
             };
-            if let Some(prev) = last_tick {
-                let periods = (at - prev).as_millis() as u64 / self.every_ms;
-                skipped += periods.saturating_sub(1);
-            }
-            last_tick = Some(at);
             let t_s = bus.now_ns().saturating_sub(start_ns) as f64 / 1e9;
+            let targets = targets_of(&objects, ctx.bindings);
             let samples = tokio::select! {
                 _ = &mut ctx.stop => break,
                 _ = &mut until => break,
-                s = round(bus, &objects, ctx.bindings, self.timeout_ms) => s,
+                s = round(bus, &targets, self.timeout_ms, &locks) => s,
             };
             rounds += 1;
             for (o, s) in objects.iter_mut().zip(&samples) {
@@ -298,7 +248,7 @@ impl Spec for Watch {
             ok: true,
             every_ms: self.every_ms,
             rounds,
-            skipped,
+            skipped: schedule.skipped,
             objects,
         };
         // Machine-readable rows are the output; the summary is for text (and --json).

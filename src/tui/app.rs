@@ -18,7 +18,7 @@ use super::messages::Level;
 use super::palette::{self, Planned, commander_words};
 use super::panes::{Ctx, Pane, Selected};
 use super::prompt::{Edit, PromptKind};
-use super::{read_all, record, stop, transmit};
+use super::{read_all, record, stop, transmit, watch};
 use crate::analysis::trace::Trace;
 use crate::od::bind::Bindings;
 use crossterm::event::{KeyCode, KeyEvent, MouseEvent};
@@ -218,12 +218,19 @@ impl App {
                 Event::Act(a) => self.act(a),
                 Event::Replay(a) => self.capture.replay_key(a, &mut q),
                 Event::StopAll(nodes, options) => {
+                    watch::stop_all(self.screen.watch_mut(), &mut q);
                     let pane = self.screen.transmit_mut();
                     transmit::disable_all(&self.capture, pane, &self.bindings, &mut q);
                     let objects = self.screen.objects_mut();
                     stop::stop_all(&self.capture, objects, &nodes, options, &mut q);
                 }
                 Event::Quit => self.request_quit(),
+                Event::Watch(ask) => {
+                    let (pane, objects) = self.screen.watch_and_objects();
+                    if let Some(text) = watch::ask(&self.capture, pane, objects, ask, &mut q) {
+                        self.screen.prompt_mut().open(PromptKind::Palette, &text);
+                    }
+                }
                 Event::Transmit(ask) => {
                     let pane = self.screen.transmit_mut();
                     if let Some((text, cursor)) = transmit::ask(&self.capture, pane, &self.bindings, ask, &mut q) {
@@ -509,7 +516,9 @@ impl App {
     pub fn run_command(&mut self, line: &str) {
         self.dirty = true;
         let mut q = Queue::default();
-        if commands::run(line, &mut self.capture, &mut self.screen, &mut q) == Ran::Commander {
+        if line.split_whitespace().next() == Some("watch") {
+            watch::command(&self.capture, self.screen.watch_mut(), &self.bindings, line, &mut q);
+        } else if commands::run(line, &mut self.capture, &mut self.screen, &mut q) == Ran::Commander {
             self.commander(line);
         }
         self.route(q);

@@ -155,6 +155,11 @@ pub(crate) fn run(line: &str, capture: &mut Capture, screen: &mut Screen, q: &mu
                 .map_err(CommandError::from)
                 .inspect(|text| screen.log(Level::Info, text))
         }
+        "export" if rest.split_whitespace().next() == Some("watch") => {
+            super::watch::export(rest.trim_start_matches("watch"), screen.panes().watch())
+                .map_err(CommandError::from)
+                .inspect(|text| screen.log(Level::Info, text))
+        }
         "export" => export::command(rest, capture.trace(), screen.view())
             .map_err(CommandError::from)
             .inspect(|text| screen.log(Level::Info, text)),

@@ -50,6 +50,19 @@ pub(crate) enum Event {
     Quit,
     /// What the Transmit pane asks.
     Transmit(TransmitAsk),
+    /// What the Watch pane asks.
+    Watch(WatchAsk),
+}
+
+/// What the Watch pane asks of the application (row numbers from 0).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum WatchAsk {
+    /// Open the palette for a `watch` line (of the selected row's node).
+    Add(Option<u8>),
+    /// Stop watching this row's object.
+    Delete(usize),
+    /// Show this row's object in the Objects pane.
+    Open(usize),
 }
 
 /// What the Transmit pane asks of the application (row numbers from 0).

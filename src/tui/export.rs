@@ -39,6 +39,12 @@ pub enum ExportError {
     /// `export plot` with no signal in the Plot pane.
     #[error("export plot: no signal is plotted")]
     NothingPlotted,
+    /// `export watch` without a file.
+    #[error("export: usage `export watch FILE.csv [--force]`")]
+    WatchUsage,
+    /// `export watch` with nothing watched.
+    #[error("export watch: nothing is watched (`watch NODE OBJ...` first)")]
+    NothingWatched,
     /// The export file could not be written.
     #[error("export: {file}: {source}{hint}", hint = overwrite_hint(source))]
     Write { file: String, source: std::io::Error },

@@ -7,6 +7,7 @@
 use super::frame_feed::{BACKLOG_FRAMES, FrameFeed};
 use super::messages::Level;
 use super::source::{BusNote, Feed};
+use super::watch_board::SharedBoard;
 use crate::bus::{Bus, BusError, BusState, Event, StateChange};
 use crate::command::cyclic::{self, Progress};
 use crate::command::stop::{Commanded, StopOptions, stop_nodes};
@@ -45,6 +46,9 @@ pub enum Request {
         entries: Vec<Resolved>,
         progress: ListProgress,
     },
+    /// The Watch pane's list changed: stop its polls, poll each group of `board` still
+    /// polling something (what they read goes on the board).
+    Watch { board: SharedBoard },
 }
 
 /// A handle to send requests to the live task.
@@ -345,6 +349,8 @@ struct Jobs {
     stopped_tx: UnboundedSender<Vec<u8>>,
     /// The Transmit pane's list being sent (one at a time: a new list replaces it).
     transmit: Option<AbortHandle>,
+    /// The Watch pane's poll groups (a new list replaces them).
+    watch: Vec<AbortHandle>,
 }
 
 impl Jobs {
@@ -355,6 +361,7 @@ impl Jobs {
             commanded: Commanded::default(),
             stopped_tx,
             transmit: None,
+            watch: Vec::new(),
         }
     }
 
@@ -418,6 +425,10 @@ impl Jobs {
                 });
                 self.transmit = Some(task.abort_handle());
             }
+            Request::Watch { board } => {
+                self.watch.drain(..).for_each(|t| t.abort());
+                self.watch = super::watch_run::start(&bus, &board, bindings);
+            }
             Request::ListJobs => {
                 let text = if self.running.is_empty() {
                     "jobs: nothing running".to_string()
@@ -472,6 +483,11 @@ impl Jobs {
             t.abort();
             cancelled.push("the Transmit pane's list".to_string());
         }
+        let polling = self.watch.iter().any(|t| !t.is_finished());
+        self.watch.drain(..).for_each(|t| t.abort());
+        if polling {
+            cancelled.push("the Watch pane's polls".to_string());
+        }
         self.running.sort_by_key(|j| j.cyclic.is_none());
         cancelled.extend(
             self.running
@@ -489,6 +505,7 @@ impl Jobs {
             Request::Run { line, .. } => format!("{line}: not sent: {why}"),
             Request::ListJobs | Request::StopJob(_) => format!("jobs: the bus is unavailable ({why})"),
             Request::Transmit { .. } => format!("transmit: not sent: {why}"),
+            Request::Watch { .. } => format!("watch: nothing polled: {why}"),
             Request::Sim { line, .. } => not_simulated(&line),
             Request::StopAll { mut nodes, .. } => {
                 let cancelled = self.cancel_all();
@@ -729,6 +746,99 @@ mod tests {
         tokio::time::sleep(Duration::from_millis(100)).await;
         while let Some(Ok(f)) = sub.try_recv() {
             assert!(f.id != 0x123, "a list frame after the stop: {f:?}");
+        }
+    }
+}
+
+#[cfg(test)]
+mod watch_tests {
+    use super::*;
+    use crate::command::watch_table::Watched;
+    use crate::tui::watch_board::{SharedBoard, lock};
+
+    /// The object an upload request of ours to `node` asks for, if `f` is one.
+    fn upload_of(f: &Frame, node: u8) -> Option<(u16, u8)> {
+        let d = &f.data;
+        (f.id == crate::cob::sdo_request(node) && f.direction() == crate::frame::Direction::Tx && d[0] == 0x40)
+            .then(|| (u16::from_le_bytes([d[1], d[2]]), d[3]))
+    }
+
+    #[tokio::test(start_paused = true)]
+    async fn the_watch_pane_polls_on_its_period_marks_the_absent_and_times_out_and_stop_all_cancels_it() {
+        let bus = crate::sim::demo::start(false);
+        let bindings = crate::cli::bind::bindings_on(crate::connect::DEMO, &[], &[]).unwrap();
+        let (tx, rx) = sync_channel(64);
+        let (stopped_tx, _stopped) = unbounded_channel();
+        let mut jobs = Jobs::new(stopped_tx);
+        let mut sub = bus.subscribe();
+        let board = SharedBoard::default();
+        let d2 = bindings.dictionary(2);
+        let objects = vec![
+            Watched::new(d2, 2, 0x6041, 0),
+            Watched::new(d2, 2, 0x2FFF, 0),
+            Watched::new(bindings.dictionary(9), 9, 0x1000, 0),
+        ];
+        lock(&board).add(objects, 50, 20);
+        jobs.start(&bus, Request::Watch { board: board.clone() }, &bindings, &tx);
+        // 500 ms of bus time from our first request, by the frames' own timestamps.
+        let (mut first, mut statusword, mut absent) = (None, 0, 0);
+        loop {
+            let f = sub.recv().await.unwrap();
+            let t0 = *first.get_or_insert(f.ts_ns);
+            if f.ts_ns - t0 >= 500_000_000 {
+                break;
+            }
+            statusword += (upload_of(&f, 2) == Some((0x6041, 0))) as u32;
+            absent += (upload_of(&f, 2) == Some((0x2FFF, 0))) as u32;
+        }
+        assert_eq!(statusword, 10, "one read every 50 ms");
+        assert_eq!(absent, 1, "an object the node lacks is asked once");
+        {
+            let b = lock(&board);
+            let [sw, gone, silent] = &b.rows[..] else {
+                panic!("{:?}", b.rows)
+            };
+            assert!(sw.watched.reads >= 10 && sw.watched.last_text.is_some(), "{sw:?}");
+            assert!(sw.at_ns.is_some());
+            assert!(gone.watched.absent, "{gone:?}");
+            assert!(
+                gone.watched
+                    .last_error
+                    .as_deref()
+                    .unwrap_or("")
+                    .starts_with("abort 0x06020000"),
+                "{gone:?}"
+            );
+            assert_eq!(silent.watched.last_error.as_deref(), Some("timeout"));
+            assert!(silent.watched.failures >= 5, "the timeouts go on: {silent:?}");
+        }
+        let options = StopOptions {
+            timeout_ms: 50,
+            ramp_ms: 10,
+        };
+        jobs.start(
+            &bus,
+            Request::StopAll {
+                nodes: BTreeSet::new(),
+                options,
+            },
+            &bindings,
+            &tx,
+        );
+        let report = loop {
+            if let Ok(Feed::Stopped(_, text, _)) = rx.try_recv() {
+                break text;
+            }
+            tokio::time::sleep(Duration::from_millis(5)).await;
+        };
+        assert!(report.contains("cancelled: the Watch pane's polls"), "{report}");
+        while sub.try_recv().is_some() {}
+        tokio::time::sleep(Duration::from_millis(300)).await;
+        while let Some(Ok(f)) = sub.try_recv() {
+            assert!(
+                upload_of(&f, 2).is_none() && upload_of(&f, 9).is_none(),
+                "a poll after the stop: {f:?}"
+            );
         }
     }
 }

@@ -29,3 +29,6 @@ pub mod term;
 mod transmit;
 pub mod trigger;
 pub mod ui;
+mod watch;
+pub mod watch_board;
+mod watch_run;

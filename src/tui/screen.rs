@@ -101,6 +101,16 @@ impl Screen {
         self.panes.transmit_mut()
     }
 
+    /// The Watch pane, to change.
+    pub(crate) fn watch_mut(&mut self) -> &mut super::panes::watch::WatchPane {
+        self.panes.watch_mut()
+    }
+
+    /// The Watch pane and the Objects pane, to change both (enter on a watched object).
+    pub(crate) fn watch_and_objects(&mut self) -> (&mut super::panes::watch::WatchPane, &mut ObjectsPane) {
+        self.panes.watch_and_objects()
+    }
+
     /// The Objects pane, to change.
     pub(crate) fn objects_mut(&mut self) -> &mut ObjectsPane {
         self.panes.objects_mut()
@@ -678,8 +688,12 @@ impl Screen {
             Action::PaneObjects => self.focus = Pane::Objects,
             Action::PaneProblems => self.focus = Pane::Problems,
             Action::PaneTransmit => self.focus = Pane::Transmit,
+            Action::PaneWatch => self.focus = Pane::Watch,
             Action::TransmitAdd | Action::TransmitDelete => {
-                self.message = Some(format!("{}: only in the Transmit pane (9)", a.name().replace('_', " ")))
+                self.message = Some(format!(
+                    "{}: only in the Transmit (9) and Watch (0) panes",
+                    a.name().replace("transmit_", "")
+                ))
             }
             Action::Copy => self.message = Some("copy: only in the message log (m)".into()),
             Action::EditObject | Action::ReadAll => {
@@ -788,6 +802,7 @@ impl Screen {
             Pane::Pdo,
             Pane::Problems,
             Pane::Transmit,
+            Pane::Watch,
         ] {
             self.panes.get_mut(p).fit(height, &ctx);
         }

@@ -40,14 +40,20 @@ pub fn draw(f: &mut Frame, app: &mut App) {
     } else {
         (main, None)
     };
-    // Each tab padded by a space both sides; on a narrow screen (80 columns) one space apart.
-    let padded: usize = Pane::ALL.iter().map(|p| p.title().chars().count() + 4).sum();
-    let pad = if padded > usize::from(tabs.width) { "" } else { " " };
+    // Each tab padded by a space both sides; on a narrow screen (80 columns) one space apart,
+    // and narrower still the long titles shortened. Keys 1 to 9, then 0.
+    let width = |short: bool| -> usize { Pane::ALL.iter().map(|p| p.title_fit(short).chars().count() + 3).sum() };
+    let pad = if width(false) + Pane::ALL.len() > usize::from(tabs.width) {
+        ""
+    } else {
+        " "
+    };
+    let short = width(false) > usize::from(tabs.width);
     let spans: Vec<Span> = Pane::ALL
         .iter()
         .enumerate()
         .map(|(i, p)| {
-            let s = format!(" {} {}{pad}", i + 1, p.title());
+            let s = format!(" {} {}{pad}", (i + 1) % 10, p.title_fit(short));
             if *p == app.focus() {
                 Span::styled(s, Style::default().bg(Color::White).fg(Color::Black))
             } else {

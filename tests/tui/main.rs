@@ -19,3 +19,4 @@ mod transmit_demo;
 mod tui_cli;
 mod tui_tmux;
 mod two_buses;
+mod watch_demo;

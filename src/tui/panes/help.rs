@@ -40,6 +40,14 @@ pub const PALETTE_SYNTAX: &[(&str, &str)] = &[
         "The plotted signals as CSV (visible window; --all: every point)",
     ),
     (
+        "export watch FILE.csv [--force]",
+        "The Watch pane's rounds as CSV (as cotui watch --format csv)",
+    ),
+    (
+        "watch NODE OBJ... [--every DUR] [--timeout DUR] | off",
+        "Live/demo: poll objects by SDO in the Watch pane (0); off: stop every poll",
+    ),
+    (
         "record start FILE [--force|--append]",
         "Live/demo: record the frames received to a candump -l log",
     ),

@@ -19,6 +19,7 @@ pub mod status;
 pub mod trace;
 pub mod trace_time;
 pub mod transmit;
+pub mod watch;
 
 use crate::analysis::trace::Trace;
 use crate::decode::Kind;
@@ -41,11 +42,12 @@ pub enum Pane {
     Pdo,
     Problems,
     Transmit,
+    Watch,
 }
 
 impl Pane {
     /// Every pane in tab order.
-    pub const ALL: [Pane; 9] = [
+    pub const ALL: [Pane; 10] = [
         Pane::Trace,
         Pane::Nodes,
         Pane::Sdo,
@@ -55,7 +57,17 @@ impl Pane {
         Pane::Pdo,
         Pane::Problems,
         Pane::Transmit,
+        Pane::Watch,
     ];
+    /// Tab title, `short` on a narrow tab bar (`Probl`, `Trans`).
+    pub fn title_fit(self, short: bool) -> &'static str {
+        match self {
+            Pane::Problems if short => "Probl",
+            Pane::Transmit if short => "Trans",
+            p => p.title(),
+        }
+    }
+
     /// Tab title.
     pub fn title(self) -> &'static str {
         match self {
@@ -68,6 +80,7 @@ impl Pane {
             Pane::Pdo => "PDO",
             Pane::Problems => "Problems",
             Pane::Transmit => "Transmit",
+            Pane::Watch => "Watch",
         }
     }
 }
@@ -93,6 +106,8 @@ pub struct Panes {
     problems: problems::ProblemsPane,
     /// One row per entry of the transmit list.
     transmit: transmit::TransmitPane,
+    /// One row per watched object.
+    watch: watch::WatchPane,
 }
 
 impl Panes {
@@ -151,6 +166,21 @@ impl Panes {
         &mut self.transmit
     }
 
+    /// The Watch pane.
+    pub fn watch(&self) -> &watch::WatchPane {
+        &self.watch
+    }
+
+    /// The Watch pane, to change (its board, what is polled).
+    pub(crate) fn watch_mut(&mut self) -> &mut watch::WatchPane {
+        &mut self.watch
+    }
+
+    /// The Watch pane and the Objects pane, to change both.
+    pub(crate) fn watch_and_objects(&mut self) -> (&mut watch::WatchPane, &mut objects::ObjectsPane) {
+        (&mut self.watch, &mut self.objects)
+    }
+
     /// The Plot pane.
     pub fn plot(&self) -> &plot::PlotPane {
         &self.plot
@@ -175,6 +205,7 @@ impl Panes {
             Pane::Pdo => &self.pdo,
             Pane::Problems => &self.problems,
             Pane::Transmit => &self.transmit,
+            Pane::Watch => &self.watch,
         }
     }
 
@@ -190,6 +221,7 @@ impl Panes {
             Pane::Pdo => &mut self.pdo,
             Pane::Problems => &mut self.problems,
             Pane::Transmit => &mut self.transmit,
+            Pane::Watch => &mut self.watch,
         }
     }
 }

@@ -286,6 +286,11 @@ impl ObjectsPane {
         }
     }
 
+    /// Shows `node` (until the Nodes pane's selection changes), as `[`/`]` would pick it.
+    pub(crate) fn pick(&mut self, node: NodeKey) {
+        self.picked = Some(node);
+    }
+
     /// Sets the find text (as typed: the rows follow each key).
     pub fn set_query(&mut self, text: &str) {
         self.query = text.trim().to_lowercase();

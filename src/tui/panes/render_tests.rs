@@ -688,7 +688,8 @@ fn problems_pane_lists_the_incidents_and_opens_one_at_80x24() {
     assert_eq!(a.focus(), Pane::Problems);
     let s = screen(&mut a, 80, 24);
     // Node 2 refused the read of 0x6041:00 and sent an EMCY; nothing recovered.
-    assert!(s.contains("8 Problems"), "{s}");
+    // 80 columns: the long tab titles are shortened.
+    assert!(s.contains("8 Probl 9 Trans 0 Watch"), "{s}");
     assert!(s.contains("Problems (2 open, 0 recovered, 0 warnings)"), "{s}");
     assert!(s.contains("OPEN      Node 2"), "{s}");
     insta::assert_snapshot!("problems_80x24_list", s);
