@@ -3,7 +3,7 @@
 //! machine through a socketcand server ([`socketcand`]), anything else a SocketCAN
 //! interface. The one place that knows them all, so the bus layer does not depend on the simulator.
 
-use crate::bus::{Bus, BusError, socketcan, socketcand};
+use crate::bus::{Bus, BusError, bitrate, socketcan, socketcand};
 
 /// The interface name of the in-process simulated bus.
 pub const DEMO: &str = crate::sim::demo::BUS_NAME;
@@ -25,5 +25,17 @@ pub async fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
         socketcand::open(iface, listen_only).await
     } else {
         socketcan::open(iface, listen_only)
+    }
+}
+
+/// The bit rate `iface` is configured with, or why it has none, in words that follow its
+/// name (see [`bitrate::configured`]): the simulated buses and socketcand channels have none.
+pub fn configured_bitrate(iface: &str) -> Result<u64, String> {
+    if is_demo(iface) {
+        Err("is simulated: it has no bit rate".to_string())
+    } else if socketcand::is_url(iface) {
+        Err("is a socketcand channel: socketcand does not tell its bit rate".to_string())
+    } else {
+        bitrate::configured(iface)
     }
 }

@@ -150,8 +150,8 @@ impl Stats {
     }
 
     /// The bus bit rate used for the load, and where it came from.
-    pub fn bitrate(&self) -> Bitrate {
-        self.bitrate
+    pub fn bitrate(&self) -> &Bitrate {
+        &self.bitrate
     }
 
     /// Adds the frame just stored (the last one in `store`).

@@ -151,7 +151,7 @@ impl Trace {
 
     /// Forgets every frame (a replay seeking backwards starts over).
     pub fn clear(&mut self) {
-        let bitrate = self.stats.bitrate();
+        let bitrate = self.stats.bitrate().clone();
         *self = Trace::with_views(self.initial.clone(), bitrate, self.views);
     }
 

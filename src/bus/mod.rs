@@ -15,6 +15,7 @@
 //! subscriptions as an [`Event::State`] in order with the frames ([`Subscription::next`]);
 //! [`Subscription::recv`] gives frames only and turns a loss of capture into an error.
 
+pub mod bitrate;
 mod error;
 mod pace;
 pub mod socketcan;

@@ -202,6 +202,11 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding, transmit: Opt
     };
     let decoder = crate::decode::Decoder::from_bindings(&bindings);
     let open_file = matches!(kind, SourceKind::Open) && std::path::Path::new(name).is_file();
+    let bitrate = match &feed {
+        Feeding::Log(_) => Bitrate::given_or_assumed(ui.bitrate),
+        Feeding::Live(ifaces, _) => live_bitrate(ui.bitrate, ifaces),
+        Feeding::Demo(..) => live_bitrate(ui.bitrate, &[crate::connect::DEMO.to_string()]),
+    };
     let src = match feed {
         Feeding::Log((rx, ctl)) => SourceInfo::new(name, kind, rx, ctl),
         Feeding::Live(ifaces, listen_only) => {
@@ -214,7 +219,7 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding, transmit: Opt
             SourceInfo::live(name, kind, rx, req)
         }
     };
-    let mut app = App::new(Trace::new(decoder, Bitrate::given_or_assumed(ui.bitrate)), keymap, src);
+    let mut app = App::new(Trace::new(decoder, bitrate), keymap, src);
     app.set_bindings(bindings);
     // `cotui open FILE`: the bookmarks are kept beside the log (README, "Bookmarks").
     if open_file {
@@ -240,6 +245,16 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding, transmit: Opt
             ExitCode::Unavailable
         }
     }
+}
+
+/// The bit rate of a live session on `ifaces` (see [`Bitrate::of_live`]): each interface is
+/// asked for its configured rate.
+fn live_bitrate(option: Option<u64>, ifaces: &[String]) -> Bitrate {
+    let rates: Vec<(&str, Result<u64, String>)> = ifaces
+        .iter()
+        .map(|i| (i.as_str(), crate::connect::configured_bitrate(i)))
+        .collect();
+    Bitrate::of_live(option, &rates)
 }
 
 fn check_file(path: &std::path::Path) -> Result<(), ExitCode> {

@@ -34,12 +34,15 @@ impl BitrateSource {
 }
 
 /// A bus bit rate and where it came from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Bitrate {
     /// Bits per second (nominal, arbitration phase).
     pub bps: u64,
     /// Where it came from.
     pub source: BitrateSource,
+    /// Of the interface: the interface it came from; assumed: why (`vcan0 reports no bit
+    /// rate`); then what the other interfaces of the session said, when they disagree.
+    pub note: Option<String>,
 }
 
 impl Bitrate {
@@ -47,13 +50,55 @@ impl Bitrate {
     pub const ASSUMED: Bitrate = Bitrate {
         bps: 500_000,
         source: BitrateSource::Assumed,
+        note: None,
     };
     /// `--bitrate` when given, else [`Bitrate::ASSUMED`].
     pub fn given_or_assumed(bps: Option<u64>) -> Bitrate {
-        bps.map_or(Bitrate::ASSUMED, |bps| Bitrate {
-            bps,
-            source: BitrateSource::Option,
-        })
+        bps.map_or(Bitrate::ASSUMED, Bitrate::from)
+    }
+
+    /// The rate of a live session: `--bitrate` when given; else the rate of the first of
+    /// its interfaces that reports one; else 500 kbit/s assumed. `ifaces` are each
+    /// interface's name and its configured rate, or why it has none (the words after its
+    /// name: `reports no bit rate`). What every other interface said, when it is not that
+    /// rate, goes into the note.
+    pub fn of_live(option: Option<u64>, ifaces: &[(&str, Result<u64, String>)]) -> Bitrate {
+        if option.is_some() {
+            return Bitrate::given_or_assumed(option);
+        }
+        let chosen = ifaces
+            .iter()
+            .find_map(|(name, r)| r.as_ref().ok().map(|&bps| (*name, bps)));
+        let mut said: Vec<String> = chosen.iter().map(|(name, _)| name.to_string()).collect();
+        for (name, r) in ifaces {
+            match r {
+                Ok(bps) if chosen.is_some_and(|(_, c)| c == *bps) => {}
+                Ok(bps) => said.push(format!("{name} reports {} kbit/s", *bps as f64 / 1000.0)),
+                Err(why) => said.push(format!("{name} {why}")),
+            }
+        }
+        let note = (!said.is_empty()).then(|| said.join("; "));
+        match chosen {
+            Some((_, bps)) => Bitrate {
+                bps,
+                source: BitrateSource::Interface,
+                note,
+            },
+            None => Bitrate {
+                note,
+                ..Bitrate::ASSUMED
+            },
+        }
+    }
+
+    /// Where the rate came from, as the reports say it after the rate: `given`, `of can0`,
+    /// `assumed`, `assumed: vcan0 reports no bit rate`.
+    pub fn said(&self) -> String {
+        match (self.source, &self.note) {
+            (source, None) => source.as_str().to_string(),
+            (BitrateSource::Interface, Some(note)) => format!("of {note}"),
+            (source, Some(note)) => format!("{}: {note}", source.as_str()),
+        }
     }
 }
 
@@ -63,6 +108,7 @@ impl From<u64> for Bitrate {
         Bitrate {
             bps,
             source: BitrateSource::Option,
+            note: None,
         }
     }
 }
@@ -151,8 +197,8 @@ impl BusLoad {
     }
 
     /// The bit rate the load is counted against.
-    pub fn bitrate(&self) -> Bitrate {
-        self.bitrate
+    pub fn bitrate(&self) -> &Bitrate {
+        &self.bitrate
     }
 
     /// Counts one frame (of `node`, when it has one). Frames are taken in time order; a
@@ -331,7 +377,7 @@ impl BusLoad {
             self.bits,
             self.stuff_bits,
             self.bitrate.bps as f64 / 1000.0,
-            self.bitrate.source.as_str(),
+            self.bitrate.said(),
             round6(self.busiest_bits as f64 / self.window_capacity()) * 100.0,
             round6(self.longest_burst_ns as f64 / 1e6),
         );
@@ -407,6 +453,58 @@ mod tests {
     use super::*;
     use crate::frame::Flags;
 
+    fn none(why: &str) -> Result<u64, String> {
+        Err(why.to_string())
+    }
+
+    #[test]
+    fn a_live_session_takes_the_interface_rate_else_assumes_500k_and_says_why() {
+        let can0 = ("can0", Ok(250_000));
+        let vcan0 = ("vcan0", none("reports no bit rate"));
+        // --bitrate wins over what the interface says.
+        let given = Bitrate::of_live(Some(1_000_000), std::slice::from_ref(&can0));
+        assert_eq!((given.bps, given.said()), (1_000_000, "given".to_string()));
+        let of_can0 = Bitrate::of_live(None, std::slice::from_ref(&can0));
+        assert_eq!(of_can0.source, BitrateSource::Interface);
+        assert_eq!((of_can0.bps, of_can0.said()), (250_000, "of can0".to_string()));
+        let vcan = Bitrate::of_live(None, std::slice::from_ref(&vcan0));
+        assert_eq!(vcan.source, BitrateSource::Assumed);
+        assert_eq!(
+            (vcan.bps, vcan.said()),
+            (500_000, "assumed: vcan0 reports no bit rate".to_string())
+        );
+        // Several interfaces: the first rate reported; the others' say when they differ.
+        let mixed = Bitrate::of_live(
+            None,
+            &[
+                vcan0.clone(),
+                can0.clone(),
+                ("can1", Ok(125_000)),
+                ("can2", Ok(250_000)),
+            ],
+        );
+        assert_eq!(mixed.bps, 250_000);
+        assert_eq!(
+            mixed.said(),
+            "of can0; vcan0 reports no bit rate; can1 reports 125 kbit/s"
+        );
+        // No interface (a log) and nothing given: assumed, nothing to say why.
+        assert_eq!(Bitrate::of_live(None, &[]).said(), "assumed");
+    }
+
+    #[test]
+    fn the_summary_text_says_where_the_rate_came_from() {
+        let bitrate = Bitrate::of_live(None, &[("vcan0", none("reports no bit rate"))]);
+        let mut bus = BusLoad::new(bitrate);
+        bus.add(&at(0, 0x80, &[]), None);
+        let mut out = String::new();
+        bus.to_text(&mut out, |_, _| {});
+        assert!(
+            out.contains("at 500 kbit/s (assumed: vcan0 reports no bit rate)"),
+            "{out}"
+        );
+    }
+
     fn at(ms: u64, id: u32, data: &[u8]) -> Frame {
         let mut f = Frame::classic(id, data);
         f.ts_ns = ms * 1_000_000;
@@ -442,10 +540,7 @@ mod tests {
 
     #[test]
     fn a_burst_lasts_while_frames_follow_each_other() {
-        let mut b = BusLoad::new(Bitrate {
-            bps: 1_000_000,
-            source: BitrateSource::Option,
-        });
+        let mut b = BusLoad::new(Bitrate::from(1_000_000));
         // 82 bits at 1 Mbit/s: 82 µs each; frames every 100 µs are one burst.
         for i in 0..10u64 {
             let mut f = at(0, 0x185, &[0x25, 0, 0xEA, 0]);

@@ -2,7 +2,7 @@
 //! function code and node, its data bits by CANopen field with CANopen bit numbers, and
 //! the frame on the wire (see [`crate::wire`]) with its stuff bits and figures.
 
-use crate::decode::{Decoded, Kind};
+use crate::decode::{Body, Decoded, Kind};
 use crate::frame::Frame;
 use crate::wire::{Field, Wire, WireError, rebuild};
 use serde::Serialize;
@@ -90,6 +90,52 @@ pub fn data_fields(kind: Kind, payload: &[u8]) -> Vec<(Range<usize>, &'static st
         .collect()
 }
 
+/// A mapped object of a PDO and the CANopen bits of the payload it takes.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct MappedBits {
+    /// Object index.
+    pub index: u16,
+    /// Subindex.
+    pub sub: u8,
+    /// `6041 Statusword` (`6041:02 Name` for a subindex, `6041:00` for an unnamed object).
+    pub label: String,
+    /// CANopen numbers of its last and first bit (`15, 0` for bits 15..0).
+    pub canopen_bits: [usize; 2],
+}
+
+impl MappedBits {
+    fn holds(&self, canopen_bit: usize) -> bool {
+        (self.canopen_bits[1]..=self.canopen_bits[0]).contains(&canopen_bit)
+    }
+}
+
+/// The mapped objects of a PDO the decoder read through a known mapping (profile, EDS or
+/// learned), in mapping order; none for another frame or a PDO of unknown mapping.
+pub fn pdo_objects(decoded: &Decoded) -> Vec<MappedBits> {
+    let Body::Pdo(pdo) = &decoded.body else {
+        return Vec::new();
+    };
+    pdo.signals
+        .iter()
+        .filter(|s| s.bits > 0)
+        .map(|s| {
+            let unnamed = format!("0x{:04X}:{:02X}", s.index, s.sub);
+            let label = match (s.sub, s.name == unnamed) {
+                (_, true) => format!("{:04X}:{:02X}", s.index, s.sub),
+                (0, false) => format!("{:04X} {}", s.index, s.name),
+                (sub, false) => format!("{:04X}:{sub:02X} {}", s.index, s.name),
+            };
+            let first = usize::from(s.bit);
+            MappedBits {
+                index: s.index,
+                sub: s.sub,
+                label,
+                canopen_bits: [first + usize::from(s.bits) - 1, first],
+            }
+        })
+        .collect()
+}
+
 /// One data byte as `explain` shows it.
 #[derive(Clone, Debug, Serialize)]
 pub struct DataByte {
@@ -101,36 +147,79 @@ pub struct DataByte {
     pub bits: String,
     /// CANopen numbers of its first and last bit as sent (`8 x byte + 7` down to `8 x byte`).
     pub canopen_bits: [usize; 2],
-    /// The CANopen field it belongs to.
-    pub field: &'static str,
+    /// The CANopen field it belongs to: for a PDO of known mapping the objects whose bits
+    /// it holds (`6041 Statusword`, several joined by ` + `).
+    pub field: String,
 }
 
-/// The payload byte by byte with its fields.
-pub fn data_bytes(kind: Kind, payload: &[u8]) -> Vec<DataByte> {
+/// The payload byte by byte with its fields (`objects`: a PDO's, see [`pdo_objects`]).
+pub fn data_bytes(kind: Kind, payload: &[u8], objects: &[MappedBits]) -> Vec<DataByte> {
     let fields = data_fields(kind, payload);
     payload
         .iter()
         .enumerate()
-        .map(|(i, &b)| DataByte {
-            byte: i,
-            value: b,
-            bits: format!("{b:08b}"),
-            canopen_bits: [8 * i + 7, 8 * i],
-            field: fields.iter().find(|(r, _)| r.contains(&i)).map_or("data", |(_, n)| *n),
+        .map(|(i, &b)| {
+            let held: Vec<&str> = objects
+                .iter()
+                .filter(|o| (8 * i..8 * i + 8).any(|bit| o.holds(bit)))
+                .map(|o| o.label.as_str())
+                .collect();
+            let field = if held.is_empty() {
+                fields
+                    .iter()
+                    .find(|(r, _)| r.contains(&i))
+                    .map_or("data", |(_, n)| *n)
+                    .to_string()
+            } else {
+                held.join(" + ")
+            };
+            DataByte {
+                byte: i,
+                value: b,
+                bits: format!("{b:08b}"),
+                canopen_bits: [8 * i + 7, 8 * i],
+                field,
+            }
         })
         .collect()
 }
 
-/// The wire bits field by field, in order: (field, bits as `0`/`1` with stuff bits in
-/// brackets, `00000[1]0`).
-pub fn wire_groups(wire: &Wire) -> Vec<(Field, String)> {
-    let mut groups: Vec<(Field, String)> = Vec::new();
+/// A run of wire bits of one field (and, in a PDO's data, of one mapped object).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct WireGroup {
+    /// The field.
+    pub field: Field,
+    /// Data bits: the index in `objects` of the object they belong to.
+    pub object: Option<usize>,
+    /// The bits as `0`/`1`, stuff bits in brackets: `00000[1]0`.
+    pub bits: String,
+}
+
+/// The wire bits field by field, in order; the data bits also by mapped object (`objects`
+/// of [`pdo_objects`]; a data bit is sent MSB first, so the k-th data bit on the wire is
+/// CANopen bit `8 x (k / 8) + 7 - k % 8`). A stuff bit goes with the bit before it.
+pub fn wire_groups(wire: &Wire, objects: &[MappedBits]) -> Vec<WireGroup> {
+    let mut groups: Vec<WireGroup> = Vec::new();
+    let mut data_bit = 0usize;
     for b in &wire.bits {
         let c = if b.level { '1' } else { '0' };
         let text = if b.stuff { format!("[{c}]") } else { c.to_string() };
-        match groups.last_mut() {
-            Some((f, s)) if *f == b.field => s.push_str(&text),
-            _ => groups.push((b.field, text)),
+        let last = groups.last_mut().filter(|g| g.field == b.field);
+        let object = match (b.field, b.stuff) {
+            (Field::Data, false) => {
+                let canopen = 8 * (data_bit / 8) + 7 - data_bit % 8;
+                data_bit += 1;
+                objects.iter().position(|o| o.holds(canopen))
+            }
+            _ => last.as_ref().and_then(|g| g.object),
+        };
+        match last {
+            Some(g) if g.object == object => g.bits.push_str(&text),
+            _ => groups.push(WireGroup {
+                field: b.field,
+                object,
+                bits: text,
+            }),
         }
     }
     groups
@@ -189,7 +278,8 @@ impl Explained<'_> {
         if let Some(m) = &self.decoded.malformed {
             s.push_str(&format!("  malformed   {m}\n"));
         }
-        let bytes = data_bytes(self.decoded.kind, f.payload());
+        let objects = pdo_objects(self.decoded);
+        let bytes = data_bytes(self.decoded.kind, f.payload(), &objects);
         if !bytes.is_empty() {
             s.push_str("  data bits (as sent, MSB first; CANopen bit numbers)\n");
         }
@@ -200,11 +290,26 @@ impl Explained<'_> {
                 b.byte, b.value, b.bits, b.field
             ));
         }
+        if !objects.is_empty() {
+            s.push_str("  PDO objects (CANopen bit numbers)\n");
+        }
+        for o in &objects {
+            let numbers = format!("{}..{}", o.canopen_bits[0], o.canopen_bits[1]);
+            s.push_str(&format!("    bits {numbers:<8} {}\n", o.label));
+        }
         match self.wire() {
             Ok(w) => {
                 s.push_str("  on the wire (stuff bits in [ ])\n");
-                for (field, bits) in wire_groups(&w) {
-                    s.push_str(&format!("    {:<14} {bits}\n", field.as_str()));
+                for g in wire_groups(&w, &objects) {
+                    match g.object {
+                        Some(i) => s.push_str(&format!(
+                            "    {:<14} {}  {}\n",
+                            g.field.as_str(),
+                            g.bits,
+                            objects[i].label
+                        )),
+                        None => s.push_str(&format!("    {:<14} {}\n", g.field.as_str(), g.bits)),
+                    }
                 }
                 let assumed = if self.assumed { " (assumed)" } else { "" };
                 s.push_str(&format!("  figures     {}{assumed}\n", figures_text(&w, self.bitrate)));
@@ -217,6 +322,7 @@ impl Explained<'_> {
     /// The JSON record.
     pub fn to_json(&self) -> ExplainJson {
         let wire = self.wire();
+        let objects = pdo_objects(self.decoded);
         let (bits, stuff_bits, crc, crc_bits, time_us, groups, why) = match &wire {
             Ok(w) => (
                 Some(w.figures.bits),
@@ -224,11 +330,12 @@ impl Explained<'_> {
                 Some(format!("0x{:X}", w.figures.crc)),
                 Some(w.figures.crc_bits),
                 Some((w.figures.time_us(self.bitrate) * 1000.0).round() / 1000.0),
-                wire_groups(w)
+                wire_groups(w, &objects)
                     .into_iter()
-                    .map(|(f, b)| WireField {
-                        field: f.as_str(),
-                        bits: b,
+                    .map(|g| WireField {
+                        field: g.field.as_str(),
+                        object: g.object.map(|i| objects[i].label.clone()),
+                        bits: g.bits,
                     })
                     .collect(),
                 None,
@@ -244,7 +351,8 @@ impl Explained<'_> {
             node: self.decoded.node,
             canopen: self.decoded.label.clone(),
             malformed: self.decoded.malformed.clone(),
-            data: data_bytes(self.decoded.kind, self.frame.payload()),
+            data: data_bytes(self.decoded.kind, self.frame.payload(), &objects),
+            objects,
             wire: groups,
             no_wire: why,
             bits,
@@ -264,6 +372,9 @@ impl Explained<'_> {
 pub struct WireField {
     /// Field name (`SOF`, `ID`, `DLC`, `CRC`...).
     pub field: &'static str,
+    /// Data bits of a PDO of known mapping: the object they belong to (`6041 Statusword`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub object: Option<String>,
     /// Its bits as sent, stuff bits in brackets.
     pub bits: String,
 }
@@ -290,6 +401,9 @@ pub struct ExplainJson {
     pub malformed: Option<String>,
     /// The data bytes with bits and fields.
     pub data: Vec<DataByte>,
+    /// A PDO of known mapping: its mapped objects and their CANopen bits.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub objects: Vec<MappedBits>,
     /// The wire bits field by field.
     pub wire: Vec<WireField>,
     /// Why the frame has no wire form (an error frame).
@@ -327,6 +441,40 @@ mod tests {
         assert_eq!(split(&Frame::classic(0x1234_5678, &[])), None);
     }
 
+    /// A bit-packed mapping: object A in CANopen bits 0..3, B in bits 4..15. Byte 0 goes
+    /// out MSB first, so its wire bits are B's (7..4) then A's (3..0), then byte 1 (B's).
+    #[test]
+    fn packed_pdo_bits_on_the_wire_go_by_object_in_the_order_sent() {
+        let object = |label: &str, canopen_bits| MappedBits {
+            index: 0x2000,
+            sub: 0,
+            label: label.into(),
+            canopen_bits,
+        };
+        let objects = [object("A", [3, 0]), object("B", [15, 4])];
+        let wire = rebuild(&Frame::classic(0x181, &[0x5A, 0xC3])).unwrap();
+        let data: Vec<(&str, String)> = wire_groups(&wire, &objects)
+            .into_iter()
+            .filter(|g| g.field == Field::Data)
+            .map(|g| {
+                (
+                    objects[g.object.unwrap()].label.as_str(),
+                    g.bits.replace(['[', ']'], ""),
+                )
+            })
+            .collect();
+        assert_eq!(
+            data,
+            [("B", "0101".into()), ("A", "1010".into()), ("B", "11000011".into())]
+        );
+        let bytes = data_bytes(Kind::Tpdo, &[0x5A, 0xC3], &objects);
+        assert_eq!((bytes[0].field.as_str(), bytes[1].field.as_str()), ("A + B", "B"));
+        // Without a mapping the data stays one field.
+        let plain = wire_groups(&wire, &[]);
+        assert_eq!(plain.iter().filter(|g| g.field == Field::Data).count(), 1);
+        assert_eq!(data_bytes(Kind::Tpdo, &[0x5A], &[])[0].field, "PDO data");
+    }
+
     #[test]
     fn sdo_fields_follow_the_command() {
         let init = data_fields(Kind::SdoRx, &[0x40, 0x41, 0x60, 0, 0, 0, 0, 0]);
@@ -336,6 +484,6 @@ mod tests {
         );
         let seg = data_fields(Kind::SdoTx, &[0x00, 1, 2, 3, 4, 5, 6, 7]);
         assert_eq!(seg[1], (1..8, "segment data"));
-        assert_eq!(data_bytes(Kind::Heartbeat, &[0x05])[0].canopen_bits, [7, 0]);
+        assert_eq!(data_bytes(Kind::Heartbeat, &[0x05], &[])[0].canopen_bits, [7, 0]);
     }
 }

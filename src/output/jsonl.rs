@@ -349,6 +349,8 @@ mod tests {
         let sig = |name: &str, text: &str, value: Value| Signal {
             index: 0x6041,
             sub: 0,
+            bit: 0,
+            bits: 16,
             name: name.into(),
             value,
             text: text.into(),

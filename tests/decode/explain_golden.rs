@@ -56,6 +56,54 @@ fn explain_of_canworks_example_gives_its_figures() {
     );
 }
 
+/// A TPDO1 of the aimotor seed profile (statusword, mode display, position actual value):
+/// each data bit range is named by its mapped object, in the bytes, in a list of the
+/// objects and on the wire; in JSON as `objects` and each data run's `object`.
+#[test]
+fn explain_names_a_mapped_pdos_bits_by_object() {
+    let args = ["--profile", "1=aimotor", "181#3702030A000000"];
+    let (code, text, err) = explain(&args);
+    assert_eq!(code, 0, "{err}");
+    for line in [
+        "    byte 1  0x02  00000010  bits 15..8    6041 Statusword\n",
+        "    byte 2  0x03  00000011  bits 23..16   6061 Modes of operation display\n",
+        "  PDO objects (CANopen bit numbers)\n    bits 15..0    6041 Statusword\n",
+        "    bits 55..24   6064 Position actual value\n",
+        "    data           0011011100000[1]010  6041 Statusword\n",
+        "    data           0000[1]0011  6061 Modes of operation display\n",
+    ] {
+        assert!(text.contains(line), "{line}: {text}");
+    }
+    let (_, jsonl, _) = explain(&[&["--format", "jsonl"][..], &args].concat());
+    let j: serde_json::Value = serde_json::from_str(jsonl.trim()).unwrap();
+    assert_eq!(
+        j["objects"][0],
+        serde_json::json!({"index": 0x6041, "sub": 0, "label": "6041 Statusword", "canopen_bits": [15, 0]})
+    );
+    assert_eq!(j["objects"][2]["canopen_bits"], serde_json::json!([55, 24]));
+    assert_eq!(j["data"][3]["field"], "6064 Position actual value");
+    let data: Vec<&str> = j["wire"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|w| w["field"] == "data")
+        .map(|w| w["object"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        data,
+        [
+            "6041 Statusword",
+            "6061 Modes of operation display",
+            "6064 Position actual value"
+        ]
+    );
+    // Without the profile the mapping is unknown: plain PDO data, no objects.
+    let (_, plain, _) = explain(&["--format", "jsonl", "181#3702030A000000"]);
+    let j: serde_json::Value = serde_json::from_str(plain.trim()).unwrap();
+    assert!(j.get("objects").is_none(), "{plain}");
+    assert_eq!(j["data"][0]["field"], "PDO data");
+}
+
 #[test]
 fn a_malformed_frame_says_why_and_exits_1() {
     for (frame, why) in [

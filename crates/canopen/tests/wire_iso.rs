@@ -36,13 +36,22 @@ fn iso_crc(stream: &[u8], width: usize, generator: u64, init: u64) -> u64 {
 
 /// Inserts a complement after every 5 equal consecutive bits (the inserted bit counts in
 /// the next run). Returns the stuffed stream and the count.
-fn iso_stuff(stream: &[u8]) -> (Vec<u8>, usize) {
-    let mut out = Vec::new();
+///
+/// With `before_fixed` (CAN FD, the stream ends where the stuff count starts): the stuff
+/// condition is checked when the next bit is about to go out, so 5 equal bits at the very
+/// end take no stuff bit here, nor count one: the fixed stuff bit that starts the stuff
+/// count (the complement of the last bit) is their stuff bit. ISO 11898-1:2015 10.5 as
+/// modelled by CTU CAN FD's ISO 16845 test framework (`BitFrame::InsertNormalStuffBits`:
+/// "there shall be no regular stuff bit inserted before stuff count").
+fn iso_stuff(stream: &[u8], before_fixed: bool) -> (Vec<u8>, usize) {
+    let mut out: Vec<u8> = Vec::new();
     let mut count = 0;
-    for &b in stream {
+    for (k, &b) in stream.iter().enumerate() {
         out.push(b);
         let tail = &out[out.len().saturating_sub(5)..];
-        if tail.len() == 5 && tail.iter().all(|&x| x == b) {
+        let run_of_five = tail.len() == 5 && tail.iter().all(|&x| x == b);
+        let at_end = k + 1 == stream.len();
+        if run_of_five && !(before_fixed && at_end) {
             out.push(1 - b);
             count += 1;
         }
@@ -50,36 +59,50 @@ fn iso_stuff(stream: &[u8]) -> (Vec<u8>, usize) {
     (out, count)
 }
 
-/// The reference: (levels SOF..EOF, stuff bits, CRC).
-fn reference(f: &Frame) -> (Vec<u8>, usize, u64) {
-    let ext = f.flags.has(Flags::EXT);
-    let rtr = f.flags.has(Flags::RTR);
-    let data: Vec<u8> = f.payload().iter().flat_map(|&b| bits(u64::from(b), 8)).collect();
+/// SOF and the identifier (with SRR, IDE and the extension for 29 bits), unstuffed.
+fn iso_id(f: &Frame) -> Vec<u8> {
     let mut head = vec![0u8];
     let id = u64::from(f.id);
-    if ext {
+    if f.flags.has(Flags::EXT) {
         head.extend(bits(id >> 18, 11));
         head.extend([1, 1]);
         head.extend(bits(id & 0x3FFFF, 18));
     } else {
         head.extend(bits(id, 11));
     }
+    head
+}
+
+fn iso_data(f: &Frame) -> Vec<u8> {
+    f.payload().iter().flat_map(|&b| bits(u64::from(b), 8)).collect()
+}
+
+/// A CAN FD frame from SOF to the end of its data field, unstuffed: the part with dynamic
+/// stuff bits.
+fn iso_fd_dynamic_part(f: &Frame) -> Vec<u8> {
+    let mut head = iso_id(f);
+    let dlc = [0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64]
+        .iter()
+        .position(|&l| l == f.len)
+        .unwrap() as u64;
+    head.push(0); // RRS
+    if !f.flags.has(Flags::EXT) {
+        head.push(0); // IDE
+    }
+    head.extend([1, 0]); // FDF, res
+    head.push(u8::from(f.flags.has(Flags::BRS)));
+    head.push(u8::from(f.flags.has(Flags::ESI)));
+    head.extend(bits(dlc, 4));
+    head.extend(iso_data(f));
+    head
+}
+
+/// The reference: (levels SOF..EOF, stuff bits, CRC).
+fn reference(f: &Frame) -> (Vec<u8>, usize, u64) {
+    let rtr = f.flags.has(Flags::RTR);
     let tail = [1u8; 10];
     if f.flags.has(Flags::FD) {
-        let dlc = [0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64]
-            .iter()
-            .position(|&l| l == f.len)
-            .unwrap() as u64;
-        head.push(0); // RRS
-        if !ext {
-            head.push(0); // IDE
-        }
-        head.extend([1, 0]); // FDF, res
-        head.push(u8::from(f.flags.has(Flags::BRS)));
-        head.push(u8::from(f.flags.has(Flags::ESI)));
-        head.extend(bits(dlc, 4));
-        head.extend(&data);
-        let (mut sent, dynamic) = iso_stuff(&head);
+        let (mut sent, dynamic) = iso_stuff(&iso_fd_dynamic_part(f), true);
         let gray = [0b000, 0b001, 0b011, 0b010, 0b110, 0b111, 0b101, 0b100][dynamic % 8];
         let mut sc = bits(gray, 3);
         sc.push(sc.iter().sum::<u8>() % 2);
@@ -100,13 +123,14 @@ fn reference(f: &Frame) -> (Vec<u8>, usize, u64) {
         (sent, dynamic + fixed, crc)
     } else {
         let dlc = if f.len == 8 && f.raw_dlc > 8 { f.raw_dlc } else { f.len };
+        let mut head = iso_id(f);
         head.push(u8::from(rtr));
         head.extend([0, 0]); // IDE/r1, r0
         head.extend(bits(u64::from(dlc), 4));
-        head.extend(&data);
+        head.extend(iso_data(f));
         let crc = iso_crc(&head, 15, 0x4599, 0);
         head.extend(bits(crc, 15));
-        let (mut sent, n) = iso_stuff(&head);
+        let (mut sent, n) = iso_stuff(&head, false);
         sent.extend(tail);
         (sent, n, crc)
     }
@@ -190,6 +214,34 @@ fn sparse_classic() -> impl Strategy<Value = Frame> {
         })
 }
 
+/// A CAN FD frame whose dynamic part (SOF to the end of the data field) ends with 5 equal
+/// bits since the last bit change or stuff bit: the stuff condition is met exactly where
+/// the stuff count starts.
+fn ends_in_a_pending_stuff_bit(f: &Frame) -> bool {
+    let part = iso_fd_dynamic_part(f);
+    iso_stuff(&part, false).1 != iso_stuff(&part, true).1
+}
+
+/// Random CAN FD frames that end in five equal bits before the stuff count: the last byte
+/// ends in 0b00000 or 0b11111 (or there is no data and the DLC ends the run), and those
+/// whose run does not end exactly there are left out.
+fn fd_ending_in_a_run() -> impl Strategy<Value = Frame> {
+    (fd(), prop::sample::select(vec![0x00u8, 0xE0, 0x1F, 0xFF, 0x20, 0xDF]))
+        .prop_map(|(mut f, last)| {
+            if f.len > 0 {
+                let i = usize::from(f.len) - 1;
+                f.data[i] = (f.data[i] & 0xE0) | (last & 0x1F);
+                if last & 0x20 != 0 {
+                    f.data[i] = last;
+                }
+            }
+            f
+        })
+        .prop_filter("the stuff condition is met where the stuff count starts", |f| {
+            ends_in_a_pending_stuff_bit(f)
+        })
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(4000))]
     #[test]
@@ -198,6 +250,12 @@ proptest! {
     }
     #[test]
     fn fd_frames_match_the_iso_reference(f in fd()) {
+        check(&f)?;
+    }
+    /// The edge of ISO 11898-1:2015: 5 equal bits right before the stuff count take the
+    /// fixed stuff bit as their only stuff bit, and the stuff count does not count it.
+    #[test]
+    fn fd_frames_ending_in_five_equal_bits_match_the_iso_reference(f in fd_ending_in_a_run()) {
         check(&f)?;
     }
     #[test]

@@ -191,12 +191,14 @@ fn frame_lines(trace: &Trace, f: &Frame, d: &Decoded, pos: usize) -> Vec<Line<'s
         ))),
         _ => {}
     }
-    v.extend(wire_lines(f, trace.stats.bitrate().bps));
+    let objects = crate::output::explain::pdo_objects(d);
+    v.extend(wire_lines(f, trace.stats.bitrate().bps, &objects));
     v
 }
 
-/// The frame on the wire: its figures, then its bits field by field, stuff bits marked.
-pub fn wire_lines(f: &Frame, bitrate: u64) -> Vec<Line<'static>> {
+/// The frame on the wire: its figures, then its bits field by field, stuff bits marked; a
+/// PDO's data bits by mapped object (`objects`, see [`crate::output::explain::pdo_objects`]).
+pub fn wire_lines(f: &Frame, bitrate: u64, objects: &[crate::output::explain::MappedBits]) -> Vec<Line<'static>> {
     let wire = match crate::wire::rebuild(f) {
         Ok(w) => w,
         Err(e) => return vec![Line::raw(format!("on the wire: none ({e})"))],
@@ -207,7 +209,8 @@ pub fn wire_lines(f: &Frame, bitrate: u64) -> Vec<Line<'static>> {
     ))];
     let stuff = Style::default().fg(Color::Yellow).add_modifier(Modifier::BOLD);
     let mut line: Vec<Span<'static>> = Vec::new();
-    for (field, bits) in crate::output::explain::wire_groups(&wire) {
+    for g in crate::output::explain::wire_groups(&wire, objects) {
+        let (field, bits) = (g.field, g.bits);
         let wide = matches!(field, crate::wire::Field::Data | crate::wire::Field::Crc);
         if wide && !line.is_empty() {
             v.push(Line::from(std::mem::take(&mut line)));
@@ -216,6 +219,13 @@ pub fn wire_lines(f: &Frame, bitrate: u64) -> Vec<Line<'static>> {
             format!("{} ", field.as_str()),
             Style::default().fg(Color::DarkGray),
         ));
+        if let Some(o) = g.object.map(|i| &objects[i]) {
+            let numbers = format!("{}..{}", o.canopen_bits[0], o.canopen_bits[1]);
+            line.push(Span::styled(
+                format!("{} bits {numbers} ", o.label),
+                Style::default().fg(Color::Cyan),
+            ));
+        }
         // Stuff bits come as `[b]`: shown as the bit alone, highlighted.
         let mut rest = bits.as_str();
         while !rest.is_empty() {

@@ -440,7 +440,12 @@ pub(crate) mod testutil {
 
     /// An app holding `frames` (fully ingested, on can0), default keymap.
     pub fn app_of(frames: &[Frame]) -> App {
-        let mut trace = Trace::new(Decoder::new(Dictionary::default(), Vec::new()), 500_000);
+        app_at(frames, 500_000.into())
+    }
+
+    /// [`app_of`] with the bus load counted at `bitrate`.
+    pub fn app_at(frames: &[Frame], bitrate: crate::output::busload::Bitrate) -> App {
+        let mut trace = Trace::new(Decoder::new(Dictionary::default(), Vec::new()), bitrate);
         trace.ifaces.intern("can0");
         for f in frames {
             trace.push(f);

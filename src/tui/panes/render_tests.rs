@@ -377,6 +377,27 @@ fn stats_pane_shows_rates_and_bus_load() {
     insta::assert_snapshot!(s);
 }
 
+/// A live session on a vcan (no bit rate): the load is counted at 500 kbit/s assumed, and
+/// the Stats pane says why; on a configured interface it says whose rate it is.
+#[test]
+fn stats_pane_says_where_the_bit_rate_came_from() {
+    use crate::output::busload::Bitrate;
+    let frames = super::testutil::frames();
+    let vcan = Bitrate::of_live(None, &[("vcan0", Err("reports no bit rate".to_string()))]);
+    let mut a = super::testutil::app_at(&frames, vcan);
+    a.screen_mut().focus_on(Pane::Stats);
+    let s = screen(&mut a, 160, 12);
+    assert!(
+        s.contains("bus load 0.7% at 500 kbit/s (assumed: vcan0 reports no bit rate), 44 fr"),
+        "{s}"
+    );
+    let can0 = Bitrate::of_live(None, &[("can0", Ok(250_000))]);
+    let mut a = super::testutil::app_at(&frames, can0);
+    a.screen_mut().focus_on(Pane::Stats);
+    let s = screen(&mut a, 160, 12);
+    assert!(s.contains("bus load 1.4% at 250 kbit/s (of can0), 44 fr"), "{s}");
+}
+
 #[test]
 fn receive_list_shows_latest_data_periods_and_labels_sorted_by_a_key() {
     let mut a = app();

@@ -173,10 +173,11 @@ impl Component for StatsPane {
         }
         let st = &ctx.trace.stats;
         let rate = st.bitrate();
-        let assumed = if rate.source == BitrateSource::Assumed {
-            " (assumed)"
+        // A rate given with --bitrate goes without saying; else where it came from.
+        let assumed = if rate.source == BitrateSource::Option {
+            String::new()
         } else {
-            ""
+            format!(" ({})", rate.said())
         };
         let names = ctx.trace.ifaces.names();
         let load = if names.len() > 1 {

@@ -8,6 +8,10 @@ use serde::Serialize;
 pub struct Signal {
     pub index: u16,
     pub sub: u8,
+    /// CANopen number of its first bit in the payload (bit 0 is byte 0's LSB).
+    pub bit: u16,
+    /// Its length in bits.
+    pub bits: u8,
     /// Object name from the dictionary (or `0xIIII:SS`).
     pub name: String,
     /// Raw value typed by the object's data type.
@@ -194,6 +198,8 @@ pub(crate) fn decode_values(payload: &[u8], mapping: &PdoMapping, dict: &Diction
         signals.push(Signal {
             index: e.index,
             sub: e.sub,
+            bit: pos as u16,
+            bits: e.bits,
             name: String::new(),
             value: value(payload, pos, e, dict.object(e.index, e.sub)),
             text: String::new(),
@@ -231,6 +237,8 @@ fn signal(payload: &[u8], pos: usize, e: &MappedEntry, dict: &Dictionary, mode: 
     Signal {
         index: e.index,
         sub: e.sub,
+        bit: pos as u16,
+        bits: e.bits,
         name,
         value,
         text,

@@ -10,7 +10,10 @@
 //! dynamic stuff bits from SOF to the end of the data field (the CRC covers them); then the
 //! stuff count (the dynamic stuff bits modulo 8, Gray coded, and an even parity bit) and
 //! the CRC-17 (up to 16 data bytes) or CRC-21, with a fixed stuff bit of the other level
-//! before the stuff count and after every 4 bits of it and of the CRC. Every bit is counted
+//! before the stuff count and after every 4 bits of it and of the CRC. When the dynamic
+//! part ends with 5 equal bits, the fixed stuff bit before the stuff count is their only
+//! stuff bit: no dynamic one goes out there, and the stuff count does not count one (as
+//! the ISO 16845 conformance model of CTU CAN FD does). Every bit is counted
 //! at the nominal rate (the faster data phase of a BRS frame is not known to a trace).
 //!
 //! [`figures`] is the cheap path for bus load (table-driven CRC and stuffing for classic
@@ -422,15 +425,20 @@ fn walk(layout: &Layout, out: &mut dyn FnMut(Bit)) -> Figures {
     };
     let mut state = tables::STUFF_START;
     let mut crc = init;
+    let mut last = false;
     // Classic: the CRC covers the unstuffed bits; FD: the bits as sent, stuff bits too.
     for i in 0..layout.bits.len {
         let (level, field) = (layout.bits.get(i), field_of(i));
         emit(level, field, false);
+        last = level;
         crc = crc_bit(crc, level, crc_bits, poly);
         let (next, stuffed) = stuff_step(state, level);
         state = next;
-        if stuffed {
+        // CAN FD: 5 equal bits that end the dynamic part take no dynamic stuff bit (nor
+        // count one): the fixed stuff bit before the stuff count is their stuff bit.
+        if stuffed && !(layout.fd && i + 1 == layout.bits.len) {
             emit(!level, field, true);
+            last = !level;
             stuffs += 1;
             if layout.fd {
                 crc = crc_bit(crc, !level, crc_bits, poly);
@@ -438,7 +446,6 @@ fn walk(layout: &Layout, out: &mut dyn FnMut(Bit)) -> Figures {
         }
     }
     if layout.fd {
-        let mut last = state & 0b100 != 0;
         let count = stuffs % 8;
         let gray = count ^ (count >> 1);
         let parity = gray.count_ones() & 1;

@@ -111,3 +111,37 @@ fn fd_frames_have_a_stuff_count_and_fixed_stuff_bits() {
     fd.len = 16;
     assert_eq!(figures(&fd).unwrap().crc_bits, 17);
 }
+
+/// ISO 11898-1:2015: CAN FD `185##020` ends its data field with 5 dominant bits; the fixed
+/// stuff bit before the stuff count is their only stuff bit (no dynamic one before it) and
+/// the stuff count counts only the one dynamic stuff bit of the identifier.
+#[test]
+fn fd_run_of_five_before_the_stuff_count_takes_only_the_fixed_stuff_bit() {
+    let mut fd = frame(0x185, &[0x20]);
+    fd.flags = Flags(Flags::FD);
+    let w = rebuild(&fd).unwrap();
+    let sc = w.bits.iter().position(|b| b.field == Field::StuffCount).unwrap();
+    let before: Vec<(bool, bool)> = w.bits[sc - 5..sc].iter().map(|b| (b.level, b.stuff)).collect();
+    assert_eq!(
+        before,
+        [(false, false); 5],
+        "the data field ends with 5 dominant data bits"
+    );
+    assert_eq!(
+        w.bits[sc],
+        Bit {
+            level: true,
+            field: Field::StuffCount,
+            stuff: true
+        }
+    );
+    let dynamic = w.bits[..sc].iter().filter(|b| b.stuff).count();
+    assert_eq!(dynamic, 1);
+    // Gray code of 1 is 001, even parity 1.
+    let count: Vec<bool> = w.bits[sc..]
+        .iter()
+        .filter(|b| b.field == Field::StuffCount && !b.stuff)
+        .map(|b| b.level)
+        .collect();
+    assert_eq!(count, [false, false, true, true]);
+}
