@@ -4,8 +4,9 @@
 //! Modes as socketcand has them: after `< hi >` the session has no bus; `< open BUS >`
 //! (the one bus this server serves) gives BCM mode, where frames reach the client only
 //! for the identifiers it subscribed to (`< subscribe SECS USECS ID >`, at most one per
-//! interval); `< rawmode >` gives every frame. `< send >` works in both modes when the
-//! server allows sending; otherwise it is answered with an error and nothing is sent.
+//! interval); `< rawmode >` gives every frame (CAN FD ones as `< fdframe >`). `< send >` and
+//! `< fdsend >` work in both modes when the server allows sending; otherwise they are
+//! answered with an error and nothing is sent.
 
 use crate::bus::socketcand::wire::{self, Request, WireError};
 use crate::frame::Frame;
@@ -216,6 +217,35 @@ mod tests {
         assert_eq!(
             s.on_element(Err(WireError::TooLong)),
             reply("< error command longer than 4096 bytes, skipped >")
+        );
+    }
+
+    #[test]
+    fn fd_frames_go_out_as_fdframe_and_fdsend_follows_the_send_policy() {
+        let fdsend = "fdsend 123 01 12 11 12 13 14 15 16 17 18 19 1a 1b 1c";
+        let Ok(Request::Send(fd)) = wire::parse_request(fdsend) else {
+            panic!()
+        };
+        let mut open = Session::new("demo", None);
+        say(&mut open, "open demo");
+        say(&mut open, "rawmode");
+        assert_eq!(
+            open.forward(&fd).as_deref(),
+            Some("< fdframe 123 01 0.000000 1112131415161718191A1B1C >")
+        );
+        assert_eq!(say(&mut open, fdsend), vec![Action::Send(fd)]);
+        let mut closed = Session::new("demo", Some("the server was started without --allow-send".into()));
+        say(&mut closed, "open demo");
+        assert_eq!(
+            say(&mut closed, fdsend),
+            vec![
+                Action::Reply("< error send refused: the server was started without --allow-send >".into()),
+                Action::Refused(fd)
+            ]
+        );
+        assert_eq!(
+            say(&mut closed, "fdsend 123 01 13"),
+            reply("< error fdsend: length 13 is not a CAN FD length (0..8, 12, 16, 20, 24, 32, 48, 64) >")
         );
     }
 

@@ -1,6 +1,7 @@
 //! `cotui serve demo --socketcand 0` (loopback, a free port) against real clients:
 //! python-can's `socketcand` interface, cotui's own `socketcand://` client (sdo, lss, nmt,
-//! record), and a raw TCP client sending garbage, a 1 MB element and 200 connections.
+//! record, CAN FD frames both ways), and a raw TCP client sending garbage, a 1 MB element and
+//! 200 connections.
 //! Every wait is on a condition (a line on stderr, an answer), never a fixed sleep.
 
 use std::io::{BufRead, BufReader, Read, Write};
@@ -271,7 +272,7 @@ fn garbage_a_huge_element_and_many_connections_leave_the_server_serving() {
     c.until("< error text outside ? ?, ignored >");
     c.until("< error unknown command frobnicate >");
     c.say("< send 601 9 >< send 999 0 >< send 601 1 zz >< subscribe x >< \u{1}\u{2} >");
-    c.until("< error send: length 9 is not 0..8 >");
+    c.until("< error send: length 9 is not 0..8 (a CAN FD frame goes as fdsend ID FLAGS LEN DATA) >");
     c.until("< error identifier 999 does not fit 11 bits");
     c.until("< error send: zz is not a byte in hex >");
     c.until("< error subscribe takes SECS USECS ID >");
@@ -477,4 +478,98 @@ fn sdo_timeouts_count_on_the_remote_bus_not_across_the_network() {
         "{}",
         text(&missing)
     );
+}
+
+/// The stdout lines of a child, as they come.
+struct Lines(Arc<Mutex<Vec<String>>>);
+
+impl Lines {
+    fn of(child: &mut Child) -> Lines {
+        let out = child.stdout.take().unwrap();
+        let lines = Arc::new(Mutex::new(Vec::new()));
+        let sink = lines.clone();
+        std::thread::spawn(move || {
+            for l in BufReader::new(out).lines().map_while(Result::ok) {
+                sink.lock().unwrap().push(l);
+            }
+        });
+        Lines(lines)
+    }
+    /// Waits (60 s at most) for a line that satisfies `f`.
+    fn wait(&self, what: &str, f: impl Fn(&str) -> bool) -> String {
+        let start = Instant::now();
+        loop {
+            if let Some(l) = self.0.lock().unwrap().iter().find(|l| f(l)) {
+                return l.clone();
+            }
+            assert!(
+                start.elapsed() < Duration::from_secs(60),
+                "no {what} in:\n{}",
+                self.0.lock().unwrap().join("\n")
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+}
+
+/// CAN FD through the server, with four clients on the bus at once: cotui's own client
+/// sends an FD frame (`< fdsend >`), a raw socketcand client gets it as `< fdframe >` and
+/// sends one itself, cotui's own client records both as FD frames (flags kept), and
+/// python-can's socketcand interface (classic only) skips the FD frames and goes on
+/// receiving; its own FD message (written as a `< send >` with a hex length) is refused
+/// with an error and nothing reaches the bus.
+#[test]
+fn fd_frames_cross_the_server_both_ways_and_python_can_skips_them() {
+    let s = Server::demo(&["--allow-send"]);
+    let url = s.url();
+    let mut py = Command::new("python3")
+        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/commander/socketcand_fd.py"))
+        .arg(s.port.to_string())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let py_out = Lines::of(&mut py);
+    py_out.wait("the python clients' ready", |l| l == "ready");
+    let mut rec = Command::new(env!("CARGO_BIN_EXE_cotui"))
+        .args(["record", &url, "-o", "-"])
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let recorded = Lines::of(&mut rec);
+    recorded.wait("a first recorded frame", |_| true);
+
+    let o = cotui(&["send", &url, "123##1112233445566778899AABBCC"]);
+    assert!(o.status.success(), "{}", text(&o));
+    s.wait_line("the audit of the FD frame", |l| {
+        l.ends_with(" sent 123##1112233445566778899AABBCC")
+    });
+    let got = py_out.wait("the raw client's fdframe", |l| l.starts_with("raw got"));
+    assert!(got.starts_with("raw got < fdframe 123 01 "), "{got}");
+    assert!(got.ends_with(" 112233445566778899AABBCC >"), "{got}");
+    // The raw client's fdsend: 29-bit, BRS and ESI, 16 bytes.
+    s.wait_line("the raw client's FD frame", |l| {
+        l.ends_with(" sent 0000ABCD##3000102030405060708090A0B0C0D0E0F")
+    });
+    recorded.wait("the FD frame of cotui's client", |l| {
+        l.ends_with(&format!(" {url} 123##1112233445566778899AABBCC"))
+    });
+    recorded.wait("the FD frame of the raw client", |l| {
+        l.ends_with(&format!(" {url} 0000ABCD##3000102030405060708090A0B0C0D0E0F"))
+    });
+
+    let skipped = py_out.wait("python-can's classic frame after the FD ones", |l| {
+        l.starts_with("python-can got 125")
+    });
+    assert!(skipped.starts_with("python-can got 125 aa after "), "{skipped}");
+    assert!(skipped.ends_with("fd frames delivered: 0"), "{skipped}");
+    py_out.wait("python-can's FD send", |l| {
+        l == "python-can fd send: error from the server"
+    });
+    assert!(py.wait().unwrap().success());
+    let _ = rec.kill();
+    let _ = rec.wait();
+    assert!(!s.lines().iter().any(|l| l.contains(" sent 126")), "{:?}", s.lines());
+    s.wait_line("python-can's disconnect", |l| {
+        l.contains("client 1 (") && l.contains("0 frames sent, 0 sends refused") && l.ends_with("1 errors answered")
+    });
 }

@@ -2,8 +2,9 @@
 //! `cotui serve`, or linux-can's socketcand daemon.
 //!
 //! The handle connects, opens CHANNEL in raw mode and then behaves as a SocketCAN handle:
-//! frames carry the server's receive timestamps (`< frame ID SECS.USECS DATA >`), a frame
-//! sent comes back marked TX, and a lost connection is a state change
+//! frames carry the server's receive timestamps (`< frame ID SECS.USECS DATA >`, CAN FD
+//! frames `< fdframe ID FLAGS SECS.USECS DATA >` and sent as `< fdsend >`, see [`wire`]), a
+//! frame sent comes back marked TX, and a lost connection is a state change
 //! ([`BusState::Disconnected`]), after which the reader reconnects every second and reports
 //! [`BusState::Active`] when capture is back.
 //!
@@ -134,7 +135,7 @@ impl Link {
         }
     }
 
-    /// Sends `frame` as `< send >`; its echo goes to the subscriptions marked TX.
+    /// Sends `frame` as `< send >` (`< fdsend >` for CAN FD); its echo goes to the subscriptions marked TX.
     pub(super) async fn write(&self, frame: &Frame) -> Result<(), BusError> {
         if let Some(why) = self.refused.lock().ok().and_then(|r| r.clone()) {
             return Err(BusError::Unavailable {
@@ -147,7 +148,7 @@ impl Link {
         let Some(text) = wire::send_element(frame) else {
             return Err(BusError::Io {
                 iface: self.name.clone(),
-                reason: "socketcand carries classic data frames only (no CAN FD, remote request or error frames)"
+                reason: "socketcand carries data frames only, classic and CAN FD (no remote request or error frames)"
                     .into(),
             });
         };

@@ -9,7 +9,16 @@
 //! `< error CLASS SECS.USECS >`; a client sends with `< send ID LEN B0 B1 ... >` (bytes in
 //! unpadded hex); `< echo >` comes back as it is. Elements are not lines: they may follow
 //! each other without a separator, and bytes between them are ignored.
+//!
+//! CAN FD is not in socketcand's released protocol; this module speaks it as the open
+//! socketcand pull request linux-can/socketcand#33 does (reviewed upstream, not merged):
+//! `< fdframe ID FLAGS SECS.USECS DATA >` from the server and `< fdsend ID FLAGS LEN B0 ... >`
+//! from a client, FLAGS two hex digits of `struct canfd_frame`'s flags (01 BRS, 02 ESI,
+//! 04 FDF), LEN decimal and one of the CAN FD lengths (0..8, 12, 16, 20, 24, 32, 48, 64).
+//! The client also reads `< fdframe ID SECS.USECS DATA >` without FLAGS, as the
+//! maintainer's `rawmode-canfd` branch of socketcand writes it.
 
+use crate::frame::linux::{CANFD_BRS, CANFD_ESI, CANFD_FDF};
 use crate::frame::{Flags, Frame};
 use std::fmt;
 
@@ -119,7 +128,7 @@ pub enum Request {
     BcmMode,
     /// `echo`
     Echo,
-    /// `send ID LEN DATA...`: one frame.
+    /// `send ID LEN DATA...` (classic) or `fdsend ID FLAGS LEN DATA...` (CAN FD): one frame.
     Send(Frame),
     /// `subscribe SECS USECS ID` (BCM mode): frames of `id`, at most one per `interval_us`.
     Subscribe { id: u32, ext: bool, interval_us: u64 },
@@ -171,6 +180,7 @@ pub fn parse_request(text: &str) -> Result<Request, WireError> {
         "echo" => none(Request::Echo),
         "cotui_send_policy" => none(Request::SendPolicy),
         "send" => parse_send(&rest).map(Request::Send),
+        "fdsend" => parse_fdsend(&rest).map(Request::Send),
         "subscribe" => match rest.as_slice() {
             [secs, usecs, id] => {
                 let secs = number(secs, "subscribe: seconds")?;
@@ -228,21 +238,97 @@ fn parse_send(words: &[&str]) -> Result<Frame, WireError> {
     let (id, ext) = parse_id(id)?;
     let len = match len.parse::<usize>() {
         Ok(n) if len.len() <= 2 && n <= 8 => n,
-        _ => return Err(syntax(format!("send: length {} is not 0..8", printable(len, 16)))),
+        _ => {
+            return Err(syntax(format!(
+                "send: length {} is not 0..8 (a CAN FD frame goes as fdsend ID FLAGS LEN DATA)",
+                printable(len, 16)
+            )));
+        }
     };
-    if data.len() != len {
-        return Err(syntax(format!("send: length {len} but {} data bytes", data.len())));
-    }
-    let mut bytes = [0u8; 8];
-    for (b, w) in bytes.iter_mut().zip(data) {
-        *b = match u8::from_str_radix(w, 16) {
-            Ok(v) if w.len() <= 2 => v,
-            _ => return Err(syntax(format!("send: {} is not a byte in hex", printable(w, 16)))),
-        };
-    }
+    let bytes = parse_bytes("send", len, data)?;
     let mut f = Frame::classic(id, &bytes[..len]);
     f.flags.set(Flags::EXT, ext);
     Ok(f)
+}
+
+/// `ID FLAGS LEN B0 B1 ...` of an `fdsend`.
+fn parse_fdsend(words: &[&str]) -> Result<Frame, WireError> {
+    let [id, flags, len, data @ ..] = words else {
+        return Err(syntax(
+            "fdsend takes ID FLAGS LEN and LEN data bytes: fdsend 123 01 12 11 22 33 44 55 66 77 88 99 aa bb cc",
+        ));
+    };
+    let (id, ext) = parse_id(id)?;
+    let flags = parse_fd_flags(flags, "fdsend")?;
+    if flags & !(CANFD_BRS | CANFD_ESI | CANFD_FDF) != 0 {
+        return Err(syntax(format!(
+            "fdsend: flags {flags:02X} has bits other than 01 (BRS), 02 (ESI), 04 (FDF)"
+        )));
+    }
+    let len = match len.parse::<usize>() {
+        Ok(n) if len.len() <= 2 && is_fd_len(n) => n,
+        _ => {
+            return Err(syntax(format!(
+                "fdsend: length {} is not a CAN FD length ({FD_LENGTHS})",
+                printable(len, 16)
+            )));
+        }
+    };
+    let bytes = parse_bytes("fdsend", len, data)?;
+    Ok(fd_frame(id, ext, flags, &bytes[..len]))
+}
+
+/// The CAN FD payload lengths, as error texts name them.
+const FD_LENGTHS: &str = "0..8, 12, 16, 20, 24, 32, 48, 64";
+
+/// True for a payload length a CAN FD DLC gives.
+fn is_fd_len(n: usize) -> bool {
+    matches!(n, 0..=8 | 12 | 16 | 20 | 24 | 32 | 48 | 64)
+}
+
+/// Exactly `len` words of one or two hex digits each, the data of `cmd`.
+fn parse_bytes(cmd: &str, len: usize, words: &[&str]) -> Result<[u8; 64], WireError> {
+    if words.len() != len {
+        return Err(syntax(format!("{cmd}: length {len} but {} data bytes", words.len())));
+    }
+    let mut bytes = [0u8; 64];
+    for (b, w) in bytes.iter_mut().zip(words) {
+        *b = match u8::from_str_radix(w, 16) {
+            Ok(v) if w.len() <= 2 => v,
+            _ => return Err(syntax(format!("{cmd}: {} is not a byte in hex", printable(w, 16)))),
+        };
+    }
+    Ok(bytes)
+}
+
+/// FLAGS of an `fdsend` or `fdframe`: one or two hex digits.
+fn parse_fd_flags(s: &str, cmd: &str) -> Result<u8, WireError> {
+    match u8::from_str_radix(s, 16) {
+        Ok(v) if s.len() <= 2 => Ok(v),
+        _ => Err(syntax(format!(
+            "{cmd}: flags {} is not one byte in hex (01 BRS, 02 ESI)",
+            printable(s, 16)
+        ))),
+    }
+}
+
+/// A CAN FD frame with `struct canfd_frame`'s `flags` (bits other than BRS, ESI, FDF ignored).
+fn fd_frame(id: u32, ext: bool, flags: u8, data: &[u8]) -> Frame {
+    let mut f = Frame { id, ..Frame::default() };
+    f.len = data.len() as u8;
+    f.data[..data.len()].copy_from_slice(data);
+    f.flags.set(Flags::EXT, ext);
+    f.flags.set(Flags::FD, true);
+    f.flags.set(Flags::BRS, flags & CANFD_BRS != 0);
+    f.flags.set(Flags::ESI, flags & CANFD_ESI != 0);
+    f.flags.set(Flags::FDF, flags & CANFD_FDF != 0);
+    f
+}
+
+/// `struct canfd_frame`'s `flags` of an FD frame.
+fn fd_flags(f: &Frame) -> u8 {
+    let bit = |flag, raw| if f.flags.has(flag) { raw } else { 0 };
+    bit(Flags::BRS, CANFD_BRS) | bit(Flags::ESI, CANFD_ESI) | bit(Flags::FDF, CANFD_FDF)
 }
 
 /// What a server sends (the text of one element).
@@ -254,8 +340,8 @@ pub enum Reply {
     Ok,
     /// `echo`
     Echo,
-    /// `frame ID SECS.USECS DATA`, or `error CLASS SECS.USECS` as an error frame; stamped
-    /// with the server's time.
+    /// `frame ID SECS.USECS DATA`, `fdframe ID [FLAGS] SECS.USECS DATA` (CAN FD), or
+    /// `error CLASS SECS.USECS` as an error frame; stamped with the server's time.
     Frame(Frame),
     /// `error TEXT`
     Error(String),
@@ -278,12 +364,13 @@ pub fn parse_reply(text: &str) -> Result<Reply, WireError> {
             let (id, ext) = parse_id(id)?;
             let ts_ns = parse_time(ts)?;
             let hex: String = data.concat();
-            let bytes = parse_hex(&hex)?;
+            let bytes = parse_hex(&hex, 8, "frame")?;
             let mut f = Frame::classic(id, &bytes);
             f.flags.set(Flags::EXT, ext);
             f.ts_ns = ts_ns;
             Ok(Reply::Frame(f))
         }
+        ("fdframe", _) => parse_fdframe(&rest).map(Reply::Frame),
         ("error", [class, ts]) if parse_time(ts).is_ok() => {
             let class = u32::from_str_radix(class, 16)
                 .ok()
@@ -302,6 +389,28 @@ pub fn parse_reply(text: &str) -> Result<Reply, WireError> {
         ("cotui_send_policy", ["refused", why @ ..]) => Ok(Reply::SendPolicy(Some(why.join(" ")))),
         _ => Ok(Reply::Other(text.to_string())),
     }
+}
+
+/// `ID FLAGS SECS.USECS DATA` of an `fdframe` (socketcand#33), or `ID SECS.USECS DATA`
+/// (socketcand's `rawmode-canfd` branch): told apart by where the time is.
+fn parse_fdframe(words: &[&str]) -> Result<Frame, WireError> {
+    let (id, flags, ts, data) = match words {
+        [id, ts, data @ ..] if ts.contains('.') => (id, 0, ts, data),
+        [id, flags, ts, data @ ..] => (id, parse_fd_flags(flags, "fdframe")?, ts, data),
+        _ => return Err(syntax("fdframe takes ID FLAGS SECS.USECS DATA")),
+    };
+    let (id, ext) = parse_id(id)?;
+    let ts_ns = parse_time(ts)?;
+    let bytes = parse_hex(&data.concat(), 64, "fdframe")?;
+    if !is_fd_len(bytes.len()) {
+        return Err(syntax(format!(
+            "fdframe: {} data bytes is not a CAN FD length ({FD_LENGTHS})",
+            bytes.len()
+        )));
+    }
+    let mut f = fd_frame(id, ext, flags, &bytes);
+    f.ts_ns = ts_ns;
+    Ok(f)
 }
 
 /// `SECS.FRACTION` (1 to 9 fractional digits) as ns.
@@ -323,11 +432,11 @@ fn frac_len(s: &str) -> u32 {
     s.split_once('.').map_or(0, |(_, f)| f.len()) as u32
 }
 
-/// Up to 8 bytes in hex, two digits each.
-fn parse_hex(s: &str) -> Result<Vec<u8>, WireError> {
-    if !s.len().is_multiple_of(2) || s.len() > 16 || !s.bytes().all(|b| b.is_ascii_hexdigit()) {
+/// Up to `max` bytes in hex, two digits each, the data of a `cmd` element.
+fn parse_hex(s: &str, max: usize, cmd: &str) -> Result<Vec<u8>, WireError> {
+    if !s.len().is_multiple_of(2) || s.len() > 2 * max || !s.bytes().all(|b| b.is_ascii_hexdigit()) {
         return Err(syntax(format!(
-            "frame data {} is not up to 8 bytes in hex",
+            "{cmd} data {} is not up to {max} bytes in hex",
             printable(s, 24)
         )));
     }
@@ -370,26 +479,36 @@ fn time_text(ts_ns: u64) -> String {
     format!("{}.{:06}", ts_ns / 1_000_000_000, ts_ns % 1_000_000_000 / 1000)
 }
 
-/// The element a server sends for a bus frame: `< frame ... >`, `< error ... >` for an
-/// error frame; none for what socketcand cannot carry (remote request and CAN FD frames).
+/// The element a server sends for a bus frame: `< frame ... >`, `< fdframe ... >` for a
+/// CAN FD frame, `< error ... >` for an error frame; none for what socketcand cannot carry
+/// (remote request frames).
 pub fn frame_element(f: &Frame) -> Option<String> {
     if f.is_err() {
         return Some(format!("< error {:03X} {} >", f.id & 0x1FFF_FFFF, time_text(f.ts_ns)));
     }
-    if f.is_rtr() || f.is_fd() {
+    if f.is_rtr() || (f.is_fd() && !is_fd_len(f.len as usize)) {
         return None;
     }
     let data: String = f.payload().iter().map(|b| format!("{b:02X}")).collect();
+    if f.is_fd() {
+        let (id, flags, ts) = (id_text(f), fd_flags(f), time_text(f.ts_ns));
+        return Some(format!("< fdframe {id} {flags:02X} {ts} {data} >"));
+    }
     Some(format!("< frame {} {} {data} >", id_text(f), time_text(f.ts_ns)))
 }
 
-/// The element a client sends to put `f` on the bus: `< send ID LEN B0 ... >`; none for what
-/// the protocol cannot carry (remote request, CAN FD and error frames).
+/// The element a client sends to put `f` on the bus: `< send ID LEN B0 ... >`, or
+/// `< fdsend ID FLAGS LEN B0 ... >` for a CAN FD frame; none for what the protocol cannot
+/// carry (remote request and error frames).
 pub fn send_element(f: &Frame) -> Option<String> {
-    if f.is_rtr() || f.is_fd() || f.is_err() {
+    if f.is_rtr() || f.is_err() || (f.is_fd() && !is_fd_len(f.len as usize)) {
         return None;
     }
-    let mut s = format!("< send {} {}", id_text(f), f.len);
+    let mut s = if f.is_fd() {
+        format!("< fdsend {} {:02X} {}", id_text(f), fd_flags(f), f.len)
+    } else {
+        format!("< send {} {}", id_text(f), f.len)
+    };
     for b in f.payload() {
         s.push_str(&format!(" {b:x}"));
     }
@@ -493,7 +612,10 @@ mod tests {
     fn bad_requests_say_what_is_wrong() {
         let e = |t| parse_request(t).unwrap_err().to_string();
         assert_eq!(e("send 601 2 40"), "send: length 2 but 1 data bytes");
-        assert_eq!(e("send 601 9 1 2 3 4 5 6 7 8 9"), "send: length 9 is not 0..8");
+        assert_eq!(
+            e("send 601 9 1 2 3 4 5 6 7 8 9"),
+            "send: length 9 is not 0..8 (a CAN FD frame goes as fdsend ID FLAGS LEN DATA)"
+        );
         assert_eq!(
             e("send 901 0"),
             "identifier 901 does not fit 11 bits (write 8 hex digits for a 29-bit identifier)"
@@ -538,6 +660,122 @@ mod tests {
             g.ts_ns = 1_500_000_000;
             Ok(Reply::Frame(g))
         });
+    }
+
+    /// An FD frame as the parsers build it.
+    fn fd(id: u32, ext: bool, flags: u8, data: &[u8], ts_ns: u64) -> Frame {
+        let mut f = fd_frame(id, ext, flags, data);
+        f.ts_ns = ts_ns;
+        f
+    }
+
+    #[test]
+    fn fd_frames_are_fdframe_and_fdsend_with_their_flags() {
+        let data: Vec<u8> = (0x11..=0x1C).collect();
+        let mut f = fd(0x123, false, CANFD_BRS, &data, 23_424_242_000);
+        assert!(f.is_fd() && f.flags.has(Flags::BRS) && !f.flags.has(Flags::ESI));
+        let text = frame_element(&f).unwrap();
+        assert_eq!(text, "< fdframe 123 01 23.424242 1112131415161718191A1B1C >");
+        let inner = text.trim_start_matches('<').trim_end_matches('>').trim();
+        assert_eq!(parse_reply(inner), Ok(Reply::Frame(f)));
+        f.ts_ns = 0;
+        assert_eq!(
+            send_element(&f).unwrap(),
+            "< fdsend 123 01 12 11 12 13 14 15 16 17 18 19 1a 1b 1c >"
+        );
+        assert_eq!(
+            parse_request("fdsend 123 01 12 11 12 13 14 15 16 17 18 19 1a 1b 1c"),
+            Ok(Request::Send(f))
+        );
+        // 29-bit, ESI, 64 bytes, and an empty FD frame.
+        let big = fd(0x1ABC_DEF0, true, CANFD_ESI | CANFD_BRS, &[0xAB; 64], 1_000_000);
+        let text = frame_element(&big).unwrap();
+        assert!(text.starts_with("< fdframe 1ABCDEF0 03 0.001000 ABAB"), "{text}");
+        let inner = text.trim_start_matches('<').trim_end_matches('>').trim();
+        assert_eq!(parse_reply(inner), Ok(Reply::Frame(big)));
+        let empty = fd(0x7FF, false, 0, &[], 0);
+        assert_eq!(send_element(&empty).unwrap(), "< fdsend 7FF 00 0 >");
+        assert_eq!(parse_request("fdsend 7FF 0 0"), Ok(Request::Send(empty)));
+        // The kernel's FDF bit is carried as it came.
+        let fdf = fd(0x10, false, CANFD_FDF, &[1], 0);
+        assert_eq!(frame_element(&fdf).unwrap(), "< fdframe 010 04 0.000000 01 >");
+        // The maintainer's branch writes no FLAGS; unknown flag bits from a server are ignored.
+        assert_eq!(
+            parse_reply("fdframe 03B 1589476062.377071 7D1FDF312DD0DE1CAABBCCDD"),
+            Ok(Reply::Frame(fd(
+                0x3B,
+                false,
+                0,
+                &[0x7D, 0x1F, 0xDF, 0x31, 0x2D, 0xD0, 0xDE, 0x1C, 0xAA, 0xBB, 0xCC, 0xDD],
+                1_589_476_062_377_071_000
+            )))
+        );
+        assert_eq!(
+            parse_reply("fdframe 123 F1 1.000000 01"),
+            Ok(Reply::Frame(fd(0x123, false, CANFD_BRS, &[1], 1_000_000_000)))
+        );
+    }
+
+    #[test]
+    fn malformed_fd_elements_say_what_is_wrong() {
+        let reply = |t: &str| parse_reply(t).unwrap_err().to_string();
+        assert_eq!(reply("fdframe"), "fdframe takes ID FLAGS SECS.USECS DATA");
+        assert_eq!(reply("fdframe 123"), "fdframe takes ID FLAGS SECS.USECS DATA");
+        assert_eq!(reply("fdframe 123 01"), "fdframe takes ID FLAGS SECS.USECS DATA");
+        assert_eq!(reply("fdframe 123 01 later 00"), "later is not a time SECS.USECS");
+        assert_eq!(
+            reply("fdframe 123 1FF 1.5 00"),
+            "fdframe: flags 1FF is not one byte in hex (01 BRS, 02 ESI)"
+        );
+        assert_eq!(
+            reply("fdframe 12345 01 1.5 00"),
+            "identifier 12345 does not fit 11 bits (write 8 hex digits for a 29-bit identifier)"
+        );
+        assert_eq!(
+            reply("fdframe 123 01 1.5 ABC"),
+            "fdframe data ABC is not up to 64 bytes in hex"
+        );
+        assert_eq!(
+            reply("fdframe 123 01 1.5 XY"),
+            "fdframe data XY is not up to 64 bytes in hex"
+        );
+        let long = "00".repeat(65);
+        assert!(reply(&format!("fdframe 123 01 1.5 {long}")).ends_with("is not up to 64 bytes in hex"));
+        assert_eq!(
+            reply("fdframe 123 01 1.5 00112233445566778899"),
+            "fdframe: 10 data bytes is not a CAN FD length (0..8, 12, 16, 20, 24, 32, 48, 64)"
+        );
+        let req = |t: &str| parse_request(t).unwrap_err().to_string();
+        assert!(req("fdsend").starts_with("fdsend takes ID FLAGS LEN and LEN data bytes"));
+        assert!(req("fdsend 123 01").starts_with("fdsend takes ID FLAGS LEN and LEN data bytes"));
+        assert_eq!(
+            req("fdsend 123 x 1 00"),
+            "fdsend: flags x is not one byte in hex (01 BRS, 02 ESI)"
+        );
+        assert_eq!(
+            req("fdsend 123 10 1 00"),
+            "fdsend: flags 10 has bits other than 01 (BRS), 02 (ESI), 04 (FDF)"
+        );
+        assert_eq!(
+            req("fdsend 123 01 13 0 1 2 3 4 5 6 7 8 9 a b c"),
+            "fdsend: length 13 is not a CAN FD length (0..8, 12, 16, 20, 24, 32, 48, 64)"
+        );
+        assert_eq!(
+            req("fdsend 123 01 C 0 1 2 3 4 5 6 7 8 9 a b"),
+            "fdsend: length C is not a CAN FD length (0..8, 12, 16, 20, 24, 32, 48, 64)"
+        );
+        assert_eq!(req("fdsend 123 01 12 0 1 2"), "fdsend: length 12 but 3 data bytes");
+        assert_eq!(req("fdsend 123 01 1 100"), "fdsend: 100 is not a byte in hex");
+        assert_eq!(
+            req("fdsend 1234 01 0"),
+            "identifier 1234 does not fit 11 bits (write 8 hex digits for a 29-bit identifier)"
+        );
+        // python-can writes an FD message as a `send` with its length in hex: refused,
+        // naming fdsend.
+        assert_eq!(
+            req("send 123 C 0 1 2 3 4 5 6 7 8 9 a b"),
+            "send: length C is not 0..8 (a CAN FD frame goes as fdsend ID FLAGS LEN DATA)"
+        );
     }
 
     #[test]
