@@ -104,6 +104,7 @@ actions! {
     Bookmark = "bookmark": "Trace: set (or remove) a bookmark on the selected frame",
     NextBookmark = "next_bookmark": "Trace: jump to the next bookmark (wraps)",
     ShowFrames = "show_frames": "Problems: show the selected incident's frames in the trace (first, then the next at each press)",
+    Boots = "boots": "Problems: the boot stories of each node, as diagnose --boots (again: the incidents)",
 }
 
 /// One key press, normalised (no SHIFT on characters).

@@ -749,6 +749,12 @@ impl Screen {
             }
             // From any pane: the next frame of the incident selected in the Problems pane, so
             // that pressing it again in the trace walks through the incident's frames.
+            // From any pane: the boot stories in the Problems pane.
+            Action::Boots => {
+                self.focus = Pane::Problems;
+                let ctx = self.ctx(trace, paused);
+                self.panes.problems_mut().handle(a, &ctx, q);
+            }
             Action::ShowFrames => {
                 let ctx = self.ctx(trace, paused);
                 self.panes.problems_mut().refresh(&ctx);

@@ -2,6 +2,7 @@
 //! ([`Component::handle`], answering with events of [`crate::tui::event`]) and draws
 //! itself; plus the shared styles.
 
+mod boots;
 mod cycles;
 pub mod detail;
 pub mod help;

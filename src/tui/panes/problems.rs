@@ -3,6 +3,7 @@
 //! check first, why it matters) and, on a timeline step, shows that frame in the trace;
 //! `show_frames` shows the selected incident's frames in the trace one after the other.
 
+use super::boots::BootsView;
 use super::{Component, Ctx, ListState, Selected, block, fit, header, selected};
 use crate::analysis::{Incident, Problem, Status};
 use crate::tui::event::{Event, Queue};
@@ -34,6 +35,9 @@ pub struct ProblemsPane {
     /// The trace's diagnosis version the incidents were built at.
     version: Option<u64>,
     jump: Option<Jump>,
+    /// The boot stories, shown in place of the incidents while `showing_boots`.
+    boots: BootsView,
+    showing_boots: bool,
 }
 
 /// Seconds since the first frame, as `12.345`.
@@ -134,6 +138,14 @@ impl Component for ProblemsPane {
     /// Moves the selection; `expand` opens an incident, and on a timeline step shows its
     /// frame in the trace; `show_frames` goes through the incident's frames; `back` closes.
     fn handle(&mut self, action: Action, ctx: &Ctx, q: &mut Queue) -> bool {
+        if action == Action::Boots {
+            self.showing_boots = !self.showing_boots;
+            self.boots.refresh(ctx);
+            return true;
+        }
+        if self.showing_boots && action != Action::ShowFrames {
+            return self.boots.handle(action, ctx, q);
+        }
         if let Some(delta) = ListState::movement(action, ctx.page) {
             self.scroll(delta, ctx);
             return true;
@@ -176,16 +188,26 @@ impl Component for ProblemsPane {
     }
 
     fn click(&mut self, row: usize, ctx: &Ctx) {
+        if self.showing_boots {
+            return self.boots.click(row, ctx);
+        }
         self.list.click(row, self.len(), ctx.page);
     }
 
     fn fit(&mut self, height: usize, ctx: &Ctx) {
         self.refresh(ctx);
         self.list.clamp(self.len(), height);
+        if self.showing_boots {
+            self.boots.fit(height, ctx);
+        }
     }
 
-    /// The frame of the selected timeline step, or the incident's first frame.
+    /// The frame of the selected timeline step, or the incident's first frame (the boot's
+    /// step or first frame while the boot stories show).
     fn selected(&self, _ctx: &Ctx) -> Option<Selected> {
+        if self.showing_boots {
+            return self.boots.selected();
+        }
         let inc = self.current()?;
         let step = match self.opened {
             Some(_) => inc.events.get(self.list.selected),
@@ -195,6 +217,9 @@ impl Component for ProblemsPane {
     }
 
     fn render(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
+        if self.showing_boots {
+            return self.boots.render(f, area, ctx, focused);
+        }
         match self.opened.and_then(|o| self.incidents.get(o)) {
             Some(inc) => self.render_incident(inc, f, area, ctx, focused),
             None => self.render_list(f, area, ctx, focused),

@@ -724,6 +724,50 @@ fn problems_pane_lists_the_incidents_and_opens_one_at_80x24() {
 }
 
 #[test]
+fn boot_stories_list_each_boot_and_open_one_with_its_steps_and_findings() {
+    let mut a = app_of_log("tests/fixtures/boot/boots_differ.log");
+    // From the trace: `boots` goes to the Problems pane and shows the stories.
+    a.act(Action::Boots);
+    assert_eq!(a.focus(), Pane::Problems);
+    let s = screen(&mut a, 120, 24);
+    assert!(s.contains("Boot stories (2 boots, 1 with findings)"), "{s}");
+    let row = |s: &str, boot: &str| s.lines().find(|l| l.contains(boot)).unwrap_or_default().to_string();
+    let first = row(&s, "Node 5              1");
+    assert!(first.contains("0.000        0.100     6        0  -"), "{s}");
+    let second = row(&s, "Node 5              2");
+    assert!(second.contains("1.000        1.200     7        5  boot 1"), "{s}");
+    insta::assert_snapshot!("boot_stories_120x24_list", s);
+    // The second boot opened: its steps as `diagnose --boots` tells them, then the findings.
+    a.act(Action::Down);
+    a.act(Action::Expand);
+    let s = screen(&mut a, 120, 24);
+    assert!(
+        s.contains("Node 5, boot 2 at 1.000 s, operational at 1.200 s (heartbeat)"),
+        "{s}"
+    );
+    assert!(
+        s.contains("1.130 s  #19      write 0x1400:02 = 0xFE  refused: Invalid value"),
+        "{s}"
+    );
+    assert!(s.contains("missing: 0x1800:02 not written, boot 1 wrote 0x01"), "{s}");
+    insta::assert_snapshot!("boot_stories_120x24_opened", s);
+    // Enter on the third step (the write of 0x1017:00, frame 15) shows it in the trace.
+    a.act(Action::Down);
+    a.act(Action::Down);
+    a.act(Action::Expand);
+    assert_eq!(a.focus(), Pane::Trace);
+    assert_eq!(a.selected_position(), Some(14));
+    // Back in the pane, `back` closes the boot, `boots` again shows the incidents.
+    a.act(Action::PaneProblems);
+    a.act(Action::Back);
+    let s = screen(&mut a, 120, 24);
+    assert!(s.contains("Boot stories (2 boots"), "{s}");
+    a.act(Action::Boots);
+    let s = screen(&mut a, 120, 24);
+    assert!(s.contains("Problems (2 open"), "{s}");
+}
+
+#[test]
 fn problems_pane_shows_a_boot_that_differs_with_its_findings_as_steps() {
     let mut a = app_of_log("tests/fixtures/boot/boots_differ.log");
     a.act(Action::PaneProblems);
