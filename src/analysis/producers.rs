@@ -1,7 +1,8 @@
 //! Other producers of a broadcast service heard lately: who else sent SYNC (0x080) or NMT
 //! (0x000) frames in the seconds before the newest frame, not counting the frames cotui sent
 //! itself (those carry the TX flag). The palette warns with it before starting a second
-//! SYNC producer or commanding as a second NMT master.
+//! SYNC producer or commanding as a second NMT master; `cotui sync` and `cotui nmt` listen
+//! with [`from_other`] and [`Heard::note`] before they send (`command::listen_first`).
 
 use super::trace::Trace;
 use crate::frame::Flags;
@@ -18,6 +19,23 @@ pub struct Heard {
     pub last_ns: u64,
 }
 
+impl Heard {
+    /// `heard` with one more frame of the other producer, stamped `ts_ns`.
+    pub fn note(heard: Option<Heard>, ts_ns: u64) -> Heard {
+        let h = heard.unwrap_or(Heard { count: 0, last_ns: 0 });
+        Heard {
+            count: h.count + 1,
+            last_ns: h.last_ns.max(ts_ns),
+        }
+    }
+}
+
+/// True for a frame another producer of `cob_id` sent: a classic 11-bit frame with that
+/// id, not cotui's own (TX) and not an error frame.
+pub fn from_other(id: u32, flags: Flags, cob_id: u32) -> bool {
+    id == cob_id && !flags.has(Flags::TX) && !flags.has(Flags::EXT) && !flags.has(Flags::ERR)
+}
+
 /// Classic 11-bit frames with `cob_id`, not sent by cotui, in the [`RECENT_NS`] before the
 /// trace's newest frame; None when there were none.
 pub fn heard(trace: &Trace, cob_id: u32) -> Option<Heard> {
@@ -32,11 +50,8 @@ pub fn heard(trace: &Trace, cob_id: u32) -> Option<Heard> {
         if p.ts_ns < since {
             break;
         }
-        let flags = Flags(p.flags);
-        if p.id == cob_id && !flags.has(Flags::TX) && !flags.has(Flags::EXT) && !flags.has(Flags::ERR) {
-            let h = out.get_or_insert(Heard { count: 0, last_ns: 0 });
-            h.count += 1;
-            h.last_ns = h.last_ns.max(p.ts_ns);
+        if from_other(p.id, Flags(p.flags), cob_id) {
+            out = Some(Heard::note(out, p.ts_ns));
         }
     }
     out

@@ -8,6 +8,7 @@ pub mod drive;
 pub mod error;
 pub mod exec;
 pub mod grammar;
+pub mod listen_first;
 pub mod lss;
 pub mod nmt;
 pub mod object;

@@ -2,8 +2,9 @@
 
 use super::error::CommandError;
 use super::grammar::NMT_WAIT_MS;
+use super::listen_first::{LISTEN_MS, Listen, OtherProducer};
 use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
-use super::words::{NMT_WORDS, ParseError, TypedWords, ms_arg, node_or_all_arg};
+use super::words::{NMT_WORDS, ParseError, TypedWords, ms_arg, ms_or_zero_arg, node_or_all_arg};
 use crate::bus::Bus;
 use crate::cob;
 use crate::decode::heartbeat::NmtState;
@@ -12,7 +13,7 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::time::Duration;
 
-/// `nmt ACTION NODE [--wait] [--timeout MS]`.
+/// `nmt ACTION NODE [--wait] [--timeout MS] [--listen DUR] [--force]`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct NmtArgs {
     /// start, stop, preop, reset-node or reset-comm.
@@ -27,6 +28,12 @@ pub struct NmtArgs {
     /// How long --wait waits (DUR: a bare number is ms, or 500ms, 2s, 1min).
     #[arg(long, value_parser = ms_arg, default_value_t = NMT_WAIT_MS)]
     pub timeout: u64,
+    /// How long to listen for another NMT master before sending (DUR; 0: do not listen).
+    #[arg(long, value_parser = ms_or_zero_arg, default_value_t = LISTEN_MS)]
+    pub listen: u64,
+    /// Send even when another NMT master is heard.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// An NMT command to a node (0 = all), optionally confirmed.
@@ -37,6 +44,8 @@ pub struct Nmt {
     /// Wait for the heartbeat or boot-up that confirms it.
     pub wait: bool,
     pub timeout_ms: u64,
+    /// Listening for another NMT master first.
+    pub listen: Listen,
 }
 
 impl<D> CommandArgs<D> for NmtArgs {
@@ -50,6 +59,10 @@ impl<D> CommandArgs<D> for NmtArgs {
             node: self.node,
             wait: self.wait,
             timeout_ms: self.timeout,
+            listen: Listen {
+                ms: self.listen,
+                force: self.force,
+            },
         })
     }
 }
@@ -62,6 +75,8 @@ pub struct NmtSent {
     node: u8,
     /// With `--wait`: node -> the state that confirmed the command; else null.
     confirmed: Option<BTreeMap<String, &'static str>>,
+    /// The other NMT master heard before sending (sent with --force); else null.
+    other_producer: Option<OtherProducer>,
 }
 
 impl NmtSent {
@@ -75,6 +90,9 @@ impl NmtSent {
         let mut t = format!("NMT {} sent to {target}", self.action);
         for (n, state) in self.confirmed.iter().flatten() {
             t.push_str(&format!("\nnode {n}: {state}"));
+        }
+        if let Some(o) = &self.other_producer {
+            t.push_str(&format!("\nsent anyway (--force): {}", o.text()));
         }
         t
     }
@@ -95,7 +113,9 @@ impl Spec for Nmt {
         })
     }
 
+    /// Listens for another NMT master, then sends (and waits for the confirmation).
     async fn run(&self, ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
+        let other = super::listen_first::before_sending(ctx.bus, cob::NMT, "NMT master", self.listen).await?;
         let seen = nmt(ctx.bus, self.action, self.node, self.wait, self.timeout_ms).await?;
         let sent = NmtSent {
             ok: true,
@@ -104,6 +124,7 @@ impl Spec for Nmt {
             confirmed: self
                 .wait
                 .then(|| seen.iter().map(|(n, s)| (n.to_string(), s.as_str())).collect()),
+            other_producer: other,
         };
         let text = sent.text();
         Ok(Outcome::new(sent, text))

@@ -1,14 +1,17 @@
-//! `sync --period MS [--counter N] [--count N] [--cob-id ID]`: the SYNC producer, with the
-//! CiA 301 counter when asked (see [`super::cyclic`] for the timing and its report).
+//! `sync --period MS [--counter N] [--count N] [--cob-id ID] [--listen DUR] [--force]`: the
+//! SYNC producer, with the CiA 301 counter when asked (see [`super::cyclic`] for the timing
+//! and its report), after listening for another SYNC producer ([`super::listen_first`]).
 
 use super::cyclic::{Schedule, Source, sync_frame};
 use super::error::CommandError;
+use super::listen_first::{LISTEN_MS, Listen, OtherProducer};
 use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
-use super::words::{ParseError, cob_arg, count_arg, counter_arg, ms_arg, not_reserved};
+use super::words::{ParseError, cob_arg, count_arg, counter_arg, ms_arg, ms_or_zero_arg, not_reserved};
 use crate::cob;
 use crate::od::bind::Bindings;
+use serde::Serialize;
 
-/// `sync --period MS [--counter N] [--count N] [--cob-id ID]`.
+/// `sync --period MS [--counter N] [--count N] [--cob-id ID] [--listen DUR] [--force]`.
 #[derive(clap::Args, Clone, Debug)]
 pub struct SyncArgs {
     /// The SYNC period in ms.
@@ -23,7 +26,11 @@ pub struct SyncArgs {
     /// The SYNC COB-ID (11-bit).
     #[arg(long, value_parser = cob_arg, default_value = "0x080")]
     pub cob_id: u32,
-    /// Use a --cob-id that another service owns (an SDO, EMCY or heartbeat id...).
+    /// How long to listen for another SYNC producer before sending (DUR; 0: do not listen).
+    #[arg(long, value_parser = ms_or_zero_arg, default_value_t = LISTEN_MS)]
+    pub listen: u64,
+    /// Use a --cob-id that another service owns (an SDO, EMCY or heartbeat id...), and send
+    /// even when another SYNC producer is heard.
     #[arg(long)]
     pub force: bool,
 }
@@ -35,6 +42,16 @@ pub struct Sync {
     /// The CiA 301 counter's overflow value (2..=240), if the counter is sent.
     pub counter: Option<u8>,
     pub schedule: Schedule,
+    /// Listening for another SYNC producer first.
+    pub listen: Listen,
+}
+
+/// `sync --json`: the cyclic report and the other SYNC producer heard (sent with --force).
+#[derive(Debug, Serialize)]
+struct SyncReport {
+    #[serde(flatten)]
+    sent: super::cyclic::Report,
+    other_producer: Option<OtherProducer>,
 }
 
 impl<D> CommandArgs<D> for SyncArgs {
@@ -55,6 +72,10 @@ impl<D> CommandArgs<D> for SyncArgs {
                 every_ms: Some(self.period),
                 count: self.count,
             },
+            listen: Listen {
+                ms: self.listen,
+                force: self.force,
+            },
         })
     }
 }
@@ -66,8 +87,21 @@ impl Spec for Sync {
         super::spec::cyclic_preview(self, known, &counter)
     }
 
+    /// Listens for another SYNC producer, then sends the SYNCs.
     async fn run(&self, ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
-        super::spec::cyclic_run(self, ctx).await
+        let other = super::listen_first::before_sending(ctx.bus, self.cob_id, "SYNC producer", self.listen).await?;
+        let sent = super::cyclic::transmit(ctx.bus, self.frames(), ctx.progress, ctx.stop).await?;
+        let mut text = sent.text();
+        if let Some(o) = &other {
+            text.push_str(&format!("\nsent anyway (--force): {}", o.text()));
+        }
+        Ok(Outcome::new(
+            SyncReport {
+                sent,
+                other_producer: other,
+            },
+            text,
+        ))
     }
 
     fn cyclic(&self) -> bool {
@@ -75,12 +109,19 @@ impl Spec for Sync {
     }
 
     fn source(&self, _bindings: &Bindings) -> Option<Result<Source, CommandError>> {
+        Some(Ok(self.frames()))
+    }
+}
+
+impl Sync {
+    /// The SYNC frames on their schedule.
+    fn frames(&self) -> Source {
         let (cob, counter) = (self.cob_id, self.counter);
-        Some(Ok(Source {
+        Source {
             what: format!("SYNC {cob:03X}"),
             next: Box::new(move |i| sync_frame(cob, counter, i)),
             defaulted: Vec::new(),
             schedule: self.schedule,
-        }))
+        }
     }
 }

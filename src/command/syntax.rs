@@ -213,6 +213,7 @@ mod tests {
                 node: 0,
                 wait: true,
                 timeout_ms: crate::command::grammar::NMT_WAIT_MS,
+                listen: crate::command::listen_first::Listen { ms: 300, force: false },
             })
         );
         assert_eq!(
@@ -385,7 +386,8 @@ mod tests {
             Command::Sync(crate::command::sync::Sync {
                 cob_id: 0x080,
                 counter: Some(240),
-                schedule: every(Some(10), Some(3))
+                schedule: every(Some(10), Some(3)),
+                listen: crate::command::listen_first::Listen { ms: 300, force: false },
             })
         );
         assert_eq!(

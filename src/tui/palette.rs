@@ -56,11 +56,18 @@ pub fn plan(
 /// Before `sync` (a second SYNC producer) or `nmt` (a second NMT master): when another
 /// producer of that COB-ID was heard in the last 2 s (not cotui's own frames), the preview
 /// says so and the line must be confirmed. `t0_ns` is the trace's start (times are shown
-/// from it, as the trace's).
+/// from it, as the trace's). This check replaces the command line's listening before
+/// sending (the trace already holds the bus's last seconds), which the command then skips.
 pub fn warn_second_producer(p: &mut Planned, trace: &Trace, t0_ns: u64) {
-    let (cob_id, who) = match &p.command {
-        Command::Sync(s) => (s.cob_id, "SYNC producer"),
-        Command::Nmt(_) => (0x000, "NMT master"),
+    let (cob_id, who) = match &mut p.command {
+        Command::Sync(s) => {
+            s.listen.ms = 0;
+            (s.cob_id, "SYNC producer")
+        }
+        Command::Nmt(n) => {
+            n.listen.ms = 0;
+            (0x000, "NMT master")
+        }
         _ => return,
     };
     let Some(h) = producers::heard(trace, cob_id) else {
@@ -138,6 +145,10 @@ mod tests {
         let p = planned("nmt start 2", &other);
         let warning = "another NMT master is on the bus: 0x000 seen 1 time in the last 2 s, last at 4.000 s";
         assert_eq!(p.confirm.as_deref(), Some(warning));
+        // The trace was the check: the commands do not listen again before sending.
+        assert!(matches!(&p.command, Command::Nmt(n) if n.listen.ms == 0));
+        let p = planned("sync --period 10 --listen 1s", &other);
+        assert!(matches!(&p.command, Command::Sync(s) if s.listen.ms == 0));
     }
 
     #[test]

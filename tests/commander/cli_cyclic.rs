@@ -92,7 +92,7 @@ async fn sync_counts_1_to_n_at_the_period() {
     let d = Demo::spawn(Simulation::demo(), false);
     let b = cotui::od::bind::Bindings::new().unwrap();
     let mut watch = d.bus.subscribe();
-    let sync = parse_command("sync --period 10 --counter 2 --count 5").unwrap();
+    let sync = parse_command("sync --period 10 --counter 2 --count 5 --force").unwrap();
     let o = execute(&d.bus, &sync, &b).await.unwrap();
     assert_eq!(
         (o.json()["count"].as_u64(), o.json()["seen"].as_u64()),

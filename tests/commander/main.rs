@@ -25,6 +25,7 @@ mod run;
 mod sdo_client_misbehave;
 mod sdo_client_server;
 mod sdo_proptest;
+mod second_producer;
 mod socketcan_live;
 mod socketcand;
 mod trigger_live;
