@@ -86,17 +86,22 @@ impl ExportFormat {
     }
 }
 
+/// Creates the export file `path`: an existing file is refused unless `force` (then replaced).
+pub(crate) fn create(path: &Path, force: bool) -> io::Result<std::fs::File> {
+    if force {
+        OpenOptions::new().write(true).create(true).truncate(true).open(path)
+    } else {
+        OpenOptions::new().write(true).create_new(true).open(path)
+    }
+}
+
 /// Frames decoded per step when exporting JSON lines.
 const CHUNK: usize = 4096;
 
 /// Writes the rows of `view` to `path` (refusing an existing file unless `force`); returns
 /// how many frames were written.
 pub fn export(trace: &Trace, view: &View, path: &Path, format: ExportFormat, force: bool) -> io::Result<usize> {
-    let file = if force {
-        OpenOptions::new().write(true).create(true).truncate(true).open(path)?
-    } else {
-        OpenOptions::new().write(true).create_new(true).open(path)?
-    };
+    let file = create(path, force)?;
     let mut out = BufWriter::new(file);
     let rows = view.len(trace);
     let positions = (0..rows).map(|r| view.position(r));

@@ -7,8 +7,8 @@ use super::panes::plot::PlotPane;
 use crate::analysis::series::{SeriesKey, TimeWindow};
 use crate::analysis::trace::Trace;
 use crate::od::format_number;
-use std::fs::OpenOptions;
 use std::io::Write;
+use std::path::Path;
 
 /// The CSV text of `keys` within `window` (None: every point): a row per time any signal
 /// has a value; a signal without a value at that time leaves its cell empty. Values are as
@@ -80,18 +80,12 @@ pub(crate) fn command(rest: &str, trace: &Trace, plot: &PlotPane) -> Result<Stri
     let keys = plot.shown(trace);
     let window = plot.visible_window(trace).ok_or(ExportError::NothingPlotted)?;
     let text = csv(trace, &keys, (!all).then_some(window));
-    let write = || -> std::io::Result<()> {
-        let mut f = if force {
-            OpenOptions::new().write(true).create(true).truncate(true).open(&file)?
-        } else {
-            OpenOptions::new().write(true).create_new(true).open(&file)?
-        };
-        f.write_all(text.as_bytes())
-    };
-    write().map_err(|source| ExportError::Write {
-        file: file.clone(),
-        source,
-    })?;
+    crate::tui::export::create(Path::new(&file), force)
+        .and_then(|mut f| f.write_all(text.as_bytes()))
+        .map_err(|source| ExportError::Write {
+            file: file.clone(),
+            source,
+        })?;
     let rows = text.lines().count().saturating_sub(1);
     let what = if all { "all points" } else { "the visible window" };
     Ok(format!(

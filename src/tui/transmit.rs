@@ -254,11 +254,11 @@ pub(crate) fn submit(
 
 #[cfg(test)]
 mod tests {
-    use crate::tui::app::{App, SourceInfo, SourceKind};
+    use crate::tui::app::App;
     use crate::tui::keymap::Action;
     use crate::tui::live::Request;
     use crate::tui::panes::Pane;
-    use crate::tui::panes::testutil::{app, screen};
+    use crate::tui::panes::testutil::{live_app, screen};
     use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 
     /// A list: a periodic frame, an RPDO of the demo's node 2 disabled, a bad frame.
@@ -274,16 +274,6 @@ mod tests {
         let path = std::env::temp_dir().join(format!("cotui-tx-{name}-{}.json", std::process::id()));
         std::fs::write(&path, LIST).unwrap();
         path
-    }
-
-    /// `app()` fed by a live source whose requests the test reads, with demo bindings.
-    fn live_app(listen_only: bool) -> (App, tokio::sync::mpsc::UnboundedReceiver<Request>) {
-        let (_ftx, frx) = std::sync::mpsc::channel();
-        let (rtx, rrx) = tokio::sync::mpsc::unbounded_channel();
-        let mut a = app();
-        *a.capture_mut().source_mut() = SourceInfo::live("vcan0", SourceKind::Live { listen_only }, frx, rtx);
-        a.set_bindings(crate::cli::bind::bindings_on(crate::connect::DEMO, &[], &[]).unwrap());
-        (a, rrx)
     }
 
     /// The enabled flags of the last list sent to the bus task.

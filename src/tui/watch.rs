@@ -16,8 +16,8 @@ use crate::command::Command;
 use crate::command::watch_table::WatchFormat;
 use crate::frame::NodeKey;
 use crate::od::bind::Bindings;
-use std::fs::OpenOptions;
 use std::io::Write;
+use std::path::Path;
 
 /// Why a listen-only session polls nothing.
 const LISTEN_ONLY: &str = "watch: listen-only session — nothing can be sent, so no object is polled";
@@ -145,18 +145,12 @@ pub(crate) fn export(rest: &str, pane: &WatchPane) -> Result<String, ExportError
         return Err(ExportError::NothingWatched);
     }
     let text = board.csv();
-    let write = || -> std::io::Result<()> {
-        let mut f = if force {
-            OpenOptions::new().write(true).create(true).truncate(true).open(&file)?
-        } else {
-            OpenOptions::new().write(true).create_new(true).open(&file)?
-        };
-        f.write_all(text.as_bytes())
-    };
-    write().map_err(|source| ExportError::Write {
-        file: file.clone(),
-        source,
-    })?;
+    crate::tui::export::create(Path::new(&file), force)
+        .and_then(|mut f| f.write_all(text.as_bytes()))
+        .map_err(|source| ExportError::Write {
+            file: file.clone(),
+            source,
+        })?;
     let rows = text.lines().count().saturating_sub(1);
     let dropped = match board.rounds().1 {
         0 => String::new(),
@@ -172,23 +166,13 @@ pub(crate) fn export(rest: &str, pane: &WatchPane) -> Result<String, ExportError
 mod tests {
     use crate::command::watch_table::Sample;
     use crate::od::Value;
-    use crate::tui::app::{App, SourceInfo, SourceKind};
+    use crate::tui::app::App;
     use crate::tui::keymap::Action;
     use crate::tui::live::Request;
     use crate::tui::panes::Pane;
-    use crate::tui::panes::testutil::{app, screen};
+    use crate::tui::panes::testutil::{app, live_app, screen};
     use crate::tui::watch_board::lock;
     use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
-
-    /// `app()` fed by a live source whose requests the test reads, with demo bindings.
-    fn live_app(listen_only: bool) -> (App, tokio::sync::mpsc::UnboundedReceiver<Request>) {
-        let (_ftx, frx) = std::sync::mpsc::channel();
-        let (rtx, rrx) = tokio::sync::mpsc::unbounded_channel();
-        let mut a = app();
-        *a.capture_mut().source_mut() = SourceInfo::live("vcan0", SourceKind::Live { listen_only }, frx, rtx);
-        a.set_bindings(crate::cli::bind::bindings_on(crate::connect::DEMO, &[], &[]).unwrap());
-        (a, rrx)
-    }
 
     /// The requests sent: `watch` or `stop`.
     fn sent(req: &mut tokio::sync::mpsc::UnboundedReceiver<Request>) -> Vec<String> {

@@ -398,6 +398,16 @@ pub(crate) mod testutil {
     use ratatui::Terminal;
     use ratatui::backend::TestBackend;
 
+    /// `app()` fed by a live source whose requests the test reads, with demo bindings.
+    pub fn live_app(listen_only: bool) -> (App, tokio::sync::mpsc::UnboundedReceiver<crate::tui::live::Request>) {
+        let (_ftx, frx) = std::sync::mpsc::channel();
+        let (rtx, rrx) = tokio::sync::mpsc::unbounded_channel();
+        let mut a = app();
+        *a.capture_mut().source_mut() = SourceInfo::live("vcan0", SourceKind::Live { listen_only }, frx, rtx);
+        a.set_bindings(crate::cli::bind::bindings_on(crate::connect::DEMO, &[], &[]).unwrap());
+        (a, rrx)
+    }
+
     /// A small fixed capture: boot-ups, NMT start, a PDO mapping written by SDO, heartbeats,
     /// statusword PDOs (switched on, then operation enabled), an SDO abort, an EMCY.
     pub fn frames() -> Vec<Frame> {
