@@ -73,23 +73,18 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
             return ExitCode::Usage;
         }
     };
-    let mut expected = Vec::new();
-    for arg in &args.expect {
-        match super::expect::read(arg, |n| decoder.dictionary(n)) {
-            Ok((node, values, warnings)) => {
-                for w in warnings {
-                    eprintln!("cotui diagnose: warning: {w}");
-                }
-                expected.push((node, values));
-            }
-            Err(e) => {
-                eprintln!("cotui diagnose: {e}");
-                return ExitCode::Usage;
-            }
+    let expected = match crate::command::dcf::expect::read_all(&args.expect, &decoder) {
+        Ok(e) => e,
+        Err(e) => {
+            eprintln!("cotui diagnose: {e}");
+            return ExitCode::Usage;
         }
+    };
+    for w in &expected.warnings {
+        eprintln!("cotui diagnose: warning: {w}");
     }
     let mut trace = Trace::headless(decoder, Views::Diagnosis);
-    for (node, values) in expected {
+    for (node, values) in expected.nodes {
         trace.diagnosis.expect(node, values);
     }
     if args.duration.is_some() && args.live.is_none() {

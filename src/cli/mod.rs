@@ -11,7 +11,6 @@ mod decode_parquet;
 mod decode_records;
 mod decode_sync;
 pub mod diagnose;
-mod expect;
 pub mod explain;
 pub mod gateway;
 pub mod input;

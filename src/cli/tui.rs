@@ -29,6 +29,10 @@ pub struct UiArgs {
     /// Bind an EDS/DCF file to a node: NODE=FILE.
     #[arg(long = "eds", value_name = "NODE=FILE")]
     pub eds: Vec<String>,
+    /// The configuration a node's boots should write: NODE=FILE.dcf, compared in the boot
+    /// stories (`B`) as `diagnose --expect` compares it (also `:expect` in the palette).
+    #[arg(long = "expect", value_name = "NODE=FILE")]
+    pub expect: Vec<String>,
 }
 
 /// The nominal bit rates `--bitrate` takes: CAN's arbitration rate is at most 1 Mbit/s
@@ -207,6 +211,14 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding, transmit: Opt
         Feeding::Live(ifaces, _) => live_bitrate(ui.bitrate, ifaces),
         Feeding::Demo(..) => live_bitrate(ui.bitrate, &[crate::connect::DEMO.to_string()]),
     };
+    let mut trace = Trace::new(decoder, bitrate);
+    let warnings = match crate::tui::expect::set(&mut trace, &ui.expect) {
+        Ok(w) => w,
+        Err(e) => {
+            eprintln!("cotui: --{e}");
+            return ExitCode::Usage;
+        }
+    };
     let src = match feed {
         Feeding::Log((rx, ctl)) => SourceInfo::new(name, kind, rx, ctl),
         Feeding::Live(ifaces, listen_only) => {
@@ -219,7 +231,11 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding, transmit: Opt
             SourceInfo::live(name, kind, rx, req)
         }
     };
-    let mut app = App::new(Trace::new(decoder, bitrate), keymap, src);
+    let mut app = App::new(trace, keymap, src);
+    for w in warnings {
+        app.screen_mut()
+            .log(crate::tui::messages::Level::Warn, &format!("--expect: {w}"));
+    }
     app.set_bindings(bindings);
     // `cotui open FILE`: the bookmarks are kept beside the log (README, "Bookmarks").
     if open_file {

@@ -153,6 +153,11 @@ impl Capture {
         &mut self.trace
     }
 
+    /// Runs `:expect` (see [`super::expect::command`]) on the trace's diagnosis.
+    pub(crate) fn expect(&mut self, rest: &str) -> Result<(String, Vec<String>), String> {
+        super::expect::command(rest, &mut self.trace)
+    }
+
     /// The capture source.
     pub fn source(&self) -> &SourceInfo {
         &self.source

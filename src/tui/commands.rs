@@ -36,6 +36,7 @@ pub const PALETTE_COMMANDS: &[&str] = &[
     "sim",
     "trigger",
     "bookmarks",
+    "expect",
 ];
 
 /// Why a built-in palette command (`goto`, `time`, `speed`, `plot`, `export`, ...) failed;
@@ -182,6 +183,22 @@ pub(crate) fn run(line: &str, capture: &mut Capture, screen: &mut Screen, q: &mu
         "trigger" => {
             match screen.apply_trigger(capture.trace(), rest) {
                 Ok(text) => screen.set_message(Some(text)),
+                Err(e) => {
+                    screen.log(Level::Error, &e);
+                    screen.set_message(Some(e));
+                }
+            }
+            return Ran::Done;
+        }
+        "expect" => {
+            match capture.expect(rest) {
+                Ok((text, warnings)) => {
+                    for w in &warnings {
+                        screen.log(Level::Warn, &format!("expect: {w}"));
+                    }
+                    screen.log(Level::Info, &text);
+                    screen.set_message(Some(text));
+                }
                 Err(e) => {
                     screen.log(Level::Error, &e);
                     screen.set_message(Some(e));

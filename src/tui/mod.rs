@@ -9,6 +9,7 @@ pub mod bookmarks;
 pub mod capture;
 pub mod commands;
 mod event;
+pub mod expect;
 pub mod export;
 mod export_plot;
 mod frame_feed;

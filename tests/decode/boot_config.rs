@@ -223,6 +223,18 @@ fn a_dcf_whose_type_disagrees_with_the_dictionary_names_the_object_and_line() {
     );
 }
 
+#[test]
+fn the_tui_refuses_an_expect_dcf_that_disagrees_with_the_dictionary_before_it_starts() {
+    // `open --expect` reads the DCF as `diagnose --expect` does, and says why before any
+    // terminal is taken.
+    let out = cotui(&["open", "--expect", "5=tests/fixtures/boot/bad_type.dcf", AGREE], None);
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(
+        String::from_utf8(out.stderr).unwrap(),
+        "cotui: --expect: tests/fixtures/boot/bad_type.dcf:7: 0x1017:00 Producer heartbeat time: DataType U32 in the DCF, U16 in the node's EDS/dictionary\n"
+    );
+}
+
 /// (node, boot, operational_by, writes, NMT commands, findings) of each boot of `--boots`.
 fn stories(path: &str) -> Vec<(u64, u64, Value, usize, usize, usize)> {
     let (boots, code) = jsonl(&["--boots", path]);

@@ -49,6 +49,16 @@ impl BootConfigs {
         self.expected.insert(node, values);
     }
 
+    /// No node has an expected configuration any more.
+    pub(super) fn expect_nothing(&mut self) {
+        self.expected.clear();
+    }
+
+    /// The nodes with an expected configuration.
+    pub(super) fn expected_nodes(&self) -> Vec<u8> {
+        self.expected.keys().copied().collect()
+    }
+
     /// A new boot of `n` beginning at `at` with `first`.
     fn begin(&mut self, n: NodeKey, at: At, first: BootStep) {
         let boots = self.stories.entry(n).or_default();

@@ -153,6 +153,16 @@ impl Diagnoser {
         self.boot_configs.expect(node, values);
     }
 
+    /// Forgets every expected configuration ([`Diagnoser::expect`]).
+    pub fn expect_nothing(&mut self) {
+        self.boot_configs.expect_nothing();
+    }
+
+    /// The nodes with an expected configuration, in order.
+    pub fn expected_nodes(&self) -> Vec<u8> {
+        self.boot_configs.expected_nodes()
+    }
+
     /// Names interface `iface` (as the frames of the source call it); a node of a capture
     /// with several interfaces is then shown with its interface's name.
     pub fn name_interface(&mut self, iface: u16, name: &str) {

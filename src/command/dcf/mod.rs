@@ -5,6 +5,7 @@
 //! and written, in which order, is planned by the pure [`plan`]; this module is the bus IO.
 
 pub mod command;
+pub mod expect;
 pub mod plan;
 mod report;
 

@@ -19,6 +19,8 @@ pub(super) struct BootsView {
     list: ListState,
     opened: Option<usize>,
     boots: Vec<Boot>,
+    /// The nodes with an expected configuration (`--expect`, `:expect`).
+    expected: Vec<u8>,
     /// The trace's diagnosis version the boots were built at.
     version: Option<u64>,
 }
@@ -45,6 +47,7 @@ impl BootsView {
         }
         self.version = Some(ctx.trace.diagnosis_version);
         self.boots = ctx.trace.diagnosis.clone().finish_with_boots().1;
+        self.expected = ctx.trace.diagnosis.expected_nodes();
         if self.opened.is_some_and(|o| o >= self.boots.len()) {
             self.opened = None;
         }
@@ -123,7 +126,17 @@ impl BootsView {
 
     fn render_list(&self, origin: u64, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
         let differ = self.boots.iter().filter(|b| !b.findings.is_empty()).count();
-        let title = format!(" Boot stories ({} boots, {differ} with findings) ", self.boots.len());
+        let against = match self.expected.as_slice() {
+            [] => String::new(),
+            nodes => {
+                let list: Vec<String> = nodes.iter().map(u8::to_string).collect();
+                format!("; expected configuration of node {}", list.join(", "))
+            }
+        };
+        let title = format!(
+            " Boot stories ({} boots, {differ} with findings{against}) ",
+            self.boots.len()
+        );
         f.render_widget(block(&title, focused), area);
         let inner = block("", true).inner(area);
         if inner.height == 0 {
@@ -149,9 +162,12 @@ impl BootsView {
             .take(inner.height as usize - 1)
         {
             let op = b.operational.map_or("no".to_string(), |o| secs(o.t_ns, origin));
-            let reference = match b.reference {
-                Some(r) => format!("boot {r}"),
-                None => "-".to_string(),
+            let expected = self.expected.contains(&b.node.node);
+            let reference = match (b.reference, expected) {
+                (Some(r), true) => format!("boot {r} + expected"),
+                (Some(r), false) => format!("boot {r}"),
+                (None, true) => "expected".to_string(),
+                (None, false) => "-".to_string(),
             };
             let text = format!(
                 "{:<16} {:>4} {:>9} {:>12} {:>5} {:>8}  {reference}",

@@ -60,6 +60,10 @@ pub const PALETTE_SYNTAX: &[(&str, &str)] = &[
         "bookmarks",
         "List the bookmarks (open FILE: kept in FILE.cotui-bookmarks.json)",
     ),
+    (
+        "expect NODE=FILE.dcf ... | off",
+        "Compare the node's boots with a DCF (boot stories: B), as diagnose --expect",
+    ),
     ("help", "This help"),
     ("messages", "The message log"),
     ("quit", "Quit"),

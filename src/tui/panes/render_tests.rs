@@ -768,6 +768,45 @@ fn boot_stories_list_each_boot_and_open_one_with_its_steps_and_findings() {
 }
 
 #[test]
+fn expect_in_the_palette_compares_the_boots_with_a_dcf_and_off_forgets_it() {
+    let mut a = app_of_log("tests/fixtures/boot/boots_agree.log");
+    a.act(Action::Boots);
+    let s = screen(&mut a, 120, 24);
+    assert!(s.contains("Boot stories (2 boots, 0 with findings)"), "{s}");
+    // The DCF wants 0x2002:00 = 5, which neither boot writes (as `diagnose --expect`).
+    a.run_command("expect 5=tests/fixtures/boot/node5.dcf");
+    assert_eq!(
+        a.message(),
+        Some("expect: configuration expected of node 5 (the boot stories compare it: B)")
+    );
+    let s = screen(&mut a, 120, 24);
+    assert!(
+        s.contains("Boot stories (2 boots, 2 with findings; expected configuration of node 5)"),
+        "{s}"
+    );
+    let row = |s: &str, boot: &str| s.lines().find(|l| l.contains(boot)).unwrap_or_default().to_string();
+    assert!(row(&s, "Node 5              1").contains("1  expected "), "{s}");
+    assert!(row(&s, "Node 5              2").contains("1  boot 1 + expected"), "{s}");
+    insta::assert_snapshot!("boot_stories_expected_120x24_list", s);
+    a.act(Action::Expand);
+    let s = screen(&mut a, 120, 24);
+    insta::assert_snapshot!("boot_stories_expected_120x24_opened", s);
+    // A file that is not there changes nothing and says why.
+    a.run_command("expect 5=tests/fixtures/boot/nothing_here.dcf");
+    assert!(
+        a.message()
+            .unwrap_or_default()
+            .starts_with("expect: tests/fixtures/boot/nothing_here.dcf: "),
+        "{:?}",
+        a.message()
+    );
+    a.run_command("expect off");
+    a.act(Action::Back);
+    let s = screen(&mut a, 120, 24);
+    assert!(s.contains("Boot stories (2 boots, 0 with findings)"), "{s}");
+}
+
+#[test]
 fn problems_pane_shows_a_boot_that_differs_with_its_findings_as_steps() {
     let mut a = app_of_log("tests/fixtures/boot/boots_differ.log");
     a.act(Action::PaneProblems);

@@ -1,11 +1,34 @@
-//! `diagnose --expect NODE=FILE.dcf`: a DCF read as the configuration a node's boots
-//! should write, typed here at the edge so the diagnosis gets plain values.
+//! `--expect NODE=FILE.dcf` (`diagnose`, the TUI and its `:expect`): a DCF read as the
+//! configuration a node's boots should write, typed here at the edge so the diagnosis gets
+//! plain values.
 
+use super::plan::{never_written, read_dcf, same_value, value_bytes};
 use crate::analysis::boot_story::{Bytes, Expected};
-use crate::command::dcf::plan::{never_written, read_dcf, same_value, value_bytes};
 use crate::od::eds::{import, key_values};
 use crate::od::{Access, Dictionary};
 use std::collections::BTreeMap;
+
+/// Every `NODE=FILE` of `args` read with [`read`] against `decoder`'s dictionaries: the
+/// expected values per node and the files' warnings; the first file that cannot be read is
+/// the error.
+pub fn read_all(args: &[String], decoder: &crate::decode::Decoder) -> Result<Expectations, String> {
+    let mut out = Expectations::default();
+    for arg in args {
+        let (node, values, warnings) = read(arg, |n| decoder.dictionary(n))?;
+        out.nodes.push((node, values));
+        out.warnings.extend(warnings);
+    }
+    Ok(out)
+}
+
+/// What [`read_all`] read: the expected values of each node, and what was left out.
+#[derive(Debug, Default)]
+pub struct Expectations {
+    /// Node and its expected values, in the order given.
+    pub nodes: Vec<(u8, Vec<Expected>)>,
+    /// Values left out of the files, located.
+    pub warnings: Vec<String>,
+}
 
 /// The node and its expected values of `arg` (`NODE=FILE`), with the file's warnings
 /// (values left out, located); `dict(node)` is the node's dictionary (its EDS, profile,
