@@ -14,7 +14,8 @@ exec 9>"$cache/.lock"
 flock 9 # one build at a time; concurrent runs wait for it
 
 # Modules the guest loads; their dependencies are added by modprobe --show-depends.
-modules=(virtio_pci virtio_mmio virtio_console 9pnet_virtio 9p vcan can_raw can_bcm can_gw)
+# kvaser_pci (with sja1000 and can-dev) drives the emulated controllers of VBUS_CAN.
+modules=(virtio_pci virtio_mmio virtio_console 9pnet_virtio 9p vcan can_raw can_bcm can_gw kvaser_pci)
 
 resolve_pkg() {
     apt-cache depends linux-image-amd64 2>/dev/null | awk '/Depends: linux-image-[0-9]/ {print $2; exit}'

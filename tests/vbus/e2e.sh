@@ -35,7 +35,7 @@ live_test=$(cargo test --quiet --test commander --no-run --message-format=json |
 echo "e2e: built on the host in $(since) s"
 
 t_vm=$(date +%s.%N)
-VBUS_IFACES="vcan0 vcan1:fd" VBUS_TIMEOUT=${VBUS_TIMEOUT:-1200} VBUS_TIMING=1 \
+VBUS_IFACES="vcan0 vcan1:fd" VBUS_CAN=2 VBUS_TIMEOUT=${VBUS_TIMEOUT:-$((1200 + ${VBUS_SOAK_S:-60}))} VBUS_TIMING=1 \
     tests/vbus/run.sh tests/vbus/e2e_guest.sh target/release/cotui "$live_test"
 rc=$?
 vm=$(awk -v a="$t_vm" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')

@@ -99,6 +99,20 @@ for d in ${VBUS_OUT:-} ${VBUS_RW:-}; do
     printf 'vbus.rw%s %s\n' "$n" "$d" >> "$x/rw"
 done
 
+# VBUS_CAN=N: N emulated Kvaser PCI controllers (SJA1000, driver kvaser_pci) on one qemu
+# CAN bus, can0..can(N-1) in the guest: real controllers with a bit rate and error
+# counters, down until the command sets a bit rate (`ip link set can0 type can bitrate R`).
+can_args=()
+if [ "${VBUS_CAN:-0}" -gt 0 ]; then
+    can_args+=(-object can-bus,id=vbuscan)
+    # The controllers have I/O-port BARs, which conflict with the host bridge's ACPI
+    # windows under pci=noacpi: PCI routing by ACPI then (slower boot, working BARs).
+    kextra=${kextra/pci=noacpi /}
+    for _ in $(seq "$VBUS_CAN"); do
+        can_args+=(-device kvaser_pci,canbus=vbuscan)
+    done
+fi
+
 # The command's stdout/stderr come back through virtio ports into FIFOs read here, so
 # they stream live to whatever this script's stdout/stderr are.
 mkfifo "$tmp/out" "$tmp/err"
@@ -149,7 +163,7 @@ timeout --kill-after=5 $((timeout_s + ${VBUS_BOOT_ALLOWANCE:-90})) \
     -device virtio-9p-pci,fsdev=root,mount_tag=vbus.root \
     -fsdev "local,id=x,path=$x,security_model=none" \
     -device virtio-9p-pci,fsdev=x,mount_tag=vbus.x \
-    "${rw_args[@]}" \
+    "${rw_args[@]}" "${can_args[@]}" \
     -device virtio-serial-pci \
     -chardev "file,id=out,path=$tmp/out" -device virtserialport,chardev=out,name=vbus.out \
     -chardev "file,id=err,path=$tmp/err" -device virtserialport,chardev=err,name=vbus.err \
