@@ -34,6 +34,8 @@ c() {
 }
 # Waits up to 10 s until process $1 has a socket open (a CAN recorder is listening).
 wait_socket() { for _ in $(seq 100); do ls -l "/proc/$1/fd" 2> /dev/null | grep -q socket: && return 0; sleep 0.1; done; return 1; }
+# Gives process $2 up to $1 tenths of a second to end by itself, then stops it; reaps it.
+end_within() { for _ in $(seq "$1"); do kill -0 "$2" 2> /dev/null || break; sleep 0.1; done; kill "$2" 2> /dev/null; wait "$2" 2> /dev/null; }
 # Waits up to $2 tenths of a second for file $1 to contain $3.
 wait_for() { for _ in $(seq "$2"); do grep -qF -- "$3" "$1" 2> /dev/null && return 0; sleep 0.1; done; return 1; }
 
@@ -1149,7 +1151,8 @@ kill -TERM "$gw_peer" 2> /dev/null
 "$cotui" serve vcan0 --socketcand 29536 --allow-send 2> serve.err &
 served=$!
 wait_for serve.err 100 "socketcand on 127.0.0.1:29536"
-timeout 180 candump -n 1 vcan0,321:7FF > sc_dump.txt &
+# candump itself (no timeout wrapper): wait_socket looks at this pid's sockets.
+candump -n 1 vcan0,321:7FF > sc_dump.txt &
 dump=$!
 wait_socket "$dump"
 python3 - > sc_py.out 2>&1 <<'PY' &
@@ -1170,7 +1173,7 @@ py=$!
 wait_for sc_py.out 100 open
 for _ in $(seq 50); do cansend vcan0 123#11; grep -q got sc_py.out && break; sleep 0.2; done
 wait "$py"
-wait "$dump"
+end_within 100 "$dump"
 grep -q "got 11" sc_py.out && grep -qE "321 +\[1\] +22" sc_dump.txt && grep -q "sent 321#22" serve.err &&
     ok "socketcand: python-can through cotui serve vcan0 receives a cansend frame and sends one candump sees (audited)" ||
     bad "socketcand: python-can: $(cat sc_py.out) / candump: $(cat sc_dump.txt) / $(tail -3 serve.err)"
@@ -1182,6 +1185,35 @@ wait "$rec"
 [ "$(grep -c ' socketcand://127.0.0.1:29536/vcan0 124#33' sc_rec.log 2> /dev/null)" = 3 ] &&
     ok "socketcand: cotui record socketcand://127.0.0.1:29536/vcan0 records cansend frames" ||
     bad "socketcand: record: $(cat sc_rec.out) $(head -3 sc_rec.log 2> /dev/null)"
+kill "$served" 2> /dev/null
+wait "$served" 2> /dev/null
+# CAN FD over socketcand (`< fdframe >` / `< fdsend >`) on the FD interface vcan1: cansend's FD
+# frames reach `cotui record socketcand://...` whole (flags, 12 and 20 data bytes), and an FD
+# frame sent by cotui's client through the server reaches candump on vcan1.
+"$cotui" serve vcan1 --socketcand 29537 --allow-send 2> serve_fd.err &
+served=$!
+wait_for serve_fd.err 100 "socketcand on 127.0.0.1:29537"
+timeout 30 "$cotui" record socketcand://127.0.0.1:29537/vcan1 -o sc_fd.log --count 6 > sc_fd.out 2>&1 &
+rec=$!
+wait_for serve_fd.err 100 "client 1 ("
+for _ in $(seq 50); do
+    cansend vcan1 456##1112233445566778899AABBCC
+    cansend vcan1 1BCDEF01##0000102030405060708090A0B0C0D0E0F10111213
+    kill -0 "$rec" 2> /dev/null || break
+    sleep 0.2
+done
+wait "$rec"
+grep -qE ' 456##[15]112233445566778899AABBCC$' sc_fd.log && grep -qE ' 1BCDEF01##[04]000102030405060708090A0B0C0D0E0F10111213$' sc_fd.log &&
+    ok "socketcand FD: cotui record socketcand://.../vcan1 gets cansend's FD frames whole (BRS, 29-bit, 12 and 20 bytes)" ||
+    bad "socketcand FD: record: $(cat sc_fd.out) $(head -4 sc_fd.log 2> /dev/null)"
+candump -L -n 1 vcan1,457:7FF > sc_fd_dump.txt &
+dump=$!
+wait_socket "$dump"
+c send socketcand://127.0.0.1:29537/vcan1 '457##1AABBCCDDEEFF001122334455'
+end_within 100 "$dump"
+grep -qE ' vcan1 457##[15]AABBCCDDEEFF001122334455$' sc_fd_dump.txt &&
+    ok "socketcand FD: cotui send through cotui serve vcan1 puts the FD frame (BRS, 12 bytes) on vcan1 (candump)" ||
+    bad "socketcand FD: send rc=$rc $out $err / candump: $(cat sc_fd_dump.txt) / $(tail -3 serve_fd.err)"
 kill "$served" 2> /dev/null
 wait "$served" 2> /dev/null
 # ---- 19 trigger: record --trigger's window equals candump's frames in it ----------------
