@@ -145,20 +145,10 @@ impl Link {
                     .into(),
             });
         }
-        let Some(text) = wire::send_element(frame) else {
-            let reason = if frame.is_fd() && !frame.is_rtr() && !frame.is_err() {
-                format!(
-                    "a CAN FD frame of {} bytes has no DLC (FD lengths: 0-8, 12, 16, 20, 24, 32, 48, 64)",
-                    frame.len
-                )
-            } else {
-                "socketcand carries data frames only, classic and CAN FD (no remote request or error frames)".into()
-            };
-            return Err(BusError::Io {
-                iface: self.name.clone(),
-                reason,
-            });
-        };
+        let text = wire::send_element(frame).map_err(|reason| BusError::Io {
+            iface: self.name.clone(),
+            reason,
+        })?;
         let mut w = self.writer.lock().await;
         let Some(stream) = w.as_mut() else {
             return Err(self.lost());

@@ -498,11 +498,19 @@ pub fn frame_element(f: &Frame) -> Option<String> {
 }
 
 /// The element a client sends to put `f` on the bus: `< send ID LEN B0 ... >`, or
-/// `< fdsend ID FLAGS LEN B0 ... >` for a CAN FD frame; none for what the protocol cannot
-/// carry (remote request and error frames).
-pub fn send_element(f: &Frame) -> Option<String> {
-    if f.is_rtr() || f.is_err() || (f.is_fd() && !is_fd_len(f.len as usize)) {
-        return None;
+/// `< fdsend ID FLAGS LEN B0 ... >` for a CAN FD frame; else why the protocol cannot carry
+/// it (a remote request or error frame, a CAN FD length with no DLC).
+pub fn send_element(f: &Frame) -> Result<String, String> {
+    if f.is_rtr() || f.is_err() {
+        return Err(
+            "socketcand carries data frames only, classic and CAN FD (no remote request or error frames)".into(),
+        );
+    }
+    if f.is_fd() && !is_fd_len(f.len as usize) {
+        return Err(format!(
+            "a CAN FD frame of {} bytes has no DLC (FD lengths: 0-8, 12, 16, 20, 24, 32, 48, 64)",
+            f.len
+        ));
     }
     let mut s = if f.is_fd() {
         format!("< fdsend {} {:02X} {}", id_text(f), fd_flags(f), f.len)
@@ -513,7 +521,7 @@ pub fn send_element(f: &Frame) -> Option<String> {
         s.push_str(&format!(" {b:x}"));
     }
     s.push_str(" >");
-    Some(s)
+    Ok(s)
 }
 
 /// The element of an error the server answers with (text made safe).
@@ -695,6 +703,11 @@ mod tests {
         assert_eq!(parse_reply(inner), Ok(Reply::Frame(big)));
         let empty = fd(0x7FF, false, 0, &[], 0);
         assert_eq!(send_element(&empty).unwrap(), "< fdsend 7FF 00 0 >");
+        // Ten bytes: no FD DLC says ten, so nothing is sent, and the reason says why.
+        assert_eq!(
+            send_element(&fd(0x457, false, CANFD_BRS, &[0xAA; 10], 0)),
+            Err("a CAN FD frame of 10 bytes has no DLC (FD lengths: 0-8, 12, 16, 20, 24, 32, 48, 64)".into())
+        );
         assert_eq!(parse_request("fdsend 7FF 0 0"), Ok(Request::Send(empty)));
         // The kernel's FDF bit is carried as it came.
         let fdf = fd(0x10, false, CANFD_FDF, &[1], 0);
