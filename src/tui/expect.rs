@@ -40,13 +40,13 @@ pub fn set(trace: &mut Trace, args: &[String]) -> Result<Vec<String>, String> {
 
 /// `expect: node 3, 5 (boot stories: B)`, or that none is set.
 fn listed(trace: &Trace) -> String {
-    let nodes = trace.diagnosis.expected_nodes();
-    if nodes.is_empty() {
-        return "expect: no expected configuration (`expect NODE=FILE.dcf`)".into();
+    match nodes_text(&trace.diagnosis.expected_nodes()) {
+        None => "expect: no expected configuration (`expect NODE=FILE.dcf`)".into(),
+        Some(list) => format!("expect: configuration expected of node {list} (the boot stories compare it: B)"),
     }
-    let list: Vec<String> = nodes.iter().map(u8::to_string).collect();
-    format!(
-        "expect: configuration expected of node {} (the boot stories compare it: B)",
-        list.join(", ")
-    )
+}
+
+/// `3, 5`: the nodes with an expected configuration; None when there are none.
+pub(crate) fn nodes_text(nodes: &[u8]) -> Option<String> {
+    (!nodes.is_empty()).then(|| nodes.iter().map(u8::to_string).collect::<Vec<_>>().join(", "))
 }

@@ -126,13 +126,8 @@ impl BootsView {
 
     fn render_list(&self, origin: u64, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
         let differ = self.boots.iter().filter(|b| !b.findings.is_empty()).count();
-        let against = match self.expected.as_slice() {
-            [] => String::new(),
-            nodes => {
-                let list: Vec<String> = nodes.iter().map(u8::to_string).collect();
-                format!("; expected configuration of node {}", list.join(", "))
-            }
-        };
+        let against = crate::tui::expect::nodes_text(&self.expected)
+            .map_or(String::new(), |list| format!("; expected configuration of node {list}"));
         let title = format!(
             " Boot stories ({} boots, {differ} with findings{against}) ",
             self.boots.len()
