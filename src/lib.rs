@@ -9,6 +9,7 @@
 pub use canopen::{calendar, cob, decode, frame, log, lss, od, sdo, wire};
 
 pub mod analysis;
+pub mod audit;
 pub mod bench;
 pub mod bus;
 pub mod cli;

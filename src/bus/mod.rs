@@ -18,6 +18,7 @@
 pub mod bitrate;
 mod error;
 mod pace;
+mod sdo_turns;
 pub mod socketcan;
 pub mod socketcand;
 pub mod state;
@@ -89,6 +90,8 @@ pub struct Bus {
     socket: Option<Arc<socketcan::Shared>>,
     /// The clock of the frames' timestamps.
     clock: Clock,
+    /// One SDO transfer per node at a time, shared by every handle of this bus.
+    turns: sdo_turns::SdoTurns,
 }
 
 impl fmt::Debug for Bus {
@@ -146,6 +149,18 @@ impl Bus {
             origin: 0,
             item: Item::Frame(frame),
         });
+    }
+    /// Waits for `node`'s SDO turn: no other transfer of this bus's handles to `node` runs
+    /// until the guard is dropped. `None` at once on a handle [`Bus::ahead_of_turns`].
+    pub(crate) async fn sdo_turn(&self, node: u8) -> Option<tokio::sync::MutexGuard<'_, ()>> {
+        self.turns.take(node).await
+    }
+    /// This handle, its SDO transfers never waiting for a turn (a stop goes first).
+    pub fn ahead_of_turns(&self) -> Bus {
+        Bus {
+            turns: self.turns.ahead(),
+            ..self.clone()
+        }
     }
     /// A new subscription that sees every frame from now on.
     pub fn subscribe(&self) -> Subscription {

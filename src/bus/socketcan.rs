@@ -141,6 +141,7 @@ pub fn open(iface: &str, listen_only: bool) -> Result<Bus, BusError> {
         sender,
         socket: Some(Arc::new(Shared { task, link, catch_up })),
         clock: super::Clock::Wall,
+        turns: Default::default(),
     })
 }
 

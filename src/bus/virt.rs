@@ -4,6 +4,7 @@
 //! stamped when sent with wall-clock time that advances with tokio's clock, so a
 //! test with paused time gets deterministic timestamps.
 
+use super::sdo_turns::SdoTurns;
 use super::{Bus, BusError, Carried, Item, QUEUE_DEPTH, Sender};
 use crate::frame::Frame;
 use std::sync::Arc;
@@ -18,6 +19,8 @@ pub struct VirtualBus {
     events: broadcast::Sender<Carried>,
     next_endpoint: Arc<AtomicU32>,
     clock: Clock,
+    /// The SDO turns of every endpoint (tools on one virtual bus wait for each other too).
+    turns: SdoTurns,
 }
 
 /// The clock of a virtual bus: wall-clock time at creation plus tokio's elapsed time.
@@ -67,6 +70,7 @@ impl VirtualBus {
                 epoch_ns,
                 start: Instant::now(),
             },
+            turns: SdoTurns::default(),
         }
     }
     /// A new endpoint (one node or one tool) on the bus. A listen-only endpoint has no send path.
@@ -84,6 +88,7 @@ impl VirtualBus {
             }),
             socket: None,
             clock: super::Clock::Virtual(self.clock),
+            turns: self.turns.clone(),
         }
     }
     /// The bus time now in nanoseconds, as frames sent now would be stamped.

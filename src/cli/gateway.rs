@@ -1,7 +1,9 @@
 //! `cotui gateway IFACE --stdio | --unix PATH | --tcp ADDR:PORT`: the CiA 309-3 ASCII
 //! gateway ([`crate::gateway`]) on a bus, for scripts in any language.
 
+use crate::audit::Audit;
 use crate::command::ExitCode;
+use crate::gateway::listen::Bound;
 use crate::gateway::serve::Gateway;
 use crate::gateway::session::Policy;
 use clap::Args;
@@ -43,12 +45,24 @@ enum GatewayError {
     Bus(#[from] crate::bus::BusError),
     #[error("{what}: {source}")]
     Io { what: String, source: std::io::Error },
-    #[error("{0}")]
-    Refused(String),
 }
 
 /// Runs the gateway until its input ends (`--stdio`) or Ctrl-C; returns the exit status.
 pub fn run_gateway(args: &GatewayArgs) -> ExitCode {
+    // The socket first: a taken address is said before the bus is opened.
+    let bound = match (&args.tcp, &args.unix) {
+        (Some(addr), _) => Some(Bound::tcp(addr)),
+        (None, Some(path)) => Some(Bound::unix(path.clone())),
+        (None, None) => None,
+    }
+    .transpose();
+    let bound = match bound {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("cotui gateway: {e}");
+            return ExitCode::Usage;
+        }
+    };
     let rt = match tokio::runtime::Builder::new_current_thread().enable_all().build() {
         Ok(rt) => rt,
         Err(e) => {
@@ -56,7 +70,7 @@ pub fn run_gateway(args: &GatewayArgs) -> ExitCode {
             return ExitCode::Usage;
         }
     };
-    match rt.block_on(serve(args)) {
+    match rt.block_on(serve(args, bound)) {
         Ok(()) => ExitCode::Ok,
         Err(e) => {
             eprintln!("cotui gateway: {e}");
@@ -68,88 +82,52 @@ pub fn run_gateway(args: &GatewayArgs) -> ExitCode {
     }
 }
 
-async fn serve(args: &GatewayArgs) -> Result<(), GatewayError> {
-    let bus = crate::connect::open(&args.iface, args.listen_only).await?;
+async fn serve(args: &GatewayArgs, bound: Option<Bound>) -> Result<(), GatewayError> {
+    let bus = match crate::connect::open(&args.iface, args.listen_only).await {
+        Ok(b) => b,
+        Err(e) => {
+            if let Some(b) = bound {
+                b.close();
+            }
+            return Err(e.into());
+        }
+    };
     let policy = Policy {
         allow_writes: args.allow_writes,
         notify: args.notify,
     };
-    let gw = Gateway::start(bus, policy);
-    let io = |what: String| move |source| GatewayError::Io { what, source };
-    if args.stdio {
+    let gw = Gateway::start(bus, policy, Audit::stderr("gateway"));
+    let Some(bound) = bound else {
         return gw
-            .serve(tokio::io::stdin(), tokio::io::stdout())
+            .serve("stdio", tokio::io::stdin(), tokio::io::stdout())
             .await
-            .map_err(io("stdio".into()));
-    }
+            .map_err(|source| GatewayError::Io {
+                what: "stdio".into(),
+                source,
+            });
+    };
+    let at = bound.at();
+    gw.say(&format!(
+        "{} on {at}{}",
+        args.iface,
+        mode(args.listen_only, args.allow_writes)
+    ));
     let ctrl_c = async {
         if tokio::signal::ctrl_c().await.is_err() {
             std::future::pending::<()>().await;
         }
     };
-    tokio::pin!(ctrl_c);
-    if let Some(addr) = &args.tcp {
-        let listener = tokio::net::TcpListener::bind(addr.as_str())
-            .await
-            .map_err(io(format!("cannot listen on {addr}")))?;
-        let at = listener.local_addr().map_err(io(addr.clone()))?;
-        eprintln!("cotui gateway: {} on tcp {at}{}", args.iface, mode(args));
-        loop {
-            tokio::select! {
-                _ = &mut ctrl_c => return Ok(()),
-                got = listener.accept() => match got {
-                    Ok((stream, peer)) => gw.spawn_client(stream, format!("tcp {peer}")),
-                    Err(e) => eprintln!("cotui gateway: accept failed: {e}"),
-                },
-            }
-        }
-    }
-    let Some(path) = &args.unix else {
-        return Err(GatewayError::Refused(
-            "give --stdio, --unix PATH or --tcp ADDR:PORT".into(),
-        ));
-    };
-    replace_stale_socket(path)?;
-    let listener = tokio::net::UnixListener::bind(path).map_err(io(format!("cannot listen on {}", path.display())))?;
-    eprintln!("cotui gateway: {} on unix {}{}", args.iface, path.display(), mode(args));
-    let mut n = 0u64;
-    let end = loop {
-        tokio::select! {
-            _ = &mut ctrl_c => break Ok(()),
-            got = listener.accept() => match got {
-                Ok((stream, _)) => {
-                    n += 1;
-                    gw.spawn_client(stream, format!("unix client {n}"));
-                }
-                Err(e) => eprintln!("cotui gateway: accept failed: {e}"),
-            },
-        }
-    };
-    let _ = std::fs::remove_file(path);
-    end
+    bound
+        .serve(&gw, ctrl_c)
+        .await
+        .map_err(|source| GatewayError::Io { what: at, source })
 }
 
 /// What the clients may do, for the line that says where the gateway listens.
-fn mode(args: &GatewayArgs) -> &'static str {
-    match (args.listen_only, args.allow_writes) {
+pub fn mode(listen_only: bool, allow_writes: bool) -> &'static str {
+    match (listen_only, allow_writes) {
         (true, _) => " (listen-only: nothing is sent)",
         (false, true) => " (writes, NMT and LSS allowed)",
         (false, false) => " (read-only: --allow-writes for write, NMT and LSS)",
-    }
-}
-
-/// Removes a socket left at `path` by an earlier gateway; refuses any other kind of file.
-fn replace_stale_socket(path: &std::path::Path) -> Result<(), GatewayError> {
-    use std::os::unix::fs::FileTypeExt;
-    match std::fs::symlink_metadata(path) {
-        Err(_) => Ok(()),
-        Ok(m) if m.file_type().is_socket() => std::fs::remove_file(path).map_err(|source| GatewayError::Io {
-            what: format!("cannot replace the socket {}", path.display()),
-            source,
-        }),
-        Ok(_) => Err(GatewayError::Refused(format!(
-            "{} exists and is not a socket: not replaced (give another PATH)",
-            path.display()
-        ))),
     }
 }

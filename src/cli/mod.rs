@@ -13,6 +13,7 @@ mod decode_sync;
 pub mod diagnose;
 pub mod explain;
 pub mod gateway;
+pub mod host;
 pub mod input;
 mod merge;
 pub mod open_logs;

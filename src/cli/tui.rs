@@ -1,9 +1,11 @@
 //! `cotui open FILE` and `cotui replay FILE`: the interactive analyzer on a log.
 
+use super::host::HostArgs;
 use crate::analysis::trace::Trace;
 use crate::command::ExitCode;
 use crate::output::busload::Bitrate;
 use crate::tui::app::{App, SourceInfo, SourceKind};
+use crate::tui::hosted::Hosted;
 use crate::tui::keymap::{self, Keymap, KeymapError};
 use crate::tui::source;
 use clap::Args;
@@ -106,6 +108,8 @@ pub struct LiveArgs {
     #[arg(long, value_name = "FILE")]
     pub transmit: Option<PathBuf>,
     #[command(flatten)]
+    pub host: HostArgs,
+    #[command(flatten)]
     pub ui: UiArgs,
 }
 
@@ -124,6 +128,8 @@ pub struct DemoArgs {
     /// Repeatable. Default: 2=aimotor 3=syntron-ds.
     #[arg(long = "node", value_name = "NODE=MODEL[@SERIAL]")]
     pub nodes: Vec<String>,
+    #[command(flatten)]
+    pub host: HostArgs,
     #[command(flatten)]
     pub ui: UiArgs,
 }
@@ -178,10 +184,11 @@ pub fn load_keymap(choice: &str) -> Result<Keymap, String> {
 enum Feeding {
     /// A log task with an optional control line.
     Log(source::Feeds),
-    /// Live buses (interfaces, listen-only) that also run commands (on the first).
-    Live(Vec<String>, bool),
-    /// The demo bus with these simulated drives (listen-only).
-    Demo(crate::sim::Simulation, bool),
+    /// Live buses (interfaces, listen-only) that also run commands and the hosted servers
+    /// (on the first).
+    Live(Vec<String>, bool, Hosted),
+    /// The demo bus with these simulated drives (listen-only), hosting these servers.
+    Demo(crate::sim::Simulation, bool, Hosted),
 }
 
 fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding, transmit: Option<&std::path::Path>) -> ExitCode {
@@ -193,8 +200,8 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding, transmit: Opt
         }
     };
     let bindings = match &feed {
-        Feeding::Demo(sim, _) => super::bind::bindings_for_demo(sim, &ui.profiles, &ui.eds),
-        Feeding::Live(ifaces, _) => super::bind::bindings_on(&ifaces[0], &ui.profiles, &ui.eds),
+        Feeding::Demo(sim, ..) => super::bind::bindings_for_demo(sim, &ui.profiles, &ui.eds),
+        Feeding::Live(ifaces, ..) => super::bind::bindings_on(&ifaces[0], &ui.profiles, &ui.eds),
         Feeding::Log(_) => super::bind::bindings_on(name, &ui.profiles, &ui.eds),
     };
     let bindings = match bindings {
@@ -208,7 +215,7 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding, transmit: Opt
     let open_file = matches!(kind, SourceKind::Open) && std::path::Path::new(name).is_file();
     let bitrate = match &feed {
         Feeding::Log(_) => Bitrate::given_or_assumed(ui.bitrate),
-        Feeding::Live(ifaces, _) => live_bitrate(ui.bitrate, ifaces),
+        Feeding::Live(ifaces, ..) => live_bitrate(ui.bitrate, ifaces),
         Feeding::Demo(..) => live_bitrate(ui.bitrate, &[crate::connect::DEMO.to_string()]),
     };
     let mut trace = Trace::new(decoder, bitrate);
@@ -221,13 +228,13 @@ fn start(ui: &UiArgs, name: &str, kind: SourceKind, feed: Feeding, transmit: Opt
     };
     let src = match feed {
         Feeding::Log((rx, ctl)) => SourceInfo::new(name, kind, rx, ctl),
-        Feeding::Live(ifaces, listen_only) => {
-            let (rx, req) = crate::tui::live::start(&ifaces, listen_only, bindings.clone(), None);
+        Feeding::Live(ifaces, listen_only, hosted) => {
+            let (rx, req) = crate::tui::live::start(&ifaces, listen_only, bindings.clone(), None, hosted);
             SourceInfo::live(name, kind, rx, req)
         }
-        Feeding::Demo(sim, listen_only) => {
+        Feeding::Demo(sim, listen_only, hosted) => {
             let demo = [crate::connect::DEMO.to_string()];
-            let (rx, req) = crate::tui::live::start(&demo, listen_only, bindings.clone(), Some(sim));
+            let (rx, req) = crate::tui::live::start(&demo, listen_only, bindings.clone(), Some(sim), hosted);
             SourceInfo::live(name, kind, rx, req)
         }
     };
@@ -350,7 +357,14 @@ pub fn run_live(args: &LiveArgs) -> ExitCode {
     let kind = SourceKind::Live {
         listen_only: args.listen_only,
     };
-    let feed = Feeding::Live(args.iface.clone(), args.listen_only);
+    let hosted = match args.host.bind(&args.iface[0], args.listen_only) {
+        Ok(h) => h,
+        Err(e) => {
+            eprintln!("cotui live: {e}");
+            return ExitCode::Usage;
+        }
+    };
+    let feed = Feeding::Live(args.iface.clone(), args.listen_only, hosted);
     start(&args.ui, &args.iface.join(" "), kind, feed, args.transmit.as_deref())
 }
 
@@ -366,7 +380,14 @@ pub fn run_demo(args: &DemoArgs) -> ExitCode {
             return ExitCode::Usage;
         }
     };
-    let feed = Feeding::Demo(crate::sim::Simulation::demo_with(drives), args.listen_only);
+    let hosted = match args.host.bind(crate::connect::DEMO, args.listen_only) {
+        Ok(h) => h,
+        Err(e) => {
+            eprintln!("cotui demo: {e}");
+            return ExitCode::Usage;
+        }
+    };
+    let feed = Feeding::Demo(crate::sim::Simulation::demo_with(drives), args.listen_only, hosted);
     start(&args.ui, crate::connect::DEMO, kind, feed, args.transmit.as_deref())
 }
 

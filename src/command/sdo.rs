@@ -5,6 +5,10 @@
 //! to reading them: before declaring a timeout, the loop lets the bus reader pass on what
 //! it has and consumes every queued frame. On the virtual bus the clock follows tokio's, so
 //! tests with paused time are deterministic.
+//!
+//! Each transfer waits for its node's turn ([`Bus::sdo_turn`]): the palette, the Watch and
+//! Objects panes, the gateway's clients and the commands never run two transfers to one
+//! node at once (their answers would cross); a stop's handle does not wait.
 
 use super::error::CommandError;
 use crate::bus::{Bus, BusError, Subscription};
@@ -55,6 +59,7 @@ pub async fn upload_within(
     block: bool,
     timing: Timing,
 ) -> Result<Vec<u8>, CommandError> {
+    let _turn = bus.sdo_turn(node).await;
     let mut rx = bus.subscribe();
     let mut client = SdoClient::new(config(timing));
     let first = client
@@ -89,6 +94,7 @@ pub async fn download_within(
     block: bool,
     timing: Timing,
 ) -> Result<(), CommandError> {
+    let _turn = bus.sdo_turn(node).await;
     let mut rx = bus.subscribe();
     let mut client = SdoClient::new(config(timing));
     let first = client
@@ -302,6 +308,35 @@ mod tests {
             tokio::time::sleep(Duration::from_millis(10)).await;
         }
         last()
+    }
+
+    #[tokio::test(start_paused = true)]
+    async fn two_clients_reading_one_node_take_turns_and_both_get_their_value() {
+        let vbus = VirtualBus::new("vbus");
+        // A 14-byte segmented upload: initiate, then two segments (toggle 0, then 1 and last).
+        let log = serve(
+            &vbus,
+            Box::new(|req| match req[0] {
+                0x40 => vec![(2, vec![0x41, 0x00, 0x20, 0x00, 14, 0, 0, 0])],
+                0x60 => vec![(2, [&[0x00][..], b"cotui s"].concat())],
+                0x70 => vec![(2, [&[0x11][..], b"egments"].concat())],
+                _ => vec![],
+            }),
+        );
+        // Two tools on the bus (a palette read and a gateway client, say), at once.
+        let (a, b) = (vbus.endpoint(false), vbus.endpoint(false));
+        let (ra, rb) = tokio::join!(
+            upload_within(&a, NODE, 0x2000, 0, false, timing(1000, None)),
+            upload_within(&b, NODE, 0x2000, 0, false, timing(1000, None)),
+        );
+        assert_eq!(ra.unwrap(), b"cotui segments");
+        assert_eq!(rb.unwrap(), b"cotui segments");
+        let firsts: Vec<u8> = log.lock().unwrap().iter().map(|r| r[0]).collect();
+        assert_eq!(
+            firsts,
+            [0x40, 0x60, 0x70, 0x40, 0x60, 0x70],
+            "one transfer after the other"
+        );
     }
 
     #[tokio::test(start_paused = true)]

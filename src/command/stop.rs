@@ -295,7 +295,8 @@ pub async fn stop_nodes(bus: &Bus, nodes: &BTreeSet<u8>, opts: StopOptions) -> R
     }
     let mut set = JoinSet::new();
     for &n in nodes {
-        let bus = bus.clone();
+        // A stop never waits behind another client's SDO transfer to the node.
+        let bus = bus.ahead_of_turns();
         set.spawn(async move { stop_drive(&bus, n, opts.timeout_ms, opts.ramp_ms).await });
     }
     let mut done = BTreeMap::new();

@@ -12,7 +12,7 @@ use super::error::{CommandError, ParseError};
 use super::grammar::DEFAULT_TIMEOUT_MS;
 use super::sdo::first_upload_frame;
 use super::spec::{CommandArgs, Ctx, Known, Outcome, Preview, Spec};
-use super::watch_poll::{NodeLocks, Schedule, Target, round};
+use super::watch_poll::{Schedule, Target, round};
 use super::watch_table::{WatchFormat, Watched, csv_header, csv_row, jsonl_rows, text_table};
 use super::words::{TypedWords, ms_arg, node_arg};
 use crate::od::bind::Bindings;
@@ -216,7 +216,6 @@ impl Spec for Watch {
         };
         tokio::pin!(until);
         let mut schedule = Schedule::every(self.every_ms);
-        let locks = NodeLocks::default();
         let mut rounds = 0u64;
         loop {
             tokio::select! {
@@ -229,7 +228,7 @@ impl Spec for Watch {
             let samples = tokio::select! {
                 _ = &mut ctx.stop => break,
                 _ = &mut until => break,
-                s = round(bus, &targets, self.timeout_ms, &locks) => s,
+                s = round(bus, &targets, self.timeout_ms) => s,
             };
             rounds += 1;
             for (o, s) in objects.iter_mut().zip(&samples) {

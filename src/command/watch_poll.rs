@@ -1,7 +1,7 @@
 //! One poll round of a watch list, shared by `cotui watch` ([`super::watch`]) and the TUI's
 //! Watch pane: the nodes of a round polled side by side in one task, each node's objects
-//! one after the other, and a per-node lock ([`NodeLocks`]) so that two watch lists polling
-//! one node never overlap either; [`Schedule`] the period (a round still running when the
+//! one after the other (each read waits for the node's SDO turn, [`Bus::sdo_turn`], so a
+//! palette read or another watch group never overlaps a poll); [`Schedule`] the period (a round still running when the
 //! next is due makes that one skipped, never a burst). What a failed poll shows (absent,
 //! timeout, abort) is [`sample_of_error`].
 
@@ -11,10 +11,8 @@ use super::value::decode;
 use super::watch_table::{Sample, Watched};
 use crate::bus::Bus;
 use crate::od::DataType;
-use std::collections::BTreeMap;
 use std::future::Future;
 use std::pin::Pin;
-use std::sync::{Arc, Mutex};
 use std::task::Poll;
 use std::time::Duration;
 use tokio::time::{Instant, Interval, MissedTickBehavior};
@@ -44,18 +42,6 @@ impl Target {
     }
 }
 
-/// One lock per node: the polls of one node, by any watch list, one at a time.
-#[derive(Clone, Debug, Default)]
-pub struct NodeLocks(Arc<Mutex<BTreeMap<u8, Arc<tokio::sync::Mutex<()>>>>>);
-
-impl NodeLocks {
-    /// The lock of `node`.
-    fn of(&self, node: u8) -> Arc<tokio::sync::Mutex<()>> {
-        let mut map = self.0.lock().unwrap_or_else(|e| e.into_inner());
-        map.entry(node).or_default().clone()
-    }
-}
-
 /// What a failed poll shows.
 pub fn sample_of_error(e: &CommandError) -> Sample {
     match e {
@@ -68,14 +54,8 @@ pub fn sample_of_error(e: &CommandError) -> Sample {
     }
 }
 
-/// Reads `targets` (all of one node) in turn, holding the node's lock; (position, sample).
-async fn node_round(
-    bus: &Bus,
-    targets: Vec<(usize, Target)>,
-    timeout_ms: u64,
-    lock: Arc<tokio::sync::Mutex<()>>,
-) -> Vec<(usize, Sample)> {
-    let _held = lock.lock().await;
+/// Reads `targets` (all of one node) one after the other; (position, sample).
+async fn node_round(bus: &Bus, targets: Vec<(usize, Target)>, timeout_ms: u64) -> Vec<(usize, Sample)> {
     let mut out = Vec::with_capacity(targets.len());
     for (k, t) in targets {
         let s = match upload(bus, t.node, t.index, t.sub, false, timeout_ms).await {
@@ -109,8 +89,8 @@ async fn join_all<F: Future>(futs: Vec<F>) -> Vec<F::Output> {
 }
 
 /// One round: one sample per target, in order (`None`: not polled, [`Sample::Skipped`]).
-/// The nodes side by side, each node's objects in turn under its lock.
-pub async fn round(bus: &Bus, targets: &[Option<Target>], timeout_ms: u64, locks: &NodeLocks) -> Vec<Sample> {
+/// The nodes side by side, each node's objects one after the other.
+pub async fn round(bus: &Bus, targets: &[Option<Target>], timeout_ms: u64) -> Vec<Sample> {
     let mut nodes: Vec<u8> = targets.iter().flatten().map(|t| t.node).collect();
     nodes.sort_unstable();
     nodes.dedup();
@@ -120,7 +100,7 @@ pub async fn round(bus: &Bus, targets: &[Option<Target>], timeout_ms: u64, locks
             .enumerate()
             .filter_map(|(k, t)| t.filter(|t| t.node == node).map(|t| (k, t)))
             .collect();
-        node_round(bus, mine, timeout_ms, locks.of(node))
+        node_round(bus, mine, timeout_ms)
     });
     let mut samples = vec![Sample::Skipped; targets.len()];
     for (k, s) in join_all(per_node.collect()).await.into_iter().flatten() {

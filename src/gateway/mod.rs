@@ -4,10 +4,12 @@
 //! The text side is pure: [`line`] parses a request, [`types`] prints and parses the data
 //! types, [`answer`] writes answers and notifications, [`watch`] finds what to notify of in
 //! the bus frames. [`session`] runs a request through the command layer (SDO client, NMT,
-//! LSS master) on the bus; [`serve`] is the IO (sockets, bounded lines, notifications).
+//! LSS master) on the bus; [`serve`] is the IO (clients, bounded lines, notifications) and
+//! [`listen`] the sockets it listens on.
 
 pub mod answer;
 pub mod line;
+pub mod listen;
 pub mod serve;
 pub mod session;
 pub mod types;

@@ -10,6 +10,7 @@ use super::answer::Notice;
 use super::line::MAX_LINE;
 use super::session::{Policy, Session, seq_of};
 use super::watch::Watch;
+use crate::audit::Audit;
 use crate::bus::Bus;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -31,11 +32,14 @@ pub struct Gateway {
     lock: Arc<Mutex<()>>,
     notices: broadcast::Sender<Notice>,
     clients: Arc<AtomicUsize>,
+    audit: Audit,
 }
 
 impl Gateway {
-    /// A gateway on `bus`; starts the watch that makes the notifications. Needs a tokio runtime.
-    pub fn start(bus: Bus, policy: Policy) -> Gateway {
+    /// A gateway on `bus`, its clients' connects and disconnects (and, when `audit` asks,
+    /// every request and answer) told to `audit`; starts the watch that makes the
+    /// notifications. Needs a tokio runtime.
+    pub fn start(bus: Bus, policy: Policy, audit: Audit) -> Gateway {
         let (notices, _) = broadcast::channel(NOTICE_QUEUE);
         let tx = notices.clone();
         let mut rx = bus.subscribe();
@@ -59,11 +63,13 @@ impl Gateway {
             lock: Arc::new(Mutex::new(())),
             notices,
             clients: Arc::new(AtomicUsize::new(0)),
+            audit,
         }
     }
 
-    /// Serves one client until it closes its side (or writing to it fails).
-    pub async fn serve<R, W>(&self, reader: R, mut writer: W) -> std::io::Result<()>
+    /// Serves one client (`who`, in request audit lines) until it closes its side (or
+    /// writing to it fails).
+    pub async fn serve<R, W>(&self, who: &str, reader: R, mut writer: W) -> std::io::Result<()>
     where
         R: tokio::io::AsyncRead + Unpin,
         W: AsyncWrite + Unpin,
@@ -98,7 +104,12 @@ impl Gateway {
                         None => return Ok(()),
                         Some(Read::Line(bytes)) => {
                             let _turn = self.lock.lock().await;
-                            session.answer(&bytes).await
+                            let answer = session.answer(&bytes).await;
+                            if self.audit.logs_requests() {
+                                let asked = String::from_utf8_lossy(&bytes);
+                                self.audit.say(&format!("{who}: {} -> {}", asked.trim(), answer.trim_end()));
+                            }
+                            answer
                         }
                         Some(Read::TooLong(prefix)) => super::answer::error(
                             seq_of(&prefix).unwrap_or(0),
@@ -111,6 +122,11 @@ impl Gateway {
                 }
             }
         }
+    }
+
+    /// Writes an audit line (where it listens, accept failures).
+    pub fn say(&self, line: &str) {
+        self.audit.say(line);
     }
 
     /// Counts a client in; `None` (and nothing counted) when [`MAX_CLIENTS`] are served.
@@ -129,7 +145,7 @@ impl Gateway {
         S: tokio::io::AsyncRead + AsyncWrite + Send + Unpin + 'static,
     {
         let Some(admitted) = self.admit() else {
-            eprintln!("cotui gateway: {who} refused: {MAX_CLIENTS} clients already");
+            self.audit.say(&format!("{who} refused: {MAX_CLIENTS} clients already"));
             tokio::spawn(async move {
                 let mut stream = stream;
                 let text = super::answer::error(
@@ -142,15 +158,15 @@ impl Gateway {
             });
             return;
         };
-        eprintln!("cotui gateway: {who} connected");
+        self.audit.say(&format!("{who} connected"));
         let gw = self.clone();
         tokio::spawn(async move {
             let (r, w) = tokio::io::split(stream);
-            let end = gw.serve(r, w).await;
+            let end = gw.serve(&who, r, w).await;
             drop(admitted);
             match end {
-                Ok(()) => eprintln!("cotui gateway: {who} disconnected"),
-                Err(e) => eprintln!("cotui gateway: {who} disconnected: {e}"),
+                Ok(()) => gw.audit.say(&format!("{who} disconnected")),
+                Err(e) => gw.audit.say(&format!("{who} disconnected: {e}")),
             }
         });
     }

@@ -10,17 +10,19 @@
 //! Safe by default: clients receive only (`< send >` is answered with an error and nothing
 //! is sent) unless `--allow-send`, which `--listen-only` refuses; the caller binds loopback
 //! unless told otherwise. Every connect, disconnect, frame sent and send refused is an
-//! audit line on stderr. A client that does not read loses frames, never the server's
+//! audit line ([`Audit`]: stderr, or the TUI's message log when the TUI hosts the server). A client that does not read loses frames, never the server's
 //! memory: each client has a queue of [`CLIENT_QUEUE`] elements, frames that do not fit
 //! are dropped and counted (an audit line at the first, the total at disconnect).
 
 pub mod session;
 
+use crate::audit::Audit;
 use crate::bus::socketcand::wire::{self, Splitter};
 use crate::bus::virt::VirtualBus;
 use crate::bus::{Bus, BusError, Event};
 use crate::frame::Flags;
 use session::{Action, Session};
+use std::future::Future;
 use std::net::SocketAddr;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -72,7 +74,7 @@ pub enum ServeError {
 }
 
 /// Where each client's bus handle comes from.
-enum Source {
+pub enum Source {
     /// The demo's virtual bus, one endpoint per client; lives as long as the server.
     Virtual(VirtualBus),
     /// A bus opened by name, one handle per client.
@@ -91,18 +93,15 @@ impl Source {
 /// What the server shares with every client task.
 struct Shared {
     source: Source,
+    audit: Audit,
     bus: String,
     refused: Option<String>,
     connected: AtomicUsize,
     max_clients: usize,
 }
 
-/// One audit line on stderr.
-fn audit(line: &str) {
-    eprintln!("cotui serve: {line}");
-}
-
-/// Serves `cfg` until SIGINT/SIGTERM. The first audit line names the address bound (port 0 picks one).
+/// Serves `cfg` until SIGINT/SIGTERM, audit lines on stderr. The first audit line names
+/// the address bound (port 0 picks one).
 pub async fn serve(cfg: Config) -> Result<(), ServeError> {
     use tokio::signal::unix::{SignalKind, signal};
     let mut int = signal(SignalKind::interrupt()).map_err(ServeError::Signal)?;
@@ -115,14 +114,38 @@ pub async fn serve(cfg: Config) -> Result<(), ServeError> {
         let bus = crate::connect::open(&cfg.iface, true).await?;
         (Source::Named(cfg.iface.clone()), bus)
     };
-    let listener = TcpListener::bind(cfg.addr)
+    let listener = listen(cfg.addr).await?;
+    let stop = async {
+        tokio::select! {
+            _ = int.recv() => {}
+            _ = term.recv() => {}
+        }
+    };
+    run(listener, source, watch, &cfg, Audit::stderr("serve"), stop).await
+}
+
+/// Binds `addr` for [`run`].
+pub async fn listen(addr: SocketAddr) -> Result<TcpListener, ServeError> {
+    TcpListener::bind(addr)
         .await
-        .map_err(|source| ServeError::Bind { addr: cfg.addr, source })?;
+        .map_err(|source| ServeError::Bind { addr, source })
+}
+
+/// Serves clients of `listener` on buses from `source` until `stop` resolves or the bus
+/// `watch` (a listen-only handle of the same bus) closes; its state changes are audit lines.
+pub async fn run(
+    listener: TcpListener,
+    source: Source,
+    watch: Bus,
+    cfg: &Config,
+    audit: Audit,
+    stop: impl Future<Output = ()>,
+) -> Result<(), ServeError> {
     let local = listener
         .local_addr()
         .map_err(|source| ServeError::Bind { addr: cfg.addr, source })?;
     let refused = (!cfg.allow_send).then(|| "the server was started without --allow-send".to_string());
-    audit(&format!(
+    audit.say(&format!(
         "socketcand on {local}, bus {} ({}); clients connect to socketcand://{local}/{}",
         cfg.iface,
         if cfg.allow_send {
@@ -134,16 +157,18 @@ pub async fn serve(cfg: Config) -> Result<(), ServeError> {
     ));
     let shared = Arc::new(Shared {
         source,
+        audit: audit.clone(),
         bus: cfg.iface.clone(),
         refused,
         connected: AtomicUsize::new(0),
         max_clients: cfg.max_clients,
     });
     if cfg.beacon {
-        tokio::spawn(beacon(local, cfg.iface.clone()));
+        tokio::spawn(beacon(local, cfg.iface.clone(), audit.clone()));
     }
     let mut states = watch.subscribe();
     let mut next_id = 0u64;
+    tokio::pin!(stop);
     loop {
         tokio::select! {
             got = listener.accept() => match got {
@@ -153,23 +178,22 @@ pub async fn serve(cfg: Config) -> Result<(), ServeError> {
                 }
                 Err(e) => {
                     // Out of descriptors and the like: say so, wait a little, go on.
-                    audit(&format!("accept failed: {e}"));
+                    audit.say(&format!("accept failed: {e}"));
                     tokio::time::sleep(Duration::from_millis(100)).await;
                 }
             },
             ev = states.next() => match ev {
-                Ok(Event::State(s)) => audit(&format!("bus {}", s.text(&cfg.iface))),
+                Ok(Event::State(s)) => audit.say(&format!("bus {}", s.text(&cfg.iface))),
                 Ok(Event::Frame(_)) | Err(BusError::Io { .. } | BusError::Unavailable { .. } | BusError::ListenOnly) => {}
                 Err(BusError::Closed) => {
-                    audit("the bus was closed");
+                    audit.say("the bus was closed");
                     return Ok(());
                 }
             },
-            _ = int.recv() => break,
-            _ = term.recv() => break,
+            _ = &mut stop => break,
         }
     }
-    audit("stopped");
+    audit.say("stopped");
     Ok(())
 }
 
@@ -198,9 +222,9 @@ struct Tally {
 
 impl Tally {
     /// The audit line at the first frame this client loses.
-    fn first_drop(&self, who: &str) {
+    fn first_drop(&self, who: &str, audit: &Audit) {
         if self.dropped + self.lagged == 0 {
-            audit(&format!(
+            audit.say(&format!(
                 "{who} does not read fast enough: dropping frames to it (its queue of {CLIENT_QUEUE} is full)"
             ));
         }
@@ -219,7 +243,7 @@ async fn client(id: u64, stream: TcpStream, peer: SocketAddr, shared: Arc<Shared
     }
     let (mut rd, mut wr) = stream.into_split();
     if n > shared.max_clients {
-        audit(&format!(
+        shared.audit.say(&format!(
             "{who} refused: {} clients connected already (--max-clients)",
             n - 1
         ));
@@ -230,14 +254,14 @@ async fn client(id: u64, stream: TcpStream, peer: SocketAddr, shared: Arc<Shared
     let bus = match shared.source.open(shared.refused.is_some()).await {
         Ok(b) => b,
         Err(e) => {
-            audit(&format!("{who}: bus unavailable: {e}"));
+            shared.audit.say(&format!("{who}: bus unavailable: {e}"));
             let _ = wr
                 .write_all(wire::error_element(&format!("could not open bus: {e}")).as_bytes())
                 .await;
             return;
         }
     };
-    audit(&format!("{who} connected"));
+    shared.audit.say(&format!("{who} connected"));
     let (tx, mut rx) = mpsc::channel::<String>(CLIENT_QUEUE);
     let writer = tokio::spawn(async move {
         while let Some(text) = rx.recv().await {
@@ -252,7 +276,7 @@ async fn client(id: u64, stream: TcpStream, peer: SocketAddr, shared: Arc<Shared
     // Let the last replies (an error before a close) reach the client, but never wait on
     // a client that does not read.
     let _ = tokio::time::timeout(Duration::from_secs(1), writer).await;
-    audit(&format!(
+    shared.audit.say(&format!(
         "{who} disconnected ({end}): {} frames sent, {} sends refused, {} frames received, {} dropped (queue full), {} errors answered",
         tally.sent,
         tally.refused,
@@ -313,18 +337,18 @@ async fn session(
                             Action::Send(f) => match bus.send(&f).await {
                                 Ok(()) => {
                                     tally.sent += 1;
-                                    audit(&format!("{who} sent {}", crate::command::candump(&f)));
+                                    shared.audit.say(&format!("{who} sent {}", crate::command::candump(&f)));
                                     // A burst of sends must not starve the other clients' sessions.
                                     tokio::task::yield_now().await;
                                 }
                                 Err(e) => {
-                                    audit(&format!("{who}: sending {} failed: {e}", crate::command::candump(&f)));
+                                    shared.audit.say(&format!("{who}: sending {} failed: {e}", crate::command::candump(&f)));
                                     let _ = tx.send(wire::error_element(&format!("send failed: {e}"))).await;
                                 }
                             },
                             Action::Refused(f) => {
                                 tally.refused += 1;
-                                audit(&format!("{who} send refused (no --allow-send): {}", crate::command::candump(&f)));
+                                shared.audit.say(&format!("{who} send refused (no --allow-send): {}", crate::command::candump(&f)));
                             }
                             Action::Close => return "wrong bus",
                         }
@@ -342,7 +366,7 @@ async fn session(
                     match tx.try_send(text) {
                         Ok(()) => tally.forwarded += 1,
                         Err(mpsc::error::TrySendError::Full(_)) => {
-                            tally.first_drop(who);
+                            tally.first_drop(who, &shared.audit);
                             tally.dropped += 1;
                         }
                         Err(mpsc::error::TrySendError::Closed(_)) => return "write failed",
@@ -354,27 +378,27 @@ async fn session(
             },
         }
         if sub.lost() > tally.lagged {
-            tally.first_drop(who);
+            tally.first_drop(who, &shared.audit);
             tally.lagged = sub.lost();
         }
     }
 }
 
 /// Announces the bus as socketcand does: a UDP broadcast on port 42000 every 3 s.
-async fn beacon(local: SocketAddr, bus: String) {
+async fn beacon(local: SocketAddr, bus: String, audit: Audit) {
     let Ok(sock) = tokio::net::UdpSocket::bind("0.0.0.0:0").await else {
-        audit("beacon: cannot open a UDP socket");
+        audit.say("beacon: cannot open a UDP socket");
         return;
     };
     if sock.set_broadcast(true).is_err() {
-        audit("beacon: broadcast not permitted");
+        audit.say("beacon: broadcast not permitted");
         return;
     }
     let text = format!(
         "<CANBeacon name=\"cotui\" type=\"SocketCAN\" description=\"cotui serve\">\n<URL>can://{local}</URL><Bus name=\"{}\"/></CANBeacon>",
         wire::printable(&bus, 64)
     );
-    audit(&format!("beacon: announcing {bus} on UDP port 42000 every 3 s"));
+    audit.say(&format!("beacon: announcing {bus} on UDP port 42000 every 3 s"));
     loop {
         let _ = sock.send_to(text.as_bytes(), "255.255.255.255:42000").await;
         tokio::time::sleep(Duration::from_secs(3)).await;

@@ -64,12 +64,13 @@ const QUEUE: usize = 256;
 /// first demo bus runs `demo`, the standard demo when `None`, the others the standard demo),
 /// one capture task per interface on one runtime, their frames tagged with the interface's
 /// index in `ifaces`. Palette commands go to the first interface; they use `bindings` for
-/// object names and types.
+/// object names and types. The first interface's task also runs what the TUI `hosted`.
 pub fn start(
     ifaces: &[String],
     listen_only: bool,
     bindings: Bindings,
     demo: Option<crate::sim::Simulation>,
+    hosted: super::hosted::Hosted,
 ) -> (Receiver<Feed>, Requests) {
     let (tx, rx) = sync_channel(QUEUE);
     let (req_tx, req_rx) = unbounded_channel();
@@ -87,7 +88,7 @@ pub fn start(
             return;
         }
         let mut demo = demo;
-        let mut first = Some(req_rx);
+        let mut first = Some((req_rx, hosted));
         let local = tokio::task::LocalSet::new();
         for (i, iface) in ifaces.into_iter().enumerate() {
             let sim = if crate::connect::is_demo(&iface) {
@@ -100,7 +101,8 @@ pub fn start(
                 iface,
                 listen_only,
             };
-            local.spawn_local(capture(bus, bindings.clone(), tx.clone(), first.take(), sim));
+            let (req, hosted) = first.take().unzip();
+            local.spawn_local(capture(bus, bindings.clone(), tx.clone(), req, sim, hosted));
         }
         drop(tx);
         // The capture ends when every interface's task has (the UI went away, or a bus closed).
@@ -139,14 +141,15 @@ async fn next_request(req: &mut Option<UnboundedReceiver<Request>>) -> Option<Re
 /// and every change of the interface or controller state: [`Feed::BusError`] (with the
 /// fix) when capture stops or the controller is in trouble, [`Feed::BusOk`] when it is
 /// back. The bus handle follows the interface by name, so capture resumes by itself. With
-/// `req`, the task also runs the palette's commands on this bus; `demo` is the simulation
-/// of a demo bus.
+/// `req`, the task also runs the palette's commands on this bus, and `hosted`'s servers;
+/// `demo` is the simulation of a demo bus.
 async fn capture(
     cap: Capture,
     bindings: Bindings,
     tx: SyncSender<Feed>,
     mut req: Option<UnboundedReceiver<Request>>,
     mut demo: Option<crate::sim::Simulation>,
+    hosted: Option<super::hosted::Hosted>,
 ) {
     let Capture {
         index,
@@ -191,6 +194,11 @@ async fn capture(
         .is_err()
     {
         return;
+    }
+    // The hosted servers' audit lines, to the message log in order with the frames.
+    let (log_tx, mut log) = unbounded_channel();
+    if let Some(h) = hosted {
+        h.start(&bus, sim.as_ref().map(|d| &d.vbus), &log_tx);
     }
     let mut feed = FrameFeed::new(tx.clone(), BACKLOG_FRAMES);
     // Frames dropped (past the backlog's bound) not yet reported.
@@ -250,6 +258,11 @@ async fn capture(
                 None => return,
             },
             Some(nodes) = stopped.recv() => jobs.stopped(&nodes),
+            Some(line) = log.recv() => {
+                if !feed.frames(std::mem::take(&mut batch)) || !feed.send(Feed::Result(Level::Info, line)) {
+                    return;
+                }
+            }
         }
     }
 }
@@ -349,8 +362,8 @@ struct Jobs {
     stopped_tx: UnboundedSender<Vec<u8>>,
     /// The Transmit pane's list being sent (one at a time: a new list replaces it).
     transmit: Option<AbortHandle>,
-    /// The Watch pane's poll groups (a new list replaces them).
-    watch: Vec<AbortHandle>,
+    /// The Watch pane's poll groups (a changed list starts and stops only what changed).
+    watch: super::watch_run::Polls,
 }
 
 impl Jobs {
@@ -361,7 +374,7 @@ impl Jobs {
             commanded: Commanded::default(),
             stopped_tx,
             transmit: None,
-            watch: Vec::new(),
+            watch: Default::default(),
         }
     }
 
@@ -426,8 +439,7 @@ impl Jobs {
                 self.transmit = Some(task.abort_handle());
             }
             Request::Watch { board } => {
-                self.watch.drain(..).for_each(|t| t.abort());
-                self.watch = super::watch_run::start(&bus, &board, bindings);
+                self.watch.follow(&bus, &board, bindings);
             }
             Request::ListJobs => {
                 let text = if self.running.is_empty() {
@@ -483,9 +495,7 @@ impl Jobs {
             t.abort();
             cancelled.push("the Transmit pane's list".to_string());
         }
-        let polling = self.watch.iter().any(|t| !t.is_finished());
-        self.watch.drain(..).for_each(|t| t.abort());
-        if polling {
+        if self.watch.stop() {
             cancelled.push("the Watch pane's polls".to_string());
         }
         self.running.sort_by_key(|j| j.cyclic.is_none());

@@ -14,6 +14,7 @@ pub mod export;
 mod export_plot;
 mod frame_feed;
 pub mod fuzzy;
+pub mod hosted;
 pub mod keymap;
 pub mod live;
 pub mod messages;

@@ -501,7 +501,7 @@ fn stop_all_in_the_live_task_cancels_a_running_procedure_first() {
     let read = |_: &std::path::Path| Ok(SLOW_PROFILE.into());
     let mut b = cotui::od::bind::Bindings::new().unwrap();
     b.bind_profile(2, "slow.json", &read).unwrap();
-    let (feed, req) = start(&["demo".into()], false, b, None);
+    let (feed, req) = start(&["demo".into()], false, b, None, Default::default());
     let command = cotui::command::parse_command("run 2 slowpv").unwrap();
     req.send(Request::Run {
         line: "run 2 slowpv".into(),

@@ -5,6 +5,7 @@
 
 mod agreement;
 mod filter_search;
+mod hosted;
 mod objects_demo;
 mod objects_tmux;
 mod open_logs;

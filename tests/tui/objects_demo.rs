@@ -35,7 +35,7 @@ fn until(a: &mut App, what: &str, f: impl Fn(&App, &str) -> bool) -> String {
 pub(crate) fn demo_app() -> App {
     let bindings = cotui::cli::bind::bindings_on("demo", &[], &[]).unwrap();
     let trace = Trace::new(Decoder::from_bindings(&bindings), 500_000);
-    let (rx, req) = cotui::tui::live::start(&["demo".into()], false, bindings.clone(), None);
+    let (rx, req) = cotui::tui::live::start(&["demo".into()], false, bindings.clone(), None, Default::default());
     let src = SourceInfo::live("demo", SourceKind::Demo { listen_only: false }, rx, req);
     let mut a = App::new(trace, Keymap::default_map(), src);
     a.set_bindings(bindings);

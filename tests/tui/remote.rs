@@ -43,7 +43,13 @@ fn the_tui_attaches_to_a_remote_bus_with_the_palette_and_follows_the_server() {
     let url = format!("socketcand://127.0.0.1:{port}/demo");
     let bindings = cotui::cli::bind::bindings_on(&url, &[], &[]).unwrap();
     let trace = Trace::new(Decoder::from_bindings(&bindings), 500_000);
-    let (rx, req) = cotui::tui::live::start(std::slice::from_ref(&url), false, bindings.clone(), None);
+    let (rx, req) = cotui::tui::live::start(
+        std::slice::from_ref(&url),
+        false,
+        bindings.clone(),
+        None,
+        Default::default(),
+    );
     let src = SourceInfo::live(&url, SourceKind::Live { listen_only: false }, rx, req);
     let mut a = App::new(trace, Keymap::default_map(), src);
     a.set_bindings(bindings);
@@ -127,7 +133,13 @@ fn a_flood_from_a_remote_bus_reaches_the_trace_whole_however_slowly_the_ui_takes
     let url = format!("socketcand://127.0.0.1:{}/can0", flood_server(N));
     let bindings = cotui::cli::bind::bindings_on(&url, &[], &[]).unwrap();
     let trace = Trace::new(Decoder::from_bindings(&bindings), 500_000);
-    let (rx, req) = cotui::tui::live::start(std::slice::from_ref(&url), true, bindings.clone(), None);
+    let (rx, req) = cotui::tui::live::start(
+        std::slice::from_ref(&url),
+        true,
+        bindings.clone(),
+        None,
+        Default::default(),
+    );
     let src = SourceInfo::live(&url, SourceKind::Live { listen_only: true }, rx, req);
     let mut a = App::new(trace, Keymap::default_map(), src);
     let s = until(&mut a, "every frame", |a, _| a.trace().len() >= N as usize);

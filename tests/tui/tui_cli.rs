@@ -152,3 +152,48 @@ fn a_keymap_that_cannot_quit_or_cannot_be_read_is_refused_and_located() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn hosted_servers_are_checked_before_the_terminal_is_taken() {
+    let dir = tempdir("host");
+    let out = cotui(&["demo", "--gateway", "127.0.0.1:5555"], &dir);
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr).trim(),
+        "cotui demo: --gateway 127.0.0.1:5555: give tcp:ADDR:PORT (e.g. tcp:127.0.0.1:5555) or unix:PATH"
+    );
+    let out = cotui(
+        &[
+            "demo",
+            "--listen-only",
+            "--gateway",
+            "tcp:127.0.0.1:0",
+            "--allow-writes",
+        ],
+        &dir,
+    );
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("--allow-writes and --listen-only contradict each other"),
+        "{out:?}"
+    );
+    // A taken port is said at once, naming it.
+    let taken = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = taken.local_addr().unwrap().port().to_string();
+    let out = cotui(&["live", "vcan0", "--socketcand", &port], &dir);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).starts_with(&format!(
+            "cotui live: --socketcand {port}: cannot listen on 127.0.0.1:{port}: "
+        )),
+        "{out:?}"
+    );
+    // --allow-send means nothing without --socketcand.
+    let out = cotui(&["demo", "--allow-send"], &dir);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("required arguments were not provided:\n  --socketcand"),
+        "{out:?}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

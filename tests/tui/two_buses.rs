@@ -18,7 +18,7 @@ fn two_demo_buses() -> App {
     let bindings = cotui::cli::bind::bindings_on("demo", &[], &[]).unwrap();
     let trace = Trace::new(Decoder::from_bindings(&bindings), 500_000);
     let ifaces = ["demo".to_string(), "demo2".to_string()];
-    let (rx, req) = cotui::tui::live::start(&ifaces, true, bindings.clone(), None);
+    let (rx, req) = cotui::tui::live::start(&ifaces, true, bindings.clone(), None, Default::default());
     let src = SourceInfo::live("demo demo2", SourceKind::Live { listen_only: true }, rx, req);
     let mut a = App::new(trace, Keymap::default_map(), src);
     a.set_bindings(bindings);

@@ -340,6 +340,7 @@ pub async fn open(url: &str, listen_only: bool) -> Result<Bus, BusError> {
         sender,
         socket: None,
         clock: Clock::Remote(Arc::new(Shared { link, task })),
+        turns: Default::default(),
     })
 }
 
