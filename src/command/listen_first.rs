@@ -6,6 +6,8 @@ use super::error::{CommandError, ExitCode};
 use crate::analysis::producers::{self, Heard};
 use crate::bus::{Bus, BusError};
 use serde::Serialize;
+use std::future::Future;
+use std::pin::Pin;
 use std::time::Duration;
 
 /// How long `sync` and `nmt` listen by default before sending (ms of bus time).
@@ -58,19 +60,24 @@ struct Refused {
     message: String,
 }
 
+/// The command's stop (Ctrl-C), as [`super::spec::Ctx::stop`] holds it.
+pub type Stop<'a, 'b> = &'b mut Pin<&'a mut (dyn Future<Output = ()> + Send)>;
+
 /// Before sending `cob_id` as `producer`: fails at once on a listen-only handle (nothing
 /// could be sent), listens `listen.ms` of bus time, and refuses (exit 2) when another
-/// producer was heard, unless `listen.force`. What was heard, if anything, for the report.
+/// producer was heard, unless `listen.force`; `stop` while listening ends it at once with
+/// nothing sent (exit 2, `error: "stopped"`). What was heard, if anything, for the report.
 pub async fn before_sending(
     bus: &Bus,
     cob_id: u32,
     producer: &'static str,
     listen: Listen,
+    stop: Stop<'_, '_>,
 ) -> Result<Option<OtherProducer>, CommandError> {
     if bus.is_listen_only() {
         return Err(BusError::ListenOnly.into());
     }
-    let Some(other) = hear(bus, cob_id, producer, listen.ms).await? else {
+    let Some(other) = hear(bus, cob_id, producer, listen.ms, stop).await? else {
         return Ok(None);
     };
     if listen.force {
@@ -91,9 +98,36 @@ pub async fn before_sending(
     })
 }
 
+/// Stopped while listening: the failure, its `--json` object `{error: "stopped", ...}`.
+fn stopped(producer: &str, listened_ms: u64) -> CommandError {
+    #[derive(Serialize)]
+    struct Stopped {
+        listened_ms: u64,
+        message: String,
+    }
+    let message =
+        format!("stopped after {listened_ms} ms of listening for another {producer}, before sending: nothing sent");
+    CommandError::Report {
+        exit: ExitCode::Unavailable,
+        error: "stopped",
+        report: super::report::Reported::new(Stopped {
+            listened_ms,
+            message: message.clone(),
+        }),
+        text: message,
+    }
+}
+
 /// Listens `ms` of bus time (until a frame stamped past the window, or the timer on a quiet
-/// bus) for frames of `cob_id` another producer sent; None when none was heard (or ms is 0).
-async fn hear(bus: &Bus, cob_id: u32, producer: &'static str, ms: u64) -> Result<Option<OtherProducer>, CommandError> {
+/// bus, or `stop`) for frames of `cob_id` another producer sent; None when none was heard
+/// (or ms is 0).
+async fn hear(
+    bus: &Bus,
+    cob_id: u32,
+    producer: &'static str,
+    ms: u64,
+    stop: Stop<'_, '_>,
+) -> Result<Option<OtherProducer>, CommandError> {
     if ms == 0 {
         return Ok(None);
     }
@@ -105,6 +139,7 @@ async fn hear(bus: &Bus, cob_id: u32, producer: &'static str, ms: u64) -> Result
     let mut heard: Option<Heard> = None;
     loop {
         let f = tokio::select! {
+            _ = &mut *stop => return Err(stopped(producer, bus.now_ns().saturating_sub(start) / 1_000_000)),
             _ = &mut timer => break,
             got = rx.recv() => match got {
                 Ok(f) => f,

@@ -114,8 +114,9 @@ impl Spec for Nmt {
     }
 
     /// Listens for another NMT master, then sends (and waits for the confirmation).
-    async fn run(&self, ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
-        let other = super::listen_first::before_sending(ctx.bus, cob::NMT, "NMT master", self.listen).await?;
+    async fn run(&self, mut ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
+        let other =
+            super::listen_first::before_sending(ctx.bus, cob::NMT, "NMT master", self.listen, &mut ctx.stop).await?;
         let seen = nmt(ctx.bus, self.action, self.node, self.wait, self.timeout_ms).await?;
         let sent = NmtSent {
             ok: true,

@@ -88,8 +88,10 @@ impl Spec for Sync {
     }
 
     /// Listens for another SYNC producer, then sends the SYNCs.
-    async fn run(&self, ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
-        let other = super::listen_first::before_sending(ctx.bus, self.cob_id, "SYNC producer", self.listen).await?;
+    async fn run(&self, mut ctx: Ctx<'_>) -> Result<Outcome, CommandError> {
+        let other =
+            super::listen_first::before_sending(ctx.bus, self.cob_id, "SYNC producer", self.listen, &mut ctx.stop)
+                .await?;
         let sent = super::cyclic::transmit(ctx.bus, self.frames(), ctx.progress, ctx.stop).await?;
         let mut text = sent.text();
         if let Some(o) = &other {

@@ -71,6 +71,30 @@ async fn sync_refuses_beside_the_demos_sync_producer_and_force_sends() {
 }
 
 #[tokio::test(start_paused = true)]
+async fn a_stop_while_listening_ends_the_command_at_once_with_nothing_sent() {
+    let d = Demo::spawn(Simulation::demo(), false);
+    let mut rx = d.bus.subscribe();
+    let b = Bindings::new().unwrap();
+    for line in [
+        "sync --period 10 --listen 5s --force",
+        "nmt start 2 --listen 5s --force",
+    ] {
+        // Ctrl-C 150 ms into a 5 s window: no waiting for the window, even with --force.
+        let stop = tokio::time::sleep(std::time::Duration::from_millis(150));
+        let cmd = parse_command(line).unwrap();
+        let e = cotui::command::execute_until(&d.bus, &cmd, &b, Default::default(), stop)
+            .await
+            .unwrap_err();
+        assert_eq!(e.exit_code(), 2, "{line}");
+        let j = e.to_json();
+        assert_eq!(j["error"], "stopped", "{line}: {j}");
+        assert_eq!(j["listened_ms"], 150, "{line}: {j}");
+        assert!(e.to_string().ends_with("before sending: nothing sent"), "{e}");
+        assert_eq!(sent_ids(&d.bus, &mut rx).await, Vec::<u32>::new(), "{line}");
+    }
+}
+
+#[tokio::test(start_paused = true)]
 async fn nmt_refuses_when_the_demos_nmt_master_is_heard_and_force_sends() {
     let d = Demo::spawn(Simulation::demo(), false);
     let mut rx = d.bus.subscribe();
