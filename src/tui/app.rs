@@ -184,10 +184,16 @@ impl App {
         }
     }
 
-    /// Advances the node table to the capture time at wall time `now` (live and replay).
+    /// Advances the node table and the trigger to the capture time at wall time `now`
+    /// (live and replay).
     fn liveness_tick(&mut self, now: Instant) {
         let mut q = Queue::default();
         if self.capture.liveness_tick(now, &mut q) {
+            self.dirty = true;
+        }
+        if let Some(t) = self.capture.now_ns(now)
+            && self.screen.trigger_tick(self.capture.trace(), t)
+        {
             self.dirty = true;
         }
         self.route(q);
@@ -744,6 +750,37 @@ mod tests {
         a.capture_mut().source_mut().kind = SourceKind::Replay { speed: 1.0 };
         a.capture_mut().source_mut().paused = true;
         assert_eq!(a.capture().now_ns(taken + Duration::from_secs(9)), None);
+    }
+
+    #[test]
+    fn hb_lost_on_a_silent_live_bus_is_a_trigger_hit_by_the_capture_clock() {
+        let (ftx, frx) = std::sync::mpsc::channel();
+        let (rtx, _rrx) = tokio::sync::mpsc::unbounded_channel();
+        let mut a = app();
+        *a.capture_mut().source_mut() = SourceInfo::live("vcan0", SourceKind::Live { listen_only: true }, frx, rtx);
+        let t0 = a.trace().nodes.now_ns();
+        a.run_command("trigger hb lost");
+        let batch: Vec<crate::frame::Frame> = (1..=5u64)
+            .map(|i| {
+                let mut f = crate::frame::Frame::classic(0x705, &[0x05]);
+                f.ts_ns = t0 + i * 100_000_000;
+                f
+            })
+            .collect();
+        ftx.send(Feed::Frames(batch)).unwrap();
+        a.ingest(Duration::from_millis(100));
+        while a.work(Duration::from_millis(100)) {}
+        let taken = Instant::now();
+        let hits = |a: &App| a.screen().trigger().map(|t| t.hits().to_vec()).unwrap_or_default();
+        let before = hits(&a);
+        let last = a.trace().len() - 1;
+        assert!(!before.contains(&last), "node 5 beats every 100 ms: {before:?}");
+        // No frame for a second: no frame brings node 5's loss, the capture clock does, and
+        // the hit is marked at the last frame before it.
+        a.liveness_tick(taken + Duration::from_secs(1));
+        assert_eq!(hits(&a), [before.clone(), vec![last]].concat());
+        a.liveness_tick(taken + Duration::from_secs(2));
+        assert_eq!(hits(&a), [before, vec![last]].concat(), "lost once");
     }
 
     #[test]

@@ -318,6 +318,12 @@ impl Screen {
         Ok(summary)
     }
 
+    /// The capture clock reached `now_ns` with no new frame: the trigger's time-only hits
+    /// (`hb lost` on a silent bus); true when one was found.
+    pub(crate) fn trigger_tick(&mut self, trace: &Trace, now_ns: u64) -> bool {
+        self.panes.trace_mut().trigger_tick(trace, now_ns)
+    }
+
     /// The trigger in force.
     pub fn trigger(&self) -> Option<&TriggerScan> {
         self.panes.trace().trigger()

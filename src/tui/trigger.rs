@@ -79,6 +79,23 @@ impl TriggerScan {
         self.next < len
     }
 
+    /// The capture clock reached `now_ns` with no new frame (a quiet live bus): what fires
+    /// on time alone (`hb lost`, a window of `A then B within` running out) is a hit at the
+    /// last frame, once every frame has been judged. True when it made a hit.
+    pub fn tick(&mut self, trace: &Trace, now_ns: u64) -> bool {
+        let len = trace.store.len();
+        if self.next < len || len == 0 {
+            return false;
+        }
+        let mut found: Vec<Hit> = Vec::new();
+        self.detector.tick(now_ns, &mut found);
+        if found.is_empty() || self.hits.last() == Some(&(len - 1)) {
+            return false;
+        }
+        self.hits.push(len - 1);
+        true
+    }
+
     /// Trace positions of the hits so far, rising.
     pub fn hits(&self) -> &[usize] {
         &self.hits

@@ -100,6 +100,12 @@ impl TracePane {
         (more, changed)
     }
 
+    /// The capture clock reached `now_ns` with no new frame: the trigger's time-only hits
+    /// (see [`TriggerScan::tick`]); true when one was found.
+    pub fn trigger_tick(&mut self, trace: &Trace, now_ns: u64) -> bool {
+        self.trigger.as_mut().is_some_and(|t| t.tick(trace, now_ns))
+    }
+
     /// The trigger in force.
     pub fn trigger(&self) -> Option<&TriggerScan> {
         self.trigger.as_ref()
