@@ -25,6 +25,7 @@ pub mod stop;
 pub mod sync;
 pub mod syntax;
 pub mod time_order;
+pub mod transmit_line;
 pub mod transmit_list;
 pub mod transmit_run;
 pub mod value;

@@ -16,8 +16,6 @@ use std::path::Path;
 const LISTEN_ONLY: &str = "transmit: listen-only session — nothing can be sent, the entry stays disabled";
 
 /// A template for a new entry (the cursor goes inside the frame's quotes).
-const TEMPLATE: &str = r#"{"frame": "", "every_ms": 100}"#;
-
 /// Loads the list file at `path` into `pane` (a bad entry is shown as such with its
 /// line, the others work), then sends it; what went wrong goes to `q`. An unreadable file
 /// or one that is not a list is an error.
@@ -168,7 +166,7 @@ pub(crate) fn ask(
         }
         TransmitAsk::Add => {
             pane.editing = None;
-            Some((TEMPLATE.into(), TEMPLATE.find("\"\"").map_or(0, |c| c + 1)))
+            Some((String::new(), 0))
         }
         TransmitAsk::Edit(k) => {
             let raw = pane.rows.get(k)?.raw.clone();
@@ -180,6 +178,8 @@ pub(crate) fn ask(
             if k < pane.rows.len() {
                 bank(pane);
                 pane.rows.remove(k);
+                // The last row deleted: the one before it is selected.
+                pane.select(k.min(pane.rows.len().saturating_sub(1)));
                 send(capture, pane);
                 q.push(Event::Note(format!("transmit: entry {} deleted (w: save)", k + 1)));
             }
@@ -216,7 +216,11 @@ pub(crate) fn submit(
 ) -> Result<(), String> {
     let k = pane.editing.take().filter(|k| *k < pane.rows.len());
     let index = k.unwrap_or(pane.rows.len());
-    let entry = load_entry(text, index + 1, bindings).map_err(|p| {
+    let json = crate::command::transmit_line::entry_json(text).map_err(|e| {
+        pane.editing = k;
+        format!("transmit entry: {e}")
+    })?;
+    let entry = load_entry(&json, index + 1, bindings).map_err(|p| {
         pane.editing = k;
         format!("transmit entry: {}", p.message)
     })?;
@@ -226,7 +230,7 @@ pub(crate) fn submit(
     }
     bank(pane);
     let row = TxRow {
-        raw: compact(text),
+        raw: compact(&json),
         entry: Ok(entry),
         sent_before: 0,
     };
@@ -343,7 +347,7 @@ mod tests {
         // Space on entry 1: disabled, the list sent again without it enabled.
         key(&mut a, ' ');
         assert_eq!(last_sent(&mut req).unwrap()[0], ("123#0102".to_string(), false));
-        // `a`: a template with the cursor in the frame's quotes.
+        // `a`: an entry typed on one line (a frame, sent once).
         key(&mut a, 'a');
         for c in "7FF#AA".chars() {
             key(&mut a, c);
@@ -351,6 +355,19 @@ mod tests {
         a.key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
         let sent = last_sent(&mut req).unwrap();
         assert_eq!(sent.last().unwrap(), &("7FF#AA".to_string(), true));
+        // An RPDO by its signal names, on one line, encoded through node 2's mapping.
+        key(&mut a, 'a');
+        for c in "rpdo1 2 Controlword=0x0F every 10ms # enable".chars() {
+            key(&mut a, c);
+        }
+        a.key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
+        let sent = last_sent(&mut req).unwrap();
+        assert_eq!(
+            sent.last().unwrap(),
+            &("RPDO1 node 2 202#0F0000000000".to_string(), true)
+        );
+        key(&mut a, 'd');
+        last_sent(&mut req);
         // A bad entry typed keeps the prompt open and says why.
         key(&mut a, 'a');
         a.key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
