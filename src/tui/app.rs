@@ -230,6 +230,10 @@ impl App {
                     let objects = self.screen.objects_mut();
                     stop::stop_all(&self.capture, objects, &nodes, options, &mut q);
                 }
+                Event::TransmitStopped(why) => {
+                    let pane = self.screen.transmit_mut();
+                    transmit::stopped_elsewhere(pane, &self.bindings, &why, &mut q);
+                }
                 Event::Quit => self.request_quit(),
                 Event::Watch(ask) => {
                     let (pane, objects) = self.screen.watch_and_objects();

@@ -278,6 +278,7 @@ impl Capture {
             }
             Ok(Feed::Result(level, s)) => q.push(Event::Result(level, s)),
             Ok(Feed::Stopped(level, s, failed)) => q.push(Event::Stopped(level, s, failed)),
+            Ok(Feed::TransmitStopped(why)) => q.push(Event::TransmitStopped(why)),
             Ok(Feed::Lost(n)) => self.source.drops += n,
             Ok(Feed::BusError(note)) => {
                 let bus = self.source.buses.entry(note.iface).or_insert((note.state, None));

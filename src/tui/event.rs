@@ -50,6 +50,8 @@ pub(crate) enum Event {
     Quit,
     /// What the Transmit pane asks.
     Transmit(TransmitAsk),
+    /// The Transmit pane's list stopped on the bus task (why): every entry is off.
+    TransmitStopped(String),
     /// What the Watch pane asks.
     Watch(WatchAsk),
 }

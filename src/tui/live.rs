@@ -426,14 +426,12 @@ impl Jobs {
                 }
                 let task = tokio::spawn(async move {
                     let stop = std::future::pending();
-                    let text = match transmit_list(&bus, "Transmit pane", entries, None, progress, stop).await {
-                        Ok(r) => r
-                            .stopped_by
-                            .map(|why| (Level::Warn, format!("transmit: every entry disabled: {why}"))),
-                        Err(e) => Some((Level::Error, format!("transmit: not sent: {e}"))),
+                    let feed = match transmit_list(&bus, "Transmit pane", entries, None, progress, stop).await {
+                        Ok(r) => r.stopped_by.map(Feed::TransmitStopped),
+                        Err(e) => Some(Feed::Result(Level::Error, format!("transmit: not sent: {e}"))),
                     };
-                    if let Some((level, text)) = text {
-                        let _ = tx.send(Feed::Result(level, text));
+                    if let Some(feed) = feed {
+                        let _ = tx.send(feed);
                     }
                 });
                 self.transmit = Some(task.abort_handle());

@@ -46,6 +46,9 @@ pub enum Feed {
     Extent(Extent),
     /// The result of a palette command, and how much it matters.
     Result(super::messages::Level, String),
+    /// The Transmit pane's list stopped by itself (a quick stop another program put on the
+    /// bus): why; the pane shows every entry off.
+    TransmitStopped(String),
     /// The result of a stop-all, as [`Feed::Result`], with the nodes not confirmed stopped
     /// (every target when nothing could be sent).
     Stopped(super::messages::Level, String, Vec<u8>),

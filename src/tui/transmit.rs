@@ -122,6 +122,19 @@ pub(crate) fn disable_all(capture: &Capture, pane: &mut TransmitPane, bindings: 
     ));
 }
 
+/// The list stopped on the bus task (`why`: a quick stop another program sent): every
+/// entry shows off, as it is; nothing is sent again until one is enabled.
+pub(crate) fn stopped_elsewhere(pane: &mut TransmitPane, bindings: &Bindings, why: &str, q: &mut Queue) {
+    bank(pane);
+    for k in 0..pane.rows.len() {
+        set_enabled(pane, k, false, bindings);
+    }
+    q.push(Event::Say(
+        Level::Warn,
+        format!("transmit: every entry disabled: {why}"),
+    ));
+}
+
 /// Does what the pane asked.
 pub(crate) fn ask(
     capture: &Capture,
@@ -335,6 +348,35 @@ mod tests {
         assert!(s.contains("bad"), "{s}");
         let s = s.replace(&path.display().to_string(), "LIST.json");
         insta::assert_snapshot!("transmit_pane_loaded", s);
+    }
+
+    #[test]
+    fn a_quick_stop_from_elsewhere_ends_the_list_and_the_pane_shows_every_entry_off() {
+        use crate::tui::app::{SourceInfo, SourceKind};
+        use crate::tui::source::Feed;
+        let (ftx, frx) = std::sync::mpsc::channel();
+        let (rtx, mut req) = tokio::sync::mpsc::unbounded_channel();
+        let mut a = crate::tui::panes::testutil::app();
+        *a.capture_mut().source_mut() = SourceInfo::live("vcan0", SourceKind::Live { listen_only: false }, frx, rtx);
+        a.set_bindings(crate::cli::bind::bindings_on(crate::connect::DEMO, &[], &[]).unwrap());
+        a.load_transmit(&list_file("elsewhere")).unwrap();
+        last_sent(&mut req);
+        a.act(Action::PaneTransmit);
+        assert_eq!(state(&screen(&mut a, 160, 12), "123#0102"), "on");
+        // The bus task's sender saw another program's quick stop and ended.
+        let why = "a quick stop of node 2 was seen on the bus (a stop-all); nothing more sent";
+        ftx.send(Feed::TransmitStopped(why.into())).unwrap();
+        a.ingest(std::time::Duration::from_millis(100));
+        let s = screen(&mut a, 160, 12);
+        assert_eq!(state(&s, "123#0102"), "off", "{s}");
+        assert_eq!(
+            a.message(),
+            Some(format!("transmit: every entry disabled: {why}").as_str())
+        );
+        assert!(last_sent(&mut req).is_none(), "nothing sent again");
+        // Space enables the entry again: the list is sent with it on.
+        key(&mut a, ' ');
+        assert_eq!(last_sent(&mut req).unwrap()[0], ("123#0102".to_string(), true));
     }
 
     #[test]
