@@ -468,7 +468,7 @@ fn render(p: &PlotPane, trace: &Trace, f: &mut Frame, area: Rect, focused: bool)
         chart(group, plot, axes, y_label_w, p.cursor, f, *area);
     }
     if !bits.is_empty() {
-        lanes(&bits, win, p.cursor, label_w, f, lanes_area);
+        lanes(&bits, axes, p.cursor, label_w, f, lanes_area);
     }
     f.render_widget(Paragraph::new(readout_text).wrap(Wrap { trim: false }), readout);
 }
@@ -661,20 +661,35 @@ fn chart(values: &[&Shown], p: &Plotted, axes: Axes, label_w: usize, cursor: Opt
 }
 
 /// One lane per named bit: `█` set, `▁` clear, `▒` both within a column, blank before the
-/// first value; the cursor's column is shown reversed.
-fn lanes(bits: &[&Shown], win: TimeWindow, cursor: Option<f64>, label_w: u16, f: &mut Frame, area: Rect) {
+/// first value; the cursor's column is shown reversed, a trigger hit's column marked `▼`
+/// above the lanes and on a red ground in them.
+fn lanes(bits: &[&Shown], axes: Axes, cursor: Option<f64>, label_w: u16, f: &mut Frame, area: Rect) {
+    let win = axes.win;
     let cols = area.width.saturating_sub(label_w + 1) as usize;
     let width = win.width() / cols.max(1) as f64;
-    let cursor_col = cursor
-        .filter(|c| (win.start..=win.end).contains(c))
-        .map(|c| (((c - win.start) / width) as usize).min(cols.saturating_sub(1)));
+    let col_of = |t: f64| (((t - win.start) / width) as usize).min(cols.saturating_sub(1));
+    let cursor_col = cursor.filter(|c| (win.start..=win.end).contains(c)).map(col_of);
+    // The trigger's hits: a `▼` above the signal's lanes, its cells marked in every lane.
+    let mut hit_cols = vec![false; cols];
+    for &h in axes.hits {
+        if let Some(c) = hit_cols.get_mut(col_of(h)) {
+            *c = true;
+        }
+    }
     let mut out: Vec<Line> = Vec::new();
     for s in bits {
         let Some(names) = s.bits() else { continue };
-        out.push(Line::styled(
-            fit(&s.name, area.width as usize),
-            Style::default().fg(s.color).add_modifier(Modifier::BOLD),
-        ));
+        let bold = Style::default().fg(s.color).add_modifier(Modifier::BOLD);
+        if hit_cols.contains(&true) {
+            let label = fit(&s.name, label_w as usize);
+            let marks: String = hit_cols.iter().map(|&h| if h { '▼' } else { ' ' }).collect();
+            out.push(Line::from(vec![
+                Span::styled(format!("{label:<w$} ", w = label_w as usize), bold),
+                Span::styled(marks, Style::default().fg(Color::LightRed)),
+            ]));
+        } else {
+            out.push(Line::styled(fit(&s.name, area.width as usize), bold));
+        }
         // Per column: (seen low, seen high) of every bit, from the value held at the
         // column's start and each point inside it.
         let pts = s.line.window(win.start, win.end);
@@ -725,11 +740,12 @@ fn lanes(bits: &[&Shown], win: TimeWindow, cursor: Option<f64>, label_w: u16, f:
                     (true, false) => "▁",
                     (false, false) => " ",
                 };
-                let style = if Some(c) == cursor_col {
-                    Style::default().fg(s.color).add_modifier(Modifier::REVERSED)
-                } else {
-                    Style::default().fg(s.color)
-                };
+                let mut style = Style::default().fg(s.color);
+                if Some(c) == cursor_col {
+                    style = style.add_modifier(Modifier::REVERSED);
+                } else if hit_cols[c] {
+                    style = style.bg(Color::LightRed);
+                }
                 spans.push(Span::styled(ch, style));
             }
             out.push(Line::from(spans));

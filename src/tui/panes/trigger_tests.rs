@@ -134,4 +134,18 @@ fn the_plot_title_counts_the_trigger_hits_in_its_window() {
     let s = screen(&mut a, 120, 30);
     assert!(s.contains("trigger Statusword & 0x0008: armed, 5 hits"), "{s}");
     assert!(s.contains("5 trigger hits shown"), "{s}");
+    // The statusword's bit lanes: a mark above each hit's column (one column holds two
+    // hits here), and in each of them the Fault bit is set (`▒`: it rose in that column).
+    let row = |name: &str| -> Vec<char> { s.lines().find(|l| l.contains(name)).unwrap().chars().collect() };
+    let (head, fault) = (row("n1 Statusword"), row(" 3 Fault"));
+    let marked: Vec<usize> = head
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| **c == '▼')
+        .map(|(i, _)| i)
+        .collect();
+    assert_eq!(marked.len(), 5, "{s}");
+    assert!(marked.iter().all(|&i| matches!(fault[i], '█' | '▒')), "{s}");
+    let rose = fault.iter().position(|c| matches!(*c, '█' | '▒')).unwrap();
+    assert_eq!(marked[0], rose, "the first hit is where the fault sets: {s}");
 }
