@@ -88,8 +88,23 @@ pub enum Lss {
     GetNode,
     /// `_lss_fastscan [TIMEOUT_MS]`.
     Fastscan(Option<u16>),
-    /// `lss_allnodes ...` (not supported by this gateway).
-    AllNodes,
+    /// `lss_allnodes [TIMEOUT_MS [FIRST STORE [SCAN0 VENDOR SCAN1 PRODUCT SCAN2 REVISION
+    /// SCAN3 SERIAL]]]`: every non-configured slave a fastscan finds gets the next node-ID.
+    AllNodes(AllNodes),
+}
+
+/// What `lss_allnodes` does, as canopend takes its words.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AllNodes {
+    /// The fastscan's wait for each answer (0 or absent: 100 ms).
+    pub timeout_ms: u16,
+    /// The node-ID of the first slave found (absent: 2); each next one gets one more.
+    pub first: u8,
+    /// Each slave stores its node-ID (absent: yes).
+    pub store: bool,
+    /// Vendor-ID, product code, revision, serial: `Some` to match (scan type 2), `None` to
+    /// scan (scan type 0; scan type 1, ignore, is scanned too: the same slaves are found).
+    pub known: [Option<u32>; 4],
 }
 
 /// Why a line is refused: the sequence number when it was read, the code and what was wrong.
@@ -362,8 +377,33 @@ fn lss(word: &str, words: &mut Words<'_>) -> Result<Lss, Fail> {
             }
         }
         "lss_allnodes" => {
-            words.value();
-            Lss::AllNodes
+            let mut a = AllNodes {
+                timeout_ms: 100,
+                first: 2,
+                store: true,
+                known: [None; 4],
+            };
+            if !words.done() {
+                let t = number(words, "the timeout (ms)", 0, 0xFFFF)? as u16;
+                if t > 0 {
+                    a.timeout_ms = t;
+                }
+            }
+            if !words.done() {
+                a.first = number(words, "the first node-ID", 1, 127)? as u8;
+                a.store = number(words, "store (0 or 1)", 0, 1)? == 1;
+            }
+            if !words.done() {
+                for (k, part) in ["vendor-ID", "product code", "revision number", "serial number"]
+                    .iter()
+                    .enumerate()
+                {
+                    let scan = number(words, "the scan type (0 fastscan, 1 ignore, 2 match)", 0, 2)?;
+                    let value = u32_word(words, &format!("the {part}"))?;
+                    a.known[k] = (scan == 2).then_some(value);
+                }
+            }
+            Lss::AllNodes(a)
         }
         _ => {
             return Err((
@@ -390,6 +430,47 @@ mod tests {
     fn refused(line: &str) -> (Option<u32>, u16) {
         let r = parse(line).unwrap_err();
         (r.seq, r.code.number())
+    }
+
+    #[test]
+    fn lss_allnodes_takes_canopends_optional_words() {
+        let all = |line: &str| match req(line).command {
+            Command::Lss(Lss::AllNodes(a)) => a,
+            other => panic!("{line}: {other:?}"),
+        };
+        let plain = AllNodes {
+            timeout_ms: 100,
+            first: 2,
+            store: true,
+            known: [None; 4],
+        };
+        assert_eq!(all("[1] lss_allnodes"), plain);
+        assert_eq!(all("[1] lss_allnodes 0"), plain, "0: the default timeout");
+        assert_eq!(
+            all("[1] lss_allnodes 200 10 0"),
+            AllNodes {
+                timeout_ms: 200,
+                first: 10,
+                store: false,
+                ..plain
+            }
+        );
+        assert_eq!(
+            all("[1] lss_allnodes 200 10 1 2 0x1234 0 0 1 0 2 99").known,
+            [Some(0x1234), None, None, Some(99)]
+        );
+        assert_eq!(refused("[2] lss_allnodes 200 128 1"), (Some(2), 101));
+        assert_eq!(refused("[3] lss_allnodes 200 10"), (Some(3), 101), "FIRST needs STORE");
+        assert_eq!(
+            refused("[4] lss_allnodes 200 10 1 3 0"),
+            (Some(4), 101),
+            "scan type 0..2"
+        );
+        assert_eq!(
+            refused("[5] lss_allnodes 200 10 1 2 5"),
+            (Some(5), 101),
+            "four parts or none"
+        );
     }
 
     #[test]

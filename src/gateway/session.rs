@@ -189,13 +189,7 @@ impl Session {
                     Err(e) => failed(seq, e),
                 };
             }
-            Lss::AllNodes => {
-                return answer::error(
-                    seq,
-                    Code::NotSupported,
-                    "lss_allnodes is not supported: use _lss_fastscan, lss_set_node, lss_store and lss_switch_glob 0",
-                );
-            }
+            Lss::AllNodes(a) => return self.all_nodes(seq, a).await,
         };
         match exchange(&self.bus, service, LSS_TIMEOUT_MS).await {
             Ok(Answer::Address(a)) => answer::value(seq, &address(a)),
@@ -203,6 +197,47 @@ impl Session {
             Ok(Answer::NodeId(n)) => answer::value(seq, &format!("0x{n:02X}")),
             Ok(_) => answer::ok(seq),
             Err(e) => failed(seq, e),
+        }
+    }
+}
+
+impl Session {
+    /// `lss_allnodes`, as canopend runs it: fastscan for a non-configured slave, give it the
+    /// next node-ID (stored when asked), back to waiting; again until no slave answers or
+    /// node-ID 127 was given. Each slave is a `# Node-ID N assigned to: ...` line before the
+    /// answer; the count (`# Found N nodes, search finished.`) or `# Not all nodes
+    /// scanned!` before the last `OK`. A failure ends it, after the lines of the slaves done.
+    async fn all_nodes(&mut self, seq: u32, a: line::AllNodes) -> String {
+        let mut out = String::new();
+        let (mut node, mut found) = (a.first, 0u32);
+        loop {
+            let addr = match fastscan(&self.bus, a.known, u64::from(a.timeout_ms)).await {
+                Ok(Some(addr)) => addr,
+                Ok(None) => {
+                    out.push_str(&format!("# Found {found} nodes, search finished.\n"));
+                    out.push_str(&answer::ok(seq));
+                    return out;
+                }
+                Err(e) => return out + &failed(seq, e),
+            };
+            let mut steps = vec![Service::ConfigureNodeId(node)];
+            if a.store {
+                steps.push(Service::StoreConfiguration);
+            }
+            steps.push(Service::SwitchGlobal(false));
+            for step in steps {
+                if let Err(e) = exchange(&self.bus, step, LSS_TIMEOUT_MS).await {
+                    return out + &failed(seq, e);
+                }
+            }
+            found += 1;
+            out.push_str(&format!("# Node-ID {node} assigned to: {}\n", address(addr)));
+            if node == 127 {
+                out.push_str("# Not all nodes scanned!\n");
+                out.push_str(&answer::ok(seq));
+                return out;
+            }
+            node += 1;
         }
     }
 }
@@ -305,4 +340,7 @@ LSS commands (need --allow-writes):
   lss_store                                store configuration
   lss_inquire_addr [0..3]                  vendor, product, revision, serial (all four without)
   lss_get_node                             inquire node-ID
-  _lss_fastscan [TIMEOUT_MS]               find one non-configured slave";
+  _lss_fastscan [TIMEOUT_MS]               find one non-configured slave
+  lss_allnodes [TIMEOUT_MS [FIRST STORE    node-IDs FIRST, FIRST+1, ... (2, stored) to every
+    [S0 VENDOR S1 PRODUCT S2 REV S3 SERIAL]]] non-configured slave found; S: 0 scan, 1 ignore,
+                                           2 match the value";

@@ -116,3 +116,40 @@ async fn nmt_through_the_gateway_shows_in_the_node_table() {
         .collect();
     assert_eq!(lss, [vec![4, 1, 0, 0, 0, 0, 0, 0], vec![4, 0, 0, 0, 0, 0, 0, 0]]);
 }
+
+#[tokio::test(start_paused = true)]
+async fn lss_allnodes_gives_every_fresh_drive_a_node_id_as_canopend_does() {
+    use cotui::sim::drive::Drive;
+    use cotui::sim::spec::parse_node;
+    let drives = ["ff=servo@0x99", "ff=servo@0x1234"]
+        .iter()
+        .map(|s| {
+            let (node, profile) = parse_node(s).unwrap();
+            Drive::new(node, profile)
+        })
+        .collect();
+    let d = Demo::spawn(Simulation::new(drives, 0), false);
+    let mut s = Session::new(d.bus.clone(), writes(true));
+    let a = s.answer(b"[1] lss_allnodes 100 10 1").await;
+    let lines: Vec<&str> = a.lines().collect();
+    assert_eq!(lines.len(), 4, "{a}");
+    // The fastscan finds the lower serial first (its bits are walked from the top down).
+    assert!(lines[0].starts_with("# Node-ID 10 assigned to: 0x"), "{a}");
+    assert!(lines[0].ends_with(" 0x00000099"), "{a}");
+    assert!(
+        lines[1].starts_with("# Node-ID 11 assigned to: ") && lines[1].ends_with(" 0x00001234"),
+        "{a}"
+    );
+    assert_eq!(lines[2..], ["# Found 2 nodes, search finished.", "[1] OK"]);
+    assert!(a.ends_with("[1] OK\r\n"));
+    // Both took their node-ID at the reset: they answer SDO there.
+    assert_eq!(s.answer(b"[2] 0 reset comm").await, "[2] OK\r\n");
+    tokio::time::sleep(Duration::from_millis(100)).await;
+    assert_eq!(s.answer(b"[3] 10 r 0x1018 4 u32").await, "[3] 153\r\n");
+    assert_eq!(s.answer(b"[4] 11 r 0x1018 4 u32").await, "[4] 4660\r\n");
+    // None left: found 0.
+    assert_eq!(
+        s.answer(b"[5] lss_allnodes").await,
+        "# Found 0 nodes, search finished.\n[5] OK\r\n"
+    );
+}
