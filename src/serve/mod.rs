@@ -14,6 +14,7 @@
 //! memory: each client has a queue of [`CLIENT_QUEUE`] elements, frames that do not fit
 //! are dropped and counted (an audit line at the first, the total at disconnect).
 
+mod jobs;
 pub mod session;
 
 use crate::audit::Audit;
@@ -303,6 +304,8 @@ async fn session(
     // Frames wait until then after `< rawmode >` (see RAW_GRACE).
     let mut hold: Option<tokio::time::Instant> = None;
     let mut streaming = false;
+    // The client's send jobs: they end with the session.
+    let mut jobs = jobs::Jobs::default();
     if tx.send(Session::greeting().to_string()).await.is_err() {
         return "write failed";
     }
@@ -351,6 +354,23 @@ async fn session(
                                 shared.audit.say(&format!("{who} send refused (no --allow-send): {}", crate::command::candump(&f)));
                             }
                             Action::Close => return "wrong bus",
+                            Action::Cyclic { frame, interval_ns } => {
+                                let every = if interval_ns == 0 {
+                                    "once".to_string()
+                                } else {
+                                    format!("every {} us", interval_ns / 1000)
+                                };
+                                shared.audit.say(&format!("{who} send job {} {every}", crate::command::candump(&frame)));
+                                jobs.add(bus, frame, interval_ns, who.to_string(), shared.audit.clone());
+                            }
+                            Action::Update(frame) => {
+                                shared.audit.say(&format!("{who} send job updated: {}", crate::command::candump(&frame)));
+                                jobs.update(frame);
+                            }
+                            Action::Delete(id, ext) => {
+                                shared.audit.say(&format!("{who} send job {id:X} deleted"));
+                                jobs.delete(id, ext);
+                            }
                         }
                     }
                     if s.raw() && !was_raw {

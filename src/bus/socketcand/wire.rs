@@ -134,6 +134,30 @@ pub enum Request {
     Subscribe { id: u32, ext: bool, interval_us: u64 },
     /// `unsubscribe ID` (BCM mode).
     Unsubscribe { id: u32, ext: bool },
+    /// `add SECS USECS ID LEN DATA...` (BCM mode): send `frame` every `interval_us`.
+    Add { interval_us: u64, frame: Frame },
+    /// `update ID LEN DATA...` (BCM mode): new content for the send job of its identifier,
+    /// its timer kept.
+    Update(Frame),
+    /// `delete ID` (BCM mode): the send job of `id` ends.
+    Delete { id: u32, ext: bool },
+    /// `filter SECS USECS ID LEN MASK...` (BCM mode): frames of `id` when the bits in `mask`
+    /// (or the length) changed, at most one per `interval_us`.
+    Filter {
+        id: u32,
+        ext: bool,
+        interval_us: u64,
+        mask: Vec<u8>,
+    },
+    /// `muxfilter SECS USECS ID N TUPLES...` (BCM mode): `tuples[0]` is the multiplexer's
+    /// mask; each further tuple holds a multiplexer value (in the mask's bits) and the
+    /// mask of what to watch in frames of that value.
+    MuxFilter {
+        id: u32,
+        ext: bool,
+        interval_us: u64,
+        tuples: Vec<[u8; 8]>,
+    },
     /// `cotui_send_policy`: cotui's question whether this server lets the client send
     /// (another socketcand answers it with an error, which the client takes as yes).
     SendPolicy,
@@ -142,18 +166,7 @@ pub enum Request {
 }
 
 /// The commands of socketcand this server does not implement.
-const UNSUPPORTED: &[&str] = &[
-    "add",
-    "update",
-    "delete",
-    "filter",
-    "muxfilter",
-    "controlmode",
-    "isotpmode",
-    "statistics",
-    "isotpconf",
-    "sendpdu",
-];
+const UNSUPPORTED: &[&str] = &["controlmode", "isotpmode", "statistics", "isotpconf", "sendpdu"];
 
 /// Parses the text of one element a client sent.
 pub fn parse_request(text: &str) -> Result<Request, WireError> {
@@ -195,9 +208,84 @@ pub fn parse_request(text: &str) -> Result<Request, WireError> {
             [id] => parse_id(id).map(|(id, ext)| Request::Unsubscribe { id, ext }),
             _ => Err(syntax("unsubscribe takes one ID")),
         },
+        "add" => match rest.as_slice() {
+            [secs, usecs, frame @ ..] => Ok(Request::Add {
+                interval_us: interval("add", secs, usecs)?,
+                frame: parse_send(frame).map_err(|e| renamed(e, "add"))?,
+            }),
+            _ => Err(syntax("add takes SECS USECS ID LEN DATA: add 1 0 123 2 11 22")),
+        },
+        "update" => parse_send(&rest).map(Request::Update).map_err(|e| renamed(e, "update")),
+        "delete" => match rest.as_slice() {
+            [id] => parse_id(id).map(|(id, ext)| Request::Delete { id, ext }),
+            _ => Err(syntax("delete takes one ID")),
+        },
+        "filter" => match rest.as_slice() {
+            [secs, usecs, frame @ ..] => {
+                let f = parse_send(frame).map_err(|e| renamed(e, "filter"))?;
+                Ok(Request::Filter {
+                    id: f.id,
+                    ext: f.is_ext(),
+                    interval_us: interval("filter", secs, usecs)?,
+                    mask: f.payload().to_vec(),
+                })
+            }
+            _ => Err(syntax("filter takes SECS USECS ID LEN MASK: filter 0 0 123 1 FF")),
+        },
+        "muxfilter" => parse_muxfilter(&rest),
         w if UNSUPPORTED.contains(&w) => Ok(Request::Unsupported(w.to_string())),
         w => Err(syntax(format!("unknown command {}", printable(w, 32)))),
     }
+}
+
+/// `SECS USECS` as microseconds.
+fn interval(cmd: &str, secs: &str, usecs: &str) -> Result<u64, WireError> {
+    let secs = number(secs, &format!("{cmd}: seconds"))?;
+    let usecs = number(usecs, &format!("{cmd}: microseconds"))?;
+    Ok(secs.saturating_mul(1_000_000).saturating_add(usecs))
+}
+
+/// A `send` parse error said for `cmd`, which takes the same `ID LEN DATA`.
+fn renamed(e: WireError, cmd: &str) -> WireError {
+    match e {
+        WireError::Syntax(t) => WireError::Syntax(t.replacen("send", cmd, 1)),
+        other => other,
+    }
+}
+
+/// `SECS USECS ID N B0 ... B(8N-1)` of a `muxfilter` (2 <= N <= 257).
+fn parse_muxfilter(words: &[&str]) -> Result<Request, WireError> {
+    let [secs, usecs, id, n, data @ ..] = words else {
+        return Err(syntax(
+            "muxfilter takes SECS USECS ID N and N tuples of 8 bytes: the multiplexer mask, then a value and its mask each",
+        ));
+    };
+    let interval_us = interval("muxfilter", secs, usecs)?;
+    let (id, ext) = parse_id(id)?;
+    let n = match number(n, "muxfilter: tuples") {
+        Ok(n) if (2..=257).contains(&n) => n as usize,
+        _ => return Err(syntax(format!("muxfilter: {} tuples: give 2..257", printable(n, 16)))),
+    };
+    if data.len() != n * 8 {
+        return Err(syntax(format!(
+            "muxfilter: {n} tuples are {} bytes, {} given",
+            n * 8,
+            data.len()
+        )));
+    }
+    let mut tuples = Vec::with_capacity(n);
+    for chunk in data.chunks(8) {
+        let bytes = parse_bytes("muxfilter", 8, chunk)?;
+        let mut t = [0u8; 8];
+        t.copy_from_slice(&bytes[..8]);
+        tuples.push(t);
+    }
+    Ok(Request::MuxFilter {
+        id,
+        ext,
+        interval_us,
+        tuples,
+    })
 }
 
 /// A decimal number of at most 9 digits.
@@ -613,7 +701,48 @@ mod tests {
                 interval_us: 1_500_000
             })
         );
-        assert_eq!(parse_request("add 1 0 123 0"), Ok(Request::Unsupported("add".into())));
+        assert_eq!(
+            parse_request("add 1 0 123 2 11 22"),
+            Ok(Request::Add {
+                interval_us: 1_000_000,
+                frame: Frame::classic(0x123, &[0x11, 0x22])
+            })
+        );
+        assert_eq!(
+            parse_request("filter 1 500000 123 2 FF 00"),
+            Ok(Request::Filter {
+                id: 0x123,
+                ext: false,
+                interval_us: 1_500_000,
+                mask: vec![0xFF, 0]
+            })
+        );
+        assert_eq!(
+            parse_request("muxfilter 0 0 123 2 FF 00 00 00 00 00 00 00 33 FF FF FF FF FF FF FF"),
+            Ok(Request::MuxFilter {
+                id: 0x123,
+                ext: false,
+                interval_us: 0,
+                tuples: vec![
+                    [0xFF, 0, 0, 0, 0, 0, 0, 0],
+                    [0x33, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF]
+                ]
+            })
+        );
+        assert_eq!(
+            parse_request("delete 1AAAAAAA"),
+            Ok(Request::Delete {
+                id: 0x1AAA_AAAA,
+                ext: true
+            })
+        );
+        assert!(
+            matches!(parse_request("update 123 9"), Err(WireError::Syntax(t)) if t.starts_with("update: length 9"))
+        );
+        assert!(
+            matches!(parse_request("muxfilter 0 0 123 2 FF"), Err(WireError::Syntax(t)) if t.contains("16 bytes, 1 given"))
+        );
+        assert!(matches!(parse_request("muxfilter 0 0 123 1"), Err(WireError::Syntax(t)) if t.contains("give 2..257")));
     }
 
     #[test]
