@@ -107,11 +107,7 @@ async fn serve(args: &GatewayArgs, bound: Option<Bound>) -> Result<(), GatewayEr
             });
     };
     let at = bound.at();
-    gw.say(&format!(
-        "{} on {at}{}",
-        args.iface,
-        mode(args.listen_only, args.allow_writes)
-    ));
+    gw.say(&format!("{} on {at}{}", args.iface, policy.mode(args.listen_only)));
     let ctrl_c = async {
         if tokio::signal::ctrl_c().await.is_err() {
             std::future::pending::<()>().await;
@@ -121,13 +117,4 @@ async fn serve(args: &GatewayArgs, bound: Option<Bound>) -> Result<(), GatewayEr
         .serve(&gw, ctrl_c)
         .await
         .map_err(|source| GatewayError::Io { what: at, source })
-}
-
-/// What the clients may do, for the line that says where the gateway listens.
-pub fn mode(listen_only: bool, allow_writes: bool) -> &'static str {
-    match (listen_only, allow_writes) {
-        (true, _) => " (listen-only: nothing is sent)",
-        (false, true) => " (writes, NMT and LSS allowed)",
-        (false, false) => " (read-only: --allow-writes for write, NMT and LSS)",
-    }
 }

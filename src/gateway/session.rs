@@ -27,6 +27,17 @@ pub struct Policy {
     pub notify: bool,
 }
 
+impl Policy {
+    /// What the clients may do, for the line that says where the gateway listens.
+    pub fn mode(&self, listen_only: bool) -> &'static str {
+        match (listen_only, self.allow_writes) {
+            (true, _) => " (listen-only: nothing is sent)",
+            (false, true) => " (writes, NMT and LSS allowed)",
+            (false, false) => " (read-only: --allow-writes for write, NMT and LSS)",
+        }
+    }
+}
+
 /// The default SDO timeout of a session, in ms (canopend's).
 pub const SDO_TIMEOUT_MS: u16 = 500;
 

@@ -36,7 +36,7 @@ impl Hosted {
         if let Some((bound, policy)) = self.gateway {
             let gw = Gateway::start(bus.clone(), policy, sink("gateway"));
             let at = bound.at();
-            let mode = crate::cli::gateway::mode(bus.is_listen_only(), policy.allow_writes);
+            let mode = policy.mode(bus.is_listen_only());
             gw.say(&format!("{} on {at}{mode}", bus.name()));
             tokio::spawn(async move {
                 if let Err(e) = bound.serve(&gw, std::future::pending()).await {
