@@ -23,9 +23,10 @@ pub struct Finished {
     pub error: Option<io::Error>,
 }
 
-/// Runs `reader` on a scoped thread and calls `consume` for every batch, in
-/// order, on the calling thread. Returns the reader's counts (and the read
-/// error, if reading stopped on one) and whatever `consume` returned last.
+/// Calls `consume` for every batch of `reader`, in order, on the calling thread; past the
+/// first batch the reader runs ahead on a scoped thread (a log of one batch, the 10-line
+/// paste, starts no thread). Returns the reader's counts (and the read error, if reading
+/// stopped on one) and whatever `consume` returned last.
 pub fn for_each_batch<R, E>(
     mut reader: Reader<R>,
     mut consume: impl FnMut(&Batch) -> Result<(), E>,
@@ -33,11 +34,25 @@ pub fn for_each_batch<R, E>(
 where
     R: BufRead + Send,
 {
+    let mut lines = Vec::with_capacity(BATCH);
+    let error = reader.fill(&mut lines, BATCH).err();
+    let names = reader.interfaces().names();
+    let mut sent_ifaces = names.len();
+    let first = Batch {
+        lines,
+        new_interfaces: names.to_vec(),
+    };
+    if first.lines.len() < BATCH || error.is_some() {
+        consume(&first)?;
+        return Ok(Ok(Finished {
+            counts: reader.counts().clone(),
+            error,
+        }));
+    }
     let (tx, rx) = mpsc::sync_channel::<Batch>(4);
     let (recycle_tx, recycle_rx) = mpsc::channel::<Vec<(u64, Outcome)>>();
     std::thread::scope(|s| {
         let producer = s.spawn(move || -> Result<Finished, io::Error> {
-            let mut sent_ifaces = 0;
             loop {
                 let mut lines = recycle_rx.try_recv().unwrap_or_else(|_| Vec::with_capacity(BATCH));
                 lines.clear();
@@ -54,14 +69,15 @@ where
                 }
             }
         });
-        let mut result = Ok(());
-        for batch in rx.iter() {
-            if result.is_ok() {
+        let mut result = consume(&first);
+        let _ = recycle_tx.send(first.lines);
+        if result.is_ok() {
+            for batch in rx.iter() {
                 result = consume(&batch);
-            }
-            let _ = recycle_tx.send(batch.lines);
-            if result.is_err() {
-                break;
+                let _ = recycle_tx.send(batch.lines);
+                if result.is_err() {
+                    break;
+                }
             }
         }
         drop(rx);
