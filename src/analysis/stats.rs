@@ -199,7 +199,7 @@ impl Stats {
             return;
         };
         while self.window_start < store.len() && store.packed(self.window_start).ts_ns <= since {
-            let old = *store.packed(self.window_start);
+            let old = store.packed(self.window_start);
             let bits = self.window.pop_front().map_or(0, u64::from);
             self.window_bits = self.window_bits.saturating_sub(bits);
             if let Some(b) = self.iface_bits.get_mut(old.iface as usize) {

@@ -1,9 +1,13 @@
-//! The trace store: every captured frame, packed into 32 bytes.
+//! The trace store: every captured frame, packed into 24 bytes.
 //!
-//! A [`Packed`] frame keeps the timestamp, identifier, flags, length, interface and the
-//! first 8 payload bytes inline, plus the frame's kind and node from the indexing pass
-//! (one byte each, so filters on kind and node never decode). CAN FD payloads longer than
-//! 8 bytes go to a side arena; their inline bytes then hold the arena offset.
+//! A stored frame keeps a 32-bit timestamp offset, the identifier, flags, length,
+//! interface and the first 8 payload bytes inline, plus the frame's kind and node from the
+//! indexing pass (one byte each, so filters on kind and node never decode). CAN FD
+//! payloads longer than 8 bytes go to a side arena; their inline bytes then hold the arena
+//! offset. The offset counts nanoseconds from its segment's base: a chunk starts a new
+//! segment (its base 2^31 ns before the frame) whenever a timestamp falls outside the
+//! current one, so a rising capture needs one segment per ~4.3 s and a step back of up to
+//! ~2.1 s (frames of two interfaces a little out of order) needs none.
 //!
 //! Frames live in fixed-size chunks so that growing the store never copies what is
 //! already stored and never reserves more than one chunk ahead.
@@ -11,19 +15,22 @@
 use crate::decode::Kind;
 use crate::frame::{Flags, Frame};
 
-/// Frames per chunk (2 MiB of packed frames).
+/// Frames per chunk (1.5 MiB of packed frames).
 const CHUNK: usize = 1 << 16;
 
 /// `node` byte meaning "no node".
 const NO_NODE: u8 = 0xFF;
+
+/// How far before its first frame a segment's base lies (ns): steps back up to this
+/// much stay in the segment.
+const BACK_NS: u64 = 1 << 31;
 
 /// The stored byte of a kind.
 pub fn kind_byte(kind: Kind) -> u8 {
     kind.index() as u8
 }
 
-/// One stored frame (32 bytes).
-#[repr(C)]
+/// One stored frame as the store gives it back, its timestamp whole.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Packed {
     /// Timestamp in nanoseconds.
@@ -59,10 +66,77 @@ impl Packed {
     }
 }
 
+/// A frame as kept (24 bytes): [`Packed`] with the timestamp as an offset in its segment.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+struct Kept {
+    ts_off: u32,
+    id: u32,
+    iface: u16,
+    flags: u8,
+    len: u8,
+    raw_dlc: u8,
+    kind: u8,
+    node: u8,
+    data: [u8; 8],
+}
+
+/// Up to [`CHUNK`] frames and the timestamp bases of their segments.
+#[derive(Default)]
+struct Chunk {
+    frames: Vec<Kept>,
+    /// (index of the segment's first frame in the chunk, its base in ns), rising.
+    segments: Vec<(u32, u64)>,
+}
+
+impl Chunk {
+    fn new() -> Chunk {
+        Chunk {
+            frames: Vec::with_capacity(CHUNK),
+            segments: Vec::new(),
+        }
+    }
+
+    /// The offset of `ts_ns` in the current segment, a new segment started when it does
+    /// not fit (`at`: the index the frame will take).
+    fn offset(&mut self, ts_ns: u64, at: usize) -> u32 {
+        if let Some(&(_, base)) = self.segments.last()
+            && let Some(off) = ts_ns.checked_sub(base).and_then(|o| u32::try_from(o).ok())
+        {
+            return off;
+        }
+        let base = ts_ns.saturating_sub(BACK_NS);
+        self.segments.push((at as u32, base));
+        (ts_ns - base) as u32
+    }
+
+    /// The base of the segment of frame `k`.
+    fn base(&self, k: usize) -> u64 {
+        let n = self.segments.partition_point(|&(first, _)| first as usize <= k);
+        self.segments[n.saturating_sub(1)].1
+    }
+
+    /// Frame `k`, its timestamp whole.
+    fn get(&self, k: usize) -> Packed {
+        let f = &self.frames[k];
+        Packed {
+            ts_ns: self.base(k) + u64::from(f.ts_off),
+            id: f.id,
+            iface: f.iface,
+            flags: f.flags,
+            len: f.len,
+            raw_dlc: f.raw_dlc,
+            kind: f.kind,
+            node: f.node,
+            data: f.data,
+        }
+    }
+}
+
 /// The trace store.
 #[derive(Default)]
 pub struct Store {
-    chunks: Vec<Vec<Packed>>,
+    chunks: Vec<Chunk>,
     arena: Vec<u8>,
     len: usize,
 }
@@ -99,8 +173,16 @@ impl Store {
         } else {
             data.copy_from_slice(&frame.data[..8]);
         }
-        let p = Packed {
-            ts_ns: frame.ts_ns,
+        if self.len.is_multiple_of(CHUNK) {
+            self.chunks.push(Chunk::new());
+        }
+        let at = self.len % CHUNK;
+        let Some(chunk) = self.chunks.last_mut() else {
+            unreachable!("a chunk was just pushed")
+        };
+        let ts_off = chunk.offset(frame.ts_ns, at);
+        chunk.frames.push(Kept {
+            ts_off,
             id: frame.id,
             iface: frame.iface,
             flags: frame.flags.0,
@@ -109,25 +191,20 @@ impl Store {
             kind: kind_byte(kind),
             node: node.unwrap_or(NO_NODE),
             data,
-        };
-        if self.len.is_multiple_of(CHUNK) {
-            self.chunks.push(Vec::with_capacity(CHUNK));
-        }
-        let last = self.chunks.len() - 1;
-        self.chunks[last].push(p);
+        });
         self.len += 1;
         self.len - 1
     }
 
-    /// The packed frame at `i` (panics past the end, like a slice).
-    pub fn packed(&self, i: usize) -> &Packed {
-        &self.chunks[i / CHUNK][i % CHUNK]
+    /// The stored frame at `i` (panics past the end, like a slice).
+    pub fn packed(&self, i: usize) -> Packed {
+        self.chunks[i / CHUNK].get(i % CHUNK)
     }
 
     /// Gives back the unused room of the last chunk (when no more frames will come).
     pub fn shrink(&mut self) {
         if let Some(last) = self.chunks.last_mut() {
-            last.shrink_to_fit();
+            last.frames.shrink_to_fit();
         }
         self.arena.shrink_to_fit();
     }
@@ -167,9 +244,14 @@ impl Store {
         lo
     }
 
-    /// Bytes of memory held by stored frames (chunk capacity plus arena).
+    /// Bytes of memory held by stored frames (chunk capacity, segment bases and arena).
     pub fn bytes(&self) -> usize {
-        self.chunks.iter().map(|c| c.capacity()).sum::<usize>() * size_of::<Packed>() + self.arena.capacity()
+        let chunks: usize = self
+            .chunks
+            .iter()
+            .map(|c| c.frames.capacity() * size_of::<Kept>() + c.segments.capacity() * size_of::<(u32, u64)>())
+            .sum();
+        chunks + self.arena.capacity()
     }
 }
 
@@ -178,8 +260,33 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_packed_frame_is_32_bytes() {
-        assert_eq!(size_of::<Packed>(), 32);
+    fn a_kept_frame_is_24_bytes() {
+        assert_eq!(size_of::<Kept>(), 24);
+    }
+
+    #[test]
+    fn timestamps_come_back_whole_across_segments_and_steps_back() {
+        let mut s = Store::new();
+        // Rising by 3 s (a new segment every other frame), a step back of 2 s (same
+        // segment), one of an hour (a new one), the clock's extremes.
+        let times = [
+            5,
+            3_000_000_005,
+            6_000_000_005,
+            4_000_000_005,
+            4_000_000_006,
+            1,
+            u64::MAX,
+            0,
+            7,
+        ];
+        for &t in &times {
+            let mut f = Frame::classic(0x181, &[1]);
+            f.ts_ns = t;
+            s.push(&f, Kind::Tpdo, Some(1));
+        }
+        let back: Vec<u64> = (0..times.len()).map(|i| s.packed(i).ts_ns).collect();
+        assert_eq!(back, times);
     }
 
     #[test]
@@ -199,7 +306,14 @@ mod tests {
         let at = s.push(&fd, Kind::Other, None);
         assert_eq!(s.len(), CHUNK + 4);
         s.shrink();
-        assert_eq!(s.bytes(), (CHUNK + 4) * 32 + 12);
+        // 24 bytes a frame, the FD payload, and one segment base a chunk (the frames span
+        // 0.65 ms), as a small vector's room.
+        let frames = (CHUNK + 4) * 24 + 12;
+        assert!(
+            (frames + 2 * 16..=frames + 2 * 4 * 16).contains(&s.bytes()),
+            "{}",
+            s.bytes()
+        );
         assert_eq!(s.frame(at), fd);
         assert_eq!(s.frame(CHUNK + 1).payload(), &[(CHUNK + 1) as u8, 2, 3]);
         assert_eq!(s.packed(5).kind(), Kind::Tpdo);

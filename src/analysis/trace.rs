@@ -209,7 +209,7 @@ impl Trace {
                 let peeked @ (kind, node, _) = self.diagnose(frame);
                 self.cycles.frame(frame, pos, peeked);
                 self.store.push(frame, kind, node);
-                let p = *self.store.packed(pos as usize);
+                let p = self.store.packed(pos as usize);
                 self.stats.add(&p, &self.store);
                 if let Some(n) = node {
                     self.nodes.frame(NodeKey::of(frame, n), frame.ts_ns);

@@ -102,7 +102,7 @@ impl View {
     }
 
     fn subject<'a>(&self, trace: &'a Trace, pos: usize, t0_ns: u64, decoded: Option<&'a Decoded>) -> Subject<'a> {
-        let facts = Facts::from(trace.store.packed(pos));
+        let facts = Facts::from(&trace.store.packed(pos));
         let transfer = if !self.filter.needs_transfer() || !matches!(facts.kind, Kind::SdoTx | Kind::SdoRx) {
             Transfer::Known(None)
         } else if let Some(&k) = self.transfers.get(&(pos as u32)) {

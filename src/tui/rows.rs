@@ -92,6 +92,6 @@ fn prev_same_id(trace: &Trace, pos: usize) -> Option<u64> {
     (pos.saturating_sub(SAME_ID_BOUND)..pos)
         .rev()
         .map(|i| trace.store.packed(i))
-        .find(|p| key(p) == key(this))
+        .find(|p| key(p) == key(&this))
         .map(|p| p.ts_ns)
 }
