@@ -30,8 +30,8 @@ pub struct Slot {
     pub node: u8,
     /// The TPDO number (1 for TPDO1).
     pub pdo: u16,
-    /// Time since the cycle's SYNC (µs).
-    pub offset_us: u64,
+    /// Time since the cycle's SYNC (µs; at most 4295 s, a longer gap is saturated).
+    pub offset_us: u32,
     /// Sent after the synchronous window closed.
     pub late: bool,
 }
@@ -210,6 +210,8 @@ impl SyncCycles {
         if let Some(c) = self.open[i].and_then(|a| self.cycles.get_mut(a - self.base)) {
             let period = frame.ts_ns.saturating_sub(c.start_ns);
             c.period_ns = Some(period);
+            // Closed: its slots take no more room than they fill.
+            c.frames.shrink_to_fit();
             let t = &mut self.totals;
             t.periods += 1;
             t.period_sum_ns += period;
@@ -269,7 +271,7 @@ impl SyncCycles {
             cob_id: frame.id,
             node: key.node,
             pdo,
-            offset_us,
+            offset_us: u32::try_from(offset_us).unwrap_or(u32::MAX),
             late,
         });
     }
@@ -422,11 +424,11 @@ mod tests {
             (1, Some(1), Some(10_000_000))
         );
         assert_eq!(c[0].window_us, None);
-        let offs: Vec<(u32, u64, bool)> = c[0].frames.iter().map(|f| (f.cob_id, f.offset_us, f.late)).collect();
+        let offs: Vec<(u32, u32, bool)> = c[0].frames.iter().map(|f| (f.cob_id, f.offset_us, f.late)).collect();
         assert_eq!(offs, [(0x181, 800, false), (0x282, 1000, false)]);
         // The window 2000 µs written to node 1 holds for the interface.
         assert_eq!(c[1].window_us, Some(2000));
-        let offs: Vec<(u32, u64, bool)> = c[1].frames.iter().map(|f| (f.cob_id, f.offset_us, f.late)).collect();
+        let offs: Vec<(u32, u32, bool)> = c[1].frames.iter().map(|f| (f.cob_id, f.offset_us, f.late)).collect();
         assert_eq!(offs, [(0x181, 900, false), (0x282, 3500, true)]);
         assert_eq!((c[1].late(), c[1].period_ns), (1, Some(10_200_000)));
         assert_eq!(c[2].period_ns, None);

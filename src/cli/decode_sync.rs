@@ -35,7 +35,7 @@ struct SlotJson {
     cob_id: u32,
     node: u8,
     pdo: u16,
-    offset_us: u64,
+    offset_us: u32,
     late: bool,
 }
 
