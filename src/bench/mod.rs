@@ -291,6 +291,14 @@ fn measure_all(args: &BenchArgs, exe: &Path, dir: &Path) -> std::io::Result<Figu
             None,
         ),
     ];
+    // The candump path on the quarter log, to hold each input format's row against.
+    runs.push(Run::new(
+        "summary-quarter",
+        "decode --summary, candump input (1/4 log)",
+        &["decode", "--summary", &s],
+        n / 4,
+        None,
+    ));
     // One row per input format, of the same frames as the quarter log.
     let format_logs: Vec<(String, String)> = log::INPUT_FORMATS
         .iter()
