@@ -113,21 +113,33 @@ impl Column {
     }
 
     /// The buffered strings or bytes as `ByteArray`s into `out` (cleared first): slices
-    /// of one shared buffer, so no copy or allocation per value.
-    fn byte_arrays(&mut self, out: &mut Vec<ByteArray>) {
+    /// of one shared buffer, so no copy or allocation per value. The buffer is lent until
+    /// [`Column::reclaim`] (`None` for other columns).
+    fn byte_arrays(&mut self, out: &mut Vec<ByteArray>) -> Option<Bytes> {
         out.clear();
         let Values::Bytes { buf, ends } = &mut self.values else {
-            return;
+            return None;
         };
-        // The next group's values need as much room again: keep the capacity.
-        let data = Bytes::from(std::mem::replace(buf, Vec::with_capacity(buf.capacity())));
+        let data = Bytes::from(std::mem::take(buf));
         let mut start = 0;
         out.extend(ends.iter().map(|&end| {
             let v = ByteArray::from(data.slice(start..end));
             start = end;
             v
         }));
-        ends.clear();
+        Some(data)
+    }
+
+    /// Takes back the buffer lent by [`Column::byte_arrays`] once no value refers to it:
+    /// the next group fills the same memory (a fresh buffer per group, allocated on the
+    /// writer thread and grown on the decoder's, let the heap grow with the log).
+    fn reclaim(&mut self, data: Bytes) {
+        if let Values::Bytes { buf, .. } = &mut self.values {
+            *buf = match data.try_into_mut() {
+                Ok(unique) => Vec::from(unique),
+                Err(shared) => Vec::with_capacity(shared.len()),
+            };
+        }
     }
 }
 
@@ -209,7 +221,7 @@ impl Group {
                     "parquet: fewer columns in the file than in the schema",
                 ));
             };
-            c.byte_arrays(&mut self.arrays);
+            let lent = c.byte_arrays(&mut self.arrays);
             let defs = c.col.null.then_some(c.defs.as_slice());
             match &c.values {
                 Values::Bool(v) => w.typed::<BoolType>().write_batch(v, defs, None),
@@ -221,6 +233,9 @@ impl Group {
             .map_err(pq_err)?;
             self.arrays.clear();
             w.close().map_err(pq_err)?;
+            if let Some(data) = lent {
+                c.reclaim(data);
+            }
             c.clear();
         }
         group.close().map_err(pq_err)?;
