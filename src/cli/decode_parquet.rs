@@ -9,10 +9,10 @@ use crate::command::ExitCode;
 use crate::decode::{Body, Decoded, Decoder};
 use crate::frame::{Flags, Frame, Interfaces};
 use crate::od::Dictionary;
-use crate::output::parquet::{Col, Table, Ty, V};
+use crate::output::parquet::{Col, Table, Ty, V, WriteFailed};
 use crate::sdo::{SdoCommand, Transaction};
 use std::fs::File;
-use std::io::{self, BufWriter, Write};
+use std::io::{self, BufWriter};
 use std::path::{Path, PathBuf};
 
 const fn col(name: &'static str, ty: Ty, null: bool) -> Col {
@@ -22,9 +22,9 @@ const fn col(name: &'static str, ty: Ty, null: bool) -> Col {
 /// Columns of `frames.parquet`, one row per frame.
 pub const FRAME_COLS: [Col; 29] = [
     col("file", Ty::Str, false),
-    col("line", Ty::I64, false),
+    col("line", Ty::I64Unique, false),
     col("ts", Ty::TimestampUs, false),
-    col("ts_ns", Ty::I64, false),
+    col("ts_ns", Ty::I64Unique, false),
     col("iface", Ty::Str, false),
     col("id", Ty::I32, false),
     col("ext", Ty::Bool, false),
@@ -58,9 +58,9 @@ pub const VALUE_COLS: [Col; 22] = [
     col("file", Ty::Str, false),
     col("source", Ty::Str, false),
     col("ts", Ty::TimestampUs, false),
-    col("ts_ns", Ty::I64, false),
+    col("ts_ns", Ty::I64Unique, false),
     col("start_ts", Ty::TimestampUs, false),
-    col("start_ts_ns", Ty::I64, false),
+    col("start_ts_ns", Ty::I64Unique, false),
     col("iface", Ty::Str, false),
     col("node", Ty::I32, false),
     col("index", Ty::I32, true),
@@ -78,8 +78,6 @@ pub const VALUE_COLS: [Col; 22] = [
     col("pdo_num", Ty::I32, true),
     col("frames", Ty::I64, false),
 ];
-
-type Writer = Table<BufWriter<File>>;
 
 /// Where the two tables go: `-o DIR` gives `DIR/frames.parquet` and `DIR/values.parquet`;
 /// `-o NAME.parquet` gives `NAME.parquet` (frames) and `NAME.values.parquet`.
@@ -101,7 +99,7 @@ struct CreateError {
     source: io::Error,
 }
 
-fn create(path: &Path, name: &str, cols: &[Col]) -> Result<Writer, CreateError> {
+fn create(path: &Path, name: &str, cols: &[Col]) -> Result<Table, CreateError> {
     let at = |p: &Path| {
         let path = p.to_path_buf();
         move |source| CreateError { path, source }
@@ -180,11 +178,12 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
             }
         }
     }
-    let mut end = || -> io::Result<()> {
+    let mut end = || -> Result<(), WriteFailed> {
         for t in decoder.finish() {
+            // Past the last input: no line to name (the message names none).
             transaction_row(
                 &mut values,
-                &last_file,
+                (&last_file, 0),
                 ifaces.name(t.iface),
                 &t,
                 decoder.dictionary(t.node),
@@ -192,8 +191,8 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
         }
         Ok(())
     };
-    fn at(table: &Path) -> impl Fn(io::Error) -> String + '_ {
-        move |e| format!("{}: {e}", table.display())
+    fn at(table: &Path) -> impl Fn(WriteFailed) -> String + '_ {
+        move |f| format!("{}: {}", table.display(), f.error)
     }
     let result = end()
         .map_err(at(&values_path))
@@ -211,8 +210,8 @@ pub fn run(args: &DecodeArgs) -> ExitCode {
 
 /// The two tables being written, and their paths (for a write error's message).
 struct Tables<'a> {
-    frames: &'a mut Writer,
-    values: &'a mut Writer,
+    frames: &'a mut Table,
+    values: &'a mut Table,
     paths: (&'a Path, &'a Path),
 }
 
@@ -235,8 +234,13 @@ fn write_stream(
     let Tables { frames, values, paths } = tables;
     // The first write error, said as the user reads it; reading stops there.
     let mut write_error: Option<String> = None;
-    let mut wrote = |table: &Path, line: u64, e: io::Error| {
-        write_error.get_or_insert(format!("cannot write {}: {e} (at {path} line {line})", table.display()));
+    let mut wrote = |table: &Path, f: WriteFailed| {
+        write_error.get_or_insert(format!(
+            "cannot write {}: {} (at {path} line {})",
+            table.display(),
+            f.error,
+            f.line
+        ));
         io::Error::other("write failed")
     };
     let result = input::for_each_frame(path, input, |batch| {
@@ -247,11 +251,11 @@ fn write_stream(
         for (line, frame) in batch {
             let d = decoder.decode(frame);
             let iface = ifaces.name(frame.iface);
-            frame_row(frames, path, line, frame, iface, &d).map_err(|e| wrote(paths.0, line, e))?;
+            frame_row(frames, (path, line), frame, iface, &d).map_err(|f| wrote(paths.0, f))?;
             if let (Body::Pdo(p), Some(node)) = (&d.body, d.node) {
                 for s in &p.signals {
                     values
-                        .row(|r| {
+                        .row(line, |r| {
                             let (us, ns) = (V::I64(ts_us(frame.ts_ns)), V::I64(ts_ns(frame.ts_ns)));
                             r.push(Some(V::Str(path)))?
                                 .push(Some(V::Str("pdo")))?
@@ -277,17 +281,29 @@ fn write_stream(
                                 .push(Some(V::I64(1)))?;
                             Ok(())
                         })
-                        .map_err(|e| wrote(paths.1, line, e))?;
+                        .map_err(|f| wrote(paths.1, f))?;
                 }
             }
+            decoder.recycle(d);
             for t in decoder.take_transactions() {
-                transaction_row(values, path, ifaces.name(t.iface), &t, decoder.dictionary(t.node))
-                    .map_err(|e| wrote(paths.1, line, e))?;
+                transaction_row(
+                    values,
+                    (path, line),
+                    ifaces.name(t.iface),
+                    &t,
+                    decoder.dictionary(t.node),
+                )
+                .map_err(|f| wrote(paths.1, f))?;
             }
         }
         Ok(())
     });
-    match (result, write_error) {
+    // The row groups of this input written so far: a failed one is said with its line.
+    let synced = frames
+        .sync()
+        .map_err(|f| wrote(paths.0, f))
+        .and_then(|()| values.sync().map_err(|f| wrote(paths.1, f)));
+    match (result.and_then(|counts| synced.map(|()| counts)), write_error) {
         (_, Some(m)) => Err(Failed::Write(m)),
         (Err(e), None) => Err(Failed::Read(e)),
         (Ok(counts), None) => {
@@ -307,14 +323,8 @@ fn ts_us(ns: u64) -> i64 {
     (ns / 1000) as i64
 }
 
-fn frame_row<W: Write + Send>(
-    t: &mut Table<W>,
-    file: &str,
-    line: u64,
-    f: &Frame,
-    iface: &str,
-    d: &Decoded,
-) -> io::Result<()> {
+/// One row of `frames.parquet` for frame `f` at `(file, line)`.
+fn frame_row(t: &mut Table, (file, line): (&str, u64), f: &Frame, iface: &str, d: &Decoded) -> Result<(), WriteFailed> {
     let i32v = |v: i32| Some(V::I32(v));
     let (mut nmt_command, mut nmt_target, mut nmt_state) = (None, None, None);
     let (mut emcy_code, mut emcy_register, mut emcy_text) = (None, None, None);
@@ -347,7 +357,7 @@ fn frame_row<W: Write + Send>(
         }
         _ => {}
     }
-    t.row(|r| {
+    t.row(line, |r| {
         r.push(Some(V::Str(file)))?
             .push(Some(V::I64(line as i64)))?
             .push(Some(V::I64(ts_us(f.ts_ns))))?
@@ -383,17 +393,17 @@ fn frame_row<W: Write + Send>(
 
 /// One row of `values.parquet` for an SDO transaction of interface `iface`; the decoded
 /// value, name and abort text are the ones `--transactions --format jsonl` gives.
-fn transaction_row<W: Write + Send>(
-    t: &mut Table<W>,
-    file: &str,
+fn transaction_row(
+    t: &mut Table,
+    (file, line): (&str, u64),
     iface: &str,
     tr: &Transaction,
     dict: &Dictionary,
-) -> io::Result<()> {
+) -> Result<(), WriteFailed> {
     let j = tr.to_json(dict);
     let partial = tr.is_partial();
     let frames = tr.frames.len() as u64 + tr.frames_dropped;
-    t.row(|r| {
+    t.row(line, |r| {
         r.push(Some(V::Str(file)))?
             .push(Some(V::Str("sdo")))?
             .push(Some(V::I64(ts_us(tr.end_ns))))?
@@ -439,8 +449,8 @@ mod tests {
             )
         ) {
             let mut decoder = Decoder::new(Dictionary::default(), vec![]);
-            let mut out = Vec::new();
-            let mut t = Table::new(&mut out, "frames", &FRAME_COLS).unwrap();
+            let path = std::env::temp_dir().join(format!("cotui-parquet-fuzz-{}.parquet", std::process::id()));
+            let mut t = Table::new(File::create(&path).unwrap(), "frames", &FRAME_COLS).unwrap();
             let mut v = Table::new(Vec::new(), "values", &VALUE_COLS).unwrap();
             let mut ifaces = Interfaces::default();
             ifaces.intern("can\u{1b}0");
@@ -449,16 +459,18 @@ mod tests {
                 f.flags = Flags(*flags);
                 f.ts_ns = *ts_ns;
                 let d = decoder.decode(&f);
-                frame_row(&mut t, "fuzz", i as u64, &f, ifaces.name(0), &d).unwrap();
+                frame_row(&mut t, ("fuzz", i as u64), &f, ifaces.name(0), &d).unwrap();
                 for tr in decoder.take_transactions() {
-                    transaction_row(&mut v, "fuzz", ifaces.name(0), &tr, decoder.dictionary(tr.node)).unwrap();
+                    transaction_row(&mut v, ("fuzz", i as u64), ifaces.name(0), &tr, decoder.dictionary(tr.node)).unwrap();
                 }
             }
             for tr in decoder.finish() {
-                transaction_row(&mut v, "fuzz", ifaces.name(0), &tr, decoder.dictionary(tr.node)).unwrap();
+                transaction_row(&mut v, ("fuzz", 0), ifaces.name(0), &tr, decoder.dictionary(tr.node)).unwrap();
             }
             t.finish().unwrap();
             v.finish().unwrap();
+            let out = std::fs::read(&path).unwrap();
+            std::fs::remove_file(&path).unwrap();
             prop_assert_eq!(&out[out.len() - 4..], b"PAR1");
         }
     }
