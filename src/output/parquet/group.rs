@@ -1,7 +1,7 @@
 //! One row group being filled: the buffered values of every column (strings and bytes of
 //! a column in one buffer, no allocation per value), and its encoding into the file.
 
-use super::{Col, Ty, V, pq_err};
+use super::column::{Col, Ty, V, pq_err};
 use bytes::Bytes;
 use parquet::data_type::{BoolType, ByteArray, ByteArrayType, DoubleType, Int32Type, Int64Type};
 use parquet::file::writer::SerializedFileWriter;

@@ -15,8 +15,11 @@
 //! unsigned annotations), DOUBLE, BOOLEAN, BYTE_ARRAY (UTF8 or plain binary) and
 //! INT64 TIMESTAMP(MICROS, UTC) (Spark rejects TIMESTAMP(NANOS)).
 
+mod column;
 mod group;
 
+use column::pq_err;
+pub use column::{Col, Ty, V};
 use group::Group;
 pub use group::Row;
 use parquet::basic::{Compression, Encoding};
@@ -38,45 +41,6 @@ pub const ROW_GROUP_BYTES: usize = 16 << 20;
 
 /// Values handed to the column encoder per step.
 const WRITE_BATCH: usize = 8192;
-
-/// Physical and logical type of a column.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Ty {
-    Bool,
-    I32,
-    I64,
-    /// INT64 whose values hardly repeat (nanosecond times, line numbers), delta-encoded.
-    I64Unique,
-    F64,
-    /// INT64 microseconds since the Unix epoch, TIMESTAMP(MICROS, UTC), delta-encoded.
-    TimestampUs,
-    /// UTF-8 text with few distinct values (BYTE_ARRAY, UTF8), dictionary-encoded.
-    Str,
-    /// UTF-8 text with mostly distinct values (BYTE_ARRAY, UTF8), plain-encoded.
-    Text,
-    /// Raw bytes (BYTE_ARRAY).
-    Bin,
-}
-
-/// One column of a table's schema.
-#[derive(Clone, Copy, Debug)]
-pub struct Col {
-    pub name: &'static str,
-    pub ty: Ty,
-    /// Nullable (OPTIONAL) rather than REQUIRED.
-    pub null: bool,
-}
-
-/// One value of a row; `None` is a null.
-#[derive(Clone, Debug, PartialEq)]
-pub enum V<'a> {
-    Bool(bool),
-    I32(i32),
-    I64(i64),
-    F64(f64),
-    Str(&'a str),
-    Bin(&'a [u8]),
-}
 
 /// A table that could not be written: the error, and the input line of the last row of
 /// the row group being written then (or of the row that did not fit).
@@ -103,16 +67,6 @@ fn schema_line(c: &Col) -> String {
         _ => "",
     };
     format!("  {rep} {ty} {}{logical};\n", c.name)
-}
-
-fn pq_err(e: parquet::errors::ParquetError) -> io::Error {
-    // A failed write of the file underneath (disk full) is that error, as the OS says it.
-    if let parquet::errors::ParquetError::External(inner) = &e
-        && let Some(io) = inner.downcast_ref::<io::Error>()
-    {
-        return io::Error::new(io.kind(), io.to_string());
-    }
-    io::Error::other(format!("parquet: {e}"))
 }
 
 /// A Parquet file being written.
