@@ -87,15 +87,21 @@ pub async fn before_sending(
         "refused, nothing sent: {}; --force sends anyway, --listen 0 skips listening",
         other.text()
     );
-    Err(CommandError::Report {
+    let json = Refused {
+        other_producer: other,
+        message: message.clone(),
+    };
+    Err(nothing_sent("other_producer", json, message))
+}
+
+/// A listen that ends the command with nothing sent (exit 2): its `--json` object and text.
+fn nothing_sent(error: &'static str, json: impl super::report::Report + 'static, text: String) -> CommandError {
+    CommandError::Report {
         exit: ExitCode::Unavailable,
-        error: "other_producer",
-        report: super::report::Reported::new(Refused {
-            other_producer: other,
-            message: message.clone(),
-        }),
-        text: message,
-    })
+        error,
+        report: super::report::Reported::new(json),
+        text,
+    }
 }
 
 /// Stopped while listening: the failure, its `--json` object `{error: "stopped", ...}`.
@@ -107,15 +113,11 @@ fn stopped(producer: &str, listened_ms: u64) -> CommandError {
     }
     let message =
         format!("stopped after {listened_ms} ms of listening for another {producer}, before sending: nothing sent");
-    CommandError::Report {
-        exit: ExitCode::Unavailable,
-        error: "stopped",
-        report: super::report::Reported::new(Stopped {
-            listened_ms,
-            message: message.clone(),
-        }),
-        text: message,
-    }
+    let json = Stopped {
+        listened_ms,
+        message: message.clone(),
+    };
+    nothing_sent("stopped", json, message)
 }
 
 /// Listens `ms` of bus time (until a frame stamped past the window, or the timer on a quiet

@@ -689,14 +689,15 @@ mod tests {
         assert_eq!(a.trace().transactions.len(), 1, "listed once");
     }
 
-    #[test]
-    fn a_live_node_that_falls_silent_is_lost_by_the_capture_clock() {
+    /// A listen-only live app, `before` done on it, then fed node 5's heartbeat every 100 ms
+    /// for 0.5 s of capture time from its node table's now (returned).
+    fn live_app_with_heartbeats(before: impl FnOnce(&mut App)) -> (App, u64) {
         let (ftx, frx) = std::sync::mpsc::channel();
         let (rtx, _rrx) = tokio::sync::mpsc::unbounded_channel();
         let mut a = app();
         *a.capture_mut().source_mut() = SourceInfo::live("vcan0", SourceKind::Live { listen_only: true }, frx, rtx);
         let t0 = a.trace().nodes.now_ns();
-        a.capture_mut().trace_mut().nodes.take_events();
+        before(&mut a);
         let batch: Vec<crate::frame::Frame> = (1..=5u64)
             .map(|i| {
                 let mut f = crate::frame::Frame::classic(0x705, &[0x05]);
@@ -706,6 +707,14 @@ mod tests {
             .collect();
         ftx.send(Feed::Frames(batch)).unwrap();
         a.ingest(Duration::from_millis(100));
+        (a, t0)
+    }
+
+    #[test]
+    fn a_live_node_that_falls_silent_is_lost_by_the_capture_clock() {
+        let (mut a, t0) = live_app_with_heartbeats(|a| {
+            a.capture_mut().trace_mut().nodes.take_events();
+        });
         let taken = Instant::now();
         // Node 2 (heartbeats every 14 ms in the capture) was found lost by these frames.
         assert!(
@@ -758,21 +767,7 @@ mod tests {
 
     #[test]
     fn hb_lost_on_a_silent_live_bus_is_a_trigger_hit_by_the_capture_clock() {
-        let (ftx, frx) = std::sync::mpsc::channel();
-        let (rtx, _rrx) = tokio::sync::mpsc::unbounded_channel();
-        let mut a = app();
-        *a.capture_mut().source_mut() = SourceInfo::live("vcan0", SourceKind::Live { listen_only: true }, frx, rtx);
-        let t0 = a.trace().nodes.now_ns();
-        a.run_command("trigger hb lost");
-        let batch: Vec<crate::frame::Frame> = (1..=5u64)
-            .map(|i| {
-                let mut f = crate::frame::Frame::classic(0x705, &[0x05]);
-                f.ts_ns = t0 + i * 100_000_000;
-                f
-            })
-            .collect();
-        ftx.send(Feed::Frames(batch)).unwrap();
-        a.ingest(Duration::from_millis(100));
+        let (mut a, _) = live_app_with_heartbeats(|a| a.run_command("trigger hb lost"));
         while a.work(Duration::from_millis(100)) {}
         let taken = Instant::now();
         let hits = |a: &App| a.screen().trigger().map(|t| t.hits().to_vec()).unwrap_or_default();

@@ -106,15 +106,20 @@ fn send(capture: &Capture, pane: &mut TransmitPane) {
     });
 }
 
+/// Every entry disabled, the counts so far kept (nothing is sent here).
+fn all_off(pane: &mut TransmitPane, bindings: &Bindings) {
+    bank(pane);
+    for k in 0..pane.rows.len() {
+        set_enabled(pane, k, false, bindings);
+    }
+}
+
 /// Stop-all: every entry disabled (before the drives are stopped); nothing more is sent.
 pub(crate) fn disable_all(capture: &Capture, pane: &mut TransmitPane, bindings: &Bindings, q: &mut Queue) {
     if !pane.rows.iter().any(enabled) {
         return;
     }
-    bank(pane);
-    for k in 0..pane.rows.len() {
-        set_enabled(pane, k, false, bindings);
-    }
+    all_off(pane, bindings);
     send(capture, pane);
     q.push(Event::Log(
         Level::Warn,
@@ -125,10 +130,7 @@ pub(crate) fn disable_all(capture: &Capture, pane: &mut TransmitPane, bindings: 
 /// The list stopped on the bus task (`why`: a quick stop another program sent): every
 /// entry shows off, as it is; nothing is sent again until one is enabled.
 pub(crate) fn stopped_elsewhere(pane: &mut TransmitPane, bindings: &Bindings, why: &str, q: &mut Queue) {
-    bank(pane);
-    for k in 0..pane.rows.len() {
-        set_enabled(pane, k, false, bindings);
-    }
+    all_off(pane, bindings);
     q.push(Event::Say(
         Level::Warn,
         format!("transmit: every entry disabled: {why}"),
