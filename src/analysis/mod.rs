@@ -22,6 +22,7 @@ pub mod store;
 pub mod sync_cycles;
 pub mod timing;
 pub mod trace;
+pub mod transfer_list;
 pub mod transfers;
 pub mod trigger;
 pub mod values;

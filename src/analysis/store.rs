@@ -1,8 +1,11 @@
-//! The trace store: every captured frame, packed into 24 bytes.
+//! The trace store: every captured frame, packed into 20 bytes.
 //!
 //! A stored frame keeps a 32-bit timestamp offset, the identifier, flags, length,
 //! interface and the first 8 payload bytes inline, plus the frame's kind and node from the
-//! indexing pass (one byte each, so filters on kind and node never decode). CAN FD
+//! indexing pass (so filters on kind and node never decode). The length shares a byte
+//! with a classic frame's raw DLC, the interface (up to the 15th) a byte with the kind; a
+//! frame on a later interface, or of another shape, keeps those in its chunk's side table.
+//! CAN FD
 //! payloads longer than 8 bytes go to a side arena; their inline bytes then hold the arena
 //! offset. The offset counts nanoseconds from its segment's base: a chunk starts a new
 //! segment (its base 2^31 ns before the frame) whenever a timestamp falls outside the
@@ -66,19 +69,52 @@ impl Packed {
     }
 }
 
-/// A frame as kept (24 bytes): [`Packed`] with the timestamp as an offset in its segment.
+/// A frame as kept (20 bytes): [`Packed`] with the timestamp as an offset in its segment.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default)]
 struct Kept {
     ts_off: u32,
     id: u32,
-    iface: u16,
+    data: [u8; 8],
     flags: u8,
+    /// An FD frame's length; a classic frame's length (low nibble) and raw DLC (high).
+    len_dlc: u8,
+    /// The kind (low nibble) and the interface (high nibble; [`ODD`]: see the side table).
+    kind_iface: u8,
+    node: u8,
+}
+
+/// Interface nibble of a frame whose interface, length and raw DLC are in
+/// [`Chunk::odd`].
+const ODD: u8 = 15;
+
+/// The interface, length and raw DLC of a frame that does not fit [`Kept`]'s bytes.
+#[derive(Clone, Copy, Debug)]
+struct Odd {
+    at: u32,
+    iface: u16,
     len: u8,
     raw_dlc: u8,
-    kind: u8,
-    node: u8,
-    data: [u8; 8],
+}
+
+impl Kept {
+    /// The length-and-DLC byte of a frame, when its shape fits one.
+    fn len_dlc(frame: &Frame) -> Option<u8> {
+        if frame.flags.has(Flags::FD) {
+            (frame.raw_dlc == 0).then_some(frame.len)
+        } else {
+            (frame.len < 16 && frame.raw_dlc < 16).then_some(frame.len | frame.raw_dlc << 4)
+        }
+    }
+
+    /// (length, raw DLC) from the byte.
+    fn len_and_dlc(&self) -> (u8, u8) {
+        if Flags(self.flags).has(Flags::FD) {
+            (self.len_dlc, 0)
+        } else {
+            (self.len_dlc & 15, self.len_dlc >> 4)
+        }
+    }
 }
 
 /// Up to [`CHUNK`] frames and the timestamp bases of their segments.
@@ -87,6 +123,8 @@ struct Chunk {
     frames: Vec<Kept>,
     /// (index of the segment's first frame in the chunk, its base in ns), rising.
     segments: Vec<(u32, u64)>,
+    /// The frames marked [`ODD`], by rising index.
+    odd: Vec<Odd>,
 }
 
 impl Chunk {
@@ -94,6 +132,7 @@ impl Chunk {
         Chunk {
             frames: Vec::with_capacity(CHUNK),
             segments: Vec::new(),
+            odd: Vec::new(),
         }
     }
 
@@ -119,14 +158,21 @@ impl Chunk {
     /// Frame `k`, its timestamp whole.
     fn get(&self, k: usize) -> Packed {
         let f = &self.frames[k];
+        let (iface, (len, raw_dlc)) = match f.kind_iface >> 4 {
+            ODD => {
+                let i = self.odd.partition_point(|o| (o.at as usize) < k);
+                self.odd.get(i).map_or((0, (0, 0)), |o| (o.iface, (o.len, o.raw_dlc)))
+            }
+            iface => (u16::from(iface), f.len_and_dlc()),
+        };
         Packed {
             ts_ns: self.base(k) + u64::from(f.ts_off),
             id: f.id,
-            iface: f.iface,
+            iface,
             flags: f.flags,
-            len: f.len,
-            raw_dlc: f.raw_dlc,
-            kind: f.kind,
+            len,
+            raw_dlc,
+            kind: f.kind_iface & 15,
             node: f.node,
             data: f.data,
         }
@@ -181,16 +227,24 @@ impl Store {
             unreachable!("a chunk was just pushed")
         };
         let ts_off = chunk.offset(frame.ts_ns, at);
+        let fits = Kept::len_dlc(frame).filter(|_| frame.iface < u16::from(ODD));
+        if fits.is_none() {
+            chunk.odd.push(Odd {
+                at: at as u32,
+                iface: frame.iface,
+                len: frame.len,
+                raw_dlc: frame.raw_dlc,
+            });
+        }
+        let iface = fits.map_or(ODD, |_| frame.iface as u8);
         chunk.frames.push(Kept {
             ts_off,
             id: frame.id,
-            iface: frame.iface,
-            flags: frame.flags.0,
-            len: frame.len,
-            raw_dlc: frame.raw_dlc,
-            kind: kind_byte(kind),
-            node: node.unwrap_or(NO_NODE),
             data,
+            flags: frame.flags.0,
+            len_dlc: fits.unwrap_or(0),
+            kind_iface: kind_byte(kind) | iface << 4,
+            node: node.unwrap_or(NO_NODE),
         });
         self.len += 1;
         self.len - 1
@@ -205,6 +259,7 @@ impl Store {
     pub fn shrink(&mut self) {
         if let Some(last) = self.chunks.last_mut() {
             last.frames.shrink_to_fit();
+            last.odd.shrink_to_fit();
         }
         self.arena.shrink_to_fit();
     }
@@ -249,7 +304,11 @@ impl Store {
         let chunks: usize = self
             .chunks
             .iter()
-            .map(|c| c.frames.capacity() * size_of::<Kept>() + c.segments.capacity() * size_of::<(u32, u64)>())
+            .map(|c| {
+                c.frames.capacity() * size_of::<Kept>()
+                    + c.segments.capacity() * size_of::<(u32, u64)>()
+                    + c.odd.capacity() * size_of::<Odd>()
+            })
             .sum();
         chunks + self.arena.capacity()
     }
@@ -260,8 +319,37 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_kept_frame_is_24_bytes() {
-        assert_eq!(size_of::<Kept>(), 24);
+    fn a_kept_frame_is_20_bytes() {
+        assert_eq!(size_of::<Kept>(), 20);
+        assert!(Kind::ALL.len() < 16, "a kind fits a nibble");
+    }
+
+    /// Frames on interfaces past the 15th, classic frames with a raw DLC over 8 and FD
+    /// frames of every length come back whole, mixed with common ones.
+    #[test]
+    fn every_interface_length_and_dlc_comes_back() {
+        let mut s = Store::new();
+        let mut frames = Vec::new();
+        for i in 0..40u16 {
+            let mut f = Frame::classic(0x181 + u32::from(i), &[i as u8; 8]);
+            f.iface = i * 7 % 300;
+            if i % 3 == 0 {
+                f.raw_dlc = 9 + (i % 7) as u8;
+            }
+            if i % 5 == 0 {
+                f.flags.set(Flags::FD, true);
+                f.len = [12, 64, 8, 0][usize::from(i / 5 % 4)];
+                f.raw_dlc = 0;
+            }
+            f.ts_ns = u64::from(i) * 1000;
+            s.push(&f, Kind::ALL[usize::from(i) % Kind::ALL.len()], Some(i as u8));
+            frames.push(f);
+        }
+        for (i, f) in frames.iter().enumerate() {
+            assert_eq!(&s.frame(i), f, "frame {i}");
+            assert_eq!(s.packed(i).kind(), Kind::ALL[i % Kind::ALL.len()]);
+            assert_eq!(s.packed(i).node(), Some(i as u8));
+        }
     }
 
     #[test]
@@ -306,9 +394,9 @@ mod tests {
         let at = s.push(&fd, Kind::Other, None);
         assert_eq!(s.len(), CHUNK + 4);
         s.shrink();
-        // 24 bytes a frame, the FD payload, and one segment base a chunk (the frames span
+        // 20 bytes a frame, the FD payload, and one segment base a chunk (the frames span
         // 0.65 ms), as a small vector's room.
-        let frames = (CHUNK + 4) * 24 + 12;
+        let frames = (CHUNK + 4) * 20 + 12;
         assert!(
             (frames + 2 * 16..=frames + 2 * 4 * 16).contains(&s.bytes()),
             "{}",

@@ -23,6 +23,7 @@ use super::series::Series;
 use super::stats::Stats;
 use super::store::Store;
 use super::sync_cycles::SyncCycles;
+use super::transfer_list::TransferList;
 use super::transfers::Transfers;
 use super::values::Values;
 use crate::decode::{Body, Decoded, Decoder, Kind};
@@ -79,9 +80,12 @@ pub struct Trace {
     /// The decoder as it was for a fresh start (used when nothing is checkpointed yet).
     initial: Decoder,
     checkpoints: Vec<Decoder>,
-    /// SDO transactions in order of completion, then (once the input ended) those left
-    /// running, as incomplete: the transfers `cotui decode --transactions` lists.
-    pub transactions: Vec<Transaction>,
+    /// With [`Views::All`]: SDO transactions in order of completion, then (once the input
+    /// ended) those left running, as incomplete: the transfers `cotui decode
+    /// --transactions` lists.
+    pub transactions: TransferList,
+    /// With [`Views::Transactions`] and [`Views::Frames`]: the same transfers, until taken.
+    listed: Vec<Transaction>,
     transfers: Transfers,
     /// Per-node state.
     pub nodes: Nodes,
@@ -140,7 +144,8 @@ impl Trace {
             initial: decoder.clone(),
             decoder,
             checkpoints: Vec::new(),
-            transactions: Vec::new(),
+            transactions: TransferList::default(),
+            listed: Vec::new(),
             transfers: Transfers::new(),
             nodes,
             stats: Stats::new(bitrate),
@@ -287,7 +292,7 @@ impl Trace {
                     self.transactions.push(t);
                 }
             }
-            Views::Transactions | Views::Frames => self.transactions.extend(done),
+            Views::Transactions | Views::Frames => self.listed.extend(done),
             Views::Events => done.iter().for_each(|t| self.events.transaction(t)),
             Views::Diagnosis => done.iter().for_each(|t| self.diagnosis.transaction(t)),
             Views::SyncCycles => done.iter().for_each(|t| self.cycles.transaction(t)),
@@ -308,7 +313,8 @@ impl Trace {
     pub fn end_of_input(&mut self) {
         let rest = self.transfers.end(&mut self.decoder);
         match self.views {
-            Views::All | Views::Transactions => self.transactions.extend(rest),
+            Views::All => rest.into_iter().for_each(|t| self.transactions.push(t)),
+            Views::Transactions => self.listed.extend(rest),
             Views::Diagnosis => {
                 for t in &rest {
                     self.diagnosis.transaction(t);
@@ -322,7 +328,7 @@ impl Trace {
     /// Takes the SDO transactions listed so far (a headless command prints them as they
     /// come, keeping memory flat).
     pub fn take_transactions(&mut self) -> Vec<Transaction> {
-        std::mem::take(&mut self.transactions)
+        std::mem::take(&mut self.listed)
     }
 
     fn observe(&mut self, frame: &Frame, d: &Decoded) {
@@ -394,10 +400,12 @@ impl Trace {
                 if matches!(p.kind(), Kind::SdoRx | Kind::SdoTx | Kind::Tpdo | Kind::Rpdo) {
                     dec.set_seq(i as u64);
                     dec.decode(&self.store.frame(i));
+                    dec.forget_transactions();
                 }
             }
             dec.set_seq(pos as u64);
             out.push(dec.decode(&self.store.frame(pos)));
+            dec.forget_transactions();
             *walker = Some((dec, pos + 1));
         }
         out
@@ -494,7 +502,7 @@ mod tests {
         let want_s: Vec<String> = scattered.iter().map(|&i| want[i].clone()).collect();
         assert_eq!(got, want_s);
         assert!(!t.transactions.is_empty());
-        let first = &t.transactions[0];
+        let first = t.transactions.get(0).expect("a transfer");
         let f = t.store.packed(first.frames[0] as usize - 1);
         assert!(matches!(f.kind(), Kind::SdoRx | Kind::SdoTx));
     }

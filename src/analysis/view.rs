@@ -8,7 +8,7 @@
 //! forward through the slice. With an `abort` condition, an SDO frame whose transfer has
 //! not ended yet waits until it has (or until the source ends: [`View::settle`]).
 
-use super::filter::{Facts, Filter, Subject, Transfer, Tri};
+use super::filter::{Ended, Facts, Filter, Subject, Transfer, Tri};
 use super::trace::Trace;
 use crate::decode::{Decoded, Decoder, Kind};
 use std::collections::HashMap;
@@ -106,7 +106,7 @@ impl View {
         let transfer = if !self.filter.needs_transfer() || !matches!(facts.kind, Kind::SdoTx | Kind::SdoRx) {
             Transfer::Known(None)
         } else if let Some(&k) = self.transfers.get(&(pos as u32)) {
-            Transfer::Known(trace.transactions.get(k as usize))
+            Transfer::Known(trace.transactions.outcome(k as usize).map(|o| Ended::of(&o)))
         } else if self.settled {
             Transfer::Known(None)
         } else {
@@ -167,7 +167,13 @@ impl View {
 
     /// Adds the frames of newly completed transactions to the position index.
     fn index_transfers(&mut self, trace: &Trace) {
-        for (k, t) in trace.transactions.iter().enumerate().skip(self.transactions_seen) {
+        let seen = self.transactions_seen;
+        for (k, t) in trace
+            .transactions
+            .iter_from(seen)
+            .enumerate()
+            .map(|(i, t)| (seen + i, t))
+        {
             for &seq in &t.frames {
                 self.transfers.insert(seq.saturating_sub(1) as u32, k as u32);
             }

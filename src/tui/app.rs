@@ -666,9 +666,10 @@ mod tests {
         assert!(a.trace().transactions.is_empty(), "still running while the log is read");
         ftx.send(Feed::Done).unwrap();
         a.ingest(Duration::from_millis(100));
-        let t = &a.trace().transactions;
+        let list = &a.trace().transactions;
+        let t = list.get(0).expect("one transfer");
         assert_eq!(
-            (t.len(), t[0].outcome.as_str(), t[0].cut_short_of()),
+            (list.len(), t.outcome.as_str(), t.cut_short_of()),
             (1, "incomplete", Some(64))
         );
         // A replay: at its last frame.

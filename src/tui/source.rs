@@ -93,7 +93,7 @@ pub enum Control {
 pub type Feeds = (Receiver<Feed>, Option<Sender<Control>>);
 
 /// Capacity of the feed channel in batches; a full channel makes the reader wait.
-const QUEUE: usize = 64;
+const QUEUE: usize = 16;
 
 /// A log that cannot be read, with its path.
 #[derive(Debug, thiserror::Error)]

@@ -184,7 +184,7 @@ fn a_block_download_shows_segment_numbers_and_the_acknowledge() {
 fn enter_on_an_arrow_shows_its_frame_in_the_trace_and_detail() {
     let mut app = mix();
     let i = transfer(&app, 3, 0x1008);
-    let second = app.trace().transactions[i].frames[1];
+    let second = app.trace().transactions.get(i).expect("the transfer").frames[1];
     open_diagram(&mut app, i);
     app.act(Action::Down);
     let s = draw(&mut app, 160, 30);

@@ -66,11 +66,30 @@ impl From<&crate::analysis::store::Packed> for Facts {
 
 /// The SDO transfer a frame belongs to, as far as known.
 #[derive(Clone, Copy, Debug)]
-pub enum Transfer<'a> {
+pub enum Transfer {
     /// Not known yet (the transfer may still be running).
     Unknown,
-    /// Known: the transfer, or none (not an SDO frame, or a frame of no transfer).
-    Known(Option<&'a Transaction>),
+    /// Known: how the transfer ended, or none (not an SDO frame, or a frame of no transfer).
+    Known(Option<Ended>),
+}
+
+/// How an SDO transfer ended, as far as a filter asks (`abort`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ended {
+    /// Aborted with this code.
+    Aborted(u32),
+    /// Completed, broken off or cut by the end of the input.
+    Otherwise,
+}
+
+impl Ended {
+    /// How a transfer with `outcome` ended.
+    pub fn of(outcome: &Outcome) -> Ended {
+        match outcome {
+            Outcome::Aborted { code, .. } => Ended::Aborted(*code),
+            _ => Ended::Otherwise,
+        }
+    }
 }
 
 /// One frame to judge.
@@ -85,7 +104,7 @@ pub struct Subject<'a> {
     /// The decoded frame, when decoded.
     pub decoded: Option<&'a Decoded>,
     /// Its SDO transfer.
-    pub transfer: Transfer<'a>,
+    pub transfer: Transfer,
 }
 
 fn is_sdo(k: Kind) -> bool {
@@ -170,9 +189,7 @@ fn term(t: &Term, s: &Subject) -> Tri {
             let code_ok = |code: u32| prefix.is_none_or(|p| p.matches(code));
             match s.transfer {
                 Transfer::Unknown => Tri::Unknown,
-                Transfer::Known(Some(t)) => {
-                    Tri::of(matches!(t.outcome, Outcome::Aborted { code, .. } if code_ok(code)))
-                }
+                Transfer::Known(Some(ended)) => Tri::of(matches!(ended, Ended::Aborted(code) if code_ok(code))),
                 // An abort frame outside any transfer still says abort.
                 Transfer::Known(None) => match s.decoded {
                     None => Tri::Unknown,

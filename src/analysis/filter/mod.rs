@@ -27,7 +27,7 @@ mod parse;
 pub mod stream;
 
 pub use error::FilterError;
-pub use eval::{Facts, Subject, Transfer, Tri};
+pub use eval::{Ended, Facts, Subject, Transfer, Tri};
 pub use lex::Cmp;
 pub use names::{Names, NoNames};
 pub use parse::{CodePrefix, Expr, IdMatch, Term, Test, kinds};

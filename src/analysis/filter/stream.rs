@@ -4,7 +4,7 @@
 //! so the output keeps the input's order. Judged exactly as a filtered view of the same
 //! frames ([`crate::analysis::view::View`]).
 
-use super::{Facts, Filter, Subject, Transfer, Tri};
+use super::{Ended, Facts, Filter, Subject, Transfer, Tri};
 use crate::decode::{Decoded, Kind};
 use crate::sdo::Transaction;
 use std::collections::{HashMap, VecDeque};
@@ -54,12 +54,12 @@ impl<T> Stream<T> {
             }
             for e in self.queue.iter_mut() {
                 if let Some(t) = of.get(&e.pos) {
-                    judge(&self.filter, e, t0, Transfer::Known(Some(t)));
+                    judge(&self.filter, e, t0, Transfer::Known(Some(Ended::of(&t.outcome))));
                 }
             }
         }
         let transfer = match of.get(&pos) {
-            Some(t) => Transfer::Known(Some(*t)),
+            Some(t) => Transfer::Known(Some(Ended::of(&t.outcome))),
             None if self.filter.needs_transfer() && matches!(facts.kind, Kind::SdoTx | Kind::SdoRx) => {
                 Transfer::Unknown
             }

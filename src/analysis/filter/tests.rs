@@ -292,7 +292,7 @@ fn matches(text: &str, frames: &[Frame]) -> Vec<usize> {
                 t0_ns: t0,
                 iface: IFACES[usize::from(frames[i].iface)],
                 decoded: Some(d),
-                transfer: Transfer::Known(of.get(&i).map(|&k| &txs[k])),
+                transfer: Transfer::Known(of.get(&i).map(|&k| Ended::of(&txs[k].outcome))),
             });
             assert_ne!(full, Tri::Unknown, "{text} at {i}");
             assert!(cheap == Tri::Unknown || cheap == full, "{text} at {i}");

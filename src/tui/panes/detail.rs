@@ -330,7 +330,7 @@ impl DetailPane {
         let inner = block("", true).inner(area);
         let lines = match selected {
             Some(Selected::Transfer(i)) => match trace.transactions.get(i) {
-                Some(t) => transaction_lines(trace, t),
+                Some(t) => transaction_lines(trace, &t),
                 None => vec![Line::raw("no transfer selected")],
             },
             Some(Selected::Frame(pos)) => match &self.decoded {

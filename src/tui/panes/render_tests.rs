@@ -1281,7 +1281,8 @@ fn a_block_download_of_thousands_of_frames_opens_as_a_sequence_diagram_with_its_
     // 20000 bytes: 2858 segments in 23 sub-blocks, the last of 64 segments.
     let mut a = super::testutil::app_of(&block_download(20_000));
     assert_eq!(a.trace().transactions.len(), 1);
-    assert!(a.trace().transactions[0].is_ok(), "{:?}", a.trace().transactions[0]);
+    let t = a.trace().transactions.get(0).expect("one transfer");
+    assert!(t.is_ok(), "{t:?}");
     a.screen_mut().focus_on(Pane::Sdo);
     let _ = screen(&mut a, 140, 14);
     let opened = std::time::Instant::now();

@@ -149,7 +149,7 @@ impl Default for SdoPane {
 
 impl SdoPane {
     /// The opened transfer and its diagram, if any.
-    fn opened<'t>(&self, trace: &'t Trace) -> Option<(&Sequence, &'t Transaction)> {
+    fn opened(&self, trace: &Trace) -> Option<(&Sequence, Transaction)> {
         let s = self.opened.as_ref()?;
         Some((s, trace.transactions.get(s.transfer)?))
     }
@@ -157,7 +157,7 @@ impl SdoPane {
     /// Rows of the list: transfers, or the rows of the opened transfer's diagram.
     fn len(&self, trace: &Trace) -> usize {
         match self.opened {
-            Some(_) => self.opened(trace).map(|(s, t)| s.len(t)).unwrap_or(0),
+            Some(_) => self.opened(trace).map(|(s, t)| s.len(&t)).unwrap_or(0),
             None => trace.transactions.len(),
         }
     }
@@ -239,12 +239,12 @@ impl Component for SdoPane {
     fn render(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
         match self.opened(ctx.trace) {
             Some((s, t)) => {
-                f.render_widget(block(&Sequence::title(t), focused), area);
+                f.render_widget(block(&Sequence::title(&t), focused), area);
                 let inner = block("", true).inner(area);
                 let l = self.list;
                 let lines = s.lines(
                     ctx.trace,
-                    t,
+                    &t,
                     inner.width as usize,
                     inner.height as usize,
                     l.offset,
@@ -291,14 +291,12 @@ impl SdoPane {
             ),
             header(),
         )];
-        for (i, t) in trace
-            .transactions
-            .iter()
-            .enumerate()
-            .skip(l.offset)
-            .take(inner.height as usize - 1)
-        {
-            let line = Line::styled(row_text(trace, t, inner.width as usize), Style::default().fg(color(t)));
+        let rows = l.offset..trace.transactions.len().min(l.offset + inner.height as usize - 1);
+        for (i, t) in rows.clone().zip(trace.transactions.iter_from(rows.start)) {
+            let line = Line::styled(
+                row_text(trace, &t, inner.width as usize),
+                Style::default().fg(color(&t)),
+            );
             lines.push(if i == l.selected { line.style(selected()) } else { line });
         }
         if trace.transactions.is_empty() {

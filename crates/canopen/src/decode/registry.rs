@@ -719,6 +719,13 @@ impl Decoder {
         out
     }
 
+    /// Forgets the SDO transactions completed since the last take: a decoder that only
+    /// replays frames for their labels calls it after each frame, so a long replay (a search
+    /// through the whole trace) does not pile up transfers nobody takes.
+    pub fn forget_transactions(&mut self) {
+        self.completed.clear();
+    }
+
     /// SDO transactions completed since the last call.
     pub fn take_transactions(&mut self) -> Vec<Transaction> {
         std::mem::take(&mut self.completed)
