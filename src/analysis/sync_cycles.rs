@@ -82,6 +82,36 @@ pub struct Totals {
     pub late_cycles: u64,
 }
 
+/// A cycle as kept (56 bytes): [`Cycle`] with its TPDOs in its interface's [`Lanes`].
+#[derive(Clone, Copy, Debug)]
+struct Kept {
+    sync_pos: u64,
+    start_ns: u64,
+    /// [`NO_PERIOD`] for none.
+    period_ns: u64,
+    /// 0 for none (a window of 0 is no window).
+    window_us: u64,
+    dropped: u64,
+    /// Index of its first TPDO in its interface's lanes (counted from the first ever kept).
+    first_slot: u64,
+    slots: u16,
+    late: u16,
+    iface: u16,
+    counter: Option<u8>,
+}
+
+/// The period of a cycle with none (no capture spans 2^64 ns).
+const NO_PERIOD: u64 = u64::MAX;
+
+/// The TPDOs of one interface's cycles, in order: a cycle's are contiguous, since an
+/// interface has one open cycle at a time.
+#[derive(Clone, Debug, Default)]
+struct Lanes {
+    slots: VecDeque<Slot>,
+    /// How many were taken from the front.
+    base: u64,
+}
+
 /// Default sync window (µs) and TPDO transmission types of a node-ID's dictionary.
 type Defaults = (u8, Option<u64>, Vec<(u16, u8)>);
 
@@ -89,8 +119,10 @@ type Defaults = (u8, Option<u64>, Vec<(u16, u8)>);
 #[derive(Clone, Debug, Default)]
 pub struct SyncCycles {
     /// The cycles not yet taken, in order of their SYNC; `base` is the number taken.
-    cycles: VecDeque<Cycle>,
+    cycles: VecDeque<Kept>,
     base: usize,
+    /// Their TPDOs, per interface.
+    lanes: Vec<Lanes>,
     /// The open cycle of each interface (absolute index: `base` + position).
     open: Vec<Option<usize>>,
     /// 0x1007 per node (µs).
@@ -207,11 +239,12 @@ impl SyncCycles {
         if self.open.len() <= i {
             self.open.resize(i + 1, None);
         }
+        if self.lanes.len() <= i {
+            self.lanes.resize_with(i + 1, Lanes::default);
+        }
         if let Some(c) = self.open[i].and_then(|a| self.cycles.get_mut(a - self.base)) {
-            let period = frame.ts_ns.saturating_sub(c.start_ns);
-            c.period_ns = Some(period);
-            // Closed: its slots take no more room than they fill.
-            c.frames.shrink_to_fit();
+            let period = frame.ts_ns.saturating_sub(c.start_ns).min(NO_PERIOD - 1);
+            c.period_ns = period;
             let t = &mut self.totals;
             t.periods += 1;
             t.period_sum_ns += period;
@@ -220,14 +253,17 @@ impl SyncCycles {
             }
         }
         self.totals.cycles += 1;
-        self.cycles.push_back(Cycle {
+        let lanes = &self.lanes[i];
+        self.cycles.push_back(Kept {
             iface: frame.iface,
             sync_pos: pos,
             start_ns: frame.ts_ns,
-            period_ns: None,
+            period_ns: NO_PERIOD,
             counter: frame.payload().first().copied(),
-            window_us: self.window_of(frame.iface),
-            frames: Vec::new(),
+            window_us: self.window_of(frame.iface).unwrap_or(0),
+            first_slot: lanes.base + lanes.slots.len() as u64,
+            slots: 0,
+            late: 0,
             dropped: 0,
         });
         self.open[i] = Some(self.base + self.cycles.len() - 1);
@@ -255,7 +291,7 @@ impl SyncCycles {
         let Some(c) = open.and_then(|a| self.cycles.get_mut(a - self.base)) else {
             return;
         };
-        if c.frames.len() >= SLOTS_KEPT {
+        if usize::from(c.slots) >= SLOTS_KEPT {
             c.dropped += 1;
             return;
         }
@@ -263,11 +299,17 @@ impl SyncCycles {
         let late = window.is_some_and(|w| offset_us > w);
         if late {
             self.totals.late_frames += 1;
-            if c.late() == 0 {
+            if c.late == 0 {
                 self.totals.late_cycles += 1;
             }
+            c.late += 1;
         }
-        c.frames.push(Slot {
+        c.slots += 1;
+        // The open cycle's interface has lanes: its SYNC made them.
+        let Some(lanes) = self.lanes.get_mut(usize::from(frame.iface)) else {
+            return;
+        };
+        lanes.slots.push_back(Slot {
             cob_id: frame.id,
             node: key.node,
             pdo,
@@ -308,9 +350,32 @@ impl SyncCycles {
         self.open.clear();
     }
 
-    /// The cycles not taken, in order of their SYNC (the open ones last on their interface).
-    pub fn cycles(&self) -> &VecDeque<Cycle> {
-        &self.cycles
+    /// Number of cycles not taken.
+    pub fn len(&self) -> usize {
+        self.cycles.len()
+    }
+
+    /// True when no cycle is kept.
+    pub fn is_empty(&self) -> bool {
+        self.cycles.is_empty()
+    }
+
+    /// Cycle `i` of those not taken, in order of their SYNC (the open ones last on their
+    /// interface).
+    pub fn get(&self, i: usize) -> Option<Cycle> {
+        let c = self.cycles.get(i)?;
+        let lanes = self.lanes.get(usize::from(c.iface))?;
+        let from = (c.first_slot - lanes.base) as usize;
+        Some(Cycle {
+            iface: c.iface,
+            sync_pos: c.sync_pos,
+            start_ns: c.start_ns,
+            period_ns: (c.period_ns != NO_PERIOD).then_some(c.period_ns),
+            counter: c.counter,
+            window_us: (c.window_us != 0).then_some(c.window_us),
+            frames: lanes.slots.range(from..from + usize::from(c.slots)).copied().collect(),
+            dropped: c.dropped,
+        })
     }
 
     /// Takes the cycles that are closed, up to the first still open (a headless command
@@ -327,8 +392,17 @@ impl SyncCycles {
         }
         let first_open = self.open.iter().flatten().min().copied().unwrap_or(usize::MAX);
         let n = first_open.saturating_sub(self.base).min(self.cycles.len());
+        let taken: Vec<Cycle> = (0..n).filter_map(|i| self.get(i)).collect();
+        // An interface's taken cycles are the first of its own, so their TPDOs are the
+        // first of its lanes.
+        for c in self.cycles.drain(..n) {
+            if let Some(lanes) = self.lanes.get_mut(usize::from(c.iface)) {
+                lanes.slots.drain(..usize::from(c.slots));
+                lanes.base += u64::from(c.slots);
+            }
+        }
         self.base += n;
-        self.cycles.drain(..n).collect()
+        taken
     }
 
     /// How many cycles were taken so far.
@@ -344,7 +418,7 @@ impl SyncCycles {
     /// Index (into [`SyncCycles::cycles`]) of the cycle with the longest period.
     pub fn slowest(&self) -> Option<usize> {
         let periods = self.cycles.iter().enumerate();
-        let with = periods.filter_map(|(i, c)| Some((c.period_ns?, i)));
+        let with = periods.filter_map(|(i, c)| (c.period_ns != NO_PERIOD).then_some((c.period_ns, i)));
         // The first of equal periods.
         with.max_by(|a, b| a.0.cmp(&b.0).then(b.1.cmp(&a.1))).map(|(_, i)| i)
     }
@@ -354,7 +428,7 @@ impl SyncCycles {
     pub fn next_late(&self, after: Option<usize>) -> Option<usize> {
         let n = self.cycles.len();
         let from = after.map_or(0, |a| a + 1);
-        (0..n).map(|k| (from + k) % n).find(|&i| self.cycles[i].late() > 0)
+        (0..n).map(|k| (from + k) % n).find(|&i| self.cycles[i].late > 0)
     }
 }
 
@@ -385,6 +459,11 @@ mod tests {
         let mut t = d.take_transactions();
         assert_eq!(t.len(), 1);
         t.remove(0)
+    }
+
+    /// Every cycle not taken.
+    fn all(s: &SyncCycles) -> Vec<Cycle> {
+        (0..s.len()).filter_map(|i| s.get(i)).collect()
     }
 
     fn push(s: &mut SyncCycles, f: &Frame, pos: u64) {
@@ -455,7 +534,7 @@ mod tests {
         for (i, f) in frames.iter().enumerate() {
             push(&mut s, f, i as u64);
         }
-        let c = s.cycles();
+        let c = all(&s);
         assert_eq!(c.len(), 4);
         assert_eq!(c[0].frames.len(), 1, "TPDO2 of node 2 is event-driven (254)");
         assert_eq!(c[0].counter, None);
@@ -477,7 +556,7 @@ mod tests {
         for i in 0..SLOTS_KEPT + 10 {
             push(&mut s, &frame(0x181, &[], 1.0 + i as f64), i as u64 + 1);
         }
-        let c = &s.cycles()[0];
+        let c = &all(&s)[0];
         assert_eq!((c.frames.len(), c.dropped), (SLOTS_KEPT, 10));
     }
 
@@ -490,7 +569,7 @@ mod tests {
         s.transaction(&write(1, 0x1007, 0, &[0xD0, 0x07, 0, 0]));
         push(&mut s, &frame(0x080, &[], 10.0), 2);
         push(&mut s, &frame(0x181, &[], 11.6), 3);
-        let c = s.cycles();
+        let c = all(&s);
         assert_eq!(c[0].window_us, Some(1500));
         assert!(c[0].frames[0].late, "1600 µs after the SYNC, window 1500 µs");
         assert_eq!(c[1].window_us, Some(2000));
@@ -525,7 +604,7 @@ mod tests {
         push(&mut s, &p, 2);
         a.ts_ns = 10_000_000;
         push(&mut s, &a, 3);
-        let c = s.cycles();
+        let c = all(&s);
         assert_eq!(
             (c[0].iface, c[0].period_ns, c[0].frames.len()),
             (0, Some(10_000_000), 0)
@@ -533,5 +612,46 @@ mod tests {
         assert_eq!((c[1].iface, c[1].period_ns, c[1].frames[0].offset_us), (1, None, 1000));
         // Can0's first cycle is closed but can1's (older than can0's second) is not.
         assert_eq!(s.take_closed().len(), 1);
+    }
+
+    /// Two interfaces' cycles interleave, each with its own TPDOs; taking the closed ones
+    /// (while the other interface's are open) leaves every later cycle its own TPDOs.
+    #[test]
+    fn taken_cycles_leave_the_others_their_tpdos() {
+        let mut s = SyncCycles::default();
+        let mut pos = 0;
+        let mut taken = Vec::new();
+        for k in 0..40u64 {
+            let iface = (k % 2) as u16;
+            let t = k * 10_000_000 + u64::from(iface) * 1_000_000;
+            let mut sync = frame(0x080, &[k as u8], 0.0);
+            (sync.iface, sync.ts_ns) = (iface, t);
+            push(&mut s, &sync, pos);
+            pos += 1;
+            // k TPDOs of node k % 7 + 1 (none in some cycles), at k µs steps.
+            for j in 0..k % 4 {
+                let mut p = frame(0x181 + (k % 7) as u32, &[], 0.0);
+                (p.iface, p.ts_ns) = (iface, t + (j + 1) * 1000);
+                push(&mut s, &p, pos);
+                pos += 1;
+            }
+            if k % 5 == 4 {
+                taken.extend(s.take_closed());
+            }
+        }
+        s.end();
+        taken.extend(s.take_closed());
+        assert_eq!(taken.len(), 40);
+        for (k, c) in taken.iter().enumerate() {
+            let k = k as u64;
+            assert_eq!((c.iface, c.counter), ((k % 2) as u16, Some(k as u8)), "cycle {k}");
+            let got: Vec<(u32, u32)> = c.frames.iter().map(|f| (f.cob_id, f.offset_us)).collect();
+            let want: Vec<(u32, u32)> = (0..k % 4).map(|j| (0x181 + (k % 7) as u32, (j as u32 + 1))).collect();
+            assert_eq!(got, want, "cycle {k}");
+        }
+        assert!(
+            s.lanes.iter().all(|l| l.slots.is_empty()),
+            "every TPDO went with its cycle"
+        );
     }
 }

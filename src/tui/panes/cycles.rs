@@ -33,7 +33,7 @@ fn ms(ns: u64) -> String {
 
 impl CyclesView {
     fn len(ctx: &Ctx) -> usize {
-        ctx.trace.cycles.cycles().len()
+        ctx.trace.cycles.len()
     }
 
     /// Selects cycle `i`, shown about a third down the page, and its SYNC frame in the
@@ -42,7 +42,7 @@ impl CyclesView {
         self.list.selected = i;
         self.list.offset = i.saturating_sub(ctx.page / 3);
         self.list.clamp(Self::len(ctx), ctx.page);
-        if let Some(c) = ctx.trace.cycles.cycles().get(i) {
+        if let Some(c) = ctx.trace.cycles.get(i) {
             q.push(Event::Select(c.sync_pos as usize));
         }
     }
@@ -70,7 +70,7 @@ impl CyclesView {
                 }
             }
             Action::Expand => {
-                if let Some(c) = cycles.cycles().get(self.list.selected) {
+                if let Some(c) = cycles.get(self.list.selected) {
                     q.push(Event::Show(c.sync_pos as usize));
                 }
             }
@@ -96,12 +96,12 @@ impl CyclesView {
 
     /// The selected cycle's SYNC frame.
     pub(crate) fn selected(&self, ctx: &Ctx) -> Option<Selected> {
-        let c = ctx.trace.cycles.cycles().get(self.list.selected)?;
+        let c = ctx.trace.cycles.get(self.list.selected)?;
         Some(Selected::Frame(c.sync_pos as usize))
     }
 
     pub(crate) fn render(&self, f: &mut Frame, area: Rect, ctx: &Ctx, focused: bool) {
-        let cycles = ctx.trace.cycles.cycles();
+        let cycles = &ctx.trace.cycles;
         let t = ctx.trace.cycles.totals();
         let mut title = format!(" SYNC cycles: {}", t.cycles);
         if let Some((max, _, _)) = t.slowest {
@@ -120,12 +120,8 @@ impl CyclesView {
         let width = inner.width as usize;
         let several = ctx.trace.ifaces.names().len() > 1;
         let l = self.list;
-        let rows: Vec<(usize, &Cycle)> = cycles
-            .iter()
-            .enumerate()
-            .skip(l.offset)
-            .take(inner.height as usize - 1)
-            .collect();
+        let shown = l.offset..cycles.len().min(l.offset + inner.height as usize - 1);
+        let rows: Vec<(usize, Cycle)> = shown.filter_map(|i| Some((i, cycles.get(i)?))).collect();
         // The lanes: the COB-IDs of the visible cycles' TPDOs.
         let mut lanes: Vec<u32> = rows
             .iter()
