@@ -549,7 +549,7 @@ mod tests {
     fn the_dictionary_default_applies_from_the_first_heartbeat() {
         let eds =
             std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/eds/minimal.eds")).unwrap();
-        let mut b = crate::od::bind::Bindings::new().unwrap();
+        let mut b = crate::od::bind::Bindings::new();
         b.bind_eds(7, "minimal.eds", &eds);
         let f = vec![(0, 0x707, "05"), (1400, 0x080, ""), (1600, 0x080, "")];
         assert_eq!(

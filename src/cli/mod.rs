@@ -98,9 +98,19 @@ All commands:              cotui --help
 /// Runs the command line and returns the process exit status.
 pub fn run() -> ExitCode {
     use clap::FromArgMatches;
-    let cli = match cli_command().try_get_matches().and_then(|m| Cli::from_arg_matches(&m)) {
+    // The help texts' examples are rewritten (`cli_command`) only when clap has something
+    // to show: a command line that parses never prints them.
+    let mut plain = <Cli as clap::CommandFactory>::command();
+    let parsed = plain.try_get_matches_from_mut(std::env::args_os());
+    // The declaration is not looked at again: freeing its thousand allocations would cost
+    // a tenth of a short decode's start-up, the process's exit frees them at no cost.
+    std::mem::forget(plain);
+    let cli = match parsed.and_then(|m| Cli::from_arg_matches(&m)) {
         Ok(c) => c,
-        Err(e) => return refused(e, std::env::args_os().skip(1)),
+        Err(_) => match cli_command().try_get_matches().and_then(|m| Cli::from_arg_matches(&m)) {
+            Ok(c) => c,
+            Err(e) => return refused(e, std::env::args_os().skip(1)),
+        },
     };
     VERBOSE.store(cli.verbose, std::sync::atomic::Ordering::Relaxed);
     match cli.command {

@@ -120,7 +120,7 @@ mod tests {
     }
 
     fn bus() -> Bus {
-        let mut b = Bindings::new().unwrap();
+        let mut b = Bindings::new();
         let no_files = |_: &std::path::Path| Err(std::io::Error::other("no files here"));
         b.bind_profile(2, "syntron-ds", &no_files).unwrap();
         b.bind_profile(3, "aimotor", &no_files).unwrap();

@@ -781,7 +781,7 @@ mod tests {
     }
 
     fn dict() -> Dictionary {
-        crate::od::bind::Bindings::new().unwrap().default_dictionary().clone()
+        crate::od::bind::Bindings::new().default_dictionary().clone()
     }
 
     #[test]

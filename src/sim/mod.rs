@@ -217,7 +217,7 @@ mod pdo_layer_tests {
     #[test]
     fn demo_pdos_decode_from_the_first_frame() {
         let sim = Simulation::demo();
-        let mut bindings = Bindings::new().unwrap();
+        let mut bindings = Bindings::new();
         for (node, layer) in sim.pdo_layers() {
             bindings.bind_config(node, layer);
         }

@@ -60,7 +60,7 @@ impl crate::command::complete::Known for Heard<'_> {
 impl App {
     /// An application showing `trace`, fed by `source`.
     pub fn new(trace: Trace, keymap: Keymap, source: SourceInfo) -> App {
-        let bindings = Bindings::new().expect("the built-in profiles load");
+        let bindings = Bindings::new();
         App {
             capture: Capture::new(trace, source),
             screen: Screen::default(),

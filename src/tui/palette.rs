@@ -92,7 +92,7 @@ mod tests {
     use super::*;
 
     fn b() -> Bindings {
-        Bindings::new().unwrap()
+        Bindings::new()
     }
 
     /// A trace of `n` frames 10 ms apart: SYNCs (cotui's own when `own`) with heartbeats

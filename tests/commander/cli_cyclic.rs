@@ -90,7 +90,7 @@ async fn the_drive_takes_the_rpdo_values() {
 #[tokio::test(start_paused = true)]
 async fn sync_counts_1_to_n_at_the_period() {
     let d = Demo::spawn(Simulation::demo(), false);
-    let b = cotui::od::bind::Bindings::new().unwrap();
+    let b = cotui::od::bind::Bindings::new();
     let mut watch = d.bus.subscribe();
     let sync = parse_command("sync --period 10 --counter 2 --count 5 --force").unwrap();
     let o = execute(&d.bus, &sync, &b).await.unwrap();

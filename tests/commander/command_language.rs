@@ -197,7 +197,7 @@ fn argument_errors_with_json_print_exactly_one_json_object() {
 #[tokio::test(start_paused = true)]
 async fn the_preview_of_a_block_write_is_the_frame_the_client_sends() {
     let d = Demo::spawn(Simulation::demo(), false);
-    let b = Bindings::new().unwrap();
+    let b = Bindings::new();
     for (line, blocked) in [
         ("sdo write 2 0x6060 3 --type i8 --block", true),
         ("sdo write 2 0x6060 3 --type i8", false),

@@ -297,7 +297,7 @@ async fn our_requests_come_back_tx_and_decode_like_received_frames() {
 #[tokio::test(start_paused = true)]
 async fn palette_lines_run_through_execute() {
     let d = demo();
-    let b = cotui::od::bind::Bindings::new().unwrap();
+    let b = cotui::od::bind::Bindings::new();
     let run = |line: &str| cotui::command::parse_command(line).unwrap();
     let o = cotui::command::execute(&d.bus, &run("sdo read 2 statusword"), &b)
         .await
@@ -454,7 +454,7 @@ async fn listen_only_stop_says_nothing_can_be_sent_and_sends_nothing() {
     let mut watch = d.vbus.endpoint(true).subscribe();
     tokio::time::sleep(Duration::from_millis(50)).await;
     while watch.try_recv().is_some() {}
-    let b = cotui::od::bind::Bindings::new().unwrap();
+    let b = cotui::od::bind::Bindings::new();
     for line in ["stop", "stop 2 3"] {
         let cmd = cotui::command::parse_command(line).unwrap();
         let e = cotui::command::execute(&d.bus, &cmd, &b).await.unwrap_err();
@@ -499,7 +499,7 @@ fn stop_all_in_the_live_task_cancels_a_running_procedure_first() {
     use std::collections::BTreeSet;
     use std::time::Instant;
     let read = |_: &std::path::Path| Ok(SLOW_PROFILE.into());
-    let mut b = cotui::od::bind::Bindings::new().unwrap();
+    let mut b = cotui::od::bind::Bindings::new();
     b.bind_profile(2, "slow.json", &read).unwrap();
     let (feed, req) = start(&["demo".into()], false, b, None, Default::default());
     let command = cotui::command::parse_command("run 2 slowpv").unwrap();

@@ -23,7 +23,7 @@ fn fresh_drives(specs: &[&str]) -> Demo {
 
 async fn run(d: &Demo, line: &str) -> Result<serde_json::Value, CommandError> {
     let cmd = parse_command(line).unwrap();
-    Ok(execute(&d.bus, &cmd, &Bindings::new().unwrap()).await?.json())
+    Ok(execute(&d.bus, &cmd, &Bindings::new()).await?.json())
 }
 
 #[tokio::test(start_paused = true)]

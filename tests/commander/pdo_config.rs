@@ -139,7 +139,7 @@ async fn after_map_tpdo1_the_drive_sends_and_the_decoder_decodes_the_new_signals
     );
     // Reading the mapping back (the verification, or `pdo 2`) keeps it "configured"; a
     // decoder that saw only a read learns it as "read from node".
-    let mut fresh = Decoder::from_bindings(&cotui::od::Bindings::new().unwrap());
+    let mut fresh = Decoder::from_bindings(&cotui::od::Bindings::new());
     execute(&d.bus, &parse_command("pdo 2").unwrap(), &b).await.unwrap();
     while let Some(Ok(f)) = watch.try_recv() {
         decoder.decode(&f);

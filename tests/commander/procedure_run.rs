@@ -45,7 +45,7 @@ const PROFILE: &str = r#"{
 
 fn bindings() -> Bindings {
     let read = |_: &std::path::Path| Ok(PROFILE.into());
-    let mut b = Bindings::new().unwrap();
+    let mut b = Bindings::new();
     b.bind_profile(2, "run-test.json", &read).unwrap();
     assert!(b.warnings().is_empty(), "{:?}", b.warnings());
     b

@@ -29,7 +29,7 @@ async fn sent_ids(bus: &Bus, rx: &mut Subscription) -> Vec<u32> {
 }
 
 async fn run(d: &Demo, line: &str) -> Result<serde_json::Value, CommandError> {
-    let b = Bindings::new().unwrap();
+    let b = Bindings::new();
     execute(&d.bus, &parse_command(line).unwrap(), &b)
         .await
         .map(|o| o.json())
@@ -74,7 +74,7 @@ async fn sync_refuses_beside_the_demos_sync_producer_and_force_sends() {
 async fn a_stop_while_listening_ends_the_command_at_once_with_nothing_sent() {
     let d = Demo::spawn(Simulation::demo(), false);
     let mut rx = d.bus.subscribe();
-    let b = Bindings::new().unwrap();
+    let b = Bindings::new();
     for line in [
         "sync --period 10 --listen 5s --force",
         "nmt start 2 --listen 5s --force",

@@ -198,7 +198,7 @@ fn vendor_quirks_inline_comments_signed_hex_limits_and_latin1_lines() {
         [2000]\nParameterName=Offset\nDataType=0x0004\nAccessType=rw\nLowLimit=0x80000000\n\
         HighLimit=0x7FFFFFFF\nDefaultValue=0xFFFFFFFE ; two below zero\n\
         [Comments]\nLines=1\nLine1=Copyright \xA9 Gr\xFC\xDFe\n";
-    let mut b = Bindings::new().unwrap();
+    let mut b = Bindings::new();
     b.bind_eds_bytes(4, "quirks.eds", text);
     let o = b.dictionary(4).object(0x2000, 0).unwrap();
     assert_eq!((o.min, o.max), (Some(-2147483648), Some(2147483647)));
@@ -249,7 +249,7 @@ fn every_real_world_eds_and_dcf_imports_with_names_types_and_few_warning_kinds()
     assert!(files.len() >= 40, "{} files", files.len());
     for path in files {
         let name = path.file_name().unwrap().to_string_lossy().to_string();
-        let mut b = Bindings::new().unwrap();
+        let mut b = Bindings::new();
         b.bind_eds_bytes(5, &name, &std::fs::read(&path).unwrap());
         let d = b.dictionary(5);
         // Every file names the mandatory objects from its own text.
@@ -290,7 +290,7 @@ fn real_world_files_agree_with_python_canopen_on_names_types_and_pdo_mappings() 
         let Some(objects) = py["objects"].as_object() else {
             continue; // the library cannot read this file: no reference
         };
-        let mut b = Bindings::new().unwrap();
+        let mut b = Bindings::new();
         b.bind_eds_bytes(5, &name, &std::fs::read(path).unwrap());
         let d = b.dictionary(5);
         compared += 1;

@@ -50,7 +50,7 @@ proptest! {
     fn eds_bytes_of_any_encoding_never_panic(bytes in prop::collection::vec(any::<u8>(), 0..600), node in 1u8..=127) {
         let (text, fallback) = cotui::od::text::decode(&bytes);
         prop_assert!(fallback.iter().all(|l| *l >= 1 && *l <= text.lines().count().max(1)));
-        let mut b = cotui::od::Bindings::new().unwrap();
+        let mut b = cotui::od::Bindings::new();
         b.bind_eds_bytes(node, "fuzz.eds", &bytes);
     }
 
@@ -82,7 +82,7 @@ proptest! {
 
     #[test]
     fn resolving_never_panics(text in ".{0,30}") {
-        let b = Bindings::new().unwrap();
+        let b = Bindings::new();
         let _ = resolve_object(b.dictionary(1), &text);
     }
 
@@ -148,7 +148,7 @@ proptest! {
 
     #[test]
     fn transmit_lists_never_panic(pieces in prop::collection::vec(list_piece(), 0..40), text in ".{0,200}") {
-        let b = Bindings::new().unwrap();
+        let b = Bindings::new();
         let joined = pieces.concat();
         let _ = cotui::command::transmit_list::load(&format!("{{\"entries\": [{joined}]}}"), &b);
         let _ = cotui::command::transmit_list::load(&joined, &b);

@@ -110,7 +110,7 @@ fn aqmd_modbus_registers_map_to_objects() {
 fn identity_values_suggest_the_profile() {
     use cotui::od::Value;
     use cotui::od::bind::Bindings;
-    let mut b = Bindings::new().expect("built-ins");
+    let mut b = Bindings::new();
     let suggest = |b: &mut Bindings, index: u16, text: &str| {
         let read = |i: u16, s: u8| (i == index && s == 0).then(|| Value::Text(text.to_string()));
         b.identify(&read).map(|p| p.name.clone())

@@ -26,7 +26,7 @@
 //!
 //! let log = b"(1.000000) can0 705#7F\n(1.100000) can0 605#4041600000000000\n\
 //!             (1.101000) can0 585#4B41600037020000\n";
-//! let mut decoder = Decoder::from_bindings(&Bindings::new().expect("built-in profiles"));
+//! let mut decoder = Decoder::from_bindings(&Bindings::new());
 //! let mut labels = Vec::new();
 //! for line in LogReader::new(&log[..]).expect("in-memory log") {
 //!     if let (_, Outcome::Frame(frame)) = line.expect("in-memory read") {

@@ -6,7 +6,7 @@ use crate::frame::{Flags, Frame};
 use std::collections::HashMap;
 
 fn decoder() -> Decoder {
-    Decoder::from_bindings(&crate::od::bind::Bindings::new().unwrap())
+    Decoder::from_bindings(&crate::od::bind::Bindings::new())
 }
 
 fn parse(s: &str) -> Expr {

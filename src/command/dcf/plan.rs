@@ -677,7 +677,7 @@ mod tests {
 
     #[test]
     fn save_reads_what_the_dictionaries_know() {
-        let dict = crate::od::bind::Bindings::new().unwrap().dictionary(5).clone();
+        let dict = crate::od::bind::Bindings::new().dictionary(5).clone();
         let plan = save_plan(&dict);
         let t = |i: u16| plan.targets.iter().find(|t| t.index == i).cloned();
         assert_eq!(t(0x1000).map(|t| t.subs), Some(vec![0]));

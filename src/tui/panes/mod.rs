@@ -489,7 +489,7 @@ pub(crate) mod testutil {
     /// velocity actual value (rpm) and the mode display: 40 PDOs 10 ms apart, enabled at
     /// the 10th, a speed ramp, profile velocity mode from the 20th, a fault at the 35th.
     pub fn plot_app() -> App {
-        let bindings = crate::od::bind::Bindings::new().unwrap();
+        let bindings = crate::od::bind::Bindings::new();
         let mut trace = Trace::new(Decoder::from_bindings(&bindings), 500_000);
         trace.ifaces.intern("can0");
         let mut t = 1_700_000_000_000_000_000u64;
@@ -531,7 +531,7 @@ pub(crate) mod testutil {
     /// Node 1's TPDO1 mapped (sniffed SDO writes) to the position actual value, a constant
     /// 0x1000, and the velocity actual value, a ramp 0 to 975 over 40 frames 10 ms apart.
     pub fn constant_and_ramp_app() -> App {
-        let bindings = crate::od::bind::Bindings::new().unwrap();
+        let bindings = crate::od::bind::Bindings::new();
         let mut trace = Trace::new(Decoder::from_bindings(&bindings), 500_000);
         trace.ifaces.intern("can0");
         let mut t = 1_700_000_000_000_000_000u64;

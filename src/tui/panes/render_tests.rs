@@ -1124,7 +1124,7 @@ fn y_in_the_message_log_copies_the_selected_entry_whole_and_says_copied() {
 #[test]
 fn nodes_and_objects_keep_the_two_node_5s_apart() {
     // The two buses' node 5 each answer a read of their heartbeat time, with different values.
-    let bindings = crate::od::bind::Bindings::new().unwrap();
+    let bindings = crate::od::bind::Bindings::new();
     let mut a = two_bus_app_with(crate::decode::Decoder::from_bindings(&bindings));
     let t = a.trace().store.packed(a.trace().len() - 1).ts_ns;
     for (k, (iface, ms)) in [("can0", 100u16), ("can1", 250)].into_iter().enumerate() {

@@ -140,29 +140,47 @@ pub struct Bindings {
     loaded: BTreeMap<String, Arc<Profile>>,
     nodes: BTreeMap<u8, NodeBinding>,
     dictionaries: BTreeMap<u8, Dictionary>,
+    /// CiA 402 + CiA 301, built on first use: a capture that names no object (NMT,
+    /// heartbeats, SYNC, PDOs without a mapping) never parses the built-in profiles.
     default: Dictionary,
     warnings: Vec<Warning>,
 }
 
+/// The layers of nodes without bindings: CiA 402 over CiA 301, from the process's shared
+/// built-ins (the same `Arc`s [`Bindings`] hands out by name).
+fn base_layers() -> Vec<Arc<Profile>> {
+    let layers = ["cia402", "cia301"]
+        .iter()
+        .filter_map(|name| match shared_builtin(name) {
+            Some(Ok((profile, _))) => Some(profile),
+            // The built-ins load without error or warning (their tests check it).
+            _ => None,
+        });
+    layers.collect()
+}
+
+impl Default for Bindings {
+    fn default() -> Bindings {
+        Bindings::new()
+    }
+}
+
 impl Bindings {
-    /// Bindings with no node bound: every node uses CiA 402 + CiA 301.
-    pub fn new() -> Result<Bindings, BindError> {
-        let mut b = Bindings {
+    /// Bindings with no node bound: every node uses CiA 402 + CiA 301 (built when first
+    /// asked for).
+    pub fn new() -> Bindings {
+        Bindings {
             loaded: BTreeMap::new(),
             nodes: BTreeMap::new(),
             dictionaries: BTreeMap::new(),
-            default: Dictionary::default(),
+            default: Dictionary::lazy(base_layers),
             warnings: Vec::new(),
-        };
-        let cia402 = b.named("cia402", None, None)?;
-        let cia301 = b.named("cia301", None, None)?;
-        b.default = Dictionary::new(vec![cia402, cia301]);
-        Ok(b)
+        }
     }
 
     /// Bindings from `--profile NODE=NAME` and `--eds NODE=FILE` arguments.
     pub fn from_args(profiles: &[String], eds: &[String], read: ReadFile) -> Result<Bindings, BindError> {
-        let mut b = Bindings::new()?;
+        let mut b = Bindings::new();
         for arg in profiles {
             let (node, name) = parse_node_arg(arg)?;
             b.bind_profile(node, name, read).map_err(|e| BindError::Profile {
@@ -405,7 +423,7 @@ mod tests {
 
     #[test]
     fn builtins_have_what_the_seeds_need() {
-        let b = Bindings::new().unwrap();
+        let b = Bindings::new();
         let d = b.dictionary(5);
         assert_eq!(d.profile_name(), "cia402");
         let sw = d.object(0x6041, 0).unwrap();
@@ -515,7 +533,7 @@ mod tests {
 
     #[test]
     fn resolve_forms() {
-        let b = Bindings::new().unwrap();
+        let b = Bindings::new();
         let d = b.dictionary(1);
         assert_eq!(resolve_object(d, "0x6041"), Ok((0x6041, 0)));
         assert_eq!(resolve_object(d, "0x1018:1"), Ok((0x1018, 1)));
@@ -547,7 +565,7 @@ mod tests {
 
     #[test]
     fn identify_picks_a_matching_builtin() {
-        let mut b = Bindings::new().unwrap();
+        let mut b = Bindings::new();
         let drive = |i: u16, _s: u8| (i == 0x1000).then_some(crate::od::Value::Unsigned(0x0002_0192));
         assert_eq!(b.identify(&drive).map(|p| p.name.clone()), Some("cia402".to_string()));
         assert!(b.identify(&|_, _| Some(crate::od::Value::Unsigned(0x191))).is_none());
