@@ -46,8 +46,10 @@ pub fn verbose() -> bool {
     VERBOSE.load(std::sync::atomic::Ordering::Relaxed)
 }
 
-/// The subcommands.
+/// The subcommands. Each one's arguments are declared when it is parsed or its help is
+/// shown (`defer`): a command line pays only for its own subcommand.
 #[derive(Subcommand, Debug)]
+#[command(defer = true)]
 pub enum Command {
     /// Decode candump / ASC logs to text, JSON lines, SDO transactions, a summary or pcapng.
     Decode(decode_args::DecodeArgs),
@@ -174,7 +176,7 @@ pub fn cli_command() -> clap::Command {
         }
         cmd
     }
-    let mut cmd = <Cli as clap::CommandFactory>::command();
+    let mut cmd = crate::command::syntax::declared(<Cli as clap::CommandFactory>::command());
     for sub in ON_A_BUS {
         if cmd.find_subcommand(sub).is_some() {
             cmd = cmd.mut_subcommand(sub, |c| with_iface(c, sub));
@@ -253,6 +255,25 @@ mod tests {
             let name = format!("{path} {}", sub.get_name());
             every_help(sub, &name, out);
         }
+    }
+
+    /// The overview (`cotui --help`) gives each subcommand's own line, not the doc comment
+    /// of its arguments' type that declaring a deferred subcommand brings along.
+    #[test]
+    fn the_overview_lists_each_subcommand_by_its_own_text() {
+        let help = cli_command().render_help().to_string();
+        assert!(help.contains("decode    Decode candump / ASC logs"), "{help}");
+        assert!(help.contains("nmt       "), "{help}");
+        for own in ["Arguments of", "A command's own arguments"] {
+            assert!(!help.contains(own), "`{own}` in the overview:\n{help}");
+        }
+        let mut decode = cli_command();
+        let decode = decode
+            .find_subcommand_mut("decode")
+            .unwrap()
+            .render_long_help()
+            .to_string();
+        assert!(decode.starts_with("Decode candump / ASC logs"), "{decode}");
     }
 
     #[test]

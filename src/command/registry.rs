@@ -18,7 +18,10 @@ macro_rules! commands {
         /// The commander commands as clap declares them. `B`: the options in front of every
         /// command (see [`super::words::Session`]), `D`: the dictionary options of the
         /// commands that name objects (`sdo`, `run`, `pdo`, `dcf`).
+        /// Each command's arguments are declared when it is parsed or its help is shown
+        /// (`defer`): a command line pays only for its own command.
         #[derive(clap::Subcommand, Clone, Debug)]
+        #[command(defer = true)]
         pub enum Commander<B: clap::Args, D: clap::Args> {
             $($(#[$attr])* $variant($declared),)*
         }

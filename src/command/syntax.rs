@@ -28,11 +28,30 @@ struct Palette {
 /// The palette's clap command, built once.
 fn palette() -> &'static clap::Command {
     static CMD: OnceLock<clap::Command> = OnceLock::new();
-    CMD.get_or_init(|| {
-        let mut c = Palette::command();
-        c.build();
-        c
-    })
+    CMD.get_or_init(|| declared(Palette::command()))
+}
+
+/// `cmd` with its deferred subcommands declared, each keeping its own help text: clap
+/// gives a deferred subcommand the doc comment of its arguments' type when it declares
+/// them (`Arguments of cotui decode`), over the subcommand's own.
+pub fn declared(mut cmd: clap::Command) -> clap::Command {
+    use clap::builder::Resettable;
+    let texts: Vec<_> = cmd
+        .get_subcommands()
+        .map(|s| {
+            (
+                s.get_name().to_string(),
+                s.get_about().cloned(),
+                s.get_long_about().cloned(),
+            )
+        })
+        .collect();
+    cmd.build();
+    for (name, about, long_about) in texts {
+        let text = |t: Option<clap::builder::StyledStr>| t.map_or(Resettable::Reset, Resettable::Value);
+        cmd = cmd.mut_subcommand(name, |s| s.about(text(about)).long_about(text(long_about)));
+    }
+    cmd
 }
 
 /// Parses one palette line (the command line's words without IFACE and its flags), e.g.

@@ -5,8 +5,9 @@
 use super::{Figures, WireError, figures};
 use crate::frame::Frame;
 
-/// Slots in the memo (direct-mapped): about half the frames of the bench log hit.
-const SLOTS: usize = 4096;
+/// Sets in the memo, of two slots each (the most recently used first): 66 % of the frames
+/// of the bench log hit (a memo that forgot nothing: 72 %; direct-mapped 4096 slots: 52 %).
+const SETS: usize = 8192;
 
 /// One remembered classic frame: what tells it apart on the wire, and its figures.
 #[derive(Clone, Copy, Debug)]
@@ -28,7 +29,7 @@ const EMPTY: u64 = u64::MAX;
 #[derive(Clone, Debug, Default)]
 pub struct FiguresCache {
     /// Empty until the first classic frame.
-    slots: Vec<Slot>,
+    slots: Vec<[Slot; 2]>,
 }
 
 impl FiguresCache {
@@ -56,20 +57,24 @@ impl FiguresCache {
             n => u64::from_le_bytes(bytes) & (u64::MAX >> (64 - 8 * n)),
         };
         if self.slots.is_empty() {
-            self.slots = vec![
-                Slot {
-                    head: EMPTY,
-                    data: 0,
-                    crc: 0,
-                    bits: 0,
-                    stuff_bits: 0,
-                };
-                SLOTS
-            ];
+            let empty = Slot {
+                head: EMPTY,
+                data: 0,
+                crc: 0,
+                bits: 0,
+                stuff_bits: 0,
+            };
+            self.slots = vec![[empty; 2]; SETS];
         }
-        let hash = (head ^ data.rotate_left(29)).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 52;
-        let slot = &mut self.slots[hash as usize % SLOTS];
-        if slot.head == head && slot.data == data {
+        let hash = (head ^ data.rotate_left(29)).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 51;
+        let set = &mut self.slots[hash as usize % SETS];
+        let known = |slot: &Slot| slot.head == head && slot.data == data;
+        if known(&set[0]) || known(&set[1]) {
+            // The most recently used goes first (what the next miss keeps).
+            if !known(&set[0]) {
+                set.swap(0, 1);
+            }
+            let slot = &set[0];
             return Ok(Figures {
                 bits: u32::from(slot.bits),
                 stuff_bits: u32::from(slot.stuff_bits),
@@ -78,8 +83,10 @@ impl FiguresCache {
             });
         }
         let f = figures(frame)?;
-        // A classic frame takes at most 160 bits and its CRC 15: they fit the slot.
-        *slot = Slot {
+        // A classic frame takes at most 160 bits and its CRC 15: they fit the slot. The
+        // least recently used slot of the set makes way.
+        set[1] = set[0];
+        set[0] = Slot {
             head,
             data,
             crc: f.crc as u16,
