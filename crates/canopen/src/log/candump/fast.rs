@@ -27,16 +27,16 @@ pub(super) fn line(buf: &[u8], iface: &mut IfaceCache, ifaces: &mut Interfaces, 
     c.byte(b' ')?;
     let (id, flags) = c.can_id()?;
     c.byte(b'#')?;
-    let mut f = Frame {
+    // `frame` is scratch until `Some`: it is written as the line is read.
+    *frame = Frame {
         ts_ns,
         id,
         flags: Flags(flags),
         ..Frame::default()
     };
-    let (n, end) = c.packed_bytes_line(&mut f.data[..8])?;
-    f.len = n as u8;
-    f.iface = name.index(iface, ifaces)?;
-    *frame = f;
+    let (n, end) = c.packed_bytes_line(&mut frame.data[..8])?;
+    frame.len = n as u8;
+    frame.iface = name.index(iface, ifaces)?;
     Some(end)
 }
 
