@@ -226,7 +226,7 @@ impl<'a> Cursor<'a> {
     /// The pairs and the line end are looked for in the next 18 bytes at once: a line that
     /// ends closer to the end of the buffer gives `None`.
     #[inline(always)]
-    pub(super) fn packed_bytes_line(&mut self, out: &mut [u8]) -> Option<(usize, usize)> {
+    pub(super) fn packed_bytes_line(&mut self, out: &mut [u8; 8]) -> Option<(usize, usize)> {
         let t: &[u8; 18] = self.buf.get(self.at..self.at + 18)?.try_into().ok()?;
         let mut n = 0;
         loop {
@@ -240,7 +240,7 @@ impl<'a> Cursor<'a> {
                 return Some((n, self.at));
             }
             let (hi, lo) = (HEX[c as usize], HEX[d as usize]);
-            if n == 8 || n == out.len() || (hi | lo) > 15 {
+            if n == 8 || (hi | lo) > 15 {
                 return None;
             }
             out[n] = hi << 4 | lo;

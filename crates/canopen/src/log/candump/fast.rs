@@ -34,7 +34,7 @@ pub(super) fn line(buf: &[u8], iface: &mut IfaceCache, ifaces: &mut Interfaces, 
         flags: Flags(flags),
         ..Frame::default()
     };
-    let (n, end) = c.packed_bytes_line(&mut frame.data[..8])?;
+    let (n, end) = c.packed_bytes_line(frame.data.first_chunk_mut()?)?;
     frame.len = n as u8;
     frame.iface = name.index(iface, ifaces)?;
     Some(end)
