@@ -3,6 +3,7 @@
 use crate::frame::{Flags, Frame};
 use crate::log::export::{AscWriter, TrcWriter};
 use crate::log::writer::LogWriter;
+use crate::output::blf::BlfWriter;
 use crate::sim::synth::Traffic;
 use std::io::Write;
 use std::path::Path;
@@ -78,20 +79,23 @@ const GARBAGE: [&str; 3] = [
 ];
 
 /// The input formats `cotui bench` times besides candump, with their file names.
-pub const INPUT_FORMATS: [(&str, &str); 5] = [
+pub const INPUT_FORMATS: [(&str, &str); 6] = [
     ("screen", "bench-quarter.screen.txt"),
     ("asc", "bench-quarter.asc"),
     ("trc", "bench-quarter.trc"),
     ("csv", "bench-quarter.csv"),
     ("mf4", "bench-quarter.mf4"),
+    ("blf", "bench-quarter.blf"),
 ];
 
 /// Writes the same synthetic frames as [`write_log`] in input format `format` (one of
 /// [`INPUT_FORMATS`]): candump screen output (`-ta`), Vector ASC, PEAK TRC 2.1,
-/// python-can CSV or ASAM MDF4.
+/// python-can CSV, ASAM MDF4 or Vector BLF (by cotui's own BLF writer).
 pub fn write_format_log(path: &Path, frames: u64, format: &str) -> std::io::Result<()> {
-    if format == "mf4" {
-        return super::mf4::write_mf4_log(path, frames);
+    match format {
+        "mf4" => return super::mf4::write_mf4_log(path, frames),
+        "blf" => return write_blf_log(path, frames),
+        _ => {}
     }
     let file = std::fs::File::create(path)?;
     let mut out = std::io::BufWriter::with_capacity(1 << 20, file);
@@ -115,6 +119,21 @@ pub fn write_format_log(path: &Path, frames: u64, format: &str) -> std::io::Resu
     asc.finish(&mut line);
     out.write_all(line.as_bytes())?;
     out.flush()
+}
+
+/// Writes the synthetic frames as a Vector BLF file with cotui's BLF writer, the final
+/// header (with the totals) written over the first one.
+fn write_blf_log(path: &Path, frames: u64) -> std::io::Result<()> {
+    use std::io::{Seek, SeekFrom};
+    let mut file = std::fs::File::create(path)?;
+    let mut blf = BlfWriter::new(std::io::BufWriter::with_capacity(1 << 20, &file));
+    for frame in Traffic::new(frames, 1_700_000_000_000_000_000) {
+        blf.write_frame("can0", &frame)?;
+    }
+    let header = blf.finish()?;
+    drop(blf);
+    file.seek(SeekFrom::Start(0))?;
+    file.write_all(&header)
 }
 
 /// candump `-ta` screen output: ` (1700000000.000100)  can0  181   [2]  11 22`.

@@ -29,6 +29,10 @@ pub struct BenchArgs {
     /// Only write the generated log to this file (for profiling or tests) and exit.
     #[arg(long, value_name = "FILE")]
     pub write_log: Option<PathBuf>,
+    /// With --write-log: write the bench frames in this input format instead of the
+    /// candump log (screen, asc, trc, csv, mf4, blf), as the per-format rows read them.
+    #[arg(long, value_name = "FORMAT", requires = "write_log", value_parser = clap::builder::PossibleValuesParser::new(log::INPUT_FORMATS.map(|(f, _)| f)))]
+    pub log_format: Option<String>,
     /// Measure the interactive analyzer instead: first screen, full index, memory per
     /// frame, redraw and key response times (use --frames 10000000 for the target figures).
     #[arg(long)]
@@ -168,7 +172,10 @@ pub fn run(args: &BenchArgs) -> ExitCode {
 
 fn bench(args: &BenchArgs) -> std::io::Result<()> {
     if let Some(path) = &args.write_log {
-        return log::write_bench_log(path, args.frames);
+        return match &args.log_format {
+            Some(format) => log::write_format_log(path, args.frames, format),
+            None => log::write_bench_log(path, args.frames),
+        };
     }
     if args.tui {
         return tui::bench(args.frames, args.json);
@@ -316,6 +323,7 @@ fn measure_all(args: &BenchArgs, exe: &Path, dir: &Path) -> std::io::Result<Figu
             "asc" => ("summary-asc", "decode --summary, ASC input (1/4 log)"),
             "trc" => ("summary-trc", "decode --summary, TRC input (1/4 log)"),
             "mf4" => ("summary-mf4", "decode --summary, MF4 input (1/4 log)"),
+            "blf" => ("summary-blf-quarter", "decode --summary, BLF input (1/4 log)"),
             _ => ("summary-csv", "decode --summary, CSV input (1/4 log)"),
         };
         runs.push(Run::new(name, title, &["decode", "--summary", path], n / 4, None));

@@ -33,6 +33,8 @@
 //!   skipped as [`SkipReason::Event`], `CANXL` lines as [`SkipReason::CanXl`], lines not
 //!   starting with a timestamp as [`SkipReason::Header`] or [`SkipReason::Comment`] (`//`).
 
+mod fast;
+
 use super::lex::{self, Channels, Tokens, dec_u32, err, hex_u32, trim_end};
 use super::status::{self, State};
 use super::{Line, ParseError, SkipReason};

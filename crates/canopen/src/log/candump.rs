@@ -20,6 +20,8 @@
 //! 11-bit id above 7FF is reported as an error, so that what parses is exactly what
 //! [`super::writer`] writes back.
 
+mod fast;
+
 use super::lex::{self, IfaceCache, err, hex, is_ws, skip_ws, token_end, trim_end};
 use super::{Line, ParseError, SkipReason};
 use crate::frame::linux::CAN_ERR_FLAG;
@@ -44,12 +46,12 @@ impl Parser {
         self.tail
     }
 
-    /// Reads the common `-l` line at the start of `buf` (see [`super::fast`]) into `frame`;
+    /// Reads the common `-l` line at the start of `buf` (see [`fast`]) into `frame`;
     /// returns the bytes it took, its line end included, or `None` when the general
     /// [`Parser::parse_into`] must read it.
     #[inline]
     pub fn parse_fast(&mut self, buf: &[u8], ifaces: &mut Interfaces, frame: &mut Frame) -> Option<usize> {
-        let n = super::fast::line(buf, &mut self.iface, ifaces, frame)?;
+        let n = fast::line(buf, &mut self.iface, ifaces, frame)?;
         self.tail = false;
         Some(n)
     }

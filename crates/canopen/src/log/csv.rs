@@ -10,6 +10,8 @@
 //! CAN FD frame (python-can keeps no FD flag in CSV); with `error` set the id is the
 //! SocketCAN error class.
 
+mod fast;
+
 use super::lex::{IfaceCache, dec_u32, err, hex_u32, trim_end};
 use super::{Line, ParseError, SkipReason};
 use crate::frame::{Flags, Frame, Interfaces};
@@ -69,11 +71,27 @@ impl Parser {
         let (ext, rtr, error) = (flag(ext)?, flag(rtr)?, flag(error)?);
         let digits = id.1.strip_prefix(b"0x").unwrap_or(id.1);
         let raw = hex_u32(digits).ok_or_else(|| err(id.0, "expected a hex CAN id"))?;
+        self.fill(&mut f, ifaces, (id.0, raw), [ext, rtr, error], dlc, data)?;
+        Ok(Line::Frame(f))
+    }
+
+    /// Fills in the frame of a row from its fields after the timestamp: the id's value,
+    /// the flags `[extended, remote, error]`, the DLC and the base64 data (fields with
+    /// their indexes in the line).
+    fn fill(
+        &mut self,
+        f: &mut Frame,
+        ifaces: &mut Interfaces,
+        (id_at, raw): (usize, u32),
+        [ext, rtr, error]: [bool; 3],
+        dlc: (usize, &[u8]),
+        data: (usize, &[u8]),
+    ) -> Result<(), ParseError> {
         if error {
             f.flags.set(Flags::ERR, true);
             f.id = raw & 0x1FFF_FFFF;
         } else if raw > if ext { 0x1FFF_FFFF } else { 0x7FF } {
-            return Err(err(id.0, "CAN id out of range"));
+            return Err(err(id_at, "CAN id out of range"));
         } else {
             f.id = raw;
             f.flags.set(Flags::EXT, ext);
@@ -101,7 +119,7 @@ impl Parser {
             }
         }
         f.iface = self.iface.get(ifaces, b"can0", 0)?;
-        Ok(Line::Frame(f))
+        Ok(())
     }
 }
 

@@ -101,23 +101,25 @@ pub(crate) fn err(i: usize, message: &'static str) -> ParseError {
     ParseError { column: i + 1, message }
 }
 
+/// `10^(9 - k)`: the nanoseconds of one unit of a `k`-digit fraction of a second.
+pub(crate) const FRACTION_NS: [u64; 10] = [
+    1_000_000_000,
+    100_000_000,
+    10_000_000,
+    1_000_000,
+    100_000,
+    10_000,
+    1000,
+    100,
+    10,
+    1,
+];
+
 /// Parses `digits[.digits]` at `i` into nanoseconds; returns the value and the index after it.
 ///
 /// Any number of fraction digits is accepted (python-can writes `(0.0)`); digits past the
 /// ninth are truncated.
 pub(crate) fn timestamp(s: &[u8], mut i: usize) -> Result<(u64, usize), ParseError> {
-    const POW10: [u64; 10] = [
-        1_000_000_000,
-        100_000_000,
-        10_000_000,
-        1_000_000,
-        100_000,
-        10_000,
-        1000,
-        100,
-        10,
-        1,
-    ];
     let start = i;
     let mut secs: u64 = 0;
     while i < s.len() && s[i].is_ascii_digit() {
@@ -142,7 +144,7 @@ pub(crate) fn timestamp(s: &[u8], mut i: usize) -> Result<(u64, usize), ParseErr
             }
             i += 1;
         }
-        frac *= POW10[(i - from).min(9)];
+        frac *= FRACTION_NS[(i - from).min(9)];
     }
     let ns = secs
         .checked_mul(1_000_000_000)

@@ -131,6 +131,22 @@ impl Field {
     }
     /// The value as an unsigned integer (integers up to 64 bits).
     pub fn uint(&self, rec: &[u8]) -> Option<u64> {
+        let le = !matches!(self.kind, DataType::Uint { be: true } | DataType::Int { be: true });
+        let width = u32::from(self.bit) + self.bits;
+        // Little endian, at most 8 bytes and 8 bytes of record from its first: one load,
+        // the bytes past the field shifted and masked away.
+        if le
+            && self.bits > 0
+            && width <= 64
+            && let Some(word) = rec.get(self.byte as usize..).and_then(|r| r.first_chunk::<8>())
+        {
+            let v = u64::from_le_bytes(*word) >> self.bit;
+            return Some(if self.bits >= 64 {
+                v
+            } else {
+                v & ((1u64 << self.bits) - 1)
+            });
+        }
         let bytes = self.span(rec)?;
         if bytes.len() > 8 || self.bits == 0 {
             return (self.bits == 0).then_some(0);

@@ -12,8 +12,10 @@ mod asc_date;
 pub mod blf;
 pub mod candump;
 pub mod csv;
+mod cursor;
 pub mod export;
-mod fast;
+#[cfg(test)]
+mod fast_check;
 mod lex;
 pub mod mf4;
 pub mod savvycan;
@@ -339,38 +341,43 @@ impl<R: BufRead> LogReader<R> {
     /// A line that lies whole in the source's buffer is parsed in place; one that straddles
     /// the buffer's end is gathered in the reader's own line buffer (reused, never shrunk).
     pub fn next_line(&mut self) -> io::Result<Option<(u64, Outcome)>> {
-        if let Parser::Candump(p) = &mut self.parser {
-            let available = self.src.fill_buf()?;
-            if let Some(n) = p.parse_fast(available, &mut self.ifaces, &mut self.frame) {
-                self.src.consume(n);
-                self.line_no += 1;
-                self.counts.frames += 1;
-                return Ok(Some((self.line_no, Outcome::Frame(self.frame))));
-            }
+        let available = self.src.fill_buf()?;
+        if let Some(n) = self.parser.parse_fast(available, &mut self.ifaces, &mut self.frame) {
+            self.src.consume(n);
+            self.line_no += 1;
+            self.counts.frames += 1;
+            return Ok(Some((self.line_no, Outcome::Frame(self.frame))));
         }
         self.general_line()
     }
 
     /// Appends the next lines to `out`, as [`LogReader::next_line`] gives them, until `out`
-    /// holds `max` or the input ends. Runs of common candump lines are read in one go from
-    /// the source's buffer.
+    /// holds `max` or the input ends. Runs of the format's common lines are read in one go
+    /// from the source's buffer by its fast path.
     pub fn fill(&mut self, out: &mut Vec<(u64, Outcome)>, max: usize) -> io::Result<()> {
         while out.len() < max {
-            if let Parser::Candump(p) = &mut self.parser {
-                let buf = self.src.fill_buf()?;
-                let (mut at, before) = (0, out.len());
-                while out.len() < max
-                    && let Some(n) = p.parse_fast(&buf[at..], &mut self.ifaces, &mut self.frame)
-                {
-                    at += n;
-                    self.line_no += 1;
-                    out.push((self.line_no, Outcome::Frame(self.frame)));
-                }
-                self.counts.frames += (out.len() - before) as u64;
-                self.src.consume(at);
-                if out.len() == max {
-                    break;
-                }
+            let buf = self.src.fill_buf()?;
+            let before = out.len();
+            let mut run = FastRun {
+                buf,
+                ifaces: &mut self.ifaces,
+                frame: &mut self.frame,
+                line_no: &mut self.line_no,
+                out,
+                max,
+            };
+            let at = match &mut self.parser {
+                Parser::Candump(p) => run.lines(|b, i, f| p.parse_fast(b, i, f)),
+                Parser::Screen(p) => run.lines(|b, i, f| p.parse_fast(b, i, f)),
+                Parser::Asc(p) => run.lines(|b, i, f| p.parse_fast(b, i, f)),
+                Parser::Trc(p) => run.lines(|b, i, f| p.parse_fast(b, i, f)),
+                Parser::Csv(p) => run.lines(|b, i, f| p.parse_fast(b, i, f)),
+                Parser::Savvycan(_) => 0,
+            };
+            self.counts.frames += (out.len() - before) as u64;
+            self.src.consume(at);
+            if out.len() == max {
+                break;
             }
             match self.general_line()? {
                 Some(item) => out.push(item),
@@ -453,7 +460,48 @@ impl<R: BufRead> LogReader<R> {
     }
 }
 
+/// A run of fast-path lines read from one source buffer into a batch.
+struct FastRun<'a> {
+    buf: &'a [u8],
+    ifaces: &'a mut Interfaces,
+    frame: &'a mut Frame,
+    line_no: &'a mut u64,
+    out: &'a mut Vec<(u64, Outcome)>,
+    max: usize,
+}
+
+impl FastRun<'_> {
+    /// Pushes the frames `fast` reads from the start of the buffer on, until it leaves a
+    /// line to the general parser or the batch is full; returns the bytes read.
+    #[inline]
+    fn lines(&mut self, mut fast: impl FnMut(&[u8], &mut Interfaces, &mut Frame) -> Option<usize>) -> usize {
+        let mut at = 0;
+        while self.out.len() < self.max
+            && let Some(n) = fast(&self.buf[at..], self.ifaces, self.frame)
+        {
+            at += n;
+            *self.line_no += 1;
+            self.out.push((*self.line_no, Outcome::Frame(*self.frame)));
+        }
+        at
+    }
+}
+
 impl Parser {
+    /// The format's fast path for its common line at the start of `buf` (see
+    /// `candump::Parser::parse_fast`); `None` leaves the line to the general parser.
+    #[inline]
+    fn parse_fast(&mut self, buf: &[u8], ifaces: &mut Interfaces, frame: &mut Frame) -> Option<usize> {
+        match self {
+            Parser::Candump(p) => p.parse_fast(buf, ifaces, frame),
+            Parser::Screen(p) => p.parse_fast(buf, ifaces, frame),
+            Parser::Asc(p) => p.parse_fast(buf, ifaces, frame),
+            Parser::Trc(p) => p.parse_fast(buf, ifaces, frame),
+            Parser::Csv(p) => p.parse_fast(buf, ifaces, frame),
+            Parser::Savvycan(_) => None,
+        }
+    }
+
     /// True when the last frame line had text after the frame that was ignored.
     fn ignored_tail(&self) -> bool {
         match self {

@@ -18,6 +18,8 @@
 //! BRS/ESI from the `-x` columns when present. CAN XL lines (`[0003]`) are skipped; the
 //! byte-swapped (`-S`) and binary (`-B`) views are reported as malformed.
 
+mod fast;
+
 use super::lex::{self, IfaceCache, Tokens, err, hex, hex_u32, skip_ws, trim_end};
 use super::{Line, ParseError, SkipReason};
 use crate::frame::{Flags, Frame, Interfaces};

@@ -28,6 +28,8 @@
 //! 2.x `ER`) are bus errors. Other
 //! events (`EC`, `EV`, ...) are skipped.
 
+mod fast;
+
 use super::lex::{self, Channels, Tokens, dec_u32, err, hex, hex_u32, trim_end};
 use super::status::{self, State};
 use super::{Line, ParseError, SkipReason};
@@ -295,32 +297,46 @@ impl Parser {
         };
         let (id_at, id) = id.ok_or_else(|| err(s.len(), "expected a CAN id (I column)"))?;
         parse_id(&mut f, id_at, id)?;
-        let (n, n_at) = dlc
-            .map(|(d, at)| (d, at, true))
-            .or(len.map(|(l, at)| (l, at, false)))
-            .map(|(v, at, is_dlc)| {
-                let n = if is_dlc && fd { fd_len(v) } else { Some(v) };
-                (n, at)
-            })
-            .ok_or_else(|| err(s.len(), "expected a data length (L or l column)"))?;
-        let bad = || err(n_at, "data length out of range");
-        if fd {
-            let n = n
-                .filter(|&n| n <= 8 || matches!(n, 12 | 16 | 20 | 24 | 32 | 48 | 64))
-                .ok_or_else(bad)?;
-            f.flags.set(Flags::FD | Flags::FDF, true);
-            f.flags.set(Flags::BRS, brs);
-            f.flags.set(Flags::ESI, esi);
-            f.len = n as u8;
-        } else {
-            let n = n.filter(|&n| n <= 15).ok_or_else(bad)?;
-            classic(&mut f, n as u8, rtr);
-        }
+        set_length(&mut f, [fd, brs, esi, rtr], dlc, len, s.len())?;
         if !rtr {
             data(&mut f, &mut toks, s.len())?;
         }
         Ok((Some((f, offset)), bus))
     }
+}
+
+/// Sets the length (and the FD flags) of a 2.x frame of type flags `[fd, brs, esi, rtr]`
+/// from its `L` column (a DLC) or else its `l` column (a length), each with its index;
+/// `end` is the line's length.
+fn set_length(
+    f: &mut Frame,
+    [fd, brs, esi, rtr]: [bool; 4],
+    dlc: Option<(u32, usize)>,
+    len: Option<(u32, usize)>,
+    end: usize,
+) -> Result<(), ParseError> {
+    let (n, n_at) = dlc
+        .map(|(d, at)| (d, at, true))
+        .or(len.map(|(l, at)| (l, at, false)))
+        .map(|(v, at, is_dlc)| {
+            let n = if is_dlc && fd { fd_len(v) } else { Some(v) };
+            (n, at)
+        })
+        .ok_or_else(|| err(end, "expected a data length (L or l column)"))?;
+    let bad = || err(n_at, "data length out of range");
+    if fd {
+        let n = n
+            .filter(|&n| n <= 8 || matches!(n, 12 | 16 | 20 | 24 | 32 | 48 | 64))
+            .ok_or_else(bad)?;
+        f.flags.set(Flags::FD | Flags::FDF, true);
+        f.flags.set(Flags::BRS, brs);
+        f.flags.set(Flags::ESI, esi);
+        f.len = n as u8;
+    } else {
+        let n = n.filter(|&n| n <= 15).ok_or_else(bad)?;
+        classic(f, n as u8, rtr);
+    }
+    Ok(())
 }
 
 /// The length of FD DLC `dlc`.
@@ -381,13 +397,18 @@ fn offset_ns(tok: Option<(usize, &[u8])>, end: usize) -> Result<u64, ParseError>
 /// An id: more than 4 hex digits is a 29-bit id.
 fn parse_id(f: &mut Frame, at: usize, tok: &[u8]) -> Result<(), ParseError> {
     let id = hex_u32(tok).ok_or_else(|| err(at, "expected a CAN id in hex"))?;
-    let ext = tok.len() > 4;
+    set_id(f, id, tok.len()).ok_or_else(|| err(at, "CAN id out of range"))
+}
+
+/// Sets the id `id` written with `digits` hex digits; `None` when out of range.
+fn set_id(f: &mut Frame, id: u32, digits: usize) -> Option<()> {
+    let ext = digits > 4;
     if id > if ext { 0x1FFF_FFFF } else { 0x7FF } {
-        return Err(err(at, "CAN id out of range"));
+        return None;
     }
     f.id = id;
     f.flags.set(Flags::EXT, ext);
-    Ok(())
+    Some(())
 }
 
 /// A classic frame's length from DLC `dlc` (a DLC above 8 is kept as the raw DLC).
