@@ -121,50 +121,56 @@ fn status_mode_bits(mode: Option<i8>) -> Option<[&'static str; 3]> {
 }
 
 /// The name of a bit from the profile's `bits`, else `fallback`.
-fn profile_bit(texts: WordTexts<'_>, bit: u8, fallback: &str) -> String {
-    texts
-        .and_then(|i| i.bits.get(&bit))
-        .cloned()
-        .unwrap_or_else(|| fallback.to_string())
+fn profile_bit<'a>(texts: WordTexts<'a>, bit: u8, fallback: &'a str) -> &'a str {
+    texts.and_then(|i| i.bits.get(&bit)).map_or(fallback, String::as_str)
+}
+
+/// Pushes `items` onto `out` joined by `, `.
+fn push_joined<'a>(out: &mut String, items: impl Iterator<Item = &'a str>) {
+    for (i, item) in items.enumerate() {
+        if i > 0 {
+            out.push_str(", ");
+        }
+        out.push_str(item);
+    }
 }
 
 /// Names of the statusword bits that are set, in bit order: bits 10/12/13 per the mode in
 /// force, else the profile's bit names, else `mode bit N`. In the cyclic synchronous modes an
 /// enabled drive with bit 12 clear also shows `target ignored`.
-pub(crate) fn statusword_bits(sw: u16, mode: Option<i8>, texts: WordTexts<'_>) -> Vec<String> {
+fn statusword_bits<'a>(sw: u16, mode: Option<i8>, texts: WordTexts<'a>) -> impl Iterator<Item = &'a str> {
     let m = status_mode_bits(mode);
-    let mut out: Vec<String> = (0..16u8)
-        .filter(|b| sw & (1 << b) != 0)
-        .map(|b| match (b, m) {
-            (10, Some(m)) => m[0].to_string(),
-            (12, Some(m)) => m[1].to_string(),
-            (13, Some(m)) => m[2].to_string(),
-            (12 | 13, None) => profile_bit(texts, b, STATUS_BITS[b as usize]),
-            _ => STATUS_BITS[b as usize].to_string(),
-        })
-        .collect();
-    if matches!(mode, Some(8..=10))
+    let ignored = matches!(mode, Some(8..=10))
         && sw & (1 << 12) == 0
-        && DriveState::from_statusword(sw) == DriveState::OperationEnabled
-    {
-        out.push("target ignored".to_string());
-    }
-    out
+        && DriveState::from_statusword(sw) == DriveState::OperationEnabled;
+    (0..16u8)
+        .filter(move |b| sw & (1 << b) != 0)
+        .map(move |b| match (b, m) {
+            (10, Some(m)) => m[0],
+            (12, Some(m)) => m[1],
+            (13, Some(m)) => m[2],
+            (12 | 13, None) => profile_bit(texts, b, STATUS_BITS[b as usize]),
+            _ => STATUS_BITS[b as usize],
+        })
+        .chain(ignored.then_some("target ignored"))
 }
 
 /// Statusword meaning: `Operation enabled [ready to switch on, ...]`.
 pub fn describe_statusword(sw: u16, mode: Option<i8>, texts: WordTexts<'_>) -> String {
-    let state = DriveState::from_statusword(sw);
-    let valid = if statusword_is_valid(sw) {
-        ""
-    } else {
-        " (invalid state bits)"
-    };
-    format!(
-        "{}{valid} [{}]",
-        state.text(),
-        statusword_bits(sw, mode, texts).join(", ")
-    )
+    let mut out = String::new();
+    write_statusword(&mut out, sw, mode, texts);
+    out
+}
+
+/// [`describe_statusword`] appended to `out`.
+fn write_statusword(out: &mut String, sw: u16, mode: Option<i8>, texts: WordTexts<'_>) {
+    out.push_str(DriveState::from_statusword(sw).text());
+    if !statusword_is_valid(sw) {
+        out.push_str(" (invalid state bits)");
+    }
+    out.push_str(" [");
+    push_joined(out, statusword_bits(sw, mode, texts));
+    out.push(']');
 }
 
 /// The device control command a controlword encodes (CiA 402 table 29).
@@ -229,33 +235,44 @@ fn control_mode_bits(mode: Option<i8>) -> Option<[&'static str; 4]> {
 /// mode in force; with the mode unknown, a profile text for the value already says what
 /// they do, else the profile's bit names (else `mode bit N`) are shown.
 pub fn describe_controlword(cw: u16, mode: Option<i8>, texts: WordTexts<'_>) -> String {
+    let mut out = String::new();
+    write_controlword(&mut out, cw, mode, texts);
+    out
+}
+
+/// [`describe_controlword`] appended to `out`.
+fn write_controlword(out: &mut String, cw: u16, mode: Option<i8>, texts: WordTexts<'_>) {
     let value_text = texts.and_then(|i| i.values.get(&i64::from(cw)));
     let m = control_mode_bits(mode);
-    let extra: Vec<String> = [4u8, 5, 6, 8, 9]
-        .iter()
+    let extra = [4u8, 5, 6, 8, 9]
+        .into_iter()
         .filter(|b| cw & (1 << *b) != 0)
-        .filter_map(|&b| {
+        .filter_map(|b| {
             let k = match b {
                 4 => 0,
                 5 => 1,
                 6 => 2,
                 9 => 3,
-                _ => return Some("halt".to_string()),
+                _ => return Some("halt"),
             };
             match m {
-                Some(m) => Some(m[k].to_string()),
+                Some(m) => Some(m[k]),
                 None if value_text.is_some() => None,
-                None => Some(profile_bit(texts, b, &format!("mode bit {b}"))),
+                None => Some(profile_bit(texts, b, MODE_BITS[k])),
             }
-        })
-        .collect();
-    let command = value_text.map_or(controlword_command(cw), String::as_str);
-    if extra.is_empty() {
-        command.to_string()
-    } else {
-        format!("{command} [{}]", extra.join(", "))
+        });
+    out.push_str(value_text.map_or(controlword_command(cw), String::as_str));
+    let mut extra = extra.peekable();
+    if extra.peek().is_some() {
+        out.push_str(" [");
+        push_joined(out, extra);
+        out.push(']');
     }
 }
+
+/// `mode bit N` for controlword bits 4, 5, 6 and 9, when neither the mode nor the profile
+/// names them.
+const MODE_BITS: [&str; 4] = ["mode bit 4", "mode bit 5", "mode bit 6", "mode bit 9"];
 
 /// Name of a mode of operation (0x6060 / 0x6061).
 pub fn mode_name(mode: i8) -> &'static str {
@@ -278,30 +295,48 @@ pub fn mode_name(mode: i8) -> &'static str {
 /// CiA 402 meaning of a value of a known object, when it has one; `texts` are the
 /// dictionary's entry for the object (profile value and bit texts).
 pub fn describe(index: u16, sub: u8, raw: i64, mode: Option<i8>, texts: WordTexts<'_>) -> Option<String> {
-    if sub != 0 {
-        return None;
+    let mut out = String::new();
+    write_description(&mut out, index, sub, raw, mode, texts).then_some(out)
+}
+
+/// Whether [`describe`] has a meaning for the object (sub-index 0 of 0x6040, 0x6041,
+/// 0x6060 or 0x6061).
+fn described(index: u16, sub: u8) -> bool {
+    sub == 0 && matches!(index, 0x6040 | 0x6041 | 0x6060 | 0x6061)
+}
+
+/// [`describe`] appended to `out`; false (nothing written) when the object has none.
+fn write_description(out: &mut String, index: u16, sub: u8, raw: i64, mode: Option<i8>, texts: WordTexts<'_>) -> bool {
+    if !described(index, sub) {
+        return false;
     }
     match index {
-        0x6040 => Some(describe_controlword(raw as u16, mode, texts)),
-        0x6041 => Some(describe_statusword(raw as u16, mode, texts)),
-        0x6060 | 0x6061 => Some(
+        0x6040 => write_controlword(out, raw as u16, mode, texts),
+        0x6041 => write_statusword(out, raw as u16, mode, texts),
+        _ => out.push_str(
             texts
                 .and_then(|i| i.values.get(&i64::from(raw as i8)))
-                .cloned()
-                .unwrap_or_else(|| mode_name(raw as i8).to_string()),
+                .map_or(mode_name(raw as i8), String::as_str),
         ),
-        _ => None,
     }
+    true
 }
 
 /// A value of a CiA 402 word as labels show it: `0x0237 (Operation enabled [...])`,
 /// `3 (Profile velocity)`; `None` for other objects.
 pub fn value_text(index: u16, sub: u8, raw: i64, mode: Option<i8>, texts: WordTexts<'_>) -> Option<String> {
-    let meaning = describe(index, sub, raw, mode, texts)?;
-    Some(match index {
-        0x6060 | 0x6061 => format!("{} ({meaning})", raw as i8),
-        _ => format!("0x{:04X} ({meaning})", raw as u16),
-    })
+    if !described(index, sub) {
+        return None;
+    }
+    use std::fmt::Write;
+    let mut out = String::with_capacity(128);
+    let _ = match index {
+        0x6060 | 0x6061 => write!(out, "{} (", raw as i8),
+        _ => write!(out, "0x{:04X} (", raw as u16),
+    };
+    write_description(&mut out, index, sub, raw, mode, texts);
+    out.push(')');
+    Some(out)
 }
 
 #[cfg(test)]
