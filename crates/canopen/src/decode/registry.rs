@@ -40,7 +40,8 @@ pub enum Body {
     Time(time::Time),
     Emcy(emcy::Emcy),
     Pdo(Pdo),
-    Sdo(SdoFrame),
+    /// Boxed: the largest body by far, so that a [`Decoded`] stays small to move.
+    Sdo(Box<SdoFrame>),
     Lss(lss::Lss),
     ErrorFrame {
         class: u32,
@@ -304,6 +305,8 @@ pub struct Decoder {
     seq: u64,
     /// A label buffer handed back by [`Decoder::recycle`], reused for the next PDO or SDO label.
     spare: String,
+    /// An SDO body's box handed back by [`Decoder::recycle`], reused for the next SDO frame.
+    spare_sdo: Option<Box<SdoFrame>>,
 }
 
 impl Decoder {
@@ -327,6 +330,7 @@ impl Decoder {
             completed: Vec::new(),
             seq: 0,
             spare: String::new(),
+            spare_sdo: None,
         }
     }
 
@@ -444,13 +448,27 @@ impl Decoder {
         bus.cobs.route(frame.id, frame.is_ext())
     }
 
-    /// Hands a decoded frame back once it is written, so that its label buffer serves the
-    /// next label (saves an allocation per frame on the hot paths).
+    /// Hands a decoded frame back once it is written, so that its label buffer (and an SDO
+    /// body's box) serves the next frame (saves allocations per frame on the hot paths).
     #[inline]
     pub fn recycle(&mut self, decoded: Decoded) {
         let mut label = decoded.label;
         label.clear();
         self.spare = label;
+        if let Body::Sdo(sdo) = decoded.body {
+            self.spare_sdo = Some(sdo);
+        }
+    }
+
+    /// `sdo` in a box, the one [`Decoder::recycle`] handed back when there is one.
+    fn boxed_sdo(&mut self, sdo: SdoFrame) -> Box<SdoFrame> {
+        match self.spare_sdo.take() {
+            Some(mut spare) => {
+                *spare = sdo;
+                spare
+            }
+            None => Box::new(sdo),
+        }
     }
 
     /// Decodes one frame, updating the bus state.
@@ -518,7 +536,7 @@ impl Decoder {
                         let p = s.malformed();
                         let mut label = std::mem::take(&mut self.spare);
                         s.write_label(&mut label);
-                        (label, Body::Sdo(s), p)
+                        (label, Body::Sdo(self.boxed_sdo(s)), p)
                     }
                 }
             }
