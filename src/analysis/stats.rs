@@ -8,6 +8,7 @@
 //! [`IdStats::stale`] tells when it passed [`STALE_PERIODS`] of its mean periods.
 
 use super::store::{Packed, Store};
+use crate::frame::Frame;
 use crate::output::busload::Bitrate;
 use crate::wire::cache::FiguresCache;
 use std::collections::{BTreeMap, VecDeque};
@@ -85,6 +86,16 @@ impl IdStats {
     }
 }
 
+/// A frame in the window of [`Stats`]: its time, its bits on the bus, its identifier's
+/// entry and its interface.
+#[derive(Clone, Copy, Debug)]
+struct InWindow {
+    ts_ns: u64,
+    bits: u32,
+    entry: u32,
+    iface: u16,
+}
+
 /// Statistics of every identifier plus the bus load.
 pub struct Stats {
     /// Each identifier's index in `entries`, in id order.
@@ -97,9 +108,10 @@ pub struct Stats {
     /// The bits in the window per interface index (the bus load of each bus).
     iface_bits: Vec<u64>,
     window_start: usize,
-    /// The bus bits of the frames in the window (store positions `window_start..`): each
-    /// frame's bits are counted once, as it comes, not again as it leaves.
-    window: VecDeque<u32>,
+    /// The frames in the window (store positions `window_start..`), with what their leaving
+    /// takes back: each frame's bits are counted once, as it comes, not again as it leaves,
+    /// and the store is not read again.
+    window: VecDeque<InWindow>,
     /// The figures of the frames seen, for those that come again.
     figures: FiguresCache,
     now_ns: u64,
@@ -154,8 +166,9 @@ impl Stats {
         &self.bitrate
     }
 
-    /// Adds the frame just stored (the last one in `store`).
-    pub fn add(&mut self, p: &Packed, store: &Store) {
+    /// Adds the frame just stored (the last one in `store`): `frame` as it came, `p` as
+    /// stored.
+    pub fn add(&mut self, p: &Packed, frame: &Frame, store: &Store) {
         let i = self.index(p.is_ext(), p.id);
         let s = &mut self.entries[i];
         if s.count == 0 {
@@ -178,35 +191,40 @@ impl Stats {
         s.last_ns = p.ts_ns;
         s.in_window += 1;
         self.start_ns.get_or_insert(p.ts_ns);
-        let frame = store.frame(store.len() - 1);
-        let bits = self.figures.figures(&frame).map_or(0, |f| u64::from(f.bus_bits()));
-        self.window.push_back(bits as u32);
+        let bits = self.figures.figures(frame).map_or(0, |f| u64::from(f.bus_bits()));
+        self.window.push_back(InWindow {
+            ts_ns: p.ts_ns,
+            bits: bits as u32,
+            entry: i as u32,
+            iface: p.iface,
+        });
         self.window_bits += bits;
         let k = p.iface as usize;
         if self.iface_bits.len() <= k {
             self.iface_bits.resize(k + 1, 0);
         }
         self.iface_bits[k] += bits;
-        self.tick(p.ts_ns, store);
+        self.tick(p.ts_ns);
     }
 
     /// Capture time has reached `now_ns` (a frame's time, or the capture clock when no
     /// frame comes): frames older than the window leave the rates and the bus load.
-    pub fn tick(&mut self, now_ns: u64, store: &Store) {
+    pub fn tick(&mut self, now_ns: u64) {
         self.now_ns = self.now_ns.max(now_ns);
         // The window is (now - 1 s, now]; nothing leaves it in the first second.
         let Some(since) = self.now_ns.checked_sub(WINDOW_NS) else {
             return;
         };
-        while self.window_start < store.len() && store.packed(self.window_start).ts_ns <= since {
-            let old = store.packed(self.window_start);
-            let bits = self.window.pop_front().map_or(0, u64::from);
+        while let Some(&old) = self.window.front()
+            && old.ts_ns <= since
+        {
+            self.window.pop_front();
+            let bits = u64::from(old.bits);
             self.window_bits = self.window_bits.saturating_sub(bits);
-            if let Some(b) = self.iface_bits.get_mut(old.iface as usize) {
+            if let Some(b) = self.iface_bits.get_mut(usize::from(old.iface)) {
                 *b = b.saturating_sub(bits);
             }
-            let i = self.index(old.is_ext(), old.id);
-            let e = &mut self.entries[i];
+            let e = &mut self.entries[old.entry as usize];
             e.in_window = e.in_window.saturating_sub(1);
             self.window_start += 1;
         }
@@ -244,8 +262,8 @@ impl Stats {
     }
 
     /// Frames in the last second of the trace.
-    pub fn window_frames(&self, store: &Store) -> usize {
-        store.len() - self.window_start
+    pub fn window_frames(&self) -> usize {
+        self.window.len()
     }
 
     /// Every identifier: (extended, id) and its statistics, in id order.
@@ -278,7 +296,7 @@ mod tests {
             let mut f = Frame::classic(0x181, &[i as u8; 8]);
             f.ts_ns = t * 1_000_000;
             let at = store.push(&f, Kind::Tpdo, Some(1));
-            st.add(&store.packed(at).clone(), &store);
+            st.add(&store.packed(at).clone(), &store.frame(at), &store);
         }
         let s = *st.iter().next().unwrap().1;
         assert_eq!(s.count, 5);
@@ -314,7 +332,7 @@ mod tests {
             let mut f = Frame::classic(0x181, &[0; 8]);
             (f.iface, f.ts_ns) = (iface, t * 1_000_000);
             let at = store.push(&f, Kind::Tpdo, Some(1));
-            st.add(&store.packed(at).clone(), &store);
+            st.add(&store.packed(at).clone(), &store.frame(at), &store);
         }
         // In the last second (0.5 s to 1.5 s): one frame of can0, none of can1.
         let bits = crate::output::busload::bus_bits(&Frame::classic(0x181, &[0; 8]));
@@ -346,7 +364,7 @@ mod tests {
         ];
         for f in &frames {
             let at = store.push(f, Kind::Other, None);
-            st.add(&store.packed(at).clone(), &store);
+            st.add(&store.packed(at).clone(), &store.frame(at), &store);
         }
         let got: Vec<((bool, u32), u64, usize)> = st.iter().map(|(k, s)| (*k, s.count, s.last_pos)).collect();
         assert_eq!(
@@ -366,7 +384,7 @@ mod tests {
         let mut f = Frame::classic(id, &[0; 8]);
         f.ts_ns = ms * 1_000_000;
         let at = store.push(&f, Kind::Other, None);
-        st.add(&store.packed(at).clone(), store);
+        st.add(&store.packed(at).clone(), &store.frame(at), store);
     }
 
     #[test]
@@ -402,14 +420,14 @@ mod tests {
         assert_eq!(s.count, 21, "the count stays");
         assert_eq!(st.rate(&get(&st, 0x080)), 10.0);
         // No frame at all, only the capture clock: everything ages, the rates fall to 0.
-        st.tick(60_000_000_000, &store);
+        st.tick(60_000_000_000);
         assert_eq!(st.rate(&get(&st, 0x080)), 0.0);
         assert!((get(&st, 0x183).age(st.now_ns()) - 58.0).abs() < 1e-9);
         assert!(get(&st, 0x080).stale(st.now_ns()));
         assert_eq!(st.load_percent(), 0.0);
-        assert_eq!(st.window_frames(&store), 0);
+        assert_eq!(st.window_frames(), 0);
         // A tick back in time (a late one) does not turn the clock back.
-        st.tick(1_000, &store);
+        st.tick(1_000);
         assert_eq!(st.now_ns(), 60_000_000_000);
     }
 

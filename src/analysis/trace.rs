@@ -215,7 +215,7 @@ impl Trace {
                 self.cycles.frame(frame, pos, peeked);
                 self.store.push(frame, kind, node);
                 let p = self.store.packed(pos as usize);
-                self.stats.add(&p, &self.store);
+                self.stats.add(&p, frame, &self.store);
                 if let Some(n) = node {
                     self.nodes.frame(NodeKey::of(frame, n), frame.ts_ns);
                 }
@@ -355,7 +355,7 @@ impl Trace {
         match self.views {
             Views::All => {
                 self.nodes.tick(now_ns);
-                self.stats.tick(now_ns, &self.store);
+                self.stats.tick(now_ns);
                 self.diagnosis.tick(now_ns);
                 self.diagnosis_version += 1;
             }

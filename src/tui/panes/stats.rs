@@ -193,7 +193,7 @@ impl Component for StatsPane {
             " Receive list by {} — bus load {load} at {} kbit/s{assumed}, {} fr in the last 1 s ",
             self.sort.name(),
             rate.bps / 1000,
-            st.window_frames(&ctx.trace.store)
+            st.window_frames()
         );
         f.render_widget(block(&title, focused), area);
         let inner = block("", true).inner(area);
@@ -431,7 +431,7 @@ mod tests {
             let mut f = Frame::classic(id, &[0]);
             f.ts_ns = ms * 1_000_000;
             let at = store.push(&f, Kind::Other, None);
-            st.add(&store.packed(at).clone(), &store);
+            st.add(&store.packed(at).clone(), &store.frame(at), &store);
         };
         for (id, ms) in [(0x701, 0), (0x181, 0), (0x181, 10), (0x181, 20), (0x181, 30)] {
             push(id, ms);
