@@ -302,6 +302,13 @@ impl<'a> Cursor<'a> {
         if !matches!(self.peek()?, b' ' | b'\t') {
             return None;
         }
+        self.rest_of_line()
+    }
+
+    /// Takes the rest of the line, its `\n` included; returns the bytes taken, as
+    /// [`Cursor::line_end`] (`None` when the buffer holds no line end).
+    #[inline(always)]
+    pub(super) fn rest_of_line(&mut self) -> Option<usize> {
         self.at += memchr::memchr(b'\n', self.rest())? + 1;
         Some(self.at)
     }

@@ -394,7 +394,8 @@ impl<R: BufRead> LogReader<R> {
                 Parser::Asc(p) => run.lines(|b, i, f| p.parse_fast(b, i, f)),
                 Parser::Trc(p) => run.lines(|b, i, f| p.parse_fast(b, i, f)),
                 Parser::Csv(p) => run.lines(|b, i, f| p.parse_fast(b, i, f)),
-                Parser::Savvycan(_) | Parser::PeakCsv(_) => 0,
+                Parser::PeakCsv(p) => run.lines(|b, i, f| p.parse_fast(b, i, f)),
+                Parser::Savvycan(_) => 0,
             };
             self.counts.frames += (out.len() - before) as u64;
             self.src.consume(at);
@@ -520,7 +521,8 @@ impl Parser {
             Parser::Asc(p) => p.parse_fast(buf, ifaces, frame),
             Parser::Trc(p) => p.parse_fast(buf, ifaces, frame),
             Parser::Csv(p) => p.parse_fast(buf, ifaces, frame),
-            Parser::Savvycan(_) | Parser::PeakCsv(_) => None,
+            Parser::PeakCsv(p) => p.parse_fast(buf, ifaces, frame),
+            Parser::Savvycan(_) => None,
         }
     }
 

@@ -25,6 +25,9 @@
 //! code in their bytes, `ER` rows bus errors, `EC` rows the error counters (RX, then TX)
 //! with the state they imply; `EV` and other types are skipped as events. The length is
 //! the data length; an FD length 9 to 15 (or 12 with 24 data bytes or more) is a DLC.
+//! `DT` rows in the default column order are read by a fast path (`fast.rs`).
+
+mod fast;
 
 use super::lex::{Channels, dec_u32, err, hex_u32, skip_ws, trim_end};
 use super::trc::{self, Kind};
@@ -326,6 +329,7 @@ pub(crate) fn is_peak_csv(s: &[u8]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::log::{Format, LogReader, Outcome};
 
     fn lines(text: &str) -> (Vec<Result<Line, ParseError>>, Interfaces) {
         let (mut p, mut ifaces) = (Parser::new(), Interfaces::default());
@@ -425,6 +429,30 @@ mod tests {
         assert_eq!(e(5).message, trc::COUNTERS);
         assert_eq!(e(6).message, "PEAK CSV column names without a Time column");
         assert_eq!((e(7).column, e(7).message), (1, "expected a message number"));
+    }
+
+    #[test]
+    fn the_readers_batches_read_as_the_general_parser() {
+        let text = "Number,Time,Bus,Direction,Type,ID,Reserved,Length,D0,D1\n1,0.100,1,Rx,DT,0181,-,2,11,22\n\
+            2,0.200,2,Tx,DT,1ABCDEF0,-,1,AA,\r\n3,0.300,1,Rx,ST,-,-,4,00,04,00,00\n4,0.400,1,Rx,DT,0701,-,1,5\n\
+            5,0.500,3,Rx,DT,0701,-,0,,\n";
+        let (general, _) = lines(text);
+        let want: Vec<Outcome> = general
+            .into_iter()
+            .map(|l| match l {
+                Ok(Line::Frame(f)) => Outcome::Frame(f),
+                Ok(Line::Skip(r)) => Outcome::Skip(r),
+                Err(e) => Outcome::Warning(e.to_string()),
+            })
+            .collect();
+        for cap in [7, 40, 4096] {
+            let src = std::io::BufReader::with_capacity(cap, text.as_bytes());
+            let mut r = LogReader::with_format(src, Format::PeakCsv);
+            let mut got = Vec::new();
+            r.fill(&mut got, 100).unwrap();
+            let got: Vec<_> = got.into_iter().map(|(_, o)| o).collect();
+            assert_eq!(got, want, "capacity {cap}");
+        }
     }
 
     #[test]

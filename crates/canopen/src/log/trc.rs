@@ -410,7 +410,7 @@ pub(super) fn parse_id(f: &mut Frame, at: usize, tok: &[u8]) -> Result<(), Parse
 }
 
 /// Sets the id `id` written with `digits` hex digits; `None` when out of range.
-fn set_id(f: &mut Frame, id: u32, digits: usize) -> Option<()> {
+pub(super) fn set_id(f: &mut Frame, id: u32, digits: usize) -> Option<()> {
     let ext = digits > 4;
     if id > if ext { 0x1FFF_FFFF } else { 0x7FF } {
         return None;
