@@ -279,6 +279,10 @@ const PEAK_CSV_ROWS: [[&str; 8 + 12]; 6] = {
     ]
 };
 
+/// A decoded PEAK CSV row as the test compares it: seconds since the start, interface, id,
+/// `[ext, rtr, fd, err]`, data and direction.
+type PeakRow<'a> = (f64, &'a str, u64, [bool; 4], &'a str, &'a str);
+
 /// PEAK CSV exports decode by content, with `,` (a copied TRC header and a row of column
 /// names) and with `;` (comment lines only, decimal commas): every frame's id, flags, data,
 /// interface, direction and time ($STARTTIME plus the offset, or the offset alone), and
@@ -314,7 +318,7 @@ fn peak_csv_decodes_by_content() {
             .lines()
             .map(|l| serde_json::from_str(l).unwrap())
             .collect();
-        let got: Vec<(f64, &str, u64, [bool; 4], &str, &str)> = lines
+        let got: Vec<PeakRow> = lines
             .iter()
             .map(|l| {
                 let flag = |k: &str| l[k].as_bool().unwrap();
