@@ -260,12 +260,12 @@ impl<'a> Cursor<'a> {
 
     /// The last step of a frame line whose data bytes are spaced hex pairs (ASC, TRC): takes
     /// `f.len` bytes into `f` and the line end or tail (as [`Cursor::line_end_or_tail`]), puts
-    /// `f` on the interface of numbered channel `channel` at `ts_ns` and stores it in
+    /// `f` on the interface of numbered channel `channel` at `ts_ns` and copies it to
     /// `frame`; returns the bytes taken, the line end included.
     #[inline(always)]
     pub(super) fn spaced_frame_end(
         &mut self,
-        mut f: Frame,
+        f: &mut Frame,
         (channels, channel): (&mut Channels, u32),
         ts_ns: u64,
         ifaces: &mut Interfaces,
@@ -276,7 +276,7 @@ impl<'a> Cursor<'a> {
         let end = self.line_end_or_tail()?;
         f.iface = channels.get(ifaces, channel, 0).ok()?;
         f.ts_ns = ts_ns;
-        *frame = f;
+        *frame = *f;
         Some(end)
     }
 

@@ -51,6 +51,6 @@ impl Parser {
         f.flags.set(Flags::EXT, ext);
         f.flags.set(Flags::TX, tx);
         let ts_ns = self.start_ns.saturating_add(ts);
-        c.spaced_frame_end(f, (&mut self.channels, channel), ts_ns, ifaces, frame)
+        c.spaced_frame_end(&mut f, (&mut self.channels, channel), ts_ns, ifaces, frame)
     }
 }

@@ -60,6 +60,6 @@ impl Parser {
         set_id(&mut f, raw, digits)?;
         set_length(&mut f, [fd, brs, esi, rtr], dlc, len, 0).ok()?;
         let ts_ns = self.start_ns.saturating_add(offset);
-        c.spaced_frame_end(f, (&mut self.channels, bus), ts_ns, ifaces, frame)
+        c.spaced_frame_end(&mut f, (&mut self.channels, bus), ts_ns, ifaces, frame)
     }
 }
