@@ -19,7 +19,8 @@
 //! header: `;` lines (`$STARTTIME` read, the rest skipped), other text skipped as comments,
 //! and a row of column names (`Number,Time,Bus,...`, any case) that places the columns.
 //!
-//! Rows read as TRC 2.x lines read (see [`super::trc`]): bus N is interface `can{N-1}`; ids
+//! Rows read as TRC 2.x lines read (see [`super::trc`]): bus N is interface `can{N-1}` (no
+//! bus: `can0`); ids
 //! of more than 4 digits are 29-bit; `FD`, `FB` (BRS), `FE` (ESI), `BI` (BRS and ESI) are
 //! CAN FD frames, `RR` remote frames; `ST` rows are controller states from the PCAN status
 //! code in their bytes, `ER` rows bus errors, `EC` rows the error counters (RX, then TX)
@@ -234,24 +235,26 @@ fn split<'a, 'b>(s: &'a [u8], delim: u8, out: &'b mut Fields<'a>) -> &'b [(usize
 }
 
 /// The columns a row of names places, when `fields` is one (it names a type and an id
-/// column); an error (index, message) when it lacks a column rows need.
+/// column, each cell a name alone or with a unit: `Time [ms]`); an error (index, message)
+/// when it lacks a column rows need.
 fn names(fields: &[(usize, &[u8])]) -> Option<Result<Columns, (usize, &'static str)>> {
+    // A name, maybe with a unit after it (`Time [ms]`), lower-cased; `None` for other text.
     let word = |t: &[u8]| {
         let end = t
             .iter()
             .position(|&b| matches!(b, b' ' | b'[' | b'('))
             .unwrap_or(t.len());
+        let unit = &t[skip_ws(t, end)..];
         let mut w = [0u8; 12];
         let n = end.min(w.len());
         w[..n].copy_from_slice(&t[..n]);
         w.make_ascii_lowercase();
-        (w, n)
+        (unit.is_empty() || unit[0] == b'[' || unit[0] == b'(').then_some((w, n))
     };
     let find = |names: &[&[u8]]| {
-        fields.iter().position(|&(_, t)| {
-            let (w, n) = word(t);
-            names.contains(&&w[..n])
-        })
+        fields
+            .iter()
+            .position(|&(_, t)| word(t).is_some_and(|(w, n)| names.contains(&&w[..n])))
     };
     let (kind, id) = (find(&[b"type"])?, find(&[b"id"])?);
     let at = fields[0].0;
@@ -397,9 +400,15 @@ mod tests {
 
     #[test]
     fn semicolons_tabs_quotes_and_named_columns() {
-        let (got, _) = lines("; PEAK-Converter\n1;1841,300;1;Rx;DT;0181;-;1;05;;\n");
+        let (got, _) =
+            lines("; PEAK-Converter\nType of export: CSV, ID in hex, Time in ms\n1;1841,300;1;Rx;DT;0181;-;1;05;;\n");
         assert_eq!(got[0], Ok(Line::Skip(SkipReason::Comment)));
-        assert_eq!((frame(&got[1]).ts_ns, frame(&got[1]).data[0]), (1_841_300_000, 5));
+        assert_eq!(
+            got[1],
+            Ok(Line::Skip(SkipReason::Comment)),
+            "header text, not column names"
+        );
+        assert_eq!((frame(&got[2]).ts_ns, frame(&got[2]).data[0]), (1_841_300_000, 5));
         let (got, _) = lines("1\t2.5\t3\tTx\tDT\t0123\t-\t0\n");
         let f = frame(&got[0]);
         assert_eq!((f.ts_ns, f.flags.0, f.id), (2_500_000, Flags::TX, 0x123));
