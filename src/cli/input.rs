@@ -25,6 +25,8 @@ pub enum InputFormat {
     Csv,
     /// SavvyCAN CSV (`Time Stamp,ID,Extended,Dir,Bus,LEN,D1,...`).
     Savvycan,
+    /// PEAK CSV (PEAK-Converter's CSV of a trace: `Number,Time,Bus,Direction,Type,ID,...`).
+    PeakCsv,
     /// Vector BLF.
     Blf,
     /// ASAM MDF4 bus logging (a file, not stdin).
@@ -41,6 +43,7 @@ impl InputFormat {
             InputFormat::Trc => ReadAs::Text(Format::Trc),
             InputFormat::Csv => ReadAs::Text(Format::Csv),
             InputFormat::Savvycan => ReadAs::Text(Format::Savvycan),
+            InputFormat::PeakCsv => ReadAs::Text(Format::PeakCsv),
             InputFormat::Blf => ReadAs::Binary(Binary::Blf),
             InputFormat::Mf4 => ReadAs::Binary(Binary::Mf4),
         }

@@ -113,6 +113,7 @@ impl<R: BufRead> Reader<R> {
                 Format::Trc => "PEAK TRC",
                 Format::Csv => "python-can CSV",
                 Format::Savvycan => "SavvyCAN CSV",
+                Format::PeakCsv => "PEAK CSV",
             }),
             Reader::Blf(_) => "Vector BLF",
             Reader::Mf4(_) => "ASAM MDF4",

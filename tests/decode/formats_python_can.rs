@@ -152,6 +152,45 @@ fn trc_2_1_and_1_0_from_python_can() {
     assert_frames("TRC 1.0", &got, &want, 1000);
 }
 
+/// python-can's TRC 2.1 (`N,O,T,B,I,d,R,L,D` lines), turned row by row into the PEAK CSV
+/// that PEAK-Converter makes of a trace (its header copied, then `Number, Time, Bus,
+/// Direction, Type, ID, Reserved, Length, D0..`, with `,` or with `;` and decimal commas),
+/// reads as exactly the same frames as the TRC, at the same times.
+#[test]
+fn peak_csv_of_python_cans_trc_reads_as_the_trc() {
+    let trc = python_can_file("p.trc", "can.TRCWriter(path)");
+    let (format, from_trc, t0) = read(&trc);
+    assert_eq!(format, Format::Trc);
+    assert_eq!(
+        from_trc.len(),
+        3,
+        "python-can's TRCWriter leaves out remote, FD and error frames"
+    );
+    for delim in [",", ";"] {
+        let mut csv = String::new();
+        for line in String::from_utf8_lossy(&trc).lines() {
+            if line.starts_with(';') {
+                csv += line;
+            } else {
+                let t: Vec<&str> = line.split_whitespace().collect();
+                let time = if delim == ";" {
+                    t[1].replace('.', ",")
+                } else {
+                    t[1].to_string()
+                };
+                let mut row = vec![t[0], &time, t[3], t[5], t[2], t[4], t[6], t[7]];
+                row.extend(&t[8..]);
+                csv += &row.join(delim);
+            }
+            csv += "\r\n";
+        }
+        let (format, got, csv_t0) = read(csv.as_bytes());
+        assert_eq!(format, Format::PeakCsv, "{csv}");
+        assert_eq!(got, from_trc, "{delim}: {csv}");
+        assert_eq!(csv_t0, t0, "{delim}");
+    }
+}
+
 #[test]
 fn csv_from_python_can() {
     let (format, got, t0) = read(&python_can_file("x.csv", "can.CSVWriter(path)"));

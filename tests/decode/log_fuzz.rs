@@ -3,7 +3,7 @@
 
 use cotui::frame::{Flags, Frame, Interfaces};
 use cotui::log::writer::{LogWriter, Timestamps};
-use cotui::log::{Format, Line, LogReader, asc, candump, csv, savvycan, screen, trc};
+use cotui::log::{Format, Line, LogReader, asc, candump, csv, peak_csv, savvycan, screen, trc};
 use proptest::prelude::*;
 
 const SAMPLES: &[&str] = &[
@@ -35,6 +35,20 @@ const SAMPLES: &[&str] = &[
     ";$COLUMNS=N,O,T,B,I,d,R,L,D",
     "1700000000.123456,0x181,0,0,0,2,ESI=",
     "2.5,0x7ff,0,0,0,12,AAECAwQFBgcICQoL",
+    "1,1841.300,1,Rx,DT,0181,-,2,11,22,,",
+    "2;0,200;2;Tx;FB;18FF0102;-;12;00;01;02;03;04;05;06;07;08;09;0A;0B",
+    "3\t0.300\t1\tRx\tRR\t0701\t-\t1",
+    "4,100.000,1,Rx,ST,-,-,4,00,04,00,00",
+    "6,0.600,1,Rx,EC,-,-,2,02,81",
+    "\"Number\",\"Time\",\"Bus\",\"Direction\",\"Type\",\"ID\",\"Reserved\",\"Length\",\"D0\"",
+    "      7       0.700 EC  1         - Rx -  2    02 81",
+];
+
+/// PEAK CSV lines that set a parser's delimiter and columns before the line under test.
+const PEAK_CSV_HEADERS: &[&str] = &[
+    "Number;Time;Bus;Direction;Type;ID;Reserved;Length;D0",
+    "type,id,time,len,d0",
+    "1\t0.1\t1\tRx\tDT\t0701\t-\t0",
 ];
 
 /// TRC header lines that put a parser in each version's layout.
@@ -66,6 +80,12 @@ fn parse_all(line: &[u8]) {
         "Time Stamp,ID,Extended,Bus,LEN,D1",
     ] {
         let mut p = savvycan::Parser::new();
+        let _ = p.parse_line(header.as_bytes(), &mut ifaces);
+        let _ = p.parse_line(line, &mut ifaces);
+    }
+    let _ = peak_csv::Parser::new().parse_line(line, &mut ifaces);
+    for header in PEAK_CSV_HEADERS {
+        let mut p = peak_csv::Parser::new();
         let _ = p.parse_line(header.as_bytes(), &mut ifaces);
         let _ = p.parse_line(line, &mut ifaces);
     }
@@ -177,7 +197,7 @@ proptest! {
     #[test]
     fn arbitrary_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..200)) {
         parse_all(&bytes);
-        for format in [Format::Candump, Format::Screen, Format::Asc, Format::Trc, Format::Csv, Format::Savvycan] {
+        for format in [Format::Candump, Format::Screen, Format::Asc, Format::Trc, Format::Csv, Format::Savvycan, Format::PeakCsv] {
             let reader = LogReader::with_format(&bytes[..], format);
             for item in reader {
                 item.unwrap();
@@ -201,6 +221,60 @@ proptest! {
             let back = candump::parse_line(out.as_bytes(), &mut again);
             prop_assert_eq!(back, Ok(Line::Frame(Frame { iface: 0, ..f })), "{}", out);
         }
+    }
+
+    #[test]
+    fn peak_csv_rows_read_back_their_frames(
+        f in frame(),
+        ms in 0u64..10_000_000_000,
+        micros in 0u64..1000,
+        delim in prop::sample::select(vec![",", ";", "\t"]),
+        comma in any::<bool>(),
+        bus in 1u32..20,
+        tx: bool,
+    ) {
+        // What a PEAK CSV row holds: no error frames (read as data frames here), FD lengths
+        // a DLC gives, FDF always set with FD.
+        let mut f = f;
+        f.flags.set(Flags::ERR, false);
+        let fd = f.flags.0 & Flags::FD != 0;
+        if fd {
+            let len = [0u8, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64].into_iter().rfind(|&l| l <= f.len).unwrap_or(0);
+            f.len = len;
+            f.data[len as usize..].fill(0);
+        } else if !f.is_ext() {
+            f.id &= 0x7FF;
+        }
+        let mut want = f;
+        want.flags.set(Flags::FDF, fd);
+        want.flags.set(Flags::TX, tx);
+        want.ts_ns = ms * 1_000_000 + micros * 1000;
+        let kind = match (fd, want.flags.0 & Flags::BRS != 0, want.flags.0 & Flags::ESI != 0) {
+            (false, ..) if f.is_rtr() => "RR",
+            (false, ..) => "DT",
+            (true, false, false) => "FD",
+            (true, true, false) => "FB",
+            (true, false, true) => "FE",
+            (true, true, true) => "BI",
+        };
+        let id = if f.is_ext() { format!("{:08X}", f.id) } else { format!("{:04X}", f.id) };
+        let length = if f.raw_dlc > 8 { f.raw_dlc } else { f.len };
+        let mut time = format!("{ms}.{micros:03}");
+        if comma && delim != "," {
+            time = time.replace('.', ",");
+        }
+        let mut cells = vec![
+            "7".to_string(), time, bus.to_string(), if tx { "Tx" } else { "Rx" }.to_string(),
+            kind.to_string(), id, "-".to_string(), length.to_string(),
+        ];
+        if !f.is_rtr() {
+            cells.extend(f.payload().iter().map(|b| format!("{b:02X}")));
+        }
+        let row = cells.join(delim);
+        let mut ifaces = Interfaces::default();
+        let got = peak_csv::Parser::new().parse_line(row.as_bytes(), &mut ifaces);
+        prop_assert_eq!(got, Ok(Line::Frame(want)), "{}", row);
+        prop_assert_eq!(ifaces.name(0), format!("can{}", bus - 1));
     }
 
     #[test]

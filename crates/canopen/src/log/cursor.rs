@@ -4,9 +4,9 @@
 //! have another shape, or the buffer ends first) and the fast path leaves the line to the
 //! general parser.
 
-use super::lex::{FRACTION_NS, HEX, IfaceCache};
+use super::lex::{Channels, FRACTION_NS, HEX, IfaceCache};
 use crate::frame::linux::CAN_ERR_FLAG;
-use crate::frame::{Flags, Interfaces};
+use crate::frame::{Flags, Frame, Interfaces};
 
 /// A read position in a buffer that holds a line (and maybe more after it).
 #[derive(Clone, Copy, Debug)]
@@ -258,6 +258,28 @@ impl<'a> Cursor<'a> {
         Some(())
     }
 
+    /// The last step of a frame line whose data bytes are spaced hex pairs (ASC, TRC): takes
+    /// `f.len` bytes into `f` and the line end or tail (as [`Cursor::line_end_or_tail`]), puts
+    /// `f` on the interface of numbered channel `channel` at `ts_ns` and copies it to
+    /// `frame`; returns the bytes taken, the line end included.
+    #[inline(always)]
+    pub(super) fn spaced_frame_end(
+        &mut self,
+        f: &mut Frame,
+        (channels, channel): (&mut Channels, u32),
+        ts_ns: u64,
+        ifaces: &mut Interfaces,
+        frame: &mut Frame,
+    ) -> Option<usize> {
+        let n = f.len as usize;
+        self.spaced_bytes(&mut f.data[..n])?;
+        let end = self.line_end_or_tail()?;
+        f.iface = channels.get(ifaces, channel, 0).ok()?;
+        f.ts_ns = ts_ns;
+        *frame = *f;
+        Some(end)
+    }
+
     /// Takes the line end (`\n` or `\r\n`); returns the bytes taken so far, the line end
     /// included.
     #[inline(always)]
@@ -280,6 +302,13 @@ impl<'a> Cursor<'a> {
         if !matches!(self.peek()?, b' ' | b'\t') {
             return None;
         }
+        self.rest_of_line()
+    }
+
+    /// Takes the rest of the line, its `\n` included; returns the bytes taken, as
+    /// [`Cursor::line_end`] (`None` when the buffer holds no line end).
+    #[inline(always)]
+    pub(super) fn rest_of_line(&mut self) -> Option<usize> {
         self.at += memchr::memchr(b'\n', self.rest())? + 1;
         Some(self.at)
     }

@@ -3,7 +3,7 @@
 //! frame (and the bytes) the general parser reads, in the same parser state (property
 //! tests, one a format).
 
-use super::{Line, ParseError, asc, candump, csv, screen, trc};
+use super::{Line, ParseError, asc, candump, csv, peak_csv, screen, trc};
 use crate::frame::FD_LENS;
 use crate::frame::{Frame, Interfaces};
 use proptest::prelude::*;
@@ -30,7 +30,14 @@ macro_rules! fast_and_general {
     )*};
 }
 
-fast_and_general!(candump::Parser, screen::Parser, asc::Parser, trc::Parser, csv::Parser);
+fast_and_general!(
+    candump::Parser,
+    screen::Parser,
+    asc::Parser,
+    trc::Parser,
+    csv::Parser,
+    peak_csv::Parser
+);
 
 /// Bytes the mutations put into lines: blanks, line ends, digits, letters and signs.
 const NOISE: &[u8] = b" \t\r\n09aAfFgGxX.,;#()[]-=+/rdRT\xFF";
@@ -288,5 +295,45 @@ proptest! {
             let must = muts.is_empty() && fits && flags.join(",") == "0,0,0"
                 && v <= 0x7FF && data.len() <= 8 && dlc_off == 0;
             agree(csv::Parser::new, &mutate(&line, &muts), b"1700000000.000002,0x124,0,0,0,1,Ig==\n", must)?;
+        }
+        #[test]
+        fn peak_csv_rows_read_as_the_general_parser_reads_them(
+            first in prop::sample::select(vec!["names", "row", "none", "other names"]),
+            delim in prop::sample::select(vec![",", ";", "\t"]),
+            number in 0u32..10_000_000,
+            (ts, fits) in times(),
+            bus in 0u32..70,
+            dir in prop::sample::select(vec!["Rx", "Tx"]),
+            kind in prop::sample::select(vec!["DT", "DT", "FD", "RR", "ST"]),
+            id in any::<u32>(),
+            wide in any::<bool>(),
+            len in 0usize..16,
+            data in prop::collection::vec(any::<u8>(), 8),
+            short in any::<bool>(),
+            trailing in 0usize..4,
+            crlf in any::<bool>(),
+            muts in mutations(),
+        ) {
+            let d = delim;
+            let v = if wide { id & 0x3FFF_FFFF } else { id % 0x900 };
+            let n = len.min(8) - usize::from(short && len > 0);
+            let mut cells = vec![
+                number.to_string(), ts.clone(), bus.to_string(), dir.to_string(), kind.to_string(),
+                hex(v, if wide { 8 } else { 4 }), "-".to_string(), len.to_string(),
+            ];
+            cells.extend(data[..n].iter().map(|b| format!("{b:02X}")));
+            cells.extend(std::iter::repeat_n(String::new(), trailing));
+            let line = format!("{}{}\n", cells.join(d), if crlf { "\r" } else { "" });
+            let header = match first {
+                "names" => ["Number", "Time", "Bus", "Direction", "Type", "ID", "Reserved", "Length", "D0"].join(d),
+                "row" => ["1", "0.1", "1", "Rx", "DT", "0701", "-", "0"].join(d),
+                "other names" => ["Time", "Type", "ID", "Length", "D0"].join(d),
+                _ => String::new(),
+            };
+            let must = muts.is_empty() && matches!(first, "names" | "row") && kind == "DT" && fits
+                && !(short && len > 0) && v <= if wide { 0x1FFF_FFFF } else { 0x7FF };
+            let next = format!("{}\n", ["9", "1.000", "1", "Rx", "DT", "0124", "-", "1", "22"].join(d));
+            let make = || after(peak_csv::Parser::new(), &[header.as_str()]);
+            agree(make, &mutate(&line, &muts), next.as_bytes(), must)?;
         }
 }

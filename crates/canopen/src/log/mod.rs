@@ -1,5 +1,5 @@
-//! Log formats: candump `-l` logs, candump's screen output, Vector ASC, PEAK TRC,
-//! python-can CSV and SavvyCAN CSV, plus a candump log writer; [`blf`] and [`mf4`] hold the byte-level halves
+//! Log formats: candump `-l` logs, candump's screen output, Vector ASC, PEAK TRC and PEAK
+//! CSV, python-can CSV and SavvyCAN CSV, plus a candump log writer; [`blf`] and [`mf4`] hold the byte-level halves
 //! of Vector BLF and ASAM MDF4 bus logging (their file IO and zlib live in cotui's `logio`).
 //!
 //! Each format has a line parser (`parse_line(&mut self, &[u8], &mut Interfaces)`) that
@@ -18,6 +18,7 @@ pub mod export;
 mod fast_check;
 mod lex;
 pub mod mf4;
+pub mod peak_csv;
 pub mod savvycan;
 pub mod screen;
 mod status;
@@ -44,6 +45,8 @@ pub enum Format {
     Csv,
     /// SavvyCAN CSV: `166064000,00000181,false,Rx,0,2,11,22,`.
     Savvycan,
+    /// PEAK CSV (PEAK-Converter's export of a trace): `1,1841.300,1,Rx,DT,0181,-,2,11,22`.
+    PeakCsv,
 }
 
 /// Why a line was not a frame.
@@ -167,22 +170,38 @@ impl Counts {
 
 /// Guesses the format from the first non-empty lines of `sample` (e.g. the reader's first
 /// buffer). Comments, `DROPCOUNT` lines and blank lines are passed over; `None` when no
-/// line decides.
+/// line decides. A TRC header (`;$FILEVERSION`, `;$STARTTIME`) is TRC unless the first
+/// line after it is a PEAK CSV row (PEAK-Converter copies the header into its CSV).
 pub(crate) fn detect(sample: &[u8]) -> Option<Format> {
-    sample.split(|&b| b == b'\n').take(64).find_map(detect_line)
+    let mut trc_header = false;
+    for line in sample.split(|&b| b == b'\n').take(64) {
+        let s = lex::trim_end(line);
+        if s.starts_with(b";$FILEVERSION") || s.starts_with(b";$STARTTIME") {
+            trc_header = true;
+        } else if trc_header && !s.is_empty() && !s.starts_with(b";") {
+            return Some(if peak_csv::is_peak_csv(s) {
+                Format::PeakCsv
+            } else {
+                Format::Trc
+            });
+        } else if !trc_header && let Some(f) = detect_line(s) {
+            return Some(f);
+        }
+    }
+    trc_header.then_some(Format::Trc)
 }
 
 /// The format one line belongs to, if it tells.
 fn detect_line(line: &[u8]) -> Option<Format> {
     let s = lex::trim_end(line);
-    if s.starts_with(b";$FILEVERSION") || s.starts_with(b";$STARTTIME") {
-        return Some(Format::Trc);
-    }
     if s == csv::HEADER {
         return Some(Format::Csv);
     }
     if s.starts_with(savvycan::HEADER_START) {
         return Some(Format::Savvycan);
+    }
+    if peak_csv::is_peak_csv(s) {
+        return Some(Format::PeakCsv);
     }
     let mut toks = lex::Tokens::new(s, 0);
     let (_, first) = toks.next()?;
@@ -240,6 +259,7 @@ enum Parser {
     Trc(Box<trc::Parser>),
     Csv(csv::Parser),
     Savvycan(savvycan::Parser),
+    PeakCsv(Box<peak_csv::Parser>),
 }
 
 /// The longest line a reader takes: a longer one (e.g. a file with no line ends) is
@@ -281,6 +301,7 @@ impl<R: BufRead> LogReader<R> {
             Format::Trc => Some(trc_label(trc::detect_version(sample))),
             Format::Csv => Some("python-can CSV"),
             Format::Savvycan => Some("SavvyCAN CSV"),
+            Format::PeakCsv => Some("PEAK CSV"),
             _ => None,
         };
         let mut reader = LogReader::with_format(src, format);
@@ -301,6 +322,7 @@ impl<R: BufRead> LogReader<R> {
             Format::Trc => Parser::Trc(Box::default()),
             Format::Csv => Parser::Csv(csv::Parser::new()),
             Format::Savvycan => Parser::Savvycan(savvycan::Parser::new()),
+            Format::PeakCsv => Parser::PeakCsv(Box::default()),
         };
         LogReader {
             src,
@@ -372,6 +394,7 @@ impl<R: BufRead> LogReader<R> {
                 Parser::Asc(p) => run.lines(|b, i, f| p.parse_fast(b, i, f)),
                 Parser::Trc(p) => run.lines(|b, i, f| p.parse_fast(b, i, f)),
                 Parser::Csv(p) => run.lines(|b, i, f| p.parse_fast(b, i, f)),
+                Parser::PeakCsv(p) => run.lines(|b, i, f| p.parse_fast(b, i, f)),
                 Parser::Savvycan(_) => 0,
             };
             self.counts.frames += (out.len() - before) as u64;
@@ -498,6 +521,7 @@ impl Parser {
             Parser::Asc(p) => p.parse_fast(buf, ifaces, frame),
             Parser::Trc(p) => p.parse_fast(buf, ifaces, frame),
             Parser::Csv(p) => p.parse_fast(buf, ifaces, frame),
+            Parser::PeakCsv(p) => p.parse_fast(buf, ifaces, frame),
             Parser::Savvycan(_) => None,
         }
     }
@@ -507,7 +531,7 @@ impl Parser {
         match self {
             Parser::Candump(p) => p.ignored_tail(),
             Parser::Screen(p) => p.ignored_tail(),
-            Parser::Asc(_) | Parser::Trc(_) | Parser::Csv(_) | Parser::Savvycan(_) => false,
+            Parser::Asc(_) | Parser::Trc(_) | Parser::Csv(_) | Parser::Savvycan(_) | Parser::PeakCsv(_) => false,
         }
     }
 }
@@ -526,6 +550,7 @@ fn parse(
         Parser::Trc(p) => into(p.parse_line(line, ifaces), frame),
         Parser::Csv(p) => into(p.parse_line(line, ifaces), frame),
         Parser::Savvycan(p) => into(p.parse_line(line, ifaces), frame),
+        Parser::PeakCsv(p) => into(p.parse_line(line, ifaces), frame),
     }
 }
 
@@ -586,6 +611,26 @@ mod tests {
         assert_eq!(
             detect(b"Time Stamp,ID,Extended,Dir,Bus,LEN,D1,D2,D3,D4,D5,D6,D7,D8\n"),
             Some(Format::Savvycan)
+        );
+        // PEAK CSV: its rows, its column names, or rows under a copied TRC header.
+        assert_eq!(
+            detect(b"; PEAK-Converter\n1,1841.300,1,Rx,DT,0181,-,2,11,22\n"),
+            Some(Format::PeakCsv)
+        );
+        assert_eq!(
+            detect(
+                b";$FILEVERSION=2.1\n;$STARTTIME=45244.5\n;\nNumber;Time;Bus;Direction;Type;ID;Reserved;Length;D0\n"
+            ),
+            Some(Format::PeakCsv)
+        );
+        assert_eq!(
+            detect(b";$FILEVERSION=2.1\n;$STARTTIME=45244.5\n      1         0.100 DT  1      0181 Rx -  2    11 22\n"),
+            Some(Format::Trc)
+        );
+        assert_eq!(
+            detect(b";$FILEVERSION=2.1\n;$COLUMNS=O,T,B,I,d,R,L,D\n         0.100 DT  1      0181 Rx -  2    11 22\n"),
+            Some(Format::Trc),
+            "not ASC though the line starts with a time"
         );
         assert_eq!(detect(b"hello\n\n"), None);
     }

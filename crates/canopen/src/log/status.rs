@@ -1,6 +1,6 @@
 //! The SocketCAN error frames (linux/can/error.h) that stand for the controller states and
-//! bus errors other log formats write as text (ASC status lines, TRC status and error
-//! lines), so that they take the path of candump error frames.
+//! bus errors other log formats write as text (ASC status lines, TRC and PEAK CSV status,
+//! error and error counter lines), so that they take the path of candump error frames.
 
 use crate::frame::{Flags, Frame};
 
@@ -43,6 +43,18 @@ pub(crate) fn state_frame(state: State, counters: Option<(u32, u32)>) -> Frame {
         f.data[7] = rx.min(255) as u8;
     }
     f
+}
+
+/// The error frame of an error counter report (TRC `EC` lines): `CAN_ERR_CNT` with both
+/// counters and the state they imply, as a SocketCAN controller reports it: error passive
+/// from 128, error warning from 96, else error active.
+pub(crate) fn counters_frame(tx: u32, rx: u32) -> Frame {
+    let state = match tx.max(rx) {
+        128.. => State::Passive,
+        96.. => State::Warning,
+        _ => State::Active,
+    };
+    state_frame(state, Some((tx, rx)))
 }
 
 /// A bus error with no detail (ASC `ErrorFrame`): `CAN_ERR_BUSERROR`, 8 zero bytes.

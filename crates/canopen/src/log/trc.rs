@@ -10,6 +10,7 @@
 //!       3         0.300 RR  1      0701 Rx -  1
 //!       4         0.400 ST  1           Rx    00 00 00 08
 //!       5         0.500 ER  1           Rx    04 00 02 00 00
+//!       6         0.600 EC  1           Rx    02 81
 //! ```
 //! Header lines start with `;`: `$FILEVERSION` picks the line layout (none: 1.0),
 //! `$STARTTIME` (days since 1899-12-30, as UTC) is added to every message's time offset
@@ -25,8 +26,9 @@
 //! `FFFFFFFF`, 2.x `ST`) are controller states from the PCAN status code in the last four
 //! bytes (`BUSOFF` 0x10, `BUSPASSIVE` 0x40000, `BUSHEAVY` 0x08 and `BUSLIGHT` 0x04 warning
 //! level, 0 error active); error lines (1.0 `ERROR` in place of the data, 1.1 to 1.3 `Error`,
-//! 2.x `ER`) are bus errors. Other
-//! events (`EC`, `EV`, ...) are skipped.
+//! 2.x `ER`) are bus errors; error counter lines (2.x `EC`: the RX error counter, then the TX
+//! one) are the counters with the state they imply (error passive from 128, warning from 96).
+//! Other events (`EV` user text, ...) are skipped.
 
 mod fast;
 
@@ -94,7 +96,7 @@ impl Default for Parser {
 }
 
 /// What the type of a line makes of it.
-enum Kind {
+pub(super) enum Kind {
     Frame {
         fd: bool,
         brs: bool,
@@ -104,6 +106,7 @@ enum Kind {
     },
     Status,
     Error,
+    Counters,
     Other,
 }
 
@@ -138,15 +141,10 @@ impl Parser {
 
     /// A `;` line: `$FILEVERSION`, `$STARTTIME` and `$COLUMNS` are read, others are comments.
     fn header_line(&mut self, text: &[u8]) -> SkipReason {
-        let Some((key, value)) = text
-            .iter()
-            .position(|&b| b == b'=')
-            .map(|i| (&text[..i], &text[i + 1..]))
-        else {
+        let Some((key, value)) = header_entry(text) else {
             return SkipReason::Comment;
         };
-        let value = lex::trim_end(&value[lex::skip_ws(value, 0)..]);
-        match trim_end(key) {
+        match key {
             b"$FILEVERSION" => {
                 self.version = match value {
                     b"1.1" => Version::V1_1,
@@ -227,9 +225,9 @@ impl Parser {
                 }
                 f
             }
-            Kind::Status => status_frame(&mut toks),
+            Kind::Status => status_frame(hex_pairs(&mut toks).0),
             Kind::Error => status::protocol_error(),
-            Kind::Other => return Ok((None, bus)),
+            Kind::Counters | Kind::Other => return Ok((None, bus)),
         };
         Ok((Some((f, offset)), bus))
     }
@@ -258,8 +256,9 @@ impl Parser {
                         bus = toks.next().and_then(|(b_at, b)| dec_u32(b).map(|n| (n, b_at))).or(bus);
                     }
                     let f = match k {
-                        Kind::Status => status_frame(&mut toks),
+                        Kind::Status => status_frame(hex_pairs(&mut toks).0),
                         Kind::Error => status::protocol_error(),
+                        Kind::Counters => counters_frame(hex_pairs(&mut toks)).ok_or_else(|| err(end, COUNTERS))?,
                         _ => return Ok((None, bus)),
                     };
                     return Ok((Some((f, offset)), bus));
@@ -305,10 +304,18 @@ impl Parser {
     }
 }
 
+/// The key and value of a `;` header line's text (`$STARTTIME=45244.5`), both trimmed;
+/// `None` without a `=`.
+pub(super) fn header_entry(text: &[u8]) -> Option<(&[u8], &[u8])> {
+    let i = text.iter().position(|&b| b == b'=')?;
+    let value = &text[i + 1..];
+    Some((trim_end(&text[..i]), trim_end(&value[lex::skip_ws(value, 0)..])))
+}
+
 /// Sets the length (and the FD flags) of a 2.x frame of type flags `[fd, brs, esi, rtr]`
 /// from its `L` column (a DLC) or else its `l` column (a length), each with its index;
 /// `end` is the line's length.
-fn set_length(
+pub(super) fn set_length(
     f: &mut Frame,
     [fd, brs, esi, rtr]: [bool; 4],
     dlc: Option<(u32, usize)>,
@@ -363,7 +370,8 @@ fn v1_kind(t: &[u8]) -> Kind {
     }
 }
 
-fn v2_kind(t: &[u8]) -> Kind {
+/// What a 2.x message type (`DT`, `FB`, `ST`, ...) makes of a line.
+pub(super) fn v2_kind(t: &[u8]) -> Kind {
     let frame = |fd, brs, esi, rtr| Kind::Frame {
         fd,
         brs,
@@ -380,12 +388,13 @@ fn v2_kind(t: &[u8]) -> Kind {
         b"BI" => frame(true, true, true, false),
         b"ST" => Kind::Status,
         b"ER" => Kind::Error,
+        b"EC" => Kind::Counters,
         _ => Kind::Other,
     }
 }
 
 /// A time offset in milliseconds (`1059.900`) as nanoseconds.
-fn offset_ns(tok: Option<(usize, &[u8])>, end: usize) -> Result<u64, ParseError> {
+pub(super) fn offset_ns(tok: Option<(usize, &[u8])>, end: usize) -> Result<u64, ParseError> {
     let (at, t) = tok.ok_or_else(|| err(end, "expected a time offset (ms)"))?;
     let (v, stop) = lex::timestamp(t, 0).map_err(|e| err(at + e.column - 1, e.message))?;
     if stop != t.len() {
@@ -395,13 +404,13 @@ fn offset_ns(tok: Option<(usize, &[u8])>, end: usize) -> Result<u64, ParseError>
 }
 
 /// An id: more than 4 hex digits is a 29-bit id.
-fn parse_id(f: &mut Frame, at: usize, tok: &[u8]) -> Result<(), ParseError> {
+pub(super) fn parse_id(f: &mut Frame, at: usize, tok: &[u8]) -> Result<(), ParseError> {
     let id = hex_u32(tok).ok_or_else(|| err(at, "expected a CAN id in hex"))?;
     set_id(f, id, tok.len()).ok_or_else(|| err(at, "CAN id out of range"))
 }
 
 /// Sets the id `id` written with `digits` hex digits; `None` when out of range.
-fn set_id(f: &mut Frame, id: u32, digits: usize) -> Option<()> {
+pub(super) fn set_id(f: &mut Frame, id: u32, digits: usize) -> Option<()> {
     let ext = digits > 4;
     if id > if ext { 0x1FFF_FFFF } else { 0x7FF } {
         return None;
@@ -437,15 +446,31 @@ fn data(f: &mut Frame, toks: &mut Tokens<'_>, end: usize) -> Result<(), ParseErr
     Ok(())
 }
 
-/// The controller state of a status line: the PCAN status code in its last four byte
-/// tokens (`00 00 00 08 BUSHEAVY`: a trailing name is read past).
-fn status_frame(toks: &mut Tokens<'_>) -> Frame {
-    let mut code = 0u32;
+/// The bytes of a status or counter line: its two-digit hex tokens (`00 00 00 08 BUSHEAVY`:
+/// a trailing name, a `-` or `Rx` column, a one-digit length are read past) as a big-endian
+/// number of their last four, and how many there were.
+pub(super) fn hex_pairs<'a>(toks: impl IntoIterator<Item = (usize, &'a [u8])>) -> (u32, usize) {
+    let (mut code, mut n) = (0u32, 0);
     for (_, t) in toks {
         if let (2, Some(b)) = (t.len(), hex_u32(t)) {
             code = code << 8 | b;
+            n += 1;
         }
     }
+    (code, n)
+}
+
+/// What an `EC` line lacks when it has fewer than two bytes.
+pub(super) const COUNTERS: &str = "expected 2 error counter bytes (RX, TX)";
+
+/// The error frame of an error counter line's bytes `(code, count)` (as [`hex_pairs`] gives
+/// them): the RX counter, then the TX counter; `None` with fewer than two bytes.
+pub(super) fn counters_frame((code, n): (u32, usize)) -> Option<Frame> {
+    (n >= 2).then(|| status::counters_frame(code & 0xFF, code >> 8 & 0xFF))
+}
+
+/// The controller state of a status line's PCAN status code (the line's last four bytes).
+pub(super) fn status_frame(code: u32) -> Frame {
     let state = if code & 0x10 != 0 {
         State::BusOff
     } else if code & 0x4_0000 != 0 {
@@ -460,7 +485,7 @@ fn status_frame(toks: &mut Tokens<'_>) -> Frame {
 
 /// `$STARTTIME`: days (with fraction) since 1899-12-30 as nanoseconds since the Unix
 /// epoch; `None` when malformed or before 1970.
-fn ole_days_to_ns(value: &[u8]) -> Option<u64> {
+pub(super) fn ole_days_to_ns(value: &[u8]) -> Option<u64> {
     const UNIX_DAY: u128 = 25_569;
     const NS_PER_DAY: u128 = 86_400_000_000_000;
     let (int, frac) = match value.iter().position(|&b| b == b'.') {
@@ -543,9 +568,9 @@ mod tests {
     #[test]
     fn version_2_columns_fd_remote_status_and_errors() {
         let (fs, ifaces) = frames(
-            ";$FILEVERSION=2.1\n;$STARTTIME=25570\n;$COLUMNS=N,O,T,B,I,d,R,L,D\n      1         0.100 DT  1      0181 Rx -  2    11 22\n      2         0.200 FB  2  18FF0102 Tx -  9    00 01 02 03 04 05 06 07 08 09 0A 0B\n      3         0.300 RR  1      0701 Rx -  1\n      4         0.400 ST  1           Rx    00 04 00 00\n      5         0.500 ER  1           Rx    04 00 02 00 00\n      6         0.600 EV  1  some event\n",
+            ";$FILEVERSION=2.1\n;$STARTTIME=25570\n;$COLUMNS=N,O,T,B,I,d,R,L,D\n      1         0.100 DT  1      0181 Rx -  2    11 22\n      2         0.200 FB  2  18FF0102 Tx -  9    00 01 02 03 04 05 06 07 08 09 0A 0B\n      3         0.300 RR  1      0701 Rx -  1\n      4         0.400 ST  1           Rx    00 04 00 00\n      5         0.500 ER  1           Rx    04 00 02 00 00\n      6         0.600 EV  1  some event\n      7         0.700 EC  1         - Rx -  2    02 81\n      8         0.800 EC  2         - Rx -  2    61 05\n      9         0.900 EC  1         - Rx -  2    00 00\n",
         );
-        assert_eq!(fs.len(), 5);
+        assert_eq!(fs.len(), 8, "EV skipped, EC read");
         assert_eq!(
             (fs[0].ts_ns, fs[0].id, fs[0].payload()),
             (86_400_000_100_000, 0x181, &[0x11, 0x22][..])
@@ -562,6 +587,18 @@ mod tests {
         assert_eq!((fs[2].flags.0, fs[2].len), (Flags::RTR, 1));
         assert_eq!((fs[3].id, fs[3].data[1]), (0x004, 0x20), "BUSPASSIVE");
         assert_eq!(fs[4].id, 0x88);
+        // EC: RX counter 2, TX 0x81 = 129: error passive on the TX side, with the counters
+        // (CAN_ERR_CRTL | CAN_ERR_CNT, data[6] TX, data[7] RX).
+        assert_eq!(
+            (fs[5].id, fs[5].data[1], fs[5].data[6], fs[5].data[7], fs[5].ts_ns),
+            (0x204, 0x20, 0x81, 0x02, 86_400_000_700_000)
+        );
+        assert_eq!(
+            (ifaces.name(fs[6].iface), fs[6].data[1], fs[6].data[6], fs[6].data[7]),
+            ("can1", 0x04, 5, 97),
+            "RX 97: RX warning"
+        );
+        assert_eq!((fs[7].id, fs[7].data[1]), (0x204, 0x40), "both 0: error active");
         // 2.0 with a length column.
         let (fs, _) = frames(
             ";$FILEVERSION=2.0\n;$COLUMNS=N,O,T,I,d,l,D\n      1      1054.310 FE     0300 Rx 12 11 22 33 44 55 66 77 88 99 AA BB CC\n",
@@ -581,6 +618,10 @@ mod tests {
         assert_eq!(e("     1)      18x1  0001    0").column, 16);
         assert_eq!(e("     1)      1841  0801    0").message, "CAN id out of range");
         assert_eq!(e("     1      1841  0001    0").column, 6);
+        let mut p2 = Parser::new();
+        p2.parse_line(b";$FILEVERSION=2.1", &mut ifaces).unwrap();
+        let ec = p2.parse_line(b"      1         0.700 EC  1         - Rx -  1    02", &mut ifaces);
+        assert_eq!(ec, Err(err(51, COUNTERS)));
         assert_eq!(ole_days_to_ns(b"45244.5"), Some(1_699_963_200_000_000_000));
         assert_eq!(ole_days_to_ns(b"100"), None);
     }

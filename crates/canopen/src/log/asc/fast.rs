@@ -50,12 +50,7 @@ impl Parser {
         };
         f.flags.set(Flags::EXT, ext);
         f.flags.set(Flags::TX, tx);
-        let n = f.len as usize;
-        c.spaced_bytes(&mut f.data[..n])?;
-        let end = c.line_end_or_tail()?;
-        f.iface = self.channels.get(ifaces, channel, 0).ok()?;
-        f.ts_ns = self.start_ns.saturating_add(ts);
-        *frame = f;
-        Some(end)
+        let ts_ns = self.start_ns.saturating_add(ts);
+        c.spaced_frame_end(&mut f, (&mut self.channels, channel), ts_ns, ifaces, frame)
     }
 }

@@ -59,12 +59,7 @@ impl Parser {
         let (raw, digits) = id?;
         set_id(&mut f, raw, digits)?;
         set_length(&mut f, [fd, brs, esi, rtr], dlc, len, 0).ok()?;
-        let n = f.len as usize;
-        c.spaced_bytes(&mut f.data[..n])?;
-        let end = c.line_end_or_tail()?;
-        f.iface = self.channels.get(ifaces, bus, 0).ok()?;
-        f.ts_ns = self.start_ns.saturating_add(offset);
-        *frame = f;
-        Some(end)
+        let ts_ns = self.start_ns.saturating_add(offset);
+        c.spaced_frame_end(&mut f, (&mut self.channels, bus), ts_ns, ifaces, frame)
     }
 }
