@@ -7,7 +7,6 @@
 //! second; its age (time since its last frame) grows with later frames and ticks, and
 //! [`IdStats::stale`] tells when it passed [`STALE_PERIODS`] of its mean periods.
 
-use super::store::{Packed, Store};
 use crate::frame::Frame;
 use crate::output::busload::Bitrate;
 use crate::wire::cache::FiguresCache;
@@ -166,15 +165,14 @@ impl Stats {
         &self.bitrate
     }
 
-    /// Adds the frame just stored (the last one in `store`): `frame` as it came, `p` as
-    /// stored.
-    pub fn add(&mut self, p: &Packed, frame: &Frame, store: &Store) {
-        let i = self.index(p.is_ext(), p.id);
+    /// Adds `frame`, just stored at position `pos`.
+    pub fn add(&mut self, frame: &Frame, pos: usize) {
+        let i = self.index(frame.is_ext(), frame.id);
         let s = &mut self.entries[i];
         if s.count == 0 {
-            s.first_ns = p.ts_ns;
+            s.first_ns = frame.ts_ns;
         } else {
-            let gap = p.ts_ns.saturating_sub(s.last_ns) as f64 / 1e9;
+            let gap = frame.ts_ns.saturating_sub(s.last_ns) as f64 / 1e9;
             s.sum_gap += gap;
             s.sum_gap2 += gap * gap;
             s.last_gap = gap;
@@ -186,25 +184,25 @@ impl Stats {
             }
             s.prev_pos = Some(s.last_pos);
         }
-        s.last_pos = store.len() - 1;
+        s.last_pos = pos;
         s.count += 1;
-        s.last_ns = p.ts_ns;
+        s.last_ns = frame.ts_ns;
         s.in_window += 1;
-        self.start_ns.get_or_insert(p.ts_ns);
+        self.start_ns.get_or_insert(frame.ts_ns);
         let bits = self.figures.figures(frame).map_or(0, |f| u64::from(f.bus_bits()));
         self.window.push_back(InWindow {
-            ts_ns: p.ts_ns,
+            ts_ns: frame.ts_ns,
             bits: bits as u32,
             entry: i as u32,
-            iface: p.iface,
+            iface: frame.iface,
         });
         self.window_bits += bits;
-        let k = p.iface as usize;
+        let k = frame.iface as usize;
         if self.iface_bits.len() <= k {
             self.iface_bits.resize(k + 1, 0);
         }
         self.iface_bits[k] += bits;
-        self.tick(p.ts_ns);
+        self.tick(frame.ts_ns);
     }
 
     /// Capture time has reached `now_ns` (a frame's time, or the capture clock when no
@@ -285,8 +283,8 @@ impl Stats {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::analysis::store::Store;
     use crate::decode::Kind;
-    use crate::frame::Frame;
 
     #[test]
     fn period_jitter_rate_and_load() {
@@ -296,7 +294,7 @@ mod tests {
             let mut f = Frame::classic(0x181, &[i as u8; 8]);
             f.ts_ns = t * 1_000_000;
             let at = store.push(&f, Kind::Tpdo, Some(1));
-            st.add(&store.packed(at).clone(), &store.frame(at), &store);
+            st.add(&store.frame(at), at);
         }
         let s = *st.iter().next().unwrap().1;
         assert_eq!(s.count, 5);
@@ -332,7 +330,7 @@ mod tests {
             let mut f = Frame::classic(0x181, &[0; 8]);
             (f.iface, f.ts_ns) = (iface, t * 1_000_000);
             let at = store.push(&f, Kind::Tpdo, Some(1));
-            st.add(&store.packed(at).clone(), &store.frame(at), &store);
+            st.add(&store.frame(at), at);
         }
         // In the last second (0.5 s to 1.5 s): one frame of can0, none of can1.
         let bits = crate::output::busload::bus_bits(&Frame::classic(0x181, &[0; 8]));
@@ -364,7 +362,7 @@ mod tests {
         ];
         for f in &frames {
             let at = store.push(f, Kind::Other, None);
-            st.add(&store.packed(at).clone(), &store.frame(at), &store);
+            st.add(&store.frame(at), at);
         }
         let got: Vec<((bool, u32), u64, usize)> = st.iter().map(|(k, s)| (*k, s.count, s.last_pos)).collect();
         assert_eq!(
@@ -384,7 +382,7 @@ mod tests {
         let mut f = Frame::classic(id, &[0; 8]);
         f.ts_ns = ms * 1_000_000;
         let at = store.push(&f, Kind::Other, None);
-        st.add(&store.packed(at).clone(), &store.frame(at), store);
+        st.add(&store.frame(at), at);
     }
 
     #[test]

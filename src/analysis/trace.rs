@@ -213,9 +213,8 @@ impl Trace {
             Views::All => {
                 let peeked @ (kind, node, _) = self.diagnose(frame);
                 self.cycles.frame(frame, pos, peeked);
-                self.store.push(frame, kind, node);
-                let p = self.store.packed(pos as usize);
-                self.stats.add(&p, frame, &self.store);
+                let at = self.store.push(frame, kind, node);
+                self.stats.add(frame, at);
                 if let Some(n) = node {
                     self.nodes.frame(NodeKey::of(frame, n), frame.ts_ns);
                 }
