@@ -316,19 +316,16 @@ impl Diagnoser {
                     self.boot_configs.operational(tl, n, "TPDO");
                 }
                 self.pdos.arrived(tl, n, p.transmit, p.num, self.syncs.last);
-                let mut words = Vec::new();
-                for s in &p.signals {
-                    let Some(v) = s.value.as_i64() else { continue };
-                    words.push((s.index, v as u16));
-                }
                 if p.signals.is_empty() && p.num == 1 && tl.node(n).cia402 && frame.payload().len() >= 2 {
                     // CiA 402 predefined mapping: TPDO1 starts with the statusword, RPDO1
                     // with the controlword.
                     let w = u16::from_le_bytes([frame.payload()[0], frame.payload()[1]]);
-                    words.push((if p.transmit { 0x6041 } else { 0x6040 }, w));
+                    self.drive_word(n, if p.transmit { 0x6041 } else { 0x6040 }, w);
                 }
-                for (index, w) in words {
-                    self.drive_word(n, index, w);
+                for s in &p.signals {
+                    if let Some(v) = s.value.as_i64() {
+                        self.drive_word(n, s.index, v as u16);
+                    }
                 }
             }
             _ => {
