@@ -484,6 +484,26 @@ fn trc_status_and_error_lines_are_bus_state_events_and_bus_errors() {
     }
 }
 
+/// A controller that went bus off and then, by an error counter line, back to error
+/// passive: diagnose's `bus_errors` title names the worst state it reached (bus off), not
+/// the last one.
+#[test]
+fn bus_errors_title_names_the_worst_state_reached() {
+    let log = ";$FILEVERSION=2.1\n;$STARTTIME=45244.5\n;$COLUMNS=N,O,T,B,I,d,R,L,D\n      1         0.100 DT  1      0701 Rx -  1    05\n      2       100.000 ER  1           Rx    04 00 02 00 00\n      3       200.000 ST  1           Rx    00 00 00 10\n      4       300.000 EC  1           Rx    00 80\n";
+    let out = crate::run::cotui(&["decode", "--events", "-"], Some(log));
+    let events = String::from_utf8_lossy(&out.stdout);
+    assert!(events.contains("-> bus off (bus off)"), "{events}");
+    assert!(events.contains("bus off -> error passive"), "{events}");
+    let out = crate::run::cotui(&["diagnose", "--format", "jsonl", "-"], Some(log));
+    let bus: serde_json::Value = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap())
+        .find(|i| i["kind"] == "bus_errors")
+        .expect("a bus_errors incident");
+    assert_eq!(bus["title"], "3 CAN error frames (the controller went bus off)");
+    assert_eq!(bus["status"], "open", "still error passive at the end");
+}
+
 /// A TRC 1.0 log (no `$FILEVERSION`): a status line is id FFFFFFFF, an error frame has
 /// `ERROR` in place of its data; both count in diagnose's `bus_errors`.
 #[test]

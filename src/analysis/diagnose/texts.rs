@@ -290,15 +290,10 @@ const WORDS: &[Words] = &[
         problem: Problem::BusErrors,
         with_cause: false,
         title: Some(Text::Made(|inc, f| {
-            let worst = inc.events.iter().rev().find_map(|e| {
-                if e.text.contains("bus off") {
-                    Some("bus off")
-                } else if e.text.contains("error passive") {
-                    Some("error passive")
-                } else {
-                    None
-                }
-            });
+            // The worst state the controller reached, not the last: bus off followed by an
+            // error counter line back in error passive still went bus off.
+            let said = |state: &str| inc.events.iter().any(|e| e.text.contains(state));
+            let worst = ["bus off", "error passive"].into_iter().find(|w| said(w));
             match worst {
                 Some(w) => format!(
                     "{} (the controller went {w})",
