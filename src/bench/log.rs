@@ -8,6 +8,9 @@ use crate::sim::synth::Traffic;
 use std::io::Write;
 use std::path::Path;
 
+/// When the bench frames begin (ns since the epoch).
+const START_NS: u64 = 1_700_000_000_000_000_000;
+
 /// One garbage line (tool chatter the decoder must skip) every this many frames.
 const GARBAGE_EVERY: u64 = 5_000;
 
@@ -29,7 +32,7 @@ pub fn write_many_iface_log(path: &Path, frames: u64, ifaces: u32) -> std::io::R
     let mut out = std::io::BufWriter::with_capacity(1 << 20, file);
     let mut writer = LogWriter::new();
     let mut line = String::with_capacity(1 << 16);
-    for (i, frame) in Traffic::new(frames, 1_700_000_000_000_000_000).enumerate() {
+    for (i, frame) in Traffic::new(frames, START_NS).enumerate() {
         writer.write_line(&mut line, &frame, &format!("can{}", i as u32 % ifaces.max(1)));
         if line.len() > 1 << 15 {
             out.write_all(line.as_bytes())?;
@@ -46,7 +49,7 @@ pub fn bytes_per_frame() -> f64 {
     const SAMPLE: u64 = 10_000;
     let mut writer = LogWriter::new();
     let mut line = String::new();
-    for frame in Traffic::new(SAMPLE, 1_700_000_000_000_000_000) {
+    for frame in Traffic::new(SAMPLE, START_NS) {
         writer.write_line(&mut line, &frame, "can0");
     }
     line.len() as f64 / SAMPLE as f64
@@ -57,7 +60,7 @@ fn write_frames(path: &Path, frames: u64, garbage_every: Option<u64>) -> std::io
     let mut out = std::io::BufWriter::with_capacity(1 << 20, file);
     let mut writer = LogWriter::new();
     let mut line = String::with_capacity(1 << 16);
-    for (i, frame) in Traffic::new(frames, 1_700_000_000_000_000_000).enumerate() {
+    for (i, frame) in Traffic::new(frames, START_NS).enumerate() {
         if garbage_every.is_some_and(|g| i as u64 % g == g - 1) {
             line.push_str(GARBAGE[i / 5_000 % GARBAGE.len()]);
         }
@@ -79,18 +82,21 @@ const GARBAGE: [&str; 3] = [
 ];
 
 /// The input formats `cotui bench` times besides candump, with their file names.
-pub const INPUT_FORMATS: [(&str, &str); 6] = [
+pub const INPUT_FORMATS: [(&str, &str); 8] = [
     ("screen", "bench-quarter.screen.txt"),
     ("asc", "bench-quarter.asc"),
     ("trc", "bench-quarter.trc"),
     ("csv", "bench-quarter.csv"),
+    ("peak-csv", "bench-quarter.peak.csv"),
+    ("savvycan", "bench-quarter.savvycan.csv"),
     ("mf4", "bench-quarter.mf4"),
     ("blf", "bench-quarter.blf"),
 ];
 
 /// Writes the same synthetic frames as [`write_log`] in input format `format` (one of
 /// [`INPUT_FORMATS`]): candump screen output (`-ta`), Vector ASC, PEAK TRC 2.1,
-/// python-can CSV, ASAM MDF4 or Vector BLF (by cotui's own BLF writer).
+/// python-can CSV, PEAK CSV, SavvyCAN CSV, ASAM MDF4 or Vector BLF (by cotui's own BLF
+/// writer).
 pub fn write_format_log(path: &Path, frames: u64, format: &str) -> std::io::Result<()> {
     match format {
         "mf4" => return super::mf4::write_mf4_log(path, frames),
@@ -101,14 +107,19 @@ pub fn write_format_log(path: &Path, frames: u64, format: &str) -> std::io::Resu
     let mut out = std::io::BufWriter::with_capacity(1 << 20, file);
     let (mut asc, mut trc) = (AscWriter::new(), TrcWriter::new());
     let mut line = String::with_capacity(1 << 16);
-    if format == "csv" {
-        line.push_str("timestamp,arbitration_id,extended,remote,error,dlc,data\n");
-    }
-    for frame in Traffic::new(frames, 1_700_000_000_000_000_000) {
+    line.push_str(match format {
+        "csv" => "timestamp,arbitration_id,extended,remote,error,dlc,data\n",
+        "peak-csv" => PEAK_CSV_HEADER,
+        "savvycan" => "Time Stamp,ID,Extended,Dir,Bus,LEN,D1,D2,D3,D4,D5,D6,D7,D8\n",
+        _ => "",
+    });
+    for (i, frame) in Traffic::new(frames, START_NS).enumerate() {
         match format {
             "asc" => asc.write_line(&mut line, &frame, "can0"),
             "trc" => trc.write_line(&mut line, &frame, "can0"),
             "csv" => csv_line(&mut line, &frame),
+            "peak-csv" => peak_csv_line(&mut line, i as u64 + 1, &frame, START_NS),
+            "savvycan" => savvycan_line(&mut line, &frame),
             _ => screen_line(&mut line, &frame),
         }
         if line.len() > 1 << 15 {
@@ -127,7 +138,7 @@ fn write_blf_log(path: &Path, frames: u64) -> std::io::Result<()> {
     use std::io::{Seek, SeekFrom};
     let mut file = std::fs::File::create(path)?;
     let mut blf = BlfWriter::new(std::io::BufWriter::with_capacity(1 << 20, &file));
-    for frame in Traffic::new(frames, 1_700_000_000_000_000_000) {
+    for frame in Traffic::new(frames, START_NS) {
         blf.write_frame("can0", &frame)?;
     }
     let header = blf.finish()?;
@@ -152,6 +163,37 @@ fn screen_line(out: &mut String, f: &Frame) {
         for b in f.payload() {
             let _ = write!(out, " {b:02X}");
         }
+    }
+    out.push('\n');
+}
+
+/// The header of the bench's PEAK CSV: the start time [`START_NS`] as PEAK writes it (days
+/// since 1899-12-30, 12 decimals) and the column names.
+const PEAK_CSV_HEADER: &str = ";$FILEVERSION=2.1\n;$STARTTIME=45244.925925925926\nNumber,Time,Bus,Direction,Type,ID,Reserved,Length,D0,D1,D2,D3,D4,D5,D6,D7\n";
+
+/// A PEAK CSV row of a classic data frame, its time in milliseconds after `start_ns`:
+/// `2,0.100,1,Rx,DT,0181,-,3,37,02,03,,,,,`.
+fn peak_csv_line(out: &mut String, number: u64, f: &Frame, start_ns: u64) {
+    use std::fmt::Write as _;
+    let since = f.ts_ns - start_ns;
+    let (ms, ns) = (since / 1_000_000, since % 1_000_000);
+    let _ = write!(out, "{number},{ms}.{:03},1,Rx,DT,{:04X},-,{}", ns / 1000, f.id, f.len);
+    for k in 0..8 {
+        match f.payload().get(k) {
+            Some(b) => write!(out, ",{b:02X}"),
+            None => write!(out, ","),
+        }
+        .ok();
+    }
+    out.push('\n');
+}
+
+/// A SavvyCAN CSV row: `1700000000000100,00000181,false,Rx,0,3,37,02,03,`.
+fn savvycan_line(out: &mut String, f: &Frame) {
+    use std::fmt::Write as _;
+    let _ = write!(out, "{},{:08X},false,Rx,0,{},", f.ts_ns / 1000, f.id, f.len);
+    for b in f.payload() {
+        let _ = write!(out, "{b:02X},");
     }
     out.push('\n');
 }

@@ -30,7 +30,7 @@ pub struct BenchArgs {
     #[arg(long, value_name = "FILE")]
     pub write_log: Option<PathBuf>,
     /// With --write-log: write the bench frames in this input format instead of the
-    /// candump log (screen, asc, trc, csv, mf4, blf), as the per-format rows read them.
+    /// candump log (screen, asc, trc, csv, peak-csv, savvycan, mf4, blf), as the per-format rows read them.
     #[arg(long, value_name = "FORMAT", requires = "write_log", value_parser = clap::builder::PossibleValuesParser::new(log::INPUT_FORMATS.map(|(f, _)| f)))]
     pub log_format: Option<String>,
     /// Measure the interactive analyzer instead: first screen, full index, memory per
@@ -324,6 +324,8 @@ fn measure_all(args: &BenchArgs, exe: &Path, dir: &Path) -> std::io::Result<Figu
             "trc" => ("summary-trc", "decode --summary, TRC input (1/4 log)"),
             "mf4" => ("summary-mf4", "decode --summary, MF4 input (1/4 log)"),
             "blf" => ("summary-blf-quarter", "decode --summary, BLF input (1/4 log)"),
+            "peak-csv" => ("summary-peak-csv", "decode --summary, PEAK CSV input (1/4 log)"),
+            "savvycan" => ("summary-savvycan", "decode --summary, SavvyCAN CSV input (1/4 log)"),
             _ => ("summary-csv", "decode --summary, CSV input (1/4 log)"),
         };
         runs.push(Run::new(name, title, &["decode", "--summary", path], n / 4, None));
