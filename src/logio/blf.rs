@@ -22,13 +22,17 @@ pub struct BlfReader<R> {
     outer: Vec<u8>,
     outer_off: u64,
     eof: bool,
-    /// Unpacked container data; `inner[inner_at..]` is not yet used and starts at byte
-    /// `inner_off` of the unpacked object stream.
+    /// Unpacked container data; `inner[inner_at..inner_end]` is not yet used and starts
+    /// at byte `inner_off` of the unpacked object stream. The bytes after `inner_end` are
+    /// room kept from container to container (written once, never zeroed again).
     inner: Vec<u8>,
     inner_at: usize,
+    inner_end: usize,
     inner_off: u64,
     /// File byte of the container whose data `inner` ends with.
     container_at: u64,
+    /// The inflater, reset for each container (not made anew).
+    zlib: flate2::Decompress,
     start_ns: u64,
     header_read: bool,
     objects: u64,
@@ -48,8 +52,10 @@ impl<R: BufRead> BlfReader<R> {
             eof: false,
             inner: Vec::with_capacity(1 << 18),
             inner_at: 0,
+            inner_end: 0,
             inner_off: 0,
             container_at: 0,
+            zlib: flate2::Decompress::new(true),
             start_ns: 0,
             header_read: false,
             objects: 0,
@@ -94,12 +100,12 @@ impl<R: BufRead> BlfReader<R> {
                 Some(o) => self.push(out, o),
                 None if self.eof && self.outer.is_empty() => {
                     self.done = true;
-                    if self.inner[self.inner_at..].iter().any(|&b| b != 0) {
+                    if self.inner[self.inner_at..self.inner_end].iter().any(|&b| b != 0) {
                         let w = format!(
                             "byte {} of the unpacked objects (container at byte {}): object cut short at the end of the file",
                             self.inner_off, self.container_at
                         );
-                        self.inner.clear();
+                        self.inner_end = self.inner_at;
                         self.push(out, Outcome::Warning(w));
                     }
                 }
@@ -226,14 +232,35 @@ impl<R: BufRead> BlfReader<R> {
             Err(why) => return Some(Outcome::Warning(format!("container at byte {at}: {why}"))),
         };
         // Drop what was used; keep an object that continues in this container.
-        self.inner.drain(..self.inner_at);
+        self.inner.copy_within(self.inner_at..self.inner_end, 0);
+        self.inner_end -= self.inner_at;
         self.inner_at = 0;
         self.container_at = at;
         match method {
-            Compression::None => self.inner.extend_from_slice(data),
+            Compression::None => {
+                self.inner.truncate(self.inner_end);
+                self.inner.extend_from_slice(data);
+                self.inner_end = self.inner.len();
+            }
             Compression::Zlib => {
+                let unpacked = blf::container_unpacked(&self.outer[..len]).unwrap_or(0) as usize;
+                // Deflate unpacks to at most 1032 times its size: a larger size is damage.
+                if unpacked as u64 <= MAX_UNPACKED.min(data.len() as u64 * 1032 + 1024) {
+                    if self.inner.len() < self.inner_end + unpacked {
+                        self.inner.resize(self.inner_end + unpacked, 0);
+                    }
+                    if let Some(n) = inflate_whole(&mut self.zlib, data, &mut self.inner[self.inner_end..]) {
+                        self.inner_end += n;
+                        return None;
+                    }
+                }
+                // Not a sound stream within the room its header gives: inflated as a
+                // stream instead, which keeps what comes before the damage.
+                self.inner.truncate(self.inner_end);
                 let mut z = flate2::read::ZlibDecoder::new(data).take(MAX_UNPACKED);
-                if let Err(e) = z.read_to_end(&mut self.inner) {
+                let read = z.read_to_end(&mut self.inner);
+                self.inner_end = self.inner.len();
+                if let Err(e) = read {
                     // What was inflated before the damage is kept and read.
                     return Some(Outcome::Warning(format!(
                         "container at byte {at}: zlib data damaged or cut short ({e}); its objects after that are lost"
@@ -246,7 +273,7 @@ impl<R: BufRead> BlfReader<R> {
 
     /// The next object of the unpacked container data, when one lies whole in it.
     fn next_inner(&mut self) -> Option<Outcome> {
-        let rest = &self.inner[self.inner_at..];
+        let rest = &self.inner[self.inner_at..self.inner_end];
         if rest.is_empty() {
             return None;
         }
@@ -273,6 +300,17 @@ impl<R: BufRead> BlfReader<R> {
         self.inner_off += used as u64;
         outcome
     }
+}
+
+/// Inflates the whole zlib stream `data` in one call into `room` (written before, so
+/// neither allocated nor zeroed again): the bytes it unpacked when the stream ends sound
+/// in `room` and within [`MAX_UNPACKED`]; `None` for the streaming inflater to read the
+/// same data with its located warning.
+fn inflate_whole(z: &mut flate2::Decompress, data: &[u8], room: &mut [u8]) -> Option<usize> {
+    z.reset(true);
+    let status = z.decompress(data, room, flate2::FlushDecompress::Finish);
+    let n = usize::try_from(z.total_out()).ok()?;
+    (matches!(status, Ok(flate2::Status::StreamEnd)) && n as u64 <= MAX_UNPACKED).then_some(n)
 }
 
 /// One object as an outcome: its frame with the channel's interface, a skip for other

@@ -97,6 +97,16 @@ impl<S: Source> Mf4Reader<S> {
                 self.push(out, o);
                 continue;
             }
+            if let [stream] = &mut self.streams[..] {
+                // One data group: its records in their order, nothing to merge.
+                let o = match stream.next(&mut self.src, self.start_ns)? {
+                    Some(Ok((bus, frame))) => self.framed(bus, frame),
+                    Some(Err(w)) => Outcome::Warning(w),
+                    None => break,
+                };
+                self.push(out, o);
+                continue;
+            }
             for (stream, head) in self.streams.iter_mut().zip(&mut self.heads) {
                 if head.is_none() && stream.live() {
                     match stream.next(&mut self.src, self.start_ns)? {
@@ -116,20 +126,26 @@ impl<S: Source> Mf4Reader<S> {
                 .filter_map(|(i, h)| h.as_ref().map(|(_, f)| (f.ts_ns, i)))
                 .min();
             let Some((_, i)) = first else { break };
-            let Some((bus, mut frame)) = self.heads[i].take() else {
+            let Some((bus, frame)) = self.heads[i].take() else {
                 break;
             };
-            frame.iface = match self.buses.iter().find(|(b, _)| *b == bus) {
-                Some(&(_, iface)) => iface,
-                None => {
-                    let iface = self.ifaces.intern(&mf4::channel_name(bus));
-                    self.buses.push((bus, iface));
-                    iface
-                }
-            };
-            self.push(out, Outcome::Frame(frame));
+            let o = self.framed(bus, frame);
+            self.push(out, o);
         }
         Ok(())
+    }
+
+    /// The outcome of a frame on bus channel `bus`: the frame with its interface.
+    fn framed(&mut self, bus: u64, mut frame: crate::frame::Frame) -> Outcome {
+        frame.iface = match self.buses.iter().find(|(b, _)| *b == bus) {
+            Some(&(_, iface)) => iface,
+            None => {
+                let iface = self.ifaces.intern(&mf4::channel_name(bus));
+                self.buses.push((bus, iface));
+                iface
+            }
+        };
+        Outcome::Frame(frame)
     }
 
     fn push(&mut self, out: &mut Vec<(u64, Outcome)>, o: Outcome) {
@@ -256,7 +272,6 @@ impl<S: Source> Mf4Reader<S> {
             record_id_size: dg.record_id_size,
             bytes: Bytes::new(blocks),
             groups,
-            record: Vec::new(),
             payload: Vec::new(),
             records: 0,
             held: VecDeque::new(),
@@ -504,7 +519,16 @@ impl Bytes {
 
     /// Makes at least `want` bytes available; false when the data ends first. A damaged
     /// block is a warning and the next block is read.
+    #[inline(always)]
     fn fill<S: Source>(&mut self, src: &mut S, want: usize, warn: &mut Vec<String>) -> io::Result<bool> {
+        if self.buf.len() - self.at >= want {
+            return Ok(true);
+        }
+        self.refill(src, want, warn)
+    }
+
+    /// [`Bytes::fill`] when the buffer holds fewer than `want` bytes: reads blocks on.
+    fn refill<S: Source>(&mut self, src: &mut S, want: usize, warn: &mut Vec<String>) -> io::Result<bool> {
         while self.buf.len() - self.at < want {
             if self.at > 0 {
                 self.buf.drain(..self.at);
@@ -639,7 +663,6 @@ struct Stream {
     record_id_size: u8,
     bytes: Bytes,
     groups: Vec<Cg>,
-    record: Vec<u8>,
     payload: Vec<u8>,
     records: u64,
     /// Outcomes read and not yet given (warnings of block damage before a record).
@@ -715,19 +738,29 @@ impl Stream {
             if !self.bytes.fill(src, size, warn)? {
                 return self.end();
             }
-            self.record.clear();
-            self.record.extend_from_slice(&self.bytes.available()[..size]);
-            self.bytes.consume(size);
-            let What::Frames(frames) = &mut self.groups[idx].what else {
+            // The other groups (VLSD records) beside this one.
+            let (before, rest) = self.groups.split_at_mut(idx);
+            let Some((
+                Cg {
+                    what: What::Frames(frames),
+                    ..
+                },
+                after,
+            )) = rest.split_first_mut()
+            else {
+                self.bytes.consume(size);
                 continue;
             };
-            let layout = frames.layout;
-            let payload = match &mut frames.vlsd {
+            // The record is read in place: `buf` starts with it.
+            let buf = self.bytes.available();
+            let rec = &buf[..size];
+            let Frames { layout, vlsd } = &mut **frames;
+            let payload = match vlsd {
                 Vlsd::None => Ok(None),
                 Vlsd::Group(rid) => {
-                    let want = layout.vlsd_offset(&self.record);
+                    let want = layout.vlsd_offset(rec);
                     let rid = *rid;
-                    let entry = self.groups.iter().find_map(|g| match &g.what {
+                    let entry = before.iter().chain(after.iter()).find_map(|g| match &g.what {
                         What::Vlsd {
                             last: Some((off, bytes)),
                             ..
@@ -744,14 +777,15 @@ impl Stream {
                     }
                 }
                 Vlsd::Stream { bytes, offset } => {
-                    let want = layout.vlsd_offset(&self.record).unwrap_or(u64::MAX);
+                    let want = layout.vlsd_offset(rec).unwrap_or(u64::MAX);
                     signal_entry(src, bytes, offset, want, &mut self.payload, warn)?.map(Some)
                 }
             };
             let result = payload.and_then(|p| {
                 let vlsd = p.map(|()| self.payload.as_slice());
-                layout.frame(&self.record, vlsd, start_ns)
+                layout.frame_in(buf, size, vlsd, start_ns)
             });
+            self.bytes.consume(size);
             return Ok(Some(result.map_err(|why| {
                 format!("data group at byte {}, record {}: {why}", self.at, self.records)
             })));

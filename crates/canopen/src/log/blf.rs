@@ -223,6 +223,13 @@ pub fn container(obj: &[u8]) -> Result<(Compression, &[u8]), &'static str> {
     }
 }
 
+/// The size a log container's data has unpacked, as its header says (`None` when the
+/// header is cut short). Only a hint for the room to inflate into: damage may make it wrong.
+pub fn container_unpacked(obj: &[u8]) -> Option<u32> {
+    let head = object_head(obj)?;
+    u32_at(obj, usize::from(head.header_size).checked_add(8)?)
+}
+
 /// What one (non-container) object held.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Object {
@@ -266,14 +273,17 @@ pub fn object(obj: &[u8], start_ns: u64) -> Result<Object, &'static str> {
     };
     let (channel, id) = match head.kind {
         CAN_MESSAGE | CAN_MESSAGE2 => {
-            let b = body.get(..16).ok_or(SHORT)?;
-            let (channel, mflags, dlc, id) = (u16_at(b, 0).ok_or(SHORT)?, b[2], b[3], u32_at(b, 4).ok_or(SHORT)?);
-            let data = &b[8..16];
+            let b: &[u8; 16] = body.first_chunk().ok_or(SHORT)?;
+            let (channel, mflags, dlc) = (u16::from_le_bytes([b[0], b[1]]), b[2], b[3]);
+            let id = u32::from_le_bytes([b[4], b[5], b[6], b[7]]);
             f.flags.set(Flags::TX, mflags & MSG_TX != 0);
             f.flags.set(Flags::RTR, mflags & MSG_RTR != 0);
             classic_len(&mut f, dlc);
             if !f.is_rtr() {
-                f.data[..f.len as usize].copy_from_slice(&data[..f.len as usize]);
+                // The first `len` of the 8 data bytes in one store (the rest stay zero).
+                let keep = u64::MAX.checked_shr(64 - 8 * u32::from(f.len)).unwrap_or(0);
+                let data = u64::from_le_bytes([b[8], b[9], b[10], b[11], b[12], b[13], b[14], b[15]]);
+                f.data[..8].copy_from_slice(&(data & keep).to_le_bytes());
             }
             (channel, id)
         }

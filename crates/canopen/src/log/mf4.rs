@@ -481,6 +481,82 @@ pub struct Layout {
     fields: [Option<Field>; 9],
     /// `.DataBytes`.
     pub payload: Option<Payload>,
+    /// The fields as fixed loads, resolved when a member is added.
+    plan: Plan,
+}
+
+/// A little-endian integer field as one 8-byte load at `at`, shifted and masked.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Slot {
+    at: u32,
+    shift: u8,
+    mask: u64,
+}
+
+impl Slot {
+    /// The slot of `f`, `None` when `f` needs [`Field::uint`]'s general path (big endian,
+    /// or wider than one load).
+    fn of(f: Field) -> Option<Slot> {
+        let be = matches!(f.kind, DataType::Uint { be: true } | DataType::Int { be: true });
+        (!be && u32::from(f.bit) + f.bits <= 64).then_some(Slot {
+            at: f.byte,
+            shift: f.bit,
+            mask: if f.bits >= 64 { u64::MAX } else { (1u64 << f.bits) - 1 },
+        })
+    }
+
+    /// The value in `buf` (whose record holds the field's bytes: bytes after them, of the
+    /// record or of the next ones, are masked off).
+    #[inline(always)]
+    fn read(self, buf: &[u8]) -> u64 {
+        let at = self.at as usize;
+        let word = match buf.get(at..).and_then(|r| r.first_chunk::<8>()) {
+            Some(w) => u64::from_le_bytes(*w),
+            None => {
+                let tail = buf.get(at..).unwrap_or_default();
+                let mut raw = [0u8; 8];
+                raw[..tail.len().min(8)].copy_from_slice(&tail[..tail.len().min(8)]);
+                u64::from_le_bytes(raw)
+            }
+        };
+        (word >> self.shift) & self.mask
+    }
+}
+
+/// A [`Layout`]'s fields resolved once per channel group: when `slots` is `Some`, every
+/// member is a [`Slot`] and a record of at least `end` bytes reads with no check a field.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Plan {
+    /// Bytes a record needs for every field, the time and a fixed payload to lie in it.
+    end: usize,
+    /// The members' slots (`None` inside: the member is absent); `None`: some member needs
+    /// the general path.
+    slots: Option<[Option<Slot>; 9]>,
+    /// The time channel's byte when it is a little-endian f64 at bit 0.
+    time_f64: Option<u32>,
+}
+
+impl Plan {
+    fn of(l: &Layout) -> Plan {
+        let span = |f: Field| f.byte as usize + (u64::from(f.bit) + u64::from(f.bits)).div_ceil(8) as usize;
+        let (time, _) = l.time;
+        let mut end = span(time);
+        if let Some(Payload::Fixed(p)) = l.payload {
+            end = end.max(span(p));
+        }
+        let mut slots = Some([None; 9]);
+        for (i, f) in l.fields.iter().enumerate() {
+            let Some(f) = *f else { continue };
+            end = end.max(span(f));
+            match (Slot::of(f), slots.as_mut()) {
+                (Some(slot), Some(s)) => s[i] = Some(slot),
+                _ => slots = None,
+            }
+        }
+        let time_f64 =
+            (time.kind == DataType::Float { be: false } && time.bit == 0 && time.bits == 64).then_some(time.byte);
+        Plan { end, slots, time_f64 }
+    }
 }
 
 const NAMES: [&[u8]; 9] = [
@@ -507,12 +583,19 @@ const BUS: usize = 8;
 impl Layout {
     /// A layout for a group of `kind` with its time channel; members are added by name.
     pub fn new(kind: Kind, time: (Field, Linear)) -> Layout {
-        Layout {
+        let mut l = Layout {
             kind,
             time,
             fields: [None; 9],
             payload: None,
-        }
+            plan: Plan {
+                end: 0,
+                slots: None,
+                time_f64: None,
+            },
+        };
+        l.plan = Plan::of(&l);
+        l
     }
 
     /// Takes the channel `name` (`CAN_DataFrame.ID`, or `ID`) when it is one of the frame's
@@ -531,6 +614,7 @@ impl Layout {
         } else if let Some(i) = NAMES.iter().position(|n| *n == member) {
             self.fields[i] = Some(field);
         }
+        self.plan = Plan::of(self);
     }
 
     /// Whether the group can give frames (data and remote frames need their ID).
@@ -559,27 +643,84 @@ impl Layout {
     /// The record `rec` as a frame and its bus channel number; `vlsd` holds the payload of
     /// a VLSD group. Times are seconds after `start_ns`.
     pub fn frame(&self, rec: &[u8], vlsd: Option<&[u8]>, start_ns: u64) -> Result<(u64, Frame), &'static str> {
-        let (tf, conv) = self.time;
-        let raw_t = tf.float(rec).ok_or("record shorter than its time channel")?;
+        self.frame_in(rec, rec.len(), vlsd, start_ns)
+    }
+
+    /// [`Layout::frame`] of the record `buf[..size]`, read in place: the bytes after it
+    /// (the next records) are only loaded and masked off, so a record whose fields all lie
+    /// in it is read by the group's fixed offsets, with no check a field.
+    pub fn frame_in(
+        &self,
+        buf: &[u8],
+        size: usize,
+        vlsd: Option<&[u8]>,
+        start_ns: u64,
+    ) -> Result<(u64, Frame), &'static str> {
+        let rec = buf.get(..size).unwrap_or(buf);
+        match &self.plan.slots {
+            Some(slots) if rec.len() == size && size >= self.plan.end => {
+                let time = match self.plan.time_f64 {
+                    Some(at) => Some(f64::from_bits(
+                        Slot {
+                            at,
+                            shift: 0,
+                            mask: u64::MAX,
+                        }
+                        .read(buf),
+                    )),
+                    None => self.time.0.float(rec),
+                };
+                self.build(time, &Planned { slots, buf }, rec, vlsd, start_ns)
+            }
+            _ => self.build(
+                self.time.0.float(rec),
+                &General { layout: self, rec },
+                rec,
+                vlsd,
+                start_ns,
+            ),
+        }
+    }
+
+    /// The frame of a record whose time is `raw_t` and whose members `m` reads.
+    #[inline(always)]
+    fn build(
+        &self,
+        raw_t: Option<f64>,
+        m: &impl Members,
+        rec: &[u8],
+        vlsd: Option<&[u8]>,
+        start_ns: u64,
+    ) -> Result<(u64, Frame), &'static str> {
+        let get = |i| m.get(i);
+        let conv = self.time.1;
+        let raw_t = raw_t.ok_or("record shorter than its time channel")?;
         let secs = conv.offset + conv.factor * raw_t;
         if !secs.is_finite() {
             return Err("time is not a number");
         }
-        let ts = i128::from(start_ns).saturating_add((secs * 1e9).round() as i128);
+        let ns = (secs * 1e9).round();
+        // Within an i64 (every time of a log) the cheaper conversion gives the same.
+        let ns = if ns.abs() < 9.2e18 {
+            i128::from(ns as i64)
+        } else {
+            ns as i128
+        };
+        let ts = i128::from(start_ns).saturating_add(ns);
         let mut f = Frame {
             ts_ns: u64::try_from(ts.max(0)).unwrap_or(u64::MAX),
             ..Frame::default()
         };
-        let bus = self.get(BUS, rec)?.unwrap_or(0);
-        let flag = |i| self.get(i, rec).map(|v| v.unwrap_or(0) != 0);
+        let bus = get(BUS)?.unwrap_or(0);
+        let flag = |i| get(i).map(|v| v.unwrap_or(0) != 0);
         f.flags.set(Flags::TX, flag(DIR)?);
-        let dlc = self.get(DLC, rec)?;
+        let dlc = get(DLC)?;
         if self.kind == Kind::Error {
             f.flags.set(Flags::ERR, true);
             f.id = CAN_ERR_BUSERROR;
             return Ok((bus, f));
         }
-        let raw_id = self.get(ID, rec)?.ok_or("no ID channel")?;
+        let raw_id = get(ID)?.ok_or("no ID channel")?;
         let ext = flag(IDE)? || raw_id & 0x8000_0000 != 0;
         f.id = (raw_id & 0x1FFF_FFFF) as u32;
         f.flags.set(Flags::EXT, ext);
@@ -589,14 +730,14 @@ impl Layout {
         let fd = flag(EDL)?;
         if self.kind == Kind::Remote {
             f.flags.set(Flags::RTR, true);
-            let n = self.get(DATA_LENGTH, rec)?.filter(|&n| n > 0).or(dlc).unwrap_or(0);
+            let n = get(DATA_LENGTH)?.filter(|&n| n > 0).or(dlc).unwrap_or(0);
             f.len = n.min(8) as u8;
             return Ok((bus, f));
         }
         f.flags.set(Flags::FD, fd);
         f.flags.set(Flags::BRS, fd && flag(BRS)?);
         f.flags.set(Flags::ESI, fd && flag(ESI)?);
-        let len = match (self.get(DATA_LENGTH, rec)?, dlc) {
+        let len = match (get(DATA_LENGTH)?, dlc) {
             (Some(n), _) => n,
             (None, Some(d)) if fd => u64::from(FD_LENS[(d & 15) as usize]),
             (None, Some(d)) => d.min(8),
@@ -623,6 +764,37 @@ impl Layout {
             .ok_or("fewer data bytes than the data length")?;
         f.data[..data.len()].copy_from_slice(data);
         Ok((bus, f))
+    }
+}
+
+/// How [`Layout::build`] reads a record's members (by index into [`NAMES`]).
+trait Members {
+    fn get(&self, i: usize) -> Result<Option<u64>, &'static str>;
+}
+
+/// Members read by the group's plan.
+struct Planned<'a> {
+    slots: &'a [Option<Slot>; 9],
+    buf: &'a [u8],
+}
+
+impl Members for Planned<'_> {
+    #[inline(always)]
+    fn get(&self, i: usize) -> Result<Option<u64>, &'static str> {
+        Ok(self.slots.get(i).copied().flatten().map(|s| s.read(self.buf)))
+    }
+}
+
+/// Members read channel by channel, each checked against the record.
+struct General<'a> {
+    layout: &'a Layout,
+    rec: &'a [u8],
+}
+
+impl Members for General<'_> {
+    #[inline(always)]
+    fn get(&self, i: usize) -> Result<Option<u64>, &'static str> {
+        self.layout.get(i, self.rec)
     }
 }
 
@@ -719,5 +891,51 @@ mod tests {
         );
         rec[13] = 9;
         assert_eq!(l.frame(&rec, None, 0), Err("data length above what the frame can hold"));
+    }
+
+    fn any_field() -> impl proptest::strategy::Strategy<Value = Field> {
+        use proptest::prelude::*;
+        let kind = prop_oneof![
+            any::<bool>().prop_map(|be| DataType::Uint { be }),
+            any::<bool>().prop_map(|be| DataType::Int { be }),
+            any::<bool>().prop_map(|be| DataType::Float { be }),
+            Just(DataType::Bytes),
+        ];
+        (
+            0u32..24,
+            0u8..8,
+            prop_oneof![0u32..70, Just(8u32), Just(32u32), Just(64u32)],
+            kind,
+        )
+            .prop_map(|(byte, bit, bits, kind)| Field { byte, bit, bits, kind })
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn a_record_read_in_place_is_the_record_read_alone(
+            time in any_field(),
+            members in proptest::collection::vec((0usize..NAMES.len(), any_field()), 0..12),
+            payload in proptest::option::of((any_field(), proptest::prelude::any::<bool>())),
+            kind in proptest::sample::select(vec![Kind::Data, Kind::Remote, Kind::Error]),
+            bytes in proptest::collection::vec(proptest::prelude::any::<u8>(), 0..48),
+            size in 0usize..48,
+        ) {
+            let mut l = Layout::new(kind, (time, Linear { offset: 0.5, factor: 1e-3 }));
+            for (i, f) in members {
+                l.add(NAMES[i], f, false);
+            }
+            if let Some((f, vlsd)) = payload {
+                l.add(b"CAN_DataFrame.DataBytes", f, vlsd);
+            }
+            let size = size.min(bytes.len());
+            // The same layout read channel by channel, with no plan.
+            let mut general = l;
+            general.plan.slots = None;
+            general.plan.time_f64 = None;
+            proptest::prop_assert_eq!(
+                l.frame_in(&bytes, size, Some(&[1, 2, 3][..]), 7),
+                general.frame(&bytes[..size], Some(&[1, 2, 3][..]), 7)
+            );
+        }
     }
 }

@@ -35,10 +35,7 @@ impl Parser {
         c.byte(b',')?;
         let dlc = (c.pos(), c.take_while(|b| b.is_ascii_digit()));
         c.byte(b',')?;
-        let data = (
-            c.pos(),
-            c.take_while(|b| b.is_ascii_alphanumeric() || matches!(b, b'+' | b'/' | b'=')),
-        );
+        let data = (c.pos(), c.take_while(super::is_base64));
         let end = c.line_end()?;
         let mut f = Frame {
             ts_ns,
