@@ -100,6 +100,34 @@ impl<'a> Cursor<'a> {
         (self.at > from).then_some(v)
     }
 
+    /// Takes 1 to 19 decimal digits not followed by another (as [`Cursor::decimal`] with
+    /// `max` 19), up to 16 of them eight at a time: a long integer time stamp.
+    #[inline(always)]
+    pub(super) fn long_decimal(&mut self) -> Option<u64> {
+        let from = self.at;
+        let mut v = 0u64;
+        while self.at - from <= 8 {
+            let Some(group) = self
+                .buf
+                .get(self.at..self.at + 8)
+                .and_then(|t| digits8(t.try_into().ok()?))
+            else {
+                break;
+            };
+            v = v * 100_000_000 + group;
+            self.at += 8;
+        }
+        while let Some(d) = self.peek().filter(u8::is_ascii_digit) {
+            if self.at - from == 19 {
+                return None;
+            }
+            // At most 19 digits: below 10^19 < u64::MAX.
+            v = v * 10 + u64::from(d - b'0');
+            self.at += 1;
+        }
+        (self.at > from).then_some(v)
+    }
+
     /// Takes `secs.frac` as nanoseconds: 1 to 10 digits of seconds, 1 to 9 of fraction,
     /// and no digit after them. The 10.6-digit shape of epoch microseconds is read in
     /// digit groups.
@@ -381,6 +409,28 @@ mod tests {
         assert_eq!(ns(b"9999999999.999999999 "), Some((9_999_999_999_999_999_999, 20)));
         for bad in [&b"12345678901.0 "[..], b"1.0000000001 ", b"1. ", b".5 ", b"1 "] {
             assert_eq!(ns(bad), None, "{:?}", String::from_utf8_lossy(bad));
+        }
+    }
+
+    #[test]
+    fn long_decimals_in_groups_and_digits() {
+        for (text, want) in [
+            ("0,", Some(0)),
+            ("12345678,", Some(12_345_678)),
+            ("1700000000000100,", Some(1_700_000_000_000_100)),
+            ("9999999999999999999,", Some(9_999_999_999_999_999_999)),
+            ("10000000000000000000,", None),
+            ("123456789012345678901234,", None),
+            (",", None),
+        ] {
+            let mut c = Cursor::new(text.as_bytes());
+            let got = c.long_decimal();
+            assert_eq!(got, want, "{text}");
+            let mut d = Cursor::new(text.as_bytes());
+            assert_eq!(got, d.decimal(19), "{text}: as decimal(19)");
+            if got.is_some() {
+                assert_eq!((c.pos(), c.peek()), (text.len() - 1, Some(b',')));
+            }
         }
     }
 

@@ -3,7 +3,7 @@
 //! frame (and the bytes) the general parser reads, in the same parser state (property
 //! tests, one a format).
 
-use super::{Line, ParseError, asc, candump, csv, peak_csv, screen, trc};
+use super::{Line, ParseError, asc, candump, csv, peak_csv, savvycan, screen, trc};
 use crate::frame::FD_LENS;
 use crate::frame::{Frame, Interfaces};
 use proptest::prelude::*;
@@ -36,7 +36,8 @@ fast_and_general!(
     asc::Parser,
     trc::Parser,
     csv::Parser,
-    peak_csv::Parser
+    peak_csv::Parser,
+    savvycan::Parser
 );
 
 /// Bytes the mutations put into lines: blanks, line ends, digits, letters and signs.
@@ -335,5 +336,44 @@ proptest! {
             let next = format!("{}\n", ["9", "1.000", "1", "Rx", "DT", "0124", "-", "1", "22"].join(d));
             let make = || after(peak_csv::Parser::new(), &[header.as_str()]);
             agree(make, &mutate(&line, &muts), next.as_bytes(), must)?;
+        }
+        #[test]
+        fn savvycan_rows_read_as_the_general_parser_reads_them(
+            header in prop::sample::select(vec![
+                "Time Stamp,ID,Extended,Dir,Bus,LEN,D1,D2,D3,D4,D5,D6,D7,D8",
+                "Time Stamp,ID,Extended,Bus,LEN,D1,D2,D3,D4,D5,D6,D7,D8",
+                "",
+            ]),
+            us in prop_oneof![0u64..1_000_000, 0u64..u64::MAX],
+            id in any::<u32>(),
+            wide in any::<bool>(),
+            ext in prop::sample::select(vec!["true", "false", "1", "0", "yes"]),
+            dir in prop::sample::select(vec!["Rx", "Tx", "rx"]),
+            bus in prop_oneof![0u32..20, 0u32..2000],
+            len in 0usize..13,
+            data in prop::collection::vec(any::<u8>(), 12),
+            padding in 0usize..12,
+            crlf in any::<bool>(),
+            muts in mutations(),
+        ) {
+            let v = if wide { id & 0x3FFF_FFFF } else { id % 0x900 };
+            let mut cells = vec![
+                us.to_string(), hex(v, if wide { 8 } else { 4 }), ext.to_string(), dir.to_string(),
+                bus.to_string(), len.to_string(),
+            ];
+            if header.contains("Dir,Bus") {
+            } else {
+                cells.remove(3);
+            }
+            cells.extend(data[..len].iter().map(|b| format!("{b:02X}")));
+            cells.extend(std::iter::repeat_n(String::new(), padding));
+            let line = format!("{}{}\n", cells.join(","), if crlf { "\r" } else { "" });
+            let ext_ok = ["true", "false", "1", "0"].contains(&ext);
+            let is_ext = ext == "true" || ext == "1";
+            let must = muts.is_empty() && header.contains("Dir,Bus") && ext_ok && dir != "rx"
+                && us < u64::MAX / 1000 && bus < 1000 && len <= 8 && padding <= 8
+                && v <= if is_ext { 0x1FFF_FFFF } else { 0x7FF };
+            let make = || after(savvycan::Parser::new(), &[header]);
+            agree(make, &mutate(&line, &muts), b"5,00000124,false,Rx,1,1,22,\n", must)?;
         }
 }

@@ -395,7 +395,7 @@ impl<R: BufRead> LogReader<R> {
                 Parser::Trc(p) => run.lines(|b, i, f| p.parse_fast(b, i, f)),
                 Parser::Csv(p) => run.lines(|b, i, f| p.parse_fast(b, i, f)),
                 Parser::PeakCsv(p) => run.lines(|b, i, f| p.parse_fast(b, i, f)),
-                Parser::Savvycan(_) => 0,
+                Parser::Savvycan(p) => run.lines(|b, i, f| p.parse_fast(b, i, f)),
             };
             self.counts.frames += (out.len() - before) as u64;
             self.src.consume(at);
@@ -522,7 +522,7 @@ impl Parser {
             Parser::Trc(p) => p.parse_fast(buf, ifaces, frame),
             Parser::Csv(p) => p.parse_fast(buf, ifaces, frame),
             Parser::PeakCsv(p) => p.parse_fast(buf, ifaces, frame),
-            Parser::Savvycan(_) => None,
+            Parser::Savvycan(p) => p.parse_fast(buf, ifaces, frame),
         }
     }
 

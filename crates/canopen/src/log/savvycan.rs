@@ -9,6 +9,8 @@
 //! `can1`, ...), `LEN` the data length (above 8: a CAN FD frame), then one hex byte per
 //! column (empty columns past `LEN` are left alone). The columns are taken from the header.
 
+mod fast;
+
 use super::lex::{IfaceCache, dec_u32, err, hex_u32, trim_end};
 use super::{Line, ParseError, SkipReason};
 use crate::frame::{FD_LENS, Flags, Frame, Interfaces};
@@ -22,15 +24,25 @@ pub struct Parser {
     /// Column of `Dir`, `Bus`, `LEN` and the first data byte, once the header is read.
     columns: Option<Columns>,
     iface: IfaceCache,
+    /// The bus of the last row the fast path read and its interface index.
+    last_bus: Option<(u32, u16)>,
 }
 
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Columns {
     dir: Option<usize>,
     bus: Option<usize>,
     len: usize,
     data: usize,
 }
+
+/// The columns of the header SavvyCAN writes: `Time Stamp,ID,Extended,Dir,Bus,LEN,D1,...`.
+const DEFAULT_COLUMNS: Columns = Columns {
+    dir: Some(3),
+    bus: Some(4),
+    len: 5,
+    data: 6,
+};
 
 /// The most columns read from one row (64 data bytes and the leading ones).
 const MAX_FIELDS: usize = 80;
@@ -140,20 +152,27 @@ impl Parser {
             }
             None => 0,
         };
-        let mut name = *b"can000";
-        let digits = if bus >= 100 {
-            3
-        } else if bus >= 10 {
-            2
-        } else {
-            1
-        };
-        for k in 0..digits {
-            name[3 + digits - 1 - k] = b'0' + (bus / 10u32.pow(k as u32) % 10) as u8;
-        }
-        f.iface = self.iface.get(ifaces, &name[..3 + digits], 0)?;
+        let (name, n) = bus_name(bus);
+        f.iface = self.iface.get(ifaces, &name[..n], 0)?;
         Ok(Line::Frame(f))
     }
+}
+
+/// The interface name of bus `bus` (below 1000): `can0`, `can12`; the name's bytes and
+/// its length.
+fn bus_name(bus: u32) -> ([u8; 6], usize) {
+    let mut name = *b"can000";
+    let digits = if bus >= 100 {
+        3
+    } else if bus >= 10 {
+        2
+    } else {
+        1
+    };
+    for k in 0..digits {
+        name[3 + digits - 1 - k] = b'0' + (bus / 10u32.pow(k as u32) % 10) as u8;
+    }
+    (name, 3 + digits)
 }
 
 #[cfg(test)]
