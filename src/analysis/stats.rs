@@ -106,10 +106,9 @@ pub struct Stats {
     window_bits: u64,
     /// The bits in the window per interface index (the bus load of each bus).
     iface_bits: Vec<u64>,
-    window_start: usize,
-    /// The frames in the window (store positions `window_start..`), with what their leaving
-    /// takes back: each frame's bits are counted once, as it comes, not again as it leaves,
-    /// and the store is not read again.
+    /// The frames in the window, oldest first, with what their leaving takes back: each
+    /// frame's bits are counted once, as it comes, not again as it leaves, and the store is
+    /// not read again.
     window: VecDeque<InWindow>,
     /// The figures of the frames seen, for those that come again.
     figures: FiguresCache,
@@ -132,7 +131,6 @@ impl Stats {
             },
             window_bits: 0,
             iface_bits: Vec::new(),
-            window_start: 0,
             window: VecDeque::new(),
             figures: FiguresCache::new(),
             now_ns: 0,
@@ -224,7 +222,6 @@ impl Stats {
             }
             let e = &mut self.entries[old.entry as usize];
             e.in_window = e.in_window.saturating_sub(1);
-            self.window_start += 1;
         }
     }
 
