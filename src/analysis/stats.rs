@@ -10,6 +10,7 @@
 use crate::frame::Frame;
 use crate::output::busload::Bitrate;
 use crate::wire::cache::FiguresCache;
+use crate::wire::{Figures, WireError};
 use std::collections::{BTreeMap, VecDeque};
 
 /// Statistics of one identifier.
@@ -164,7 +165,7 @@ impl Stats {
     }
 
     /// Adds `frame`, just stored at position `pos`.
-    pub fn add(&mut self, frame: &Frame, pos: usize) {
+    pub fn add(&mut self, frame: &Frame, pos: usize, figures: Option<Result<Figures, WireError>>) {
         let i = self.index(frame.is_ext(), frame.id);
         let s = &mut self.entries[i];
         if s.count == 0 {
@@ -187,7 +188,8 @@ impl Stats {
         s.last_ns = frame.ts_ns;
         s.in_window += 1;
         self.start_ns.get_or_insert(frame.ts_ns);
-        let bits = self.figures.figures(frame).map_or(0, |f| u64::from(f.bus_bits()));
+        let figures = figures.unwrap_or_else(|| self.figures.figures(frame));
+        let bits = figures.map_or(0, |f| u64::from(f.bus_bits()));
         self.window.push_back(InWindow {
             ts_ns: frame.ts_ns,
             bits: bits as u32,
@@ -291,7 +293,7 @@ mod tests {
             let mut f = Frame::classic(0x181, &[i as u8; 8]);
             f.ts_ns = t * 1_000_000;
             let at = store.push(&f, Kind::Tpdo, Some(1));
-            st.add(&store.frame(at), at);
+            st.add(&store.frame(at), at, None);
         }
         let s = *st.iter().next().unwrap().1;
         assert_eq!(s.count, 5);
@@ -327,7 +329,7 @@ mod tests {
             let mut f = Frame::classic(0x181, &[0; 8]);
             (f.iface, f.ts_ns) = (iface, t * 1_000_000);
             let at = store.push(&f, Kind::Tpdo, Some(1));
-            st.add(&store.frame(at), at);
+            st.add(&store.frame(at), at, None);
         }
         // In the last second (0.5 s to 1.5 s): one frame of can0, none of can1.
         let bits = crate::output::busload::bus_bits(&Frame::classic(0x181, &[0; 8]));
@@ -359,7 +361,7 @@ mod tests {
         ];
         for f in &frames {
             let at = store.push(f, Kind::Other, None);
-            st.add(&store.frame(at), at);
+            st.add(&store.frame(at), at, None);
         }
         let got: Vec<((bool, u32), u64, usize)> = st.iter().map(|(k, s)| (*k, s.count, s.last_pos)).collect();
         assert_eq!(
@@ -379,7 +381,7 @@ mod tests {
         let mut f = Frame::classic(id, &[0; 8]);
         f.ts_ns = ms * 1_000_000;
         let at = store.push(&f, Kind::Other, None);
-        st.add(&store.frame(at), at);
+        st.add(&store.frame(at), at, None);
     }
 
     #[test]

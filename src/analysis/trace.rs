@@ -31,6 +31,7 @@ use crate::frame::{Frame, Interfaces, NodeKey};
 use crate::output::busload::Bitrate;
 use crate::output::summary::Summary;
 use crate::sdo::Transaction;
+use crate::wire::{Figures, WireError};
 
 /// Which views a [`Trace`] derives from its frames, chosen once at construction. Each
 /// mode other than [`Views::All`] is the fast path of one headless command: it decodes
@@ -198,6 +199,12 @@ impl Trace {
     /// checkpointed, classified into the store, counted in nodes and statistics), then the
     /// SDO transfers it completed go to the views that take them.
     pub fn push(&mut self, frame: &Frame) {
+        self.push_figured(frame, None);
+    }
+
+    /// [`Trace::push`] of a frame whose wire figures were worked out already (by the
+    /// thread that read it); `None`: worked out here when a view counts bits.
+    pub fn push_figured(&mut self, frame: &Frame, figures: Option<Result<Figures, WireError>>) {
         let pos = self.pushed;
         self.pushed += 1;
         let all = self.views == Views::All;
@@ -214,7 +221,7 @@ impl Trace {
                 let peeked @ (kind, node, _) = self.diagnose(frame);
                 self.cycles.frame(frame, pos, peeked);
                 let at = self.store.push(frame, kind, node);
-                self.stats.add(frame, at);
+                self.stats.add(frame, at, figures);
                 if let Some(n) = node {
                     self.nodes.frame(NodeKey::of(frame, n), frame.ts_ns);
                 }
@@ -224,7 +231,7 @@ impl Trace {
             }
             Views::Summary => {
                 let (kind, node) = self.decoder.classify(frame);
-                self.summary.add_frame(frame, kind, node);
+                self.summary.add_frame(frame, kind, node, figures);
             }
             // Only the transfers are kept: frames are tracked, not labelled.
             Views::Transactions => self.decoder.track(frame),

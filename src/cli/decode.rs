@@ -112,7 +112,14 @@ fn decode_stream(
     if let Pipeline::View(trace) = run {
         trace.new_input();
     }
-    let counts = input::for_each_frame(path, input, |frames| {
+    // A summary counts bus load: the reader's thread works out the wire figures.
+    let figured = matches!(run, Pipeline::View(trace) if trace.views() == Views::Summary);
+    let walk = if figured {
+        input::for_each_figured_frame
+    } else {
+        input::for_each_frame
+    };
+    let counts = walk(path, input, &mut |mut frames: input::Frames<'_>| {
         let ifaces = frames.ifaces;
         note_interfaces(names, ifaces);
         match run {
@@ -135,8 +142,8 @@ fn decode_stream(
             }
             Pipeline::View(trace) => {
                 trace.name_interfaces(ifaces);
-                for (_, frame) in frames {
-                    trace.push(frame);
+                while let Some((_, frame, figures)) = frames.next_figured() {
+                    trace.push_figured(frame, figures);
                 }
                 write_view(trace, fmt, names, &mut buf, &mut json, &mut label);
             }

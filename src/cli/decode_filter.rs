@@ -184,7 +184,7 @@ impl Run {
     fn take(&mut self, buf: &mut Vec<u8>, ready: Vec<Out>) {
         for o in ready {
             match o {
-                Out::Count(frame, kind, node) => self.trace.summary.add_frame(&frame, kind, node),
+                Out::Count(frame, kind, node) => self.trace.summary.add_frame(&frame, kind, node, None),
                 Out::Line(s) => buf.extend_from_slice(&s),
             }
         }

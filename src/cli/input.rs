@@ -7,6 +7,7 @@ use crate::log::{Counts, Format, Outcome};
 use crate::logio::read_ahead;
 pub use crate::logio::reader::report_counts;
 use crate::logio::reader::{Binary, Log, ReadAs};
+use crate::wire::{Figures, WireError};
 use clap::{Args, ValueEnum};
 use std::io::{self, BufReader};
 
@@ -133,22 +134,32 @@ pub fn open_input(path: &str, what: &str, format: Option<ReadAs>) -> Option<Log>
 pub struct Frames<'a> {
     path: &'a str,
     lines: std::slice::Iter<'a, (u64, Outcome)>,
+    /// The wire figures of the frames, when the reader worked them out
+    /// ([`for_each_figured_frame`]); empty otherwise.
+    figures: std::slice::Iter<'a, Result<Figures, WireError>>,
     /// The interface names the frames' `iface` indices refer to.
     pub ifaces: &'a Interfaces,
+}
+
+impl<'a> Frames<'a> {
+    /// The next frame with its wire figures, when the reader worked them out.
+    pub fn next_figured(&mut self) -> Option<(u64, &'a Frame, Option<Result<Figures, WireError>>)> {
+        for (line, outcome) in self.lines.by_ref() {
+            match outcome {
+                Outcome::Frame(f) => return Some((*line, f, self.figures.next().copied())),
+                Outcome::Skip(_) => {}
+                Outcome::Warning(msg) => eprintln!("{}:{line}: warning: {msg}", self.path),
+            }
+        }
+        None
+    }
 }
 
 impl<'a> Iterator for Frames<'a> {
     type Item = (u64, &'a Frame);
 
     fn next(&mut self) -> Option<(u64, &'a Frame)> {
-        for (line, outcome) in self.lines.by_ref() {
-            match outcome {
-                Outcome::Frame(f) => return Some((*line, f)),
-                Outcome::Skip(_) => {}
-                Outcome::Warning(msg) => eprintln!("{}:{line}: warning: {msg}", self.path),
-            }
-        }
-        None
+        self.next_figured().map(|(line, frame, _)| (line, frame))
     }
 }
 
@@ -160,9 +171,30 @@ impl<'a> Iterator for Frames<'a> {
 pub fn for_each_frame(
     path: &str,
     input: impl Into<Input>,
+    consume: impl FnMut(Frames<'_>) -> io::Result<()>,
+) -> io::Result<Counts> {
+    walk(path, input.into(), false, consume)
+}
+
+/// [`for_each_frame`] for a caller that counts bus load: the reader of one log works out
+/// each frame's wire figures on its own thread ([`Frames::next_figured`]); merged logs come
+/// without them.
+pub fn for_each_figured_frame(
+    path: &str,
+    input: impl Into<Input>,
+    consume: impl FnMut(Frames<'_>) -> io::Result<()>,
+) -> io::Result<Counts> {
+    walk(path, input.into(), true, consume)
+}
+
+/// [`for_each_frame`], the figures worked out by the reader when `figured`.
+fn walk(
+    path: &str,
+    input: Input,
+    figured: bool,
     mut consume: impl FnMut(Frames<'_>) -> io::Result<()>,
 ) -> io::Result<Counts> {
-    let log = match input.into() {
+    let log = match input {
         Input::One(log) => log,
         Input::Merged(inputs, per_file) => {
             super::merge::for_each_merged(
@@ -173,6 +205,7 @@ pub fn for_each_frame(
                     consume(Frames {
                         path,
                         lines: lines.iter(),
+                        figures: [].iter(),
                         ifaces,
                     })
                 },
@@ -182,13 +215,14 @@ pub fn for_each_frame(
     };
     let reader = log.reader(path)?;
     let mut ifaces = Interfaces::default();
-    let finished = read_ahead::for_each_batch(reader, |batch| {
+    let finished = read_ahead::for_each_batch(reader, figured, |batch| {
         for name in &batch.new_interfaces {
             ifaces.intern(name);
         }
         consume(Frames {
             path,
             lines: batch.lines.iter(),
+            figures: batch.figures.iter(),
             ifaces: &ifaces,
         })
     })??;

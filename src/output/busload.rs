@@ -4,6 +4,7 @@
 //! frames on the wire: they count nothing.
 
 use crate::frame::{Frame, NodeKey};
+use crate::wire::{Figures, WireError};
 use serde::Serialize;
 use std::collections::{HashMap, VecDeque};
 
@@ -201,16 +202,17 @@ impl BusLoad {
         &self.bitrate
     }
 
-    /// Counts one frame (of `node`, when it has one). Frames are taken in time order; a
-    /// frame's timestamp is taken as the end of its EOF.
+    /// Counts one frame (of `node`, when it has one) with its wire `figures` (`None`:
+    /// worked out here). Frames are taken in time order; a frame's timestamp is taken as
+    /// the end of its EOF.
     #[inline]
-    pub fn add(&mut self, frame: &Frame, node: Option<u8>) {
+    pub fn add(&mut self, frame: &Frame, node: Option<u8>, figures: Option<Result<Figures, WireError>>) {
         let per_iface = frame.iface != 0 || !self.ifaces.is_empty();
         if per_iface {
             self.iface_frame(frame.iface);
         }
         self.frames += 1;
-        let Ok(fig) = self.figures.figures(frame) else {
+        let Ok(fig) = figures.unwrap_or_else(|| self.figures.figures(frame)) else {
             return;
         };
         let bits = fig.bus_bits();
@@ -496,7 +498,7 @@ mod tests {
     fn the_summary_text_says_where_the_rate_came_from() {
         let bitrate = Bitrate::of_live(None, &[("vcan0", none("reports no bit rate"))]);
         let mut bus = BusLoad::new(bitrate);
-        bus.add(&at(0, 0x80, &[]), None);
+        bus.add(&at(0, 0x80, &[]), None, None);
         let mut out = String::new();
         bus.to_text(&mut out, |_, _| {});
         assert!(
@@ -517,12 +519,12 @@ mod tests {
     fn totals_per_node_and_load_by_hand() {
         let sync = crate::wire::figures(&Frame::classic(0x80, &[])).unwrap();
         let mut b = BusLoad::new(Bitrate::ASSUMED);
-        b.add(&at(0, 0x185, &[0x25, 0, 0xEA, 0]), Some(5));
-        b.add(&at(10, 0x80, &[]), None);
-        b.add(&at(1000, 0x185, &[0x25, 0, 0xEA, 0]), Some(5));
+        b.add(&at(0, 0x185, &[0x25, 0, 0xEA, 0]), Some(5), None);
+        b.add(&at(10, 0x80, &[]), None, None);
+        b.add(&at(1000, 0x185, &[0x25, 0, 0xEA, 0]), Some(5), None);
         let mut err = at(500, 4, &[0; 8]);
         err.flags = Flags(Flags::ERR);
-        b.add(&err, None);
+        b.add(&err, None, None);
         let total = 82 * 2 + u64::from(sync.bus_bits());
         assert_eq!(b.bits(), total);
         assert_eq!(b.by_node(), [(NodeKey::new(0, 5), 164)]);
@@ -545,10 +547,10 @@ mod tests {
         for i in 0..10u64 {
             let mut f = at(0, 0x185, &[0x25, 0, 0xEA, 0]);
             f.ts_ns = 1_000_000 + i * 100_000;
-            b.add(&f, Some(5));
+            b.add(&f, Some(5), None);
         }
         // A frame 10 ms later starts a new one.
-        b.add(&at(20, 0x185, &[0x25, 0, 0xEA, 0]), Some(5));
+        b.add(&at(20, 0x185, &[0x25, 0, 0xEA, 0]), Some(5), None);
         // From the start of the first (1 ms - 82 µs) to the end of the tenth (1.9 ms).
         assert_eq!(b.to_json(|k| k.node.to_string()).longest_burst_ms, 0.982);
         assert_eq!(b.load(), Some(11.0 * 82.0 / 19_000.0));

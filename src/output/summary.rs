@@ -3,6 +3,7 @@
 use super::busload::{BusJson, BusLoad, IfaceJson};
 use crate::decode::Kind;
 use crate::frame::{Frame, Interfaces, NodeKey};
+use crate::wire::{Figures, WireError};
 use serde::Serialize;
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write;
@@ -69,11 +70,18 @@ impl Summary {
         }
     }
 
-    /// Counts one frame: its kind and node, and its bits on the wire.
+    /// Counts one frame: its kind and node, and its bits on the wire (`figures`: worked
+    /// out already, else here).
     #[inline]
-    pub fn add_frame(&mut self, frame: &Frame, kind: Kind, node: Option<u8>) {
+    pub fn add_frame(
+        &mut self,
+        frame: &Frame,
+        kind: Kind,
+        node: Option<u8>,
+        figures: Option<Result<Figures, WireError>>,
+    ) {
         self.add_on(frame.iface, kind, node);
-        self.bus.add(frame, node);
+        self.bus.add(frame, node, figures);
     }
 
     /// Takes note of the interface names of the frames counted (a source's table grows as

@@ -115,7 +115,7 @@ impl Link {
     }
     /// The one transaction the tracker reassembled.
     fn seen(&mut self) -> Transaction {
-        let mut v = self.tracker.take_completed();
+        let mut v: Vec<Transaction> = self.tracker.drain_completed().collect();
         assert_eq!(v.len(), 1, "{v:#?}");
         v.remove(0)
     }

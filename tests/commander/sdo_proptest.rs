@@ -56,7 +56,7 @@ proptest! {
             let f = t.on_frame(i as u64, i as u64 * 1000, cotui::frame::NodeKey::new(0, *node), *c2s, bytes, &dict);
             prop_assert!(!f.label().is_empty());
             prop_assert!(serde_json::to_value(f.to_json()).unwrap()["cs"].is_string());
-            txns.extend(t.take_completed());
+            txns.extend(t.drain_completed());
         }
         txns.extend(t.finish());
         let mut seen = HashSet::new();

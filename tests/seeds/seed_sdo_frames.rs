@@ -78,7 +78,7 @@ impl Trace {
         f.label()
     }
     fn done(&mut self) -> Vec<Transaction> {
-        self.tracker.take_completed()
+        self.tracker.drain_completed().collect()
     }
     fn one(&mut self) -> Transaction {
         let mut v = self.done();

@@ -431,7 +431,7 @@ mod tests {
             let mut f = Frame::classic(id, &[0]);
             f.ts_ns = ms * 1_000_000;
             let at = store.push(&f, Kind::Other, None);
-            st.add(&store.frame(at), at);
+            st.add(&store.frame(at), at, None);
         };
         for (id, ms) in [(0x701, 0), (0x181, 0), (0x181, 10), (0x181, 20), (0x181, 30)] {
             push(id, ms);

@@ -17,7 +17,7 @@ pub struct Route {
 }
 
 impl Route {
-    fn new(kind: Kind, node: Option<u8>, pdo: u16) -> Route {
+    const fn new(kind: Kind, node: Option<u8>, pdo: u16) -> Route {
         Route {
             kind,
             node,
@@ -71,40 +71,60 @@ impl CobTable {
     }
 }
 
-/// CiA 301 predefined connection set for an 11-bit id.
+/// CiA 301 predefined connection set for an 11-bit id (a larger id is [`Kind::Other`]).
+#[inline]
 pub fn predefined(id: u32) -> Route {
-    let node = (id & 0x7F) as u8;
-    let func = id >> 7;
-    let with_node = |kind: Kind, pdo: u16| {
-        if node == 0 {
-            Route {
-                kind: Kind::Other,
-                node: None,
-                pdo: 0,
-                reserved: true,
-            }
-        } else {
-            Route::new(kind, Some(node), pdo)
-        }
-    };
+    match PREDEFINED.get(id as usize) {
+        Some(route) => *route,
+        None => Route::new(Kind::Other, None, 0),
+    }
+}
+
+/// [`predefined`] of every 11-bit id, made at compile time: a frame is routed by one load.
+static PREDEFINED: [Route; 2048] = {
+    let mut table = [Route::new(Kind::Other, None, 0); 2048];
+    let mut id = 0;
+    while id < 2048 {
+        table[id] = predefined_route(id as u32);
+        id += 1;
+    }
+    table
+};
+
+/// The route of a predefined connection with a node-ID in its low 7 bits (node 0 is
+/// reserved).
+const fn with_node(id: u32, kind: Kind, pdo: u16) -> Route {
+    match (id & 0x7F) as u8 {
+        0 => Route {
+            kind: Kind::Other,
+            node: None,
+            pdo: 0,
+            reserved: true,
+        },
+        node => Route::new(kind, Some(node), pdo),
+    }
+}
+
+/// The predefined connection set's route for an 11-bit id (CiA 301 7.3.5).
+const fn predefined_route(id: u32) -> Route {
     match id {
         0x000 => Route::new(Kind::Nmt, None, 0),
         0x080 => Route::new(Kind::Sync, None, 0),
         0x100 => Route::new(Kind::Time, None, 0),
         0x7E4 | 0x7E5 => Route::new(Kind::Lss, None, 0),
-        _ => match func {
-            0x1 => with_node(Kind::Emcy, 0),
-            0x3 => with_node(Kind::Tpdo, 1),
-            0x4 => with_node(Kind::Rpdo, 1),
-            0x5 => with_node(Kind::Tpdo, 2),
-            0x6 => with_node(Kind::Rpdo, 2),
-            0x7 => with_node(Kind::Tpdo, 3),
-            0x8 => with_node(Kind::Rpdo, 3),
-            0x9 => with_node(Kind::Tpdo, 4),
-            0xA => with_node(Kind::Rpdo, 4),
-            0xB => with_node(Kind::SdoTx, 0),
-            0xC => with_node(Kind::SdoRx, 0),
-            0xE => with_node(Kind::Heartbeat, 0),
+        _ => match id >> 7 {
+            0x1 => with_node(id, Kind::Emcy, 0),
+            0x3 => with_node(id, Kind::Tpdo, 1),
+            0x4 => with_node(id, Kind::Rpdo, 1),
+            0x5 => with_node(id, Kind::Tpdo, 2),
+            0x6 => with_node(id, Kind::Rpdo, 2),
+            0x7 => with_node(id, Kind::Tpdo, 3),
+            0x8 => with_node(id, Kind::Rpdo, 3),
+            0x9 => with_node(id, Kind::Tpdo, 4),
+            0xA => with_node(id, Kind::Rpdo, 4),
+            0xB => with_node(id, Kind::SdoTx, 0),
+            0xC => with_node(id, Kind::SdoRx, 0),
+            0xE => with_node(id, Kind::Heartbeat, 0),
             // 0x001-0x07F, 0x101-0x17F, 0x680-0x6FF and 0x780-0x7FF (except LSS) are
             // reserved or used by other CiA specifications.
             _ => Route {
@@ -118,7 +138,7 @@ pub fn predefined(id: u32) -> Route {
 }
 
 /// CiA 301 reserved COB-IDs (CiA 301 7.3.5, table 65 and CiA 305 for LSS).
-pub(crate) fn is_reserved(id: u32) -> bool {
+pub(crate) const fn is_reserved(id: u32) -> bool {
     matches!(id, 0x001..=0x07F | 0x101..=0x180 | 0x580 | 0x600 | 0x6E0..=0x6FF | 0x700 | 0x780..=0x7FF)
         && !matches!(id, 0x7E4 | 0x7E5)
 }

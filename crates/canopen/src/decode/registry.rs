@@ -608,7 +608,7 @@ impl Decoder {
         }
         let dict = &self.dicts[n as usize & 0x7F];
         let s = self.sdo.track(self.seq, frame.ts_ns, key, c2s, frame.payload(), dict);
-        for mut t in self.sdo.take_completed() {
+        for mut t in self.sdo.drain_completed() {
             let dict = &self.dicts[t.node as usize & 0x7F];
             let bus = Self::bus_in(&mut self.buses, &self.fresh, t.iface);
             t.mode = bus.mode(t.node);

@@ -125,8 +125,10 @@ impl Pending {
     }
 }
 
-/// Per-channel state; an idle one (the default) is not kept, so a capture of many
-/// interfaces or channels costs only the transfers running.
+/// Per-channel state; an idle one is the same as the default. Idle states stay in the
+/// map (a channel's next transfer finds its place) until there are more than
+/// [`IDLE_KEPT`] channels, so a capture of many interfaces or channels costs only the
+/// transfers running and a few idle channels.
 #[derive(Clone, Debug, Default)]
 struct ChannelState {
     pending: Option<Pending>,
@@ -167,10 +169,16 @@ pub struct Tracked {
     pub problems: Vec<String>,
 }
 
+/// Channels kept before idle ones are dropped: a bus's every node's default channel and
+/// then some, while memory stays a few hundred kilobytes.
+const IDLE_KEPT: usize = 1024;
+
 /// Tracks SDO transfers on every channel and collects completed transactions.
 #[derive(Clone, Debug, Default)]
 pub struct TransferTracker {
     channels: BTreeMap<Channel, ChannelState>,
+    /// The number of channels past which idle ones are dropped (0: [`IDLE_KEPT`]).
+    sweep_at: usize,
     completed: Vec<Transaction>,
 }
 
@@ -217,9 +225,7 @@ impl TransferTracker {
             // Shown as malformed, never allowed to disturb a running transfer.
             // A client's unknown command awaits a reply; a server's unknown command is that reply.
             state.unknown_request = side == Side::Client;
-            if state.is_idle() {
-                self.channels.remove(&channel);
-            }
+            self.sweep();
             return tracked;
         }
         let ctx = FrameCtx {
@@ -243,31 +249,34 @@ impl TransferTracker {
             completed: &mut self.completed,
             dict,
         };
-        let ended = match state.pending.take() {
-            Some(p) => advance(state, p, &ctx, &mut out),
-            None => {
-                start(state, &ctx, &mut out);
-                None
-            }
-        };
+        let ended = advance(state, &ctx, &mut out);
         let pending = state.pending.as_ref().and_then(Pending::object);
-        if state.is_idle() {
-            self.channels.remove(&channel);
-        }
         tracked.object = tracked.object.or(ended).or(pending);
         tracked.problems = out.notes;
+        self.sweep();
         tracked
     }
 
-    /// Transactions completed since the last call, oldest first.
-    pub fn take_completed(&mut self) -> Vec<Transaction> {
-        std::mem::take(&mut self.completed)
+    /// Drops the idle channels once there are more channels than [`IDLE_KEPT`] (or twice
+    /// as many as were running at the last sweep).
+    fn sweep(&mut self) {
+        if self.channels.len() <= self.sweep_at.max(IDLE_KEPT) {
+            return;
+        }
+        self.channels.retain(|_, state| !state.is_idle());
+        self.sweep_at = self.channels.len() * 2;
+    }
+
+    /// Transactions completed since the last call, oldest first (the list keeps its room
+    /// for the next ones).
+    pub fn drain_completed(&mut self) -> std::vec::Drain<'_, Transaction> {
+        self.completed.drain(..)
     }
 
     /// Ends the input: every transfer still running becomes [`Outcome::Incomplete`];
     /// returns them after any completed ones not yet taken.
     pub fn finish(&mut self) -> Vec<Transaction> {
-        let mut out = self.take_completed();
+        let mut out = std::mem::take(&mut self.completed);
         for (_, state) in std::mem::take(&mut self.channels) {
             if let Some(p) = state.pending.filter(|p| !p.tentative) {
                 let mut t = p.txn;
@@ -430,10 +439,15 @@ fn new_txn(ctx: &FrameCtx, index: u16, sub: u8, dir: TransferDirection, proto: P
     }
 }
 
-/// Runs a frame through the transfer pending on the channel; returns the object of the
-/// transfer when the frame ended it.
-fn advance(state: &mut ChannelState, mut p: Pending, ctx: &FrameCtx, out: &mut Out) -> Option<(u16, u8)> {
-    match step(&mut p, ctx, out) {
+/// Runs a frame through the transfer pending on the channel (it stays in place while it
+/// goes on), or [`start`]s one when none is; returns the object of the transfer when the
+/// frame ended it.
+fn advance(state: &mut ChannelState, ctx: &FrameCtx, out: &mut Out) -> Option<(u16, u8)> {
+    let Some(p) = state.pending.as_mut() else {
+        start(state, ctx, out);
+        return None;
+    };
+    match step(p, ctx, out) {
         Step::Continue => {
             if std::mem::take(&mut p.tentative) {
                 let dir = p.txn.direction.as_str();
@@ -441,24 +455,28 @@ fn advance(state: &mut ChannelState, mut p: Pending, ctx: &FrameCtx, out: &mut O
                     .push(format!("resynchronised: block {dir} started before the capture"));
             }
             attach(&mut p.txn, ctx);
-            state.pending = Some(p);
             None
         }
         Step::Complete(outcome) => {
             attach(&mut p.txn, ctx);
             let object = p.object();
-            out.complete(p, outcome);
+            if let Some(p) = state.pending.take() {
+                out.complete(p, outcome);
+            }
             object
         }
         Step::Unexpected if p.tentative || ctx.reveals_opener => {
             // One impossible byte was not the start of a run after all, or one
             // seemingly valid command was its start: either way no transaction.
+            state.pending = None;
             start(state, ctx, out);
             None
         }
         Step::Unexpected => {
-            let outcome = interrupted(&p, ctx);
-            out.complete(p, outcome);
+            if let Some(p) = state.pending.take() {
+                let outcome = interrupted(&p, ctx);
+                out.complete(p, outcome);
+            }
             start(state, ctx, out);
             None
         }

@@ -67,9 +67,9 @@ impl SdoTracker {
         labelled(tracked, payload, dict)
     }
 
-    /// Transactions completed since the last call, oldest first.
-    pub fn take_completed(&mut self) -> Vec<Transaction> {
-        self.transfers.take_completed()
+    /// Transactions completed since the last call, oldest first (the list keeps its room).
+    pub fn drain_completed(&mut self) -> std::vec::Drain<'_, Transaction> {
+        self.transfers.drain_completed()
     }
 
     /// Ends the input: every transfer still running becomes incomplete; returns them after

@@ -68,7 +68,7 @@ impl Bus {
         self.send(node, false, bytes)
     }
     fn done(&mut self) -> Vec<Transaction> {
-        self.t.take_completed()
+        self.t.drain_completed().collect()
     }
     fn one(&mut self) -> Transaction {
         let mut v = self.done();
@@ -216,6 +216,56 @@ fn segmented_download() {
         t.label(&bus.dict),
         "Download 0x1008:00 Manufacturer device name = \"DEXMART DEV 1.0\" (segmented, 15 bytes, 7.000 ms): ok"
     );
+}
+
+/// Transfers on thousands of channels (idle ones are dropped past a thousand): each
+/// completes as on one channel, and a segmented download running meanwhile, and an
+/// unanswered request on another channel, go on through the drops.
+#[test]
+fn many_channels_keep_their_running_transfers() {
+    let d = dict();
+    let mut t = SdoTracker::new();
+    let seq = &mut 0u64;
+    let mut send = |t: &mut SdoTracker, iface: u16, node: u8, c2s: bool, bytes: &[u8]| {
+        *seq += 1;
+        t.on_frame(*seq, *seq * 1000, NodeKey::new(iface, node), c2s, bytes, &d)
+    };
+    send(&mut t, 0, 5, true, &[0x21, 0x08, 0x10, 0x00, 8, 0, 0, 0]);
+    send(&mut t, 0, 5, false, &[0x60, 0x08, 0x10, 0x00, 0, 0, 0, 0]);
+    send(&mut t, 0, 6, true, &[0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0]);
+    for i in 0..5000u32 {
+        let (iface, node) = (1 + (i / 100) as u16, 1 + (i % 100) as u8);
+        send(&mut t, iface, node, true, &[0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0]);
+        send(
+            &mut t,
+            iface,
+            node,
+            false,
+            &[0x43, 0x00, 0x10, 0x00, 0x92, 0x01, 0x02, 0x00],
+        );
+    }
+    let done: Vec<_> = t.drain_completed().collect();
+    assert_eq!(done.len(), 5000);
+    assert!(
+        done.iter()
+            .all(|x| x.outcome == Outcome::Ok && x.data == [0x92, 0x01, 0x02, 0x00])
+    );
+    let f = send(&mut t, 0, 5, true, &[0x00, b'D', b'E', b'X', b'M', b'A', b'R', b'T']);
+    assert_eq!(f.label(), "Download segment t=0 \"DEXMART\" c=0");
+    send(&mut t, 0, 5, false, &[0x20, 0, 0, 0, 0, 0, 0, 0]);
+    send(&mut t, 0, 5, true, &[0x1D, b'!', 0, 0, 0, 0, 0, 0]);
+    send(&mut t, 0, 5, false, &[0x30, 0, 0, 0, 0, 0, 0, 0]);
+    let f = send(&mut t, 0, 6, false, &[0x43, 0x00, 0x10, 0x00, 0x92, 0x01, 0x02, 0x00]);
+    assert!(f.problems.is_empty(), "{:?}", f.problems);
+    let done: Vec<_> = t.drain_completed().collect();
+    assert_eq!(done.len(), 2);
+    assert_eq!(
+        (done[0].node, done[0].data.as_slice(), &done[0].outcome),
+        (5, &b"DEXMART!"[..], &Outcome::Ok)
+    );
+    assert!(done[0].problems.is_empty(), "{:?}", done[0].problems);
+    assert_eq!((done[1].node, &done[1].outcome), (6, &Outcome::Ok));
+    assert!(done[1].problems.is_empty(), "{:?}", done[1].problems);
 }
 
 #[test]
@@ -650,7 +700,7 @@ fn non_default_channel() {
     t.on_channel_frame(1, 10, ch, Side::Client, &[0x40, 0x41, 0x60, 0, 0, 0, 0, 0], &d);
     t.on_frame(2, 11, NodeKey::new(0, 7), false, &[0x4B, 0x41, 0x60, 0, 1, 0, 0, 0], &d);
     t.on_channel_frame(3, 12, ch, Side::Server, &[0x4B, 0x41, 0x60, 0, 2, 0, 0, 0], &d);
-    let v = t.take_completed();
+    let v: Vec<_> = t.drain_completed().collect();
     assert_eq!(v.len(), 2);
     assert_eq!(v[0].problems, vec![Problem::UnmatchedResponse]);
     assert_eq!((v[1].channel, v[1].data.as_slice()), (ch, &[2u8, 0][..]));
