@@ -9,8 +9,8 @@
 
 use crate::frame::Frame;
 use crate::output::busload::Bitrate;
+use crate::wire::WireFigures;
 use crate::wire::cache::FiguresCache;
-use crate::wire::{Figures, WireError};
 use std::collections::{BTreeMap, VecDeque};
 
 /// Statistics of one identifier.
@@ -165,7 +165,7 @@ impl Stats {
     }
 
     /// Adds `frame`, just stored at position `pos`.
-    pub fn add(&mut self, frame: &Frame, pos: usize, figures: Option<Result<Figures, WireError>>) {
+    pub fn add(&mut self, frame: &Frame, pos: usize, figures: Option<WireFigures>) {
         let i = self.index(frame.is_ext(), frame.id);
         let s = &mut self.entries[i];
         if s.count == 0 {

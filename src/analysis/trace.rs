@@ -31,7 +31,7 @@ use crate::frame::{Frame, Interfaces, NodeKey};
 use crate::output::busload::Bitrate;
 use crate::output::summary::Summary;
 use crate::sdo::Transaction;
-use crate::wire::{Figures, WireError};
+use crate::wire::WireFigures;
 
 /// Which views a [`Trace`] derives from its frames, chosen once at construction. Each
 /// mode other than [`Views::All`] is the fast path of one headless command: it decodes
@@ -204,7 +204,7 @@ impl Trace {
 
     /// [`Trace::push`] of a frame whose wire figures were worked out already (by the
     /// thread that read it); `None`: worked out here when a view counts bits.
-    pub fn push_figured(&mut self, frame: &Frame, figures: Option<Result<Figures, WireError>>) {
+    pub fn push_figured(&mut self, frame: &Frame, figures: Option<WireFigures>) {
         let pos = self.pushed;
         self.pushed += 1;
         let all = self.views == Views::All;

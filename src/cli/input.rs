@@ -7,7 +7,7 @@ use crate::log::{Counts, Format, Outcome};
 use crate::logio::read_ahead;
 pub use crate::logio::reader::report_counts;
 use crate::logio::reader::{Binary, Log, ReadAs};
-use crate::wire::{Figures, WireError};
+use crate::wire::WireFigures;
 use clap::{Args, ValueEnum};
 use std::io::{self, BufReader};
 
@@ -136,14 +136,14 @@ pub struct Frames<'a> {
     lines: std::slice::Iter<'a, (u64, Outcome)>,
     /// The wire figures of the frames, when the reader worked them out
     /// ([`for_each_figured_frame`]); empty otherwise.
-    figures: std::slice::Iter<'a, Result<Figures, WireError>>,
+    figures: std::slice::Iter<'a, WireFigures>,
     /// The interface names the frames' `iface` indices refer to.
     pub ifaces: &'a Interfaces,
 }
 
 impl<'a> Frames<'a> {
     /// The next frame with its wire figures, when the reader worked them out.
-    pub fn next_figured(&mut self) -> Option<(u64, &'a Frame, Option<Result<Figures, WireError>>)> {
+    pub fn next_figured(&mut self) -> Option<(u64, &'a Frame, Option<WireFigures>)> {
         for (line, outcome) in self.lines.by_ref() {
             match outcome {
                 Outcome::Frame(f) => return Some((*line, f, self.figures.next().copied())),

@@ -59,7 +59,7 @@ pub fn merged_feed(inputs: Vec<(String, Log)>, per_file: bool) -> Receiver<Feed>
                     crate::log::Outcome::Frame(f) => Some(*f),
                     _ => None,
                 });
-                tx.send(Feed::Frames(frames.collect())).map_err(|_| gone())
+                tx.send(Feed::frames(frames.collect())).map_err(|_| gone())
             },
         );
         if let Err(e) = result {

@@ -3,8 +3,8 @@
 
 use crate::log::{Counts, Outcome};
 use crate::logio::reader::Reader;
+use crate::wire::WireFigures;
 use crate::wire::cache::FiguresCache;
-use crate::wire::{Figures, WireError};
 use std::io::{self, BufRead};
 use std::sync::mpsc;
 
@@ -19,11 +19,11 @@ pub struct Batch {
     pub new_interfaces: Vec<String>,
     /// The wire figures of each frame among `lines`, in order, when they were asked for
     /// (worked out on the reader's thread); empty otherwise.
-    pub figures: Vec<Result<Figures, WireError>>,
+    pub figures: Vec<WireFigures>,
 }
 
 /// Works out the wire figures of the frames of `lines` into `figures` (emptied first).
-fn figure(cache: &mut FiguresCache, lines: &[(u64, Outcome)], figures: &mut Vec<Result<Figures, WireError>>) {
+fn figure(cache: &mut FiguresCache, lines: &[(u64, Outcome)], figures: &mut Vec<WireFigures>) {
     figures.clear();
     for (_, outcome) in lines {
         if let Outcome::Frame(f) = outcome {

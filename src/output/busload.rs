@@ -4,7 +4,7 @@
 //! frames on the wire: they count nothing.
 
 use crate::frame::{Frame, NodeKey};
-use crate::wire::{Figures, WireError};
+use crate::wire::WireFigures;
 use serde::Serialize;
 use std::collections::{HashMap, VecDeque};
 
@@ -206,7 +206,7 @@ impl BusLoad {
     /// worked out here). Frames are taken in time order; a frame's timestamp is taken as
     /// the end of its EOF.
     #[inline]
-    pub fn add(&mut self, frame: &Frame, node: Option<u8>, figures: Option<Result<Figures, WireError>>) {
+    pub fn add(&mut self, frame: &Frame, node: Option<u8>, figures: Option<WireFigures>) {
         let per_iface = frame.iface != 0 || !self.ifaces.is_empty();
         if per_iface {
             self.iface_frame(frame.iface);

@@ -3,7 +3,7 @@
 use super::busload::{BusJson, BusLoad, IfaceJson};
 use crate::decode::Kind;
 use crate::frame::{Frame, Interfaces, NodeKey};
-use crate::wire::{Figures, WireError};
+use crate::wire::WireFigures;
 use serde::Serialize;
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write;
@@ -73,13 +73,7 @@ impl Summary {
     /// Counts one frame: its kind and node, and its bits on the wire (`figures`: worked
     /// out already, else here).
     #[inline]
-    pub fn add_frame(
-        &mut self,
-        frame: &Frame,
-        kind: Kind,
-        node: Option<u8>,
-        figures: Option<Result<Figures, WireError>>,
-    ) {
+    pub fn add_frame(&mut self, frame: &Frame, kind: Kind, node: Option<u8>, figures: Option<WireFigures>) {
         self.add_on(frame.iface, kind, node);
         self.bus.add(frame, node, figures);
     }

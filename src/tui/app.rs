@@ -658,7 +658,7 @@ mod tests {
             let mut a = app();
             a.capture_mut().trace_mut().clear();
             *a.capture_mut().source_mut() = SourceInfo::new("x.log", kind, frx, None);
-            ftx.send(Feed::Frames(frames())).unwrap();
+            ftx.send(Feed::frames(frames())).unwrap();
             (a, ftx)
         };
         let (mut a, ftx) = fresh(SourceKind::Open);
@@ -706,7 +706,7 @@ mod tests {
                 f
             })
             .collect();
-        ftx.send(Feed::Frames(batch)).unwrap();
+        ftx.send(Feed::frames(batch)).unwrap();
         a.ingest(Duration::from_millis(100));
         (a, t0)
     }

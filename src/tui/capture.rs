@@ -247,10 +247,11 @@ impl Capture {
             return Flow::Empty;
         };
         match feed.try_recv() {
-            Ok(Feed::Frames(batch)) => {
+            Ok(Feed::Frames { frames: batch, figures }) => {
+                let mut figures = figures.into_iter();
                 for f in &batch {
                     self.commanded.observe(f);
-                    self.trace.push(f);
+                    self.trace.push_figured(f, figures.next());
                 }
                 self.clock = batch.last().map(|f| (f.ts_ns, Instant::now()));
                 self.record(&batch, q);

@@ -81,9 +81,9 @@ impl FrameFeed {
     }
 
     fn try_frames(&self, batch: Vec<Frame>) -> Offered {
-        match self.tx.try_send(Feed::Frames(batch)) {
+        match self.tx.try_send(Feed::frames(batch)) {
             Ok(()) => Offered::Sent,
-            Err(TrySendError::Full(Feed::Frames(b))) => Offered::Full(b),
+            Err(TrySendError::Full(Feed::Frames { frames: b, .. })) => Offered::Full(b),
             // Only frames are offered here.
             Err(TrySendError::Full(_)) => Offered::Sent,
             Err(TrySendError::Disconnected(_)) => Offered::Gone,
@@ -112,7 +112,7 @@ impl FrameFeed {
     pub(super) fn send(&mut self, item: Feed) -> bool {
         while let Some(b) = self.backlog.pop_front() {
             self.waiting -= b.len();
-            if self.tx.send(Feed::Frames(b)).is_err() {
+            if self.tx.send(Feed::frames(b)).is_err() {
                 return false;
             }
         }
@@ -147,7 +147,7 @@ mod tests {
     fn drain(rx: &Receiver<Feed>) -> Vec<u64> {
         let mut times = Vec::new();
         while let Ok(f) = rx.try_recv() {
-            if let Feed::Frames(b) = f {
+            if let Feed::Frames { frames: b, .. } = f {
                 times.extend(b.iter().map(|f| f.ts_ns));
             }
         }
@@ -188,7 +188,7 @@ mod tests {
         let (mut times, mut notes) = (Vec::new(), Vec::new());
         while notes.is_empty() {
             match rx.recv() {
-                Ok(Feed::Frames(b)) => times.extend(b.iter().map(|f| f.ts_ns)),
+                Ok(Feed::Frames { frames: b, .. }) => times.extend(b.iter().map(|f| f.ts_ns)),
                 Ok(Feed::Status(s)) => notes.push(format!("{s} after {}", times.len())),
                 Ok(_) => {}
                 Err(e) => panic!("the feed closed: {e}"),

@@ -5,6 +5,8 @@
 use crate::frame::Frame;
 use crate::log::Outcome;
 use crate::logio::reader::{ReadAs, Reader};
+use crate::wire::WireFigures;
+use crate::wire::cache::FiguresCache;
 use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
@@ -21,8 +23,13 @@ const LINES: usize = 1024;
 /// What a capture task sends.
 #[derive(Debug)]
 pub enum Feed {
-    /// Frames in order.
-    Frames(Vec<Frame>),
+    /// Frames in order, with their wire figures in the same order when the sending thread
+    /// worked them out (a log read or replayed: bus load is then counted on its core, not
+    /// the UI's); empty otherwise.
+    Frames {
+        frames: Vec<Frame>,
+        figures: Vec<WireFigures>,
+    },
     /// Interface names first seen since the previous such message, in index order
     /// (frames index into the table they extend).
     Interfaces(Vec<String>),
@@ -52,6 +59,16 @@ pub enum Feed {
     /// The result of a stop-all, as [`Feed::Result`], with the nodes not confirmed stopped
     /// (every target when nothing could be sent).
     Stopped(super::messages::Level, String, Vec<u8>),
+}
+
+impl Feed {
+    /// Frames without their wire figures (the UI works them out).
+    pub fn frames(frames: Vec<Frame>) -> Feed {
+        Feed::Frames {
+            frames,
+            figures: Vec::new(),
+        }
+    }
 }
 
 /// A change of one interface's condition, from a live capture task.
@@ -134,6 +151,7 @@ pub fn open(path: PathBuf, format: Option<ReadAs>) -> Receiver<Feed> {
         };
         let _ = tx.send(Feed::Status(opened(&path, &r)));
         let mut batch = Vec::with_capacity(BATCH);
+        let mut figures = FiguresCache::new();
         let mut lines = Vec::with_capacity(LINES);
         let mut names = 0;
         let mut first_warning = None;
@@ -149,7 +167,7 @@ pub fn open(path: PathBuf, format: Option<ReadAs>) -> Receiver<Feed> {
                     }
                     Outcome::Skip(_) => {}
                 }
-                if batch.len() == BATCH && !send_batch(&tx, &mut batch, &r, &mut names) {
+                if batch.len() == BATCH && !send_batch(&tx, &mut batch, &mut figures, &r, &mut names) {
                     return;
                 }
             }
@@ -161,7 +179,7 @@ pub fn open(path: PathBuf, format: Option<ReadAs>) -> Receiver<Feed> {
                 break;
             }
         }
-        send_batch(&tx, &mut batch, &r, &mut names);
+        send_batch(&tx, &mut batch, &mut figures, &r, &mut names);
         let w = r.counts().warnings;
         if w > 0 {
             let first = first_warning.unwrap_or_default();
@@ -178,10 +196,12 @@ fn opened<R: std::io::BufRead>(path: &Path, r: &Reader<R>) -> String {
     format!("{name}: {}", r.format_name())
 }
 
-/// Sends the batch (and new interface names first); false when the UI is gone.
+/// Sends the batch with its wire figures (worked out here, with `figures`'s memo), new
+/// interface names first; false when the UI is gone.
 fn send_batch<R: std::io::BufRead>(
     tx: &SyncSender<Feed>,
     batch: &mut Vec<Frame>,
+    figures: &mut FiguresCache,
     r: &Reader<R>,
     names: &mut usize,
 ) -> bool {
@@ -196,8 +216,9 @@ fn send_batch<R: std::io::BufRead>(
     if batch.is_empty() {
         return true;
     }
-    tx.send(Feed::Frames(std::mem::replace(batch, Vec::with_capacity(BATCH))))
-        .is_ok()
+    let frames = std::mem::replace(batch, Vec::with_capacity(BATCH));
+    let figures = frames.iter().map(|f| figures.figures(f)).collect();
+    tx.send(Feed::Frames { frames, figures }).is_ok()
 }
 
 /// Replay speeds accepted besides 0 (as fast as possible).
@@ -247,6 +268,7 @@ pub fn replay(path: PathBuf, speed: f64, format: Option<ReadAs>) -> (Receiver<Fe
             first_ns: None,
             looping: false,
             said_format: false,
+            figures: FiguresCache::new(),
         };
         if let Err(e) = player.run() {
             let _ = player.tx.send(Feed::Status(e.to_string()));
@@ -281,6 +303,8 @@ struct Player {
     looping: bool,
     /// The format detected was said (on the first play only).
     said_format: bool,
+    /// The wire figures of the frames played, for those that come again.
+    figures: FiguresCache,
 }
 
 /// Why the replay loop stopped reading.
@@ -509,13 +533,13 @@ impl Player {
 
     /// Sends the batch and the position; false when the UI is gone.
     fn flush<R: std::io::BufRead>(
-        &self,
+        &mut self,
         batch: &mut Vec<Frame>,
         r: &Reader<R>,
         names: &mut usize,
         at: Position,
     ) -> bool {
-        send_batch(&self.tx, batch, r, names) && self.tx.send(Feed::Position(at)).is_ok()
+        send_batch(&self.tx, batch, &mut self.figures, r, names) && self.tx.send(Feed::Position(at)).is_ok()
     }
 
     /// Applies a command with the replay at `at`.
@@ -591,7 +615,7 @@ mod tests {
         let (mut frames, mut resets, mut notes) = (0, 0, Vec::new());
         for f in rx.iter() {
             match f {
-                Feed::Frames(b) => frames += b.len(),
+                Feed::Frames { frames: b, .. } => frames += b.len(),
                 Feed::Reset => resets += 1,
                 Feed::Status(s) => notes.push(s),
                 Feed::Interfaces(n) => assert_eq!(n, ["can0"]),
@@ -651,7 +675,7 @@ mod tests {
         fn until(&mut self, rx: &Receiver<Feed>, done: impl Fn(&Ui) -> bool) {
             while !done(self) {
                 match rx.recv_timeout(Duration::from_secs(60)).expect("the replay answers") {
-                    Feed::Frames(b) => self.frames.extend(b),
+                    Feed::Frames { frames: b, .. } => self.frames.extend(b),
                     Feed::Reset => {
                         self.frames.clear();
                         self.resets += 1;
@@ -679,7 +703,7 @@ mod tests {
             .iter()
             .take_while(|f| !matches!(f, Feed::Done))
             .flat_map(|f| match f {
-                Feed::Frames(b) => b,
+                Feed::Frames { frames: b, .. } => b,
                 _ => Vec::new(),
             })
             .collect()

@@ -515,7 +515,7 @@ fn stop_all_in_the_live_task_cancels_a_running_procedure_first() {
     let give_up = Instant::now() + Duration::from_secs(60);
     while Instant::now() < give_up {
         match feed.recv_timeout(Duration::from_millis(100)) {
-            Ok(Feed::Frames(batch)) => {
+            Ok(Feed::Frames { frames: batch, .. }) => {
                 for f in batch {
                     let p = f.payload();
                     if f.id == 0x602 && f.direction() == cotui::frame::Direction::Tx && p[..4] == [0x2B, 0x40, 0x60, 0]

@@ -174,12 +174,25 @@ pub struct Tracked {
 const IDLE_KEPT: usize = 1024;
 
 /// Tracks SDO transfers on every channel and collects completed transactions.
-#[derive(Clone, Debug, Default)]
+#[derive(Debug, Default)]
 pub struct TransferTracker {
     channels: BTreeMap<Channel, ChannelState>,
     /// The number of channels past which idle ones are dropped (0: [`IDLE_KEPT`]).
     sweep_at: usize,
     completed: Vec<Transaction>,
+}
+
+/// A clone carries the running channels only (an idle state is the same as none): the
+/// TUI keeps a decoder clone every few thousand frames, and idle states would add up.
+impl Clone for TransferTracker {
+    fn clone(&self) -> TransferTracker {
+        let running = self.channels.iter().filter(|(_, state)| !state.is_idle());
+        TransferTracker {
+            channels: running.map(|(channel, state)| (*channel, state.clone())).collect(),
+            sweep_at: 0,
+            completed: self.completed.clone(),
+        }
+    }
 }
 
 impl TransferTracker {

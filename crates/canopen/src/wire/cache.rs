@@ -2,7 +2,7 @@
 //! frames (heartbeats, SYNC, constant PDOs, SDO polls), and a repeated frame's figures are
 //! found by one hash and one compare instead of being computed again.
 
-use super::{Figures, WireError, figures};
+use super::{Figures, WireFigures, figures};
 use crate::frame::Frame;
 
 /// Sets in the memo, of two slots each (the most recently used first): 66 % of the frames
@@ -40,7 +40,7 @@ impl FiguresCache {
 
     /// [`figures`] of `frame`: remembered when the same classic frame came before.
     #[inline]
-    pub fn figures(&mut self, frame: &Frame) -> Result<Figures, WireError> {
+    pub fn figures(&mut self, frame: &Frame) -> WireFigures {
         if frame.is_fd() || frame.is_err() || frame.len > 8 {
             return figures(frame);
         }

@@ -118,6 +118,9 @@ pub struct Bit {
     pub stuff: bool,
 }
 
+/// A frame's [`Figures`], or why it has none (what the bus-load counters take).
+pub type WireFigures = Result<Figures, WireError>;
+
 /// The figures of a frame on the wire.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Figures {
@@ -321,7 +324,7 @@ impl Layout {
 /// frames go a whole byte at a time through the CRC and stuffing tables: the fields from
 /// SOF to the DLC end where the data bytes start, so the frame up to its CRC is whole bytes
 /// once a few bits go before SOF (see [`classic_head`]).
-pub fn figures(frame: &Frame) -> Result<Figures, WireError> {
+pub fn figures(frame: &Frame) -> WireFigures {
     if frame.is_fd() || frame.is_err() || frame.len > 8 {
         let layout = Layout::of(frame)?;
         return Ok(walk(&layout, &mut |_| {}));
