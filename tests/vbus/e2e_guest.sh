@@ -1282,12 +1282,13 @@ if ip link set can0 type can bitrate 250000 && ip link set can0 up &&
     can_peer=$!
     pids+=($can_peer)
     if wait_for sdo_can1.out 900 "sdo_server ready can1 5"; then
-        # The python peer answers at TCG's pace on a loaded machine: 5 s per answer.
-        c sdo read can0 5 0x1008 --json --type string --timeout 5s
+        # The python peer answers at TCG's pace on a loaded machine: the timeout only bounds a
+        # peer that never answers (5 s per answer ran out once next to a parallel build).
+        c sdo read can0 5 0x1008 --json --type string --timeout 30s
         [ $rc = 0 ] && [ "$(echo "$out" | j .value)" = "vbus sdo peer" ] &&
             ok "controllers: cotui sdo read can0 5 0x1008 through two controllers = \"vbus sdo peer\"" ||
             bad "controllers: sdo read 0x1008: rc=$rc $out $err"
-        c sdo read can0 5 0x2005 --json --block --timeout 5s
+        c sdo read can0 5 0x2005 --json --block --timeout 30s
         [ $rc = 0 ] && [ "$(echo "$out" | j .len)" = 300 ] &&
             ok "controllers: block read of 0x2005 (300 bytes) on can0" ||
             bad "controllers: sdo read 0x2005: rc=$rc $out $err"
