@@ -114,12 +114,7 @@ fn decode_stream(
     }
     // A summary counts bus load: the reader's thread works out the wire figures.
     let figured = matches!(run, Pipeline::View(trace) if trace.views() == Views::Summary);
-    let walk = if figured {
-        input::for_each_figured_frame
-    } else {
-        input::for_each_frame
-    };
-    let counts = walk(path, input, &mut |mut frames: input::Frames<'_>| {
+    let counts = input::for_each_frame_figured(path, input, figured, |mut frames| {
         let ifaces = frames.ifaces;
         note_interfaces(names, ifaces);
         match run {

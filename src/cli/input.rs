@@ -135,7 +135,7 @@ pub struct Frames<'a> {
     path: &'a str,
     lines: std::slice::Iter<'a, (u64, Outcome)>,
     /// The wire figures of the frames, when the reader worked them out
-    /// ([`for_each_figured_frame`]); empty otherwise.
+    /// ([`for_each_frame_figured`]); empty otherwise.
     figures: std::slice::Iter<'a, WireFigures>,
     /// The interface names the frames' `iface` indices refer to.
     pub ifaces: &'a Interfaces,
@@ -173,22 +173,13 @@ pub fn for_each_frame(
     input: impl Into<Input>,
     consume: impl FnMut(Frames<'_>) -> io::Result<()>,
 ) -> io::Result<Counts> {
-    walk(path, input.into(), false, consume)
+    for_each_frame_figured(path, input.into(), false, consume)
 }
 
-/// [`for_each_frame`] for a caller that counts bus load: the reader of one log works out
-/// each frame's wire figures on its own thread ([`Frames::next_figured`]); merged logs come
-/// without them.
-pub fn for_each_figured_frame(
-    path: &str,
-    input: impl Into<Input>,
-    consume: impl FnMut(Frames<'_>) -> io::Result<()>,
-) -> io::Result<Counts> {
-    walk(path, input.into(), true, consume)
-}
-
-/// [`for_each_frame`], the figures worked out by the reader when `figured`.
-fn walk(
+/// [`for_each_frame`] for a caller that counts bus load when `figured`: the reader of one
+/// log then works out each frame's wire figures on its own thread ([`Frames::next_figured`]);
+/// merged logs come without them.
+pub fn for_each_frame_figured(
     path: &str,
     input: Input,
     figured: bool,
